@@ -1,0 +1,5 @@
+import sys
+
+from eyeviz.cli import main
+
+sys.exit(main())
