@@ -1,0 +1,67 @@
+"""compute_state against EyePair, element by element, and the layers-only rule."""
+
+import numpy as np
+import pytest
+
+from eyeviz.geometry import EyePair
+from eyeviz.scene import Eyes, Feature, Scene
+from eyeviz.state import compute_state, owners
+
+
+def _scene(m=720, layers=("eyes", "bitmaps", "readout")):
+    fs = [
+        Feature("a", 0.0, 1500.0, 50.0),
+        Feature("b", -1400.0, 3800.0, 250.0),
+        Feature("c", 10.0, 1510.0, 60.0),  # overlaps a's ommatidia: c (later) wins
+        Feature("d", -40.0, 5.0, 1.0),  # on eye A: A sees it with every ommatidium
+        Feature("e", 5000.0, -10.0, 3.0),  # behind the BFV
+    ]
+    return Scene(Eyes(40.0, 20.0, m), fs, list(layers))
+
+
+@pytest.mark.parametrize("m", [16, 720, 36000])
+def test_state_matches_geometry(m):
+    s = _scene(m)
+    st = compute_state(s)
+    pair = EyePair(40.0, 20.0, m)
+    x, y, g = st.x, st.y, st.g
+    for got, want in zip((st.LA, st.RA, st.LB, st.RB), pair.intervals(x, y, g), strict=True):
+        np.testing.assert_array_equal(got, want)
+    np.testing.assert_array_equal(st.in_bfv, pair.in_bfv(x, y, g))
+    va, vb = pair.visible(x, y, g)
+    np.testing.assert_array_equal(st.vis_a, va)
+    np.testing.assert_array_equal(st.vis_b, vb)
+    oa, ob = pair.overlaps_eye(x, y, g)
+    np.testing.assert_array_equal(st.overlap_a, oa)
+    np.testing.assert_array_equal(st.overlap_b, ob)
+    np.testing.assert_allclose(st.r, np.hypot(x, y))
+    np.testing.assert_allclose(st.rB, np.hypot(x - 40.0, y))
+    wa, wb = pair.bitmaps(x, y, g)
+    for i in range(st.n):
+        ba, bb = st.bitmaps(i)
+        np.testing.assert_array_equal(ba, wa[i])
+        np.testing.assert_array_equal(bb, wb[i])
+        np.testing.assert_array_equal(st.bitmaps(i, m // 2)[0], wa[i][: m // 2])
+    for owner, bits in ((st.owner_a, wa), (st.owner_b, wb)):
+        lit_by_any = bits.any(axis=0)
+        np.testing.assert_array_equal(owner >= 0, lit_by_any)
+        for k in np.flatnonzero(lit_by_any):
+            assert owner[k] == np.flatnonzero(bits[:, k]).max()
+
+
+def test_owner_wraps_around_zero():
+    o = owners(np.array([6]), np.array([9]), 8)
+    np.testing.assert_array_equal(o, [0, 0, -1, -1, -1, -1, 0, 0])
+
+
+def test_only_needed_fields_are_computed():
+    st = compute_state(_scene(layers=("bfv",)))
+    assert st.LA is None and st.owner_a is None and st.in_bfv is None
+    st = compute_state(_scene(layers=("bitmaps",)))
+    assert st.LA is not None and st.owner_a is None and st.r is None
+
+
+def test_no_features():
+    st = compute_state(Scene(features=[]))
+    assert st.n == 0
+    assert (st.owner_a == -1).all() and st.owner_a.shape == (720,)
