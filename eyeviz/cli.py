@@ -44,9 +44,11 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
-    if not argv or argv[0] not in parser._subparsers._group_actions[0].choices and not argv[
-        0
-    ].startswith("-"):
+    if (
+        not argv
+        or argv[0] not in parser._subparsers._group_actions[0].choices
+        and not argv[0].startswith("-")
+    ):
         argv = [DEFAULT_COMMAND, *argv]
     args = parser.parse_args(argv)
     if getattr(args, "_run", None) is None:

@@ -77,9 +77,7 @@ def sign_linear(u: Fraction, v: Fraction, w: Fraction, n: int, m: int) -> int:
     raise ArithmeticError(f"cannot separate a boundary test from 0 at {_MAX_PREC} bits")
 
 
-def exact_floor_pair(
-    x: float, y: float, g: float, cx: float, m: int
-) -> tuple[int, int] | None:
+def exact_floor_pair(x: float, y: float, g: float, cx: float, m: int) -> tuple[int, int] | None:
     """Exact ``(floor(t_lo), floor(t_hi))`` of Eq. 11 for one feature and one eye.
 
     ``t = (phi_E -/+ asin(g / r_E)) * m / (2*pi)`` with phi_E in (-pi, pi]. Returns None
@@ -91,12 +89,16 @@ def exact_floor_pair(
     G = Fraction(g)
     if X * X + Y * Y <= G * G:
         return None
-    prec = 192
+    # enough bits to hold x - cx exactly, however far apart their exponents are
+    prec = max(192, 2 * max(X.numerator.bit_length(), X.denominator.bit_length()))
     while True:
         with mpmath.workprec(prec):
             dx, dy, gg = _mpf(X), _mpf(Y), _mpf(G)
             r = mpmath.hypot(dx, dy)
             q = gg / r
+            if q >= 1:  # outside by less than this precision resolves
+                prec *= 2
+                continue
             phi = mpmath.atan2(dy, dx)
             alpha = mpmath.asin(q)
             k = m / (2 * mpmath.pi)
@@ -115,7 +117,9 @@ def exact_floor_pair(
     return out[0], out[1]
 
 
-def _endpoint_at_or_past(X: Fraction, Y: Fraction, G: Fraction, n: int, m: int, upper: bool) -> bool:
+def _endpoint_at_or_past(
+    X: Fraction, Y: Fraction, G: Fraction, n: int, m: int, upper: bool
+) -> bool:
     """Is the tangent direction (upper: phi + alpha, else phi - alpha) >= beta_n?
 
     With delta = phi - beta_n near -/+alpha (so |delta| < pi), s = r*sin(delta) and

@@ -43,9 +43,13 @@ def _first_index(mask: np.ndarray) -> int | tuple[int, ...]:
 def validate_points(x, y) -> tuple[np.ndarray, np.ndarray]:
     """Broadcast x, y to float64 arrays; refuse NaN/inf with count and first index."""
     try:
-        xa, ya = np.broadcast_arrays(np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64))
+        xa, ya = np.broadcast_arrays(
+            np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
+        )
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"coordinates must be real numbers of broadcastable shapes: {exc}") from None
+        raise ValueError(
+            f"coordinates must be real numbers of broadcastable shapes: {exc}"
+        ) from None
     for name, a in (("x", xa), ("y", ya)):
         bad = ~np.isfinite(a)
         if bad.any():
@@ -59,9 +63,7 @@ def validate_points(x, y) -> tuple[np.ndarray, np.ndarray]:
 def validate_features(x, y, g) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Broadcast x, y, g to float64; refuse non-finite values and g <= 0."""
     try:
-        xa, ya, ga = np.broadcast_arrays(
-            *(np.asarray(v, dtype=np.float64) for v in (x, y, g))
-        )
+        xa, ya, ga = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (x, y, g)))
     except (TypeError, ValueError) as exc:
         raise ValueError(f"x, y, g must be real numbers of broadcastable shapes: {exc}") from None
     for name, a in (("x", xa), ("y", ya), ("g", ga)):
@@ -112,7 +114,9 @@ class EyePair:
         if l <= 0:
             raise ValueError(f"l (eye radius) must be > 0, got {self.l!r}")
         if h <= l:
-            raise ValueError(f"h must be > l (eyes may not touch the y-axis), got h={self.h!r}, l={self.l!r}")
+            raise ValueError(
+                f"h must be > l (eyes may not touch the y-axis), got h={self.h!r}, l={self.l!r}"
+            )
         m = self.m
         if isinstance(m, bool):
             raise ValueError(f"m must be an even integer >= 4, got {m!r}")
@@ -198,8 +202,13 @@ class EyePair:
         return np.mod(out, self.m).reshape(shape)
 
     # --- features ---------------------------------------------------------------------
-    def _eye_floors(self, x, y, g, cx: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Raw (floor(t_lo), floor(t_hi), whole) of Eq. 11 for one eye on 1-D arrays."""
+    def _eye_floors(
+        self, x, y, g, cx: float, refine: bool = True
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Raw (floor(t_lo), floor(t_hi), whole) of Eq. 11 for one eye on 1-D arrays.
+
+        ``refine=False`` skips the exact fallback (benchmarks measure its cost with it).
+        """
         n = x.shape[0]
         lo_out = np.empty(n, np.int64)
         hi_out = np.empty(n, np.int64)
@@ -207,31 +216,39 @@ class EyePair:
         k = self._k
         tol0 = (_TOL_BASE + _TOL_GRAZE / (1 - _Q_SAFE)) * _U * self.m
         for s in range(0, n, _CHUNK):
-            sl = slice(s, s + _CHUNK)
-            xs, ys, gs = x[sl], y[sl], g[sl]
-            dx = xs - cx
-            r = np.hypot(dx, ys)
-            pk = np.arctan2(ys, dx)
-            pk *= k
-            q = gs / r
-            ak = np.arcsin(np.minimum(q, 1.0))
-            ak *= k
-            t_lo = pk - ak
-            t_hi = pk + ak
-            f_lo = np.floor(t_lo)
-            f_hi = np.floor(t_hi)
-            t_lo -= f_lo
-            t_hi -= f_hi
-            t_lo -= 0.5
-            t_hi -= 0.5
-            near = np.maximum(np.abs(t_lo), np.abs(t_hi)) > 0.5 - tol0
-            near |= q > _Q_SAFE
-            lo_out[sl] = f_lo
-            hi_out[sl] = f_hi
-            idx = np.flatnonzero(near)
-            if idx.size:
-                self._refine(xs, ys, gs, q, t_lo, t_hi, idx, cx, lo_out[sl], hi_out[sl], whole[sl])
+            with np.errstate(divide="ignore", invalid="ignore"):
+                self._block(
+                    x, y, g, cx, refine, slice(s, s + _CHUNK), k, tol0, lo_out, hi_out, whole
+                )
         return lo_out, hi_out, whole
+
+    def _block(self, x, y, g, cx, refine, sl, k, tol0, lo_out, hi_out, whole) -> None:
+        """Fast path of Eq. 11 on one cache-sized block; flags elements near a boundary."""
+        xs, ys, gs = x[sl], y[sl], g[sl]
+        dx = xs - cx
+        r = np.hypot(dx, ys)
+        pk = np.arctan2(ys, dx)
+        pk *= k
+        q = gs / r
+        ak = np.arcsin(np.minimum(q, 1.0))
+        ak *= k
+        t_lo = pk - ak
+        t_hi = pk + ak
+        f_lo = np.floor(t_lo)
+        f_hi = np.floor(t_hi)
+        t_lo -= f_lo
+        t_hi -= f_hi
+        t_lo -= 0.5
+        t_hi -= 0.5
+        near = np.maximum(np.abs(t_lo), np.abs(t_hi)) > 0.5 - tol0
+        near |= q > _Q_SAFE
+        lo_out[sl] = f_lo
+        hi_out[sl] = f_hi
+        if not refine:
+            whole[sl] = q >= 1
+        idx = np.flatnonzero(near)
+        if refine and idx.size:
+            self._refine(xs, ys, gs, q, t_lo, t_hi, idx, cx, lo_out[sl], hi_out[sl], whole[sl])
 
     def _refine(self, xs, ys, gs, q, c_lo, c_hi, idx, cx, lo, hi, whole) -> None:
         """Re-decide flagged elements: a per-element rounding bound, then exact."""
@@ -264,12 +281,15 @@ class EyePair:
         Eye E lights {k mod m : L_E <= k <= R_E} with 0 <= L_E < m and L_E <= R_E < L_E + m;
         (0, m-1) when the eye centre lies in the closed feature disc.
         """
+        return self._intervals(x, y, g)
+
+    def _intervals(self, x, y, g, refine: bool = True) -> tuple[np.ndarray, ...]:
         xa, ya, ga = validate_features(x, y, g)
         shape = xa.shape
         xf, yf, gf = (np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, ga))
         out = []
         for cx in (-self.h, self.h):
-            L, R = self._normalised(*self._eye_floors(xf, yf, gf, cx))
+            L, R = self._normalised(*self._eye_floors(xf, yf, gf, cx, refine))
             out += [L.reshape(shape), R.reshape(shape)]
         return tuple(out)
 
