@@ -1,0 +1,53 @@
+"""Error metrics of Section 5: MAE (Eq. 33), MAPE (Eq. 34) and R^2 (Eq. 35).
+
+R^2 is the standard coefficient of determination, 1 - SS_res / SS_tot with SS_tot the
+spread of the TRUE values (as scikit-learn's ``r2_score``); the paper's Eq. 35-36 divide
+by the spread of the predictions, which DESIGN.md §4 lists as an erratum.
+NaN predictions are refused: filter them with the estimator's ``valid`` mask first.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["mae", "mape", "r2", "summary"]
+
+
+def _pair(y_true, y_pred) -> tuple[np.ndarray, np.ndarray]:
+    t = np.asarray(y_true, np.float64).ravel()
+    p = np.asarray(y_pred, np.float64).ravel()
+    if t.shape != p.shape:
+        raise ValueError(f"y_true and y_pred differ in length: {t.size} and {p.size}")
+    if t.size == 0:
+        raise ValueError("metrics need at least one value")
+    if not (np.isfinite(t).all() and np.isfinite(p).all()):
+        raise ValueError("metrics need finite values; drop rows where the prediction is NaN")
+    return t, p
+
+
+def mae(y_true, y_pred) -> float:
+    """Mean absolute error (Eq. 33)."""
+    t, p = _pair(y_true, y_pred)
+    return float(np.mean(np.abs(p - t)))
+
+
+def mape(y_true, y_pred) -> float:
+    """Mean absolute percentage error in percent (Eq. 34); y_true must be non-zero."""
+    t, p = _pair(y_true, y_pred)
+    if np.any(t == 0):
+        raise ValueError("MAPE is undefined where the true value is 0")
+    return float(100.0 * np.mean(np.abs((p - t) / t)))
+
+
+def r2(y_true, y_pred) -> float:
+    """Standard coefficient of determination (Eq. 35 with the true values' mean)."""
+    t, p = _pair(y_true, y_pred)
+    ss_tot = float(np.sum((t - t.mean()) ** 2))
+    if ss_tot == 0:
+        raise ValueError("R^2 is undefined when all true values are equal")
+    return 1.0 - float(np.sum((p - t) ** 2)) / ss_tot
+
+
+def summary(y_true, y_pred) -> dict[str, float]:
+    """{"mape": %, "mae": ..., "r2": ...} of one target."""
+    return {"mape": mape(y_true, y_pred), "mae": mae(y_true, y_pred), "r2": r2(y_true, y_pred)}
