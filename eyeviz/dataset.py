@@ -1,0 +1,460 @@
+"""Training data sets of the paper's Algorithm 1, single- and multi-pass, vectorised.
+
+An element is (Omega_A, Omega_B, r, phi, g): a circular feature of radius g centred at
+polar (r, phi) about the origin, and the bitmaps of ommatidia 0..m/2-1 of the left (A)
+and right (B) eye that see it (Section 4; DESIGN.md §3).
+
+``mode="single"`` is Algorithm 1 as written, run on whole batches: for every pending
+element, draw r (step 7), g in [r sin(gamma/2), g_max] (steps 8-10) and phi in the
+angular range that keeps the disc in the BFV (step 12, Prop. 4); reject it on step 9
+(g_min > g_max), step 11 (g > r), an empty phi range, or when the exact geometry core
+says the disc is not in the BFV or is not visible (Def. 1) to both eyes (DESIGN.md §4);
+rejected elements are drawn again (the repeat/until loop) until every slot is filled.
+
+``mode="multi"`` is the paper's multi-pass generation (Section 5, Figure 11): the range of
+r is cut into equal segments and each segment gets a number of elements proportional to
+its mean radius, hence to its area, so that centres are (nearly) uniform over the BFV
+area and the histogram of r grows linearly with r. The paper's own counts do not add up
+(DESIGN.md §4): here they are apportioned exactly to the requested n. The segments are
+interleaved in a random order (a streamed uniform shuffle), not written one after another.
+
+Coordinates: x = r cos(phi), y = r sin(phi) (numpy float64); the bitmaps are those of the
+geometry core (:class:`eyeviz.geometry.EyePair`) at that (x, y, g), which is exact.
+The same parameters and seed give the same elements (and the same file bytes).
+
+Generation is streamed in chunks of :data:`CHUNK` elements, so a data set of any size is
+written without holding it in memory (:func:`write`). Imports numpy only.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from eyeviz import EyevizError
+from eyeviz.geometry import EyePair, intervals_to_bitmap
+
+__all__ = [
+    "CHUNK",
+    "Dataset",
+    "GenParams",
+    "PAPER_EYES",
+    "generate",
+    "iter_generate",
+    "load",
+    "save",
+    "write",
+]
+
+PAPER_EYES = EyePair(40.0, 20.0, 720)  # Table 3
+CHUNK = 1 << 14  # elements per generated chunk; fixed, so the output never depends on it
+SEGMENT_WIDTH = 5.0  # the paper's multi-pass segment length (Section 5)
+_MAX_IDLE_ROUNDS = 200  # redraw rounds in a row without one accepted element before giving up
+MODES = ("single", "multi")
+
+
+@dataclass(frozen=True)
+class GenParams:
+    """Validated parameters of Algorithm 1 (Tables 3, 4) and of the multi-pass plan."""
+
+    eyes: EyePair = PAPER_EYES
+    r_min: float = 1000.0
+    r_max: float = 5000.0
+    g_max: float = 500.0
+    mode: str = "single"
+    seed: int = 0
+    unique_bitmaps: bool = False
+    segments: int | None = None  # multi only; default: segments of length SEGMENT_WIDTH
+
+    def as_dict(self) -> dict:
+        e = self.eyes
+        return {
+            "h": e.h, "l": e.l, "m": e.m, "r_min": self.r_min, "r_max": self.r_max,
+            "g_max": self.g_max, "mode": self.mode, "seed": self.seed,
+            "unique_bitmaps": self.unique_bitmaps, "segments": self.segments,
+        }
+
+
+@dataclass
+class Dataset:
+    """Rows (Omega_A, Omega_B, r, phi, g) of the paper's data set (DESIGN.md §3).
+
+    ``omega_a``, ``omega_b``: bool (n, m/2), ommatidia 0..m/2-1 of eye A (left), B (right);
+    ``r``, ``phi``: centre in polar coordinates about the origin (phi in radians);
+    ``g``: feature radius (NaN when read from a CSV without the g column).
+    ``params``: the generation parameters (empty when unknown, e.g. read from a CSV).
+    """
+
+    omega_a: np.ndarray
+    omega_b: np.ndarray
+    r: np.ndarray
+    phi: np.ndarray
+    g: np.ndarray
+    eyes: EyePair = PAPER_EYES
+    params: dict = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return int(self.r.shape[0])
+
+    @property
+    def m(self) -> int:
+        return self.eyes.m
+
+    @property
+    def x(self) -> np.ndarray:
+        return self.r * np.cos(self.phi)
+
+    @property
+    def y(self) -> np.ndarray:
+        return self.r * np.sin(self.phi)
+
+    @property
+    def bits(self) -> np.ndarray:
+        """The network input of Appendix A/B: (n, m) uint8, Omega_A then Omega_B."""
+        return np.concatenate([self.omega_a, self.omega_b], axis=1).view(np.uint8)
+
+    def __getitem__(self, idx) -> Dataset:
+        return Dataset(self.omega_a[idx], self.omega_b[idx], self.r[idx], self.phi[idx],
+                       self.g[idx], self.eyes, dict(self.params))
+
+    @staticmethod
+    def concat(parts: list[Dataset]) -> Dataset:
+        if not parts:
+            raise ValueError("cannot concatenate an empty list of data sets")
+        first = parts[0]
+        return Dataset(
+            *(np.concatenate([getattr(p, k) for p in parts])
+              for k in ("omega_a", "omega_b", "r", "phi", "g")),
+            eyes=first.eyes, params=dict(first.params),
+        )
+
+
+@dataclass
+class Chunk:
+    """One generated chunk in interval form: eye E lights ommatidia L_E..R_E (0 <= L <= R < m/2)."""
+
+    r: np.ndarray
+    phi: np.ndarray
+    g: np.ndarray
+    la: np.ndarray
+    ra: np.ndarray
+    lb: np.ndarray
+    rb: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.r.shape[0])
+
+    def to_dataset(self, p: GenParams) -> Dataset:
+        m, w = p.eyes.m, p.eyes.m // 2
+        return Dataset(
+            intervals_to_bitmap(self.la, self.ra, m, width=w),
+            intervals_to_bitmap(self.lb, self.rb, m, width=w),
+            self.r, self.phi, self.g, p.eyes, p.as_dict(),
+        )
+
+
+# --- parameters ----------------------------------------------------------------------
+
+def _real(name: str, v) -> float:
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        raise EyevizError(f"{name} must be a real number, got {v!r}") from None
+    if not math.isfinite(f):
+        raise EyevizError(f"{name} must be finite, got {v!r}")
+    return f
+
+
+def effective_r_max(p: GenParams) -> float:
+    """Largest r step 9 can accept: r sin(gamma/2) <= g_max."""
+    return min(p.r_max, p.g_max / math.sin(p.eyes.gamma / 2))
+
+
+def make_params(
+    eyes: EyePair | None = None,
+    r_min=1000.0,
+    r_max=5000.0,
+    g_max=500.0,
+    mode: str = "single",
+    seed: int = 0,
+    unique_bitmaps: bool = False,
+    segments: int | None = None,
+) -> GenParams:
+    """Check every parameter at the boundary (one-line :class:`EyevizError` naming it).
+
+    Besides r_min < r_max and g_max > 0, refuse ranges where no feature can be both in the
+    BFV and visible: step 8-9 needs g >= r sin(gamma/2) <= g_max for some r >= r_min, and a
+    disc fits in the BFV only if g < r cos(psi) (Prop. 4: asin(g/r) <= pi/2 - psi).
+    """
+    eyes = PAPER_EYES if eyes is None else eyes
+    if not isinstance(eyes, EyePair):
+        raise EyevizError(f"eyes must be an EyePair, got {type(eyes).__name__}")
+    r_min, r_max, g_max = _real("r_min", r_min), _real("r_max", r_max), _real("g_max", g_max)
+    if r_min <= 0:
+        raise EyevizError(f"r_min must be > 0, got {r_min!r}")
+    if r_min >= r_max:
+        raise EyevizError(f"r_min must be < r_max, got r_min={r_min!r}, r_max={r_max!r}")
+    if g_max <= 0:
+        raise EyevizError(f"g_max must be > 0, got {g_max!r}")
+    if mode not in MODES:
+        raise EyevizError(f"mode must be 'single' or 'multi', got {mode!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise EyevizError(f"seed must be an integer >= 0, got {seed!r}")
+    s = math.sin(eyes.gamma / 2)
+    c = math.cos(eyes.psi)
+    if g_max <= r_min * s:
+        raise EyevizError(
+            f"no feature can be visible: g_max={g_max:g} <= r_min*sin(gamma/2)="
+            f"{r_min * s:.6g} (Algorithm 1 step 9 rejects every r >= r_min)"
+        )
+    if s >= c:
+        raise EyevizError(
+            f"no visible feature fits in the BFV: sin(gamma/2)={s:.6g} >= cos(psi)={c:.6g} "
+            f"(m={eyes.m} too small for h={eyes.h:g}, l={eyes.l:g})"
+        )
+    if segments is not None:
+        if isinstance(segments, bool) or not isinstance(segments, int | np.integer) \
+                or segments < 1:
+            raise EyevizError(f"segments must be an integer >= 1, got {segments!r}")
+        segments = int(segments)
+    return GenParams(eyes, r_min, r_max, g_max, mode, int(seed), bool(unique_bitmaps), segments)
+
+
+def _check_n(n) -> int:
+    if isinstance(n, bool) or not isinstance(n, int | np.integer):
+        raise EyevizError(f"n must be an integer >= 1, got {n!r}")
+    if n < 1:
+        raise EyevizError(f"n must be >= 1, got {n}")
+    return int(n)
+
+
+# --- multi-pass plan -----------------------------------------------------------------
+
+def segment_plan(n: int, p: GenParams) -> tuple[np.ndarray, np.ndarray]:
+    """Segment edges (K+1,) and counts (K,) summing to n, counts proportional to mid radius.
+
+    Equal-width segments of r over [r_min, r_max'] (r_max' = the largest r step 9 accepts),
+    so a segment's share of the BFV annulus area is proportional to its mid radius.
+    Counts are apportioned by largest remainders (deterministic).
+    """
+    hi = effective_r_max(p)
+    k = p.segments or max(1, math.ceil((hi - p.r_min) / SEGMENT_WIDTH - 1e-9))
+    edges = np.linspace(p.r_min, hi, k + 1)
+    w = 0.5 * (edges[:-1] + edges[1:])
+    quota = n * w / w.sum()
+    counts = np.floor(quota).astype(np.int64)
+    short = n - int(counts.sum())
+    if short:
+        order = np.argsort(-(quota - counts), kind="stable")
+        counts[order[:short]] += 1
+    return edges, counts
+
+
+# --- Algorithm 1 on a batch ----------------------------------------------------------
+
+class _Sampler:
+    """Fills slots with accepted elements; slot i draws r in [lo_i, hi_i)."""
+
+    def __init__(self, p: GenParams, rng: np.random.Generator):
+        self.p = p
+        self.rng = rng
+        self.sin_half = math.sin(p.eyes.gamma / 2)
+        self.psi = p.eyes.psi
+        self.half = p.eyes.m // 2
+        self.seen: set[int] | None = set() if p.unique_bitmaps else None
+        self.drawn = 0  # candidates drawn (for the acceptance rate)
+
+    def _keys(self, la, ra, lb, rb) -> list[int]:
+        h = self.half
+        if h**4 < 2**62:
+            return (((la * h + ra) * h + lb) * h + rb).tolist()
+        return [((a * h + b) * h + c) * h + d for a, b, c, d in
+                zip(la.tolist(), ra.tolist(), lb.tolist(), rb.tolist(), strict=True)]
+
+    def fill(self, lo: np.ndarray, hi: np.ndarray) -> Chunk:
+        p, rng, eyes = self.p, self.rng, self.p.eyes
+        n = lo.shape[0]
+        out_r = np.empty(n)
+        out_phi = np.empty(n)
+        out_g = np.empty(n)
+        ivs = [np.empty(n, np.int64) for _ in range(4)]
+        pending = np.arange(n)
+        idle = 0
+        while pending.size:
+            k = pending.size
+            self.drawn += k
+            u = rng.random((3, k))
+            lo_p, hi_p = lo[pending], hi[pending]
+            r = lo_p + (hi_p - lo_p) * u[0]                      # step 7
+            g_min = r * self.sin_half                             # step 8
+            ok = g_min <= p.g_max                                 # step 9
+            g = g_min + (p.g_max - g_min) * u[1]                  # step 10
+            ok &= g <= r                                          # step 11
+            a = np.arcsin(np.minimum(g / r, 1.0))
+            ph_lo = self.psi + a
+            ph_hi = (math.pi - self.psi) - a
+            ok &= ph_lo <= ph_hi
+            phi = ph_lo + (ph_hi - ph_lo) * u[2]                  # step 12
+            idx = np.flatnonzero(ok)
+            r, g, phi = r[idx], g[idx], phi[idx]
+            x = r * np.cos(phi)
+            y = r * np.sin(phi)
+            la, ra, lb, rb = eyes.intervals(x, y, g)              # steps 13-16 (Prop. 2)
+            good = eyes.in_bfv(x, y, g)                           # Prop. 4, exact
+            good &= (ra > la) & (rb > lb)                         # Def. 1, both eyes
+            good &= (rb < self.half) & (ra < self.half)           # Property 3 (always true)
+            sel = np.flatnonzero(good)
+            if self.seen is not None and sel.size:
+                sel = self._new_only(sel, la, ra, lb, rb)
+            if sel.size == 0:
+                idle += 1
+                if idle >= _MAX_IDLE_ROUNDS:
+                    self._give_up()
+                continue
+            idle = 0
+            dst = pending[idx[sel]]
+            out_r[dst], out_phi[dst], out_g[dst] = r[sel], phi[sel], g[sel]
+            for o, v in zip(ivs, (la, ra, lb, rb), strict=True):
+                o[dst] = v[sel]
+            keep = np.ones(k, bool)
+            keep[idx[sel]] = False
+            pending = pending[keep]
+        return Chunk(out_r, out_phi, out_g, *ivs)
+
+    def _new_only(self, sel, la, ra, lb, rb) -> np.ndarray:
+        keys = self._keys(la[sel], ra[sel], lb[sel], rb[sel])
+        seen = self.seen
+        keep = []
+        for i, key in zip(sel.tolist(), keys, strict=True):
+            if key not in seen:
+                seen.add(key)
+                keep.append(i)
+        return np.asarray(keep, dtype=np.int64)
+
+    def _give_up(self) -> None:
+        if self.seen is not None:
+            raise EyevizError(
+                f"only {len(self.seen)} distinct bitmap pairs were found after drawing "
+                f"{self.drawn} candidates; ask for fewer elements or drop --unique-bitmaps"
+            )
+        raise EyevizError(
+            f"no element was accepted in {_MAX_IDLE_ROUNDS} rounds ({self.drawn} candidates "
+            "drawn): no feature in this range is visible inside the BFV"
+        )
+
+
+def iter_chunks(n: int, p: GenParams, chunk: int = CHUNK) -> Iterator[Chunk]:
+    """Generate n elements of Algorithm 1 as :class:`Chunk` objects of <= chunk elements."""
+    rng = np.random.default_rng(p.seed)
+    sampler = _Sampler(p, rng)
+    if p.mode == "single":
+        for start in range(0, n, chunk):
+            c = min(chunk, n - start)
+            yield sampler.fill(np.full(c, p.r_min), np.full(c, p.r_max))
+        return
+    edges, remaining = segment_plan(n, p)
+    left = n
+    for _ in range(0, n, chunk):
+        c = min(chunk, left)
+        if c == left:
+            comp = remaining
+        else:
+            comp = rng.multivariate_hypergeometric(remaining, c, method="marginals")
+        remaining = remaining - comp
+        left -= c
+        labels = np.repeat(np.arange(comp.size), comp)
+        rng.shuffle(labels)
+        yield sampler.fill(edges[labels], edges[labels + 1])
+
+
+# --- public API ----------------------------------------------------------------------
+
+def iter_generate(
+    n: int,
+    eyes: EyePair | None = None,
+    r_min=1000.0,
+    r_max=5000.0,
+    g_max=500.0,
+    mode: str = "single",
+    seed: int = 0,
+    unique_bitmaps: bool = False,
+    segments: int | None = None,
+    chunk: int = CHUNK,
+) -> Iterator[Dataset]:
+    """Like :func:`generate`, yielding :class:`Dataset` chunks (bounded memory)."""
+    n = _check_n(n)
+    p = make_params(eyes, r_min, r_max, g_max, mode, seed, unique_bitmaps, segments)
+    for c in iter_chunks(n, p, chunk):
+        yield c.to_dataset(p)
+
+
+def generate(
+    n: int,
+    eyes: EyePair | None = None,
+    r_min=1000.0,
+    r_max=5000.0,
+    g_max=500.0,
+    mode: str = "single",
+    seed: int = 0,
+    unique_bitmaps: bool = False,
+    segments: int | None = None,
+) -> Dataset:
+    """n elements of the paper's Algorithm 1 (Section 4), in memory.
+
+    Defaults are Tables 3 and 4 (h=40, l=20, m=720; r in [1000, 5000], g_max=500).
+    ``mode``: "single" (one pass, Figures 8, 10) or "multi" (segments of r with counts
+    proportional to their radius, Figures 9, 11). ``unique_bitmaps``: redraw an element
+    whose (Omega_A, Omega_B) pair was already produced, as the authors' published set
+    has one element per pair; this thins out far, small features (few distinct bitmaps)
+    and so shifts the distribution towards near and large ones.
+    """
+    return Dataset.concat(list(iter_generate(
+        n, eyes, r_min, r_max, g_max, mode, seed, unique_bitmaps, segments)))
+
+
+def write(
+    path,
+    n: int,
+    eyes: EyePair | None = None,
+    r_min=1000.0,
+    r_max=5000.0,
+    g_max=500.0,
+    mode: str = "single",
+    seed: int = 0,
+    unique_bitmaps: bool = False,
+    segments: int | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> None:
+    """Generate n elements straight into ``path`` (.csv or .npz), streamed and atomic.
+
+    Every parameter is checked before the file is touched; ``progress(k)`` is called
+    after each chunk of k elements.
+    """
+    from eyeviz import dataset_io
+
+    n = _check_n(n)
+    p = make_params(eyes, r_min, r_max, g_max, mode, seed, unique_bitmaps, segments)
+    fmt = dataset_io.format_of(path)
+    dataset_io.write_chunks(path, fmt, n, p.eyes.m, p.as_dict(), iter_chunks(n, p), progress)
+
+
+def save(ds: Dataset, path) -> None:
+    """Write an in-memory data set to ``path`` (.csv or .npz), atomically."""
+    from eyeviz import dataset_io
+
+    dataset_io.save(ds, path)
+
+
+def load(path, eyes: EyePair | None = None) -> Dataset:
+    """Read a data set written by :func:`save`/:func:`write` (or any CSV of DESIGN.md §3).
+
+    A CSV does not record h and l: ``eyes`` defaults to Table 3's with m from the number
+    of columns (m + 3 with g, m + 2 without). A malformed CSV raises an error naming the
+    line and column.
+    """
+    from eyeviz import dataset_io
+
+    return dataset_io.load(path, eyes)
