@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 import operator
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,6 +34,10 @@ _Q_SAFE = 0.75  # g / r_E below this uses one scalar rounding bound per block
 # term grows like 1/(1 - g/r_E) near grazing.
 _TOL_BASE = 64.0
 _TOL_GRAZE = 16.0
+
+#: Diagnostics for the stability report: elements the fast path flagged near a boundary
+#: ("flagged") and those of them decided by the exact predicates ("exact").
+FALLBACK_COUNTS: Counter[str] = Counter()
 
 
 def _first_index(mask: np.ndarray) -> int | tuple[int, ...]:
@@ -260,7 +265,10 @@ class EyePair:
             np.maximum(np.abs(c_lo[idx]), np.abs(c_hi[idx])) <= 0.5 - tol
         )
         whole[idx[clear_inside]] = True
-        for j in idx[~(clear_inside | clear_outside)]:
+        todo = idx[~(clear_inside | clear_outside)]
+        FALLBACK_COUNTS["flagged"] += idx.size
+        FALLBACK_COUNTS["exact"] += todo.size
+        for j in todo:
             res = exact.exact_floor_pair(float(xs[j]), float(ys[j]), float(gs[j]), cx, self.m)
             if res is None:
                 whole[j] = True
@@ -344,10 +352,24 @@ def intervals_to_bitmap(L, R, m: int, width: int | None = None) -> np.ndarray:
     """Bool bitmap (..., width) of ommatidia 0..width-1 lit by {k mod m : L <= k <= R}.
 
     ``width`` defaults to m (the whole eye); m // 2 gives the paper's Omega (Section 4).
+    Built in row blocks so the temporaries stay in cache: ``k - L`` read as unsigned is
+    at most ``R - L`` exactly on the lit ommatidia of a run that does not wrap past m - 1;
+    the few runs that wrap add ``k <= R - m``.
     """
-    L = np.asarray(L, dtype=np.int64)
-    R = np.asarray(R, dtype=np.int64)
+    L, R = np.broadcast_arrays(np.asarray(L, dtype=np.int64), np.asarray(R, dtype=np.int64))
     width = m if width is None else width
-    k = np.arange(width, dtype=np.int64)
-    Le, Re = L[..., None], R[..., None]
-    return ((k >= Le) & (k <= Re)) | (k <= Re - m)
+    out = np.empty(L.shape + (width,), dtype=bool)
+    flat = out.reshape(-1, width)
+    sdt = np.int16 if m < 2**15 else np.int32 if m < 2**31 else np.int64
+    udt = np.dtype(sdt).str.replace("i", "u")
+    k = np.arange(width, dtype=sdt)
+    Lf = L.reshape(-1, 1).astype(sdt)
+    Cf = (R - L).reshape(-1, 1).astype(udt)
+    rows = max(1, (1 << 19) // max(width, 1))
+    for s in range(0, flat.shape[0], rows):
+        d = k - Lf[s : s + rows]
+        np.less_equal(d.view(udt), Cf[s : s + rows], out=flat[s : s + rows])
+    wrap = np.flatnonzero(R.reshape(-1) >= m)
+    if wrap.size:
+        flat[wrap] |= k <= (R.reshape(-1)[wrap, None] - m)
+    return out

@@ -1,0 +1,49 @@
+"""`eyeviz report stability`: files written, core exact, literal formulas shown wrong."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+
+from eyeviz.reports import stability
+
+
+def test_report_writes_table_csv_and_plot(tmp_path):
+    out = tmp_path / "report"
+    res = subprocess.run(
+        [sys.executable, "-m", "eyeviz", "report", "stability", "-o", str(out), "-n", "150"],
+        capture_output=True,
+        text=True,
+    )
+    assert res.returncode == 0, res.stderr
+    md = (out / "stability.md").read_text()
+    assert "| grazing |" in md and "eyeviz core diffs" in md
+    with open(out / "stability.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 8
+    assert all(int(r["diffs eyeviz core"]) == 0 for r in rows)
+    # the paper's formulas taken literally fail on the tie classes
+    ground = next(r for r in rows if r["case"] == "resting on y = 0")
+    assert int(ground["diffs paper float64"]) > 0
+    assert int(ground["exact fallbacks"]) > 0
+    png = (out / "stability.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]
+
+
+def test_bad_n_is_refused_in_one_line(tmp_path):
+    res = subprocess.run(
+        [sys.executable, "-m", "eyeviz", "report", "stability", "-o", str(tmp_path), "-n", "0"],
+        capture_output=True,
+        text=True,
+    )
+    assert res.returncode == 2
+    assert res.stderr.strip() == "eyeviz: error: -n must be >= 1, got 0"
+
+
+def test_measure_times_every_method():
+    rows = stability.measure(n=50, seed=3)
+    for r in rows:
+        assert set(r.seconds_per_feature) == {*stability.METHODS, "reference (mpmath)"}
+        assert all(t > 0 for t in r.seconds_per_feature.values())
