@@ -149,9 +149,7 @@ class _Checker:
     def keys(self, tab: dict, prefix: str, allowed: tuple[str, ...]) -> None:
         for k in tab:
             if k not in allowed:
-                raise self.fail(
-                    f"{prefix}{k}", f"unknown key (allowed: {', '.join(allowed)})"
-                )
+                raise self.fail(f"{prefix}{k}", f"unknown key (allowed: {', '.join(allowed)})")
 
     def number(self, tab: dict, key: str, prefix: str, default=None, rule: str = "") -> float:
         if key not in tab:

@@ -1,0 +1,211 @@
+"""The app's model: the open scene, the selection, and drags written as generators.
+
+Qt-free (napari's split): the window feeds mouse events in and listens for changes. Every
+edit goes through :meth:`AppModel.commit` (one undo step; the window installs a
+QUndoStack-backed ``push``); live changes during a drag go through :meth:`AppModel.live`
+and are committed once, when the drag ends.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Generator
+from dataclasses import dataclass
+
+from eyeviz.scene import OKABE_ITO, Feature, Scene
+from eyeviz.state import SceneState, compute_state
+
+__all__ = ["AppModel", "MouseEvent", "DRAG_THRESHOLD_PX", "drag_feature", "hit_test"]
+
+DRAG_THRESHOLD_PX = 4.0  # a press released closer than this to where it started is a click
+HANDLE_PX = 14.0  # radius of the grab zone of the radius handle
+BODY_PX = 8.0  # grab margin around a disc (and the minimum grab radius for tiny features)
+M_MAX = 200_000  # larger m cannot be redrawn live
+
+
+@dataclass
+class MouseEvent:
+    """One mouse event in model (x, y) and widget pixel (px, py) coordinates."""
+
+    type: str  # "press" | "move" | "release"
+    x: float
+    y: float
+    px: float
+    py: float
+
+
+class AppModel:
+    """The open scene plus the selection; notifies listeners ``fn(what, index)``."""
+
+    def __init__(self, scene: Scene):
+        self.scene = scene
+        self.selected: int | None = 0 if scene.features else None
+        self.listeners: list[Callable[[str, int | None], None]] = []
+        self._state: SceneState | None = None
+        self.push: Callable[..., None] = self._push_plain
+
+    # --- state ------------------------------------------------------------------------
+    @property
+    def state(self) -> SceneState:
+        if self._state is None:
+            self._state = compute_state(self.scene)
+        return self._state
+
+    def _notify(self, what: str, index: int | None = None) -> None:
+        self._state = None
+        for fn in list(self.listeners):
+            fn(what, index)
+
+    # --- edits --------------------------------------------------------------------------
+    def _push_plain(self, before: Scene, after: Scene, text: str, merge_key=None) -> None:
+        self.set_scene(after)
+
+    def set_scene(self, scene: Scene, what: str = "scene") -> None:
+        """Replace the scene (undo/redo and file open land here)."""
+        self.scene = scene.copy()
+        n = len(self.scene.features)
+        if self.selected is not None and self.selected >= n:
+            self.selected = n - 1 if n else None
+        if self.selected is None and n:
+            self.selected = 0
+        self._notify(what)
+
+    def commit(self, after: Scene, text: str, before: Scene | None = None, merge_key=None) -> None:
+        """One undoable edit from ``before`` (default: the current scene) to ``after``.
+
+        Consecutive edits with the same ``merge_key`` (wheel steps) merge into one step.
+        """
+        before = self.scene.copy() if before is None else before
+        if after == before:
+            return
+        self.push(before, after.copy(), text, merge_key)
+
+    def live(self, index: int, **values: float) -> None:
+        """Change a feature during a drag (not an undo step until the drag commits)."""
+        f = self.scene.features[index]
+        for k, v in values.items():
+            setattr(f, k, float(v))
+        self._notify("feature", index)
+
+    def select(self, index: int | None) -> None:
+        if index != self.selected:
+            self.selected = index
+            self._notify("selection", index)
+
+    def set_eyes(self, h: float, l: float, m: int) -> None:
+        """New eye parameters; ValueError (naming the parameter) leaves the scene as it was."""
+        if isinstance(m, float) and m.is_integer():
+            m = int(m)
+        if isinstance(m, int) and m > M_MAX:
+            raise ValueError(f"m must be <= {M_MAX} to be drawn live, got {m}")
+        after = self.scene.copy()
+        after.eyes.h, after.eyes.l, after.eyes.m = h, l, m
+        after.eyes.pair()  # raises before anything changes
+        after.eyes.h, after.eyes.l = float(h), float(l)
+        self.commit(after, "Change eyes")
+
+    def set_feature(self, index: int, **values) -> None:
+        after = self.scene.copy()
+        f = after.features[index]
+        for k, v in values.items():
+            if k == "name":
+                v = str(v).strip()
+                if not v:
+                    raise ValueError("name must not be empty")
+                if any(o.name == v for j, o in enumerate(after.features) if j != index):
+                    raise ValueError(f"another feature is already named {v!r}")
+            else:
+                v = float(v)
+                if not math.isfinite(v):
+                    raise ValueError(f"{k} must be finite, got {v!r}")
+                if k == "g" and v <= 0:
+                    raise ValueError(f"g (feature radius) must be > 0, got {v!r}")
+            setattr(f, k, v)
+        self.commit(after, f"Edit {f.name}")
+
+    def _new_name(self, base: str) -> str:
+        names = {f.name for f in self.scene.features}
+        i = 1
+        while f"{base} {i}" in names:
+            i += 1
+        return f"{base} {i}"
+
+    def add_feature(self, x: float, y: float, g: float | None = None) -> None:
+        after = self.scene.copy()
+        if g is None:
+            g = max(self.scene.view.width / 80.0, 1e-6)
+        color = OKABE_ITO[len(after.features) % len(OKABE_ITO)]
+        after.features.append(
+            Feature(self._new_name("feature"), float(x), float(y), float(g), color)
+        )
+        self.commit(after, "Add feature")
+        self.select(len(self.scene.features) - 1)
+
+    def duplicate_feature(self, index: int) -> None:
+        after = self.scene.copy()
+        f = after.features[index]
+        off = 2.5 * f.g
+        color = OKABE_ITO[len(after.features) % len(OKABE_ITO)]
+        after.features.append(Feature(self._new_name(f.name), f.x + off, f.y, f.g, color))
+        self.commit(after, f"Duplicate {f.name}")
+        self.select(len(self.scene.features) - 1)
+
+    def delete_feature(self, index: int) -> None:
+        after = self.scene.copy()
+        name = after.features.pop(index).name
+        self.commit(after, f"Delete {name}")
+
+    def set_layer(self, layer: str, on: bool) -> None:
+        after = self.scene.copy()
+        if on and layer not in after.layers:
+            after.layers.append(layer)
+        elif not on and layer in after.layers:
+            after.layers.remove(layer)
+        self.commit(after, f"{'Show' if on else 'Hide'} {layer}")
+
+
+def hit_test(scene: Scene, selected: int | None, x: float, y: float, units_per_px: float):
+    """(index, "handle"|"body") of what lies under (x, y), or (None, None).
+
+    The selected feature's radius handle (at (x + g, y)) wins, then the topmost disc (the
+    last in the list); tiny discs are grabbed within BODY_PX of their centre.
+    """
+    fs = scene.features
+    if selected is not None and 0 <= selected < len(fs):
+        f = fs[selected]
+        if math.hypot(x - f.x - f.g, y - f.y) <= HANDLE_PX * units_per_px:
+            return selected, "handle"
+    for i in range(len(fs) - 1, -1, -1):
+        f = fs[i]
+        if math.hypot(x - f.x, y - f.y) <= max(f.g, 0.0) + BODY_PX * units_per_px:
+            return i, "body"
+    return None, None
+
+
+def drag_feature(model: AppModel, event: MouseEvent, index: int, part: str) -> Generator:
+    """A whole drag of feature ``index`` (napari-style): press, moves, release.
+
+    Send each following event with ``gen.send(event)``. Moving the body keeps the grab
+    offset; the handle sets the radius to the cursor's distance from the centre. Under
+    DRAG_THRESHOLD_PX of travel it is a click (select only); a drag is ONE undo step.
+    """
+    model.select(index)
+    before = model.scene.copy()
+    f0 = before.features[index]
+    x0, y0, px0, py0 = event.x, event.y, event.px, event.py
+    dragging = False
+    event = yield
+    while event.type == "move":
+        if not dragging and math.hypot(event.px - px0, event.py - py0) >= DRAG_THRESHOLD_PX:
+            dragging = True
+        if dragging:
+            if part == "body":
+                model.live(index, x=f0.x + (event.x - x0), y=f0.y + (event.y - y0))
+            else:
+                g = math.hypot(event.x - f0.x, event.y - f0.y)
+                model.live(index, g=max(g, f0.g * 1e-3, 1e-9))
+        event = yield
+    if dragging:
+        after = model.scene.copy()
+        model.scene = before.copy()  # the undo command sets `after` again on push
+        model.commit(after, ("Move " if part == "body" else "Resize ") + f0.name, before=before)

@@ -1,0 +1,334 @@
+"""Qt side panels: bitmaps, readout, eye parameters, feature list, layer toggles.
+
+Panels draw from the model's :class:`~eyeviz.state.SceneState` and send edits to the
+:class:`~eyeviz.app.model.AppModel`; none keeps its own copy of the truth.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from PyQt5 import QtCore, QtGui, QtWidgets
+
+from eyeviz.app.model import AppModel
+from eyeviz.render.actors import UNLIT, hex_rgb
+from eyeviz.scene import LAYERS
+
+__all__ = ["BitmapPanel", "EyesPanel", "FeaturePanel", "LayersPanel", "ReadoutPanel"]
+
+ERROR_STYLE = "color: #b00020; font-weight: bold;"
+INK = QtGui.QColor(30, 30, 30)
+
+
+def _downsample(owner: np.ndarray, width: int) -> np.ndarray:
+    """Per pixel column, the owner of any lit ommatidium in it (max), so nothing lit vanishes."""
+    n = owner.shape[0]
+    if width <= 0:
+        return owner[:0]
+    if n <= width:
+        return owner
+    starts = (np.arange(width) * n) // width
+    return np.maximum.reduceat(owner, starts)
+
+
+class BitmapPanel(QtWidgets.QWidget):
+    """Omega_A and Omega_B: the m/2 the networks see and the whole eye, lit [L, R] beside."""
+
+    ROWS = (("A", False), ("A", True), ("B", False), ("B", True))
+
+    def __init__(self, model: AppModel, parent=None):
+        super().__init__(parent)
+        self.model = model
+        self.strips: dict[tuple[str, bool], np.ndarray] = {}
+        self.colors = np.array([UNLIT], dtype=np.uint8)
+        self.intervals: dict[str, tuple[int, int] | None] = {"A": None, "B": None}
+        self.sel_color = INK
+        self.setMinimumHeight(150)
+        self.setMaximumHeight(190)
+        self.setSizePolicy(QtWidgets.QSizePolicy.Expanding, QtWidgets.QSizePolicy.Fixed)
+
+    def refresh(self) -> None:
+        st = self.model.state
+        sc = self.model.scene
+        self.strips.clear()
+        self.intervals = {"A": None, "B": None}
+        if st.LA is not None:
+            m = st.m
+            oa = st.owner_a if st.owner_a is not None else _owners_of(st, "A")
+            ob = st.owner_b if st.owner_b is not None else _owners_of(st, "B")
+            for eye, own in (("A", oa), ("B", ob)):
+                self.strips[(eye, True)] = own
+                self.strips[(eye, False)] = own[: m // 2]
+            i = self.model.selected
+            if i is not None and i < st.n:
+                self.intervals = {
+                    "A": (int(st.LA[i]), int(st.RA[i])),
+                    "B": (int(st.LB[i]), int(st.RB[i])),
+                }
+        self.colors = np.vstack([UNLIT] + [hex_rgb(f.color) for f in sc.features]).astype(np.uint8)
+        i = self.model.selected
+        self.sel_color = QtGui.QColor(
+            sc.features[i].color if i is not None and i < st.n else "#222"
+        )
+        self.update()
+
+    def lit(self, eye: str, whole: bool) -> np.ndarray:
+        """The bitmap shown in a strip (bool per ommatidium)."""
+        return self.strips[(eye, whole)] >= 0
+
+    def paintEvent(self, event) -> None:  # noqa: N802 (Qt name)
+        p = QtGui.QPainter(self)
+        p.fillRect(self.rect(), QtGui.QColor("white"))
+        if not self.model.scene.shows("bitmaps") or not self.strips:
+            p.setPen(INK)
+            p.drawText(self.rect(), QtCore.Qt.AlignCenter, "bitmaps layer hidden")
+            return
+        fm = p.fontMetrics()
+        label_w = fm.horizontalAdvance("Ω_B  whole eye ") + 8
+        right_w = fm.horizontalAdvance("[35999, 35999] ") + 8
+        m = self.model.state.m
+        row_h = max(fm.height() + 10, (self.height() - 8) // 4)
+        x0, x1 = label_w, self.width() - right_w
+        width = max(x1 - x0, 1)
+        for r, (eye, whole) in enumerate(self.ROWS):
+            y = 4 + r * row_h
+            own = self.strips[(eye, whole)]
+            cols = _downsample(own, width)
+            rgb = np.ascontiguousarray(self.colors[cols + 1])
+            img = QtGui.QImage(
+                rgb.data, rgb.shape[0], 1, 3 * rgb.shape[0], QtGui.QImage.Format_RGB888
+            )
+            target = QtCore.QRect(x0, y + 3, width, row_h - 8)
+            p.drawImage(target, img)
+            p.setPen(QtGui.QPen(INK, 1))
+            p.drawRect(target)
+            p.setPen(INK)
+            name = f"Ω_{eye}  " + ("whole eye" if whole else "0…m/2−1")
+            p.drawText(QtCore.QRect(4, y, label_w - 8, row_h), QtCore.Qt.AlignVCenter, name)
+            iv = self.intervals[eye]
+            if iv is not None:
+                p.setPen(self.sel_color)
+                text = f"[{iv[0]}, {iv[1]}]" if whole else _half_text(iv, m)
+                p.drawText(QtCore.QRect(x1 + 8, y, right_w, row_h), QtCore.Qt.AlignVCenter, text)
+        p.end()
+
+
+def _half_text(iv: tuple[int, int], m: int) -> str:
+    """The selected feature's lit indices among the m/2 the networks see."""
+    from eyeviz.geometry import intervals_to_bitmap
+
+    k = np.flatnonzero(intervals_to_bitmap(iv[0], iv[1], m, m // 2))
+    if k.size == 0:
+        return "none"
+    gaps = np.flatnonzero(np.diff(k) > 1)
+    if gaps.size == 0:
+        return f"[{k[0]}, {k[-1]}]"
+    return f"[{k[0]}, {k[gaps[0]]}] ∪ [{k[gaps[0] + 1]}, {k[-1]}]"
+
+
+def _owners_of(st, eye: str) -> np.ndarray:
+    from eyeviz.state import owners
+
+    return owners(st.LA, st.RA, st.m) if eye == "A" else owners(st.LB, st.RB, st.m)
+
+
+class ReadoutPanel(QtWidgets.QLabel):
+    """The selected feature: r, phi, r_A, phi_A, r_B, phi_B, BFV, visibility, overlap."""
+
+    def __init__(self, model: AppModel, parent=None):
+        super().__init__(parent)
+        self.model = model
+        self.setTextFormat(QtCore.Qt.RichText)
+        self.setAlignment(QtCore.Qt.AlignTop | QtCore.Qt.AlignLeft)
+        self.setMargin(8)
+        self.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
+
+    def refresh(self) -> None:
+        st, sc, i = self.model.state, self.model.scene, self.model.selected
+        if i is None or i >= len(sc.features):
+            self.setText("<i>no feature selected</i>")
+            return
+        f = sc.features[i]
+        if st.r is None:
+            self.setText(f"<b style='color:{f.color}'>{f.name}</b><br><i>readout layer hidden</i>")
+            return
+
+        def yes(v, good=True):
+            ok = bool(v) == good
+            color = "#1b7837" if ok else "#b00020"
+            return f"<b style='color:{color}'>{'yes' if v else 'no'}</b>"
+
+        deg = 180.0 / math.pi
+        rows = [
+            ("r, φ", f"{st.r[i]:.1f}, {st.phi[i] * deg:.2f}°"),
+            ("r<sub>A</sub>, φ<sub>A</sub>", f"{st.rA[i]:.1f}, {st.phiA[i] * deg:.2f}°"),
+            ("r<sub>B</sub>, φ<sub>B</sub>", f"{st.rB[i]:.1f}, {st.phiB[i] * deg:.2f}°"),
+            ("g", f"{f.g:g}"),
+            ("in BFV", yes(st.in_bfv[i])),
+            ("visible A / B", f"{yes(st.vis_a[i])} / {yes(st.vis_b[i])}"),
+            ("overlaps A / B", f"{yes(st.overlap_a[i], False)} / {yes(st.overlap_b[i], False)}"),
+        ]
+        html = (
+            f"<div style='font-size:17pt; font-weight:bold; color:{f.color}'>● {f.name}</div>"
+            "<table cellspacing='0' cellpadding='3'>"
+            + "".join(f"<tr><td>{k}</td><td>&nbsp;&nbsp;{v}</td></tr>" for k, v in rows)
+            + "</table>"
+        )
+        self.setText(html)
+
+
+class EyesPanel(QtWidgets.QWidget):
+    """h, l, m; a value the model forbids is refused with a message and nothing changes."""
+
+    def __init__(self, model: AppModel, parent=None):
+        super().__init__(parent)
+        self.model = model
+        form = QtWidgets.QFormLayout(self)
+        self.edits: dict[str, QtWidgets.QLineEdit] = {}
+        for key, tip in (("h", "origin to eye centre"), ("l", "eye radius"), ("m", "ommatidia")):
+            e = QtWidgets.QLineEdit()
+            e.setToolTip(tip)
+            e.editingFinished.connect(self.apply)
+            form.addRow(f"{key}  ({tip})", e)
+            self.edits[key] = e
+        self.message = QtWidgets.QLabel("")
+        self.message.setWordWrap(True)
+        self.message.setStyleSheet(ERROR_STYLE)
+        form.addRow(self.message)
+
+    def refresh(self) -> None:
+        e = self.model.scene.eyes
+        for key, val in (("h", f"{e.h:g}"), ("l", f"{e.l:g}"), ("m", str(e.m))):
+            if not self.edits[key].hasFocus() or self.edits[key].text() == "":
+                self.edits[key].setText(val)
+
+    def apply(self) -> None:
+        e = self.model.scene.eyes
+        texts = {k: w.text().strip() for k, w in self.edits.items()}
+        if texts == {"h": f"{e.h:g}", "l": f"{e.l:g}", "m": str(e.m)}:
+            return
+        try:
+            try:
+                h, l = float(texts["h"]), float(texts["l"])
+            except ValueError:
+                raise ValueError("h and l must be numbers") from None
+            try:
+                m = int(texts["m"])
+            except ValueError:
+                raise ValueError(f"m must be an even integer >= 4, got {texts['m']!r}") from None
+            self.model.set_eyes(h, l, m)
+        except ValueError as exc:
+            self.message.setText(f"Refused: {exc}")
+            for key, val in (("h", f"{e.h:g}"), ("l", f"{e.l:g}"), ("m", str(e.m))):
+                self.edits[key].setText(val)
+            return
+        self.message.setText("")
+
+
+class FeaturePanel(QtWidgets.QWidget):
+    """The feature list with editable name, x, y, g; selecting a row selects the feature."""
+
+    COLS = ("name", "x", "y", "g")
+
+    def __init__(self, model: AppModel, parent=None):
+        super().__init__(parent)
+        self.model = model
+        lay = QtWidgets.QVBoxLayout(self)
+        lay.setContentsMargins(2, 2, 2, 2)
+        self.table = QtWidgets.QTableWidget(0, 4)
+        self.table.setHorizontalHeaderLabels(list(self.COLS))
+        self.table.verticalHeader().setVisible(False)
+        self.table.horizontalHeader().setSectionResizeMode(QtWidgets.QHeaderView.Stretch)
+        self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectRows)
+        self.table.setSelectionMode(QtWidgets.QAbstractItemView.SingleSelection)
+        lay.addWidget(self.table)
+        self.message = QtWidgets.QLabel("")
+        self.message.setWordWrap(True)
+        self.message.setStyleSheet(ERROR_STYLE)
+        lay.addWidget(self.message)
+        self._filling = False
+        self.table.itemChanged.connect(self._edited)
+        self.table.itemSelectionChanged.connect(self._selected)
+
+    @staticmethod
+    def _fmt(v: float) -> str:
+        return f"{v:.6g}"
+
+    def refresh(self, index: int | None = None) -> None:
+        fs = self.model.scene.features
+        self._filling = True
+        try:
+            if index is not None and self.table.rowCount() == len(fs):
+                rows = [index]
+            else:
+                self.table.setRowCount(len(fs))
+                rows = range(len(fs))
+            for r in rows:
+                f = fs[r]
+                for c, val in enumerate((f.name, self._fmt(f.x), self._fmt(f.y), self._fmt(f.g))):
+                    item = self.table.item(r, c)
+                    if item is None:
+                        item = QtWidgets.QTableWidgetItem()
+                        self.table.setItem(r, c, item)
+                    if item.text() != val:
+                        item.setText(val)
+                name_item = self.table.item(r, 0)
+                name_item.setForeground(QtGui.QBrush(QtGui.QColor(f.color)))
+                font = name_item.font()
+                font.setBold(True)
+                name_item.setFont(font)
+            sel = self.model.selected
+            if sel is not None and sel < len(fs) and self.table.currentRow() != sel:
+                self.table.selectRow(sel)
+        finally:
+            self._filling = False
+
+    def _selected(self) -> None:
+        if self._filling:
+            return
+        rows = {i.row() for i in self.table.selectedIndexes()}
+        if len(rows) == 1:
+            self.model.select(rows.pop())
+
+    def _edited(self, item: QtWidgets.QTableWidgetItem) -> None:
+        if self._filling:
+            return
+        r, c = item.row(), item.column()
+        try:
+            self.model.set_feature(r, **{self.COLS[c]: item.text()})
+            self.message.setText("")
+        except ValueError as exc:
+            msg = str(exc)
+            if msg.startswith("could not convert"):
+                msg = f"{self.COLS[c]} must be a number, got {item.text()!r}"
+            self.message.setText(f"Refused: {msg}")
+            self.refresh()
+
+
+class LayersPanel(QtWidgets.QWidget):
+    """One check box per layer; toggling is an undoable edit of the scene's layers."""
+
+    def __init__(self, model: AppModel, parent=None):
+        super().__init__(parent)
+        self.model = model
+        grid = QtWidgets.QGridLayout(self)
+        self.boxes: dict[str, QtWidgets.QCheckBox] = {}
+        for i, name in enumerate(LAYERS):
+            b = QtWidgets.QCheckBox(name)
+            b.toggled.connect(lambda on, n=name: self._toggled(n, on))
+            grid.addWidget(b, i // 2, i % 2)
+            self.boxes[name] = b
+        self._filling = False
+
+    def refresh(self) -> None:
+        self._filling = True
+        try:
+            for name, b in self.boxes.items():
+                b.setChecked(name in self.model.scene.layers)
+        finally:
+            self._filling = False
+
+    def _toggled(self, name: str, on: bool) -> None:
+        if not self._filling:
+            self.model.set_layer(name, on)

@@ -1,0 +1,368 @@
+"""Scene -> VTK actors, updated in place (the app's 2D top view).
+
+``SceneActors`` owns every actor of the main view and of the magnified inset of the eyes.
+Each eye is ONE PolyData of m triangle cells (Figure 2: ommatidium k is the isosceles
+triangle between the rim directions k*gamma and (k+1)*gamma, Eq. 6); lighting them only
+writes the cell colour array in place (``mesh.cell_data[...][:] = ...``). Meshes are
+rebuilt only when their structure changes (m, h or l; the number of features; the layers
+shown). Nothing here computes geometry: colours and positions come from a
+:class:`eyeviz.state.SceneState`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pyvista as pv
+import vtk
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+from eyeviz.scene import Scene
+from eyeviz.state import SceneState
+
+__all__ = ["INSET_VIEWPORT", "SceneActors", "hex_rgb", "eye_mesh"]
+
+BACKGROUND = (1.0, 1.0, 1.0)
+INSET_BACKGROUND = (0.965, 0.965, 0.955)
+UNLIT = np.array([225, 225, 225], dtype=np.uint8)
+INK = (0.15, 0.15, 0.15)
+BFV_FILL = (0.93, 0.91, 0.80)
+BFV_LINE = (0.45, 0.42, 0.30)
+INSET_VIEWPORT = (0.6, 0.0, 1.0, 0.5)  # (xmin, ymin, xmax, ymax) of the render window
+EDGE_MIN_PX = 7.0  # draw triangle edges when an ommatidium's rim is at least this wide
+Z_BFV, Z_EYES, Z_FEAT, Z_LINE, Z_POINT = -3.0, 0.0, 1.0, 2.0, 3.0
+_CIRCLE_N = 160
+
+
+def hex_rgb(color: str) -> tuple[int, int, int]:
+    c = color.lstrip("#")
+    return int(c[0:2], 16), int(c[2:4], 16), int(c[4:6], 16)
+
+
+def _rgbf(color: str) -> tuple[float, float, float]:
+    return tuple(v / 255.0 for v in hex_rgb(color))
+
+
+def eye_mesh(cx: float, l: float, m: int) -> pv.PolyData:
+    """The m ommatidium triangles of the eye centred at (cx, 0) (Figure 2)."""
+    t = np.arange(m) * (2.0 * math.pi / m)
+    pts = np.zeros((m + 1, 3))
+    pts[0] = (cx, 0.0, Z_EYES)
+    pts[1:, 0] = cx + l * np.cos(t)
+    pts[1:, 1] = l * np.sin(t)
+    pts[1:, 2] = Z_EYES
+    k = np.arange(m)
+    faces = np.column_stack([np.full(m, 3), np.zeros(m, int), k + 1, (k + 1) % m + 1]).ravel()
+    mesh = pv.PolyData(pts, faces=faces)
+    mesh.cell_data["rgb"] = np.tile(UNLIT, (m, 1))
+    return mesh
+
+
+def _actor(mesh, color=None, rgb: bool = False) -> vtk.vtkActor:
+    mapper = vtk.vtkPolyDataMapper()
+    mapper.SetInputData(mesh)
+    if rgb:
+        mapper.SetScalarModeToUseCellFieldData()
+        mapper.SelectColorArray("rgb")
+        mapper.SetColorModeToDirectScalars()
+        mapper.ScalarVisibilityOn()
+    else:
+        mapper.ScalarVisibilityOff()
+    actor = vtk.vtkActor()
+    actor.SetMapper(mapper)
+    prop = actor.GetProperty()
+    prop.LightingOff()
+    prop.SetAmbient(1.0)
+    prop.SetDiffuse(0.0)
+    if color is not None:
+        prop.SetColor(*color)
+    return actor
+
+
+def _circle(n: int = _CIRCLE_N) -> np.ndarray:
+    t = np.linspace(0.0, 2.0 * math.pi, n, endpoint=False)
+    return np.column_stack([np.cos(t), np.sin(t)])
+
+
+_UNIT = _circle()
+
+
+def _ring(x: float, y: float, r: float, z: float) -> np.ndarray:
+    pts = np.empty((_CIRCLE_N, 3))
+    pts[:, 0] = x + r * _UNIT[:, 0]
+    pts[:, 1] = y + r * _UNIT[:, 1]
+    pts[:, 2] = z
+    return pts
+
+
+@dataclass
+class _FeatureActors:
+    fill_mesh: pv.PolyData
+    line_mesh: pv.PolyData
+    fill: vtk.vtkActor
+    line: vtk.vtkActor
+    label: vtk.vtkBillboardTextActor3D | None
+
+
+class SceneActors:
+    """All actors of one scene in a main renderer and an inset renderer (the eyes, magnified).
+
+    ``update(scene, state, selected)`` is the only entry point: it rebuilds what changed in
+    structure and writes colours and coordinates in place otherwise.
+    """
+
+    def __init__(self, main: vtk.vtkRenderer, inset: vtk.vtkRenderer):
+        self.main = main
+        self.inset = inset
+        self._eyes_key = None
+        self._feat_key = None
+        self.eye_meshes: list[pv.PolyData] = []
+        self._eye_actors: list[vtk.vtkActor] = []  # [main A, main B, inset A, inset B]
+        self._static: list[tuple[vtk.vtkRenderer, vtk.vtkProp]] = []
+        self._features: list[_FeatureActors] = []
+        self._feature_props: list[tuple[vtk.vtkRenderer, vtk.vtkProp]] = []
+        self.centers_mesh: pv.PolyData | None = None
+        self.handle_mesh = pv.PolyData(np.zeros((1, 3)))
+        self.handle_actor = self._points_actor(self.handle_mesh, 13, (0.35, 0.35, 0.35))
+        self.sight_mesh = pv.PolyData(np.zeros((3, 3)), lines=[3, 0, 1, 2])
+        self.sight_actors = [_actor(self.sight_mesh, INK), _actor(self.sight_mesh, INK)]
+        for a in self.sight_actors:
+            a.GetProperty().SetLineWidth(2.0)
+            a.GetProperty().SetLineStipplePattern(0xF0F0)
+        self.main.AddActor(self.handle_actor)
+        self.main.AddActor(self.sight_actors[0])
+        self.inset.AddActor(self.sight_actors[1])
+        self._inset_label = vtk.vtkTextActor()
+        tp = self._inset_label.GetTextProperty()
+        tp.SetFontSize(20)
+        tp.SetColor(*INK)
+        tp.BoldOn()
+        self._inset_label.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+        self._inset_label.SetPosition(0.03, 0.86)
+        self.inset.AddViewProp(self._inset_label)
+        self._inset_border = self._border_actor()
+        self.inset.AddViewProp(self._inset_border)
+        self.edges_main = False
+        self.edges_inset = False
+
+    # --- construction ---------------------------------------------------------------
+    @staticmethod
+    def _points_actor(mesh, size: float, color) -> vtk.vtkActor:
+        a = _actor(mesh, color)
+        p = a.GetProperty()
+        p.SetRepresentationToPoints()
+        p.SetPointSize(size)
+        p.RenderPointsAsSpheresOn()
+        return a
+
+    @staticmethod
+    def _border_actor() -> vtk.vtkActor2D:
+        pts = vtk.vtkPoints()
+        for x, y in ((0.002, 0.004), (0.998, 0.004), (0.998, 0.996), (0.002, 0.996)):
+            pts.InsertNextPoint(x, y, 0)
+        lines = vtk.vtkCellArray()
+        lines.InsertNextCell(5)
+        for i in (0, 1, 2, 3, 0):
+            lines.InsertCellPoint(i)
+        poly = vtk.vtkPolyData()
+        poly.SetPoints(pts)
+        poly.SetLines(lines)
+        coord = vtk.vtkCoordinate()
+        coord.SetCoordinateSystemToNormalizedViewport()
+        mapper = vtk.vtkPolyDataMapper2D()
+        mapper.SetInputData(poly)
+        mapper.SetTransformCoordinate(coord)
+        actor = vtk.vtkActor2D()
+        actor.SetMapper(mapper)
+        actor.GetProperty().SetColor(*INK)
+        actor.GetProperty().SetLineWidth(3)
+        return actor
+
+    def _add(self, store, renderer, prop) -> None:
+        renderer.AddActor(prop)
+        store.append((renderer, prop))
+
+    def _clear(self, store) -> None:
+        for renderer, prop in store:
+            renderer.RemoveActor(prop)
+        store.clear()
+
+    def _build_static(self, scene: Scene) -> None:
+        """Eyes, outlines, origin and BFV wedge: depend on h, l, m and the layers only."""
+        self._clear(self._static)
+        self.eye_meshes, self._eye_actors = [], []
+        pair = scene.eyes.pair()
+        h, l, m = pair.h, pair.l, pair.m
+        if scene.shows("bfv"):
+            far = 1.0e7
+            a = pair.psi
+            wedge = pv.PolyData(
+                np.array(
+                    [
+                        [0, 0, Z_BFV],
+                        [far * math.cos(a), far * math.sin(a), Z_BFV],
+                        [-far * math.cos(a), far * math.sin(a), Z_BFV],
+                    ]
+                ),
+                faces=[3, 0, 1, 2],
+            )
+            rays = pv.PolyData(
+                np.array(
+                    [
+                        [far * math.cos(a), far * math.sin(a), Z_LINE],
+                        [0, 0, Z_LINE],
+                        [-far * math.cos(a), far * math.sin(a), Z_LINE],
+                    ]
+                ),
+                lines=[3, 0, 1, 2],
+            )
+            for ren in (self.main, self.inset):
+                self._add(self._static, ren, _actor(wedge, BFV_FILL))
+                ra = _actor(rays, BFV_LINE)
+                ra.GetProperty().SetLineWidth(2.5)
+                self._add(self._static, ren, ra)
+        if scene.shows("eyes"):
+            for cx in (-h, h):
+                self.eye_meshes.append(eye_mesh(cx, l, m))
+            for ren in (self.main, self.inset):
+                for mesh in self.eye_meshes:
+                    a = _actor(mesh, rgb=True)
+                    a.GetProperty().SetEdgeColor(0.35, 0.35, 0.35)
+                    a.GetProperty().SetLineWidth(1.0)
+                    self._add(self._static, ren, a)
+                    self._eye_actors.append(a)
+            for cx in (-h, h):
+                ring = pv.PolyData(_ring(cx, 0.0, l, Z_LINE))
+                ring.lines = np.concatenate([[_CIRCLE_N + 1], np.arange(_CIRCLE_N), [0]])
+                for ren in (self.main, self.inset):
+                    ra = _actor(ring, INK)
+                    ra.GetProperty().SetLineWidth(2.0)
+                    self._add(self._static, ren, ra)
+        origin = pv.PolyData(np.array([[0.0, 0.0, Z_POINT]]))
+        self._add(self._static, self.main, self._points_actor(origin, 9, INK))
+        self._add(self._static, self.inset, self._points_actor(origin, 9, INK))
+        if scene.shows("labels"):
+            for text, (x, y) in (
+                ("A", (-h, -1.35 * l)),
+                ("B", (h, -1.35 * l)),
+                ("O", (0, -0.55 * l)),
+            ):
+                t = vtk.vtkBillboardTextActor3D()
+                t.SetInput(text)
+                t.SetPosition(x, y, Z_POINT)
+                tp = t.GetTextProperty()
+                tp.SetFontSize(22)
+                tp.BoldOn()
+                tp.SetColor(*INK)
+                tp.SetJustificationToCentered()
+                tp.SetVerticalJustificationToCentered()
+                self._add(self._static, self.inset, t)
+        self._inset_label.SetInput(f"eyes (m = {m})")
+
+    def _build_features(self, scene: Scene) -> None:
+        self._clear(self._feature_props)
+        self._features = []
+        self.centers_mesh = None
+        if not scene.shows("features") or not scene.features:
+            return
+        n = len(scene.features)
+        for f in scene.features:
+            pts = vtk.vtkPoints()
+            pts.SetNumberOfPoints(_CIRCLE_N)
+            fill = pv.PolyData()
+            fill.SetPoints(pts)
+            fill.faces = np.concatenate([[_CIRCLE_N], np.arange(_CIRCLE_N)])
+            line = pv.PolyData()
+            line.SetPoints(pts)
+            line.lines = np.concatenate([[_CIRCLE_N + 1], np.arange(_CIRCLE_N), [0]])
+            col = _rgbf(f.color)
+            fa = _actor(fill, col)
+            fa.GetProperty().SetOpacity(0.45)
+            la = _actor(line, col)
+            la.GetProperty().SetLineWidth(3.0)
+            label = None
+            if scene.shows("labels"):
+                label = vtk.vtkBillboardTextActor3D()
+                tp = label.GetTextProperty()
+                tp.SetFontSize(22)
+                tp.BoldOn()
+                tp.SetColor(*col)
+                tp.SetJustificationToLeft()
+                tp.SetVerticalJustificationToBottom()
+                self._add(self._feature_props, self.main, label)
+            self._add(self._feature_props, self.main, fa)
+            self._add(self._feature_props, self.main, la)
+            self._features.append(_FeatureActors(fill, line, fa, la, label))
+        self.centers_mesh = pv.PolyData(np.zeros((n, 3)))
+        self.centers_mesh.point_data["rgb"] = np.array(
+            [hex_rgb(f.color) for f in scene.features], dtype=np.uint8
+        )
+        ca = self._points_actor(self.centers_mesh, 11, None)
+        mapper = ca.GetMapper()
+        mapper.SetScalarModeToUsePointFieldData()
+        mapper.SelectColorArray("rgb")
+        mapper.SetColorModeToDirectScalars()
+        mapper.ScalarVisibilityOn()
+        self._add(self._feature_props, self.main, ca)
+
+    # --- updates ----------------------------------------------------------------------
+    def update(self, scene: Scene, state: SceneState, selected: int | None) -> None:
+        eyes_key = (scene.eyes.h, scene.eyes.l, scene.eyes.m, tuple(scene.layers))
+        feat_key = (tuple((f.name, f.color) for f in scene.features), tuple(scene.layers))
+        if eyes_key != self._eyes_key:
+            self._build_static(scene)
+            self._eyes_key = eyes_key
+        if feat_key != self._feat_key:
+            self._build_features(scene)
+            self._feat_key = feat_key
+        self._update_eyes(scene, state)
+        self._update_features(scene, state, selected)
+
+    def _update_eyes(self, scene: Scene, state: SceneState) -> None:
+        if not self.eye_meshes:
+            return
+        palette = np.vstack([UNLIT] + [hex_rgb(f.color) for f in scene.features]).astype(np.uint8)
+        for mesh, owner in zip(self.eye_meshes, (state.owner_a, state.owner_b), strict=True):
+            mesh.cell_data["rgb"][:] = palette[owner + 1]
+
+    def _update_features(self, scene: Scene, state: SceneState, selected: int | None) -> None:
+        for fa, f in zip(self._features, scene.features, strict=True):
+            pts = fa.fill_mesh.GetPoints()
+            ring = _ring(f.x, f.y, f.g, Z_FEAT)
+            arr = vtk_to_numpy(pts.GetData())
+            arr[:] = ring
+            pts.Modified()
+            fa.fill_mesh.Modified()
+            fa.line_mesh.Modified()
+            if fa.label is not None:
+                fa.label.SetInput(f" {f.name}")
+                fa.label.SetPosition(f.x + f.g * 0.75, f.y + f.g * 0.75, Z_POINT)
+        if self.centers_mesh is not None:
+            self.centers_mesh.points[:] = np.column_stack(
+                [state.x, state.y, np.full(state.n, Z_POINT)]
+            )
+        has_sel = selected is not None and 0 <= selected < len(scene.features)
+        show_handle = has_sel and scene.shows("features")
+        self.handle_actor.SetVisibility(show_handle)
+        for a in self.sight_actors:
+            a.SetVisibility(has_sel and scene.shows("features"))
+        if has_sel:
+            f = scene.features[selected]
+            self.handle_mesh.points[:] = [[f.x + f.g, f.y, Z_POINT + 0.5]]
+            h = scene.eyes.h
+            self.sight_mesh.points[:] = [[-h, 0, Z_LINE], [f.x, f.y, Z_LINE], [h, 0, Z_LINE]]
+            col = _rgbf(f.color)
+            for a in self.sight_actors:
+                a.GetProperty().SetColor(*col)
+            for i, fa in enumerate(self._features):
+                fa.line.GetProperty().SetLineWidth(5.0 if i == selected else 3.0)
+
+    def set_edges(self, main_px_per_unit: float, inset_px_per_unit: float, l: float, m: int):
+        """Triangle edges only where an ommatidium's rim is wide enough on screen."""
+        rim = l * 2.0 * math.pi / m
+        self.edges_main = rim * main_px_per_unit >= EDGE_MIN_PX
+        self.edges_inset = rim * inset_px_per_unit >= EDGE_MIN_PX
+        for i, a in enumerate(self._eye_actors):
+            a.GetProperty().SetEdgeVisibility(self.edges_main if i < 2 else self.edges_inset)
