@@ -221,7 +221,7 @@ class EyePair:
         k = self._k
         tol0 = (_TOL_BASE + _TOL_GRAZE / (1 - _Q_SAFE)) * _U * self.m
         for s in range(0, n, _CHUNK):
-            with np.errstate(divide="ignore", invalid="ignore"):
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 self._block(
                     x, y, g, cx, refine, slice(s, s + _CHUNK), k, tol0, lo_out, hi_out, whole
                 )
