@@ -1,0 +1,55 @@
+"""``eyeviz report dataset``: PNG, Markdown and CSV summary of data sets."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+
+import pytest
+
+from eyeviz import dataset as D
+
+EYEVIZ = [sys.executable, "-m", "eyeviz"]
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("ds")
+    D.write(d / "single.npz", 20000, seed=1)
+    D.write(d / "multi.csv", 20000, seed=1, mode="multi")
+    return d
+
+
+def test_report_side_by_side(files, tmp_path):
+    out = tmp_path / "rep"
+    res = subprocess.run([*EYEVIZ, "report", "dataset", str(files / "single.npz"),
+                          str(files / "multi.csv"), "--labels", "one pass", "multi-pass",
+                          "-o", str(out)], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    png = (out / "dataset.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 50_000
+    with open(out / "dataset.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [r["label"] for r in rows] == ["one pass", "multi-pass"]
+    single, multi = rows
+    assert single["mode"] == "single" and int(single["n"]) == 20000
+    assert multi["mode"] == "?"  # a CSV does not record how it was made
+    # one pass: flat in r, so the density per area halves from inner to outer half
+    assert float(single["area_density_ratio"]) == pytest.approx(0.5, abs=0.05)
+    # multi-pass: uniform over the BFV area
+    assert float(multi["area_density_ratio"]) == pytest.approx(1.0, abs=0.05)
+    md = (out / "dataset.md").read_text()
+    assert "![r histograms and centres](dataset.png)" in md and "| multi-pass | 20,000 |" in md
+    assert not [p for p in out.iterdir() if p.name.endswith(".part")]
+
+
+def test_report_bad_input(files, tmp_path):
+    res = subprocess.run([*EYEVIZ, "report", "dataset", str(files / "single.npz"),
+                          "--labels", "a", "b", "-o", str(tmp_path / "r")],
+                         capture_output=True, text=True, timeout=60)
+    assert res.returncode == 2 and "one label per data set" in res.stderr
+    res = subprocess.run([*EYEVIZ, "report", "dataset", str(tmp_path / "none.csv"),
+                          "-o", str(tmp_path / "r")], capture_output=True, text=True, timeout=60)
+    assert res.returncode == 2 and "no such data set file" in res.stderr
+    assert "Traceback" not in res.stderr and not (tmp_path / "r").exists()
