@@ -32,9 +32,13 @@ if [ ! -x .venv/bin/python ]; then
 fi
 stamp=.venv/.eyeviz-installed
 if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
-    .venv/bin/python -m pip install -q --upgrade pip >/dev/null
-    # torch first, pinned: any other request pulls a multi-GB CUDA build.
-    .venv/bin/python -m pip install -q "torch==2.13.0"
-    .venv/bin/python -m pip install -q -e ".[app,ml,dev]"
+    echo "eyeviz setup: installing Python packages into .venv (first run takes a few minutes)" >&2
+    log=.venv/setup.log
+    {
+        .venv/bin/python -m pip install --upgrade pip &&
+        # torch first, pinned: any other request pulls a multi-GB CUDA build.
+        .venv/bin/python -m pip install "torch==2.13.0" &&
+        .venv/bin/python -m pip install -e ".[app,ml,dev]"
+    } >"$log" 2>&1 || { tail -n 30 "$log" >&2; echo "eyeviz setup: pip failed (log: $log)" >&2; exit 1; }
     touch "$stamp"
 fi
