@@ -167,13 +167,15 @@ class AppModel:
 def hit_test(scene: Scene, selected: int | None, x: float, y: float, units_per_px: float):
     """(index, "handle"|"body") of what lies under (x, y), or (None, None).
 
-    The selected feature's radius handle (at (x + g, y)) wins, then the topmost disc (the
-    last in the list); tiny discs are grabbed within BODY_PX of their centre.
+    The selected feature's radius handle (at (x + g, y)) wins when the cursor is nearer to
+    it than to the centre, then the topmost disc (the last in the list); tiny discs are
+    grabbed within BODY_PX of their centre.
     """
     fs = scene.features
     if selected is not None and 0 <= selected < len(fs):
         f = fs[selected]
-        if math.hypot(x - f.x - f.g, y - f.y) <= HANDLE_PX * units_per_px:
+        d_handle = math.hypot(x - f.x - f.g, y - f.y)
+        if d_handle <= HANDLE_PX * units_per_px and d_handle < math.hypot(x - f.x, y - f.y):
             return selected, "handle"
     for i in range(len(fs) - 1, -1, -1):
         f = fs[i]

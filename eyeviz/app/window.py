@@ -135,7 +135,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.statusBar().addPermanentWidget(self.cursor_label)
         self._build_menus()
         self.model.listeners.append(self._on_model)
-        self.undo_stack.cleanChanged.connect(lambda _c: self._update_title())
+        self.undo_stack.cleanChanged.connect(self._clean_changed)
         self.resize(1280, 800)
         self._restore_settings()
         self.fit_inset()
@@ -226,6 +226,12 @@ class MainWindow(QtWidgets.QMainWindow):
         self.recent_menu.setEnabled(bool(self.recent_files()))
 
     # --- files ----------------------------------------------------------------------
+    def _clean_changed(self, _clean: bool) -> None:
+        try:
+            self._update_title()
+        except RuntimeError:  # the stack is being destroyed with the window
+            pass
+
     def _update_title(self) -> None:
         name = self.path.name if self.path else "untitled"
         star = "" if self.undo_stack.isClean() else " *"

@@ -1,0 +1,33 @@
+"""A real eyeviz window (Qt + VTK) under Xvfb, with settings in a temporary file."""
+
+import os
+
+import pytest
+
+os.environ.setdefault("QT_API", "pyqt5")
+
+if not os.environ.get("DISPLAY"):
+    pytest.skip(
+        "the app tests need an X display: run them under xvfb-run -a", allow_module_level=True
+    )
+
+
+@pytest.fixture
+def make_window(qtbot, tmp_path):
+    from eyeviz.app.window import MainWindow, make_app, make_settings
+
+    make_app()
+    made = []
+
+    def make(scene, path=None):
+        win = MainWindow(scene, path, settings=make_settings(tmp_path / "settings.ini"))
+        qtbot.addWidget(win)
+        win.show()
+        qtbot.waitExposed(win)
+        win.fit_inset()
+        made.append(win)
+        return win
+
+    yield make
+    for w in made:
+        w.close()

@@ -1,0 +1,295 @@
+"""The app on a real window: drags with mouse events, parameters, files, undo, screenshot."""
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import vtk
+from PyQt5 import QtCore, QtGui
+from PyQt5.QtTest import QTest
+
+from eyeviz.app.model import DRAG_THRESHOLD_PX
+from eyeviz.app.window import qimage_to_array
+from eyeviz.geometry import EyePair
+from eyeviz.render.actors import UNLIT, Z_FEAT, hex_rgb
+from eyeviz.scene import Eyes, Feature, Scene, View, load
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def two_features(m=720):
+    return Scene(
+        Eyes(40.0, 20.0, m),
+        [
+            Feature("target", 0.0, 1500.0, 50.0, "#D55E00"),
+            Feature("other", -1200.0, 3000.0, 200.0, "#0072B2"),
+        ],
+        ["eyes", "bfv", "features", "bitmaps", "readout", "labels"],
+        view=View((0.0, 2300.0), 7000.0),
+    )
+
+
+def pixel_of(win, x, y):
+    """Model -> Qt widget pixel through VTK's own camera transform (not the app's maths)."""
+    c = vtk.vtkCoordinate()
+    c.SetCoordinateSystemToWorld()
+    c.SetValue(x, y, Z_FEAT)
+    dx, dy = c.GetComputedDoubleDisplayValue(win.main_ren)
+    h = win.ren_win.GetSize()[1]
+    return QtCore.QPoint(round(dx), round(h - dy))
+
+
+def drag(win, start, end, steps=12):
+    w = win.plotter
+    QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
+    for k in range(1, steps + 1):
+        p = start + (end - start) * (k / steps)
+        QTest.mouseMove(w, p)
+    QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, end)
+
+
+def expected_owner(scene, eye):
+    pair = scene.eyes.pair()
+    fs = scene.features
+    wa, wb = pair.bitmaps([f.x for f in fs], [f.y for f in fs], [f.g for f in fs])
+    bits = wa if eye == "A" else wb
+    owner = np.full(pair.m, -1)
+    for i in range(len(fs)):
+        owner[bits[i]] = i
+    return owner, bits
+
+
+def check_lit(win):
+    """Eye meshes and bitmap panel equal EyePair.bitmaps of the scene's features."""
+    sc = win.model.scene
+    palette = np.vstack([UNLIT] + [hex_rgb(f.color) for f in sc.features])
+    m = sc.eyes.m
+    for k, eye in enumerate("AB"):
+        owner, bits = expected_owner(sc, eye)
+        np.testing.assert_array_equal(win.actors.eye_meshes[k].cell_data["rgb"], palette[owner + 1])
+        np.testing.assert_array_equal(win.bitmaps.lit(eye, True), bits.any(axis=0))
+        np.testing.assert_array_equal(win.bitmaps.lit(eye, False), bits.any(axis=0)[: m // 2])
+        np.testing.assert_array_equal(win.bitmaps.strips[(eye, True)], owner)
+
+
+def test_drag_moves_feature_lights_ommatidia_and_undo_restores(make_window):
+    win = make_window(two_features())
+    check_lit(win)
+    before = win.model.scene.copy()
+    lit_before = win.actors.eye_meshes[0].cell_data["rgb"].copy()
+    start = pixel_of(win, 0.0, 1500.0)
+    end = pixel_of(win, -700.0, 2500.0)
+    drag(win, start, end)
+    f = win.model.scene.features[0]
+    u = win.units_per_px()
+    assert abs(f.x - -700.0) <= 2 * u and abs(f.y - 2500.0) <= 2 * u
+    assert f.g == 50.0 and win.model.scene.features[1] == before.features[1]
+    check_lit(win)
+    assert not np.array_equal(win.actors.eye_meshes[0].cell_data["rgb"], lit_before)
+    # one drag is one undo step
+    assert win.undo_stack.count() == 1
+    win.undo_stack.undo()
+    assert win.model.scene.features == before.features
+    np.testing.assert_array_equal(win.actors.eye_meshes[0].cell_data["rgb"], lit_before)
+    check_lit(win)
+    win.undo_stack.redo()
+    assert win.model.scene.features[0].x == f.x
+    check_lit(win)
+
+
+def test_click_selects_without_an_undo_step(make_window):
+    win = make_window(two_features())
+    p = pixel_of(win, -1200.0, 3000.0)
+    small = QtCore.QPoint(int(DRAG_THRESHOLD_PX) - 2, 0)
+    drag(win, p, p + small, steps=2)
+    assert win.model.selected == 1
+    assert win.undo_stack.count() == 0
+    assert win.model.scene.features[1].x == -1200.0
+
+
+def test_drag_on_handle_changes_radius_and_wheel_too(make_window):
+    win = make_window(two_features())
+    win.model.select(1)
+    start = pixel_of(win, -1200.0 + 200.0, 3000.0)
+    end = pixel_of(win, -1200.0 + 500.0, 3000.0)
+    drag(win, start, end)
+    f = win.model.scene.features[1]
+    assert abs(f.g - 500.0) <= 2 * win.units_per_px() and (f.x, f.y) == (-1200.0, 3000.0)
+    g = f.g
+    pos = pixel_of(win, -1200.0, 3000.0)
+    for _ in range(3):
+        wheel = QtGui.QWheelEvent(
+            QtCore.QPointF(pos),
+            QtCore.QPointF(win.plotter.mapToGlobal(pos)),
+            QtCore.QPoint(),
+            QtCore.QPoint(0, 120),
+            QtCore.Qt.NoButton,
+            QtCore.Qt.NoModifier,
+            QtCore.Qt.NoScrollPhase,
+            False,
+        )
+        QtCore.QCoreApplication.sendEvent(win.plotter, wheel)
+    assert win.model.scene.features[1].g == pytest.approx(g * 1.08**3)
+    assert win.undo_stack.count() == 2  # the drag, then the three wheel steps merged
+    check_lit(win)
+
+
+def test_changing_m_rebuilds_the_eyes(make_window, qtbot):
+    win = make_window(two_features())
+    edit = win.eyes_panel.edits["m"]
+    edit.setText("36")
+    edit.editingFinished.emit()
+    assert win.model.scene.eyes.m == 36
+    assert [mesh.n_cells for mesh in win.actors.eye_meshes] == [36, 36]
+    check_lit(win)
+    win.undo_stack.undo()
+    assert [mesh.n_cells for mesh in win.actors.eye_meshes] == [720, 720]
+
+
+@pytest.mark.parametrize(
+    "key, text, words",
+    [
+        ("m", "7", "even integer"),
+        ("h", "10", "h must be > l"),
+        ("l", "-1", "l"),
+        ("m", "1000000", "<= 200000"),
+        ("h", "abc", "number"),
+    ],
+)
+def test_forbidden_parameter_is_refused(make_window, key, text, words):
+    win = make_window(two_features())
+    before = win.model.scene.copy()
+    edit = win.eyes_panel.edits[key]
+    edit.setText(text)
+    edit.editingFinished.emit()
+    assert win.model.scene == before
+    assert words in win.eyes_panel.message.text() and "Refused" in win.eyes_panel.message.text()
+    assert edit.text() == {"h": "40", "l": "20", "m": "720"}[key]
+    assert win.undo_stack.count() == 0
+    assert [mesh.n_cells for mesh in win.actors.eye_meshes] == [720, 720]
+
+
+def test_invalid_scene_file_shows_a_dialog_and_keeps_the_scene(make_window, tmp_path):
+    win = make_window(two_features())
+    before = win.model.scene.copy()
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[eyes]\nh = 40.0\nl = 20.0\nm = 7\n")
+    assert win.open_path(bad) is False
+    assert win.model.scene == before
+    assert win.error_box is not None and win.error_box.isVisible()
+    assert "bad.toml:4" in win.error_box.text() and "even integer" in win.error_box.text()
+    win.error_box.close()
+
+
+def test_save_load_round_trip_and_recent_files(make_window, tmp_path):
+    win = make_window(two_features())
+    win.model.add_feature(300.0, 2000.0, 80.0)
+    win.model.set_feature(0, name="renamed", x=12.5)
+    out = tmp_path / "saved.toml"
+    assert win.save_path(out)
+    assert load(out) == win.model.scene
+    assert win.undo_stack.isClean() and "saved.toml" in win.windowTitle()
+    win2 = make_window(Scene())
+    assert win2.open_path(out)
+    assert win2.model.scene == win.model.scene
+    assert win2.recent_files()[0] == str(out.resolve())
+
+
+def test_feature_table_edit_and_bad_value(make_window):
+    win = make_window(two_features())
+    table = win.features_panel.table
+    table.item(0, 3).setText("75")
+    assert win.model.scene.features[0].g == 75.0
+    check_lit(win)
+    before = win.model.scene.copy()
+    table.item(0, 3).setText("-5")
+    assert win.model.scene == before
+    assert "g (feature radius) must be > 0" in win.features_panel.message.text()
+    assert table.item(0, 3).text() == "75"
+
+
+def test_add_duplicate_delete(make_window):
+    win = make_window(two_features())
+    menu = win._context_menu(pixel_of(win, 0.0, 1500.0), QtCore.QPoint(0, 0))
+    texts = [a.text() for a in menu.actions()]
+    assert texts[1:] == ["Duplicate target", "Delete target"]
+    menu.actions()[1].trigger()
+    menu.close()
+    assert len(win.model.scene.features) == 3 and win.model.selected == 2
+    win.delete_selected()
+    win.delete_selected()
+    assert [f.name for f in win.model.scene.features] == ["target"]
+    check_lit(win)
+
+
+def test_screenshot_is_not_blank_and_shows_the_lit_colour(make_window, tmp_path):
+    sc = load(ROOT / "assets" / "scenes" / "figure3b.toml")
+    win = make_window(sc)
+    out = win.save_screenshot(tmp_path / "shot.png")
+    img = qimage_to_array(QtGui.QImage(str(out)))
+    assert img.shape[0] >= 600 and img.std() > 20
+    assert len(np.unique(img.reshape(-1, 3), axis=0)) > 50
+    # the lit ommatidia of eye B (1..3) drawn in the feature's colour in the inset
+    f = sc.features[0]
+    col = np.array(hex_rgb(f.color))
+    pair = EyePair(sc.eyes.h, sc.eyes.l, sc.eyes.m)
+    top = win.plotter.mapTo(win, QtCore.QPoint(0, 0))
+    for k in (1, 2, 3):
+        a = (k + 0.5) * pair.gamma
+        x, y = pair.h + 0.6 * pair.l * math.cos(a), 0.6 * pair.l * math.sin(a)
+        px, py = win.to_pixel(x, y, "inset")
+        rgb = img[int(py) + top.y(), int(px) + top.x()]
+        assert np.abs(rgb.astype(int) - col).max() <= 12, (k, rgb)
+    a = 8.5 * pair.gamma  # an unlit ommatidium
+    px, py = win.to_pixel(pair.h + 0.6 * pair.l * math.cos(a), 0.6 * pair.l * math.sin(a), "inset")
+    assert np.abs(img[int(py) + top.y(), int(px) + top.x()].astype(int) - UNLIT).max() <= 12
+
+
+def test_app_does_not_import_torch(tmp_path):
+    code = (
+        "import sys\n"
+        "from eyeviz.app.window import MainWindow, make_app, make_settings\n"
+        "from eyeviz.scene import load\n"
+        "app = make_app()\n"
+        f"w = MainWindow(load({str(ROOT / 'assets/scenes/default.toml')!r}), "
+        f"settings=make_settings({str(tmp_path / 's.ini')!r}))\n"
+        "w.show(); app.processEvents(); w.render()\n"
+        "print('torch' in sys.modules)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip().splitlines()[-1] == "False"
+
+
+def test_cli_screenshot(tmp_path):
+    out = tmp_path / "cli.png"
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "eyeviz",
+            "app",
+            str(ROOT / "assets/scenes/figure5.toml"),
+            "--screenshot",
+            str(out),
+            "--settings",
+            str(tmp_path / "s.ini"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert r.returncode == 0, r.stderr
+    assert out.stat().st_size > 10_000 and str(out) in r.stdout
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[eyes]\nm = 3\n")
+    r = subprocess.run(
+        [sys.executable, "-m", "eyeviz", "app", str(bad)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert r.returncode == 2 and "eyes.m" in r.stderr and "Traceback" not in r.stderr
