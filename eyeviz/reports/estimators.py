@@ -175,9 +175,13 @@ def _time_single(est, oa, ob, max_calls: int = 300, max_seconds: float = 3.0) ->
 def measure_one(name: str, est, test_sets: dict) -> Result:
     """Score and time a loaded estimator on every test set."""
     md = getattr(est, "metadata", {}) or {}
+    label = str(md.get("label", ""))
+    if not label and "sample_size" in md:  # the bayes table
+        label = (f"{md.get('target', '')} posterior per interval key from "
+                 f"{int(md['sample_size']):,} samples ({int(md.get('keys', 0)):,} keys)")
     res = Result(
         name=name,
-        label=str(md.get("label", "")),
+        label=label,
         n_weights=int(est.n_weights),
         train_seconds=md.get("train_seconds"),
     )
