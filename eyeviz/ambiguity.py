@@ -38,6 +38,7 @@ from eyeviz.geometry import EyePair, validate_features
 
 __all__ = [
     "AmbiguityRegion",
+    "ambiguity_polygon",
     "ambiguity_radius_range",
     "ambiguity_region",
     "clip_halfplanes",
@@ -173,10 +174,7 @@ def ambiguity_region(pair: EyePair, x, y, g, *, box=None) -> AmbiguityRegion:
     x, y, g, iv = _checked(pair, x, y, g)
     box = _default_box(x, y, g, pair.h) if box is None else tuple(float(v) for v in box)
     x0, x1, y0, y1 = box
-    a, b, c, _ = halfplanes(pair, iv)
-    square = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=np.float64)
-    poly = clip_halfplanes(square, a, c - b * g)
-    poly = _dedupe(poly, tol=1e-12 * max(abs(v) for v in box))
+    poly = ambiguity_polygon(pair, iv, g, box)
     tol = 1e-9 * max(abs(v) for v in box)
     bounded = bool(
         len(poly)
@@ -188,6 +186,16 @@ def ambiguity_region(pair: EyePair, x, y, g, *, box=None) -> AmbiguityRegion:
         )
     )
     return AmbiguityRegion(iv, g, poly, bounded, box)
+
+
+def ambiguity_polygon(pair: EyePair, intervals, g: float, box) -> np.ndarray:
+    """Closure of the centres of radius-g discs lighting ``intervals`` = (LA, RA, LB, RB),
+    clipped to ``box`` (xmin, xmax, ymin, ymax): (k, 2) vertices, empty when none."""
+    x0, x1, y0, y1 = (float(v) for v in box)
+    a, b, c, _ = halfplanes(pair, intervals)
+    square = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=np.float64)
+    poly = clip_halfplanes(square, a, c - b * float(g))
+    return _dedupe(poly, tol=1e-12 * max(abs(v) for v in (x0, x1, y0, y1)))
 
 
 def _dedupe(poly: np.ndarray, tol: float) -> np.ndarray:

@@ -72,6 +72,9 @@ def export(scene, path, scale: float = 1.0, transparent: bool = False, *,
         with matplotlib.rc_context(vector.RC):
             fig.savefig(tmp, format=fmt, dpi=dpi if fmt == "png" else 72,
                         transparent=transparent, metadata=_metadata(fmt, scene))
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a figure is an ordinary file
         os.replace(tmp, target)
     except BaseException:
         try:

@@ -28,7 +28,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from matplotlib import patheffects
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Polygon, Rectangle, Wedge
@@ -64,6 +63,7 @@ RC = {
     "font.size": FONT,
     "font.family": "DejaVu Sans",
     "mathtext.fontset": "dejavusans",
+    "mathtext.default": "regular",
     "axes.linewidth": 0.5,
     "axes.edgecolor": GREY,
     "axes.labelcolor": INK,
@@ -86,7 +86,8 @@ RC = {
     "svg.id": "eyeviz",
 }
 
-_HALO = [patheffects.withStroke(linewidth=1.6, foreground="white")]
+# a soft white ground behind labels (a path-effect halo would turn SVG text into outlines)
+_HALO = {"boxstyle": "round,pad=0.08", "facecolor": "white", "edgecolor": "none", "alpha": 0.75}
 
 
 def estimator_colors(names) -> dict[str, str]:
@@ -142,7 +143,7 @@ def _layout(scene: Scene, width: float) -> _Layout:
     rows = _readout_rows(scene)
     readout_h = rows * _TEXT_ROW + (0.06 if rows else 0.0)
     shows_bitmaps = "bitmaps" in scene.layers and scene.features
-    bitmaps_h = 4 * 7 / 72 + 0.02 + 0.12 * 2 + 0.11 if shows_bitmaps else 0.0
+    bitmaps_h = 4 * 7 / 72 + 0.02 + 0.12 * 2 + 0.13 if shows_bitmaps else 0.0
     title_h = 0.2 if scene.title else 0.05
     bottom = 0.06
     y = bottom
@@ -153,7 +154,9 @@ def _layout(scene: Scene, width: float) -> _Layout:
     main = _Box(left, y, main_w, main_h)
     y += main_h
     title_y = y + 0.06 if scene.title else None
-    return _Layout(width, y + title_h, main, bitmaps, readout, rows, title_y)
+    # whole hundredths of an inch: the PNG's pixel size then scales exactly with --scale
+    height = math.ceil((y + title_h) * 100 - 1e-9) / 100
+    return _Layout(width, height, main, bitmaps, readout, rows, title_y)
 
 
 # --- eyes --------------------------------------------------------------------------------
@@ -219,7 +222,7 @@ class _Painter:
         self.units_per_in = w / lay.main.w
         if sc.title and lay.title_y is not None:
             self.fig.text(0.5, lay.title_y / lay.height, sc.title, ha="center", va="bottom",
-                          fontsize=FONT + 0.5, color=INK, fontweight="bold", gid="title")
+                          fontsize=FONT + 1.0, color=INK, gid="title")
         self.inset = None
         self.eye_ax = ax
         self.eye_units_per_in = self.units_per_in
@@ -347,7 +350,7 @@ class _Painter:
         upi = self.units_per_in
         self._label_boxes.append((-0.3 * upi, rad * 1.04, 0.3 * upi, rad * 1.04 + 0.12 * upi))
         ax.text(0, rad * 1.04, f"\u03b8 = {math.degrees(p.theta):.0f}\u00b0", ha="center",
-                va="bottom", fontsize=SMALL, color=BFV_LINE, path_effects=_HALO, zorder=7,
+                va="bottom", fontsize=SMALL, color=BFV_LINE, bbox=_HALO, zorder=7,
                 gid="bfv-theta-label")
         rpsi = 0.72 * rad
         ax.plot([0, 1.3 * rpsi], [0, 0], color=BFV_LINE, lw=0.4, ls=(0, (1.5, 1.5)), zorder=1)
@@ -357,7 +360,7 @@ class _Painter:
         self._label_boxes.append((lx, ly - 0.06 * upi, lx + 0.45 * upi, ly + 0.06 * upi))
         ax.text(1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid),
                 f"\u03c8 = {math.degrees(psi):.0f}\u00b0", ha="left", va="center",
-                fontsize=SMALL, color=BFV_LINE, path_effects=_HALO, zorder=7,
+                fontsize=SMALL, color=BFV_LINE, bbox=_HALO, zorder=7,
                 gid="bfv-psi-label")
 
     def _merge_eyes(self) -> bool:
@@ -476,7 +479,7 @@ class _Painter:
         x0, y0 = best
         self._label_boxes.append((x0, y0, x0 + tw, y0 + th))
         self.ax.text(x0, y0 + th / 2, f.name, ha="left", va="center", fontsize=FONT,
-                     color=_dark(col), path_effects=_HALO, zorder=9,
+                     color=_dark(col), bbox=_HALO, zorder=9,
                      gid=f"label-{_slug(f.name)}", clip_on=True)
 
     def labels(self) -> None:
@@ -484,11 +487,11 @@ class _Painter:
         numbered = "eyes" in self.layers and self._numbers_fit()
         for name, (cx, cy) in zip("AB", p.centers, strict=True):
             ax.text(cx, cy - p.l * (1.55 if numbered else 1.12), name, ha="center", va="top",
-                    fontsize=FONT, color=INK, fontweight="bold", zorder=6, gid=f"label-eye-{name}",
-                    path_effects=_HALO)
+                    fontsize=FONT + 0.5, color=INK, zorder=6, gid=f"label-eye-{name}",
+                    bbox=_HALO)
         ax.plot([0], [0], marker="+", ms=4, color=INK, mew=0.6, zorder=6)
         ax.text(0, -0.12 * p.l, "O", ha="center", va="top", fontsize=SMALL, color=INK,
-                zorder=6, gid="label-origin", path_effects=_HALO)
+                zorder=6, gid="label-origin", bbox=_HALO)
         if "eyes" in self.layers:
             self.ommatidium_numbers()
 
@@ -525,7 +528,7 @@ class _Painter:
                 lx, ly = cx + 1.1 * rad * math.cos(mid), cy + 1.1 * rad * math.sin(mid)
                 eax.text(lx, ly, rf"$\arcsin(g/r_{name})$" + f" = {math.degrees(alpha):.1f}\u00b0",
                          ha="right" if math.cos(mid) < 0 else "left", va="bottom",
-                         fontsize=SMALL, color=_dark(f.color), path_effects=_HALO, zorder=9,
+                         fontsize=SMALL, color=_dark(f.color), bbox=_HALO, zorder=9,
                          gid=f"tangent-angle-label-{name}-{_slug(f.name)}")
 
     def sectors(self) -> None:
@@ -562,7 +565,7 @@ class _Painter:
             a = (k + 0.5) * p.gamma
             ax.text(cx + rad * math.cos(a), cy + rad * math.sin(a), str(k % p.m), ha="center",
                     va="center", fontsize=SMALL - 0.5, color=_dark(f.color), zorder=6,
-                    path_effects=_HALO, gid=f"sector-number-{name}-{k % p.m}")
+                    bbox=_HALO, gid=f"sector-number-{name}-{k % p.m}")
 
     def _out_of_domain(self) -> np.ndarray:
         n = len(self.scene.features)
@@ -667,7 +670,7 @@ class _Painter:
         ax.axis("off")
         row = 7.0 / 72  # one label row
         strip = 0.12
-        axis_h = 0.11
+        axis_h = 0.13
         yB = 2 * row + 0.01
         yA = yB + strip + axis_h
         palette = self.colors
@@ -702,8 +705,8 @@ class _Painter:
         ymid = yB + strip + axis_h / 2
         for k in (0, m // 4, half, 3 * m // 4, m):
             lab = f"{k}" if k != half else f"m/2 = {half}"
-            ax.plot([k, k], [yA - 0.02, yA], color=GREY, lw=0.4)
-            ax.plot([k, k], [yB + strip, yB + strip + 0.02], color=GREY, lw=0.4)
+            ax.plot([k, k], [yA - 0.015, yA], color=GREY, lw=0.4)
+            ax.plot([k, k], [yB + strip, yB + strip + 0.015], color=GREY, lw=0.4)
             ax.text(k, ymid, lab, ha="center", va="center", fontsize=SMALL - 0.5, color=GREY)
 
     def _interval_labels(self, ax, name, y0, strip, Ls, Rs, row) -> None:

@@ -1,0 +1,154 @@
+"""The vector figure: drawn from the scene model, one path per ommatidium and feature,
+only the scene's layers, text as text, runs merged where triangles are below a pixel."""
+
+import io
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from eyeviz import scene as scene_mod
+from eyeviz.render import vector
+from eyeviz.state import compute_state
+
+SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
+SVG = "{http://www.w3.org/2000/svg}"
+
+
+def _svg(sc, **kw) -> ET.Element:
+    import matplotlib
+
+    fig = vector.figure(sc, dpi=vector.VECTOR_DPI, **kw)
+    buf = io.BytesIO()
+    with matplotlib.rc_context(vector.RC):
+        fig.savefig(buf, format="svg")
+    return ET.fromstring(buf.getvalue())
+
+
+def _groups(root, prefix):
+    return {g.get("id"): g for g in root.iter(f"{SVG}g") if (g.get("id") or "").startswith(prefix)}
+
+
+def _paths_in(group):
+    return list(group.iter(f"{SVG}path")) + list(group.iter(f"{SVG}use"))
+
+
+def test_one_path_per_ommatidium_and_feature_small_m():
+    sc = scene_mod.load(SCENES / "figure2.toml")
+    root = _svg(sc)
+    omm = _groups(root, "ommatidium-")
+    omm = {k: v for k, v in omm.items() if not k.startswith("ommatidium-number")}
+    m = sc.eyes.m
+    assert set(omm) == {f"ommatidium-{e}-{k}" for e in "AB" for k in range(m)}
+    assert all(len(_paths_in(g)) == 1 for g in omm.values())
+    feats = _groups(root, "feature-")
+    assert set(feats) == {"feature-feature"}
+    assert len(_paths_in(feats["feature-feature"])) == 1
+    # the lit ommatidia carry the feature's colour, the rest the unlit grey
+    st = compute_state(sc)
+    lit = {f"ommatidium-A-{k}" for k in np.flatnonzero(st.owner_a >= 0)}
+    for gid, g in omm.items():
+        style = _paths_in(g)[0].get("style", "")
+        colour = sc.features[0].color.lower()
+        assert (colour in style.lower()) == (gid in lit or (
+            gid.startswith("ommatidium-B") and st.owner_b[int(gid.rsplit("-", 1)[1])] >= 0))
+
+
+def test_text_is_text_and_labels_present():
+    sc = scene_mod.load(SCENES / "default.toml")
+    root = _svg(sc)
+    texts = " ".join("".join(t.itertext()) for t in root.iter(f"{SVG}text"))
+    for word in ("target", "far", "side", sc.title, "\u03b8 = 120\u00b0"):
+        assert word in texts
+    assert "[173, 180]" in texts  # the lit interval beside the bitmap strip
+
+
+def test_unmerged_default_scene_has_every_triangle():
+    sc = scene_mod.load(SCENES / "default.toml")
+    omm = _groups(_svg(sc, merge=False), "ommatidium-")
+    assert len([k for k in omm if k.count("-") == 2]) == 2 * 720
+
+
+def test_merged_runs_match_the_lit_intervals():
+    sc = scene_mod.load(SCENES / "default.toml")
+    st = compute_state(sc)
+    root = _svg(sc, merge=True)
+    runs = _groups(root, "ommatidia-") | _groups(root, "ommatidium-")
+    ids = sorted(runs)
+    for e, owner in (("A", st.owner_a), ("B", st.owner_b)):
+        colours = vector._owner_colors(owner, [f.color for f in sc.features])
+        starts, stops = vector.eye_runs(colours)
+        want = {f"ommatidia-{e}-{s}-{t - 1}" if t - s > 1 else f"ommatidium-{e}-{s}"
+                for s, t in zip(starts, stops, strict=True)}
+        assert want == {i for i in ids if i.split("-")[1] == e}
+
+
+def test_huge_m_merges_runs():
+    sc = scene_mod.load(SCENES / "default.toml")
+    sc.eyes.m = 100_000
+    root = _svg(sc)
+    runs = [k for k in _groups(root, "ommatidi") if "number" not in k]
+    # 3 features: at most 2 * (3 lit + 4 unlit) runs, never 10^5 paths
+    assert 2 <= len(runs) <= 14
+    n_paths = len(list(root.iter(f"{SVG}path")))
+    assert n_paths < 400
+
+
+def test_only_the_scenes_layers_are_drawn():
+    sc = scene_mod.load(SCENES / "default.toml")
+    sc.layers = ["features"]
+    root = _svg(sc)
+    assert _groups(root, "feature-")
+    for prefix in ("ommatidi", "bfv", "bitmap", "readout", "label", "tangent", "sector",
+                   "inset"):
+        assert not _groups(root, prefix), prefix
+    sc.layers = ["eyes", "bfv", "features", "tangents", "sectors"]
+    root = _svg(sc)
+    for prefix in ("ommatidi", "bfv-wedge", "tangent-", "sector-", "inset"):
+        assert _groups(root, prefix), prefix
+    assert not _groups(root, "bitmap")
+
+
+def test_predictions_drawn_as_ghosts_and_out_of_domain_greyed():
+    sc = scene_mod.load(SCENES / "figure5.toml")
+    sc.layers = ["eyes", "bfv", "features", "predictions", "readout"]
+    sc.estimators = ["analytic"]
+    st = compute_state(sc)
+    r_hat, phi_hat = st.r * 1.05, st.phi + 0.01
+    root = _svg(sc, predictions={"analytic": (r_hat, phi_hat)})
+    ghosts = _groups(root, "prediction-analytic-")
+    domain = st.in_domain()
+    assert not domain.all() and domain.any()
+    want = {f"prediction-analytic-{vector._slug(f.name)}"
+            for f, ok in zip(sc.features, domain, strict=True) if ok}
+    assert set(ghosts) == want
+    texts = " ".join("".join(t.itertext()) for t in root.iter(f"{SVG}text"))
+    assert "outside the networks' domain" in texts
+    assert "+5.0 %" in texts
+
+
+def test_predictions_from_a_real_estimator():
+    sc = scene_mod.load(SCENES / "default.toml")
+    sc.layers = ["features", "predictions", "readout"]
+    sc.estimators = ["analytic"]
+    root = _svg(sc)
+    assert set(_groups(root, "prediction-analytic-")) == {
+        "prediction-analytic-target", "prediction-analytic-far", "prediction-analytic-side"}
+
+
+def test_ambiguity_and_trajectory_layers():
+    sc = scene_mod.load(SCENES / "default.toml")
+    sc.layers = ["features", "ambiguity", "trajectory", "readout"]
+    sc.trajectory = scene_mod.Trajectory("horizontal", 3000.0, 50.0)
+    root = _svg(sc)
+    assert set(_groups(root, "ambiguity-")) == {"ambiguity-target", "ambiguity-far",
+                                                 "ambiguity-side"}
+    assert _groups(root, "trajectory-horizontal")
+
+
+@pytest.mark.parametrize("name", ["default", "figure2", "figure3b", "figure5"])
+def test_every_shipped_scene_draws(name):
+    sc = scene_mod.load(SCENES / f"{name}.toml")
+    root = _svg(sc)
+    assert _groups(root, "feature-")
