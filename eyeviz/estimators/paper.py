@@ -497,16 +497,19 @@ def train(
             lr=ad_lr if name == "ad" else None, max_epochs=max_epochs,
             val=(x[va], y[va]), eval_max=eval_max, checkpoint=wfile, progress=progress,
         )
+        label = (
+            f"paper {name.upper()} after {info['epochs_reached']:.2f} of "
+            f"{spec.paper_epochs} epochs ({budget_seconds:.0f} s budget on {device})"
+        )
         cpu_state = {k: v.detach().cpu() for k, v in net.state_dict().items()}
-        _atomic_write(wfile, lambda tmp, s=cpu_state: torch.save({"model": s}, tmp))
+        tagged = {"model": cpu_state, "label": label, "budget_seconds": budget_seconds,
+                  "epochs_reached": info["epochs_reached"]}
+        _atomic_write(wfile, lambda tmp, t=tagged: torch.save(t, tmp))
         meta = {
             "estimator": "paper",
             "net": name,
             "target": spec.target,
-            "label": (
-                f"paper {name.upper()} after {info['epochs_reached']:.2f} of "
-                f"{spec.paper_epochs} epochs ({budget_seconds:.0f} s budget on {device})"
-            ),
+            "label": label,
             "budget_seconds": budget_seconds,
             **info,
             "paper_epochs": spec.paper_epochs,
