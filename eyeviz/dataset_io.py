@@ -1,9 +1,10 @@
 """CSV and NPZ files of data sets (DESIGN.md §3), streamed and written atomically.
 
 CSV: no header, comma separated, ``Omega_A[0..m/2-1], Omega_B[0..m/2-1], r, phi, g``;
-bits as ``0``/``1``, floats in Python's shortest round-trip form (``repr``), lines ending
-in ``\\n``. The paper's Appendix A/B loader (``row[:720]``, ``row[720]``, ``row[721]``)
-reads it unchanged. A CSV without the g column (m + 2 columns) is read too.
+bits as ``0``/``1``, floats as ``'%.17g'`` (17 significant digits: every float64 reads
+back bit-exactly), lines ending in ``\\n``. The paper's Appendix A/B loader
+(``row[:720]``, ``row[720]``, ``row[721]``) reads it unchanged. A CSV without the g
+column (m + 2 columns) is read too.
 
 NPZ: an uncompressed zip of two ``.npy`` members: ``meta`` (a JSON string: format
 version, m, n and the generation parameters) and ``rows``, a structured array with
@@ -18,11 +19,13 @@ so an interruption or a full disk leaves no partial output.
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import tempfile
 import zipfile
 from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +35,8 @@ from eyeviz.geometry import EyePair
 
 FORMATS = ("csv", "npz")
 NPZ_VERSION = 1
-_ZERO, _ONE, _COMMA = 48, 49, 44
+_ZERO, _ONE, _COMMA, _NEWLINE = 48, 49, 44, 10
+_TABLE_MAX_W = 4096  # packed lookup tables up to 2 x 2 MB
 
 
 def format_of(path) -> str:
@@ -64,6 +68,119 @@ def atomic_output(path) -> Iterator[Path]:
         raise
 
 
+# --- float formatting ----------------------------------------------------------------
+
+_FW = 24  # widest '%.17g' text in fixed notation: "-0.000" + 17 digits
+_P10 = 10.0 ** np.arange(23)  # exact doubles 1 .. 1e22
+_P10_INT = 10 ** np.arange(16, -1, -1, dtype=np.int64)  # 1e16 .. 1
+
+
+def _two_prod(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """a*b = hi + lo exactly (Dekker's product; no overflow for our magnitudes)."""
+    hi = a * b
+    c = 134217729.0 * a
+    ah = c - (c - a)
+    al = a - ah
+    c = 134217729.0 * b
+    bh = c - (c - b)
+    bl = b - bh
+    lo = ((ah * bh - hi) + ah * bl + al * bh) + al * bl
+    return hi, lo
+
+
+def _digits17(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(D, X): a = D * 10**(X - 16) rounded to 17 significant digits, 1e16 <= D < 1e17.
+
+    For 1e-6 <= a < 1e17: the scaled value a * 10**k (k = 16 - X <= 22, 10**k exact) is
+    computed exactly as hi + lo, and rounded half-even (hi is an even integer there).
+    """
+    x = np.floor(np.log10(a)).astype(np.int64)
+    for _ in range(3):
+        k = np.clip(16 - x, 0, 22)
+        hi, lo = _two_prod(a, _P10[k])
+        d = hi.astype(np.int64) + np.rint(lo).astype(np.int64)
+        up = d >= 10**17
+        down = d < 10**16
+        if not (up.any() or down.any()):
+            break
+        x = x + up - down
+    return d, x
+
+
+def _ascii17(d: np.ndarray) -> np.ndarray:
+    """ASCII digits (n, 17) of integers 1e16 <= d < 1e17, via a table of 4-digit groups."""
+    out = np.empty((d.shape[0], 17), np.uint8)
+    out[:, 0] = d // 10**16 + 48
+    rest = d % 10**16
+    hi8, lo8 = np.divmod(rest, 10**8)
+    for j, grp in enumerate(np.divmod(hi8, 10**4) + np.divmod(lo8, 10**4)):
+        out[:, 1 + 4 * j:5 + 4 * j] = _GROUPS.take(grp, axis=0)
+    return out
+
+
+_GROUPS = np.array([list(f"{i:04d}".encode()) for i in range(10**4)], np.uint8)
+
+
+def format_g17(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Texts of ``'%.17g' % v`` as (chars (n, 24) uint8, NUL-padded; lengths (n,)).
+
+    17 significant digits always read back to the same float64. Fixed notation (the
+    common case, 1e-4 <= |v| < 1e17) is vectorised; anything else goes through Python.
+    """
+    v = np.asarray(v, dtype=np.float64)
+    n = v.shape[0]
+    out = np.zeros((n, _FW), np.uint8)
+    lens = np.zeros(n, np.int64)
+    a = np.abs(v)
+    fast = np.isfinite(a) & (a >= 1e-6) & (a < 1e17)
+    all_fast = bool(fast.all())
+    idx = np.arange(n) if all_fast else np.flatnonzero(fast)
+    if idx.size:
+        d, x = _digits17(a if all_fast else a[idx])
+        ok = (x >= -4) & (x <= 16)
+        if not ok.all():
+            idx, d, x = idx[ok], d[ok], x[ok]
+            all_fast = False
+            fast[:] = False
+            fast[idx] = True
+        dig = _ascii17(d)
+        sig = 17 - np.argmax(dig[:, ::-1] != 48, axis=1)  # without trailing zeros
+        neg = v[idx] < 0
+        body = out if all_fast else np.zeros((idx.size, _FW), np.uint8)
+        blen = np.empty(idx.size, np.int64)
+        for xv in np.unique(x).tolist():
+            sel = slice(None) if x[0] == xv and (x == xv).all() else np.flatnonzero(x == xv)
+            if xv >= 0:
+                dec = np.maximum(sig[sel] - (xv + 1), 0)
+                blk = np.empty((dig[sel].shape[0], 18), np.uint8)
+                blk[:, :xv + 1] = dig[sel, :xv + 1]
+                blk[:, xv + 1] = 46
+                blk[:, xv + 2:] = dig[sel, xv + 1:]
+                blen[sel] = xv + 1 + np.where(dec > 0, dec + 1, 0)
+                body[sel, :18] = blk
+            else:
+                z = -xv - 1
+                body[sel, 0] = 48
+                body[sel, 1] = 46
+                body[sel, 2:2 + z] = 48
+                body[sel, 2 + z:19 + z] = dig[sel]
+                blen[sel] = 2 + z + sig[sel]
+        body[np.arange(_FW)[None, :] >= blen[:, None]] = 0
+        if neg.any():
+            pos = np.flatnonzero(neg)
+            body[pos, 1:] = body[pos, :-1]
+            body[pos, 0] = 45
+            blen = blen + neg
+        if not all_fast:
+            out[idx] = body
+        lens[idx] = blen
+    for i in np.flatnonzero(~fast).tolist():
+        t = format(float(v[i]), ".17g").encode()
+        out[i, :len(t)] = np.frombuffer(t, np.uint8)
+        lens[i] = len(t)
+    return out, lens
+
+
 # --- CSV encoding --------------------------------------------------------------------
 
 class CsvEncoder:
@@ -81,21 +198,31 @@ class CsvEncoder:
         self.buf[:, 0::2] = _ZERO
         self.buf[:, 1::2] = _COMMA
         self.flat = self.buf.reshape(-1)
+        mv = memoryview(self.flat)
+        self.row_views = [mv[i * self.rb:(i + 1) * self.rb] for i in range(rows)]
 
     def _tails(self, r, phi, g) -> list[bytes]:
+        """Per row ``r,phi,g\n`` (``%.17g``), built as one NUL-padded matrix."""
+        cols = [format_g17(r), format_g17(phi)]
         if self.with_g:
-            s = "{!r},{!r},{!r}\n".format
-            lines = map(s, r.tolist(), phi.tolist(), g.tolist())
-        else:
-            s = "{!r},{!r}\n".format
-            lines = map(s, r.tolist(), phi.tolist())
-        return [t.encode() for t in lines]
+            cols.append(format_g17(g))
+        n = r.shape[0]
+        width = len(cols) * (_FW + 1)
+        tail = np.zeros((n, width), np.uint8)
+        rows = np.arange(n)
+        at = np.zeros(n, np.int64)
+        for j, (chars, lens) in enumerate(cols):
+            for o in np.unique(at).tolist():
+                sel = at == o
+                tail[sel, o:o + _FW] = chars[sel]
+            at = at + lens
+            tail[rows, at] = _NEWLINE if j == len(cols) - 1 else _COMMA
+            at += 1
+        return tail.view(f"S{width}").ravel().tolist()
 
     def _join(self, n: int, tails: list[bytes]) -> bytes:
-        rb = self.rb
-        mv = memoryview(self.flat)
         parts: list = [None] * (2 * n)
-        parts[0::2] = [mv[i * rb:(i + 1) * rb] for i in range(n)]
+        parts[0::2] = self.row_views[:n]
         parts[1::2] = tails
         return b"".join(parts)
 
@@ -138,15 +265,30 @@ def npz_dtype(m: int) -> np.dtype:
                      ("r", "<f8"), ("phi", "<f8"), ("g", "<f8")])
 
 
+@functools.lru_cache(maxsize=8)
+def _pack_tables(w: int) -> tuple[np.ndarray, np.ndarray]:
+    """np.packbits of the bitmaps {k >= lo} (row lo) and {k <= hi} (row hi), k < w."""
+    k = np.arange(w)
+    return (np.packbits(k[None, :] >= k[:, None], axis=1),
+            np.packbits(k[None, :] <= k[:, None], axis=1))
+
+
 def _packed_from_intervals(lo, hi, w: int) -> np.ndarray:
     """np.packbits of the bitmap lit on lo..hi (0 <= lo <= hi < w), without building it."""
-    nb = (w + 7) // 8
-    start = np.arange(nb, dtype=np.int16) * 8
-    a = np.clip(lo.astype(np.int16)[:, None] - start, 0, 8)
-    b = np.clip(hi.astype(np.int16)[:, None] + 1 - start, 0, 8)
+    if w > _TABLE_MAX_W:
+        return _packed_clip(lo, hi, w)
+    ge, le = _pack_tables(w)
+    out = ge.take(lo, axis=0)
+    out &= le.take(hi, axis=0)
+    return out
+
+
+def _packed_clip(lo, hi, w: int) -> np.ndarray:
+    start = np.arange((w + 7) // 8, dtype=np.int64) * 8
+    a = np.clip(lo[:, None] - start, 0, 8)
+    b = np.clip(hi[:, None] + 1 - start, 0, 8)
     # bits a..b-1 of a byte, most significant first: (0xFF >> a) & ~(0xFF >> b)
-    full = np.int16(0xFF)
-    return ((full >> a) & ~(full >> b)).astype(np.uint8)
+    return ((0xFF >> a) & ~(0xFF >> b)).astype(np.uint8)
 
 
 def _npz_rows(m: int, n: int) -> np.ndarray:
@@ -165,27 +307,71 @@ class _NpzWriter:
                   "shape": (n,)}
         np.lib.format.write_array_header_1_0(self.f, header)
 
-    def write_intervals(self, r, phi, g, la, ra, lb, rb) -> None:
+    def rows_from_intervals(self, r, phi, g, la, ra, lb, rb) -> np.ndarray:
         rows = _npz_rows(self.m, r.shape[0])
         w = self.m // 2
         rows["omega_a"] = _packed_from_intervals(la, ra, w)
         rows["omega_b"] = _packed_from_intervals(lb, rb, w)
         rows["r"], rows["phi"], rows["g"] = r, phi, g
-        self.f.write(rows.data)
+        return rows
 
-    def write_bitmaps(self, omega_a, omega_b, r, phi, g) -> None:
+    def rows_from_bitmaps(self, omega_a, omega_b, r, phi, g) -> np.ndarray:
         rows = _npz_rows(self.m, r.shape[0])
         rows["omega_a"] = np.packbits(omega_a, axis=1)
         rows["omega_b"] = np.packbits(omega_b, axis=1)
         rows["r"], rows["phi"], rows["g"] = r, phi, g
-        self.f.write(rows.data)
+        return rows
 
-    def close(self) -> None:
-        self.f.close()
-        self.zf.close()
+    def __enter__(self) -> _NpzWriter:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        try:
+            self.f.close()
+        finally:
+            self.zf.close()
 
 
 # --- writing -------------------------------------------------------------------------
+
+class _Overlapped:
+    """Runs ``write`` calls on one worker thread, one at a time, so the file write of a
+    chunk overlaps the generation and encoding of the next (I/O releases the GIL).
+
+    Every call gets a fresh buffer; errors surface at the next call or at ``wait``.
+    """
+
+    def __init__(self, write: Callable[[object], object]):
+        self._write = write
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="eyeviz-write")
+        self._pending: Future | None = None
+
+    def __call__(self, buf) -> None:
+        self.wait()
+        self._pending = self._pool.submit(self._write, buf)
+
+    def wait(self) -> None:
+        if self._pending is not None:
+            pending, self._pending = self._pending, None
+            pending.result()
+
+    def __enter__(self) -> _Overlapped:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        try:
+            if exc_type is None:
+                self.wait()
+            elif self._pending is not None:
+                with contextlib.suppress(BaseException):
+                    self._pending.result()
+        finally:
+            self._pool.shutdown(wait=True)
+
+
+def _encode_csv_chunk(enc: CsvEncoder, c) -> bytes:
+    return enc.encode_intervals(c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb)
+
 
 def write_chunks(path, fmt: str, n: int, m: int, params: dict, chunks: Iterable,
                  progress: Callable[[int], None] | None = None) -> None:
@@ -195,21 +381,18 @@ def write_chunks(path, fmt: str, n: int, m: int, params: dict, chunks: Iterable,
     with atomic_output(path) as tmp:
         if fmt == "csv":
             enc = CsvEncoder(m, CHUNK)
-            with open(tmp, "wb") as f:
+            with open(tmp, "wb") as f, _Overlapped(f.write) as out:
                 for c in chunks:
-                    f.write(enc.encode_intervals(c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb))
+                    out(_encode_csv_chunk(enc, c))
                     if progress:
                         progress(len(c))
         else:
             meta = {"version": NPZ_VERSION, "m": m, "n": n, "params": params}
-            wr = _NpzWriter(tmp, m, n, meta)
-            try:
+            with _NpzWriter(tmp, m, n, meta) as wr, _Overlapped(wr.f.write) as out:
                 for c in chunks:
-                    wr.write_intervals(c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb)
+                    out(wr.rows_from_intervals(c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb))
                     if progress:
                         progress(len(c))
-            finally:
-                wr.close()
 
 
 def save(ds, path) -> None:
@@ -229,14 +412,11 @@ def save(ds, path) -> None:
             e = ds.eyes
             meta = {"version": NPZ_VERSION, "m": m, "n": n,
                     "params": {**ds.params, "h": e.h, "l": e.l, "m": m}}
-            wr = _NpzWriter(tmp, m, n, meta)
-            try:
+            with _NpzWriter(tmp, m, n, meta) as wr:
                 for s in range(0, n, step):
                     sl = slice(s, s + step)
-                    wr.write_bitmaps(ds.omega_a[sl], ds.omega_b[sl], ds.r[sl], ds.phi[sl],
-                                     ds.g[sl])
-            finally:
-                wr.close()
+                    wr.f.write(wr.rows_from_bitmaps(ds.omega_a[sl], ds.omega_b[sl], ds.r[sl],
+                                                    ds.phi[sl], ds.g[sl]))
 
 
 # --- reading -------------------------------------------------------------------------

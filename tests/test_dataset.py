@@ -347,3 +347,21 @@ def test_file_mode_respects_umask(tmp_path):
     os.umask(umask)
     assert mode == 0o666 & ~umask
     assert Path(tmp_path / "m.npz").stat().st_size > 0
+
+
+def test_float_text_is_printf_17g_and_round_trips():
+    from eyeviz.dataset_io import format_g17
+
+    rng = np.random.default_rng(0)
+    edges = [0.0, -0.0, 1.0, 0.1, 1e-4, 9.9999999999999995e-5, 1e16, 1e17, 9.999999999999999e16,
+             1000.0, 0.5, float("nan"), float("inf"), -float("inf"), 5e-324, 1e300, -3.25,
+             2.0**53 + 2, np.nextafter(1e-4, 0), np.nextafter(10.0, 0), np.nextafter(1.0, 2)]
+    p10 = 10.0 ** np.arange(-8, 20)
+    v = np.concatenate([edges, rng.uniform(1000, 5000, 20000), rng.uniform(0, 3.2, 20000),
+                        10 ** rng.uniform(-8, 20, 20000) * rng.choice([-1, 1], 20000),
+                        np.arange(-300, 300) / 8.0, p10, np.nextafter(p10, 0),
+                        np.nextafter(p10, np.inf)])
+    chars, lens = format_g17(v)
+    got = [bytes(chars[i, :lens[i]]).decode() for i in range(len(v))]
+    assert got == [format(x, ".17g") for x in v.tolist()]
+    assert all(float(t) == x for t, x in zip(got, v.tolist(), strict=True) if x == x)
