@@ -231,10 +231,14 @@ class EyePair:
         """Fast path of Eq. 11 on one cache-sized block; flags elements near a boundary."""
         xs, ys, gs = x[sl], y[sl], g[sl]
         dx = xs - cx
-        r = np.hypot(dx, ys)
+        r2 = dx * dx
+        r2 += ys * ys
+        r = np.sqrt(r2)
         pk = np.arctan2(ys, dx)
         pk *= k
         q = gs / r
+        # outside this range the squares may over/underflow: leave those to the exact path
+        q[~((r2 >= 1e-290) & (r2 <= 1e300))] = np.nan
         ak = np.arcsin(np.minimum(q, 1.0))
         ak *= k
         t_lo = pk - ak
@@ -246,7 +250,7 @@ class EyePair:
         t_lo -= 0.5
         t_hi -= 0.5
         near = np.maximum(np.abs(t_lo), np.abs(t_hi)) > 0.5 - tol0
-        near |= q > _Q_SAFE
+        near |= ~(q <= _Q_SAFE)  # also NaN
         lo_out[sl] = f_lo
         hi_out[sl] = f_hi
         if not refine:
@@ -277,7 +281,8 @@ class EyePair:
 
     def _normalised(self, f_lo, f_hi, whole) -> tuple[np.ndarray, np.ndarray]:
         m = self.m
-        L = np.mod(f_lo, m)
+        # floors come from phi in (-pi, pi] and alpha <= pi/2, so f_lo > -m: one wrap at most
+        L = f_lo + m * (f_lo < 0)
         R = f_hi - f_lo + L
         L[whole] = 0
         R[whole] = m - 1

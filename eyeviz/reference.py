@@ -2,12 +2,14 @@
 
 An independent, slow implementation used to judge the fast core and the paper's literal
 float formulas. Each feature is converted from its float inputs exactly, Eq. 11 is
-evaluated with ``dps`` significant digits (default 80), and a value within
-``10**-(dps - 20)`` of an integer n is taken to be n itself: a tangent direction exactly
-on a boundary belongs to the sector that starts there (Eq. 8).
+evaluated with ``dps`` significant digits (default 80) beyond those needed to hold the
+inputs exactly, and a value within ``10**-(dps - 20)`` of an integer n is taken to be n:
+a tangent direction exactly on a boundary belongs to the sector that starts there (Eq. 8).
 """
 
 from __future__ import annotations
+
+from fractions import Fraction
 
 import mpmath
 import numpy as np
@@ -19,8 +21,14 @@ def reference_interval(
     x: float, y: float, g: float, cx: float, m: int, dps: int = 80
 ) -> tuple[int, int]:
     """Normalised (L, R) of one eye for one feature; whole eye is (0, m - 1)."""
+    # enough digits to hold x - cx, y and g exactly, then dps more: a value that is not a
+    # tie lies further from an integer than inputs this fine can come
+    bits = max(
+        max(abs(q.numerator).bit_length(), q.denominator.bit_length())
+        for q in (Fraction(x) - Fraction(cx), Fraction(y), Fraction(g))
+    )
+    dps = dps + int(bits * 0.302) + 10
     with mpmath.workdps(dps):
-        # 53-bit inputs: the difference and the squares below are exact at this precision
         dx = mpmath.mpf(x) - mpmath.mpf(cx)
         dy = mpmath.mpf(y)
         gg = mpmath.mpf(g)

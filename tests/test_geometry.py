@@ -235,3 +235,19 @@ def test_importing_geometry_pulls_in_no_heavy_library():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+@pytest.mark.parametrize(
+    ("x", "y", "g"),
+    [
+        (40.0 + 1e-13, 1e-160, 1e-161),  # squares underflow
+        (1e-170, 3e-170, 1e-170),
+        (1e200, 1e200, 1e199),  # squares overflow
+        (-1e160, -3e155, 2e159),
+        (40.0, 1e-300, 1e-300),  # centre on the eye: whole eye
+    ],
+)
+def test_over_and_underflowing_squares_are_still_exact(x, y, g):
+    core = np.array(PAPER.intervals(x, y, g))
+    ref = np.array(reference_intervals(PAPER, x, y, g)).ravel()
+    np.testing.assert_array_equal(core, ref)
