@@ -32,6 +32,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Polygon, Rectangle, Wedge
 
+from eyeviz import EyevizError
 from eyeviz.scene import Scene
 from eyeviz.state import SceneState, compute_state
 
@@ -120,6 +121,7 @@ class _Layout:
     readout: _Box | None
     readout_rows: int
     title_y: float | None
+    lanes: tuple[int, int] = (2, 2)
 
 
 _TEXT_ROW = 0.118  # inches per readout row at 6 pt
@@ -136,14 +138,48 @@ def _readout_rows(scene: Scene) -> int:
     return rows
 
 
-def _layout(scene: Scene, width: float) -> _Layout:
+_ROW = 7.0 / 72  # one interval-label lane above/below a bitmap strip, inches
+_LABEL_PT = SMALL - 0.5
+
+
+def interval_lanes(L, R, m: int, strip_in: float) -> list[tuple[int, str, float, int]]:
+    """Place the [L, R] labels of one strip: (feature index, text, centre, lane) each.
+
+    Labels go over their run; one that would overlap an earlier label moves to the
+    next lane out, so none collide.
+    """
+    idx_per_in = m / strip_in
+    placed: list[tuple[int, str, float, int, float]] = []
+    for i in sorted(range(len(L)), key=lambda j: int(L[j])):
+        lo, hi = int(L[i]), int(R[i])
+        text = "whole eye" if hi - lo >= m - 1 else f"[{lo}, {hi % m}]"
+        wid = (len(text) * 0.56 * _LABEL_PT / 72 + 0.04) * idx_per_in
+        centre = min(max(((lo + hi + 1) / 2) % m, wid / 2), m - wid / 2)
+        lane = 0
+        while any(abs(centre - c) < (wid + w) / 2 and ln == lane for _, _, c, ln, w in placed):
+            lane += 1
+        placed.append((i, text, centre, lane, wid))
+    return [(i, t, c, ln) for i, t, c, ln, _ in placed]
+
+
+def _lanes_needed(scene: Scene, state: SceneState | None, strip_in: float) -> tuple[int, int]:
+    if state is None or state.LA is None:
+        return (1, 1)
+    m = state.pair.m
+    a = interval_lanes(state.LA, state.RA, m, strip_in)
+    b = interval_lanes(state.LB, state.RB, m, strip_in)
+    return (1 + max(ln for *_, ln in a), 1 + max(ln for *_, ln in b))
+
+
+def _layout(scene: Scene, width: float, state: SceneState | None = None) -> _Layout:
     left, right = 0.42, 0.08
     main_w = width - left - right
+    lanes = _lanes_needed(scene, state, main_w) if scene.features else (0, 0)
     main_h = round(main_w * 0.86, 3)
     rows = _readout_rows(scene)
     readout_h = rows * _TEXT_ROW + (0.06 if rows else 0.0)
     shows_bitmaps = "bitmaps" in scene.layers and scene.features
-    bitmaps_h = 4 * 7 / 72 + 0.02 + 0.12 * 2 + 0.13 if shows_bitmaps else 0.0
+    bitmaps_h = sum(lanes) * _ROW + 0.02 + 0.12 * 2 + 0.13 if shows_bitmaps else 0.0
     title_h = 0.2 if scene.title else 0.05
     bottom = 0.06
     y = bottom
@@ -156,7 +192,7 @@ def _layout(scene: Scene, width: float) -> _Layout:
     title_y = y + 0.06 if scene.title else None
     # whole hundredths of an inch: the PNG's pixel size then scales exactly with --scale
     height = math.ceil((y + title_h) * 100 - 1e-9) / 100
-    return _Layout(width, height, main, bitmaps, readout, rows, title_y)
+    return _Layout(width, height, main, bitmaps, readout, rows, title_y, lanes)
 
 
 # --- eyes --------------------------------------------------------------------------------
@@ -192,7 +228,7 @@ class _Painter:
         self.merge = merge
         self.pred_in = predictions
         self.layers = set(scene.layers)
-        self.lay = _layout(scene, width)
+        self.lay = _layout(scene, width, state)
         self.fig = Figure(figsize=(self.lay.width, self.lay.height), dpi=dpi)
         self.fig.patch.set_facecolor(WHITE)
         self.colors = [f.color for f in scene.features]
@@ -269,7 +305,7 @@ class _Painter:
         ins.set_gid("inset")
         scale = (x1 - x0) / (self.units_per_in * box_w)
         ins.text(0.02, 0.96, f"eyes \u00d7{_round_sig(1 / scale)}", transform=ins.transAxes,
-                 ha="left", va="top", fontsize=SMALL - 0.5, color=GREY)
+                 ha="left", va="top", fontsize=SMALL - 0.5, color=GREY, bbox=_HALO, zorder=8)
         # a leader from the inset to the eyes' true place (the origin) in the main view
         ox, oy = self._to_inches(0.0, 0.0)
         cx_, cy_ = bx + box_w / 2, by + box_h / 2
@@ -324,8 +360,8 @@ class _Painter:
         xs = [*self.xlim, *self.xlim]
         ys = [self.ylim[0], self.ylim[0], self.ylim[1], self.ylim[1]]
         far = 1.5 * max(math.hypot(x, y) for x, y in zip(xs, ys, strict=True)) + 10 * p.h
-        pts = [(0.0, 0.0), (far * math.cos(psi), far * math.sin(psi)),
-               (far * math.cos(math.pi - psi), far * math.sin(math.pi - psi))]
+        arc = np.linspace(psi, math.pi - psi, 17)
+        pts = [(0.0, 0.0), *zip(far * np.cos(arc), far * np.sin(arc), strict=True)]
         axes = [self.ax] + ([self.inset] if self.inset is not None else [])
         for ax in axes:
             wedge = Polygon(pts, closed=True, facecolor=BFV_FILL, edgecolor="none", zorder=0,
@@ -506,13 +542,16 @@ class _Painter:
                 alpha = math.asin(f.g / rE)
                 t = math.sqrt(rE * rE - f.g * f.g)
                 for ax in axes:
+                    thin = ax is self.ax and self.inset is not None
                     for sgn in (-1, 1):
                         a = phE + sgn * alpha
                         ax.plot([cx, cx + 1.04 * t * math.cos(a)],
                                 [cy, cy + 1.04 * t * math.sin(a)], color=_dark(f.color),
-                                lw=0.55, zorder=7, gid=f"tangent-{name}-{_slug(f.name)}")
-                    ax.plot([cx, f.x], [cy, f.y], color=_dark(f.color), lw=0.4,
-                            ls=(0, (3, 2)), zorder=7)
+                                lw=0.35 if thin else 0.55, alpha=0.8 if thin else 1.0,
+                                zorder=7, gid=f"tangent-{name}-{_slug(f.name)}")
+                    if not thin:
+                        ax.plot([cx, f.x], [cy, f.y], color=_dark(f.color), lw=0.4,
+                                ls=(0, (3, 2)), zorder=7)
                 # the angle arcsin(g/r_E) (Figure 3b) for the nearer eye, where it reads
                 if (name == "A") != (st.rA[i] < st.rB[i]):
                     continue
@@ -668,10 +707,10 @@ class _Painter:
         ax.set_xlim(0, m)
         ax.set_ylim(0, box.h)  # y in inches
         ax.axis("off")
-        row = 7.0 / 72  # one label row
+        row = _ROW
         strip = 0.12
         axis_h = 0.13
-        yB = 2 * row + 0.01
+        yB = self.lay.lanes[1] * row + 0.01
         yA = yB + strip + axis_h
         palette = self.colors
         fills = [None] + list(dict.fromkeys(palette))
@@ -707,31 +746,17 @@ class _Painter:
             lab = f"{k}" if k != half else f"m/2 = {half}"
             ax.plot([k, k], [yA - 0.015, yA], color=GREY, lw=0.4)
             ax.plot([k, k], [yB + strip, yB + strip + 0.015], color=GREY, lw=0.4)
-            ax.text(k, ymid, lab, ha="center", va="center", fontsize=SMALL - 0.5, color=GREY)
+            ha = "left" if k == 0 else "right" if k == m else "center"
+            ax.text(k, ymid, lab, ha=ha, va="center", fontsize=SMALL - 0.5, color=GREY)
 
     def _interval_labels(self, ax, name, y0, strip, Ls, Rs, row) -> None:
-        m = self.pair.m
         above = name == "A"
-        size = SMALL - 0.5
-        idx_per_in = m / self.lay.bitmaps.w
-        placed: list[tuple[float, float, int]] = []
-        order = sorted(range(len(Ls)), key=lambda i: int(Ls[i]))
-        for i in order:
+        for i, text, centre, lane in interval_lanes(Ls, Rs, self.pair.m, self.lay.bitmaps.w):
             f = self.scene.features[i]
-            L, R = int(Ls[i]), int(Rs[i])
-            text = "whole eye" if R - L >= m - 1 else f"[{L}, {R % m}]"
-            wid = (len(text) * 0.56 * size / 72 + 0.04) * idx_per_in
-            centre = min(max(((L + R + 1) / 2) % m, wid / 2), m - wid / 2)
-            lane = 0
-            while any(abs(centre - c) < (wid + w) / 2 and ln == lane for c, w, ln in placed):
-                lane += 1
-            if lane > 1:
-                continue  # no room: the readout and the strip still show it
-            placed.append((centre, wid, lane))
             dy = 0.008 + lane * row
             y = y0 + strip + dy if above else y0 - dy
             ax.text(centre, y, text, ha="center", va="bottom" if above else "top",
-                    fontsize=size, color=_dark(f.color),
+                    fontsize=_LABEL_PT, color=_dark(f.color),
                     gid=f"bitmap-interval-{name}-{_slug(f.name)}")
 
     def readout(self) -> None:
@@ -865,7 +890,10 @@ def predict_scene(scene: Scene, state: SceneState) -> dict[str, tuple[np.ndarray
     ob = np.stack([state.bitmaps(i, m // 2)[1] for i in range(state.n)]).astype(np.float32)
     out = {}
     for name in scene.estimators:
-        est = estimators.load(name)
+        try:
+            est = estimators.load(name)
+        except (ImportError, OSError, ValueError) as exc:
+            raise EyevizError(f"predictions layer: cannot load estimator {name!r}: {exc}") from None
         r_hat, phi_hat = est.predict(oa, ob)
         out[name] = (np.asarray(r_hat, dtype=np.float64), np.asarray(phi_hat, dtype=np.float64))
     return out
