@@ -52,7 +52,9 @@ __all__ = [
 PAPER_EYES = EyePair(40.0, 20.0, 720)  # Table 3
 CHUNK = 1 << 14  # elements per generated chunk; fixed, so the output never depends on it
 SEGMENT_WIDTH = 5.0  # the paper's multi-pass segment length (Section 5)
-_MAX_IDLE_ROUNDS = 200  # redraw rounds in a row without one accepted element before giving up
+# give up after this many redraw rounds and candidates in a row without one accepted element
+_MAX_IDLE_ROUNDS = 200
+_MAX_IDLE_DRAWS = 200_000
 MODES = ("single", "multi")
 
 
@@ -274,20 +276,21 @@ class _Sampler:
         return [((a * h + b) * h + c) * h + d for a, b, c, d in
                 zip(la.tolist(), ra.tolist(), lb.tolist(), rb.tolist(), strict=True)]
 
-    def fill(self, lo: np.ndarray, hi: np.ndarray) -> Chunk:
+    def fill(self, n: int, lo: float | np.ndarray, hi: float | np.ndarray) -> Chunk:
+        """n accepted elements; slot i draws r in [lo_i, hi_i] (scalars: every slot)."""
         p, rng, eyes = self.p, self.rng, self.p.eyes
-        n = lo.shape[0]
+        per_slot = isinstance(lo, np.ndarray)
         out_r = np.empty(n)
         out_phi = np.empty(n)
         out_g = np.empty(n)
         ivs = [np.empty(n, np.int64) for _ in range(4)]
         pending = np.arange(n)
-        idle = 0
+        idle = idle_draws = 0
         while pending.size:
             k = pending.size
             self.drawn += k
             u = rng.random((3, k))
-            lo_p, hi_p = lo[pending], hi[pending]
+            lo_p, hi_p = (lo[pending], hi[pending]) if per_slot else (lo, hi)
             r = lo_p + (hi_p - lo_p) * u[0]                      # step 7
             g_min = r * self.sin_half                             # step 8
             ok = g_min <= p.g_max                                 # step 9
@@ -311,10 +314,11 @@ class _Sampler:
                 sel = self._new_only(sel, la, ra, lb, rb)
             if sel.size == 0:
                 idle += 1
-                if idle >= _MAX_IDLE_ROUNDS:
-                    self._give_up()
+                idle_draws += k
+                if idle >= _MAX_IDLE_ROUNDS and idle_draws >= _MAX_IDLE_DRAWS:
+                    self._give_up(float(np.min(lo_p)), float(np.max(hi_p)))
                 continue
-            idle = 0
+            idle = idle_draws = 0
             dst = pending[idx[sel]]
             out_r[dst], out_phi[dst], out_g[dst] = r[sel], phi[sel], g[sel]
             for o, v in zip(ivs, (la, ra, lb, rb), strict=True):
@@ -334,15 +338,17 @@ class _Sampler:
                 keep.append(i)
         return np.asarray(keep, dtype=np.int64)
 
-    def _give_up(self) -> None:
+    def _give_up(self, r_lo: float, r_hi: float) -> None:
         if self.seen is not None:
+            where = f" with r in [{r_lo:.6g}, {r_hi:.6g}]" if self.p.mode == "multi" else ""
             raise EyevizError(
                 f"only {len(self.seen)} distinct bitmap pairs were found after drawing "
-                f"{self.drawn} candidates; ask for fewer elements or drop --unique-bitmaps"
+                f"{self.drawn} candidates; no new pair{where} turns up: ask for fewer "
+                "elements, or drop --unique-bitmaps"
             )
         raise EyevizError(
-            f"no element was accepted in {_MAX_IDLE_ROUNDS} rounds ({self.drawn} candidates "
-            "drawn): no feature in this range is visible inside the BFV"
+            f"no element was accepted in {_MAX_IDLE_DRAWS} candidates in a row: "
+            "(almost) no feature in this range is visible inside the BFV"
         )
 
 
@@ -353,7 +359,7 @@ def iter_chunks(n: int, p: GenParams, chunk: int = CHUNK) -> Iterator[Chunk]:
     if p.mode == "single":
         for start in range(0, n, chunk):
             c = min(chunk, n - start)
-            yield sampler.fill(np.full(c, p.r_min), np.full(c, p.r_max))
+            yield sampler.fill(c, p.r_min, p.r_max)
         return
     edges, remaining = segment_plan(n, p)
     left = n
@@ -367,7 +373,7 @@ def iter_chunks(n: int, p: GenParams, chunk: int = CHUNK) -> Iterator[Chunk]:
         left -= c
         labels = np.repeat(np.arange(comp.size), comp)
         rng.shuffle(labels)
-        yield sampler.fill(edges[labels], edges[labels + 1])
+        yield sampler.fill(c, edges[labels], edges[labels + 1])
 
 
 # --- public API ----------------------------------------------------------------------
