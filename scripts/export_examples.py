@@ -1,0 +1,52 @@
+"""Regenerate the README's exported figures, docs/img/figure_*.png (and .pdf/.svg with --all).
+
+    .venv/bin/python scripts/export_examples.py [--all]
+
+Every figure is `eyeviz.export.export` of a shipped scene (assets/scenes), plus one
+variant of the default scene built here that shows the predictions (analytic estimator)
+and ambiguity layers and a feature outside the networks' domain.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+from pathlib import Path
+
+from eyeviz import scene as scene_mod
+from eyeviz.export import export
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = ROOT / "assets" / "scenes"
+OUT = ROOT / "docs" / "img"
+
+
+def predictions_scene() -> scene_mod.Scene:
+    sc = copy.deepcopy(scene_mod.load(SCENES / "default.toml"))
+    sc.title = "Predictions (analytic) and the centres with the same bitmaps"
+    sc.features.append(scene_mod.Feature("outside", 3000.0, 800.0, 100.0, "#E69F00"))
+    sc.layers = ["eyes", "bfv", "features", "predictions", "ambiguity", "readout", "labels"]
+    sc.estimators = ["analytic"]
+    return sc
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--all", action="store_true", help="also write .svg and .pdf")
+    args = ap.parse_args()
+    OUT.mkdir(parents=True, exist_ok=True)
+    figures = {
+        "figure_default": scene_mod.load(SCENES / "default.toml"),
+        "figure_3b": scene_mod.load(SCENES / "figure3b.toml"),
+        "figure_bfv": scene_mod.load(SCENES / "figure5.toml"),
+        "figure_2": scene_mod.load(SCENES / "figure2.toml"),
+        "figure_predictions": predictions_scene(),
+    }
+    for name, sc in figures.items():
+        for suffix in (".png", ".svg", ".pdf") if args.all else (".png",):
+            print(export(sc, OUT / f"{name}{suffix}").relative_to(ROOT))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
