@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import time
 
 NAME = "generate"
 HELP = "generate a training data set with the paper's Algorithm 1 (CSV or NPZ)"
@@ -60,9 +62,14 @@ def run(args: argparse.Namespace) -> int:
 
         bar = tqdm(total=args.n, unit="rows", unit_scale=True, file=sys.stderr,
                    desc=f"generate {args.output}", leave=False, mininterval=0.5)
+    t0 = time.perf_counter()
     try:
         dataset.write(args.output, args.n, progress=bar.update if bar else None, **kw)
     finally:
         if bar is not None:
             bar.close()
+    if not args.quiet:
+        size = os.path.getsize(args.output) / 1e6
+        print(f"wrote {args.n:,} elements ({args.mode} pass, seed {args.seed}) to "
+              f"{args.output} ({size:.1f} MB) in {time.perf_counter() - t0:.2f} s")
     return 0
