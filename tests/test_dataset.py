@@ -365,3 +365,21 @@ def test_float_text_is_printf_17g_and_round_trips():
     got = [bytes(chars[i, :lens[i]]).decode() for i in range(len(v))]
     assert got == [format(x, ".17g") for x in v.tolist()]
     assert all(float(t) == x for t, x in zip(got, v.tolist(), strict=True) if x == x)
+
+
+@pytest.mark.parametrize("name", ["full.csv", "full.npz"])
+def test_full_disk_leaves_no_file(tmp_path, name):
+    # RLIMIT_FSIZE makes write() fail with EFBIG past 5 MB, as a full disk fails it with
+    # ENOSPC; the error must surface from the writer thread and remove the temporary file.
+    import resource
+
+    def limit():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (5_000_000, 5_000_000))
+
+    res = subprocess.run([*EYEVIZ, "generate", "-n", "300000", "-o", str(tmp_path / name),
+                          "--quiet"], capture_output=True, text=True, timeout=120,
+                         preexec_fn=limit)
+    assert res.returncode == 2, res.stderr
+    assert "File too large" in res.stderr and res.stderr.count("\n") == 1, res.stderr
+    assert list(tmp_path.iterdir()) == []
