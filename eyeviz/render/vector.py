@@ -130,7 +130,7 @@ _TEXT_ROW = 0.118  # inches per readout row at 6 pt
 def _readout_rows(scene: Scene) -> int:
     if "readout" not in scene.layers or not scene.features:
         return 0
-    rows = 1 + len(scene.features)
+    rows = 2 + len(scene.features)
     if "predictions" in scene.layers:
         rows += len(scene.features) * len(scene.estimators)
     if "ambiguity" in scene.layers:
@@ -565,10 +565,11 @@ class _Painter:
                                    center=(cx, cy)))
                 mid = phE + alpha / 2
                 lx, ly = cx + 1.1 * rad * math.cos(mid), cy + 1.1 * rad * math.sin(mid)
-                eax.text(lx, ly, rf"$\arcsin(g/r_{name})$" + f" = {math.degrees(alpha):.1f}\u00b0",
-                         ha="right" if math.cos(mid) < 0 else "left", va="bottom",
-                         fontsize=SMALL, color=_dark(f.color), bbox=_HALO, zorder=9,
-                         gid=f"tangent-angle-label-{name}-{_slug(f.name)}")
+                _subscripted(eax, lx, ly, [("arcsin(g / r", False), (name, True),
+                                           (f") = {math.degrees(alpha):.1f}\u00b0", False)],
+                             SMALL, "right" if math.cos(mid) < 0 else "left", _dark(f.color),
+                             gid=f"tangent-angle-label-{name}-{_slug(f.name)}", zorder=9,
+                             bbox=_HALO)
 
     def sectors(self) -> None:
         st, p = self.st, self.pair
@@ -736,8 +737,8 @@ class _Painter:
                                    lw=0.4, zorder=3))
             ax.plot([half, half], [y0 - 0.012, y0 + strip + 0.012], color=INK, lw=0.7,
                     zorder=4, solid_capstyle="butt")
-            ax.text(-0.015 * m, y0 + strip / 2, rf"$\Omega_{name}$", ha="right",
-                    va="center", fontsize=FONT, color=INK)
+            _subscripted(ax, -0.015 * m, y0 + strip / 2, [("\u03a9", False), (name, True)],
+                         FONT, "right", INK, gid=f"bitmap-{name}-name")
             ax.text(0.75 * m, y0 + strip / 2, "rear half: not a network input",
                     ha="center", va="center", fontsize=SMALL - 1.5, color=GREY, zorder=3)
             self._interval_labels(ax, name, y0, strip, Ls, Rs, row)
@@ -771,15 +772,20 @@ class _Painter:
         ax.set_ylim(0, 1)
         rows = self.lay.readout_rows
         dy = 1.0 / rows
-        cols = [("feature", 0.0, "left"), (r"$r$", 0.29, "right"),
-                (r"$\varphi$", 0.395, "right"), (r"$r_A$", 0.50, "right"),
-                (r"$\varphi_A$", 0.605, "right"), (r"$r_B$", 0.71, "right"),
-                (r"$\varphi_B$", 0.815, "right"), ("BFV", 0.862, "center"),
-                ("seen by", 1.0, "right")]
+        cols = [("feature", 0.0, "left"), ("r", 0.29, "right"), ("\u03c6", 0.395, "right"),
+                ("r", 0.50, "right"), ("\u03c6", 0.605, "right"), ("r", 0.71, "right"),
+                ("\u03c6", 0.815, "right"), ("BFV", 0.862, "center"), ("seen by", 1.0, "right")]
+        # two header rows: where the polar coordinates are centred, then r and phi
         y = 1 - dy / 2
+        for text, x0, x1 in (("about the origin O", 0.215, 0.40), ("about eye A", 0.425, 0.61),
+                             ("about eye B", 0.635, 0.82)):
+            ax.text((x0 + x1) / 2, y, text, ha="center", va="center", fontsize=SMALL - 0.5,
+                    color=GREY)
+            ax.plot([x0 + 0.01, x1], [y - 0.42 * dy] * 2, color=LIGHT, lw=0.4)
+        y -= dy
         for text, x, ha in cols:
             ax.text(x, y, text, ha=ha, va="center", fontsize=SMALL, color=GREY)
-        ax.plot([0, 1], [1 - dy, 1 - dy], color=LIGHT, lw=0.4)
+        ax.plot([0, 1], [y - dy / 2, y - dy / 2], color=LIGHT, lw=0.4)
         grey = self._out_of_domain()
         cnames = estimator_colors(sc.estimators)
         for i, f in enumerate(sc.features):
@@ -838,6 +844,32 @@ def _arc(radius, th1, th2, color, gid, center=(0.0, 0.0)):
             zorder=6)
     a.set_gid(gid)
     return a
+
+
+def _subscripted(ax, x, y, parts, size, ha, color, **kw) -> None:
+    """Text with subscripts as plain text objects (no mathtext: every SVG viewer reads it).
+
+    ``parts`` is a list of (text, is_subscript); vertically centred on (x, y) in data units.
+    """
+    from matplotlib.textpath import TextPath
+    from matplotlib.transforms import offset_copy
+
+    sub_size = 0.72 * size
+    widths = [TextPath((0, 0), t, size=sub_size if sub else size).get_extents().width
+              + (0.6 if sub else 0.0) for t, sub in parts]
+    total = sum(widths)
+    start = {"left": 0.0, "center": -total / 2, "right": -total}[ha]
+    fig = ax.figure
+    gid = kw.pop("gid", None)
+    x_pt = start
+    for (t, sub), w in zip(parts, widths, strict=True):
+        tr = offset_copy(ax.transData, fig=fig, x=x_pt, y=-0.3 * size if sub else 0.0,
+                         units="points")
+        txt = ax.text(x, y, t, transform=tr, ha="left", va="center",
+                      fontsize=sub_size if sub else size, color=color, **kw)
+        if gid:
+            txt.set_gid(f"{gid}-{len(ax.texts)}")
+        x_pt += w
 
 
 def _slug(name: str) -> str:
