@@ -184,10 +184,12 @@ def format_g17(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 # --- CSV encoding --------------------------------------------------------------------
 
 class CsvEncoder:
-    """Encodes chunks of rows as CSV bytes, reusing one preformatted bit buffer.
+    """Encodes chunks of rows as CSV, reusing one preformatted bit buffer.
 
     The buffer holds ``0,`` for every bit of ``rows`` rows; a chunk sets its lit bits to
-    ``1`` by one scatter, encodes, and sets them back, so no page is touched twice.
+    ``1`` by one scatter (the previous chunk's are set back first). ``encode_*`` return
+    the chunk as a list of buffers (row views into the bit buffer and the row tails) for
+    :func:`write_parts`: valid until the next ``encode_*`` call on the same encoder.
     """
 
     def __init__(self, m: int, rows: int, with_g: bool = True):
@@ -200,6 +202,7 @@ class CsvEncoder:
         self.flat = self.buf.reshape(-1)
         mv = memoryview(self.flat)
         self.row_views = [mv[i * self.rb:(i + 1) * self.rb] for i in range(rows)]
+        self._lit: np.ndarray | None = None
 
     def _tails(self, r, phi, g) -> list[bytes]:
         """Per row ``r,phi,g\n`` (``%.17g``), built as one NUL-padded matrix."""
@@ -220,11 +223,11 @@ class CsvEncoder:
             at += 1
         return tail.view(f"S{width}").ravel().tolist()
 
-    def _join(self, n: int, tails: list[bytes]) -> bytes:
+    def _parts(self, n: int, tails: list[bytes]) -> list:
         parts: list = [None] * (2 * n)
         parts[0::2] = self.row_views[:n]
         parts[1::2] = tails
-        return b"".join(parts)
+        return parts
 
     def _lit_positions(self, lo: np.ndarray, hi: np.ndarray, col0: int) -> np.ndarray:
         """Flat buffer positions of the '0' bytes of bits lo..hi of each row (lo <= hi)."""
@@ -234,27 +237,45 @@ class CsvEncoder:
         excl = np.cumsum(cnt) - cnt
         return np.repeat(base - 2 * excl, cnt) + 2 * np.arange(tot, dtype=np.int64)
 
-    def encode_intervals(self, r, phi, g, la, ra, lb, rb) -> bytes:
+    def encode_intervals(self, r, phi, g, la, ra, lb, rb) -> list:
         """Rows whose eye E lights bits L_E..R_E (0 <= L <= R < m/2)."""
-        n = r.shape[0]
+        if self._lit is not None:
+            self.flat[self._lit] = _ZERO
         pos = np.concatenate([self._lit_positions(la, ra, 0),
                               self._lit_positions(lb, rb, self.w)])
         self.flat[pos] = _ONE
-        try:
-            return self._join(n, self._tails(r, phi, g))
-        finally:
-            self.flat[pos] = _ZERO
+        self._lit = pos
+        return self._parts(r.shape[0], self._tails(r, phi, g))
 
-    def encode_bitmaps(self, omega_a, omega_b, r, phi, g) -> bytes:
+    def encode_bitmaps(self, omega_a, omega_b, r, phi, g) -> list:
+        if self._lit is not None:  # invariant: the buffer is "0," except at self._lit
+            self.flat[self._lit] = _ZERO
         n = r.shape[0]
         view = self.buf[:n]
         w = self.w
         view[:, 0:2 * w:2] = _ZERO + omega_a.view(np.uint8)
         view[:, 2 * w::2] = _ZERO + omega_b.view(np.uint8)
-        try:
-            return self._join(n, self._tails(r, phi, g))
-        finally:
-            view[:, 0::2] = _ZERO
+        self._lit = np.flatnonzero(self.buf[:n].reshape(-1) == _ONE)
+        return self._parts(n, self._tails(r, phi, g))
+
+
+_IOV = 1024  # buffers per writev call (IOV_MAX on Linux)
+
+
+def write_parts(f, parts: list) -> None:
+    """Write a list of buffers to an unbuffered binary file, without joining them."""
+    if not hasattr(os, "writev"):
+        f.write(b"".join(parts))
+        return
+    fd = f.fileno()
+    for s in range(0, len(parts), _IOV):
+        group = parts[s:s + _IOV]
+        done = os.writev(fd, group)
+        total = sum(map(len, group))
+        if done < total:
+            rest = memoryview(b"".join(group))[done:]
+            while rest:
+                rest = rest[os.write(fd, rest):]
 
 
 # --- NPZ -----------------------------------------------------------------------------
@@ -369,7 +390,7 @@ class _Overlapped:
             self._pool.shutdown(wait=True)
 
 
-def _encode_csv_chunk(enc: CsvEncoder, c) -> bytes:
+def _encode_csv_chunk(enc: CsvEncoder, c) -> list:
     return enc.encode_intervals(c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb)
 
 
@@ -380,10 +401,13 @@ def write_chunks(path, fmt: str, n: int, m: int, params: dict, chunks: Iterable,
 
     with atomic_output(path) as tmp:
         if fmt == "csv":
-            enc = CsvEncoder(m, CHUNK)
-            with open(tmp, "wb") as f, _Overlapped(f.write) as out:
-                for c in chunks:
-                    out(_encode_csv_chunk(enc, c))
+            # two buffers: chunk k+1 is encoded while chunk k is written; encoding k+2
+            # into k's buffer starts only after out() has waited for k's write
+            encs = (CsvEncoder(m, CHUNK), CsvEncoder(m, CHUNK))
+            with open(tmp, "wb", buffering=0) as f, \
+                    _Overlapped(functools.partial(write_parts, f)) as out:
+                for i, c in enumerate(chunks):
+                    out(_encode_csv_chunk(encs[i % 2], c))
                     if progress:
                         progress(len(c))
         else:
@@ -403,11 +427,11 @@ def save(ds, path) -> None:
         if fmt == "csv":
             with_g = not bool(np.all(np.isnan(ds.g))) if n else True
             enc = CsvEncoder(m, min(step, max(n, 1)), with_g)
-            with open(tmp, "wb") as f:
+            with open(tmp, "wb", buffering=0) as f:
                 for s in range(0, n, step):
                     sl = slice(s, s + step)
-                    f.write(enc.encode_bitmaps(ds.omega_a[sl], ds.omega_b[sl], ds.r[sl],
-                                               ds.phi[sl], ds.g[sl]))
+                    write_parts(f, enc.encode_bitmaps(ds.omega_a[sl], ds.omega_b[sl],
+                                                      ds.r[sl], ds.phi[sl], ds.g[sl]))
         else:
             e = ds.eyes
             meta = {"version": NPZ_VERSION, "m": m, "n": n,
