@@ -507,24 +507,25 @@ def _load_csv(path: Path, eyes: EyePair | None):
                                          f"m={eyes.m}")
     n = len(lines)
     nf = 3 if with_g else 2
-    bits = np.empty((n, m), np.uint8)
-    floats = np.empty((n, nf))
+    w = m // 2
+    oa = np.empty((n, w), np.uint8)
+    ob = np.empty((n, w), np.uint8)
+    floats = np.empty((nf, n))
     step = 1 << 14
     for s in range(0, n, step):
         block = lines[s:s + step]
+        e = s + len(block)
         try:
-            _parse_block(block, m, nf, bits[s:s + len(block)], floats[s:s + len(block)])
+            _parse_block(block, m, nf, oa[s:e], ob[s:e], floats[:, s:e])
         except ValueError:
             _diagnose(path, block, s, m, ncols)
             raise
-    w = m // 2
-    g = floats[:, 2] if with_g else np.full(n, np.nan)
-    bits_b = bits.view(bool)
-    return Dataset(bits_b[:, :w].copy(), bits_b[:, w:].copy(), floats[:, 0].copy(),
-                   floats[:, 1].copy(), g.copy(), eyes, {})
+    g = floats[2] if with_g else np.full(n, np.nan)
+    return Dataset(oa.view(bool), ob.view(bool), floats[0], floats[1], g, eyes, {})
 
 
-def _parse_block(block: list[bytes], m: int, nf: int, bits: np.ndarray, floats: np.ndarray):
+def _parse_block(block: list[bytes], m: int, nf: int, oa: np.ndarray, ob: np.ndarray,
+                 floats: np.ndarray) -> None:
     """Fast path: every line is exactly ``b,`` * m followed by nf floats."""
     rb = 2 * m
     head = np.frombuffer(b"".join([ln[:rb] for ln in block]), np.uint8)
@@ -533,11 +534,13 @@ def _parse_block(block: list[bytes], m: int, nf: int, bits: np.ndarray, floats: 
     head = head.reshape(len(block), m, 2)
     if not (np.all(head[:, :, 1] == _COMMA) and np.all((head[:, :, 0] | 1) == _ONE)):
         raise ValueError("bad bits")
-    bits[:] = head[:, :, 0] - _ZERO
+    w = m // 2
+    np.subtract(head[:, :w, 0], _ZERO, out=oa)
+    np.subtract(head[:, w:, 0], _ZERO, out=ob)
     tails = b",".join([ln[rb:] for ln in block]).split(b",")
     if len(tails) != len(block) * nf:
         raise ValueError("bad field count")
-    floats[:] = np.array(list(map(float, tails))).reshape(len(block), nf)
+    floats[:] = np.array(list(map(float, tails))).reshape(len(block), nf).T
     if not np.all(np.isfinite(floats)):
         raise ValueError("non-finite")
 
