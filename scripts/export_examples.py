@@ -4,7 +4,8 @@
 
 Every figure is `eyeviz.export.export` of a shipped scene (assets/scenes), plus one
 variant of the default scene built here that shows the predictions (analytic estimator)
-and ambiguity layers and a feature outside the networks' domain.
+and ambiguity layers and a feature outside the networks' domain, and a close-up of one
+feature's ambiguity region.
 """
 
 from __future__ import annotations
@@ -30,6 +31,17 @@ def predictions_scene() -> scene_mod.Scene:
     return sc
 
 
+def ambiguity_scene() -> scene_mod.Scene:
+    sc = scene_mod.Scene(
+        eyes=scene_mod.Eyes(40.0, 20.0, 720),
+        features=[scene_mod.Feature("target", 0.0, 1500.0, 50.0, "#D55E00")],
+        layers=["features", "ambiguity", "tangents", "labels", "readout"],
+        view=scene_mod.View((0.0, 1600.0), 500.0),
+        title="Every centre in the hatched needle gives the same two bitmaps",
+    )
+    return sc
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--all", action="store_true", help="also write .svg and .pdf")
@@ -41,6 +53,7 @@ def main() -> int:
         "figure_bfv": scene_mod.load(SCENES / "figure5.toml"),
         "figure_2": scene_mod.load(SCENES / "figure2.toml"),
         "figure_predictions": predictions_scene(),
+        "figure_ambiguity": ambiguity_scene(),
     }
     for name, sc in figures.items():
         for suffix in (".png", ".svg", ".pdf") if args.all else (".png",):

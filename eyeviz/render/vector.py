@@ -668,10 +668,12 @@ class _Painter:
             self.regions[f.name] = reg
             if len(reg.polygon) < 3:
                 continue
-            poly = Polygon(reg.polygon, closed=True, facecolor=_mix(f.color, 0.25),
-                           edgecolor=_dark(f.color), lw=0.6, hatch="//////", zorder=7.5)
+            poly = Polygon(reg.polygon, closed=True, facecolor=_mix(f.color, 0.3),
+                           edgecolor=_dark(f.color), lw=0.6, hatch="//////", zorder=8.5,
+                           alpha=0.85)
             poly.set_gid(f"ambiguity-{_slug(f.name)}")
             self.ax.add_patch(poly)
+            self.ax.plot([f.x], [f.y], marker="+", ms=3.5, mew=0.6, color=INK, zorder=8.7)
 
     def trajectory(self) -> None:
         t = self.scene.trajectory
