@@ -68,7 +68,7 @@ def summarise(ds, label: str, path: str) -> Summary:
     distinct = len(np.unique(keys.view(np.dtype((np.void, keys.shape[1]))).ravel()))
     g = ds.g[np.isfinite(ds.g)]
     return Summary(
-        label, path, len(ds), ds.m, str(ds.params.get("mode", "?")), lo, hi, float(r.mean()),
+        label, path, len(ds), ds.m, str(ds.params.get("mode", "unknown")), lo, hi, float(r.mean()),
         float(g.min()) if g.size else math.nan, float(g.max()) if g.size else math.nan,
         math.degrees(float(ds.phi.min())), math.degrees(float(ds.phi.max())), distinct,
         float(ratio),

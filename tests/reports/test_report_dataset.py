@@ -34,7 +34,7 @@ def test_report_side_by_side(files, tmp_path):
     assert [r["label"] for r in rows] == ["one pass", "multi-pass"]
     single, multi = rows
     assert single["mode"] == "single" and int(single["n"]) == 20000
-    assert multi["mode"] == "?"  # a CSV does not record how it was made
+    assert multi["mode"] == "unknown"  # a CSV does not record how it was made
     # one pass: flat in r, so the density per area halves from inner to outer half
     assert float(single["area_density_ratio"]) == pytest.approx(0.5, abs=0.05)
     # multi-pass: uniform over the BFV area
