@@ -15,10 +15,14 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-import vtk
 from PyQt5 import QtCore, QtGui, QtWidgets
 from pyvistaqt import QtInteractor
 from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkRenderingCore import (
+    vtkRenderer,
+    vtkTextActor,
+    vtkWindowToImageFilter,
+)
 
 from eyeviz.app.model import AppModel, MouseEvent, drag_feature, hit_test
 from eyeviz.app.panels import BitmapPanel, EyesPanel, FeaturePanel, LayersPanel, ReadoutPanel
@@ -88,17 +92,17 @@ class MainWindow(QtWidgets.QMainWindow):
         self.inset_view = View((0.0, 0.0), 1.0)
         self.inset_auto = True
 
-        self.plotter = QtInteractor(self, auto_update=False)
+        self.plotter = QtInteractor(self, auto_update=False, multi_samples=0)
         self.plotter.set_background(BACKGROUND)
         self.ren_win = self.plotter.ren_win
         self.main_ren = self.plotter.renderer
-        self.inset_ren = vtk.vtkRenderer()
+        self.inset_ren = vtkRenderer()
         self.inset_ren.SetViewport(*INSET_VIEWPORT)
         self.inset_ren.SetBackground(*INSET_BACKGROUND)
         self.inset_ren.InteractiveOff()
         self.ren_win.AddRenderer(self.inset_ren)
         self.actors = SceneActors(self.main_ren, self.inset_ren)
-        self.title_actor = vtk.vtkTextActor()
+        self.title_actor = vtkTextActor()
         tp = self.title_actor.GetTextProperty()
         tp.SetFontSize(24)
         tp.BoldOn()
@@ -527,7 +531,7 @@ class MainWindow(QtWidgets.QMainWindow):
         QtWidgets.QApplication.processEvents()
         self.apply_cameras()
         self.render()
-        w2i = vtk.vtkWindowToImageFilter()
+        w2i = vtkWindowToImageFilter()
         w2i.SetInput(self.ren_win)
         w2i.SetInputBufferTypeToRGB()
         w2i.ReadFrontBufferOff()
@@ -551,6 +555,9 @@ class MainWindow(QtWidgets.QMainWindow):
         try:
             if not img.save(tmp, "PNG"):
                 raise OSError(f"cannot write {path}")
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)
             os.replace(tmp, path)
         finally:
             if os.path.exists(tmp):

@@ -16,8 +16,20 @@ from dataclasses import dataclass
 
 import numpy as np
 import pyvista as pv
-import vtk
 from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkCommonCore import vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+from vtkmodules.vtkRenderingCore import (
+    vtkActor,
+    vtkActor2D,
+    vtkBillboardTextActor3D,
+    vtkCoordinate,
+    vtkPolyDataMapper,
+    vtkPolyDataMapper2D,
+    vtkProp,
+    vtkRenderer,
+    vtkTextActor,
+)
 
 from eyeviz.scene import Scene
 from eyeviz.state import SceneState
@@ -31,6 +43,7 @@ INK = (0.15, 0.15, 0.15)
 BFV_FILL = (0.93, 0.91, 0.80)
 BFV_LINE = (0.45, 0.42, 0.30)
 INSET_VIEWPORT = (0.6, 0.0, 1.0, 0.5)  # (xmin, ymin, xmax, ymax) of the render window
+FILL_ALPHA = 0.4
 EDGE_MIN_PX = 7.0  # draw triangle edges when an ommatidium's rim is at least this wide
 Z_BFV, Z_EYES, Z_FEAT, Z_LINE, Z_POINT = -3.0, 0.0, 1.0, 2.0, 3.0
 _CIRCLE_N = 160
@@ -60,8 +73,8 @@ def eye_mesh(cx: float, l: float, m: int) -> pv.PolyData:
     return mesh
 
 
-def _actor(mesh, color=None, rgb: bool = False) -> vtk.vtkActor:
-    mapper = vtk.vtkPolyDataMapper()
+def _actor(mesh, color=None, rgb: bool = False) -> vtkActor:
+    mapper = vtkPolyDataMapper()
     mapper.SetInputData(mesh)
     if rgb:
         mapper.SetScalarModeToUseCellFieldData()
@@ -70,7 +83,7 @@ def _actor(mesh, color=None, rgb: bool = False) -> vtk.vtkActor:
         mapper.ScalarVisibilityOn()
     else:
         mapper.ScalarVisibilityOff()
-    actor = vtk.vtkActor()
+    actor = vtkActor()
     actor.SetMapper(mapper)
     prop = actor.GetProperty()
     prop.LightingOff()
@@ -101,9 +114,9 @@ def _ring(x: float, y: float, r: float, z: float) -> np.ndarray:
 class _FeatureActors:
     fill_mesh: pv.PolyData
     line_mesh: pv.PolyData
-    fill: vtk.vtkActor
-    line: vtk.vtkActor
-    label: vtk.vtkBillboardTextActor3D | None
+    fill: vtkActor
+    line: vtkActor
+    label: vtkBillboardTextActor3D | None
 
 
 class SceneActors:
@@ -113,16 +126,16 @@ class SceneActors:
     structure and writes colours and coordinates in place otherwise.
     """
 
-    def __init__(self, main: vtk.vtkRenderer, inset: vtk.vtkRenderer):
+    def __init__(self, main: vtkRenderer, inset: vtkRenderer):
         self.main = main
         self.inset = inset
         self._eyes_key = None
         self._feat_key = None
         self.eye_meshes: list[pv.PolyData] = []
-        self._eye_actors: list[vtk.vtkActor] = []  # [main A, main B, inset A, inset B]
-        self._static: list[tuple[vtk.vtkRenderer, vtk.vtkProp]] = []
+        self._eye_actors: list[vtkActor] = []  # [main A, main B, inset A, inset B]
+        self._static: list[tuple[vtkRenderer, vtkProp]] = []
         self._features: list[_FeatureActors] = []
-        self._feature_props: list[tuple[vtk.vtkRenderer, vtk.vtkProp]] = []
+        self._feature_props: list[tuple[vtkRenderer, vtkProp]] = []
         self.centers_mesh: pv.PolyData | None = None
         self.handle_mesh = pv.PolyData(np.zeros((1, 3)))
         self.handle_actor = self._points_actor(self.handle_mesh, 13, (0.35, 0.35, 0.35))
@@ -134,7 +147,7 @@ class SceneActors:
         self.main.AddActor(self.handle_actor)
         self.main.AddActor(self.sight_actors[0])
         self.inset.AddActor(self.sight_actors[1])
-        self._inset_label = vtk.vtkTextActor()
+        self._inset_label = vtkTextActor()
         tp = self._inset_label.GetTextProperty()
         tp.SetFontSize(20)
         tp.SetColor(*INK)
@@ -149,7 +162,7 @@ class SceneActors:
 
     # --- construction ---------------------------------------------------------------
     @staticmethod
-    def _points_actor(mesh, size: float, color) -> vtk.vtkActor:
+    def _points_actor(mesh, size: float, color) -> vtkActor:
         a = _actor(mesh, color)
         p = a.GetProperty()
         p.SetRepresentationToPoints()
@@ -158,23 +171,23 @@ class SceneActors:
         return a
 
     @staticmethod
-    def _border_actor() -> vtk.vtkActor2D:
-        pts = vtk.vtkPoints()
+    def _border_actor() -> vtkActor2D:
+        pts = vtkPoints()
         for x, y in ((0.002, 0.004), (0.998, 0.004), (0.998, 0.996), (0.002, 0.996)):
             pts.InsertNextPoint(x, y, 0)
-        lines = vtk.vtkCellArray()
+        lines = vtkCellArray()
         lines.InsertNextCell(5)
         for i in (0, 1, 2, 3, 0):
             lines.InsertCellPoint(i)
-        poly = vtk.vtkPolyData()
+        poly = vtkPolyData()
         poly.SetPoints(pts)
         poly.SetLines(lines)
-        coord = vtk.vtkCoordinate()
+        coord = vtkCoordinate()
         coord.SetCoordinateSystemToNormalizedViewport()
-        mapper = vtk.vtkPolyDataMapper2D()
+        mapper = vtkPolyDataMapper2D()
         mapper.SetInputData(poly)
         mapper.SetTransformCoordinate(coord)
-        actor = vtk.vtkActor2D()
+        actor = vtkActor2D()
         actor.SetMapper(mapper)
         actor.GetProperty().SetColor(*INK)
         actor.GetProperty().SetLineWidth(3)
@@ -249,7 +262,7 @@ class SceneActors:
                 ("B", (h, -1.35 * l)),
                 ("O", (0, -0.55 * l)),
             ):
-                t = vtk.vtkBillboardTextActor3D()
+                t = vtkBillboardTextActor3D()
                 t.SetInput(text)
                 t.SetPosition(x, y, Z_POINT)
                 tp = t.GetTextProperty()
@@ -269,7 +282,7 @@ class SceneActors:
             return
         n = len(scene.features)
         for f in scene.features:
-            pts = vtk.vtkPoints()
+            pts = vtkPoints()
             pts.SetNumberOfPoints(_CIRCLE_N)
             fill = pv.PolyData()
             fill.SetPoints(pts)
@@ -278,13 +291,13 @@ class SceneActors:
             line.SetPoints(pts)
             line.lines = np.concatenate([[_CIRCLE_N + 1], np.arange(_CIRCLE_N), [0]])
             col = _rgbf(f.color)
-            fa = _actor(fill, col)
-            fa.GetProperty().SetOpacity(0.45)
+            # an opaque tint, not alpha: translucency costs whole extra passes in software GL
+            fa = _actor(fill, tuple(FILL_ALPHA * c + (1 - FILL_ALPHA) for c in col))
             la = _actor(line, col)
             la.GetProperty().SetLineWidth(3.0)
             label = None
             if scene.shows("labels"):
-                label = vtk.vtkBillboardTextActor3D()
+                label = vtkBillboardTextActor3D()
                 tp = label.GetTextProperty()
                 tp.SetFontSize(22)
                 tp.BoldOn()

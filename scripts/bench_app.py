@@ -1,0 +1,181 @@
+"""Latency of the app: mouse-move during a drag -> rendered frame, and window-up time.
+
+Runs under Xvfb (re-executes itself with xvfb-run when $DISPLAY is unset), 1280x800,
+this machine's software OpenGL. For m = 720 with 10 features and m = 36,000 with 50
+features it presses on a feature, sends >= 200 mouse-move events along a path and times
+each from the event to the end of the frame (VTK render finished with glFinish, Qt
+panels painted). Prints p50/p95 and the ratio to the targets (p95 <= 16 ms, <= 50 ms),
+with a baseline measured in the same run: a bare re-render of the same window.
+Window-up: whole process, start to first rendered frame (median of 3), target <= 3 s.
+
+    xvfb-run -a .venv/bin/python scripts/bench_app.py [--events 240]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = ((720, 10, 16.0), (36_000, 50, 50.0))
+UP_TARGET_S = 3.0
+
+
+def _scene(m: int, n: int):
+    import numpy as np
+
+    from eyeviz.scene import OKABE_ITO, Eyes, Feature, Scene, View
+
+    rng = np.random.default_rng(7)
+    fs = []
+    for i in range(n):
+        r = rng.uniform(1000, 5000)
+        phi = rng.uniform(math.radians(40), math.radians(140))
+        fs.append(
+            Feature(
+                f"f{i}",
+                r * math.cos(phi),
+                r * math.sin(phi),
+                float(rng.uniform(20, 300)),
+                OKABE_ITO[i % len(OKABE_ITO)],
+            )
+        )
+    fs[0] = Feature("dragged", 0.0, 1500.0, 50.0, OKABE_ITO[0])
+    layers = ["eyes", "bfv", "features", "bitmaps", "readout", "labels"]
+    return Scene(Eyes(40.0, 20.0, m), fs, layers, view=View((0.0, 2600.0), 9000.0))
+
+
+def _pct(v, q):
+    s = sorted(v)
+    return s[min(len(s) - 1, int(round(q / 100 * (len(s) - 1))))]
+
+
+def bench_drag(m: int, n: int, events: int, settings: str) -> dict:
+    from PyQt5 import QtCore
+    from PyQt5.QtTest import QTest
+
+    from eyeviz.app.window import MainWindow, make_app, make_settings
+
+    app = make_app()
+    win = MainWindow(_scene(m, n), settings=make_settings(settings))
+    win.resize(1280, 800)
+    win.show()
+    for _ in range(5):
+        app.processEvents()
+    win.fit_inset()
+    w = win.plotter
+    rw = win.ren_win
+
+    def frame():
+        app.processEvents()
+        rw.WaitForCompletion()
+
+    base = []
+    for _ in range(60):
+        t0 = time.perf_counter()
+        win.render()
+        frame()
+        base.append(1e3 * (time.perf_counter() - t0))
+    px, py = win.to_pixel(0.0, 1500.0)
+    start = QtCore.QPoint(round(px), round(py))
+    QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
+    lat = []
+    for k in range(events + 10):
+        a = 2 * math.pi * k / 80
+        p = start + QtCore.QPoint(round(150 * math.sin(a)) + k % 3, round(-60 * (1 - math.cos(a))))
+        t0 = time.perf_counter()
+        QTest.mouseMove(w, p)
+        frame()
+        if k >= 10:  # the first moves cross the click/drag threshold
+            lat.append(1e3 * (time.perf_counter() - t0))
+    QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, p)
+    moved = win.model.scene.features[0].x != 0.0
+    steps = win.undo_stack.count()
+    win.close()
+    app.processEvents()
+    return {
+        "p50": _pct(lat, 50),
+        "p95": _pct(lat, 95),
+        "max": max(lat),
+        "n": len(lat),
+        "base50": _pct(base, 50),
+        "moved": moved,
+        "undo_steps": steps,
+    }
+
+
+def bench_up(settings: str) -> float:
+    code = (
+        "import time; t0 = time.perf_counter()\n"
+        "from eyeviz.app.window import MainWindow, make_app, make_settings\n"
+        "from eyeviz.scene import load\n"
+        "app = make_app()\n"
+        f"w = MainWindow(load({str(ROOT / 'assets/scenes/default.toml')!r}), "
+        f"settings=make_settings({settings!r}))\n"
+        "w.show(); app.processEvents(); w.fit_inset(); w.ren_win.WaitForCompletion()\n"
+        "print('up', flush=True)\n"
+    )
+    times = []
+    for _ in range(3):
+        t0 = time.perf_counter()
+        p = subprocess.Popen(
+            [sys.executable, "-c", code],
+            stdout=subprocess.PIPE,
+            text=True,
+            stderr=subprocess.DEVNULL,
+        )
+        for line in p.stdout:
+            if line.strip() == "up":
+                times.append(time.perf_counter() - t0)
+                break
+        p.wait()
+    return statistics.median(times)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--events", type=int, default=240, help="mouse-move events per case (>= 200)")
+    args = ap.parse_args()
+    if args.events < 200:
+        ap.error("--events must be >= 200")
+    if not os.environ.get("DISPLAY"):
+        if not shutil.which("xvfb-run"):
+            print("bench_app: no display and no xvfb-run", file=sys.stderr)
+            return 2
+        cmd = ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24", sys.executable, *sys.argv]
+        return subprocess.call(cmd)
+    os.environ.setdefault("QT_API", "pyqt5")
+    with tempfile.TemporaryDirectory() as tmp:
+        settings = str(Path(tmp) / "bench.ini")
+        print(
+            f"{'case':<24}{'events':>7}{'p50 ms':>9}{'p95 ms':>9}{'max ms':>9}"
+            f"{'target':>8}{'p95/target':>12}{'bare render':>13}"
+        )
+        ok = True
+        for m, n, target in CASES:
+            r = bench_drag(m, n, args.events, settings)
+            ok &= r["p95"] <= target and r["moved"] and r["undo_steps"] == 1
+            print(
+                f"{f'm={m:,}, {n} features':<24}{r['n']:>7}{r['p50']:>9.1f}{r['p95']:>9.1f}"
+                f"{r['max']:>9.1f}{target:>8.0f}{r['p95'] / target:>12.2f}{r['base50']:>11.1f}ms"
+            )
+        up = bench_up(settings)
+        ok &= up <= UP_TARGET_S
+        print(
+            f"window up (whole process, median of 3): {up:.2f} s, target {UP_TARGET_S:.0f} s, "
+            f"ratio {up / UP_TARGET_S:.2f}"
+        )
+    print("all targets met" if ok else "SOME TARGETS MISSED")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
