@@ -626,7 +626,7 @@ class _Painter:
         cols = estimator_colors(sc.estimators)
         handles = []
         for name in sc.estimators:
-            if name not in preds:
+            if not isinstance(preds.get(name), tuple | list):
                 continue
             r_hat, phi_hat = (np.asarray(v, dtype=np.float64) for v in preds[name])
             col = cols[name]
@@ -818,6 +818,8 @@ class _Painter:
             return f"{name}: outside the networks' domain (not in the BFV or not seen by both)"
         if name not in self.preds:
             return f"{name}: no prediction"
+        if isinstance(self.preds[name], str):
+            return f"{name}: {self.preds[name]}"
         r_hat, phi_hat = (float(np.asarray(v)[i]) for v in self.preds[name])
         if not (math.isfinite(r_hat) and math.isfinite(phi_hat)):
             return f"{name}: no answer for these bitmaps"
@@ -910,26 +912,42 @@ def _round_sig(v: float) -> str:
     return f"{v:.1f}"
 
 
-def predict_scene(scene: Scene, state: SceneState) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Each of the scene's estimators on every feature's Omega bitmaps (Section 4: m/2 each).
+def predict_scene(
+    scene: Scene, state: SceneState
+) -> dict[str, tuple[np.ndarray, np.ndarray] | str]:
+    """Each of the scene's estimators on the in-domain features' Omega bitmaps (m/2 each).
 
-    Imports :mod:`eyeviz.estimators` (and through it torch for the networks) only here.
+    Returns name -> (r_hat, phi_hat) per feature (NaN for features outside the networks'
+    domain: not in the BFV or not seen by both eyes), or name -> a one-line reason when
+    the estimator cannot answer for this scene (made for another m, say). An estimator
+    that cannot be loaded at all is an :class:`EyevizError`. Imports
+    :mod:`eyeviz.estimators` (and through it torch for the networks) only here.
     """
     from eyeviz import estimators
 
     m = state.pair.m
-    if state.LA is None:
+    if state.LA is None or state.in_bfv is None:
         state = compute_state(scene, ["bitmaps", "readout"])
-    oa = np.stack([state.bitmaps(i, m // 2)[0] for i in range(state.n)]).astype(np.float32)
-    ob = np.stack([state.bitmaps(i, m // 2)[1] for i in range(state.n)]).astype(np.float32)
-    out = {}
+    n = state.n
+    ok = np.flatnonzero(state.in_domain())
+    out: dict[str, tuple[np.ndarray, np.ndarray] | str] = {}
     for name in scene.estimators:
         try:
             est = estimators.load(name)
         except (ImportError, OSError, ValueError) as exc:
             raise EyevizError(f"predictions layer: cannot load estimator {name!r}: {exc}") from None
-        r_hat, phi_hat = est.predict(oa, ob)
-        out[name] = (np.asarray(r_hat, dtype=np.float64), np.asarray(phi_hat, dtype=np.float64))
+        r_hat, phi_hat = np.full(n, np.nan), np.full(n, np.nan)
+        if ok.size:
+            oa = np.stack([state.bitmaps(i, m // 2)[0] for i in ok]).astype(np.float32)
+            ob = np.stack([state.bitmaps(i, m // 2)[1] for i in ok]).astype(np.float32)
+            try:
+                r_ok, phi_ok = est.predict(oa, ob)
+            except ValueError as exc:
+                out[name] = str(exc).splitlines()[0]
+                continue
+            r_hat[ok] = np.asarray(r_ok, dtype=np.float64)
+            phi_hat[ok] = np.asarray(phi_ok, dtype=np.float64)
+        out[name] = (r_hat, phi_hat)
     return out
 
 

@@ -152,3 +152,15 @@ def test_every_shipped_scene_draws(name):
     sc = scene_mod.load(SCENES / f"{name}.toml")
     root = _svg(sc)
     assert _groups(root, "feature-")
+
+
+def test_predictions_for_a_scene_the_estimator_was_not_made_for():
+    """m = 24 against an estimator made for m = 720: a one-line note, not a crash."""
+    sc = scene_mod.load(SCENES / "figure3b.toml")
+    sc.features.append(scene_mod.Feature("front", 0.0, 150.0, 20.0, "#0072B2"))
+    sc.layers = ["eyes", "features", "predictions", "readout"]
+    sc.estimators = ["analytic"]
+    root = _svg(sc)
+    texts = " ".join("".join(t.itertext()) for t in root.iter(f"{SVG}text"))
+    assert "analytic: omega_a rows must have length m/2 = 360" in texts
+    assert not _groups(root, "prediction-analytic-")
