@@ -18,8 +18,6 @@ from __future__ import annotations
 from fractions import Fraction
 from math import gcd
 
-import mpmath
-
 #: cos(30k deg) = a + b*sqrt(3), k = 0..11, as (a, b)
 _COS30 = [
     (1, 0), (0, Fraction(1, 2)), (Fraction(1, 2), 0), (0, 0),
@@ -47,7 +45,9 @@ def sign_a_plus_b_sqrt(a: Fraction, b: Fraction, k: int) -> int:
     return sa if diff > 0 else sb if diff < 0 else 0
 
 
-def _mpf(q: Fraction) -> mpmath.mpf:
+def _mpf(q: Fraction):
+    import mpmath  # imported on first use: most programs never reach the exact path
+
     return mpmath.mpf(q.numerator) / q.denominator
 
 
@@ -64,6 +64,8 @@ def sign_linear(u: Fraction, v: Fraction, w: Fraction, n: int, m: int) -> int:
             return sign_a_plus_b_sqrt(u + v * ca + w * sa, v * cb + w * sb, root)
     if u == 0 and v == 0 and w == 0:
         return 0
+    import mpmath
+
     scale = abs(u) + abs(v) + abs(w)
     prec = 128
     while prec <= _MAX_PREC:
@@ -89,6 +91,8 @@ def exact_floor_pair(x: float, y: float, g: float, cx: float, m: int) -> tuple[i
     G = Fraction(g)
     if X * X + Y * Y <= G * G:
         return None
+    import mpmath
+
     # enough bits to hold x - cx exactly, however far apart their exponents are
     prec = max(192, 2 * max(X.numerator.bit_length(), X.denominator.bit_length()))
     while True:
