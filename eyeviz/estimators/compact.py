@@ -1,0 +1,289 @@
+"""Compact networks: two tiny MLPs on features of the four lit-interval integers.
+
+A bitmap pair is fully described by (LA, RA, LB, RB) (Prop. 2), so instead of the
+paper's 720 bits (Appendix A/B, 60 M and 33 M weights) each network reads 11 numbers
+derived from them: the edge disparities LB - LA and RB - RA (the stereo cue for distance),
+the widths and their logs (the size cue), the mean centre angle, and the analytic
+triangulation itself (:mod:`eyeviz.estimators.analytic`). Each network predicts a
+correction to the triangulation:
+
+- DD: log r = log r_analytic + f(x), trained on the relative error |r_hat / r - 1|
+  (the MAPE of Eq. 34), so it learns the 1/r-weighted posterior median;
+- AD: phi = phi_analytic + 1e-3 * f(x), trained on |phi_hat / phi - 1|; its last layer
+  starts at zero, so training starts from the triangulation.
+
+Weights: ``assets/models/compact_dd.pt`` and ``compact_ad.pt`` (a few kB each) with
+``compact.json`` (data parameters, seed, metrics, training time, command).
+This is the only estimator module besides ``paper`` that imports torch.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch import nn
+
+from eyeviz.estimators.analytic import AnalyticEstimator
+from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
+
+__all__ = ["CompactEstimator", "CompactNet", "features", "load", "train", "default_dir"]
+
+N_FEATURES = 11
+AD_SCALE = 1e-3  # radians per unit of the AD network's output
+
+
+def default_dir() -> Path:
+    return Path(__file__).resolve().parents[2] / "assets" / "models"
+
+
+def features(LA, RA, LB, RB, domain: Domain = PAPER_DOMAIN):
+    """(X float32 (N, 11), log r_analytic, phi_analytic) from interval arrays."""
+    la, ra, lb, rb = (np.asarray(v, np.float64) for v in (LA, RA, LB, RB))
+    gam = 2.0 * math.pi / domain.m
+    wa = ra - la + 1.0
+    wb = rb - lb + 1.0
+    dl = lb - la
+    dr = rb - ra
+    c = (la + ra + lb + rb + 2.0) * (0.25 * gam)
+    r0, p0 = AnalyticEstimator(domain)._predict_intervals(la, ra, lb, rb)
+    log_r0 = np.log(r0)
+    x = np.empty((la.shape[0], N_FEATURES), np.float32)
+    x[:, 0] = dl * 0.25
+    x[:, 1] = dr * 0.25
+    x[:, 2] = (wb - wa) * 0.5
+    x[:, 3] = np.log(wa) - 3.0
+    x[:, 4] = np.log(wb) - 3.0
+    x[:, 5] = c - 0.5 * math.pi
+    x[:, 6] = np.sin(c) - 0.8
+    x[:, 7] = log_r0 - math.log(math.sqrt(domain.r_min * domain.r_max))
+    x[:, 8] = 1.0 / (0.5 * (dl + dr) + 1.0)
+    x[:, 9] = 1.0 / (dl + 1.5)
+    x[:, 10] = 1.0 / (dr + 1.5)
+    return x, log_r0, p0
+
+
+class CompactNet(nn.Module):
+    """Linear(11, H) - SiLU - Linear(H, H) - SiLU - Linear(H, 1)."""
+
+    def __init__(self, hidden: int = 32, zero_last: bool = False) -> None:
+        super().__init__()
+        self.net = nn.Sequential(
+            nn.Linear(N_FEATURES, hidden), nn.SiLU(),
+            nn.Linear(hidden, hidden), nn.SiLU(),
+            nn.Linear(hidden, 1),
+        )
+        if zero_last:
+            nn.init.zeros_(self.net[-1].weight)
+            nn.init.zeros_(self.net[-1].bias)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return self.net(x).squeeze(-1)
+
+
+def count_weights(net: nn.Module) -> int:
+    return sum(p.numel() for p in net.parameters())
+
+
+class CompactEstimator(Estimator):
+    name = "compact"
+
+    def __init__(self, dd: CompactNet, ad: CompactNet, domain: Domain = PAPER_DOMAIN,
+                 metadata: dict | None = None) -> None:
+        meta = dict(metadata or {})
+        meta["n_weights"] = count_weights(dd) + count_weights(ad)
+        super().__init__(domain, meta)
+        self.dd = dd.eval()
+        self.ad = ad.eval()
+
+    def _predict_intervals(self, LA, RA, LB, RB):
+        x, log_r0, p0 = features(LA, RA, LB, RB, self.domain)
+        with torch.inference_mode():
+            xt = torch.from_numpy(x)
+            d = self.dd(xt).numpy()
+            a = self.ad(xt).numpy()
+        return np.exp(log_r0 + d), p0 + AD_SCALE * a
+
+
+def _atomic(path: Path, write: Callable[[str], None]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _save_net(net: CompactNet, hidden: int, path: Path) -> None:
+    weights = {k: v.detach().clone() for k, v in net.state_dict().items()}
+    state = {"hidden": hidden, "state": weights}
+    _atomic(path, lambda tmp: torch.save(state, tmp))
+
+
+def _load_net(path: Path) -> CompactNet:
+    obj = torch.load(path, map_location="cpu", weights_only=True)
+    net = CompactNet(int(obj["hidden"]))
+    net.load_state_dict(obj["state"])
+    return net
+
+
+def load(path=None, domain: Domain | None = None) -> CompactEstimator:
+    """Weights from ``path`` (a directory with compact.json), default assets/models/."""
+    d = Path(path) if path is not None else default_dir()
+    meta_f = d / "compact.json"
+    if not meta_f.is_file():
+        raise ValueError(
+            f"compact weights not found in {d} (no compact.json); "
+            f"train them with `eyeviz train compact -o {d}`"
+        )
+    meta = json.loads(meta_f.read_text())
+    try:
+        dd = _load_net(d / meta["files"]["dd"])
+        ad = _load_net(d / meta["files"]["ad"])
+    except (OSError, KeyError, RuntimeError) as exc:
+        raise ValueError(f"cannot load compact weights from {d}: {exc}") from None
+    dom = domain or Domain.from_dict(meta["data"])
+    torch.set_num_threads(min(2, torch.get_num_threads()))
+    return CompactEstimator(dd, ad, dom, meta)
+
+
+# --- training ------------------------------------------------------------------------------
+
+def _generate(n: int, domain: Domain, seed: int, mode: str = "single"):
+    from eyeviz import dataset
+
+    p = dataset.make_params(domain.eyes, domain.r_min, domain.r_max, domain.g_max, mode, seed)
+    chunks = list(dataset.iter_chunks(n, p, chunk=1 << 17))
+    return {k: np.concatenate([getattr(c, k) for c in chunks])
+            for k in ("r", "phi", "la", "ra", "lb", "rb")}
+
+
+def _fit(net: CompactNet, x, y, xv, yv, predict: Callable, epochs: int, batch: int, lr: float,
+         patience: int, seed: int, ckpt: Callable[[CompactNet], None],
+         progress: Callable[[str, int, int, float], None] | None, label: str) -> dict:
+    """Adam with a one-cycle schedule on the relative error; early stopping on validation."""
+    g = torch.Generator().manual_seed(seed)
+    n = x.shape[0]
+    steps = n // batch
+    opt = torch.optim.Adam(net.parameters(), lr=lr)
+    sched = torch.optim.lr_scheduler.OneCycleLR(opt, max_lr=lr, total_steps=epochs * steps)
+    best, best_state, bad, history = math.inf, None, 0, []
+    for ep in range(epochs):
+        net.train()
+        perm = torch.randperm(n, generator=g)
+        for i in range(steps):
+            idx = perm[i * batch:(i + 1) * batch]
+            opt.zero_grad(set_to_none=True)
+            loss = predict(net(x[idx]), y[idx])
+            loss.backward()
+            opt.step()
+            sched.step()
+        net.eval()
+        with torch.inference_mode():
+            val = float(predict(net(xv), yv))
+        history.append(val)
+        if progress is not None:
+            progress(label, ep + 1, epochs, val)
+        if val < best - 1e-7:
+            best, bad = val, 0
+            best_state = {k: v.detach().clone() for k, v in net.state_dict().items()}
+            ckpt(net)
+        else:
+            bad += 1
+            if bad >= patience:
+                break
+    if best_state is not None:
+        net.load_state_dict(best_state)
+    return {"epochs": len(history), "val_history": [round(v, 7) for v in history],
+            "best_val": best}
+
+
+def train(out_dir=None, n_train: int = 1_000_000, n_val: int = 100_000, seed: int = 0,
+          epochs: int = 12, hidden: int = 32, batch: int = 4096, lr: float = 4e-3,
+          patience: int = 3, domain: Domain = PAPER_DOMAIN, threads: int = 2,
+          command: str | None = None,
+          progress: Callable[[str, int, int, float], None] | None = None) -> dict:
+    """Generate data (single pass, seeds ``seed`` and ``seed + 1``), train both nets, save.
+
+    Weights are written atomically to ``out_dir`` after every improving epoch; the final
+    ``compact.json`` is written last. Returns the metadata.
+    """
+    t0 = time.perf_counter()
+    torch.set_num_threads(threads)
+    torch.manual_seed(seed)
+    out = Path(out_dir) if out_dir is not None else default_dir()
+    tr = _generate(n_train, domain, seed)
+    va = _generate(n_val, domain, seed + 1)
+    t_gen = time.perf_counter() - t0
+
+    def prep(d):
+        x, log_r0, p0 = features(d["la"], d["ra"], d["lb"], d["rb"], domain)
+        return (torch.from_numpy(x),
+                torch.from_numpy((np.log(d["r"]) - log_r0).astype(np.float32)),
+                torch.from_numpy(((d["phi"] - p0) / AD_SCALE).astype(np.float32)),
+                torch.from_numpy((d["phi"] / AD_SCALE).astype(np.float32)))
+
+    x, yd, ya, sa = prep(tr)
+    xv, ydv, yav, sav = prep(va)
+
+    def dd_loss(out, y):
+        return (torch.exp(out - y) - 1.0).abs().mean()
+
+    # AD: |phi_hat - phi| / phi with phi_hat - phi = AD_SCALE * (out - y)
+    ya_pair = torch.stack([ya, sa], 1)
+    yav_pair = torch.stack([yav, sav], 1)
+
+    def ad_loss(out, y):
+        return ((out - y[:, 0]).abs() / y[:, 1]).mean()
+
+    files = {"dd": "compact_dd.pt", "ad": "compact_ad.pt"}
+    info = {}
+    nets = {}
+    for name, y, yv, loss, zero in (("dd", yd, ydv, dd_loss, False),
+                                    ("ad", ya_pair, yav_pair, ad_loss, True)):
+        torch.manual_seed(seed)
+        net = CompactNet(hidden, zero_last=zero)
+        ts = time.perf_counter()
+        path = out / files[name]
+        info[name] = _fit(net, x, y, xv, yv, loss, epochs, batch, lr, patience, seed,
+                          lambda n_, p=path: _save_net(n_, hidden, p), progress, name.upper())
+        info[name]["seconds"] = round(time.perf_counter() - ts, 1)
+        _save_net(net, hidden, path)
+        nets[name] = net
+    est = CompactEstimator(nets["dd"], nets["ad"], domain)
+    pv = est.predict_intervals(va["la"], va["ra"], va["lb"], va["rb"])
+    from eyeviz.estimators import metrics
+
+    meta = {
+        "estimator": "compact",
+        "files": files,
+        "architecture": f"{N_FEATURES}-{hidden}-{hidden}-1 SiLU MLP per target (DD, AD)",
+        "n_weights": est.n_weights,
+        "data": {**domain.to_dict(), "mode": "single", "n_train": n_train, "n_val": n_val,
+                 "train_seed": seed, "val_seed": seed + 1},
+        "training": {"epochs_max": epochs, "batch": batch, "lr": lr, "patience": patience,
+                     "optimizer": "Adam + one-cycle", "threads": threads,
+                     "dd_loss": "mean |r_hat/r - 1|", "ad_loss": "mean |phi_hat/phi - 1|",
+                     **{name: info[name] for name in info}},
+        "train_seconds": round(time.perf_counter() - t0, 1),
+        "generate_seconds": round(t_gen, 1),
+        "val_metrics": {"dd": metrics.summary(va["r"], pv.r),
+                        "ad": metrics.summary(va["phi"], pv.phi)},
+        "torch": torch.__version__,
+        "command": command,
+        "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+    }
+    text = json.dumps(meta, indent=2)
+    _atomic(out / "compact.json", lambda tmp: Path(tmp).write_text(text))
+    return meta

@@ -1,0 +1,85 @@
+"""The shipped compact networks: targets of issue 4 on a fresh test set, loading, torch."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from eyeviz import dataset, estimators
+from eyeviz.estimators import metrics
+
+MODELS = Path(__file__).resolve().parents[2] / "assets" / "models"
+TEST_SEED = 777_001  # not the training (0) or validation (1) seed
+
+
+@pytest.fixture(scope="module")
+def fresh():
+    return dataset.generate(20_000, seed=TEST_SEED)
+
+
+def test_shipped_files_are_small_and_documented():
+    meta = json.loads((MODELS / "compact.json").read_text())
+    for f in meta["files"].values():
+        assert (MODELS / f).stat().st_size <= 1_000_000
+    assert meta["data"]["train_seed"] != TEST_SEED
+    assert meta["command"].startswith("eyeviz train compact")
+    assert meta["train_seconds"] <= 300
+
+
+def test_shipped_weights_meet_the_targets(fresh):
+    est = estimators.load("compact")
+    p = est.predict(fresh.omega_a, fresh.omega_b)
+    assert p.valid.all() and p.in_domain.all()
+    dd = metrics.summary(fresh.r, p.r)
+    ad = metrics.summary(fresh.phi, p.phi)
+    assert ad["mape"] <= 0.09
+    assert dd["mape"] <= 7.25
+    assert dd["r2"] >= 0.915
+    # far better than a constant predictor
+    assert dd["mape"] < 0.3 * metrics.mape(fresh.r, np.full(len(fresh), np.median(fresh.r)))
+    assert ad["mape"] < 0.01 * metrics.mape(fresh.phi, np.full(len(fresh), np.median(fresh.phi)))
+    # and better than the analytic triangulation it corrects
+    ana = estimators.load("analytic").predict(fresh.omega_a, fresh.omega_b)
+    assert dd["mape"] < metrics.mape(fresh.r, ana.r) - 1.5
+
+
+def test_bad_rows_and_single_row():
+    est = estimators.load("compact")
+    ds = dataset.generate(10, seed=TEST_SEED + 1)
+    a = ds.omega_a.copy()
+    a[4] = False
+    p = est.predict(a, ds.omega_b)
+    assert np.isnan(p.r[4]) and not p.valid[4] and p.valid.sum() == 9
+    one = est.predict(ds.omega_a[0], ds.omega_b[0])
+    assert np.ndim(one.r) == 0 and abs(one.r - ds.r[0]) / ds.r[0] < 0.5
+    with pytest.raises(ValueError, match="length"):
+        est.predict(ds.omega_a[:, :100], ds.omega_b[:, :100])
+
+
+def test_missing_weights_is_a_clear_error(tmp_path):
+    with pytest.raises(ValueError, match="eyeviz train compact"):
+        estimators.load("compact", path=tmp_path)
+
+
+def test_load_compact_imports_torch():
+    code = ("import sys, eyeviz.estimators as e; assert 'torch' not in sys.modules;"
+            "e.load('compact'); print('torch' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "True"
+
+
+def test_training_runs_and_writes_atomically(tmp_path):
+    from eyeviz.estimators import compact
+
+    meta = compact.train(tmp_path, n_train=20_000, n_val=5_000, seed=3, epochs=2, hidden=8,
+                         batch=1024)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "compact.json", "compact_ad.pt", "compact_dd.pt"]
+    est = estimators.load("compact", path=tmp_path)
+    assert est.n_weights == meta["n_weights"]
+    ds = dataset.generate(2000, seed=9)
+    p = est.predict(ds.omega_a, ds.omega_b)
+    assert metrics.mape(ds.r, p.r) < 20
