@@ -373,7 +373,7 @@ class MainWindow(QtWidgets.QMainWindow):
             cam.SetParallelScale(v.width * h / w / 2.0)
             cam.SetClippingRange(1.0, 2.0 * CAMERA_DISTANCE)
         e = self.model.scene.eyes
-        self.actors.set_edges(
+        self.actors.set_zoom(
             1.0 / self.units_per_px("main"), 1.0 / self.units_per_px("inset"), e.l, e.m
         )
 

@@ -12,7 +12,6 @@ shown). Nothing here computes geometry: colours and positions come from a
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 import pyvista as pv
@@ -44,6 +43,7 @@ BFV_FILL = (0.93, 0.91, 0.80)
 BFV_LINE = (0.45, 0.42, 0.30)
 INSET_VIEWPORT = (0.6, 0.0, 1.0, 0.5)  # (xmin, ymin, xmax, ymax) of the render window
 FILL_ALPHA = 0.4
+LABEL_ALL_MAX = 12  # more features than this: only the selected one is labelled
 EDGE_MIN_PX = 7.0  # draw triangle edges when an ommatidium's rim is at least this wide
 Z_BFV, Z_EYES, Z_FEAT, Z_LINE, Z_POINT = -3.0, 0.0, 1.0, 2.0, 3.0
 _CIRCLE_N = 160
@@ -58,19 +58,32 @@ def _rgbf(color: str) -> tuple[float, float, float]:
     return tuple(v / 255.0 for v in hex_rgb(color))
 
 
-def eye_mesh(cx: float, l: float, m: int) -> pv.PolyData:
-    """The m ommatidium triangles of the eye centred at (cx, 0) (Figure 2)."""
-    t = np.arange(m) * (2.0 * math.pi / m)
-    pts = np.zeros((m + 1, 3))
+def eye_mesh(cx: float, l: float, m: int, starts=None) -> pv.PolyData:
+    """The m ommatidium triangles of the eye centred at (cx, 0) (Figure 2).
+
+    Cell k spans the rim directions starts[k]*gamma .. starts[k+1]*gamma (default: one cell
+    per ommatidium); pooled cells serve as the level of detail of a small eye.
+    """
+    if starts is None:
+        starts = np.arange(m)
+    n = len(starts)
+    edges = np.append(starts, m)  # rim vertices at every cell boundary
+    t = edges * (2.0 * math.pi / m)
+    pts = np.zeros((n + 2, 3))
     pts[0] = (cx, 0.0, Z_EYES)
     pts[1:, 0] = cx + l * np.cos(t)
     pts[1:, 1] = l * np.sin(t)
     pts[1:, 2] = Z_EYES
-    k = np.arange(m)
-    faces = np.column_stack([np.full(m, 3), np.zeros(m, int), k + 1, (k + 1) % m + 1]).ravel()
+    k = np.arange(n)
+    faces = np.column_stack([np.full(n, 3), np.zeros(n, int), k + 1, k + 2]).ravel()
     mesh = pv.PolyData(pts, faces=faces)
-    mesh.cell_data["rgb"] = np.tile(UNLIT, (m, 1))
+    mesh.cell_data["rgb"] = np.tile(UNLIT, (n, 1))
     return mesh
+
+
+def _pool(owner: np.ndarray, k: int) -> np.ndarray:
+    """Owner of each run of k ommatidia: the last feature lighting any of them (or -1)."""
+    return owner if k == 1 else np.maximum.reduceat(owner, np.arange(0, owner.shape[0], k))
 
 
 def _actor(mesh, color=None, rgb: bool = False) -> vtkActor:
@@ -110,15 +123,6 @@ def _ring(x: float, y: float, r: float, z: float) -> np.ndarray:
     return pts
 
 
-@dataclass
-class _FeatureActors:
-    fill_mesh: pv.PolyData
-    line_mesh: pv.PolyData
-    fill: vtkActor
-    line: vtkActor
-    label: vtkBillboardTextActor3D | None
-
-
 class SceneActors:
     """All actors of one scene in a main renderer and an inset renderer (the eyes, magnified).
 
@@ -134,7 +138,11 @@ class SceneActors:
         self.eye_meshes: list[pv.PolyData] = []
         self._eye_actors: list[vtkActor] = []  # [main A, main B, inset A, inset B]
         self._static: list[tuple[vtkRenderer, vtkProp]] = []
-        self._features: list[_FeatureActors] = []
+        self._lod: dict[tuple[int, int], pv.PolyData] = {}
+        self._lod_k = {"main": 1, "inset": 1}
+        self.fill_mesh: pv.PolyData | None = None
+        self.line_mesh: pv.PolyData | None = None
+        self._labels: list[vtkBillboardTextActor3D] = []
         self._feature_props: list[tuple[vtkRenderer, vtkProp]] = []
         self.centers_mesh: pv.PolyData | None = None
         self.handle_mesh = pv.PolyData(np.zeros((1, 3)))
@@ -144,6 +152,11 @@ class SceneActors:
         for a in self.sight_actors:
             a.GetProperty().SetLineWidth(2.0)
             a.GetProperty().SetLineStipplePattern(0xF0F0)
+        self.sel_mesh = pv.PolyData(_ring(0, 0, 1, Z_LINE))
+        self.sel_mesh.lines = np.concatenate([[_CIRCLE_N + 1], np.arange(_CIRCLE_N), [0]])
+        self.sel_actor = _actor(self.sel_mesh, INK)
+        self.sel_actor.GetProperty().SetLineWidth(5.0)
+        self.main.AddActor(self.sel_actor)
         self.main.AddActor(self.handle_actor)
         self.main.AddActor(self.sight_actors[0])
         self.inset.AddActor(self.sight_actors[1])
@@ -239,6 +252,8 @@ class SceneActors:
         if scene.shows("eyes"):
             for cx in (-h, h):
                 self.eye_meshes.append(eye_mesh(cx, l, m))
+            self._lod = {}
+            self._lod_k = {"main": 1, "inset": 1}
             for ren in (self.main, self.inset):
                 for mesh in self.eye_meshes:
                     a = _actor(mesh, rgb=True)
@@ -275,43 +290,45 @@ class SceneActors:
         self._inset_label.SetInput(f"eyes (m = {m})")
 
     def _build_features(self, scene: Scene) -> None:
+        """All discs in ONE fill mesh and ONE outline mesh (cell colours): few draw calls."""
         self._clear(self._feature_props)
-        self._features = []
-        self.centers_mesh = None
+        self._labels = []
+        self.centers_mesh = self.fill_mesh = self.line_mesh = None
         if not scene.shows("features") or not scene.features:
             return
-        n = len(scene.features)
-        for f in scene.features:
-            pts = vtkPoints()
-            pts.SetNumberOfPoints(_CIRCLE_N)
-            fill = pv.PolyData()
-            fill.SetPoints(pts)
-            fill.faces = np.concatenate([[_CIRCLE_N], np.arange(_CIRCLE_N)])
-            line = pv.PolyData()
-            line.SetPoints(pts)
-            line.lines = np.concatenate([[_CIRCLE_N + 1], np.arange(_CIRCLE_N), [0]])
-            col = _rgbf(f.color)
-            # an opaque tint, not alpha: translucency costs whole extra passes in software GL
-            fa = _actor(fill, tuple(FILL_ALPHA * c + (1 - FILL_ALPHA) for c in col))
-            la = _actor(line, col)
-            la.GetProperty().SetLineWidth(3.0)
-            label = None
-            if scene.shows("labels"):
+        n, c = len(scene.features), _CIRCLE_N
+        cols = np.array([hex_rgb(f.color) for f in scene.features], dtype=np.float64)
+        # an opaque tint, not alpha: translucency costs whole extra passes in software GL
+        tint = np.round(FILL_ALPHA * cols + (1 - FILL_ALPHA) * 255).astype(np.uint8)
+        pts = vtkPoints()
+        pts.SetNumberOfPoints(n * c)
+        idx = np.arange(n * c).reshape(n, c)
+        self.fill_mesh = pv.PolyData()
+        self.fill_mesh.SetPoints(pts)
+        self.fill_mesh.faces = np.column_stack([np.full(n, c), idx]).ravel()
+        self.fill_mesh.cell_data["rgb"] = tint
+        self.line_mesh = pv.PolyData()
+        self.line_mesh.SetPoints(pts)
+        self.line_mesh.lines = np.column_stack([np.full(n, c + 1), idx, idx[:, :1]]).ravel()
+        self.line_mesh.cell_data["rgb"] = cols.astype(np.uint8)
+        fa = _actor(self.fill_mesh, rgb=True)
+        la = _actor(self.line_mesh, rgb=True)
+        la.GetProperty().SetLineWidth(3.0)
+        self._add(self._feature_props, self.main, fa)
+        self._add(self._feature_props, self.main, la)
+        if scene.shows("labels"):
+            for f in scene.features:
                 label = vtkBillboardTextActor3D()
                 tp = label.GetTextProperty()
                 tp.SetFontSize(22)
                 tp.BoldOn()
-                tp.SetColor(*col)
+                tp.SetColor(*_rgbf(f.color))
                 tp.SetJustificationToLeft()
                 tp.SetVerticalJustificationToBottom()
                 self._add(self._feature_props, self.main, label)
-            self._add(self._feature_props, self.main, fa)
-            self._add(self._feature_props, self.main, la)
-            self._features.append(_FeatureActors(fill, line, fa, la, label))
+                self._labels.append(label)
         self.centers_mesh = pv.PolyData(np.zeros((n, 3)))
-        self.centers_mesh.point_data["rgb"] = np.array(
-            [hex_rgb(f.color) for f in scene.features], dtype=np.uint8
-        )
+        self.centers_mesh.point_data["rgb"] = cols.astype(np.uint8)
         ca = self._points_actor(self.centers_mesh, 11, None)
         mapper = ca.GetMapper()
         mapper.SetScalarModeToUsePointFieldData()
@@ -337,45 +354,88 @@ class SceneActors:
         if not self.eye_meshes:
             return
         palette = np.vstack([UNLIT] + [hex_rgb(f.color) for f in scene.features]).astype(np.uint8)
-        for mesh, owner in zip(self.eye_meshes, (state.owner_a, state.owner_b), strict=True):
+        self._palette = palette
+        for e, (mesh, owner) in enumerate(
+            zip(self.eye_meshes, (state.owner_a, state.owner_b), strict=True)
+        ):
             mesh.cell_data["rgb"][:] = palette[owner + 1]
+            for (eye, k), lod in self._lod.items():
+                if eye == e:
+                    lod.cell_data["rgb"][:] = palette[_pool(owner, k) + 1]
+        self._owners = (state.owner_a, state.owner_b)
 
     def _update_features(self, scene: Scene, state: SceneState, selected: int | None) -> None:
-        for fa, f in zip(self._features, scene.features, strict=True):
-            pts = fa.fill_mesh.GetPoints()
-            ring = _ring(f.x, f.y, f.g, Z_FEAT)
-            arr = vtk_to_numpy(pts.GetData())
-            arr[:] = ring
+        n = len(scene.features)
+        if self.fill_mesh is not None:
+            zf = Z_FEAT + 0.9 * np.arange(n) / n
+            ring = np.empty((n, _CIRCLE_N, 3))
+            ring[..., 0] = state.x[:, None] + state.g[:, None] * _UNIT[None, :, 0]
+            ring[..., 1] = state.y[:, None] + state.g[:, None] * _UNIT[None, :, 1]
+            ring[..., 2] = zf[:, None]
+            pts = self.fill_mesh.GetPoints()
+            vtk_to_numpy(pts.GetData())[:] = ring.reshape(-1, 3)
             pts.Modified()
-            fa.fill_mesh.Modified()
-            fa.line_mesh.Modified()
-            if fa.label is not None:
-                fa.label.SetInput(f" {f.name}")
-                fa.label.SetPosition(f.x + f.g * 0.75, f.y + f.g * 0.75, Z_POINT)
+            self.fill_mesh.Modified()
+            self.line_mesh.Modified()
+            few = n <= LABEL_ALL_MAX
+            for i, (label, f) in enumerate(zip(self._labels, scene.features, strict=True)):
+                label.SetVisibility(few or i == selected)
+                label.SetInput(f" {f.name}")
+                label.SetPosition(f.x + f.g * 0.75, f.y + f.g * 0.75, Z_POINT)
         if self.centers_mesh is not None:
             self.centers_mesh.points[:] = np.column_stack(
                 [state.x, state.y, np.full(state.n, Z_POINT)]
             )
-        has_sel = selected is not None and 0 <= selected < len(scene.features)
-        show_handle = has_sel and scene.shows("features")
-        self.handle_actor.SetVisibility(show_handle)
+        has_sel = selected is not None and 0 <= selected < n and scene.shows("features")
+        self.handle_actor.SetVisibility(has_sel)
+        self.sel_actor.SetVisibility(has_sel)
         for a in self.sight_actors:
-            a.SetVisibility(has_sel and scene.shows("features"))
+            a.SetVisibility(has_sel)
         if has_sel:
             f = scene.features[selected]
             self.handle_mesh.points[:] = [[f.x + f.g, f.y, Z_POINT + 0.5]]
+            self.sel_mesh.points[:] = _ring(f.x, f.y, f.g, Z_LINE)
             h = scene.eyes.h
             self.sight_mesh.points[:] = [[-h, 0, Z_LINE], [f.x, f.y, Z_LINE], [h, 0, Z_LINE]]
             col = _rgbf(f.color)
+            self.sel_actor.GetProperty().SetColor(*col)
             for a in self.sight_actors:
                 a.GetProperty().SetColor(*col)
-            for i, fa in enumerate(self._features):
-                fa.line.GetProperty().SetLineWidth(5.0 if i == selected else 3.0)
 
-    def set_edges(self, main_px_per_unit: float, inset_px_per_unit: float, l: float, m: int):
-        """Triangle edges only where an ommatidium's rim is wide enough on screen."""
-        rim = l * 2.0 * math.pi / m
-        self.edges_main = rim * main_px_per_unit >= EDGE_MIN_PX
-        self.edges_inset = rim * inset_px_per_unit >= EDGE_MIN_PX
-        for i, a in enumerate(self._eye_actors):
-            a.GetProperty().SetEdgeVisibility(self.edges_main if i < 2 else self.edges_inset)
+    def set_zoom(self, main_px_per_unit: float, inset_px_per_unit: float, l: float, m: int):
+        """Level of detail by on-screen size: where the eye's rim is narrower than m/2 pixels,
+        neighbouring ommatidia are pooled (a pooled cell is lit if any of its ommatidia is, in
+        the colour of the last feature lighting it); edges only where a cell is wide enough.
+        """
+        if not self.eye_meshes:
+            return
+        rim_px = {
+            "main": 2 * math.pi * l * main_px_per_unit,
+            "inset": 2 * math.pi * l * inset_px_per_unit,
+        }
+        for which, ren_actors in (("main", self._eye_actors[:2]), ("inset", self._eye_actors[2:])):
+            k = max(1, math.ceil(m / max(2.0 * rim_px[which], 8.0)))
+            self._lod_k[which] = k
+            for e, a in enumerate(ren_actors):
+                mesh = self.eye_meshes[e] if k == 1 else self._lod_mesh(e, k)
+                if a.GetMapper().GetInput() is not mesh:
+                    a.GetMapper().SetInputData(mesh)
+                cell_px = rim_px[which] * k / m
+                a.GetProperty().SetEdgeVisibility(cell_px >= EDGE_MIN_PX)
+        self.edges_main = self._eye_actors[0].GetProperty().GetEdgeVisibility()
+        self.edges_inset = self._eye_actors[2].GetProperty().GetEdgeVisibility()
+        used = {(e, k) for k in self._lod_k.values() for e in (0, 1)}
+        for key in [key for key in self._lod if key not in used]:
+            del self._lod[key]
+
+    def _lod_mesh(self, e: int, k: int) -> pv.PolyData:
+        if (e, k) not in self._lod:
+            src = self.eye_meshes[e]
+            cx = float(src.points[0, 0])
+            m = src.n_cells
+            l = float(np.hypot(src.points[1, 0] - cx, src.points[1, 1]))
+            mesh = eye_mesh(cx, l, m, np.arange(0, m, k))
+            if getattr(self, "_owners", None) is not None:
+                mesh.cell_data["rgb"][:] = self._palette[_pool(self._owners[e], k) + 1]
+            self._lod[(e, k)] = mesh
+        return self._lod[(e, k)]
