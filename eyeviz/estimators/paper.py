@@ -409,7 +409,7 @@ def train_net(
             steps += 1
             seen += len(idx)
             done_in_epoch += len(idx)
-            lv = float(loss)
+            lv = loss.item()
             loss_ema = lv if math.isnan(loss_ema) else 0.98 * loss_ema + 0.02 * lv
             elapsed = time.perf_counter() - t0 - ckpt_seconds
             if bar is not None and (steps % 5 == 0 or elapsed >= budget_seconds):
