@@ -43,7 +43,7 @@ BFV_FILL = (0.93, 0.91, 0.80)
 BFV_LINE = (0.45, 0.42, 0.30)
 INSET_VIEWPORT = (0.6, 0.0, 1.0, 0.5)  # (xmin, ymin, xmax, ymax) of the render window
 FILL_ALPHA = 0.4
-LABEL_ALL_MAX = 12  # more features than this: only the selected one is labelled
+LABEL_ALL_MAX = 6  # more features than this: only the selected one is labelled
 EDGE_MIN_PX = 7.0  # draw triangle edges when an ommatidium's rim is at least this wide
 Z_BFV, Z_EYES, Z_FEAT, Z_LINE, Z_POINT = -3.0, 0.0, 1.0, 2.0, 3.0
 _CIRCLE_N = 160
@@ -301,6 +301,7 @@ class SceneActors:
         # an opaque tint, not alpha: translucency costs whole extra passes in software GL
         tint = np.round(FILL_ALPHA * cols + (1 - FILL_ALPHA) * 255).astype(np.uint8)
         pts = vtkPoints()
+        pts.SetDataTypeToDouble()  # features lie far from the origin: keep float64
         pts.SetNumberOfPoints(n * c)
         idx = np.arange(n * c).reshape(n, c)
         self.fill_mesh = pv.PolyData()
@@ -378,7 +379,7 @@ class SceneActors:
             self.fill_mesh.Modified()
             self.line_mesh.Modified()
             few = n <= LABEL_ALL_MAX
-            for i, (label, f) in enumerate(zip(self._labels, scene.features, strict=True)):
+            for i, (label, f) in enumerate(zip(self._labels, scene.features, strict=False)):
                 label.SetVisibility(few or i == selected)
                 label.SetInput(f" {f.name}")
                 label.SetPosition(f.x + f.g * 0.75, f.y + f.g * 0.75, Z_POINT)

@@ -1,0 +1,105 @@
+"""SceneActors on real VTK renderers (off-screen): in-place updates, rebuilds, level of detail."""
+
+import math
+
+import numpy as np
+import pytest
+
+pv = pytest.importorskip("pyvista")
+
+from eyeviz.render.actors import UNLIT, SceneActors, eye_mesh, hex_rgb  # noqa: E402
+from eyeviz.scene import Eyes, Feature, Scene  # noqa: E402
+from eyeviz.state import compute_state  # noqa: E402
+
+
+@pytest.fixture
+def rig():
+    pl = pv.Plotter(off_screen=True, window_size=(400, 300))
+    inset = pv.Renderer(pl)
+    pl.ren_win.AddRenderer(inset)
+    yield pl, SceneActors(pl.renderer, inset)
+    pl.close()
+
+
+def scene(m=720):
+    fs = [Feature("a", 0.0, 1500.0, 50.0, "#D55E00"), Feature("b", 30.0, 1500.0, 50.0, "#0072B2")]
+    return Scene(Eyes(40.0, 20.0, m), fs, ["eyes", "bfv", "features", "labels"])
+
+
+def expected_rgb(sc, eye):
+    pair = sc.eyes.pair()
+    fs = sc.features
+    bits = pair.bitmaps([f.x for f in fs], [f.y for f in fs], [f.g for f in fs])[eye]
+    owner = np.full(pair.m, -1)
+    for i in range(len(fs)):
+        owner[bits[i]] = i
+    palette = np.vstack([UNLIT] + [hex_rgb(f.color) for f in fs])
+    return palette[owner + 1], owner
+
+
+def test_eye_mesh_is_figure_2():
+    mesh = eye_mesh(40.0, 20.0, 8)
+    assert mesh.n_cells == 8 and mesh.n_points == 10
+    tri = mesh.get_cell(2).points  # ommatidium 2: between 90 and 135 degrees
+    np.testing.assert_allclose(tri[0], [40, 0, 0])
+    np.testing.assert_allclose(tri[1][:2], [40, 20], atol=1e-12)
+    np.testing.assert_allclose(tri[2][:2], [40 - 20 / math.sqrt(2), 20 / math.sqrt(2)])
+
+
+def test_colours_updated_in_place_and_rebuilt_on_m(rig):
+    pl, act = rig
+    sc = scene()
+    act.update(sc, compute_state(sc), 0)
+    meshes = list(act.eye_meshes)
+    arrays = [m.cell_data["rgb"] for m in meshes]
+    for e in (0, 1):
+        np.testing.assert_array_equal(meshes[e].cell_data["rgb"], expected_rgb(sc, e)[0])
+    fill = act.fill_mesh
+    sc.features[0].x, sc.features[0].y = -900.0, 2000.0
+    act.update(sc, compute_state(sc), 0)
+    assert act.eye_meshes[0] is meshes[0] and act.fill_mesh is fill  # not rebuilt
+    assert np.shares_memory(act.eye_meshes[0].cell_data["rgb"], arrays[0])
+    for e in (0, 1):
+        np.testing.assert_array_equal(meshes[e].cell_data["rgb"], expected_rgb(sc, e)[0])
+    ring = fill.points.reshape(2, -1, 3)[0]
+    np.testing.assert_allclose(np.hypot(ring[:, 0] + 900.0, ring[:, 1] - 2000.0), 50.0)
+    sc.eyes.m = 36
+    act.update(sc, compute_state(sc), 0)
+    assert act.eye_meshes[0] is not meshes[0] and act.eye_meshes[0].n_cells == 36
+    img = pl.screenshot(return_img=True)
+    assert img.std() > 0
+
+
+def test_level_of_detail_pools_and_keeps_every_lit_ommatidium(rig):
+    pl, act = rig
+    sc = scene(36000)
+    act.update(sc, compute_state(sc), 0)
+    act.set_zoom(main_px_per_unit=0.1, inset_px_per_unit=3.0, l=20.0, m=36000)
+    k = act._lod_k["main"]
+    assert k > 1 and act._lod_k["inset"] > 1 and not act.edges_main
+    main_input = act._eye_actors[0].GetMapper().GetInput()
+    assert main_input.GetNumberOfCells() == math.ceil(36000 / k)
+    rgb, owner = expected_rgb(sc, 0)
+    lod = pv.wrap(main_input).cell_data["rgb"]
+    lit_bins = np.unique(np.flatnonzero(owner >= 0) // k)
+    assert set(np.flatnonzero((lod != UNLIT).any(axis=1))) == set(lit_bins)
+    # moving a feature updates the pooled mesh in place too
+    sc.features[1].x = 2000.0
+    act.update(sc, compute_state(sc), 0)
+    rgb, owner = expected_rgb(sc, 0)
+    lit_bins = np.unique(np.flatnonzero(owner >= 0) // k)
+    assert set(np.flatnonzero((lod != UNLIT).any(axis=1))) == set(lit_bins)
+    # zoomed in far enough: the full mesh again, with edges
+    act.set_zoom(main_px_per_unit=1e4, inset_px_per_unit=3.0, l=20.0, m=36000)
+    assert act._eye_actors[0].GetMapper().GetInput() is act.eye_meshes[0] and act.edges_main
+
+
+def test_only_named_layers_are_built(rig):
+    pl, act = rig
+    sc = scene()
+    sc.layers = ["features"]
+    act.update(sc, compute_state(sc), None)
+    assert act.eye_meshes == [] and act.fill_mesh is not None
+    sc.layers = ["eyes"]
+    act.update(sc, compute_state(sc), None)
+    assert act.fill_mesh is None and len(act.eye_meshes) == 2
