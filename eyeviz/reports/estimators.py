@@ -58,11 +58,18 @@ class Result:
     batched_us: float | None = None  # per sample, batched over the single-pass test set
     single_ms: float | None = None  # one sample alone, median
     metrics: dict = field(default_factory=dict)  # test set -> {"n", "n_valid", "ad", "dd"}
-    note: str = ""
+    table_keys: int | None = None  # lookup-table estimators (bayes): stored keys
 
     @property
     def ok(self) -> bool:
         return self.status == "ok"
+
+    def label_short(self) -> str:
+        if self.n_weights:
+            return f"{self.name} ({_fmt_weights(self.n_weights)} weights)"
+        if self.table_keys:
+            return f"{self.name} (table of {_fmt_weights(self.table_keys)} keys)"
+        return f"{self.name} (no weights)"
 
 
 # --- shared helpers (also used by the trajectories report) --------------------------------
@@ -187,6 +194,7 @@ def measure_one(name: str, est, test_sets: dict) -> Result:
         label=label,
         n_weights=int(est.n_weights),
         train_seconds=md.get("train_seconds"),
+        table_keys=int(md["keys"]) if "keys" in md else None,
     )
     for mode, data in test_sets.items():
         pred, secs = _time_batched(est, data.omega_a, data.omega_b)
@@ -348,66 +356,76 @@ def to_markdown(results: list[Result], n_test: int, seed: int, png: str | None) 
 _COLORS = {"analytic": "#1f77b4", "bayes": "#2ca02c", "compact": "#d62728", "paper": "#9467bd"}
 
 
-def _minor_label(v: float, _pos) -> str:
-    lead = v / 10 ** math.floor(math.log10(v) + 1e-9)
-    return f"{v:g}" if round(lead) in (2, 5) else ""
-
-
 def plot(results: list[Result]):
-    """Figure: AD and DD MAPE against batched inference time per sample (log-log)."""
+    """Figure: AD and DD MAPE against inference time per sample (log-log).
+
+    Markers sit at the batched time; a thin line runs from there to the time of one call
+    with one sample (the latency an interactive user sees).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import FuncFormatter
+    from matplotlib.lines import Line2D
+    from matplotlib.ticker import FuncFormatter, LogLocator
 
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), constrained_layout=True)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.8), constrained_layout=True)
     lim = _limit(results)
     ok = [r for r in results if r.ok and r.batched_us]
+    handles: dict[str, Line2D] = {}
     for ax, (key, title) in zip(axes, (("ad", "AD: azimuth"), ("dd", "DD: distance")),
                                 strict=True):
-        for r in ok:
+        for i, r in enumerate(ok):
             c = _COLORS.get(r.name, "#7f7f7f")
+            size = 45 + 45 * (len(ok) - 1 - i)  # coincident points show as concentric rings
             x = r.batched_us * 1e-6
+            y = r.metrics["single"][key]["mape"]
+            if r.single_ms and math.isfinite(y):
+                ax.plot([x, r.single_ms * 1e-3], [y, y], color=c, lw=1.0, alpha=0.6,
+                        marker="|", markevery=[1], ms=10, zorder=2)
             for mode, marker, face in (("single", "o", c), ("multi", "s", "none")):
                 y = r.metrics[mode][key]["mape"]
                 if math.isfinite(y):
-                    ax.scatter([x], [y], marker=marker, s=60, facecolors=face, edgecolors=c,
-                               linewidths=1.5, zorder=3)
-            y = r.metrics["single"][key]["mape"]
-            if math.isfinite(y):
-                ax.annotate(r.name, (x, y), xytext=(7, 5), textcoords="offset points",
-                            color=c, fontsize=10)
+                    ax.scatter([x], [y], marker=marker, s=size, facecolors=face,
+                               edgecolors=c, linewidths=1.5, zorder=3 + i)
+            handles.setdefault(r.name, Line2D([], [], marker="o", ls="", color=c,
+                                              label=r.label_short()))
         t5 = PAPER_TABLE5[key]["mape"]
-        ax.axhline(t5, color="#555555", ls=":", lw=1.2)
-        ax.text(0.02, t5, f" paper Table 5: {t5} %", transform=ax.get_yaxis_transform(),
-                va="bottom", ha="left", fontsize=8, color="#555555")
+        ax.axhline(t5, color="#555555", ls=":", lw=1.3)
         if lim is not None:
-            y = lim.metrics["single"][key]["mape"]
-            ax.axhline(y, color=_COLORS["bayes"], ls="--", lw=1.0, alpha=0.7)
-            ax.text(0.98, y, f"information limit {y:.3g} % ", transform=ax.get_yaxis_transform(),
-                    va="top", ha="right", fontsize=8, color=_COLORS["bayes"])
+            ax.axhline(lim.metrics["single"][key]["mape"], color=_COLORS["bayes"], ls="--",
+                       lw=1.0, alpha=0.8)
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.margins(x=0.2, y=0.25)
+        lo, hi = ax.get_ylim()
+        major = (1.0, 2.0, 5.0) if math.log10(hi / lo) > 1.2 else (1.0, 2.0, 3.0, 4.0, 5.0, 6.0,
+                                                                    7.0, 8.0, 9.0)
+        ax.yaxis.set_major_locator(LogLocator(subs=major))
         ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-        ax.yaxis.set_minor_formatter(FuncFormatter(_minor_label))
-        ax.set_xlabel("inference time per sample, batched (s)")
+        ax.yaxis.set_minor_locator(LogLocator(subs=tuple(float(k) for k in range(1, 10))))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: ""))
+        ax.set_xlabel("inference time per sample (s)")
         ax.set_ylabel("MAPE (%)")
         ax.set_title(title)
-        ax.grid(True, which="both", alpha=0.25)
-        ax.margins(x=0.25, y=0.2)
-    from matplotlib.lines import Line2D
-
-    handles = [
-        Line2D([], [], marker="o", ls="", color="k", label="single-pass test set"),
+        ax.grid(True, which="major", alpha=0.35)
+        ax.grid(True, which="minor", alpha=0.12)
+    extra = [
+        Line2D([], [], marker="o", ls="", color="k", label="single-pass test set, batched"),
         Line2D([], [], marker="s", ls="", markerfacecolor="none", color="k",
-               label="multi-pass test set"),
+               label="multi-pass test set, batched"),
+        Line2D([], [], marker="|", ms=10, color="k", lw=1.0, alpha=0.6,
+               label="one sample per call"),
+        Line2D([], [], ls=":", color="#555555", lw=1.3, label="paper Table 5 (quoted)"),
     ]
-    axes[1].legend(handles=handles, loc="lower right", fontsize=8, framealpha=0.9)
+    if lim is not None:
+        extra.append(Line2D([], [], ls="--", color=_COLORS["bayes"],
+                            label="information limit (bayes, single-pass)"))
     missing = [r.name for r in results if not r.ok]
     if missing:
-        fig.text(0.01, -0.02, "not shown (unavailable): " + ", ".join(missing), fontsize=8,
-                 color="#555555")
+        extra.append(Line2D([], [], ls="", label="unavailable: " + ", ".join(missing)))
+    fig.legend(handles=[*handles.values(), *extra], loc="outside lower center", ncol=4,
+               fontsize=8, frameon=False)
     return fig
 
 
