@@ -26,7 +26,13 @@ from vtkmodules.vtkRenderingCore import (
 
 from eyeviz.app.model import AppModel, MouseEvent, drag_feature, hit_test
 from eyeviz.app.panels import BitmapPanel, EyesPanel, FeaturePanel, LayersPanel, ReadoutPanel
-from eyeviz.render.actors import BACKGROUND, INSET_BACKGROUND, INSET_VIEWPORT, SceneActors
+from eyeviz.render.actors import (
+    BACKGROUND,
+    INSET_BACKGROUND,
+    INSET_VIEWPORT,
+    SceneActors,
+    style_text,
+)
 from eyeviz.scene import Scene, SceneError, View, load, save
 
 __all__ = ["MainWindow", "make_settings", "run_app"]
@@ -103,10 +109,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.ren_win.AddRenderer(self.inset_ren)
         self.actors = SceneActors(self.main_ren, self.inset_ren)
         self.title_actor = vtkTextActor()
-        tp = self.title_actor.GetTextProperty()
-        tp.SetFontSize(24)
-        tp.BoldOn()
-        tp.SetColor(0.1, 0.1, 0.1)
+        style_text(self.title_actor.GetTextProperty(), 24, (0.1, 0.1, 0.1))
         self.title_actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
         self.title_actor.SetPosition(0.015, 0.93)
         self.main_ren.AddViewProp(self.title_actor)
@@ -316,6 +319,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.actors.update(scene, st, self.model.selected)
         self.title_actor.SetInput(scene.title)
         self.readout.refresh()
+        self.bitmaps.setVisible(scene.shows("bitmaps"))
         self.bitmaps.refresh()
         if what == "feature":
             self.features_panel.refresh(index)

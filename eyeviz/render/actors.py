@@ -49,6 +49,31 @@ Z_BFV, Z_EYES, Z_FEAT, Z_LINE, Z_POINT = -3.0, 0.0, 1.0, 2.0, 3.0
 _CIRCLE_N = 160
 
 
+def _font_file() -> str | None:
+    """DejaVu Sans Bold from matplotlib's data (has Greek; VTK's built-in Arial has not)."""
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.find_spec("matplotlib")
+    if spec is None or spec.origin is None:
+        return None
+    f = Path(spec.origin).parent / "mpl-data" / "fonts" / "ttf" / "DejaVuSans-Bold.ttf"
+    return str(f) if f.exists() else None
+
+
+FONT_FILE = _font_file()
+
+
+def style_text(tp, size: int, color) -> None:
+    """Bold DejaVu Sans at ``size`` pixels in ``color``."""
+    if FONT_FILE:
+        tp.SetFontFamily(4)  # VTK_FONT_FILE
+        tp.SetFontFile(FONT_FILE)
+    tp.SetFontSize(size)
+    tp.BoldOn()
+    tp.SetColor(*color)
+
+
 def hex_rgb(color: str) -> tuple[int, int, int]:
     c = color.lstrip("#")
     return int(c[0:2], 16), int(c[2:4], 16), int(c[4:6], 16)
@@ -159,12 +184,30 @@ class SceneActors:
         self.main.AddActor(self.sel_actor)
         self.main.AddActor(self.handle_actor)
         self.main.AddActor(self.sight_actors[0])
+        # teaching overlays (Figures 3b, 5-6): tangent rays and sector boundaries
+        four_lines = [2, 0, 1, 2, 0, 2, 2, 3, 4, 2, 3, 5]
+        self.tangent_mesh = pv.PolyData(np.zeros((6, 3)), lines=four_lines)
+        self.sector_mesh = pv.PolyData(np.zeros((6, 3)), lines=four_lines)
+        self.overlay_actors: dict[str, list[vtkActor]] = {}
+        for name, mesh, width, color in (
+            ("tangents", self.tangent_mesh, 2.5, INK),
+            ("sectors", self.sector_mesh, 2.0, (0.45, 0.45, 0.45)),
+        ):
+            acts = []
+            for ren in (self.main, self.inset):
+                a = _actor(mesh, color)
+                a.GetProperty().SetLineWidth(width)
+                if name == "sectors":
+                    a.GetProperty().SetLineStipplePattern(0xFF00)
+                ren.AddActor(a)
+                acts.append(a)
+            self.overlay_actors[name] = acts
+        self.tangent_text = self._text(20, INK)
+        self.tangent_text.GetTextProperty().SetJustificationToRight()
+        self.main.AddActor(self.tangent_text)
         self.inset.AddActor(self.sight_actors[1])
         self._inset_label = vtkTextActor()
-        tp = self._inset_label.GetTextProperty()
-        tp.SetFontSize(20)
-        tp.SetColor(*INK)
-        tp.BoldOn()
+        style_text(self._inset_label.GetTextProperty(), 20, INK)
         self._inset_label.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
         self._inset_label.SetPosition(0.03, 0.86)
         self.inset.AddViewProp(self._inset_label)
@@ -174,6 +217,16 @@ class SceneActors:
         self.edges_inset = False
 
     # --- construction ---------------------------------------------------------------
+    @staticmethod
+    def _text(size: int, color, center: bool = False) -> vtkBillboardTextActor3D:
+        t = vtkBillboardTextActor3D()
+        tp = t.GetTextProperty()
+        style_text(tp, size, color)
+        if center:
+            tp.SetJustificationToCentered()
+            tp.SetVerticalJustificationToCentered()
+        return t
+
     @staticmethod
     def _points_actor(mesh, size: float, color) -> vtkActor:
         a = _actor(mesh, color)
@@ -281,13 +334,21 @@ class SceneActors:
                 t.SetInput(text)
                 t.SetPosition(x, y, Z_POINT)
                 tp = t.GetTextProperty()
-                tp.SetFontSize(22)
-                tp.BoldOn()
-                tp.SetColor(*INK)
+                style_text(tp, 22, INK)
                 tp.SetJustificationToCentered()
                 tp.SetVerticalJustificationToCentered()
                 self._add(self._static, self.inset, t)
         self._inset_label.SetInput(f"eyes (m = {m})")
+        if scene.shows("bfv") and scene.shows("labels"):
+            deg = 180.0 / math.pi
+            for text, (x, y) in (
+                (f"θ = {pair.theta * deg:.1f}°", (0.0, 1.75 * l)),
+                (f"ψ = {pair.psi * deg:.1f}°", (-(h + 0.55 * l), 1.8 * l)),
+            ):
+                t = self._text(18, BFV_LINE, center=True)
+                t.SetInput(text)
+                t.SetPosition(x, y, Z_POINT)
+                self._add(self._static, self.inset, t)
 
     def _build_features(self, scene: Scene) -> None:
         """All discs in ONE fill mesh and ONE outline mesh (cell colours): few draw calls."""
@@ -321,9 +382,7 @@ class SceneActors:
             for f in scene.features:
                 label = vtkBillboardTextActor3D()
                 tp = label.GetTextProperty()
-                tp.SetFontSize(22)
-                tp.BoldOn()
-                tp.SetColor(*_rgbf(f.color))
+                style_text(tp, 22, _rgbf(f.color))
                 tp.SetJustificationToLeft()
                 tp.SetVerticalJustificationToBottom()
                 self._add(self._feature_props, self.main, label)
@@ -350,6 +409,77 @@ class SceneActors:
             self._feat_key = feat_key
         self._update_eyes(scene, state)
         self._update_features(scene, state, selected)
+        self._update_overlays(scene, state, selected)
+
+    def _update_overlays(self, scene: Scene, state: SceneState, selected: int | None) -> None:
+        """Tangents from each eye centre to the selected feature at phi_E +- arcsin(g/r_E)
+        (Prop. 2, Figure 3b) and the boundaries L*gamma, (R+1)*gamma of its lit sectors."""
+        ok = selected is not None and 0 <= selected < state.n
+        show_t = ok and scene.shows("tangents") and state.rA is not None
+        show_s = ok and scene.shows("sectors") and state.LA is not None
+        for a in self.overlay_actors["tangents"]:
+            a.SetVisibility(show_t)
+        for a in self.overlay_actors["sectors"]:
+            a.SetVisibility(show_s)
+        self.tangent_text.SetVisibility(show_t)
+        if not (show_t or show_s):
+            return
+        i = selected
+        pair = state.pair
+        g = float(state.g[i])
+        if show_t:
+            pts = np.zeros((6, 3))
+            angles = []
+            for e, (cx, r, phi) in enumerate(
+                ((-pair.h, state.rA[i], state.phiA[i]), (pair.h, state.rB[i], state.phiB[i]))
+            ):
+                pts[3 * e] = (cx, 0.0, Z_LINE)
+                if r > g:
+                    a = math.asin(g / r)
+                    d = math.sqrt(r * r - g * g)
+                    angles.append(a)
+                    for j, s in enumerate((-1.0, 1.0)):
+                        pts[3 * e + 1 + j] = (
+                            cx + d * math.cos(phi + s * a),
+                            d * math.sin(phi + s * a),
+                            Z_LINE,
+                        )
+                else:
+                    pts[3 * e + 1 : 3 * e + 3] = pts[3 * e]
+            self.tangent_mesh.points[:] = pts
+            f = scene.features[i]
+            if len(angles) == 2:
+                deg = 180.0 / math.pi
+                a_deg, b_deg = angles[0] * deg, angles[1] * deg
+                self.tangent_text.SetInput(
+                    f"arcsin(g/r_A) = {a_deg:.2f}°\narcsin(g/r_B) = {b_deg:.2f}°"
+                )
+                self.tangent_text.SetPosition(f.x - 1.15 * f.g, f.y + 1.15 * f.g, Z_POINT)
+            else:
+                self.tangent_text.SetVisibility(False)
+        if show_s:
+            pts = np.zeros((6, 3))
+            gm = pair.gamma
+            for e, (cx, r, L, R) in enumerate(
+                (
+                    (
+                        -pair.h,
+                        math.hypot(state.x[i] + pair.h, state.y[i]),
+                        state.LA[i],
+                        state.RA[i],
+                    ),
+                    (pair.h, math.hypot(state.x[i] - pair.h, state.y[i]), state.LB[i], state.RB[i]),
+                )
+            ):
+                reach = 1.25 * (r + g)
+                pts[3 * e] = (cx, 0.0, Z_LINE)
+                for j, k in enumerate((L, R + 1)):
+                    pts[3 * e + 1 + j] = (
+                        cx + reach * math.cos(k * gm),
+                        reach * math.sin(k * gm),
+                        Z_LINE,
+                    )
+            self.sector_mesh.points[:] = pts
 
     def _update_eyes(self, scene: Scene, state: SceneState) -> None:
         if not self.eye_meshes:

@@ -103,3 +103,32 @@ def test_only_named_layers_are_built(rig):
     sc.layers = ["eyes"]
     act.update(sc, compute_state(sc), None)
     assert act.fill_mesh is None and len(act.eye_meshes) == 2
+
+
+def test_tangents_touch_the_feature_and_sectors_bound_the_lit_interval(rig):
+    pl, act = rig
+    sc = Scene(
+        Eyes(40.0, 20.0, 24),
+        [Feature("f", 119.3, 60.9, 20.0)],
+        ["eyes", "features", "tangents", "sectors"],
+    )
+    st = compute_state(sc)
+    act.update(sc, st, 0)
+    pts = np.asarray(act.tangent_mesh.points)
+    for e, cx in enumerate((-40.0, 40.0)):
+        centre, t1, t2 = pts[3 * e], pts[3 * e + 1], pts[3 * e + 2]
+        assert centre[0] == cx
+        for t in (t1, t2):  # on the circle, and the ray is perpendicular to the radius
+            assert math.hypot(t[0] - 119.3, t[1] - 60.9) == pytest.approx(20.0)
+            assert np.dot(t[:2] - centre[:2], t[:2] - [119.3, 60.9]) == pytest.approx(0, abs=1e-9)
+    sec = np.asarray(act.sector_mesh.points)
+    gamma = 2 * math.pi / 24
+    for e, (L, R) in enumerate(((st.LA[0], st.RA[0]), (st.LB[0], st.RB[0]))):
+        c = sec[3 * e]
+        angles = [
+            math.atan2(p[1] - c[1], p[0] - c[0]) % (2 * math.pi) for p in sec[3 * e + 1 : 3 * e + 3]
+        ]
+        assert angles == pytest.approx([L * gamma, (R + 1) * gamma])
+    sc.layers.remove("tangents")
+    act.update(sc, compute_state(sc), 0)
+    assert not act.overlay_actors["tangents"][0].GetVisibility()
