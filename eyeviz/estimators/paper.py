@@ -247,10 +247,12 @@ def _cache_dir() -> Path:
 
 
 def weights_dirs() -> list[Path]:
-    """Where the weights are looked for, in order: $EYEVIZ_PAPER_DIR, assets/, the user cache."""
+    """Where the weights are looked for: $EYEVIZ_PAPER_DIR alone when it is set, else
+    assets/models/paper/ in the source tree, then the user cache (~/.cache/eyeviz/...)."""
     env = os.environ.get("EYEVIZ_PAPER_DIR")
-    dirs = [Path(env)] if env else []
-    return dirs + [_repo_dir(), _cache_dir()]
+    if env:
+        return [Path(env)]
+    return [_repo_dir(), _cache_dir()]
 
 
 def default_out_dir() -> Path:
