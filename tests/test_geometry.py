@@ -251,3 +251,28 @@ def test_over_and_underflowing_squares_are_still_exact(x, y, g):
     core = np.array(PAPER.intervals(x, y, g))
     ref = np.array(reference_intervals(PAPER, x, y, g)).ravel()
     np.testing.assert_array_equal(core, ref)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.floats(-1e4, 1e4, allow_nan=False),
+    st.sampled_from(["free", "axis_x", "axis_y", "diagonal", "antidiagonal"]),
+    coord,
+    st.sampled_from([8, 24, 360, 720, 1000, 2**20]),
+    st.sampled_from(["A", "B"]),
+)
+def test_ommatidium_of_a_point_matches_the_reference(a, kind, free, m, eye):
+    eyes = EyePair(40, 20, m)
+    cx = eyes.centers[0 if eye == "A" else 1][0]
+    x, y = {
+        "free": (free, a),
+        "axis_x": (cx + a, 0.0),
+        "axis_y": (cx, a),
+        "diagonal": (cx + a, a),
+        "antidiagonal": (cx + a, -a),
+    }[kind]
+    assume(x != cx or y != 0)
+    from eyeviz.reference import reference_interval
+
+    expect = reference_interval(x, y, 0.0, cx, m)[0]
+    assert int(eyes.ommatidium(x, y, eye)) == expect
