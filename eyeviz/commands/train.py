@@ -49,7 +49,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help="training elements (default 10^6)")
     c.add_argument("--n-val", type=_positive_int, default=100_000)
     c.add_argument("--epochs", type=_positive_int, default=12)
-    c.add_argument("--hidden", type=_positive_int, default=32)
+    c.add_argument("--hidden", type=_positive_int, default=32, help="DD hidden width")
+    c.add_argument("--hidden-ad", type=_positive_int, default=8, help="AD hidden width")
     c.add_argument("--patience", type=_positive_int, default=3)
     c.add_argument("--seed", type=int, default=0)
     c.add_argument("--threads", type=_positive_int, default=2)
@@ -105,8 +106,9 @@ def _compact(args) -> int:
 
     try:
         meta = compact.train(args.out, args.n_train, args.n_val, args.seed, args.epochs,
-                             args.hidden, patience=args.patience, domain=_domain(args),
-                             threads=args.threads, command=_command(), progress=progress)
+                             args.hidden, args.hidden_ad, patience=args.patience,
+                             domain=_domain(args), threads=args.threads, command=_command(),
+                             progress=progress)
     finally:
         bar.close()
     v = meta["val_metrics"]
