@@ -22,15 +22,15 @@ import contextlib
 import functools
 import json
 import os
-import tempfile
 import zipfile
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
 from eyeviz import EyevizError
+from eyeviz.atomic import atomic_output
 from eyeviz.geometry import EyePair
 
 FORMATS = ("csv", "npz")
@@ -44,28 +44,6 @@ def format_of(path) -> str:
     if suffix not in FORMATS:
         raise EyevizError(f"output must end in .csv or .npz, got {str(path)!r}")
     return suffix
-
-
-@contextlib.contextmanager
-def atomic_output(path) -> Iterator[Path]:
-    """Yield a temporary path next to ``path``; rename it over ``path`` only on success."""
-    path = Path(path)
-    d = path.parent if str(path.parent) else Path(".")
-    if not d.is_dir():
-        raise EyevizError(f"output directory does not exist: {str(d)!r}")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=d)
-    os.close(fd)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file the usual mode
-    tmp = Path(tmp)
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            tmp.unlink()
-        raise
 
 
 # --- float formatting ----------------------------------------------------------------

@@ -11,11 +11,10 @@ matplotlib is imported inside :func:`export`, so importing this module stays lig
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from pathlib import Path
 
 from eyeviz import EyevizError
+from eyeviz.atomic import atomic_output
 
 __all__ = ["FORMATS", "export", "format_of"]
 
@@ -65,23 +64,9 @@ def export(scene, path, scale: float = 1.0, transparent: bool = False, *,
 
     dpi = vector.BASE_DPI * scale if fmt == "png" else vector.VECTOR_DPI
     fig = vector.figure(scene, state, dpi=dpi, merge=merge, predictions=predictions)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=f".part{target.suffix}",
-                               dir=parent)
-    os.close(fd)
-    try:
-        with matplotlib.rc_context(vector.RC):
-            fig.savefig(tmp, format=fmt, dpi=dpi if fmt == "png" else 72,
-                        transparent=transparent, metadata=_metadata(fmt, scene))
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a figure is an ordinary file
-        os.replace(tmp, target)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    with atomic_output(target) as tmp, matplotlib.rc_context(vector.RC):
+        fig.savefig(tmp, format=fmt, dpi=dpi if fmt == "png" else 72,
+                    transparent=transparent, metadata=_metadata(fmt, scene))
     return target
 
 

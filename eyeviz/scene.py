@@ -14,14 +14,13 @@ from __future__ import annotations
 
 import copy
 import math
-import os
 import re
-import tempfile
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from eyeviz import EyevizError
+from eyeviz.atomic import atomic_output
 from eyeviz.geometry import EyePair
 
 __all__ = [
@@ -380,14 +379,5 @@ def save(scene: Scene, path) -> None:
     text = dumps(scene)
     loads(text, str(path))  # refuse to write a scene that would not load back
     p = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent or ".")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, p)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    with atomic_output(p) as tmp:
+        tmp.write_text(text, encoding="utf-8")

@@ -304,7 +304,7 @@ def test_ctrl_c_on_the_command_leaves_no_file(tmp_path):
     try:
         deadline = time.monotonic() + 30
         while time.monotonic() < deadline:
-            parts = [p for p in tmp_path.iterdir() if p.name.endswith(".part")]
+            parts = [p for p in tmp_path.iterdir() if ".part" in p.name]
             if parts and parts[0].stat().st_size > 0:
                 break
             time.sleep(0.02)

@@ -23,13 +23,12 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
+from eyeviz.atomic import atomic_output
 from eyeviz.estimators.analytic import AnalyticEstimator
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
 
@@ -143,15 +142,8 @@ def save_table(table: dict, path) -> None:
         arrays[f"logr_{t}"] = np.log(table[f"r_{t}"] / ra).astype(np.float16)
         arrays[f"dphi_{t}"] = (table[f"phi_{t}"] - pa).astype(np.float16)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.name, suffix=".tmp.npz", dir=path.parent)
-    os.close(fd)
-    try:
+    with atomic_output(path) as tmp:
         np.savez_compressed(tmp, **arrays)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def load_table(path) -> dict:

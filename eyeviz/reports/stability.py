@@ -11,13 +11,13 @@ from __future__ import annotations
 import argparse
 import csv
 import io
-import os
-import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
+from eyeviz.atomic import atomic_output
 
 HELP = "numerical stability of the geometry against an 80-digit reference"
 
@@ -148,17 +148,8 @@ def _plot(rows: list[Row], path: Path) -> None:
 
 
 def _write_atomic(path: Path, writer) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
-    os.close(fd)
-    try:
-        writer(Path(tmp))
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the usual mode
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    with atomic_output(path) as tmp:
+        writer(tmp)
 
 
 def write(rows: list[Row], outdir: Path) -> None:
