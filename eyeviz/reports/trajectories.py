@@ -219,7 +219,8 @@ def plot(points: list[Point], kind: str, names: list[str]):
             ax = axes[row, col]
             ax.axvspan(TRAIN_R[1], 10500, color="#eeeeee", zorder=0)
             lows = []
-            for name in names:
+            series = []
+            for i, name in enumerate(names):
                 pts = sorted((p for p in points if p.kind == kind and p.g == g
                               and p.estimator == name), key=lambda p: p.r)
                 if not pts:
@@ -227,8 +228,11 @@ def plot(points: list[Point], kind: str, names: list[str]):
                 xs = [p.r for p in pts]
                 ys = [getattr(p, f"{target}_accuracy") for p in pts]
                 lows += [v for v in ys if math.isfinite(v)]
-                ax.plot(xs, ys, marker="o", ms=4, lw=1.6, color=_COLORS.get(name, "#7f7f7f"),
-                        label=name)
+                series.append((name, xs, ys))
+                # earlier estimators drawn wider, so identical curves stay visible
+                ax.plot(xs, ys, marker="o", ms=3.5 + 0.8 * (len(names) - 1 - i),
+                        lw=1.4 + 0.6 * (len(names) - 1 - i), color=_COLORS.get(name, "#7f7f7f"),
+                        label=name, zorder=2 + i)
             ref = PAPER_TEXT.get((kind, target, g))
             if ref:
                 ax.plot(*zip(*ref, strict=True), ls="", marker="x", ms=8, mew=2,
@@ -241,6 +245,11 @@ def plot(points: list[Point], kind: str, names: list[str]):
                 lows.append(level)
             bottom = max(-100.0, min([*lows, 90.0]) - 5.0)
             ax.set_ylim(bottom, 101)
+            for name, xs, ys in series:  # below the axis: a triangle on its edge
+                off = [x for x, v in zip(xs, ys, strict=True) if v < bottom]
+                if off:
+                    ax.plot(off, [bottom] * len(off), ls="", marker="v", ms=8, clip_on=False,
+                            color=_COLORS.get(name, "#7f7f7f"))
             ax.set_xlim(500, 10500)
             ax.grid(True, alpha=0.3)
             ax.set_title(f"{target.upper()} ({'azimuth' if target == 'ad' else 'distance'}), "
@@ -257,6 +266,9 @@ def plot(points: list[Point], kind: str, names: list[str]):
                 labels.append(lab)
     handles.append(plt.Rectangle((0, 0), 1, 1, color="#eeeeee"))
     labels.append("outside the training range r <= 5000")
+    if any(v < -100 for p in points if p.kind == kind for v in (p.ad_accuracy, p.dd_accuracy)):
+        handles.append(plt.Line2D([], [], ls="", marker="v", color="#555555"))
+        labels.append("below -100 %")
     fig.legend(handles, labels, loc="outside lower center", ncol=len(labels), fontsize=9,
                frameon=False)
     title = {"horizontal": "Horizontal trajectories (Figure 15)",
