@@ -151,7 +151,7 @@ def test_train_save_load_predict_roundtrip(tmp_path):
         assert m["split"] == {"train": 32, "heldout": 8, "seed": 3}
         assert "of 100 epochs" in m["label"] or "of 80 epochs" in m["label"]
         assert m["heldout"]["n"] == 8 and np.isfinite(m["heldout"]["mae"])
-        assert not list(tmp_path.glob(".*.tmp"))
+        assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temp files
     est = P.load(path=tmp_path)
     assert est.n_weights == 60_671_521 + 32_674_321
     oa, ob, *_ = data
