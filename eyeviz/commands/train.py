@@ -74,8 +74,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     p.add_argument("--budget", type=float, default=600.0, help="seconds per network")
     p.add_argument("--device", default="cpu")
     p.add_argument("--nets", default="ad,dd", help="comma-separated subset of ad,dd")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("-o", "--out", default=None, help="output directory")
+    p.add_argument("--seed", type=int, default=0, help="data, split and init seed")
+    p.add_argument("--ad-lr", type=float, default=None,
+                   help="AD learning rate (default 0.003 as Appendix A; Table 5 says 0.004)")
+    p.add_argument("--dd-momentum", type=float, default=None,
+                   help="DD Nesterov momentum (default 0 = Keras default = plain SGD)")
+    p.add_argument("--tag", default="", help="suffix of the output files (ad<TAG>.pt)")
+    p.add_argument("--threads", type=_positive_int, default=None, help="torch CPU threads")
+    p.add_argument("-o", "--out", default=None,
+                   help="output directory (default assets/models/paper/ or the user cache)")
     _domain_args(p)
 
 
@@ -142,6 +149,8 @@ def _paper(args) -> int:
     from eyeviz import dataset
     from eyeviz.estimators import paper
 
+    if args.threads is not None:
+        paper.torch.set_num_threads(args.threads)
     nets = tuple(s.strip() for s in args.nets.split(",") if s.strip())
     dom = _domain(args)
     if args.data:
@@ -152,7 +161,11 @@ def _paper(args) -> int:
                                 args.mode, args.seed)
         params = {**dom.to_dict(), "n": args.n, "mode": args.mode, "seed": args.seed}
     res = paper.train(data, args.budget, args.device, args.out, args.seed, nets=nets,
+                      ad_lr=args.ad_lr, dd_momentum=args.dd_momentum, tag=args.tag,
                       data_params=params, command=_command())
-    for name, meta in res.items():
-        print(f"paper {name}: {meta.get('label', '')}")
+    for meta in res.values():
+        h = meta.get("heldout", {})
+        print(f"{meta.get('label', '')}: held-out MAPE {h.get('mape', float('nan')):.3f} %, "
+              f"MAE {h.get('mae', float('nan')):.4g}, R^2 {h.get('r2', float('nan')):.4f} "
+              f"-> {meta.get('weights_file', '?')}")
     return 0

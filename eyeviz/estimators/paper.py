@@ -600,67 +600,7 @@ def load(path: str | os.PathLike | None = None, device: str = "cpu") -> PaperEst
 # --- command line (``eyeviz train paper`` and ``python -m eyeviz.estimators.paper``) --------
 
 
-def add_train_arguments(parser) -> None:
-    """Options of ``eyeviz train paper``."""
-    parser.add_argument("--budget", type=float, default=600.0,
-                        help="wall-clock seconds of training per network (default 600)")
-    parser.add_argument("--device", default="cpu", help="cpu or cuda (default cpu)")
-    parser.add_argument("-n", "--n", type=int, default=100_000,
-                        help="generated samples, 80%% train / 20%% held out (default 100000)")
-    parser.add_argument("--mode", choices=("single", "multi"), default="single")
-    parser.add_argument("--seed", type=int, default=0, help="data, split and init seed")
-    parser.add_argument("--nets", default="ad,dd", help="which nets: ad, dd or ad,dd")
-    parser.add_argument("--ad-lr", type=float, default=None,
-                        help="AD learning rate (default 0.003 as Appendix A; Table 5 says 0.004)")
-    parser.add_argument("--dd-momentum", type=float, default=None,
-                        help="DD Nesterov momentum (default 0 = Keras default = plain SGD)")
-    parser.add_argument("--tag", default="", help="suffix of the output files (ad<TAG>.pt)")
-    parser.add_argument("--threads", type=int, default=None, help="torch CPU threads")
-    parser.add_argument("-o", "--out-dir", default=None,
-                        help="output directory (default assets/models/paper/ or the user cache)")
-
-
-def run_train(args) -> int:
-    from eyeviz import dataset
-
-    if args.threads is not None:
-        if args.threads < 1:
-            raise EyevizError(f"--threads must be >= 1, got {args.threads}")
-        torch.set_num_threads(args.threads)
-    nets = tuple(s.strip() for s in str(args.nets).split(",") if s.strip())
-    if args.n < 10:
-        raise EyevizError(f"-n must be >= 10, got {args.n}")
-    _resolve_device(args.device)
-    data = dataset.generate(args.n, mode=args.mode, seed=args.seed)
-    cmd = (f"eyeviz train paper --budget {args.budget:g} --device {args.device} -n {args.n} "
-           f"--mode {args.mode} --seed {args.seed} --nets {','.join(nets)}")
-    if args.ad_lr is not None:
-        cmd += f" --ad-lr {args.ad_lr:g}"
-    if args.dd_momentum is not None:
-        cmd += f" --dd-momentum {args.dd_momentum:g}"
-    if args.tag:
-        cmd += f" --tag {args.tag}"
-    res = train(
-        data, args.budget, args.device, args.out_dir, args.seed, nets=nets, ad_lr=args.ad_lr,
-        dd_momentum=args.dd_momentum, tag=args.tag, data_params={"n": args.n, **data.params},
-        command=cmd,
-    )
-    for meta in res.values():
-        h = meta.get("heldout", {})
-        print(f"{meta['label']}: held-out MAPE {h.get('mape', float('nan')):.3f} %, "
-              f"MAE {h.get('mae', float('nan')):.4g}, R^2 {h.get('r2', float('nan')):.4f} "
-              f"-> {meta['weights_file']}")
-    return 0
-
-
 if __name__ == "__main__":
-    import argparse
+    from eyeviz.cli import main
 
-    _p = argparse.ArgumentParser(prog="python -m eyeviz.estimators.paper",
-                                 description="train the paper's AD/DD networks for a budget")
-    add_train_arguments(_p)
-    try:
-        sys.exit(run_train(_p.parse_args()))
-    except ValueError as _exc:
-        print(f"error: {_exc}", file=sys.stderr)
-        sys.exit(2)
+    sys.exit(main(["train", "paper", *sys.argv[1:]]))
