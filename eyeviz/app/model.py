@@ -42,6 +42,9 @@ class AppModel:
         self.selected: int | None = 0 if scene.features else None
         self.listeners: list[Callable[[str, int | None], None]] = []
         self._state: SceneState | None = None
+        self._predictions: dict | None = None
+        self._ambiguity: dict | None | bool = False  # False: not computed yet
+        self.predictor = None  # eyeviz.app.predict.Predictor, made on first use
         self.push: Callable[..., None] = self._push_plain
 
     # --- state ------------------------------------------------------------------------
@@ -51,8 +54,40 @@ class AppModel:
             self._state = compute_state(self.scene)
         return self._state
 
+    @property
+    def predictions(self) -> dict:
+        """estimator -> (r_hat, phi_hat) per feature, or a one-line reason; {} when the
+        predictions layer is off (nothing is imported then)."""
+        if not self.scene.shows("predictions") or not self.scene.features:
+            return {}
+        if self._predictions is None:
+            from eyeviz.app.predict import Predictor
+
+            if self.predictor is None:
+                self.predictor = Predictor()
+            self._predictions = self.predictor.predict(self.scene, self.state)
+        return self._predictions
+
+    @property
+    def ambiguity(self) -> dict | None:
+        """The selected feature's ambiguity region (eyeviz.app.predict.ambiguity_of)."""
+        i = self.selected
+        if not self.scene.shows("ambiguity") or i is None or i >= len(self.scene.features):
+            return None
+        if self._ambiguity is False:
+            from eyeviz.app.predict import ambiguity_of
+
+            f, v = self.scene.features[i], self.scene.view
+            half = 1.5 * v.width + math.hypot(f.x - v.center[0], f.y - v.center[1])
+            box = (v.center[0] - half, v.center[0] + half, v.center[1] - half,
+                   v.center[1] + half)
+            self._ambiguity = ambiguity_of(self.scene.eyes.pair(), f.x, f.y, f.g, box)
+        return self._ambiguity
+
     def _notify(self, what: str, index: int | None = None) -> None:
         self._state = None
+        self._predictions = None
+        self._ambiguity = False
         for fn in list(self.listeners):
             fn(what, index)
 

@@ -16,23 +16,20 @@ from pathlib import Path
 
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
-from pyvistaqt import QtInteractor
 from vtkmodules.util.numpy_support import vtk_to_numpy
-from vtkmodules.vtkRenderingCore import (
-    vtkRenderer,
-    vtkTextActor,
-    vtkWindowToImageFilter,
-)
+from vtkmodules.vtkRenderingCore import vtkTextActor, vtkWindowToImageFilter
 
 from eyeviz.app.model import AppModel, MouseEvent, drag_feature, hit_test
 from eyeviz.app.panels import BitmapPanel, EyesPanel, FeaturePanel, LayersPanel, ReadoutPanel
+from eyeviz.app.view import VtkView, fast_renderer
 from eyeviz.render.actors import (
     BACKGROUND,
     INSET_BACKGROUND,
-    INSET_VIEWPORT,
     SceneActors,
+    inset_viewport,
     style_text,
 )
+from eyeviz.render.overlays import OverlayActors
 from eyeviz.scene import Scene, SceneError, View, load, save
 
 __all__ = ["MainWindow", "make_settings", "run_app"]
@@ -42,6 +39,8 @@ RECENT_MAX = 8
 CAMERA_DISTANCE = 1000.0
 ZOOM_STEP = 1.15
 WHEEL_RADIUS_STEP = 1.08
+INSET_TEXT_PX = 24.0  # a line of text in the inset
+INSET_HIDE_EYE_PX = 60.0  # eyes at least this wide on screen: no magnified inset
 
 
 def make_settings(path: str | os.PathLike | None = None) -> QtCore.QSettings:
@@ -98,16 +97,23 @@ class MainWindow(QtWidgets.QMainWindow):
         self.inset_view = View((0.0, 0.0), 1.0)
         self.inset_auto = True
 
-        self.plotter = QtInteractor(self, auto_update=False, multi_samples=0)
+        self._dirty: set[int] = set()  # features changed live, not yet drawn
+        self._frame_pending = False
+        self.inset_shown = True
+
+        self.plotter = VtkView(self)
         self.plotter.set_background(BACKGROUND)
+        self.plotter.before_render = self._flush
         self.ren_win = self.plotter.ren_win
         self.main_ren = self.plotter.renderer
-        self.inset_ren = vtkRenderer()
-        self.inset_ren.SetViewport(*INSET_VIEWPORT)
-        self.inset_ren.SetBackground(*INSET_BACKGROUND)
+        self.inset_ren = fast_renderer(INSET_BACKGROUND)
         self.inset_ren.InteractiveOff()
         self.ren_win.AddRenderer(self.inset_ren)
         self.actors = SceneActors(self.main_ren, self.inset_ren)
+        self.overlays = OverlayActors(self.main_ren)
+        self.picker = None  # docks built on first use (issue 6 layers)
+        self.trajectory_panel = None
+        self._docks: dict[str, QtWidgets.QDockWidget] = {}
         self.title_actor = vtkTextActor()
         style_text(self.title_actor.GetTextProperty(), 24, (0.1, 0.1, 0.1))
         self.title_actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
@@ -136,7 +142,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.tabifyDockWidget(d_feat, d_eyes)
         self.tabifyDockWidget(d_eyes, d_lay)
         d_feat.raise_()
-        del d_read
+        self._docks.update(features=d_feat, readout=d_read)
 
         self.cursor_label = QtWidgets.QLabel("")
         self.statusBar().addPermanentWidget(self.cursor_label)
@@ -178,6 +184,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self._action(f, "&Save", self.save_current, QtGui.QKeySequence.Save)
         self._action(f, "Save &as…", self.save_dialog, QtGui.QKeySequence.SaveAs)
         f.addSeparator()
+        self._action(f, "&Export figure…", self.export_dialog, "Ctrl+E")
+        f.addSeparator()
         self._action(f, "&Quit", self.close, QtGui.QKeySequence.Quit)
         e = mb.addMenu("&Edit")
         undo = self.undo_stack.createUndoAction(self, "&Undo")
@@ -194,6 +202,11 @@ class MainWindow(QtWidgets.QMainWindow):
         v = mb.addMenu("&View")
         self._action(v, "&Fit view", self.fit_view, "F")
         self._action(v, "Fit &inset to the eyes", self.fit_inset, "Shift+F")
+        v.addSeparator()
+        t = v.addMenu("&Trajectory")
+        for kind in ("horizontal", "circular", "vertical"):
+            t.addAction(kind.capitalize(), lambda k=kind: self.show_trajectory(k))
+        self._action(v, "&Play / pause trajectory", self.toggle_play, "Space")
         self._refresh_recent()
 
     # --- settings -------------------------------------------------------------------
@@ -209,6 +222,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.settings.setValue("window/geometry", self.saveGeometry())
         self.settings.setValue("window/state", self.saveState())
         self.settings.sync()
+        self._frame_pending = True  # no frame after close
         self.plotter.close()
         super().closeEvent(event)
 
@@ -314,9 +328,21 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # --- model -> view ---------------------------------------------------------------
     def _on_model(self, what: str, index: int | None) -> None:
+        if what == "feature" and index is not None:
+            # a live change (drag, animation): update the model only; one frame is
+            # pending at most and draws every change made before it runs
+            self._dirty.add(index)
+            self.request_frame()
+            return
+        self._dirty.clear()
+        self._refresh(what, index)
+        self.render()
+
+    def _refresh(self, what: str, index: int | None) -> None:
         scene = self.model.scene
         st = self.model.state
         self.actors.update(scene, st, self.model.selected)
+        self._refresh_overlays(scene, st)
         self.title_actor.SetInput(scene.title)
         self.readout.refresh()
         self.bitmaps.setVisible(scene.shows("bitmaps"))
@@ -327,11 +353,118 @@ class MainWindow(QtWidgets.QMainWindow):
             self.features_panel.refresh()
             self.eyes_panel.refresh()
             self.layers_panel.refresh()
+            self._refresh_docks(scene)
             self.apply_cameras()
+
+    def _refresh_overlays(self, scene: Scene, st) -> None:
+        preds = self.model.predictions  # {} unless the predictions layer is shown
+        colors = {}
+        if preds:
+            from eyeviz.render.vector import estimator_colors
+
+            colors = estimator_colors(scene.estimators)
+        self.overlays.update_predictions(scene, st, preds, colors)
+        i = self.model.selected
+        sel_color = scene.features[i].color if i is not None and i < st.n else None
+        self.overlays.update_ambiguity(scene, self.model.ambiguity, sel_color)
+        path = self.trajectory_panel.path if self.trajectory_panel is not None else None
+        self.overlays.update_trajectory(scene, path)
+
+    def _refresh_docks(self, scene: Scene) -> None:
+        """The predictions and trajectory docks, built the first time they are needed."""
+        if scene.shows("predictions"):
+            if self.picker is None:
+                from eyeviz.app.docks import EstimatorPicker
+
+                self.picker = EstimatorPicker(self.model)
+                self._docks["predictions"] = self._dock("Estimators", self.picker, "predictions")
+                self.tabifyDockWidget(self._docks["features"], self._docks["predictions"])
+            self.picker.refresh()
+        if "predictions" in self._docks:
+            self._docks["predictions"].setVisible(scene.shows("predictions"))
+        if scene.shows("trajectory"):
+            self._trajectory_dock().refresh()
+            path = self.trajectory_panel.path
+            self.overlays.update_trajectory(scene, path)
+        if "trajectory" in self._docks:
+            self._docks["trajectory"].setVisible(scene.shows("trajectory"))
+            if not scene.shows("trajectory") and self.trajectory_panel.timer.isActive():
+                self.trajectory_panel.set_playing(False)
+
+    def _trajectory_dock(self):
+        if self.trajectory_panel is None:
+            from eyeviz.app.docks import TrajectoryPanel
+
+            self.trajectory_panel = TrajectoryPanel(self.model)
+            d = self._dock("Trajectory (Figure 14)", self.trajectory_panel, "trajectory")
+            self.addDockWidget(QtCore.Qt.RightDockWidgetArea, d)
+            self.splitDockWidget(self._docks["readout"], d, QtCore.Qt.Vertical)
+            self._docks["trajectory"] = d
+        return self.trajectory_panel
+
+    def show_trajectory(self, kind: str) -> None:
+        """View > Trajectory: a path of this kind for the selected feature, with its plot."""
+        panel = self._trajectory_dock()
+        panel.ensure_trajectory(kind)
+        if not self.model.scene.shows("trajectory"):
+            self.model.set_layer("trajectory", True)
+        self._docks["trajectory"].show()
+        panel.refresh()
+
+    def toggle_play(self) -> None:
+        panel = self._trajectory_dock()
+        if not self.model.scene.shows("trajectory"):
+            self.show_trajectory("horizontal")
+        panel.set_playing(not panel.timer.isActive())
+
+    # --- export ---------------------------------------------------------------------
+    def export_dialog(self) -> None:
+        from eyeviz.app.docks import ExportDialog
+
+        base = self.path.with_suffix(".png") if self.path else Path.cwd() / "figure.png"
+        dlg = ExportDialog(self, str(base))
+        if dlg.exec_() == QtWidgets.QDialog.Accepted:
+            self.export_to(*dlg.values())
+
+    def export_to(self, path, scale: float = 1.0, transparent: bool = False) -> Path | None:
+        """The scene as a figure (eyeviz.export: PNG, SVG, PDF); errors in a dialog."""
+        from eyeviz import EyevizError
+        from eyeviz.export import export
+
+        preds = None
+        if self.model.scene.shows("predictions"):
+            preds = self.model.predictions
+        try:
+            out = export(self.model.scene, path, scale, transparent, predictions=preds)
+        except (EyevizError, OSError, ValueError) as exc:
+            self.show_error("Cannot export", str(exc))
+            return None
+        self.statusBar().showMessage(f"exported {out}", 8000)
+        return Path(out)
+
+    def _flush(self) -> None:
+        """Bring actors and panels up to the model's live changes (before a render)."""
+        if self._dirty:
+            dirty, self._dirty = self._dirty, set()
+            self._refresh("feature", next(iter(dirty)) if len(dirty) == 1 else None)
+
+    def request_frame(self) -> None:
+        """Draw once the pending events are handled (moves arriving meanwhile coalesce)."""
+        if not self._frame_pending:
+            self._frame_pending = True
+            QtCore.QTimer.singleShot(0, self._frame)
+
+    def _frame(self) -> None:
+        self._frame_pending = False
         self.render()
 
     def render(self) -> None:
-        self.ren_win.Render()
+        """Draw now (with any pending live changes)."""
+        self.plotter.draw()
+
+    def flush(self) -> None:
+        """Apply pending live changes to actors and panels without rendering."""
+        self._flush()
 
     # --- cameras and pixel <-> model --------------------------------------------------
     def _viewport_px(self, which: str) -> tuple[float, float, float, float]:
@@ -339,7 +472,7 @@ class MainWindow(QtWidgets.QMainWindow):
         w, h = max(self.plotter.width(), 1), max(self.plotter.height(), 1)
         if which == "main":
             return 0.0, 0.0, float(w), float(h)
-        x0, y0, x1, y1 = INSET_VIEWPORT
+        x0, y0, x1, y1 = inset_viewport(w, h)
         return x0 * w, (1.0 - y1) * h, (x1 - x0) * w, (y1 - y0) * h
 
     def _view(self, which: str) -> View:
@@ -352,7 +485,8 @@ class MainWindow(QtWidgets.QMainWindow):
         """Widget pixel -> (which renderer, x, y) in model units."""
         if which is None:
             left, top, w, h = self._viewport_px("inset")
-            which = "inset" if (left <= px <= left + w and top <= py <= top + h) else "main"
+            inside = left <= px <= left + w and top <= py <= top + h
+            which = "inset" if (self.inset_shown and inside) else "main"
         left, top, w, h = self._viewport_px(which)
         v = self._view(which)
         u = v.width / w
@@ -365,6 +499,9 @@ class MainWindow(QtWidgets.QMainWindow):
         return left + w / 2 + (x - v.center[0]) / u, top + h / 2 - (y - v.center[1]) / u
 
     def apply_cameras(self) -> None:
+        w, h = max(self.plotter.width(), 1), max(self.plotter.height(), 1)
+        self.inset_ren.SetViewport(*inset_viewport(w, h))
+        self._update_inset_visibility()
         for which, ren in (("main", self.main_ren), ("inset", self.inset_ren)):
             _, _, w, h = self._viewport_px(which)
             v = self._view(which)
@@ -380,6 +517,17 @@ class MainWindow(QtWidgets.QMainWindow):
         self.actors.set_zoom(
             1.0 / self.units_per_px("main"), 1.0 / self.units_per_px("inset"), e.l, e.m
         )
+
+    def _update_inset_visibility(self) -> None:
+        """The inset magnifies the eyes; where they are already large on screen (or the
+        scene has no eyes) it would only duplicate the main view, so it is hidden."""
+        e = self.model.scene.eyes
+        eye_px = 2.0 * e.l / self.units_per_px("main")
+        want = self.model.scene.shows("eyes") and eye_px < INSET_HIDE_EYE_PX
+        if want != self.inset_shown or self.inset_ren.GetDraw() != want:
+            self.inset_shown = want
+            self.inset_ren.SetDraw(want)
+            self.actors.set_inset_shown(want)
 
     def fit_view(self) -> None:
         sc = self.model.scene
@@ -400,8 +548,10 @@ class MainWindow(QtWidgets.QMainWindow):
     def fit_inset(self) -> None:
         e = self.model.scene.eyes
         _, _, w, h = self._viewport_px("inset")
-        width = max(2 * (e.h + e.l) * 1.12, 2 * e.l * 2.2 * w / h)
-        self.inset_view = View((0.0, 0.2 * e.l), width)
+        # the eyes with their A/B labels (y from -1.8 l to 1.3 l) between a header line
+        # and the theta/psi line (INSET_TEXT_PX each)
+        u = max(2 * (e.h + e.l) * 1.08 / w, 3.1 * e.l / max(h - 2 * INSET_TEXT_PX, 1.0))
+        self.inset_view = View((0.0, -0.25 * e.l), u * w)
         self.inset_auto = True
         self.apply_cameras()
         self.render()
@@ -433,7 +583,7 @@ class MainWindow(QtWidgets.QMainWindow):
             u = self.units_per_px(which)
             v.center = (c0[0] - (ev.px - px0) * u, c0[1] + (ev.py - py0) * u)
             self.apply_cameras()
-            self.render()
+            self.request_frame()
             ev = yield
 
     # --- events ---------------------------------------------------------------------

@@ -33,7 +33,7 @@ from vtkmodules.vtkRenderingCore import (
 from eyeviz.scene import Scene
 from eyeviz.state import SceneState
 
-__all__ = ["INSET_VIEWPORT", "SceneActors", "hex_rgb", "eye_mesh"]
+__all__ = ["SceneActors", "hex_rgb", "eye_mesh", "inset_viewport"]
 
 BACKGROUND = (1.0, 1.0, 1.0)
 INSET_BACKGROUND = (0.965, 0.965, 0.955)
@@ -41,8 +41,11 @@ UNLIT = np.array([225, 225, 225], dtype=np.uint8)
 INK = (0.15, 0.15, 0.15)
 BFV_FILL = (0.93, 0.91, 0.80)
 BFV_LINE = (0.45, 0.42, 0.30)
-INSET_VIEWPORT = (0.6, 0.0, 1.0, 0.5)  # (xmin, ymin, xmax, ymax) of the render window
+INSET_MIN_PX, INSET_MAX_PX, INSET_FRACTION = 230.0, 340.0, 0.3  # inset width on screen
+INSET_ASPECT = 0.66  # height / width: the eyes, their labels and a line of text
 FILL_ALPHA = 0.4
+OUT_FILL = np.array([214, 214, 214], dtype=np.uint8)  # a feature outside the domain
+OUT_LINE = np.array([140, 140, 140], dtype=np.uint8)
 LABEL_ALL_MAX = 6  # more features than this: only the selected one is labelled
 EDGE_MIN_PX = 7.0  # draw triangle edges when an ommatidium's rim is at least this wide
 Z_BFV, Z_EYES, Z_FEAT, Z_LINE, Z_POINT = -3.0, 0.0, 1.0, 2.0, 3.0
@@ -72,6 +75,14 @@ def style_text(tp, size: int, color) -> None:
     tp.SetFontSize(size)
     tp.BoldOn()
     tp.SetColor(*color)
+
+
+def inset_viewport(w: float, h: float) -> tuple[float, float, float, float]:
+    """(xmin, ymin, xmax, ymax) of the eye inset in a w x h pixel view: the bottom-left
+    corner (outside the BFV wedge of a view centred on the field of view), ~30 % wide."""
+    wpx = min(max(INSET_FRACTION * w, INSET_MIN_PX), INSET_MAX_PX, 0.6 * w)
+    hpx = min(INSET_ASPECT * wpx, 0.5 * h)
+    return (0.0, 0.0, wpx / max(w, 1.0), hpx / max(h, 1.0))
 
 
 def hex_rgb(color: str) -> tuple[int, int, int]:
@@ -202,14 +213,24 @@ class SceneActors:
                 ren.AddActor(a)
                 acts.append(a)
             self.overlay_actors[name] = acts
-        self.tangent_text = self._text(20, INK)
-        self.tangent_text.GetTextProperty().SetJustificationToRight()
-        self.main.AddActor(self.tangent_text)
+        # the tangent angles as a screen-space note under the title: never over the rays
+        self.tangent_text = self._screen_text(20, INK, (0.015, 0.90), top=True)
+        self.main.AddViewProp(self.tangent_text)
+        # theta and psi of the BFV: a line in the inset, or in the main view without it
+        self.bfv_text = {
+            "inset": self._screen_text(16, BFV_LINE, (0.5, 0.03), center=True),
+            "main": self._screen_text(20, BFV_LINE, (0.985, 0.02), right=True),
+        }
+        self.inset.AddViewProp(self.bfv_text["inset"])
+        self.main.AddViewProp(self.bfv_text["main"])
+        self.inset_shown = True
+        self._main_eye_labels: list[vtkProp] = []
         self.inset.AddActor(self.sight_actors[1])
         self._inset_label = vtkTextActor()
-        style_text(self._inset_label.GetTextProperty(), 20, INK)
+        style_text(self._inset_label.GetTextProperty(), 16, INK)
+        self._inset_label.GetTextProperty().SetVerticalJustificationToTop()
         self._inset_label.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
-        self._inset_label.SetPosition(0.03, 0.86)
+        self._inset_label.SetPosition(0.03, 0.96)
         self.inset.AddViewProp(self._inset_label)
         self._inset_border = self._border_actor()
         self.inset.AddViewProp(self._inset_border)
@@ -226,6 +247,34 @@ class SceneActors:
             tp.SetJustificationToCentered()
             tp.SetVerticalJustificationToCentered()
         return t
+
+    @staticmethod
+    def _screen_text(size, color, pos, top=False, center=False, right=False) -> vtkTextActor:
+        t = vtkTextActor()
+        tp = t.GetTextProperty()
+        style_text(tp, size, color)
+        if top:
+            tp.SetVerticalJustificationToTop()
+        if center:
+            tp.SetJustificationToCentered()
+        if right:
+            tp.SetJustificationToRight()
+        t.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+        t.SetPosition(*pos)
+        return t
+
+    def set_inset_shown(self, shown: bool) -> None:
+        """Labels of the eyes and of the BFV go to the inset when it is shown, else to the
+        main view (where the eyes are then large enough to carry them)."""
+        self.inset_shown = bool(shown)
+        for t in self._main_eye_labels:
+            t.SetVisibility(not shown)
+        self._place_bfv_text()
+
+    def _place_bfv_text(self) -> None:
+        has = bool(self.bfv_text["main"].GetInput())
+        self.bfv_text["inset"].SetVisibility(has and self.inset_shown)
+        self.bfv_text["main"].SetVisibility(has and not self.inset_shown)
 
     @staticmethod
     def _points_actor(mesh, size: float, color) -> vtkActor:
@@ -324,31 +373,29 @@ class SceneActors:
         origin = pv.PolyData(np.array([[0.0, 0.0, Z_POINT]]))
         self._add(self._static, self.main, self._points_actor(origin, 9, INK))
         self._add(self._static, self.inset, self._points_actor(origin, 9, INK))
+        self._main_eye_labels = []
         if scene.shows("labels"):
             for text, (x, y) in (
                 ("A", (-h, -1.35 * l)),
                 ("B", (h, -1.35 * l)),
                 ("O", (0, -0.55 * l)),
             ):
-                t = vtkBillboardTextActor3D()
-                t.SetInput(text)
-                t.SetPosition(x, y, Z_POINT)
-                tp = t.GetTextProperty()
-                style_text(tp, 22, INK)
-                tp.SetJustificationToCentered()
-                tp.SetVerticalJustificationToCentered()
-                self._add(self._static, self.inset, t)
+                for ren in (self.inset, self.main):
+                    t = self._text(22, INK, center=True)
+                    t.SetInput(text)
+                    t.SetPosition(x, y, Z_POINT)
+                    self._add(self._static, ren, t)
+                    if ren is self.main:
+                        t.SetVisibility(not self.inset_shown)
+                        self._main_eye_labels.append(t)
         self._inset_label.SetInput(f"eyes (m = {m})")
+        text = ""
         if scene.shows("bfv") and scene.shows("labels"):
             deg = 180.0 / math.pi
-            for text, (x, y) in (
-                (f"θ = {pair.theta * deg:.1f}°", (0.0, 1.75 * l)),
-                (f"ψ = {pair.psi * deg:.1f}°", (-(h + 0.55 * l), 1.8 * l)),
-            ):
-                t = self._text(18, BFV_LINE, center=True)
-                t.SetInput(text)
-                t.SetPosition(x, y, Z_POINT)
-                self._add(self._static, self.inset, t)
+            text = f"θ = {pair.theta * deg:.1f}°    ψ = {pair.psi * deg:.1f}°"
+        for t in self.bfv_text.values():
+            t.SetInput(text)
+        self._place_bfv_text()
 
     def _build_features(self, scene: Scene) -> None:
         """All discs in ONE fill mesh and ONE outline mesh (cell colours): few draw calls."""
@@ -369,6 +416,8 @@ class SceneActors:
         self.fill_mesh.SetPoints(pts)
         self.fill_mesh.faces = np.column_stack([np.full(n, c), idx]).ravel()
         self.fill_mesh.cell_data["rgb"] = tint
+        self._feat_rgb = (tint, cols.astype(np.uint8))
+        self._grey_key = None
         self.line_mesh = pv.PolyData()
         self.line_mesh.SetPoints(pts)
         self.line_mesh.lines = np.column_stack([np.full(n, c + 1), idx, idx[:, :1]]).ravel()
@@ -447,14 +496,12 @@ class SceneActors:
                 else:
                     pts[3 * e + 1 : 3 * e + 3] = pts[3 * e]
             self.tangent_mesh.points[:] = pts
-            f = scene.features[i]
             if len(angles) == 2:
                 deg = 180.0 / math.pi
                 a_deg, b_deg = angles[0] * deg, angles[1] * deg
                 self.tangent_text.SetInput(
-                    f"arcsin(g/r_A) = {a_deg:.2f}°\narcsin(g/r_B) = {b_deg:.2f}°"
+                    f"tangents: arcsin(g/r_A) = {a_deg:.2f}°,  arcsin(g/r_B) = {b_deg:.2f}°"
                 )
-                self.tangent_text.SetPosition(f.x - 1.15 * f.g, f.y + 1.15 * f.g, Z_POINT)
             else:
                 self.tangent_text.SetVisibility(False)
         if show_s:
@@ -513,6 +560,7 @@ class SceneActors:
                 label.SetVisibility(few or i == selected)
                 label.SetInput(f" {f.name}")
                 label.SetPosition(f.x + f.g * 0.75, f.y + f.g * 0.75, Z_POINT)
+            self._grey(scene, state)
         if self.centers_mesh is not None:
             self.centers_mesh.points[:] = np.column_stack(
                 [state.x, state.y, np.full(state.n, Z_POINT)]
@@ -532,6 +580,26 @@ class SceneActors:
             self.sel_actor.GetProperty().SetColor(*col)
             for a in self.sight_actors:
                 a.GetProperty().SetColor(*col)
+
+    def _grey(self, scene: Scene, state: SceneState) -> None:
+        """With the predictions layer, features outside the networks' domain (not in the
+        BFV or not seen by both eyes) are drawn grey; colours are written only on change."""
+        grey = None
+        if scene.shows("predictions") and state.in_bfv is not None and state.n:
+            grey = ~state.in_domain()
+        key = None if grey is None or not grey.any() else tuple(grey.tolist())
+        if key == self._grey_key:
+            return
+        self._grey_key = key
+        tint, cols = (a.copy() for a in self._feat_rgb)
+        if key is not None:
+            tint[grey] = OUT_FILL
+            cols[grey] = OUT_LINE
+        self.fill_mesh.cell_data["rgb"][:] = tint
+        self.line_mesh.cell_data["rgb"][:] = cols
+        if self.centers_mesh is not None:
+            self.centers_mesh.point_data["rgb"][:] = cols
+        self.grey = np.zeros(state.n, bool) if key is None else grey
 
     def set_zoom(self, main_px_per_unit: float, inset_px_per_unit: float, l: float, m: int):
         """Level of detail by on-screen size: where the eye's rim is narrower than m/2 pixels,

@@ -232,7 +232,9 @@ def test_screenshot_is_not_blank_and_shows_the_lit_colour(make_window, tmp_path)
     img = qimage_to_array(QtGui.QImage(str(out)))
     assert img.shape[0] >= 600 and img.std() > 20
     assert len(np.unique(img.reshape(-1, 3), axis=0)) > 50
-    # the lit ommatidia of eye B (1..3) drawn in the feature's colour in the inset
+    # the eyes are large on screen here: no inset duplicating them
+    assert not win.inset_shown and not win.inset_ren.GetDraw()
+    # the lit ommatidia of eye B (1..3) drawn in the feature's colour in the main view
     f = sc.features[0]
     col = np.array(hex_rgb(f.color))
     pair = EyePair(sc.eyes.h, sc.eyes.l, sc.eyes.m)
@@ -240,11 +242,11 @@ def test_screenshot_is_not_blank_and_shows_the_lit_colour(make_window, tmp_path)
     for k in (1, 2, 3):
         a = (k + 0.5) * pair.gamma
         x, y = pair.h + 0.6 * pair.l * math.cos(a), 0.6 * pair.l * math.sin(a)
-        px, py = win.to_pixel(x, y, "inset")
+        px, py = win.to_pixel(x, y, "main")
         rgb = img[int(py) + top.y(), int(px) + top.x()]
         assert np.abs(rgb.astype(int) - col).max() <= 12, (k, rgb)
     a = 8.5 * pair.gamma  # an unlit ommatidium
-    px, py = win.to_pixel(pair.h + 0.6 * pair.l * math.cos(a), 0.6 * pair.l * math.sin(a), "inset")
+    px, py = win.to_pixel(pair.h + 0.6 * pair.l * math.cos(a), 0.6 * pair.l * math.sin(a), "main")
     assert np.abs(img[int(py) + top.y(), int(px) + top.x()].astype(int) - UNLIT).max() <= 12
 
 

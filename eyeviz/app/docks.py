@@ -1,0 +1,295 @@
+"""Issue 6 panels: the estimator picker, the trajectory player with its accuracy plot,
+and the export dialog. Built only when their layer (or menu entry) is first used, so a
+scene without them imports neither matplotlib nor the estimators.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from PyQt5 import QtCore, QtGui, QtWidgets
+
+from eyeviz.app.model import AppModel
+from eyeviz.scene import TRAJECTORY_KINDS, Trajectory
+
+__all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel"]
+
+ESTIMATOR_HELP = {
+    "analytic": "triangulation of the two eyes' centre rays (no weights)",
+    "compact": "small networks on the lit intervals",
+    "bayes": "the information limit (posterior mean)",
+    "paper": "the paper's networks (needs their weights)",
+}
+
+
+class EstimatorPicker(QtWidgets.QWidget):
+    """A check box per estimator (several at once); each chosen one gets its colour
+    (eyeviz.render.vector.estimator_colors, as in exported figures)."""
+
+    def __init__(self, model: AppModel, parent=None):
+        super().__init__(parent)
+        from eyeviz import estimators
+
+        self.model = model
+        lay = QtWidgets.QVBoxLayout(self)
+        self.boxes: dict[str, QtWidgets.QCheckBox] = {}
+        for name in estimators.available():
+            b = QtWidgets.QCheckBox(name)
+            b.setToolTip(ESTIMATOR_HELP.get(name, ""))
+            b.toggled.connect(lambda on, n=name: self._toggled(n, on))
+            lay.addWidget(b)
+            self.boxes[name] = b
+        self.note = QtWidgets.QLabel("")
+        self.note.setWordWrap(True)
+        lay.addWidget(self.note)
+        lay.addStretch(1)
+        self._filling = False
+
+    def refresh(self) -> None:
+        from eyeviz.render.vector import estimator_colors
+
+        chosen = self.model.scene.estimators
+        cols = estimator_colors(chosen)
+        self._filling = True
+        try:
+            for name, b in self.boxes.items():
+                b.setChecked(name in chosen)
+                pix = QtGui.QPixmap(16, 16)
+                pix.fill(QtGui.QColor(cols.get(name, "#ffffff")))
+                b.setIcon(QtGui.QIcon(pix) if name in chosen else QtGui.QIcon())
+        finally:
+            self._filling = False
+        preds = self.model.predictions
+        bad = [f"{n}: {v}" for n, v in preds.items() if isinstance(v, str)]
+        self.note.setText("\n".join(bad))
+        self.note.setStyleSheet("color: #b00020;" if bad else "")
+
+    def _toggled(self, name: str, on: bool) -> None:
+        if self._filling:
+            return
+        after = self.model.scene.copy()
+        est = [n for n in after.estimators if n != name]
+        if on:
+            est.append(name)
+        after.estimators = est
+        self.model.commit(after, f"{'Show' if on else 'Hide'} {name} predictions")
+
+
+class TrajectoryPanel(QtWidgets.QWidget):
+    """Figure 14: play / pause / speed along a horizontal, circular or vertical path, with
+    a live plot of AD and DD accuracy (100 % - APE) along it for the chosen estimators."""
+
+    def __init__(self, model: AppModel, parent=None):
+        super().__init__(parent)
+        from matplotlib.backends.backend_qt5agg import FigureCanvasQTAgg
+        from matplotlib.figure import Figure
+
+        self.model = model
+        self.path = None
+        self.pos = 0.0  # index along the path (fractional: speed may be < 1 point a tick)
+        self.feature: int | None = None
+        self.message = ""
+        self.timer = QtCore.QTimer(self)
+        self.timer.setInterval(40)
+        self.timer.timeout.connect(self.step)
+
+        lay = QtWidgets.QVBoxLayout(self)
+        row = QtWidgets.QHBoxLayout()
+        self.kind = QtWidgets.QComboBox()
+        self.kind.addItems(list(TRAJECTORY_KINDS))
+        self.kind.activated.connect(self._kind_chosen)
+        self.play_button = QtWidgets.QPushButton("▶ Play")
+        self.play_button.setCheckable(True)
+        self.play_button.toggled.connect(self.set_playing)
+        self.speed = QtWidgets.QSlider(QtCore.Qt.Horizontal)
+        self.speed.setRange(1, 20)
+        self.speed.setValue(4)
+        self.speed.setToolTip("points of the path per tick (25 ticks a second)")
+        row.addWidget(QtWidgets.QLabel("path"))
+        row.addWidget(self.kind)
+        row.addWidget(self.play_button)
+        row.addWidget(QtWidgets.QLabel("speed"))
+        row.addWidget(self.speed, 1)
+        lay.addLayout(row)
+        self.info = QtWidgets.QLabel("")
+        self.info.setWordWrap(True)
+        lay.addWidget(self.info)
+        self.fig = Figure(figsize=(4.2, 2.8), dpi=100, layout="constrained")
+        self.canvas = FigureCanvasQTAgg(self.fig)
+        self.canvas.setMinimumHeight(220)
+        lay.addWidget(self.canvas, 1)
+        self.ax_ad = self.fig.add_subplot(2, 1, 1)
+        self.ax_dd = self.fig.add_subplot(2, 1, 2, sharex=self.ax_ad)
+        self.cursors = []
+        self._key = None
+        self._before = None
+
+    # --- model --------------------------------------------------------------------------
+    def ensure_trajectory(self, kind: str | None = None) -> None:
+        """Give the scene a trajectory (from the selected feature's distance and radius)."""
+        sc = self.model.scene
+        if sc.trajectory is not None and (kind is None or kind == sc.trajectory.kind):
+            return
+        i = self.model.selected
+        f = sc.features[i] if i is not None and i < len(sc.features) else None
+        r = math.hypot(f.x, f.y) if f else 2000.0
+        g = f.g if f else 50.0
+        if not 100.0 < r < 1e6:
+            r = 2000.0
+        after = sc.copy()
+        after.trajectory = Trajectory(kind or "horizontal", float(r), float(g))
+        if "trajectory" not in after.layers:
+            after.layers.append("trajectory")
+        self.model.commit(after, f"Trajectory {after.trajectory.kind}")
+
+    def _kind_chosen(self, _index: int) -> None:
+        self.ensure_trajectory(self.kind.currentText())
+
+    def refresh(self) -> None:
+        """Recompute the path and its accuracy curves when the scene's trajectory, eyes or
+        estimators change (not when the animated feature moves)."""
+        from eyeviz.app.predict import Predictor, trajectory_path
+
+        sc = self.model.scene
+        t = sc.trajectory
+        key = (None if t is None else (t.kind, t.distance, t.g), sc.eyes.h, sc.eyes.l,
+               sc.eyes.m, tuple(sc.estimators))
+        if key == self._key:
+            return
+        self._key = key
+        self.path = None
+        self.message = ""
+        if t is None:
+            self.message = "no trajectory: choose a path"
+        else:
+            self.kind.setCurrentText(t.kind)
+            if self.model.predictor is None:
+                self.model.predictor = Predictor()
+            try:
+                self.path = trajectory_path(sc.eyes.pair(), t, sc.estimators,
+                                            self.model.predictor)
+            except ValueError as exc:
+                self.message = str(exc)
+        self.pos = 0.0
+        self._plot()
+
+    def _plot(self) -> None:
+        from eyeviz.render.vector import estimator_colors
+
+        for ax in (self.ax_ad, self.ax_dd):
+            ax.clear()
+            ax.grid(True, color="#dddddd", lw=0.6)
+        self.cursors = []
+        p = self.path
+        notes = [self.message] if self.message else []
+        if p is not None:
+            cols = estimator_colors(self.model.scene.estimators)
+            for name, acc in p.accuracy.items():
+                if isinstance(acc, str):
+                    notes.append(f"{name}: {acc}")
+                    continue
+                self.ax_ad.plot(p.axis, acc[0], color=cols[name], lw=2, label=name)
+                self.ax_dd.plot(p.axis, acc[1], color=cols[name], lw=2, label=name)
+            for ax in (self.ax_ad, self.ax_dd):
+                self.cursors.append(ax.axvline(p.axis[0], color="#333333", lw=1.2))
+            t = self.model.scene.trajectory
+            self.ax_dd.set_xlabel(p.axis_label)
+            notes.insert(0, f"{t.kind} path, distance {t.distance:g}, g = {t.g:g}: "
+                            f"{p.n} points in the BFV")
+            if any(not isinstance(a, str) for a in p.accuracy.values()):
+                self.ax_ad.legend(loc="lower left", fontsize=8, ncol=3)
+        self.ax_ad.set_ylabel("AD accuracy %")
+        self.ax_dd.set_ylabel("DD accuracy %")
+        self.info.setText("\n".join(notes))
+        self.canvas.draw_idle()
+
+    # --- animation ----------------------------------------------------------------------
+    def set_playing(self, on: bool) -> None:
+        if on:
+            self.ensure_trajectory()
+            self.refresh()
+            if self.path is None:
+                self.play_button.setChecked(False)
+                return
+            self.feature = self.model.selected if self.model.selected is not None else 0
+            if self.feature >= len(self.model.scene.features):
+                self.play_button.setChecked(False)
+                return
+            self._before = self.model.scene.copy()
+            self.timer.start()
+        else:
+            self.timer.stop()
+            before, self._before = self._before, None
+            if before is not None and self.feature is not None:
+                # the whole animation is one undo step (like a drag)
+                after = self.model.scene.copy()
+                self.model.scene = before.copy()
+                name = after.features[self.feature].name
+                self.model.commit(after, f"Animate {name}", before=before)
+        self.play_button.setText("❚❚ Pause" if on else "▶ Play")
+        if self.play_button.isChecked() != on:
+            self.play_button.setChecked(on)
+
+    def step(self, points: float | None = None) -> tuple[float, float] | None:
+        """Move the animated feature ``points`` along the path (default: the speed);
+        returns its new centre. The feature gets the trajectory's radius."""
+        p = self.path
+        if p is None:
+            self.refresh()
+            p = self.path
+            if p is None:
+                return None
+        if self.feature is None:
+            self.feature = self.model.selected if self.model.selected is not None else 0
+        if self.feature >= len(self.model.scene.features):
+            return None
+        self.pos = (self.pos + (self.speed.value() if points is None else points)) % p.n
+        k = int(self.pos)
+        x, y = float(p.x[k]), float(p.y[k])
+        self.model.live(self.feature, x=x, y=y, g=p.g)
+        for c in self.cursors:
+            c.set_xdata([p.axis[k], p.axis[k]])
+        self.canvas.draw_idle()
+        return x, y
+
+
+class ExportDialog(QtWidgets.QDialog):
+    """File > Export: path (.png, .svg or .pdf), PNG scale, transparent background."""
+
+    def __init__(self, parent, start: str):
+        super().__init__(parent)
+        self.setWindowTitle("Export figure")
+        form = QtWidgets.QFormLayout(self)
+        self.path = QtWidgets.QLineEdit(start)
+        browse = QtWidgets.QPushButton("Browse…")
+        browse.clicked.connect(self._browse)
+        row = QtWidgets.QHBoxLayout()
+        row.addWidget(self.path, 1)
+        row.addWidget(browse)
+        form.addRow("file (.png, .svg, .pdf)", row)
+        self.scale = QtWidgets.QDoubleSpinBox()
+        self.scale.setRange(0.25, 20.0)
+        self.scale.setSingleStep(0.5)
+        self.scale.setValue(1.0)
+        self.scale.setToolTip("PNG only: 1 = 300 dpi at a 3.5 inch column")
+        form.addRow("PNG scale", self.scale)
+        self.transparent = QtWidgets.QCheckBox("transparent background")
+        form.addRow(self.transparent)
+        buttons = QtWidgets.QDialogButtonBox(
+            QtWidgets.QDialogButtonBox.Ok | QtWidgets.QDialogButtonBox.Cancel
+        )
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        form.addRow(buttons)
+
+    def _browse(self) -> None:
+        p, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self, "Export figure", self.path.text(), "Figures (*.png *.svg *.pdf)"
+        )
+        if p:
+            self.path.setText(p)
+
+    def values(self) -> tuple[Path, float, bool]:
+        return Path(self.path.text()), float(self.scale.value()), self.transparent.isChecked()
+

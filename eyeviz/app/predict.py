@@ -1,0 +1,171 @@
+"""Predictions, ambiguity and trajectory accuracy for the app (Qt-free, VTK-free).
+
+:class:`Predictor` keeps each estimator loaded once (``eyeviz.estimators`` is imported on
+the first prediction, so torch only when the predictions layer is on and a network is
+chosen). An estimator that cannot be loaded or cannot answer for the scene (weights
+missing, another m) becomes a one-line message, never an exception.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from eyeviz.geometry import EyePair, intervals_to_bitmap
+from eyeviz.scene import Scene, Trajectory
+from eyeviz.state import SceneState
+
+__all__ = [
+    "Predictor",
+    "TrajectoryPath",
+    "ambiguity_of",
+    "errors",
+    "trajectory_path",
+]
+
+Result = tuple[np.ndarray, np.ndarray] | str
+
+
+class Predictor:
+    """name -> (r_hat, phi_hat) per feature, NaN outside the networks' domain."""
+
+    def __init__(self) -> None:
+        self._loaded: dict[str, object] = {}
+        self._failed: dict[str, str] = {}
+
+    def estimator(self, name: str):
+        """The loaded estimator, or a str saying why it is unavailable."""
+        if name in self._loaded:
+            return self._loaded[name]
+        if name in self._failed:
+            return self._failed[name]
+        from eyeviz import estimators
+
+        try:
+            est = estimators.load(name)
+        except Exception as exc:  # noqa: BLE001  (any failure is shown, never raised)
+            msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+            self._failed[name] = f"unavailable: {msg}"
+            return self._failed[name]
+        self._loaded[name] = est
+        return est
+
+    def predict_bitmaps(self, name: str, oa: np.ndarray, ob: np.ndarray) -> Result:
+        est = self.estimator(name)
+        if isinstance(est, str):
+            return est
+        try:
+            r, phi = est.predict(oa, ob)
+        except (ValueError, RuntimeError) as exc:
+            return f"cannot answer: {str(exc).splitlines()[0]}"
+        return np.asarray(r, dtype=np.float64), np.asarray(phi, dtype=np.float64)
+
+    def predict(self, scene: Scene, state: SceneState) -> dict[str, Result]:
+        """Each of the scene's estimators on the in-domain features' Omega (m/2 each)."""
+        n, m = state.n, state.m
+        ok = np.flatnonzero(state.in_domain()) if n else np.zeros(0, int)
+        out: dict[str, Result] = {}
+        if ok.size:
+            oa = intervals_to_bitmap(state.LA[ok], state.RA[ok], m, m // 2)
+            ob = intervals_to_bitmap(state.LB[ok], state.RB[ok], m, m // 2)
+        for name in scene.estimators:
+            r_hat, phi_hat = np.full(n, np.nan), np.full(n, np.nan)
+            if ok.size:
+                res = self.predict_bitmaps(name, oa, ob)
+                if isinstance(res, str):
+                    out[name] = res
+                    continue
+                r_hat[ok], phi_hat[ok] = res
+            else:
+                est = self.estimator(name)
+                if isinstance(est, str):
+                    out[name] = est
+                    continue
+            out[name] = (r_hat, phi_hat)
+        return out
+
+
+def errors(r: float, phi: float, r_hat: float, phi_hat: float) -> tuple[float, float, float]:
+    """(delta r, delta r in % of r, delta phi in degrees wrapped to (-180, 180])."""
+    dr = r_hat - r
+    dphi = math.degrees(math.remainder(phi_hat - phi, 2 * math.pi))
+    return dr, 100.0 * dr / r, dphi
+
+
+def ambiguity_of(pair: EyePair, x: float, y: float, g: float, box) -> dict | None:
+    """The ambiguity region of one feature (eyeviz.ambiguity) with its ranges, or None
+    when the feature covers an eye centre (no polygon then)."""
+    from eyeviz.ambiguity import ambiguity_radius_range, ambiguity_region
+
+    try:
+        reg = ambiguity_region(pair, x, y, g, box=box)
+        g_range = ambiguity_radius_range(pair, x, y, g, box=box)
+    except ValueError:
+        return None
+    return {
+        "polygon": reg.polygon,
+        "bounded": reg.bounded,
+        "r_range": reg.distance_range(),
+        "phi_range": reg.azimuth_range(),
+        "g_range": g_range,
+    }
+
+
+@dataclass
+class TrajectoryPath:
+    """Points of a Figure 14 trajectory and the estimators' accuracy along it."""
+
+    kind: str
+    x: np.ndarray
+    y: np.ndarray
+    g: float
+    axis: np.ndarray  # the abscissa of the accuracy plot
+    axis_label: str
+    accuracy: dict[str, tuple[np.ndarray, np.ndarray] | str]  # name -> (AD %, DD %) or why not
+
+    @property
+    def n(self) -> int:
+        return int(self.x.shape[0])
+
+
+def trajectory_path(
+    pair: EyePair, traj: Trajectory, estimators: list[str], predictor: Predictor | None,
+    n: int = 240, stop: float = 6000.0,
+) -> TrajectoryPath:
+    """Points along ``traj`` (eyeviz.trajectories) where the feature is in the BFV, with
+    AD and DD accuracy (100 % - APE, Section 6, Figure 15) per estimator at each point.
+    ValueError (one line) when the trajectory never enters the BFV."""
+    from eyeviz import trajectories as tr
+
+    if traj.kind == "horizontal":
+        x, y = tr.horizontal(traj.distance, traj.g, n, h=pair.h, l=pair.l)
+        axis, label = x, f"x along y = {traj.distance:g}"
+    elif traj.kind == "circular":
+        x, y = tr.circular(traj.distance, traj.g, n, h=pair.h, l=pair.l)
+        axis, label = np.degrees(np.arctan2(y, x)), f"φ (°) on r = {traj.distance:g}"
+    elif traj.kind == "vertical":
+        x, y = tr.vertical(traj.g, n, start=traj.distance, stop=max(stop, 2 * traj.distance),
+                           h=pair.h, l=pair.l)
+        axis, label = y, "y along x = 0"
+    else:
+        raise ValueError(f"trajectory kind must be horizontal, circular or vertical, "
+                         f"got {traj.kind!r}")
+    acc: dict[str, tuple[np.ndarray, np.ndarray] | str] = {}
+    if predictor is not None and estimators:
+        m = pair.m
+        LA, RA, LB, RB = pair.intervals(x, y, np.full_like(x, traj.g))
+        oa = intervals_to_bitmap(LA, RA, m, m // 2)
+        ob = intervals_to_bitmap(LB, RB, m, m // 2)
+        r, phi = np.hypot(x, y), np.arctan2(y, x)
+        for name in estimators:
+            res = predictor.predict_bitmaps(name, oa, ob)
+            if isinstance(res, str):
+                acc[name] = res
+                continue
+            r_hat, phi_hat = res
+            ad = 100.0 - 100.0 * np.abs(phi_hat - phi) / phi
+            dd = 100.0 - 100.0 * np.abs(r_hat - r) / r
+            acc[name] = (ad, dd)
+    return TrajectoryPath(traj.kind, x, y, float(traj.g), np.asarray(axis), label, acc)
