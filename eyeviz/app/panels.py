@@ -134,6 +134,7 @@ def _owners_of(st, eye: str) -> np.ndarray:
 
 
 GOOD, BAD, GREY = "#1b7837", "#b00020", "#777777"
+READOUT_MIN_WIDTH = 420
 
 
 class ReadoutPanel(QtWidgets.QWidget):
@@ -165,6 +166,8 @@ class ReadoutPanel(QtWidgets.QWidget):
         self._rows: list[tuple[QtWidgets.QLabel, QtWidgets.QLabel]] = []
         self._cache: dict[int, tuple] = {}
         self._title_key = None
+        self.setMinimumWidth(READOUT_MIN_WIDTH)
+        self.title.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Preferred)
 
     def _row(self, k: int) -> tuple[QtWidgets.QLabel, QtWidgets.QLabel]:
         while len(self._rows) <= k:
@@ -173,6 +176,8 @@ class ReadoutPanel(QtWidgets.QWidget):
             val.setTextFormat(QtCore.Qt.PlainText)
             val.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
             val.setAlignment(QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop)
+            # changing numbers must never resize the dock (and the view) during a drag
+            val.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Preferred)
             key.setAlignment(QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop)
             r = len(self._rows)
             self.grid.addWidget(key, r, 0)

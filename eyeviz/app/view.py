@@ -49,12 +49,15 @@ class VtkView(QVTKRenderWindowInteractor):
         self._Iren.SetInteractorStyle(None)
         self.frames = 0  # renders completed: the bench's "frame that reflects the event"
         self.before_render = None  # callable run before each render (pending updates)
+        self.closed = False
 
     def set_background(self, color) -> None:
         self.renderer.SetBackground(*color)
 
     def draw(self) -> None:
-        """Apply pending updates, then render synchronously."""
+        """Apply pending updates, then render synchronously (never after close)."""
+        if self.closed:
+            return
         if self.before_render is not None:
             self.before_render()
         self.ren_win.Render()
@@ -65,5 +68,7 @@ class VtkView(QVTKRenderWindowInteractor):
             self.draw()
 
     def close(self) -> bool:
-        self.Finalize()
+        if not self.closed:
+            self.closed = True
+            self.Finalize()
         return super().close()

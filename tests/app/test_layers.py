@@ -1,0 +1,183 @@
+"""Issue 6 in the app: prediction ghosts, domain flags, ambiguity region, trajectory
+animation and File > Export, on a real window (xvfb-run)."""
+
+import math
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+import vtk
+from PyQt5 import QtCore, QtGui
+from PyQt5.QtTest import QTest
+
+from eyeviz import estimators
+from eyeviz import trajectories as tr
+from eyeviz.render.actors import OUT_FILL, Z_FEAT
+from eyeviz.scene import Eyes, Feature, Scene, Trajectory, View
+
+ROOT = Path(__file__).resolve().parents[2]
+LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout", "labels", "predictions", "ambiguity"]
+
+
+def scene(m=720, est=("analytic",)):
+    return Scene(
+        Eyes(40.0, 20.0, m),
+        [
+            Feature("target", 300.0, 2500.0, 60.0, "#D55E00"),
+            Feature("outside", 2900.0, 900.0, 120.0, "#0072B2"),
+        ],
+        list(LAYERS),
+        estimators=list(est),
+        view=View((0.0, 2300.0), 7000.0),
+    )
+
+
+def pixel_of(win, x, y):
+    c = vtk.vtkCoordinate()
+    c.SetCoordinateSystemToWorld()
+    c.SetValue(x, y, Z_FEAT)
+    dx, dy = c.GetComputedDoubleDisplayValue(win.main_ren)
+    return QtCore.QPoint(round(dx), round(win.ren_win.GetSize()[1] - dy))
+
+
+def drag(win, start, end, steps=10):
+    w = win.plotter
+    QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
+    for k in range(1, steps + 1):
+        QTest.mouseMove(w, start + (end - start) * (k / steps))
+    QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, end)
+
+
+def analytic_answer(f, m=720):
+    pair = Eyes(40.0, 20.0, m).pair()
+    wa, wb = pair.bitmaps(f.x, f.y, f.g)
+    r, phi = estimators.load("analytic").predict(wa[: m // 2], wb[: m // 2])
+    return float(np.asarray(r).ravel()[0]), float(np.asarray(phi).ravel()[0])
+
+
+def test_moving_a_feature_moves_its_prediction_ghost(make_window):
+    win = make_window(scene())
+    before = win.overlays.ghosts["analytic"][0].copy()
+    drag(win, pixel_of(win, 300.0, 2500.0), pixel_of(win, -900.0, 3600.0))
+    f = win.model.scene.features[0]
+    assert abs(f.x - -900.0) < 3 * win.units_per_px()
+    r, phi = analytic_answer(f)
+    np.testing.assert_allclose(win.overlays.ghosts["analytic"][0],
+                               [r * math.cos(phi), r * math.sin(phi)], rtol=1e-9)
+    assert not np.allclose(win.overlays.ghosts["analytic"][0], before)
+    # the ghost's centre point drawn in the view, and the errors in the readout
+    pts = np.asarray(win.overlays.ghost_points.points)[:, :2]
+    assert np.min(np.hypot(*(pts - [r * math.cos(phi), r * math.sin(phi)]).T)) < 1e-6
+    text = win.readout.texts["pred:analytic"]
+    dr = r - math.hypot(f.x, f.y)
+    assert f"Δr {dr:+.1f}" in text and "Δφ" in text and "%" in text
+
+
+def test_out_of_domain_feature_is_flagged_and_greyed(make_window):
+    win = make_window(scene())
+    st = win.model.state
+    assert list(st.in_domain()) == [True, False]
+    assert np.isnan(win.overlays.ghosts["analytic"][1]).all()
+    assert list(win.actors.grey) == [False, True]
+    np.testing.assert_array_equal(win.actors.fill_mesh.cell_data["rgb"][1], OUT_FILL)
+    win.model.select(1)
+    assert "outside the networks' domain" in win.readout.texts["domain"]
+    # moved into the BFV it is in the domain again, in its own colour
+    win.model.set_feature(1, x=0.0, y=3500.0)
+    assert list(win.actors.grey) == [False, False]
+    assert np.isfinite(win.overlays.ghosts["analytic"][1]).all()
+
+
+def test_an_estimator_that_cannot_answer_is_a_message(make_window):
+    win = make_window(scene(m=360, est=("analytic",)))
+    assert "cannot answer" in win.readout.texts["pred:analytic"]
+    assert "m/2 = 360" in win.picker.note.text() or "360" in win.picker.note.text()
+    assert not win.overlays.ghost_actor.GetVisibility()
+
+
+def _inside(poly, x, y):
+    a, b = poly, np.roll(poly, -1, axis=0)
+    cross = (b[:, 0] - a[:, 0]) * (y - a[:, 1]) - (b[:, 1] - a[:, 1]) * (x - a[:, 0])
+    return np.all(cross >= 0) or np.all(cross <= 0)
+
+
+def test_ambiguity_region_contains_the_centre_and_gives_the_same_bitmaps(make_window):
+    win = make_window(scene())
+    poly = win.overlays.amb_polygon
+    f = win.model.scene.features[0]
+    assert poly is not None and len(poly) >= 3 and win.overlays.amb_fill.GetVisibility()
+    assert _inside(poly, f.x, f.y)
+    pair = win.model.scene.eyes.pair()
+    iv = [int(v) for v in pair.intervals(f.x, f.y, f.g)]
+    c = poly.mean(axis=0)
+    for v in poly:  # just inside each vertex
+        p = v + 1e-6 * (c - v)
+        assert [int(k) for k in pair.intervals(p[0], p[1], f.g)] == iv
+    assert "r ∈ [" in win.readout.texts["ambiguity"] and "g ∈ [" in win.readout.texts["ambiguity"]
+    lo, hi = (float(s) for s in win.readout.texts["ambiguity"].split("[")[1].split("]")[0]
+              .split(","))
+    assert lo <= math.hypot(f.x, f.y) <= hi
+
+
+def test_trajectory_animation_steps_the_feature_along_the_path(make_window, qtbot):
+    sc = scene()
+    sc.trajectory = Trajectory("horizontal", 2000.0, 50.0)
+    sc.layers.append("trajectory")
+    win = make_window(sc)
+    panel = win.trajectory_panel
+    assert panel is not None and panel.path is not None
+    x, y = tr.horizontal(2000.0, 50.0, panel.path.n)
+    np.testing.assert_allclose(panel.path.x, x)
+    assert panel.step(5) == (x[5], 2000.0)
+    f = win.model.scene.features[0]
+    assert (f.x, f.y, f.g) == (x[5], 2000.0, 50.0)
+    assert panel.step(7) == (x[12], 2000.0)
+    # the plot holds one AD and one DD curve per estimator, 100 % - APE along the path
+    ad = panel.ax_ad.get_lines()[0].get_ydata()
+    assert len(ad) == panel.path.n and np.all(ad <= 100.0) and np.nanmedian(ad) > 90
+    # the timer drives it; pausing makes the whole animation one undo step
+    n0 = win.undo_stack.count()
+    panel.set_playing(True)
+    qtbot.waitUntil(lambda: int(panel.pos) >= 12 + 3 * panel.speed.value(), timeout=5000)
+    panel.set_playing(False)
+    k = int(panel.pos)
+    assert win.model.scene.features[0].x == pytest.approx(x[k])
+    assert win.undo_stack.count() == n0 + 1
+    win.undo_stack.undo()
+    assert win.model.scene.features[0].x == x[12]
+
+
+def test_file_export_writes_files_that_open(make_window, tmp_path):
+    win = make_window(scene())
+    png = win.export_to(tmp_path / "fig.png", scale=1.0)
+    img = QtGui.QImage(str(png))
+    assert not img.isNull() and img.width() > 500
+    svg = win.export_to(tmp_path / "fig.svg", transparent=True)
+    assert ET.parse(svg).getroot().tag.endswith("svg")
+    assert win.export_to(tmp_path / "fig.txt") is None
+    assert "cannot export" in win.last_error and not (tmp_path / "fig.txt").exists()
+    win.error_box.close()
+
+
+def test_torch_is_imported_only_with_the_predictions_layer(tmp_path):
+    code = (
+        "import sys\n"
+        "from eyeviz.app.window import MainWindow, make_app, make_settings\n"
+        "from eyeviz.scene import load\n"
+        "app = make_app()\n"
+        f"w = MainWindow(load({str(ROOT / 'assets/scenes/default.toml')!r}), "
+        f"settings=make_settings({str(tmp_path / 's.ini')!r}))\n"
+        "w.show(); app.processEvents(); w.render()\n"
+        "print('torch' in sys.modules)\n"
+        "w.model.set_layer('predictions', True)\n"
+        "app.processEvents()\n"
+        "print('torch' in sys.modules, sorted(w.model.predictions))\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=90)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.strip().splitlines()
+    assert lines[-2] == "False"
+    assert lines[-1] == "True ['compact']"
