@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
 from eyeviz.app.model import AppModel
@@ -115,9 +116,9 @@ class TrajectoryPanel(QtWidgets.QWidget):
         self.info = QtWidgets.QLabel("")
         self.info.setWordWrap(True)
         lay.addWidget(self.info)
-        self.fig = Figure(figsize=(4.2, 2.8), dpi=100, layout="constrained")
+        self.fig = Figure(figsize=(4.2, 3.0), dpi=100, layout="constrained")
         self.canvas = FigureCanvasQTAgg(self.fig)
-        self.canvas.setMinimumHeight(220)
+        self.canvas.setMinimumHeight(240)
         lay.addWidget(self.canvas, 1)
         self.ax_ad = self.fig.add_subplot(2, 1, 1)
         self.ax_dd = self.fig.add_subplot(2, 1, 2, sharex=self.ax_ad)
@@ -185,22 +186,29 @@ class TrajectoryPanel(QtWidgets.QWidget):
         notes = [self.message] if self.message else []
         if p is not None:
             cols = estimator_colors(self.model.scene.estimators)
-            for name, acc in p.accuracy.items():
+            for j, (name, acc) in enumerate(p.accuracy.items()):
                 if isinstance(acc, str):
                     notes.append(f"{name}: {acc}")
                     continue
-                self.ax_ad.plot(p.axis, acc[0], color=cols[name], lw=2, label=name)
-                self.ax_dd.plot(p.axis, acc[1], color=cols[name], lw=2, label=name)
+                lw = max(3.2 - 1.0 * j, 1.2)  # later curves thinner: equal ones stay visible
+                self.ax_ad.plot(p.axis, acc[0], color=cols[name], lw=lw, label=name)
+                self.ax_dd.plot(p.axis, acc[1], color=cols[name], lw=lw, label=name)
             for ax in (self.ax_ad, self.ax_dd):
                 self.cursors.append(ax.axvline(p.axis[0], color="#333333", lw=1.2))
+                lo = min([np.nanmin(a[k]) for a in p.accuracy.values() if not isinstance(a, str)
+                          for k in (0, 1)] + [90.0])
+            self.ax_dd.set_ylim(max(0.0, min(lo, 90.0)) - 2, 101)
             t = self.model.scene.trajectory
             self.ax_dd.set_xlabel(p.axis_label)
             notes.insert(0, f"{t.kind} path, distance {t.distance:g}, g = {t.g:g}: "
                             f"{p.n} points in the BFV")
             if any(not isinstance(a, str) for a in p.accuracy.values()):
-                self.ax_ad.legend(loc="lower left", fontsize=8, ncol=3)
-        self.ax_ad.set_ylabel("AD accuracy %")
-        self.ax_dd.set_ylabel("DD accuracy %")
+                self.ax_ad.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8,
+                                  ncol=4, frameon=False)
+        self.ax_ad.set_title("AD accuracy (%)", fontsize=9, loc="left")
+        self.ax_dd.set_title("DD accuracy (%)", fontsize=9, loc="left")
+        self.ax_ad.tick_params(labelsize=8, labelbottom=False)
+        self.ax_dd.tick_params(labelsize=8)
         self.info.setText("\n".join(notes))
         self.canvas.draw_idle()
 

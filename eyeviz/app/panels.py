@@ -161,6 +161,8 @@ class ReadoutPanel(QtWidgets.QWidget):
         self.grid = QtWidgets.QGridLayout()
         self.grid.setHorizontalSpacing(14)
         self.grid.setVerticalSpacing(3)
+        self.grid.setColumnStretch(0, 0)
+        self.grid.setColumnStretch(1, 1)
         lay.addLayout(self.grid)
         lay.addStretch(1)
         self._rows: list[tuple[QtWidgets.QLabel, QtWidgets.QLabel]] = []
@@ -283,8 +285,8 @@ class ReadoutPanel(QtWidgets.QWidget):
                 rows.append((f"pred:{name}", key, "no answer for these bitmaps", GREY))
                 continue
             dr, pct, dphi = errors(float(st.r[i]), float(st.phi[i]), r_hat, phi_hat)
-            text = (f"→ r {r_hat:.1f}  (Δr {dr:+.1f}, {pct:+.2f} %)\n"
-                    f"→ φ {math.degrees(phi_hat):.2f}°  (Δφ {dphi:+.3f}°)")
+            text = (f"r {r_hat:.1f}   Δr {dr:+.1f} ({pct:+.2f} %)\n"
+                    f"φ {math.degrees(phi_hat):.2f}°   Δφ {dphi:+.3f}°")
             rows.append((f"pred:{name}", key, text, "#1e1e1e"))
         return rows
 
@@ -296,7 +298,7 @@ class ReadoutPanel(QtWidgets.QWidget):
         a0, a1 = amb["phi_range"]
         g0, g1 = amb["g_range"]
         more = "" if amb["bounded"] else " (unbounded)"
-        text = (f"r ∈ [{lo:.0f}, {hi:.0f}]{more}  (Δ {hi - lo:.0f})\n"
+        text = (f"r ∈ [{lo:.0f}, {hi:.0f}]{more}\n"
                 f"φ ∈ [{math.degrees(a0):.2f}°, {math.degrees(a1):.2f}°]\n"
                 f"g ∈ [{g0:.3g}, {g1:.3g}]")
         return ("ambiguity", "same bitmaps", text, "#1e1e1e")

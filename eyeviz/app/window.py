@@ -40,7 +40,7 @@ CAMERA_DISTANCE = 1000.0
 ZOOM_STEP = 1.15
 WHEEL_RADIUS_STEP = 1.08
 INSET_TEXT_PX = 24.0  # a line of text in the inset
-INSET_HIDE_EYE_PX = 60.0  # eyes at least this wide on screen: no magnified inset
+INSET_HIDE_EYE_PX = 40.0  # eyes at least this wide on screen: no magnified inset
 
 
 def make_settings(path: str | os.PathLike | None = None) -> QtCore.QSettings:
@@ -98,6 +98,13 @@ class MainWindow(QtWidgets.QMainWindow):
         self.inset_auto = True
 
         self._dirty: set[int] = set()  # features changed live, not yet drawn
+        self._table_index: int | None = None
+        self._table_timer = QtCore.QTimer(self)
+        self._table_timer.setSingleShot(True)
+        self._table_timer.setInterval(100)
+        self._table_timer.timeout.connect(
+            lambda: self.features_panel.refresh(self._table_index)
+        )
         self._frame_pending = False
         self.inset_shown = True
 
@@ -348,8 +355,13 @@ class MainWindow(QtWidgets.QMainWindow):
         self.bitmaps.setVisible(scene.shows("bitmaps"))
         self.bitmaps.refresh()
         if what == "feature":
-            self.features_panel.refresh(index)
+            # the table follows a drag at <= 10 Hz (a row repaint per frame costs ~1 ms);
+            # the drag's end refreshes it at once
+            self._table_index = index
+            if not self._table_timer.isActive():
+                self._table_timer.start()
         else:
+            self._table_timer.stop()
             self.features_panel.refresh()
             self.eyes_panel.refresh()
             self.layers_panel.refresh()
@@ -397,9 +409,9 @@ class MainWindow(QtWidgets.QMainWindow):
 
             self.trajectory_panel = TrajectoryPanel(self.model)
             d = self._dock("Trajectory (Figure 14)", self.trajectory_panel, "trajectory")
-            self.addDockWidget(QtCore.Qt.RightDockWidgetArea, d)
-            self.splitDockWidget(self._docks["readout"], d, QtCore.Qt.Vertical)
+            self.tabifyDockWidget(self._docks["features"], d)
             self._docks["trajectory"] = d
+            QtCore.QTimer.singleShot(0, d.raise_)
         return self.trajectory_panel
 
     def show_trajectory(self, kind: str) -> None:
@@ -548,10 +560,11 @@ class MainWindow(QtWidgets.QMainWindow):
     def fit_inset(self) -> None:
         e = self.model.scene.eyes
         _, _, w, h = self._viewport_px("inset")
-        # the eyes with their A/B labels (y from -1.8 l to 1.3 l) between a header line
-        # and the theta/psi line (INSET_TEXT_PX each)
-        u = max(2 * (e.h + e.l) * 1.08 / w, 3.1 * e.l / max(h - 2 * INSET_TEXT_PX, 1.0))
-        self.inset_view = View((0.0, -0.25 * e.l), u * w)
+        # the eyes with their A/B labels (y from -1.8 l to 1.3 l) above the m/theta/psi line
+        u = max(2 * (e.h + e.l) * 1.08 / w, 3.1 * e.l / max(h - 1.6 * INSET_TEXT_PX, 1.0))
+        # centre the content in the part of the inset above the text line
+        shift = 0.8 * INSET_TEXT_PX * u
+        self.inset_view = View((0.0, -0.25 * e.l - shift), u * w)
         self.inset_auto = True
         self.apply_cameras()
         self.render()

@@ -218,7 +218,7 @@ class SceneActors:
         self.main.AddViewProp(self.tangent_text)
         # theta and psi of the BFV: a line in the inset, or in the main view without it
         self.bfv_text = {
-            "inset": self._screen_text(16, BFV_LINE, (0.5, 0.03), center=True),
+            "inset": self._screen_text(14, BFV_LINE, (0.5, 0.03), center=True),
             "main": self._screen_text(20, BFV_LINE, (0.985, 0.02), right=True),
         }
         self.inset.AddViewProp(self.bfv_text["inset"])
@@ -321,6 +321,7 @@ class SceneActors:
         """Eyes, outlines, origin and BFV wedge: depend on h, l, m and the layers only."""
         self._clear(self._static)
         self.eye_meshes, self._eye_actors = [], []
+        self._owners = None
         pair = scene.eyes.pair()
         h, l, m = pair.h, pair.l, pair.m
         if scene.shows("bfv"):
@@ -378,7 +379,7 @@ class SceneActors:
             for text, (x, y) in (
                 ("A", (-h, -1.35 * l)),
                 ("B", (h, -1.35 * l)),
-                ("O", (0, -0.55 * l)),
+                ("O", (0, -1.35 * l)),
             ):
                 for ren in (self.inset, self.main):
                     t = self._text(22, INK, center=True)
@@ -388,13 +389,13 @@ class SceneActors:
                     if ren is self.main:
                         t.SetVisibility(not self.inset_shown)
                         self._main_eye_labels.append(t)
-        self._inset_label.SetInput(f"eyes (m = {m})")
-        text = ""
+        self._inset_label.SetInput("")
+        text = f"m = {m}"
         if scene.shows("bfv") and scene.shows("labels"):
             deg = 180.0 / math.pi
-            text = f"θ = {pair.theta * deg:.1f}°    ψ = {pair.psi * deg:.1f}°"
-        for t in self.bfv_text.values():
-            t.SetInput(text)
+            text += f"  θ = {pair.theta * deg:.4g}°  ψ = {pair.psi * deg:.4g}°"
+        self.bfv_text["inset"].SetInput(text)
+        self.bfv_text["main"].SetInput(text if "θ" in text else "")
         self._place_bfv_text()
 
     def _build_features(self, scene: Scene) -> None:
@@ -532,10 +533,16 @@ class SceneActors:
         if not self.eye_meshes:
             return
         palette = np.vstack([UNLIT] + [hex_rgb(f.color) for f in scene.features]).astype(np.uint8)
+        same_palette = getattr(self, "_palette", None) is not None and np.array_equal(
+            palette, self._palette
+        )
         self._palette = palette
+        old = getattr(self, "_owners", None)
         for e, (mesh, owner) in enumerate(
             zip(self.eye_meshes, (state.owner_a, state.owner_b), strict=True)
         ):
+            if same_palette and old is not None and np.array_equal(old[e], owner):
+                continue  # unchanged: no colour write, so no buffer upload at the next render
             mesh.cell_data["rgb"][:] = palette[owner + 1]
             for (eye, k), lod in self._lod.items():
                 if eye == e:
