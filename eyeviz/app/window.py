@@ -152,6 +152,10 @@ class MainWindow(QtWidgets.QMainWindow):
         self._docks.update(features=d_feat, readout=d_read)
 
         self.cursor_label = QtWidgets.QLabel("")
+        # a fixed width: a new cursor text must not re-lay out the status bar every move
+        fm = self.cursor_label.fontMetrics()
+        self.cursor_label.setFixedWidth(fm.horizontalAdvance("x -00,000.0   y -00,000.0     "
+                                                             "r 00,000.0   φ 000.00°  "))
         self.statusBar().addPermanentWidget(self.cursor_label)
         self._build_menus()
         self.model.listeners.append(self._on_model)

@@ -415,8 +415,12 @@ class SceneActors:
         idx = np.arange(n * c).reshape(n, c)
         self.fill_mesh = pv.PolyData()
         self.fill_mesh.SetPoints(pts)
-        self.fill_mesh.faces = np.column_stack([np.full(n, c), idx]).ravel()
-        self.fill_mesh.cell_data["rgb"] = tint
+        # triangle fans, not c-gons: VTK would re-triangulate every polygon at each upload
+        j = np.arange(1, c - 1)
+        fan = np.stack(np.broadcast_arrays(3, idx[:, :1], idx[:, j], idx[:, j + 1]), axis=-1)
+        self.fill_mesh.faces = fan.reshape(-1)
+        self._fan = c - 2
+        self.fill_mesh.cell_data["rgb"] = np.repeat(tint, self._fan, axis=0)
         self._feat_rgb = (tint, cols.astype(np.uint8))
         self._grey_key = None
         self.line_mesh = pv.PolyData()
@@ -588,6 +592,10 @@ class SceneActors:
             for a in self.sight_actors:
                 a.GetProperty().SetColor(*col)
 
+    def fill_rgb(self, i: int) -> np.ndarray:
+        """The fill colour feature i is drawn in."""
+        return self.fill_mesh.cell_data["rgb"][i * self._fan]
+
     def _grey(self, scene: Scene, state: SceneState) -> None:
         """With the predictions layer, features outside the networks' domain (not in the
         BFV or not seen by both eyes) are drawn grey; colours are written only on change."""
@@ -602,7 +610,7 @@ class SceneActors:
         if key is not None:
             tint[grey] = OUT_FILL
             cols[grey] = OUT_LINE
-        self.fill_mesh.cell_data["rgb"][:] = tint
+        self.fill_mesh.cell_data["rgb"][:] = np.repeat(tint, self._fan, axis=0)
         self.line_mesh.cell_data["rgb"][:] = cols
         if self.centers_mesh is not None:
             self.centers_mesh.point_data["rgb"][:] = cols

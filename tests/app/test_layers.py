@@ -82,7 +82,8 @@ def test_out_of_domain_feature_is_flagged_and_greyed(make_window):
     assert list(st.in_domain()) == [True, False]
     assert np.isnan(win.overlays.ghosts["analytic"][1]).all()
     assert list(win.actors.grey) == [False, True]
-    np.testing.assert_array_equal(win.actors.fill_mesh.cell_data["rgb"][1], OUT_FILL)
+    np.testing.assert_array_equal(win.actors.fill_rgb(1), OUT_FILL)
+    assert not np.array_equal(win.actors.fill_rgb(0), OUT_FILL)
     win.model.select(1)
     assert "outside the networks' domain" in win.readout.texts["domain"]
     # moved into the BFV it is in the domain again, in its own colour

@@ -295,3 +295,15 @@ def test_cli_screenshot(tmp_path):
         timeout=60,
     )
     assert r.returncode == 2 and "eyes.m" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_inset_shows_tiny_eyes_in_a_corner_and_hides_for_large_ones(make_window):
+    win = make_window(load(ROOT / "assets" / "scenes" / "default.toml"))
+    assert win.inset_shown and win.inset_ren.GetDraw()
+    left, top, w, h = win._viewport_px("inset")
+    assert left == 0 and top + h == pytest.approx(win.plotter.height())
+    assert w * h <= 0.25 * win.plotter.width() * win.plotter.height()
+    assert win.to_model(left + w / 2, top + h / 2)[0] == "inset"
+    win.model.scene.view = View((0.0, 0.0), 300.0)  # zoomed onto the eyes
+    win.apply_cameras()
+    assert not win.inset_shown and win.to_model(left + w / 2, top + h / 2)[0] == "main"

@@ -132,3 +132,23 @@ def test_tangents_touch_the_feature_and_sectors_bound_the_lit_interval(rig):
     sc.layers.remove("tangents")
     act.update(sc, compute_state(sc), 0)
     assert not act.overlay_actors["tangents"][0].GetVisibility()
+
+
+def test_inset_is_a_small_bottom_left_corner():
+    from eyeviz.render.actors import inset_viewport
+
+    for w, h, most in ((843, 552, 0.12), (1600, 1000, 0.06), (400, 300, 0.3)):
+        x0, y0, x1, y1 = inset_viewport(w, h)
+        assert (x0, y0) == (0.0, 0.0)
+        assert (x1 - x0) * (y1 - y0) <= most  # the old inset took 20 % of the view
+        assert 200 <= (x1 - x0) * w <= 340
+
+
+def test_feature_fill_is_triangle_fans_in_the_feature_colours(rig):
+    pl, act = rig
+    sc = scene()
+    act.update(sc, compute_state(sc), 0)
+    assert act.fill_mesh.is_all_triangles
+    for i, f in enumerate(sc.features):
+        tint = np.round(0.4 * np.array(hex_rgb(f.color)) + 0.6 * 255)
+        np.testing.assert_array_equal(act.fill_rgb(i), tint)
