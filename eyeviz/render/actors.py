@@ -15,9 +15,10 @@ import math
 
 import numpy as np
 import pyvista as pv
-from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+from vtkmodules.vtkCommonMath import vtkMatrix4x4
 from vtkmodules.vtkRenderingCore import (
     vtkActor,
     vtkActor2D,
@@ -159,6 +160,33 @@ def _ring(x: float, y: float, r: float, z: float) -> np.ndarray:
     return pts
 
 
+def _set_rgb(data, rgb: np.ndarray) -> None:
+    """Set the uint8 "rgb" array of point or cell data (may be empty: pyvista refuses)."""
+    arr = numpy_to_vtk(np.ascontiguousarray(rgb, dtype=np.uint8).reshape(-1, 3), deep=1)
+    arr.SetName("rgb")
+    data.AddArray(arr)
+
+
+def _unit_ring(z: float) -> pv.PolyData:
+    """The closed unit circle at height z (an outline template)."""
+    mesh = pv.PolyData(_ring(0.0, 0.0, 1.0, z))
+    mesh.lines = np.concatenate([[_CIRCLE_N + 1], np.arange(_CIRCLE_N), [0]])
+    return mesh
+
+
+def _fans(idx: np.ndarray) -> np.ndarray:
+    """Triangle fans (VTK cell array) over rings of point ids idx (n, c)."""
+    j = np.arange(1, idx.shape[1] - 1)
+    return np.stack(np.broadcast_arrays(3, idx[:, :1], idx[:, j], idx[:, j + 1]), axis=-1)
+
+
+def _unit_fan() -> pv.PolyData:
+    """The unit disc as one triangle fan (a fill template)."""
+    mesh = pv.PolyData(_ring(0.0, 0.0, 1.0, 0.0))
+    mesh.faces = _fans(np.arange(_CIRCLE_N)[None, :]).reshape(-1)
+    return mesh
+
+
 class SceneActors:
     """All actors of one scene in a main renderer and an inset renderer (the eyes, magnified).
 
@@ -181,17 +209,33 @@ class SceneActors:
         self._labels: list[vtkBillboardTextActor3D] = []
         self._feature_props: list[tuple[vtkRenderer, vtkProp]] = []
         self.centers_mesh: pv.PolyData | None = None
+        # the selected (dragged) feature: template meshes placed by actor transforms, so a
+        # drag uploads no geometry (a transform is a uniform, not a buffer)
         self.handle_mesh = pv.PolyData(np.zeros((1, 3)))
         self.handle_actor = self._points_actor(self.handle_mesh, 13, (0.35, 0.35, 0.35))
-        self.sight_mesh = pv.PolyData(np.zeros((3, 3)), lines=[3, 0, 1, 2])
+        # sight lines (-h, 0) -> (x, y) -> (h, 0): the template (-1, 0) -> (0, 1) -> (1, 0)
+        # under the linear map [[h, x], [0, y]]
+        self.sight_mesh = pv.PolyData(
+            np.array([[-1.0, 0.0, Z_LINE], [0.0, 1.0, Z_LINE], [1.0, 0.0, Z_LINE]]),
+            lines=[3, 0, 1, 2],
+        )
+        self.sight_matrix = vtkMatrix4x4()
         self.sight_actors = [_actor(self.sight_mesh, INK), _actor(self.sight_mesh, INK)]
         for a in self.sight_actors:
             a.GetProperty().SetLineWidth(2.0)
             a.GetProperty().SetLineStipplePattern(0xF0F0)
-        self.sel_mesh = pv.PolyData(_ring(0, 0, 1, Z_LINE))
-        self.sel_mesh.lines = np.concatenate([[_CIRCLE_N + 1], np.arange(_CIRCLE_N), [0]])
+            a.SetUserMatrix(self.sight_matrix)
+        self.sel_mesh = _unit_ring(0.0)
         self.sel_actor = _actor(self.sel_mesh, INK)
         self.sel_actor.GetProperty().SetLineWidth(5.0)
+        self.live_fill = _actor(_unit_fan())
+        self.live_line = _actor(_unit_ring(0.0))
+        self.live_line.GetProperty().SetLineWidth(3.0)
+        self.live_center = self._points_actor(pv.PolyData(np.zeros((1, 3))), 11, INK)
+        self.live_actors = (self.live_fill, self.live_line, self.live_center)
+        for a in self.live_actors:
+            a.SetVisibility(False)
+            self.main.AddActor(a)
         self.main.AddActor(self.sel_actor)
         self.main.AddActor(self.handle_actor)
         self.main.AddActor(self.sight_actors[0])
@@ -399,34 +443,32 @@ class SceneActors:
         self._place_bfv_text()
 
     def _build_features(self, scene: Scene) -> None:
-        """All discs in ONE fill mesh and ONE outline mesh (cell colours): few draw calls."""
+        """All discs but the selected one in ONE fill mesh and ONE outline mesh (cell
+        colours): few draw calls. The selected disc is drawn by the live actors."""
         self._clear(self._feature_props)
         self._labels = []
         self.centers_mesh = self.fill_mesh = self.line_mesh = None
+        self._merged_key = None
         if not scene.shows("features") or not scene.features:
             return
         n, c = len(scene.features), _CIRCLE_N
         cols = np.array([hex_rgb(f.color) for f in scene.features], dtype=np.float64)
         # an opaque tint, not alpha: translucency costs whole extra passes in software GL
         tint = np.round(FILL_ALPHA * cols + (1 - FILL_ALPHA) * 255).astype(np.uint8)
+        self._feat_rgb = (tint, cols.astype(np.uint8))
+        self._rgb_now = self._feat_rgb
+        self.grey = np.zeros(n, bool)
         pts = vtkPoints()
         pts.SetDataTypeToDouble()  # features lie far from the origin: keep float64
         pts.SetNumberOfPoints(n * c)
-        idx = np.arange(n * c).reshape(n, c)
+        self._idx = np.arange(n * c).reshape(n, c)
+        # triangle fans, not c-gons: VTK would re-triangulate every polygon at each upload
+        self._fan_cells = _fans(self._idx)
+        self._fan = c - 2
         self.fill_mesh = pv.PolyData()
         self.fill_mesh.SetPoints(pts)
-        # triangle fans, not c-gons: VTK would re-triangulate every polygon at each upload
-        j = np.arange(1, c - 1)
-        fan = np.stack(np.broadcast_arrays(3, idx[:, :1], idx[:, j], idx[:, j + 1]), axis=-1)
-        self.fill_mesh.faces = fan.reshape(-1)
-        self._fan = c - 2
-        self.fill_mesh.cell_data["rgb"] = np.repeat(tint, self._fan, axis=0)
-        self._feat_rgb = (tint, cols.astype(np.uint8))
-        self._grey_key = None
         self.line_mesh = pv.PolyData()
         self.line_mesh.SetPoints(pts)
-        self.line_mesh.lines = np.column_stack([np.full(n, c + 1), idx, idx[:, :1]]).ravel()
-        self.line_mesh.cell_data["rgb"] = cols.astype(np.uint8)
         fa = _actor(self.fill_mesh, rgb=True)
         la = _actor(self.line_mesh, rgb=True)
         la.GetProperty().SetLineWidth(3.0)
@@ -442,14 +484,13 @@ class SceneActors:
                 self._add(self._feature_props, self.main, label)
                 self._labels.append(label)
         self.centers_mesh = pv.PolyData(np.zeros((n, 3)))
-        self.centers_mesh.point_data["rgb"] = cols.astype(np.uint8)
-        ca = self._points_actor(self.centers_mesh, 11, None)
-        mapper = ca.GetMapper()
+        self._centers_actor = self._points_actor(self.centers_mesh, 11, None)
+        mapper = self._centers_actor.GetMapper()
         mapper.SetScalarModeToUsePointFieldData()
         mapper.SelectColorArray("rgb")
         mapper.SetColorModeToDirectScalars()
         mapper.ScalarVisibilityOn()
-        self._add(self._feature_props, self.main, ca)
+        self._add(self._feature_props, self.main, self._centers_actor)
 
     # --- updates ----------------------------------------------------------------------
     def update(self, scene: Scene, state: SceneState, selected: int | None) -> None:
@@ -555,66 +596,103 @@ class SceneActors:
 
     def _update_features(self, scene: Scene, state: SceneState, selected: int | None) -> None:
         n = len(scene.features)
+        has_sel = selected is not None and 0 <= selected < n and scene.shows("features")
+        sel = selected if has_sel and self.fill_mesh is not None else None
         if self.fill_mesh is not None:
-            zf = Z_FEAT + 0.9 * np.arange(n) / n
-            ring = np.empty((n, _CIRCLE_N, 3))
-            ring[..., 0] = state.x[:, None] + state.g[:, None] * _UNIT[None, :, 0]
-            ring[..., 1] = state.y[:, None] + state.g[:, None] * _UNIT[None, :, 1]
-            ring[..., 2] = zf[:, None]
-            pts = self.fill_mesh.GetPoints()
-            vtk_to_numpy(pts.GetData())[:] = ring.reshape(-1, 3)
-            pts.Modified()
-            self.fill_mesh.Modified()
-            self.line_mesh.Modified()
+            self._grey(scene, state)
+            tint, cols = self._rgb_now
+            others = np.ones(n, bool)
+            if sel is not None:
+                others[sel] = False
+            geo = np.column_stack([state.x, state.y, state.g])[others]
+            key = (sel, geo.tobytes(), tint.tobytes(), cols.tobytes())
+            if key != self._merged_key:  # not while only the selected feature moves
+                self._merged_key = key
+                self._write_merged(state, others, tint, cols)
             few = n <= LABEL_ALL_MAX
             for i, (label, f) in enumerate(zip(self._labels, scene.features, strict=False)):
                 label.SetVisibility(few or i == selected)
-                label.SetInput(f" {f.name}")
+                label.SetInput(f" {f.name}")  # no-op (no Modified) when unchanged
                 label.SetPosition(f.x + f.g * 0.75, f.y + f.g * 0.75, Z_POINT)
-            self._grey(scene, state)
-        if self.centers_mesh is not None:
-            self.centers_mesh.points[:] = np.column_stack(
-                [state.x, state.y, np.full(state.n, Z_POINT)]
-            )
-        has_sel = selected is not None and 0 <= selected < n and scene.shows("features")
+        for a in self.live_actors:
+            a.SetVisibility(sel is not None)
         self.handle_actor.SetVisibility(has_sel)
         self.sel_actor.SetVisibility(has_sel)
         for a in self.sight_actors:
             a.SetVisibility(has_sel)
         if has_sel:
             f = scene.features[selected]
-            self.handle_mesh.points[:] = [[f.x + f.g, f.y, Z_POINT + 0.5]]
-            self.sel_mesh.points[:] = _ring(f.x, f.y, f.g, Z_LINE)
+            x, y, g = float(state.x[selected]), float(state.y[selected]), float(state.g[selected])
+            if sel is not None:
+                z = Z_FEAT + 0.9 * sel / n
+                tint, cols = self._rgb_now
+                self.live_fill.SetPosition(x, y, z)
+                self.live_line.SetPosition(x, y, z)
+                self.live_center.SetPosition(x, y, Z_POINT)
+                for a in (self.live_fill, self.live_line):
+                    a.SetScale(g, g, 1.0)
+                self.live_fill.GetProperty().SetColor(*(tint[sel] / 255.0))
+                for a in (self.live_line, self.live_center):
+                    a.GetProperty().SetColor(*(cols[sel] / 255.0))
+            self.handle_actor.SetPosition(x + g, y, Z_POINT + 0.5)
+            self.sel_actor.SetPosition(x, y, Z_LINE)
+            self.sel_actor.SetScale(g, g, 1.0)
             h = scene.eyes.h
-            self.sight_mesh.points[:] = [[-h, 0, Z_LINE], [f.x, f.y, Z_LINE], [h, 0, Z_LINE]]
+            mat = self.sight_matrix
+            if (mat.GetElement(0, 0), mat.GetElement(0, 1), mat.GetElement(1, 1)) != (h, x, y):
+                mat.SetElement(0, 0, h)
+                mat.SetElement(0, 1, x)
+                mat.SetElement(1, 1, y)
+                mat.Modified()
             col = _rgbf(f.color)
             self.sel_actor.GetProperty().SetColor(*col)
             for a in self.sight_actors:
                 a.GetProperty().SetColor(*col)
 
+    def _write_merged(self, state: SceneState, others: np.ndarray, tint, cols) -> None:
+        """The merged fill/outline/centre meshes of every feature but the selected one."""
+        n = state.n
+        zf = Z_FEAT + 0.9 * np.arange(n) / n
+        ring = np.empty((n, _CIRCLE_N, 3))
+        ring[..., 0] = state.x[:, None] + state.g[:, None] * _UNIT[None, :, 0]
+        ring[..., 1] = state.y[:, None] + state.g[:, None] * _UNIT[None, :, 1]
+        ring[..., 2] = zf[:, None]
+        pts = self.fill_mesh.GetPoints()
+        vtk_to_numpy(pts.GetData())[:] = ring.reshape(-1, 3)
+        pts.Modified()
+        idx = self._idx[others]
+        self.fill_mesh.faces = self._fan_cells[others].reshape(-1)
+        _set_rgb(self.fill_mesh.GetCellData(), np.repeat(tint[others], self._fan, axis=0))
+        self.line_mesh.lines = np.column_stack(
+            [np.full(len(idx), _CIRCLE_N + 1), idx, idx[:, :1]]
+        ).ravel()
+        _set_rgb(self.line_mesh.GetCellData(), cols[others])
+        self.fill_mesh.Modified()
+        self.line_mesh.Modified()
+        centers = pv.PolyData(np.column_stack([state.x, state.y, np.full(n, Z_POINT)])[others])
+        _set_rgb(centers.GetPointData(), cols[others])
+        self.centers_mesh = centers
+        self._centers_actor.GetMapper().SetInputData(centers)
+
     def fill_rgb(self, i: int) -> np.ndarray:
         """The fill colour feature i is drawn in."""
-        return self.fill_mesh.cell_data["rgb"][i * self._fan]
+        return self._rgb_now[0][i]
 
     def _grey(self, scene: Scene, state: SceneState) -> None:
         """With the predictions layer, features outside the networks' domain (not in the
-        BFV or not seen by both eyes) are drawn grey; colours are written only on change."""
+        BFV or not seen by both eyes) are drawn grey."""
         grey = None
         if scene.shows("predictions") and state.in_bfv is not None and state.n:
             grey = ~state.in_domain()
-        key = None if grey is None or not grey.any() else tuple(grey.tolist())
-        if key == self._grey_key:
+        if grey is None or not grey.any():
+            self._rgb_now = self._feat_rgb
+            self.grey = np.zeros(state.n, bool)
             return
-        self._grey_key = key
         tint, cols = (a.copy() for a in self._feat_rgb)
-        if key is not None:
-            tint[grey] = OUT_FILL
-            cols[grey] = OUT_LINE
-        self.fill_mesh.cell_data["rgb"][:] = np.repeat(tint, self._fan, axis=0)
-        self.line_mesh.cell_data["rgb"][:] = cols
-        if self.centers_mesh is not None:
-            self.centers_mesh.point_data["rgb"][:] = cols
-        self.grey = np.zeros(state.n, bool) if key is None else grey
+        tint[grey] = OUT_FILL
+        cols[grey] = OUT_LINE
+        self._rgb_now = (tint, cols)
+        self.grey = grey
 
     def set_zoom(self, main_px_per_unit: float, inset_px_per_unit: float, l: float, m: int):
         """Level of detail by on-screen size: where the eye's rim is narrower than m/2 pixels,

@@ -307,3 +307,34 @@ def test_inset_shows_tiny_eyes_in_a_corner_and_hides_for_large_ones(make_window)
     win.model.scene.view = View((0.0, 0.0), 300.0)  # zoomed onto the eyes
     win.apply_cameras()
     assert not win.inset_shown and win.to_model(left + w / 2, top + h / 2)[0] == "main"
+
+
+def test_dragged_disc_is_drawn_at_its_new_place_during_and_after_the_drag(make_window):
+    """The selected disc is a separate actor moved by its transform: it must follow."""
+    win = make_window(two_features())
+    w = win.plotter
+    start, end = pixel_of(win, -1200.0, 3000.0), pixel_of(win, -400.0, 2500.0)
+    tint = np.round(0.4 * np.array(hex_rgb("#0072B2")) + 0.6 * 255)
+    top = w.mapTo(win, QtCore.QPoint(0, 0))
+
+    def fill_at(x, y):
+        win.flush()
+        win.render()
+        img = qimage_to_array(win.grab_image())
+        px, py = win.to_pixel(x, y, "main")
+        return np.abs(img[int(py) + top.y(), int(px) + top.x()].astype(int) - tint).max() <= 12
+
+    QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
+    for k in range(1, 13):
+        QTest.mouseMove(w, start + (end - start) * (k / 12))
+    for _ in ("during the drag", "after the release"):
+        f = win.model.scene.features[1]
+        assert win.model.selected == 1 and f.g == 200.0 and abs(f.x + 400.0) < 30
+        win.flush()  # the moves are coalesced into the next frame
+        x0, x1, y0, y1, _, _ = win.actors.live_fill.GetBounds()
+        assert win.actors.live_fill.GetVisibility()
+        np.testing.assert_allclose([x0, x1, y0, y1], [f.x - 200, f.x + 200, f.y - 200, f.y + 200])
+        assert fill_at(f.x + 120.0, f.y) and fill_at(f.x, f.y - 120.0)
+        assert not fill_at(-1200.0 - 120.0, 3000.0)  # nothing left at the old place
+        QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, end)
+    assert win.undo_stack.count() == 1

@@ -61,6 +61,19 @@ def test_colours_updated_in_place_and_rebuilt_on_m(rig):
     assert np.shares_memory(act.eye_meshes[0].cell_data["rgb"], arrays[0])
     for e in (0, 1):
         np.testing.assert_array_equal(meshes[e].cell_data["rgb"], expected_rgb(sc, e)[0])
+    # the selected disc is the live actor, placed by its transform; the merged mesh holds
+    # the other disc only and was not rewritten by the move
+    x0, x1, y0, y1, _, _ = act.live_fill.GetBounds()
+    np.testing.assert_allclose([x0, x1, y0, y1], [-950, -850, 1950, 2050], atol=1e-6)
+    assert fill.n_cells == act._fan and act.line_mesh.n_cells == 1
+    ring = fill.points.reshape(2, -1, 3)[1]
+    np.testing.assert_allclose(np.hypot(ring[:, 0] - 30.0, ring[:, 1] - 1500.0), 50.0)
+    sc.features[1].x = 60.0  # not selected: the merged mesh follows
+    act.update(sc, compute_state(sc), 0)
+    ring = fill.points.reshape(2, -1, 3)[1]
+    np.testing.assert_allclose(np.hypot(ring[:, 0] - 60.0, ring[:, 1] - 1500.0), 50.0)
+    act.update(sc, compute_state(sc), None)  # nothing selected: both discs merged
+    assert fill.n_cells == 2 * act._fan and not act.live_fill.GetVisibility()
     ring = fill.points.reshape(2, -1, 3)[0]
     np.testing.assert_allclose(np.hypot(ring[:, 0] + 900.0, ring[:, 1] - 2000.0), 50.0)
     sc.eyes.m = 36
