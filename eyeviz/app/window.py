@@ -1,4 +1,4 @@
-"""The eyeviz main window: a 2D top view (pyvistaqt QtInteractor) plus side panels.
+"""The eyeviz main window: a 2D top view (VTK's Qt widget, see view.py) plus side panels.
 
 Flow (DESIGN.md §2): a Qt event mutates the Scene through :class:`AppModel` ->
 ``compute_state`` -> :class:`SceneActors` and the panels redraw from that state. Mouse
