@@ -50,7 +50,9 @@ def _scene(m: int, n: int):
                 OKABE_ITO[i % len(OKABE_ITO)],
             )
         )
-    fs[0] = Feature("dragged", 0.0, 1500.0, 50.0, OKABE_ITO[0])
+    # the dragged feature goes last: the topmost disc, so the press grabs it even where
+    # a random disc overlaps it
+    fs[-1] = Feature("dragged", 0.0, 1500.0, 50.0, OKABE_ITO[0])
     layers = ["eyes", "bfv", "features", "bitmaps", "readout", "labels"]
     return Scene(Eyes(40.0, 20.0, m), fs, layers, view=View((0.0, 2600.0), 9000.0))
 
@@ -81,7 +83,7 @@ def bench_drag(m: int, n: int, events: int, settings: str) -> dict:
         idle = 0
         while w.frames == before:
             app.processEvents()
-            f = win.model.scene.features[0]
+            f = win.model.scene.features[-1]
             if not win._frame_pending and (f.x, f.y) == was:
                 idle += 1
                 if idle > 3:  # Qt sent no event (same pixel) or the feature did not move
@@ -106,7 +108,7 @@ def bench_drag(m: int, n: int, events: int, settings: str) -> dict:
         p = start + QtCore.QPoint(round(150 * math.sin(a)) + k % 3, round(-60 * (1 - math.cos(a))))
         t0 = time.perf_counter()
         before = w.frames
-        f = win.model.scene.features[0]
+        f = win.model.scene.features[-1]
         was = (f.x, f.y)
         QTest.mouseMove(w, p)
         drew = frame(before, was)
@@ -116,7 +118,7 @@ def bench_drag(m: int, n: int, events: int, settings: str) -> dict:
                 continue
             lat.append(1e3 * (time.perf_counter() - t0))
     QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, p)
-    moved = win.model.scene.features[0].x != 0.0
+    moved = win.model.scene.features[-1].x != 0.0
     steps = win.undo_stack.count()
     win.close()
     app.processEvents()
