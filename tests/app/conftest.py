@@ -7,8 +7,9 @@ import pytest
 os.environ.setdefault("QT_API", "pyqt5")
 
 if not os.environ.get("DISPLAY"):
-    pytest.skip(
-        "the app tests need an X display: run them under xvfb-run -a", allow_module_level=True
+    # a failure, not a skip: a missing display must never pass for a green GUI suite
+    raise RuntimeError(
+        "the app tests need an X display: run them under xvfb-run -a (scripts/test.sh does)"
     )
 
 

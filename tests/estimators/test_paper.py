@@ -5,8 +5,7 @@ import math
 
 import numpy as np
 import pytest
-
-torch = pytest.importorskip("torch")
+import torch
 
 from eyeviz import EyevizError  # noqa: E402
 from eyeviz.estimators import paper as P  # noqa: E402

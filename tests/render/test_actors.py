@@ -4,12 +4,11 @@ import math
 
 import numpy as np
 import pytest
+import pyvista as pv
 
-pv = pytest.importorskip("pyvista")
-
-from eyeviz.render.actors import UNLIT, SceneActors, eye_mesh, hex_rgb  # noqa: E402
-from eyeviz.scene import Eyes, Feature, Scene  # noqa: E402
-from eyeviz.state import compute_state  # noqa: E402
+from eyeviz.render.actors import UNLIT, SceneActors, eye_mesh, hex_rgb
+from eyeviz.scene import Eyes, Feature, Scene
+from eyeviz.state import compute_state
 
 
 @pytest.fixture
