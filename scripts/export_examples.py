@@ -37,7 +37,7 @@ def ambiguity_scene() -> scene_mod.Scene:
         features=[scene_mod.Feature("target", 0.0, 1500.0, 50.0, "#D55E00")],
         layers=["features", "ambiguity", "tangents", "labels", "readout"],
         view=scene_mod.View((0.0, 1600.0), 500.0),
-        title="Every centre in the hatched needle gives the same two bitmaps",
+        title="The hatched needle: centres with the same two bitmaps",
     )
     return sc
 
