@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from eyeviz import EyevizError
-from eyeviz.geometry import EyePair
+from eyeviz.geometry import EyePair, intervals_to_bitmap
 
 __all__ = [
     "CHUNK",
@@ -150,21 +150,10 @@ class Chunk:
         return int(self.r.shape[0])
 
     def to_dataset(self, p: GenParams) -> Dataset:
-        w = p.eyes.m // 2
-        return Dataset(_bitmap(self.la, self.ra, w), _bitmap(self.lb, self.rb, w),
+        m = p.eyes.m
+        return Dataset(intervals_to_bitmap(self.la, self.ra, m, m // 2),
+                       intervals_to_bitmap(self.lb, self.rb, m, m // 2),
                        self.r, self.phi, self.g, p.eyes, p.as_dict())
-
-
-def _bitmap(lo: np.ndarray, hi: np.ndarray, w: int) -> np.ndarray:
-    """Bool (n, w) lit on lo..hi (0 <= lo <= hi < w): ``intervals_to_bitmap(lo, hi, m, w)``
-    for intervals inside the upper half, built by one scatter of the lit bits."""
-    n = lo.shape[0]
-    out = np.zeros((n, w), bool)
-    cnt = hi - lo + 1
-    excl = np.cumsum(cnt) - cnt
-    base = np.arange(n, dtype=np.int64) * w + lo
-    out.reshape(-1)[np.repeat(base - excl, cnt) + np.arange(int(cnt.sum()))] = True
-    return out
 
 
 # --- parameters ----------------------------------------------------------------------
