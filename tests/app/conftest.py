@@ -1,10 +1,13 @@
 """A real eyeviz window (Qt + VTK) under Xvfb, with settings in a temporary file."""
 
 import os
+import sys
+from pathlib import Path
 
 import pytest
 
 os.environ.setdefault("QT_API", "pyqt5")
+sys.path.insert(0, str(Path(__file__).parent))  # the shared helpers in mouse.py
 
 if not os.environ.get("DISPLAY"):
     # a failure, not a skip: a missing display must never pass for a green GUI suite

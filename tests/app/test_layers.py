@@ -9,13 +9,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import vtk
-from PyQt5 import QtCore, QtGui
-from PyQt5.QtTest import QTest
+from mouse import drag, pixel_of
+from PyQt5 import QtGui
 
 from eyeviz import estimators
 from eyeviz import trajectories as tr
-from eyeviz.render.actors import OUT_FILL, Z_FEAT
+from eyeviz.render.actors import OUT_FILL
 from eyeviz.scene import Eyes, Feature, Scene, Trajectory, View
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -35,22 +34,6 @@ def scene(m=720, est=("analytic",)):
     )
 
 
-def pixel_of(win, x, y):
-    c = vtk.vtkCoordinate()
-    c.SetCoordinateSystemToWorld()
-    c.SetValue(x, y, Z_FEAT)
-    dx, dy = c.GetComputedDoubleDisplayValue(win.main_ren)
-    return QtCore.QPoint(round(dx), round(win.ren_win.GetSize()[1] - dy))
-
-
-def drag(win, start, end, steps=10):
-    w = win.plotter
-    QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
-    for k in range(1, steps + 1):
-        QTest.mouseMove(w, start + (end - start) * (k / steps))
-    QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, end)
-
-
 def analytic_answer(f, m=720):
     pair = Eyes(40.0, 20.0, m).pair()
     wa, wb = pair.bitmaps(f.x, f.y, f.g)
@@ -61,12 +44,13 @@ def analytic_answer(f, m=720):
 def test_moving_a_feature_moves_its_prediction_ghost(make_window):
     win = make_window(scene())
     before = win.overlays.ghosts["analytic"][0].copy()
-    drag(win, pixel_of(win, 300.0, 2500.0), pixel_of(win, -900.0, 3600.0))
+    drag(win, pixel_of(win, 300.0, 2500.0), pixel_of(win, -900.0, 3600.0), steps=10)
     f = win.model.scene.features[0]
     assert abs(f.x - -900.0) < 3 * win.units_per_px()
     r, phi = analytic_answer(f)
-    np.testing.assert_allclose(win.overlays.ghosts["analytic"][0],
-                               [r * math.cos(phi), r * math.sin(phi)], rtol=1e-9)
+    np.testing.assert_allclose(
+        win.overlays.ghosts["analytic"][0], [r * math.cos(phi), r * math.sin(phi)], rtol=1e-9
+    )
     assert not np.allclose(win.overlays.ghosts["analytic"][0], before)
     # the ghost's centre point drawn in the view, and the errors in the readout
     pts = np.asarray(win.overlays.ghost_points.points)[:, :2]
@@ -118,8 +102,9 @@ def test_ambiguity_region_contains_the_centre_and_gives_the_same_bitmaps(make_wi
         p = v + 1e-6 * (c - v)
         assert [int(k) for k in pair.intervals(p[0], p[1], f.g)] == iv
     assert "r ∈ [" in win.readout.texts["ambiguity"] and "g ∈ [" in win.readout.texts["ambiguity"]
-    lo, hi = (float(s) for s in win.readout.texts["ambiguity"].split("[")[1].split("]")[0]
-              .split(","))
+    lo, hi = (
+        float(s) for s in win.readout.texts["ambiguity"].split("[")[1].split("]")[0].split(",")
+    )
     assert lo <= math.hypot(f.x, f.y) <= hi
 
 

@@ -7,14 +7,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import vtk
+from mouse import drag, pixel_of
 from PyQt5 import QtCore, QtGui
 from PyQt5.QtTest import QTest
 
 from eyeviz.app.model import DRAG_THRESHOLD_PX
 from eyeviz.app.window import qimage_to_array
 from eyeviz.geometry import EyePair
-from eyeviz.render.actors import UNLIT, Z_FEAT, hex_rgb
+from eyeviz.render.actors import UNLIT, hex_rgb
 from eyeviz.scene import Eyes, Feature, Scene, View, load
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -30,25 +30,6 @@ def two_features(m=720):
         ["eyes", "bfv", "features", "bitmaps", "readout", "labels"],
         view=View((0.0, 2300.0), 7000.0),
     )
-
-
-def pixel_of(win, x, y):
-    """Model -> Qt widget pixel through VTK's own camera transform (not the app's maths)."""
-    c = vtk.vtkCoordinate()
-    c.SetCoordinateSystemToWorld()
-    c.SetValue(x, y, Z_FEAT)
-    dx, dy = c.GetComputedDoubleDisplayValue(win.main_ren)
-    h = win.ren_win.GetSize()[1]
-    return QtCore.QPoint(round(dx), round(h - dy))
-
-
-def drag(win, start, end, steps=12):
-    w = win.plotter
-    QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
-    for k in range(1, steps + 1):
-        p = start + (end - start) * (k / steps)
-        QTest.mouseMove(w, p)
-    QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, end)
 
 
 def expected_owner(scene, eye):

@@ -11,16 +11,6 @@ from eyeviz.estimators import load, metrics
 from eyeviz.reports import estimators as rep
 
 
-@pytest.fixture()
-def no_paper_weights(tmp_path, monkeypatch):
-    """Point the paper weights search at an empty directory (weights may exist locally)."""
-    empty = tmp_path / "no_weights"
-    empty.mkdir()
-    monkeypatch.setenv("EYEVIZ_PAPER_DIR", str(empty))
-    monkeypatch.setenv("XDG_CACHE_HOME", str(empty))
-    return empty
-
-
 def test_report_writes_md_csv_png_and_lists_missing_paper(tmp_path, no_paper_weights, capsys):
     out = tmp_path / "rep"
     seed = 4242

@@ -12,14 +12,6 @@ from eyeviz.reports import trajectories as rep
 from eyeviz.trajectories import horizontal
 
 
-@pytest.fixture()
-def no_paper_weights(tmp_path, monkeypatch):
-    empty = tmp_path / "no_weights"
-    empty.mkdir()
-    monkeypatch.setenv("EYEVIZ_PAPER_DIR", str(empty))
-    monkeypatch.setenv("XDG_CACHE_HOME", str(empty))
-
-
 def test_report_runs_all_trajectories(tmp_path, no_paper_weights):
     out = tmp_path / "traj"
     assert main(["report", "trajectories", "-o", str(out), "--estimators", "analytic,paper",
