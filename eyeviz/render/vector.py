@@ -923,32 +923,17 @@ def predict_scene(
     that cannot be loaded at all is an :class:`EyevizError`. Imports
     :mod:`eyeviz.estimators` (and through it torch for the networks) only here.
     """
-    from eyeviz import estimators
+    from eyeviz.predictions import Predictor
 
-    m = state.pair.m
     if state.LA is None or state.in_bfv is None:
         state = compute_state(scene, ["bitmaps", "readout"])
-    n = state.n
-    ok = np.flatnonzero(state.in_domain())
-    out: dict[str, tuple[np.ndarray, np.ndarray] | str] = {}
+    predictor = Predictor()
     for name in scene.estimators:
-        try:
-            est = estimators.load(name)
-        except (ImportError, OSError, ValueError) as exc:
-            raise EyevizError(f"predictions layer: cannot load estimator {name!r}: {exc}") from None
-        r_hat, phi_hat = np.full(n, np.nan), np.full(n, np.nan)
-        if ok.size:
-            oa = np.stack([state.bitmaps(i, m // 2)[0] for i in ok]).astype(np.float32)
-            ob = np.stack([state.bitmaps(i, m // 2)[1] for i in ok]).astype(np.float32)
-            try:
-                r_ok, phi_ok = est.predict(oa, ob)
-            except ValueError as exc:
-                out[name] = str(exc).splitlines()[0]
-                continue
-            r_hat[ok] = np.asarray(r_ok, dtype=np.float64)
-            phi_hat[ok] = np.asarray(phi_ok, dtype=np.float64)
-        out[name] = (r_hat, phi_hat)
-    return out
+        est = predictor.estimator(name)
+        if isinstance(est, str):
+            reason = est.removeprefix("unavailable: ")
+            raise EyevizError(f"predictions layer: cannot load estimator {name!r}: {reason}")
+    return predictor.predict(scene, state)
 
 
 def figure(scene: Scene, state: SceneState | None = None, *, dpi: float = BASE_DPI,
