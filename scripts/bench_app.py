@@ -34,7 +34,7 @@ UP_TARGET_S = 3.0
 def _scene(m: int, n: int):
     import numpy as np
 
-    from eyeviz.scene import OKABE_ITO, Eyes, Feature, Scene, View
+    from eyeviz.model.scene import OKABE_ITO, Eyes, Feature, Scene, View
 
     rng = np.random.default_rng(7)
     fs = []
@@ -138,7 +138,7 @@ def bench_up(settings: str) -> float:
     code = (
         "import time; t0 = time.perf_counter()\n"
         "from eyeviz.app.window import MainWindow, make_app, make_settings\n"
-        "from eyeviz.scene import load\n"
+        "from eyeviz.model.scene import load\n"
         "app = make_app()\n"
         f"w = MainWindow(load({str(ROOT / 'assets/scenes/default.toml')!r}), "
         f"settings=make_settings({settings!r}))\n"

@@ -34,9 +34,18 @@ ROOT = Path(__file__).resolve().parent.parent
 
 # --- the baseline: Algorithm 1, one element at a time, csv module --------------------
 
-def baseline_generate(n: int, out: str, seed: int = 0, h: float = 40.0, l: float = 20.0,
-                      m: int = 720, r_min: float = 1000.0, r_max: float = 5000.0,
-                      g_max: float = 500.0) -> None:
+
+def baseline_generate(
+    n: int,
+    out: str,
+    seed: int = 0,
+    h: float = 40.0,
+    l: float = 20.0,
+    m: int = 720,
+    r_min: float = 1000.0,
+    r_max: float = 5000.0,
+    g_max: float = 500.0,
+) -> None:
     """Algorithm 1 as printed, in pure Python: numpy's uniform per draw, math per element,
     bitmaps built bit by bit (steps 17-28), rejection as eyeviz does, csv.writer rows."""
     import numpy as np
@@ -59,34 +68,35 @@ def baseline_generate(n: int, out: str, seed: int = 0, h: float = 40.0, l: float
         writer = csv.writer(f, lineterminator="\n")
         for _ in range(n):
             while True:
-                r = rng.uniform(r_min, r_max)                         # step 7
-                g_min = r * math.sin(gamma / 2)                       # step 8
-                if g_min > g_max:                                     # step 9
+                r = rng.uniform(r_min, r_max)  # step 7
+                g_min = r * math.sin(gamma / 2)  # step 8
+                if g_min > g_max:  # step 9
                     continue
-                g = rng.uniform(g_min, g_max)                         # step 10
-                if g > r:                                             # step 11
+                g = rng.uniform(g_min, g_max)  # step 10
+                if g > r:  # step 11
                     continue
                 a = math.asin(g / r)
                 lo, hi = psi + a, math.pi - psi - a
                 if lo > hi:
                     continue
-                phi = rng.uniform(lo, hi)                             # step 12
+                phi = rng.uniform(lo, hi)  # step 12
                 x, y = r * math.cos(phi), r * math.sin(phi)
-                if w * y - l * abs(x) - g * h < 0:                    # Prop. 4
+                if w * y - l * abs(x) - g * h < 0:  # Prop. 4
                     continue
-                lb, rb = interval(h, x, y, g)                         # steps 13-14
-                la, ra = interval(-h, x, y, g)                        # steps 15-16
-                if ra <= la or rb <= lb:                              # Def. 1
+                lb, rb = interval(h, x, y, g)  # steps 13-14
+                la, ra = interval(-h, x, y, g)  # steps 15-16
+                if ra <= la or rb <= lb:  # Def. 1
                     continue
                 break
             omega_a, omega_b = [0] * half, [0] * half
-            for j in range(half):                                     # steps 17-28
+            for j in range(half):  # steps 17-28
                 omega_b[j] = 1 if lb <= j <= rb else 0
                 omega_a[j] = 1 if la <= j <= ra else 0
             writer.writerow(omega_a + omega_b + [r, phi, g])
 
 
 # --- measuring ------------------------------------------------------------------------
+
 
 def timed(cmd: list[str]) -> dict:
     """Wall time, CPU time (user + sys) and peak RSS of one child process."""
@@ -137,28 +147,39 @@ def main() -> int:
         print(f"load average before: {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs")
         ev = eyeviz_cmd()
         csv_out = scratch / "paper.csv"
-        runs = [timed([*ev, "generate", "-n", str(args.n_csv), "-o", str(csv_out), "--quiet"])
-                for _ in range(args.repeat)]
+        runs = [
+            timed([*ev, "generate", "-n", str(args.n_csv), "-o", str(csv_out), "--quiet"])
+            for _ in range(args.repeat)
+        ]
         size_mb = csv_out.stat().st_size / 1e6
         best = min(r["wall"] for r in runs)
         med = statistics.median(r["wall"] for r in runs)
         cpu = min(r["cpu"] for r in runs)
-        print(f"\neyeviz generate -n {args.n_csv} -o X.csv ({size_mb:.1f} MB), whole process, "
-              f"{args.repeat} runs:")
-        print(f"  wall best {best:.3f} s, median {med:.3f} s; CPU best {cpu:.3f} s; "
-              f"peak RSS {max(r['rss_mb'] for r in runs):.0f} MB")
+        print(
+            f"\neyeviz generate -n {args.n_csv} -o X.csv ({size_mb:.1f} MB), whole process, "
+            f"{args.repeat} runs:"
+        )
+        print(
+            f"  wall best {best:.3f} s, median {med:.3f} s; CPU best {cpu:.3f} s; "
+            f"peak RSS {max(r['rss_mb'] for r in runs):.0f} MB"
+        )
         print(f"  Appendix A/B loader: {appendix_columns(csv_out)[1]} columns per row")
         results = {"csv_wall_best": best, "csv_wall_median": med, "csv_cpu": cpu}
         if not args.skip_baseline:
             base_out = scratch / "baseline.csv"
-            b = timed([sys.executable, __file__, "--baseline-worker", str(args.n_csv),
-                       str(base_out)])
-            print(f"\none-element-at-a-time Python + csv module, same rows and layout "
-                  f"({base_out.stat().st_size / 1e6:.1f} MB, "
-                  f"{appendix_columns(base_out)[1]} columns):")
+            b = timed(
+                [sys.executable, __file__, "--baseline-worker", str(args.n_csv), str(base_out)]
+            )
+            print(
+                f"\none-element-at-a-time Python + csv module, same rows and layout "
+                f"({base_out.stat().st_size / 1e6:.1f} MB, "
+                f"{appendix_columns(base_out)[1]} columns):"
+            )
             print(f"  wall {b['wall']:.2f} s; CPU {b['cpu']:.2f} s")
-            print(f"  ratio (baseline / eyeviz): wall {b['wall'] / med:.1f}x (median), "
-                  f"{b['wall'] / best:.1f}x (best); CPU {b['cpu'] / cpu:.1f}x")
+            print(
+                f"  ratio (baseline / eyeviz): wall {b['wall'] / med:.1f}x (median), "
+                f"{b['wall'] / best:.1f}x (best); CPU {b['cpu'] / cpu:.1f}x"
+            )
             results["baseline_wall"] = b["wall"]
             base_out.unlink()
         csv_out.unlink()
@@ -169,10 +190,14 @@ def main() -> int:
         big = timed([*ev, "generate", "-n", str(args.n_npz), "-o", str(npz_out), "--quiet"])
         size_mb = npz_out.stat().st_size / 1e6
         print(f"\neyeviz generate -n {args.n_npz:,} -o X.npz ({size_mb:.0f} MB):")
-        print(f"  wall {big['wall']:.2f} s = {args.n_npz / big['wall'] / 1e6:.2f} M rows/s; "
-              f"CPU {big['cpu']:.2f} s = {args.n_npz / big['cpu'] / 1e6:.2f} M rows/s")
-        print(f"  peak RSS {big['rss_mb']:.0f} MB (vs {small['rss_mb']:.0f} MB for "
-              f"{small_n:,} rows: memory does not grow with n)")
+        print(
+            f"  wall {big['wall']:.2f} s = {args.n_npz / big['wall'] / 1e6:.2f} M rows/s; "
+            f"CPU {big['cpu']:.2f} s = {args.n_npz / big['cpu'] / 1e6:.2f} M rows/s"
+        )
+        print(
+            f"  peak RSS {big['rss_mb']:.0f} MB (vs {small['rss_mb']:.0f} MB for "
+            f"{small_n:,} rows: memory does not grow with n)"
+        )
         print(f"\nload average after: {os.getloadavg()[0]:.2f}")
     finally:
         shutil.rmtree(scratch, ignore_errors=True)

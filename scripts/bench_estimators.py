@@ -41,8 +41,10 @@ def main() -> int:
     base = _best(lambda: bitmaps_to_intervals(a, b), args.repeat)
     print(f"data: {args.n} rows of 2 x {a.shape[1]} bits; torch threads 2")
     print(f"baseline (interval extraction only): {args.n / base:,.0f} samples/s")
-    print(f"{'estimator':10s} {'batched samples/s':>18s} {'x baseline time':>16s} "
-          f"{'single (median)':>16s}  targets")
+    print(
+        f"{'estimator':10s} {'batched samples/s':>18s} {'x baseline time':>16s} "
+        f"{'single (median)':>16s}  targets"
+    )
     for name in args.estimators.split(","):
         try:
             est = estimators.load(name)
@@ -62,8 +64,10 @@ def main() -> int:
         if name == "compact":
             ok = rate >= 1e6 and single <= 1e-3
             note = f"{'MET' if ok else 'MISSED'} (>= 1e6/s, <= 1 ms)"
-        print(f"{name:10s} {rate:18,.0f} {t / (base * n / args.n):16.2f} "
-              f"{single * 1e6:13.0f} us  {note}")
+        print(
+            f"{name:10s} {rate:18,.0f} {t / (base * n / args.n):16.2f} "
+            f"{single * 1e6:13.0f} us  {note}"
+        )
     return 0
 
 

@@ -15,8 +15,8 @@ import time
 
 import numpy as np
 
-from eyeviz import stability_cases
-from eyeviz.geometry import EyePair
+from eyeviz.core.geometry import EyePair
+from eyeviz.reference import stability_cases
 
 
 def python_loop(eyes: EyePair, xs, ys, gs) -> list[tuple[int, int, int, int]]:

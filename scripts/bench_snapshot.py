@@ -28,8 +28,13 @@ TARGET_S = 3.0
 def timed(cmd: list[str]) -> tuple[float, float]:
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    subprocess.run(cmd, check=True, cwd=ROOT, stdout=subprocess.DEVNULL,
-                   env={**os.environ, "MPLBACKEND": "Agg"})
+    subprocess.run(
+        cmd,
+        check=True,
+        cwd=ROOT,
+        stdout=subprocess.DEVNULL,
+        env={**os.environ, "MPLBACKEND": "Agg"},
+    )
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -48,13 +53,18 @@ def main() -> int:
     args = ap.parse_args()
     py = sys.executable
     eyeviz = [py, "-m", "eyeviz"]
-    print(f"load average: {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs; "
-          f"median of {args.repeat} runs each\n")
+    print(
+        f"load average: {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs; "
+        f"median of {args.repeat} runs each\n"
+    )
     base = {
         "python -c pass": [py, "-c", "pass"],
         "eyeviz --help": [*eyeviz, "--help"],
         "import matplotlib Figure+Agg": [
-            py, "-c", "import matplotlib.figure, matplotlib.backends.backend_agg"],
+            py,
+            "-c",
+            "import matplotlib.figure, matplotlib.backends.backend_agg",
+        ],
     }
     rows = []
     for name, cmd in base.items():

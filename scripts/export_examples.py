@@ -2,7 +2,7 @@
 
     .venv/bin/python scripts/export_examples.py [--all]
 
-Every figure is `eyeviz.export.export` of a shipped scene (assets/scenes), plus one
+Every figure is `eyeviz.render.mpl.export.export` of a shipped scene (assets/scenes), plus one
 variant of the default scene built here that shows the predictions (analytic estimator)
 and ambiguity layers and a feature outside the networks' domain, and a close-up of one
 feature's ambiguity region.
@@ -14,8 +14,8 @@ import argparse
 import copy
 from pathlib import Path
 
-from eyeviz import scene as scene_mod
-from eyeviz.export import export
+from eyeviz.model import scene as scene_mod
+from eyeviz.render.mpl.export import export
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "assets" / "scenes"

@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
-from eyeviz.app.model import AppModel
-from eyeviz.scene import TRAJECTORY_KINDS, Trajectory
+from eyeviz.model.app_model import AppModel
+from eyeviz.model.scene import TRAJECTORY_KINDS, Trajectory
 
 __all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel"]
 
@@ -26,7 +26,7 @@ ESTIMATOR_HELP = {
 
 class EstimatorPicker(QtWidgets.QWidget):
     """A check box per estimator (several at once); each chosen one gets its colour
-    (eyeviz.render.vector.estimator_colors, as in exported figures)."""
+    (eyeviz.render.mpl.vector.estimator_colors, as in exported figures)."""
 
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
@@ -48,7 +48,7 @@ class EstimatorPicker(QtWidgets.QWidget):
         self._filling = False
 
     def refresh(self) -> None:
-        from eyeviz.render.vector import estimator_colors
+        from eyeviz.render.mpl.vector import estimator_colors
 
         chosen = self.model.scene.estimators
         cols = estimator_colors(chosen)
@@ -150,12 +150,17 @@ class TrajectoryPanel(QtWidgets.QWidget):
     def refresh(self) -> None:
         """Recompute the path and its accuracy curves when the scene's trajectory, eyes or
         estimators change (not when the animated feature moves)."""
-        from eyeviz.app.predict import Predictor, trajectory_path
+        from eyeviz.model.derived import Predictor, trajectory_path
 
         sc = self.model.scene
         t = sc.trajectory
-        key = (None if t is None else (t.kind, t.distance, t.g), sc.eyes.h, sc.eyes.l,
-               sc.eyes.m, tuple(sc.estimators))
+        key = (
+            None if t is None else (t.kind, t.distance, t.g),
+            sc.eyes.h,
+            sc.eyes.l,
+            sc.eyes.m,
+            tuple(sc.estimators),
+        )
         if key == self._key:
             return
         self._key = key
@@ -168,15 +173,14 @@ class TrajectoryPanel(QtWidgets.QWidget):
             if self.model.predictor is None:
                 self.model.predictor = Predictor()
             try:
-                self.path = trajectory_path(sc.eyes.pair(), t, sc.estimators,
-                                            self.model.predictor)
+                self.path = trajectory_path(sc.eyes.pair(), t, sc.estimators, self.model.predictor)
             except ValueError as exc:
                 self.message = str(exc)
         self.pos = 0.0
         self._plot()
 
     def _plot(self) -> None:
-        from eyeviz.render.vector import estimator_colors
+        from eyeviz.render.mpl.vector import estimator_colors
 
         for ax in (self.ax_ad, self.ax_dd):
             ax.clear()
@@ -195,16 +199,25 @@ class TrajectoryPanel(QtWidgets.QWidget):
                 self.ax_dd.plot(p.axis, acc[1], color=cols[name], lw=lw, label=name)
             for ax in (self.ax_ad, self.ax_dd):
                 self.cursors.append(ax.axvline(p.axis[0], color="#333333", lw=1.2))
-                lo = min([np.nanmin(a[k]) for a in p.accuracy.values() if not isinstance(a, str)
-                          for k in (0, 1)] + [90.0])
+                lo = min(
+                    [
+                        np.nanmin(a[k])
+                        for a in p.accuracy.values()
+                        if not isinstance(a, str)
+                        for k in (0, 1)
+                    ]
+                    + [90.0]
+                )
             self.ax_dd.set_ylim(max(0.0, min(lo, 90.0)) - 2, 101)
             t = self.model.scene.trajectory
             self.ax_dd.set_xlabel(p.axis_label)
-            notes.insert(0, f"{t.kind} path, distance {t.distance:g}, g = {t.g:g}: "
-                            f"{p.n} points in the BFV")
+            notes.insert(
+                0, f"{t.kind} path, distance {t.distance:g}, g = {t.g:g}: {p.n} points in the BFV"
+            )
             if any(not isinstance(a, str) for a in p.accuracy.values()):
-                self.ax_ad.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8,
-                                  ncol=4, frameon=False)
+                self.ax_ad.legend(
+                    loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, ncol=4, frameon=False
+                )
         self.ax_ad.set_title("AD accuracy (%)", fontsize=9, loc="left")
         self.ax_dd.set_title("DD accuracy (%)", fontsize=9, loc="left")
         self.ax_ad.tick_params(labelsize=8, labelbottom=False)
@@ -300,4 +313,3 @@ class ExportDialog(QtWidgets.QDialog):
 
     def values(self) -> tuple[Path, float, bool]:
         return Path(self.path.text()), float(self.scale.value()), self.transparent.isChecked()
-

@@ -1,7 +1,7 @@
 """Qt side panels: bitmaps, readout, eye parameters, feature list, layer toggles.
 
-Panels draw from the model's :class:`~eyeviz.state.SceneState` and send edits to the
-:class:`~eyeviz.app.model.AppModel`; none keeps its own copy of the truth.
+Panels draw from the model's :class:`~eyeviz.model.state.SceneState` and send edits to the
+:class:`~eyeviz.model.app_model.AppModel`; none keeps its own copy of the truth.
 """
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ import math
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
-from eyeviz.app.model import AppModel
-from eyeviz.render.actors import UNLIT, hex_rgb
-from eyeviz.scene import LAYERS
+from eyeviz.model.app_model import AppModel
+from eyeviz.model.scene import LAYERS
+from eyeviz.render.vtk.actors import UNLIT, hex_rgb
 
 __all__ = ["BitmapPanel", "EyesPanel", "FeaturePanel", "LayersPanel", "ReadoutPanel"]
 
@@ -116,7 +116,7 @@ class BitmapPanel(QtWidgets.QWidget):
 
 def _half_text(iv: tuple[int, int], m: int) -> str:
     """The selected feature's lit indices among the m/2 the networks see."""
-    from eyeviz.geometry import intervals_to_bitmap
+    from eyeviz.core.geometry import intervals_to_bitmap
 
     k = np.flatnonzero(intervals_to_bitmap(iv[0], iv[1], m, m // 2))
     if k.size == 0:
@@ -128,7 +128,7 @@ def _half_text(iv: tuple[int, int], m: int) -> str:
 
 
 def _owners_of(st, eye: str) -> np.ndarray:
-    from eyeviz.state import owners
+    from eyeviz.model.state import owners
 
     return owners(st.LA, st.RA, st.m) if eye == "A" else owners(st.LB, st.RB, st.m)
 
@@ -263,16 +263,21 @@ class ReadoutPanel(QtWidgets.QWidget):
         self._set(rows)
 
     def _prediction_rows(self, i: int) -> list[tuple[str, str, str, str]]:
-        from eyeviz.app.predict import errors
-        from eyeviz.render.vector import estimator_colors
+        from eyeviz.model.derived import errors
+        from eyeviz.render.mpl.vector import estimator_colors
 
         st, sc = self.model.state, self.model.scene
         preds = self.model.predictions
         cols = estimator_colors(sc.estimators)
         if not bool(st.in_domain()[i]):
-            return [("domain", "predictions",
-                     "outside the networks' domain\n(not in the BFV or not seen by both eyes)",
-                     BAD)]
+            return [
+                (
+                    "domain",
+                    "predictions",
+                    "outside the networks' domain\n(not in the BFV or not seen by both eyes)",
+                    BAD,
+                )
+            ]
         rows = []
         for name in sc.estimators:
             res = preds.get(name, "no prediction")
@@ -285,8 +290,10 @@ class ReadoutPanel(QtWidgets.QWidget):
                 rows.append((f"pred:{name}", key, "no answer for these bitmaps", GREY))
                 continue
             dr, pct, dphi = errors(float(st.r[i]), float(st.phi[i]), r_hat, phi_hat)
-            text = (f"r {r_hat:.1f}   Δr {dr:+.1f} ({pct:+.2f} %)\n"
-                    f"φ {math.degrees(phi_hat):.2f}°   Δφ {dphi:+.3f}°")
+            text = (
+                f"r {r_hat:.1f}   Δr {dr:+.1f} ({pct:+.2f} %)\n"
+                f"φ {math.degrees(phi_hat):.2f}°   Δφ {dphi:+.3f}°"
+            )
             rows.append((f"pred:{name}", key, text, "#1e1e1e"))
         return rows
 
@@ -298,9 +305,11 @@ class ReadoutPanel(QtWidgets.QWidget):
         a0, a1 = amb["phi_range"]
         g0, g1 = amb["g_range"]
         more = "" if amb["bounded"] else " (unbounded)"
-        text = (f"r ∈ [{lo:.0f}, {hi:.0f}]{more}\n"
-                f"φ ∈ [{math.degrees(a0):.2f}°, {math.degrees(a1):.2f}°]\n"
-                f"g ∈ [{g0:.3g}, {g1:.3g}]")
+        text = (
+            f"r ∈ [{lo:.0f}, {hi:.0f}]{more}\n"
+            f"φ ∈ [{math.degrees(a0):.2f}°, {math.degrees(a1):.2f}°]\n"
+            f"g ∈ [{g0:.3g}, {g1:.3g}]"
+        )
         return ("ambiguity", "same bitmaps", text, "#1e1e1e")
 
 

@@ -19,18 +19,18 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkRenderingCore import vtkTextActor, vtkWindowToImageFilter
 
-from eyeviz.app.model import AppModel, MouseEvent, drag_feature, hit_test
 from eyeviz.app.panels import BitmapPanel, EyesPanel, FeaturePanel, LayersPanel, ReadoutPanel
 from eyeviz.app.view import VtkView, fast_renderer
-from eyeviz.render.actors import (
+from eyeviz.model.app_model import AppModel, MouseEvent, drag_feature, hit_test
+from eyeviz.model.scene import Scene, SceneError, View, load, save
+from eyeviz.render.vtk.actors import (
     BACKGROUND,
     INSET_BACKGROUND,
     SceneActors,
     inset_viewport,
     style_text,
 )
-from eyeviz.render.overlays import OverlayActors
-from eyeviz.scene import Scene, SceneError, View, load, save
+from eyeviz.render.vtk.overlays import OverlayActors
 
 __all__ = ["MainWindow", "make_settings", "run_app"]
 
@@ -102,9 +102,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._table_timer = QtCore.QTimer(self)
         self._table_timer.setSingleShot(True)
         self._table_timer.setInterval(100)
-        self._table_timer.timeout.connect(
-            lambda: self.features_panel.refresh(self._table_index)
-        )
+        self._table_timer.timeout.connect(lambda: self.features_panel.refresh(self._table_index))
         self._frame_pending = False
         self.inset_shown = True
 
@@ -154,8 +152,9 @@ class MainWindow(QtWidgets.QMainWindow):
         self.cursor_label = QtWidgets.QLabel("")
         # a fixed width: a new cursor text must not re-lay out the status bar every move
         fm = self.cursor_label.fontMetrics()
-        self.cursor_label.setFixedWidth(fm.horizontalAdvance("x -00,000.0   y -00,000.0     "
-                                                             "r 00,000.0   φ 000.00°  "))
+        self.cursor_label.setFixedWidth(
+            fm.horizontalAdvance("x -00,000.0   y -00,000.0     r 00,000.0   φ 000.00°  ")
+        )
         self.statusBar().addPermanentWidget(self.cursor_label)
         self._build_menus()
         self.model.listeners.append(self._on_model)
@@ -376,7 +375,7 @@ class MainWindow(QtWidgets.QMainWindow):
         preds = self.model.predictions  # {} unless the predictions layer is shown
         colors = {}
         if preds:
-            from eyeviz.render.vector import estimator_colors
+            from eyeviz.render.mpl.vector import estimator_colors
 
             colors = estimator_colors(scene.estimators)
         self.overlays.update_predictions(scene, st, preds, colors)
@@ -443,9 +442,9 @@ class MainWindow(QtWidgets.QMainWindow):
             self.export_to(*dlg.values())
 
     def export_to(self, path, scale: float = 1.0, transparent: bool = False) -> Path | None:
-        """The scene as a figure (eyeviz.export: PNG, SVG, PDF); errors in a dialog."""
+        """The scene as a figure (eyeviz.render.mpl.export: PNG, SVG, PDF); errors in a dialog."""
         from eyeviz import EyevizError
-        from eyeviz.export import export
+        from eyeviz.render.mpl.export import export
 
         preds = None
         if self.model.scene.shows("predictions"):

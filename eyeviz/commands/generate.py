@@ -13,55 +13,95 @@ _PROGRESS_MIN = 200_000  # elements; below this a run takes well under a second
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("-n", type=int, required=True, metavar="N",
-                        help="number of elements (rows)")
-    parser.add_argument("-o", "--output", required=True, metavar="OUT",
-                        help="output file: .csv (the paper's format) or .npz (bit-packed)")
-    parser.add_argument("--mode", choices=("single", "multi"), default="single",
-                        help="single pass (Algorithm 1 as written) or multi-pass: segments "
-                             "of r with counts proportional to r, uniform over the BFV "
-                             "(default: single)")
+    parser.add_argument(
+        "-n", type=int, required=True, metavar="N", help="number of elements (rows)"
+    )
+    parser.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        metavar="OUT",
+        help="output file: .csv (the paper's format) or .npz (bit-packed)",
+    )
+    parser.add_argument(
+        "--mode",
+        choices=("single", "multi"),
+        default="single",
+        help="single pass (Algorithm 1 as written) or multi-pass: segments "
+        "of r with counts proportional to r, uniform over the BFV "
+        "(default: single)",
+    )
     parser.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
-    parser.add_argument("--h", type=float, default=40.0,
-                        help="origin to eye centre distance (default: 40, Table 3)")
+    parser.add_argument(
+        "--h", type=float, default=40.0, help="origin to eye centre distance (default: 40, Table 3)"
+    )
     parser.add_argument("--l", type=float, default=20.0, help="eye radius (default: 20)")
-    parser.add_argument("--m", type=int, default=720,
-                        help="ommatidia per eye, even (default: 720)")
-    parser.add_argument("--r-min", type=float, default=1000.0,
-                        help="minimum distance of a feature centre (default: 1000, Table 4)")
-    parser.add_argument("--r-max", type=float, default=5000.0,
-                        help="maximum distance of a feature centre (default: 5000)")
-    parser.add_argument("--g-max", type=float, default=500.0,
-                        help="maximum feature radius (default: 500)")
-    parser.add_argument("--segments", type=int, default=None,
-                        help="multi mode: number of r segments (default: segments of "
-                             "length 5, as the paper)")
-    parser.add_argument("--unique-bitmaps", action="store_true",
-                        help="keep one element per distinct (Omega_A, Omega_B) pair, as the "
-                             "authors' published data set")
+    parser.add_argument("--m", type=int, default=720, help="ommatidia per eye, even (default: 720)")
+    parser.add_argument(
+        "--r-min",
+        type=float,
+        default=1000.0,
+        help="minimum distance of a feature centre (default: 1000, Table 4)",
+    )
+    parser.add_argument(
+        "--r-max",
+        type=float,
+        default=5000.0,
+        help="maximum distance of a feature centre (default: 5000)",
+    )
+    parser.add_argument(
+        "--g-max", type=float, default=500.0, help="maximum feature radius (default: 500)"
+    )
+    parser.add_argument(
+        "--segments",
+        type=int,
+        default=None,
+        help="multi mode: number of r segments (default: segments of length 5, as the paper)",
+    )
+    parser.add_argument(
+        "--unique-bitmaps",
+        action="store_true",
+        help="keep one element per distinct (Omega_A, Omega_B) pair, as the "
+        "authors' published data set",
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def run(args: argparse.Namespace) -> int:
-    from eyeviz import EyevizError, dataset, dataset_io
-    from eyeviz.geometry import EyePair
+    from eyeviz import EyevizError, dataset
+    from eyeviz.core.geometry import EyePair
+    from eyeviz.dataset import io as dataset_io
 
     try:
         eyes = EyePair(args.h, args.l, args.m)
     except ValueError as exc:
         raise EyevizError(str(exc)) from None
     dataset_io.format_of(args.output)
-    kw = dict(eyes=eyes, r_min=args.r_min, r_max=args.r_max, g_max=args.g_max,
-              mode=args.mode, seed=args.seed, unique_bitmaps=args.unique_bitmaps,
-              segments=args.segments)
-    dataset._check_n(args.n)
+    kw = dict(
+        eyes=eyes,
+        r_min=args.r_min,
+        r_max=args.r_max,
+        g_max=args.g_max,
+        mode=args.mode,
+        seed=args.seed,
+        unique_bitmaps=args.unique_bitmaps,
+        segments=args.segments,
+    )
+    dataset.check_n(args.n)
     dataset.make_params(**kw)
     bar = None
     if not args.quiet and args.n >= _PROGRESS_MIN:
         from tqdm import tqdm
 
-        bar = tqdm(total=args.n, unit="rows", unit_scale=True, file=sys.stderr,
-                   desc=f"generate {args.output}", leave=False, mininterval=0.5)
+        bar = tqdm(
+            total=args.n,
+            unit="rows",
+            unit_scale=True,
+            file=sys.stderr,
+            desc=f"generate {args.output}",
+            leave=False,
+            mininterval=0.5,
+        )
     t0 = time.perf_counter()
     try:
         dataset.write(args.output, args.n, progress=bar.update if bar else None, **kw)
@@ -70,6 +110,8 @@ def run(args: argparse.Namespace) -> int:
             bar.close()
     if not args.quiet:
         size = os.path.getsize(args.output) / 1e6
-        print(f"wrote {args.n:,} elements ({args.mode} pass, seed {args.seed}) to "
-              f"{args.output} ({size:.1f} MB) in {time.perf_counter() - t0:.2f} s")
+        print(
+            f"wrote {args.n:,} elements ({args.mode} pass, seed {args.seed}) to "
+            f"{args.output} ({size:.1f} MB) in {time.perf_counter() - t0:.2f} s"
+        )
     return 0

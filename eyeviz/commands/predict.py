@@ -19,11 +19,16 @@ HELP = "predict distance and azimuth for every row of a data set"
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("data", help="data set (.csv or .npz, as `eyeviz generate` writes)")
-    parser.add_argument("-e", "--estimator", default="compact",
-                        help="analytic, bayes, compact or paper (default compact)")
+    parser.add_argument(
+        "-e",
+        "--estimator",
+        default="compact",
+        help="analytic, bayes, compact or paper (default compact)",
+    )
     parser.add_argument("-o", "--out", required=True, help="output CSV (r_hat,phi_hat)")
-    parser.add_argument("--weights", default=None,
-                        help="weights directory/file instead of the shipped ones")
+    parser.add_argument(
+        "--weights", default=None, help="weights directory/file instead of the shipped ones"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -33,8 +38,9 @@ def run(args: argparse.Namespace) -> int:
     from eyeviz.estimators import metrics
 
     if args.estimator not in estimators.available():
-        raise EyevizError(f"unknown estimator {args.estimator!r}; available: "
-                          f"{', '.join(estimators.available())}")
+        raise EyevizError(
+            f"unknown estimator {args.estimator!r}; available: {', '.join(estimators.available())}"
+        )
     out = Path(args.out)
     if not out.parent.is_dir():
         raise EyevizError(f"output directory {out.parent} does not exist")
@@ -66,7 +72,9 @@ def run(args: argparse.Namespace) -> int:
     if valid.sum() >= 2:
         dd = metrics.summary(ds.r[valid], pred.r[valid])
         ad = metrics.summary(ds.phi[valid], pred.phi[valid])
-        print(f"DD MAPE {dd['mape']:.3f} %  MAE {dd['mae']:.2f}  R^2 {dd['r2']:.4f} | "
-              f"AD MAPE {ad['mape']:.4f} %  MAE {ad['mae']:.3g} rad  R^2 {ad['r2']:.6f}",
-              file=sys.stderr)
+        print(
+            f"DD MAPE {dd['mape']:.3f} %  MAE {dd['mae']:.2f}  R^2 {dd['r2']:.4f} | "
+            f"AD MAPE {ad['mape']:.4f} %  MAE {ad['mae']:.3g} rad  R^2 {ad['r2']:.6f}",
+            file=sys.stderr,
+        )
     return 0

@@ -1,7 +1,7 @@
 """``eyeviz snapshot SCENE -o OUT.png|.svg|.pdf``: a scene as a figure, headless.
 
 No window, no Qt, no VTK: the figure is drawn by matplotlib (Agg) from the scene model
-(:mod:`eyeviz.render.vector`). torch is imported only when the scene shows predictions.
+(:mod:`eyeviz.render.mpl.vector`). torch is imported only when the scene shows predictions.
 """
 
 from __future__ import annotations
@@ -14,20 +14,31 @@ HELP = "export a scene as a figure (PNG, or true-vector SVG/PDF) without opening
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", metavar="SCENE", help="scene file (TOML)")
-    parser.add_argument("-o", "--output", metavar="OUT", required=True,
-                        help="output file; the suffix picks the format: .png, .svg or .pdf")
-    parser.add_argument("--scale", type=float, default=1.0, metavar="S",
-                        help="PNG pixel scale (1 = 300 dpi, 1050 px wide); default 1")
-    parser.add_argument("--transparent", action="store_true",
-                        help="transparent background instead of white")
+    parser.add_argument(
+        "-o",
+        "--output",
+        metavar="OUT",
+        required=True,
+        help="output file; the suffix picks the format: .png, .svg or .pdf",
+    )
+    parser.add_argument(
+        "--scale",
+        type=float,
+        default=1.0,
+        metavar="S",
+        help="PNG pixel scale (1 = 300 dpi, 1050 px wide); default 1",
+    )
+    parser.add_argument(
+        "--transparent", action="store_true", help="transparent background instead of white"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
     import os
 
     os.environ.setdefault("MPLBACKEND", "Agg")
-    from eyeviz import scene as scene_mod
-    from eyeviz.export import export, format_of
+    from eyeviz.model import scene as scene_mod
+    from eyeviz.render.mpl.export import export, format_of
 
     format_of(args.output)  # refuse a bad suffix before reading anything
     sc = scene_mod.load(args.scene)

@@ -45,8 +45,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
     c = sub.add_parser("compact", help="the compact networks (a few minutes on 2 CPU cores)")
     c.add_argument("-o", "--out", default=None, help="output directory (default assets/models)")
-    c.add_argument("-n", "--n-train", type=_positive_int, default=1_000_000,
-                   help="training elements (default 10^6)")
+    c.add_argument(
+        "-n",
+        "--n-train",
+        type=_positive_int,
+        default=1_000_000,
+        help="training elements (default 10^6)",
+    )
     c.add_argument("--n-val", type=_positive_int, default=100_000)
     c.add_argument("--epochs", type=_positive_int, default=12)
     c.add_argument("--hidden", type=_positive_int, default=32, help="DD hidden width")
@@ -57,32 +62,56 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     _domain_args(c)
 
     b = sub.add_parser("bayes", help="the posterior table of the information limit")
-    b.add_argument("-o", "--out", default=None,
-                   help="output .npz (default assets/models/bayes.npz)")
-    b.add_argument("-n", type=_positive_int, default=30_000_000,
-                   help="sample size (default 3*10^7; ~4 GB of memory while building)")
+    b.add_argument(
+        "-o", "--out", default=None, help="output .npz (default assets/models/bayes.npz)"
+    )
+    b.add_argument(
+        "-n",
+        type=_positive_int,
+        default=30_000_000,
+        help="sample size (default 3*10^7; ~4 GB of memory while building)",
+    )
     b.add_argument("--seed", type=int, default=12345)
     _domain_args(b)
 
     p = sub.add_parser("paper", help="the paper's AD and DD networks, for a time budget")
-    p.add_argument("data", nargs="?", default=None,
-                   help="training data (.csv or .npz from `eyeviz generate`); "
-                        "default: generate --n elements")
-    p.add_argument("-n", type=_positive_int, default=100_000,
-                   help="elements to generate when no data file is given")
+    p.add_argument(
+        "data",
+        nargs="?",
+        default=None,
+        help="training data (.csv or .npz from `eyeviz generate`); default: generate --n elements",
+    )
+    p.add_argument(
+        "-n",
+        type=_positive_int,
+        default=100_000,
+        help="elements to generate when no data file is given",
+    )
     p.add_argument("--mode", choices=("single", "multi"), default="single")
     p.add_argument("--budget", type=float, default=600.0, help="seconds per network")
     p.add_argument("--device", default="cpu")
     p.add_argument("--nets", default="ad,dd", help="comma-separated subset of ad,dd")
     p.add_argument("--seed", type=int, default=0, help="data, split and init seed")
-    p.add_argument("--ad-lr", type=float, default=None,
-                   help="AD learning rate (default 0.003 as Appendix A; Table 5 says 0.004)")
-    p.add_argument("--dd-momentum", type=float, default=None,
-                   help="DD Nesterov momentum (default 0 = Keras default = plain SGD)")
+    p.add_argument(
+        "--ad-lr",
+        type=float,
+        default=None,
+        help="AD learning rate (default 0.003 as Appendix A; Table 5 says 0.004)",
+    )
+    p.add_argument(
+        "--dd-momentum",
+        type=float,
+        default=None,
+        help="DD Nesterov momentum (default 0 = Keras default = plain SGD)",
+    )
     p.add_argument("--tag", default="", help="suffix of the output files (ad<TAG>.pt)")
     p.add_argument("--threads", type=_positive_int, default=None, help="torch CPU threads")
-    p.add_argument("-o", "--out", default=None,
-                   help="output directory (default assets/models/paper/ or the user cache)")
+    p.add_argument(
+        "-o",
+        "--out",
+        default=None,
+        help="output directory (default assets/models/paper/ or the user cache)",
+    )
     _domain_args(p)
 
 
@@ -112,16 +141,28 @@ def _compact(args) -> int:
         bar.update(1)
 
     try:
-        meta = compact.train(args.out, args.n_train, args.n_val, args.seed, args.epochs,
-                             args.hidden, args.hidden_ad, patience=args.patience,
-                             domain=_domain(args), threads=args.threads, command=_command(),
-                             progress=progress)
+        meta = compact.train(
+            args.out,
+            args.n_train,
+            args.n_val,
+            args.seed,
+            args.epochs,
+            args.hidden,
+            args.hidden_ad,
+            patience=args.patience,
+            domain=_domain(args),
+            threads=args.threads,
+            command=_command(),
+            progress=progress,
+        )
     finally:
         bar.close()
     v = meta["val_metrics"]
-    print(f"compact: {meta['n_weights']} weights, {meta['train_seconds']} s; validation "
-          f"DD MAPE {v['dd']['mape']:.3f} % R^2 {v['dd']['r2']:.4f}, "
-          f"AD MAPE {v['ad']['mape']:.4f} %")
+    print(
+        f"compact: {meta['n_weights']} weights, {meta['train_seconds']} s; validation "
+        f"DD MAPE {v['dd']['mape']:.3f} % R^2 {v['dd']['r2']:.4f}, "
+        f"AD MAPE {v['ad']['mape']:.4f} %"
+    )
     return 0
 
 
@@ -133,8 +174,10 @@ def _bayes(args) -> int:
     out = args.out or str(bayes.default_path())
     if not out.endswith(".npz"):
         raise ValueError(f"bayes output must end in .npz, got {out!r}")
-    with tqdm(total=args.n, desc="bayes sample", unit="el", unit_scale=True,
-              file=sys.stderr) as bar:
+    with tqdm(
+        total=args.n, desc="bayes sample", unit="el", unit_scale=True, file=sys.stderr
+    ) as bar:
+
         def progress(done, total):
             bar.update(done - bar.n)
 
@@ -157,15 +200,28 @@ def _paper(args) -> int:
         data = dataset.load(args.data, dom.eyes)
         params = {"file": args.data}
     else:
-        data = dataset.generate(args.n, dom.eyes, dom.r_min, dom.r_max, dom.g_max,
-                                args.mode, args.seed)
+        data = dataset.generate(
+            args.n, dom.eyes, dom.r_min, dom.r_max, dom.g_max, args.mode, args.seed
+        )
         params = {**dom.to_dict(), "n": args.n, "mode": args.mode, "seed": args.seed}
-    res = paper.train(data, args.budget, args.device, args.out, args.seed, nets=nets,
-                      ad_lr=args.ad_lr, dd_momentum=args.dd_momentum, tag=args.tag,
-                      data_params=params, command=_command())
+    res = paper.train(
+        data,
+        args.budget,
+        args.device,
+        args.out,
+        args.seed,
+        nets=nets,
+        ad_lr=args.ad_lr,
+        dd_momentum=args.dd_momentum,
+        tag=args.tag,
+        data_params=params,
+        command=_command(),
+    )
     for meta in res.values():
         h = meta.get("heldout", {})
-        print(f"{meta.get('label', '')}: held-out MAPE {h.get('mape', float('nan')):.3f} %, "
-              f"MAE {h.get('mae', float('nan')):.4g}, R^2 {h.get('r2', float('nan')):.4f} "
-              f"-> {meta.get('weights_file', '?')}")
+        print(
+            f"{meta.get('label', '')}: held-out MAPE {h.get('mape', float('nan')):.3f} %, "
+            f"MAE {h.get('mae', float('nan')):.4g}, R^2 {h.get('r2', float('nan')):.4f} "
+            f"-> {meta.get('weights_file', '?')}"
+        )
     return 0

@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from eyeviz.geometry import EyePair, intervals_to_bitmap
+from eyeviz.core.geometry import EyePair, intervals_to_bitmap
 
 __all__ = [
     "Domain",
@@ -180,7 +180,7 @@ def bitmaps_to_intervals(omega_a, omega_b, width: int | None = None):
 
     ``valid`` is False for a row where either eye has no lit ommatidium or more than one
     lit run; its interval values are then meaningless. Inverse of
-    :func:`eyeviz.geometry.intervals_to_bitmap` with ``width = m/2`` on single runs.
+    :func:`eyeviz.core.geometry.intervals_to_bitmap` with ``width = m/2`` on single runs.
     """
     if width is None:
         width = np.shape(omega_a)[-1]

@@ -28,9 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from eyeviz.atomic import atomic_output
 from eyeviz.estimators.analytic import AnalyticEstimator
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
+from eyeviz.files.atomic import atomic_output
 
 __all__ = ["BayesEstimator", "build_table", "load", "default_path", "TARGETS"]
 
@@ -59,8 +59,9 @@ def _group_medians(key: np.ndarray, value: np.ndarray, lo: float, hi: float, wei
 
     One integer sort of key * 2^24 + quantised value (a precision of (hi - lo) / 2^24).
     """
-    q = np.clip(((value - lo) / (hi - lo) * (1 << _VALUE_BITS)).astype(np.int64), 0,
-                (1 << _VALUE_BITS) - 1)
+    q = np.clip(
+        ((value - lo) / (hi - lo) * (1 << _VALUE_BITS)).astype(np.int64), 0, (1 << _VALUE_BITS) - 1
+    )
     comb = np.sort((key << _VALUE_BITS) | q)
     k = comb >> _VALUE_BITS
     v = lo + ((comb & ((1 << _VALUE_BITS) - 1)) + 0.5) * ((hi - lo) / (1 << _VALUE_BITS))
@@ -75,8 +76,7 @@ def _group_medians(key: np.ndarray, value: np.ndarray, lo: float, hi: float, wei
     return k[starts], v[idx], np.diff(np.r_[starts, k.size])
 
 
-def build_table(n: int, domain: Domain = PAPER_DOMAIN, seed: int = 12345,
-                progress=None) -> dict:
+def build_table(n: int, domain: Domain = PAPER_DOMAIN, seed: int = 12345, progress=None) -> dict:
     """Sample n elements (single pass) and return the posterior tables as arrays.
 
     ``progress(done, total)`` is called after each generated chunk.
@@ -92,8 +92,11 @@ def build_table(n: int, domain: Domain = PAPER_DOMAIN, seed: int = 12345,
     for c in dataset.iter_chunks(n, p, chunk=1 << 17):
         for k, r, phi in (
             (_encode(c.la, c.ra, c.lb, c.rb, w), c.r, c.phi),
-            (_encode(w - 1 - c.rb, w - 1 - c.lb, w - 1 - c.ra, w - 1 - c.la, w), c.r,
-             math.pi - c.phi),
+            (
+                _encode(w - 1 - c.rb, w - 1 - c.lb, w - 1 - c.ra, w - 1 - c.la, w),
+                c.r,
+                math.pi - c.phi,
+            ),
         ):
             keys.append(k)
             rs.append(r)
@@ -115,8 +118,13 @@ def build_table(n: int, domain: Domain = PAPER_DOMAIN, seed: int = 12345,
     out["key"] = k
     out["count"] = cnt
     out["meta"] = {
-        "n": int(n), "seed": int(seed), "domain": domain.to_dict(), "mode": "single",
-        "symmetrised": True, "keys": int(k.size), "build_seconds": time.perf_counter() - t0,
+        "n": int(n),
+        "seed": int(seed),
+        "domain": domain.to_dict(),
+        "mode": "single",
+        "symmetrised": True,
+        "keys": int(k.size),
+        "build_seconds": time.perf_counter() - t0,
     }
     return out
 
@@ -169,9 +177,16 @@ class BayesEstimator(Estimator):
             raise ValueError(f"target must be one of {TARGETS}, got {target!r}")
         meta = table["meta"]
         domain = Domain.from_dict(meta["domain"])
-        super().__init__(domain, {"n_weights": 0, "train_seconds": meta.get("build_seconds", 0.0),
-                                  "sample_size": meta["n"], "keys": meta["keys"],
-                                  "target": target})
+        super().__init__(
+            domain,
+            {
+                "n_weights": 0,
+                "train_seconds": meta.get("build_seconds", 0.0),
+                "sample_size": meta["n"],
+                "keys": meta["keys"],
+                "target": target,
+            },
+        )
         self.target = target
         self._key = table["key"]
         self._r = table[f"r_{target}"]
@@ -180,8 +195,9 @@ class BayesEstimator(Estimator):
 
     def lookup(self, LA, RA, LB, RB):
         """(r, phi, seen) for valid interval arrays; seen is False where the key is new."""
-        key = _encode(np.asarray(LA), np.asarray(RA), np.asarray(LB), np.asarray(RB),
-                      self.domain.width)
+        key = _encode(
+            np.asarray(LA), np.asarray(RA), np.asarray(LB), np.asarray(RB), self.domain.width
+        )
         i = np.minimum(np.searchsorted(self._key, key), self._key.size - 1)
         seen = self._key[i] == key
         r = self._r[i]
@@ -191,7 +207,8 @@ class BayesEstimator(Estimator):
             r = r.copy()
             phi = phi.copy()
             r[miss], phi[miss] = self._fallback._predict_intervals(
-                LA[miss], RA[miss], LB[miss], RB[miss])
+                LA[miss], RA[miss], LB[miss], RB[miss]
+            )
         return r, phi, seen
 
     def _predict_intervals(self, LA, RA, LB, RB):
@@ -199,8 +216,13 @@ class BayesEstimator(Estimator):
         return r, phi
 
 
-def load(path=None, target: str = "mape", n: int | None = None, seed: int = 12345,
-         domain: Domain = PAPER_DOMAIN) -> BayesEstimator:
+def load(
+    path=None,
+    target: str = "mape",
+    n: int | None = None,
+    seed: int = 12345,
+    domain: Domain = PAPER_DOMAIN,
+) -> BayesEstimator:
     """The shipped table (or ``path``); with ``n``, build a fresh table in memory instead."""
     if n is not None:
         return BayesEstimator(build_table(n, domain, seed), target)

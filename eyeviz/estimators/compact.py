@@ -29,9 +29,9 @@ import numpy as np
 import torch
 from torch import nn
 
-from eyeviz.atomic import atomic_output
 from eyeviz.estimators.analytic import AnalyticEstimator
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
+from eyeviz.files.atomic import atomic_output
 
 __all__ = ["CompactEstimator", "CompactNet", "features", "load", "train", "default_dir"]
 
@@ -75,8 +75,10 @@ class CompactNet(nn.Module):
     def __init__(self, hidden: int = 32, zero_last: bool = False) -> None:
         super().__init__()
         self.net = nn.Sequential(
-            nn.Linear(N_FEATURES, hidden), nn.SiLU(),
-            nn.Linear(hidden, hidden), nn.SiLU(),
+            nn.Linear(N_FEATURES, hidden),
+            nn.SiLU(),
+            nn.Linear(hidden, hidden),
+            nn.SiLU(),
             nn.Linear(hidden, 1),
         )
         if zero_last:
@@ -94,8 +96,13 @@ def count_weights(net: nn.Module) -> int:
 class CompactEstimator(Estimator):
     name = "compact"
 
-    def __init__(self, dd: CompactNet, ad: CompactNet, domain: Domain = PAPER_DOMAIN,
-                 metadata: dict | None = None) -> None:
+    def __init__(
+        self,
+        dd: CompactNet,
+        ad: CompactNet,
+        domain: Domain = PAPER_DOMAIN,
+        metadata: dict | None = None,
+    ) -> None:
         meta = dict(metadata or {})
         meta["n_weights"] = count_weights(dd) + count_weights(ad)
         super().__init__(domain, meta)
@@ -160,18 +167,34 @@ def load(path=None, domain: Domain | None = None) -> CompactEstimator:
 
 # --- training ------------------------------------------------------------------------------
 
+
 def _generate(n: int, domain: Domain, seed: int, mode: str = "single"):
     from eyeviz import dataset
 
     p = dataset.make_params(domain.eyes, domain.r_min, domain.r_max, domain.g_max, mode, seed)
     chunks = list(dataset.iter_chunks(n, p, chunk=1 << 17))
-    return {k: np.concatenate([getattr(c, k) for c in chunks])
-            for k in ("r", "phi", "la", "ra", "lb", "rb")}
+    return {
+        k: np.concatenate([getattr(c, k) for c in chunks])
+        for k in ("r", "phi", "la", "ra", "lb", "rb")
+    }
 
 
-def _fit(net: CompactNet, x, y, xv, yv, predict: Callable, epochs: int, batch: int, lr: float,
-         patience: int, seed: int, ckpt: Callable[[CompactNet], None],
-         progress: Callable[[str, int, int, float], None] | None, label: str) -> dict:
+def _fit(
+    net: CompactNet,
+    x,
+    y,
+    xv,
+    yv,
+    predict: Callable,
+    epochs: int,
+    batch: int,
+    lr: float,
+    patience: int,
+    seed: int,
+    ckpt: Callable[[CompactNet], None],
+    progress: Callable[[str, int, int, float], None] | None,
+    label: str,
+) -> dict:
     """Adam with a one-cycle schedule on the relative error; early stopping on validation."""
     g = torch.Generator().manual_seed(seed)
     n = x.shape[0]
@@ -183,7 +206,7 @@ def _fit(net: CompactNet, x, y, xv, yv, predict: Callable, epochs: int, batch: i
         net.train()
         perm = torch.randperm(n, generator=g)
         for i in range(steps):
-            idx = perm[i * batch:(i + 1) * batch]
+            idx = perm[i * batch : (i + 1) * batch]
             opt.zero_grad(set_to_none=True)
             loss = predict(net(x[idx]), y[idx])
             loss.backward()
@@ -205,16 +228,25 @@ def _fit(net: CompactNet, x, y, xv, yv, predict: Callable, epochs: int, batch: i
                 break
     if best_state is not None:
         net.load_state_dict(best_state)
-    return {"epochs": len(history), "val_history": [round(v, 7) for v in history],
-            "best_val": best}
+    return {"epochs": len(history), "val_history": [round(v, 7) for v in history], "best_val": best}
 
 
-def train(out_dir=None, n_train: int = 1_000_000, n_val: int = 100_000, seed: int = 0,
-          epochs: int = 12, hidden: int = 32, hidden_ad: int = 8, batch: int = 4096,
-          lr: float = 4e-3,
-          patience: int = 3, domain: Domain = PAPER_DOMAIN, threads: int = 2,
-          command: str | None = None,
-          progress: Callable[[str, int, int, float], None] | None = None) -> dict:
+def train(
+    out_dir=None,
+    n_train: int = 1_000_000,
+    n_val: int = 100_000,
+    seed: int = 0,
+    epochs: int = 12,
+    hidden: int = 32,
+    hidden_ad: int = 8,
+    batch: int = 4096,
+    lr: float = 4e-3,
+    patience: int = 3,
+    domain: Domain = PAPER_DOMAIN,
+    threads: int = 2,
+    command: str | None = None,
+    progress: Callable[[str, int, int, float], None] | None = None,
+) -> dict:
     """Generate data (single pass, seeds ``seed`` and ``seed + 1``), train both nets, save.
 
     Weights are written atomically to ``out_dir`` after every improving epoch; the final
@@ -230,10 +262,12 @@ def train(out_dir=None, n_train: int = 1_000_000, n_val: int = 100_000, seed: in
 
     def prep(d):
         x, log_r0, p0 = features(d["la"], d["ra"], d["lb"], d["rb"], domain)
-        return (torch.from_numpy(x),
-                torch.from_numpy((np.log(d["r"]) - log_r0).astype(np.float32)),
-                torch.from_numpy(((d["phi"] - p0) / AD_SCALE).astype(np.float32)),
-                torch.from_numpy((d["phi"] / AD_SCALE).astype(np.float32)))
+        return (
+            torch.from_numpy(x),
+            torch.from_numpy((np.log(d["r"]) - log_r0).astype(np.float32)),
+            torch.from_numpy(((d["phi"] - p0) / AD_SCALE).astype(np.float32)),
+            torch.from_numpy((d["phi"] / AD_SCALE).astype(np.float32)),
+        )
 
     x, yd, ya, sa = prep(tr)
     xv, ydv, yav, sav = prep(va)
@@ -251,15 +285,30 @@ def train(out_dir=None, n_train: int = 1_000_000, n_val: int = 100_000, seed: in
     files = {"dd": "compact_dd.pt", "ad": "compact_ad.pt"}
     info = {}
     nets = {}
-    for name, y, yv, loss, zero, width in (("dd", yd, ydv, dd_loss, False, hidden),
-                                           ("ad", ya_pair, yav_pair, ad_loss, True, hidden_ad)):
+    for name, y, yv, loss, zero, width in (
+        ("dd", yd, ydv, dd_loss, False, hidden),
+        ("ad", ya_pair, yav_pair, ad_loss, True, hidden_ad),
+    ):
         torch.manual_seed(seed)
         net = CompactNet(width, zero_last=zero)
         ts = time.perf_counter()
         path = out / files[name]
-        info[name] = _fit(net, x, y, xv, yv, loss, epochs, batch, lr, patience, seed,
-                          lambda n_, p=path, w=width: _save_net(n_, w, p), progress,
-                          name.upper())
+        info[name] = _fit(
+            net,
+            x,
+            y,
+            xv,
+            yv,
+            loss,
+            epochs,
+            batch,
+            lr,
+            patience,
+            seed,
+            lambda n_, p=path, w=width: _save_net(n_, w, p),
+            progress,
+            name.upper(),
+        )
         info[name]["seconds"] = round(time.perf_counter() - ts, 1)
         _save_net(net, width, path)
         nets[name] = net
@@ -271,18 +320,33 @@ def train(out_dir=None, n_train: int = 1_000_000, n_val: int = 100_000, seed: in
         "estimator": "compact",
         "files": files,
         "architecture": f"DD {N_FEATURES}-{hidden}-{hidden}-1, "
-                        f"AD {N_FEATURES}-{hidden_ad}-{hidden_ad}-1, SiLU MLPs",
+        f"AD {N_FEATURES}-{hidden_ad}-{hidden_ad}-1, SiLU MLPs",
         "n_weights": est.n_weights,
-        "data": {**domain.to_dict(), "mode": "single", "n_train": n_train, "n_val": n_val,
-                 "train_seed": seed, "val_seed": seed + 1},
-        "training": {"epochs_max": epochs, "batch": batch, "lr": lr, "patience": patience,
-                     "optimizer": "Adam + one-cycle", "threads": threads,
-                     "dd_loss": "mean |r_hat/r - 1|", "ad_loss": "mean |phi_hat/phi - 1|",
-                     **{name: info[name] for name in info}},
+        "data": {
+            **domain.to_dict(),
+            "mode": "single",
+            "n_train": n_train,
+            "n_val": n_val,
+            "train_seed": seed,
+            "val_seed": seed + 1,
+        },
+        "training": {
+            "epochs_max": epochs,
+            "batch": batch,
+            "lr": lr,
+            "patience": patience,
+            "optimizer": "Adam + one-cycle",
+            "threads": threads,
+            "dd_loss": "mean |r_hat/r - 1|",
+            "ad_loss": "mean |phi_hat/phi - 1|",
+            **{name: info[name] for name in info},
+        },
         "train_seconds": round(time.perf_counter() - t0, 1),
         "generate_seconds": round(t_gen, 1),
-        "val_metrics": {"dd": metrics.summary(va["r"], pv.r),
-                        "ad": metrics.summary(va["phi"], pv.phi)},
+        "val_metrics": {
+            "dd": metrics.summary(va["r"], pv.r),
+            "ad": metrics.summary(va["phi"], pv.phi),
+        },
         "torch": torch.__version__,
         "command": command,
         "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"),

@@ -281,7 +281,7 @@ def find_weights(name: str, path: str | os.PathLike | None = None) -> Path:
 
 def _atomic_write(path: Path, write) -> None:
     """``write(tmp)`` into a temporary file next to ``path``, then rename it over ``path``."""
-    from eyeviz.atomic import atomic_output
+    from eyeviz.files.atomic import atomic_output
 
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_output(path) as tmp:
@@ -371,7 +371,10 @@ def train_net(
         from tqdm import tqdm
 
         bar = tqdm(
-            total=int(budget_seconds), unit="s", desc=f"paper {spec.name}", leave=False,
+            total=int(budget_seconds),
+            unit="s",
+            desc=f"paper {spec.name}",
+            leave=False,
             bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.0f}/{total} s {postfix}",
         )
     steps = 0
@@ -490,17 +493,30 @@ def train(
         y = targets[spec.target]
         wfile = out / f"{name}{tag}.pt"
         net, info = train_net(
-            spec, x[tr], y[tr], budget_seconds=budget_seconds, device=device, seed=seed,
-            lr=ad_lr if name == "ad" else None, max_epochs=max_epochs,
-            val=(x[va], y[va]), eval_max=eval_max, checkpoint=wfile, progress=progress,
+            spec,
+            x[tr],
+            y[tr],
+            budget_seconds=budget_seconds,
+            device=device,
+            seed=seed,
+            lr=ad_lr if name == "ad" else None,
+            max_epochs=max_epochs,
+            val=(x[va], y[va]),
+            eval_max=eval_max,
+            checkpoint=wfile,
+            progress=progress,
         )
         label = (
             f"paper {name.upper()} after {info['epochs_reached']:.2f} of "
             f"{spec.paper_epochs} epochs ({budget_seconds:.0f} s budget on {device})"
         )
         cpu_state = {k: v.detach().cpu() for k, v in net.state_dict().items()}
-        tagged = {"model": cpu_state, "label": label, "budget_seconds": budget_seconds,
-                  "epochs_reached": info["epochs_reached"]}
+        tagged = {
+            "model": cpu_state,
+            "label": label,
+            "budget_seconds": budget_seconds,
+            "epochs_reached": info["epochs_reached"],
+        }
         _atomic_write(wfile, lambda tmp, t=tagged: torch.save(t, tmp))
         meta = {
             "estimator": "paper",

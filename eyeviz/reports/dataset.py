@@ -25,14 +25,24 @@ HELP = "distribution of a data set: r histogram and centres in the BFV (Figures 
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("data", nargs="+", type=Path, metavar="DATA",
-                        help="data set files (.csv or .npz), shown side by side")
+    parser.add_argument(
+        "data",
+        nargs="+",
+        type=Path,
+        metavar="DATA",
+        help="data set files (.csv or .npz), shown side by side",
+    )
     parser.add_argument("-o", "--output", required=True, type=Path, help="output directory")
-    parser.add_argument("--labels", nargs="+", default=None,
-                        help="one title per data set (default: the file names)")
+    parser.add_argument(
+        "--labels", nargs="+", default=None, help="one title per data set (default: the file names)"
+    )
     parser.add_argument("--bins", type=int, default=40, help="histogram bins (default 40)")
-    parser.add_argument("--max-points", type=int, default=20000,
-                        help="centres drawn per scatter plot (default 20000)")
+    parser.add_argument(
+        "--max-points",
+        type=int,
+        default=20000,
+        help="centres drawn per scatter plot (default 20000)",
+    )
 
 
 @dataclass
@@ -52,8 +62,22 @@ class Summary:
     distinct_pairs: int
     area_density_ratio: float
 
-    FIELDS = ("label", "path", "n", "m", "mode", "r_min", "r_max", "r_mean", "g_min",
-              "g_max", "phi_min_deg", "phi_max_deg", "distinct_pairs", "area_density_ratio")
+    FIELDS = (
+        "label",
+        "path",
+        "n",
+        "m",
+        "mode",
+        "r_min",
+        "r_max",
+        "r_mean",
+        "g_min",
+        "g_max",
+        "phi_min_deg",
+        "phi_max_deg",
+        "distinct_pairs",
+        "area_density_ratio",
+    )
 
 
 def summarise(ds, label: str, path: str) -> Summary:
@@ -68,9 +92,19 @@ def summarise(ds, label: str, path: str) -> Summary:
     distinct = len(np.unique(keys.view(np.dtype((np.void, keys.shape[1]))).ravel()))
     g = ds.g[np.isfinite(ds.g)]
     return Summary(
-        label, path, len(ds), ds.m, str(ds.params.get("mode", "unknown")), lo, hi, float(r.mean()),
-        float(g.min()) if g.size else math.nan, float(g.max()) if g.size else math.nan,
-        math.degrees(float(ds.phi.min())), math.degrees(float(ds.phi.max())), distinct,
+        label,
+        path,
+        len(ds),
+        ds.m,
+        str(ds.params.get("mode", "unknown")),
+        lo,
+        hi,
+        float(r.mean()),
+        float(g.min()) if g.size else math.nan,
+        float(g.max()) if g.size else math.nan,
+        math.degrees(float(ds.phi.min())),
+        math.degrees(float(ds.phi.max())),
+        distinct,
         float(ratio),
     )
 
@@ -82,8 +116,9 @@ def _plot(datasets, summaries, bins: int, max_points: int, path: Path) -> None:
     import matplotlib.pyplot as plt
 
     k = len(datasets)
-    fig, axes = plt.subplots(2, k, figsize=(4.6 * k, 8.4), squeeze=False,
-                             gridspec_kw={"height_ratios": [1, 1.25]})
+    fig, axes = plt.subplots(
+        2, k, figsize=(4.6 * k, 8.4), squeeze=False, gridspec_kw={"height_ratios": [1, 1.25]}
+    )
     r_lo = min(s.r_min for s in summaries)
     r_hi = max(s.r_max for s in summaries)
     edges = np.linspace(r_lo, r_hi, bins + 1)
@@ -91,8 +126,15 @@ def _plot(datasets, summaries, bins: int, max_points: int, path: Path) -> None:
     for j, (ds, s) in enumerate(zip(datasets, summaries, strict=True)):
         ax = axes[0, j]
         counts = np.histogram(ds.r, bins=edges)[0]
-        ax.bar(edges[:-1], counts, width=np.diff(edges), align="edge", color="#4c72b0",
-               edgecolor="white", linewidth=0.4)
+        ax.bar(
+            edges[:-1],
+            counts,
+            width=np.diff(edges),
+            align="edge",
+            color="#4c72b0",
+            edgecolor="white",
+            linewidth=0.4,
+        )
         mids = 0.5 * (edges[:-1] + edges[1:])
         flat = np.full(bins, len(ds) / bins)
         lin = len(ds) * mids / mids.sum()
@@ -112,8 +154,7 @@ def _plot(datasets, summaries, bins: int, max_points: int, path: Path) -> None:
         psi = ds.eyes.psi
         reach = r_hi * 1.05
         for ang in (psi, math.pi - psi):
-            ax.plot([0, reach * math.cos(ang)], [0, reach * math.sin(ang)], color="0.35",
-                    lw=0.9)
+            ax.plot([0, reach * math.cos(ang)], [0, reach * math.sin(ang)], color="0.35", lw=0.9)
         for rr in (r_lo, r_hi):
             t = np.linspace(psi, math.pi - psi, 200)
             ax.plot(rr * np.cos(t), rr * np.sin(t), color="0.6", lw=0.6, ls="--")
@@ -124,8 +165,11 @@ def _plot(datasets, summaries, bins: int, max_points: int, path: Path) -> None:
         ax.set_xlabel("x")
         ax.set_ylabel("y" if j == 0 else "")
         shown = f"every {step}th of " if step > 1 else ""
-        ax.set_title(f"centres in the BFV ({shown}{s.n:,})\n"
-                     f"outer/inner density per area: {s.area_density_ratio:.2f}", fontsize=9)
+        ax.set_title(
+            f"centres in the BFV ({shown}{s.n:,})\n"
+            f"outer/inner density per area: {s.area_density_ratio:.2f}",
+            fontsize=9,
+        )
     fig.suptitle("Data set distribution (paper Figures 8-11)", fontsize=12)
     fig.tight_layout()
     buf = io.BytesIO()
@@ -135,7 +179,7 @@ def _plot(datasets, summaries, bins: int, max_points: int, path: Path) -> None:
 
 
 def _write_atomic(path: Path, data: bytes) -> None:
-    from eyeviz.dataset_io import atomic_output
+    from eyeviz.dataset.io import atomic_output
 
     with atomic_output(path) as tmp:
         tmp.write_bytes(data)
@@ -179,14 +223,16 @@ def run(args: argparse.Namespace) -> int:
         raise EyevizError(f"--max-points must be >= 1, got {args.max_points}")
     labels = args.labels or [p.name for p in args.data]
     if len(labels) != len(args.data):
-        raise EyevizError(f"--labels needs one label per data set ({len(args.data)}), "
-                          f"got {len(labels)}")
+        raise EyevizError(
+            f"--labels needs one label per data set ({len(args.data)}), got {len(labels)}"
+        )
     datasets = [load(p) for p in args.data]
     for p, ds in zip(args.data, datasets, strict=True):
         if len(ds) == 0:
             raise EyevizError(f"{p}: the data set is empty")
-    summaries = [summarise(ds, lab, str(p))
-                 for ds, lab, p in zip(datasets, labels, args.data, strict=True)]
+    summaries = [
+        summarise(ds, lab, str(p)) for ds, lab, p in zip(datasets, labels, args.data, strict=True)
+    ]
     out = args.output
     out.mkdir(parents=True, exist_ok=True)
     _plot(datasets, summaries, args.bins, args.max_points, out / "dataset.png")

@@ -35,10 +35,18 @@ TARGETS = (("ad", "phi"), ("dd", "r"))
 
 # Table 5 of the paper, quoted. Its R^2 is Eq. 35 (spread of the predictions).
 PAPER_TABLE5 = {
-    "ad": {"mape": 0.832, "r2": 0.998, "train_seconds": 2 * 3600 + 3 * 60 + 49,
-           "setup": "RMSProp, batch 64, lr 0.004"},
-    "dd": {"mape": 7.713, "r2": 0.899, "train_seconds": 48 * 60 + 53,
-           "setup": "SGD, batch 32, lr 0.001"},
+    "ad": {
+        "mape": 0.832,
+        "r2": 0.998,
+        "train_seconds": 2 * 3600 + 3 * 60 + 49,
+        "setup": "RMSProp, batch 64, lr 0.004",
+    },
+    "dd": {
+        "mape": 7.713,
+        "r2": 0.899,
+        "train_seconds": 48 * 60 + 53,
+        "setup": "SGD, batch 32, lr 0.001",
+    },
     "n_weights": 60_671_521 + 32_674_321,  # Appendix A + B layer sizes
     "hardware": "nVidia Tesla P4 (Google Colab)",
 }
@@ -105,7 +113,7 @@ def try_load(name: str):
 
 def write_atomic(path: Path, data: bytes | str) -> None:
     """Write a file via a temporary file in the same directory and ``os.replace``."""
-    from eyeviz.atomic import atomic_output
+    from eyeviz.files.atomic import atomic_output
 
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_output(path) as tmp:
@@ -142,9 +150,7 @@ def make_test_sets(n: int, seed: int = TEST_SEED) -> dict:
     """Fresh single- and multi-pass test sets with the paper's parameters (Tables 3, 4)."""
     from eyeviz import dataset
 
-    return {
-        mode: dataset.generate(n, mode=mode, seed=seed + i) for i, mode in enumerate(TEST_SETS)
-    }
+    return {mode: dataset.generate(n, mode=mode, seed=seed + i) for i, mode in enumerate(TEST_SETS)}
 
 
 def _time_batched(est, oa, ob) -> tuple[object, float]:
@@ -177,8 +183,10 @@ def measure_one(name: str, est, test_sets: dict) -> Result:
     md = getattr(est, "metadata", {}) or {}
     label = str(md.get("label", ""))
     if not label and "sample_size" in md:  # the bayes table
-        label = (f"{md.get('target', '')} posterior per interval key from "
-                 f"{int(md['sample_size']):,} samples ({int(md.get('keys', 0)):,} keys)")
+        label = (
+            f"{md.get('target', '')} posterior per interval key from "
+            f"{int(md['sample_size']):,} samples ({int(md.get('keys', 0)):,} keys)"
+        )
     res = Result(
         name=name,
         label=label,
@@ -206,8 +214,9 @@ def measure(names: list[str], n_test: int, seed: int = TEST_SEED, progress=None)
     out = []
     for name in names:
         est, why = try_load(name)
-        out.append(measure_one(name, est, test_sets) if est is not None else
-                   Result(name=name, status=why))
+        out.append(
+            measure_one(name, est, test_sets) if est is not None else Result(name=name, status=why)
+        )
         if progress is not None:
             progress(name)
     return out
@@ -247,9 +256,22 @@ def _limit(results: list[Result]) -> Result | None:
 
 
 CSV_FIELDS = [
-    "estimator", "status", "test_set", "n", "n_valid",
-    "ad_mape_pct", "ad_mae_rad", "ad_r2", "dd_mape_pct", "dd_mae", "dd_r2",
-    "train_seconds", "infer_us_per_sample_batched", "infer_ms_single", "n_weights", "label",
+    "estimator",
+    "status",
+    "test_set",
+    "n",
+    "n_valid",
+    "ad_mape_pct",
+    "ad_mae_rad",
+    "ad_r2",
+    "dd_mape_pct",
+    "dd_mae",
+    "dd_r2",
+    "train_seconds",
+    "infer_us_per_sample_batched",
+    "infer_ms_single",
+    "n_weights",
+    "label",
 ]
 
 
@@ -263,18 +285,43 @@ def to_csv(results: list[Result]) -> str:
             w.writerow([r.name, r.status, "", "", "", "", "", "", "", "", "", *[""] * 4, ""])
             continue
         for mode, e in r.metrics.items():
-            w.writerow([
-                r.name, "ok", mode, e["n"], e["n_valid"],
-                e["ad"]["mape"], e["ad"]["mae"], e["ad"]["r2"],
-                e["dd"]["mape"], e["dd"]["mae"], e["dd"]["r2"], *common_tail,
-            ])
+            w.writerow(
+                [
+                    r.name,
+                    "ok",
+                    mode,
+                    e["n"],
+                    e["n_valid"],
+                    e["ad"]["mape"],
+                    e["ad"]["mae"],
+                    e["ad"]["r2"],
+                    e["dd"]["mape"],
+                    e["dd"]["mae"],
+                    e["dd"]["r2"],
+                    *common_tail,
+                ]
+            )
     t5 = PAPER_TABLE5
-    w.writerow([
-        "paper Table 5 (quoted)", "reference", "paper's own test split", "20000", "",
-        t5["ad"]["mape"], "", t5["ad"]["r2"], t5["dd"]["mape"], "", t5["dd"]["r2"],
-        t5["ad"]["train_seconds"] + t5["dd"]["train_seconds"], "", "", t5["n_weights"],
-        "R^2 by Eq. 35 (spread of predictions); trained on " + t5["hardware"],
-    ])
+    w.writerow(
+        [
+            "paper Table 5 (quoted)",
+            "reference",
+            "paper's own test split",
+            "20000",
+            "",
+            t5["ad"]["mape"],
+            "",
+            t5["ad"]["r2"],
+            t5["dd"]["mape"],
+            "",
+            t5["dd"]["r2"],
+            t5["ad"]["train_seconds"] + t5["dd"]["train_seconds"],
+            "",
+            "",
+            t5["n_weights"],
+            "R^2 by Eq. 35 (spread of predictions); trained on " + t5["hardware"],
+        ]
+    )
     return buf.getvalue()
 
 
@@ -327,7 +374,8 @@ def to_markdown(results: list[Result], n_test: int, seed: int, png: str | None) 
                 "",
                 f"Information limit (bayes) on this set: AD MAPE {_fmt(e['ad']['mape'])} %, "
                 f"DD MAPE {_fmt(e['dd']['mape'])} %"
-                + (f" — {lim.label}" if lim.label else "") + ".",
+                + (f" — {lim.label}" if lim.label else "")
+                + ".",
             ]
         lines.append("")
     lines += [
@@ -363,34 +411,59 @@ def plot(results: list[Result]):
     lim = _limit(results)
     ok = [r for r in results if r.ok and r.batched_us]
     handles: dict[str, Line2D] = {}
-    for ax, (key, title) in zip(axes, (("ad", "AD: azimuth"), ("dd", "DD: distance")),
-                                strict=True):
+    for ax, (key, title) in zip(axes, (("ad", "AD: azimuth"), ("dd", "DD: distance")), strict=True):
         for i, r in enumerate(ok):
             c = _COLORS.get(r.name, "#7f7f7f")
             size = 45 + 45 * (len(ok) - 1 - i)  # coincident points show as concentric rings
             x = r.batched_us * 1e-6
             y = r.metrics["single"][key]["mape"]
             if r.single_ms and math.isfinite(y):
-                ax.plot([x, r.single_ms * 1e-3], [y, y], color=c, lw=1.0, alpha=0.6,
-                        marker="|", markevery=[1], ms=10, zorder=2)
+                ax.plot(
+                    [x, r.single_ms * 1e-3],
+                    [y, y],
+                    color=c,
+                    lw=1.0,
+                    alpha=0.6,
+                    marker="|",
+                    markevery=[1],
+                    ms=10,
+                    zorder=2,
+                )
             for mode, marker, face in (("single", "o", c), ("multi", "s", "none")):
                 y = r.metrics[mode][key]["mape"]
                 if math.isfinite(y):
-                    ax.scatter([x], [y], marker=marker, s=size, facecolors=face,
-                               edgecolors=c, linewidths=1.5, zorder=3 + i)
-            handles.setdefault(r.name, Line2D([], [], marker="o", ls="", color=c,
-                                              label=r.label_short()))
+                    ax.scatter(
+                        [x],
+                        [y],
+                        marker=marker,
+                        s=size,
+                        facecolors=face,
+                        edgecolors=c,
+                        linewidths=1.5,
+                        zorder=3 + i,
+                    )
+            handles.setdefault(
+                r.name, Line2D([], [], marker="o", ls="", color=c, label=r.label_short())
+            )
         t5 = PAPER_TABLE5[key]["mape"]
         ax.axhline(t5, color="#555555", ls=":", lw=1.3)
         if lim is not None:
-            ax.axhline(lim.metrics["single"][key]["mape"], color=_COLORS["bayes"], ls="--",
-                       lw=1.0, alpha=0.8)
+            ax.axhline(
+                lim.metrics["single"][key]["mape"],
+                color=_COLORS["bayes"],
+                ls="--",
+                lw=1.0,
+                alpha=0.8,
+            )
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.margins(x=0.2, y=0.25)
         lo, hi = ax.get_ylim()
-        major = (1.0, 2.0, 5.0) if math.log10(hi / lo) > 1.2 else (1.0, 2.0, 3.0, 4.0, 5.0, 6.0,
-                                                                    7.0, 8.0, 9.0)
+        major = (
+            (1.0, 2.0, 5.0)
+            if math.log10(hi / lo) > 1.2
+            else (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0)
+        )
         ax.yaxis.set_major_locator(LogLocator(subs=major))
         ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         ax.yaxis.set_minor_locator(LogLocator(subs=tuple(float(k) for k in range(1, 10))))
@@ -402,20 +475,40 @@ def plot(results: list[Result]):
         ax.grid(True, which="minor", alpha=0.12)
     extra = [
         Line2D([], [], marker="o", ls="", color="k", label="single-pass test set, batched"),
-        Line2D([], [], marker="s", ls="", markerfacecolor="none", color="k",
-               label="multi-pass test set, batched"),
-        Line2D([], [], marker="|", ms=10, color="k", lw=1.0, alpha=0.6,
-               label="one sample per call"),
+        Line2D(
+            [],
+            [],
+            marker="s",
+            ls="",
+            markerfacecolor="none",
+            color="k",
+            label="multi-pass test set, batched",
+        ),
+        Line2D(
+            [], [], marker="|", ms=10, color="k", lw=1.0, alpha=0.6, label="one sample per call"
+        ),
         Line2D([], [], ls=":", color="#555555", lw=1.3, label="paper Table 5 (quoted)"),
     ]
     if lim is not None:
-        extra.append(Line2D([], [], ls="--", color=_COLORS["bayes"],
-                            label="information limit (bayes, single-pass)"))
+        extra.append(
+            Line2D(
+                [],
+                [],
+                ls="--",
+                color=_COLORS["bayes"],
+                label="information limit (bayes, single-pass)",
+            )
+        )
     missing = [r.name for r in results if not r.ok]
     if missing:
         extra.append(Line2D([], [], ls="", label="unavailable: " + ", ".join(missing)))
-    fig.legend(handles=[*handles.values(), *extra], loc="outside lower center", ncol=4,
-               fontsize=8, frameon=False)
+    fig.legend(
+        handles=[*handles.values(), *extra],
+        loc="outside lower center",
+        ncol=4,
+        fontsize=8,
+        frameon=False,
+    )
     return fig
 
 
@@ -434,12 +527,21 @@ def write(results: list[Result], outdir: Path, n_test: int, seed: int) -> list[P
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True, type=Path, help="output directory")
-    parser.add_argument("--n-test", type=int, default=20000,
-                        help="elements per test set (default 20000, the paper's test sample)")
-    parser.add_argument("--estimators", default=None,
-                        help="comma-separated names (default: all available)")
-    parser.add_argument("--seed", type=int, default=TEST_SEED,
-                        help=f"test-set seed; multi-pass uses seed+1 (default {TEST_SEED})")
+    parser.add_argument(
+        "--n-test",
+        type=int,
+        default=20000,
+        help="elements per test set (default 20000, the paper's test sample)",
+    )
+    parser.add_argument(
+        "--estimators", default=None, help="comma-separated names (default: all available)"
+    )
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=TEST_SEED,
+        help=f"test-set seed; multi-pass uses seed+1 (default {TEST_SEED})",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -460,9 +562,11 @@ def run(args: argparse.Namespace) -> int:
     for r in results:
         if r.ok:
             e = r.metrics["single"]
-            print(f"{r.name:9s} AD MAPE {e['ad']['mape']:.3f} %  DD MAPE {e['dd']['mape']:.3f} %  "
-                  f"R^2 {e['dd']['r2']:.4f}  {r.batched_us:.3g} µs/sample  "
-                  f"{r.single_ms:.3g} ms single")
+            print(
+                f"{r.name:9s} AD MAPE {e['ad']['mape']:.3f} %  DD MAPE {e['dd']['mape']:.3f} %  "
+                f"R^2 {e['dd']['r2']:.4f}  {r.batched_us:.3g} µs/sample  "
+                f"{r.single_ms:.3g} ms single"
+            )
         else:
             print(f"{r.name:9s} unavailable: {r.status}")
     print("wrote " + ", ".join(str(p) for p in paths))

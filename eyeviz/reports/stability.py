@@ -1,7 +1,7 @@
 """``eyeviz report stability -o DIR``: the geometry's error against run time.
 
-For every case class of :mod:`eyeviz.stability_cases`, three implementations of Eq. 11
-and 22-25 are compared with the mpmath reference (:mod:`eyeviz.reference`, 80 digits):
+For every case class of :mod:`eyeviz.reference.stability_cases`, three implementations of Eq. 11
+and 22-25 are compared with the mpmath reference (:mod:`eyeviz.reference.digits80`, 80 digits):
 (a) the paper's formulas taken literally in float64, (b) the same in float32, (c) the
 eyeviz core. A feature counts as a difference when either eye's bitmap differs.
 """
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from eyeviz.atomic import atomic_output
+from eyeviz.files.atomic import atomic_output
 
 HELP = "numerical stability of the geometry against an 80-digit reference"
 
@@ -52,9 +52,9 @@ def _timed(fn, repeats: int = 3) -> tuple[object, float]:
 
 def measure_case(cs) -> Row:
     """Differences from the reference and time per feature of each method on one class."""
-    from eyeviz import geometry
-    from eyeviz.paper_formulas import paper_intervals
-    from eyeviz.reference import reference_intervals
+    from eyeviz.core import geometry
+    from eyeviz.reference.digits80 import reference_intervals
+    from eyeviz.reference.paper_formulas import paper_intervals
 
     e, x, y, g = cs.eyes, cs.x, cs.y, cs.g
     ref, t_ref = _timed(lambda: np.array(reference_intervals(e, x, y, g)), 1)
@@ -76,7 +76,7 @@ def measure_case(cs) -> Row:
 
 def measure(n: int = 2000, seed: int = 0, progress=None) -> list[Row]:
     """Run every case class; returns one :class:`Row` per class."""
-    from eyeviz import stability_cases
+    from eyeviz.reference import stability_cases
 
     rows = []
     for i, name in enumerate(stability_cases.CLASSES):
@@ -179,7 +179,7 @@ def run(args: argparse.Namespace) -> int:
         raise ValueError(f"-n must be >= 1, got {args.n}")
     from tqdm import tqdm
 
-    from eyeviz import stability_cases
+    from eyeviz.reference import stability_cases
 
     with tqdm(total=len(stability_cases.CLASSES), desc="stability", unit="class") as bar:
         rows = measure(args.n, args.seed, progress=lambda _name: bar.update())

@@ -1,7 +1,7 @@
 """``eyeviz report trajectories -o DIR``: the experiments of Section 6 (Figures 14-17).
 
 Circular features of radius g in {5, 50, 500} move along three kinds of trajectory
-(:mod:`eyeviz.trajectories`): horizontal lines y = r and circles of radius r about the
+(:mod:`eyeviz.model.trajectories`): horizontal lines y = r and circles of radius r about the
 origin for r = 1000, 2000, ..., 10000, and the central axis x = 0 from y = 1000 to 10000.
 Section 6 places 1.5r/g, r/g and 4500/g features on them; those counts are used, clipped
 to [--min-count, --max-count] (the paper's 3 features for g = 500 on the nearest line
@@ -51,10 +51,14 @@ PAPER_TEXT = {
 }
 # Levels the text states as "about" / "more than" / "not below": {(kind, target, g): %}
 PAPER_LEVELS = {
-    ("horizontal", "ad", 5.0): 95.0, ("horizontal", "ad", 50.0): 99.0,
-    ("horizontal", "ad", 500.0): 99.0, ("circular", "ad", 5.0): 97.0,
-    ("circular", "ad", 50.0): 99.0, ("circular", "ad", 500.0): 99.0,
-    ("vertical", "dd", 5.0): 70.0, ("vertical", "dd", 50.0): 70.0,
+    ("horizontal", "ad", 5.0): 95.0,
+    ("horizontal", "ad", 50.0): 99.0,
+    ("horizontal", "ad", 500.0): 99.0,
+    ("circular", "ad", 5.0): 97.0,
+    ("circular", "ad", 50.0): 99.0,
+    ("circular", "ad", 500.0): 99.0,
+    ("vertical", "dd", 5.0): 70.0,
+    ("vertical", "dd", 50.0): 70.0,
     ("vertical", "dd", 500.0): 70.0,
 }
 PAPER_TEXT_SUMMARY = [
@@ -80,7 +84,7 @@ class Point:
 
 def trajectory_points(kind: str, g: float, lo: int, hi: int):
     """[(r, x, y)] for one kind and g: the features Section 6 places on each trajectory."""
-    from eyeviz import trajectories as T
+    from eyeviz.model import trajectories as T
 
     out = []
     if kind == "vertical":
@@ -107,10 +111,11 @@ def _accuracy(truth: np.ndarray, pred: np.ndarray) -> float:
     return 100.0 - 100.0 * float(np.mean(np.abs((pred[ok] - truth[ok]) / truth[ok])))
 
 
-def measure(names: list[str], lo: int = 30, hi: int = 2000, kinds=KINDS, g_values=G_VALUES,
-            progress=None) -> tuple[list[Point], dict[str, str]]:
+def measure(
+    names: list[str], lo: int = 30, hi: int = 2000, kinds=KINDS, g_values=G_VALUES, progress=None
+) -> tuple[list[Point], dict[str, str]]:
     """Accuracy per (kind, g, r, estimator); also {name: reason} of unavailable estimators."""
-    from eyeviz.geometry import EyePair, intervals_to_bitmap
+    from eyeviz.core.geometry import EyePair, intervals_to_bitmap
 
     eyes = EyePair(40.0, 20.0, 720)
     loaded, missing = {}, {}
@@ -131,10 +136,18 @@ def measure(names: list[str], lo: int = 30, hi: int = 2000, kinds=KINDS, g_value
                 for name, est in loaded.items():
                     pred = est.predict(oa, ob)
                     r_hat, phi_hat = (np.asarray(v, np.float64) for v in pred)
-                    points.append(Point(
-                        kind, g, r, name, int(len(x)), int(np.isfinite(r_hat).sum()),
-                        _accuracy(phi_true, phi_hat), _accuracy(r_true, r_hat),
-                    ))
+                    points.append(
+                        Point(
+                            kind,
+                            g,
+                            r,
+                            name,
+                            int(len(x)),
+                            int(np.isfinite(r_hat).sum()),
+                            _accuracy(phi_true, phi_hat),
+                            _accuracy(r_true, r_hat),
+                        )
+                    )
             if progress is not None:
                 progress(f"{kind} g={g:g}")
     return points, missing
@@ -143,11 +156,22 @@ def measure(names: list[str], lo: int = 30, hi: int = 2000, kinds=KINDS, g_value
 def to_csv(points: list[Point]) -> str:
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["trajectory", "g", "r", "estimator", "n", "n_valid",
-                "ad_accuracy_pct", "dd_accuracy_pct"])
+    w.writerow(
+        ["trajectory", "g", "r", "estimator", "n", "n_valid", "ad_accuracy_pct", "dd_accuracy_pct"]
+    )
     for p in points:
-        w.writerow([p.kind, p.g, p.r, p.estimator, p.n, p.n_valid,
-                    round(p.ad_accuracy, 4), round(p.dd_accuracy, 4)])
+        w.writerow(
+            [
+                p.kind,
+                p.g,
+                p.r,
+                p.estimator,
+                p.n,
+                p.n_valid,
+                round(p.ad_accuracy, 4),
+                round(p.dd_accuracy, 4),
+            ]
+        )
     return buf.getvalue()
 
 
@@ -162,11 +186,15 @@ def _table(points: list[Point], kind: str, target: str, names: list[str]) -> lis
     ]
     for name in names:
         for g in G_VALUES:
-            vals = {p.r: getattr(p, f"{target}_accuracy") for p in points
-                    if p.kind == kind and p.g == g and p.estimator == name}
+            vals = {
+                p.r: getattr(p, f"{target}_accuracy")
+                for p in points
+                if p.kind == kind and p.g == g and p.estimator == name
+            }
             if vals:
-                cells = " | ".join(f"{vals[r]:.2f}" if r in vals and math.isfinite(vals[r])
-                                   else "–" for r in rs)
+                cells = " | ".join(
+                    f"{vals[r]:.2f}" if r in vals and math.isfinite(vals[r]) else "–" for r in rs
+                )
                 lines.append(f"| {name} | {g:g} | {cells} |")
     return [f"{target.upper()} accuracy (%) against {head}:", "", *lines, ""]
 
@@ -189,8 +217,10 @@ def to_markdown(points, missing, names, lo, hi, pngs) -> str:
         "",
     ]
     if missing:
-        lines += ["Not shown (unavailable): " + "; ".join(
-            f"**{k}**: {v}" for k, v in missing.items()), ""]
+        lines += [
+            "Not shown (unavailable): " + "; ".join(f"**{k}**: {v}" for k, v in missing.items()),
+            "",
+        ]
     for kind in KINDS:
         if not any(p.kind == kind for p in points):
             continue
@@ -209,11 +239,14 @@ def plot(points: list[Point], kind: str, names: list[str]):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, len(G_VALUES), figsize=(13, 7), sharex=True,
-                             constrained_layout=True)
-    xlabel = {"horizontal": "distance r of the line y = r",
-              "circular": "radius r of the circle",
-              "vertical": "y along the central axis (segment centre)"}[kind]
+    fig, axes = plt.subplots(
+        2, len(G_VALUES), figsize=(13, 7), sharex=True, constrained_layout=True
+    )
+    xlabel = {
+        "horizontal": "distance r of the line y = r",
+        "circular": "radius r of the circle",
+        "vertical": "y along the central axis (segment centre)",
+    }[kind]
     for row, target in enumerate(("ad", "dd")):
         for col, g in enumerate(G_VALUES):
             ax = axes[row, col]
@@ -221,8 +254,10 @@ def plot(points: list[Point], kind: str, names: list[str]):
             lows = []
             series = []
             for i, name in enumerate(names):
-                pts = sorted((p for p in points if p.kind == kind and p.g == g
-                              and p.estimator == name), key=lambda p: p.r)
+                pts = sorted(
+                    (p for p in points if p.kind == kind and p.g == g and p.estimator == name),
+                    key=lambda p: p.r,
+                )
                 if not pts:
                     continue
                 xs = [p.r for p in pts]
@@ -230,30 +265,54 @@ def plot(points: list[Point], kind: str, names: list[str]):
                 lows += [v for v in ys if math.isfinite(v)]
                 series.append((name, xs, ys))
                 # earlier estimators drawn wider, so identical curves stay visible
-                ax.plot(xs, ys, marker="o", ms=3.5 + 0.8 * (len(names) - 1 - i),
-                        lw=1.4 + 0.6 * (len(names) - 1 - i), color=_COLORS.get(name, "#7f7f7f"),
-                        label=name, zorder=2 + i)
+                ax.plot(
+                    xs,
+                    ys,
+                    marker="o",
+                    ms=3.5 + 0.8 * (len(names) - 1 - i),
+                    lw=1.4 + 0.6 * (len(names) - 1 - i),
+                    color=_COLORS.get(name, "#7f7f7f"),
+                    label=name,
+                    zorder=2 + i,
+                )
             ref = PAPER_TEXT.get((kind, target, g))
             if ref:
-                ax.plot(*zip(*ref, strict=True), ls="", marker="x", ms=8, mew=2,
-                        color="#555555", label="paper (Section 6 text)")
+                ax.plot(
+                    *zip(*ref, strict=True),
+                    ls="",
+                    marker="x",
+                    ms=8,
+                    mew=2,
+                    color="#555555",
+                    label="paper (Section 6 text)",
+                )
                 lows += [a for _, a in ref]
             level = PAPER_LEVELS.get((kind, target, g))
             if level is not None:
-                ax.axhline(level, color="#555555", ls=":", lw=1.3,
-                           label="paper: level stated in Section 6")
+                ax.axhline(
+                    level, color="#555555", ls=":", lw=1.3, label="paper: level stated in Section 6"
+                )
                 lows.append(level)
             bottom = max(-100.0, min([*lows, 90.0]) - 5.0)
             ax.set_ylim(bottom, 101)
             for name, xs, ys in series:  # below the axis: a triangle on its edge
                 off = [x for x, v in zip(xs, ys, strict=True) if v < bottom]
                 if off:
-                    ax.plot(off, [bottom] * len(off), ls="", marker="v", ms=8, clip_on=False,
-                            color=_COLORS.get(name, "#7f7f7f"))
+                    ax.plot(
+                        off,
+                        [bottom] * len(off),
+                        ls="",
+                        marker="v",
+                        ms=8,
+                        clip_on=False,
+                        color=_COLORS.get(name, "#7f7f7f"),
+                    )
             ax.set_xlim(500, 10500)
             ax.grid(True, alpha=0.3)
-            ax.set_title(f"{target.upper()} ({'azimuth' if target == 'ad' else 'distance'}), "
-                         f"g = {g:g}", fontsize=10)
+            ax.set_title(
+                f"{target.upper()} ({'azimuth' if target == 'ad' else 'distance'}), g = {g:g}",
+                fontsize=10,
+            )
             if col == 0:
                 ax.set_ylabel("accuracy = 100 % - MAPE")
             if row == 1:
@@ -269,11 +328,14 @@ def plot(points: list[Point], kind: str, names: list[str]):
     if any(v < -100 for p in points if p.kind == kind for v in (p.ad_accuracy, p.dd_accuracy)):
         handles.append(plt.Line2D([], [], ls="", marker="v", color="#555555"))
         labels.append("below -100 %")
-    fig.legend(handles, labels, loc="outside lower center", ncol=len(labels), fontsize=9,
-               frameon=False)
-    title = {"horizontal": "Horizontal trajectories (Figure 15)",
-             "circular": "Circular trajectories (Figure 16)",
-             "vertical": "Vertical trajectory (Figure 17)"}[kind]
+    fig.legend(
+        handles, labels, loc="outside lower center", ncol=len(labels), fontsize=9, frameon=False
+    )
+    title = {
+        "horizontal": "Horizontal trajectories (Figure 15)",
+        "circular": "Circular trajectories (Figure 16)",
+        "vertical": "Vertical trajectory (Figure 17)",
+    }[kind]
     fig.suptitle(title)
     return fig
 
@@ -301,12 +363,15 @@ def write(points, missing, names, outdir: Path, lo: int, hi: int) -> list[Path]:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True, type=Path, help="output directory")
-    parser.add_argument("--estimators", default=None,
-                        help="comma-separated names (default: all available)")
-    parser.add_argument("--min-count", type=int, default=30,
-                        help="fewest features per trajectory (default 30)")
-    parser.add_argument("--max-count", type=int, default=2000,
-                        help="most features per trajectory (default 2000)")
+    parser.add_argument(
+        "--estimators", default=None, help="comma-separated names (default: all available)"
+    )
+    parser.add_argument(
+        "--min-count", type=int, default=30, help="fewest features per trajectory (default 30)"
+    )
+    parser.add_argument(
+        "--max-count", type=int, default=2000, help="most features per trajectory (default 2000)"
+    )
 
 
 def run(args: argparse.Namespace) -> int:

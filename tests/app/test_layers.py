@@ -13,9 +13,9 @@ from mouse import drag, pixel_of
 from PyQt5 import QtGui
 
 from eyeviz import estimators
-from eyeviz import trajectories as tr
-from eyeviz.render.actors import OUT_FILL
-from eyeviz.scene import Eyes, Feature, Scene, Trajectory, View
+from eyeviz.model import trajectories as tr
+from eyeviz.model.scene import Eyes, Feature, Scene, Trajectory, View
+from eyeviz.render.vtk.actors import OUT_FILL
 
 ROOT = Path(__file__).resolve().parents[2]
 LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout", "labels", "predictions", "ambiguity"]
@@ -152,7 +152,7 @@ def test_torch_is_imported_only_with_the_predictions_layer(tmp_path):
     code = (
         "import sys\n"
         "from eyeviz.app.window import MainWindow, make_app, make_settings\n"
-        "from eyeviz.scene import load\n"
+        "from eyeviz.model.scene import load\n"
         "app = make_app()\n"
         f"w = MainWindow(load({str(ROOT / 'assets/scenes/default.toml')!r}), "
         f"settings=make_settings({str(tmp_path / 's.ini')!r}))\n"

@@ -11,11 +11,11 @@ from mouse import drag, pixel_of
 from PyQt5 import QtCore, QtGui
 from PyQt5.QtTest import QTest
 
-from eyeviz.app.model import DRAG_THRESHOLD_PX
 from eyeviz.app.window import qimage_to_array
-from eyeviz.geometry import EyePair
-from eyeviz.render.actors import UNLIT, hex_rgb
-from eyeviz.scene import Eyes, Feature, Scene, View, load
+from eyeviz.core.geometry import EyePair
+from eyeviz.model.app_model import DRAG_THRESHOLD_PX
+from eyeviz.model.scene import Eyes, Feature, Scene, View, load
+from eyeviz.render.vtk.actors import UNLIT, hex_rgb
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -235,7 +235,7 @@ def test_app_does_not_import_torch(tmp_path):
     code = (
         "import sys\n"
         "from eyeviz.app.window import MainWindow, make_app, make_settings\n"
-        "from eyeviz.scene import load\n"
+        "from eyeviz.model.scene import load\n"
         "app = make_app()\n"
         f"w = MainWindow(load({str(ROOT / 'assets/scenes/default.toml')!r}), "
         f"settings=make_settings({str(tmp_path / 's.ini')!r}))\n"

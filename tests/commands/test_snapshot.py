@@ -20,15 +20,21 @@ print(json.dumps({"rc": rc, "heavy": heavy}))
 
 
 def run_probe(*args):
-    out = subprocess.run([sys.executable, "-c", PROBE, *map(str, args)], capture_output=True,
-                         text=True, timeout=120, cwd=ROOT)
+    out = subprocess.run(
+        [sys.executable, "-c", PROBE, *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=ROOT,
+    )
     assert out.returncode == 0, out.stderr
     return json.loads(out.stdout.strip().splitlines()[-1]), out
 
 
 def test_snapshot_png_without_heavy_imports(tmp_path):
-    res, _ = run_probe("snapshot", SCENES / "default.toml", "-o", tmp_path / "s.png",
-                       "--scale", "0.5")
+    res, _ = run_probe(
+        "snapshot", SCENES / "default.toml", "-o", tmp_path / "s.png", "--scale", "0.5"
+    )
     assert res == {"rc": 0, "heavy": []}
     data = (tmp_path / "s.png").read_bytes()
     assert struct.unpack(">II", data[16:24])[0] == 525
@@ -53,8 +59,9 @@ def test_snapshot_bad_input_is_one_line(tmp_path):
     bad.write_text("[eyes]\nm = 7\n")
     cases.append([bad, "-o", tmp_path / "x.png"])
     for args in cases:
-        out = subprocess.run([*exe, *map(str, args)], capture_output=True, text=True,
-                             timeout=120, cwd=ROOT)
+        out = subprocess.run(
+            [*exe, *map(str, args)], capture_output=True, text=True, timeout=120, cwd=ROOT
+        )
         assert out.returncode == 2, out
         lines = out.stderr.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith("eyeviz: error:"), out.stderr

@@ -5,8 +5,8 @@ import math
 import numpy as np
 
 from eyeviz import estimators
+from eyeviz.core.geometry import EyePair
 from eyeviz.estimators.base import triangulate
-from eyeviz.geometry import EyePair
 
 
 def test_triangulate_recovers_a_point():

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from eyeviz import estimators
+from eyeviz.core.geometry import EyePair, intervals_to_bitmap
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, bitmaps_to_intervals, in_domain
-from eyeviz.geometry import EyePair, intervals_to_bitmap
 
 W = PAPER_DOMAIN.width
 
@@ -38,7 +38,7 @@ def test_runs_at_the_bitmap_ends_and_odd_widths():
         a[0, 0] = True
         a[1, width - 1] = True
         a[2, :] = True
-        a[3, 2:width - 3] = True
+        a[3, 2 : width - 3] = True
         LA, RA, LB, RB, valid = bitmaps_to_intervals(a, a)
         assert valid.all()
         np.testing.assert_array_equal(LA, [0, width - 1, 0, 2])

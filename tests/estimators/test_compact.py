@@ -65,8 +65,10 @@ def test_missing_weights_is_a_clear_error(tmp_path):
 
 
 def test_load_compact_imports_torch():
-    code = ("import sys, eyeviz.estimators as e; assert 'torch' not in sys.modules;"
-            "e.load('compact'); print('torch' in sys.modules)")
+    code = (
+        "import sys, eyeviz.estimators as e; assert 'torch' not in sys.modules;"
+        "e.load('compact'); print('torch' in sys.modules)"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "True"
 
@@ -74,10 +76,14 @@ def test_load_compact_imports_torch():
 def test_training_runs_and_writes_atomically(tmp_path):
     from eyeviz.estimators import compact
 
-    meta = compact.train(tmp_path, n_train=20_000, n_val=5_000, seed=3, epochs=2, hidden=8,
-                         batch=1024)
+    meta = compact.train(
+        tmp_path, n_train=20_000, n_val=5_000, seed=3, epochs=2, hidden=8, batch=1024
+    )
     assert sorted(p.name for p in tmp_path.iterdir()) == [
-        "compact.json", "compact_ad.pt", "compact_dd.pt"]
+        "compact.json",
+        "compact_ad.pt",
+        "compact_dd.pt",
+    ]
     est = estimators.load("compact", path=tmp_path)
     assert est.n_weights == meta["n_weights"]
     ds = dataset.generate(2000, seed=9)

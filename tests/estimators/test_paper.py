@@ -8,15 +8,25 @@ import pytest
 import torch
 
 from eyeviz import EyevizError  # noqa: E402
+from eyeviz.core.geometry import EyePair, intervals_to_bitmap  # noqa: E402
 from eyeviz.estimators import paper as P  # noqa: E402
-from eyeviz.geometry import EyePair, intervals_to_bitmap  # noqa: E402
 
 APPENDIX = {
     # (in, out, activation after the Dense) as Appendix A / B list them
-    "ad": [(720, 720, torch.nn.ReLU), (720, 5760, torch.nn.Tanh), (5760, 6480, torch.nn.Tanh),
-           (6480, 2880, torch.nn.ReLU), (2880, 1, None)],
-    "dd": [(720, 720, torch.nn.ReLU), (720, 5040, torch.nn.Sigmoid),
-           (5040, 3600, torch.nn.ReLU), (3600, 2880, torch.nn.ReLU), (2880, 1, None)],
+    "ad": [
+        (720, 720, torch.nn.ReLU),
+        (720, 5760, torch.nn.Tanh),
+        (5760, 6480, torch.nn.Tanh),
+        (6480, 2880, torch.nn.ReLU),
+        (2880, 1, None),
+    ],
+    "dd": [
+        (720, 720, torch.nn.ReLU),
+        (720, 5040, torch.nn.Sigmoid),
+        (5040, 3600, torch.nn.ReLU),
+        (3600, 2880, torch.nn.ReLU),
+        (2880, 1, None),
+    ],
 }
 
 
@@ -40,8 +50,7 @@ def _data(n, seed=0):
     g = rng.uniform(5, 100, n)
     x, y = r * np.cos(phi), r * np.sin(phi)
     LA, RA, LB, RB = eyes.intervals(x, y, g)
-    return (intervals_to_bitmap(LA, RA, 720, 360), intervals_to_bitmap(LB, RB, 720, 360),
-            r, phi, g)
+    return (intervals_to_bitmap(LA, RA, 720, 360), intervals_to_bitmap(LB, RB, 720, 360), r, phi, g)
 
 
 @pytest.mark.parametrize("spec", [P.AD, P.DD], ids=["ad", "dd"])
@@ -61,10 +70,19 @@ def test_layer_shapes_match_appendix(spec):
 
 
 def test_training_setup_as_appendix():
-    assert (P.AD.optimizer, P.AD.batch_size, P.AD.lr, P.AD.paper_epochs) == ("rmsprop", 64,
-                                                                             0.003, 100)
+    assert (P.AD.optimizer, P.AD.batch_size, P.AD.lr, P.AD.paper_epochs) == (
+        "rmsprop",
+        64,
+        0.003,
+        100,
+    )
     assert (P.DD.optimizer, P.DD.batch_size, P.DD.lr, P.DD.decay, P.DD.paper_epochs) == (
-        "sgd", 32, 0.001, 1e-5, 80)
+        "sgd",
+        32,
+        0.001,
+        1e-5,
+        80,
+    )
 
 
 def test_keras_rmsprop_matches_tf_formula():
@@ -139,8 +157,15 @@ def test_train_save_load_predict_roundtrip(tmp_path):
     """Budgeted training writes labelled metadata; the estimator loads and predicts."""
     torch.set_num_threads(1)
     data = _data(40, seed=2)
-    meta = P.train(data, budget_seconds=0.5, out_dir=tmp_path, seed=3, max_epochs=1,
-                   progress=False, data_params={"n": 40})
+    meta = P.train(
+        data,
+        budget_seconds=0.5,
+        out_dir=tmp_path,
+        seed=3,
+        max_epochs=1,
+        progress=False,
+        data_params={"n": 40},
+    )
     for name in ("ad", "dd"):
         m = json.loads((tmp_path / f"{name}.json").read_text())
         assert m == json.loads(json.dumps(meta[name]))

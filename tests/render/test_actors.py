@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import pyvista as pv
 
-from eyeviz.render.actors import UNLIT, SceneActors, eye_mesh, hex_rgb
-from eyeviz.scene import Eyes, Feature, Scene
-from eyeviz.state import compute_state
+from eyeviz.model.scene import Eyes, Feature, Scene
+from eyeviz.model.state import compute_state
+from eyeviz.render.vtk.actors import UNLIT, SceneActors, eye_mesh, hex_rgb
 
 
 @pytest.fixture
@@ -147,7 +147,7 @@ def test_tangents_touch_the_feature_and_sectors_bound_the_lit_interval(rig):
 
 
 def test_inset_is_a_small_bottom_left_corner():
-    from eyeviz.render.actors import inset_viewport
+    from eyeviz.render.vtk.actors import inset_viewport
 
     for w, h, most in ((843, 552, 0.12), (1600, 1000, 0.06), (400, 300, 0.3)):
         x0, y0, x1, y1 = inset_viewport(w, h)

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from eyeviz import scene as scene_mod
-from eyeviz.render import vector
-from eyeviz.state import compute_state
+from eyeviz.model import scene as scene_mod
+from eyeviz.model.state import compute_state
+from eyeviz.render.mpl import vector
 
 SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 SVG = "{http://www.w3.org/2000/svg}"
@@ -51,8 +51,10 @@ def test_one_path_per_ommatidium_and_feature_small_m():
     for gid, g in omm.items():
         style = _paths_in(g)[0].get("style", "")
         colour = sc.features[0].color.lower()
-        assert (colour in style.lower()) == (gid in lit or (
-            gid.startswith("ommatidium-B") and st.owner_b[int(gid.rsplit("-", 1)[1])] >= 0))
+        assert (colour in style.lower()) == (
+            gid in lit
+            or (gid.startswith("ommatidium-B") and st.owner_b[int(gid.rsplit("-", 1)[1])] >= 0)
+        )
 
 
 def test_text_is_text_and_labels_present():
@@ -79,8 +81,10 @@ def test_merged_runs_match_the_lit_intervals():
     for e, owner in (("A", st.owner_a), ("B", st.owner_b)):
         colours = vector._owner_colors(owner, [f.color for f in sc.features])
         starts, stops = vector.eye_runs(colours)
-        want = {f"ommatidia-{e}-{s}-{t - 1}" if t - s > 1 else f"ommatidium-{e}-{s}"
-                for s, t in zip(starts, stops, strict=True)}
+        want = {
+            f"ommatidia-{e}-{s}-{t - 1}" if t - s > 1 else f"ommatidium-{e}-{s}"
+            for s, t in zip(starts, stops, strict=True)
+        }
         assert want == {i for i in ids if i.split("-")[1] == e}
 
 
@@ -100,8 +104,7 @@ def test_only_the_scenes_layers_are_drawn():
     sc.layers = ["features"]
     root = _svg(sc)
     assert _groups(root, "feature-")
-    for prefix in ("ommatidi", "bfv", "bitmap", "readout", "label", "tangent", "sector",
-                   "inset"):
+    for prefix in ("ommatidi", "bfv", "bitmap", "readout", "label", "tangent", "sector", "inset"):
         assert not _groups(root, prefix), prefix
     sc.layers = ["eyes", "bfv", "features", "tangents", "sectors"]
     root = _svg(sc)
@@ -120,8 +123,11 @@ def test_predictions_drawn_as_ghosts_and_out_of_domain_greyed():
     ghosts = _groups(root, "prediction-analytic-")
     domain = st.in_domain()
     assert not domain.all() and domain.any()
-    want = {f"prediction-analytic-{vector._slug(f.name)}"
-            for f, ok in zip(sc.features, domain, strict=True) if ok}
+    want = {
+        f"prediction-analytic-{vector._slug(f.name)}"
+        for f, ok in zip(sc.features, domain, strict=True)
+        if ok
+    }
     assert set(ghosts) == want
     texts = " ".join("".join(t.itertext()) for t in root.iter(f"{SVG}text"))
     assert "outside the networks' domain" in texts
@@ -134,7 +140,10 @@ def test_predictions_from_a_real_estimator():
     sc.estimators = ["analytic"]
     root = _svg(sc)
     assert set(_groups(root, "prediction-analytic-")) == {
-        "prediction-analytic-target", "prediction-analytic-far", "prediction-analytic-side"}
+        "prediction-analytic-target",
+        "prediction-analytic-far",
+        "prediction-analytic-side",
+    }
 
 
 def test_ambiguity_and_trajectory_layers():
@@ -142,8 +151,11 @@ def test_ambiguity_and_trajectory_layers():
     sc.layers = ["features", "ambiguity", "trajectory", "readout"]
     sc.trajectory = scene_mod.Trajectory("horizontal", 3000.0, 50.0)
     root = _svg(sc)
-    assert set(_groups(root, "ambiguity-")) == {"ambiguity-target", "ambiguity-far",
-                                                 "ambiguity-side"}
+    assert set(_groups(root, "ambiguity-")) == {
+        "ambiguity-target",
+        "ambiguity-far",
+        "ambiguity-side",
+    }
     assert _groups(root, "trajectory-horizontal")
 
 

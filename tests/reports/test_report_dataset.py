@@ -23,9 +23,23 @@ def files(tmp_path_factory):
 
 def test_report_side_by_side(files, tmp_path):
     out = tmp_path / "rep"
-    res = subprocess.run([*EYEVIZ, "report", "dataset", str(files / "single.npz"),
-                          str(files / "multi.csv"), "--labels", "one pass", "multi-pass",
-                          "-o", str(out)], capture_output=True, text=True, timeout=120)
+    res = subprocess.run(
+        [
+            *EYEVIZ,
+            "report",
+            "dataset",
+            str(files / "single.npz"),
+            str(files / "multi.csv"),
+            "--labels",
+            "one pass",
+            "multi-pass",
+            "-o",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert res.returncode == 0, res.stderr
     png = (out / "dataset.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 50_000
@@ -45,11 +59,28 @@ def test_report_side_by_side(files, tmp_path):
 
 
 def test_report_bad_input(files, tmp_path):
-    res = subprocess.run([*EYEVIZ, "report", "dataset", str(files / "single.npz"),
-                          "--labels", "a", "b", "-o", str(tmp_path / "r")],
-                         capture_output=True, text=True, timeout=60)
+    res = subprocess.run(
+        [
+            *EYEVIZ,
+            "report",
+            "dataset",
+            str(files / "single.npz"),
+            "--labels",
+            "a",
+            "b",
+            "-o",
+            str(tmp_path / "r"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert res.returncode == 2 and "one label per data set" in res.stderr
-    res = subprocess.run([*EYEVIZ, "report", "dataset", str(tmp_path / "none.csv"),
-                          "-o", str(tmp_path / "r")], capture_output=True, text=True, timeout=60)
+    res = subprocess.run(
+        [*EYEVIZ, "report", "dataset", str(tmp_path / "none.csv"), "-o", str(tmp_path / "r")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert res.returncode == 2 and "no such data set file" in res.stderr
     assert "Traceback" not in res.stderr and not (tmp_path / "r").exists()

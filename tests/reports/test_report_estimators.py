@@ -14,10 +14,24 @@ from eyeviz.reports import estimators as rep
 def test_report_writes_md_csv_png_and_lists_missing_paper(tmp_path, no_paper_weights, capsys):
     out = tmp_path / "rep"
     seed = 4242
-    assert main(["report", "estimators", "-o", str(out), "--n-test", "300",
-                 "--estimators", "analytic,paper", "--seed", str(seed)]) == 0
-    assert {p.name for p in out.iterdir()} == {"estimators.md", "estimators.csv",
-                                               "estimators.png"}
+    assert (
+        main(
+            [
+                "report",
+                "estimators",
+                "-o",
+                str(out),
+                "--n-test",
+                "300",
+                "--estimators",
+                "analytic,paper",
+                "--seed",
+                str(seed),
+            ]
+        )
+        == 0
+    )
+    assert {p.name for p in out.iterdir()} == {"estimators.md", "estimators.csv", "estimators.png"}
     rows = list(csv.DictReader((out / "estimators.csv").open()))
     by = {(r["estimator"], r["test_set"]): r for r in rows}
     # paper without weights: listed as not trained here, no crash

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from eyeviz.geometry import intervals_to_bitmap
-from eyeviz.scene import Scene
-from eyeviz.state import SceneState
+from eyeviz.core.geometry import intervals_to_bitmap
+from eyeviz.model.scene import Scene
+from eyeviz.model.state import SceneState
 
 __all__ = ["Predictor", "Result"]
 

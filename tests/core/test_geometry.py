@@ -11,9 +11,9 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from eyeviz import stability_cases as sc
-from eyeviz.geometry import EyePair, intervals_to_bitmap
-from eyeviz.reference import reference_intervals
+from eyeviz.core.geometry import EyePair, intervals_to_bitmap
+from eyeviz.reference import stability_cases as sc
+from eyeviz.reference.digits80 import reference_intervals
 
 PAPER = EyePair(40, 20, 720)
 
@@ -229,7 +229,7 @@ def test_bitmaps_agree_with_intervals_and_half_width():
 
 def test_importing_geometry_pulls_in_no_heavy_library():
     code = (
-        "import sys, eyeviz.geometry\n"
+        "import sys, eyeviz.core.geometry\n"
         "heavy = {'torch', 'PyQt5', 'vtk', 'vtkmodules', 'pyvista', 'pyvistaqt', 'matplotlib'}\n"
         "print(sorted(heavy & {m.split('.')[0] for m in sys.modules}))\n"
     )
@@ -272,7 +272,7 @@ def test_ommatidium_of_a_point_matches_the_reference(a, kind, free, m, eye):
         "antidiagonal": (cx + a, -a),
     }[kind]
     assume(x != cx or y != 0)
-    from eyeviz.reference import reference_interval
+    from eyeviz.reference.digits80 import reference_interval
 
     expect = reference_interval(x, y, 0.0, cx, m)[0]
     assert int(eyes.ommatidium(x, y, eye)) == expect

@@ -19,7 +19,7 @@ area and the histogram of r grows linearly with r. The paper's own counts do not
 interleaved in a random order (a streamed uniform shuffle), not written one after another.
 
 Coordinates: x = r cos(phi), y = r sin(phi) (numpy float64); the bitmaps are those of the
-geometry core (:class:`eyeviz.geometry.EyePair`) at that (x, y, g), which is exact.
+geometry core (:class:`eyeviz.core.geometry.EyePair`) at that (x, y, g), which is exact.
 The same parameters and seed give the same elements (and the same file bytes).
 
 Generation is streamed in chunks of :data:`CHUNK` elements, so a data set of any size is
@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from eyeviz import EyevizError
-from eyeviz.geometry import EyePair, intervals_to_bitmap
+from eyeviz.core.geometry import EyePair, intervals_to_bitmap
 
 __all__ = [
     "CHUNK",
@@ -74,9 +74,16 @@ class GenParams:
     def as_dict(self) -> dict:
         e = self.eyes
         return {
-            "h": e.h, "l": e.l, "m": e.m, "r_min": self.r_min, "r_max": self.r_max,
-            "g_max": self.g_max, "mode": self.mode, "seed": self.seed,
-            "unique_bitmaps": self.unique_bitmaps, "segments": self.segments,
+            "h": e.h,
+            "l": e.l,
+            "m": e.m,
+            "r_min": self.r_min,
+            "r_max": self.r_max,
+            "g_max": self.g_max,
+            "mode": self.mode,
+            "seed": self.seed,
+            "unique_bitmaps": self.unique_bitmaps,
+            "segments": self.segments,
         }
 
 
@@ -119,8 +126,15 @@ class Dataset:
         return np.concatenate([self.omega_a, self.omega_b], axis=1).view(np.uint8)
 
     def __getitem__(self, idx) -> Dataset:
-        return Dataset(self.omega_a[idx], self.omega_b[idx], self.r[idx], self.phi[idx],
-                       self.g[idx], self.eyes, dict(self.params))
+        return Dataset(
+            self.omega_a[idx],
+            self.omega_b[idx],
+            self.r[idx],
+            self.phi[idx],
+            self.g[idx],
+            self.eyes,
+            dict(self.params),
+        )
 
     @staticmethod
     def concat(parts: list[Dataset]) -> Dataset:
@@ -128,9 +142,12 @@ class Dataset:
             raise ValueError("cannot concatenate an empty list of data sets")
         first = parts[0]
         return Dataset(
-            *(np.concatenate([getattr(p, k) for p in parts])
-              for k in ("omega_a", "omega_b", "r", "phi", "g")),
-            eyes=first.eyes, params=dict(first.params),
+            *(
+                np.concatenate([getattr(p, k) for p in parts])
+                for k in ("omega_a", "omega_b", "r", "phi", "g")
+            ),
+            eyes=first.eyes,
+            params=dict(first.params),
         )
 
 
@@ -151,12 +168,19 @@ class Chunk:
 
     def to_dataset(self, p: GenParams) -> Dataset:
         m = p.eyes.m
-        return Dataset(intervals_to_bitmap(self.la, self.ra, m, m // 2),
-                       intervals_to_bitmap(self.lb, self.rb, m, m // 2),
-                       self.r, self.phi, self.g, p.eyes, p.as_dict())
+        return Dataset(
+            intervals_to_bitmap(self.la, self.ra, m, m // 2),
+            intervals_to_bitmap(self.lb, self.rb, m, m // 2),
+            self.r,
+            self.phi,
+            self.g,
+            p.eyes,
+            p.as_dict(),
+        )
 
 
 # --- parameters ----------------------------------------------------------------------
+
 
 def _real(name: str, v) -> float:
     try:
@@ -216,14 +240,13 @@ def make_params(
             f"(m={eyes.m} too small for h={eyes.h:g}, l={eyes.l:g})"
         )
     if segments is not None:
-        if isinstance(segments, bool) or not isinstance(segments, int | np.integer) \
-                or segments < 1:
+        if isinstance(segments, bool) or not isinstance(segments, int | np.integer) or segments < 1:
             raise EyevizError(f"segments must be an integer >= 1, got {segments!r}")
         segments = int(segments)
     return GenParams(eyes, r_min, r_max, g_max, mode, int(seed), bool(unique_bitmaps), segments)
 
 
-def _check_n(n) -> int:
+def check_n(n) -> int:
     if isinstance(n, bool) or not isinstance(n, int | np.integer):
         raise EyevizError(f"n must be an integer >= 1, got {n!r}")
     if n < 1:
@@ -232,6 +255,7 @@ def _check_n(n) -> int:
 
 
 # --- multi-pass plan -----------------------------------------------------------------
+
 
 def segment_plan(n: int, p: GenParams) -> tuple[np.ndarray, np.ndarray]:
     """Segment edges (K+1,) and counts (K,) summing to n, counts proportional to mid radius.
@@ -255,6 +279,7 @@ def segment_plan(n: int, p: GenParams) -> tuple[np.ndarray, np.ndarray]:
 
 # --- Algorithm 1 on a batch ----------------------------------------------------------
 
+
 class _Sampler:
     """Fills slots with accepted elements; slot i draws r in [lo_i, hi_i)."""
 
@@ -271,8 +296,10 @@ class _Sampler:
         h = self.half
         if h**4 < 2**62:
             return (((la * h + ra) * h + lb) * h + rb).tolist()
-        return [((a * h + b) * h + c) * h + d for a, b, c, d in
-                zip(la.tolist(), ra.tolist(), lb.tolist(), rb.tolist(), strict=True)]
+        return [
+            ((a * h + b) * h + c) * h + d
+            for a, b, c, d in zip(la.tolist(), ra.tolist(), lb.tolist(), rb.tolist(), strict=True)
+        ]
 
     def fill(self, n: int, lo: float | np.ndarray, hi: float | np.ndarray) -> Chunk:
         """n accepted elements; slot i draws r in [lo_i, hi_i] (scalars: every slot)."""
@@ -289,24 +316,24 @@ class _Sampler:
             self.drawn += k
             u = rng.random((3, k))
             lo_p, hi_p = (lo[pending], hi[pending]) if per_slot else (lo, hi)
-            r = lo_p + (hi_p - lo_p) * u[0]                      # step 7
-            g_min = r * self.sin_half                             # step 8
-            ok = g_min <= p.g_max                                 # step 9
-            g = g_min + (p.g_max - g_min) * u[1]                  # step 10
-            ok &= g <= r                                          # step 11
+            r = lo_p + (hi_p - lo_p) * u[0]  # step 7
+            g_min = r * self.sin_half  # step 8
+            ok = g_min <= p.g_max  # step 9
+            g = g_min + (p.g_max - g_min) * u[1]  # step 10
+            ok &= g <= r  # step 11
             a = np.arcsin(np.minimum(g / r, 1.0))
             ph_lo = self.psi + a
             ph_hi = (math.pi - self.psi) - a
             ok &= ph_lo <= ph_hi
-            phi = ph_lo + (ph_hi - ph_lo) * u[2]                  # step 12
+            phi = ph_lo + (ph_hi - ph_lo) * u[2]  # step 12
             idx = np.flatnonzero(ok)
             r, g, phi = r[idx], g[idx], phi[idx]
             x = r * np.cos(phi)
             y = r * np.sin(phi)
-            la, ra, lb, rb = eyes.intervals(x, y, g)              # steps 13-16 (Prop. 2)
-            good = eyes.in_bfv(x, y, g)                           # Prop. 4, exact
-            good &= (ra > la) & (rb > lb)                         # Def. 1, both eyes
-            good &= (rb < self.half) & (ra < self.half)           # Property 3 (always true)
+            la, ra, lb, rb = eyes.intervals(x, y, g)  # steps 13-16 (Prop. 2)
+            good = eyes.in_bfv(x, y, g)  # Prop. 4, exact
+            good &= (ra > la) & (rb > lb)  # Def. 1, both eyes
+            good &= (rb < self.half) & (ra < self.half)  # Property 3 (always true)
             sel = np.flatnonzero(good)
             if self.seen is not None and sel.size:
                 sel = self._new_only(sel, la, ra, lb, rb)
@@ -376,6 +403,7 @@ def iter_chunks(n: int, p: GenParams, chunk: int = CHUNK) -> Iterator[Chunk]:
 
 # --- public API ----------------------------------------------------------------------
 
+
 def iter_generate(
     n: int,
     eyes: EyePair | None = None,
@@ -389,7 +417,7 @@ def iter_generate(
     chunk: int = CHUNK,
 ) -> Iterator[Dataset]:
     """Like :func:`generate`, yielding :class:`Dataset` chunks (bounded memory)."""
-    n = _check_n(n)
+    n = check_n(n)
     p = make_params(eyes, r_min, r_max, g_max, mode, seed, unique_bitmaps, segments)
     for c in iter_chunks(n, p, chunk):
         yield c.to_dataset(p)
@@ -415,8 +443,9 @@ def generate(
     has one element per pair; this thins out far, small features (few distinct bitmaps)
     and so shifts the distribution towards near and large ones.
     """
-    return Dataset.concat(list(iter_generate(
-        n, eyes, r_min, r_max, g_max, mode, seed, unique_bitmaps, segments)))
+    return Dataset.concat(
+        list(iter_generate(n, eyes, r_min, r_max, g_max, mode, seed, unique_bitmaps, segments))
+    )
 
 
 def write(
@@ -437,9 +466,9 @@ def write(
     Every parameter is checked before the file is touched; ``progress(k)`` is called
     after each chunk of k elements.
     """
-    from eyeviz import dataset_io
+    from eyeviz.dataset import io as dataset_io
 
-    n = _check_n(n)
+    n = check_n(n)
     p = make_params(eyes, r_min, r_max, g_max, mode, seed, unique_bitmaps, segments)
     fmt = dataset_io.format_of(path)
     dataset_io.write_chunks(path, fmt, n, p.eyes.m, p.as_dict(), iter_chunks(n, p), progress)
@@ -447,7 +476,7 @@ def write(
 
 def save(ds: Dataset, path) -> None:
     """Write an in-memory data set to ``path`` (.csv or .npz), atomically."""
-    from eyeviz import dataset_io
+    from eyeviz.dataset import io as dataset_io
 
     dataset_io.save(ds, path)
 
@@ -459,6 +488,6 @@ def load(path, eyes: EyePair | None = None) -> Dataset:
     of columns (m + 3 with g, m + 2 without). A malformed CSV raises an error naming the
     line and column.
     """
-    from eyeviz import dataset_io
+    from eyeviz.dataset import io as dataset_io
 
     return dataset_io.load(path, eyes)

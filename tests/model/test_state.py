@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from eyeviz.geometry import EyePair
-from eyeviz.scene import Eyes, Feature, Scene
-from eyeviz.state import compute_state, owners
+from eyeviz.core.geometry import EyePair
+from eyeviz.model.scene import Eyes, Feature, Scene
+from eyeviz.model.state import compute_state, owners
 
 
 def _scene(m=720, layers=("eyes", "bitmaps", "readout")):

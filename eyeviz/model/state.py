@@ -1,6 +1,6 @@
 """The computed state of a scene: what every view (VTK app, vector export) draws from.
 
-``compute_state(scene)`` runs the geometry core (:class:`eyeviz.geometry.EyePair`) once for
+``compute_state(scene)`` runs the geometry core (:class:`eyeviz.core.geometry.EyePair`) once for
 all features, vectorised: the lit intervals of Prop. 2, visibility (Definition 1), BFV
 membership (Prop. 4), overlap with the eyes, polar coordinates about the origin and each
 eye centre, and per-eye ownership of every ommatidium. Only what the scene's layers need
@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from eyeviz.geometry import EyePair, intervals_to_bitmap
-from eyeviz.scene import Scene
+from eyeviz.core.geometry import EyePair, intervals_to_bitmap
+from eyeviz.model.scene import Scene
 
 __all__ = ["SceneState", "compute_state", "owners"]
 

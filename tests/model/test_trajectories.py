@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from eyeviz.geometry import EyePair
-from eyeviz.trajectories import circular, horizontal, paper_count, vertical
+from eyeviz.core.geometry import EyePair
+from eyeviz.model.trajectories import circular, horizontal, paper_count, vertical
 
 EYES = EyePair(40.0, 20.0, 720)
 

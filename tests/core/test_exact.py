@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from eyeviz import exact
+from eyeviz.core import exact
 
 small = st.fractions(min_value=-50, max_value=50, max_denominator=64)
 

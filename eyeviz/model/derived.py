@@ -1,6 +1,6 @@
 """Predictions, ambiguity and trajectory accuracy for the app (Qt-free, VTK-free).
 
-:class:`Predictor` lives in :mod:`eyeviz.predictions` (shared with the vector export).
+:class:`Predictor` lives in :mod:`eyeviz.model.predictor` (shared with the vector export).
 """
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from eyeviz.geometry import EyePair, intervals_to_bitmap
-from eyeviz.predictions import Predictor
-from eyeviz.scene import Trajectory
+from eyeviz.core.geometry import EyePair, intervals_to_bitmap
+from eyeviz.model.predictor import Predictor
+from eyeviz.model.scene import Trajectory
 
 __all__ = [
     "Predictor",
@@ -22,6 +22,7 @@ __all__ = [
     "trajectory_path",
 ]
 
+
 def errors(r: float, phi: float, r_hat: float, phi_hat: float) -> tuple[float, float, float]:
     """(delta r, delta r in % of r, delta phi in degrees wrapped to (-180, 180])."""
     dr = r_hat - r
@@ -30,9 +31,9 @@ def errors(r: float, phi: float, r_hat: float, phi_hat: float) -> tuple[float, f
 
 
 def ambiguity_of(pair: EyePair, x: float, y: float, g: float, box) -> dict | None:
-    """The ambiguity region of one feature (eyeviz.ambiguity) with its ranges, or None
+    """The ambiguity region of one feature (eyeviz.core.ambiguity) with its ranges, or None
     when the feature covers an eye centre (no polygon then)."""
-    from eyeviz.ambiguity import ambiguity_radius_range, ambiguity_region
+    from eyeviz.core.ambiguity import ambiguity_radius_range, ambiguity_region
 
     try:
         reg = ambiguity_region(pair, x, y, g, box=box)
@@ -66,13 +67,17 @@ class TrajectoryPath:
 
 
 def trajectory_path(
-    pair: EyePair, traj: Trajectory, estimators: list[str], predictor: Predictor | None,
-    n: int = 240, stop: float = 6000.0,
+    pair: EyePair,
+    traj: Trajectory,
+    estimators: list[str],
+    predictor: Predictor | None,
+    n: int = 240,
+    stop: float = 6000.0,
 ) -> TrajectoryPath:
-    """Points along ``traj`` (eyeviz.trajectories) where the feature is in the BFV, with
+    """Points along ``traj`` (eyeviz.model.trajectories) where the feature is in the BFV, with
     AD and DD accuracy (100 % - APE, Section 6, Figure 15) per estimator at each point.
     ValueError (one line) when the trajectory never enters the BFV."""
-    from eyeviz import trajectories as tr
+    from eyeviz.model import trajectories as tr
 
     if traj.kind == "horizontal":
         x, y = tr.horizontal(traj.distance, traj.g, n, h=pair.h, l=pair.l)
@@ -81,12 +86,14 @@ def trajectory_path(
         x, y = tr.circular(traj.distance, traj.g, n, h=pair.h, l=pair.l)
         axis, label = np.degrees(np.arctan2(y, x)), f"φ (°) on r = {traj.distance:g}"
     elif traj.kind == "vertical":
-        x, y = tr.vertical(traj.g, n, start=traj.distance, stop=max(stop, 2 * traj.distance),
-                           h=pair.h, l=pair.l)
+        x, y = tr.vertical(
+            traj.g, n, start=traj.distance, stop=max(stop, 2 * traj.distance), h=pair.h, l=pair.l
+        )
         axis, label = y, "y along x = 0"
     else:
-        raise ValueError(f"trajectory kind must be horizontal, circular or vertical, "
-                         f"got {traj.kind!r}")
+        raise ValueError(
+            f"trajectory kind must be horizontal, circular or vertical, got {traj.kind!r}"
+        )
     acc: dict[str, tuple[np.ndarray, np.ndarray] | str] = {}
     if predictor is not None and estimators:
         m = pair.m

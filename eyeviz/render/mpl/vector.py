@@ -1,6 +1,7 @@
 """Scene -> a matplotlib figure for papers: true vectors, drawn from the scene model.
 
-Everything comes from :class:`eyeviz.scene.Scene` and its :class:`eyeviz.state.SceneState`
+Everything comes from :class:`eyeviz.model.scene.Scene`
+and its :class:`eyeviz.model.state.SceneState`
 (never from VTK), so SVG and PDF hold one path per ommatidium (Figure 2), feature disc and
 the BFV wedge (Definition 2), with text kept as text. Styled like the app (white ground,
 beige BFV, grey unlit ommatidia lit in the feature's colour, a magnified inset of the
@@ -16,7 +17,7 @@ eyes when they are tiny next to the view), sized for a printed column (3.5 in wi
 - ``bitmaps``: Omega_A and Omega_B as two strips with the lit [L, R] (Section 4);
 - ``readout``: r, phi, r_A, phi_A, r_B, phi_B, BFV and visibility per feature;
 - ``predictions``: each estimator's (r_hat, phi_hat) as a ghost joined to the truth;
-- ``ambiguity``: the centres giving the same bitmaps (:mod:`eyeviz.ambiguity`);
+- ``ambiguity``: the centres giving the same bitmaps (:mod:`eyeviz.core.ambiguity`);
 - ``trajectory``: the Figure 14 path.
 
 matplotlib is imported when this module is; callers that must stay light import it late.
@@ -33,8 +34,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Polygon, Rectangle, Wedge
 
 from eyeviz import EyevizError
-from eyeviz.scene import Scene
-from eyeviz.state import SceneState, compute_state
+from eyeviz.model.scene import Scene
+from eyeviz.model.state import SceneState, compute_state
 
 __all__ = ["BASE_DPI", "VECTOR_DPI", "RC", "figure", "eye_runs", "estimator_colors"]
 
@@ -219,8 +220,15 @@ def _owner_colors(owner: np.ndarray, palette: list[str]) -> np.ndarray:
 class _Painter:
     """Draws one scene into a figure; each method is one layer."""
 
-    def __init__(self, scene: Scene, state: SceneState, dpi: float, merge: bool | None,
-                 predictions: dict | None, width: float):
+    def __init__(
+        self,
+        scene: Scene,
+        state: SceneState,
+        dpi: float,
+        merge: bool | None,
+        predictions: dict | None,
+        width: float,
+    ):
         self.scene = scene
         self.st = state
         self.pair = state.pair
@@ -257,8 +265,16 @@ class _Painter:
         self.xlim, self.ylim = (cx - w / 2, cx + w / 2), (cy - h / 2, cy + h / 2)
         self.units_per_in = w / lay.main.w
         if sc.title and lay.title_y is not None:
-            self.fig.text(0.5, lay.title_y / lay.height, sc.title, ha="center", va="bottom",
-                          fontsize=FONT + 1.0, color=INK, gid="title")
+            self.fig.text(
+                0.5,
+                lay.title_y / lay.height,
+                sc.title,
+                ha="center",
+                va="bottom",
+                fontsize=FONT + 1.0,
+                color=INK,
+                gid="title",
+            )
         self.inset = None
         self.eye_ax = ax
         self.eye_units_per_in = self.units_per_in
@@ -282,8 +298,10 @@ class _Painter:
             "lower left": (mx + margin, my + margin),
             "lower right": (mx + self.lay.main.w - margin - box_w, my + margin),
             "upper left": (mx + margin, my + self.lay.main.h - margin - box_h),
-            "upper right": (mx + self.lay.main.w - margin - box_w,
-                            my + self.lay.main.h - margin - box_h),
+            "upper right": (
+                mx + self.lay.main.w - margin - box_w,
+                my + self.lay.main.h - margin - box_h,
+            ),
         }
         best, best_cost = None, math.inf
         for i, (bx, by) in enumerate(corners.values()):
@@ -304,8 +322,18 @@ class _Painter:
         ins.set_zorder(5)
         ins.set_gid("inset")
         scale = (x1 - x0) / (self.units_per_in * box_w)
-        ins.text(0.02, 0.96, f"eyes \u00d7{_round_sig(1 / scale)}", transform=ins.transAxes,
-                 ha="left", va="top", fontsize=SMALL - 0.5, color=GREY, bbox=_HALO, zorder=8)
+        ins.text(
+            0.02,
+            0.96,
+            f"eyes \u00d7{_round_sig(1 / scale)}",
+            transform=ins.transAxes,
+            ha="left",
+            va="top",
+            fontsize=SMALL - 0.5,
+            color=GREY,
+            bbox=_HALO,
+            zorder=8,
+        )
         # a leader from the inset to the eyes' true place (the origin) in the main view
         ox, oy = self._to_inches(0.0, 0.0)
         cx_, cy_ = bx + box_w / 2, by + box_h / 2
@@ -314,8 +342,17 @@ class _Painter:
         if bx <= ox <= bx + box_w and by <= oy <= by + box_h:
             ex, ey = cx_, cy_
         if not (bx <= ox <= bx + box_w and by <= oy <= by + box_h):
-            self.fig.add_artist(Line2D([ex / fw, ox / fw], [ey / fh, oy / fh], color=GREY,
-                                       lw=0.5, ls=(0, (2, 1.5)), zorder=4, gid="inset-leader"))
+            self.fig.add_artist(
+                Line2D(
+                    [ex / fw, ox / fw],
+                    [ey / fh, oy / fh],
+                    color=GREY,
+                    lw=0.5,
+                    ls=(0, (2, 1.5)),
+                    zorder=4,
+                    gid="inset-leader",
+                )
+            )
         self.ax.plot([0], [0], marker="s", ms=2.4, mfc="none", mec=GREY, mew=0.6, zorder=6)
         self.inset = ins
         self.eye_ax = ins
@@ -364,14 +401,26 @@ class _Painter:
         pts = [(0.0, 0.0), *zip(far * np.cos(arc), far * np.sin(arc), strict=True)]
         axes = [self.ax] + ([self.inset] if self.inset is not None else [])
         for ax in axes:
-            wedge = Polygon(pts, closed=True, facecolor=BFV_FILL, edgecolor="none", zorder=0,
-                            alpha=0.75 if ax is self.ax else 0.6)
+            wedge = Polygon(
+                pts,
+                closed=True,
+                facecolor=BFV_FILL,
+                edgecolor="none",
+                zorder=0,
+                alpha=0.75 if ax is self.ax else 0.6,
+            )
             wedge.set_gid("bfv-wedge" if ax is self.ax else "bfv-wedge-inset")
             ax.add_patch(wedge)
             for sgn, name in ((1, "right"), (-1, "left")):
                 ang = psi if sgn == 1 else math.pi - psi
-                ax.plot([0, far * math.cos(ang)], [0, far * math.sin(ang)], color=BFV_LINE,
-                        lw=0.6, zorder=1, gid=f"bfv-{name}")
+                ax.plot(
+                    [0, far * math.cos(ang)],
+                    [0, far * math.sin(ang)],
+                    color=BFV_LINE,
+                    lw=0.6,
+                    zorder=1,
+                    gid=f"bfv-{name}",
+                )
         # psi and theta (Figures 5-6), on the axes where the origin reads best
         ax = self.ax
         vh = self.ylim[1] - self.ylim[0]
@@ -385,19 +434,36 @@ class _Painter:
         ax.add_patch(_arc(rad, th1, th2, BFV_LINE, "bfv-theta-arc"))
         upi = self.units_per_in
         self._label_boxes.append((-0.3 * upi, rad * 1.04, 0.3 * upi, rad * 1.04 + 0.12 * upi))
-        ax.text(0, rad * 1.04, f"\u03b8 = {math.degrees(p.theta):.0f}\u00b0", ha="center",
-                va="bottom", fontsize=SMALL, color=BFV_LINE, bbox=_HALO, zorder=7,
-                gid="bfv-theta-label")
+        ax.text(
+            0,
+            rad * 1.04,
+            f"\u03b8 = {math.degrees(p.theta):.0f}\u00b0",
+            ha="center",
+            va="bottom",
+            fontsize=SMALL,
+            color=BFV_LINE,
+            bbox=_HALO,
+            zorder=7,
+            gid="bfv-theta-label",
+        )
         rpsi = 0.72 * rad
         ax.plot([0, 1.3 * rpsi], [0, 0], color=BFV_LINE, lw=0.4, ls=(0, (1.5, 1.5)), zorder=1)
         ax.add_patch(_arc(rpsi, 0, th1, BFV_LINE, "bfv-psi-arc"))
         mid = math.radians(th1 / 2)
         lx, ly = 1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid)
         self._label_boxes.append((lx, ly - 0.06 * upi, lx + 0.45 * upi, ly + 0.06 * upi))
-        ax.text(1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid),
-                f"\u03c8 = {math.degrees(psi):.0f}\u00b0", ha="left", va="center",
-                fontsize=SMALL, color=BFV_LINE, bbox=_HALO, zorder=7,
-                gid="bfv-psi-label")
+        ax.text(
+            1.08 * rpsi * math.cos(mid),
+            1.08 * rpsi * math.sin(mid),
+            f"\u03c8 = {math.degrees(psi):.0f}\u00b0",
+            ha="left",
+            va="center",
+            fontsize=SMALL,
+            color=BFV_LINE,
+            bbox=_HALO,
+            zorder=7,
+            gid="bfv-psi-label",
+        )
 
     def _merge_eyes(self) -> bool:
         if self.merge is not None:
@@ -414,8 +480,10 @@ class _Painter:
         edges = base_in * 72 >= 2.5 and not merge
         palette = self.colors
         gam = p.gamma
-        for name, (cx, cy), owner in (("A", p.centers[0], st.owner_a),
-                                      ("B", p.centers[1], st.owner_b)):
+        for name, (cx, cy), owner in (
+            ("A", p.centers[0], st.owner_a),
+            ("B", p.centers[1], st.owner_b),
+        ):
             owner = np.full(p.m, -1, np.int64) if owner is None else owner
             cidx = _owner_colors(owner, palette) if palette else np.zeros(p.m, np.int64)
             uniq = list(dict.fromkeys(palette))
@@ -427,24 +495,38 @@ class _Painter:
                     if e - s == p.m:
                         patch = Circle((cx, cy), p.l)
                     else:
-                        patch = Wedge((cx, cy), p.l, math.degrees(s * gam),
-                                      math.degrees(e * gam))
+                        patch = Wedge((cx, cy), p.l, math.degrees(s * gam), math.degrees(e * gam))
                     patch.set(facecolor=col, edgecolor="none", lw=0, zorder=2)
-                    patch.set_gid(f"ommatidia-{name}-{s}-{e - 1}" if e - s > 1
-                                  else f"ommatidium-{name}-{s}")
+                    patch.set_gid(
+                        f"ommatidia-{name}-{s}-{e - 1}" if e - s > 1 else f"ommatidium-{name}-{s}"
+                    )
                     ax.add_patch(patch)
             else:
                 k = np.arange(p.m + 1) * gam
                 rim = np.column_stack([cx + p.l * np.cos(k), cy + p.l * np.sin(k)])
                 for i in range(p.m):
-                    tri = Polygon([(cx, cy), rim[i], rim[i + 1]], closed=True,
-                                  facecolor=fills[cidx[i]],
-                                  edgecolor=EDGE if edges else "none",
-                                  lw=0.3 if edges else 0, joinstyle="round", zorder=2)
+                    tri = Polygon(
+                        [(cx, cy), rim[i], rim[i + 1]],
+                        closed=True,
+                        facecolor=fills[cidx[i]],
+                        edgecolor=EDGE if edges else "none",
+                        lw=0.3 if edges else 0,
+                        joinstyle="round",
+                        zorder=2,
+                    )
                     tri.set_gid(f"ommatidium-{name}-{i}")
                     ax.add_patch(tri)
-            ax.add_patch(Circle((cx, cy), p.l, facecolor="none", edgecolor=INK, lw=0.5,
-                                zorder=3, gid=f"eye-{name}-rim"))
+            ax.add_patch(
+                Circle(
+                    (cx, cy),
+                    p.l,
+                    facecolor="none",
+                    edgecolor=INK,
+                    lw=0.5,
+                    zorder=3,
+                    gid=f"eye-{name}-rim",
+                )
+            )
             ax.plot([cx], [cy], marker="o", ms=1.6, color=INK, zorder=4, mew=0)
         if self.inset is not None:
             for cx, cy in p.centers:
@@ -463,17 +545,26 @@ class _Painter:
         for name, (cx, cy) in zip("AB", p.centers, strict=True):
             for k in range(0, p.m, step):
                 a = (k + 0.5) * p.gamma
-                ax.text(cx + 1.28 * p.l * math.cos(a), cy + 1.28 * p.l * math.sin(a), str(k),
-                        ha="center", va="center", fontsize=SMALL - 1, color=GREY, zorder=4,
-                        gid=f"ommatidium-number-{name}-{k}")
+                ax.text(
+                    cx + 1.28 * p.l * math.cos(a),
+                    cy + 1.28 * p.l * math.sin(a),
+                    str(k),
+                    ha="center",
+                    va="center",
+                    fontsize=SMALL - 1,
+                    color=GREY,
+                    zorder=4,
+                    gid=f"ommatidium-number-{name}-{k}",
+                )
 
     def features(self) -> None:
         ax, st = self.ax, self.st
         grey = self._out_of_domain()
         for i, f in enumerate(self.scene.features):
             col = OUT_OF_DOMAIN if grey[i] else f.color
-            disc = Circle((f.x, f.y), f.g, facecolor=_mix(col, 0.45), edgecolor=col, lw=0.8,
-                          zorder=8)
+            disc = Circle(
+                (f.x, f.y), f.g, facecolor=_mix(col, 0.45), edgecolor=col, lw=0.8, zorder=8
+            )
             disc.set_gid(f"feature-{_slug(f.name)}")
             ax.add_patch(disc)
             minimum = 1.2 * self.units_per_in / 72  # keep a point-sized feature visible
@@ -514,20 +605,49 @@ class _Painter:
                 best, best_cost = (x0, y0), cost
         x0, y0 = best
         self._label_boxes.append((x0, y0, x0 + tw, y0 + th))
-        self.ax.text(x0, y0 + th / 2, f.name, ha="left", va="center", fontsize=FONT,
-                     color=_dark(col), bbox=_HALO, zorder=9,
-                     gid=f"label-{_slug(f.name)}", clip_on=True)
+        self.ax.text(
+            x0,
+            y0 + th / 2,
+            f.name,
+            ha="left",
+            va="center",
+            fontsize=FONT,
+            color=_dark(col),
+            bbox=_HALO,
+            zorder=9,
+            gid=f"label-{_slug(f.name)}",
+            clip_on=True,
+        )
 
     def labels(self) -> None:
         p, ax = self.pair, self.eye_ax
         numbered = "eyes" in self.layers and self._numbers_fit()
         for name, (cx, cy) in zip("AB", p.centers, strict=True):
-            ax.text(cx, cy - p.l * (1.55 if numbered else 1.12), name, ha="center", va="top",
-                    fontsize=FONT + 0.5, color=INK, zorder=6, gid=f"label-eye-{name}",
-                    bbox=_HALO)
+            ax.text(
+                cx,
+                cy - p.l * (1.55 if numbered else 1.12),
+                name,
+                ha="center",
+                va="top",
+                fontsize=FONT + 0.5,
+                color=INK,
+                zorder=6,
+                gid=f"label-eye-{name}",
+                bbox=_HALO,
+            )
         ax.plot([0], [0], marker="+", ms=4, color=INK, mew=0.6, zorder=6)
-        ax.text(0, -0.12 * p.l, "O", ha="center", va="top", fontsize=SMALL, color=INK,
-                zorder=6, gid="label-origin", bbox=_HALO)
+        ax.text(
+            0,
+            -0.12 * p.l,
+            "O",
+            ha="center",
+            va="top",
+            fontsize=SMALL,
+            color=INK,
+            zorder=6,
+            gid="label-origin",
+            bbox=_HALO,
+        )
         if "eyes" in self.layers:
             self.ommatidium_numbers()
 
@@ -535,8 +655,10 @@ class _Painter:
         st, p = self.st, self.pair
         axes = [self.ax] + ([self.inset] if self.inset is not None else [])
         for i, f in enumerate(self.scene.features):
-            for name, (cx, cy), rE, phE in (("A", p.centers[0], st.rA[i], st.phiA[i]),
-                                            ("B", p.centers[1], st.rB[i], st.phiB[i])):
+            for name, (cx, cy), rE, phE in (
+                ("A", p.centers[0], st.rA[i], st.phiA[i]),
+                ("B", p.centers[1], st.rB[i], st.phiB[i]),
+            ):
                 if rE <= f.g:
                     continue
                 alpha = math.asin(f.g / rE)
@@ -545,13 +667,24 @@ class _Painter:
                     thin = ax is self.ax and self.inset is not None
                     for sgn in (-1, 1):
                         a = phE + sgn * alpha
-                        ax.plot([cx, cx + 1.04 * t * math.cos(a)],
-                                [cy, cy + 1.04 * t * math.sin(a)], color=_dark(f.color),
-                                lw=0.35 if thin else 0.55, alpha=0.8 if thin else 1.0,
-                                zorder=7, gid=f"tangent-{name}-{_slug(f.name)}")
+                        ax.plot(
+                            [cx, cx + 1.04 * t * math.cos(a)],
+                            [cy, cy + 1.04 * t * math.sin(a)],
+                            color=_dark(f.color),
+                            lw=0.35 if thin else 0.55,
+                            alpha=0.8 if thin else 1.0,
+                            zorder=7,
+                            gid=f"tangent-{name}-{_slug(f.name)}",
+                        )
                     if not thin:
-                        ax.plot([cx, f.x], [cy, f.y], color=_dark(f.color), lw=0.4,
-                                ls=(0, (3, 2)), zorder=7)
+                        ax.plot(
+                            [cx, f.x],
+                            [cy, f.y],
+                            color=_dark(f.color),
+                            lw=0.4,
+                            ls=(0, (3, 2)),
+                            zorder=7,
+                        )
                 # the angle arcsin(g/r_E) (Figure 3b) for the nearer eye, where it reads
                 if (name == "A") != (st.rA[i] < st.rB[i]):
                     continue
@@ -560,23 +693,43 @@ class _Painter:
                 rad = min(0.5 * (rE - f.g), 0.6 * upi)
                 if alpha * rad / upi * 72 < 4:
                     continue
-                eax.add_patch(_arc(rad, math.degrees(phE), math.degrees(phE + alpha),
-                                   _dark(f.color), f"tangent-angle-{name}-{_slug(f.name)}",
-                                   center=(cx, cy)))
+                eax.add_patch(
+                    _arc(
+                        rad,
+                        math.degrees(phE),
+                        math.degrees(phE + alpha),
+                        _dark(f.color),
+                        f"tangent-angle-{name}-{_slug(f.name)}",
+                        center=(cx, cy),
+                    )
+                )
                 mid = phE + alpha / 2
                 lx, ly = cx + 1.1 * rad * math.cos(mid), cy + 1.1 * rad * math.sin(mid)
-                _subscripted(eax, lx, ly, [("arcsin(g / r", False), (name, True),
-                                           (f") = {math.degrees(alpha):.1f}\u00b0", False)],
-                             SMALL, "right" if math.cos(mid) < 0 else "left", _dark(f.color),
-                             gid=f"tangent-angle-label-{name}-{_slug(f.name)}", zorder=9,
-                             bbox=_HALO)
+                _subscripted(
+                    eax,
+                    lx,
+                    ly,
+                    [
+                        ("arcsin(g / r", False),
+                        (name, True),
+                        (f") = {math.degrees(alpha):.1f}\u00b0", False),
+                    ],
+                    SMALL,
+                    "right" if math.cos(mid) < 0 else "left",
+                    _dark(f.color),
+                    gid=f"tangent-angle-label-{name}-{_slug(f.name)}",
+                    zorder=9,
+                    bbox=_HALO,
+                )
 
     def sectors(self) -> None:
         st, p = self.st, self.pair
         axes = [self.ax] + ([self.inset] if self.inset is not None else [])
         for i, f in enumerate(self.scene.features):
-            for name, (cx, cy), L, R, rE in (("A", p.centers[0], st.LA[i], st.RA[i], st.rA[i]),
-                                             ("B", p.centers[1], st.LB[i], st.RB[i], st.rB[i])):
+            for name, (cx, cy), L, R, rE in (
+                ("A", p.centers[0], st.LA[i], st.RA[i], st.rA[i]),
+                ("B", p.centers[1], st.LB[i], st.RB[i], st.rB[i]),
+            ):
                 L, R = int(L), int(R)
                 if R - L >= p.m - 1:
                     continue
@@ -584,15 +737,29 @@ class _Painter:
                 th1, th2 = math.degrees(L * p.gamma), math.degrees((R + 1) * p.gamma)
                 ks = range(L, R + 2) if R - L < 24 else (L, R + 1)
                 for ax in axes:
-                    fan = Wedge((cx, cy), reach, th1, th2, facecolor=f.color, alpha=0.06,
-                                edgecolor="none", zorder=1)
+                    fan = Wedge(
+                        (cx, cy),
+                        reach,
+                        th1,
+                        th2,
+                        facecolor=f.color,
+                        alpha=0.06,
+                        edgecolor="none",
+                        zorder=1,
+                    )
                     fan.set_gid(f"sector-fan-{name}-{_slug(f.name)}")
                     ax.add_patch(fan)
                     for k in ks:
                         a = k * p.gamma
-                        ax.plot([cx, cx + reach * math.cos(a)], [cy, cy + reach * math.sin(a)],
-                                color=GREY, lw=0.35, ls=(0, (2.5, 1.5)), zorder=1.5,
-                                gid=f"sector-{name}-{k % p.m}")
+                        ax.plot(
+                            [cx, cx + reach * math.cos(a)],
+                            [cy, cy + reach * math.sin(a)],
+                            color=GREY,
+                            lw=0.35,
+                            ls=(0, (2.5, 1.5)),
+                            zorder=1.5,
+                            gid=f"sector-{name}-{k % p.m}",
+                        )
                 self._sector_numbers(name, cx, cy, L, R, f)
 
     def _sector_numbers(self, name, cx, cy, L, R, f) -> None:
@@ -603,9 +770,18 @@ class _Painter:
             return
         for k in range(L, R + 1):
             a = (k + 0.5) * p.gamma
-            ax.text(cx + rad * math.cos(a), cy + rad * math.sin(a), str(k % p.m), ha="center",
-                    va="center", fontsize=SMALL - 0.5, color=_dark(f.color), zorder=6,
-                    bbox=_HALO, gid=f"sector-number-{name}-{k % p.m}")
+            ax.text(
+                cx + rad * math.cos(a),
+                cy + rad * math.sin(a),
+                str(k % p.m),
+                ha="center",
+                va="center",
+                fontsize=SMALL - 0.5,
+                color=_dark(f.color),
+                zorder=6,
+                bbox=_HALO,
+                gid=f"sector-number-{name}-{k % p.m}",
+            )
 
     def _out_of_domain(self) -> np.ndarray:
         n = len(self.scene.features)
@@ -634,27 +810,68 @@ class _Painter:
                 if grey[i] or not (np.isfinite(r_hat[i]) and np.isfinite(phi_hat[i])):
                     continue
                 px, py = r_hat[i] * math.cos(phi_hat[i]), r_hat[i] * math.sin(phi_hat[i])
-                self.ax.plot([f.x, px], [f.y, py], color=col, lw=0.7, zorder=9,
-                             gid=f"prediction-link-{_slug(name)}-{_slug(f.name)}")
-                ghost = Circle((px, py), f.g, facecolor="none", edgecolor=col, lw=0.9,
-                               ls=(0, (2.2, 1.2)), zorder=9)
+                self.ax.plot(
+                    [f.x, px],
+                    [f.y, py],
+                    color=col,
+                    lw=0.7,
+                    zorder=9,
+                    gid=f"prediction-link-{_slug(name)}-{_slug(f.name)}",
+                )
+                ghost = Circle(
+                    (px, py),
+                    f.g,
+                    facecolor="none",
+                    edgecolor=col,
+                    lw=0.9,
+                    ls=(0, (2.2, 1.2)),
+                    zorder=9,
+                )
                 ghost.set_gid(f"prediction-{_slug(name)}-{_slug(f.name)}")
                 self.ax.add_patch(ghost)
                 self.ax.plot([px], [py], marker="x", ms=3, mew=0.7, color=col, zorder=9)
-            handles.append(Line2D([], [], color=col, lw=0.9, ls=(0, (2.2, 1.2)), marker="x",
-                                  ms=3, mew=0.7, label=f"{name} (predicted)"))
+            handles.append(
+                Line2D(
+                    [],
+                    [],
+                    color=col,
+                    lw=0.9,
+                    ls=(0, (2.2, 1.2)),
+                    marker="x",
+                    ms=3,
+                    mew=0.7,
+                    label=f"{name} (predicted)",
+                )
+            )
         if grey.any():
-            handles.append(Line2D([], [], color=OUT_OF_DOMAIN, lw=0, marker="o", ms=4,
-                                  label="outside the networks' domain"))
+            handles.append(
+                Line2D(
+                    [],
+                    [],
+                    color=OUT_OF_DOMAIN,
+                    lw=0,
+                    marker="o",
+                    ms=4,
+                    label="outside the networks' domain",
+                )
+            )
         if handles:
-            leg = self.ax.legend(handles=handles, loc="upper right", fontsize=SMALL,
-                                 frameon=True, framealpha=0.9, edgecolor=LIGHT,
-                                 handlelength=2.2, borderpad=0.4, labelspacing=0.3)
+            leg = self.ax.legend(
+                handles=handles,
+                loc="upper right",
+                fontsize=SMALL,
+                frameon=True,
+                framealpha=0.9,
+                edgecolor=LIGHT,
+                handlelength=2.2,
+                borderpad=0.4,
+                labelspacing=0.3,
+            )
             leg.set_zorder(12)
             leg.get_frame().set_linewidth(0.4)
 
     def ambiguity(self) -> None:
-        from eyeviz.ambiguity import ambiguity_region
+        from eyeviz.core.ambiguity import ambiguity_region
 
         p = self.pair
         w = self.xlim[1] - self.xlim[0]
@@ -668,9 +885,16 @@ class _Painter:
             self.regions[f.name] = reg
             if len(reg.polygon) < 3:
                 continue
-            poly = Polygon(reg.polygon, closed=True, facecolor=_mix(f.color, 0.3),
-                           edgecolor=_dark(f.color), lw=0.6, hatch="//////", zorder=8.5,
-                           alpha=0.85)
+            poly = Polygon(
+                reg.polygon,
+                closed=True,
+                facecolor=_mix(f.color, 0.3),
+                edgecolor=_dark(f.color),
+                lw=0.6,
+                hatch="//////",
+                zorder=8.5,
+                alpha=0.85,
+            )
             poly.set_gid(f"ambiguity-{_slug(f.name)}")
             self.ax.add_patch(poly)
             self.ax.plot([f.x], [f.y], marker="+", ms=3.5, mew=0.6, color=INK, zorder=8.7)
@@ -679,7 +903,7 @@ class _Painter:
         t = self.scene.trajectory
         if t is None:
             return
-        from eyeviz import trajectories as tr
+        from eyeviz.model import trajectories as tr
 
         p = self.pair
         try:
@@ -692,11 +916,16 @@ class _Painter:
                 x, y = tr.vertical(t.g, 400, start=t.distance, stop=stop, h=p.h, l=p.l)
         except ValueError:
             return
-        self.ax.plot(x, y, color=INK, lw=0.7, ls=(0, (4, 2)), zorder=6.5,
-                     gid=f"trajectory-{t.kind}")
-        self.ax.annotate("", xy=(x[-1], y[-1]), xytext=(x[-8], y[-8]),
-                         arrowprops=dict(arrowstyle="-|>", lw=0.7, color=INK,
-                                         mutation_scale=6), zorder=6.5)
+        self.ax.plot(
+            x, y, color=INK, lw=0.7, ls=(0, (4, 2)), zorder=6.5, gid=f"trajectory-{t.kind}"
+        )
+        self.ax.annotate(
+            "",
+            xy=(x[-1], y[-1]),
+            xytext=(x[-8], y[-8]),
+            arrowprops=dict(arrowstyle="-|>", lw=0.7, color=INK, mutation_scale=6),
+            zorder=6.5,
+        )
 
     # --- panels ----------------------------------------------------------------------
     def bitmaps(self) -> None:
@@ -717,32 +946,83 @@ class _Painter:
         yA = yB + strip + axis_h
         palette = self.colors
         fills = [None] + list(dict.fromkeys(palette))
-        for name, y0, owner, Ls, Rs in (("A", yA, st.owner_a, st.LA, st.RA),
-                                        ("B", yB, st.owner_b, st.LB, st.RB)):
+        for name, y0, owner, Ls, Rs in (
+            ("A", yA, st.owner_a, st.LA, st.RA),
+            ("B", yB, st.owner_b, st.LB, st.RB),
+        ):
             if owner is None:
-                from eyeviz.state import owners
+                from eyeviz.model.state import owners
 
                 owner = owners(Ls, Rs, m)
-            ax.add_patch(Rectangle((0, y0), half, strip, facecolor=UNLIT, edgecolor="none",
-                                   zorder=1, gid=f"bitmap-{name}-omega"))
-            ax.add_patch(Rectangle((half, y0), m - half, strip, facecolor="#F4F4F4",
-                                   edgecolor="none", zorder=1, gid=f"bitmap-{name}-rear"))
+            ax.add_patch(
+                Rectangle(
+                    (0, y0),
+                    half,
+                    strip,
+                    facecolor=UNLIT,
+                    edgecolor="none",
+                    zorder=1,
+                    gid=f"bitmap-{name}-omega",
+                )
+            )
+            ax.add_patch(
+                Rectangle(
+                    (half, y0),
+                    m - half,
+                    strip,
+                    facecolor="#F4F4F4",
+                    edgecolor="none",
+                    zorder=1,
+                    gid=f"bitmap-{name}-rear",
+                )
+            )
             cidx = _owner_colors(owner, palette)
             starts, stops = eye_runs(cidx)
             for s_, e in zip(starts.tolist(), stops.tolist(), strict=True):
                 if cidx[s_] == 0:
                     continue
-                ax.add_patch(Rectangle((s_, y0), e - s_, strip, facecolor=fills[cidx[s_]],
-                                       edgecolor="none", zorder=2,
-                                       gid=f"bitmap-{name}-lit-{s_}-{e - 1}"))
-            ax.add_patch(Rectangle((0, y0), m, strip, facecolor="none", edgecolor=GREY,
-                                   lw=0.4, zorder=3))
-            ax.plot([half, half], [y0 - 0.012, y0 + strip + 0.012], color=INK, lw=0.7,
-                    zorder=4, solid_capstyle="butt")
-            _subscripted(ax, -0.015 * m, y0 + strip / 2, [("\u03a9", False), (name, True)],
-                         FONT, "right", INK, gid=f"bitmap-{name}-name")
-            ax.text(0.75 * m, y0 + strip / 2, "rear half: not a network input",
-                    ha="center", va="center", fontsize=SMALL - 1.5, color=GREY, zorder=3)
+                ax.add_patch(
+                    Rectangle(
+                        (s_, y0),
+                        e - s_,
+                        strip,
+                        facecolor=fills[cidx[s_]],
+                        edgecolor="none",
+                        zorder=2,
+                        gid=f"bitmap-{name}-lit-{s_}-{e - 1}",
+                    )
+                )
+            ax.add_patch(
+                Rectangle((0, y0), m, strip, facecolor="none", edgecolor=GREY, lw=0.4, zorder=3)
+            )
+            ax.plot(
+                [half, half],
+                [y0 - 0.012, y0 + strip + 0.012],
+                color=INK,
+                lw=0.7,
+                zorder=4,
+                solid_capstyle="butt",
+            )
+            _subscripted(
+                ax,
+                -0.015 * m,
+                y0 + strip / 2,
+                [("\u03a9", False), (name, True)],
+                FONT,
+                "right",
+                INK,
+                gid=f"bitmap-{name}-name",
+            )
+            ax.text(
+                0.75 * m,
+                y0 + strip / 2,
+                "rear half: not a network input",
+                ha="center",
+                va="center",
+                fontsize=SMALL - 1.5,
+                color=GREY,
+                zorder=3,
+            )
             self._interval_labels(ax, name, y0, strip, Ls, Rs, row)
         ymid = yB + strip + axis_h / 2
         for k in (0, m // 4, half, 3 * m // 4, m):
@@ -758,9 +1038,16 @@ class _Painter:
             f = self.scene.features[i]
             dy = 0.008 + lane * row
             y = y0 + strip + dy if above else y0 - dy
-            ax.text(centre, y, text, ha="center", va="bottom" if above else "top",
-                    fontsize=_LABEL_PT, color=_dark(f.color),
-                    gid=f"bitmap-interval-{name}-{_slug(f.name)}")
+            ax.text(
+                centre,
+                y,
+                text,
+                ha="center",
+                va="bottom" if above else "top",
+                fontsize=_LABEL_PT,
+                color=_dark(f.color),
+                gid=f"bitmap-interval-{name}-{_slug(f.name)}",
+            )
 
     def readout(self) -> None:
         box = self.lay.readout
@@ -774,15 +1061,27 @@ class _Painter:
         ax.set_ylim(0, 1)
         rows = self.lay.readout_rows
         dy = 1.0 / rows
-        cols = [("feature", 0.0, "left"), ("r", 0.29, "right"), ("\u03c6", 0.395, "right"),
-                ("r", 0.50, "right"), ("\u03c6", 0.605, "right"), ("r", 0.71, "right"),
-                ("\u03c6", 0.815, "right"), ("BFV", 0.862, "center"), ("seen by", 1.0, "right")]
+        cols = [
+            ("feature", 0.0, "left"),
+            ("r", 0.29, "right"),
+            ("\u03c6", 0.395, "right"),
+            ("r", 0.50, "right"),
+            ("\u03c6", 0.605, "right"),
+            ("r", 0.71, "right"),
+            ("\u03c6", 0.815, "right"),
+            ("BFV", 0.862, "center"),
+            ("seen by", 1.0, "right"),
+        ]
         # two header rows: where the polar coordinates are centred, then r and phi
         y = 1 - dy / 2
-        for text, x0, x1 in (("about the origin O", 0.215, 0.40), ("about eye A", 0.425, 0.61),
-                             ("about eye B", 0.635, 0.82)):
-            ax.text((x0 + x1) / 2, y, text, ha="center", va="center", fontsize=SMALL - 0.5,
-                    color=GREY)
+        for text, x0, x1 in (
+            ("about the origin O", 0.215, 0.40),
+            ("about eye A", 0.425, 0.61),
+            ("about eye B", 0.635, 0.82),
+        ):
+            ax.text(
+                (x0 + x1) / 2, y, text, ha="center", va="center", fontsize=SMALL - 0.5, color=GREY
+            )
             ax.plot([x0 + 0.01, x1], [y - 0.42 * dy] * 2, color=LIGHT, lw=0.4)
         y -= dy
         for text, x, ha in cols:
@@ -795,23 +1094,51 @@ class _Painter:
             col = OUT_OF_DOMAIN if grey[i] else _dark(f.color)
             seen = " ".join(e for e, v in (("A", st.vis_a[i]), ("B", st.vis_b[i])) if v)
             seen = seen or "none"
-            vals = [_short(f.name, 15), f"{st.r[i]:.0f}", f"{math.degrees(st.phi[i]):.1f}\u00b0",
-                    f"{st.rA[i]:.0f}", f"{math.degrees(st.phiA[i]):.1f}\u00b0",
-                    f"{st.rB[i]:.0f}", f"{math.degrees(st.phiB[i]):.1f}\u00b0",
-                    "yes" if st.in_bfv[i] else "no", seen]
+            vals = [
+                _short(f.name, 15),
+                f"{st.r[i]:.0f}",
+                f"{math.degrees(st.phi[i]):.1f}\u00b0",
+                f"{st.rA[i]:.0f}",
+                f"{math.degrees(st.phiA[i]):.1f}\u00b0",
+                f"{st.rB[i]:.0f}",
+                f"{math.degrees(st.phiB[i]):.1f}\u00b0",
+                "yes" if st.in_bfv[i] else "no",
+                seen,
+            ]
             for (_, x, ha), v in zip(cols, vals, strict=True):
-                ax.text(x, y, v, ha=ha, va="center", fontsize=SMALL, color=col,
-                        gid=f"readout-{_slug(f.name)}" if x == 0 else None)
+                ax.text(
+                    x,
+                    y,
+                    v,
+                    ha=ha,
+                    va="center",
+                    fontsize=SMALL,
+                    color=col,
+                    gid=f"readout-{_slug(f.name)}" if x == 0 else None,
+                )
             if "predictions" in self.layers:
                 for name in sc.estimators:
                     y -= dy
-                    ax.text(0.03, y, self._prediction_line(i, name, grey[i]), ha="left",
-                            va="center", fontsize=SMALL - 0.5,
-                            color=OUT_OF_DOMAIN if grey[i] else cnames[name])
+                    ax.text(
+                        0.03,
+                        y,
+                        self._prediction_line(i, name, grey[i]),
+                        ha="left",
+                        va="center",
+                        fontsize=SMALL - 0.5,
+                        color=OUT_OF_DOMAIN if grey[i] else cnames[name],
+                    )
             if "ambiguity" in self.layers:
                 y -= dy
-                ax.text(0.03, y, self._ambiguity_line(f), ha="left", va="center",
-                        fontsize=SMALL - 0.5, color=col)
+                ax.text(
+                    0.03,
+                    y,
+                    self._ambiguity_line(f),
+                    ha="left",
+                    va="center",
+                    fontsize=SMALL - 0.5,
+                    color=col,
+                )
 
     def _prediction_line(self, i: int, name: str, outside: bool) -> str:
         if outside:
@@ -826,9 +1153,11 @@ class _Painter:
         r, phi = float(self.st.r[i]), float(self.st.phi[i])
         dr = r_hat - r
         dphi = math.degrees(math.remainder(phi_hat - phi, 2 * math.pi))
-        return (f"{name}: r\u0302 = {r_hat:.0f} (\u0394r {dr:+.0f}, {100 * dr / r:+.1f} %),  "
-                f"\u03c6\u0302 = {math.degrees(phi_hat):.2f}\u00b0 "
-                f"(\u0394\u03c6 {dphi:+.2f}\u00b0)")
+        return (
+            f"{name}: r\u0302 = {r_hat:.0f} (\u0394r {dr:+.0f}, {100 * dr / r:+.1f} %),  "
+            f"\u03c6\u0302 = {math.degrees(phi_hat):.2f}\u00b0 "
+            f"(\u0394\u03c6 {dphi:+.2f}\u00b0)"
+        )
 
     def _ambiguity_line(self, f) -> str:
         reg = getattr(self, "regions", {}).get(f.name)
@@ -837,15 +1166,16 @@ class _Painter:
         lo, hi = reg.distance_range()
         a0, a1 = reg.azimuth_range()
         more = "" if reg.bounded else "+ (unbounded)"
-        return (f"same bitmaps for centres at r \u2208 [{lo:.0f}, {hi:.0f}]{more}, "
-                f"\u03c6 \u2208 [{math.degrees(a0):.2f}\u00b0, {math.degrees(a1):.2f}\u00b0]")
+        return (
+            f"same bitmaps for centres at r \u2208 [{lo:.0f}, {hi:.0f}]{more}, "
+            f"\u03c6 \u2208 [{math.degrees(a0):.2f}\u00b0, {math.degrees(a1):.2f}\u00b0]"
+        )
 
 
 def _arc(radius, th1, th2, color, gid, center=(0.0, 0.0)):
     from matplotlib.patches import Arc
 
-    a = Arc(center, 2 * radius, 2 * radius, theta1=th1, theta2=th2, color=color, lw=0.6,
-            zorder=6)
+    a = Arc(center, 2 * radius, 2 * radius, theta1=th1, theta2=th2, color=color, lw=0.6, zorder=6)
     a.set_gid(gid)
     return a
 
@@ -859,18 +1189,31 @@ def _subscripted(ax, x, y, parts, size, ha, color, **kw) -> None:
     from matplotlib.transforms import offset_copy
 
     sub_size = 0.72 * size
-    widths = [TextPath((0, 0), t, size=sub_size if sub else size).get_extents().width
-              + (0.6 if sub else 0.0) for t, sub in parts]
+    widths = [
+        TextPath((0, 0), t, size=sub_size if sub else size).get_extents().width
+        + (0.6 if sub else 0.0)
+        for t, sub in parts
+    ]
     total = sum(widths)
     start = {"left": 0.0, "center": -total / 2, "right": -total}[ha]
     fig = ax.figure
     gid = kw.pop("gid", None)
     x_pt = start
     for (t, sub), w in zip(parts, widths, strict=True):
-        tr = offset_copy(ax.transData, fig=fig, x=x_pt, y=-0.3 * size if sub else 0.0,
-                         units="points")
-        txt = ax.text(x, y, t, transform=tr, ha="left", va="center",
-                      fontsize=sub_size if sub else size, color=color, **kw)
+        tr = offset_copy(
+            ax.transData, fig=fig, x=x_pt, y=-0.3 * size if sub else 0.0, units="points"
+        )
+        txt = ax.text(
+            x,
+            y,
+            t,
+            transform=tr,
+            ha="left",
+            va="center",
+            fontsize=sub_size if sub else size,
+            color=color,
+            **kw,
+        )
         if gid:
             txt.set_gid(f"{gid}-{len(ax.texts)}")
         x_pt += w
@@ -923,7 +1266,7 @@ def predict_scene(
     that cannot be loaded at all is an :class:`EyevizError`. Imports
     :mod:`eyeviz.estimators` (and through it torch for the networks) only here.
     """
-    from eyeviz.predictions import Predictor
+    from eyeviz.model.predictor import Predictor
 
     if state.LA is None or state.in_bfv is None:
         state = compute_state(scene, ["bitmaps", "readout"])
@@ -936,9 +1279,15 @@ def predict_scene(
     return predictor.predict(scene, state)
 
 
-def figure(scene: Scene, state: SceneState | None = None, *, dpi: float = BASE_DPI,
-           merge: bool | None = None, predictions: dict | None = None,
-           width: float = WIDTH_IN) -> Figure:
+def figure(
+    scene: Scene,
+    state: SceneState | None = None,
+    *,
+    dpi: float = BASE_DPI,
+    merge: bool | None = None,
+    predictions: dict | None = None,
+    width: float = WIDTH_IN,
+) -> Figure:
     """The scene as a matplotlib Figure (no pyplot, no GUI), ``width`` inches wide.
 
     ``dpi`` is the resolution the figure will be rendered at (decides, with ``merge=None``,
@@ -950,8 +1299,7 @@ def figure(scene: Scene, state: SceneState | None = None, *, dpi: float = BASE_D
     import matplotlib
 
     state = compute_state(scene) if state is None else state
-    need = {"eyes": "owner_a", "readout": "r", "tangents": "rA", "sectors": "LA",
-            "bitmaps": "LA"}
+    need = {"eyes": "owner_a", "readout": "r", "tangents": "rA", "sectors": "LA", "bitmaps": "LA"}
     for layer, attr in need.items():
         if layer in scene.layers and getattr(state, attr) is None:
             state = compute_state(scene)

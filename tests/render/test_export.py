@@ -10,10 +10,10 @@ import pytest
 from matplotlib.figure import Figure
 
 from eyeviz import EyevizError
-from eyeviz import scene as scene_mod
-from eyeviz.export import export
+from eyeviz.model import scene as scene_mod
+from eyeviz.render.mpl.export import export
 
-SCENES = Path(__file__).resolve().parents[1] / "assets" / "scenes"
+SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 
 
 @pytest.fixture(scope="module")
@@ -64,8 +64,11 @@ def test_pdf_renders_and_is_not_blank(tmp_path, default_scene):
     data = pdf.read_bytes()
     assert data.startswith(b"%PDF")
     assert b"/Type3" not in data and b"FontFile2" in data  # TrueType (fonttype 42) text
-    subprocess.run(["pdftoppm", "-r", "60", "-png", "-singlefile", str(pdf),
-                    str(tmp_path / "render")], check=True, timeout=60)
+    subprocess.run(
+        ["pdftoppm", "-r", "60", "-png", "-singlefile", str(pdf), str(tmp_path / "render")],
+        check=True,
+        timeout=60,
+    )
     img = read_png(tmp_path / "render.png")
     rgb = (img[..., :3] * 255).round().astype(int)
     assert rgb.std() > 20

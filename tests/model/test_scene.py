@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from eyeviz import EyevizError
-from eyeviz.scene import (
+from eyeviz.model.scene import (
     LAYERS,
     Eyes,
     Feature,
@@ -21,7 +21,7 @@ from eyeviz.scene import (
     save,
 )
 
-SCENES = Path(__file__).resolve().parents[1] / "assets" / "scenes"
+SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 BASE = """
 [eyes]
 h = 40.0
@@ -89,8 +89,10 @@ def test_missing_colours_take_okabe_ito_in_order():
         (("g = 50.0", "g = 50.0\ncolor = 'red'"), ["features[0].color", "#rrggbb"]),
         (("m = 720", "m = 720\n[layers]\nshow = ['eyes', 'nope']"), ["layers.show", "'nope'"]),
         (("m = 720", "m = 720 x"), ["not valid TOML", "line 5"]),
-        (("m = 720", "m = 720\n[trajectory]\nkind = 'zigzag'\ndistance = 1.0\ng = 1.0"),
-         ["trajectory.kind", "horizontal"]),
+        (
+            ("m = 720", "m = 720\n[trajectory]\nkind = 'zigzag'\ndistance = 1.0\ng = 1.0"),
+            ["trajectory.kind", "horizontal"],
+        ),
         (("m = 720", "m = 720\n[view]\nwidth = 0.0"), ["view.width", "> 0"]),
     ],
 )
@@ -124,7 +126,7 @@ def test_save_is_atomic_and_leaves_no_temp(tmp_path):
 
 def test_scene_module_imports_nothing_heavy():
     code = (
-        "import sys, eyeviz.scene, eyeviz.state; "
+        "import sys, eyeviz.model.scene, eyeviz.model.state; "
         "heavy = ('torch', 'PyQt5', 'pyvista', 'vtk', 'matplotlib'); "
         "bad = [m for m in heavy if m in sys.modules]; "
         "print(bad); sys.exit(1 if bad else 0)"

@@ -30,8 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from eyeviz import EyevizError
-from eyeviz.atomic import atomic_output
-from eyeviz.geometry import EyePair
+from eyeviz.core.geometry import EyePair
+from eyeviz.files.atomic import atomic_output
 
 FORMATS = ("csv", "npz")
 NPZ_VERSION = 1
@@ -92,7 +92,7 @@ def _ascii17(d: np.ndarray) -> np.ndarray:
     rest = d % 10**16
     hi8, lo8 = np.divmod(rest, 10**8)
     for j, grp in enumerate(np.divmod(hi8, 10**4) + np.divmod(lo8, 10**4)):
-        out[:, 1 + 4 * j:5 + 4 * j] = _GROUPS.take(grp, axis=0)
+        out[:, 1 + 4 * j : 5 + 4 * j] = _GROUPS.take(grp, axis=0)
     return out
 
 
@@ -131,17 +131,17 @@ def format_g17(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             if xv >= 0:
                 dec = np.maximum(sig[sel] - (xv + 1), 0)
                 blk = np.empty((dig[sel].shape[0], 18), np.uint8)
-                blk[:, :xv + 1] = dig[sel, :xv + 1]
+                blk[:, : xv + 1] = dig[sel, : xv + 1]
                 blk[:, xv + 1] = 46
-                blk[:, xv + 2:] = dig[sel, xv + 1:]
+                blk[:, xv + 2 :] = dig[sel, xv + 1 :]
                 blen[sel] = xv + 1 + np.where(dec > 0, dec + 1, 0)
                 body[sel, :18] = blk
             else:
                 z = -xv - 1
                 body[sel, 0] = 48
                 body[sel, 1] = 46
-                body[sel, 2:2 + z] = 48
-                body[sel, 2 + z:19 + z] = dig[sel]
+                body[sel, 2 : 2 + z] = 48
+                body[sel, 2 + z : 19 + z] = dig[sel]
                 blen[sel] = 2 + z + sig[sel]
         body[np.arange(_FW)[None, :] >= blen[:, None]] = 0
         if neg.any():
@@ -154,12 +154,13 @@ def format_g17(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         lens[idx] = blen
     for i in np.flatnonzero(~fast).tolist():
         t = format(float(v[i]), ".17g").encode()
-        out[i, :len(t)] = np.frombuffer(t, np.uint8)
+        out[i, : len(t)] = np.frombuffer(t, np.uint8)
         lens[i] = len(t)
     return out, lens
 
 
 # --- CSV encoding --------------------------------------------------------------------
+
 
 class CsvEncoder:
     """Encodes chunks of rows as CSV, reusing one preformatted bit buffer.
@@ -179,7 +180,7 @@ class CsvEncoder:
         self.buf[:, 1::2] = _COMMA
         self.flat = self.buf.reshape(-1)
         mv = memoryview(self.flat)
-        self.row_views = [mv[i * self.rb:(i + 1) * self.rb] for i in range(rows)]
+        self.row_views = [mv[i * self.rb : (i + 1) * self.rb] for i in range(rows)]
         self._lit: np.ndarray | None = None
 
     def _tails(self, r, phi, g) -> list[bytes]:
@@ -195,7 +196,7 @@ class CsvEncoder:
         for j, (chars, lens) in enumerate(cols):
             for o in np.unique(at).tolist():
                 sel = at == o
-                tail[sel, o:o + _FW] = chars[sel]
+                tail[sel, o : o + _FW] = chars[sel]
             at = at + lens
             tail[rows, at] = _NEWLINE if j == len(cols) - 1 else _COMMA
             at += 1
@@ -219,8 +220,7 @@ class CsvEncoder:
         """Rows whose eye E lights bits L_E..R_E (0 <= L <= R < m/2)."""
         if self._lit is not None:
             self.flat[self._lit] = _ZERO
-        pos = np.concatenate([self._lit_positions(la, ra, 0),
-                              self._lit_positions(lb, rb, self.w)])
+        pos = np.concatenate([self._lit_positions(la, ra, 0), self._lit_positions(lb, rb, self.w)])
         self.flat[pos] = _ONE
         self._lit = pos
         return self._parts(r.shape[0], self._tails(r, phi, g))
@@ -231,8 +231,8 @@ class CsvEncoder:
         n = r.shape[0]
         view = self.buf[:n]
         w = self.w
-        view[:, 0:2 * w:2] = _ZERO + omega_a.view(np.uint8)
-        view[:, 2 * w::2] = _ZERO + omega_b.view(np.uint8)
+        view[:, 0 : 2 * w : 2] = _ZERO + omega_a.view(np.uint8)
+        view[:, 2 * w :: 2] = _ZERO + omega_b.view(np.uint8)
         self._lit = np.flatnonzero(self.buf[:n].reshape(-1) == _ONE)
         return self._parts(n, self._tails(r, phi, g))
 
@@ -247,29 +247,39 @@ def write_parts(f, parts: list) -> None:
         return
     fd = f.fileno()
     for s in range(0, len(parts), _IOV):
-        group = parts[s:s + _IOV]
+        group = parts[s : s + _IOV]
         done = os.writev(fd, group)
         total = sum(map(len, group))
         if done < total:
             rest = memoryview(b"".join(group))[done:]
             while rest:
-                rest = rest[os.write(fd, rest):]
+                rest = rest[os.write(fd, rest) :]
 
 
 # --- NPZ -----------------------------------------------------------------------------
 
+
 def npz_dtype(m: int) -> np.dtype:
     nb = (m // 2 + 7) // 8
-    return np.dtype([("omega_a", np.uint8, (nb,)), ("omega_b", np.uint8, (nb,)),
-                     ("r", "<f8"), ("phi", "<f8"), ("g", "<f8")])
+    return np.dtype(
+        [
+            ("omega_a", np.uint8, (nb,)),
+            ("omega_b", np.uint8, (nb,)),
+            ("r", "<f8"),
+            ("phi", "<f8"),
+            ("g", "<f8"),
+        ]
+    )
 
 
 @functools.lru_cache(maxsize=8)
 def _pack_tables(w: int) -> tuple[np.ndarray, np.ndarray]:
     """np.packbits of the bitmaps {k >= lo} (row lo) and {k <= hi} (row hi), k < w."""
     k = np.arange(w)
-    return (np.packbits(k[None, :] >= k[:, None], axis=1),
-            np.packbits(k[None, :] <= k[:, None], axis=1))
+    return (
+        np.packbits(k[None, :] >= k[:, None], axis=1),
+        np.packbits(k[None, :] <= k[:, None], axis=1),
+    )
 
 
 def _packed_from_intervals(lo, hi, w: int) -> np.ndarray:
@@ -302,8 +312,7 @@ class _NpzWriter:
             np.lib.format.write_array(f, np.array(json.dumps(meta)), allow_pickle=False)
         self.f = self.zf.open("rows.npy", "w", force_zip64=True)
         dt = npz_dtype(m)
-        header = {"descr": np.lib.format.dtype_to_descr(dt), "fortran_order": False,
-                  "shape": (n,)}
+        header = {"descr": np.lib.format.dtype_to_descr(dt), "fortran_order": False, "shape": (n,)}
         np.lib.format.write_array_header_1_0(self.f, header)
 
     def rows_from_intervals(self, r, phi, g, la, ra, lb, rb) -> np.ndarray:
@@ -332,6 +341,7 @@ class _NpzWriter:
 
 
 # --- writing -------------------------------------------------------------------------
+
 
 class _Overlapped:
     """Runs ``write`` calls on one worker thread, one at a time, so the file write of a
@@ -372,8 +382,15 @@ def _encode_csv_chunk(enc: CsvEncoder, c) -> list:
     return enc.encode_intervals(c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb)
 
 
-def write_chunks(path, fmt: str, n: int, m: int, params: dict, chunks: Iterable,
-                 progress: Callable[[int], None] | None = None) -> None:
+def write_chunks(
+    path,
+    fmt: str,
+    n: int,
+    m: int,
+    params: dict,
+    chunks: Iterable,
+    progress: Callable[[int], None] | None = None,
+) -> None:
     """Stream generated :class:`eyeviz.dataset.Chunk` objects into ``path``."""
     from eyeviz.dataset import CHUNK
 
@@ -382,8 +399,10 @@ def write_chunks(path, fmt: str, n: int, m: int, params: dict, chunks: Iterable,
             # two buffers: chunk k+1 is encoded while chunk k is written; encoding k+2
             # into k's buffer starts only after out() has waited for k's write
             encs = (CsvEncoder(m, CHUNK), CsvEncoder(m, CHUNK))
-            with open(tmp, "wb", buffering=0) as f, \
-                    _Overlapped(functools.partial(write_parts, f)) as out:
+            with (
+                open(tmp, "wb", buffering=0) as f,
+                _Overlapped(functools.partial(write_parts, f)) as out,
+            ):
                 for i, c in enumerate(chunks):
                     out(_encode_csv_chunk(encs[i % 2], c))
                     if progress:
@@ -408,20 +427,32 @@ def save(ds, path) -> None:
             with open(tmp, "wb", buffering=0) as f:
                 for s in range(0, n, step):
                     sl = slice(s, s + step)
-                    write_parts(f, enc.encode_bitmaps(ds.omega_a[sl], ds.omega_b[sl],
-                                                      ds.r[sl], ds.phi[sl], ds.g[sl]))
+                    write_parts(
+                        f,
+                        enc.encode_bitmaps(
+                            ds.omega_a[sl], ds.omega_b[sl], ds.r[sl], ds.phi[sl], ds.g[sl]
+                        ),
+                    )
         else:
             e = ds.eyes
-            meta = {"version": NPZ_VERSION, "m": m, "n": n,
-                    "params": {**ds.params, "h": e.h, "l": e.l, "m": m}}
+            meta = {
+                "version": NPZ_VERSION,
+                "m": m,
+                "n": n,
+                "params": {**ds.params, "h": e.h, "l": e.l, "m": m},
+            }
             with _NpzWriter(tmp, m, n, meta) as wr:
                 for s in range(0, n, step):
                     sl = slice(s, s + step)
-                    wr.f.write(wr.rows_from_bitmaps(ds.omega_a[sl], ds.omega_b[sl], ds.r[sl],
-                                                    ds.phi[sl], ds.g[sl]))
+                    wr.f.write(
+                        wr.rows_from_bitmaps(
+                            ds.omega_a[sl], ds.omega_b[sl], ds.r[sl], ds.phi[sl], ds.g[sl]
+                        )
+                    )
 
 
 # --- reading -------------------------------------------------------------------------
+
 
 def load(path, eyes: EyePair | None = None):
     path = Path(path)
@@ -449,8 +480,7 @@ def _load_npz(path: Path, eyes: EyePair | None):
     w = m // 2
     oa = np.unpackbits(rows["omega_a"], axis=1, count=w).view(bool)
     ob = np.unpackbits(rows["omega_b"], axis=1, count=w).view(bool)
-    return Dataset(oa, ob, rows["r"].copy(), rows["phi"].copy(), rows["g"].copy(), eyes,
-                   params)
+    return Dataset(oa, ob, rows["r"].copy(), rows["phi"].copy(), rows["g"].copy(), eyes, params)
 
 
 def _csv_error(path: Path, line: int, col: int, msg: str) -> EyevizError:
@@ -481,8 +511,7 @@ def _load_csv(path: Path, eyes: EyePair | None):
     if eyes is None:
         eyes = EyePair(40.0, 20.0, m)
     elif eyes.m != m:
-        raise _csv_error(path, 1, ncols, f"{ncols} columns mean m={m}, but eyes have "
-                                         f"m={eyes.m}")
+        raise _csv_error(path, 1, ncols, f"{ncols} columns mean m={m}, but eyes have m={eyes.m}")
     n = len(lines)
     nf = 3 if with_g else 2
     w = m // 2
@@ -491,7 +520,7 @@ def _load_csv(path: Path, eyes: EyePair | None):
     floats = np.empty((nf, n))
     step = 1 << 14
     for s in range(0, n, step):
-        block = lines[s:s + step]
+        block = lines[s : s + step]
         e = s + len(block)
         try:
             _parse_block(block, m, nf, oa[s:e], ob[s:e], floats[:, s:e])
@@ -502,8 +531,9 @@ def _load_csv(path: Path, eyes: EyePair | None):
     return Dataset(oa.view(bool), ob.view(bool), floats[0], floats[1], g, eyes, {})
 
 
-def _parse_block(block: list[bytes], m: int, nf: int, oa: np.ndarray, ob: np.ndarray,
-                 floats: np.ndarray) -> None:
+def _parse_block(
+    block: list[bytes], m: int, nf: int, oa: np.ndarray, ob: np.ndarray, floats: np.ndarray
+) -> None:
     """Fast path: every line is exactly ``b,`` * m followed by nf floats."""
     rb = 2 * m
     head = np.frombuffer(b"".join([ln[:rb] for ln in block]), np.uint8)
@@ -529,18 +559,27 @@ def _diagnose(path: Path, block: list[bytes], offset: int, m: int, ncols: int) -
         lineno = offset + i + 1
         fields = ln.split(b",")
         if len(fields) != ncols:
-            raise _csv_error(path, lineno, min(len(fields), ncols) + (len(fields) < ncols),
-                             f"expected {ncols} columns, found {len(fields)}")
+            raise _csv_error(
+                path,
+                lineno,
+                min(len(fields), ncols) + (len(fields) < ncols),
+                f"expected {ncols} columns, found {len(fields)}",
+            )
         for j, fv in enumerate(fields):
             if j < m:
                 if fv not in (b"0", b"1"):
-                    raise _csv_error(path, lineno, j + 1,
-                                     f"bit must be 0 or 1, got {fv.decode(errors='replace')!r}")
+                    raise _csv_error(
+                        path,
+                        lineno,
+                        j + 1,
+                        f"bit must be 0 or 1, got {fv.decode(errors='replace')!r}",
+                    )
             else:
                 try:
                     v = float(fv)
                 except ValueError:
-                    raise _csv_error(path, lineno, j + 1,
-                                     f"not a number: {fv.decode(errors='replace')!r}") from None
+                    raise _csv_error(
+                        path, lineno, j + 1, f"not a number: {fv.decode(errors='replace')!r}"
+                    ) from None
                 if not np.isfinite(v):
                     raise _csv_error(path, lineno, j + 1, f"not a finite number: {v!r}")

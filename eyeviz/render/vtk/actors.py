@@ -6,7 +6,7 @@ triangle between the rim directions k*gamma and (k+1)*gamma, Eq. 6); lighting th
 writes the cell colour array in place (``mesh.cell_data[...][:] = ...``). Meshes are
 rebuilt only when their structure changes (m, h or l; the number of features; the layers
 shown). Nothing here computes geometry: colours and positions come from a
-:class:`eyeviz.state.SceneState`.
+:class:`eyeviz.model.state.SceneState`.
 """
 
 from __future__ import annotations
@@ -31,8 +31,8 @@ from vtkmodules.vtkRenderingCore import (
     vtkTextActor,
 )
 
-from eyeviz.scene import Scene
-from eyeviz.state import SceneState
+from eyeviz.model.scene import Scene
+from eyeviz.model.state import SceneState
 
 __all__ = ["SceneActors", "hex_rgb", "eye_mesh", "inset_viewport"]
 

@@ -12,8 +12,8 @@ import math
 from collections.abc import Callable, Generator
 from dataclasses import dataclass
 
-from eyeviz.scene import OKABE_ITO, Feature, Scene
-from eyeviz.state import SceneState, compute_state
+from eyeviz.model.scene import OKABE_ITO, Feature, Scene
+from eyeviz.model.state import SceneState, compute_state
 
 __all__ = ["AppModel", "MouseEvent", "DRAG_THRESHOLD_PX", "drag_feature", "hit_test"]
 
@@ -44,7 +44,7 @@ class AppModel:
         self._state: SceneState | None = None
         self._predictions: dict | None = None
         self._ambiguity: dict | None | bool = False  # False: not computed yet
-        self.predictor = None  # eyeviz.app.predict.Predictor, made on first use
+        self.predictor = None  # eyeviz.model.derived.Predictor, made on first use
         self.push: Callable[..., None] = self._push_plain
 
     # --- state ------------------------------------------------------------------------
@@ -61,7 +61,7 @@ class AppModel:
         if not self.scene.shows("predictions") or not self.scene.features:
             return {}
         if self._predictions is None:
-            from eyeviz.app.predict import Predictor
+            from eyeviz.model.derived import Predictor
 
             if self.predictor is None:
                 self.predictor = Predictor()
@@ -70,17 +70,16 @@ class AppModel:
 
     @property
     def ambiguity(self) -> dict | None:
-        """The selected feature's ambiguity region (eyeviz.app.predict.ambiguity_of)."""
+        """The selected feature's ambiguity region (eyeviz.model.derived.ambiguity_of)."""
         i = self.selected
         if not self.scene.shows("ambiguity") or i is None or i >= len(self.scene.features):
             return None
         if self._ambiguity is False:
-            from eyeviz.app.predict import ambiguity_of
+            from eyeviz.model.derived import ambiguity_of
 
             f, v = self.scene.features[i], self.scene.view
             half = 1.5 * v.width + math.hypot(f.x - v.center[0], f.y - v.center[1])
-            box = (v.center[0] - half, v.center[0] + half, v.center[1] - half,
-                   v.center[1] + half)
+            box = (v.center[0] - half, v.center[0] + half, v.center[1] - half, v.center[1] + half)
             self._ambiguity = ambiguity_of(self.scene.eyes.pair(), f.x, f.y, f.g, box)
         return self._ambiguity
 

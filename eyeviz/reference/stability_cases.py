@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from eyeviz.geometry import EyePair
+from eyeviz.core.geometry import EyePair
 
 PAPER = EyePair(40.0, 20.0, 720)
 

@@ -2,7 +2,7 @@
 
 Each layer is one or two actors whose PolyData is replaced when its content changes (a
 few hundred points at most); nothing is drawn for a layer the scene does not show.
-Colours follow :func:`eyeviz.render.vector.estimator_colors`, so the app and the
+Colours follow :func:`eyeviz.render.mpl.vector.estimator_colors`, so the app and the
 exported figures agree.
 """
 
@@ -14,7 +14,7 @@ import numpy as np
 import pyvista as pv
 from vtkmodules.vtkRenderingCore import vtkRenderer
 
-from eyeviz.render.actors import INK, Z_LINE, Z_POINT, _actor, hex_rgb
+from eyeviz.render.vtk.actors import INK, Z_LINE, Z_POINT, _actor, hex_rgb
 
 __all__ = ["OverlayActors", "Z_AMBIGUITY", "GHOST_N"]
 
@@ -51,8 +51,13 @@ class OverlayActors:
         self.amb_line.GetProperty().SetLineWidth(3.5)
         self.path_actor = _actor(pv.PolyData(), (0.35, 0.35, 0.35))
         self.path_actor.GetProperty().SetLineWidth(2.5)
-        for a in (self.amb_fill, self.amb_line, self.path_actor, self.ghost_actor,
-                  self.ghost_point_actor):
+        for a in (
+            self.amb_fill,
+            self.amb_line,
+            self.path_actor,
+            self.ghost_actor,
+            self.ghost_point_actor,
+        ):
             a.SetVisibility(False)
             main.AddActor(a)
         self.ghosts: dict[str, np.ndarray] = {}  # estimator -> (n, 2) ghost centres (NaN: none)
@@ -82,8 +87,9 @@ class OverlayActors:
             rgb = hex_rgb(colors[name])
             for i in np.flatnonzero(np.isfinite(gx) & np.isfinite(gy)):
                 g = state.g[i]
-                ring = np.column_stack([gx[i] + g * np.cos(t), gy[i] + g * np.sin(t),
-                                        np.full(GHOST_N, Z_GHOST)])
+                ring = np.column_stack(
+                    [gx[i] + g * np.cos(t), gy[i] + g * np.sin(t), np.full(GHOST_N, Z_GHOST)]
+                )
                 pts.append(ring)
                 lines.append(np.concatenate([[GHOST_N + 1], k + np.arange(GHOST_N), [k]]))
                 k += GHOST_N
@@ -97,8 +103,10 @@ class OverlayActors:
             self.ghost_actor.SetVisibility(False)
             self.ghost_point_actor.SetVisibility(False)
             return
-        mesh = pv.PolyData(np.vstack(pts).astype(np.float64),
-                           lines=np.concatenate([np.asarray(li) for li in lines]))
+        mesh = pv.PolyData(
+            np.vstack(pts).astype(np.float64),
+            lines=np.concatenate([np.asarray(li) for li in lines]),
+        )
         mesh.cell_data["rgb"] = np.array(cols, dtype=np.uint8)
         self.ghost_actor.GetMapper().SetInputData(mesh)
         self.ghost_mesh = mesh
@@ -126,8 +134,10 @@ class OverlayActors:
         k = len(poly)
         pts = np.column_stack([poly, np.full(k, Z_AMBIGUITY)])
         fill = pv.PolyData(pts, faces=np.concatenate([[k], np.arange(k)]))
-        line = pv.PolyData(pts + [0, 0, Z_LINE + 0.1 - Z_AMBIGUITY],  # over the discs
-                           lines=np.concatenate([[k + 1], np.arange(k), [0]]))
+        line = pv.PolyData(
+            pts + [0, 0, Z_LINE + 0.1 - Z_AMBIGUITY],  # over the discs
+            lines=np.concatenate([[k + 1], np.arange(k), [0]]),
+        )
         self.amb_fill.GetMapper().SetInputData(fill)
         self.amb_line.GetMapper().SetInputData(line)
         rgb = hex_rgb(color or "#555555")

@@ -16,7 +16,7 @@ import pytest
 
 from eyeviz import EyevizError
 from eyeviz import dataset as D
-from eyeviz.geometry import EyePair, intervals_to_bitmap
+from eyeviz.core.geometry import EyePair, intervals_to_bitmap
 
 SMALL = dict(eyes=EyePair(30.0, 10.0, 64), r_min=100.0, r_max=400.0, g_max=60.0)
 EYEVIZ = [sys.executable, "-m", "eyeviz"]
@@ -33,11 +33,16 @@ def paper_multi():
 
 
 def _all_cases(paper_single, paper_multi):
-    return [paper_single, paper_multi, D.generate(3000, mode="multi", seed=5, **SMALL),
-            D.generate(1500, seed=6, unique_bitmaps=True, **SMALL)]
+    return [
+        paper_single,
+        paper_multi,
+        D.generate(3000, mode="multi", seed=5, **SMALL),
+        D.generate(1500, seed=6, unique_bitmaps=True, **SMALL),
+    ]
 
 
 # --- the elements --------------------------------------------------------------------
+
 
 def test_bitmaps_equal_geometry_core(paper_single, paper_multi):
     for ds in _all_cases(paper_single, paper_multi):
@@ -63,8 +68,11 @@ def test_every_row_in_bfv_and_visible_to_both_eyes(paper_single, paper_multi):
 
 
 def test_ranges(paper_single, paper_multi):
-    for ds, p in [(paper_single, {}), (paper_multi, {}),
-                  (D.generate(3000, seed=1, **SMALL), SMALL)]:
+    for ds, p in [
+        (paper_single, {}),
+        (paper_multi, {}),
+        (D.generate(3000, seed=1, **SMALL), SMALL),
+    ]:
         e = p.get("eyes", D.PAPER_EYES)
         r_min, r_max, g_max = p.get("r_min", 1000.0), p.get("r_max", 5000.0), p.get("g_max", 500.0)
         assert (ds.r >= r_min).all() and (ds.r <= r_max).all()
@@ -134,8 +142,9 @@ def test_unique_bitmaps_are_unique_and_shift_distribution():
 
 def test_unique_bitmaps_exhausted_is_a_clear_error():
     with pytest.raises(EyevizError, match="distinct bitmap pairs"):
-        D.generate(500, eyes=EyePair(30.0, 10.0, 8), r_min=100, r_max=200, g_max=60,
-                   unique_bitmaps=True)
+        D.generate(
+            500, eyes=EyePair(30.0, 10.0, 8), r_min=100, r_max=200, g_max=60, unique_bitmaps=True
+        )
 
 
 def test_same_seed_same_elements_different_seed_different():
@@ -148,6 +157,7 @@ def test_same_seed_same_elements_different_seed_different():
 
 
 # --- files ---------------------------------------------------------------------------
+
 
 def _same_dataset(a, b, with_g=True):
     for k in ("omega_a", "omega_b", "r", "phi") + (("g",) if with_g else ()):
@@ -201,8 +211,10 @@ def test_csv_layout_and_appendix_loader(tmp_path, paper_single):
 
 def test_csv_without_g_column_is_read(tmp_path):
     ds = D.generate(50, seed=1, **SMALL)
-    lines = [",".join(map(str, np.concatenate([a, b]).astype(int))) + f",{float(r)!r},{float(p)!r}"
-             for a, b, r, p in zip(ds.omega_a, ds.omega_b, ds.r, ds.phi, strict=True)]
+    lines = [
+        ",".join(map(str, np.concatenate([a, b]).astype(int))) + f",{float(r)!r},{float(p)!r}"
+        for a, b, r, p in zip(ds.omega_a, ds.omega_b, ds.r, ds.phi, strict=True)
+    ]
     path = tmp_path / "nog.csv"
     path.write_text("\r\n".join(lines) + "\r\n")
     back = D.load(path)
@@ -210,12 +222,15 @@ def test_csv_without_g_column_is_read(tmp_path):
     _same_dataset(back, ds, with_g=False)
 
 
-@pytest.mark.parametrize("mutate, where", [
-    (lambda rows: rows[2].__setitem__(5, "2"), "line 3, column 6: bit must be 0 or 1"),
-    (lambda rows: rows[1].__setitem__(65, "abc"), "line 2, column 66: not a number"),
-    (lambda rows: rows[3].pop(), "line 4, column 67: expected 67 columns, found 66"),
-    (lambda rows: rows[0].__setitem__(64, "nan"), "line 1, column 65: not a finite"),
-])
+@pytest.mark.parametrize(
+    "mutate, where",
+    [
+        (lambda rows: rows[2].__setitem__(5, "2"), "line 3, column 6: bit must be 0 or 1"),
+        (lambda rows: rows[1].__setitem__(65, "abc"), "line 2, column 66: not a number"),
+        (lambda rows: rows[3].pop(), "line 4, column 67: expected 67 columns, found 66"),
+        (lambda rows: rows[0].__setitem__(64, "nan"), "line 1, column 65: not a finite"),
+    ],
+)
 def test_malformed_csv_names_line_and_column(tmp_path, mutate, where):
     path = tmp_path / "d.csv"
     D.save(D.generate(20, seed=1, **SMALL), path)
@@ -240,18 +255,24 @@ def test_load_refuses_wrong_files(tmp_path):
 
 # --- bad input and interruption ------------------------------------------------------
 
-@pytest.mark.parametrize("kw, msg", [
-    (dict(n=0), "n must be >= 1"),
-    (dict(n=10, r_min=5000, r_max=1000), "r_min must be < r_max"),
-    (dict(n=10, r_min=1000, r_max=1000), "r_min must be < r_max"),
-    (dict(n=10, g_max=0), "g_max must be > 0"),
-    (dict(n=10, g_max=4.0), "no feature can be visible"),
-    (dict(n=10, r_min=-1), "r_min must be > 0"),
-    (dict(n=10, mode="triple"), "mode must be"),
-    (dict(n=10, eyes=EyePair(40, 39.9, 4), r_min=100, r_max=200, g_max=90),
-     "no visible feature fits in the BFV"),
-    (dict(n=10, r_max=float("nan")), "r_max must be finite"),
-])
+
+@pytest.mark.parametrize(
+    "kw, msg",
+    [
+        (dict(n=0), "n must be >= 1"),
+        (dict(n=10, r_min=5000, r_max=1000), "r_min must be < r_max"),
+        (dict(n=10, r_min=1000, r_max=1000), "r_min must be < r_max"),
+        (dict(n=10, g_max=0), "g_max must be > 0"),
+        (dict(n=10, g_max=4.0), "no feature can be visible"),
+        (dict(n=10, r_min=-1), "r_min must be > 0"),
+        (dict(n=10, mode="triple"), "mode must be"),
+        (
+            dict(n=10, eyes=EyePair(40, 39.9, 4), r_min=100, r_max=200, g_max=90),
+            "no visible feature fits in the BFV",
+        ),
+        (dict(n=10, r_max=float("nan")), "r_max must be finite"),
+    ],
+)
 def test_bad_parameters_refused(kw, msg):
     with pytest.raises(EyevizError, match=msg):
         D.generate(**kw)
@@ -259,13 +280,16 @@ def test_bad_parameters_refused(kw, msg):
 
 def test_cli_refuses_bad_parameters_before_any_work(tmp_path):
     out = tmp_path / "x.csv"
-    for args, msg in [(["-n", "0"], "n must be >= 1"),
-                      (["-n", "5", "--r-min", "3000", "--r-max", "2000"], "r_min must be < r_max"),
-                      (["-n", "5", "--g-max", "-1"], "g_max must be > 0"),
-                      (["-n", "5", "--g-max", "1"], "no feature can be visible"),
-                      (["-n", "5", "--m", "7"], "m must be an even integer")]:
-        res = subprocess.run([*EYEVIZ, "generate", *args, "-o", str(out)],
-                             capture_output=True, text=True, timeout=60)
+    for args, msg in [
+        (["-n", "0"], "n must be >= 1"),
+        (["-n", "5", "--r-min", "3000", "--r-max", "2000"], "r_min must be < r_max"),
+        (["-n", "5", "--g-max", "-1"], "g_max must be > 0"),
+        (["-n", "5", "--g-max", "1"], "no feature can be visible"),
+        (["-n", "5", "--m", "7"], "m must be an even integer"),
+    ]:
+        res = subprocess.run(
+            [*EYEVIZ, "generate", *args, "-o", str(out)], capture_output=True, text=True, timeout=60
+        )
         assert res.returncode == 2, res.stderr
         assert msg in res.stderr and res.stderr.count("\n") == 1, res.stderr
         assert "Traceback" not in res.stderr
@@ -274,10 +298,35 @@ def test_cli_refuses_bad_parameters_before_any_work(tmp_path):
 
 def test_cli_writes_npz_and_csv(tmp_path):
     for name in ("a.npz", "a.csv"):
-        res = subprocess.run([*EYEVIZ, "generate", "-n", "300", "--mode", "multi", "--seed", "4",
-                              "--m", "64", "--h", "30", "--l", "10", "--r-min", "100",
-                              "--r-max", "400", "--g-max", "60", "-o", str(tmp_path / name)],
-                             capture_output=True, text=True, timeout=60)
+        res = subprocess.run(
+            [
+                *EYEVIZ,
+                "generate",
+                "-n",
+                "300",
+                "--mode",
+                "multi",
+                "--seed",
+                "4",
+                "--m",
+                "64",
+                "--h",
+                "30",
+                "--l",
+                "10",
+                "--r-min",
+                "100",
+                "--r-max",
+                "400",
+                "--g-max",
+                "60",
+                "-o",
+                str(tmp_path / name),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
         assert res.returncode == 0, res.stderr
     a, b = D.load(tmp_path / "a.npz"), D.load(tmp_path / "a.csv")
     _same_dataset(a, b)
@@ -299,8 +348,11 @@ def test_interrupted_write_leaves_no_file(tmp_path):
 
 def test_ctrl_c_on_the_command_leaves_no_file(tmp_path):
     out = tmp_path / "big.csv"
-    proc = subprocess.Popen([*EYEVIZ, "generate", "-n", "5000000", "-o", str(out), "--quiet"],
-                            stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [*EYEVIZ, "generate", "-n", "5000000", "-o", str(out), "--quiet"],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         deadline = time.monotonic() + 30
         while time.monotonic() < deadline:
@@ -334,8 +386,10 @@ def test_existing_output_survives_failed_run(tmp_path):
 
 
 def test_import_is_light():
-    code = ("import sys, eyeviz.dataset; bad = {'torch', 'PyQt5', 'pyvista', 'matplotlib', "
-            "'tqdm'} & set(sys.modules); print(sorted(bad))")
+    code = (
+        "import sys, eyeviz.dataset; bad = {'torch', 'PyQt5', 'pyvista', 'matplotlib', "
+        "'tqdm'} & set(sys.modules); print(sorted(bad))"
+    )
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert res.stdout.strip() == "[]", res.stdout + res.stderr
 
@@ -350,19 +404,47 @@ def test_file_mode_respects_umask(tmp_path):
 
 
 def test_float_text_is_printf_17g_and_round_trips():
-    from eyeviz.dataset_io import format_g17
+    from eyeviz.dataset.io import format_g17
 
     rng = np.random.default_rng(0)
-    edges = [0.0, -0.0, 1.0, 0.1, 1e-4, 9.9999999999999995e-5, 1e16, 1e17, 9.999999999999999e16,
-             1000.0, 0.5, float("nan"), float("inf"), -float("inf"), 5e-324, 1e300, -3.25,
-             2.0**53 + 2, np.nextafter(1e-4, 0), np.nextafter(10.0, 0), np.nextafter(1.0, 2)]
+    edges = [
+        0.0,
+        -0.0,
+        1.0,
+        0.1,
+        1e-4,
+        9.9999999999999995e-5,
+        1e16,
+        1e17,
+        9.999999999999999e16,
+        1000.0,
+        0.5,
+        float("nan"),
+        float("inf"),
+        -float("inf"),
+        5e-324,
+        1e300,
+        -3.25,
+        2.0**53 + 2,
+        np.nextafter(1e-4, 0),
+        np.nextafter(10.0, 0),
+        np.nextafter(1.0, 2),
+    ]
     p10 = 10.0 ** np.arange(-8, 20)
-    v = np.concatenate([edges, rng.uniform(1000, 5000, 20000), rng.uniform(0, 3.2, 20000),
-                        10 ** rng.uniform(-8, 20, 20000) * rng.choice([-1, 1], 20000),
-                        np.arange(-300, 300) / 8.0, p10, np.nextafter(p10, 0),
-                        np.nextafter(p10, np.inf)])
+    v = np.concatenate(
+        [
+            edges,
+            rng.uniform(1000, 5000, 20000),
+            rng.uniform(0, 3.2, 20000),
+            10 ** rng.uniform(-8, 20, 20000) * rng.choice([-1, 1], 20000),
+            np.arange(-300, 300) / 8.0,
+            p10,
+            np.nextafter(p10, 0),
+            np.nextafter(p10, np.inf),
+        ]
+    )
     chars, lens = format_g17(v)
-    got = [bytes(chars[i, :lens[i]]).decode() for i in range(len(v))]
+    got = [bytes(chars[i, : lens[i]]).decode() for i in range(len(v))]
     assert got == [format(x, ".17g") for x in v.tolist()]
     assert all(float(t) == x for t, x in zip(got, v.tolist(), strict=True) if x == x)
 
@@ -377,9 +459,13 @@ def test_full_disk_leaves_no_file(tmp_path, name):
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
         resource.setrlimit(resource.RLIMIT_FSIZE, (5_000_000, 5_000_000))
 
-    res = subprocess.run([*EYEVIZ, "generate", "-n", "300000", "-o", str(tmp_path / name),
-                          "--quiet"], capture_output=True, text=True, timeout=120,
-                         preexec_fn=limit)
+    res = subprocess.run(
+        [*EYEVIZ, "generate", "-n", "300000", "-o", str(tmp_path / name), "--quiet"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        preexec_fn=limit,
+    )
     assert res.returncode == 2, res.stderr
     assert "File too large" in res.stderr and res.stderr.count("\n") == 1, res.stderr
     assert list(tmp_path.iterdir()) == []

@@ -7,12 +7,18 @@ import math
 import numpy as np
 import pytest
 
-from eyeviz.ambiguity import ambiguity_polygon, ambiguity_radius_range, ambiguity_region
-from eyeviz.geometry import EyePair
+from eyeviz.core.ambiguity import ambiguity_polygon, ambiguity_radius_range, ambiguity_region
+from eyeviz.core.geometry import EyePair
 
 PAIR = EyePair(40.0, 20.0, 720)
-FEATURES = [(0.0, 1500.0, 50.0), (-1400.0, 3800.0, 250.0), (1700.0, 2200.0, 120.0),
-            (100.0, 300.0, 10.0), (50.0, 200.0, 3.0), (-900.0, 1200.0, 30.0)]
+FEATURES = [
+    (0.0, 1500.0, 50.0),
+    (-1400.0, 3800.0, 250.0),
+    (1700.0, 2200.0, 120.0),
+    (100.0, 300.0, 10.0),
+    (50.0, 200.0, 3.0),
+    (-900.0, 1200.0, 30.0),
+]
 
 
 def _same(pair, pts, g, iv):
@@ -22,8 +28,9 @@ def _same(pair, pts, g, iv):
 
 def _inside(poly, pts):
     a, b = poly, np.roll(poly, -1, axis=0)
-    cross = ((b[:, 0] - a[:, 0])[None] * (pts[:, 1:2] - a[:, 1][None])
-             - (b[:, 1] - a[:, 1])[None] * (pts[:, 0:1] - a[:, 0][None]))
+    cross = (b[:, 0] - a[:, 0])[None] * (pts[:, 1:2] - a[:, 1][None]) - (b[:, 1] - a[:, 1])[
+        None
+    ] * (pts[:, 0:1] - a[:, 0][None])
     return np.all(cross >= 0, axis=1)
 
 
@@ -67,8 +74,10 @@ def test_region_holds_every_matching_centre(x, y, g):
     reg = ambiguity_region(PAIR, x, y, g)
     lo, hi = reg.polygon.min(axis=0), reg.polygon.max(axis=0)
     pad = 0.3 * (hi - lo)
-    gx, gy = np.meshgrid(np.linspace(lo[0] - pad[0], hi[0] + pad[0], 160),
-                         np.linspace(lo[1] - pad[1], hi[1] + pad[1], 160))
+    gx, gy = np.meshgrid(
+        np.linspace(lo[0] - pad[0], hi[0] + pad[0], 160),
+        np.linspace(lo[1] - pad[1], hi[1] + pad[1], 160),
+    )
     pts = np.column_stack([gx.ravel(), gy.ravel()])
     same = _same(PAIR, pts, g, reg.intervals)
     assert same.sum() > 50

@@ -1,0 +1,43 @@
+"""Algorithm 1 (single- and multi-pass) and the paper's data set files (CSV, NPZ).
+
+Stable public path ``eyeviz.dataset``: :mod:`eyeviz.dataset.algorithm1` samples,
+:mod:`eyeviz.dataset.io` reads and writes.
+"""
+
+from eyeviz.dataset.algorithm1 import (
+    CHUNK,
+    MODES,
+    PAPER_EYES,
+    Chunk,
+    Dataset,
+    GenParams,
+    check_n,
+    effective_r_max,
+    generate,
+    iter_chunks,
+    iter_generate,
+    load,
+    make_params,
+    save,
+    segment_plan,
+    write,
+)
+
+__all__ = [
+    "CHUNK",
+    "MODES",
+    "Chunk",
+    "Dataset",
+    "GenParams",
+    "check_n",
+    "effective_r_max",
+    "iter_chunks",
+    "make_params",
+    "segment_plan",
+    "PAPER_EYES",
+    "generate",
+    "iter_generate",
+    "load",
+    "save",
+    "write",
+]

@@ -1,0 +1,1 @@
+"""Safe file handling shared by every writer and reader (atomic outputs)."""

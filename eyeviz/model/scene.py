@@ -1,0 +1,383 @@
+"""Scenes: what the app shows and what a figure exports (DESIGN.md §3, scene contract).
+
+A :class:`Scene` is plain data: the eye pair's parameters (h, l, m of Table 3), circular
+features (name, centre, radius g, colour), the layers to show, the estimators of the
+predictions layer, the view and an optional trajectory (Figure 14). It is read from and
+written to TOML; every rule is checked at this boundary and a broken one raises
+:class:`SceneError` naming the file, the key (with its line when it can be found) and the
+rule.
+
+This module imports numpy and the standard library only (no Qt, VTK or torch).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from eyeviz import EyevizError
+from eyeviz.core.geometry import EyePair
+from eyeviz.files.atomic import atomic_output
+
+__all__ = [
+    "LAYERS",
+    "OKABE_ITO",
+    "TRAJECTORY_KINDS",
+    "Eyes",
+    "Feature",
+    "Scene",
+    "SceneError",
+    "Trajectory",
+    "View",
+    "dumps",
+    "load",
+    "loads",
+    "save",
+]
+
+LAYERS = (
+    "eyes",
+    "bfv",
+    "features",
+    "bitmaps",
+    "readout",
+    "tangents",
+    "sectors",
+    "labels",
+    "predictions",
+    "ambiguity",
+    "trajectory",
+)
+TRAJECTORY_KINDS = ("horizontal", "circular", "vertical")
+# Okabe & Ito (2008) colour-blind-safe palette, black left out (it is the eyes' ink).
+OKABE_ITO = ("#D55E00", "#0072B2", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#F0E442")
+DEFAULT_LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout"]
+_COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
+
+
+class SceneError(EyevizError):
+    """A scene file or value breaks a rule; the message names file, key and rule."""
+
+
+@dataclass
+class Feature:
+    """A circular feature of radius g centred at (x, y) (Section 3, Prop. 2)."""
+
+    name: str
+    x: float
+    y: float
+    g: float
+    color: str = "#d62728"
+
+
+@dataclass
+class Eyes:
+    """EyePair parameters: h origin-to-centre, l eye radius, m ommatidia (Table 3)."""
+
+    h: float = 40.0
+    l: float = 20.0
+    m: int = 720
+
+    def pair(self) -> EyePair:
+        return EyePair(self.h, self.l, self.m)
+
+
+@dataclass
+class View:
+    """The visible region: centre (x, y) and width in model units."""
+
+    center: tuple[float, float] = (0.0, 2500.0)
+    width: float = 8000.0
+
+
+@dataclass
+class Trajectory:
+    """A Figure 14 trajectory at ``distance`` from the origin for a feature of radius g."""
+
+    kind: str
+    distance: float
+    g: float
+
+
+@dataclass
+class Scene:
+    eyes: Eyes = field(default_factory=Eyes)
+    features: list[Feature] = field(default_factory=list)
+    layers: list[str] = field(default_factory=lambda: list(DEFAULT_LAYERS))
+    estimators: list[str] = field(default_factory=lambda: ["compact"])
+    view: View = field(default_factory=View)
+    title: str = ""
+    trajectory: Trajectory | None = None
+
+    def copy(self) -> Scene:
+        return copy.deepcopy(self)
+
+    def shows(self, layer: str) -> bool:
+        return layer in self.layers
+
+
+# --- validation ------------------------------------------------------------------------
+
+
+class _Checker:
+    """Checks one parsed TOML document; errors name source, key, line and rule."""
+
+    def __init__(self, text: str, source: str):
+        self.text = text
+        self.source = source
+
+    def fail(self, key: str, rule: str) -> SceneError:
+        line = _line_of(self.text, key)
+        where = f"{self.source}:{line}" if line else self.source
+        return SceneError(f"{where}: {key}: {rule}")
+
+    def table(self, doc: dict, key: str, required: bool = False) -> dict:
+        if key not in doc:
+            if required:
+                raise self.fail(key, "missing table")
+            return {}
+        val = doc[key]
+        if not isinstance(val, dict):
+            raise self.fail(key, "must be a table")
+        return val
+
+    def keys(self, tab: dict, prefix: str, allowed: tuple[str, ...]) -> None:
+        for k in tab:
+            if k not in allowed:
+                raise self.fail(f"{prefix}{k}", f"unknown key (allowed: {', '.join(allowed)})")
+
+    def number(self, tab: dict, key: str, prefix: str, default=None, rule: str = "") -> float:
+        if key not in tab:
+            if default is None:
+                raise self.fail(f"{prefix}{key}", f"missing ({rule or 'a number'})")
+            return default
+        v = tab[key]
+        if isinstance(v, bool) or not isinstance(v, int | float):
+            raise self.fail(f"{prefix}{key}", f"must be a number, got {v!r}")
+        if not math.isfinite(v):
+            raise self.fail(f"{prefix}{key}", f"must be finite, got {v!r}")
+        return float(v)
+
+    def string(self, tab: dict, key: str, prefix: str, default=None) -> str:
+        if key not in tab:
+            if default is None:
+                raise self.fail(f"{prefix}{key}", "missing (a string)")
+            return default
+        v = tab[key]
+        if not isinstance(v, str):
+            raise self.fail(f"{prefix}{key}", f"must be a string, got {v!r}")
+        return v
+
+    def strings(self, tab: dict, key: str, prefix: str, default: list[str]) -> list[str]:
+        if key not in tab:
+            return list(default)
+        v = tab[key]
+        if not isinstance(v, list) or not all(isinstance(s, str) for s in v):
+            raise self.fail(f"{prefix}{key}", f"must be a list of strings, got {v!r}")
+        return list(v)
+
+
+def _line_of(text: str, key: str) -> int | None:
+    """1-based line of ``key`` ("eyes.m", "features[2].g", "layers.show") in TOML text."""
+    m = re.fullmatch(r"(\w+)(?:\[(\d+)\])?(?:\.(\w+))?", key)
+    if not m:
+        return None
+    table, index, name = m.group(1), m.group(2), m.group(3)
+    current, count = None, -1
+    for no, raw in enumerate(text.splitlines(), 1):
+        line = raw.strip()
+        head = re.fullmatch(r"\[\[\s*(\w+)\s*\]\]|\[\s*(\w+)\s*\]", line.split("#")[0].strip())
+        if head:
+            current = head.group(1) or head.group(2)
+            if head.group(1) == table:
+                count += 1
+            if name is None and current == table and (index is None or count == int(index)):
+                return no
+            continue
+        key_here = re.match(r"(\w+)\s*=", line)
+        if not key_here:
+            continue
+        if current is None and name is None and key_here.group(1) == table:
+            return no
+        if (
+            current == table
+            and name is not None
+            and key_here.group(1) == name
+            and (index is None or count == int(index))
+        ):
+            return no
+    return None
+
+
+def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
+    c = _Checker(text, source)
+    c.keys(doc, "", ("title", "eyes", "features", "layers", "predictions", "view", "trajectory"))
+    title = c.string(doc, "title", "", default="")
+
+    eyes_t = c.table(doc, "eyes")
+    c.keys(eyes_t, "eyes.", ("h", "l", "m"))
+    h = c.number(eyes_t, "h", "eyes.", default=40.0)
+    l = c.number(eyes_t, "l", "eyes.", default=20.0)
+    m = eyes_t.get("m", 720)
+    if isinstance(m, bool) or not isinstance(m, int):
+        raise c.fail("eyes.m", f"must be an even integer >= 4, got {m!r}")
+    try:
+        EyePair(h, l, m)
+    except ValueError as exc:
+        first = str(exc).split(" ")[0]
+        raise c.fail(f"eyes.{first if first in ('h', 'l', 'm') else 'h'}", str(exc)) from None
+    eyes = Eyes(h, l, m)
+
+    raw_features = doc.get("features", [])
+    if not isinstance(raw_features, list):
+        raise c.fail("features", "must be an array of tables ([[features]])")
+    features, names = [], set()
+    for i, ft in enumerate(raw_features):
+        p = f"features[{i}]."
+        if not isinstance(ft, dict):
+            raise c.fail(f"features[{i}]", "must be a table")
+        c.keys(ft, p, ("name", "x", "y", "g", "color"))
+        name = c.string(ft, "name", p, default=f"feature {i + 1}")
+        if not name.strip():
+            raise c.fail(f"{p}name", "must not be empty")
+        if name in names:
+            raise c.fail(f"{p}name", f"duplicate feature name {name!r}")
+        names.add(name)
+        x = c.number(ft, "x", p, rule="centre x in model units")
+        y = c.number(ft, "y", p, rule="centre y in model units")
+        g = c.number(ft, "g", p, rule="radius g > 0")
+        if g <= 0:
+            raise c.fail(f"{p}g", f"feature radius must be > 0, got {g!r}")
+        color = c.string(ft, "color", p, default=OKABE_ITO[i % len(OKABE_ITO)])
+        if not _COLOR.match(color):
+            raise c.fail(f"{p}color", f"must be a colour '#rrggbb', got {color!r}")
+        features.append(Feature(name, x, y, g, color))
+
+    layers_t = c.table(doc, "layers")
+    c.keys(layers_t, "layers.", ("show",))
+    layers = c.strings(layers_t, "show", "layers.", DEFAULT_LAYERS)
+    for name in layers:
+        if name not in LAYERS:
+            raise c.fail("layers.show", f"unknown layer {name!r} (known: {', '.join(LAYERS)})")
+    if len(set(layers)) != len(layers):
+        raise c.fail("layers.show", "a layer is named twice")
+
+    pred_t = c.table(doc, "predictions")
+    c.keys(pred_t, "predictions.", ("estimators",))
+    estimators = c.strings(pred_t, "estimators", "predictions.", ["compact"])
+    if not estimators and "predictions" in layers:
+        raise c.fail("predictions.estimators", "needs at least one estimator name")
+
+    view_t = c.table(doc, "view")
+    c.keys(view_t, "view.", ("center", "width"))
+    center = view_t.get("center", [0.0, 2500.0])
+    if (
+        not isinstance(center, list)
+        or len(center) != 2
+        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in center)
+        or not all(math.isfinite(v) for v in center)
+    ):
+        raise c.fail("view.center", f"must be [x, y] (two finite numbers), got {center!r}")
+    width = c.number(view_t, "width", "view.", default=8000.0)
+    if width <= 0:
+        raise c.fail("view.width", f"must be > 0, got {width!r}")
+    view = View((float(center[0]), float(center[1])), width)
+
+    trajectory = None
+    if "trajectory" in doc:
+        tt = c.table(doc, "trajectory")
+        c.keys(tt, "trajectory.", ("kind", "distance", "g"))
+        kind = c.string(tt, "kind", "trajectory.")
+        if kind not in TRAJECTORY_KINDS:
+            kinds = ", ".join(TRAJECTORY_KINDS)
+            raise c.fail("trajectory.kind", f"must be one of {kinds}, got {kind!r}")
+        dist = c.number(tt, "distance", "trajectory.", rule="distance > 0")
+        if dist <= 0:
+            raise c.fail("trajectory.distance", f"must be > 0, got {dist!r}")
+        tg = c.number(tt, "g", "trajectory.", rule="feature radius g > 0")
+        if tg <= 0:
+            raise c.fail("trajectory.g", f"must be > 0, got {tg!r}")
+        trajectory = Trajectory(kind, dist, tg)
+
+    return Scene(eyes, features, layers, estimators, view, title, trajectory)
+
+
+# --- public I/O ------------------------------------------------------------------------
+
+
+def loads(text: str, source: str = "<string>") -> Scene:
+    """Parse and validate a scene from TOML text; ``source`` names it in errors."""
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{source}: not valid TOML: {exc}") from None
+    return _scene_from_doc(doc, text, source)
+
+
+def load(path) -> Scene:
+    """Read a scene file (TOML, DESIGN.md §3)."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SceneError(f"{p}: no such scene file") from None
+    except UnicodeDecodeError:
+        raise SceneError(f"{p}: not a text (UTF-8) file") from None
+    except OSError as exc:
+        raise SceneError(f"{p}: cannot read: {exc.strerror or exc}") from None
+    return loads(text, str(p))
+
+
+def _fmt(v: float) -> str:
+    return repr(float(v))
+
+
+def _q(s: str) -> str:
+    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def dumps(scene: Scene) -> str:
+    """TOML text of ``scene``; ``loads(dumps(s)) == s``."""
+    out = []
+    if scene.title:
+        out += [f"title = {_q(scene.title)}", ""]
+    e = scene.eyes
+    out += ["[eyes]", f"h = {_fmt(e.h)}", f"l = {_fmt(e.l)}", f"m = {int(e.m)}", ""]
+    for f in scene.features:
+        out += [
+            "[[features]]",
+            f"name = {_q(f.name)}",
+            f"x = {_fmt(f.x)}",
+            f"y = {_fmt(f.y)}",
+            f"g = {_fmt(f.g)}",
+            f"color = {_q(f.color)}",
+            "",
+        ]
+    out += ["[layers]", "show = [" + ", ".join(_q(s) for s in scene.layers) + "]", ""]
+    ests = ", ".join(_q(s) for s in scene.estimators)
+    out += ["[predictions]", f"estimators = [{ests}]", ""]
+    cx, cy = scene.view.center
+    out += ["[view]", f"center = [{_fmt(cx)}, {_fmt(cy)}]", f"width = {_fmt(scene.view.width)}", ""]
+    if scene.trajectory is not None:
+        t = scene.trajectory
+        out += [
+            "[trajectory]",
+            f"kind = {_q(t.kind)}",
+            f"distance = {_fmt(t.distance)}",
+            f"g = {_fmt(t.g)}",
+            "",
+        ]
+    return "\n".join(out)
+
+
+def save(scene: Scene, path) -> None:
+    """Write ``scene`` atomically (temp file in the same directory, then os.replace)."""
+    text = dumps(scene)
+    loads(text, str(path))  # refuse to write a scene that would not load back
+    p = Path(path)
+    with atomic_output(p) as tmp:
+        tmp.write_text(text, encoding="utf-8")

@@ -1,0 +1,1 @@
+"""Matplotlib painters: true-vector figures drawn from the scene model."""
