@@ -39,7 +39,7 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
         .venv/bin/python -m pip install --upgrade pip &&
         # torch first, pinned: any other request pulls a multi-GB CUDA build.
         .venv/bin/python -m pip install "torch==2.13.0" &&
-        .venv/bin/python -m pip install -e ".[app,ml,dev]"
+        .venv/bin/python -m pip install -e ".[app,ml,study,dev]"
     } >"$log" 2>&1 || { tail -n 30 "$log" >&2; echo "eyeviz setup: pip failed (log: $log)" >&2; exit 1; }
     touch "$stamp"
 fi
