@@ -31,6 +31,7 @@ from eyeviz.render.vtk.actors import (
     style_text,
 )
 from eyeviz.render.vtk.overlays import OverlayActors
+from eyeviz.resources import scene_path as scene_path_of
 
 __all__ = ["MainWindow", "make_settings", "run_app"]
 
@@ -768,7 +769,7 @@ def run_app(scene_path=None, screenshot=None, settings_path=None) -> int:
             "or use scripts/run.sh"
         )
     if scene_path is None:
-        scene_path = Path(__file__).resolve().parents[2] / "assets" / "scenes" / "default.toml"
+        scene_path = scene_path_of("default")
     scene = load(scene_path)
     app = make_app()
     win = MainWindow(scene, scene_path, settings=make_settings(settings_path))

@@ -31,6 +31,7 @@ import numpy as np
 from eyeviz.estimators.analytic import AnalyticEstimator
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
 from eyeviz.files.atomic import atomic_output
+from eyeviz.resources import models_dir
 
 __all__ = ["BayesEstimator", "build_table", "load", "default_path", "TARGETS"]
 
@@ -39,7 +40,7 @@ _VALUE_BITS = 24  # quantisation of a value inside its key for the one-pass sort
 
 
 def default_path() -> Path:
-    return Path(__file__).resolve().parents[2] / "assets" / "models" / "bayes.npz"
+    return models_dir() / "bayes.npz"
 
 
 def _encode(LA, RA, LB, RB, w: int) -> np.ndarray:

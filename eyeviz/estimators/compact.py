@@ -32,6 +32,7 @@ from torch import nn
 from eyeviz.estimators.analytic import AnalyticEstimator
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
 from eyeviz.files.atomic import atomic_output
+from eyeviz.resources import models_dir
 
 __all__ = ["CompactEstimator", "CompactNet", "features", "load", "train", "default_dir"]
 
@@ -40,7 +41,7 @@ AD_SCALE = 1e-3  # radians per unit of the AD network's output
 
 
 def default_dir() -> Path:
-    return Path(__file__).resolve().parents[2] / "assets" / "models"
+    return models_dir()
 
 
 def features(LA, RA, LB, RB, domain: Domain = PAPER_DOMAIN):

@@ -44,6 +44,7 @@ from torch import nn
 
 from eyeviz import EyevizError
 from eyeviz.estimators.base import PAPER_DOMAIN, Estimator
+from eyeviz.resources import models_dir
 
 __all__ = [
     "AD",
@@ -237,7 +238,7 @@ def predict_net(
 
 
 def _repo_dir() -> Path:
-    return Path(__file__).resolve().parents[2] / "assets" / "models" / "paper"
+    return models_dir() / "paper"
 
 
 def _cache_dir() -> Path:
