@@ -463,7 +463,7 @@ def load(path, eyes: EyePair | None = None):
 
 
 def _load_npz(path: Path, eyes: EyePair | None):
-    from eyeviz.dataset import Dataset
+    from eyeviz.dataset.records import Dataset
 
     try:
         with np.load(path, allow_pickle=False) as z:
@@ -497,7 +497,7 @@ def _csv_lines(data: bytes) -> list[bytes]:
 
 
 def _load_csv(path: Path, eyes: EyePair | None):
-    from eyeviz.dataset import Dataset
+    from eyeviz.dataset.records import Dataset
 
     data = path.read_bytes()
     lines = _csv_lines(data)
