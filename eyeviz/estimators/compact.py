@@ -29,8 +29,11 @@ import numpy as np
 import torch
 from torch import nn
 
-from eyeviz.estimators.analytic import AnalyticEstimator
+from eyeviz import EyevizError
+from eyeviz.core.validation import check_int, check_real
+from eyeviz.estimators import analytic
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
+from eyeviz.estimators.store import staged, user_models_dir
 from eyeviz.files.atomic import atomic_output
 from eyeviz.resources import models_dir
 
@@ -53,7 +56,7 @@ def features(LA, RA, LB, RB, domain: Domain = PAPER_DOMAIN):
     dl = lb - la
     dr = rb - ra
     c = (la + ra + lb + rb + 2.0) * (0.25 * gam)
-    r0, p0 = AnalyticEstimator(domain)._predict_intervals(la, ra, lb, rb)
+    r0, p0 = analytic.estimate(la, ra, lb, rb, domain)
     log_r0 = np.log(r0)
     x = np.empty((la.shape[0], N_FEATURES), np.float32)
     x[:, 0] = dl * 0.25
@@ -247,19 +250,107 @@ def train(
     threads: int = 2,
     command: str | None = None,
     progress: Callable[[str, int, int, float], None] | None = None,
+    data=None,
 ) -> dict:
     """Generate data (single pass, seeds ``seed`` and ``seed + 1``), train both nets, save.
 
-    Weights are written atomically to ``out_dir`` after every improving epoch; the final
-    ``compact.json`` is written last. Returns the metadata.
+    ``data`` (a :class:`eyeviz.dataset.Dataset`) replaces the generated data: its single
+    feature rows are split 90 % / 10 % (seeded) into training and validation. Every file
+    (checkpoints, final weights, ``compact.json``) is written into a staging directory and
+    moved into ``out_dir`` (default: the user models directory, never the shipped assets
+    unless named) only at the end, so an interruption leaves the previous model intact.
+    Returns the metadata.
     """
+    batch = check_int("batch", batch, ge=1)
+    n_train = check_int("n_train", n_train, ge=1)
+    n_val = check_int("n_val", n_val, ge=1)
+    epochs = check_int("epochs", epochs, ge=1)
+    lr = check_real("lr", lr, gt=0)
     t0 = time.perf_counter()
+    if data is None:
+        if n_train < batch:
+            raise EyevizError(
+                f"-n must be >= {batch} (one batch of the one-cycle schedule), got {n_train}"
+            )
+        tr = _generate(n_train, domain, seed)
+        va = _generate(n_val, domain, seed + 1)
+    else:
+        tr, va = _split(data, seed, domain)
+        n_train, n_val = len(tr["r"]), len(va["r"])
+        if n_train < batch:
+            raise EyevizError(
+                f"need >= {batch} training rows (one batch), the data has {n_train} usable"
+            )
+    t_gen = time.perf_counter() - t0
+    out = Path(out_dir) if out_dir is not None else user_models_dir()
+    with staged(out) as stage:
+        return _train_into(
+            stage,
+            tr,
+            va,
+            t0,
+            t_gen,
+            n_train,
+            n_val,
+            seed,
+            epochs,
+            hidden,
+            hidden_ad,
+            batch,
+            lr,
+            patience,
+            domain,
+            threads,
+            command,
+            progress,
+            "single" if data is None else "given data set (90/10 split)",
+        )
+
+
+def _split(data, seed: int, domain: Domain) -> tuple[dict, dict]:
+    """Single-feature rows of a data set as interval columns, split 90/10 (seeded)."""
+    from eyeviz.estimators.base import bitmaps_to_intervals
+
+    if (data.eyes.h, data.eyes.l, data.eyes.m) != domain.design:
+        raise EyevizError(
+            f"data design h={data.eyes.h:g}, l={data.eyes.l:g}, m={data.eyes.m} differs from "
+            f"the domain's h={domain.h:g}, l={domain.l:g}, m={domain.m}"
+        )
+    la, ra, lb, rb, ok = bitmaps_to_intervals(data.omega_a, data.omega_b, domain.width)
+    cols = {"r": data.r, "phi": data.phi, "la": la, "ra": ra, "lb": lb, "rb": rb}
+    cols = {k: np.asarray(v)[ok] for k, v in cols.items()}
+    perm = np.random.default_rng(seed).permutation(len(cols["r"]))
+    n_val = max(1, len(perm) // 10)
+    return (
+        {k: v[perm[n_val:]] for k, v in cols.items()},
+        {k: v[perm[:n_val]] for k, v in cols.items()},
+    )
+
+
+def _train_into(
+    out: Path,
+    tr,
+    va,
+    t0,
+    t_gen,
+    n_train,
+    n_val,
+    seed,
+    epochs,
+    hidden,
+    hidden_ad,
+    batch,
+    lr,
+    patience,
+    domain,
+    threads,
+    command,
+    progress,
+    source,
+) -> dict:
+    """The body of :func:`train`, writing into the staging directory ``out``."""
     torch.set_num_threads(threads)
     torch.manual_seed(seed)
-    out = Path(out_dir) if out_dir is not None else default_dir()
-    tr = _generate(n_train, domain, seed)
-    va = _generate(n_val, domain, seed + 1)
-    t_gen = time.perf_counter() - t0
 
     def prep(d):
         x, log_r0, p0 = features(d["la"], d["ra"], d["lb"], d["rb"], domain)
@@ -325,7 +416,7 @@ def train(
         "n_weights": est.n_weights,
         "data": {
             **domain.to_dict(),
-            "mode": "single",
+            "mode": source,
             "n_train": n_train,
             "n_val": n_val,
             "train_seed": seed,
@@ -355,3 +446,48 @@ def train(
     text = json.dumps(meta, indent=2)
     _atomic(out / "compact.json", lambda tmp: Path(tmp).write_text(text))
     return meta
+
+
+def fit(
+    data=None,
+    out_dir=None,
+    *,
+    domain: Domain | None = None,
+    n: int = 1_000_000,
+    n_val: int = 100_000,
+    seed: int = 0,
+    epochs: int = 12,
+    hidden: int = 32,
+    hidden_ad: int = 8,
+    patience: int = 3,
+    threads: int = 2,
+    command: str | None = None,
+    progress: Callable[[str, int, int, float], None] | None = None,
+) -> Path:
+    """The registry's training shape: train on ``data`` (a Dataset or a .csv/.npz path;
+    None: generate ``n`` + ``n_val`` elements in ``domain``) into ``out_dir`` (default the
+    user models directory), staged then swapped in. Returns the directory for ``load``."""
+    import os
+
+    dom = PAPER_DOMAIN if domain is None else domain
+    if isinstance(data, str | os.PathLike):
+        from eyeviz import dataset
+
+        data = dataset.load(data, dom.eyes)
+    out = Path(out_dir) if out_dir is not None else user_models_dir()
+    train(
+        out,
+        n,
+        n_val,
+        seed,
+        epochs,
+        hidden,
+        hidden_ad,
+        patience=patience,
+        domain=dom,
+        threads=threads,
+        command=command,
+        progress=progress,
+        data=data,
+    )
+    return out
