@@ -92,7 +92,7 @@ def _progress(name: str, options: dict):
 
     if name == "compact":
         epochs = options.get("epochs", 12)
-        bar = tqdm(total=2 * epochs, desc="compact", unit="epoch", file=sys.stderr)
+        bar = tqdm(total=2 * epochs, desc="compact", unit="epoch", file=sys.stderr, delay=1.0)
 
         def progress(label, ep, total, val):
             bar.set_postfix_str(f"{label} epoch {ep} val rel. error {100 * val:.4g} %")
@@ -101,7 +101,7 @@ def _progress(name: str, options: dict):
         options["progress"] = progress
         return bar
     if name == "bayes":
-        bar = tqdm(desc="bayes sample", unit="el", unit_scale=True, file=sys.stderr)
+        bar = tqdm(desc="bayes sample", unit="el", unit_scale=True, file=sys.stderr, delay=1.0)
 
         def progress_b(done, total):
             bar.total = total

@@ -469,6 +469,9 @@ def fit(
     user models directory), staged then swapped in. Returns the directory for ``load``."""
     import os
 
+    for k, v in (("hidden", hidden), ("hidden_ad", hidden_ad), ("patience", patience)):
+        check_int(k, v, ge=1)
+    threads = check_int("threads", threads, ge=1)
     dom = PAPER_DOMAIN if domain is None else domain
     if isinstance(data, str | os.PathLike):
         from eyeviz import dataset

@@ -223,40 +223,8 @@ def options_from_args(options: tuple[Option, ...], ns: argparse.Namespace) -> di
 
 
 # --- the built-in estimators --------------------------------------------------------------
-
-
-def _pos_int(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}")
-    return v
-
-
-def _pos_float(text: str) -> float:
-    import math
-
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}") from None
-    if not math.isfinite(v) or v <= 0:
-        raise argparse.ArgumentTypeError(f"expected a finite number > 0, got {text!r}")
-    return v
-
-
-def _momentum(text: str) -> float:
-    import math
-
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number in [0, 1), got {text!r}") from None
-    if not math.isfinite(v) or not 0 <= v < 1:
-        raise argparse.ArgumentTypeError(f"expected a number in [0, 1), got {text!r}")
-    return v
+# Option types are plain int/float: the estimator's fit/load checks values (NaN, <= 0, too
+# small) with one-line EyevizError messages (eyeviz.core.validation), never argparse.
 
 
 def _opt(*flags: str, **kw: Any) -> Option:
@@ -264,7 +232,7 @@ def _opt(*flags: str, **kw: Any) -> Option:
 
 
 _SEED = _opt("--seed", type=int, default=None, help="random seed")
-_THREADS = _opt("--threads", type=_pos_int, default=None, help="torch CPU threads")
+_THREADS = _opt("--threads", type=int, default=None, help="torch CPU threads")
 
 for _entry in (
     Entry(
@@ -288,7 +256,7 @@ for _entry in (
             ),
         ),
         fit_options=(
-            _opt("-n", dest="n", type=_pos_int, default=None, help="sample size (default 3*10^7)"),
+            _opt("-n", dest="n", type=int, default=None, help="sample size (default 3*10^7)"),
             _SEED,
         ),
         weights_hint="eyeviz train bayes",
@@ -305,15 +273,15 @@ for _entry in (
                 "-n",
                 "--n-train",
                 dest="n",
-                type=_pos_int,
+                type=int,
                 default=None,
                 help="training elements (default 10^6; at least one batch, 4096)",
             ),
-            _opt("--n-val", type=_pos_int, default=None, help="validation elements (10^5)"),
-            _opt("--epochs", type=_pos_int, default=None, help="at most this many (12)"),
-            _opt("--hidden", type=_pos_int, default=None, help="DD hidden width (32)"),
-            _opt("--hidden-ad", type=_pos_int, default=None, help="AD hidden width (8)"),
-            _opt("--patience", type=_pos_int, default=None, help="early stopping (3)"),
+            _opt("--n-val", type=int, default=None, help="validation elements (10^5)"),
+            _opt("--epochs", type=int, default=None, help="at most this many (12)"),
+            _opt("--hidden", type=int, default=None, help="DD hidden width (32)"),
+            _opt("--hidden-ad", type=int, default=None, help="AD hidden width (8)"),
+            _opt("--patience", type=int, default=None, help="early stopping (3)"),
             _SEED,
             _THREADS,
         ),
@@ -330,23 +298,23 @@ for _entry in (
             _opt(
                 "-n",
                 dest="n",
-                type=_pos_int,
+                type=int,
                 default=None,
                 help="elements to generate when no data file is given (10^5)",
             ),
             _opt("--mode", choices=("single", "multi"), default=None),
-            _opt("--budget", type=_pos_float, default=None, help="seconds per network (600)"),
+            _opt("--budget", type=float, default=None, help="seconds per network (600)"),
             _opt("--device", default=None, help="cpu or cuda"),
             _opt("--nets", default=None, help="comma-separated subset of ad,dd"),
             _opt(
                 "--ad-lr",
-                type=_pos_float,
+                type=float,
                 default=None,
                 help="AD learning rate (default 0.003 as Appendix A; Table 5 says 0.004)",
             ),
             _opt(
                 "--dd-momentum",
-                type=_momentum,
+                type=float,
                 default=None,
                 help="DD Nesterov momentum in [0, 1) (default 0 = Keras default)",
             ),
