@@ -38,7 +38,7 @@ from eyeviz import EyevizError
 from eyeviz.core.domain import DEFAULTS, Domain
 from eyeviz.core.geometry import EyePair
 from eyeviz.core.validation import check_choice, check_int, check_real
-from eyeviz.dataset.records import PAPER_EYES, Chunk, Dataset
+from eyeviz.dataset.records import CHUNK, PAPER_EYES, Chunk, Dataset
 
 __all__ = [
     "CHUNK",
@@ -52,7 +52,6 @@ __all__ = [
     "write",
 ]
 
-CHUNK = 1 << 14  # elements per generated chunk; fixed, so the output never depends on it
 SEGMENT_WIDTH = 5.0  # the paper's multi-pass segment length (Section 5)
 # give up after this many redraw rounds and candidates in a row without one accepted element
 _MAX_IDLE_ROUNDS = 200

@@ -392,7 +392,7 @@ def write_chunks(
     progress: Callable[[int], None] | None = None,
 ) -> None:
     """Stream generated :class:`eyeviz.dataset.Chunk` objects into ``path``."""
-    from eyeviz.dataset import CHUNK
+    from eyeviz.dataset.records import CHUNK
 
     with atomic_output(path) as tmp:
         if fmt == "csv":

@@ -15,9 +15,10 @@ import numpy as np
 from eyeviz.core.domain import PAPER_DOMAIN
 from eyeviz.core.geometry import EyePair, intervals_to_bitmap
 
-__all__ = ["Chunk", "Dataset", "PAPER_EYES"]
+__all__ = ["CHUNK", "Chunk", "Dataset", "PAPER_EYES"]
 
 PAPER_EYES = PAPER_DOMAIN.eyes  # Table 3
+CHUNK = 1 << 14  # elements per generated chunk; fixed, so the output never depends on it
 
 
 @dataclass

@@ -469,3 +469,55 @@ def test_full_disk_leaves_no_file(tmp_path, name):
     assert res.returncode == 2, res.stderr
     assert "File too large" in res.stderr and res.stderr.count("\n") == 1, res.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_generator_takes_the_one_domain_record():
+    from eyeviz.core.domain import Domain
+
+    dom = Domain(h=30, l=10, m=360, r_min=500, r_max=2000, g_max=200)
+    a = D.generate(200, dom, seed=4)
+    b = D.generate(200, EyePair(30, 10, 360), 500, 2000, 200, seed=4)
+    assert np.array_equal(a.omega_a, b.omega_a) and np.array_equal(a.r, b.r)
+    assert a.eyes.m == 360 and (a.r >= 500).all() and (a.r <= 2000).all()
+    p = D.make_params(dom, mode="multi", seed=1)
+    assert p.domain == dom and p.mode == "multi"
+    assert D.GenParams.from_domain(dom).domain == dom
+    assert D.make_params(dom, r_max=1500).r_max == 1500  # an explicit range wins
+    with pytest.raises(EyevizError, match="r_min must be < r_max"):
+        D.make_params(dom, r_max=400)
+
+
+def test_defaults_are_tables_3_and_4_written_once():
+    from eyeviz.core.domain import DEFAULTS, PAPER_DOMAIN
+
+    assert DEFAULTS == {
+        "h": 40.0,
+        "l": 20.0,
+        "m": 720,
+        "r_min": 1000.0,
+        "r_max": 5000.0,
+        "g_max": 500.0,
+    }
+    p = D.make_params()
+    assert p.domain == PAPER_DOMAIN and D.PAPER_EYES == PAPER_DOMAIN.eyes
+
+
+def _imports(module) -> set[str]:
+    import ast
+
+    tree = ast.parse(Path(module.__file__).read_text())
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module:
+            out.add(node.module + ":" + ",".join(a.name for a in node.names))
+        elif isinstance(node, ast.Import):
+            out.update(a.name for a in node.names)
+    return out
+
+
+def test_records_module_is_a_leaf_and_io_does_not_import_the_sampler():
+    from eyeviz.dataset import io, records
+
+    assert not any(i.startswith("eyeviz.dataset") for i in _imports(records))
+    bad = [i for i in _imports(io) if "algorithm1" in i or i.startswith("eyeviz.dataset:")]
+    assert bad == [], bad
