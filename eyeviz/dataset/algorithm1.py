@@ -36,6 +36,7 @@ import numpy as np
 
 from eyeviz import EyevizError
 from eyeviz.core.geometry import EyePair, intervals_to_bitmap
+from eyeviz.files import limits
 
 __all__ = [
     "CHUNK",
@@ -219,6 +220,8 @@ def make_params(
     r_min, r_max, g_max = _real("r_min", r_min), _real("r_max", r_max), _real("g_max", g_max)
     if r_min <= 0:
         raise EyevizError(f"r_min must be > 0, got {r_min!r}")
+    limits.check_r_min(r_min, eyes.h)
+    limits.check_m(eyes.m)
     if r_min >= r_max:
         raise EyevizError(f"r_min must be < r_max, got r_min={r_min!r}, r_max={r_max!r}")
     if g_max <= 0:
@@ -242,7 +245,7 @@ def make_params(
     if segments is not None:
         if isinstance(segments, bool) or not isinstance(segments, int | np.integer) or segments < 1:
             raise EyevizError(f"segments must be an integer >= 1, got {segments!r}")
-        segments = int(segments)
+        segments = limits.check_segments(segments)
     return GenParams(eyes, r_min, r_max, g_max, mode, int(seed), bool(unique_bitmaps), segments)
 
 
@@ -251,7 +254,7 @@ def check_n(n) -> int:
         raise EyevizError(f"n must be an integer >= 1, got {n!r}")
     if n < 1:
         raise EyevizError(f"n must be >= 1, got {n}")
-    return int(n)
+    return limits.check_rows(n)
 
 
 # --- multi-pass plan -----------------------------------------------------------------

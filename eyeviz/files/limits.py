@@ -74,19 +74,21 @@ def check_bins(k) -> int:
     return check_int("bins", k, 1, MAX_BINS)
 
 
-def check_model_shape(name: str, shape, max_width: int = MAX_HIDDEN) -> tuple[int, ...]:
-    """A layer shape read from a model file: every dimension in [1, max_width] (or the
-    model's input width m <= MAX_M), and the product at most MAX_MODEL_PARAMS."""
+def check_model_shape(name: str, shape, max_dim: int = MAX_M) -> tuple[int, ...]:
+    """A tensor shape read from a model file, checked before anything is allocated:
+    every dimension in [1, max_dim] and at most MAX_MODEL_PARAMS elements in all.
+
+    For the hidden width of a network use :func:`check_hidden` (at most MAX_HIDDEN);
+    e.g. ``check_model_shape("compact_dd.pt: net.0.weight", (hidden, m))``."""
     try:
         dims = tuple(int(d) for d in shape)
     except (TypeError, ValueError, OverflowError):
-        raise EyevizError(
-            f"model {name}: shape must be a list of integers, got {shape!r}"
-        ) from None
+        msg = f"model {name}: shape must be a list of integers, got {shape!r}"
+        raise EyevizError(msg) from None
     total = 1
     for d in dims:
-        if not 1 <= d <= max(max_width, MAX_M):
-            raise EyevizError(f"model {name}: dimension {d} outside [1, {max_width}]")
+        if not 1 <= d <= max_dim:
+            raise EyevizError(f"model {name}: dimension {d} outside [1, {max_dim}]")
         total *= d
     if total > MAX_MODEL_PARAMS:
         raise EyevizError(f"model {name}: {total} parameters exceed {MAX_MODEL_PARAMS}")
@@ -147,5 +149,6 @@ def estimated_output_bytes(n: int, m: int, fmt: str) -> int:
 def check_r_min(r_min: float, h: float) -> float:
     """r_min must be >= MIN_R_OVER_H * h (near 1e-300 the exact path takes hours)."""
     if not r_min >= MIN_R_OVER_H * h:
-        raise EyevizError(f"r_min = {r_min!r} is below {MIN_R_OVER_H} * h = {MIN_R_OVER_H * h}")
+        bound = MIN_R_OVER_H * h
+        raise EyevizError(f"r_min = {r_min!r} is below {MIN_R_OVER_H:g} * h = {bound:g}")
     return r_min
