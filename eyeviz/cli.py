@@ -4,6 +4,8 @@ Sub-commands are discovered from :mod:`eyeviz.commands`. Every error a user can 
 ends in a one-line message on stderr and a non-zero exit, never a traceback:
 
 - :class:`EyevizError`, ValueError, OSError, OverflowError, RecursionError: exit 2;
+- any other exception (a bug: KeyError, TypeError...): exit 2 with one line starting
+  ``eyeviz: error: unexpected <type>`` (``EYEVIZ_DEBUG=1`` re-raises it);
 - Ctrl-C (SIGINT) exit 130, SIGHUP exit 129, SIGTERM exit 143: each raises
   :class:`Interrupted` (a KeyboardInterrupt) in the main thread, so every
   :func:`eyeviz.files.atomic.atomic_output` removes its temporary file;
@@ -189,6 +191,10 @@ def _run(args) -> int:
         _error("out of memory")
     except KeyboardInterrupt as exc:
         return _interrupted(exc)
+    except Exception as exc:  # the last resort: a bug, but never a traceback for a user
+        if os.environ.get("EYEVIZ_DEBUG"):
+            raise
+        _error(f"unexpected {type(exc).__name__}: {exc} (EYEVIZ_DEBUG=1 shows the traceback)")
     return 2
 
 
