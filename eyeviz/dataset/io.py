@@ -605,6 +605,28 @@ class BlockReader:
         except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
             raise self._npz_fail(_one_line(exc)) from None
 
+    def read_all(self) -> np.ndarray:
+        """Every row of an NPZ in one structured array (its size checked against the file
+        when the reader was made), floats validated."""
+        dt = self._dtype
+        rows = np.empty(self.n, dt)
+        try:
+            with zipfile.ZipFile(self.path) as zf, zf.open(self._rows_info) as f:
+                f.read(self._data_offset)
+                buf = memoryview(rows.view(np.uint8).reshape(-1))
+                got = 0
+                while got < len(buf):
+                    k = f.readinto(buf[got:]) if hasattr(f, "readinto") else 0
+                    if not k:
+                        raise self._npz_fail(f"rows end early at byte {got}")
+                    got += k
+        except EyevizError:
+            raise
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+            raise self._npz_fail(_one_line(exc)) from None
+        _check_floats(self.path, 0, rows["r"], rows["phi"], rows["g"], "row")
+        return rows
+
     # -- CSV --
 
     def _open_csv(self, eyes: EyePair | None) -> None:
@@ -678,14 +700,13 @@ def load(path, eyes: EyePair | None = None):
 
     reader = iter_blocks(path, BLOCK_ROWS, eyes)
     if reader.fmt == "npz":
-        n, w = reader.n, reader.eyes.m // 2
-        oa, ob = np.empty((n, w), bool), np.empty((n, w), bool)
-        fl = np.empty((3, n))
-        for b in reader:
-            sl = slice(b.start, b.start + len(b.r))
-            oa[sl], ob[sl] = b.omega_a, b.omega_b
-            fl[0, sl], fl[1, sl], fl[2, sl] = b.r, b.phi, b.g
-        return Dataset(oa, ob, fl[0], fl[1], fl[2], reader.eyes, reader.params)
+        rows = reader.read_all()
+        w = reader.eyes.m // 2
+        oa = np.unpackbits(rows["omega_a"], axis=1, count=w).view(bool)
+        ob = np.unpackbits(rows["omega_b"], axis=1, count=w).view(bool)
+        r, phi, g = rows["r"].copy(), rows["phi"].copy(), rows["g"].copy()
+        del rows
+        return Dataset(oa, ob, r, phi, g, reader.eyes, reader.params)
     blocks = list(reader)
     if len(blocks) == 1:
         b = blocks[0]
