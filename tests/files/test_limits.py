@@ -82,3 +82,29 @@ def test_api_generate_bounds():
         D.generate(10**10)
     with pytest.raises(EyevizError, match="segments must be in"):
         D.make_params(mode="multi", segments=10**9)
+
+
+@pytest.mark.parametrize(
+    "scene, words",
+    [
+        ("/dev/zero", "is not a regular file"),
+        ("m2e9.toml", "eyes.m: must be <= 100000"),
+        ("deep.toml", "nested too deeply"),
+        ("big.toml", "more than 1048576"),
+        ("width.toml", "view.width: must be >= 1e-06"),
+        ("nul.toml", "control character"),
+    ],
+)
+def test_snapshot_hostile_scene_files(tmp_path, scene, words):
+    files = {
+        "m2e9.toml": "[eyes]\nm = 2000000000\n",
+        "deep.toml": "a = " + "[" * 50_000 + "]" * 50_000 + "\n",
+        "big.toml": "# " + "x" * (2 << 20) + "\n",
+        "width.toml": "[view]\nwidth = 5e-324\n",
+        "nul.toml": '[[features]]\nname = "a\\u0000"\nx = 0.0\ny = 900.0\ng = 5.0\n',
+    }
+    if scene in files:
+        (tmp_path / scene).write_text(files[scene])
+    code, err, secs = _eyeviz("snapshot", scene, "-o", "out.png", cwd=tmp_path)
+    assert code == 2 and len(err) == 1 and words in err[0], err
+    assert secs < 60 and not (tmp_path / "out.png").exists()
