@@ -471,19 +471,13 @@ def __getattr__(name: str):
 
 
 __all__ = [
-    "BLOCK_ROWS",
-    "Block",
-    "BlockReader",
     "CsvEncoder",
     "FORMATS",
     "atomic_output",
-    "check_rows",
     "format_of",
     "format_g17",
-    "iter_blocks",
-    "load",
     "npz_dtype",
     "save",
     "write_chunks",
     "write_parts",
-]
+] + list(_READER_NAMES)
