@@ -294,14 +294,19 @@ def _one_line(exc: BaseException) -> str:
 
 
 def _check_floats(path: Path, start: int, r, phi, g, unit: str) -> None:
-    """r >= 0 and phi finite; g finite (or NaN in every row: a CSV without g)."""
-    bad = ~(np.isfinite(r) & (r >= 0) & np.isfinite(phi) & (np.isfinite(g) | np.isnan(g)))
+    """0 <= r <= MAX_DATA_R, |phi| <= MAX_DATA_PHI, 0 <= g <= MAX_DATA_R (or g NaN: a CSV
+    without g). Beyond these no bitmap can describe the row, and sums of squares of r
+    overflow in the metrics (r = 1e308)."""
+    R = limits.MAX_DATA_R
+    with np.errstate(invalid="ignore"):
+        ok_g = ((g >= 0) & (g <= R)) | np.isnan(g)
+        bad = ~((r >= 0) & (r <= R) & (np.abs(phi) <= limits.MAX_DATA_PHI) & ok_g)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise EyevizError(
             f"{path}: {unit} {start + i + 1}: r, phi, g = {float(r[i])!r}, {float(phi[i])!r}, "
             f"{float(g[i])!r} "
-            "(r must be finite and >= 0, phi and g finite)"
+            f"(need 0 <= r <= {R:g}, |phi| <= {limits.MAX_DATA_PHI:g} rad, 0 <= g <= {R:g})"
         )
 
 

@@ -31,6 +31,10 @@ MAX_HIDDEN = 4096
 MAX_MODEL_PARAMS = 50_000_000
 #: Length of a feature name in a scene.
 MAX_NAME_CHARS = 200
+#: Largest r and g of a data set row, and |phi| (radians): beyond these no bitmap can
+#: describe the row and the metrics' sums of squares overflow (r = 1e308 in a CSV).
+MAX_DATA_R = 1e15
+MAX_DATA_PHI = 8.0
 #: Smallest r_min of a generated data set, relative to the eye pair's h (below it the
 #: exact path works with numbers so far apart that it takes hours).
 MIN_R_OVER_H = 1e-6

@@ -83,13 +83,16 @@ def test_csv_bad_float_named(small, tmp_path, field, msg):
         D.load(p)
 
 
-def test_csv_negative_r_refused(small, tmp_path):
+@pytest.mark.parametrize(
+    "col, value", [(64, b"-5"), (64, b"1e308"), (64, b"1e16"), (65, b"100"), (66, b"-1")]
+)
+def test_csv_out_of_range_floats_refused(small, tmp_path, col, value):
     p, lines = _csv_lines(small, tmp_path)
     parts = lines[2].split(b",")
-    parts[64] = b"-5"
+    parts[col] = value
     lines[2] = b",".join(parts)
     p.write_bytes(b"\n".join(lines) + b"\n")
-    with pytest.raises(EyevizError, match=r"line 3: r, phi, g"):
+    with pytest.raises(EyevizError, match=r"line 3: r, phi, g = .* \(need 0 <= r <= 1e\+15"):
         D.load(p)
 
 
