@@ -85,6 +85,10 @@ def run(args: argparse.Namespace) -> int:
     )
     dataset.check_n(args.n)
     dataset.make_params(**kw)
+    from eyeviz.files import limits
+
+    fmt = dataset_io.format_of(args.output)
+    limits.check_free_space(args.output, limits.estimated_output_bytes(args.n, args.m, fmt))
     bar = None
     if not args.quiet and args.n >= _PROGRESS_MIN:
         from tqdm import tqdm

@@ -39,6 +39,7 @@ from eyeviz.core.domain import DEFAULTS, Domain
 from eyeviz.core.geometry import EyePair
 from eyeviz.core.validation import check_choice, check_int, check_real
 from eyeviz.dataset.records import CHUNK, PAPER_EYES, Chunk, Dataset
+from eyeviz.files import limits
 
 __all__ = [
     "CHUNK",
@@ -134,6 +135,8 @@ def make_params(
     r_min = check_real("r_min", DEFAULTS["r_min"] if r_min is None else r_min, gt=0)
     r_max = check_real("r_max", DEFAULTS["r_max"] if r_max is None else r_max, gt=0)
     g_max = check_real("g_max", DEFAULTS["g_max"] if g_max is None else g_max, gt=0)
+    limits.check_r_min(r_min, eyes.h)
+    limits.check_m(eyes.m)
     if r_min >= r_max:
         raise EyevizError(f"r_min must be < r_max, got r_min={r_min!r}, r_max={r_max!r}")
     check_choice("mode", mode, MODES)
@@ -151,12 +154,12 @@ def make_params(
             f"(m={eyes.m} too small for h={eyes.h:g}, l={eyes.l:g})"
         )
     if segments is not None:
-        segments = check_int("segments", segments, ge=1)
+        segments = limits.check_segments(check_int("segments", segments, ge=1))
     return GenParams(eyes, r_min, r_max, g_max, mode, int(seed), bool(unique_bitmaps), segments)
 
 
 def check_n(n) -> int:
-    return check_int("n", n, ge=1)
+    return limits.check_rows(check_int("n", n, ge=1))
 
 
 # --- multi-pass plan -----------------------------------------------------------------
