@@ -103,3 +103,18 @@ def test_csv_and_npz_give_the_same_predictions(data, tmp_path):
 def test_unknown_estimator_lists_the_registry(data, tmp_path):
     res = _run("predict", "-e", "nope", data / "paper.npz", "-o", tmp_path / "p.csv")
     _one_line_error(res, "unknown estimator 'nope'", "analytic", "bayes", "compact", "paper")
+
+
+def test_streamed_output_equals_in_memory_prediction(data, tmp_path):
+    from eyeviz import estimators
+
+    out = tmp_path / "p.csv"
+    res = _run("predict", "-e", "bayes", data / "paper.npz", "-o", out)
+    assert res.returncode == 0, res.stderr
+    assert out.read_text().splitlines()[0] == "r_hat,phi_hat"
+    got = np.loadtxt(out, delimiter=",", skiprows=1)
+    ds = dataset.load(data / "paper.npz")
+    want = estimators.load("bayes").predict(ds.omega_a, ds.omega_b)
+    assert np.array_equal(got[:, 0], want.r, equal_nan=True)
+    assert np.array_equal(got[:, 1], want.phi, equal_nan=True)
+    assert "300 rows" in res.stderr and "DD MAPE" in res.stderr
