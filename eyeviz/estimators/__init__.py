@@ -2,7 +2,7 @@
 
 >>> from eyeviz import estimators
 >>> estimators.available()
-['analytic', 'bayes', 'compact', 'paper']
+['analytic', 'bayes', 'compact', 'limit', 'paper']
 >>> est = estimators.load("analytic")
 >>> r, phi = est.predict(omega_a, omega_b)
 
@@ -19,7 +19,7 @@ from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator, Prediction
 
 __all__ = ["available", "load", "Estimator", "Prediction", "Domain", "PAPER_DOMAIN"]
 
-_NAMES = ("analytic", "bayes", "compact", "paper")
+_NAMES = ("analytic", "bayes", "compact", "limit", "paper")
 
 
 def available() -> list[str]:
