@@ -118,3 +118,22 @@ def test_streamed_output_equals_in_memory_prediction(data, tmp_path):
     assert np.array_equal(got[:, 0], want.r, equal_nan=True)
     assert np.array_equal(got[:, 1], want.phi, equal_nan=True)
     assert "300 rows" in res.stderr and "DD MAPE" in res.stderr
+
+
+def test_limit_domain_and_prior_from_flags(data, tmp_path):
+    out = tmp_path / "p.csv"
+    args = ["predict", "-e", "limit", "--m", "360", "--r-min", "1000", "--r-max", "5000"]
+    args += ["--g-max", "500", "--prior", "multi", data / "m360.csv", "-o", out]
+    res = _run(*args)
+    assert res.returncode == 0, res.stderr
+    got = np.loadtxt(out, delimiter=",", skiprows=1)
+    from eyeviz import estimators
+
+    ds = dataset.load(data / "m360.npz")
+    dom = estimators.Domain(40, 20, 360, 1000, 5000, 500)
+    want = estimators.load("limit", domain=dom, prior="multi").predict(ds.omega_a, ds.omega_b)
+    assert np.allclose(got[:, 0], want.r, equal_nan=True)
+    single = estimators.load("limit", domain=dom, prior="single").predict(ds.omega_a, ds.omega_b)
+    assert not np.allclose(got[:, 0], single.r, equal_nan=True)  # --prior reached the estimator
+    res = _run("predict", "-e", "limit", "--prior", "triple", data / "m360.csv", "-o", out)
+    assert res.returncode == 2 and "triple" in res.stderr
