@@ -36,7 +36,7 @@ class Domain:
 
     h: float = DEFAULTS["h"]
     l: float = DEFAULTS["l"]  # noqa: E741  (the paper's name)
-    m: int = DEFAULTS["m"]
+    m: int = int(DEFAULTS["m"])
     r_min: float = DEFAULTS["r_min"]
     r_max: float = DEFAULTS["r_max"]
     g_max: float = DEFAULTS["g_max"]

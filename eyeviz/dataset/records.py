@@ -75,14 +75,11 @@ class Dataset:
         if not parts:
             raise ValueError("cannot concatenate an empty list of data sets")
         first = parts[0]
-        return Dataset(
-            *(
-                np.concatenate([getattr(p, k) for p in parts])
-                for k in ("omega_a", "omega_b", "r", "phi", "g")
-            ),
-            eyes=first.eyes,
-            params=dict(first.params),
+        oa, ob, r, phi, g = (
+            np.concatenate([getattr(p, k) for p in parts])
+            for k in ("omega_a", "omega_b", "r", "phi", "g")
         )
+        return Dataset(oa, ob, r, phi, g, eyes=first.eyes, params=dict(first.params))
 
 
 @dataclass

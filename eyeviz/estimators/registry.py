@@ -129,14 +129,18 @@ class Entry:
 
     def load_estimator(self, **kw):
         """The estimator (``load(**kw)`` of its module)."""
-        return _resolve(self.load)(**kw)
+        loader = _resolve(self.load)
+        assert loader is not None
+        return loader(**kw)
 
     def fit_estimator(self, data=None, out_dir=None, **options) -> Path:
         """Train into ``out_dir`` (default: the user models directory); returns the path
         to give ``load(path=...)``. EyevizError for estimators that do not learn."""
         if self.fit is None:
             raise EyevizError(f"estimator {self.name!r} does not learn: nothing to train")
-        return Path(_resolve(self.fit)(data, out_dir, **options))
+        fitter = _resolve(self.fit)
+        assert fitter is not None
+        return Path(fitter(data, out_dir, **options))
 
 
 _REGISTRY: dict[str, Entry] = {}
