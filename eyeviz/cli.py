@@ -1,33 +1,120 @@
 """The ``eyeviz`` command line (DESIGN.md §3).
 
 Sub-commands are discovered from :mod:`eyeviz.commands`. Every error a user can cause
-ends in a one-line message on stderr and a non-zero exit, never a traceback.
+ends in a one-line message on stderr and a non-zero exit, never a traceback:
+
+- :class:`EyevizError`, ValueError, OSError, OverflowError, RecursionError: exit 2;
+- any other exception (a bug: KeyError, TypeError...): exit 2 with one line starting
+  ``eyeviz: error: unexpected <type>`` (``EYEVIZ_DEBUG=1`` re-raises it);
+- Ctrl-C (SIGINT) exit 130, SIGHUP exit 129, SIGTERM exit 143: each raises
+  :class:`Interrupted` (a KeyboardInterrupt) in the main thread, so every
+  :func:`eyeviz.files.atomic.atomic_output` removes its temporary file;
+- a closed stderr (``2>&-``) or stdout: they are pointed at ``os.devnull`` (progress bars
+  and messages are dropped, the work is done); a reader that goes away (``| head``,
+  EPIPE) no longer turns a finished command into an error.
 """
 
 from __future__ import annotations
 
-import argparse
-import importlib
-import pkgutil
+import os
+import signal
 import sys
 
-from eyeviz import EyevizError, __version__, commands
-
 DEFAULT_COMMAND = "app"
+_SIGNALS = {"SIGINT": 130, "SIGTERM": 143, "SIGHUP": 129}
 
 
-def _command_modules() -> list:
-    mods = []
-    for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda i: i.name):
-        if info.name.startswith("_"):
-            continue
-        mod = importlib.import_module(f"eyeviz.commands.{info.name}")
-        if hasattr(mod, "run") and hasattr(mod, "add_arguments"):
-            mods.append(mod)
-    return mods
+class Interrupted(KeyboardInterrupt):
+    """SIGINT, SIGTERM or SIGHUP arrived; ``signame`` and ``exit_code`` say which."""
+
+    def __init__(self, signame: str = "SIGINT"):
+        super().__init__(signame)
+        self.signame = signame
+        self.exit_code = _SIGNALS.get(signame, 130)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _raise_interrupted(signum, _frame) -> None:
+    raise Interrupted(signal.Signals(signum).name)
+
+
+def install_signal_handlers() -> dict:
+    """SIGTERM and SIGHUP end like Ctrl-C (an exception that unwinds every ``with``).
+
+    Returns the previous handlers (for :func:`signal.signal` to put back)."""
+    old = {}
+    for name in ("SIGTERM", "SIGHUP"):
+        sig = getattr(signal, name, None)
+        if sig is not None:
+            old[sig] = signal.signal(sig, _raise_interrupted)
+    return old
+
+
+class _QuietPipe:
+    """A text stream that drops writes once its reader has gone (EPIPE)."""
+
+    def __init__(self, stream):
+        self._s = stream
+        self.broken = False
+
+    def write(self, text):
+        if self.broken:
+            return len(text)
+        try:
+            return self._s.write(text)
+        except (BrokenPipeError, ValueError):
+            self._break()
+            return len(text)
+
+    def flush(self):
+        if self.broken:
+            return
+        try:
+            self._s.flush()
+        except (BrokenPipeError, ValueError):
+            self._break()
+
+    def _break(self):
+        self.broken = True
+        try:  # later flushes (at exit too) go to /dev/null instead of EPIPE
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, self._s.fileno())
+            os.close(devnull)
+        except (OSError, ValueError):
+            pass
+
+    def __getattr__(self, name):
+        return getattr(self._s, name)
+
+
+def _fd_open(fd: int) -> bool:
+    try:
+        os.fstat(fd)
+        return True
+    except OSError:
+        return False
+
+
+def _safe_std_streams() -> None:
+    for name, fd in (("stdout", 1), ("stderr", 2)):
+        stream = getattr(sys, name)
+        if stream is None or not _fd_open(fd):
+            setattr(sys, name, open(os.devnull, "w"))  # noqa: SIM115 - for the process
+        elif not isinstance(stream, _QuietPipe):
+            setattr(sys, name, _QuietPipe(stream))
+
+
+def _error(msg: str) -> None:
+    text = " ".join(str(msg).split()) or "error"
+    if len(text) > 500:
+        text = text[:500] + "..."
+    print(f"eyeviz: error: {text}", file=sys.stderr)
+
+
+def build_parser():
+    import argparse
+
+    from eyeviz import __version__
+
     parser = argparse.ArgumentParser(
         prog="eyeviz",
         description="Planar binocular compound-eye model: app, datasets, estimators, reports.",
@@ -41,29 +128,81 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _command_modules() -> list:
+    import importlib
+    import pkgutil
+
+    from eyeviz import commands
+
+    mods = []
+    for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda i: i.name):
+        if info.name.startswith("_"):
+            continue
+        mod = importlib.import_module(f"eyeviz.commands.{info.name}")
+        if hasattr(mod, "run") and hasattr(mod, "add_arguments"):
+            mods.append(mod)
+    return mods
+
+
 def main(argv: list[str] | None = None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser()
-    if (
-        not argv
-        or argv[0] not in parser._subparsers._group_actions[0].choices
-        and not argv[0].startswith("-")
-    ):
-        argv = [DEFAULT_COMMAND, *argv]
-    args = parser.parse_args(argv)
-    if getattr(args, "_run", None) is None:
-        args = parser.parse_args([DEFAULT_COMMAND])
+    """Run one sub-command; return its exit code (0, 2 on a user error, 128+signal)."""
+    streams = sys.stdout, sys.stderr
+    _safe_std_streams()
+    old_handlers: dict = {}
+    try:
+        argv = list(sys.argv[1:] if argv is None else argv)
+        parser = build_parser()
+        if (
+            not argv
+            or argv[0] not in parser._subparsers._group_actions[0].choices
+            and not argv[0].startswith("-")
+        ):
+            argv = [DEFAULT_COMMAND, *argv]
+        args = parser.parse_args(argv)
+        if getattr(args, "_run", None) is None:
+            args = parser.parse_args([DEFAULT_COMMAND])
+        if args.command != DEFAULT_COMMAND:
+            old_handlers = install_signal_handlers()
+        return _run(args)
+    except KeyboardInterrupt as exc:  # before the command started (imports, parsing)
+        return _interrupted(exc)
+    finally:
+        for sig, handler in old_handlers.items():
+            signal.signal(sig, handler)
+        for name, old in zip(("stdout", "stderr"), streams, strict=True):
+            cur = getattr(sys, name)
+            if isinstance(cur, _QuietPipe) and cur._s is old:
+                cur.flush()
+                setattr(sys, name, old)
+
+
+def _run(args) -> int:
+    from eyeviz import EyevizError
+
     try:
         return int(args._run(args) or 0)
     except EyevizError as exc:
-        print(f"eyeviz: error: {exc}", file=sys.stderr)
-        return 2
-    except (ValueError, OSError) as exc:
-        print(f"eyeviz: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("eyeviz: interrupted; no partial output was kept", file=sys.stderr)
-        return 130
+        _error(str(exc))
+    except (ValueError, OSError, OverflowError, ArithmeticError) as exc:
+        _error(str(exc) or type(exc).__name__)
+    except RecursionError:
+        _error("input nested too deeply")
+    except MemoryError:
+        _error("out of memory")
+    except KeyboardInterrupt as exc:
+        return _interrupted(exc)
+    except Exception as exc:  # the last resort: a bug, but never a traceback for a user
+        if os.environ.get("EYEVIZ_DEBUG"):
+            raise
+        _error(f"unexpected {type(exc).__name__}: {exc} (EYEVIZ_DEBUG=1 shows the traceback)")
+    return 2
+
+
+def _interrupted(exc: BaseException) -> int:
+    name = getattr(exc, "signame", "SIGINT")
+    what = "interrupted" if name == "SIGINT" else f"terminated by {name}"
+    print(f"eyeviz: {what}; no partial output was kept", file=sys.stderr)
+    return getattr(exc, "exit_code", 130)
 
 
 if __name__ == "__main__":

@@ -32,26 +32,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "(default: single)",
     )
     parser.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
-    parser.add_argument(
-        "--h", type=float, default=40.0, help="origin to eye centre distance (default: 40, Table 3)"
-    )
-    parser.add_argument("--l", type=float, default=20.0, help="eye radius (default: 20)")
-    parser.add_argument("--m", type=int, default=720, help="ommatidia per eye, even (default: 720)")
-    parser.add_argument(
-        "--r-min",
-        type=float,
-        default=1000.0,
-        help="minimum distance of a feature centre (default: 1000, Table 4)",
-    )
-    parser.add_argument(
-        "--r-max",
-        type=float,
-        default=5000.0,
-        help="maximum distance of a feature centre (default: 5000)",
-    )
-    parser.add_argument(
-        "--g-max", type=float, default=500.0, help="maximum feature radius (default: 500)"
-    )
+    from eyeviz.core.domain import DEFAULTS
+
+    for flag, typ, what, table in (
+        ("h", float, "origin to eye centre distance", 3),
+        ("l", float, "eye radius", 3),
+        ("m", int, "ommatidia per eye, even", 3),
+        ("r_min", float, "minimum distance of a feature centre", 4),
+        ("r_max", float, "maximum distance of a feature centre", 4),
+        ("g_max", float, "maximum feature radius", 4),
+    ):
+        parser.add_argument(
+            f"--{flag.replace('_', '-')}",
+            type=typ,
+            default=DEFAULTS[flag],
+            help=f"{what} (default: {DEFAULTS[flag]:g}, Table {table})",
+        )
     parser.add_argument(
         "--segments",
         type=int,
@@ -89,6 +85,10 @@ def run(args: argparse.Namespace) -> int:
     )
     dataset.check_n(args.n)
     dataset.make_params(**kw)
+    from eyeviz.files import limits
+
+    fmt = dataset_io.format_of(args.output)
+    limits.check_free_space(args.output, limits.estimated_output_bytes(args.n, args.m, fmt))
     bar = None
     if not args.quiet and args.n >= _PROGRESS_MIN:
         from tqdm import tqdm

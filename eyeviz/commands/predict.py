@@ -2,7 +2,15 @@
 
 Reads a data set of DESIGN.md §3 (.csv or .npz), writes a CSV with a header line
 ``r_hat,phi_hat`` and one row per input row (``nan`` where a row is not a single
-feature), atomically. Prints the metrics against the data's own r and phi.
+feature), atomically. Prints the metrics against the data's own r and phi. The data set is
+read block by block (:func:`eyeviz.dataset.io.iter_blocks`), so memory stays bounded
+whatever its size.
+
+The data set's eye design (h, l, m) must be the estimator's: an NPZ carries it, a CSV is
+described by ``--h --l --m`` (default Tables 3-4). An estimator for any design (analytic,
+limit) gets its domain from those flags (and ``--r-min --r-max --g-max``); the other
+options come from the estimator's registry entry. ``-o`` may not be the input file
+(compared by device and inode, so links count).
 """
 
 from __future__ import annotations
@@ -10,7 +18,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import tempfile
 from pathlib import Path
 
 NAME = "predict"
@@ -18,63 +25,126 @@ HELP = "predict distance and azimuth for every row of a data set"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from eyeviz.estimators import registry
+
+    names = registry.available()
     parser.add_argument("data", help="data set (.csv or .npz, as `eyeviz generate` writes)")
     parser.add_argument(
         "-e",
         "--estimator",
         default="compact",
-        help="analytic, bayes, compact or paper (default compact)",
+        help="; ".join(f"{e.name}: {e.help}" for e in registry.entries())
+        + f" (one of {', '.join(names)}; default compact)",
     )
     parser.add_argument("-o", "--out", required=True, help="output CSV (r_hat,phi_hat)")
     parser.add_argument(
         "--weights", default=None, help="weights directory/file instead of the shipped ones"
     )
+    g = parser.add_argument_group(
+        "design (a CSV's eyes; the domain of an estimator for any design; default Tables 3-4)"
+    )
+    registry.add_options(g, registry.DOMAIN_OPTIONS)
+    o = parser.add_argument_group("estimator options")
+    for e in registry.entries():
+        registry.add_options(o, e.load_options)
+
+
+def same_file(a, b) -> bool:
+    """Whether paths ``a`` and ``b`` are the same file (device and inode: links count)."""
+    try:
+        sa, sb = os.stat(a), os.stat(b)
+    except OSError:
+        return False
+    return (sa.st_dev, sa.st_ino) == (sb.st_dev, sb.st_ino)
+
+
+def _design_text(h: float, l: float, m: int) -> str:  # noqa: E741
+    return f"h={h:g}, l={l:g}, m={m}"
+
+
+def _reader(args, registry):
+    """(block reader, design): the NPZ's own design, a CSV's from the flags (Tables 3-4)."""
+    from eyeviz import EyevizError
+    from eyeviz.core.domain import PAPER_DOMAIN
+    from eyeviz.core.geometry import EyePair
+    from eyeviz.dataset.io import format_of, iter_blocks
+
+    path = Path(args.data)
+    if format_of(path) == "npz":
+        reader = iter_blocks(path)
+        e = reader.eyes
+        design = (float(e.h), float(e.l), int(e.m))
+        given = {k: getattr(args, k, None) for k in ("h", "l", "m")}
+        file_design = dict(zip(("h", "l", "m"), design, strict=True))
+        bad = {k: v for k, v in given.items() if v is not None and float(v) != file_design[k]}
+        if bad:
+            raise EyevizError(
+                f"{path} has design {_design_text(*design)}, but "
+                + ", ".join(f"--{k} {v:g}" for k, v in bad.items())
+                + " was given"
+            )
+        return reader, design
+    dom = registry.domain_from_args(args, PAPER_DOMAIN)
+    return iter_blocks(path, eyes=EyePair(dom.h, dom.l, dom.m)), dom.design
 
 
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from eyeviz import EyevizError, dataset, estimators
-    from eyeviz.estimators import metrics
+    from eyeviz import EyevizError
+    from eyeviz.core.domain import Domain
+    from eyeviz.estimators import registry
+    from eyeviz.estimators.metrics import RunningSummary
+    from eyeviz.files.atomic import atomic_output
 
-    if args.estimator not in estimators.available():
-        raise EyevizError(
-            f"unknown estimator {args.estimator!r}; available: {', '.join(estimators.available())}"
-        )
+    entry = registry.get(args.estimator)
     out = Path(args.out)
-    if not out.parent.is_dir():
-        raise EyevizError(f"output directory {out.parent} does not exist")
     if not Path(args.data).is_file():
         raise EyevizError(f"data file {args.data} not found")
-    kw = {} if args.weights is None else {"path": args.weights}
-    est = estimators.load(args.estimator, **kw)
-    ds = dataset.load(args.data, est.domain.eyes)
-    pred = est.predict(ds.omega_a, ds.omega_b)
-    table = np.column_stack([pred.r, pred.phi])
-    fd, tmp = tempfile.mkstemp(prefix=out.name + ".", suffix=".tmp", dir=out.parent)
-    os.close(fd)
-    try:
-        np.savetxt(tmp, table, fmt="%.17g", delimiter=",", header="r_hat,phi_hat", comments="")
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, out)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    n = len(pred.r)
-    valid = np.asarray(pred.valid)
+    if same_file(args.data, out):
+        raise EyevizError(f"output {args.out} is the input data file {args.data}; pick another -o")
+    if not (out.parent if str(out.parent) else Path(".")).is_dir():
+        raise EyevizError(f"output directory {out.parent} does not exist")
+    reader, design = _reader(args, registry)
+    kw = registry.options_from_args(entry.load_options, args)
+    if args.weights is not None:
+        kw["path"] = args.weights
+    if entry.any_design:
+        h, l, m = design  # noqa: E741
+        kw["domain"] = registry.domain_from_args(args, Domain(h, l, m))
+    est = entry.load_estimator(**kw)
+    if est.domain.design != design:
+        raise EyevizError(
+            f"data set {args.data} has design {_design_text(*design)}, but estimator "
+            f"{entry.name!r} answers for {_design_text(*est.domain.design)}"
+        )
+    n = invalid = outside = 0
+    dd, ad = RunningSummary(), RunningSummary()
+    with atomic_output(out) as tmp, open(tmp, "w", encoding="ascii") as fh:
+        fh.write("r_hat,phi_hat\n")
+        for b in reader:  # bounded memory: one block of rows at a time
+            pred = est.predict(b.omega_a, b.omega_b)
+            np.savetxt(fh, np.column_stack([pred.r, pred.phi]), fmt="%.17g", delimiter=",")
+            valid = np.asarray(pred.valid)
+            n += len(valid)
+            invalid += int((~valid).sum())
+            outside += int((valid & ~np.asarray(pred.in_domain)).sum())
+            dd.update(b.r[valid], pred.r[valid])
+            ad.update(b.phi[valid], pred.phi[valid])
     msg = f"{args.estimator}: {n} rows -> {out}"
-    if (~valid).any():
-        msg += f"; {int((~valid).sum())} not a single feature (nan)"
-    outside = valid & ~np.asarray(pred.in_domain)
-    if outside.any():
-        msg += f"; {int(outside.sum())} outside the training domain"
+    if invalid:
+        msg += f"; {invalid} not a single feature (nan)"
+    if outside:
+        msg += f"; {outside} outside the training domain"
     print(msg, file=sys.stderr)
-    if valid.sum() >= 2:
-        dd = metrics.summary(ds.r[valid], pred.r[valid])
-        ad = metrics.summary(ds.phi[valid], pred.phi[valid])
+    if dd.n >= 2:
+        try:
+            d, a = dd.result(), ad.result()
+        except ValueError:
+            return 0
         print(
-            f"DD MAPE {dd['mape']:.3f} %  MAE {dd['mae']:.2f}  R^2 {dd['r2']:.4f} | "
-            f"AD MAPE {ad['mape']:.4f} %  MAE {ad['mae']:.3g} rad  R^2 {ad['r2']:.6f}",
+            f"DD MAPE {d['mape']:.3f} %  MAE {d['mae']:.2f}  R^2 {d['r2']:.4f} | "
+            f"AD MAPE {a['mape']:.4f} %  MAE {a['mae']:.3g} rad  R^2 {a['r2']:.6f}",
             file=sys.stderr,
         )
     return 0

@@ -1,9 +1,13 @@
 """Algorithm 1 (single- and multi-pass) and the paper's data set files (CSV, NPZ).
 
-Stable public path ``eyeviz.dataset``: :mod:`eyeviz.dataset.algorithm1` samples,
-:mod:`eyeviz.dataset.io` reads and writes.
+Stable public path ``eyeviz.dataset``: :mod:`eyeviz.dataset.records` holds the records
+(:class:`Dataset`, :class:`Chunk`; a leaf), :mod:`eyeviz.dataset.algorithm1` samples,
+:mod:`eyeviz.dataset.io` reads and writes. Every generator function takes the one
+parameter record, :class:`eyeviz.core.domain.Domain`, in place of ``eyes`` (or the eyes
+and ranges separately); the defaults are Tables 3-4 (``eyeviz.core.domain.DEFAULTS``).
 """
 
+from eyeviz.core.domain import Domain
 from eyeviz.dataset.algorithm1 import (
     CHUNK,
     MODES,
@@ -24,6 +28,7 @@ from eyeviz.dataset.algorithm1 import (
 )
 
 __all__ = [
+    "Domain",
     "CHUNK",
     "MODES",
     "Chunk",

@@ -30,12 +30,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from eyeviz import EyevizError
-from eyeviz.core.geometry import EyePair, intervals_to_bitmap
+from eyeviz.core.domain import DEFAULTS, Domain
+from eyeviz.core.geometry import EyePair
+from eyeviz.core.validation import check_choice, check_int, check_real
+from eyeviz.dataset.records import CHUNK, PAPER_EYES, Chunk, Dataset
+from eyeviz.files import limits
 
 __all__ = [
     "CHUNK",
@@ -49,8 +53,6 @@ __all__ = [
     "write",
 ]
 
-PAPER_EYES = EyePair(40.0, 20.0, 720)  # Table 3
-CHUNK = 1 << 14  # elements per generated chunk; fixed, so the output never depends on it
 SEGMENT_WIDTH = 5.0  # the paper's multi-pass segment length (Section 5)
 # give up after this many redraw rounds and candidates in a row without one accepted element
 _MAX_IDLE_ROUNDS = 200
@@ -63,13 +65,23 @@ class GenParams:
     """Validated parameters of Algorithm 1 (Tables 3, 4) and of the multi-pass plan."""
 
     eyes: EyePair = PAPER_EYES
-    r_min: float = 1000.0
-    r_max: float = 5000.0
-    g_max: float = 500.0
+    r_min: float = DEFAULTS["r_min"]
+    r_max: float = DEFAULTS["r_max"]
+    g_max: float = DEFAULTS["g_max"]
     mode: str = "single"
     seed: int = 0
     unique_bitmaps: bool = False
     segments: int | None = None  # multi only; default: segments of length SEGMENT_WIDTH
+
+    @property
+    def domain(self) -> Domain:
+        """The design and ranges as the one parameter record, a :class:`Domain`."""
+        return Domain.from_eyes(self.eyes, r_min=self.r_min, r_max=self.r_max, g_max=self.g_max)
+
+    @classmethod
+    def from_domain(cls, domain: Domain, mode: str = "single", seed: int = 0, **kw) -> GenParams:
+        """Checked parameters of Algorithm 1 for ``domain`` (see :func:`make_params`)."""
+        return make_params(domain, mode=mode, seed=seed, **kw)
 
     def as_dict(self) -> dict:
         e = self.eyes
@@ -87,109 +99,7 @@ class GenParams:
         }
 
 
-@dataclass
-class Dataset:
-    """Rows (Omega_A, Omega_B, r, phi, g) of the paper's data set (DESIGN.md §3).
-
-    ``omega_a``, ``omega_b``: bool (n, m/2), ommatidia 0..m/2-1 of eye A (left), B (right);
-    ``r``, ``phi``: centre in polar coordinates about the origin (phi in radians);
-    ``g``: feature radius (NaN when read from a CSV without the g column).
-    ``params``: the generation parameters (empty when unknown, e.g. read from a CSV).
-    """
-
-    omega_a: np.ndarray
-    omega_b: np.ndarray
-    r: np.ndarray
-    phi: np.ndarray
-    g: np.ndarray
-    eyes: EyePair = PAPER_EYES
-    params: dict = field(default_factory=dict)
-
-    def __len__(self) -> int:
-        return int(self.r.shape[0])
-
-    @property
-    def m(self) -> int:
-        return self.eyes.m
-
-    @property
-    def x(self) -> np.ndarray:
-        return self.r * np.cos(self.phi)
-
-    @property
-    def y(self) -> np.ndarray:
-        return self.r * np.sin(self.phi)
-
-    @property
-    def bits(self) -> np.ndarray:
-        """The network input of Appendix A/B: (n, m) uint8, Omega_A then Omega_B."""
-        return np.concatenate([self.omega_a, self.omega_b], axis=1).view(np.uint8)
-
-    def __getitem__(self, idx) -> Dataset:
-        return Dataset(
-            self.omega_a[idx],
-            self.omega_b[idx],
-            self.r[idx],
-            self.phi[idx],
-            self.g[idx],
-            self.eyes,
-            dict(self.params),
-        )
-
-    @staticmethod
-    def concat(parts: list[Dataset]) -> Dataset:
-        if not parts:
-            raise ValueError("cannot concatenate an empty list of data sets")
-        first = parts[0]
-        return Dataset(
-            *(
-                np.concatenate([getattr(p, k) for p in parts])
-                for k in ("omega_a", "omega_b", "r", "phi", "g")
-            ),
-            eyes=first.eyes,
-            params=dict(first.params),
-        )
-
-
-@dataclass
-class Chunk:
-    """One generated chunk in interval form: eye E lights ommatidia L_E..R_E (0 <= L <= R < m/2)."""
-
-    r: np.ndarray
-    phi: np.ndarray
-    g: np.ndarray
-    la: np.ndarray
-    ra: np.ndarray
-    lb: np.ndarray
-    rb: np.ndarray
-
-    def __len__(self) -> int:
-        return int(self.r.shape[0])
-
-    def to_dataset(self, p: GenParams) -> Dataset:
-        m = p.eyes.m
-        return Dataset(
-            intervals_to_bitmap(self.la, self.ra, m, m // 2),
-            intervals_to_bitmap(self.lb, self.rb, m, m // 2),
-            self.r,
-            self.phi,
-            self.g,
-            p.eyes,
-            p.as_dict(),
-        )
-
-
 # --- parameters ----------------------------------------------------------------------
-
-
-def _real(name: str, v) -> float:
-    try:
-        f = float(v)
-    except (TypeError, ValueError):
-        raise EyevizError(f"{name} must be a real number, got {v!r}") from None
-    if not math.isfinite(f):
-        raise EyevizError(f"{name} must be finite, got {v!r}")
-    return f
 
 
 def effective_r_max(p: GenParams) -> float:
@@ -198,10 +108,10 @@ def effective_r_max(p: GenParams) -> float:
 
 
 def make_params(
-    eyes: EyePair | None = None,
-    r_min=1000.0,
-    r_max=5000.0,
-    g_max=500.0,
+    eyes: EyePair | Domain | None = None,
+    r_min=None,
+    r_max=None,
+    g_max=None,
     mode: str = "single",
     seed: int = 0,
     unique_bitmaps: bool = False,
@@ -213,20 +123,24 @@ def make_params(
     BFV and visible: step 8-9 needs g >= r sin(gamma/2) <= g_max for some r >= r_min, and a
     disc fits in the BFV only if g < r cos(psi) (Prop. 4: asin(g/r) <= pi/2 - psi).
     """
+    if isinstance(eyes, Domain):  # the one parameter record; explicit ranges still win
+        dom = eyes
+        eyes = dom.eyes
+        r_min = dom.r_min if r_min is None else r_min
+        r_max = dom.r_max if r_max is None else r_max
+        g_max = dom.g_max if g_max is None else g_max
     eyes = PAPER_EYES if eyes is None else eyes
     if not isinstance(eyes, EyePair):
-        raise EyevizError(f"eyes must be an EyePair, got {type(eyes).__name__}")
-    r_min, r_max, g_max = _real("r_min", r_min), _real("r_max", r_max), _real("g_max", g_max)
-    if r_min <= 0:
-        raise EyevizError(f"r_min must be > 0, got {r_min!r}")
+        raise EyevizError(f"eyes must be an EyePair or a Domain, got {type(eyes).__name__}")
+    r_min = check_real("r_min", DEFAULTS["r_min"] if r_min is None else r_min, gt=0)
+    r_max = check_real("r_max", DEFAULTS["r_max"] if r_max is None else r_max, gt=0)
+    g_max = check_real("g_max", DEFAULTS["g_max"] if g_max is None else g_max, gt=0)
+    limits.check_r_min(r_min, eyes.h)
+    limits.check_m(eyes.m)
     if r_min >= r_max:
         raise EyevizError(f"r_min must be < r_max, got r_min={r_min!r}, r_max={r_max!r}")
-    if g_max <= 0:
-        raise EyevizError(f"g_max must be > 0, got {g_max!r}")
-    if mode not in MODES:
-        raise EyevizError(f"mode must be 'single' or 'multi', got {mode!r}")
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise EyevizError(f"seed must be an integer >= 0, got {seed!r}")
+    check_choice("mode", mode, MODES)
+    seed = check_int("seed", seed, ge=0)
     s = math.sin(eyes.gamma / 2)
     c = math.cos(eyes.psi)
     if g_max <= r_min * s:
@@ -240,18 +154,12 @@ def make_params(
             f"(m={eyes.m} too small for h={eyes.h:g}, l={eyes.l:g})"
         )
     if segments is not None:
-        if isinstance(segments, bool) or not isinstance(segments, int | np.integer) or segments < 1:
-            raise EyevizError(f"segments must be an integer >= 1, got {segments!r}")
-        segments = int(segments)
+        segments = limits.check_segments(check_int("segments", segments, ge=1))
     return GenParams(eyes, r_min, r_max, g_max, mode, int(seed), bool(unique_bitmaps), segments)
 
 
 def check_n(n) -> int:
-    if isinstance(n, bool) or not isinstance(n, int | np.integer):
-        raise EyevizError(f"n must be an integer >= 1, got {n!r}")
-    if n < 1:
-        raise EyevizError(f"n must be >= 1, got {n}")
-    return int(n)
+    return limits.check_rows(check_int("n", n, ge=1))
 
 
 # --- multi-pass plan -----------------------------------------------------------------
@@ -406,10 +314,10 @@ def iter_chunks(n: int, p: GenParams, chunk: int = CHUNK) -> Iterator[Chunk]:
 
 def iter_generate(
     n: int,
-    eyes: EyePair | None = None,
-    r_min=1000.0,
-    r_max=5000.0,
-    g_max=500.0,
+    eyes: EyePair | Domain | None = None,
+    r_min=None,
+    r_max=None,
+    g_max=None,
     mode: str = "single",
     seed: int = 0,
     unique_bitmaps: bool = False,
@@ -425,10 +333,10 @@ def iter_generate(
 
 def generate(
     n: int,
-    eyes: EyePair | None = None,
-    r_min=1000.0,
-    r_max=5000.0,
-    g_max=500.0,
+    eyes: EyePair | Domain | None = None,
+    r_min=None,
+    r_max=None,
+    g_max=None,
     mode: str = "single",
     seed: int = 0,
     unique_bitmaps: bool = False,
@@ -451,10 +359,10 @@ def generate(
 def write(
     path,
     n: int,
-    eyes: EyePair | None = None,
-    r_min=1000.0,
-    r_max=5000.0,
-    g_max=500.0,
+    eyes: EyePair | Domain | None = None,
+    r_min=None,
+    r_max=None,
+    g_max=None,
     mode: str = "single",
     seed: int = 0,
     unique_bitmaps: bool = False,

@@ -13,7 +13,10 @@ big bit order), ``r``, ``phi``, ``g`` (float64). One member holds whole rows, so
 any size is streamed chunk by chunk.
 
 Both are written to a temporary file in the target directory and renamed at the end,
-so an interruption or a full disk leaves no partial output.
+so an interruption or a full disk leaves no partial output. Reading (validated, whole or
+in blocks) is :mod:`eyeviz.dataset.reader`, re-exported here. This module is over 400
+lines because the vectorised ``%.17g`` formatting and the CSV encoder belong with the
+writers they serve.
 """
 
 from __future__ import annotations
@@ -30,7 +33,6 @@ from pathlib import Path
 import numpy as np
 
 from eyeviz import EyevizError
-from eyeviz.core.geometry import EyePair
 from eyeviz.files.atomic import atomic_output
 
 FORMATS = ("csv", "npz")
@@ -392,7 +394,7 @@ def write_chunks(
     progress: Callable[[int], None] | None = None,
 ) -> None:
     """Stream generated :class:`eyeviz.dataset.Chunk` objects into ``path``."""
-    from eyeviz.dataset import CHUNK
+    from eyeviz.dataset.records import CHUNK
 
     with atomic_output(path) as tmp:
         if fmt == "csv":
@@ -417,8 +419,12 @@ def write_chunks(
 
 
 def save(ds, path) -> None:
+    """Write a data set; refuses rows :func:`load` would refuse (NaN r, bits 3 or 255)."""
+    from eyeviz.dataset.reader import check_rows
+
     fmt = format_of(path)
     n, m = len(ds), ds.eyes.m
+    check_rows(ds.omega_a, ds.omega_b, ds.r, ds.phi, ds.g, m)
     step = 1 << 14
     with atomic_output(path) as tmp:
         if fmt == "csv":
@@ -451,135 +457,27 @@ def save(ds, path) -> None:
                     )
 
 
-# --- reading -------------------------------------------------------------------------
+# Reading lives in eyeviz.dataset.reader; re-exported here (the stable path), lazily so
+# that either module can be imported first.
+_READER_NAMES = ("BLOCK_ROWS", "Block", "BlockReader", "check_rows", "iter_blocks", "load")
 
 
-def load(path, eyes: EyePair | None = None):
-    path = Path(path)
-    fmt = format_of(path)
-    if not path.is_file():
-        raise EyevizError(f"no such data set file: {str(path)!r}")
-    return _load_npz(path, eyes) if fmt == "npz" else _load_csv(path, eyes)
+def __getattr__(name: str):
+    if name in _READER_NAMES:
+        from eyeviz.dataset import reader
+
+        return getattr(reader, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def _load_npz(path: Path, eyes: EyePair | None):
-    from eyeviz.dataset import Dataset
-
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            meta = json.loads(str(z["meta"][()]))
-            rows = z["rows"]
-    except (OSError, ValueError, KeyError, zipfile.BadZipFile, json.JSONDecodeError) as exc:
-        raise EyevizError(f"{path}: not an eyeviz NPZ data set ({exc})") from None
-    m = int(meta["m"])
-    params = meta.get("params", {})
-    if eyes is None:
-        eyes = EyePair(params.get("h", 40.0), params.get("l", 20.0), m)
-    elif eyes.m != m:
-        raise EyevizError(f"{path}: data set has m={m}, but eyes have m={eyes.m}")
-    w = m // 2
-    oa = np.unpackbits(rows["omega_a"], axis=1, count=w).view(bool)
-    ob = np.unpackbits(rows["omega_b"], axis=1, count=w).view(bool)
-    return Dataset(oa, ob, rows["r"].copy(), rows["phi"].copy(), rows["g"].copy(), eyes, params)
-
-
-def _csv_error(path: Path, line: int, col: int, msg: str) -> EyevizError:
-    return EyevizError(f"{path}: line {line}, column {col}: {msg}")
-
-
-def _csv_lines(data: bytes) -> list[bytes]:
-    lines = data.split(b"\n")
-    if lines and lines[-1] == b"":
-        lines.pop()
-    if lines and lines[0].endswith(b"\r"):
-        lines = [ln[:-1] if ln.endswith(b"\r") else ln for ln in lines]
-    return lines
-
-
-def _load_csv(path: Path, eyes: EyePair | None):
-    from eyeviz.dataset import Dataset
-
-    data = path.read_bytes()
-    lines = _csv_lines(data)
-    if not lines:
-        raise EyevizError(f"{path}: the CSV file is empty")
-    ncols = lines[0].count(b",") + 1
-    with_g = ncols % 2 == 1
-    m = ncols - (3 if with_g else 2)
-    if m < 4:
-        raise _csv_error(path, 1, ncols, f"too few columns ({ncols}) for a data set row")
-    if eyes is None:
-        eyes = EyePair(40.0, 20.0, m)
-    elif eyes.m != m:
-        raise _csv_error(path, 1, ncols, f"{ncols} columns mean m={m}, but eyes have m={eyes.m}")
-    n = len(lines)
-    nf = 3 if with_g else 2
-    w = m // 2
-    oa = np.empty((n, w), np.uint8)
-    ob = np.empty((n, w), np.uint8)
-    floats = np.empty((nf, n))
-    step = 1 << 14
-    for s in range(0, n, step):
-        block = lines[s : s + step]
-        e = s + len(block)
-        try:
-            _parse_block(block, m, nf, oa[s:e], ob[s:e], floats[:, s:e])
-        except ValueError:
-            _diagnose(path, block, s, m, ncols)
-            raise
-    g = floats[2] if with_g else np.full(n, np.nan)
-    return Dataset(oa.view(bool), ob.view(bool), floats[0], floats[1], g, eyes, {})
-
-
-def _parse_block(
-    block: list[bytes], m: int, nf: int, oa: np.ndarray, ob: np.ndarray, floats: np.ndarray
-) -> None:
-    """Fast path: every line is exactly ``b,`` * m followed by nf floats."""
-    rb = 2 * m
-    head = np.frombuffer(b"".join([ln[:rb] for ln in block]), np.uint8)
-    if head.size != len(block) * rb:
-        raise ValueError("short line")
-    head = head.reshape(len(block), m, 2)
-    if not (np.all(head[:, :, 1] == _COMMA) and np.all((head[:, :, 0] | 1) == _ONE)):
-        raise ValueError("bad bits")
-    w = m // 2
-    np.subtract(head[:, :w, 0], _ZERO, out=oa)
-    np.subtract(head[:, w:, 0], _ZERO, out=ob)
-    tails = b",".join([ln[rb:] for ln in block]).split(b",")
-    if len(tails) != len(block) * nf:
-        raise ValueError("bad field count")
-    floats[:] = np.array(list(map(float, tails))).reshape(len(block), nf).T
-    if not np.all(np.isfinite(floats)):
-        raise ValueError("non-finite")
-
-
-def _diagnose(path: Path, block: list[bytes], offset: int, m: int, ncols: int) -> None:
-    """Slow path: find the first bad field and raise an error naming line and column."""
-    for i, ln in enumerate(block):
-        lineno = offset + i + 1
-        fields = ln.split(b",")
-        if len(fields) != ncols:
-            raise _csv_error(
-                path,
-                lineno,
-                min(len(fields), ncols) + (len(fields) < ncols),
-                f"expected {ncols} columns, found {len(fields)}",
-            )
-        for j, fv in enumerate(fields):
-            if j < m:
-                if fv not in (b"0", b"1"):
-                    raise _csv_error(
-                        path,
-                        lineno,
-                        j + 1,
-                        f"bit must be 0 or 1, got {fv.decode(errors='replace')!r}",
-                    )
-            else:
-                try:
-                    v = float(fv)
-                except ValueError:
-                    raise _csv_error(
-                        path, lineno, j + 1, f"not a number: {fv.decode(errors='replace')!r}"
-                    ) from None
-                if not np.isfinite(v):
-                    raise _csv_error(path, lineno, j + 1, f"not a finite number: {v!r}")
+__all__ = [
+    "CsvEncoder",
+    "FORMATS",
+    "atomic_output",
+    "format_of",
+    "format_g17",
+    "npz_dtype",
+    "save",
+    "write_chunks",
+    "write_parts",
+] + list(_READER_NAMES)

@@ -2,38 +2,50 @@
 
 >>> from eyeviz import estimators
 >>> estimators.available()
-['analytic', 'bayes', 'compact', 'paper']
+['analytic', 'bayes', 'compact', 'limit', 'paper']
 >>> est = estimators.load("analytic")
 >>> r, phi = est.predict(omega_a, omega_b)
 
-Each estimator lives in ``eyeviz.estimators.<name>`` with a ``load(**kw)`` function and
-is imported only when loaded: importing this package and calling :func:`available`
-does not import torch.
+Every estimator is an entry of :mod:`eyeviz.estimators.registry` (name, help, design,
+load, fit, command-line options); its module is imported only when loaded: importing
+this package and calling :func:`available` does not import torch. :mod:`.checks` holds
+the battery every estimator passes (:func:`check_estimator`).
 """
 
 from __future__ import annotations
 
-import importlib
+from eyeviz.core.domain import PAPER_DOMAIN, Domain
+from eyeviz.estimators import registry
+from eyeviz.estimators.base import Estimator, Prediction
 
-from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator, Prediction
-
-__all__ = ["available", "load", "Estimator", "Prediction", "Domain", "PAPER_DOMAIN"]
-
-_NAMES = ("analytic", "bayes", "compact", "paper")
+__all__ = [
+    "available",
+    "load",
+    "fit",
+    "registry",
+    "Estimator",
+    "Prediction",
+    "Domain",
+    "PAPER_DOMAIN",
+]
 
 
 def available() -> list[str]:
-    """Names accepted by :func:`load`."""
-    return list(_NAMES)
+    """Names accepted by :func:`load` (the installed registry entries)."""
+    return registry.available()
 
 
 def load(name: str, **kw) -> Estimator:
-    """The estimator called ``name``; ValueError for an unknown name or missing weights.
+    """The estimator called ``name``; ValueError (EyevizError) for an unknown name or
+    missing weights, naming the command that makes them.
 
-    Keyword arguments go to the estimator's module-level ``load`` (for instance
-    ``domain=``, or ``path=`` for a weights file).
+    Keyword arguments go to the estimator's ``load`` (for instance ``domain=``, or
+    ``path=`` for a weights file or directory).
     """
-    if name not in _NAMES:
-        raise ValueError(f"unknown estimator {name!r}; available: {', '.join(_NAMES)}")
-    module = importlib.import_module(f"eyeviz.estimators.{name}")
-    return module.load(**kw)
+    return registry.load(name, **kw)
+
+
+def fit(name: str, data=None, out_dir=None, **options):
+    """Train estimator ``name`` into ``out_dir`` (default the user models directory);
+    returns the path to give ``load(name, path=...)``."""
+    return registry.fit(name, data, out_dir, **options)

@@ -16,13 +16,24 @@ import numpy as np
 
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator, triangulate
 
-__all__ = ["AnalyticEstimator", "load", "centre_angles"]
+__all__ = ["AnalyticEstimator", "load", "centre_angles", "estimate"]
 
 
 def centre_angles(LA, RA, LB, RB, m: int) -> tuple[np.ndarray, np.ndarray]:
     """Mid-angles c_A, c_B of the lit intervals (radians, counter-clockwise from +x)."""
     half_gamma = math.pi / m
     return (LA + RA + 1) * half_gamma, (LB + RB + 1) * half_gamma
+
+
+def estimate(
+    LA, RA, LB, RB, domain: Domain = PAPER_DOMAIN, min_disparity: float = 0.25
+) -> tuple[np.ndarray, np.ndarray]:
+    """(r, phi) from valid interval arrays by centre-ray triangulation (Eq. 22-25 read
+    backwards); ``min_disparity`` in sectors. The public form of the analytic estimate
+    that other estimators (bayes' fallback, compact's baseline) build on."""
+    m = domain.m
+    ca, cb = centre_angles(LA, RA, LB, RB, m)
+    return triangulate(ca, cb, domain.h, min_disparity * 2 * math.pi / m)
 
 
 class AnalyticEstimator(Estimator):
@@ -35,9 +46,7 @@ class AnalyticEstimator(Estimator):
         self.min_disparity = float(min_disparity)
 
     def _predict_intervals(self, LA, RA, LB, RB):
-        m = self.domain.m
-        ca, cb = centre_angles(LA, RA, LB, RB, m)
-        return triangulate(ca, cb, self.domain.h, self.min_disparity * 2 * math.pi / m)
+        return estimate(LA, RA, LB, RB, self.domain, self.min_disparity)
 
 
 def load(domain: Domain = PAPER_DOMAIN, **kw) -> AnalyticEstimator:

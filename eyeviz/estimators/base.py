@@ -18,12 +18,12 @@ This module imports numpy and the standard library only (no torch).
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
-from eyeviz.core.geometry import EyePair, intervals_to_bitmap
+from eyeviz.core.domain import PAPER_DOMAIN, Domain
+from eyeviz.core.geometry import intervals_to_bitmap
 
 __all__ = [
     "Domain",
@@ -35,46 +35,6 @@ __all__ = [
     "triangulate",
     "in_domain",
 ]
-
-
-@dataclass(frozen=True)
-class Domain:
-    """Model (Table 3) and object (Table 4) parameters an estimator was made for."""
-
-    h: float = 40.0
-    l: float = 20.0
-    m: int = 720
-    r_min: float = 1000.0
-    r_max: float = 5000.0
-    g_max: float = 500.0
-
-    def __post_init__(self) -> None:
-        EyePair(self.h, self.l, self.m)  # validates h, l, m with named messages
-        if not (0 < self.r_min < self.r_max) or not math.isfinite(self.r_max):
-            raise ValueError(
-                f"need 0 < r_min < r_max < inf, got r_min={self.r_min!r}, r_max={self.r_max!r}"
-            )
-        if not (0 < self.g_max < math.inf):
-            raise ValueError(f"g_max must be a positive finite number, got {self.g_max!r}")
-
-    @property
-    def eyes(self) -> EyePair:
-        return EyePair(self.h, self.l, self.m)
-
-    @property
-    def width(self) -> int:
-        """Bitmap length per eye, m/2 (Section 4)."""
-        return self.m // 2
-
-    def to_dict(self) -> dict[str, float]:
-        return asdict(self)
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> Domain:
-        return cls(**{k: d[k] for k in ("h", "l", "m", "r_min", "r_max", "g_max") if k in d})
-
-
-PAPER_DOMAIN = Domain()
 
 
 class Prediction(tuple):

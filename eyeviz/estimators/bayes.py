@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from eyeviz.estimators.analytic import AnalyticEstimator
+from eyeviz.estimators import analytic
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
 from eyeviz.files.atomic import atomic_output
 from eyeviz.resources import models_dir
@@ -132,7 +132,7 @@ def build_table(n: int, domain: Domain = PAPER_DOMAIN, seed: int = 12345, progre
 
 def _analytic(key: np.ndarray, domain: Domain):
     LA, RA, LB, RB = _decode(key, domain.width)
-    return AnalyticEstimator(domain)._predict_intervals(LA, RA, LB, RB)
+    return analytic.estimate(LA, RA, LB, RB, domain)
 
 
 def save_table(table: dict, path) -> None:
@@ -192,7 +192,6 @@ class BayesEstimator(Estimator):
         self._key = table["key"]
         self._r = table[f"r_{target}"]
         self._phi = table[f"phi_{target}"]
-        self._fallback = AnalyticEstimator(domain)
 
     def lookup(self, LA, RA, LB, RB):
         """(r, phi, seen) for valid interval arrays; seen is False where the key is new."""
@@ -207,8 +206,8 @@ class BayesEstimator(Estimator):
             miss = np.flatnonzero(~seen)
             r = r.copy()
             phi = phi.copy()
-            r[miss], phi[miss] = self._fallback._predict_intervals(
-                LA[miss], RA[miss], LB[miss], RB[miss]
+            r[miss], phi[miss] = analytic.estimate(
+                LA[miss], RA[miss], LB[miss], RB[miss], self.domain
             )
         return r, phi, seen
 
@@ -233,3 +232,38 @@ def load(
             f"bayes table {path} not found; build it with `eyeviz train bayes -o {path}`"
         )
     return BayesEstimator(load_table(path), target)
+
+
+def fit(
+    data=None,
+    out_dir=None,
+    *,
+    domain: Domain | None = None,
+    n: int = 30_000_000,
+    seed: int = 12345,
+    filename: str = "bayes.npz",
+    command: str | None = None,
+    progress=None,
+) -> Path:
+    """The registry's training shape: sample ``n`` elements of ``domain`` (the information
+    limit needs its own large single-pass sample, so ``data`` must be None), build the
+    posterior table and write ``out_dir/filename`` (default the user models directory),
+    staged then swapped in. Returns the .npz path for ``load(path=...)``."""
+    from eyeviz import EyevizError
+    from eyeviz.core.validation import check_int
+    from eyeviz.estimators.store import staged, user_models_dir
+
+    if data is not None:
+        raise EyevizError(
+            "bayes builds its table from its own Algorithm 1 sample; give -n, not a data file"
+        )
+    if not filename.endswith(".npz") or "/" in filename:
+        raise EyevizError(f"bayes output must be a .npz file name, got {filename!r}")
+    n = check_int("n", n, ge=1)
+    dom = PAPER_DOMAIN if domain is None else domain
+    out = Path(out_dir) if out_dir is not None else user_models_dir()
+    table = build_table(n, dom, seed, progress)
+    table["meta"]["command"] = command
+    with staged(out) as stage:
+        save_table(table, stage / filename)
+    return out / filename

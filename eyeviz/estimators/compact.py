@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import json
 import math
-import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -29,7 +28,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from eyeviz.estimators.analytic import AnalyticEstimator
+from eyeviz.estimators import analytic
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
 from eyeviz.files.atomic import atomic_output
 from eyeviz.resources import models_dir
@@ -53,7 +52,7 @@ def features(LA, RA, LB, RB, domain: Domain = PAPER_DOMAIN):
     dl = lb - la
     dr = rb - ra
     c = (la + ra + lb + rb + 2.0) * (0.25 * gam)
-    r0, p0 = AnalyticEstimator(domain)._predict_intervals(la, ra, lb, rb)
+    r0, p0 = analytic.estimate(la, ra, lb, rb, domain)
     log_r0 = np.log(r0)
     x = np.empty((la.shape[0], N_FEATURES), np.float32)
     x[:, 0] = dl * 0.25
@@ -166,192 +165,18 @@ def load(path=None, domain: Domain | None = None) -> CompactEstimator:
     return CompactEstimator(dd, ad, dom, meta)
 
 
-# --- training ------------------------------------------------------------------------------
+# --- training (eyeviz.estimators.compact_training) -------------------------------------------
 
 
-def _generate(n: int, domain: Domain, seed: int, mode: str = "single"):
-    from eyeviz import dataset
+def train(*args, **kw) -> dict:
+    """Train both nets and save them; see :func:`eyeviz.estimators.compact_training.train`."""
+    from eyeviz.estimators import compact_training
 
-    p = dataset.make_params(domain.eyes, domain.r_min, domain.r_max, domain.g_max, mode, seed)
-    chunks = list(dataset.iter_chunks(n, p, chunk=1 << 17))
-    return {
-        k: np.concatenate([getattr(c, k) for c in chunks])
-        for k in ("r", "phi", "la", "ra", "lb", "rb")
-    }
+    return compact_training.train(*args, **kw)
 
 
-def _fit(
-    net: CompactNet,
-    x,
-    y,
-    xv,
-    yv,
-    predict: Callable,
-    epochs: int,
-    batch: int,
-    lr: float,
-    patience: int,
-    seed: int,
-    ckpt: Callable[[CompactNet], None],
-    progress: Callable[[str, int, int, float], None] | None,
-    label: str,
-) -> dict:
-    """Adam with a one-cycle schedule on the relative error; early stopping on validation."""
-    g = torch.Generator().manual_seed(seed)
-    n = x.shape[0]
-    steps = n // batch
-    opt = torch.optim.Adam(net.parameters(), lr=lr)
-    sched = torch.optim.lr_scheduler.OneCycleLR(opt, max_lr=lr, total_steps=epochs * steps)
-    best, best_state, bad, history = math.inf, None, 0, []
-    for ep in range(epochs):
-        net.train()
-        perm = torch.randperm(n, generator=g)
-        for i in range(steps):
-            idx = perm[i * batch : (i + 1) * batch]
-            opt.zero_grad(set_to_none=True)
-            loss = predict(net(x[idx]), y[idx])
-            loss.backward()
-            opt.step()
-            sched.step()
-        net.eval()
-        with torch.inference_mode():
-            val = float(predict(net(xv), yv))
-        history.append(val)
-        if progress is not None:
-            progress(label, ep + 1, epochs, val)
-        if val < best - 1e-7:
-            best, bad = val, 0
-            best_state = {k: v.detach().clone() for k, v in net.state_dict().items()}
-            ckpt(net)
-        else:
-            bad += 1
-            if bad >= patience:
-                break
-    if best_state is not None:
-        net.load_state_dict(best_state)
-    return {"epochs": len(history), "val_history": [round(v, 7) for v in history], "best_val": best}
+def fit(data=None, out_dir=None, **options) -> Path:
+    """The registry's training shape; see :func:`eyeviz.estimators.compact_training.fit`."""
+    from eyeviz.estimators import compact_training
 
-
-def train(
-    out_dir=None,
-    n_train: int = 1_000_000,
-    n_val: int = 100_000,
-    seed: int = 0,
-    epochs: int = 12,
-    hidden: int = 32,
-    hidden_ad: int = 8,
-    batch: int = 4096,
-    lr: float = 4e-3,
-    patience: int = 3,
-    domain: Domain = PAPER_DOMAIN,
-    threads: int = 2,
-    command: str | None = None,
-    progress: Callable[[str, int, int, float], None] | None = None,
-) -> dict:
-    """Generate data (single pass, seeds ``seed`` and ``seed + 1``), train both nets, save.
-
-    Weights are written atomically to ``out_dir`` after every improving epoch; the final
-    ``compact.json`` is written last. Returns the metadata.
-    """
-    t0 = time.perf_counter()
-    torch.set_num_threads(threads)
-    torch.manual_seed(seed)
-    out = Path(out_dir) if out_dir is not None else default_dir()
-    tr = _generate(n_train, domain, seed)
-    va = _generate(n_val, domain, seed + 1)
-    t_gen = time.perf_counter() - t0
-
-    def prep(d):
-        x, log_r0, p0 = features(d["la"], d["ra"], d["lb"], d["rb"], domain)
-        return (
-            torch.from_numpy(x),
-            torch.from_numpy((np.log(d["r"]) - log_r0).astype(np.float32)),
-            torch.from_numpy(((d["phi"] - p0) / AD_SCALE).astype(np.float32)),
-            torch.from_numpy((d["phi"] / AD_SCALE).astype(np.float32)),
-        )
-
-    x, yd, ya, sa = prep(tr)
-    xv, ydv, yav, sav = prep(va)
-
-    def dd_loss(out, y):
-        return (torch.exp(out - y) - 1.0).abs().mean()
-
-    # AD: |phi_hat - phi| / phi with phi_hat - phi = AD_SCALE * (out - y)
-    ya_pair = torch.stack([ya, sa], 1)
-    yav_pair = torch.stack([yav, sav], 1)
-
-    def ad_loss(out, y):
-        return ((out - y[:, 0]).abs() / y[:, 1]).mean()
-
-    files = {"dd": "compact_dd.pt", "ad": "compact_ad.pt"}
-    info = {}
-    nets = {}
-    for name, y, yv, loss, zero, width in (
-        ("dd", yd, ydv, dd_loss, False, hidden),
-        ("ad", ya_pair, yav_pair, ad_loss, True, hidden_ad),
-    ):
-        torch.manual_seed(seed)
-        net = CompactNet(width, zero_last=zero)
-        ts = time.perf_counter()
-        path = out / files[name]
-        info[name] = _fit(
-            net,
-            x,
-            y,
-            xv,
-            yv,
-            loss,
-            epochs,
-            batch,
-            lr,
-            patience,
-            seed,
-            lambda n_, p=path, w=width: _save_net(n_, w, p),
-            progress,
-            name.upper(),
-        )
-        info[name]["seconds"] = round(time.perf_counter() - ts, 1)
-        _save_net(net, width, path)
-        nets[name] = net
-    est = CompactEstimator(nets["dd"], nets["ad"], domain)
-    pv = est.predict_intervals(va["la"], va["ra"], va["lb"], va["rb"])
-    from eyeviz.estimators import metrics
-
-    meta = {
-        "estimator": "compact",
-        "files": files,
-        "architecture": f"DD {N_FEATURES}-{hidden}-{hidden}-1, "
-        f"AD {N_FEATURES}-{hidden_ad}-{hidden_ad}-1, SiLU MLPs",
-        "n_weights": est.n_weights,
-        "data": {
-            **domain.to_dict(),
-            "mode": "single",
-            "n_train": n_train,
-            "n_val": n_val,
-            "train_seed": seed,
-            "val_seed": seed + 1,
-        },
-        "training": {
-            "epochs_max": epochs,
-            "batch": batch,
-            "lr": lr,
-            "patience": patience,
-            "optimizer": "Adam + one-cycle",
-            "threads": threads,
-            "dd_loss": "mean |r_hat/r - 1|",
-            "ad_loss": "mean |phi_hat/phi - 1|",
-            **{name: info[name] for name in info},
-        },
-        "train_seconds": round(time.perf_counter() - t0, 1),
-        "generate_seconds": round(t_gen, 1),
-        "val_metrics": {
-            "dd": metrics.summary(va["r"], pv.r),
-            "ad": metrics.summary(va["phi"], pv.phi),
-        },
-        "torch": torch.__version__,
-        "command": command,
-        "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-    }
-    text = json.dumps(meta, indent=2)
-    _atomic(out / "compact.json", lambda tmp: Path(tmp).write_text(text))
-    return meta
+    return compact_training.fit(data, out_dir, **options)

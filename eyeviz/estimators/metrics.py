@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["mae", "mape", "r2", "summary"]
+__all__ = ["mae", "mape", "r2", "summary", "RunningSummary"]
 
 
 def _pair(y_true, y_pred) -> tuple[np.ndarray, np.ndarray]:
@@ -51,3 +51,53 @@ def r2(y_true, y_pred) -> float:
 def summary(y_true, y_pred) -> dict[str, float]:
     """{"mape": %, "mae": ..., "r2": ...} of one target."""
     return {"mape": mape(y_true, y_pred), "mae": mae(y_true, y_pred), "r2": r2(y_true, y_pred)}
+
+
+class RunningSummary:
+    """:func:`summary` accumulated block by block in O(1) memory (for streamed data sets).
+
+    Sums of |e| and |e/t| and e^2, and the true values' mean and spread merged per block
+    (Chan et al.'s parallel variance), so the result equals :func:`summary` on the whole
+    arrays up to rounding.
+    """
+
+    def __init__(self) -> None:
+        self.n = 0
+        self._abs = 0.0
+        self._rel = 0.0
+        self._sq = 0.0
+        self._mean = 0.0
+        self._m2 = 0.0
+        self._zero = False
+
+    def update(self, y_true, y_pred) -> None:
+        if np.size(y_true) == 0:
+            return
+        t, p = _pair(y_true, y_pred)
+        e = p - t
+        self._zero |= bool(np.any(t == 0))
+        self._abs += float(np.sum(np.abs(e)))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            self._rel += float(np.sum(np.abs(e / t)))
+        self._sq += float(np.sum(e * e))
+        k = t.size
+        mean_b = float(t.mean())
+        m2_b = float(np.sum((t - mean_b) ** 2))
+        n = self.n + k
+        delta = mean_b - self._mean
+        self._mean += delta * k / n
+        self._m2 += m2_b + delta * delta * self.n * k / n
+        self.n = n
+
+    def result(self) -> dict[str, float]:
+        if self.n == 0:
+            raise ValueError("metrics need at least one value")
+        if self._zero:
+            raise ValueError("MAPE is undefined where the true value is 0")
+        if self._m2 == 0:
+            raise ValueError("R^2 is undefined when all true values are equal")
+        return {
+            "mape": 100.0 * self._rel / self.n,
+            "mae": self._abs / self.n,
+            "r2": 1.0 - self._sq / self._m2,
+        }

@@ -7,7 +7,13 @@ written to TOML; every rule is checked at this boundary and a broken one raises
 :class:`SceneError` naming the file, the key (with its line when it can be found) and the
 rule.
 
-This module imports numpy and the standard library only (no Qt, VTK or torch).
+Bounds (issue 13, :mod:`eyeviz.files.limits`): a scene file is a regular file of at most
+MAX_SCENE_BYTES; m <= MAX_SCENE_M; at most MAX_FEATURES features; coordinates, radii and the
+view width within [-MAX_SCENE_COORD, MAX_SCENE_COORD] (the view width at least
+MIN_VIEW_WIDTH); names without control characters (a newline or NUL could never be saved
+and would break an SVG) and at most MAX_NAME_CHARS long.
+
+This module imports the standard library and tomli_w only (no Qt, VTK or torch).
 """
 
 from __future__ import annotations
@@ -16,11 +22,15 @@ import copy
 import math
 import re
 import tomllib
+import unicodedata
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import tomli_w
+
 from eyeviz import EyevizError
 from eyeviz.core.geometry import EyePair
+from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
 
 __all__ = [
@@ -57,6 +67,26 @@ TRAJECTORY_KINDS = ("horizontal", "circular", "vertical")
 OKABE_ITO = ("#D55E00", "#0072B2", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#F0E442")
 DEFAULT_LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout"]
 _COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
+#: Bounds of what a scene may ask the app to draw (see the module docstring).
+MAX_SCENE_M = 100_000
+MAX_SCENE_COORD = 1e12
+MIN_VIEW_WIDTH = 1e-6
+MAX_STRINGS = 100
+
+
+def _short(v, n: int = 60) -> str:
+    t = repr(v)
+    return t if len(t) <= n else t[: n - 3] + "..."
+
+
+def _bad_text(s: str) -> str | None:
+    """Why ``s`` cannot be a name or title (None when it can)."""
+    if len(s) > limits.MAX_NAME_CHARS:
+        return f"longer than {limits.MAX_NAME_CHARS} characters ({len(s)})"
+    for ch in s:
+        if unicodedata.category(ch) in ("Cc", "Cs") or ch in "\u2028\u2029":
+            return f"contains the control character {ch!r}"
+    return None
 
 
 class SceneError(EyevizError):
@@ -131,6 +161,7 @@ class _Checker:
         self.source = source
 
     def fail(self, key: str, rule: str) -> SceneError:
+        rule = " ".join(rule.split())
         line = _line_of(self.text, key)
         where = f"{self.source}:{line}" if line else self.source
         return SceneError(f"{where}: {key}: {rule}")
@@ -157,9 +188,13 @@ class _Checker:
             return default
         v = tab[key]
         if isinstance(v, bool) or not isinstance(v, int | float):
-            raise self.fail(f"{prefix}{key}", f"must be a number, got {v!r}")
+            raise self.fail(f"{prefix}{key}", f"must be a number, got {_short(v)}")
+        if isinstance(v, int) and abs(v) > MAX_SCENE_COORD:
+            raise self.fail(f"{prefix}{key}", f"must be within +-{MAX_SCENE_COORD:g}")
         if not math.isfinite(v):
             raise self.fail(f"{prefix}{key}", f"must be finite, got {v!r}")
+        if abs(v) > MAX_SCENE_COORD:
+            raise self.fail(f"{prefix}{key}", f"must be within +-{MAX_SCENE_COORD:g}, got {v!r}")
         return float(v)
 
     def string(self, tab: dict, key: str, prefix: str, default=None) -> str:
@@ -169,7 +204,10 @@ class _Checker:
             return default
         v = tab[key]
         if not isinstance(v, str):
-            raise self.fail(f"{prefix}{key}", f"must be a string, got {v!r}")
+            raise self.fail(f"{prefix}{key}", f"must be a string, got {_short(v)}")
+        why = _bad_text(v)
+        if why:
+            raise self.fail(f"{prefix}{key}", f"{_short(v)} {why}")
         return v
 
     def strings(self, tab: dict, key: str, prefix: str, default: list[str]) -> list[str]:
@@ -177,7 +215,13 @@ class _Checker:
             return list(default)
         v = tab[key]
         if not isinstance(v, list) or not all(isinstance(s, str) for s in v):
-            raise self.fail(f"{prefix}{key}", f"must be a list of strings, got {v!r}")
+            raise self.fail(f"{prefix}{key}", f"must be a list of strings, got {_short(v)}")
+        if len(v) > MAX_STRINGS:
+            raise self.fail(f"{prefix}{key}", f"more than {MAX_STRINGS} entries")
+        for s in v:
+            why = _bad_text(s)
+            if why:
+                raise self.fail(f"{prefix}{key}", f"{_short(s)} {why}")
         return list(v)
 
 
@@ -224,7 +268,9 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
     l = c.number(eyes_t, "l", "eyes.", default=20.0)
     m = eyes_t.get("m", 720)
     if isinstance(m, bool) or not isinstance(m, int):
-        raise c.fail("eyes.m", f"must be an even integer >= 4, got {m!r}")
+        raise c.fail("eyes.m", f"must be an even integer >= 4, got {_short(m)}")
+    if m > MAX_SCENE_M:
+        raise c.fail("eyes.m", f"must be <= {MAX_SCENE_M} (what the app can draw), got {_short(m)}")
     try:
         EyePair(h, l, m)
     except ValueError as exc:
@@ -235,6 +281,8 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
     raw_features = doc.get("features", [])
     if not isinstance(raw_features, list):
         raise c.fail("features", "must be an array of tables ([[features]])")
+    if len(raw_features) > limits.MAX_FEATURES:
+        raise c.fail("features", f"{len(raw_features)} features, more than {limits.MAX_FEATURES}")
     features, names = [], set()
     for i, ft in enumerate(raw_features):
         p = f"features[{i}]."
@@ -279,12 +327,15 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
         not isinstance(center, list)
         or len(center) != 2
         or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in center)
-        or not all(math.isfinite(v) for v in center)
+        or not all(abs(v) <= MAX_SCENE_COORD for v in center)
     ):
-        raise c.fail("view.center", f"must be [x, y] (two finite numbers), got {center!r}")
+        raise c.fail(
+            "view.center",
+            f"must be [x, y] (two numbers within +-{MAX_SCENE_COORD:g}), got {_short(center)}",
+        )
     width = c.number(view_t, "width", "view.", default=8000.0)
-    if width <= 0:
-        raise c.fail("view.width", f"must be > 0, got {width!r}")
+    if not width >= MIN_VIEW_WIDTH:
+        raise c.fail("view.width", f"must be >= {MIN_VIEW_WIDTH:g}, got {width!r}")
     view = View((float(center[0]), float(center[1])), width)
 
     trajectory = None
@@ -311,67 +362,91 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
 
 def loads(text: str, source: str = "<string>") -> Scene:
     """Parse and validate a scene from TOML text; ``source`` names it in errors."""
+    if len(text) > limits.MAX_SCENE_BYTES:
+        raise SceneError(f"{source}: more than {limits.MAX_SCENE_BYTES} characters")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{source}: not valid TOML: {exc}") from None
-    return _scene_from_doc(doc, text, source)
+        raise SceneError(f"{source}: not valid TOML: {' '.join(str(exc).split())}") from None
+    except RecursionError:
+        raise SceneError(f"{source}: not valid TOML: nested too deeply") from None
+    except (ValueError, OverflowError) as exc:  # e.g. an integer of 5000 digits
+        raise SceneError(f"{source}: not valid TOML: {_short(str(exc), 120)}") from None
+    try:
+        return _scene_from_doc(doc, text, source)
+    except RecursionError:
+        raise SceneError(f"{source}: nested too deeply") from None
 
 
 def load(path) -> Scene:
-    """Read a scene file (TOML, DESIGN.md §3)."""
+    """Read a scene file (TOML, DESIGN.md §3): a regular file of at most MAX_SCENE_BYTES."""
     p = Path(path)
+    if not p.exists():
+        raise SceneError(f"{p}: no such scene file")
     try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SceneError(f"{p}: no such scene file") from None
-    except UnicodeDecodeError:
-        raise SceneError(f"{p}: not a text (UTF-8) file") from None
+        data = limits.read_bounded(p, limits.MAX_SCENE_BYTES, "scene file")
+    except EyevizError as exc:
+        raise SceneError(str(exc)) from None
     except OSError as exc:
         raise SceneError(f"{p}: cannot read: {exc.strerror or exc}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise SceneError(f"{p}: not a text (UTF-8) file") from None
     return loads(text, str(p))
 
 
-def _fmt(v: float) -> str:
-    return repr(float(v))
+def _doc(scene: Scene) -> dict:
+    """The TOML document of ``scene`` as plain data, keys in the order written."""
+    doc: dict = {}
+    if scene.title:
+        doc["title"] = scene.title
+    e = scene.eyes
+    doc["eyes"] = {"h": float(e.h), "l": float(e.l), "m": int(e.m)}
+    if scene.features:
+        doc["features"] = [
+            {"name": f.name, "x": float(f.x), "y": float(f.y), "g": float(f.g), "color": f.color}
+            for f in scene.features
+        ]
+    doc["layers"] = {"show": list(scene.layers)}
+    doc["predictions"] = {"estimators": list(scene.estimators)}
+    cx, cy = scene.view.center
+    doc["view"] = {"center": [float(cx), float(cy)], "width": float(scene.view.width)}
+    if scene.trajectory is not None:
+        t = scene.trajectory
+        doc["trajectory"] = {"kind": t.kind, "distance": float(t.distance), "g": float(t.g)}
+    return doc
 
 
-def _q(s: str) -> str:
-    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
+def _value(v) -> str:
+    """One TOML value: scalars by tomli_w (its quoting and float repr), arrays on one line."""
+    if isinstance(v, list):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    return tomli_w.dumps({"v": v})[4:].rstrip("\n")
+
+
+def _table(name: str | None, tab: dict, aot: bool = False) -> list[str]:
+    head = [] if name is None else [f"[[{name}]]" if aot else f"[{name}]"]
+    return head + [f"{k} = {_value(v)}" for k, v in tab.items()] + [""]
 
 
 def dumps(scene: Scene) -> str:
-    """TOML text of ``scene``; ``loads(dumps(s)) == s``."""
-    out = []
-    if scene.title:
-        out += [f"title = {_q(scene.title)}", ""]
-    e = scene.eyes
-    out += ["[eyes]", f"h = {_fmt(e.h)}", f"l = {_fmt(e.l)}", f"m = {int(e.m)}", ""]
-    for f in scene.features:
-        out += [
-            "[[features]]",
-            f"name = {_q(f.name)}",
-            f"x = {_fmt(f.x)}",
-            f"y = {_fmt(f.y)}",
-            f"g = {_fmt(f.g)}",
-            f"color = {_q(f.color)}",
-            "",
-        ]
-    out += ["[layers]", "show = [" + ", ".join(_q(s) for s in scene.layers) + "]", ""]
-    ests = ", ".join(_q(s) for s in scene.estimators)
-    out += ["[predictions]", f"estimators = [{ests}]", ""]
-    cx, cy = scene.view.center
-    out += ["[view]", f"center = [{_fmt(cx)}, {_fmt(cy)}]", f"width = {_fmt(scene.view.width)}", ""]
-    if scene.trajectory is not None:
-        t = scene.trajectory
-        out += [
-            "[trajectory]",
-            f"kind = {_q(t.kind)}",
-            f"distance = {_fmt(t.distance)}",
-            f"g = {_fmt(t.g)}",
-            "",
-        ]
-    return "\n".join(out)
+    """TOML text of ``scene``; ``loads(dumps(s)) == s``. Values are formatted by tomli_w
+    (strings escaped, floats as repr); the layout is one ``key = value`` per line, one
+    ``[[features]]`` table per feature, as the shipped scenes are written."""
+    doc = _doc(scene)
+    out: list[str] = []
+    if "title" in doc:
+        out += _table(None, {"title": doc["title"]})
+    out += _table("eyes", doc["eyes"])
+    for f in doc.get("features", []):
+        out += _table("features", f, aot=True)
+    for name in ("layers", "predictions", "view", "trajectory"):
+        if name in doc:
+            out += _table(name, doc[name])
+    text = "\n".join(out)
+    tomllib.loads(text)  # tomli_w's values, our layout: still TOML
+    return text
 
 
 def save(scene: Scene, path) -> None:

@@ -20,7 +20,12 @@ import math
 
 import numpy as np
 
+from eyeviz.core.domain import DEFAULTS
+from eyeviz.core.validation import check_int, check_positive
+
 __all__ = ["PAPER_COUNTS", "horizontal", "circular", "vertical", "paper_count"]
+
+_H, _L = float(DEFAULTS["h"]), float(DEFAULTS["l"])  # Table 3
 
 # Section 6: features per trajectory as a function of the distance r and the radius g.
 PAPER_COUNTS = {
@@ -31,19 +36,11 @@ PAPER_COUNTS = {
 
 
 def _check_positive(name: str, value) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a positive number, got {value!r}") from None
-    if not math.isfinite(v) or v <= 0:
-        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
-    return v
+    return check_positive(name, value)
 
 
 def _check_n(n) -> int:
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"n must be an integer >= 1, got {n!r}")
-    return int(n)
+    return check_int("n", n, ge=1)
 
 
 def _check_eyes(h, l) -> tuple[float, float]:
@@ -58,7 +55,7 @@ def _cells(lo: float, hi: float, n: int) -> np.ndarray:
     return lo + (np.arange(n, dtype=np.float64) + 0.5) * ((hi - lo) / n)
 
 
-def horizontal(r, g, n, *, h: float = 40.0, l: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
+def horizontal(r, g, n, *, h: float = _H, l: float = _L) -> tuple[np.ndarray, np.ndarray]:
     """Figure 14a: the line y = r, restricted to where a disc of radius g is in the BFV.
 
     A centre (x, r) is in the BFV when ``l*|x| <= w*r - g*h`` (Eq. 17).
@@ -73,7 +70,7 @@ def horizontal(r, g, n, *, h: float = 40.0, l: float = 20.0) -> tuple[np.ndarray
     return x, np.full(n, r)
 
 
-def circular(r, g, n, *, h: float = 40.0, l: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
+def circular(r, g, n, *, h: float = _H, l: float = _L) -> tuple[np.ndarray, np.ndarray]:
     """Figure 14b: the circle of radius r about the origin, inside the BFV.
 
     On the circle, ``w*y - l*|x| = h*r*sin(phi - psi)`` for phi <= pi/2 (and the mirror image
@@ -94,7 +91,7 @@ def circular(r, g, n, *, h: float = 40.0, l: float = 20.0) -> tuple[np.ndarray, 
 
 
 def vertical(
-    g, n, start: float = 1000.0, stop: float = 10000.0, *, h: float = 40.0, l: float = 20.0
+    g, n, start: float = 1000.0, stop: float = 10000.0, *, h: float = _H, l: float = _L
 ) -> tuple[np.ndarray, np.ndarray]:
     """Figure 14c: the central axis x = 0 from y = start to y = stop (length 9000 in Section 6).
 

@@ -27,6 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
+from eyeviz.core.domain import DEFAULTS as _D
+
 HELP = "estimators' AD/DD error, training and inference time (error against run time)"
 
 TEST_SEED = 20_231_122  # not a training seed of any shipped estimator
@@ -325,19 +327,34 @@ def to_csv(results: list[Result]) -> str:
     return buf.getvalue()
 
 
+def _descriptions(results: list[Result]) -> list[str]:
+    """One line per estimator from its registry entry (the one place its help lives)."""
+    from eyeviz.estimators import registry
+
+    lines = []
+    for r in results:
+        try:
+            lines.append(f"- **{r.name}**: {registry.get(r.name).help}")
+        except ValueError:
+            continue
+    return [*lines, ""] if lines else []
+
+
 def to_markdown(results: list[Result], n_test: int, seed: int, png: str | None) -> str:
     lim = _limit(results)
     lines = [
         "# Estimators: error against run time",
         "",
         f"Fresh test sets of {n_test} elements each, generated with the paper's parameters "
-        f"(h = 40, l = 20, m = 720; r in [1000, 5000], g <= 500), single-pass (seed {seed}) "
+        f"(h = {_D['h']:g}, l = {_D['l']:g}, m = {_D['m']}; r in [{_D['r_min']:g}, "
+        f"{_D['r_max']:g}], g <= {_D['g_max']:g}), single-pass (seed {seed}) "
         f"and multi-pass (seed {seed + 1}). AD = azimuth phi (radians), DD = distance r.",
         "MAPE is Eq. 34; R^2 is the **standard** coefficient of determination (spread of the "
         "true values, as scikit-learn's `r2_score`), not Eq. 35-36 (DESIGN.md §4).",
         "Inference time: per sample when the whole single-pass set is passed at once "
         "(best of 3 for fast estimators), and the median time of one call with one sample.",
         "",
+        *_descriptions(results),
     ]
     for mode in TEST_SETS:
         lines += [

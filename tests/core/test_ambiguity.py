@@ -114,3 +114,154 @@ def test_small_m_and_feature_covering_an_eye():
     assert _inside(reg.polygon, np.array([[119.3, 60.9]]))[0]
     with pytest.raises(ValueError, match="covers eye B"):
         ambiguity_region(pair, 45.0, 0.0, 10.0)
+
+
+# --- the annulus and the view (issue 13) ---------------------------------------------------
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from eyeviz.core.ambiguity import AmbiguityRegion  # noqa: E402
+
+ISSUE_FEATURE = (9.760288422542875, 40.44349772929664, 50.49839135687297)
+PAIRS = [EyePair(40.0, 20.0, 720), EyePair(40.0, 20.0, 24), EyePair(30.0, 10.0, 64)]
+
+
+def _near_inside(poly, pts, rel=1e-7):
+    """Inside the closed polygon up to a relative tolerance (the polygon is rounded)."""
+    if len(poly) < 3:
+        return np.zeros(len(pts), bool)
+    a, b = poly, np.roll(poly, -1, axis=0)
+    d = b - a
+    cross = d[None, :, 0] * (pts[:, 1:2] - a[None, :, 1]) - d[None, :, 1] * (
+        pts[:, 0:1] - a[None, :, 0]
+    )
+    tol = (
+        rel
+        * (np.abs(poly).max() + np.abs(pts).max(axis=1, keepdims=True))
+        * np.linalg.norm(d, axis=1)[None]
+    )
+    return np.all(cross >= -tol, axis=1)
+
+
+@st.composite
+def annulus_features(draw):
+    """Features whose disc nearly covers an eye: g < r_E < g / cos(gamma/2), plus some
+    just outside that annulus and ordinary ones."""
+    pair = draw(st.sampled_from(PAIRS))
+    kind = draw(st.sampled_from(["annulus", "annulus", "edge", "plain"]))
+    g = draw(st.floats(1.0, 400.0))
+    cx = draw(st.sampled_from([-pair.h, pair.h]))
+    ang = draw(st.floats(0.05, math.pi - 0.05))
+    outer = g / math.cos(pair.gamma / 2)
+    if kind == "annulus":
+        r = g + draw(st.floats(1e-6, 1.0)) * (outer - g)
+    elif kind == "edge":
+        r = outer * (1 + draw(st.floats(0.0, 1e-3)))
+    else:
+        r = g * draw(st.floats(1.05, 50.0))
+    x, y = cx + r * math.cos(ang), r * math.sin(ang)
+    other = -cx
+    if math.hypot(x - other, y) <= g:  # covers the other eye: no polygon at all
+        y += 3 * g + 2 * pair.h
+    return pair, x, y, g
+
+
+def _region(pair, x, y, g) -> AmbiguityRegion:
+    reg = ambiguity_region(pair, x, y, g)
+    assert isinstance(reg.exact, bool)
+    return reg
+
+
+def test_issue_example_is_flagged_unknown_and_radius_range_holds_g():
+    reg = _region(PAIRS[0], *ISSUE_FEATURE)
+    assert not reg.exact and [a[0] for a in reg.annuli] == ["B"]
+    name, cx, r_in, r_out = reg.annuli[0]
+    r_b = math.hypot(ISSUE_FEATURE[0] - cx, ISSUE_FEATURE[1])
+    assert r_in < r_b < r_out  # the feature lies in the flagged annulus
+    g0, g1 = ambiguity_radius_range(PAIRS[0], *ISSUE_FEATURE)
+    assert g0 <= ISSUE_FEATURE[2] <= g1
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(annulus_features())
+def test_feature_in_its_own_region_or_unknown(feat):
+    pair, x, y, g = feat
+    reg = _region(pair, x, y, g)
+    g0, g1 = ambiguity_radius_range(pair, x, y, g)
+    assert g0 <= g <= g1
+    if reg.exact:
+        assert _near_inside(reg.hull, np.array([[x, y]]))[0], reg
+        r0, r1 = reg.distance_range()
+        assert r0 * (1 - 1e-9) <= math.hypot(x, y) <= r1 * (1 + 1e-9)
+    else:
+        # the feature is either in the polygon or in one of the flagged annuli
+        in_ring = any(
+            r_in <= math.hypot(x - cx, y) * (1 + 1e-12) and math.hypot(x - cx, y) <= r_out * 1.0001
+            for _, cx, r_in, r_out in reg.annuli
+        )
+        assert in_ring or _near_inside(reg.hull, np.array([[x, y]]))[0]
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(annulus_features(), st.integers(0, 2**32 - 1))
+def test_exact_region_holds_every_matching_centre_nearby(feat, seed):
+    """When the region says exact, every centre near the feature that lights the same
+    intervals lies in the polygon (samples at several scales around the feature)."""
+    pair, x, y, g = feat
+    reg = _region(pair, x, y, g)
+    if not reg.exact:
+        return
+    rng = np.random.default_rng(seed)
+    scales = np.repeat([1e-6, 1e-3, 1e-2, 1e-1], 200)[:, None] * (g + math.hypot(x, y))
+    pts = np.array([x, y]) + rng.normal(size=(len(scales), 2)) * scales
+    same = _same(pair, pts, g, reg.intervals)
+    assert _near_inside(reg.hull, pts[same], rel=1e-6).all()
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    annulus_features(),
+    st.floats(1e-9, 1e7),
+    st.floats(-1e4, 1e4),
+    st.floats(-1e4, 1e4),
+)
+def test_ranges_do_not_depend_on_the_box(feat, width, cx, cy):
+    pair, x, y, g = feat
+    ref = ambiguity_region(pair, x, y, g)
+    box = (cx - width, cx + width, cy - width, cy + width)
+    reg = ambiguity_region(pair, x, y, g, box=box)
+    assert reg.bounded == ref.bounded and reg.exact == ref.exact
+    np.testing.assert_array_equal(reg.distance_range(), ref.distance_range())
+    np.testing.assert_array_equal(reg.azimuth_range(), ref.azimuth_range())
+    assert ambiguity_radius_range(pair, x, y, g, box=box) == ambiguity_radius_range(pair, x, y, g)
+    if len(reg.polygon):  # the box only clips the drawing
+        assert (reg.polygon[:, 0] >= box[0] - 1e-6 * width).all()
+        assert (reg.polygon[:, 0] <= box[1] + 1e-6 * width).all()
+
+
+def test_tiny_view_does_not_fail_and_gives_the_default_ranges():
+    x, y, g = 0.0, 1500.0, 50.0
+    full = ambiguity_region(PAIR, x, y, g)
+    for w in (10.0, 1e-3, 1e-9):
+        box = (x - w, x + w, y - w, y + w)
+        reg = ambiguity_region(PAIR, x, y, g, box=box)
+        assert reg.bounded and reg.distance_range() == full.distance_range()
+        assert ambiguity_radius_range(PAIR, x, y, g, box=box) == ambiguity_radius_range(
+            PAIR, x, y, g
+        )
+    # a view nowhere near the feature: nothing to draw, same ranges
+    reg = ambiguity_region(PAIR, x, y, g, box=(1e5, 1e5 + 1, 1e5, 1e5 + 1))
+    assert len(reg.polygon) == 0 and reg.distance_range() == full.distance_range()
+    lo, hi = full.distance_range()
+    assert 1400 < lo < 1500 < hi < 1800
+    with pytest.raises(ValueError, match="box must be finite"):
+        ambiguity_region(PAIR, x, y, g, box=(0, 0, 1, 1))
+
+
+def test_unbounded_region_reports_infinite_distance():
+    reg = ambiguity_region(PAIR, 0.0, 9000.0, 5.0)
+    assert not reg.bounded and len(reg.rays)
+    assert reg.distance_range()[1] == math.inf
+    lo, hi = reg.azimuth_range()
+    assert lo < math.pi / 2 < hi

@@ -259,18 +259,18 @@ def test_load_refuses_wrong_files(tmp_path):
 @pytest.mark.parametrize(
     "kw, msg",
     [
-        (dict(n=0), "n must be >= 1"),
+        (dict(n=0), "n must be an integer >= 1, got 0"),
         (dict(n=10, r_min=5000, r_max=1000), "r_min must be < r_max"),
         (dict(n=10, r_min=1000, r_max=1000), "r_min must be < r_max"),
-        (dict(n=10, g_max=0), "g_max must be > 0"),
+        (dict(n=10, g_max=0), "g_max must be a finite number > 0, got 0"),
         (dict(n=10, g_max=4.0), "no feature can be visible"),
-        (dict(n=10, r_min=-1), "r_min must be > 0"),
+        (dict(n=10, r_min=-1), "r_min must be a finite number > 0, got -1"),
         (dict(n=10, mode="triple"), "mode must be"),
         (
             dict(n=10, eyes=EyePair(40, 39.9, 4), r_min=100, r_max=200, g_max=90),
             "no visible feature fits in the BFV",
         ),
-        (dict(n=10, r_max=float("nan")), "r_max must be finite"),
+        (dict(n=10, r_max=float("nan")), "r_max must be a finite number > 0, got nan"),
     ],
 )
 def test_bad_parameters_refused(kw, msg):
@@ -281,9 +281,9 @@ def test_bad_parameters_refused(kw, msg):
 def test_cli_refuses_bad_parameters_before_any_work(tmp_path):
     out = tmp_path / "x.csv"
     for args, msg in [
-        (["-n", "0"], "n must be >= 1"),
+        (["-n", "0"], "n must be an integer >= 1, got 0"),
         (["-n", "5", "--r-min", "3000", "--r-max", "2000"], "r_min must be < r_max"),
-        (["-n", "5", "--g-max", "-1"], "g_max must be > 0"),
+        (["-n", "5", "--g-max", "-1"], "g_max must be a finite number > 0"),
         (["-n", "5", "--g-max", "1"], "no feature can be visible"),
         (["-n", "5", "--m", "7"], "m must be an even integer"),
     ]:
@@ -469,3 +469,70 @@ def test_full_disk_leaves_no_file(tmp_path, name):
     assert res.returncode == 2, res.stderr
     assert "File too large" in res.stderr and res.stderr.count("\n") == 1, res.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_generator_takes_the_one_domain_record():
+    from eyeviz.core.domain import Domain
+
+    dom = Domain(h=30, l=10, m=360, r_min=500, r_max=2000, g_max=200)
+    a = D.generate(200, dom, seed=4)
+    b = D.generate(200, EyePair(30, 10, 360), 500, 2000, 200, seed=4)
+    assert np.array_equal(a.omega_a, b.omega_a) and np.array_equal(a.r, b.r)
+    assert a.eyes.m == 360 and (a.r >= 500).all() and (a.r <= 2000).all()
+    p = D.make_params(dom, mode="multi", seed=1)
+    assert p.domain == dom and p.mode == "multi"
+    assert D.GenParams.from_domain(dom).domain == dom
+    assert D.make_params(dom, r_max=1500).r_max == 1500  # an explicit range wins
+    with pytest.raises(EyevizError, match="r_min must be < r_max"):
+        D.make_params(dom, r_max=400)
+
+
+def test_defaults_are_tables_3_and_4_written_once():
+    from eyeviz.core.domain import DEFAULTS, PAPER_DOMAIN
+
+    assert DEFAULTS == {
+        "h": 40.0,
+        "l": 20.0,
+        "m": 720,
+        "r_min": 1000.0,
+        "r_max": 5000.0,
+        "g_max": 500.0,
+    }
+    p = D.make_params()
+    assert p.domain == PAPER_DOMAIN and D.PAPER_EYES == PAPER_DOMAIN.eyes
+
+
+def _imports(module) -> set[str]:
+    import ast
+
+    tree = ast.parse(Path(module.__file__).read_text())
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module:
+            out.add(node.module + ":" + ",".join(a.name for a in node.names))
+        elif isinstance(node, ast.Import):
+            out.update(a.name for a in node.names)
+    return out
+
+
+def test_records_module_is_a_leaf_and_io_does_not_import_the_sampler():
+    import importlib
+
+    from eyeviz.dataset import io, records
+
+    assert not any(i.startswith("eyeviz.dataset") for i in _imports(records))
+    mods = [io]
+    if importlib.util.find_spec("eyeviz.dataset.reader"):
+        mods.append(importlib.import_module("eyeviz.dataset.reader"))
+    submodules = {"io", "reader", "records"}
+    for mod in mods:
+        bad = [
+            i
+            for i in _imports(mod)
+            if "algorithm1" in i
+            or (
+                i.startswith("eyeviz.dataset:")
+                and not set(i.split(":")[1].split(",")) <= submodules
+            )
+        ]
+        assert bad == [], (mod.__name__, bad)

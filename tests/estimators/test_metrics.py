@@ -32,3 +32,20 @@ def test_summary_keys_and_bad_input():
         metrics.mape([1.0, 2.0], [np.nan, 2.0])
     with pytest.raises(ValueError, match="true value is 0"):
         metrics.mape([0.0, 2.0], [1.0, 2.0])
+
+
+def test_running_summary_equals_summary_on_blocks():
+    import numpy as np
+
+    from eyeviz.estimators.metrics import RunningSummary, summary
+
+    rng = np.random.default_rng(3)
+    t = rng.uniform(1000, 5000, 10_001)
+    p = t * rng.normal(1, 0.05, t.size)
+    run = RunningSummary()
+    for s in range(0, t.size, 777):
+        run.update(t[s : s + 777], p[s : s + 777])
+    run.update(t[:0], p[:0])
+    got, want = run.result(), summary(t, p)
+    for k in want:
+        assert abs(got[k] - want[k]) <= 1e-9 * max(1.0, abs(want[k])), k

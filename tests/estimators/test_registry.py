@@ -35,3 +35,64 @@ def test_import_and_available_do_not_import_torch():
         "print('torch' in sys.modules)"
     )
     assert _run(code) == "False"
+
+
+def test_every_entry_declares_its_contract():
+    from eyeviz.estimators import registry
+
+    for e in registry.entries():
+        assert e.help and "\n" not in e.help and len(e.help) < 120, e.name
+        assert e.any_design == (e.design is None), e.name
+        if e.learns:
+            assert e.weights_hint.startswith(f"eyeviz train {e.name}"), e.name
+        for opt in (*e.load_options, *e.fit_options):
+            assert opt.flags and opt.dest.isidentifier(), (e.name, opt.flags)
+
+
+def test_bayes_help_says_median_not_mean():
+    from eyeviz.estimators import registry
+
+    assert "median" in registry.get("bayes").help
+    assert "mean" not in registry.get("bayes").help
+
+
+def test_needs_torch_is_true_exactly_for_torch_estimators():
+    code = (
+        "import sys; from eyeviz.estimators import registry as r;"
+        "import eyeviz.estimators as e;"
+        "out = {};\n"
+        "for n in ('analytic', 'bayes', 'compact'):\n"
+        "    before = 'torch' in sys.modules; e.load(n); out[n] = 'torch' in sys.modules\n"
+        "print(out['analytic'], out['bayes'], out['compact'],"
+        " r.get('analytic').needs_torch, r.get('bayes').needs_torch, r.get('compact').needs_torch)"
+    )
+    assert _run(code) == "False False True False False True"
+
+
+def test_register_a_plug_in_and_unregister():
+    from eyeviz import EyevizError
+    from eyeviz.estimators import registry
+    from eyeviz.estimators.analytic import AnalyticEstimator
+
+    entry = registry.Entry("mine", "a test plug-in", lambda **kw: AnalyticEstimator(**kw))
+    registry.register(entry)
+    try:
+        assert "mine" in estimators.available()
+        assert isinstance(estimators.load("mine"), AnalyticEstimator)
+        with pytest.raises(EyevizError, match="already registered"):
+            registry.register(entry)
+        with pytest.raises(EyevizError, match="does not learn"):
+            estimators.fit("mine")
+    finally:
+        registry.unregister("mine")
+    assert "mine" not in estimators.available()
+
+
+def test_limit_entry_listed_only_when_its_module_exists():
+    import importlib.util
+
+    from eyeviz.estimators import registry
+
+    present = importlib.util.find_spec("eyeviz.estimators.limit") is not None
+    assert ("limit" in estimators.available()) == present
+    assert registry._REGISTRY["limit"].any_design

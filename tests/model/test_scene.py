@@ -93,7 +93,7 @@ def test_missing_colours_take_okabe_ito_in_order():
             ("m = 720", "m = 720\n[trajectory]\nkind = 'zigzag'\ndistance = 1.0\ng = 1.0"),
             ["trajectory.kind", "horizontal"],
         ),
-        (("m = 720", "m = 720\n[view]\nwidth = 0.0"), ["view.width", "> 0"]),
+        (("m = 720", "m = 720\n[view]\nwidth = 0.0"), ["view.width", ">= 1e-06"]),
     ],
 )
 def test_errors_name_key_line_and_rule(edit, words):
@@ -133,3 +133,85 @@ def test_scene_module_imports_nothing_heavy():
     )
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert r.returncode == 0, r.stdout + r.stderr
+
+
+# --- hostile scene files (issue 13) -----------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "edit, words",
+    [
+        (("m = 720", "m = 2000000000"), ["<t>:5: eyes.m", "<= 100000"]),
+        (("m = 720", "m = 9223372036854775807"), ["eyes.m", "<= 100000"]),
+        (("x = 0.0", "x = " + "9" * 400), ["features[0].x", "within"]),
+        (("x = 0.0", "x = 1e300"), ["<t>:9: features[0].x", "within +-1e+12"]),
+        (("g = 50.0", "g = 1e308"), ["features[0].g", "within"]),
+        (("m = 720", "m = 720\n[view]\nwidth = 5e-324"), ["view.width", ">= 1e-06"]),
+        (("m = 720", "m = 720\n[view]\ncenter = [1e300, 0]"), ["view.center", "within"]),
+        (('name = "a"', 'name = "a\\nb"'), ["<t>:8: features[0].name", "control character"]),
+        (('name = "a"', 'name = "a\\u0000b"'), ["features[0].name", "'\\x00'"]),
+        (('name = "a"', 'name = "' + "n" * 1_000_000 + '"'), ["longer than 200"]),
+        (("m = 720", 'm = 720\n[layers]\nshow = ["eyes\\r"]'), ["layers.show", "control"]),
+    ],
+)
+def test_hostile_values_one_line(edit, words):
+    msg = _one_line_error(BASE.replace(*edit))
+    for w in words:
+        assert w in msg, msg
+    assert len(msg) < 300
+
+
+def _one_line_error(text):
+    with pytest.raises(SceneError) as info:
+        loads(text, "<t>")
+    msg = str(info.value)
+    assert "\n" not in msg
+    return msg
+
+
+def test_deep_nesting_and_huge_numbers_one_line():
+    assert "nested too deeply" in _one_line_error("a = " + "[" * 100_000 + "]" * 100_000)
+    assert "nested too deeply" in _one_line_error("a = " + "{b = " * 5000 + "1" + "}" * 5000)
+    msg = _one_line_error("a = " + "9" * 5000)  # an int tomllib refuses to build
+    assert "not valid TOML" in msg or "a: unknown key" in msg
+
+
+def test_too_many_features():
+    many = "".join(
+        f'[[features]]\nname = "f{i}"\nx = 0.0\ny = {i + 100}.0\ng = 1.0\n' for i in range(10_001)
+    )
+    assert "10001 features, more than 10000" in _one_line_error(many)
+
+
+def test_file_bounds(tmp_path):
+    big = tmp_path / "big.toml"
+    big.write_text(BASE + "#" * (1 << 20))
+    with pytest.raises(SceneError, match="bytes, more than 1048576"):
+        load(big)
+    with pytest.raises(SceneError, match="is not a regular file"):
+        load("/dev/zero")
+    with pytest.raises(SceneError, match="is not a regular file"):
+        load(tmp_path)
+    fifo = tmp_path / "f.toml"
+    import os
+
+    os.mkfifo(fifo)
+    with pytest.raises(SceneError, match="is not a regular file"):
+        load(fifo)  # would block forever if opened
+
+
+def test_names_that_cannot_be_saved_are_refused_at_save_too(tmp_path):
+    s = loads(BASE)
+    s.features[0].name = "a\nb"
+    with pytest.raises(SceneError, match="control character"):
+        save(s, tmp_path / "s.toml")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_dumps_is_tomli_w_quoted_and_stable():
+    s = loads(BASE)
+    s.title = 'quote " backslash \\ tab-free ünïcode'
+    s.features[0].name = 'it\'s "x"'
+    text = dumps(s)
+    assert loads(text) == s and dumps(loads(text)) == text
+    assert "[[features]]" in text and 'show = ["eyes", "bfv"' in text

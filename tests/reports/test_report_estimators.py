@@ -57,6 +57,11 @@ def test_report_writes_md_csv_png_and_lists_missing_paper(tmp_path, no_paper_wei
     md = (out / "estimators.md").read_text()
     assert "standard" in md and "not trained here" in md and "Table 5" in md
     assert "estimators.png" in md
+    # each estimator described once, from its registry entry
+    from eyeviz.estimators import registry
+
+    assert f"- **analytic**: {registry.get('analytic').help}" in md
+    assert f"- **paper**: {registry.get('paper').help}" in md
     assert (out / "estimators.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "unavailable" in capsys.readouterr().out
 

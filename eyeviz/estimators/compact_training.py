@@ -1,0 +1,354 @@
+"""Training of the compact networks: data (generated or given), Adam + one-cycle with early
+stopping, staged output (:mod:`eyeviz.estimators.store`), and :func:`fit`, the registry's
+one training shape. Imports torch."""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from eyeviz import EyevizError
+from eyeviz.core.validation import check_int, check_real
+from eyeviz.estimators.base import PAPER_DOMAIN, Domain
+from eyeviz.estimators.compact import (
+    AD_SCALE,
+    N_FEATURES,
+    CompactEstimator,
+    CompactNet,
+    _atomic,
+    _save_net,
+    features,
+)
+from eyeviz.estimators.store import staged, user_models_dir
+
+__all__ = ["train", "fit"]
+
+
+def _generate(n: int, domain: Domain, seed: int, mode: str = "single"):
+    from eyeviz import dataset
+
+    p = dataset.make_params(domain.eyes, domain.r_min, domain.r_max, domain.g_max, mode, seed)
+    chunks = list(dataset.iter_chunks(n, p, chunk=1 << 17))
+    return {
+        k: np.concatenate([getattr(c, k) for c in chunks])
+        for k in ("r", "phi", "la", "ra", "lb", "rb")
+    }
+
+
+def _fit(
+    net: CompactNet,
+    x,
+    y,
+    xv,
+    yv,
+    predict: Callable,
+    epochs: int,
+    batch: int,
+    lr: float,
+    patience: int,
+    seed: int,
+    ckpt: Callable[[CompactNet], None],
+    progress: Callable[[str, int, int, float], None] | None,
+    label: str,
+) -> dict:
+    """Adam with a one-cycle schedule on the relative error; early stopping on validation."""
+    g = torch.Generator().manual_seed(seed)
+    n = x.shape[0]
+    steps = n // batch
+    opt = torch.optim.Adam(net.parameters(), lr=lr)
+    sched = torch.optim.lr_scheduler.OneCycleLR(opt, max_lr=lr, total_steps=epochs * steps)
+    best, best_state, bad, history = math.inf, None, 0, []
+    for ep in range(epochs):
+        net.train()
+        perm = torch.randperm(n, generator=g)
+        for i in range(steps):
+            idx = perm[i * batch : (i + 1) * batch]
+            opt.zero_grad(set_to_none=True)
+            loss = predict(net(x[idx]), y[idx])
+            loss.backward()
+            opt.step()
+            sched.step()
+        net.eval()
+        with torch.inference_mode():
+            val = float(predict(net(xv), yv))
+        history.append(val)
+        if progress is not None:
+            progress(label, ep + 1, epochs, val)
+        if val < best - 1e-7:
+            best, bad = val, 0
+            best_state = {k: v.detach().clone() for k, v in net.state_dict().items()}
+            ckpt(net)
+        else:
+            bad += 1
+            if bad >= patience:
+                break
+    if best_state is not None:
+        net.load_state_dict(best_state)
+    return {"epochs": len(history), "val_history": [round(v, 7) for v in history], "best_val": best}
+
+
+def train(
+    out_dir=None,
+    n_train: int = 1_000_000,
+    n_val: int = 100_000,
+    seed: int = 0,
+    epochs: int = 12,
+    hidden: int = 32,
+    hidden_ad: int = 8,
+    batch: int = 4096,
+    lr: float = 4e-3,
+    patience: int = 3,
+    domain: Domain = PAPER_DOMAIN,
+    threads: int = 2,
+    command: str | None = None,
+    progress: Callable[[str, int, int, float], None] | None = None,
+    data=None,
+) -> dict:
+    """Generate data (single pass, seeds ``seed`` and ``seed + 1``), train both nets, save.
+
+    ``data`` (a :class:`eyeviz.dataset.Dataset`) replaces the generated data: its single
+    feature rows are split 90 % / 10 % (seeded) into training and validation. Every file
+    (checkpoints, final weights, ``compact.json``) is written into a staging directory and
+    moved into ``out_dir`` (default: the user models directory, never the shipped assets
+    unless named) only at the end, so an interruption leaves the previous model intact.
+    Returns the metadata.
+    """
+    batch = check_int("batch", batch, ge=1)
+    n_train = check_int("n_train", n_train, ge=1)
+    n_val = check_int("n_val", n_val, ge=1)
+    epochs = check_int("epochs", epochs, ge=1)
+    lr = check_real("lr", lr, gt=0)
+    t0 = time.perf_counter()
+    if data is None:
+        if n_train < batch:
+            raise EyevizError(
+                f"-n must be >= {batch} (one batch of the one-cycle schedule), got {n_train}"
+            )
+        tr = _generate(n_train, domain, seed)
+        va = _generate(n_val, domain, seed + 1)
+    else:
+        tr, va = _split(data, seed, domain)
+        n_train, n_val = len(tr["r"]), len(va["r"])
+        if n_train < batch:
+            raise EyevizError(
+                f"need >= {batch} training rows (one batch), the data has {n_train} usable"
+            )
+    t_gen = time.perf_counter() - t0
+    out = Path(out_dir) if out_dir is not None else user_models_dir()
+    with staged(out) as stage:
+        return _train_into(
+            stage,
+            tr,
+            va,
+            t0,
+            t_gen,
+            n_train,
+            n_val,
+            seed,
+            epochs,
+            hidden,
+            hidden_ad,
+            batch,
+            lr,
+            patience,
+            domain,
+            threads,
+            command,
+            progress,
+            "single" if data is None else "given data set (90/10 split)",
+        )
+
+
+def _split(data, seed: int, domain: Domain) -> tuple[dict, dict]:
+    """Single-feature rows of a data set as interval columns, split 90/10 (seeded)."""
+    from eyeviz.estimators.base import bitmaps_to_intervals
+
+    if (data.eyes.h, data.eyes.l, data.eyes.m) != domain.design:
+        raise EyevizError(
+            f"data design h={data.eyes.h:g}, l={data.eyes.l:g}, m={data.eyes.m} differs from "
+            f"the domain's h={domain.h:g}, l={domain.l:g}, m={domain.m}"
+        )
+    la, ra, lb, rb, ok = bitmaps_to_intervals(data.omega_a, data.omega_b, domain.width)
+    cols = {"r": data.r, "phi": data.phi, "la": la, "ra": ra, "lb": lb, "rb": rb}
+    cols = {k: np.asarray(v)[ok] for k, v in cols.items()}
+    perm = np.random.default_rng(seed).permutation(len(cols["r"]))
+    n_val = max(1, len(perm) // 10)
+    return (
+        {k: v[perm[n_val:]] for k, v in cols.items()},
+        {k: v[perm[:n_val]] for k, v in cols.items()},
+    )
+
+
+def _train_into(
+    out: Path,
+    tr,
+    va,
+    t0,
+    t_gen,
+    n_train,
+    n_val,
+    seed,
+    epochs,
+    hidden,
+    hidden_ad,
+    batch,
+    lr,
+    patience,
+    domain,
+    threads,
+    command,
+    progress,
+    source,
+) -> dict:
+    """The body of :func:`train`, writing into the staging directory ``out``."""
+    torch.set_num_threads(threads)
+    torch.manual_seed(seed)
+
+    def prep(d):
+        x, log_r0, p0 = features(d["la"], d["ra"], d["lb"], d["rb"], domain)
+        return (
+            torch.from_numpy(x),
+            torch.from_numpy((np.log(d["r"]) - log_r0).astype(np.float32)),
+            torch.from_numpy(((d["phi"] - p0) / AD_SCALE).astype(np.float32)),
+            torch.from_numpy((d["phi"] / AD_SCALE).astype(np.float32)),
+        )
+
+    x, yd, ya, sa = prep(tr)
+    xv, ydv, yav, sav = prep(va)
+
+    def dd_loss(out, y):
+        return (torch.exp(out - y) - 1.0).abs().mean()
+
+    # AD: |phi_hat - phi| / phi with phi_hat - phi = AD_SCALE * (out - y)
+    ya_pair = torch.stack([ya, sa], 1)
+    yav_pair = torch.stack([yav, sav], 1)
+
+    def ad_loss(out, y):
+        return ((out - y[:, 0]).abs() / y[:, 1]).mean()
+
+    files = {"dd": "compact_dd.pt", "ad": "compact_ad.pt"}
+    info = {}
+    nets = {}
+    for name, y, yv, loss, zero, width in (
+        ("dd", yd, ydv, dd_loss, False, hidden),
+        ("ad", ya_pair, yav_pair, ad_loss, True, hidden_ad),
+    ):
+        torch.manual_seed(seed)
+        net = CompactNet(width, zero_last=zero)
+        ts = time.perf_counter()
+        path = out / files[name]
+        info[name] = _fit(
+            net,
+            x,
+            y,
+            xv,
+            yv,
+            loss,
+            epochs,
+            batch,
+            lr,
+            patience,
+            seed,
+            lambda n_, p=path, w=width: _save_net(n_, w, p),
+            progress,
+            name.upper(),
+        )
+        info[name]["seconds"] = round(time.perf_counter() - ts, 1)
+        _save_net(net, width, path)
+        nets[name] = net
+    est = CompactEstimator(nets["dd"], nets["ad"], domain)
+    pv = est.predict_intervals(va["la"], va["ra"], va["lb"], va["rb"])
+    from eyeviz.estimators import metrics
+
+    meta = {
+        "estimator": "compact",
+        "files": files,
+        "architecture": f"DD {N_FEATURES}-{hidden}-{hidden}-1, "
+        f"AD {N_FEATURES}-{hidden_ad}-{hidden_ad}-1, SiLU MLPs",
+        "n_weights": est.n_weights,
+        "data": {
+            **domain.to_dict(),
+            "mode": source,
+            "n_train": n_train,
+            "n_val": n_val,
+            "train_seed": seed,
+            "val_seed": seed + 1,
+        },
+        "training": {
+            "epochs_max": epochs,
+            "batch": batch,
+            "lr": lr,
+            "patience": patience,
+            "optimizer": "Adam + one-cycle",
+            "threads": threads,
+            "dd_loss": "mean |r_hat/r - 1|",
+            "ad_loss": "mean |phi_hat/phi - 1|",
+            **{name: info[name] for name in info},
+        },
+        "train_seconds": round(time.perf_counter() - t0, 1),
+        "generate_seconds": round(t_gen, 1),
+        "val_metrics": {
+            "dd": metrics.summary(va["r"], pv.r),
+            "ad": metrics.summary(va["phi"], pv.phi),
+        },
+        "torch": torch.__version__,
+        "command": command,
+        "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+    }
+    text = json.dumps(meta, indent=2)
+    _atomic(out / "compact.json", lambda tmp: Path(tmp).write_text(text))
+    return meta
+
+
+def fit(
+    data=None,
+    out_dir=None,
+    *,
+    domain: Domain | None = None,
+    n: int = 1_000_000,
+    n_val: int = 100_000,
+    seed: int = 0,
+    epochs: int = 12,
+    hidden: int = 32,
+    hidden_ad: int = 8,
+    patience: int = 3,
+    threads: int = 2,
+    command: str | None = None,
+    progress: Callable[[str, int, int, float], None] | None = None,
+) -> Path:
+    """The registry's training shape: train on ``data`` (a Dataset or a .csv/.npz path;
+    None: generate ``n`` + ``n_val`` elements in ``domain``) into ``out_dir`` (default the
+    user models directory), staged then swapped in. Returns the directory for ``load``."""
+    import os
+
+    for k, v in (("hidden", hidden), ("hidden_ad", hidden_ad), ("patience", patience)):
+        check_int(k, v, ge=1)
+    threads = check_int("threads", threads, ge=1)
+    dom = PAPER_DOMAIN if domain is None else domain
+    if isinstance(data, str | os.PathLike):
+        from eyeviz import dataset
+
+        data = dataset.load(data, dom.eyes)
+    out = Path(out_dir) if out_dir is not None else user_models_dir()
+    train(
+        out,
+        n,
+        n_val,
+        seed,
+        epochs,
+        hidden,
+        hidden_ad,
+        patience=patience,
+        domain=dom,
+        threads=threads,
+        command=command,
+        progress=progress,
+        data=data,
+    )
+    return out

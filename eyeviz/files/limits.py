@@ -1,0 +1,158 @@
+"""Bounds on every size a user or a file controls (issue 13), as named constants.
+
+Each ``check_*`` raises :class:`eyeviz.EyevizError` with a one-line message naming the
+value and the bound; a value beyond a bound is refused, never clamped. Readers call
+these *before* allocating anything the file declares.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import stat
+from pathlib import Path
+
+from eyeviz import EyevizError
+
+#: Rows of a generated data set (``eyeviz generate -n``).
+MAX_ROWS = 10**9
+#: Ommatidia per eye pair m (exactness of the interval formulas ends near 2**53 / 2; the
+#: app and the bitmaps need m/2 bytes per row and eye, so the practical bound is far lower).
+MAX_M = 1 << 20
+#: Multi-pass segments (``--segments``) and histogram bins (``--bins``).
+MAX_SEGMENTS = 10**5
+MAX_BINS = 10**5
+#: Scene TOML files, and any other small text file a user hands in.
+MAX_SCENE_BYTES = 1 << 20
+#: Features drawn in one scene / snapshot.
+MAX_FEATURES = 10**4
+#: Width of a hidden layer read from a model directory, and total parameters of a model.
+MAX_HIDDEN = 4096
+MAX_MODEL_PARAMS = 50_000_000
+#: Length of a feature name in a scene.
+MAX_NAME_CHARS = 200
+#: Largest r and g of a data set row, and |phi| (radians): beyond these no bitmap can
+#: describe the row and the metrics' sums of squares overflow (r = 1e308 in a CSV).
+MAX_DATA_R = 1e15
+MAX_DATA_PHI = 8.0
+#: Smallest r_min of a generated data set, relative to the eye pair's h (below it the
+#: exact path works with numbers so far apart that it takes hours).
+MIN_R_OVER_H = 1e-6
+
+
+def check_int(name: str, value, lo: int, hi: int) -> int:
+    """``value`` as an int in ``[lo, hi]``; floats such as 1e23 or inf are refused."""
+    if isinstance(value, bool):
+        raise EyevizError(f"{name} must be an integer, got {value!r}")
+    if isinstance(value, float):
+        if not math.isfinite(value) or value != int(value):
+            raise EyevizError(f"{name} must be a whole number, got {value!r}")
+        value = int(value)
+    try:
+        v = int(value)
+    except (TypeError, ValueError, OverflowError):
+        raise EyevizError(f"{name} must be an integer, got {value!r}") from None
+    if not lo <= v <= hi:
+        raise EyevizError(f"{name} must be in [{lo}, {hi}], got {_short(v)}")
+    return v
+
+
+def _short(v) -> str:
+    s = str(v)
+    return s if len(s) <= 40 else f"{s[:20]}...({len(s)} digits)"
+
+
+def check_rows(n) -> int:
+    return check_int("n (rows)", n, 1, MAX_ROWS)
+
+
+def check_m(m) -> int:
+    return check_int("m", m, 4, MAX_M)
+
+
+def check_segments(k) -> int:
+    return check_int("segments", k, 1, MAX_SEGMENTS)
+
+
+def check_bins(k) -> int:
+    return check_int("bins", k, 1, MAX_BINS)
+
+
+def check_model_shape(name: str, shape, max_dim: int = MAX_M) -> tuple[int, ...]:
+    """A tensor shape read from a model file, checked before anything is allocated:
+    every dimension in [1, max_dim] and at most MAX_MODEL_PARAMS elements in all.
+
+    For the hidden width of a network use :func:`check_hidden` (at most MAX_HIDDEN);
+    e.g. ``check_model_shape("compact_dd.pt: net.0.weight", (hidden, m))``."""
+    try:
+        dims = tuple(int(d) for d in shape)
+    except (TypeError, ValueError, OverflowError):
+        msg = f"model {name}: shape must be a list of integers, got {shape!r}"
+        raise EyevizError(msg) from None
+    total = 1
+    for d in dims:
+        if not 1 <= d <= max_dim:
+            raise EyevizError(f"model {name}: dimension {d} outside [1, {max_dim}]")
+        total *= d
+    if total > MAX_MODEL_PARAMS:
+        raise EyevizError(f"model {name}: {total} parameters exceed {MAX_MODEL_PARAMS}")
+    return dims
+
+
+def check_hidden(name: str, hidden) -> int:
+    """A hidden width declared by a model directory (e.g. ``compact_dd.pt`` hidden=30000)."""
+    return check_int(f"model {name}: hidden width", hidden, 1, MAX_HIDDEN)
+
+
+def check_file_size(path, max_bytes: int, what: str = "file") -> int:
+    """A regular file no larger than ``max_bytes`` (refuses /dev/zero, FIFOs, folders)."""
+    p = Path(path)
+    try:
+        st = p.stat()
+    except OSError as exc:
+        raise EyevizError(f"cannot read {what} {str(p)!r}: {exc.strerror}") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise EyevizError(f"{what} {str(p)!r} is not a regular file")
+    if st.st_size > max_bytes:
+        raise EyevizError(f"{what} {str(p)!r} is {st.st_size} bytes, more than {max_bytes}")
+    return st.st_size
+
+
+def read_bounded(path, max_bytes: int, what: str = "file") -> bytes:
+    """The bytes of a regular file, reading at most ``max_bytes + 1`` whatever it claims."""
+    check_file_size(path, max_bytes, what)
+    with open(path, "rb") as f:
+        data = f.read(max_bytes + 1)
+    if len(data) > max_bytes:
+        raise EyevizError(f"{what} {str(path)!r} is larger than {max_bytes} bytes")
+    return data
+
+
+def check_free_space(path, needed_bytes: int) -> None:
+    """Refuse an output whose estimated size exceeds the free space of its folder."""
+    d = Path(path).parent if str(Path(path).parent) else Path(".")
+    try:
+        free = shutil.disk_usage(d).free
+    except OSError:
+        return
+    if needed_bytes > free:
+        raise EyevizError(
+            f"output {str(path)!r} would need about {needed_bytes / 1e9:.3g} GB, "
+            f"only {free / 1e9:.3g} GB free in {str(d)!r}"
+        )
+
+
+def estimated_output_bytes(n: int, m: int, fmt: str) -> int:
+    """Upper-ish estimate of a data set file: CSV 2 bytes per bit + ~60 per row of floats;
+    NPZ m/8 + 24 bytes per row."""
+    if fmt == "csv":
+        return n * (2 * m + 60)
+    return n * (2 * ((m // 2 + 7) // 8) + 24)
+
+
+def check_r_min(r_min: float, h: float) -> float:
+    """r_min must be >= MIN_R_OVER_H * h (near 1e-300 the exact path takes hours)."""
+    if not r_min >= MIN_R_OVER_H * h:
+        bound = MIN_R_OVER_H * h
+        raise EyevizError(f"r_min = {r_min!r} is below {MIN_R_OVER_H:g} * h = {bound:g}")
+    return r_min

@@ -1,0 +1,120 @@
+"""The check battery over every registered estimator that can load here, and proof that
+the battery catches broken estimators."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from eyeviz import EyevizError, estimators
+from eyeviz.estimators import checks, registry
+from eyeviz.estimators.analytic import AnalyticEstimator
+
+SMALL = estimators.Domain(h=10, l=5, m=180, r_min=200, r_max=1000, g_max=100)
+
+
+def _loadable():
+    out = []
+    for e in registry.entries():
+        kw = {"domain": SMALL} if e.any_design else {}
+        try:
+            est = e.load_estimator(**kw)
+        except (ValueError, OSError) as exc:  # weights missing here: checked below
+            out.append(pytest.param(e.name, None, marks=pytest.mark.skip(reason=str(exc))))
+            continue
+        out.append(pytest.param(e.name, est, id=e.name))
+        if e.any_design:
+            out.append(pytest.param(e.name, e.load_estimator(), id=f"{e.name}-paper-domain"))
+    return out
+
+
+_CASES = [
+    pytest.param(est, check, id=f"{id_}-{check.__name__}")
+    for p in _loadable()
+    if p.values[1] is not None
+    for id_, est in [(p.id or p.values[0], p.values[1])]
+    for check in checks.CHECKS
+]
+
+
+@pytest.mark.parametrize("est, check", _CASES)
+def test_registered_estimator_passes(est, check):
+    check(est)
+
+
+def test_every_shipped_estimator_is_checked():
+    names = {c.values[0].name for c in _CASES}
+    assert {"analytic", "bayes", "compact"} <= names
+
+
+def test_paper_entry_says_weights_missing(tmp_path, monkeypatch):
+    monkeypatch.setenv("EYEVIZ_PAPER_DIR", str(tmp_path))
+    with pytest.raises(EyevizError) as info:
+        estimators.load("paper")
+    msg = str(info.value)
+    assert "not found" in msg and "eyeviz train paper" in msg and "\n" not in msg
+
+
+def test_check_estimator_returns_every_check_name():
+    done = checks.check_estimator(estimators.load("analytic"))
+    assert done == [c.__name__ for c in checks.CHECKS]
+
+
+class _Float32(AnalyticEstimator):
+    name = "float32"
+
+    def predict(self, a, b):
+        p = super().predict(a, b)
+        return type(p)(np.asarray(p.r, np.float32), p.phi, p.valid, p.in_domain)
+
+
+class _NoMask(AnalyticEstimator):
+    name = "nomask"
+
+    def predict(self, a, b):
+        p = super().predict(a, b)
+        return type(p)(np.nan_to_num(p.r, nan=1.0), p.phi, p.valid, p.in_domain)
+
+
+class _Noisy(AnalyticEstimator):
+    name = "noisy"
+
+    def _predict_intervals(self, LA, RA, LB, RB):
+        r, phi = super()._predict_intervals(LA, RA, LB, RB)
+        return r * np.random.default_rng().uniform(0.9, 1.1, r.shape), phi
+
+
+class _AcceptsAnything(AnalyticEstimator):
+    name = "lenient"
+
+    def predict(self, a, b):
+        a = np.asarray(a)
+        if a.ndim == 2 and a.shape[1] != self.domain.width:
+            a = np.zeros((a.shape[0], self.domain.width), bool)
+            return super().predict(a, a)
+        return super().predict(a, b)
+
+
+class _NoDomain(AnalyticEstimator):
+    name = "nodomain"
+
+    def __init__(self):
+        super().__init__()
+        self.domain = {"m": 720}
+
+
+@pytest.mark.parametrize(
+    "broken, failing",
+    [
+        (_Float32(), "check_shapes_and_dtypes"),
+        (_NoMask(), "check_masks"),
+        (_Noisy(), "check_deterministic"),
+        (_AcceptsAnything(), "check_rejects_wrong_m"),
+        (_NoDomain(), "check_declares_domain"),
+    ],
+)
+def test_battery_catches_broken_estimators(broken, failing):
+    with pytest.raises(AssertionError):
+        getattr(checks, failing)(broken)
+    with pytest.raises(AssertionError, match=f"{broken.name}: check_"):
+        checks.check_estimator(broken)

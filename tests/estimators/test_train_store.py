@@ -1,0 +1,181 @@
+"""Training output: the user directory by default, never the shipped assets unless asked,
+staged then swapped in (an interruption leaves the previous model as it was)."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from eyeviz import EyevizError, estimators
+from eyeviz.estimators import compact, store
+from eyeviz.resources import models_dir
+
+ROOT = Path(__file__).resolve().parents[2]
+SMALL = {"n": 4096, "n_val": 500, "epochs": 1, "threads": 1}
+
+
+def _hashes(d: Path) -> dict[str, str]:
+    return {
+        str(p.relative_to(d)): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(d.rglob("*"))
+        if p.is_file()
+    }
+
+
+def _run(args, home, timeout=300):
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "EYEVIZ_HOME": str(home), "MPLBACKEND": "Agg"}
+    return subprocess.run(
+        [sys.executable, "-m", "eyeviz", *args],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+def test_user_models_dir_follows_eyeviz_home(tmp_path, monkeypatch):
+    monkeypatch.setenv("EYEVIZ_HOME", str(tmp_path))
+    assert store.user_models_dir() == tmp_path / "models"
+    monkeypatch.delenv("EYEVIZ_HOME")
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "xdg"))
+    assert store.user_models_dir() == tmp_path / "xdg" / "eyeviz" / "models"
+    assert store.resolve_out_dir(None, False) == tmp_path / "xdg" / "eyeviz" / "models"
+    assert store.resolve_out_dir(None, True, "paper") == models_dir() / "paper"
+    with pytest.raises(EyevizError, match="either -o DIR or --into-assets"):
+        store.resolve_out_dir("x", True)
+
+
+def test_staged_swaps_on_success_and_keeps_old_on_error(tmp_path):
+    out = tmp_path / "m"
+    with store.staged(out) as st:
+        (st / "w.pt").write_text("new")
+        (st / "w.json").write_text("{}")
+    assert (out / "w.pt").read_text() == "new"
+    with pytest.raises(RuntimeError), store.staged(out) as st:
+        (st / "w.pt").write_text("half")
+        raise RuntimeError("boom")
+    assert (out / "w.pt").read_text() == "new"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m"]  # no staging left behind
+
+
+def test_interrupted_fit_leaves_previous_model_untouched(tmp_path):
+    out = tmp_path / "models"
+    path = estimators.fit("compact", None, out, **SMALL)
+    assert path == out
+    before = _hashes(out)
+    assert set(before) == {"compact.json", "compact_dd.pt", "compact_ad.pt"}
+
+    def interrupt(label, ep, total, val):
+        if label == "AD":  # the DD checkpoint has been written (into the staging dir)
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        compact.fit(None, out, n=4096, n_val=500, epochs=2, seed=3, threads=1, progress=interrupt)
+    assert _hashes(out) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["models"]
+    estimators.load("compact", path=out).predict([0] * 360, [0] * 360)
+
+
+def test_sigint_during_train_leaves_previous_output(tmp_path):
+    home = tmp_path / "home"
+    res = _run(["train", "compact", "-n", "4096", "--n-val", "500", "--epochs", "1"], home)
+    assert res.returncode == 0, res.stderr
+    out = home / "models"
+    before = _hashes(out)
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "EYEVIZ_HOME": str(home)}
+    args = ["train", "compact", "-n", "8192", "--n-val", "500", "--epochs", "400"]
+    args += ["--patience", "400", "--seed", "5", "--threads", "1"]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "eyeviz", *args],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        deadline = time.monotonic() + 120
+        while not list(home.glob(".models.staging-*/compact_dd.pt")):
+            assert proc.poll() is None, proc.communicate()
+            assert time.monotonic() < deadline, "no checkpoint in the staging dir"
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode != 0
+    assert _hashes(out) == before
+    assert not list(home.glob(".models.staging-*"))
+
+
+def test_train_leaves_shipped_assets_unchanged(tmp_path):
+    assets = models_dir()
+    before = _hashes(assets)
+    home = tmp_path / "home"
+    res = _run(["train", "compact", "-n", "4096", "--n-val", "500", "--epochs", "1"], home)
+    assert res.returncode == 0, res.stderr
+    assert str(home / "models") in res.stderr + res.stdout  # the output dir is printed
+    assert _hashes(assets) == before
+    assert (home / "models" / "compact.json").is_file()
+    data = tmp_path / "d.npz"
+    assert _run(["generate", "-n", "100", "-o", str(data)], home).returncode == 0
+    res = _run(
+        [
+            "predict",
+            "-e",
+            "compact",
+            "--weights",
+            str(home / "models"),
+            str(data),
+            "-o",
+            str(tmp_path / "p.csv"),
+        ],
+        home,
+    )
+    assert res.returncode == 0, res.stderr
+    assert len((tmp_path / "p.csv").read_text().splitlines()) == 101
+
+
+def test_train_bayes_npz_name_into_user_dir(tmp_path):
+    home = tmp_path / "home"
+    out = tmp_path / "t" / "b.npz"
+    res = _run(["train", "bayes", "-n", "20000", "-o", str(out)], home)
+    assert res.returncode == 0, res.stderr
+    est = estimators.load("bayes", path=out)
+    assert est.metadata["sample_size"] == 20000
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["paper", "--ad-lr", "nan"], "ad_lr must be a finite number > 0, got nan"),
+        (["paper", "--ad-lr", "inf"], "ad_lr must be a finite number > 0, got inf"),
+        (["paper", "--ad-lr", "0"], "ad_lr must be a finite number > 0, got 0.0"),
+        (["paper", "--dd-momentum", "1", "-n", "20"], "dd_momentum must be"),
+        (["paper", "-n", "5"], "n must be an integer >= 10, got 5"),
+        (["paper", "--budget", "-3"], "budget must be a finite number > 0"),
+        (["compact", "-n", "1000"], "-n must be >= 4096 (one batch"),
+        (["compact", "--threads", "0"], "threads must be an integer >= 1, got 0"),
+        (["bayes", "-n", "0"], "n must be an integer >= 1, got 0"),
+    ],
+)
+def test_bad_training_options_one_line(tmp_path, args, message):
+    res = _run(["train", *args], tmp_path)
+    assert res.returncode == 2
+    last = res.stderr.strip().splitlines()[-1]
+    assert last.startswith("eyeviz: error: ") and message in last, res.stderr
+    assert "Traceback" not in res.stderr
+    assert not (tmp_path / "models").exists() or not any((tmp_path / "models").rglob("*.pt"))
+
+
+def test_into_assets_and_out_together_refused(tmp_path):
+    res = _run(["train", "compact", "-o", str(tmp_path), "--into-assets"], tmp_path)
+    assert res.returncode == 2
+    assert "not allowed with" in res.stderr
