@@ -18,6 +18,8 @@ from __future__ import annotations
 from fractions import Fraction
 from math import gcd
 
+import numpy as np
+
 #: cos(30k deg) = a + b*sqrt(3), k = 0..11, as (a, b)
 _COS30 = [
     (1, 0), (0, Fraction(1, 2)), (Fraction(1, 2), 0), (0, 0),
@@ -173,3 +175,105 @@ def exact_overlaps(x: float, y: float, g: float, cx: float, l: float) -> bool:
     X = Fraction(x) - Fraction(cx)
     Y, S = Fraction(y), Fraction(g) + Fraction(l)
     return X * X + Y * Y <= S * S
+
+
+# --- vectorised ties: floating-point expansions instead of mpmath ------------------------
+#
+# On a boundary beta_n at a multiple of 30 or 45 degrees, 2*cos(beta_n) and 2*sin(beta_n)
+# are A + B*sqrt(k) with integers A, B in -2..2 (k = 3 or 2). Every test of
+# :func:`_endpoint_at_or_past` then is the sign of a + b*sqrt(k) where 2a and 2b are sums
+# of at most four floats (x - cx split exactly by two-sum, times 0, +-1 or +-2: exact).
+# Those sums' signs are exact from a nonoverlapping expansion (Shewchuk's GROW-EXPANSION);
+# a + b*sqrt(k) with b != 0 is never 0 (sqrt(k) is irrational), so when the signs of a and
+# b differ, |a| against |b|*sqrt(k) is decided in floats with a wide relative margin and
+# only the undecidable rest (none in practice) is left to the rational path.
+
+#: doubled cos(30 j deg), j = 0..11, as (rational, sqrt 3) integer parts
+_COS30_2 = np.array([(2, 0), (0, 1), (1, 0), (0, 0), (-1, 0), (0, -1),
+                     (-2, 0), (0, -1), (-1, 0), (0, 0), (1, 0), (0, 1)], np.float64)  # fmt: skip
+#: doubled cos(45 j deg), j = 0..7, as (rational, sqrt 2) integer parts
+_COS45_2 = np.array([(2, 0), (0, 1), (0, 0), (0, -1),
+                     (-2, 0), (0, -1), (0, 0), (0, 1)], np.float64)  # fmt: skip
+_SAFE_MAG = 2.0**1000  # doubling and two-sum cannot overflow below this
+_TINY = 2.0**-960  # below this a product b*sqrt(k) may lose relative accuracy
+_UNKNOWN = 2
+
+
+def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Knuth's error-free sum: s + e == a + b exactly, s = fl(a + b)."""
+    s = a + b
+    bb = s - a
+    e = (a - (s - bb)) + (b - bb)
+    return s, e
+
+
+def _expansion(terms: list[np.ndarray]) -> list[np.ndarray]:
+    """Nonoverlapping expansion (increasing magnitude, zeros allowed) of a sum of floats."""
+    e: list[np.ndarray] = []
+    for t in terms:
+        q, grown = t, []
+        for comp in e:
+            q, h = _two_sum(q, comp)
+            grown.append(h)
+        grown.append(q)
+        e = grown
+    return e
+
+
+def _sign_of(e: list[np.ndarray]) -> np.ndarray:
+    """Exact sign of an expansion: the sign of its largest nonzero component."""
+    s = np.zeros(e[0].shape, np.int8)
+    for comp in reversed(e):
+        s = np.where(s == 0, np.sign(comp).astype(np.int8), s)
+    return s
+
+
+def _sign_quadratic(a_terms, b_terms, root: np.ndarray) -> np.ndarray:
+    """Sign of a + b*sqrt(root) (a, b sums of floats); ``_UNKNOWN`` where undecided."""
+    ea, eb = _expansion(a_terms), _expansion(b_terms)
+    sa, sb = _sign_of(ea), _sign_of(eb)
+    out = np.where(sb == 0, sa, np.where((sa == 0) | (sa == sb), sb, 0)).astype(np.int8)
+    mixed = (sa != 0) & (sb != 0) & (sa != sb)
+    if mixed.any():
+        A = np.abs(sum(ea))  # relative error a few ulps: the margin below is 2^-40
+        B = np.abs(sum(eb)) * np.sqrt(root)
+        big_a = A > B * (1 + 2.0**-40)
+        big_b = B > A * (1 + 2.0**-40)
+        ok = (A > _TINY) & (B > _TINY) & (big_a | big_b)
+        out[mixed] = np.where(ok, np.where(big_a, sa, sb), _UNKNOWN)[mixed]
+    return out
+
+
+def ties_at_or_past(x, y, g, cx: float, n, m: int, upper) -> np.ndarray:
+    """Vectorised :func:`_endpoint_at_or_past` on boundaries at 30 or 45 degree multiples.
+
+    Arrays x, y, g (floats), n (int64 boundary indices), upper (bool). Returns int8:
+    1 if the tangent direction is at or past beta_n, 0 if before, -1 where this cannot
+    decide (another angle, or magnitudes near the float range's ends): use the scalar path.
+    """
+    n = np.asarray(n, np.int64)
+    x, y, g = (np.asarray(v, np.float64) for v in (x, y, g))
+    is30 = (12 * n) % m == 0
+    is45 = ~is30 & ((8 * n) % m == 0)
+    j30 = ((12 * n) // m) % 12
+    j45 = ((8 * n) // m) % 8
+    cos2 = np.where(is30[:, None], _COS30_2[j30], _COS45_2[j45])
+    sin2 = np.where(is30[:, None], _COS30_2[(j30 - 3) % 12], _COS45_2[(j45 - 2) % 8])
+    root = np.where(is30, 3.0, 2.0)
+    mag = np.maximum(np.maximum(np.abs(x), abs(cx)), np.maximum(np.abs(y), np.abs(g)))
+    usable = (is30 | is45) & (mag < _SAFE_MAG)
+    xh, xl = _two_sum(x, np.full_like(x, -cx))
+    ca, cb, sa, sb = cos2[:, 0], cos2[:, 1], sin2[:, 0], sin2[:, 1]
+    zero = np.zeros_like(x)
+    # s = y cos - x sin ; e = x cos + y sin ; s -/+ g  (all doubled)
+    s_b = [y * cb, -xh * sb, -xl * sb]
+    s = _sign_quadratic([zero, y * ca, -xh * sa, -xl * sa], s_b, root)
+    e = _sign_quadratic([zero, xh * ca, xl * ca, y * sa], [xh * cb, xl * cb, y * sb], root)
+    gs = np.where(upper, 2 * g, -2 * g)
+    sg = _sign_quadratic([gs, y * ca, -xh * sa, -xl * sa], s_b, root)
+    known = usable & (s != _UNKNOWN) & (e != _UNKNOWN) & (sg != _UNKNOWN)
+    up = (s >= 0) | ((e >= 0) & (sg >= 0))
+    lo = (s >= 0) & ((e < 0) | (sg >= 0))
+    res = np.where(upper, up, lo).astype(np.int8)
+    res[~known] = -1
+    return res

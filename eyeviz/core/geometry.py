@@ -260,19 +260,52 @@ class EyePair:
             self._refine(xs, ys, gs, q, t_lo, t_hi, idx, cx, lo_out[sl], hi_out[sl], whole[sl])
 
     def _refine(self, xs, ys, gs, q, c_lo, c_hi, idx, cx, lo, hi, whole) -> None:
-        """Re-decide flagged elements: a per-element rounding bound, then exact."""
+        """Re-decide flagged elements: a per-element rounding bound, then exact.
+
+        An endpoint within the bound of an integer n has floor n or n - 1; when beta_n is a
+        multiple of 30 or 45 degrees (every tie of the ground line, an eye's vertical line
+        and the 30/60-degree ties) :func:`exact.ties_at_or_past` decides which, vectorised
+        with floating-point expansions. Only what that cannot decide reaches mpmath.
+        """
         qi = q[idx]
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):
             tol = (_TOL_BASE + _TOL_GRAZE / np.maximum(1 - qi, 0)) * _U * self.m
+        outside = qi < 1 - 8 * _U * 4
         clear_inside = qi > 1 + 8 * _U * 4
-        clear_outside = (qi < 1 - 8 * _U * 4) & (
-            np.maximum(np.abs(c_lo[idx]), np.abs(c_hi[idx])) <= 0.5 - tol
-        )
+        clear_outside = outside & (np.maximum(np.abs(c_lo[idx]), np.abs(c_hi[idx])) <= 0.5 - tol)
         whole[idx[clear_inside]] = True
-        todo = idx[~(clear_inside | clear_outside)]
+        rest = ~(clear_inside | clear_outside)
+        todo, tol = idx[rest], tol[rest]
         FALLBACK_COUNTS["flagged"] += idx.size
+        if not todo.size:
+            return
+        valid = outside[rest] & (tol < 0.25)
+        scalar = ~valid
+        parts = []
+        for c_arr, f_arr, upper in ((c_lo, lo, False), (c_hi, hi, True)):
+            c = c_arr[todo]
+            need = valid & (np.abs(c) > 0.5 - tol)
+            j = np.flatnonzero(need)
+            n = f_arr[todo[j]] + (c[j] > 0)
+            parts.append((j, n, upper, f_arr))
+        js = np.concatenate([p[0] for p in parts])
+        if js.size:
+            el = todo[js]
+            ns = np.concatenate([p[1] for p in parts])
+            ups = np.concatenate([np.full(p[0].size, p[2]) for p in parts])
+            res = exact.ties_at_or_past(xs[el], ys[el], gs[el], cx, ns, self.m, ups)
+            scalar[js[res < 0]] = True
+            k = 0
+            for j, n, _upper, f_arr in parts:
+                r = res[k : k + j.size]
+                k += j.size
+                ok = r >= 0
+                f_arr[todo[j[ok]]] = n[ok] - 1 + r[ok]
+        todo_s = todo[scalar]
         FALLBACK_COUNTS["exact"] += todo.size
-        for j in todo:
+        FALLBACK_COUNTS["ties"] += todo.size - todo_s.size
+        FALLBACK_COUNTS["mpmath"] += todo_s.size
+        for j in todo_s:
             res = exact.exact_floor_pair(float(xs[j]), float(ys[j]), float(gs[j]), cx, self.m)
             if res is None:
                 whole[j] = True
