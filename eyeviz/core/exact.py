@@ -95,32 +95,47 @@ def exact_floor_pair(x: float, y: float, g: float, cx: float, m: int) -> tuple[i
         return None
     import mpmath
 
-    # enough bits to hold x - cx exactly, however far apart their exponents are
+    # enough bits to hold x - cx exactly, however far apart their exponents are; every
+    # mpmath operation, rounding included, runs inside workprec: the caller's global
+    # mpmath.mp.prec never matters
     prec = max(192, 2 * max(X.numerator.bit_length(), X.denominator.bit_length()))
     while True:
         with mpmath.workprec(prec):
-            dx, dy, gg = _mpf(X), _mpf(Y), _mpf(G)
-            r = mpmath.hypot(dx, dy)
-            q = gg / r
-            if q >= 1:  # outside by less than this precision resolves
-                prec *= 2
-                continue
-            phi = mpmath.atan2(dy, dx)
-            alpha = mpmath.asin(q)
-            k = m / (2 * mpmath.pi)
-            t_lo, t_hi = (phi - alpha) * k, (phi + alpha) * k
-            eps = mpmath.ldexp(m * (4 + 1 / (1 - q)), 24 - prec)
-            if eps < 0.25:
-                break
+            floors = _floors_at(X, Y, G, m, prec)
+        if floors is not None:
+            lo, hi = floors
+            break
         prec *= 2
     out = []
-    for t, upper in ((t_lo, False), (t_hi, True)):
-        n = int(mpmath.nint(t))
-        if abs(t - n) > eps:
-            out.append(int(mpmath.floor(t)))
+    for (n, t_floor), upper in ((lo, False), (hi, True)):
+        if t_floor is not None:
+            out.append(t_floor)
         else:
             out.append(n if _endpoint_at_or_past(X, Y, G, n, m, upper) else n - 1)
     return out[0], out[1]
+
+
+def _floors_at(X: Fraction, Y: Fraction, G: Fraction, m: int, prec: int):
+    """Inside a workprec(prec) block: per endpoint (n, floor) with floor None when the
+    value lies within the error bound of the integer n; None when prec is too small."""
+    import mpmath
+
+    dx, dy, gg = _mpf(X), _mpf(Y), _mpf(G)
+    r = mpmath.hypot(dx, dy)
+    q = gg / r
+    if q >= 1:  # outside by less than this precision resolves
+        return None
+    phi = mpmath.atan2(dy, dx)
+    alpha = mpmath.asin(q)
+    k = m / (2 * mpmath.pi)
+    eps = mpmath.ldexp(m * (4 + 1 / (1 - q)), 24 - prec)
+    if not eps < 0.25:
+        return None
+    res = []
+    for t in ((phi - alpha) * k, (phi + alpha) * k):
+        n = int(mpmath.nint(t))
+        res.append((n, int(mpmath.floor(t)) if abs(t - n) > eps else None))
+    return res
 
 
 def _endpoint_at_or_past(

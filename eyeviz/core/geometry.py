@@ -27,6 +27,7 @@ from eyeviz.core import exact
 __all__ = ["EyePair", "intervals_to_bitmap", "validate_features", "validate_points"]
 
 _U = 2.0**-53  # unit roundoff of float64
+_TINY_SCALE = 2.0**-960  # above this, underflow in a product errs below 16 u of the scale
 _CHUNK = 1 << 15  # elements per block: keeps the temporaries in cache
 _Q_SAFE = 0.75  # g / r_E below this uses one scalar rounding bound per block
 # A generous multiple of the forward error of the fast path, in units of u*m:
@@ -34,6 +35,12 @@ _Q_SAFE = 0.75  # g / r_E below this uses one scalar rounding bound per block
 # term grows like 1/(1 - g/r_E) near grazing.
 _TOL_BASE = 64.0
 _TOL_GRAZE = 16.0
+
+#: Largest m: sector indices and the floors of Eq. 11 (|t| < m) are held in float64 and
+#: int64 and must be exact to the unit, so m <= 2^53. From about m = 2^45 the rounding
+#: bound of the fast path exceeds half a sector and every element takes the exact path:
+#: right, but slow. ``EyePair(..., m)`` refuses larger m with a one-line message.
+M_MAX = 2**53
 
 #: Diagnostics for the stability report: elements the fast path flagged near a boundary
 #: ("flagged") and those of them decided by the exact predicates ("exact").
@@ -87,11 +94,18 @@ def validate_features(x, y, g) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return xa, ya, ga
 
 
+def _short(value) -> str:
+    """repr of a parameter for a one-line message, ints beyond float range shortened."""
+    text = repr(value)
+    return text if len(text) <= 40 else f"{text[:12]}...({len(text)} characters)"
+
+
 def _check_param(name: str, value, rule: str) -> float:
     try:
         v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number ({rule}), got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        msg = f"{name} must be a finite real number ({rule}), got {_short(value)}"
+        raise ValueError(msg) from None
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite ({rule}), got {value!r}")
     return v
@@ -123,17 +137,18 @@ class EyePair:
                 f"h must be > l (eyes may not touch the y-axis), got h={self.h!r}, l={self.l!r}"
             )
         m = self.m
+        bad_m = f"m must be an even integer in [4, {M_MAX}], got {_short(m)}"
         if isinstance(m, bool):
-            raise ValueError(f"m must be an even integer >= 4, got {m!r}")
+            raise ValueError(bad_m)
         try:
             mi = operator.index(m)
         except TypeError:
             if isinstance(m, float) and math.isfinite(m) and m.is_integer():
                 mi = int(m)
             else:
-                raise ValueError(f"m must be an even integer >= 4, got {m!r}") from None
-        if mi < 4 or mi % 2:
-            raise ValueError(f"m must be an even integer >= 4, got {m!r}")
+                raise ValueError(bad_m) from None
+        if mi < 4 or mi % 2 or mi > M_MAX:
+            raise ValueError(bad_m)
         object.__setattr__(self, "h", h)
         object.__setattr__(self, "l", l)
         object.__setattr__(self, "m", mi)
@@ -355,14 +370,19 @@ class EyePair:
         shape = xa.shape
         xa, ya, ga = xa.ravel(), ya.ravel(), ga.ravel()
         h, l = self.h, self.l
-        w = math.sqrt((h - l) * (h + l))
-        wy, lx, gh = w * ya, l * xa, ga * h
-        right = wy - lx - gh
-        left = wy + lx - gh
-        scale = np.abs(wy) + np.abs(lx) + np.abs(gh)
-        tol = 16 * _U * scale
+        with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+            w = float(np.sqrt(np.float64(h - l) * (h + l)))
+            wy, lx, gh = w * ya, l * xa, ga * h
+            right = wy - lx - gh
+            left = wy + lx - gh
+            scale = np.abs(wy) + np.abs(lx) + np.abs(gh)
+            tol = 16 * _U * scale
+            near = (np.abs(right) <= tol) | (np.abs(left) <= tol)
         out = (right >= 0) & (left >= 0)
-        near = (np.abs(right) <= tol) | (np.abs(left) <= tol)
+        # products that overflow (inf, NaN) or fall where underflow is no longer relative
+        near |= ~(scale >= _TINY_SCALE) | ~np.isfinite(scale)
+        if not 2.0**-400 < w < 2.0**400:  # h^2 - l^2 itself over- or underflowed
+            near[:] = True
         for i in np.flatnonzero(near):
             out[i] = exact.exact_in_bfv(float(xa[i]), float(ya[i]), float(ga[i]), h, l)
         return out.reshape(shape)
@@ -374,12 +394,16 @@ class EyePair:
         xa, ya, ga = xa.ravel(), ya.ravel(), ga.ravel()
         res = []
         for cx in (-self.h, self.h):
-            dx = xa - cx
-            d2 = dx * dx + ya * ya
-            s = ga + self.l
-            rhs = s * s
+            with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+                dx = xa - cx
+                d2 = dx * dx + ya * ya
+                s = ga + self.l
+                rhs = s * s
+                tot = d2 + rhs
+                near = np.abs(d2 - rhs) <= 16 * _U * tot
             out = d2 <= rhs
-            near = np.abs(d2 - rhs) <= 16 * _U * (d2 + rhs)
+            # squares that overflow (inf, NaN) or underflow: decided exactly, as intervals does
+            near |= ~(tot >= _TINY_SCALE) | ~np.isfinite(tot)
             for i in np.flatnonzero(near):
                 out[i] = exact.exact_overlaps(float(xa[i]), float(ya[i]), float(ga[i]), cx, self.l)
             res.append(out.reshape(shape))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 
@@ -30,20 +31,23 @@ def test_constants_of_the_paper():
     assert PAPER.centers == ((-40.0, 0.0), (40.0, 0.0))
 
 
+M_RULE = "m must be an even integer in [4, 9007199254740992], got "
+
+
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
         ({"h": 40, "l": 0, "m": 720}, "l (eye radius) must be > 0"),
         ({"h": 20, "l": 20, "m": 720}, "h must be > l"),
-        ({"h": 40, "l": 20, "m": 721}, "m must be an even integer >= 4, got 721"),
-        ({"h": 40, "l": 20, "m": 2}, "m must be an even integer >= 4, got 2"),
+        ({"h": 40, "l": 20, "m": 721}, M_RULE + "721"),
+        ({"h": 40, "l": 20, "m": 2}, M_RULE + "2"),
         ({"h": 40, "l": 20, "m": 7.5}, "m must be an even integer"),
         ({"h": float("nan"), "l": 20, "m": 720}, "h must be finite"),
         ({"h": 40, "l": float("inf"), "m": 720}, "l must be finite"),
     ],
 )
 def test_forbidden_parameters_are_refused(kwargs, message):
-    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+    with pytest.raises(ValueError, match=re.escape(message)):
         EyePair(**kwargs)
 
 
