@@ -222,25 +222,75 @@ class EyePair:
         return np.mod(out, self.m).reshape(shape)
 
     # --- features ---------------------------------------------------------------------
-    def _eye_floors(
-        self, x, y, g, cx: float, refine: bool = True
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Raw (floor(t_lo), floor(t_hi), whole) of Eq. 11 for one eye on 1-D arrays.
+    def _fast_intervals(self, x, y, g, refine: bool, outs) -> None:
+        """Eq. 11 for both eyes, block by block, into ``outs`` = (LA, RA, LB, RB) int64.
 
-        ``refine=False`` skips the exact fallback (benchmarks measure its cost with it).
+        Per block: y*y once for both eyes, every temporary in a reused buffer, and the
+        rounding bound checked by a few min/max reductions (r^2 in range, g/r_E <= 0.75,
+        every fractional part of t at least ``tol0`` from an integer) instead of per-element
+        masks. A block that passes writes L and R straight into the outputs; one that does
+        not (a tie, a graze, a huge m, an over/underflow) is handed to :meth:`_block`, the
+        per-element path with the exact fallback. ``refine=False`` skips that fallback
+        (benchmarks measure its cost with it).
         """
         n = x.shape[0]
-        lo_out = np.empty(n, np.int64)
-        hi_out = np.empty(n, np.int64)
-        whole = np.zeros(n, bool)
-        k = self._k
-        tol0 = (_TOL_BASE + _TOL_GRAZE / (1 - _Q_SAFE)) * _U * self.m
-        for s in range(0, n, _CHUNK):
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                self._block(
-                    x, y, g, cx, refine, slice(s, s + _CHUNK), k, tol0, lo_out, hi_out, whole
+        k, m = self._k, self.m
+        tol0 = (_TOL_BASE + _TOL_GRAZE / (1 - _Q_SAFE)) * _U * m
+        c = min(_CHUNK, max(n, 1))
+        yy, dx, r2, q, pk, ak, tlo, thi = (np.empty(c) for _ in range(8))
+        wrap = np.empty(c, np.int64)
+        eyes = ((-self.h, outs[0], outs[1]), (self.h, outs[2], outs[3]))
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+            for s in range(0, n, c):
+                e = min(n, s + c)
+                b = e - s
+                xs, ys, gs = x[s:e], y[s:e], g[s:e]
+                yy_, dx_, r2_, q_, pk_, ak_, tlo_, thi_ = (
+                    v[:b] for v in (yy, dx, r2, q, pk, ak, tlo, thi)
                 )
-        return lo_out, hi_out, whole
+                np.multiply(ys, ys, out=yy_)
+                for cx, Lo, Ro in eyes:
+                    np.subtract(xs, cx, out=dx_)
+                    np.multiply(dx_, dx_, out=r2_)
+                    r2_ += yy_
+                    np.sqrt(r2_, out=q_)
+                    np.divide(gs, q_, out=q_)
+                    clean = r2_.min() >= 1e-290 and r2_.max() <= 1e300 and q_.max() <= _Q_SAFE
+                    if clean:
+                        np.arctan2(ys, dx_, out=pk_)
+                        pk_ *= k
+                        np.arcsin(q_, out=ak_)
+                        ak_ *= k
+                        np.subtract(pk_, ak_, out=tlo_)
+                        np.add(pk_, ak_, out=thi_)
+                        np.floor(tlo_, out=pk_)  # floor(t_lo)
+                        np.floor(thi_, out=ak_)  # floor(t_hi)
+                        tlo_ -= pk_  # fractional parts in [0, 1)
+                        thi_ -= ak_
+                        clean = min(tlo_.min(), thi_.min()) >= tol0 and (
+                            max(tlo_.max(), thi_.max()) <= 1 - tol0
+                        )
+                    L, R = Lo[s:e], Ro[s:e]
+                    if not clean:
+                        self._slow_block(xs, ys, gs, cx, refine, L, R)
+                        continue
+                    # phi in (-pi, pi] and alpha <= pi/2: floor(t_lo) > -m, one wrap at most
+                    L[...] = pk_
+                    ak_ -= pk_  # R - L
+                    np.right_shift(L, 63, out=wrap[:b])
+                    wrap[:b] &= m
+                    L += wrap[:b]
+                    R[...] = ak_
+                    R += L
+
+    def _slow_block(self, xs, ys, gs, cx, refine, L, R) -> None:
+        """One block for one eye by the per-element path (flagged blocks only)."""
+        b = xs.shape[0]
+        lo, hi, whole = np.empty(b, np.int64), np.empty(b, np.int64), np.zeros(b, bool)
+        tol0 = (_TOL_BASE + _TOL_GRAZE / (1 - _Q_SAFE)) * _U * self.m
+        self._block(xs, ys, gs, cx, refine, slice(None), self._k, tol0, lo, hi, whole)
+        L[...], R[...] = self._normalised(lo, hi, whole)
+        FALLBACK_COUNTS["slow blocks"] += 1
 
     def _block(self, x, y, g, cx, refine, sl, k, tol0, lo_out, hi_out, whole) -> None:
         """Fast path of Eq. 11 on one cache-sized block; flags elements near a boundary."""
@@ -348,11 +398,9 @@ class EyePair:
         xa, ya, ga = validate_features(x, y, g)
         shape = xa.shape
         xf, yf, gf = (np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, ga))
-        out = []
-        for cx in (-self.h, self.h):
-            L, R = self._normalised(*self._eye_floors(xf, yf, gf, cx, refine))
-            out += [L.reshape(shape), R.reshape(shape)]
-        return tuple(out)
+        outs = tuple(np.empty(xf.shape[0], np.int64) for _ in range(4))
+        self._fast_intervals(xf, yf, gf, refine, outs)
+        return tuple(o.reshape(shape) for o in outs)
 
     def bitmaps(self, x, y, g) -> tuple[np.ndarray, np.ndarray]:
         """Whole-eye bitmaps (omega_a, omega_b), bool of shape (..., m)."""
