@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from eyeviz.core import exact
+from eyeviz.core import bits, exact
 
 __all__ = ["EyePair", "intervals_to_bitmap", "validate_features", "validate_points"]
 
@@ -462,24 +462,6 @@ def intervals_to_bitmap(L, R, m: int, width: int | None = None) -> np.ndarray:
     """Bool bitmap (..., width) of ommatidia 0..width-1 lit by {k mod m : L <= k <= R}.
 
     ``width`` defaults to m (the whole eye); m // 2 gives the paper's Omega (Section 4).
-    Built in row blocks so the temporaries stay in cache: ``k - L`` read as unsigned is
-    at most ``R - L`` exactly on the lit ommatidia of a run that does not wrap past m - 1;
-    the few runs that wrap add ``k <= R - m``.
+    One memcpy-sized window per row (:func:`eyeviz.core.bits.bool_bitmaps`).
     """
-    L, R = np.broadcast_arrays(np.asarray(L, dtype=np.int64), np.asarray(R, dtype=np.int64))
-    width = m if width is None else width
-    out = np.empty(L.shape + (width,), dtype=bool)
-    flat = out.reshape(-1, width)
-    sdt = np.int16 if m < 2**15 else np.int32 if m < 2**31 else np.int64
-    udt = np.dtype(sdt).str.replace("i", "u")
-    k = np.arange(width, dtype=sdt)
-    Lf = L.reshape(-1, 1).astype(sdt)
-    Cf = (R - L).reshape(-1, 1).astype(udt)
-    rows = max(1, (1 << 19) // max(width, 1))
-    for s in range(0, flat.shape[0], rows):
-        d = k - Lf[s : s + rows]
-        np.less_equal(d.view(udt), Cf[s : s + rows], out=flat[s : s + rows])
-    wrap = np.flatnonzero(R.reshape(-1) >= m)
-    if wrap.size:
-        flat[wrap] |= k <= (R.reshape(-1)[wrap, None] - m)
-    return out
+    return bits.bool_bitmaps(L, R, m, width)
