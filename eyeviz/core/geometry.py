@@ -228,9 +228,9 @@ class EyePair:
         Per block: y*y once for both eyes, every temporary in a reused buffer, and the
         rounding bound checked by a few min/max reductions (r^2 in range, g/r_E <= 0.75,
         every fractional part of t at least ``tol0`` from an integer) instead of per-element
-        masks. A block that passes writes L and R straight into the outputs; one that does
-        not (a tie, a graze, a huge m, an over/underflow) is handed to :meth:`_block`, the
-        per-element path with the exact fallback. ``refine=False`` skips that fallback
+        masks. L and R go straight into the outputs; in a block that fails the check, only
+        the elements a per-element mask flags (a tie, a graze, a huge m, an over/underflow)
+        are handed to :meth:`_block`, the per-element path with the exact fallback. ``refine=False`` skips that fallback
         (benchmarks measure its cost with it).
         """
         n = x.shape[0]
@@ -256,24 +256,21 @@ class EyePair:
                     np.sqrt(r2_, out=q_)
                     np.divide(gs, q_, out=q_)
                     clean = r2_.min() >= 1e-290 and r2_.max() <= 1e300 and q_.max() <= _Q_SAFE
-                    if clean:
-                        np.arctan2(ys, dx_, out=pk_)
-                        pk_ *= k
-                        np.arcsin(q_, out=ak_)
-                        ak_ *= k
-                        np.subtract(pk_, ak_, out=tlo_)
-                        np.add(pk_, ak_, out=thi_)
-                        np.floor(tlo_, out=pk_)  # floor(t_lo)
-                        np.floor(thi_, out=ak_)  # floor(t_hi)
-                        tlo_ -= pk_  # fractional parts in [0, 1)
-                        thi_ -= ak_
-                        clean = min(tlo_.min(), thi_.min()) >= tol0 and (
-                            max(tlo_.max(), thi_.max()) <= 1 - tol0
-                        )
+                    np.arctan2(ys, dx_, out=pk_)
+                    pk_ *= k
+                    np.arcsin(q_, out=ak_)  # NaN where q > 1: such blocks are not clean
+                    ak_ *= k
+                    np.subtract(pk_, ak_, out=tlo_)
+                    np.add(pk_, ak_, out=thi_)
+                    np.floor(tlo_, out=pk_)  # floor(t_lo)
+                    np.floor(thi_, out=ak_)  # floor(t_hi)
+                    tlo_ -= pk_  # fractional parts in [0, 1)
+                    thi_ -= ak_
+                    clean = clean and (
+                        min(tlo_.min(), thi_.min()) >= tol0
+                        and max(tlo_.max(), thi_.max()) <= 1 - tol0
+                    )
                     L, R = Lo[s:e], Ro[s:e]
-                    if not clean:
-                        self._slow_block(xs, ys, gs, cx, refine, L, R)
-                        continue
                     # phi in (-pi, pi] and alpha <= pi/2: floor(t_lo) > -m, one wrap at most
                     L[...] = pk_
                     ak_ -= pk_  # R - L
@@ -282,15 +279,22 @@ class EyePair:
                     L += wrap[:b]
                     R[...] = ak_
                     R += L
+                    if not clean:  # the few elements near a boundary, out of range or grazing
+                        near = (tlo_ < tol0) | (tlo_ > 1 - tol0) | (thi_ < tol0)
+                        near |= thi_ > 1 - tol0
+                        near |= ~((r2_ >= 1e-290) & (r2_ <= 1e300) & (q_ <= _Q_SAFE))
+                        idx = np.flatnonzero(near)
+                        L[idx], R[idx] = self._slow_block(xs[idx], ys[idx], gs[idx], cx, refine)
 
-    def _slow_block(self, xs, ys, gs, cx, refine, L, R) -> None:
-        """One block for one eye by the per-element path (flagged blocks only)."""
+    def _slow_block(self, xs, ys, gs, cx, refine) -> tuple[np.ndarray, np.ndarray]:
+        """(L, R) of one eye by the per-element path with its exact fallback (the few
+        elements of a block that the block check could not clear)."""
         b = xs.shape[0]
         lo, hi, whole = np.empty(b, np.int64), np.empty(b, np.int64), np.zeros(b, bool)
         tol0 = (_TOL_BASE + _TOL_GRAZE / (1 - _Q_SAFE)) * _U * self.m
         self._block(xs, ys, gs, cx, refine, slice(None), self._k, tol0, lo, hi, whole)
-        L[...], R[...] = self._normalised(lo, hi, whole)
-        FALLBACK_COUNTS["slow blocks"] += 1
+        FALLBACK_COUNTS["slow elements"] += b
+        return self._normalised(lo, hi, whole)
 
     def _block(self, x, y, g, cx, refine, sl, k, tol0, lo_out, hi_out, whole) -> None:
         """Fast path of Eq. 11 on one cache-sized block; flags elements near a boundary."""
