@@ -230,8 +230,8 @@ class EyePair:
         every fractional part of t at least ``tol0`` from an integer) instead of per-element
         masks. L and R go straight into the outputs; in a block that fails the check, only
         the elements a per-element mask flags (a tie, a graze, a huge m, an over/underflow)
-        are handed to :meth:`_block`, the per-element path with the exact fallback. ``refine=False`` skips that fallback
-        (benchmarks measure its cost with it).
+        are handed to :meth:`_block`, the per-element path with the exact fallback.
+        ``refine=False`` skips that fallback (benchmarks measure its cost with it).
         """
         n = x.shape[0]
         k, m = self._k, self.m
