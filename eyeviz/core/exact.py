@@ -201,7 +201,8 @@ def exact_overlaps(x: float, y: float, g: float, cx: float, l: float) -> bool:
 # Those sums' signs are exact from a nonoverlapping expansion (Shewchuk's GROW-EXPANSION);
 # a + b*sqrt(k) with b != 0 is never 0 (sqrt(k) is irrational), so when the signs of a and
 # b differ, |a| against |b|*sqrt(k) is decided in floats with a wide relative margin and
-# only the undecidable rest (none in practice) is left to the rational path.
+# only the undecidable rest (near-ties in Q(sqrt k), magnitudes near the ends of the float
+# range) is decided in exact rationals, element by element.
 
 #: doubled cos(30 j deg), j = 0..11, as (rational, sqrt 3) integer parts
 _COS30_2 = np.array([(2, 0), (0, 1), (1, 0), (0, 0), (-1, 0), (0, -1),
@@ -263,8 +264,9 @@ def ties_at_or_past(x, y, g, cx: float, n, m: int, upper) -> np.ndarray:
     """Vectorised :func:`_endpoint_at_or_past` on boundaries at 30 or 45 degree multiples.
 
     Arrays x, y, g (floats), n (int64 boundary indices), upper (bool). Returns int8:
-    1 if the tangent direction is at or past beta_n, 0 if before, -1 where this cannot
-    decide (another angle, or magnitudes near the float range's ends): use the scalar path.
+    1 if the tangent direction is at or past beta_n, 0 if before, -1 for boundaries at other
+    angles (use the scalar path). The rare elements the expansions leave undecided are
+    decided here in exact rationals (no mpmath).
     """
     n = np.asarray(n, np.int64)
     x, y, g = (np.asarray(v, np.float64) for v in (x, y, g))
@@ -290,5 +292,12 @@ def ties_at_or_past(x, y, g, cx: float, n, m: int, upper) -> np.ndarray:
     up = (s >= 0) | ((e >= 0) & (sg >= 0))
     lo = (s >= 0) & ((e < 0) | (sg >= 0))
     res = np.where(upper, up, lo).astype(np.int8)
-    res[~known] = -1
+    res[~(is30 | is45)] = -1
+    # what the floats could not decide (near-ties in Q(sqrt k), magnitudes near the ends of
+    # the float range): the same predicate in exact rationals, one element at a time
+    upper = np.broadcast_to(upper, n.shape)
+    for i in np.flatnonzero((is30 | is45) & ~known):
+        X = Fraction(float(x[i])) - Fraction(cx)
+        res[i] = _endpoint_at_or_past(X, Fraction(float(y[i])), Fraction(float(g[i])),
+                                      int(n[i]), m, bool(upper[i]))  # fmt: skip
     return res
