@@ -10,7 +10,10 @@ arithmetic on the float inputs: a float64 fast path decides each element, and th
 few whose answer lies within a proven rounding bound of a boundary are decided again by
 :mod:`eyeviz.core.exact` (rational predicates, mpmath where those cannot apply).
 
-This module imports numpy and the standard library only (no Qt, VTK or torch).
+This module imports numpy and the standard library only (no Qt, VTK or torch). It is
+over 400 lines because EyePair's public methods and the block-wise fast path they share
+(with its rounding bounds) are one unit; the exact predicates live in
+:mod:`eyeviz.core.exact`, the bit expansion in :mod:`eyeviz.core.bits`.
 """
 
 from __future__ import annotations
