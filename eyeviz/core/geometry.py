@@ -140,7 +140,7 @@ class EyePair:
                 f"h must be > l (eyes may not touch the y-axis), got h={self.h!r}, l={self.l!r}"
             )
         m = self.m
-        bad_m = f"m must be an even integer in [4, {M_MAX}], got {_short(m)}"
+        bad_m = f"m must be an even integer >= 4 and <= {M_MAX} (2^53), got {_short(m)}"
         if isinstance(m, bool):
             raise ValueError(bad_m)
         try:

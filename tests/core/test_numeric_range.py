@@ -16,7 +16,7 @@ from eyeviz.core.geometry import M_MAX, EyePair
 from eyeviz.reference.digits80 import reference_intervals
 
 EYES = EyePair(40.0, 20.0, 720)
-M_RULE = "m must be an even integer in [4, 9007199254740992], got "
+M_RULE = "m must be an even integer >= 4 and <= 9007199254740992 (2^53), got "
 scale = st.integers(-300, 300).map(lambda k: 10.0**k)
 unit = st.floats(-4, 4, allow_nan=False).filter(lambda v: abs(v) > 1e-3)
 
