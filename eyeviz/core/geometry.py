@@ -217,10 +217,15 @@ class EyePair:
         tol = _TOL_BASE * _U * self.m
         near = (frac < tol) | (frac > 1 - tol)
         out = k.astype(np.int64)
-        for i in np.flatnonzero(near):
-            if dx[i] == 0 and ya[i] == 0:
-                out[i] = 0
-                continue
+        idx = np.flatnonzero(near & ~((dx == 0) & (ya == 0)))
+        out[near & (dx == 0) & (ya == 0)] = 0
+        if idx.size and tol < 0.25:  # boundaries at 30/45-degree multiples: vectorised
+            n = out[idx] + (frac[idx] > 0.5)
+            zero = np.zeros(idx.size)
+            res = exact.ties_at_or_past(xa[idx], ya[idx], zero, cx, n, self.m, True)
+            out[idx[res >= 0]] = (n - 1 + res)[res >= 0]
+            idx = idx[res < 0]
+        for i in idx:
             out[i] = exact.exact_floor_pair(float(xa[i]), float(ya[i]), 0.0, cx, self.m)[1]
         return np.mod(out, self.m).reshape(shape)
 
