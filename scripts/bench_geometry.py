@@ -59,6 +59,17 @@ def best_of(fn, repeats: int) -> float:
     return best
 
 
+def interleaved(fns: dict, repeats: int) -> dict[str, float]:
+    """Best time per item of each (fn, items), the functions run in turn ``repeats`` times."""
+    best = dict.fromkeys(fns, float("inf"))
+    for _ in range(repeats):
+        for name, (fn, items) in fns.items():
+            t = time.perf_counter()
+            fn()
+            best[name] = min(best[name], (time.perf_counter() - t) / items)
+    return best
+
+
 def per_feature(fn, n: int, repeats: int) -> float:
     return best_of(fn, repeats) / n
 
@@ -67,13 +78,18 @@ def one_round(args, paper, ties, legacy_ties) -> dict[str, float]:
     eyes, x, y, g = paper.eyes, paper.x, paper.y, paper.g
     old = LegacyEyePair.of(eyes)
     n, r = x.size, args.repeats
-    res: dict[str, float] = {}
-    res["intervals new"] = best_of(lambda: eyes.intervals(x, y, g), r) / n
-    res["intervals old"] = best_of(lambda: old.intervals(x, y, g), r) / n
-    res["fast alone new"] = best_of(lambda: eyes._intervals(x, y, g, refine=False), r) / n
     sub = slice(0, min(args.loop_n, n))
     xs, ys, gs = x[sub].tolist(), y[sub].tolist(), g[sub].tolist()
-    res["python loop"] = best_of(lambda: python_loop(eyes, xs, ys, gs), 1) / len(xs)
+    # interleaved, best of r each: load changes hit all four alike
+    res = interleaved(
+        {
+            "intervals new": (lambda: eyes.intervals(x, y, g), n),
+            "intervals old": (lambda: old.intervals(x, y, g), n),
+            "fast alone new": (lambda: eyes._intervals(x, y, g, refine=False), n),
+            "python loop": (lambda: python_loop(eyes, xs, ys, gs), len(xs)),
+        },
+        r,
+    )
     for name, cs in ties.items():
         res[f"{name} new"] = per_feature(lambda cs=cs: cs.eyes.intervals(cs.x, cs.y, cs.g),
                                          cs.x.size, r)  # fmt: skip
@@ -104,7 +120,7 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=1_000_000)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--rounds", type=int, default=3, help="whole measurements, each printed")
-    ap.add_argument("--loop-n", type=int, default=50_000, help="features for the Python loop")
+    ap.add_argument("--loop-n", type=int, default=20_000, help="features for the Python loop")
     ap.add_argument("--ties-n", type=int, default=100_000, help="features per tie class")
     ap.add_argument("--legacy-ties-n", type=int, default=300, help="tie features, old code")
     ap.add_argument("--bitmap-n", type=int, default=200_000, help="rows for the bitmaps")
