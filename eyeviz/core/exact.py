@@ -246,8 +246,12 @@ def _sign_of(e: list[np.ndarray]) -> np.ndarray:
 
 def _sign_quadratic(a_terms, b_terms, root: np.ndarray) -> np.ndarray:
     """Sign of a + b*sqrt(root) (a, b sums of floats); ``_UNKNOWN`` where undecided."""
-    ea, eb = _expansion(a_terms), _expansion(b_terms)
-    sa, sb = _sign_of(ea), _sign_of(eb)
+    ea = _expansion(a_terms)
+    sa = _sign_of(ea)
+    if not any(t.any() for t in b_terms):  # rational boundaries (multiples of 90 degrees)
+        return sa
+    eb = _expansion(b_terms)
+    sb = _sign_of(eb)
     out = np.where(sb == 0, sa, np.where((sa == 0) | (sa == sb), sb, 0)).astype(np.int8)
     mixed = (sa != 0) & (sb != 0) & (sa != sb)
     if mixed.any():
@@ -281,11 +285,10 @@ def ties_at_or_past(x, y, g, cx: float, n, m: int, upper) -> np.ndarray:
     usable = (is30 | is45) & (mag < _SAFE_MAG)
     xh, xl = _two_sum(x, np.full_like(x, -cx))
     ca, cb, sa, sb = cos2[:, 0], cos2[:, 1], sin2[:, 0], sin2[:, 1]
-    zero = np.zeros_like(x)
     # s = y cos - x sin ; e = x cos + y sin ; s -/+ g  (all doubled)
     s_b = [y * cb, -xh * sb, -xl * sb]
-    s = _sign_quadratic([zero, y * ca, -xh * sa, -xl * sa], s_b, root)
-    e = _sign_quadratic([zero, xh * ca, xl * ca, y * sa], [xh * cb, xl * cb, y * sb], root)
+    s = _sign_quadratic([y * ca, -xh * sa, -xl * sa], s_b, root)
+    e = _sign_quadratic([xh * ca, xl * ca, y * sa], [xh * cb, xl * cb, y * sb], root)
     gs = np.where(upper, 2 * g, -2 * g)
     sg = _sign_quadratic([gs, y * ca, -xh * sa, -xl * sa], s_b, root)
     known = usable & (s != _UNKNOWN) & (e != _UNKNOWN) & (sg != _UNKNOWN)
