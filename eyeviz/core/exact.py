@@ -18,6 +18,8 @@ from __future__ import annotations
 from fractions import Fraction
 from math import gcd
 
+import numpy as np
+
 #: cos(30k deg) = a + b*sqrt(3), k = 0..11, as (a, b)
 _COS30 = [
     (1, 0), (0, Fraction(1, 2)), (Fraction(1, 2), 0), (0, 0),
@@ -93,32 +95,47 @@ def exact_floor_pair(x: float, y: float, g: float, cx: float, m: int) -> tuple[i
         return None
     import mpmath
 
-    # enough bits to hold x - cx exactly, however far apart their exponents are
+    # enough bits to hold x - cx exactly, however far apart their exponents are; every
+    # mpmath operation, rounding included, runs inside workprec: the caller's global
+    # mpmath.mp.prec never matters
     prec = max(192, 2 * max(X.numerator.bit_length(), X.denominator.bit_length()))
     while True:
         with mpmath.workprec(prec):
-            dx, dy, gg = _mpf(X), _mpf(Y), _mpf(G)
-            r = mpmath.hypot(dx, dy)
-            q = gg / r
-            if q >= 1:  # outside by less than this precision resolves
-                prec *= 2
-                continue
-            phi = mpmath.atan2(dy, dx)
-            alpha = mpmath.asin(q)
-            k = m / (2 * mpmath.pi)
-            t_lo, t_hi = (phi - alpha) * k, (phi + alpha) * k
-            eps = mpmath.ldexp(m * (4 + 1 / (1 - q)), 24 - prec)
-            if eps < 0.25:
-                break
+            floors = _floors_at(X, Y, G, m, prec)
+        if floors is not None:
+            lo, hi = floors
+            break
         prec *= 2
     out = []
-    for t, upper in ((t_lo, False), (t_hi, True)):
-        n = int(mpmath.nint(t))
-        if abs(t - n) > eps:
-            out.append(int(mpmath.floor(t)))
+    for (n, t_floor), upper in ((lo, False), (hi, True)):
+        if t_floor is not None:
+            out.append(t_floor)
         else:
             out.append(n if _endpoint_at_or_past(X, Y, G, n, m, upper) else n - 1)
     return out[0], out[1]
+
+
+def _floors_at(X: Fraction, Y: Fraction, G: Fraction, m: int, prec: int):
+    """Inside a workprec(prec) block: per endpoint (n, floor) with floor None when the
+    value lies within the error bound of the integer n; None when prec is too small."""
+    import mpmath
+
+    dx, dy, gg = _mpf(X), _mpf(Y), _mpf(G)
+    r = mpmath.hypot(dx, dy)
+    q = gg / r
+    if q >= 1:  # outside by less than this precision resolves
+        return None
+    phi = mpmath.atan2(dy, dx)
+    alpha = mpmath.asin(q)
+    k = m / (2 * mpmath.pi)
+    eps = mpmath.ldexp(m * (4 + 1 / (1 - q)), 24 - prec)
+    if not eps < 0.25:
+        return None
+    res = []
+    for t in ((phi - alpha) * k, (phi + alpha) * k):
+        n = int(mpmath.nint(t))
+        res.append((n, int(mpmath.floor(t)) if abs(t - n) > eps else None))
+    return res
 
 
 def _endpoint_at_or_past(
@@ -173,3 +190,117 @@ def exact_overlaps(x: float, y: float, g: float, cx: float, l: float) -> bool:
     X = Fraction(x) - Fraction(cx)
     Y, S = Fraction(y), Fraction(g) + Fraction(l)
     return X * X + Y * Y <= S * S
+
+
+# --- vectorised ties: floating-point expansions instead of mpmath ------------------------
+#
+# On a boundary beta_n at a multiple of 30 or 45 degrees, 2*cos(beta_n) and 2*sin(beta_n)
+# are A + B*sqrt(k) with integers A, B in -2..2 (k = 3 or 2). Every test of
+# :func:`_endpoint_at_or_past` then is the sign of a + b*sqrt(k) where 2a and 2b are sums
+# of at most four floats (x - cx split exactly by two-sum, times 0, +-1 or +-2: exact).
+# Those sums' signs are exact from a nonoverlapping expansion (Shewchuk's GROW-EXPANSION);
+# a + b*sqrt(k) with b != 0 is never 0 (sqrt(k) is irrational), so when the signs of a and
+# b differ, |a| against |b|*sqrt(k) is decided in floats with a wide relative margin and
+# only the undecidable rest (near-ties in Q(sqrt k), magnitudes near the ends of the float
+# range) is decided in exact rationals, element by element.
+
+#: doubled cos(30 j deg), j = 0..11, as (rational, sqrt 3) integer parts
+_COS30_2 = np.array([(2, 0), (0, 1), (1, 0), (0, 0), (-1, 0), (0, -1),
+                     (-2, 0), (0, -1), (-1, 0), (0, 0), (1, 0), (0, 1)], np.float64)  # fmt: skip
+#: doubled cos(45 j deg), j = 0..7, as (rational, sqrt 2) integer parts
+_COS45_2 = np.array([(2, 0), (0, 1), (0, 0), (0, -1),
+                     (-2, 0), (0, -1), (0, 0), (0, 1)], np.float64)  # fmt: skip
+_SAFE_MAG = 2.0**1000  # doubling and two-sum cannot overflow below this
+_TINY = 2.0**-960  # below this a product b*sqrt(k) may lose relative accuracy
+_UNKNOWN = 2
+
+
+def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Knuth's error-free sum: s + e == a + b exactly, s = fl(a + b)."""
+    s = a + b
+    bb = s - a
+    e = (a - (s - bb)) + (b - bb)
+    return s, e
+
+
+def _expansion(terms: list[np.ndarray]) -> list[np.ndarray]:
+    """Nonoverlapping expansion (increasing magnitude, zeros allowed) of a sum of floats."""
+    e: list[np.ndarray] = []
+    for t in terms:
+        q, grown = t, []
+        for comp in e:
+            q, h = _two_sum(q, comp)
+            grown.append(h)
+        grown.append(q)
+        e = grown
+    return e
+
+
+def _sign_of(e: list[np.ndarray]) -> np.ndarray:
+    """Exact sign of an expansion: the sign of its largest nonzero component."""
+    s = np.zeros(e[0].shape, np.int8)
+    for comp in reversed(e):
+        s = np.where(s == 0, np.sign(comp).astype(np.int8), s)
+    return s
+
+
+def _sign_quadratic(a_terms, b_terms, root: np.ndarray) -> np.ndarray:
+    """Sign of a + b*sqrt(root) (a, b sums of floats); ``_UNKNOWN`` where undecided."""
+    ea = _expansion(a_terms)
+    sa = _sign_of(ea)
+    if not any(t.any() for t in b_terms):  # rational boundaries (multiples of 90 degrees)
+        return sa
+    eb = _expansion(b_terms)
+    sb = _sign_of(eb)
+    out = np.where(sb == 0, sa, np.where((sa == 0) | (sa == sb), sb, 0)).astype(np.int8)
+    mixed = (sa != 0) & (sb != 0) & (sa != sb)
+    if mixed.any():
+        A = np.abs(sum(ea))  # relative error a few ulps: the margin below is 2^-40
+        B = np.abs(sum(eb)) * np.sqrt(root)
+        big_a = A > B * (1 + 2.0**-40)
+        big_b = B > A * (1 + 2.0**-40)
+        ok = (A > _TINY) & (B > _TINY) & (big_a | big_b)
+        out[mixed] = np.where(ok, np.where(big_a, sa, sb), _UNKNOWN)[mixed]
+    return out
+
+
+def ties_at_or_past(x, y, g, cx: float, n, m: int, upper) -> np.ndarray:
+    """Vectorised :func:`_endpoint_at_or_past` on boundaries at 30 or 45 degree multiples.
+
+    Arrays x, y, g (floats), n (int64 boundary indices), upper (bool). Returns int8:
+    1 if the tangent direction is at or past beta_n, 0 if before, -1 for boundaries at other
+    angles (use the scalar path). The rare elements the expansions leave undecided are
+    decided here in exact rationals (no mpmath).
+    """
+    n = np.asarray(n, np.int64)
+    x, y, g = (np.asarray(v, np.float64) for v in (x, y, g))
+    is30 = (12 * n) % m == 0
+    is45 = ~is30 & ((8 * n) % m == 0)
+    j30 = ((12 * n) // m) % 12
+    j45 = ((8 * n) // m) % 8
+    cos2 = np.where(is30[:, None], _COS30_2[j30], _COS45_2[j45])
+    sin2 = np.where(is30[:, None], _COS30_2[(j30 - 3) % 12], _COS45_2[(j45 - 2) % 8])
+    root = np.where(is30, 3.0, 2.0)
+    mag = np.maximum(np.maximum(np.abs(x), abs(cx)), np.maximum(np.abs(y), np.abs(g)))
+    usable = (is30 | is45) & (mag < _SAFE_MAG)
+    xh, xl = _two_sum(x, np.full_like(x, -cx))
+    ca, cb, sa, sb = cos2[:, 0], cos2[:, 1], sin2[:, 0], sin2[:, 1]
+    # s = y cos - x sin ; e = x cos + y sin ; s -/+ g  (all doubled)
+    s_b = [y * cb, -xh * sb, -xl * sb]
+    s = _sign_quadratic([y * ca, -xh * sa, -xl * sa], s_b, root)
+    e = _sign_quadratic([xh * ca, xl * ca, y * sa], [xh * cb, xl * cb, y * sb], root)
+    gs = np.where(upper, 2 * g, -2 * g)
+    sg = _sign_quadratic([gs, y * ca, -xh * sa, -xl * sa], s_b, root)
+    known = usable & (s != _UNKNOWN) & (e != _UNKNOWN) & (sg != _UNKNOWN)
+    up = (s >= 0) | ((e >= 0) & (sg >= 0))
+    lo = (s >= 0) & ((e < 0) | (sg >= 0))
+    res = np.where(upper, up, lo).astype(np.int8)
+    res[~(is30 | is45)] = -1
+    # what the floats could not decide (near-ties in Q(sqrt k), magnitudes near the ends of
+    # the float range): the same predicate in exact rationals, one element at a time
+    upper = np.broadcast_to(upper, n.shape)
+    for i in np.flatnonzero((is30 | is45) & ~known):
+        X = Fraction(float(x[i])) - Fraction(cx)
+        res[i] = _endpoint_at_or_past(X, Fraction(float(y[i])), Fraction(float(g[i])),
+                                      int(n[i]), m, bool(upper[i]))  # fmt: skip
+    return res

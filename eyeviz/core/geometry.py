@@ -10,7 +10,10 @@ arithmetic on the float inputs: a float64 fast path decides each element, and th
 few whose answer lies within a proven rounding bound of a boundary are decided again by
 :mod:`eyeviz.core.exact` (rational predicates, mpmath where those cannot apply).
 
-This module imports numpy and the standard library only (no Qt, VTK or torch).
+This module imports numpy and the standard library only (no Qt, VTK or torch). It is
+over 400 lines because EyePair's public methods and the block-wise fast path they share
+(with its rounding bounds) are one unit; the exact predicates live in
+:mod:`eyeviz.core.exact`, the bit expansion in :mod:`eyeviz.core.bits`.
 """
 
 from __future__ import annotations
@@ -22,11 +25,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from eyeviz.core import exact
+from eyeviz.core import bits, exact
 
 __all__ = ["EyePair", "intervals_to_bitmap", "validate_features", "validate_points"]
 
 _U = 2.0**-53  # unit roundoff of float64
+_TINY_SCALE = 2.0**-960  # above this, underflow in a product errs below 16 u of the scale
 _CHUNK = 1 << 15  # elements per block: keeps the temporaries in cache
 _Q_SAFE = 0.75  # g / r_E below this uses one scalar rounding bound per block
 # A generous multiple of the forward error of the fast path, in units of u*m:
@@ -34,6 +38,12 @@ _Q_SAFE = 0.75  # g / r_E below this uses one scalar rounding bound per block
 # term grows like 1/(1 - g/r_E) near grazing.
 _TOL_BASE = 64.0
 _TOL_GRAZE = 16.0
+
+#: Largest m: sector indices and the floors of Eq. 11 (|t| < m) are held in float64 and
+#: int64 and must be exact to the unit, so m <= 2^53. From about m = 2^45 the rounding
+#: bound of the fast path exceeds half a sector and every element takes the exact path:
+#: right, but slow. ``EyePair(..., m)`` refuses larger m with a one-line message.
+M_MAX = 2**53
 
 #: Diagnostics for the stability report: elements the fast path flagged near a boundary
 #: ("flagged") and those of them decided by the exact predicates ("exact").
@@ -87,11 +97,18 @@ def validate_features(x, y, g) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return xa, ya, ga
 
 
+def _short(value) -> str:
+    """repr of a parameter for a one-line message, ints beyond float range shortened."""
+    text = repr(value)
+    return text if len(text) <= 40 else f"{text[:12]}...({len(text)} characters)"
+
+
 def _check_param(name: str, value, rule: str) -> float:
     try:
         v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number ({rule}), got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        msg = f"{name} must be a finite real number ({rule}), got {_short(value)}"
+        raise ValueError(msg) from None
     if not math.isfinite(v):
         raise ValueError(f"{name} must be finite ({rule}), got {value!r}")
     return v
@@ -123,17 +140,18 @@ class EyePair:
                 f"h must be > l (eyes may not touch the y-axis), got h={self.h!r}, l={self.l!r}"
             )
         m = self.m
+        bad_m = f"m must be an even integer >= 4 and <= {M_MAX} (2^53), got {_short(m)}"
         if isinstance(m, bool):
-            raise ValueError(f"m must be an even integer >= 4, got {m!r}")
+            raise ValueError(bad_m)
         try:
             mi = operator.index(m)
         except TypeError:
             if isinstance(m, float) and math.isfinite(m) and m.is_integer():
                 mi = int(m)
             else:
-                raise ValueError(f"m must be an even integer >= 4, got {m!r}") from None
-        if mi < 4 or mi % 2:
-            raise ValueError(f"m must be an even integer >= 4, got {m!r}")
+                raise ValueError(bad_m) from None
+        if mi < 4 or mi % 2 or mi > M_MAX:
+            raise ValueError(bad_m)
         object.__setattr__(self, "h", h)
         object.__setattr__(self, "l", l)
         object.__setattr__(self, "m", mi)
@@ -199,33 +217,92 @@ class EyePair:
         tol = _TOL_BASE * _U * self.m
         near = (frac < tol) | (frac > 1 - tol)
         out = k.astype(np.int64)
-        for i in np.flatnonzero(near):
-            if dx[i] == 0 and ya[i] == 0:
-                out[i] = 0
-                continue
+        idx = np.flatnonzero(near & ~((dx == 0) & (ya == 0)))
+        out[near & (dx == 0) & (ya == 0)] = 0
+        if idx.size and tol < 0.25:  # boundaries at 30/45-degree multiples: vectorised
+            n = out[idx] + (frac[idx] > 0.5)
+            zero = np.zeros(idx.size)
+            res = exact.ties_at_or_past(xa[idx], ya[idx], zero, cx, n, self.m, True)
+            out[idx[res >= 0]] = (n - 1 + res)[res >= 0]
+            idx = idx[res < 0]
+        for i in idx:
             out[i] = exact.exact_floor_pair(float(xa[i]), float(ya[i]), 0.0, cx, self.m)[1]
         return np.mod(out, self.m).reshape(shape)
 
     # --- features ---------------------------------------------------------------------
-    def _eye_floors(
-        self, x, y, g, cx: float, refine: bool = True
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Raw (floor(t_lo), floor(t_hi), whole) of Eq. 11 for one eye on 1-D arrays.
+    def _fast_intervals(self, x, y, g, refine: bool, outs) -> None:
+        """Eq. 11 for both eyes, block by block, into ``outs`` = (LA, RA, LB, RB) int64.
 
-        ``refine=False`` skips the exact fallback (benchmarks measure its cost with it).
+        Per block: y*y once for both eyes, every temporary in a reused buffer, and the
+        rounding bound checked by a few min/max reductions (r^2 in range, g/r_E <= 0.75,
+        every fractional part of t at least ``tol0`` from an integer) instead of per-element
+        masks. L and R go straight into the outputs; in a block that fails the check, only
+        the elements a per-element mask flags (a tie, a graze, a huge m, an over/underflow)
+        are handed to :meth:`_block`, the per-element path with the exact fallback.
+        ``refine=False`` skips that fallback (benchmarks measure its cost with it).
         """
         n = x.shape[0]
-        lo_out = np.empty(n, np.int64)
-        hi_out = np.empty(n, np.int64)
-        whole = np.zeros(n, bool)
-        k = self._k
-        tol0 = (_TOL_BASE + _TOL_GRAZE / (1 - _Q_SAFE)) * _U * self.m
-        for s in range(0, n, _CHUNK):
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                self._block(
-                    x, y, g, cx, refine, slice(s, s + _CHUNK), k, tol0, lo_out, hi_out, whole
+        k, m = self._k, self.m
+        tol0 = (_TOL_BASE + _TOL_GRAZE / (1 - _Q_SAFE)) * _U * m
+        c = min(_CHUNK, max(n, 1))
+        yy, dx, r2, q, pk, ak, tlo, thi = (np.empty(c) for _ in range(8))
+        wrap = np.empty(c, np.int64)
+        eyes = ((-self.h, outs[0], outs[1]), (self.h, outs[2], outs[3]))
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+            for s in range(0, n, c):
+                e = min(n, s + c)
+                b = e - s
+                xs, ys, gs = x[s:e], y[s:e], g[s:e]
+                yy_, dx_, r2_, q_, pk_, ak_, tlo_, thi_ = (
+                    v[:b] for v in (yy, dx, r2, q, pk, ak, tlo, thi)
                 )
-        return lo_out, hi_out, whole
+                np.multiply(ys, ys, out=yy_)
+                for cx, Lo, Ro in eyes:
+                    np.subtract(xs, cx, out=dx_)
+                    np.multiply(dx_, dx_, out=r2_)
+                    r2_ += yy_
+                    np.sqrt(r2_, out=q_)
+                    np.divide(gs, q_, out=q_)
+                    clean = r2_.min() >= 1e-290 and r2_.max() <= 1e300 and q_.max() <= _Q_SAFE
+                    np.arctan2(ys, dx_, out=pk_)
+                    pk_ *= k
+                    np.arcsin(q_, out=ak_)  # NaN where q > 1: such blocks are not clean
+                    ak_ *= k
+                    np.subtract(pk_, ak_, out=tlo_)
+                    np.add(pk_, ak_, out=thi_)
+                    np.floor(tlo_, out=pk_)  # floor(t_lo)
+                    np.floor(thi_, out=ak_)  # floor(t_hi)
+                    tlo_ -= pk_  # fractional parts in [0, 1)
+                    thi_ -= ak_
+                    clean = clean and (
+                        min(tlo_.min(), thi_.min()) >= tol0
+                        and max(tlo_.max(), thi_.max()) <= 1 - tol0
+                    )
+                    L, R = Lo[s:e], Ro[s:e]
+                    # phi in (-pi, pi] and alpha <= pi/2: floor(t_lo) > -m, one wrap at most
+                    L[...] = pk_
+                    ak_ -= pk_  # R - L
+                    np.right_shift(L, 63, out=wrap[:b])
+                    wrap[:b] &= m
+                    L += wrap[:b]
+                    R[...] = ak_
+                    R += L
+                    if not clean:  # the few elements near a boundary, out of range or grazing
+                        near = (tlo_ < tol0) | (tlo_ > 1 - tol0) | (thi_ < tol0)
+                        near |= thi_ > 1 - tol0
+                        near |= ~((r2_ >= 1e-290) & (r2_ <= 1e300) & (q_ <= _Q_SAFE))
+                        idx = np.flatnonzero(near)
+                        L[idx], R[idx] = self._slow_block(xs[idx], ys[idx], gs[idx], cx, refine)
+
+    def _slow_block(self, xs, ys, gs, cx, refine) -> tuple[np.ndarray, np.ndarray]:
+        """(L, R) of one eye by the per-element path with its exact fallback (the few
+        elements of a block that the block check could not clear)."""
+        b = xs.shape[0]
+        lo, hi, whole = np.empty(b, np.int64), np.empty(b, np.int64), np.zeros(b, bool)
+        tol0 = (_TOL_BASE + _TOL_GRAZE / (1 - _Q_SAFE)) * _U * self.m
+        self._block(xs, ys, gs, cx, refine, slice(None), self._k, tol0, lo, hi, whole)
+        FALLBACK_COUNTS["slow elements"] += b
+        return self._normalised(lo, hi, whole)
 
     def _block(self, x, y, g, cx, refine, sl, k, tol0, lo_out, hi_out, whole) -> None:
         """Fast path of Eq. 11 on one cache-sized block; flags elements near a boundary."""
@@ -260,19 +337,52 @@ class EyePair:
             self._refine(xs, ys, gs, q, t_lo, t_hi, idx, cx, lo_out[sl], hi_out[sl], whole[sl])
 
     def _refine(self, xs, ys, gs, q, c_lo, c_hi, idx, cx, lo, hi, whole) -> None:
-        """Re-decide flagged elements: a per-element rounding bound, then exact."""
+        """Re-decide flagged elements: a per-element rounding bound, then exact.
+
+        An endpoint within the bound of an integer n has floor n or n - 1; when beta_n is a
+        multiple of 30 or 45 degrees (every tie of the ground line, an eye's vertical line
+        and the 30/60-degree ties) :func:`exact.ties_at_or_past` decides which, vectorised
+        with floating-point expansions. Only what that cannot decide reaches mpmath.
+        """
         qi = q[idx]
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):
             tol = (_TOL_BASE + _TOL_GRAZE / np.maximum(1 - qi, 0)) * _U * self.m
+        outside = qi < 1 - 8 * _U * 4
         clear_inside = qi > 1 + 8 * _U * 4
-        clear_outside = (qi < 1 - 8 * _U * 4) & (
-            np.maximum(np.abs(c_lo[idx]), np.abs(c_hi[idx])) <= 0.5 - tol
-        )
+        clear_outside = outside & (np.maximum(np.abs(c_lo[idx]), np.abs(c_hi[idx])) <= 0.5 - tol)
         whole[idx[clear_inside]] = True
-        todo = idx[~(clear_inside | clear_outside)]
+        rest = ~(clear_inside | clear_outside)
+        todo, tol = idx[rest], tol[rest]
         FALLBACK_COUNTS["flagged"] += idx.size
+        if not todo.size:
+            return
+        valid = outside[rest] & (tol < 0.25)
+        scalar = ~valid
+        parts = []
+        for c_arr, f_arr, upper in ((c_lo, lo, False), (c_hi, hi, True)):
+            c = c_arr[todo]
+            need = valid & (np.abs(c) > 0.5 - tol)
+            j = np.flatnonzero(need)
+            n = f_arr[todo[j]] + (c[j] > 0)
+            parts.append((j, n, upper, f_arr))
+        js = np.concatenate([p[0] for p in parts])
+        if js.size:
+            el = todo[js]
+            ns = np.concatenate([p[1] for p in parts])
+            ups = np.concatenate([np.full(p[0].size, p[2]) for p in parts])
+            res = exact.ties_at_or_past(xs[el], ys[el], gs[el], cx, ns, self.m, ups)
+            scalar[js[res < 0]] = True
+            k = 0
+            for j, n, _upper, f_arr in parts:
+                r = res[k : k + j.size]
+                k += j.size
+                ok = r >= 0
+                f_arr[todo[j[ok]]] = n[ok] - 1 + r[ok]
+        todo_s = todo[scalar]
         FALLBACK_COUNTS["exact"] += todo.size
-        for j in todo:
+        FALLBACK_COUNTS["ties"] += todo.size - todo_s.size
+        FALLBACK_COUNTS["mpmath"] += todo_s.size
+        for j in todo_s:
             res = exact.exact_floor_pair(float(xs[j]), float(ys[j]), float(gs[j]), cx, self.m)
             if res is None:
                 whole[j] = True
@@ -300,11 +410,9 @@ class EyePair:
         xa, ya, ga = validate_features(x, y, g)
         shape = xa.shape
         xf, yf, gf = (np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, ga))
-        out = []
-        for cx in (-self.h, self.h):
-            L, R = self._normalised(*self._eye_floors(xf, yf, gf, cx, refine))
-            out += [L.reshape(shape), R.reshape(shape)]
-        return tuple(out)
+        outs = tuple(np.empty(xf.shape[0], np.int64) for _ in range(4))
+        self._fast_intervals(xf, yf, gf, refine, outs)
+        return tuple(o.reshape(shape) for o in outs)
 
     def bitmaps(self, x, y, g) -> tuple[np.ndarray, np.ndarray]:
         """Whole-eye bitmaps (omega_a, omega_b), bool of shape (..., m)."""
@@ -322,14 +430,19 @@ class EyePair:
         shape = xa.shape
         xa, ya, ga = xa.ravel(), ya.ravel(), ga.ravel()
         h, l = self.h, self.l
-        w = math.sqrt((h - l) * (h + l))
-        wy, lx, gh = w * ya, l * xa, ga * h
-        right = wy - lx - gh
-        left = wy + lx - gh
-        scale = np.abs(wy) + np.abs(lx) + np.abs(gh)
-        tol = 16 * _U * scale
+        with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+            w = float(np.sqrt(np.float64(h - l) * (h + l)))
+            wy, lx, gh = w * ya, l * xa, ga * h
+            right = wy - lx - gh
+            left = wy + lx - gh
+            scale = np.abs(wy) + np.abs(lx) + np.abs(gh)
+            tol = 16 * _U * scale
+            near = (np.abs(right) <= tol) | (np.abs(left) <= tol)
         out = (right >= 0) & (left >= 0)
-        near = (np.abs(right) <= tol) | (np.abs(left) <= tol)
+        # products that overflow (inf, NaN) or fall where underflow is no longer relative
+        near |= ~(scale >= _TINY_SCALE) | ~np.isfinite(scale)
+        if not 2.0**-400 < w < 2.0**400:  # h^2 - l^2 itself over- or underflowed
+            near[:] = True
         for i in np.flatnonzero(near):
             out[i] = exact.exact_in_bfv(float(xa[i]), float(ya[i]), float(ga[i]), h, l)
         return out.reshape(shape)
@@ -341,12 +454,16 @@ class EyePair:
         xa, ya, ga = xa.ravel(), ya.ravel(), ga.ravel()
         res = []
         for cx in (-self.h, self.h):
-            dx = xa - cx
-            d2 = dx * dx + ya * ya
-            s = ga + self.l
-            rhs = s * s
+            with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+                dx = xa - cx
+                d2 = dx * dx + ya * ya
+                s = ga + self.l
+                rhs = s * s
+                tot = d2 + rhs
+                near = np.abs(d2 - rhs) <= 16 * _U * tot
             out = d2 <= rhs
-            near = np.abs(d2 - rhs) <= 16 * _U * (d2 + rhs)
+            # squares that overflow (inf, NaN) or underflow: decided exactly, as intervals does
+            near |= ~(tot >= _TINY_SCALE) | ~np.isfinite(tot)
             for i in np.flatnonzero(near):
                 out[i] = exact.exact_overlaps(float(xa[i]), float(ya[i]), float(ga[i]), cx, self.l)
             res.append(out.reshape(shape))
@@ -357,24 +474,6 @@ def intervals_to_bitmap(L, R, m: int, width: int | None = None) -> np.ndarray:
     """Bool bitmap (..., width) of ommatidia 0..width-1 lit by {k mod m : L <= k <= R}.
 
     ``width`` defaults to m (the whole eye); m // 2 gives the paper's Omega (Section 4).
-    Built in row blocks so the temporaries stay in cache: ``k - L`` read as unsigned is
-    at most ``R - L`` exactly on the lit ommatidia of a run that does not wrap past m - 1;
-    the few runs that wrap add ``k <= R - m``.
+    One memcpy-sized window per row (:func:`eyeviz.core.bits.bool_bitmaps`).
     """
-    L, R = np.broadcast_arrays(np.asarray(L, dtype=np.int64), np.asarray(R, dtype=np.int64))
-    width = m if width is None else width
-    out = np.empty(L.shape + (width,), dtype=bool)
-    flat = out.reshape(-1, width)
-    sdt = np.int16 if m < 2**15 else np.int32 if m < 2**31 else np.int64
-    udt = np.dtype(sdt).str.replace("i", "u")
-    k = np.arange(width, dtype=sdt)
-    Lf = L.reshape(-1, 1).astype(sdt)
-    Cf = (R - L).reshape(-1, 1).astype(udt)
-    rows = max(1, (1 << 19) // max(width, 1))
-    for s in range(0, flat.shape[0], rows):
-        d = k - Lf[s : s + rows]
-        np.less_equal(d.view(udt), Cf[s : s + rows], out=flat[s : s + rows])
-    wrap = np.flatnonzero(R.reshape(-1) >= m)
-    if wrap.size:
-        flat[wrap] |= k <= (R.reshape(-1)[wrap, None] - m)
-    return out
+    return bits.bool_bitmaps(L, R, m, width)

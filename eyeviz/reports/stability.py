@@ -3,7 +3,9 @@
 For every case class of :mod:`eyeviz.reference.stability_cases`, three implementations of Eq. 11
 and 22-25 are compared with the mpmath reference (:mod:`eyeviz.reference.digits80`, 80 digits):
 (a) the paper's formulas taken literally in float64, (b) the same in float32, (c) the
-eyeviz core. A feature counts as a difference when either eye's bitmap differs.
+eyeviz core. A feature counts as a difference when either eye's bitmap differs. The core
+as it was before issue 14 (:mod:`eyeviz.reference.legacy_fastpath`) is timed in the same
+run, so its cost and the speed-up stand beside the new figures.
 """
 
 from __future__ import annotations
@@ -22,6 +24,8 @@ from eyeviz.files.atomic import atomic_output
 HELP = "numerical stability of the geometry against an 80-digit reference"
 
 METHODS = ("paper float64", "paper float32", "eyeviz core")
+OLD = "eyeviz core, before issue 14"
+TIMED = (*METHODS, OLD, "reference (mpmath)")
 
 
 @dataclass
@@ -33,6 +37,8 @@ class Row:
     diffs: dict[str, int]
     seconds_per_feature: dict[str, float]
     exact_fallbacks: int
+    exact_ties: int = 0  # decided by the vectorised expansion predicates
+    exact_mpmath: int = 0  # decided by mpmath
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -54,6 +60,7 @@ def measure_case(cs) -> Row:
     """Differences from the reference and time per feature of each method on one class."""
     from eyeviz.core import geometry
     from eyeviz.reference.digits80 import reference_intervals
+    from eyeviz.reference.legacy_fastpath import LegacyEyePair
     from eyeviz.reference.paper_formulas import paper_intervals
 
     e, x, y, g = cs.eyes, cs.x, cs.y, cs.g
@@ -68,10 +75,17 @@ def measure_case(cs) -> Row:
         out, t = _timed(fn)
         diffs[method] = int((np.array(out) != ref).any(axis=0).sum())
         times[method] = t / x.size
+    old = LegacyEyePair.of(e)
+    out, t = _timed(lambda: old.intervals(x, y, g), 1)  # slow on ties: once
+    if (np.array(out) != ref).any():
+        raise AssertionError(f"the legacy core differs from the reference on {cs.name}")
+    times[OLD] = t / x.size
     geometry.FALLBACK_COUNTS.clear()
     e.intervals(x, y, g)
-    exact = geometry.FALLBACK_COUNTS["exact"]
-    return Row(cs.name, cs.description, int(x.size), e.m, diffs, times, exact)
+    c = geometry.FALLBACK_COUNTS
+    return Row(
+        cs.name, cs.description, int(x.size), e.m, diffs, times, c["exact"], c["ties"], c["mpmath"]
+    )
 
 
 def measure(n: int = 2000, seed: int = 0, progress=None) -> list[Row]:
@@ -94,16 +108,23 @@ def _markdown(rows: list[Row]) -> str:
         "time per feature. (a) and (b) are the paper's Eq. 11 and 22-25 taken literally\n"
         "(arccos form, valid for 0 <= phi <= pi only, so features below the x-axis come out\n"
         "mirrored); (c) is eyeviz's core: float64 with an exact fallback on the elements near a\n"
-        "boundary ('exact' column: how many of them per class).\n\n"
+        "boundary ('exact' column: how many of them per class; 'ties' of those were decided\n"
+        "vectorised with floating-point expansions, 'mpmath' one at a time). The core as it\n"
+        "was before issue 14 is timed in the same run: its cost per feature, and the new\n"
+        "core's speed-up over it, stand in the last columns.\n\n"
     )
     out.write("| case | n | m | " + " | ".join(f"{m} diffs" for m in METHODS))
-    out.write(" | exact | " + " | ".join(f"{m} µs" for m in (*METHODS, "reference (mpmath)")))
-    out.write(" |\n|" + "---|" * (4 + 2 * len(METHODS) + 1) + "\n")
+    out.write(" | exact | ties | mpmath | " + " | ".join(f"{m} µs" for m in TIMED))
+    out.write(" | speed-up vs before | core / paper regime |\n")
+    out.write("|" + "---|" * (3 + len(METHODS) + 3 + len(TIMED) + 2) + "\n")
+    paper = rows[0].seconds_per_feature["eyeviz core"] if rows else 1.0
     for r in rows:
+        t = r.seconds_per_feature
         cells = [r.case, str(r.n), str(r.m)]
         cells += [f"{r.diffs[m]} ({100 * r.diffs[m] / r.n:.1f} %)" for m in METHODS]
-        cells.append(str(r.exact_fallbacks))
-        cells += [f"{1e6 * r.seconds_per_feature[m]:.3g}" for m in (*METHODS, "reference (mpmath)")]
+        cells += [str(r.exact_fallbacks), str(r.exact_ties), str(r.exact_mpmath)]
+        cells += [f"{1e6 * t[m]:.3g}" for m in TIMED]
+        cells += [f"{t[OLD] / t['eyeviz core']:.3g}x", f"{t['eyeviz core'] / paper:.3g}x"]
         out.write("| " + " | ".join(cells) + " |\n")
     out.write("\nCase classes:\n\n")
     for r in rows:
@@ -117,7 +138,12 @@ def _plot(rows: list[Row], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    colors = {"paper float64": "#E69F00", "paper float32": "#CC79A7", "eyeviz core": "#0072B2"}
+    colors = {
+        "paper float64": "#E69F00",
+        "paper float32": "#CC79A7",
+        "eyeviz core": "#0072B2",
+        OLD: "#56B4E9",
+    }
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
     y = np.arange(len(rows))
     h = 0.27
@@ -132,7 +158,7 @@ def _plot(rows: list[Row], path: Path) -> None:
     ax1.set_xlabel("features with a wrong bitmap (%)")
     ax1.set_title("error against the 80-digit reference")
     ax1.legend(loc="lower right", fontsize=8)
-    for m in (*METHODS, "reference (mpmath)"):
+    for m in TIMED:
         t = [1e9 * r.seconds_per_feature[m] for r in rows]
         err = [max(100 * r.diffs.get(m, 0) / r.n, 0.01) for r in rows]
         ax2.scatter(t, err, label=m, color=colors.get(m, "#555555"), s=30)
@@ -159,15 +185,19 @@ def write(rows: list[Row], outdir: Path) -> None:
     def csv_writer(p: Path) -> None:
         with open(p, "w", newline="") as f:
             w = csv.writer(f)
-            timed = (*METHODS, "reference (mpmath)")
             w.writerow(
                 ["case", "n", "m", *(f"diffs {m}" for m in METHODS), "exact fallbacks"]
-                + [f"s/feature {m}" for m in timed]
+                + ["exact ties", "exact mpmath"]
+                + [f"s/feature {m}" for m in TIMED]
+                + ["speed-up vs before"]
             )
             for r in rows:
+                t = r.seconds_per_feature
                 w.writerow(
                     [r.case, r.n, r.m, *(r.diffs[m] for m in METHODS), r.exact_fallbacks]
-                    + [r.seconds_per_feature[m] for m in timed]
+                    + [r.exact_ties, r.exact_mpmath]
+                    + [t[m] for m in TIMED]
+                    + [t[OLD] / t["eyeviz core"]]
                 )
 
     _write_atomic(outdir / "stability.csv", csv_writer)

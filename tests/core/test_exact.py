@@ -6,8 +6,9 @@ import math
 from fractions import Fraction as F
 
 import mpmath
+import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from eyeviz.core import exact
@@ -74,3 +75,64 @@ def test_sign_sqrt_times_minus(y):
         expect = y * math.sqrt(2) - float(c)
         s = exact.sign_sqrt_times_minus(F(y), F(2), c)
         assert s == (expect > 0) - (expect < 0)
+
+
+# --- vectorised ties (issue 14) --------------------------------------------------------
+coord = st.one_of(
+    st.integers(-64, 64).map(float),
+    st.floats(-1e3, 1e3, allow_nan=False),
+    st.floats(-1e-200, 1e-200, allow_nan=False),
+    st.floats(-1e250, 1e250, allow_nan=False),
+)
+
+
+@settings(max_examples=400, deadline=None)
+@given(
+    coord,
+    coord,
+    st.floats(0, 1e3, allow_nan=False),
+    st.sampled_from([4, 8, 12, 24, 360, 720, 100, 2**20]),
+    st.integers(-3, 27),
+    st.booleans(),
+    st.sampled_from([-40.0, 40.0, 0.0, 1e-300]),
+)
+def test_vectorised_ties_agree_with_the_rational_predicate(x, y, g, m, j, upper, cx):
+    # boundaries at 30- and 45-degree multiples (and a few others, which must say -1)
+    n = j * m // 24 if j % 3 else j * m // 8
+    got = int(exact.ties_at_or_past([x], [y], [g], cx, [n], m, [upper])[0])
+    X, Y, G = F(x) - F(cx), F(y), F(g)
+    if X == 0 and Y == 0:
+        return
+    want = exact._endpoint_at_or_past(X, Y, G, n, m, upper)
+    nice = (12 * n) % m == 0 or (8 * n) % m == 0
+    if not nice:
+        assert got == -1
+        return
+    assert got == int(want)
+
+
+def test_vectorised_ties_on_the_sqrt_part():
+    # 30 degrees: the sqrt(3) parts carry y; signs of a and b differ on both sides of 0
+    xs = np.array([1.0, 1.0, 3.0, 3.0, 1e-200, 7.5])
+    ys = np.array([0.5, 0.6, 1.7320508075688772, 1.7320508075688774, 1e-200, -2.0])
+    gs = np.array([0.5, 0.25, 0.0, 0.0, 0.0, 1.0])
+    n = np.full(6, 60)  # 30 degrees at m = 720
+    for upper in (False, True):
+        got = exact.ties_at_or_past(xs, ys, gs, 0.0, n, 720, np.full(6, upper))
+        want = [
+            exact._endpoint_at_or_past(F(x), F(y), F(g), 60, 720, upper)
+            for x, y, g in zip(xs, ys, gs, strict=True)
+        ]
+        assert got.tolist() == [int(w) for w in want]
+
+
+def test_expansion_sign_is_exact_where_float_sums_cancel():
+    a = np.array([1e16, 1.0, 0.1])
+    b = np.array([1.0, 1e-30, 0.2])
+    c = np.array([-1e16, -1.0, -0.30000000000000004])
+    signs = exact._sign_of(exact._expansion([a, b, c]))
+    want = [
+        int(np.sign(F(float(p)) + F(float(q)) + F(float(r))))
+        for p, q, r in zip(a, b, c, strict=True)
+    ]
+    assert signs.tolist() == want == [1, 1, -1]
