@@ -15,7 +15,7 @@ from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import LAYERS
 from eyeviz.render.vtk.actors import UNLIT, hex_rgb
 
-__all__ = ["BitmapPanel", "EyesPanel", "FeaturePanel", "LayersPanel", "ReadoutPanel"]
+__all__ = ["BitmapPanel", "EyesPanel", "FeaturePanel", "LayersPanel", "ReadoutPanel", "ValueText"]
 
 ERROR_STYLE = "color: #b00020; font-weight: bold;"
 INK = QtGui.QColor(30, 30, 30)
@@ -44,33 +44,57 @@ class BitmapPanel(QtWidgets.QWidget):
         self.colors = np.array([UNLIT], dtype=np.uint8)
         self.intervals: dict[str, tuple[int, int] | None] = {"A": None, "B": None}
         self.sel_color = INK
+        self.selected: int | None = None
+        self.texts: dict[tuple[str, bool], str] = {}
+        self._key = None
+        self.setAttribute(QtCore.Qt.WA_OpaquePaintEvent)  # paints every pixel itself
         self.setMinimumHeight(150)
         self.setMaximumHeight(190)
         self.setSizePolicy(QtWidgets.QSizePolicy.Expanding, QtWidgets.QSizePolicy.Fixed)
 
     def refresh(self) -> None:
+        """Take the state's owners and the selected intervals; repaint only on a change
+        (a drag that lights the same ommatidia paints nothing)."""
         st = self.model.state
         sc = self.model.scene
-        self.strips.clear()
-        self.intervals = {"A": None, "B": None}
+        strips: dict[tuple[str, bool], np.ndarray] = {}
+        intervals: dict[str, tuple[int, int] | None] = {"A": None, "B": None}
         if st.LA is not None:
             m = st.m
             oa = st.owner_a if st.owner_a is not None else _owners_of(st, "A")
             ob = st.owner_b if st.owner_b is not None else _owners_of(st, "B")
             for eye, own in (("A", oa), ("B", ob)):
-                self.strips[(eye, True)] = own
-                self.strips[(eye, False)] = own[: m // 2]
+                strips[(eye, True)] = own
+                strips[(eye, False)] = own[: m // 2]
             i = self.model.selected
             if i is not None and i < st.n:
-                self.intervals = {
+                intervals = {
                     "A": (int(st.LA[i]), int(st.RA[i])),
                     "B": (int(st.LB[i]), int(st.RB[i])),
                 }
-        self.colors = np.vstack([UNLIT] + [hex_rgb(f.color) for f in sc.features]).astype(np.uint8)
+        colors = np.vstack([UNLIT] + [hex_rgb(f.color) for f in sc.features]).astype(np.uint8)
         i = self.model.selected
-        self.sel_color = QtGui.QColor(
-            sc.features[i].color if i is not None and i < st.n else "#222"
+        sel = i if i is not None and i < st.n else None
+        key = (
+            sc.shows("bitmaps"),
+            sel,
+            tuple(intervals.values()),
+            colors.tobytes(),
+            tuple((k, v.tobytes()) for k, v in strips.items()),
         )
+        if key == self._key:
+            return
+        self._key = key
+        self.strips, self.intervals, self.colors, self.selected = strips, intervals, colors, sel
+        self.sel_color = QtGui.QColor(sc.features[sel].color if sel is not None else "#222")
+        m = st.m
+        self.texts = {
+            (eye, whole): (
+                "" if iv is None else (f"[{iv[0]}, {iv[1]}]" if whole else _half_text(iv, m))
+            )
+            for (eye, whole) in self.ROWS
+            for iv in (intervals[eye],)
+        }
         self.update()
 
     def lit(self, eye: str, whole: bool) -> np.ndarray:
@@ -106,10 +130,9 @@ class BitmapPanel(QtWidgets.QWidget):
             p.setPen(INK)
             name = f"Ω_{eye}  " + ("whole eye" if whole else "0…m/2−1")
             p.drawText(QtCore.QRect(4, y, label_w - 8, row_h), QtCore.Qt.AlignVCenter, name)
-            iv = self.intervals[eye]
-            if iv is not None:
+            text = self.texts.get((eye, whole), "")
+            if text:
                 p.setPen(self.sel_color)
-                text = f"[{iv[0]}, {iv[1]}]" if whole else _half_text(iv, m)
                 p.drawText(QtCore.QRect(x1 + 8, y, right_w, row_h), QtCore.Qt.AlignVCenter, text)
         p.end()
 
@@ -135,6 +158,68 @@ def _owners_of(st, eye: str) -> np.ndarray:
 
 GOOD, BAD, GREY = "#1b7837", "#b00020", "#777777"
 READOUT_MIN_WIDTH = 420
+
+
+class ValueText(QtWidgets.QWidget):
+    """Plain text painted by the widget itself: a new text repaints this widget only.
+
+    A QLabel's ``setText`` asks its parent layout to re-lay out (``updateGeometry``) on
+    every change, which re-laid out the whole window on every drag event; this widget
+    asks for a new geometry only when its number of lines changes.
+    """
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self._text = ""
+        self._lines = 1
+        self._color = QtGui.QColor("#1e1e1e")
+        self.setAutoFillBackground(True)  # opaque: its repaint does not repaint the dock
+        self.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Fixed)
+        self.setFixedHeight(self._height(1))
+
+    def _height(self, lines: int) -> int:
+        return self.fontMetrics().lineSpacing() * lines + 2
+
+    def text(self) -> str:
+        return self._text
+
+    def setText(self, text: str) -> None:  # noqa: N802 (Qt name)
+        if text == self._text:
+            return
+        self._text = text
+        lines = text.count("\n") + 1
+        if lines != self._lines:
+            self._lines = lines
+            self.setFixedHeight(self._height(lines))  # a layout only when the shape changes
+        self.setToolTip(text if len(text) > 40 else "")
+        self.update()
+
+    def set_style(self, color: str, bold: bool) -> None:
+        f = self.font()
+        if f.bold() != bold:
+            f.setBold(bold)
+            self.setFont(f)
+            self.setFixedHeight(self._height(self._lines))
+        self._color = QtGui.QColor(color)
+        self.update()
+
+    def sizeHint(self) -> QtCore.QSize:  # noqa: N802 (Qt name)
+        return QtCore.QSize(120, self._height(self._lines))
+
+    def paintEvent(self, event) -> None:  # noqa: N802 (Qt name)
+        p = QtGui.QPainter(self)
+        p.setPen(self._color)
+        flags = QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop
+        fm = self.fontMetrics()
+        y = 0
+        for line in self._text.split("\n"):
+            p.drawText(
+                QtCore.QRect(0, y, self.width(), fm.lineSpacing()),
+                flags,
+                fm.elidedText(line, QtCore.Qt.ElideRight, self.width()),
+            )
+            y += fm.lineSpacing()
+        p.end()
 
 
 class ReadoutPanel(QtWidgets.QWidget):
@@ -173,13 +258,8 @@ class ReadoutPanel(QtWidgets.QWidget):
 
     def _row(self, k: int) -> tuple[QtWidgets.QLabel, QtWidgets.QLabel]:
         while len(self._rows) <= k:
-            key, val = QtWidgets.QLabel(), QtWidgets.QLabel()
+            key, val = QtWidgets.QLabel(), ValueText()
             key.setTextFormat(QtCore.Qt.RichText)
-            val.setTextFormat(QtCore.Qt.PlainText)
-            val.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
-            val.setAlignment(QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop)
-            # changing numbers must never resize the dock (and the view) during a drag
-            val.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Preferred)
             key.setAlignment(QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop)
             r = len(self._rows)
             self.grid.addWidget(key, r, 0)
@@ -201,14 +281,10 @@ class ReadoutPanel(QtWidgets.QWidget):
             if old is None or old[2] != text:
                 val.setText(text)
             if old is None or old[3] != color:
-                pal = val.palette()
-                pal.setColor(QtGui.QPalette.WindowText, QtGui.QColor(color))
-                val.setPalette(pal)
-                f = val.font()
-                f.setBold(color in (GOOD, BAD))
-                val.setFont(f)
-            key.show()
-            val.show()
+                val.set_style(color, color in (GOOD, BAD))
+            if old is None:
+                key.show()
+                val.show()
             self._cache[k] = row
         for k in range(len(rows), len(self._rows)):
             if self._cache.pop(k, None) is not None:
@@ -231,8 +307,9 @@ class ReadoutPanel(QtWidgets.QWidget):
             return
         f = sc.features[i]
         self._set_title(f"● {f.name}", f.color)
-        if st.r is None:
-            self._set([("hidden", "", "readout layer hidden", GREY)])
+        if not sc.shows("readout") or st.r is None:
+            # the layer is off: no value at all (other layers may still compute them)
+            self._set([("hidden", "", "readout layer hidden\n(tick it in Layers)", GREY)])
             return
 
         def yes(v, good=True):

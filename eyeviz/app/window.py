@@ -153,9 +153,11 @@ class MainWindow(QtWidgets.QMainWindow):
         self.cursor_label = QtWidgets.QLabel("")
         # a fixed width: a new cursor text must not re-lay out the status bar every move
         fm = self.cursor_label.fontMetrics()
-        self.cursor_label.setFixedWidth(
-            fm.horizontalAdvance("x -00,000.0   y -00,000.0     r 00,000.0   φ 000.00°  ")
+        self.cursor_label.setFixedSize(  # width AND height: a setText never re-lays out
+            fm.horizontalAdvance("x -00,000.0   y -00,000.0     r 00,000.0   φ 000.00°  "),
+            fm.height() + 4,
         )
+        self.cursor_label.setAutoFillBackground(True)  # opaque: repaints only itself
         self.statusBar().addPermanentWidget(self.cursor_label)
         self._build_menus()
         self.model.listeners.append(self._on_model)
