@@ -11,10 +11,13 @@ from pathlib import Path
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
+from eyeviz.app.panels import set_message, wrap_label
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import TRAJECTORY_KINDS, Trajectory
 
-__all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel"]
+__all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel", "PLOT_PT"]
+
+PLOT_PT = 10  # the smallest text of the accuracy plot (projector-readable)
 
 ESTIMATOR_HELP = {
     "analytic": "triangulation of the two eyes' centre rays (no weights)",
@@ -26,7 +29,7 @@ ESTIMATOR_HELP = {
 
 class EstimatorPicker(QtWidgets.QWidget):
     """A check box per estimator (several at once); each chosen one gets its colour
-    (eyeviz.render.mpl.vector.estimator_colors, as in exported figures)."""
+    (eyeviz.model.palette: fixed by name, as in exported figures)."""
 
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
@@ -41,14 +44,13 @@ class EstimatorPicker(QtWidgets.QWidget):
             b.toggled.connect(lambda on, n=name: self._toggled(n, on))
             lay.addWidget(b)
             self.boxes[name] = b
-        self.note = QtWidgets.QLabel("")
-        self.note.setWordWrap(True)
+        self.note = wrap_label(QtWidgets.QLabel(""))
         lay.addWidget(self.note)
         lay.addStretch(1)
         self._filling = False
 
     def refresh(self) -> None:
-        from eyeviz.render.mpl.vector import estimator_colors
+        from eyeviz.model.palette import estimator_colors
 
         chosen = self.model.scene.estimators
         cols = estimator_colors(chosen)
@@ -63,7 +65,7 @@ class EstimatorPicker(QtWidgets.QWidget):
             self._filling = False
         preds = self.model.predictions
         bad = [f"{n}: {v}" for n, v in preds.items() if isinstance(v, str)]
-        self.note.setText("\n".join(bad))
+        set_message(self.note, "\n".join(bad))
         self.note.setStyleSheet("color: #b00020;" if bad else "")
 
     def _toggled(self, name: str, on: bool) -> None:
@@ -113,8 +115,7 @@ class TrajectoryPanel(QtWidgets.QWidget):
         row.addWidget(QtWidgets.QLabel("speed"))
         row.addWidget(self.speed, 1)
         lay.addLayout(row)
-        self.info = QtWidgets.QLabel("")
-        self.info.setWordWrap(True)
+        self.info = wrap_label(QtWidgets.QLabel(""))
         lay.addWidget(self.info)
         self.fig = Figure(figsize=(4.2, 3.0), dpi=100, layout="constrained")
         self.canvas = FigureCanvasQTAgg(self.fig)
@@ -122,6 +123,9 @@ class TrajectoryPanel(QtWidgets.QWidget):
         lay.addWidget(self.canvas, 1)
         self.ax_ad = self.fig.add_subplot(2, 1, 1)
         self.ax_dd = self.fig.add_subplot(2, 1, 2, sharex=self.ax_ad)
+        self.placeholder = self.fig.text(
+            0.5, 0.5, "", ha="center", va="center", fontsize=PLOT_PT + 1, color="#555555"
+        )
         self.cursors = []
         self._key = None
         self._before = None
@@ -180,7 +184,9 @@ class TrajectoryPanel(QtWidgets.QWidget):
         self._plot()
 
     def _plot(self) -> None:
-        from eyeviz.render.mpl.vector import estimator_colors
+        """The AD and DD accuracy along the path; without a path, a placeholder text and no
+        axes (empty 0-1 axes looked like a broken plot). Text at PLOT_PT points or more."""
+        from eyeviz.model.palette import estimator_colors
 
         for ax in (self.ax_ad, self.ax_dd):
             ax.clear()
@@ -188,7 +194,15 @@ class TrajectoryPanel(QtWidgets.QWidget):
         self.cursors = []
         p = self.path
         notes = [self.message] if self.message else []
-        if p is not None:
+        self.placeholder.set_visible(p is None)
+        for ax in (self.ax_ad, self.ax_dd):
+            ax.set_visible(p is not None)
+        if p is None:
+            why = self.message or "no trajectory"
+            self.placeholder.set_text(
+                f"{why}\n\nchoose a path above (or View > Trajectory)\nto see the accuracy along it"
+            )
+        else:
             cols = estimator_colors(self.model.scene.estimators)
             for j, (name, acc) in enumerate(p.accuracy.items()):
                 if isinstance(acc, str):
@@ -199,30 +213,34 @@ class TrajectoryPanel(QtWidgets.QWidget):
                 self.ax_dd.plot(p.axis, acc[1], color=cols[name], lw=lw, label=name)
             for ax in (self.ax_ad, self.ax_dd):
                 self.cursors.append(ax.axvline(p.axis[0], color="#333333", lw=1.2))
-                lo = min(
-                    [
-                        np.nanmin(a[k])
-                        for a in p.accuracy.values()
-                        if not isinstance(a, str)
-                        for k in (0, 1)
-                    ]
-                    + [90.0]
-                )
+            lo = min(
+                [
+                    np.nanmin(a[k])
+                    for a in p.accuracy.values()
+                    if not isinstance(a, str)
+                    for k in (0, 1)
+                ]
+                + [90.0]
+            )
             self.ax_dd.set_ylim(max(0.0, min(lo, 90.0)) - 2, 101)
             t = self.model.scene.trajectory
-            self.ax_dd.set_xlabel(p.axis_label)
+            self.ax_dd.set_xlabel(p.axis_label, fontsize=PLOT_PT)
             notes.insert(
                 0, f"{t.kind} path, distance {t.distance:g}, g = {t.g:g}: {p.n} points in the BFV"
             )
             if any(not isinstance(a, str) for a in p.accuracy.values()):
                 self.ax_ad.legend(
-                    loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, ncol=4, frameon=False
+                    loc="lower right",
+                    bbox_to_anchor=(1.0, 1.0),
+                    fontsize=PLOT_PT,
+                    ncol=4,
+                    frameon=False,
                 )
-        self.ax_ad.set_title("AD accuracy (%)", fontsize=9, loc="left")
-        self.ax_dd.set_title("DD accuracy (%)", fontsize=9, loc="left")
-        self.ax_ad.tick_params(labelsize=8, labelbottom=False)
-        self.ax_dd.tick_params(labelsize=8)
-        self.info.setText("\n".join(notes))
+            self.ax_ad.set_title("AD accuracy (%)", fontsize=PLOT_PT, loc="left")
+            self.ax_dd.set_title("DD accuracy (%)", fontsize=PLOT_PT, loc="left")
+            self.ax_ad.tick_params(labelsize=PLOT_PT, labelbottom=False)
+            self.ax_dd.tick_params(labelsize=PLOT_PT)
+        set_message(self.info, "\n".join(notes))
         self.canvas.draw_idle()
 
     # --- animation ----------------------------------------------------------------------

@@ -7,6 +7,7 @@ Panels draw from the model's :class:`~eyeviz.model.state.SceneState` and send ed
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
@@ -18,6 +19,39 @@ from eyeviz.render.vtk.actors import UNLIT, hex_rgb
 __all__ = ["BitmapPanel", "EyesPanel", "FeaturePanel", "LayersPanel", "ReadoutPanel", "ValueText"]
 
 ERROR_STYLE = "color: #b00020; font-weight: bold;"
+_PATH = re.compile(r"(?:[A-Za-z]:)?(?:[\\/][^\s\\/:'\"()\[\],]+){2,}[\\/]?")
+_DEV = re.compile(
+    r"\b(?:Traceback|\w*Error|\w*Exception)\b:?\s*|\[Errno \d+\]\s*|\b\w+\.py\b(?::\d+)?"
+)
+
+
+def user_message(text: str, limit: int = 160) -> str:
+    """A message fit for a user: one line, local paths reduced to their file name,
+    Python exception names and file:line references removed, at most ``limit`` chars."""
+    line = str(text).strip().splitlines()[0] if str(text).strip() else ""
+    line = _PATH.sub(lambda mt: "‘" + re.split(r"[\\/]", mt.group(0).rstrip("\\/"))[-1] + "’", line)
+    line = _DEV.sub("", line).strip(" :")
+    return line if len(line) <= limit else line[: limit - 1] + "…"
+
+
+def wrap_label(label: QtWidgets.QLabel) -> QtWidgets.QLabel:
+    """A word-wrapped message label that never widens its panel: its width is the
+    panel's (a long word is cut, the whole text is in the tooltip)."""
+    label.setWordWrap(True)
+    label.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Minimum)
+    label.setMinimumWidth(0)
+    return label
+
+
+def set_message(label: QtWidgets.QLabel, text: str) -> None:
+    """Show ``text`` (several lines allowed) in a :func:`wrap_label`, tooltip = full text."""
+    lines = [user_message(t, 400) for t in str(text).splitlines() if t.strip()]
+    full = "\n".join(lines)
+    if label.text() != full:
+        label.setText(full)
+        label.setToolTip(full)
+
+
 INK = QtGui.QColor(30, 30, 30)
 
 
@@ -33,9 +67,16 @@ def _downsample(owner: np.ndarray, width: int) -> np.ndarray:
 
 
 class BitmapPanel(QtWidgets.QWidget):
-    """Omega_A and Omega_B: the m/2 the networks see and the whole eye, lit [L, R] beside."""
+    """Omega_A and Omega_B: the m/2 the networks see and the whole eye, lit [L, R] beside.
+
+    The selected feature is drawn over the others where they overlap (and outlined), so
+    it never hides under a neighbour; when an ommatidium is at least ``CELL_PX`` pixels
+    wide the cell boundaries are drawn, and their indices where the text fits. A change
+    repaints only the rows that changed (a drag lighting the same cells paints nothing).
+    """
 
     ROWS = (("A", False), ("A", True), ("B", False), ("B", True))
+    CELL_PX = 6.0  # cell boundaries from this width on
 
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
@@ -46,46 +87,48 @@ class BitmapPanel(QtWidgets.QWidget):
         self.sel_color = INK
         self.selected: int | None = None
         self.texts: dict[tuple[str, bool], str] = {}
-        self._key = None
+        self.sel_masks: dict[tuple[str, bool], np.ndarray] = {}
+        self._row_keys: dict[tuple[str, bool], bytes] = {}
+        self._shown = None
         self.setAttribute(QtCore.Qt.WA_OpaquePaintEvent)  # paints every pixel itself
         self.setMinimumHeight(150)
         self.setMaximumHeight(190)
         self.setSizePolicy(QtWidgets.QSizePolicy.Expanding, QtWidgets.QSizePolicy.Fixed)
 
     def refresh(self) -> None:
-        """Take the state's owners and the selected intervals; repaint only on a change
-        (a drag that lights the same ommatidia paints nothing)."""
+        """Take the state's owners and the selected intervals; repaint the changed rows."""
+        from eyeviz.core.geometry import intervals_to_bitmap
+
         st = self.model.state
         sc = self.model.scene
         strips: dict[tuple[str, bool], np.ndarray] = {}
+        masks: dict[tuple[str, bool], np.ndarray] = {}
         intervals: dict[str, tuple[int, int] | None] = {"A": None, "B": None}
+        i = self.model.selected
+        sel = i if i is not None and i < st.n else None
         if st.LA is not None:
             m = st.m
             oa = st.owner_a if st.owner_a is not None else _owners_of(st, "A")
             ob = st.owner_b if st.owner_b is not None else _owners_of(st, "B")
+            if sel is not None:
+                intervals = {
+                    "A": (int(st.LA[sel]), int(st.RA[sel])),
+                    "B": (int(st.LB[sel]), int(st.RB[sel])),
+                }
             for eye, own in (("A", oa), ("B", ob)):
+                iv = intervals[eye]
+                mask = intervals_to_bitmap(iv[0], iv[1], m) if iv is not None else np.zeros(m, bool)
+                if sel is not None and mask.any():
+                    own = own.copy()
+                    own[mask] = sel  # the selected feature on top where features overlap
                 strips[(eye, True)] = own
                 strips[(eye, False)] = own[: m // 2]
-            i = self.model.selected
-            if i is not None and i < st.n:
-                intervals = {
-                    "A": (int(st.LA[i]), int(st.RA[i])),
-                    "B": (int(st.LB[i]), int(st.RB[i])),
-                }
+                masks[(eye, True)] = mask
+                masks[(eye, False)] = mask[: m // 2]
         colors = np.vstack([UNLIT] + [hex_rgb(f.color) for f in sc.features]).astype(np.uint8)
-        i = self.model.selected
-        sel = i if i is not None and i < st.n else None
-        key = (
-            sc.shows("bitmaps"),
-            sel,
-            tuple(intervals.values()),
-            colors.tobytes(),
-            tuple((k, v.tobytes()) for k, v in strips.items()),
-        )
-        if key == self._key:
-            return
-        self._key = key
+        shown = sc.shows("bitmaps") and bool(strips)
         self.strips, self.intervals, self.colors, self.selected = strips, intervals, colors, sel
+        self.sel_masks = masks
         self.sel_color = QtGui.QColor(sc.features[sel].color if sel is not None else "#222")
         m = st.m
         self.texts = {
@@ -95,29 +138,62 @@ class BitmapPanel(QtWidgets.QWidget):
             for (eye, whole) in self.ROWS
             for iv in (intervals[eye],)
         }
-        self.update()
+        if shown != self._shown:
+            self._shown = shown
+            self._row_keys = {}
+            self.update()
+            return
+        for r, row in enumerate(self.ROWS):
+            if row not in strips:
+                continue
+            key = b"".join(
+                (
+                    strips[row].tobytes(),
+                    masks[row].tobytes(),
+                    colors.tobytes(),
+                    self.texts[row].encode(),
+                    self.sel_color.name().encode(),
+                )
+            )
+            if self._row_keys.get(row) != key:
+                self._row_keys[row] = key
+                self.update(self._row_rect(r))
 
     def lit(self, eye: str, whole: bool) -> np.ndarray:
         """The bitmap shown in a strip (bool per ommatidium)."""
         return self.strips[(eye, whole)] >= 0
 
+    def _geometry(self, fm: QtGui.QFontMetrics) -> tuple[int, int, int]:
+        label_w = fm.horizontalAdvance("Ω_B  whole eye ") + 8
+        right_w = fm.horizontalAdvance("[35999, 35999] ∪ [0, 0]") + 8
+        row_h = max(fm.height() + 10, (self.height() - 8) // 4)
+        return label_w, right_w, row_h
+
+    def _row_rect(self, r: int) -> QtCore.QRect:
+        _, _, row_h = self._geometry(self.fontMetrics())
+        return QtCore.QRect(0, 4 + r * row_h, self.width(), row_h)
+
     def paintEvent(self, event) -> None:  # noqa: N802 (Qt name)
         p = QtGui.QPainter(self)
-        p.fillRect(self.rect(), QtGui.QColor("white"))
+        p.fillRect(event.rect(), QtGui.QColor("white"))
         if not self.model.scene.shows("bitmaps") or not self.strips:
             p.setPen(INK)
             p.drawText(self.rect(), QtCore.Qt.AlignCenter, "bitmaps layer hidden")
+            p.end()
             return
         fm = p.fontMetrics()
-        label_w = fm.horizontalAdvance("Ω_B  whole eye ") + 8
-        right_w = fm.horizontalAdvance("[35999, 35999] ") + 8
-        m = self.model.state.m
-        row_h = max(fm.height() + 10, (self.height() - 8) // 4)
+        label_w, right_w, row_h = self._geometry(fm)
         x0, x1 = label_w, self.width() - right_w
         width = max(x1 - x0, 1)
+        small = QtGui.QFont(p.font())
+        small.setPointSizeF(max(7.0, 0.7 * p.font().pointSizeF()))
+        sfm = QtGui.QFontMetrics(small)
         for r, (eye, whole) in enumerate(self.ROWS):
             y = 4 + r * row_h
+            if not event.rect().intersects(QtCore.QRect(0, y, self.width(), row_h)):
+                continue
             own = self.strips[(eye, whole)]
+            n = own.shape[0]
             cols = _downsample(own, width)
             rgb = np.ascontiguousarray(self.colors[cols + 1])
             img = QtGui.QImage(
@@ -125,7 +201,33 @@ class BitmapPanel(QtWidgets.QWidget):
             )
             target = QtCore.QRect(x0, y + 3, width, row_h - 8)
             p.drawImage(target, img)
+            cell = width / max(n, 1)
+            if cell >= self.CELL_PX:  # small m: the cells and their indices
+                p.setPen(QtGui.QPen(QtGui.QColor("#9a9a9a"), 1))
+                for k in range(1, n):
+                    xk = round(x0 + k * cell)
+                    p.drawLine(xk, target.top(), xk, target.bottom())
+                every = max(1, math.ceil(sfm.horizontalAdvance(str(n - 1)) * 1.6 / cell))
+                p.setFont(small)
+                p.setPen(QtGui.QColor("#555555"))
+                for k in range(0, n, every):
+                    p.drawText(
+                        QtCore.QRectF(x0 + k * cell, target.top(), cell, target.height()),
+                        QtCore.Qt.AlignCenter,
+                        str(k),
+                    )
+                p.setFont(self.font())
+            mask = self.sel_masks.get((eye, whole))
+            if mask is not None and mask.any():  # outline the selected feature's cells
+                p.setPen(QtGui.QPen(self.sel_color.darker(130), 2))
+                p.setBrush(QtCore.Qt.NoBrush)
+                for a, b in _runs(mask):
+                    xa, xb = x0 + a * width / n, x0 + (b + 1) * width / n
+                    p.drawRect(
+                        QtCore.QRectF(xa, target.top() + 1, max(xb - xa, 2.0), target.height() - 2)
+                    )
             p.setPen(QtGui.QPen(INK, 1))
+            p.setBrush(QtCore.Qt.NoBrush)
             p.drawRect(target)
             p.setPen(INK)
             name = f"Ω_{eye}  " + ("whole eye" if whole else "0…m/2−1")
@@ -133,8 +235,21 @@ class BitmapPanel(QtWidgets.QWidget):
             text = self.texts.get((eye, whole), "")
             if text:
                 p.setPen(self.sel_color)
-                p.drawText(QtCore.QRect(x1 + 8, y, right_w, row_h), QtCore.Qt.AlignVCenter, text)
+                rect = QtCore.QRect(x1 + 8, y, right_w - 8, row_h)
+                p.drawText(
+                    rect,
+                    QtCore.Qt.AlignVCenter,
+                    fm.elidedText(text, QtCore.Qt.ElideRight, rect.width()),
+                )
         p.end()
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(first, last) index of each run of True in ``mask``."""
+    d = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return list(
+        zip(np.flatnonzero(d == 1).tolist(), (np.flatnonzero(d == -1) - 1).tolist(), strict=True)
+    )
 
 
 def _half_text(iv: tuple[int, int], m: int) -> str:
@@ -341,7 +456,7 @@ class ReadoutPanel(QtWidgets.QWidget):
 
     def _prediction_rows(self, i: int) -> list[tuple[str, str, str, str]]:
         from eyeviz.model.derived import errors
-        from eyeviz.render.mpl.vector import estimator_colors
+        from eyeviz.model.palette import estimator_colors
 
         st, sc = self.model.state, self.model.scene
         preds = self.model.predictions
@@ -360,7 +475,7 @@ class ReadoutPanel(QtWidgets.QWidget):
             res = preds.get(name, "no prediction")
             key = f"<b style='color:{cols[name]}'>{name}</b>"
             if isinstance(res, str):
-                rows.append((f"pred:{name}", key, res, GREY))
+                rows.append((f"pred:{name}", key, user_message(res, 120), GREY))
                 continue
             r_hat, phi_hat = float(res[0][i]), float(res[1][i])
             if not (math.isfinite(r_hat) and math.isfinite(phi_hat)):
@@ -404,8 +519,7 @@ class EyesPanel(QtWidgets.QWidget):
             e.editingFinished.connect(self.apply)
             form.addRow(f"{key}  ({tip})", e)
             self.edits[key] = e
-        self.message = QtWidgets.QLabel("")
-        self.message.setWordWrap(True)
+        self.message = wrap_label(QtWidgets.QLabel(""))
         self.message.setStyleSheet(ERROR_STYLE)
         form.addRow(self.message)
 
@@ -431,7 +545,7 @@ class EyesPanel(QtWidgets.QWidget):
                 raise ValueError(f"m must be an even integer >= 4, got {texts['m']!r}") from None
             self.model.set_eyes(h, l, m)
         except ValueError as exc:
-            self.message.setText(f"Refused: {exc}")
+            set_message(self.message, f"Refused: {exc}")
             for key, val in (("h", f"{e.h:g}"), ("l", f"{e.l:g}"), ("m", str(e.m))):
                 self.edits[key].setText(val)
             return
@@ -455,8 +569,7 @@ class FeaturePanel(QtWidgets.QWidget):
         self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectRows)
         self.table.setSelectionMode(QtWidgets.QAbstractItemView.SingleSelection)
         lay.addWidget(self.table)
-        self.message = QtWidgets.QLabel("")
-        self.message.setWordWrap(True)
+        self.message = wrap_label(QtWidgets.QLabel(""))
         self.message.setStyleSheet(ERROR_STYLE)
         lay.addWidget(self.message)
         self._filling = False
@@ -514,7 +627,7 @@ class FeaturePanel(QtWidgets.QWidget):
             msg = str(exc)
             if msg.startswith("could not convert"):
                 msg = f"{self.COLS[c]} must be a number, got {item.text()!r}"
-            self.message.setText(f"Refused: {msg}")
+            set_message(self.message, f"Refused: {msg}")
             self.refresh()
 
 

@@ -51,6 +51,7 @@ LABEL_ALL_MAX = 6  # more features than this: only the selected one is labelled
 EDGE_MIN_PX = 7.0  # draw triangle edges when an ommatidium's rim is at least this wide
 Z_BFV, Z_EYES, Z_FEAT, Z_LINE, Z_POINT = -3.0, 0.0, 1.0, 2.0, 3.0
 _CIRCLE_N = 160
+BFV_ARC_N = 33  # points on the far arc of the BFV wedge
 
 
 def _font_file() -> str | None:
@@ -368,32 +369,22 @@ class SceneActors:
         self._owners = None
         pair = scene.eyes.pair()
         h, l, m = pair.h, pair.l, pair.m
+        self.bfv_mesh = self.bfv_rays = None
         if scene.shows("bfv"):
-            far = 1.0e7
-            a = pair.psi
-            wedge = pv.PolyData(
-                np.array(
-                    [
-                        [0, 0, Z_BFV],
-                        [far * math.cos(a), far * math.sin(a), Z_BFV],
-                        [-far * math.cos(a), far * math.sin(a), Z_BFV],
-                    ]
-                ),
-                faces=[3, 0, 1, 2],
+            self._bfv_psi = pair.psi
+            n = BFV_ARC_N
+            self.bfv_mesh = pv.PolyData(
+                np.zeros((n + 1, 3)),
+                faces=np.column_stack(
+                    [np.full(n - 1, 3), np.zeros(n - 1, int), np.arange(1, n), np.arange(2, n + 1)]
+                ).ravel(),
             )
-            rays = pv.PolyData(
-                np.array(
-                    [
-                        [far * math.cos(a), far * math.sin(a), Z_LINE],
-                        [0, 0, Z_LINE],
-                        [-far * math.cos(a), far * math.sin(a), Z_LINE],
-                    ]
-                ),
-                lines=[3, 0, 1, 2],
-            )
+            self.bfv_rays = pv.PolyData(np.zeros((3, 3)), lines=[3, 0, 1, 2])
+            self._bfv_far = None
+            self.fit_bfv()
             for ren in (self.main, self.inset):
-                self._add(self._static, ren, _actor(wedge, BFV_FILL))
-                ra = _actor(rays, BFV_LINE)
+                self._add(self._static, ren, _actor(self.bfv_mesh, BFV_FILL))
+                ra = _actor(self.bfv_rays, BFV_LINE)
                 ra.GetProperty().SetLineWidth(2.5)
                 self._add(self._static, ren, ra)
         if scene.shows("eyes"):
@@ -694,11 +685,45 @@ class SceneActors:
         self._rgb_now = (tint, cols)
         self.grey = grey
 
+    def fit_bfv(self) -> None:
+        """Draw the BFV wedge (Prop. 4: directions in [psi, pi - psi] from the origin) out
+        to beyond the visible part of both views, whatever the zoom or pan: the wedge is
+        a fan of BFV_ARC_N points on an arc of radius R with R cos(dtheta/2) >= the
+        distance from the origin to the farthest visible corner (points in place)."""
+        if getattr(self, "bfv_mesh", None) is None:
+            return
+        far = 1.0
+        for ren in (self.main, self.inset):
+            cam = ren.GetActiveCamera()
+            cx, cy, _ = cam.GetFocalPoint()
+            half_h = cam.GetParallelScale()
+            half_w = half_h * max(ren.GetTiledAspectRatio(), 1e-3)
+            far = max(far, math.hypot(abs(cx) + half_w, abs(cy) + half_h))
+        psi = self._bfv_psi
+        span = math.pi - 2.0 * psi
+        n = BFV_ARC_N
+        radius = 1.05 * far / math.cos(min(abs(span) / (n - 1), 2.0) / 2.0)
+        if self._bfv_far is not None and self._bfv_far >= radius and self._bfv_far < 4 * radius:
+            return  # still covers the view and is not far too large (float precision)
+        self._bfv_far = radius = 2.0 * radius
+        t = psi + span * np.linspace(0.0, 1.0, n)
+        pts = np.zeros((n + 1, 3))
+        pts[1:, 0] = radius * np.cos(t)
+        pts[1:, 1] = radius * np.sin(t)
+        pts[:, 2] = Z_BFV
+        self.bfv_mesh.points[:] = pts
+        self.bfv_rays.points[:] = [
+            [radius * math.cos(psi), radius * math.sin(psi), Z_LINE],
+            [0.0, 0.0, Z_LINE],
+            [-radius * math.cos(psi), radius * math.sin(psi), Z_LINE],
+        ]
+
     def set_zoom(self, main_px_per_unit: float, inset_px_per_unit: float, l: float, m: int):
         """Level of detail by on-screen size: where the eye's rim is narrower than m/2 pixels,
         neighbouring ommatidia are pooled (a pooled cell is lit if any of its ommatidia is, in
         the colour of the last feature lighting it); edges only where a cell is wide enough.
         """
+        self.fit_bfv()
         if not self.eye_meshes:
             return
         rim_px = {

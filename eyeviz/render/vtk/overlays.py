@@ -2,8 +2,8 @@
 
 Each layer is one or two actors whose PolyData is replaced when its content changes (a
 few hundred points at most); nothing is drawn for a layer the scene does not show.
-Colours follow :func:`eyeviz.render.mpl.vector.estimator_colors`, so the app and the
-exported figures agree.
+Colours are fixed by estimator name (:func:`eyeviz.model.palette.estimator_color`), never
+by list position and never a feature's colour.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import numpy as np
 import pyvista as pv
 from vtkmodules.vtkRenderingCore import vtkRenderer
 
+from eyeviz.model.palette import estimator_color
 from eyeviz.render.vtk.actors import INK, Z_LINE, Z_POINT, _actor, hex_rgb
 
 __all__ = ["OverlayActors", "Z_AMBIGUITY", "GHOST_N"]
@@ -66,7 +67,10 @@ class OverlayActors:
 
     # --- predictions ------------------------------------------------------------------
     def update_predictions(self, scene, state, preds: dict, colors: dict[str, str]) -> None:
-        """Ghost discs of radius g at each estimator's (r_hat, phi_hat), linked to the truth."""
+        """Ghost discs of radius g at each estimator's (r_hat, phi_hat), linked to the truth.
+
+        Each estimator is drawn in its own colour, fixed by name (``colors`` is ignored).
+        """
         self.ghosts = {}
         show = scene.shows("predictions") and bool(scene.features)
         if not show:
@@ -84,7 +88,7 @@ class OverlayActors:
             gx = r_hat * np.cos(phi_hat)
             gy = r_hat * np.sin(phi_hat)
             self.ghosts[name] = np.column_stack([gx, gy])
-            rgb = hex_rgb(colors[name])
+            rgb = hex_rgb(estimator_color(name))
             for i in np.flatnonzero(np.isfinite(gx) & np.isfinite(gy)):
                 g = state.g[i]
                 ring = np.column_stack(
