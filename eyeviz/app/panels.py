@@ -43,6 +43,28 @@ def wrap_label(label: QtWidgets.QLabel) -> QtWidgets.QLabel:
     return label
 
 
+def unelide_tabs(widget: QtWidgets.QWidget) -> None:
+    """Tab names of the window's tabbed docks in full (scroll buttons when they do not all
+    fit) instead of "Fe…", "E…"."""
+    win = widget.window()
+    for bar in win.findChildren(QtWidgets.QTabBar):
+        if bar.elideMode() != QtCore.Qt.ElideNone:
+            bar.setElideMode(QtCore.Qt.ElideNone)
+            bar.setUsesScrollButtons(True)
+
+
+class _Unelide(QtCore.QObject):
+    """Re-applies :func:`unelide_tabs` whenever a tabbed dock appears or is re-tabbed."""
+
+    def eventFilter(self, obj, ev) -> bool:  # noqa: N802 (Qt name)
+        if ev.type() in (QtCore.QEvent.Show, QtCore.QEvent.ParentChange):
+            unelide_tabs(obj)
+        return False
+
+
+_UNELIDE = _Unelide()
+
+
 def set_message(label: QtWidgets.QLabel, text: str) -> None:
     """Show ``text`` (several lines allowed) in a :func:`wrap_label`, tooltip = full text."""
     lines = [user_message(t, 400) for t in str(text).splitlines() if t.strip()]
@@ -138,11 +160,8 @@ class BitmapPanel(QtWidgets.QWidget):
             for (eye, whole) in self.ROWS
             for iv in (intervals[eye],)
         }
-        if shown != self._shown:
-            self._shown = shown
-            self._row_keys = {}
-            self.update()
-            return
+        whole_panel = shown != self._shown
+        self._shown = shown
         for r, row in enumerate(self.ROWS):
             if row not in strips:
                 continue
@@ -157,7 +176,10 @@ class BitmapPanel(QtWidgets.QWidget):
             )
             if self._row_keys.get(row) != key:
                 self._row_keys[row] = key
-                self.update(self._row_rect(r))
+                if not whole_panel:
+                    self.update(self._row_rect(r))
+        if whole_panel:
+            self.update()
 
     def lit(self, eye: str, whole: bool) -> np.ndarray:
         """The bitmap shown in a strip (bool per ommatidium)."""
@@ -349,6 +371,7 @@ class ReadoutPanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
+        self.installEventFilter(_UNELIDE)
         self.texts: dict[str, str] = {}  # row key -> value text (what tests read)
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(8, 8, 8, 8)
@@ -511,6 +534,7 @@ class EyesPanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
+        self.installEventFilter(_UNELIDE)
         form = QtWidgets.QFormLayout(self)
         self.edits: dict[str, QtWidgets.QLineEdit] = {}
         for key, tip in (("h", "origin to eye centre"), ("l", "eye radius"), ("m", "ommatidia")):
@@ -560,6 +584,7 @@ class FeaturePanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
+        self.installEventFilter(_UNELIDE)
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(2, 2, 2, 2)
         self.table = QtWidgets.QTableWidget(0, 4)
@@ -637,6 +662,7 @@ class LayersPanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
+        self.installEventFilter(_UNELIDE)
         grid = QtWidgets.QGridLayout(self)
         self.boxes: dict[str, QtWidgets.QCheckBox] = {}
         for i, name in enumerate(LAYERS):
