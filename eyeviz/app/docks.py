@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
-from eyeviz.app.panels import _UNELIDE, set_message, wrap_label
+from eyeviz.app.panels import _Unelide, set_message, wrap_label
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import TRAJECTORY_KINDS, Trajectory
 
@@ -36,7 +36,8 @@ class EstimatorPicker(QtWidgets.QWidget):
         from eyeviz import estimators
 
         self.model = model
-        self.installEventFilter(_UNELIDE)
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         lay = QtWidgets.QVBoxLayout(self)
         self.boxes: dict[str, QtWidgets.QCheckBox] = {}
         for name in estimators.available():
@@ -90,7 +91,8 @@ class TrajectoryPanel(QtWidgets.QWidget):
         from matplotlib.figure import Figure
 
         self.model = model
-        self.installEventFilter(_UNELIDE)
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         self.path = None
         self.pos = 0.0  # index along the path (fractional: speed may be < 1 point a tick)
         self.feature: int | None = None

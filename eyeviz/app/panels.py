@@ -62,9 +62,6 @@ class _Unelide(QtCore.QObject):
         return False
 
 
-_UNELIDE = _Unelide()
-
-
 def set_message(label: QtWidgets.QLabel, text: str) -> None:
     """Show ``text`` (several lines allowed) in a :func:`wrap_label`, tooltip = full text."""
     lines = [user_message(t, 400) for t in str(text).splitlines() if t.strip()]
@@ -371,7 +368,8 @@ class ReadoutPanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
-        self.installEventFilter(_UNELIDE)
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         self.texts: dict[str, str] = {}  # row key -> value text (what tests read)
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(8, 8, 8, 8)
@@ -534,7 +532,8 @@ class EyesPanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
-        self.installEventFilter(_UNELIDE)
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         form = QtWidgets.QFormLayout(self)
         self.edits: dict[str, QtWidgets.QLineEdit] = {}
         for key, tip in (("h", "origin to eye centre"), ("l", "eye radius"), ("m", "ommatidia")):
@@ -584,7 +583,8 @@ class FeaturePanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
-        self.installEventFilter(_UNELIDE)
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(2, 2, 2, 2)
         self.table = QtWidgets.QTableWidget(0, 4)
@@ -662,7 +662,8 @@ class LayersPanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
-        self.installEventFilter(_UNELIDE)
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         grid = QtWidgets.QGridLayout(self)
         self.boxes: dict[str, QtWidgets.QCheckBox] = {}
         for i, name in enumerate(LAYERS):
