@@ -73,12 +73,9 @@ class EstimatorPicker(QtWidgets.QWidget):
     def _toggled(self, name: str, on: bool) -> None:
         if self._filling:
             return
-        after = self.model.scene.copy()
-        est = [n for n in after.estimators if n != name]
-        if on:
-            est.append(name)
-        after.estimators = est
-        self.model.commit(after, f"{'Show' if on else 'Hide'} {name} predictions")
+        from eyeviz.model.interactions import toggle_estimator
+
+        toggle_estimator(self.model, name, on)
 
 
 class TrajectoryPanel(QtWidgets.QWidget):
@@ -94,8 +91,6 @@ class TrajectoryPanel(QtWidgets.QWidget):
         self._unelide = _Unelide(self)
         self.installEventFilter(self._unelide)
         self.path = None
-        self.pos = 0.0  # index along the path (fractional: speed may be < 1 point a tick)
-        self.feature: int | None = None
         self.message = ""
         self.timer = QtCore.QTimer(self)
         self.timer.setInterval(40)
@@ -134,23 +129,20 @@ class TrajectoryPanel(QtWidgets.QWidget):
         self._key = None
         self._before = None
 
-    # --- model --------------------------------------------------------------------------
+    # --- model (the player's state lives in eyeviz.model.player) ---------------------
+    @property
+    def pos(self) -> float:
+        return self.model.player.pos
+
+    @property
+    def feature(self) -> int | None:
+        return self.model.player.index()
+
     def ensure_trajectory(self, kind: str | None = None) -> None:
         """Give the scene a trajectory (from the selected feature's distance and radius)."""
-        sc = self.model.scene
-        if sc.trajectory is not None and (kind is None or kind == sc.trajectory.kind):
-            return
-        i = self.model.selected
-        f = sc.features[i] if i is not None and i < len(sc.features) else None
-        r = math.hypot(f.x, f.y) if f else 2000.0
-        g = f.g if f else 50.0
-        if not 100.0 < r < 1e6:
-            r = 2000.0
-        after = sc.copy()
-        after.trajectory = Trajectory(kind or "horizontal", float(r), float(g))
-        if "trajectory" not in after.layers:
-            after.layers.append("trajectory")
-        self.model.commit(after, f"Trajectory {after.trajectory.kind}")
+        from eyeviz.model.interactions import set_trajectory
+
+        set_trajectory(self.model, kind)
 
     def _kind_chosen(self, _index: int) -> None:
         self.ensure_trajectory(self.kind.currentText())
@@ -184,7 +176,7 @@ class TrajectoryPanel(QtWidgets.QWidget):
                 self.path = trajectory_path(sc.eyes.pair(), t, sc.estimators, self.model.predictor)
             except ValueError as exc:
                 self.message = str(exc)
-        self.pos = 0.0
+        self.model.player.set_path(self.path)
         self._plot()
 
     def _plot(self) -> None:
@@ -249,52 +241,46 @@ class TrajectoryPanel(QtWidgets.QWidget):
 
     # --- animation ----------------------------------------------------------------------
     def set_playing(self, on: bool) -> None:
+        """Play or pause (the model's player holds the state; this only displays it)."""
         if on:
             self.ensure_trajectory()
             self.refresh()
-            if self.path is None:
-                self.play_button.setChecked(False)
-                return
-            self.feature = self.model.selected if self.model.selected is not None else 0
-            if self.feature >= len(self.model.scene.features):
-                self.play_button.setChecked(False)
-                return
-            self._before = self.model.scene.copy()
-            self.timer.start()
+            self.model.player.speed = float(self.speed.value())
+            self.model.player.start()
         else:
+            self.model.player.stop()
+        self.sync_player()
+
+    def sync_player(self) -> None:
+        """Timer, button and message follow the model's player."""
+        on = self.model.player.playing
+        if on and not self.timer.isActive():
+            self.timer.start()
+        elif not on and self.timer.isActive():
             self.timer.stop()
-            before, self._before = self._before, None
-            if before is not None and self.feature is not None:
-                # the whole animation is one undo step (like a drag)
-                after = self.model.scene.copy()
-                self.model.scene = before.copy()
-                name = after.features[self.feature].name
-                self.model.commit(after, f"Animate {name}", before=before)
+        self.play_button.blockSignals(True)
+        self.play_button.setChecked(on)
+        self.play_button.blockSignals(False)
         self.play_button.setText("❚❚ Pause" if on else "▶ Play")
-        if self.play_button.isChecked() != on:
-            self.play_button.setChecked(on)
+        if self.model.player.message:
+            self.info.setText(self.model.player.message)
 
     def step(self, points: float | None = None) -> tuple[float, float] | None:
         """Move the animated feature ``points`` along the path (default: the speed);
         returns its new centre. The feature gets the trajectory's radius."""
-        p = self.path
-        if p is None:
+        if self.path is None:
             self.refresh()
-            p = self.path
-            if p is None:
-                return None
-        if self.feature is None:
-            self.feature = self.model.selected if self.model.selected is not None else 0
-        if self.feature >= len(self.model.scene.features):
+        player = self.model.player
+        player.speed = float(self.speed.value())
+        xy = player.step(points)
+        if xy is None:
+            self.sync_player()
             return None
-        self.pos = (self.pos + (self.speed.value() if points is None else points)) % p.n
-        k = int(self.pos)
-        x, y = float(p.x[k]), float(p.y[k])
-        self.model.live(self.feature, x=x, y=y, g=p.g)
+        p, k = self.path, int(player.pos)
         for c in self.cursors:
             c.set_xdata([p.axis[k], p.axis[k]])
         self.canvas.draw_idle()
-        return x, y
+        return xy
 
 
 class ExportDialog(QtWidgets.QDialog):
