@@ -5,15 +5,14 @@ scene without them imports neither matplotlib nor the estimators.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
-from eyeviz.app.panels import _Unelide, set_message, wrap_label
+from eyeviz.app.panels import _Unelide, design_note, set_message, wrap_label
 from eyeviz.model.app_model import AppModel
-from eyeviz.model.scene import TRAJECTORY_KINDS, Trajectory
+from eyeviz.model.scene import TRAJECTORY_KINDS
 
 __all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel", "PLOT_PT"]
 
@@ -67,6 +66,12 @@ class EstimatorPicker(QtWidgets.QWidget):
             self._filling = False
         preds = self.model.predictions
         bad = [f"{n}: {v}" for n, v in preds.items() if isinstance(v, str)]
+        for name, b in self.boxes.items():
+            note = design_note(self.model, name) if name in chosen else None
+            b.setStyleSheet("color: #8a8a8a;" if note else "")
+            b.setToolTip(ESTIMATOR_HELP.get(name, "") + (f"\n{name}: {note}" if note else ""))
+            if note:
+                bad.append(f"{name}: {note}")
         set_message(self.note, "\n".join(bad))
         self.note.setStyleSheet("color: #b00020;" if bad else "")
 

@@ -43,6 +43,43 @@ def wrap_label(label: QtWidgets.QLabel) -> QtWidgets.QLabel:
     return label
 
 
+ANY_DESIGN = frozenset({"analytic", "limit"})  # answer for any h, l, m (no training)
+
+
+def design_note(model: AppModel, name: str) -> str | None:
+    """One short line when estimator ``name`` was made for other eyes than the scene's
+    ("trained for h = 40, l = 20, m = 720"), else None (issue 10 item 4). Reads the
+    estimator's declared ``domain``; analytic and limit answer for any eyes."""
+    if name in ANY_DESIGN or model.predictor is None:
+        return None
+    est = model.predictor.estimator(name)
+    d = getattr(est, "domain", None)
+    if isinstance(est, str) or d is None or getattr(est, "any_design", False):
+        return None
+    e = model.scene.eyes
+    if (float(d.h), float(d.l), int(d.m)) == (float(e.h), float(e.l), int(e.m)):
+        return None
+    return f"trained for h = {d.h:g}, l = {d.l:g}, m = {d.m}"
+
+
+def range_note(model: AppModel, name: str, r: float, g: float) -> str | None:
+    """Why feature (r, g) lies outside estimator ``name``'s declared r and g range, or None."""
+    est = model.predictor.estimator(name) if model.predictor is not None else None
+    d = getattr(est, "domain", None)
+    if d is None or isinstance(est, str):
+        return None
+    if not d.r_min <= r <= d.r_max or g > d.g_max:
+        return f"outside its range: r in [{d.r_min:g}, {d.r_max:g}], g <= {d.g_max:g}"
+    return None
+
+
+def design_skips(model: AppModel) -> set[str]:
+    """Estimators made for other eyes: they draw no ring."""
+    if not model.scene.shows("predictions"):
+        return set()
+    return {n for n in model.scene.estimators if design_note(model, n) is not None}
+
+
 def unelide_tabs(widget: QtWidgets.QWidget) -> None:
     """Tab names of the window's tabbed docks in full (scroll buttons when they do not all
     fit) instead of "Fe…", "E…"."""
@@ -284,6 +321,10 @@ def _half_text(iv: tuple[int, int], m: int) -> str:
     return f"[{k[0]}, {k[gaps[0]]}] ∪ [{k[gaps[0] + 1]}, {k[-1]}]"
 
 
+def f_g(scene, i: int) -> float:
+    return scene.features[i].g
+
+
 def _owners_of(st, eye: str) -> np.ndarray:
     from eyeviz.model.state import owners
 
@@ -495,6 +536,12 @@ class ReadoutPanel(QtWidgets.QWidget):
         for name in sc.estimators:
             res = preds.get(name, "no prediction")
             key = f"<b style='color:{cols[name]}'>{name}</b>"
+            note = design_note(self.model, name)
+            if note is not None:  # made for other eyes: no answer shown (greyed)
+                rows.append(
+                    (f"pred:{name}", f"<span style='color:{GREY}'>{name}</span>", note, GREY)
+                )
+                continue
             if isinstance(res, str):
                 rows.append((f"pred:{name}", key, user_message(res, 120), GREY))
                 continue
@@ -507,6 +554,10 @@ class ReadoutPanel(QtWidgets.QWidget):
                 f"r {r_hat:.1f}   Δr {dr:+.1f} ({pct:+.2f} %)\n"
                 f"φ {math.degrees(phi_hat):.2f}°   Δφ {dphi:+.3f}°"
             )
+            out = range_note(self.model, name, float(st.r[i]), float(f_g(sc, i)))
+            if out is not None:
+                rows.append((f"pred:{name}", key, f"{text}\n{out}", BAD))
+                continue
             rows.append((f"pred:{name}", key, text, "#1e1e1e"))
         return rows
 

@@ -19,7 +19,14 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkRenderingCore import vtkTextActor, vtkWindowToImageFilter
 
-from eyeviz.app.panels import BitmapPanel, EyesPanel, FeaturePanel, LayersPanel, ReadoutPanel
+from eyeviz.app.panels import (
+    BitmapPanel,
+    EyesPanel,
+    FeaturePanel,
+    LayersPanel,
+    ReadoutPanel,
+    design_skips,
+)
 from eyeviz.app.view import VtkView, fast_renderer
 from eyeviz.model.app_model import AppModel, MouseEvent, drag_feature, hit_test
 from eyeviz.model.scene import Scene, SceneError, View, load, save
@@ -381,7 +388,8 @@ class MainWindow(QtWidgets.QMainWindow):
             from eyeviz.render.mpl.vector import estimator_colors
 
             colors = estimator_colors(scene.estimators)
-        self.overlays.update_predictions(scene, st, preds, colors)
+        skip = design_skips(self.model) if preds else set()
+        self.overlays.update_predictions(scene, st, preds, colors, skip=skip)
         i = self.model.selected
         sel_color = scene.features[i].color if i is not None and i < st.n else None
         self.overlays.update_ambiguity(scene, self.model.ambiguity, sel_color)

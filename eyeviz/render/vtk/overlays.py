@@ -66,10 +66,13 @@ class OverlayActors:
         self._path_key = None
 
     # --- predictions ------------------------------------------------------------------
-    def update_predictions(self, scene, state, preds: dict, colors: dict[str, str]) -> None:
+    def update_predictions(
+        self, scene, state, preds: dict, colors: dict[str, str], skip=frozenset()
+    ) -> None:
         """Ghost discs of radius g at each estimator's (r_hat, phi_hat), linked to the truth.
 
-        Each estimator is drawn in its own colour, fixed by name (``colors`` is ignored).
+        Each estimator is drawn in its own colour, fixed by name (``colors`` is ignored);
+        estimators in ``skip`` (made for other eyes) draw no ring.
         """
         self.ghosts = {}
         show = scene.shows("predictions") and bool(scene.features)
@@ -82,7 +85,7 @@ class OverlayActors:
         k = 0
         for name in scene.estimators:
             res = preds.get(name)
-            if not isinstance(res, tuple):
+            if name in skip or not isinstance(res, tuple):
                 continue
             r_hat, phi_hat = res
             gx = r_hat * np.cos(phi_hat)
