@@ -70,7 +70,8 @@ class EstimatorPicker(QtWidgets.QWidget):
             note = design_note(self.model, name) if name in chosen else None
             b.setStyleSheet("color: #8a8a8a;" if note else "")
             b.setToolTip(ESTIMATOR_HELP.get(name, "") + (f"\n{name}: {note}" if note else ""))
-            if note:
+            if note:  # this one line replaces any "cannot answer" of the same estimator
+                bad = [t for t in bad if not t.startswith(f"{name}: ")]
                 bad.append(f"{name}: {note}")
         set_message(self.note, "\n".join(bad))
         self.note.setStyleSheet("color: #b00020;" if bad else "")
