@@ -8,12 +8,14 @@ by list position and never a feature's colour.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pyvista as pv
 from vtkmodules.vtkRenderingCore import vtkRenderer
 
+from eyeviz.model.frame import build_frame
 from eyeviz.model.palette import estimator_color
 from eyeviz.render.vtk.actors import INK, Z_LINE, Z_POINT, _actor, hex_rgb
 
@@ -83,13 +85,13 @@ class OverlayActors:
         t = np.linspace(0.0, 2 * math.pi, GHOST_N, endpoint=False)
         pts, lines, cols, centres, ccols = [], [], [], [], []
         k = 0
+        light = dataclasses.replace(scene, layers=["predictions"], trajectory=None)
+        frame = build_frame(light, state, rect=(0.0, 1.0, 0.0, 1.0), predictions=preds)
         for name in scene.estimators:
-            res = preds.get(name)
-            if name in skip or not isinstance(res, tuple):
+            pf = frame.predictions.get(name)
+            if name in skip or pf is None or isinstance(pf, str):
                 continue
-            r_hat, phi_hat = res
-            gx = r_hat * np.cos(phi_hat)
-            gy = r_hat * np.sin(phi_hat)
+            gx, gy = pf.x_hat, pf.y_hat  # the Frame's (r_hat, phi_hat) in the plane
             self.ghosts[name] = np.column_stack([gx, gy])
             rgb = hex_rgb(estimator_color(name))
             for i in np.flatnonzero(np.isfinite(gx) & np.isfinite(gy)):
