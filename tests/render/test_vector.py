@@ -88,7 +88,9 @@ def _expected_runs(sc, eye: str) -> set[str]:
     out, start = set(), 0
     for k in range(1, m + 1):
         if k == m or colour[k] != colour[start]:
-            out.add(f"ommatidia-{eye}-{start}-{k - 1}" if k - start > 1 else f"ommatidium-{eye}-{start}")
+            out.add(
+                f"ommatidia-{eye}-{start}-{k - 1}" if k - start > 1 else f"ommatidium-{eye}-{start}"
+            )
             start = k
     return out
 
