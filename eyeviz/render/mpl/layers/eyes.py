@@ -77,10 +77,20 @@ def paint(cv: Canvas) -> None:
         )
         ax.plot([cx], [cy], marker="o", ms=1.6, color=INK, zorder=4, mew=0)
     if cv.inset is not None:
+        # the main view keeps each eye a disc of its true radius (tangent to the BFV
+        # edges), never below MIN_EYE_PT so it stays visible; the inset shows the cells
         rad = max(p.l, MIN_EYE_PT / 72 * cv.units_per_in)
         for eye in fr.eyes:
             cv.ax.add_patch(
-                Circle(eye.center, rad, facecolor=INK, edgecolor="none", zorder=4, gid="eye-dot")
+                Circle(
+                    eye.center,
+                    rad,
+                    facecolor=UNLIT,
+                    edgecolor=INK,
+                    lw=0.5,
+                    zorder=4,
+                    gid=f"eye-{eye.name}-main",
+                )
             )
 
 
