@@ -61,6 +61,7 @@ __all__ = [
     "clip_wedge",
     "errors",
     "runs",
+    "state_for",
     "trajectory_path",
     "view_rect",
 ]
@@ -352,7 +353,7 @@ _NEED = {
 }
 
 
-def _state_for(scene: Scene, state: SceneState | None) -> SceneState:
+def state_for(scene: Scene, state: SceneState | None) -> SceneState:
     if state is None:
         return compute_state(scene)
     for layer, attrs in _NEED.items():
@@ -453,7 +454,7 @@ def build_frame(
     ``predictions`` (estimator -> (r_hat, phi_hat) or a reason) skips the estimators;
     otherwise ``predictor`` (made when None) answers, only if the predictions layer is on.
     """
-    st = _state_for(scene, state)
+    st = state_for(scene, state)
     pair = st.pair
     lay = set(scene.layers)
     rect = view_rect(scene) if rect is None else tuple(float(v) for v in rect)
