@@ -5,16 +5,18 @@ scene without them imports neither matplotlib nor the estimators.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
+from eyeviz.app.panels import _Unelide, design_note, set_message, wrap_label
 from eyeviz.model.app_model import AppModel
-from eyeviz.model.scene import TRAJECTORY_KINDS, Trajectory
+from eyeviz.model.scene import TRAJECTORY_KINDS
 
-__all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel"]
+__all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel", "PLOT_PT"]
+
+PLOT_PT = 10  # the smallest text of the accuracy plot (projector-readable)
 
 ESTIMATOR_HELP = {
     "analytic": "triangulation of the two eyes' centre rays (no weights)",
@@ -26,13 +28,15 @@ ESTIMATOR_HELP = {
 
 class EstimatorPicker(QtWidgets.QWidget):
     """A check box per estimator (several at once); each chosen one gets its colour
-    (eyeviz.render.mpl.vector.estimator_colors, as in exported figures)."""
+    (eyeviz.model.palette: fixed by name, as in exported figures)."""
 
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         from eyeviz import estimators
 
         self.model = model
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         lay = QtWidgets.QVBoxLayout(self)
         self.boxes: dict[str, QtWidgets.QCheckBox] = {}
         for name in estimators.available():
@@ -41,14 +45,13 @@ class EstimatorPicker(QtWidgets.QWidget):
             b.toggled.connect(lambda on, n=name: self._toggled(n, on))
             lay.addWidget(b)
             self.boxes[name] = b
-        self.note = QtWidgets.QLabel("")
-        self.note.setWordWrap(True)
+        self.note = wrap_label(QtWidgets.QLabel(""))
         lay.addWidget(self.note)
         lay.addStretch(1)
         self._filling = False
 
     def refresh(self) -> None:
-        from eyeviz.render.mpl.vector import estimator_colors
+        from eyeviz.model.palette import estimator_colors
 
         chosen = self.model.scene.estimators
         cols = estimator_colors(chosen)
@@ -63,18 +66,22 @@ class EstimatorPicker(QtWidgets.QWidget):
             self._filling = False
         preds = self.model.predictions
         bad = [f"{n}: {v}" for n, v in preds.items() if isinstance(v, str)]
-        self.note.setText("\n".join(bad))
+        for name, b in self.boxes.items():
+            note = design_note(self.model, name) if name in chosen else None
+            b.setStyleSheet("color: #8a8a8a;" if note else "")
+            b.setToolTip(ESTIMATOR_HELP.get(name, "") + (f"\n{name}: {note}" if note else ""))
+            if note:  # this one line replaces any "cannot answer" of the same estimator
+                bad = [t for t in bad if not t.startswith(f"{name}: ")]
+                bad.append(f"{name}: {note}")
+        set_message(self.note, "\n".join(bad))
         self.note.setStyleSheet("color: #b00020;" if bad else "")
 
     def _toggled(self, name: str, on: bool) -> None:
         if self._filling:
             return
-        after = self.model.scene.copy()
-        est = [n for n in after.estimators if n != name]
-        if on:
-            est.append(name)
-        after.estimators = est
-        self.model.commit(after, f"{'Show' if on else 'Hide'} {name} predictions")
+        from eyeviz.model.interactions import toggle_estimator
+
+        toggle_estimator(self.model, name, on)
 
 
 class TrajectoryPanel(QtWidgets.QWidget):
@@ -87,9 +94,9 @@ class TrajectoryPanel(QtWidgets.QWidget):
         from matplotlib.figure import Figure
 
         self.model = model
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         self.path = None
-        self.pos = 0.0  # index along the path (fractional: speed may be < 1 point a tick)
-        self.feature: int | None = None
         self.message = ""
         self.timer = QtCore.QTimer(self)
         self.timer.setInterval(40)
@@ -113,8 +120,7 @@ class TrajectoryPanel(QtWidgets.QWidget):
         row.addWidget(QtWidgets.QLabel("speed"))
         row.addWidget(self.speed, 1)
         lay.addLayout(row)
-        self.info = QtWidgets.QLabel("")
-        self.info.setWordWrap(True)
+        self.info = wrap_label(QtWidgets.QLabel(""))
         lay.addWidget(self.info)
         self.fig = Figure(figsize=(4.2, 3.0), dpi=100, layout="constrained")
         self.canvas = FigureCanvasQTAgg(self.fig)
@@ -122,27 +128,27 @@ class TrajectoryPanel(QtWidgets.QWidget):
         lay.addWidget(self.canvas, 1)
         self.ax_ad = self.fig.add_subplot(2, 1, 1)
         self.ax_dd = self.fig.add_subplot(2, 1, 2, sharex=self.ax_ad)
+        self.placeholder = self.fig.text(
+            0.5, 0.5, "", ha="center", va="center", fontsize=PLOT_PT + 1, color="#555555"
+        )
         self.cursors = []
         self._key = None
         self._before = None
 
-    # --- model --------------------------------------------------------------------------
+    # --- model (the player's state lives in eyeviz.model.player) ---------------------
+    @property
+    def pos(self) -> float:
+        return self.model.player.pos
+
+    @property
+    def feature(self) -> int | None:
+        return self.model.player.index()
+
     def ensure_trajectory(self, kind: str | None = None) -> None:
         """Give the scene a trajectory (from the selected feature's distance and radius)."""
-        sc = self.model.scene
-        if sc.trajectory is not None and (kind is None or kind == sc.trajectory.kind):
-            return
-        i = self.model.selected
-        f = sc.features[i] if i is not None and i < len(sc.features) else None
-        r = math.hypot(f.x, f.y) if f else 2000.0
-        g = f.g if f else 50.0
-        if not 100.0 < r < 1e6:
-            r = 2000.0
-        after = sc.copy()
-        after.trajectory = Trajectory(kind or "horizontal", float(r), float(g))
-        if "trajectory" not in after.layers:
-            after.layers.append("trajectory")
-        self.model.commit(after, f"Trajectory {after.trajectory.kind}")
+        from eyeviz.model.interactions import set_trajectory
+
+        set_trajectory(self.model, kind)
 
     def _kind_chosen(self, _index: int) -> None:
         self.ensure_trajectory(self.kind.currentText())
@@ -176,11 +182,13 @@ class TrajectoryPanel(QtWidgets.QWidget):
                 self.path = trajectory_path(sc.eyes.pair(), t, sc.estimators, self.model.predictor)
             except ValueError as exc:
                 self.message = str(exc)
-        self.pos = 0.0
+        self.model.player.set_path(self.path)
         self._plot()
 
     def _plot(self) -> None:
-        from eyeviz.render.mpl.vector import estimator_colors
+        """The AD and DD accuracy along the path; without a path, a placeholder text and no
+        axes (empty 0-1 axes looked like a broken plot). Text at PLOT_PT points or more."""
+        from eyeviz.model.palette import estimator_colors
 
         for ax in (self.ax_ad, self.ax_dd):
             ax.clear()
@@ -188,7 +196,15 @@ class TrajectoryPanel(QtWidgets.QWidget):
         self.cursors = []
         p = self.path
         notes = [self.message] if self.message else []
-        if p is not None:
+        self.placeholder.set_visible(p is None)
+        for ax in (self.ax_ad, self.ax_dd):
+            ax.set_visible(p is not None)
+        if p is None:
+            why = self.message or "no trajectory"
+            self.placeholder.set_text(
+                f"{why}\n\nchoose a path above (or View > Trajectory)\nto see the accuracy along it"
+            )
+        else:
             cols = estimator_colors(self.model.scene.estimators)
             for j, (name, acc) in enumerate(p.accuracy.items()):
                 if isinstance(acc, str):
@@ -199,80 +215,78 @@ class TrajectoryPanel(QtWidgets.QWidget):
                 self.ax_dd.plot(p.axis, acc[1], color=cols[name], lw=lw, label=name)
             for ax in (self.ax_ad, self.ax_dd):
                 self.cursors.append(ax.axvline(p.axis[0], color="#333333", lw=1.2))
-                lo = min(
-                    [
-                        np.nanmin(a[k])
-                        for a in p.accuracy.values()
-                        if not isinstance(a, str)
-                        for k in (0, 1)
-                    ]
-                    + [90.0]
-                )
+            lo = min(
+                [
+                    np.nanmin(a[k])
+                    for a in p.accuracy.values()
+                    if not isinstance(a, str)
+                    for k in (0, 1)
+                ]
+                + [90.0]
+            )
             self.ax_dd.set_ylim(max(0.0, min(lo, 90.0)) - 2, 101)
             t = self.model.scene.trajectory
-            self.ax_dd.set_xlabel(p.axis_label)
+            self.ax_dd.set_xlabel(p.axis_label, fontsize=PLOT_PT)
             notes.insert(
                 0, f"{t.kind} path, distance {t.distance:g}, g = {t.g:g}: {p.n} points in the BFV"
             )
             if any(not isinstance(a, str) for a in p.accuracy.values()):
                 self.ax_ad.legend(
-                    loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, ncol=4, frameon=False
+                    loc="lower right",
+                    bbox_to_anchor=(1.0, 1.0),
+                    fontsize=PLOT_PT,
+                    ncol=4,
+                    frameon=False,
                 )
-        self.ax_ad.set_title("AD accuracy (%)", fontsize=9, loc="left")
-        self.ax_dd.set_title("DD accuracy (%)", fontsize=9, loc="left")
-        self.ax_ad.tick_params(labelsize=8, labelbottom=False)
-        self.ax_dd.tick_params(labelsize=8)
-        self.info.setText("\n".join(notes))
+            self.ax_ad.set_title("AD accuracy (%)", fontsize=PLOT_PT, loc="left")
+            self.ax_dd.set_title("DD accuracy (%)", fontsize=PLOT_PT, loc="left")
+            self.ax_ad.tick_params(labelsize=PLOT_PT, labelbottom=False)
+            self.ax_dd.tick_params(labelsize=PLOT_PT)
+        set_message(self.info, "\n".join(notes))
         self.canvas.draw_idle()
 
     # --- animation ----------------------------------------------------------------------
     def set_playing(self, on: bool) -> None:
+        """Play or pause (the model's player holds the state; this only displays it)."""
         if on:
             self.ensure_trajectory()
             self.refresh()
-            if self.path is None:
-                self.play_button.setChecked(False)
-                return
-            self.feature = self.model.selected if self.model.selected is not None else 0
-            if self.feature >= len(self.model.scene.features):
-                self.play_button.setChecked(False)
-                return
-            self._before = self.model.scene.copy()
-            self.timer.start()
+            self.model.player.speed = float(self.speed.value())
+            self.model.player.start()
         else:
+            self.model.player.stop()
+        self.sync_player()
+
+    def sync_player(self) -> None:
+        """Timer, button and message follow the model's player."""
+        on = self.model.player.playing
+        if on and not self.timer.isActive():
+            self.timer.start()
+        elif not on and self.timer.isActive():
             self.timer.stop()
-            before, self._before = self._before, None
-            if before is not None and self.feature is not None:
-                # the whole animation is one undo step (like a drag)
-                after = self.model.scene.copy()
-                self.model.scene = before.copy()
-                name = after.features[self.feature].name
-                self.model.commit(after, f"Animate {name}", before=before)
+        self.play_button.blockSignals(True)
+        self.play_button.setChecked(on)
+        self.play_button.blockSignals(False)
         self.play_button.setText("❚❚ Pause" if on else "▶ Play")
-        if self.play_button.isChecked() != on:
-            self.play_button.setChecked(on)
+        if self.model.player.message:
+            self.info.setText(self.model.player.message)
 
     def step(self, points: float | None = None) -> tuple[float, float] | None:
         """Move the animated feature ``points`` along the path (default: the speed);
         returns its new centre. The feature gets the trajectory's radius."""
-        p = self.path
-        if p is None:
+        if self.path is None:
             self.refresh()
-            p = self.path
-            if p is None:
-                return None
-        if self.feature is None:
-            self.feature = self.model.selected if self.model.selected is not None else 0
-        if self.feature >= len(self.model.scene.features):
+        player = self.model.player
+        player.speed = float(self.speed.value())
+        xy = player.step(points)
+        if xy is None:
+            self.sync_player()
             return None
-        self.pos = (self.pos + (self.speed.value() if points is None else points)) % p.n
-        k = int(self.pos)
-        x, y = float(p.x[k]), float(p.y[k])
-        self.model.live(self.feature, x=x, y=y, g=p.g)
+        p, k = self.path, int(player.pos)
         for c in self.cursors:
             c.set_xdata([p.axis[k], p.axis[k]])
         self.canvas.draw_idle()
-        return x, y
+        return xy
 
 
 class ExportDialog(QtWidgets.QDialog):

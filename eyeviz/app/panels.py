@@ -7,6 +7,7 @@ Panels draw from the model's :class:`~eyeviz.model.state.SceneState` and send ed
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
@@ -15,9 +16,98 @@ from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import LAYERS
 from eyeviz.render.vtk.actors import UNLIT, hex_rgb
 
-__all__ = ["BitmapPanel", "EyesPanel", "FeaturePanel", "LayersPanel", "ReadoutPanel"]
+__all__ = ["BitmapPanel", "EyesPanel", "FeaturePanel", "LayersPanel", "ReadoutPanel", "ValueText"]
 
 ERROR_STYLE = "color: #b00020; font-weight: bold;"
+_PATH = re.compile(r"(?:[A-Za-z]:)?(?:[\\/][^\s\\/:'\"()\[\],]+){2,}[\\/]?")
+_DEV = re.compile(
+    r"\b(?:Traceback|\w*Error|\w*Exception)\b:?\s*|\[Errno \d+\]\s*|\b\w+\.py\b(?::\d+)?"
+)
+
+
+def user_message(text: str, limit: int = 160) -> str:
+    """A message fit for a user: one line, local paths reduced to their file name,
+    Python exception names and file:line references removed, at most ``limit`` chars."""
+    line = str(text).strip().splitlines()[0] if str(text).strip() else ""
+    line = _PATH.sub(lambda mt: "‘" + re.split(r"[\\/]", mt.group(0).rstrip("\\/"))[-1] + "’", line)
+    line = _DEV.sub("", line).strip(" :")
+    return line if len(line) <= limit else line[: limit - 1] + "…"
+
+
+def wrap_label(label: QtWidgets.QLabel) -> QtWidgets.QLabel:
+    """A word-wrapped message label that never widens its panel: its width is the
+    panel's (a long word is cut, the whole text is in the tooltip)."""
+    label.setWordWrap(True)
+    label.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Minimum)
+    label.setMinimumWidth(0)
+    return label
+
+
+ANY_DESIGN = frozenset({"analytic", "limit"})  # answer for any h, l, m (no training)
+
+
+def design_note(model: AppModel, name: str) -> str | None:
+    """One short line when estimator ``name`` was made for other eyes than the scene's
+    ("trained for h = 40, l = 20, m = 720"), else None (issue 10 item 4). Reads the
+    estimator's declared ``domain``; analytic and limit answer for any eyes."""
+    if name in ANY_DESIGN or model.predictor is None:
+        return None
+    est = model.predictor.estimator(name)
+    d = getattr(est, "domain", None)
+    if isinstance(est, str) or d is None or getattr(est, "any_design", False):
+        return None
+    e = model.scene.eyes
+    if (float(d.h), float(d.l), int(d.m)) == (float(e.h), float(e.l), int(e.m)):
+        return None
+    return f"trained for h = {d.h:g}, l = {d.l:g}, m = {d.m}"
+
+
+def range_note(model: AppModel, name: str, r: float, g: float) -> str | None:
+    """Why feature (r, g) lies outside estimator ``name``'s declared r and g range, or None."""
+    est = model.predictor.estimator(name) if model.predictor is not None else None
+    d = getattr(est, "domain", None)
+    if d is None or isinstance(est, str):
+        return None
+    if not d.r_min <= r <= d.r_max or g > d.g_max:
+        return f"outside its range: r in [{d.r_min:g}, {d.r_max:g}], g <= {d.g_max:g}"
+    return None
+
+
+def design_skips(model: AppModel) -> set[str]:
+    """Estimators made for other eyes: they draw no ring."""
+    if not model.scene.shows("predictions"):
+        return set()
+    return {n for n in model.scene.estimators if design_note(model, n) is not None}
+
+
+def unelide_tabs(widget: QtWidgets.QWidget) -> None:
+    """Tab names of the window's tabbed docks in full (scroll buttons when they do not all
+    fit) instead of "Fe…", "E…"."""
+    win = widget.window()
+    for bar in win.findChildren(QtWidgets.QTabBar):
+        if bar.elideMode() != QtCore.Qt.ElideNone:
+            bar.setElideMode(QtCore.Qt.ElideNone)
+            bar.setUsesScrollButtons(True)
+
+
+class _Unelide(QtCore.QObject):
+    """Re-applies :func:`unelide_tabs` whenever a tabbed dock appears or is re-tabbed."""
+
+    def eventFilter(self, obj, ev) -> bool:  # noqa: N802 (Qt name)
+        if ev.type() in (QtCore.QEvent.Show, QtCore.QEvent.ParentChange):
+            unelide_tabs(obj)
+        return False
+
+
+def set_message(label: QtWidgets.QLabel, text: str) -> None:
+    """Show ``text`` (several lines allowed) in a :func:`wrap_label`, tooltip = full text."""
+    lines = [user_message(t, 400) for t in str(text).splitlines() if t.strip()]
+    full = "\n".join(lines)
+    if label.text() != full:
+        label.setText(full)
+        label.setToolTip(full)
+
+
 INK = QtGui.QColor(30, 30, 30)
 
 
@@ -33,9 +123,16 @@ def _downsample(owner: np.ndarray, width: int) -> np.ndarray:
 
 
 class BitmapPanel(QtWidgets.QWidget):
-    """Omega_A and Omega_B: the m/2 the networks see and the whole eye, lit [L, R] beside."""
+    """Omega_A and Omega_B: the m/2 the networks see and the whole eye, lit [L, R] beside.
+
+    The selected feature is drawn over the others where they overlap (and outlined), so
+    it never hides under a neighbour; when an ommatidium is at least ``CELL_PX`` pixels
+    wide the cell boundaries are drawn, and their indices where the text fits. A change
+    repaints only the rows that changed (a drag lighting the same cells paints nothing).
+    """
 
     ROWS = (("A", False), ("A", True), ("B", False), ("B", True))
+    CELL_PX = 6.0  # cell boundaries from this width on
 
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
@@ -44,56 +141,115 @@ class BitmapPanel(QtWidgets.QWidget):
         self.colors = np.array([UNLIT], dtype=np.uint8)
         self.intervals: dict[str, tuple[int, int] | None] = {"A": None, "B": None}
         self.sel_color = INK
+        self.selected: int | None = None
+        self.texts: dict[tuple[str, bool], str] = {}
+        self.sel_masks: dict[tuple[str, bool], np.ndarray] = {}
+        self._row_keys: dict[tuple[str, bool], bytes] = {}
+        self._shown = None
+        self.setAttribute(QtCore.Qt.WA_OpaquePaintEvent)  # paints every pixel itself
         self.setMinimumHeight(150)
         self.setMaximumHeight(190)
         self.setSizePolicy(QtWidgets.QSizePolicy.Expanding, QtWidgets.QSizePolicy.Fixed)
 
     def refresh(self) -> None:
+        """Take the state's owners and the selected intervals; repaint the changed rows."""
+        from eyeviz.core.geometry import intervals_to_bitmap
+
         st = self.model.state
         sc = self.model.scene
-        self.strips.clear()
-        self.intervals = {"A": None, "B": None}
+        strips: dict[tuple[str, bool], np.ndarray] = {}
+        masks: dict[tuple[str, bool], np.ndarray] = {}
+        intervals: dict[str, tuple[int, int] | None] = {"A": None, "B": None}
+        i = self.model.selected
+        sel = i if i is not None and i < st.n else None
         if st.LA is not None:
             m = st.m
             oa = st.owner_a if st.owner_a is not None else _owners_of(st, "A")
             ob = st.owner_b if st.owner_b is not None else _owners_of(st, "B")
-            for eye, own in (("A", oa), ("B", ob)):
-                self.strips[(eye, True)] = own
-                self.strips[(eye, False)] = own[: m // 2]
-            i = self.model.selected
-            if i is not None and i < st.n:
-                self.intervals = {
-                    "A": (int(st.LA[i]), int(st.RA[i])),
-                    "B": (int(st.LB[i]), int(st.RB[i])),
+            if sel is not None:
+                intervals = {
+                    "A": (int(st.LA[sel]), int(st.RA[sel])),
+                    "B": (int(st.LB[sel]), int(st.RB[sel])),
                 }
-        self.colors = np.vstack([UNLIT] + [hex_rgb(f.color) for f in sc.features]).astype(np.uint8)
-        i = self.model.selected
-        self.sel_color = QtGui.QColor(
-            sc.features[i].color if i is not None and i < st.n else "#222"
-        )
-        self.update()
+            for eye, own in (("A", oa), ("B", ob)):
+                iv = intervals[eye]
+                mask = intervals_to_bitmap(iv[0], iv[1], m) if iv is not None else np.zeros(m, bool)
+                if sel is not None and mask.any():
+                    own = own.copy()
+                    own[mask] = sel  # the selected feature on top where features overlap
+                strips[(eye, True)] = own
+                strips[(eye, False)] = own[: m // 2]
+                masks[(eye, True)] = mask
+                masks[(eye, False)] = mask[: m // 2]
+        colors = np.vstack([UNLIT] + [hex_rgb(f.color) for f in sc.features]).astype(np.uint8)
+        shown = sc.shows("bitmaps") and bool(strips)
+        self.strips, self.intervals, self.colors, self.selected = strips, intervals, colors, sel
+        self.sel_masks = masks
+        self.sel_color = QtGui.QColor(sc.features[sel].color if sel is not None else "#222")
+        m = st.m
+        self.texts = {
+            (eye, whole): (
+                "" if iv is None else (f"[{iv[0]}, {iv[1]}]" if whole else _half_text(iv, m))
+            )
+            for (eye, whole) in self.ROWS
+            for iv in (intervals[eye],)
+        }
+        whole_panel = shown != self._shown
+        self._shown = shown
+        for r, row in enumerate(self.ROWS):
+            if row not in strips:
+                continue
+            key = b"".join(
+                (
+                    strips[row].tobytes(),
+                    masks[row].tobytes(),
+                    colors.tobytes(),
+                    self.texts[row].encode(),
+                    self.sel_color.name().encode(),
+                )
+            )
+            if self._row_keys.get(row) != key:
+                self._row_keys[row] = key
+                if not whole_panel:
+                    self.update(self._row_rect(r))
+        if whole_panel:
+            self.update()
 
     def lit(self, eye: str, whole: bool) -> np.ndarray:
         """The bitmap shown in a strip (bool per ommatidium)."""
         return self.strips[(eye, whole)] >= 0
 
+    def _geometry(self, fm: QtGui.QFontMetrics) -> tuple[int, int, int]:
+        label_w = fm.horizontalAdvance("Ω_B  whole eye ") + 8
+        right_w = fm.horizontalAdvance("[35999, 35999] ∪ [0, 0]") + 8
+        row_h = max(fm.height() + 10, (self.height() - 8) // 4)
+        return label_w, right_w, row_h
+
+    def _row_rect(self, r: int) -> QtCore.QRect:
+        _, _, row_h = self._geometry(self.fontMetrics())
+        return QtCore.QRect(0, 4 + r * row_h, self.width(), row_h)
+
     def paintEvent(self, event) -> None:  # noqa: N802 (Qt name)
         p = QtGui.QPainter(self)
-        p.fillRect(self.rect(), QtGui.QColor("white"))
+        p.fillRect(event.rect(), QtGui.QColor("white"))
         if not self.model.scene.shows("bitmaps") or not self.strips:
             p.setPen(INK)
             p.drawText(self.rect(), QtCore.Qt.AlignCenter, "bitmaps layer hidden")
+            p.end()
             return
         fm = p.fontMetrics()
-        label_w = fm.horizontalAdvance("Ω_B  whole eye ") + 8
-        right_w = fm.horizontalAdvance("[35999, 35999] ") + 8
-        m = self.model.state.m
-        row_h = max(fm.height() + 10, (self.height() - 8) // 4)
+        label_w, right_w, row_h = self._geometry(fm)
         x0, x1 = label_w, self.width() - right_w
         width = max(x1 - x0, 1)
+        small = QtGui.QFont(p.font())
+        small.setPointSizeF(max(7.0, 0.7 * p.font().pointSizeF()))
+        sfm = QtGui.QFontMetrics(small)
         for r, (eye, whole) in enumerate(self.ROWS):
             y = 4 + r * row_h
+            if not event.rect().intersects(QtCore.QRect(0, y, self.width(), row_h)):
+                continue
             own = self.strips[(eye, whole)]
+            n = own.shape[0]
             cols = _downsample(own, width)
             rgb = np.ascontiguousarray(self.colors[cols + 1])
             img = QtGui.QImage(
@@ -101,17 +257,55 @@ class BitmapPanel(QtWidgets.QWidget):
             )
             target = QtCore.QRect(x0, y + 3, width, row_h - 8)
             p.drawImage(target, img)
+            cell = width / max(n, 1)
+            if cell >= self.CELL_PX:  # small m: the cells and their indices
+                p.setPen(QtGui.QPen(QtGui.QColor("#9a9a9a"), 1))
+                for k in range(1, n):
+                    xk = round(x0 + k * cell)
+                    p.drawLine(xk, target.top(), xk, target.bottom())
+                every = max(1, math.ceil(sfm.horizontalAdvance(str(n - 1)) * 1.6 / cell))
+                p.setFont(small)
+                p.setPen(QtGui.QColor("#555555"))
+                for k in range(0, n, every):
+                    p.drawText(
+                        QtCore.QRectF(x0 + k * cell, target.top(), cell, target.height()),
+                        QtCore.Qt.AlignCenter,
+                        str(k),
+                    )
+                p.setFont(self.font())
+            mask = self.sel_masks.get((eye, whole))
+            if mask is not None and mask.any():  # outline the selected feature's cells
+                p.setPen(QtGui.QPen(self.sel_color.darker(130), 2))
+                p.setBrush(QtCore.Qt.NoBrush)
+                for a, b in _runs(mask):
+                    xa, xb = x0 + a * width / n, x0 + (b + 1) * width / n
+                    p.drawRect(
+                        QtCore.QRectF(xa, target.top() + 1, max(xb - xa, 2.0), target.height() - 2)
+                    )
             p.setPen(QtGui.QPen(INK, 1))
+            p.setBrush(QtCore.Qt.NoBrush)
             p.drawRect(target)
             p.setPen(INK)
             name = f"Ω_{eye}  " + ("whole eye" if whole else "0…m/2−1")
             p.drawText(QtCore.QRect(4, y, label_w - 8, row_h), QtCore.Qt.AlignVCenter, name)
-            iv = self.intervals[eye]
-            if iv is not None:
+            text = self.texts.get((eye, whole), "")
+            if text:
                 p.setPen(self.sel_color)
-                text = f"[{iv[0]}, {iv[1]}]" if whole else _half_text(iv, m)
-                p.drawText(QtCore.QRect(x1 + 8, y, right_w, row_h), QtCore.Qt.AlignVCenter, text)
+                rect = QtCore.QRect(x1 + 8, y, right_w - 8, row_h)
+                p.drawText(
+                    rect,
+                    QtCore.Qt.AlignVCenter,
+                    fm.elidedText(text, QtCore.Qt.ElideRight, rect.width()),
+                )
         p.end()
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(first, last) index of each run of True in ``mask``."""
+    d = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return list(
+        zip(np.flatnonzero(d == 1).tolist(), (np.flatnonzero(d == -1) - 1).tolist(), strict=True)
+    )
 
 
 def _half_text(iv: tuple[int, int], m: int) -> str:
@@ -127,6 +321,10 @@ def _half_text(iv: tuple[int, int], m: int) -> str:
     return f"[{k[0]}, {k[gaps[0]]}] ∪ [{k[gaps[0] + 1]}, {k[-1]}]"
 
 
+def f_g(scene, i: int) -> float:
+    return scene.features[i].g
+
+
 def _owners_of(st, eye: str) -> np.ndarray:
     from eyeviz.model.state import owners
 
@@ -135,6 +333,68 @@ def _owners_of(st, eye: str) -> np.ndarray:
 
 GOOD, BAD, GREY = "#1b7837", "#b00020", "#777777"
 READOUT_MIN_WIDTH = 420
+
+
+class ValueText(QtWidgets.QWidget):
+    """Plain text painted by the widget itself: a new text repaints this widget only.
+
+    A QLabel's ``setText`` asks its parent layout to re-lay out (``updateGeometry``) on
+    every change, which re-laid out the whole window on every drag event; this widget
+    asks for a new geometry only when its number of lines changes.
+    """
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self._text = ""
+        self._lines = 1
+        self._color = QtGui.QColor("#1e1e1e")
+        self.setAutoFillBackground(True)  # opaque: its repaint does not repaint the dock
+        self.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Fixed)
+        self.setFixedHeight(self._height(1))
+
+    def _height(self, lines: int) -> int:
+        return self.fontMetrics().lineSpacing() * lines + 2
+
+    def text(self) -> str:
+        return self._text
+
+    def setText(self, text: str) -> None:  # noqa: N802 (Qt name)
+        if text == self._text:
+            return
+        self._text = text
+        lines = text.count("\n") + 1
+        if lines != self._lines:
+            self._lines = lines
+            self.setFixedHeight(self._height(lines))  # a layout only when the shape changes
+        self.setToolTip(text if len(text) > 40 else "")
+        self.update()
+
+    def set_style(self, color: str, bold: bool) -> None:
+        f = self.font()
+        if f.bold() != bold:
+            f.setBold(bold)
+            self.setFont(f)
+            self.setFixedHeight(self._height(self._lines))
+        self._color = QtGui.QColor(color)
+        self.update()
+
+    def sizeHint(self) -> QtCore.QSize:  # noqa: N802 (Qt name)
+        return QtCore.QSize(120, self._height(self._lines))
+
+    def paintEvent(self, event) -> None:  # noqa: N802 (Qt name)
+        p = QtGui.QPainter(self)
+        p.setPen(self._color)
+        flags = QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop
+        fm = self.fontMetrics()
+        y = 0
+        for line in self._text.split("\n"):
+            p.drawText(
+                QtCore.QRect(0, y, self.width(), fm.lineSpacing()),
+                flags,
+                fm.elidedText(line, QtCore.Qt.ElideRight, self.width()),
+            )
+            y += fm.lineSpacing()
+        p.end()
 
 
 class ReadoutPanel(QtWidgets.QWidget):
@@ -149,6 +409,8 @@ class ReadoutPanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         self.texts: dict[str, str] = {}  # row key -> value text (what tests read)
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(8, 8, 8, 8)
@@ -173,13 +435,8 @@ class ReadoutPanel(QtWidgets.QWidget):
 
     def _row(self, k: int) -> tuple[QtWidgets.QLabel, QtWidgets.QLabel]:
         while len(self._rows) <= k:
-            key, val = QtWidgets.QLabel(), QtWidgets.QLabel()
+            key, val = QtWidgets.QLabel(), ValueText()
             key.setTextFormat(QtCore.Qt.RichText)
-            val.setTextFormat(QtCore.Qt.PlainText)
-            val.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
-            val.setAlignment(QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop)
-            # changing numbers must never resize the dock (and the view) during a drag
-            val.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Preferred)
             key.setAlignment(QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop)
             r = len(self._rows)
             self.grid.addWidget(key, r, 0)
@@ -201,14 +458,10 @@ class ReadoutPanel(QtWidgets.QWidget):
             if old is None or old[2] != text:
                 val.setText(text)
             if old is None or old[3] != color:
-                pal = val.palette()
-                pal.setColor(QtGui.QPalette.WindowText, QtGui.QColor(color))
-                val.setPalette(pal)
-                f = val.font()
-                f.setBold(color in (GOOD, BAD))
-                val.setFont(f)
-            key.show()
-            val.show()
+                val.set_style(color, color in (GOOD, BAD))
+            if old is None:
+                key.show()
+                val.show()
             self._cache[k] = row
         for k in range(len(rows), len(self._rows)):
             if self._cache.pop(k, None) is not None:
@@ -231,8 +484,9 @@ class ReadoutPanel(QtWidgets.QWidget):
             return
         f = sc.features[i]
         self._set_title(f"● {f.name}", f.color)
-        if st.r is None:
-            self._set([("hidden", "", "readout layer hidden", GREY)])
+        if not sc.shows("readout") or st.r is None:
+            # the layer is off: no value at all (other layers may still compute them)
+            self._set([("hidden", "", "readout layer hidden\n(tick it in Layers)", GREY)])
             return
 
         def yes(v, good=True):
@@ -264,7 +518,7 @@ class ReadoutPanel(QtWidgets.QWidget):
 
     def _prediction_rows(self, i: int) -> list[tuple[str, str, str, str]]:
         from eyeviz.model.derived import errors
-        from eyeviz.render.mpl.vector import estimator_colors
+        from eyeviz.model.palette import estimator_colors
 
         st, sc = self.model.state, self.model.scene
         preds = self.model.predictions
@@ -282,8 +536,14 @@ class ReadoutPanel(QtWidgets.QWidget):
         for name in sc.estimators:
             res = preds.get(name, "no prediction")
             key = f"<b style='color:{cols[name]}'>{name}</b>"
+            note = design_note(self.model, name)
+            if note is not None:  # made for other eyes: no answer shown (greyed)
+                rows.append(
+                    (f"pred:{name}", f"<span style='color:{GREY}'>{name}</span>", note, GREY)
+                )
+                continue
             if isinstance(res, str):
-                rows.append((f"pred:{name}", key, res, GREY))
+                rows.append((f"pred:{name}", key, user_message(res, 120), GREY))
                 continue
             r_hat, phi_hat = float(res[0][i]), float(res[1][i])
             if not (math.isfinite(r_hat) and math.isfinite(phi_hat)):
@@ -294,6 +554,10 @@ class ReadoutPanel(QtWidgets.QWidget):
                 f"r {r_hat:.1f}   Δr {dr:+.1f} ({pct:+.2f} %)\n"
                 f"φ {math.degrees(phi_hat):.2f}°   Δφ {dphi:+.3f}°"
             )
+            out = range_note(self.model, name, float(st.r[i]), float(f_g(sc, i)))
+            if out is not None:
+                rows.append((f"pred:{name}", key, f"{text}\n{out}", BAD))
+                continue
             rows.append((f"pred:{name}", key, text, "#1e1e1e"))
         return rows
 
@@ -319,6 +583,8 @@ class EyesPanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         form = QtWidgets.QFormLayout(self)
         self.edits: dict[str, QtWidgets.QLineEdit] = {}
         for key, tip in (("h", "origin to eye centre"), ("l", "eye radius"), ("m", "ommatidia")):
@@ -327,8 +593,7 @@ class EyesPanel(QtWidgets.QWidget):
             e.editingFinished.connect(self.apply)
             form.addRow(f"{key}  ({tip})", e)
             self.edits[key] = e
-        self.message = QtWidgets.QLabel("")
-        self.message.setWordWrap(True)
+        self.message = wrap_label(QtWidgets.QLabel(""))
         self.message.setStyleSheet(ERROR_STYLE)
         form.addRow(self.message)
 
@@ -354,7 +619,7 @@ class EyesPanel(QtWidgets.QWidget):
                 raise ValueError(f"m must be an even integer >= 4, got {texts['m']!r}") from None
             self.model.set_eyes(h, l, m)
         except ValueError as exc:
-            self.message.setText(f"Refused: {exc}")
+            set_message(self.message, f"Refused: {exc}")
             for key, val in (("h", f"{e.h:g}"), ("l", f"{e.l:g}"), ("m", str(e.m))):
                 self.edits[key].setText(val)
             return
@@ -369,6 +634,8 @@ class FeaturePanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(2, 2, 2, 2)
         self.table = QtWidgets.QTableWidget(0, 4)
@@ -378,8 +645,7 @@ class FeaturePanel(QtWidgets.QWidget):
         self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectRows)
         self.table.setSelectionMode(QtWidgets.QAbstractItemView.SingleSelection)
         lay.addWidget(self.table)
-        self.message = QtWidgets.QLabel("")
-        self.message.setWordWrap(True)
+        self.message = wrap_label(QtWidgets.QLabel(""))
         self.message.setStyleSheet(ERROR_STYLE)
         lay.addWidget(self.message)
         self._filling = False
@@ -437,7 +703,7 @@ class FeaturePanel(QtWidgets.QWidget):
             msg = str(exc)
             if msg.startswith("could not convert"):
                 msg = f"{self.COLS[c]} must be a number, got {item.text()!r}"
-            self.message.setText(f"Refused: {msg}")
+            set_message(self.message, f"Refused: {msg}")
             self.refresh()
 
 
@@ -447,6 +713,8 @@ class LayersPanel(QtWidgets.QWidget):
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
         self.model = model
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
         grid = QtWidgets.QGridLayout(self)
         self.boxes: dict[str, QtWidgets.QCheckBox] = {}
         for i, name in enumerate(LAYERS):

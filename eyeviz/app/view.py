@@ -1,10 +1,20 @@
 """The VTK view widget: a native X window that VTK renders into directly.
 
-Why not pyvistaqt's ``QtInteractor`` (a ``QOpenGLWidget``): on this machine's software
-OpenGL (llvmpipe under Xvfb) its frame costs two VTK renders (``paintGL`` always renders
-again after an explicit ``Render()``) plus a GL composition of the whole top-level window
-by Qt (~17 ms at 1280x800). A native child window costs one render and one buffer swap
-of the view only. Measured with ``scripts/bench_app.py``; see the README.
+Two implementations behind one switch (``BACKEND``, or ``$EYEVIZ_VIEW`` = ``vtk`` |
+``pyvistaqt``), both a native-window ``QWidget`` drawing one VTK render per frame:
+
+- ``vtk``: VTK's own ``QVTKRenderWindowInteractor`` (the default);
+- ``pyvistaqt``: pyvistaqt's ``QtInteractor`` pinned at 0.12.0, the last release whose
+  ``QtInteractor`` is a native-window ``QWidget``; 0.13 made it a ``QOpenGLWidget``, whose
+  ``paintGL`` renders again after every explicit render and whose frame Qt composites over
+  the whole top-level window (1.3-3x the latency on this machine's software OpenGL). It is
+  built with ``multi_samples=0, auto_update=False, lighting="none"``, OIT and depth
+  peeling off, and frames go through ``plotter.render()``.
+
+``scripts/bench_app.py`` measures both in the same run. The default stays ``vtk``: in
+three runs on this shared 2-core machine pyvistaqt's drag p50 was 0.98-1.52x of the
+native widget's at m = 720 and 0.71-1.21x at m = 36,000, i.e. not shown equal within 5 %
+(the noise was larger than that); ``EYEVIZ_VIEW=pyvistaqt`` selects it.
 
 The window never lets VTK's interactor styles see a mouse event (the main window filters
 them), so this widget only renders.
@@ -12,12 +22,17 @@ them), so this widget only renders.
 
 from __future__ import annotations
 
+import os
+
 import vtkmodules.vtkRenderingFreeType  # noqa: F401  (text actors)
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
 from vtkmodules.qt.QVTKRenderWindowInteractor import QVTKRenderWindowInteractor
 from vtkmodules.vtkRenderingCore import vtkRenderer
 
-__all__ = ["VtkView", "fast_renderer"]
+__all__ = ["BACKEND", "BACKENDS", "NativeView", "VtkView", "fast_renderer", "make_view"]
+
+BACKENDS = ("vtk", "pyvistaqt")
+BACKEND = os.environ.get("EYEVIZ_VIEW", "vtk")
 
 
 def fast_renderer(background=(1.0, 1.0, 1.0)) -> vtkRenderer:
@@ -28,31 +43,38 @@ def fast_renderer(background=(1.0, 1.0, 1.0)) -> vtkRenderer:
     blending is exact here: the 2D top view has no overlapping translucent surfaces.
     """
     ren = vtkRenderer()
-    ren.SetUseOIT(False)
-    ren.SetUseDepthPeeling(False)
+    _plain(ren)
     ren.SetBackground(*background)
     return ren
 
 
-class VtkView(QVTKRenderWindowInteractor):
-    """A ``QWidget`` with a native window VTK renders into (no multisampling)."""
+def _plain(ren: vtkRenderer) -> None:
+    ren.SetUseOIT(False)
+    ren.SetUseDepthPeeling(False)
 
-    def __init__(self, parent=None):
-        super().__init__(parent)
-        self.ren_win = self.GetRenderWindow()
+
+class _Frames:
+    """What the window needs of a view: ``draw``, ``frames``, ``before_render``."""
+
+    ren_win = None
+    closed = False
+    frames = 0  # renders completed: the bench's "frame that reflects the event"
+    before_render = None  # callable run before each render (pending updates)
+
+    def _init_frames(self) -> None:
+        self.frames = 0
+        self.before_render = None
+        self.closed = False
         self.ren_win.SetMultiSamples(0)
         self.ren_win.SetLineSmoothing(False)
         self.ren_win.SetPointSmoothing(False)
         self.ren_win.SetPolygonSmoothing(False)
-        self.renderer = fast_renderer()
-        self.ren_win.AddRenderer(self.renderer)
-        self._Iren.SetInteractorStyle(None)
-        self.frames = 0  # renders completed: the bench's "frame that reflects the event"
-        self.before_render = None  # callable run before each render (pending updates)
-        self.closed = False
 
     def set_background(self, color) -> None:
         self.renderer.SetBackground(*color)
+
+    def _render_now(self) -> None:
+        self.ren_win.Render()
 
     def draw(self) -> None:
         """Apply pending updates, then render synchronously (never after close)."""
@@ -60,15 +82,79 @@ class VtkView(QVTKRenderWindowInteractor):
             return
         if self.before_render is not None:
             self.before_render()
-        self.ren_win.Render()
+        self._render_now()
         self.frames += 1
 
     def paintEvent(self, ev) -> None:  # noqa: N802 (Qt name)
         if self.isVisible():
             self.draw()
 
+
+class NativeView(_Frames, QVTKRenderWindowInteractor):
+    """VTK's ``QWidget`` with a native window VTK renders into (no multisampling)."""
+
+    backend = "vtk"
+
+    def __init__(self, parent=None):
+        QVTKRenderWindowInteractor.__init__(self, parent)
+        self.ren_win = self.GetRenderWindow()
+        self._init_frames()
+        self.renderer = fast_renderer()
+        self.ren_win.AddRenderer(self.renderer)
+        self._Iren.SetInteractorStyle(None)
+
     def close(self) -> bool:
         if not self.closed:
             self.closed = True
             self.Finalize()
         return super().close()
+
+
+def _pyvistaqt_view(parent=None):
+    """pyvistaqt 0.12.0's ``QtInteractor`` set up for one render per frame."""
+    from pyvistaqt import QtInteractor
+
+    class PyvistaView(_Frames, QtInteractor):
+        backend = "pyvistaqt"
+
+        def __init__(self, parent=None):
+            QtInteractor.__init__(self, parent, multi_samples=0, auto_update=False, lighting="none")
+            self._init_frames()
+            for ren in self.renderers:
+                _plain(ren)
+                ren.SetBackground(1.0, 1.0, 1.0)
+            self.iren.interactor.SetInteractorStyle(None)
+
+        def set_background(self, color, *args, **kwargs) -> None:
+            """The main renderer only (pyvista's would paint the inset too)."""
+            import pyvista as pv
+
+            self.renderer.SetBackground(*pv.Color(color).float_rgb)
+
+        def _render_now(self) -> None:
+            self.render()  # pyvista's path: BasePlotter.render -> one ren_win.Render()
+
+        def close(self) -> bool:
+            if not self.closed:
+                self.closed = True
+                QtInteractor.close(self)
+            return True
+
+    return PyvistaView(parent)
+
+
+def make_view(parent=None, backend: str | None = None):
+    """The view widget of ``backend`` (default: :data:`BACKEND`)."""
+    backend = backend or BACKEND
+    if backend == "pyvistaqt":
+        return _pyvistaqt_view(parent)
+    if backend != "vtk":
+        from eyeviz import EyevizError
+
+        raise EyevizError(f"EYEVIZ_VIEW must be one of {', '.join(BACKENDS)}, got {backend!r}")
+    return NativeView(parent)
+
+
+def VtkView(parent=None):  # noqa: N802 (kept: the window's call site)
+    """The view of the configured backend (see :func:`make_view`)."""
+    return make_view(parent)

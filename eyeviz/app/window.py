@@ -19,7 +19,14 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkRenderingCore import vtkTextActor, vtkWindowToImageFilter
 
-from eyeviz.app.panels import BitmapPanel, EyesPanel, FeaturePanel, LayersPanel, ReadoutPanel
+from eyeviz.app.panels import (
+    BitmapPanel,
+    EyesPanel,
+    FeaturePanel,
+    LayersPanel,
+    ReadoutPanel,
+    design_skips,
+)
 from eyeviz.app.view import VtkView, fast_renderer
 from eyeviz.model.app_model import AppModel, MouseEvent, drag_feature, hit_test
 from eyeviz.model.scene import Scene, SceneError, View, load, save
@@ -153,9 +160,11 @@ class MainWindow(QtWidgets.QMainWindow):
         self.cursor_label = QtWidgets.QLabel("")
         # a fixed width: a new cursor text must not re-lay out the status bar every move
         fm = self.cursor_label.fontMetrics()
-        self.cursor_label.setFixedWidth(
-            fm.horizontalAdvance("x -00,000.0   y -00,000.0     r 00,000.0   φ 000.00°  ")
+        self.cursor_label.setFixedSize(  # width AND height: a setText never re-lays out
+            fm.horizontalAdvance("x -00,000.0   y -00,000.0     r 00,000.0   φ 000.00°  "),
+            fm.height() + 4,
         )
+        self.cursor_label.setAutoFillBackground(True)  # opaque: repaints only itself
         self.statusBar().addPermanentWidget(self.cursor_label)
         self._build_menus()
         self.model.listeners.append(self._on_model)
@@ -379,7 +388,8 @@ class MainWindow(QtWidgets.QMainWindow):
             from eyeviz.render.mpl.vector import estimator_colors
 
             colors = estimator_colors(scene.estimators)
-        self.overlays.update_predictions(scene, st, preds, colors)
+        skip = design_skips(self.model) if preds else set()
+        self.overlays.update_predictions(scene, st, preds, colors, skip=skip)
         i = self.model.selected
         sel_color = scene.features[i].color if i is not None and i < st.n else None
         self.overlays.update_ambiguity(scene, self.model.ambiguity, sel_color)

@@ -31,6 +31,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--transparent", action="store_true", help="transparent background instead of white"
     )
+    parser.add_argument(
+        "--width",
+        default="single",
+        metavar="W",
+        help="figure width: 'single' (3.5 in, one journal column), 'double' (7.2 in) "
+        "or inches between 3 and 10; default single",
+    )
+    parser.add_argument("--no-title", action="store_true", help="leave the title out")
+    parser.add_argument("--no-table", action="store_true", help="leave the readout table out")
+    parser.add_argument("--no-bitmaps", action="store_true", help="leave the bitmap strips out")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -39,9 +49,21 @@ def run(args: argparse.Namespace) -> int:
     os.environ.setdefault("MPLBACKEND", "Agg")
     from eyeviz.model import scene as scene_mod
     from eyeviz.render.mpl.export import export, format_of
+    from eyeviz.render.mpl.vector import check_drawable, resolve_width
 
-    format_of(args.output)  # refuse a bad suffix before reading anything
+    format_of(args.output)  # refuse a bad suffix or width before reading anything
+    width = resolve_width(args.width)
     sc = scene_mod.load(args.scene)
-    out = export(sc, args.output, scale=args.scale, transparent=args.transparent)
+    check_drawable(sc)  # too many features or undrawable coordinates: refused at once
+    out = export(
+        sc,
+        args.output,
+        scale=args.scale,
+        transparent=args.transparent,
+        width=width,
+        title=not args.no_title,
+        table=not args.no_table,
+        bitmaps=not args.no_bitmaps,
+    )
     print(out)
     return 0

@@ -1,9 +1,13 @@
-"""The app's model: the open scene, the selection, and drags written as generators.
+"""The app's model: the open scene, the selection, the cameras, the trajectory player and
+drags written as generators.
 
 Qt-free (napari's split): the window feeds mouse events in and listens for changes. Every
 edit goes through :meth:`AppModel.commit` (one undo step; the window installs a
-QUndoStack-backed ``push``); live changes during a drag go through :meth:`AppModel.live`
-and are committed once, when the drag ends.
+QUndoStack-backed ``push``). Live changes (a drag, a played trajectory) go through
+:meth:`AppModel.live` inside ``begin_live`` / ``end_live``: the whole gesture is ONE undo
+step from the scene at ``begin_live`` to the scene at ``end_live``; nothing is rewound.
+Gestures on the view (wheel, pan, fit) are in :mod:`eyeviz.model.interactions`, their maths
+in :mod:`eyeviz.model.camera`.
 """
 
 from __future__ import annotations
@@ -12,15 +16,23 @@ import math
 from collections.abc import Callable, Generator
 from dataclasses import dataclass
 
-from eyeviz.model.scene import OKABE_ITO, Feature, Scene
+from eyeviz.model.player import TrajectoryPlayer
+from eyeviz.model.scene import OKABE_ITO, Feature, Scene, View
 from eyeviz.model.state import SceneState, compute_state
 
 __all__ = ["AppModel", "MouseEvent", "DRAG_THRESHOLD_PX", "drag_feature", "hit_test"]
 
 DRAG_THRESHOLD_PX = 4.0  # a press released closer than this to where it started is a click
-HANDLE_PX = 14.0  # radius of the grab zone of the radius handle
+HANDLE_PX = 14.0  # radius of the grab zone of the radius handle (drawn at this size)
 BODY_PX = 8.0  # grab margin around a disc (and the minimum grab radius for tiny features)
 M_MAX = 200_000  # larger m cannot be redrawn live
+
+
+@dataclass
+class _Live:
+    before: Scene
+    text: str
+    owner: object
 
 
 @dataclass
@@ -46,6 +58,10 @@ class AppModel:
         self._ambiguity: dict | None | bool = False  # False: not computed yet
         self.predictor = None  # eyeviz.model.derived.Predictor, made on first use
         self.push: Callable[..., None] = self._push_plain
+        self._live: _Live | None = None
+        self.inset_view = View((0.0, 0.0), 1.0)  # the magnified eyes (camera.fit_inset)
+        self.inset_auto = True  # the inset follows h and l until the user pans/zooms it
+        self.player = TrajectoryPlayer(self)
 
     # --- state ------------------------------------------------------------------------
     @property
@@ -84,11 +100,18 @@ class AppModel:
         return self._ambiguity
 
     def _notify(self, what: str, index: int | None = None) -> None:
-        self._state = None
-        self._predictions = None
-        self._ambiguity = False
+        if what not in ("view", "player", "selection"):
+            self._state = None
+            self._predictions = None
+            self._ambiguity = False
+        elif what == "selection":
+            self._ambiguity = False
         for fn in list(self.listeners):
             fn(what, index)
+
+    def notify_view(self, which: str = "main") -> None:
+        """A camera moved (no scene edit, no undo step; derived state is kept)."""
+        self._notify("view", 0 if which == "main" else 1)
 
     # --- edits --------------------------------------------------------------------------
     def _push_plain(self, before: Scene, after: Scene, text: str, merge_key=None) -> None:
@@ -103,19 +126,54 @@ class AppModel:
         if self.selected is None and n:
             self.selected = 0
         self._notify(what)
+        self.player.scene_changed()
 
     def commit(self, after: Scene, text: str, before: Scene | None = None, merge_key=None) -> None:
         """One undoable edit from ``before`` (default: the current scene) to ``after``.
 
         Consecutive edits with the same ``merge_key`` (wheel steps) merge into one step.
         """
+        live = self._live
+        if live is not None:  # an edit during a play: close the play's step first
+            self.end_live(owner=live.owner)
         before = self.scene.copy() if before is None else before
-        if after == before:
-            return
-        self.push(before, after.copy(), text, merge_key)
+        if after != before:
+            self.push(before, after.copy(), text, merge_key)
+        if live is not None and live.owner is self.player and self.player.playing:
+            self.begin_live(live.text, owner=live.owner)
+
+    # --- live edits (one undo step per gesture) ----------------------------------------
+    @property
+    def live_open(self) -> bool:
+        return self._live is not None
+
+    def begin_live(self, text: str, owner: object = None) -> None:
+        """Start a gesture: edits through :meth:`live` until :meth:`end_live` are ONE undo
+        step named ``text``. A gesture still open is ended first."""
+        if self._live is not None:
+            self.end_live()
+        self._live = _Live(self.scene.copy(), text, owner)
+
+    def end_live(self, owner: object = None) -> bool:
+        """End the open gesture (only ``owner``'s if given): push one undo step from the
+        scene at :meth:`begin_live` to the current one; True if something changed."""
+        live = self._live
+        if live is None or (owner is not None and live.owner is not owner):
+            return False
+        self._live = None
+        after = self.scene.copy()
+        if after == live.before:
+            return False
+        self.push(live.before, after, live.text, None)
+        return True
+
+    def finish_gestures(self) -> None:
+        """Before undo/redo or a file change: stop the player, end any gesture."""
+        self.player.stop()
+        self.end_live()
 
     def live(self, index: int, **values: float) -> None:
-        """Change a feature during a drag (not an undo step until the drag commits)."""
+        """Change a feature during a gesture (part of the gesture's one undo step)."""
         f = self.scene.features[index]
         for k, v in values.items():
             setattr(f, k, float(v))
@@ -164,6 +222,18 @@ class AppModel:
             i += 1
         return f"{base} {i}"
 
+    def _copy_name(self, name: str) -> str:
+        """"feature 1" -> "feature 1 (copy)", then "(copy 2)", ...; a copy of a copy keeps
+        one suffix ("a (copy)" -> "a (copy 2)")."""
+        base = name
+        if base.endswith(")") and " (copy" in base:
+            base = base[: base.rindex(" (copy")]
+        names = {f.name for f in self.scene.features}
+        cand, k = f"{base} (copy)", 2
+        while cand in names:
+            cand, k = f"{base} (copy {k})", k + 1
+        return cand
+
     def add_feature(self, x: float, y: float, g: float | None = None) -> None:
         after = self.scene.copy()
         if g is None:
@@ -180,7 +250,7 @@ class AppModel:
         f = after.features[index]
         off = 2.5 * f.g
         color = OKABE_ITO[len(after.features) % len(OKABE_ITO)]
-        after.features.append(Feature(self._new_name(f.name), f.x + off, f.y, f.g, color))
+        after.features.append(Feature(self._copy_name(f.name), f.x + off, f.y, f.g, color))
         self.commit(after, f"Duplicate {f.name}")
         self.select(len(self.scene.features) - 1)
 
@@ -201,21 +271,37 @@ class AppModel:
 def hit_test(scene: Scene, selected: int | None, x: float, y: float, units_per_px: float):
     """(index, "handle"|"body") of what lies under (x, y), or (None, None).
 
-    The selected feature's radius handle (at (x + g, y)) wins when the cursor is nearer to
-    it than to the centre, then the topmost disc (the last in the list); tiny discs are
-    grabbed within BODY_PX of their centre.
+    Tolerances are in pixels (``units_per_px`` converts them): a disc is grabbed within
+    BODY_PX of its rim (tiny discs within BODY_PX of their centre), the topmost (last)
+    first. The selected feature's radius handle (at (x + g, y), drawn HANDLE_PX wide) is
+    grabbable only where it is drawn apart from its disc's centre (g >= HANDLE_PX on
+    screen), when the cursor is within HANDLE_PX of it, nearer to it than to the centre,
+    and not inside another disc: zoomed out, a press on a neighbour selects the neighbour
+    instead of resizing the selected feature (issue 12, item 3).
     """
     fs = scene.features
+    u = max(units_per_px, 1e-300)
+    body = None
+    for i in range(len(fs) - 1, -1, -1):
+        f = fs[i]
+        if math.hypot(x - f.x, y - f.y) <= max(f.g, 0.0) + BODY_PX * u:
+            body = i
+            break
     if selected is not None and 0 <= selected < len(fs):
         f = fs[selected]
         d_handle = math.hypot(x - f.x - f.g, y - f.y)
-        if d_handle <= HANDLE_PX * units_per_px and d_handle < math.hypot(x - f.x, y - f.y):
+        if (
+            f.g / u >= HANDLE_PX
+            and d_handle <= HANDLE_PX * u
+            and d_handle < math.hypot(x - f.x, y - f.y)
+            and not (
+                body is not None
+                and body != selected
+                and math.hypot(x - fs[body].x, y - fs[body].y) <= fs[body].g
+            )
+        ):
             return selected, "handle"
-    for i in range(len(fs) - 1, -1, -1):
-        f = fs[i]
-        if math.hypot(x - f.x, y - f.y) <= max(f.g, 0.0) + BODY_PX * units_per_px:
-            return i, "body"
-    return None, None
+    return (body, "body") if body is not None else (None, None)
 
 
 def drag_feature(model: AppModel, event: MouseEvent, index: int, part: str) -> Generator:
@@ -223,25 +309,27 @@ def drag_feature(model: AppModel, event: MouseEvent, index: int, part: str) -> G
 
     Send each following event with ``gen.send(event)``. Moving the body keeps the grab
     offset; the handle sets the radius to the cursor's distance from the centre. Under
-    DRAG_THRESHOLD_PX of travel it is a click (select only); a drag is ONE undo step.
+    DRAG_THRESHOLD_PX of travel it is a click (select only); a drag is ONE undo step
+    (``begin_live`` at the first real move, ``end_live`` at the release).
     """
     model.select(index)
-    before = model.scene.copy()
-    f0 = before.features[index]
+    f0 = model.scene.features[index]
+    f0 = Feature(f0.name, f0.x, f0.y, f0.g, f0.color)
     x0, y0, px0, py0 = event.x, event.y, event.px, event.py
     dragging = False
     event = yield
-    while event.type == "move":
-        if not dragging and math.hypot(event.px - px0, event.py - py0) >= DRAG_THRESHOLD_PX:
-            dragging = True
+    try:
+        while event.type == "move":
+            if not dragging and math.hypot(event.px - px0, event.py - py0) >= DRAG_THRESHOLD_PX:
+                dragging = True
+                model.begin_live(("Move " if part == "body" else "Resize ") + f0.name)
+            if dragging:
+                if part == "body":
+                    model.live(index, x=f0.x + (event.x - x0), y=f0.y + (event.y - y0))
+                else:
+                    g = math.hypot(event.x - f0.x, event.y - f0.y)
+                    model.live(index, g=max(g, f0.g * 1e-3, 1e-9))
+            event = yield
+    finally:
         if dragging:
-            if part == "body":
-                model.live(index, x=f0.x + (event.x - x0), y=f0.y + (event.y - y0))
-            else:
-                g = math.hypot(event.x - f0.x, event.y - f0.y)
-                model.live(index, g=max(g, f0.g * 1e-3, 1e-9))
-        event = yield
-    if dragging:
-        after = model.scene.copy()
-        model.scene = before.copy()  # the undo command sets `after` again on push
-        model.commit(after, ("Move " if part == "body" else "Resize ") + f0.name, before=before)
+            model.end_live()

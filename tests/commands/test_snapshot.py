@@ -67,3 +67,73 @@ def test_snapshot_bad_input_is_one_line(tmp_path):
         assert len(lines) == 1 and lines[0].startswith("eyeviz: error:"), out.stderr
         assert "Traceback" not in out.stderr
     assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
+
+
+def test_snapshot_width_and_toggles(tmp_path):
+    exe = [sys.executable, "-m", "eyeviz", "snapshot", SCENES / "default.toml"]
+    out = tmp_path / "d.png"
+    run = subprocess.run(
+        [*map(str, exe), "-o", str(out), "--width", "double"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=ROOT,
+    )
+    assert run.returncode == 0, run.stderr
+    assert struct.unpack(">II", out.read_bytes()[16:24])[0] == round(7.2 * 300)
+    svg = tmp_path / "bare.svg"
+    run = subprocess.run(
+        [
+            *map(str, exe),
+            "-o",
+            str(svg),
+            "--width",
+            "4",
+            "--no-title",
+            "--no-table",
+            "--no-bitmaps",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=ROOT,
+    )
+    assert run.returncode == 0, run.stderr
+    text = svg.read_text()
+    assert 'id="readout"' not in text and 'id="bitmaps"' not in text
+    assert 'id="title"' not in text and 'width="288pt"' in text
+    run = subprocess.run(
+        [*map(str, exe), "-o", str(tmp_path / "x.png"), "--width", "triple"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=ROOT,
+    )
+    assert run.returncode == 2 and run.stderr.count("\n") == 1 and "width" in run.stderr
+
+
+def test_snapshot_hostile_scenes_are_one_line(tmp_path):
+    """Too many features, a feature at 1e308: a quick one-line refusal, no file."""
+    import time
+
+    many = tmp_path / "many.toml"
+    rows = "".join(
+        f'[[features]]\nname = "f{i}"\nx = {i}.0\ny = 1500.0\ng = 1.0\n\n' for i in range(10_001)
+    )
+    many.write_text(rows)
+    far = tmp_path / "far.toml"
+    far.write_text('[[features]]\nname = "far"\nx = 1e308\ny = 1500.0\ng = 50.0\n')
+    for scene, words in ((many, "at most 10000 features"), (far, "cannot be drawn")):
+        t = time.perf_counter()
+        run = subprocess.run(
+            [sys.executable, "-m", "eyeviz", "snapshot", str(scene), "-o", str(tmp_path / "o.png")],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            cwd=ROOT,
+        )
+        assert time.perf_counter() - t < 60
+        assert run.returncode == 2, run.stderr
+        lines = run.stderr.strip().splitlines()
+        assert len(lines) == 1 and words in lines[0], run.stderr
+    assert not (tmp_path / "o.png").exists()

@@ -135,12 +135,13 @@ def test_tangents_touch_the_feature_and_sectors_bound_the_lit_interval(rig):
             assert np.dot(t[:2] - centre[:2], t[:2] - [119.3, 60.9]) == pytest.approx(0, abs=1e-9)
     sec = np.asarray(act.sector_mesh.points)
     gamma = 2 * math.pi / 24
+    slots = len(sec) // 2
     for e, (L, R) in enumerate(((st.LA[0], st.RA[0]), (st.LB[0], st.RB[0]))):
-        c = sec[3 * e]
-        angles = [
-            math.atan2(p[1] - c[1], p[0] - c[0]) % (2 * math.pi) for p in sec[3 * e + 1 : 3 * e + 3]
-        ]
-        assert angles == pytest.approx([L * gamma, (R + 1) * gamma])
+        c = sec[e * slots]
+        ends = [p for p in sec[e * slots + 1 : (e + 1) * slots] if np.hypot(*(p - c)[:2]) > 0]
+        angles = sorted(math.atan2(p[1] - c[1], p[0] - c[0]) % (2 * math.pi) for p in ends)
+        # every boundary ray k*gamma of the lit run, L .. R+1 (Eq. 8, 11)
+        assert angles == pytest.approx([(k * gamma) % (2 * math.pi) for k in range(L, R + 2)])
     sc.layers.remove("tangents")
     act.update(sc, compute_state(sc), 0)
     assert not act.overlay_actors["tangents"][0].GetVisibility()
@@ -164,3 +165,25 @@ def test_feature_fill_is_triangle_fans_in_the_feature_colours(rig):
     for i, f in enumerate(sc.features):
         tint = np.round(0.4 * np.array(hex_rgb(f.color)) + 0.6 * 255)
         np.testing.assert_array_equal(act.fill_rgb(i), tint)
+
+
+def test_bfv_wedge_is_the_frames_clipped_polygon_at_any_distance(rig):
+    from eyeviz.model.frame import clip_wedge
+
+    pl, act = rig
+    sc = Scene(Eyes(40.0, 20.0, 720), [], ["eyes", "bfv"])
+    act.update(sc, compute_state(sc), None)
+    for cx, cy, half in ((0.0, 2000.0, 3000.0), (1e7, 1e7, 2e4), (-3e8, 5e8, 1e6)):
+        for ren in (pl.renderer, act.inset):
+            cam = ren.GetActiveCamera()
+            cam.ParallelProjectionOn()
+            cam.SetFocalPoint(cx, cy, 0.0)
+            cam.SetPosition(cx, cy, 1000.0)
+            cam.SetParallelScale(half)
+        act.fit_bfv()
+        rect = act.visible_rect()
+        poly = clip_wedge(sc.eyes.pair().psi, rect)
+        pts = np.asarray(act.bfv.mesh.points)[:, :2]
+        np.testing.assert_allclose(pts[: len(poly)], poly)
+        # the visible centre is inside the drawn wedge's bounds (the old one stopped at 5e6)
+        assert pts[:, 1].max() >= cy and pts[:, 0].min() <= cx <= pts[:, 0].max()

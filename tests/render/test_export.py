@@ -1,6 +1,7 @@
 """export(): format by suffix, PNG scale, transparent background, PDF that renders,
 atomic writes (an interrupted export leaves no file and keeps an existing one)."""
 
+import math
 import struct
 import subprocess
 from pathlib import Path
@@ -120,3 +121,208 @@ def test_interrupted_export_leaves_no_file(tmp_path, default_scene, monkeypatch,
         export(default_scene, target)
     assert target.read_bytes() == b"previous figure"
     assert [p.name for p in tmp_path.iterdir()] == [target.name]
+
+
+# --- export for journals (issue 12 item 10) and hostile inputs (issue 13) ---------------
+
+from eyeviz.render.mpl import vector  # noqa: E402
+
+
+def _renderer(fig):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    return canvas.get_renderer()
+
+
+def _texts(fig):
+    """Every Text the figure draws (tick labels only for the ticks inside the view)."""
+    ticks, drawn = set(), set()
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+                ticks |= {id(tick.label1), id(tick.label2)}
+            for tick in axis._update_ticks() if ax.axison else []:
+                drawn |= {id(tick.label1), id(tick.label2)}
+    out = []
+    for t in fig.findobj(lambda a: hasattr(a, "get_text") and hasattr(a, "get_fontsize")):
+        if not (t.get_visible() and t.get_text().strip()):
+            continue
+        if id(t) in ticks and id(t) not in drawn:
+            continue
+        out.append(t)
+    return out
+
+
+def _all_scenes():
+    scenes = [scene_mod.load(p) for p in sorted(SCENES.glob("*.toml"))]
+    for sc in scenes:
+        sc.estimators = ["analytic"]  # no torch in this test
+    return scenes
+
+
+@pytest.mark.parametrize("width", ["single", "double", 5.0])
+def test_no_text_below_6pt_and_all_inside_the_figure(width):
+    for sc in _all_scenes():
+        fig = vector.figure(sc, width=width)
+        r = _renderer(fig)
+        W, H = fig.bbox.width, fig.bbox.height
+        for t in _texts(fig):
+            assert t.get_fontsize() >= 6.0, (sc.title, t.get_text(), t.get_fontsize())
+            if t.get_clip_on() and t.axes is not None and t.get_gid() != "title":
+                continue  # feature labels clipped to the view are checked by placement
+            bb = t.get_window_extent(r)
+            assert bb.x0 >= -1 and bb.y0 >= -1 and bb.x1 <= W + 1 and bb.y1 <= H + 1, (
+                sc.title,
+                t.get_text(),
+                bb,
+            )
+
+
+def test_width_single_double_and_inches(tmp_path, default_scene):
+    for w, inches in (("single", 3.5), ("double", 7.2), (4.25, 4.25)):
+        out = export(default_scene, tmp_path / f"w{w}.png", width=w)
+        assert png_size(out)[0] == round(300 * inches)
+    for bad in ("triple", 0.5, 100, float("nan")):
+        with pytest.raises(EyevizError, match="width"):
+            export(default_scene, tmp_path / "bad.png", width=bad)
+    assert not (tmp_path / "bad.png").exists()
+
+
+def test_toggles_title_table_bitmaps(tmp_path, default_scene):
+    full = export(default_scene, tmp_path / "full.svg").read_text()
+    bare = export(
+        default_scene, tmp_path / "bare.svg", title=False, table=False, bitmaps=False
+    ).read_text()
+    assert 'id="title"' in full and 'id="title"' not in bare
+    assert 'id="readout"' in full and 'id="readout"' not in bare
+    assert 'id="bitmaps"' in full and 'id="bitmaps"' not in bare
+    assert 'id="feature-target"' in bare
+
+
+def test_framing_follows_the_scene_view(default_scene):
+    fig = vector.figure(default_scene, width="double")
+    ax = next(a for a in fig.axes if a.get_gid() == "main")
+    cx, cy = default_scene.view.center
+    x0, x1 = ax.get_xlim()
+    assert (x0 + x1) / 2 == pytest.approx(cx) and x1 - x0 == pytest.approx(default_scene.view.width)
+    assert sum(ax.get_ylim()) / 2 == pytest.approx(cy)
+
+
+def test_inset_leader_stays_inside_the_axes():
+    for sc in _all_scenes() + [_origin_below_view()]:
+        fig = vector.figure(sc)
+        main = next(a for a in fig.axes if a.get_gid() == "main")
+        box = main.get_position()
+        for ln in fig.lines:
+            if ln.get_gid() == "inset-leader":
+                xs, ys = ln.get_xdata(), ln.get_ydata()
+                assert all(box.x0 - 1e-9 <= v <= box.x1 + 1e-9 for v in xs)
+                assert all(box.y0 - 1e-9 <= v <= box.y1 + 1e-9 for v in ys)
+
+
+def _origin_below_view():
+    sc = scene_mod.load(SCENES / "default.toml")
+    sc.view = scene_mod.View((0.0, 9000.0), 8000.0)
+    return sc
+
+
+def test_seven_digit_distances_do_not_run_together():
+    sc = scene_mod.Scene(
+        features=[
+            scene_mod.Feature("far", 1e7, 1e7, 5e4),
+            scene_mod.Feature("farther", -4e6, 9.9e6, 5e4),
+        ],
+        layers=["bfv", "features", "readout", "labels"],
+        view=scene_mod.View((1e7, 1e7), 4e5),
+    )
+    for width in ("single", "double"):
+        fig = vector.figure(sc, width=width)
+        r = _renderer(fig)
+        table = next(a for a in fig.axes if a.get_gid() == "readout")
+        rows: dict[int, list] = {}
+        for t in table.texts:
+            gid = t.get_gid() or ""
+            if gid.startswith("readout-") and gid.split("-")[1].isdigit():
+                rows.setdefault(int(gid.split("-")[2]), []).append(t.get_window_extent(r))
+        assert len(rows) == 2
+        for boxes in rows.values():
+            boxes.sort(key=lambda b: b.x0)
+            for a, b in zip(boxes, boxes[1:], strict=False):
+                assert a.x1 + 2 <= b.x0  # at least 2 px between cells
+        # the main axes' tick labels do not overlap either, and no offset text
+        main = next(a for a in fig.axes if a.get_gid() == "main")
+        ticks = [t.get_window_extent(r) for t in main.get_xticklabels() if t.get_text()]
+        ticks.sort(key=lambda b: b.x0)
+        for a, b in zip(ticks, ticks[1:], strict=False):
+            assert a.x1 < b.x0
+        assert not main.xaxis.get_offset_text().get_text()
+
+
+def test_theta_label_not_on_a_feature():
+    sc = scene_mod.load(SCENES / "figure5.toml")
+    # a feature exactly where the theta label would go
+    sc.features.append(scene_mod.Feature("blocker", 0.0, 145.0, 20.0, "#CC79A7"))
+    fig = vector.figure(sc)
+    r = _renderer(fig)
+    ax = next(a for a in fig.axes if a.get_gid() == "main")
+    lab = next(t for t in ax.texts if t.get_gid() == "bfv-theta-label")
+    bb = lab.get_window_extent(r).transformed(ax.transData.inverted())
+    for f in sc.features:
+        dx = max(bb.x0 - f.x, 0, f.x - bb.x1)
+        dy = max(bb.y0 - f.y, 0, f.y - bb.y1)
+        assert math.hypot(dx, dy) >= f.g, f.name
+
+
+def test_unavailable_estimator_refused_never_written(tmp_path, default_scene):
+    sc = default_scene.copy()
+    sc.layers = [*sc.layers, "predictions"]
+    sc.estimators = ["compact"]
+    given = {"compact": "unavailable: weights missing in /home/someone/secret/compact_dd.pt"}
+    with pytest.raises(EyevizError) as exc:
+        export(sc, tmp_path / "p.svg", predictions=given)
+    assert "\n" not in str(exc.value)
+    assert not (tmp_path / "p.svg").exists()
+    # an answer the estimator cannot give (another m) is a neutral note, not its message
+    sc.estimators = ["analytic"]
+    given = {"analytic": "cannot answer: made for m = 720 at /home/someone/x"}
+    text = export(sc, tmp_path / "q.svg", predictions=given).read_text()
+    assert "/home/someone" not in text and "no answer for this eye design" in text
+
+
+def test_hostile_names_and_coordinates(tmp_path, default_scene):
+    import time
+
+    sc = default_scene.copy()
+    sc.features[0].name = r"$\undefined$ x"
+    sc.features[1].name = "n" * 1_000_000
+    t = time.perf_counter()
+    out = export(sc, tmp_path / "names.png")
+    export(sc, tmp_path / "names.svg")
+    assert time.perf_counter() - t < 30
+    assert png_size(out)[0] == 1050
+    svg = (tmp_path / "names.svg").read_text()
+    assert r"$\undefined$ x" in svg  # shown literally, not parsed as mathtext
+    assert "n" * 39 + "\u2026" in svg and "n" * 1000 not in svg
+    far = default_scene.copy()
+    far.features[0].x = 1e308
+    t = time.perf_counter()
+    with pytest.raises(EyevizError, match="cannot be drawn") as exc:
+        export(far, tmp_path / "far.png")
+    assert time.perf_counter() - t < 5 and "\n" not in str(exc.value)
+    assert not (tmp_path / "far.png").exists()
+
+
+def test_too_many_features_refused_quickly(tmp_path, default_scene):
+    import time
+
+    sc = default_scene.copy()
+    f = sc.features[0]
+    sc.features = [
+        scene_mod.Feature(f"f{i}", f.x + i, f.y, f.g) for i in range(vector.MAX_FEATURES + 1)
+    ]
+    t = time.perf_counter()
+    with pytest.raises(EyevizError, match="at most 10000 features"):
+        export(sc, tmp_path / "many.png")
+    assert time.perf_counter() - t < 2

@@ -51,13 +51,19 @@ def export(
     state=None,
     predictions: dict | None = None,
     merge: bool | None = None,
+    width: float | str = "single",
+    title: bool = True,
+    table: bool = True,
+    bitmaps: bool = True,
+    predictor=None,
 ) -> Path:
     """Write ``scene`` to ``path`` (.png, .svg or .pdf), atomically; returns the path.
 
-    ``scale`` multiplies the PNG's pixel size (300 dpi at scale 1, a 3.5 in column:
+    ``scale`` multiplies the PNG's pixel size (300 dpi at scale 1; a 3.5 in column is
     1050 px wide); SVG and PDF are resolution independent and ignore it. ``transparent``
-    drops the white background. ``state``, ``predictions`` and ``merge`` go to
-    :func:`eyeviz.render.mpl.vector.figure`.
+    drops the white background. ``width`` is 'single' (3.5 in), 'double' (7.2 in) or
+    inches; ``title``, ``table`` and ``bitmaps`` (False) leave those parts out. ``state``,
+    ``predictions``, ``merge`` and ``predictor`` go to :func:`eyeviz.render.mpl.vector.figure`.
     """
     fmt = format_of(path)
     scale = _check_scale(scale)
@@ -71,7 +77,18 @@ def export(
     from eyeviz.render.mpl import vector
 
     dpi = vector.BASE_DPI * scale if fmt == "png" else vector.VECTOR_DPI
-    fig = vector.figure(scene, state, dpi=dpi, merge=merge, predictions=predictions)
+    fig = vector.figure(
+        scene,
+        state,
+        dpi=dpi,
+        merge=merge,
+        predictions=predictions,
+        width=width,
+        title=title,
+        table=table,
+        bitmaps=bitmaps,
+        predictor=predictor,
+    )
     with atomic_output(target) as tmp, matplotlib.rc_context(vector.RC):
         fig.savefig(
             tmp,

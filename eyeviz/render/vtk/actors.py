@@ -5,12 +5,15 @@ Each eye is ONE PolyData of m triangle cells (Figure 2: ommatidium k is the isos
 triangle between the rim directions k*gamma and (k+1)*gamma, Eq. 6); lighting them only
 writes the cell colour array in place (``mesh.cell_data[...][:] = ...``). Meshes are
 rebuilt only when their structure changes (m, h or l; the number of features; the layers
-shown). Nothing here computes geometry: colours and positions come from a
-:class:`eyeviz.model.state.SceneState`.
+shown). Derived geometry comes from the model: the BFV wedge, tangents and sector rays
+from a :class:`eyeviz.model.frame.Frame` (painters in ``teaching.py``), colours and
+feature positions from a :class:`eyeviz.model.state.SceneState`; what is built here is
+only the meshes of the scene's own parameters (the eye triangles of Figure 2, discs).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -31,8 +34,10 @@ from vtkmodules.vtkRenderingCore import (
     vtkTextActor,
 )
 
+from eyeviz.model.frame import build_frame
 from eyeviz.model.scene import Scene
 from eyeviz.model.state import SceneState
+from eyeviz.render.vtk.teaching import BfvPainter, SectorPainter, TangentPainter
 
 __all__ = ["SceneActors", "hex_rgb", "eye_mesh", "inset_viewport"]
 
@@ -240,9 +245,10 @@ class SceneActors:
         self.main.AddActor(self.handle_actor)
         self.main.AddActor(self.sight_actors[0])
         # teaching overlays (Figures 3b, 5-6): tangent rays and sector boundaries
-        four_lines = [2, 0, 1, 2, 0, 2, 2, 3, 4, 2, 3, 5]
-        self.tangent_mesh = pv.PolyData(np.zeros((6, 3)), lines=four_lines)
-        self.sector_mesh = pv.PolyData(np.zeros((6, 3)), lines=four_lines)
+        self.tangents = TangentPainter(Z_LINE)
+        self.sectors = SectorPainter(Z_LINE)
+        self.tangent_mesh = self.tangents.mesh
+        self.sector_mesh = self.sectors.mesh
         self.overlay_actors: dict[str, list[vtkActor]] = {}
         for name, mesh, width, color in (
             ("tangents", self.tangent_mesh, 2.5, INK),
@@ -280,6 +286,7 @@ class SceneActors:
         self.inset.AddViewProp(self._inset_border)
         self.edges_main = False
         self.edges_inset = False
+        self.bfv: BfvPainter | None = None
 
     # --- construction ---------------------------------------------------------------
     @staticmethod
@@ -368,34 +375,16 @@ class SceneActors:
         self._owners = None
         pair = scene.eyes.pair()
         h, l, m = pair.h, pair.l, pair.m
+        self.bfv = None
+        self._bfv_scene = None
         if scene.shows("bfv"):
-            far = 1.0e7
-            a = pair.psi
-            wedge = pv.PolyData(
-                np.array(
-                    [
-                        [0, 0, Z_BFV],
-                        [far * math.cos(a), far * math.sin(a), Z_BFV],
-                        [-far * math.cos(a), far * math.sin(a), Z_BFV],
-                    ]
-                ),
-                faces=[3, 0, 1, 2],
+            self._bfv_scene = dataclasses.replace(scene, features=[], layers=["bfv"])
+            self.bfv = BfvPainter(
+                (self.main, self.inset), BFV_FILL, BFV_LINE, Z_BFV, Z_LINE, _actor
             )
-            rays = pv.PolyData(
-                np.array(
-                    [
-                        [far * math.cos(a), far * math.sin(a), Z_LINE],
-                        [0, 0, Z_LINE],
-                        [-far * math.cos(a), far * math.sin(a), Z_LINE],
-                    ]
-                ),
-                lines=[3, 0, 1, 2],
-            )
-            for ren in (self.main, self.inset):
-                self._add(self._static, ren, _actor(wedge, BFV_FILL))
-                ra = _actor(rays, BFV_LINE)
-                ra.GetProperty().SetLineWidth(2.5)
-                self._add(self._static, ren, ra)
+            for ren, a in self.bfv.actors:
+                self._add(self._static, ren, a)
+            self.fit_bfv()
         if scene.shows("eyes"):
             for cx in (-h, h):
                 self.eye_meshes.append(eye_mesh(cx, l, m))
@@ -507,72 +496,23 @@ class SceneActors:
         self._update_overlays(scene, state, selected)
 
     def _update_overlays(self, scene: Scene, state: SceneState, selected: int | None) -> None:
-        """Tangents from each eye centre to the selected feature at phi_E +- arcsin(g/r_E)
-        (Prop. 2, Figure 3b) and the boundaries L*gamma, (R+1)*gamma of its lit sectors."""
+        """Tangents (Prop. 2, Figure 3b) and sector rays (Eq. 8, 11) of the selected
+        feature, from the Frame's TangentFrame / SectorFrame (no geometry here)."""
         ok = selected is not None and 0 <= selected < state.n
-        show_t = ok and scene.shows("tangents") and state.rA is not None
-        show_s = ok and scene.shows("sectors") and state.LA is not None
+        want = [name for name in ("tangents", "sectors") if ok and scene.shows(name)]
+        show_t = show_s = False
+        if want:
+            light = dataclasses.replace(scene, layers=want, estimators=[], trajectory=None)
+            frame = build_frame(light, state, rect=(0.0, 1.0, 0.0, 1.0))
+            show_t = "tangents" in want and self.tangents.update(frame, selected)
+            show_s = "sectors" in want and self.sectors.update(frame, selected)
         for a in self.overlay_actors["tangents"]:
             a.SetVisibility(show_t)
         for a in self.overlay_actors["sectors"]:
             a.SetVisibility(show_s)
-        self.tangent_text.SetVisibility(show_t)
-        if not (show_t or show_s):
-            return
-        i = selected
-        pair = state.pair
-        g = float(state.g[i])
-        if show_t:
-            pts = np.zeros((6, 3))
-            angles = []
-            for e, (cx, r, phi) in enumerate(
-                ((-pair.h, state.rA[i], state.phiA[i]), (pair.h, state.rB[i], state.phiB[i]))
-            ):
-                pts[3 * e] = (cx, 0.0, Z_LINE)
-                if r > g:
-                    a = math.asin(g / r)
-                    d = math.sqrt(r * r - g * g)
-                    angles.append(a)
-                    for j, s in enumerate((-1.0, 1.0)):
-                        pts[3 * e + 1 + j] = (
-                            cx + d * math.cos(phi + s * a),
-                            d * math.sin(phi + s * a),
-                            Z_LINE,
-                        )
-                else:
-                    pts[3 * e + 1 : 3 * e + 3] = pts[3 * e]
-            self.tangent_mesh.points[:] = pts
-            if len(angles) == 2:
-                deg = 180.0 / math.pi
-                a_deg, b_deg = angles[0] * deg, angles[1] * deg
-                self.tangent_text.SetInput(
-                    f"tangents: arcsin(g/r_A) = {a_deg:.2f}°,  arcsin(g/r_B) = {b_deg:.2f}°"
-                )
-            else:
-                self.tangent_text.SetVisibility(False)
-        if show_s:
-            pts = np.zeros((6, 3))
-            gm = pair.gamma
-            for e, (cx, r, L, R) in enumerate(
-                (
-                    (
-                        -pair.h,
-                        math.hypot(state.x[i] + pair.h, state.y[i]),
-                        state.LA[i],
-                        state.RA[i],
-                    ),
-                    (pair.h, math.hypot(state.x[i] - pair.h, state.y[i]), state.LB[i], state.RB[i]),
-                )
-            ):
-                reach = 1.25 * (r + g)
-                pts[3 * e] = (cx, 0.0, Z_LINE)
-                for j, k in enumerate((L, R + 1)):
-                    pts[3 * e + 1 + j] = (
-                        cx + reach * math.cos(k * gm),
-                        reach * math.sin(k * gm),
-                        Z_LINE,
-                    )
-            self.sector_mesh.points[:] = pts
+        self.tangent_text.SetVisibility(show_t and bool(self.tangents.text))
+        if show_t and self.tangents.text:
+            self.tangent_text.SetInput(self.tangents.text)
 
     def _update_eyes(self, scene: Scene, state: SceneState) -> None:
         if not self.eye_meshes:
@@ -694,11 +634,32 @@ class SceneActors:
         self._rgb_now = (tint, cols)
         self.grey = grey
 
+    def visible_rect(self) -> tuple[float, float, float, float]:
+        """(x0, x1, y0, y1) covering what the main view and the inset show (their cameras)."""
+        xs, ys = [], []
+        for ren in (self.main, self.inset):
+            cam = ren.GetActiveCamera()
+            cx, cy, _ = cam.GetFocalPoint()
+            half_h = cam.GetParallelScale()
+            half_w = half_h * max(ren.GetTiledAspectRatio(), 1e-3)
+            xs += [cx - half_w, cx + half_w]
+            ys += [cy - half_h, cy + half_h]
+        pad = 0.02 * max(max(xs) - min(xs), max(ys) - min(ys))
+        return (min(xs) - pad, max(xs) + pad, min(ys) - pad, max(ys) + pad)
+
+    def fit_bfv(self) -> None:
+        """The BFV wedge as the Frame clips it to the visible rectangle (drawn to the
+        view's edge at any zoom or pan; issue 12 item 5), points in place."""
+        if self.bfv is None:
+            return
+        self.bfv.update(build_frame(self._bfv_scene, rect=self.visible_rect()))
+
     def set_zoom(self, main_px_per_unit: float, inset_px_per_unit: float, l: float, m: int):
         """Level of detail by on-screen size: where the eye's rim is narrower than m/2 pixels,
         neighbouring ommatidia are pooled (a pooled cell is lit if any of its ommatidia is, in
         the colour of the last feature lighting it); edges only where a cell is wide enough.
         """
+        self.fit_bfv()
         if not self.eye_meshes:
             return
         rim_px = {

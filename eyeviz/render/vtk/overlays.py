@@ -2,18 +2,21 @@
 
 Each layer is one or two actors whose PolyData is replaced when its content changes (a
 few hundred points at most); nothing is drawn for a layer the scene does not show.
-Colours follow :func:`eyeviz.render.mpl.vector.estimator_colors`, so the app and the
-exported figures agree.
+Colours are fixed by estimator name (:func:`eyeviz.model.palette.estimator_color`), never
+by list position and never a feature's colour.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pyvista as pv
 from vtkmodules.vtkRenderingCore import vtkRenderer
 
+from eyeviz.model.frame import build_frame
+from eyeviz.model.palette import estimator_color
 from eyeviz.render.vtk.actors import INK, Z_LINE, Z_POINT, _actor, hex_rgb
 
 __all__ = ["OverlayActors", "Z_AMBIGUITY", "GHOST_N"]
@@ -65,8 +68,14 @@ class OverlayActors:
         self._path_key = None
 
     # --- predictions ------------------------------------------------------------------
-    def update_predictions(self, scene, state, preds: dict, colors: dict[str, str]) -> None:
-        """Ghost discs of radius g at each estimator's (r_hat, phi_hat), linked to the truth."""
+    def update_predictions(
+        self, scene, state, preds: dict, colors: dict[str, str], skip=frozenset()
+    ) -> None:
+        """Ghost discs of radius g at each estimator's (r_hat, phi_hat), linked to the truth.
+
+        Each estimator is drawn in its own colour, fixed by name (``colors`` is ignored);
+        estimators in ``skip`` (made for other eyes) draw no ring.
+        """
         self.ghosts = {}
         show = scene.shows("predictions") and bool(scene.features)
         if not show:
@@ -76,15 +85,15 @@ class OverlayActors:
         t = np.linspace(0.0, 2 * math.pi, GHOST_N, endpoint=False)
         pts, lines, cols, centres, ccols = [], [], [], [], []
         k = 0
+        light = dataclasses.replace(scene, layers=["predictions"], trajectory=None)
+        frame = build_frame(light, state, rect=(0.0, 1.0, 0.0, 1.0), predictions=preds)
         for name in scene.estimators:
-            res = preds.get(name)
-            if not isinstance(res, tuple):
+            pf = frame.predictions.get(name)
+            if name in skip or pf is None or isinstance(pf, str):
                 continue
-            r_hat, phi_hat = res
-            gx = r_hat * np.cos(phi_hat)
-            gy = r_hat * np.sin(phi_hat)
+            gx, gy = pf.x_hat, pf.y_hat  # the Frame's (r_hat, phi_hat) in the plane
             self.ghosts[name] = np.column_stack([gx, gy])
-            rgb = hex_rgb(colors[name])
+            rgb = hex_rgb(estimator_color(name))
             for i in np.flatnonzero(np.isfinite(gx) & np.isfinite(gy)):
                 g = state.g[i]
                 ring = np.column_stack(

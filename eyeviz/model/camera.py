@@ -1,0 +1,158 @@
+"""Cameras of the 2D top view as plain maths: pixel <-> model, zoom, pan, fit (no Qt, no VTK).
+
+The view is a parallel projection without rotation: a :class:`~eyeviz.model.scene.View`
+(centre and width in model units) shown in a :class:`Viewport` (a rectangle of widget
+pixels, y down). The window only measures its widgets and hands these functions pixels;
+tests drive them with plain numbers and no display.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from eyeviz.model.scene import Eyes, Scene, View
+
+__all__ = [
+    "INSET_TEXT_PX",
+    "MAX_WIDTH",
+    "MIN_WIDTH",
+    "ZOOM_STEP",
+    "Viewport",
+    "fit_inset",
+    "fit_view",
+    "pan",
+    "to_model",
+    "to_pixel",
+    "units_per_px",
+    "zoom_about",
+]
+
+ZOOM_STEP = 1.15  # one wheel notch
+MIN_WIDTH = 1e-6
+MAX_WIDTH = 1e9
+FIT_MARGIN = 1.15
+INSET_TEXT_PX = 24.0  # a line of text in the inset
+
+
+@dataclass(frozen=True)
+class Viewport:
+    """A renderer's rectangle in widget pixels: left, top, width, height (y down)."""
+
+    left: float
+    top: float
+    width: float
+    height: float
+
+    def contains(self, px: float, py: float) -> bool:
+        return (
+            self.left <= px <= self.left + self.width and self.top <= py <= self.top + self.height
+        )
+
+
+def units_per_px(view: View, vp: Viewport) -> float:
+    """Model units per pixel (the same along x and y: no anisotropic scaling)."""
+    return view.width / max(vp.width, 1e-9)
+
+
+def to_model(view: View, vp: Viewport, px: float, py: float) -> tuple[float, float]:
+    """Widget pixel -> model (x, y); the viewport's centre shows the view's centre."""
+    u = units_per_px(view, vp)
+    cx, cy = view.center
+    return (
+        cx + (px - vp.left - vp.width / 2.0) * u,
+        cy - (py - vp.top - vp.height / 2.0) * u,
+    )
+
+
+def to_pixel(view: View, vp: Viewport, x: float, y: float) -> tuple[float, float]:
+    """Model (x, y) -> widget pixel (inverse of :func:`to_model`)."""
+    u = units_per_px(view, vp)
+    cx, cy = view.center
+    return vp.left + vp.width / 2.0 + (x - cx) / u, vp.top + vp.height / 2.0 - (y - cy) / u
+
+
+def zoom_about(view: View, vp: Viewport, px: float, py: float, factor: float) -> View:
+    """The view ``factor`` times wider, the model point under pixel (px, py) staying there.
+
+    The width is kept in [MIN_WIDTH, MAX_WIDTH] (a zoom past a bound stops at it).
+    """
+    if not (math.isfinite(factor) and factor > 0):
+        raise ValueError(f"zoom factor must be a positive finite number, got {factor!r}")
+    x, y = to_model(view, vp, px, py)
+    width = min(max(view.width * factor, MIN_WIDTH), MAX_WIDTH)
+    k = width / view.width
+    cx, cy = view.center
+    return View((x + (cx - x) * k, y + (cy - y) * k), width)
+
+
+def pan(view: View, vp: Viewport, dpx: float, dpy: float) -> View:
+    """The view moved so that the content follows a drag of (dpx, dpy) pixels."""
+    u = units_per_px(view, vp)
+    cx, cy = view.center
+    return View((cx - dpx * u, cy + dpy * u), view.width)
+
+
+def scene_bounds(scene: Scene) -> tuple[float, float, float, float]:
+    """(xmin, xmax, ymin, ymax) of the eyes and every feature disc."""
+    e = scene.eyes
+    xs = [-(e.h + e.l), e.h + e.l]
+    ys = [-e.l, e.l]
+    for f in scene.features:
+        xs += [f.x - f.g, f.x + f.g]
+        ys += [f.y - f.g, f.y + f.g]
+    return min(xs), max(xs), min(ys), max(ys)
+
+
+def _fit_box(box, vp: Viewport, free: Viewport) -> View:
+    """The view of ``vp`` that shows ``box`` inside the sub-rectangle ``free`` of it."""
+    x0, x1, y0, y1 = box
+    bw, bh = max(x1 - x0, 1e-9), max(y1 - y0, 1e-9)
+    u = max(bw / free.width, bh / free.height) * FIT_MARGIN  # units per pixel
+    # the free rectangle's centre shows the box's centre
+    fx = free.left + free.width / 2.0 - (vp.left + vp.width / 2.0)
+    fy = free.top + free.height / 2.0 - (vp.top + vp.height / 2.0)
+    cx = (x0 + x1) / 2.0 - fx * u
+    cy = (y0 + y1) / 2.0 + fy * u
+    return View((cx, cy), min(max(u * vp.width, MIN_WIDTH), MAX_WIDTH))
+
+
+def fit_view(scene: Scene, vp: Viewport, avoid: Viewport | None = None) -> View:
+    """The main view showing the eyes and every feature, clear of ``avoid`` (the inset).
+
+    With an inset in a corner the content goes into the larger of the two rectangles the
+    inset leaves free (beside it, full height, or below/above it, full width), so that F
+    never places a feature under the inset.
+    """
+    box = scene_bounds(scene)
+    if avoid is None or avoid.width <= 0 or avoid.height <= 0:
+        return _fit_box(box, vp, vp)
+    cands = []
+    # beside the inset (full height)
+    if avoid.left - vp.left > vp.left + vp.width - (avoid.left + avoid.width):
+        cands.append(Viewport(vp.left, vp.top, avoid.left - vp.left, vp.height))
+    else:
+        right = avoid.left + avoid.width
+        cands.append(Viewport(right, vp.top, vp.left + vp.width - right, vp.height))
+    # above or below the inset (full width)
+    if avoid.top - vp.top > vp.top + vp.height - (avoid.top + avoid.height):
+        cands.append(Viewport(vp.left, vp.top, vp.width, avoid.top - vp.top))
+    else:
+        bottom = avoid.top + avoid.height
+        cands.append(Viewport(vp.left, bottom, vp.width, vp.top + vp.height - bottom))
+    cands = [c for c in cands if c.width >= 1 and c.height >= 1]
+    if not cands:
+        return _fit_box(box, vp, vp)
+    views = [_fit_box(box, vp, c) for c in cands]
+    return min(views, key=lambda v: v.width)  # the larger picture
+
+
+def fit_inset(eyes: Eyes, vp: Viewport) -> View:
+    """The inset's view: both eyes with their A/B labels above the m/theta/psi text line."""
+    w, h = max(vp.width, 1.0), max(vp.height, 1.0)
+    u = max(
+        2 * (eyes.h + eyes.l) * 1.08 / w,
+        3.1 * eyes.l / max(h - 1.6 * INSET_TEXT_PX, 1.0),
+    )
+    shift = 0.8 * INSET_TEXT_PX * u  # centre the content above the text line
+    return View((0.0, -0.25 * eyes.l - shift), u * w)

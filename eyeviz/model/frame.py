@@ -1,0 +1,520 @@
+"""One Frame: every derived drawing quantity of a scene, for every renderer (issue 9 item 2).
+
+``build_frame(scene, state=None, predictor=None, rect=...)`` runs the geometry once and
+returns a :class:`Frame`; the matplotlib figure (and the VTK view) only *draw* a Frame.
+Qt-, VTK- and matplotlib-free; only what the scene's layers need is computed (a drag frame
+with the default layers costs the intervals plus a few array operations).
+
+Fields of :class:`Frame` (``None`` / empty when no layer needs them):
+
+- ``pair`` (EyePair), ``layers`` (set of str), ``rect`` (x0, x1, y0, y1): the view rectangle
+  the BFV wedge is clipped to; ``state`` (:class:`eyeviz.model.state.SceneState`).
+- ``names``, ``colors`` (lists), ``x``, ``y``, ``g`` (arrays, one per feature).
+- ``palette``: the distinct feature colours, in first-use order.
+- ``eyes``: two :class:`EyeFrame` (A, B): ``center``, ``owner`` (feature index lighting
+  each ommatidium, -1 unlit; the last feature wins), ``color_index`` (0 unlit, else
+  1 + index into ``palette``), ``runs`` (starts, stops exclusive, color index: maximal runs
+  of equal colour for merged drawing and the bitmap strips).
+- ``intervals``: {"A": (L, R), "B": (L, R)} per feature (Prop. 2, ``EyePair.intervals``).
+- ``bfv``: :class:`BFVFrame`: ``psi`` (Eq. 15), ``theta`` (Eq. 16), ``polygon`` the wedge
+  clipped to ``rect`` (an (k, 2) array; empty when the wedge misses the rectangle) and the
+  two edge segments ``edges`` ((x0, y0, x1, y1) from the origin to the rectangle's border).
+- ``tangents``: list of :class:`TangentFrame` (feature i, eye, center, r_E, phi_E,
+  ``alpha`` = asin(g / r_E) (Prop. 2, Fig. 3b), ``length`` = sqrt(r_E^2 - g^2) and
+  ``ends`` the two tangent points (2, 2)); none for an eye inside a disc.
+- ``sectors``: list of :class:`SectorFrame` (feature i, eye, center, L, R, ``reach``,
+  ``rays`` the sector boundary indices k (angles k*gamma, Eq. 8, 11): L..R+1, or only L and
+  R+1 when the run is 24 cells or longer); whole-eye runs are omitted.
+- readout arrays ``r, phi, rA, phiA, rB, phiB`` (polar about O, A, B; angles in rad),
+  ``in_bfv``, ``vis_a``, ``vis_b``, ``in_domain`` (BFV and seen by both),
+  ``out_of_domain`` (greyed features: the predictions layer is on and not in domain).
+- ``predictions``: {estimator: :class:`PredictionFrame` (r_hat, phi_hat, x_hat, y_hat, dr,
+  dr_pct, dphi_deg arrays, NaN outside the domain) or a one-line reason str}.
+- ``ambiguity``: {feature index: dict(polygon, bounded, r_range, phi_range, g_range) or
+  None (the disc covers an eye centre)}.
+- ``trajectory``: :class:`TrajectoryPath` (points in the BFV and each estimator's accuracy)
+  or None; ``trajectory_error``: why there is none.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from eyeviz.core.geometry import EyePair, intervals_to_bitmap
+from eyeviz.model.predictor import Predictor
+from eyeviz.model.scene import Scene, Trajectory
+from eyeviz.model.state import SceneState, compute_state, owners
+
+__all__ = [
+    "BFVFrame",
+    "EyeFrame",
+    "Frame",
+    "PredictionFrame",
+    "SectorFrame",
+    "TangentFrame",
+    "TrajectoryPath",
+    "ambiguity_of",
+    "build_frame",
+    "clip_wedge",
+    "errors",
+    "runs",
+    "state_for",
+    "trajectory_path",
+    "view_rect",
+]
+
+WIDE_SECTOR = 24  # runs this long draw only their two boundary rays
+
+
+# --- small pure helpers ------------------------------------------------------------------
+
+
+def runs(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Maximal runs of equal values: (starts, stops) with stops exclusive."""
+    values = np.asarray(values)
+    n = len(values)
+    if n == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    change = np.flatnonzero(values[1:] != values[:-1]) + 1
+    starts = np.concatenate([[0], change])
+    stops = np.concatenate([change, [n]])
+    return starts.astype(np.int64), stops.astype(np.int64)
+
+
+def errors(r: float, phi: float, r_hat: float, phi_hat: float) -> tuple[float, float, float]:
+    """(delta r, delta r in % of r, delta phi in degrees wrapped to (-180, 180])."""
+    dr = r_hat - r
+    dphi = math.degrees(math.remainder(phi_hat - phi, 2 * math.pi))
+    return dr, 100.0 * dr / r, dphi
+
+
+def view_rect(scene: Scene, aspect: float = 0.86) -> tuple[float, float, float, float]:
+    """The scene's view as (x0, x1, y0, y1) for a canvas of height/width ``aspect``."""
+    cx, cy = scene.view.center
+    w = scene.view.width
+    h = w * aspect
+    return (cx - w / 2, cx + w / 2, cy - h / 2, cy + h / 2)
+
+
+def _clip_half_plane(poly: list[tuple[float, float]], nx: float, ny: float):
+    """Sutherland-Hodgman: keep the part of ``poly`` with nx*x + ny*y >= 0."""
+    out: list[tuple[float, float]] = []
+    n = len(poly)
+    for i in range(n):
+        p, q = poly[i], poly[(i + 1) % n]
+        dp, dq = nx * p[0] + ny * p[1], nx * q[0] + ny * q[1]
+        if dp >= 0:
+            out.append(p)
+        if (dp >= 0) != (dq >= 0):
+            t = dp / (dp - dq)
+            out.append((p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])))
+    return out
+
+
+def clip_wedge(psi: float, rect: tuple[float, float, float, float]) -> np.ndarray:
+    """The BFV wedge {psi <= angle <= pi - psi} (Definition 2) clipped to ``rect``.
+
+    The exact intersection of the rectangle with the two half-planes bounding the wedge,
+    so the drawn wedge covers the whole view however far it is from the origin.
+    """
+    x0, x1, y0, y1 = rect
+    poly = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+    c, s = math.cos(psi), math.sin(psi)
+    # right edge direction (c, s): keep the left side, normal (-s, c);
+    # left edge direction (-c, s): keep the right side, normal (s, c)
+    poly = _clip_half_plane(poly, -s, c)
+    if poly:
+        poly = _clip_half_plane(poly, s, c)
+    return np.array(poly, dtype=np.float64).reshape(-1, 2)
+
+
+def _ray_to_rect(angle: float, rect) -> tuple[float, float, float, float] | None:
+    """The part of the ray from the origin at ``angle`` inside ``rect``, or None."""
+    x0, x1, y0, y1 = rect
+    dx, dy = math.cos(angle), math.sin(angle)
+    t0, t1 = 0.0, math.inf
+    for d, lo, hi in ((dx, x0, x1), (dy, y0, y1)):
+        if abs(d) < 1e-300:
+            if not lo <= 0.0 <= hi:
+                return None
+            continue
+        a, b = lo / d, hi / d
+        a, b = min(a, b), max(a, b)
+        t0, t1 = max(t0, a), min(t1, b)
+    if t1 <= t0:
+        return None
+    return (t0 * dx, t0 * dy, t1 * dx, t1 * dy)
+
+
+# --- the frame's parts -------------------------------------------------------------------
+
+
+@dataclass
+class EyeFrame:
+    """One eye: centre, per-ommatidium owner and colour index, merged colour runs."""
+
+    name: str
+    center: tuple[float, float]
+    owner: np.ndarray
+    color_index: np.ndarray
+    runs: tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+@dataclass
+class BFVFrame:
+    """The BFV wedge (Definition 2, Eq. 15-16) clipped to the view rectangle."""
+
+    psi: float
+    theta: float
+    polygon: np.ndarray
+    edges: list[tuple[float, float, float, float] | None]  # right (psi), left (pi - psi)
+
+
+@dataclass
+class TangentFrame:
+    """The tangents from an eye centre to feature i's disc (Prop. 2, Figure 3b)."""
+
+    feature: int
+    eye: str
+    center: tuple[float, float]
+    r_e: float
+    phi_e: float
+    alpha: float  # asin(g / r_E)
+    length: float  # sqrt(r_E^2 - g^2)
+    ends: np.ndarray  # (2, 2): the tangent points, angle phi_E - alpha then phi_E + alpha
+
+
+@dataclass
+class SectorFrame:
+    """The ommatidium sectors of a lit interval [L, R] (Eq. 8, 11)."""
+
+    feature: int
+    eye: str
+    center: tuple[float, float]
+    L: int
+    R: int
+    reach: float
+    rays: list[int]  # boundary k of the ray at angle k * gamma
+
+
+@dataclass
+class PredictionFrame:
+    """One estimator's answers per feature (NaN outside the networks' domain)."""
+
+    r_hat: np.ndarray
+    phi_hat: np.ndarray
+    x_hat: np.ndarray
+    y_hat: np.ndarray
+    dr: np.ndarray
+    dr_pct: np.ndarray
+    dphi_deg: np.ndarray
+
+
+@dataclass
+class TrajectoryPath:
+    """Points of a Figure 14 trajectory and the estimators' accuracy along it."""
+
+    kind: str
+    x: np.ndarray
+    y: np.ndarray
+    g: float
+    axis: np.ndarray  # the abscissa of the accuracy plot
+    axis_label: str
+    accuracy: dict[str, tuple[np.ndarray, np.ndarray] | str]  # name -> (AD %, DD %) or why not
+
+    @property
+    def n(self) -> int:
+        return int(self.x.shape[0])
+
+
+@dataclass
+class Frame:
+    """Everything a renderer draws for one scene (see the module docstring)."""
+
+    pair: EyePair
+    layers: set[str]
+    rect: tuple[float, float, float, float]
+    state: SceneState
+    names: list[str]
+    colors: list[str]
+    x: np.ndarray
+    y: np.ndarray
+    g: np.ndarray
+    palette: list[str] = field(default_factory=list)
+    eyes: list[EyeFrame] = field(default_factory=list)
+    intervals: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    bfv: BFVFrame | None = None
+    tangents: list[TangentFrame] = field(default_factory=list)
+    sectors: list[SectorFrame] = field(default_factory=list)
+    r: np.ndarray | None = None
+    phi: np.ndarray | None = None
+    rA: np.ndarray | None = None
+    phiA: np.ndarray | None = None
+    rB: np.ndarray | None = None
+    phiB: np.ndarray | None = None
+    in_bfv: np.ndarray | None = None
+    vis_a: np.ndarray | None = None
+    vis_b: np.ndarray | None = None
+    in_domain: np.ndarray | None = None
+    out_of_domain: np.ndarray | None = None
+    predictions: dict[str, PredictionFrame | str] = field(default_factory=dict)
+    ambiguity: dict[int, dict | None] = field(default_factory=dict)
+    trajectory: TrajectoryPath | None = None
+    trajectory_error: str | None = None
+
+    @property
+    def n(self) -> int:
+        return int(self.x.shape[0])
+
+
+# --- derived quantities (formerly eyeviz.model.derived) ----------------------------------
+
+
+def ambiguity_of(pair: EyePair, x: float, y: float, g: float, box) -> dict | None:
+    """The ambiguity region of one feature (eyeviz.core.ambiguity) with its ranges, or None
+    when the feature covers an eye centre (no polygon then)."""
+    from eyeviz.core.ambiguity import ambiguity_radius_range, ambiguity_region
+
+    try:
+        reg = ambiguity_region(pair, x, y, g, box=box)
+        g_range = ambiguity_radius_range(pair, x, y, g, box=box)
+    except (ValueError, ArithmeticError):
+        return None
+    return {
+        "polygon": reg.polygon,
+        "bounded": reg.bounded,
+        "r_range": reg.distance_range(),
+        "phi_range": reg.azimuth_range(),
+        "g_range": g_range,
+    }
+
+
+def trajectory_path(
+    pair: EyePair,
+    traj: Trajectory,
+    estimators: list[str],
+    predictor: Predictor | None,
+    n: int = 240,
+    stop: float = 6000.0,
+) -> TrajectoryPath:
+    """Points along ``traj`` (eyeviz.model.trajectories) where the feature is in the BFV, with
+    AD and DD accuracy (100 % - APE, Section 6, Figure 15) per estimator at each point.
+    ValueError (one line) when the trajectory never enters the BFV."""
+    from eyeviz.model import trajectories as tr
+
+    if traj.kind == "horizontal":
+        x, y = tr.horizontal(traj.distance, traj.g, n, h=pair.h, l=pair.l)
+        axis, label = x, f"x along y = {traj.distance:g}"
+    elif traj.kind == "circular":
+        x, y = tr.circular(traj.distance, traj.g, n, h=pair.h, l=pair.l)
+        axis, label = np.degrees(np.arctan2(y, x)), f"φ (°) on r = {traj.distance:g}"
+    elif traj.kind == "vertical":
+        x, y = tr.vertical(
+            traj.g, n, start=traj.distance, stop=max(stop, 2 * traj.distance), h=pair.h, l=pair.l
+        )
+        axis, label = y, "y along x = 0"
+    else:
+        raise ValueError(
+            f"trajectory kind must be horizontal, circular or vertical, got {traj.kind!r}"
+        )
+    acc: dict[str, tuple[np.ndarray, np.ndarray] | str] = {}
+    if predictor is not None and estimators:
+        m = pair.m
+        LA, RA, LB, RB = pair.intervals(x, y, np.full_like(x, traj.g))
+        oa = intervals_to_bitmap(LA, RA, m, m // 2)
+        ob = intervals_to_bitmap(LB, RB, m, m // 2)
+        r, phi = np.hypot(x, y), np.arctan2(y, x)
+        for name in estimators:
+            res = predictor.predict_bitmaps(name, oa, ob)
+            if isinstance(res, str):
+                acc[name] = res
+                continue
+            r_hat, phi_hat = res
+            ad = 100.0 - 100.0 * np.abs(phi_hat - phi) / phi
+            dd = 100.0 - 100.0 * np.abs(r_hat - r) / r
+            acc[name] = (ad, dd)
+    return TrajectoryPath(traj.kind, x, y, float(traj.g), np.asarray(axis), label, acc)
+
+
+# --- building ----------------------------------------------------------------------------
+
+_NEED = {
+    "eyes": ("LA", "owner_a"),
+    "bitmaps": ("LA",),
+    "sectors": ("LA", "rA"),
+    "tangents": ("rA",),
+    "readout": ("LA", "r"),
+    "predictions": ("LA", "in_bfv"),
+    "labels": ("r",),
+    "ambiguity": ("r",),
+}
+
+
+def state_for(scene: Scene, state: SceneState | None) -> SceneState:
+    if state is None:
+        return compute_state(scene)
+    for layer, attrs in _NEED.items():
+        if layer in scene.layers and any(getattr(state, a) is None for a in attrs):
+            return compute_state(scene)
+    return state
+
+
+def _eye_frames(pair: EyePair, st: SceneState, palette: list[str], colors: list[str]):
+    uniq = {c: i + 1 for i, c in enumerate(palette)}
+    lut = np.array([0] + [uniq[c] for c in colors], dtype=np.int64)
+    out = []
+    for name, center, owner, L, R in (
+        ("A", pair.centers[0], st.owner_a, st.LA, st.RA),
+        ("B", pair.centers[1], st.owner_b, st.LB, st.RB),
+    ):
+        if owner is None:
+            owner = owners(L, R, pair.m) if L is not None else np.full(pair.m, -1, np.int64)
+        cidx = lut[owner + 1]
+        s, e = runs(cidx)
+        out.append(EyeFrame(name, center, owner, cidx, (s, e, cidx[s])))
+    return out
+
+
+def _tangents(pair: EyePair, st: SceneState) -> list[TangentFrame]:
+    out = []
+    for i in range(st.n):
+        g = float(st.g[i])
+        for name, center, rE, phE in (
+            ("A", pair.centers[0], float(st.rA[i]), float(st.phiA[i])),
+            ("B", pair.centers[1], float(st.rB[i]), float(st.phiB[i])),
+        ):
+            if not rE > g:
+                continue
+            alpha = math.asin(g / rE)
+            t = math.sqrt(rE * rE - g * g)
+            ang = np.array([phE - alpha, phE + alpha])
+            ends = np.column_stack([center[0] + t * np.cos(ang), center[1] + t * np.sin(ang)])
+            out.append(TangentFrame(i, name, center, rE, phE, alpha, t, ends))
+    return out
+
+
+def _sectors(pair: EyePair, st: SceneState) -> list[SectorFrame]:
+    out = []
+    m = pair.m
+    for i in range(st.n):
+        g = float(st.g[i])
+        for name, center, L, R, rE in (
+            ("A", pair.centers[0], st.LA[i], st.RA[i], st.rA[i]),
+            ("B", pair.centers[1], st.LB[i], st.RB[i], st.rB[i]),
+        ):
+            L, R = int(L), int(R)
+            if R - L >= m - 1 or R < L:
+                continue
+            rays = list(range(L, R + 2)) if R - L < WIDE_SECTOR else [L, R + 1]
+            out.append(SectorFrame(i, name, center, L, R, float(rE) + 1.6 * g, rays))
+    return out
+
+
+def _predictions(scene, st, predictor, given) -> dict[str, PredictionFrame | str]:
+    if given is None:
+        predictor = predictor if predictor is not None else Predictor()
+        given = predictor.predict(scene, st)
+    out: dict[str, PredictionFrame | str] = {}
+    for name in scene.estimators:
+        res = given.get(name, "no prediction")
+        if isinstance(res, str):
+            out[name] = res
+            continue
+        r_hat, phi_hat = (np.asarray(v, dtype=np.float64) for v in res)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dr = r_hat - st.r
+            dphi = np.degrees(np.remainder(phi_hat - st.phi + math.pi, 2 * math.pi) - math.pi)
+            out[name] = PredictionFrame(
+                r_hat,
+                phi_hat,
+                r_hat * np.cos(phi_hat),
+                r_hat * np.sin(phi_hat),
+                dr,
+                100.0 * dr / st.r,
+                dphi,
+            )
+    return out
+
+
+def build_frame(
+    scene: Scene,
+    state: SceneState | None = None,
+    predictor: Predictor | None = None,
+    *,
+    rect: tuple[float, float, float, float] | None = None,
+    predictions: dict | None = None,
+) -> Frame:
+    """The :class:`Frame` of ``scene`` for its layers.
+
+    ``rect`` is the view rectangle (x0, x1, y0, y1) the BFV wedge is clipped to and the
+    ambiguity regions are bounded by (default: the scene's view at the export's aspect).
+    ``predictions`` (estimator -> (r_hat, phi_hat) or a reason) skips the estimators;
+    otherwise ``predictor`` (made when None) answers, only if the predictions layer is on.
+    """
+    st = state_for(scene, state)
+    pair = st.pair
+    lay = set(scene.layers)
+    rect = view_rect(scene) if rect is None else tuple(float(v) for v in rect)
+    colors = [f.color for f in scene.features]
+    fr = Frame(
+        pair=pair,
+        layers=lay,
+        rect=rect,
+        state=st,
+        names=[f.name for f in scene.features],
+        colors=colors,
+        x=st.x,
+        y=st.y,
+        g=st.g,
+        palette=list(dict.fromkeys(colors)),
+    )
+    n = st.n
+    if st.LA is not None:
+        fr.intervals = {"A": (st.LA, st.RA), "B": (st.LB, st.RB)}
+        fr.vis_a, fr.vis_b = st.vis_a, st.vis_b
+    if st.r is not None:
+        fr.r, fr.phi, fr.rA, fr.phiA, fr.rB, fr.phiB = (
+            st.r,
+            st.phi,
+            st.rA,
+            st.phiA,
+            st.rB,
+            st.phiB,
+        )
+        fr.in_bfv = st.in_bfv
+    if fr.in_bfv is not None and fr.vis_a is not None:
+        fr.in_domain = st.in_domain()
+    fr.out_of_domain = np.zeros(n, bool)
+    if "predictions" in lay and n and fr.in_domain is not None:
+        fr.out_of_domain = ~fr.in_domain
+    if {"eyes", "bitmaps"} & lay:
+        fr.eyes = _eye_frames(pair, st, fr.palette, colors)
+    if "bfv" in lay:
+        fr.bfv = BFVFrame(
+            pair.psi,
+            pair.theta,
+            clip_wedge(pair.psi, rect),
+            [_ray_to_rect(pair.psi, rect), _ray_to_rect(math.pi - pair.psi, rect)],
+        )
+    if "tangents" in lay and n:
+        fr.tangents = _tangents(pair, st)
+    if "sectors" in lay and n:
+        fr.sectors = _sectors(pair, st)
+    if "predictions" in lay and n:
+        fr.predictions = _predictions(scene, st, predictor, predictions)
+    if "ambiguity" in lay and n:
+        x0, x1, y0, y1 = rect
+        w = x1 - x0
+        box = (x0 - w, x1 + w, y0 - w, y1 + w)
+        for i, f in enumerate(scene.features):
+            fr.ambiguity[i] = ambiguity_of(pair, f.x, f.y, f.g, box)
+    if "trajectory" in lay and scene.trajectory is not None:
+        try:
+            stop = max(scene.trajectory.distance, rect[3])
+            fr.trajectory = trajectory_path(pair, scene.trajectory, [], None, n=400, stop=stop)
+        except ValueError as exc:
+            fr.trajectory_error = str(exc).splitlines()[0]
+    return fr

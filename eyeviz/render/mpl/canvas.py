@@ -1,0 +1,192 @@
+"""The figure, its main axes and the magnified inset of the eyes: what painters draw on."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.ticker import FormatStrFormatter, MaxNLocator
+
+from eyeviz.model.frame import Frame
+from eyeviz.model.scene import Scene
+from eyeviz.render.mpl.layout import Layout, tick_chars
+from eyeviz.render.mpl.style import FONT, GREY, HALO, INK, INSET_BG, LIGHT, SMALL, WHITE, round_sig
+
+__all__ = ["Canvas", "make_canvas"]
+
+
+@dataclass
+class Canvas:
+    """A Frame being drawn: the figure, its axes and the scales between them."""
+
+    scene: Scene
+    frame: Frame
+    lay: Layout
+    fig: Figure
+    dpi: float
+    merge: bool | None
+    ax: object = None
+    inset: object = None
+    eye_ax: object = None
+    xlim: tuple[float, float] = (0.0, 1.0)
+    ylim: tuple[float, float] = (0.0, 1.0)
+    units_per_in: float = 1.0
+    eye_units_per_in: float = 1.0
+    label_boxes: list[tuple[float, float, float, float]] = field(default_factory=list)
+    merged: bool | None = None
+
+    @property
+    def layers(self) -> set[str]:
+        return self.frame.layers
+
+    @property
+    def pair(self):
+        return self.frame.pair
+
+    def eye_axes(self) -> list:
+        return [self.ax] + ([self.inset] if self.inset is not None else [])
+
+    def to_inches(self, x: float, y: float) -> tuple[float, float]:
+        lay = self.lay
+        fx = (x - self.xlim[0]) / (self.xlim[1] - self.xlim[0])
+        fy = (y - self.ylim[0]) / (self.ylim[1] - self.ylim[0])
+        return lay.main.x + fx * lay.main.w, lay.main.y + fy * lay.main.h
+
+
+def make_canvas(scene: Scene, frame: Frame, lay: Layout, dpi: float, merge, title: bool):
+    fig = Figure(figsize=(lay.width, lay.height), dpi=dpi)
+    fig.patch.set_facecolor(WHITE)
+    cv = Canvas(scene, frame, lay, fig, dpi, merge)
+    ax = fig.add_axes(lay.main.frac(lay.width, lay.height))
+    x0, x1, y0, y1 = frame.rect
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_facecolor(WHITE)
+    ax.tick_params(length=2.0)
+    # plain tick labels (no offset text to cut off), few enough not to run together
+    chars = tick_chars(x0, x1)
+    nbins = max(2, int(lay.main.w / (chars * 0.6 * SMALL / 72 + 0.2)))
+    ax.xaxis.set_major_locator(MaxNLocator(nbins=min(nbins, 8)))
+    ax.yaxis.set_major_locator(MaxNLocator(nbins=min(nbins, 8)))
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_formatter(FormatStrFormatter("%.0f" if (x1 - x0) >= 10 else "%g"))
+    ax.set_xlabel("x", labelpad=1.0)
+    ax.set_ylabel("y", labelpad=1.0)
+    for s in ax.spines.values():
+        s.set_color(LIGHT)
+    ax.set_gid("main")
+    cv.ax, cv.eye_ax = ax, ax
+    cv.xlim, cv.ylim = (x0, x1), (y0, y1)
+    cv.units_per_in = cv.eye_units_per_in = (x1 - x0) / lay.main.w
+    if title and scene.title and lay.title_y is not None:
+        fig.text(
+            0.5,
+            lay.title_y / lay.height,
+            scene.title[:200],
+            ha="center",
+            va="bottom",
+            fontsize=FONT + 1.0,
+            color=INK,
+            gid="title",
+            parse_math=False,
+        )
+    p = frame.pair
+    if p.l / cv.units_per_in < 0.1 and ({"eyes", "tangents", "sectors", "bfv"} & cv.layers):
+        _make_inset(cv)
+    return cv
+
+
+def _crowding(cv: Canvas, bx, by, bw, bh) -> float:
+    """How much of the scene an inset at (bx, by) would cover (features, the origin, BFV)."""
+    fr = cv.frame
+    cost = 0.0
+    for x, y, g in zip(fr.x.tolist(), fr.y.tolist(), fr.g.tolist(), strict=True):
+        fx, fy = cv.to_inches(x, y)
+        rad = g / cv.units_per_in + 0.12
+        dx = max(bx - fx, 0, fx - (bx + bw))
+        dy = max(by - fy, 0, fy - (by + bh))
+        if math.hypot(dx, dy) < rad:
+            cost += 1.0
+    ox, oy = cv.to_inches(0.0, 0.0)
+    if bx - 0.03 <= ox <= bx + bw + 0.03 and by - 0.03 <= oy <= by + bh + 0.03:
+        cost += 2.0
+    psi = fr.pair.psi
+    inside = 0
+    for i in range(5):
+        for j in range(4):
+            xi, yi = bx + bw * i / 4, by + bh * j / 3
+            mx = cv.xlim[0] + (xi - cv.lay.main.x) * cv.units_per_in
+            my = cv.ylim[0] + (yi - cv.lay.main.y) * cv.units_per_in
+            inside += psi <= math.atan2(my, mx) <= math.pi - psi
+    return cost + 0.5 * inside / 20
+
+
+def _make_inset(cv: Canvas) -> None:
+    p = cv.pair
+    pad = 0.3 * p.l
+    x0, x1 = -(p.h + p.l) - pad, p.h + p.l + pad
+    y0 = -p.l - (2.6 if "labels" in cv.layers else 1.0) * pad
+    y1 = p.l + 2.2 * pad
+    main = cv.lay.main
+    box_w = min(0.38 * main.w, 1.6)
+    box_h = box_w * (y1 - y0) / (x1 - x0)
+    fw, fh = cv.lay.width, cv.lay.height
+    margin = 0.05
+    corners = [
+        (main.x + margin, main.y + margin),
+        (main.x + main.w - margin - box_w, main.y + margin),
+        (main.x + margin, main.y + main.h - margin - box_h),
+        (main.x + main.w - margin - box_w, main.y + main.h - margin - box_h),
+    ]
+    costs = [_crowding(cv, bx, by, box_w, box_h) + 0.01 * i for i, (bx, by) in enumerate(corners)]
+    bx, by = corners[costs.index(min(costs))]
+    ins = cv.fig.add_axes((bx / fw, by / fh, box_w / fw, box_h / fh))
+    ins.set_xlim(x0, x1)
+    ins.set_ylim(y0, y1)
+    ins.set_aspect("equal", adjustable="box")
+    ins.set_facecolor(INSET_BG)
+    ins.set_xticks([])
+    ins.set_yticks([])
+    for s in ins.spines.values():
+        s.set_color(GREY)
+        s.set_linewidth(0.6)
+    ins.set_zorder(5)
+    ins.set_gid("inset")
+    scale = (x1 - x0) / (cv.units_per_in * box_w)
+    ins.text(
+        0.02,
+        0.96,
+        f"eyes \u00d7{round_sig(1 / scale)}",
+        transform=ins.transAxes,
+        ha="left",
+        va="top",
+        fontsize=SMALL,
+        color=GREY,
+        bbox=HALO,
+        zorder=8,
+    )
+    # a leader from the inset to the eyes' true place, drawn only when the origin is in
+    # the view, so it never leaves the axes
+    ox, oy = cv.to_inches(0.0, 0.0)
+    inside_view = main.x <= ox <= main.x + main.w and main.y <= oy <= main.y + main.h
+    in_box = bx <= ox <= bx + box_w and by <= oy <= by + box_h
+    if inside_view and not in_box:
+        ex = min(max(ox, bx), bx + box_w)
+        ey = by + box_h if oy > by + box_h else (by if oy < by else by + box_h / 2)
+        cv.fig.add_artist(
+            Line2D(
+                [ex / fw, ox / fw],
+                [ey / fh, oy / fh],
+                color=GREY,
+                lw=0.5,
+                ls=(0, (2, 1.5)),
+                zorder=4,
+                gid="inset-leader",
+            )
+        )
+    cv.ax.plot([0], [0], marker="s", ms=2.4, mfc="none", mec=GREY, mew=0.6, zorder=6)
+    cv.inset = cv.eye_ax = ins
+    cv.eye_units_per_in = (x1 - x0) / box_w

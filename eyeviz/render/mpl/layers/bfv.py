@@ -1,0 +1,106 @@
+"""``bfv``: the wedge between the tangents from the origin (Definition 2), psi and theta."""
+
+from __future__ import annotations
+
+import math
+
+from matplotlib.patches import Polygon
+
+from eyeviz.model.frame import clip_wedge
+from eyeviz.render.mpl.canvas import Canvas
+from eyeviz.render.mpl.style import BFV_FILL, BFV_LINE, HALO, SMALL, arc
+
+
+def paint(cv: Canvas) -> None:
+    b = cv.frame.bfv
+    if b is None:
+        return
+    for ax in cv.eye_axes():
+        if ax is cv.ax:
+            poly, edges = b.polygon, b.edges
+        else:  # the inset shows the wedge clipped to its own limits
+            rect = (*ax.get_xlim(), *ax.get_ylim())
+            poly = clip_wedge(b.psi, rect)
+            edges = [None, None]
+            for j, ang in enumerate((b.psi, math.pi - b.psi)):
+                far = 4 * math.hypot(max(map(abs, rect[:2])), max(map(abs, rect[2:])))
+                edges[j] = (0.0, 0.0, far * math.cos(ang), far * math.sin(ang))
+        if len(poly) >= 3:
+            wedge = Polygon(
+                poly,
+                closed=True,
+                facecolor=BFV_FILL,
+                edgecolor="none",
+                zorder=0,
+                alpha=0.75 if ax is cv.ax else 0.6,
+            )
+            wedge.set_gid("bfv-wedge" if ax is cv.ax else "bfv-wedge-inset")
+            ax.add_patch(wedge)
+        for e, name in zip(edges, ("right", "left"), strict=True):
+            if e is None:
+                continue
+            ax.plot([e[0], e[2]], [e[1], e[3]], color=BFV_LINE, lw=0.6, zorder=1, gid=f"bfv-{name}")
+    _angles(cv)
+
+
+def _free(cv: Canvas, x0, y0, x1, y1) -> bool:
+    """True when the box (data units) touches no feature disc."""
+    fr = cv.frame
+    for x, y, g in zip(fr.x.tolist(), fr.y.tolist(), fr.g.tolist(), strict=True):
+        dx = max(x0 - x, 0, x - x1)
+        dy = max(y0 - y, 0, y - y1)
+        if math.hypot(dx, dy) < g:
+            return False
+    return True
+
+
+def _angles(cv: Canvas) -> None:
+    """psi and theta (Figures 5-6), where the origin is in the view; theta's label goes to
+    the first radius along the bisector where it covers no feature."""
+    b, ax, upi = cv.frame.bfv, cv.ax, cv.units_per_in
+    p = cv.pair
+    vh = cv.ylim[1] - cv.ylim[0]
+    if not (cv.xlim[0] <= 0 <= cv.xlim[1] and cv.ylim[0] <= 0 <= cv.ylim[1]):
+        return
+    rad = 0.2 * vh
+    if cv.inset is None:
+        rad = max(rad, 1.5 * p.h)
+    th1, th2 = math.degrees(b.psi), 180 - math.degrees(b.psi)
+    ax.add_patch(arc(rad, th1, th2, BFV_LINE, "bfv-theta-arc"))
+    tw, th = 0.55 * upi, 0.12 * upi
+    ly = rad * 1.04
+    for f in (1.04, 0.7, 1.4, 0.45, 1.8):
+        if _free(cv, -tw / 2, rad * f, tw / 2, rad * f + th):
+            ly = rad * f
+            break
+    cv.label_boxes.append((-tw / 2, ly, tw / 2, ly + th))
+    ax.text(
+        0,
+        ly,
+        f"\u03b8 = {math.degrees(b.theta):.0f}\u00b0",
+        ha="center",
+        va="bottom",
+        fontsize=SMALL,
+        color=BFV_LINE,
+        bbox=HALO,
+        zorder=7,
+        gid="bfv-theta-label",
+    )
+    rpsi = 0.72 * rad
+    ax.plot([0, 1.3 * rpsi], [0, 0], color=BFV_LINE, lw=0.4, ls=(0, (1.5, 1.5)), zorder=1)
+    ax.add_patch(arc(rpsi, 0, th1, BFV_LINE, "bfv-psi-arc"))
+    mid = math.radians(th1 / 2)
+    lx, ly = 1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid)
+    cv.label_boxes.append((lx, ly - 0.06 * upi, lx + 0.45 * upi, ly + 0.06 * upi))
+    ax.text(
+        lx,
+        ly,
+        f"\u03c8 = {math.degrees(b.psi):.0f}\u00b0",
+        ha="left",
+        va="center",
+        fontsize=SMALL,
+        color=BFV_LINE,
+        bbox=HALO,
+        zorder=7,
+        gid="bfv-psi-label",
+    )

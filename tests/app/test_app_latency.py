@@ -1,0 +1,90 @@
+"""Issue 12, drag latency: a mouse move during a drag re-lays out nothing and repaints only
+the widgets whose content changed (real window, real VTK, counted by an event filter)."""
+
+import collections
+
+from mouse import pixel_of
+from PyQt5 import QtCore, QtWidgets
+from PyQt5.QtTest import QTest
+
+from eyeviz.model.scene import Eyes, Feature, Scene, View
+
+LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout", "labels"]
+
+
+class Counter(QtCore.QObject):
+    def __init__(self):
+        super().__init__()
+        self.on = False
+        self.counts = collections.Counter()
+
+    def eventFilter(self, obj, ev):  # noqa: N802
+        if self.on and ev.type() in (QtCore.QEvent.Paint, QtCore.QEvent.LayoutRequest):
+            self.counts[(int(ev.type()), type(obj).__name__)] += 1
+        return False
+
+    def total(self, kind):
+        return sum(v for (t, _), v in self.counts.items() if t == int(kind))
+
+
+def test_a_drag_move_lays_out_nothing_and_paints_little(make_window):
+    fs = [Feature(f"f{i}", -2000.0 + 400 * i, 3000.0, 60.0) for i in range(8)]
+    fs.append(Feature("dragged", 0.0, 1500.0, 50.0, "#D55E00"))
+    win = make_window(Scene(Eyes(40.0, 20.0, 720), fs, LAYERS, view=View((0.0, 2600.0), 9000.0)))
+    win.model.select(len(fs) - 1)
+    app = QtWidgets.QApplication.instance()
+    counter = Counter()
+    app.installEventFilter(counter)
+    try:
+        w = win.plotter
+        start = pixel_of(win, 0.0, 1500.0)
+        QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
+        for k in range(8):  # past the drag threshold, panels settled
+            QTest.mouseMove(w, start + QtCore.QPoint(3 * k, -k))
+            app.processEvents()
+        n, frames0 = 30, w.frames
+        x0 = win.model.scene.features[-1].x
+        counter.on = True
+        for k in range(n):
+            QTest.mouseMove(w, start + QtCore.QPoint(30 + 4 * k, -10 - 3 * k))
+            for _ in range(3):
+                app.processEvents()
+        counter.on = False
+        QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
+    finally:
+        app.removeEventFilter(counter)
+    assert win.model.scene.features[-1].x != x0 and w.frames - frames0 >= n // 2  # it moved
+    layouts = counter.total(QtCore.QEvent.LayoutRequest)
+    paints = counter.total(QtCore.QEvent.Paint)
+    # before: 5 layout requests and ~19 paint events per move (the whole window re-laid
+    # out and repainted under every changed label)
+    assert layouts <= 1, counter.counts
+    assert paints / n <= 7, counter.counts
+    assert counter.counts[(int(QtCore.QEvent.Paint), "MainWindow")] == 0, counter.counts
+    assert counter.counts[(int(QtCore.QEvent.Paint), "QDockWidget")] == 0, counter.counts
+
+
+def test_bitmaps_panel_repaints_nothing_when_the_bitmaps_do_not_change(make_window):
+    win = make_window(
+        Scene(
+            Eyes(40.0, 20.0, 72),
+            [Feature("f", 0.0, 2000.0, 50.0)],
+            LAYERS,
+            view=View((0, 0), 9000.0),
+        )
+    )
+    win.model.select(0)
+    app = QtWidgets.QApplication.instance()
+    QTest.qWait(300)  # everything of the first show painted
+    counter = Counter()
+    app.installEventFilter(counter)
+    try:
+        counter.on = True
+        win.model.live(0, x=0.01)  # far below one ommatidium: the same bitmaps
+        win.render()
+        for _ in range(3):
+            app.processEvents()
+        counter.on = False
+    finally:
+        app.removeEventFilter(counter)
+    assert counter.counts[(int(QtCore.QEvent.Paint), "BitmapPanel")] == 0, counter.counts
