@@ -1,5 +1,8 @@
 """One Frame: every derived drawing quantity of a scene, for every renderer (issue 9 item 2).
 
+(About 500 lines on purpose: the Frame's parts, their builders and the helpers folded in
+from ``eyeviz.model.derived`` are read together by both renderers; each builder is short.)
+
 ``build_frame(scene, state=None, predictor=None, rect=...)`` runs the geometry once and
 returns a :class:`Frame`; the matplotlib figure (and the VTK view) only *draw* a Frame.
 Qt-, VTK- and matplotlib-free; only what the scene's layers need is computed (a drag frame

@@ -258,6 +258,14 @@ def test_seven_digit_distances_do_not_run_together():
         for a, b in zip(ticks, ticks[1:], strict=False):
             assert a.x1 < b.x0
         assert not main.xaxis.get_offset_text().get_text()
+        W = fig.bbox.width
+        for t in _texts(fig):
+            bb = t.get_window_extent(r)
+            assert bb.x0 >= -1 and bb.x1 <= W + 1, t.get_text()
+        # full distances: r, r_A and r_B of the far feature differ and are all shown
+        cells = {t.get_gid(): t.get_text() for t in table.texts if t.get_gid()}
+        if width == "double":
+            assert cells["readout-1-0-far"] == f"{math.hypot(1e7, 1e7):.0f}"
 
 
 def test_theta_label_not_on_a_feature():
