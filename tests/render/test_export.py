@@ -305,11 +305,17 @@ def test_hostile_names_and_coordinates(tmp_path, default_scene):
     sc = default_scene.copy()
     sc.features[0].name = r"$\undefined$ x"
     sc.features[1].name = "n" * 1_000_000
+    sc.title = "$\\frac{1}{0}$ " + "t" * 1_000_000
     t = time.perf_counter()
     out = export(sc, tmp_path / "names.png")
     export(sc, tmp_path / "names.svg")
     assert time.perf_counter() - t < 30
     assert png_size(out)[0] == 1050
+    fig = vector.figure(sc)
+    r = _renderer(fig)
+    title = next(t for t in fig.texts if t.get_gid() == "title")
+    assert title.get_text().startswith("$\\frac{1}{0}$ ttt")
+    assert title.get_window_extent(r).x1 <= fig.bbox.width + 1
     svg = (tmp_path / "names.svg").read_text()
     assert r"$\undefined$ x" in svg  # shown literally, not parsed as mathtext
     assert "n" * 39 + "\u2026" in svg and "n" * 1000 not in svg
