@@ -460,12 +460,16 @@ def build_frame(
     st = state_for(scene, state)
     pair = st.pair
     lay = set(scene.layers)
-    rect = view_rect(scene) if rect is None else tuple(float(v) for v in rect)
+    box: tuple[float, float, float, float] = (
+        view_rect(scene)
+        if rect is None
+        else (float(rect[0]), float(rect[1]), float(rect[2]), float(rect[3]))
+    )
     colors = [f.color for f in scene.features]
     fr = Frame(
         pair=pair,
         layers=lay,
-        rect=rect,
+        rect=box,
         state=st,
         names=[f.name for f in scene.features],
         colors=colors,
@@ -499,8 +503,8 @@ def build_frame(
         fr.bfv = BFVFrame(
             pair.psi,
             pair.theta,
-            clip_wedge(pair.psi, rect),
-            [_ray_to_rect(pair.psi, rect), _ray_to_rect(math.pi - pair.psi, rect)],
+            clip_wedge(pair.psi, box),
+            [_ray_to_rect(pair.psi, box), _ray_to_rect(math.pi - pair.psi, box)],
         )
     if "tangents" in lay and n:
         fr.tangents = _tangents(pair, st)
@@ -509,14 +513,14 @@ def build_frame(
     if "predictions" in lay and n:
         fr.predictions = _predictions(scene, st, predictor, predictions)
     if "ambiguity" in lay and n:
-        x0, x1, y0, y1 = rect
+        x0, x1, y0, y1 = box
         w = x1 - x0
         box = (x0 - w, x1 + w, y0 - w, y1 + w)
         for i, f in enumerate(scene.features):
             fr.ambiguity[i] = ambiguity_of(pair, f.x, f.y, f.g, box)
     if "trajectory" in lay and scene.trajectory is not None:
         try:
-            stop = max(scene.trajectory.distance, rect[3])
+            stop = max(scene.trajectory.distance, box[3])
             fr.trajectory = trajectory_path(pair, scene.trajectory, [], None, n=400, stop=stop)
         except ValueError as exc:
             fr.trajectory_error = str(exc).splitlines()[0]
