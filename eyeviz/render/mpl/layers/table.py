@@ -37,7 +37,7 @@ def column_x(cells: list[list[str]], width_in: float):
     need = sum(widths) + GAP_IN * (len(widths) - 1)
     if need > width_in:
         return None
-    spare = (width_in - need) / (len(widths) - 1)
+    spare = min((width_in - need) / (len(widths) - 1), 0.3)  # compact on a wide figure
     xs, lefts, rights, x = [], [], [], 0.0
     for (_, ha), w in zip(COLUMNS, widths, strict=True):
         xs.append({"left": x, "right": x + w, "center": x + w / 2}[ha] / width_in)
@@ -131,7 +131,7 @@ def paint(cv: Canvas) -> None:
     y -= dy
     for (text, ha), x in zip(COLUMNS, xs, strict=True):
         ax.text(x, y, text, ha=ha, va="center", fontsize=SMALL, color=GREY)
-    ax.plot([0, 1], [y - dy / 2, y - dy / 2], color=LIGHT, lw=0.4)
+    ax.plot([0, rights[-1]], [y - dy / 2, y - dy / 2], color=LIGHT, lw=0.4)
     for i in range(fr.n):
         y -= dy
         col = OUT_OF_DOMAIN if fr.out_of_domain[i] else dark(fr.colors[i])
