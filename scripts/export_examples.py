@@ -1,6 +1,6 @@
 """Regenerate the README's exported figures, docs/img/figure_*.png (and .pdf/.svg with --all).
 
-    .venv/bin/python scripts/export_examples.py [--all]
+    .venv/bin/python scripts/export_examples.py [--all] [--width single|double|INCHES]
 
 Every figure is `eyeviz.render.mpl.export.export` of a shipped scene (assets/scenes), plus one
 variant of the default scene built here that shows the predictions (analytic estimator)
@@ -45,6 +45,9 @@ def ambiguity_scene() -> scene_mod.Scene:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--all", action="store_true", help="also write .svg and .pdf")
+    ap.add_argument(
+        "--width", default="single", help="'single' (3.5 in, default), 'double' or inches"
+    )
     args = ap.parse_args()
     OUT.mkdir(parents=True, exist_ok=True)
     figures = {
@@ -57,7 +60,7 @@ def main() -> int:
     }
     for name, sc in figures.items():
         for suffix in (".png", ".svg", ".pdf") if args.all else (".png",):
-            print(export(sc, OUT / f"{name}{suffix}").relative_to(ROOT))
+            print(export(sc, OUT / f"{name}{suffix}", width=args.width).relative_to(ROOT))
     return 0
 
 

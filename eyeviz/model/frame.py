@@ -1,5 +1,8 @@
 """One Frame: every derived drawing quantity of a scene, for every renderer (issue 9 item 2).
 
+(About 500 lines on purpose: the Frame's parts, their builders and the helpers folded in
+from ``eyeviz.model.derived`` are read together by both renderers; each builder is short.)
+
 ``build_frame(scene, state=None, predictor=None, rect=...)`` runs the geometry once and
 returns a :class:`Frame`; the matplotlib figure (and the VTK view) only *draw* a Frame.
 Qt-, VTK- and matplotlib-free; only what the scene's layers need is computed (a drag frame
@@ -457,12 +460,16 @@ def build_frame(
     st = state_for(scene, state)
     pair = st.pair
     lay = set(scene.layers)
-    rect = view_rect(scene) if rect is None else tuple(float(v) for v in rect)
+    box: tuple[float, float, float, float] = (
+        view_rect(scene)
+        if rect is None
+        else (float(rect[0]), float(rect[1]), float(rect[2]), float(rect[3]))
+    )
     colors = [f.color for f in scene.features]
     fr = Frame(
         pair=pair,
         layers=lay,
-        rect=rect,
+        rect=box,
         state=st,
         names=[f.name for f in scene.features],
         colors=colors,
@@ -496,8 +503,8 @@ def build_frame(
         fr.bfv = BFVFrame(
             pair.psi,
             pair.theta,
-            clip_wedge(pair.psi, rect),
-            [_ray_to_rect(pair.psi, rect), _ray_to_rect(math.pi - pair.psi, rect)],
+            clip_wedge(pair.psi, box),
+            [_ray_to_rect(pair.psi, box), _ray_to_rect(math.pi - pair.psi, box)],
         )
     if "tangents" in lay and n:
         fr.tangents = _tangents(pair, st)
@@ -506,14 +513,14 @@ def build_frame(
     if "predictions" in lay and n:
         fr.predictions = _predictions(scene, st, predictor, predictions)
     if "ambiguity" in lay and n:
-        x0, x1, y0, y1 = rect
+        x0, x1, y0, y1 = box
         w = x1 - x0
         box = (x0 - w, x1 + w, y0 - w, y1 + w)
         for i, f in enumerate(scene.features):
             fr.ambiguity[i] = ambiguity_of(pair, f.x, f.y, f.g, box)
     if "trajectory" in lay and scene.trajectory is not None:
         try:
-            stop = max(scene.trajectory.distance, rect[3])
+            stop = max(scene.trajectory.distance, box[3])
             fr.trajectory = trajectory_path(pair, scene.trajectory, [], None, n=400, stop=stop)
         except ValueError as exc:
             fr.trajectory_error = str(exc).splitlines()[0]

@@ -258,6 +258,14 @@ def test_seven_digit_distances_do_not_run_together():
         for a, b in zip(ticks, ticks[1:], strict=False):
             assert a.x1 < b.x0
         assert not main.xaxis.get_offset_text().get_text()
+        W = fig.bbox.width
+        for t in _texts(fig):
+            bb = t.get_window_extent(r)
+            assert bb.x0 >= -1 and bb.x1 <= W + 1, t.get_text()
+        # full distances: r, r_A and r_B of the far feature differ and are all shown
+        cells = {t.get_gid(): t.get_text() for t in table.texts if t.get_gid()}
+        if width == "double":
+            assert cells["readout-1-0-far"] == f"{math.hypot(1e7, 1e7):.0f}"
 
 
 def test_theta_label_not_on_a_feature():
@@ -297,11 +305,17 @@ def test_hostile_names_and_coordinates(tmp_path, default_scene):
     sc = default_scene.copy()
     sc.features[0].name = r"$\undefined$ x"
     sc.features[1].name = "n" * 1_000_000
+    sc.title = "$\\frac{1}{0}$ " + "t" * 1_000_000
     t = time.perf_counter()
     out = export(sc, tmp_path / "names.png")
     export(sc, tmp_path / "names.svg")
     assert time.perf_counter() - t < 30
     assert png_size(out)[0] == 1050
+    fig = vector.figure(sc)
+    r = _renderer(fig)
+    title = next(t for t in fig.texts if t.get_gid() == "title")
+    assert title.get_text().startswith("$\\frac{1}{0}$ ttt")
+    assert title.get_window_extent(r).x1 <= fig.bbox.width + 1
     svg = (tmp_path / "names.svg").read_text()
     assert r"$\undefined$ x" in svg  # shown literally, not parsed as mathtext
     assert "n" * 39 + "\u2026" in svg and "n" * 1000 not in svg

@@ -12,7 +12,18 @@ from matplotlib.ticker import FormatStrFormatter, MaxNLocator
 from eyeviz.model.frame import Frame
 from eyeviz.model.scene import Scene
 from eyeviz.render.mpl.layout import Layout, tick_chars
-from eyeviz.render.mpl.style import FONT, GREY, HALO, INK, INSET_BG, LIGHT, SMALL, WHITE, round_sig
+from eyeviz.render.mpl.style import (
+    FONT,
+    GREY,
+    HALO,
+    INK,
+    INSET_BG,
+    LIGHT,
+    SMALL,
+    WHITE,
+    round_sig,
+    short,
+)
 
 __all__ = ["Canvas", "make_canvas"]
 
@@ -85,7 +96,7 @@ def make_canvas(scene: Scene, frame: Frame, lay: Layout, dpi: float, merge, titl
         fig.text(
             0.5,
             lay.title_y / lay.height,
-            scene.title[:200],
+            fit_text(scene.title, FONT + 1.0, lay.width * 72 - 8),
             ha="center",
             va="bottom",
             fontsize=FONT + 1.0,
@@ -97,6 +108,30 @@ def make_canvas(scene: Scene, frame: Frame, lay: Layout, dpi: float, merge, titl
     if p.l / cv.units_per_in < 0.1 and ({"eyes", "tangents", "sectors", "bfv"} & cv.layers):
         _make_inset(cv)
     return cv
+
+
+def fit_text(text: str, size: float, width_pt: float) -> str:
+    """``text`` cut (with an ellipsis) to the longest prefix that is ``width_pt`` wide."""
+    from matplotlib.backends.backend_agg import RendererAgg
+    from matplotlib.font_manager import FontProperties
+
+    renderer = RendererAgg(10, 10, 72.0)  # 72 dpi: widths in points
+    prop = FontProperties(family="DejaVu Sans", size=size)
+
+    def width(t: str) -> float:
+        return renderer.get_text_width_height_descent(t, prop, ismath=False)[0]
+
+    text = short(text, 400)
+    if width(text) <= width_pt:
+        return text
+    lo, hi = 1, len(text)
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if width(short(text, mid)) <= width_pt:
+            lo = mid
+        else:
+            hi = mid - 1
+    return short(text, lo)
 
 
 def _crowding(cv: Canvas, bx, by, bw, bh) -> float:

@@ -91,10 +91,11 @@ def layout(
     intervals=None,
     m: int = 0,
     ylim: tuple[float, float] = (0.0, 1.0),
+    xlim: tuple[float, float] = (0.0, 1.0),
 ) -> Layout:
     """The figure's boxes for a ``width``-inch figure."""
     left = max(0.42, tick_chars(*ylim) * 0.6 * SMALL / 72 + 0.2)
-    right = 0.1
+    right = max(0.1, tick_chars(*xlim) * 0.6 * SMALL / 72 / 2 + 0.03)  # half a tick label
     main_w = width - left - right
     shows_bitmaps = "bitmaps" in layers and n_features and intervals is not None
     lanes = (0, 0)

@@ -201,6 +201,7 @@ def figure(
             intervals=_intervals(state),
             m=state.pair.m,
             ylim=(cy - scene.view.width * ASPECT / 2, cy + scene.view.width * ASPECT / 2),
+            xlim=(cx - scene.view.width / 2, cx + scene.view.width / 2),
         )
         vw = scene.view.width
         vh = vw * lay0.main.h / lay0.main.w

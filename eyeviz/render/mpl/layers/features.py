@@ -26,7 +26,8 @@ def paint(cv: Canvas) -> None:
         ax.add_patch(disc)
         if g < minimum:
             ax.plot([x], [y], marker="o", ms=2.4, color=col, zorder=8, mew=0)
-        if "labels" in cv.layers:
+        in_view = cv.xlim[0] - g <= x <= cv.xlim[1] + g and cv.ylim[0] - g <= y <= cv.ylim[1] + g
+        if "labels" in cv.layers and in_view:  # no label for a feature out of the view
             _feature_label(cv, i, col)
 
 

@@ -10,34 +10,63 @@ from eyeviz.model.palette import estimator_color
 from eyeviz.render.mpl.canvas import Canvas
 from eyeviz.render.mpl.style import GREY, LIGHT, OUT_OF_DOMAIN, SMALL, dark, distance, short, slug
 
-# (header, x as a fraction of the table's width, alignment)
+# (header, alignment); the x positions follow the widest cell of each column
 COLUMNS = [
-    ("feature", 0.0, "left"),
-    ("r", 0.29, "right"),
-    ("\u03c6", 0.395, "right"),
-    ("r", 0.50, "right"),
-    ("\u03c6", 0.605, "right"),
-    ("r", 0.71, "right"),
-    ("\u03c6", 0.815, "right"),
-    ("BFV", 0.862, "center"),
-    ("seen by", 1.0, "right"),
+    ("feature", "left"),
+    ("r", "right"),
+    ("\u03c6", "right"),
+    ("r", "right"),
+    ("\u03c6", "right"),
+    ("r", "right"),
+    ("\u03c6", "right"),
+    ("BFV", "center"),
+    ("seen by", "right"),
 ]
+CHAR_IN = 0.6 * SMALL / 72  # a generous width of one 6 pt character, inches
+GAP_IN = 0.1  # at least this much between two cells
 
 
-def row_values(fr, i: int) -> list[str]:
-    """The table's cells for feature i, from the Frame's readout arrays."""
+def column_x(cells: list[list[str]], width_in: float):
+    """(x, left, right) of each column as fractions of the table's width (x is the text
+    anchor: the right edge for right-aligned columns), from the widest cell; None when the
+    columns cannot fit."""
+    widths = [
+        max([len(h)] + [len(row[j]) for row in cells]) * CHAR_IN for j, (h, _) in enumerate(COLUMNS)
+    ]
+    widths[0] = max(widths[0], 0.55)
+    need = sum(widths) + GAP_IN * (len(widths) - 1)
+    if need > width_in:
+        return None
+    spare = min((width_in - need) / (len(widths) - 1), 0.3)  # compact on a wide figure
+    xs, lefts, rights, x = [], [], [], 0.0
+    for (_, ha), w in zip(COLUMNS, widths, strict=True):
+        xs.append({"left": x, "right": x + w, "center": x + w / 2}[ha] / width_in)
+        lefts.append(x / width_in)
+        rights.append((x + w) / width_in)
+        x += w + GAP_IN + spare
+    return xs, lefts, rights
+
+
+def row_values(fr, i: int, compact: bool = False) -> list[str]:
+    """The table's cells for feature i, from the Frame's readout arrays (distances in full,
+    or in at most 7 characters when ``compact``)."""
+    dist = distance if compact else _full
     seen = " ".join(e for e, v in (("A", fr.vis_a[i]), ("B", fr.vis_b[i])) if v) or "none"
     return [
         short(fr.names[i], 15),
-        distance(float(fr.r[i])),
+        dist(float(fr.r[i])),
         f"{math.degrees(fr.phi[i]):.1f}\u00b0",
-        distance(float(fr.rA[i])),
+        dist(float(fr.rA[i])),
         f"{math.degrees(fr.phiA[i]):.1f}\u00b0",
-        distance(float(fr.rB[i])),
+        dist(float(fr.rB[i])),
         f"{math.degrees(fr.phiB[i]):.1f}\u00b0",
         "yes" if fr.in_bfv[i] else "no",
         seen,
     ]
+
+
+def _full(v: float) -> str:
+    return f"{v:.0f}" if math.isfinite(v) else "\u2013"
 
 
 def prediction_line(fr, i: int, name: str) -> str:
@@ -80,22 +109,33 @@ def paint(cv: Canvas) -> None:
     ax.set_xlim(0, 1)
     ax.set_ylim(0, 1)
     dy = 1.0 / cv.lay.readout_rows
+    cells = [row_values(fr, i) for i in range(fr.n)]
+    cols = column_x(cells, box.w)
+    if cols is None:  # distances too long for the width: 3 significant digits
+        cells = [row_values(fr, i, compact=True) for i in range(fr.n)]
+        cols = column_x(cells, box.w)
+    if cols is None:
+        xs = [0.0, 0.29, 0.395, 0.5, 0.605, 0.71, 0.815, 0.862, 1.0]
+        lefts, rights = [x - 0.09 for x in xs], xs
+    else:
+        xs, lefts, rights = cols
     y = 1 - dy / 2
-    for text, x0, x1 in (
-        ("about the origin O", 0.215, 0.40),
-        ("about eye A", 0.425, 0.61),
-        ("about eye B", 0.635, 0.82),
+    for text, a, b in (
+        ("about the origin O", 1, 2),
+        ("about eye A", 3, 4),
+        ("about eye B", 5, 6),
     ):
+        x0, x1 = min(lefts[a], rights[b] - 0.17), rights[b]
         ax.text((x0 + x1) / 2, y, text, ha="center", va="center", fontsize=SMALL, color=GREY)
         ax.plot([x0 + 0.01, x1], [y - 0.42 * dy] * 2, color=LIGHT, lw=0.4)
     y -= dy
-    for text, x, ha in COLUMNS:
+    for (text, ha), x in zip(COLUMNS, xs, strict=True):
         ax.text(x, y, text, ha=ha, va="center", fontsize=SMALL, color=GREY)
-    ax.plot([0, 1], [y - dy / 2, y - dy / 2], color=LIGHT, lw=0.4)
+    ax.plot([0, rights[-1]], [y - dy / 2, y - dy / 2], color=LIGHT, lw=0.4)
     for i in range(fr.n):
         y -= dy
         col = OUT_OF_DOMAIN if fr.out_of_domain[i] else dark(fr.colors[i])
-        for j, ((_, x, ha), v) in enumerate(zip(COLUMNS, row_values(fr, i), strict=True)):
+        for j, ((_, ha), x, v) in enumerate(zip(COLUMNS, xs, cells[i], strict=True)):
             ax.text(
                 x,
                 y,
