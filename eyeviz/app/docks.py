@@ -5,14 +5,13 @@ scene without them imports neither matplotlib nor the estimators.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
 from eyeviz.model.app_model import AppModel
-from eyeviz.model.scene import TRAJECTORY_KINDS, Trajectory
+from eyeviz.model.scene import TRAJECTORY_KINDS
 
 __all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel"]
 

@@ -223,7 +223,7 @@ class AppModel:
         return f"{base} {i}"
 
     def _copy_name(self, name: str) -> str:
-        """"feature 1" -> "feature 1 (copy)", then "(copy 2)", ...; a copy of a copy keeps
+        """ "feature 1" -> "feature 1 (copy)", then "(copy 2)", ...; a copy of a copy keeps
         one suffix ("a (copy)" -> "a (copy 2)")."""
         base = name
         if base.endswith(")") and " (copy" in base:

@@ -185,4 +185,3 @@ def set_trajectory(model: AppModel, kind: str | None = None) -> None:
     if "trajectory" not in after.layers:
         after.layers.append("trajectory")
     model.commit(after, f"Trajectory {after.trajectory.kind}")
-

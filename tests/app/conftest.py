@@ -24,7 +24,8 @@ def make_window(qtbot, tmp_path):
     made = []
 
     def make(scene, path=None):
-        win = MainWindow(scene, path, settings=make_settings(tmp_path / "settings.ini"))
+        win = MainWindow(scene, path, settings=make_settings(tmp_path / "settings.json"))
+        win._force_close = True  # teardown closes without the unsaved-changes prompt
         qtbot.addWidget(win)
         win.show()
         qtbot.waitExposed(win)
@@ -34,4 +35,4 @@ def make_window(qtbot, tmp_path):
 
     yield make
     for w in made:
-        w.close()
+        w.force_close()
