@@ -44,6 +44,7 @@ __all__ = [
 
 SIDE_MAX_FRACTION = 0.45  # the side panels never take more than this of the window width
 SIDE_MIN_PX = 260
+DOCK_MIN_PX = 120
 
 
 class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
@@ -138,7 +139,16 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
     def _dock(self, title: str, widget: QtWidgets.QWidget, name: str) -> QtWidgets.QDockWidget:
         d = QtWidgets.QDockWidget(title, self)
         d.setObjectName(f"dock_{name}")
-        d.setWidget(widget)
+        # in a scroll area: a tall panel scrolls instead of making the window taller than a
+        # 1280x720 projector (issue 12 item 7)
+        scroll = QtWidgets.QScrollArea()
+        scroll.setWidgetResizable(True)
+        scroll.setFrameShape(QtWidgets.QFrame.NoFrame)
+        scroll.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarAlwaysOff)
+        scroll.setWidget(widget)
+        scroll.setMinimumWidth(min(widget.minimumSizeHint().width(), SIDE_MIN_PX))
+        scroll.setMinimumHeight(DOCK_MIN_PX)
+        d.setWidget(scroll)
         d.setFeatures(
             QtWidgets.QDockWidget.DockWidgetMovable | QtWidgets.QDockWidget.DockWidgetFloatable
         )
@@ -218,6 +228,9 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
             self.request_frame()
             return
         self._dirty.clear()
+        if self.last_error and what == "scene":  # a successful edit clears an old error
+            self.last_error = ""
+            self.statusBar().clearMessage()
         eyes = (self.model.scene.eyes.h, self.model.scene.eyes.l)
         if eyes != self._eyes_key:
             self._eyes_key = eyes
