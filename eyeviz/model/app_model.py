@@ -304,7 +304,9 @@ def hit_test(scene: Scene, selected: int | None, x: float, y: float, units_per_p
     return (body, "body") if body is not None else (None, None)
 
 
-def drag_feature(model: AppModel, event: MouseEvent, index: int, part: str) -> Generator:
+def drag_feature(
+    model: AppModel, event: MouseEvent, index: int, part: str
+) -> Generator[None, MouseEvent, None]:
     """A whole drag of feature ``index`` (napari-style): press, moves, release.
 
     Send each following event with ``gen.send(event)``. Moving the body keeps the grab
