@@ -7,6 +7,8 @@ model, so a drag during an export cannot change what is being written.
 
 from __future__ import annotations
 
+import atexit
+import weakref
 from collections.abc import Callable
 
 from PyQt5 import QtCore, QtWidgets
@@ -30,7 +32,10 @@ class Job(QtCore.QRunnable):
             res, err = self.fn(), None
         except BaseException as exc:  # noqa: BLE001 (reported on the GUI thread)
             res, err = None, exc
-        self.signals.finished.emit(res, err)
+        try:
+            self.signals.finished.emit(res, err)
+        except RuntimeError:  # the window (and its receiver) is gone: nothing to report
+            pass
 
 
 class JobRunner(QtCore.QObject):
@@ -42,6 +47,8 @@ class JobRunner(QtCore.QObject):
         self.pool.setMaxThreadCount(1)
         self.status = status
         self.running: list[Job] = []
+        ref = weakref.ref(self)
+        atexit.register(lambda: _drain(ref))
 
     def start(
         self,
@@ -77,3 +84,14 @@ class JobRunner(QtCore.QObject):
         QtCore.QCoreApplication.sendPostedEvents()
         QtWidgets.QApplication.processEvents()
         return ok
+
+
+def _drain(ref) -> None:
+    """At interpreter exit: let a running job finish (never kill a half-written file)."""
+    runner = ref()
+    if runner is None:
+        return
+    try:
+        runner.pool.waitForDone(120000)
+    except RuntimeError:  # already deleted with its window
+        pass

@@ -126,6 +126,7 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         self.statusBar().addPermanentWidget(self.cursor_label)
         build_menus(self)
         self.model.listeners.append(self._on_model)
+        self.model.load_in_background = self._load_estimators
         self.undo_stack.cleanChanged.connect(self._clean_changed)
         self.resize(1280, 720)
         self._restore_settings()
@@ -323,6 +324,20 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         if not self.model.scene.shows("trajectory"):
             self.show_trajectory("horizontal")
         panel.set_playing(not self.model.player.playing)
+
+    def _load_estimators(self, predictor, names: list[str]) -> None:
+        """Load estimators (torch, weights) on a worker thread; the window stays live."""
+
+        def finished(_res=None) -> None:
+            self.model.loading = ""
+            self.model._notify("predictions")
+
+        self.jobs.start(
+            lambda: [predictor.estimator(n) for n in names],
+            f"loading estimators {', '.join(names)}…",
+            finished,
+            lambda exc: finished(),
+        )
 
     # --- export (off the GUI thread) ------------------------------------------------
     def export_dialog(self) -> None:

@@ -62,6 +62,9 @@ class AppModel:
         self.inset_view = View((0.0, 0.0), 1.0)  # the magnified eyes (camera.fit_inset)
         self.inset_auto = True  # the inset follows h and l until the user pans/zooms it
         self.player = TrajectoryPlayer(self)
+        # set by the window: load estimators off the GUI thread (issue 12 item 9)
+        self.load_in_background: Callable[[object, list[str]], None] | None = None
+        self.loading = ""  # a message while estimators load
 
     # --- state ------------------------------------------------------------------------
     @property
@@ -81,7 +84,18 @@ class AppModel:
 
             if self.predictor is None:
                 self.predictor = Predictor()
-            self._predictions = self.predictor.predict(self.scene, self.state)
+            p = self.predictor
+            missing = [
+                n for n in self.scene.estimators if n not in p._loaded and n not in p._failed
+            ]
+            if missing and self.load_in_background is not None:
+                # the window loads them on a worker thread and notifies "predictions" when
+                # done; meanwhile each estimator is a one-line "loading" message
+                if not self.loading:
+                    self.loading = f"loading {', '.join(missing)}…"
+                    self.load_in_background(p, missing)
+                return {n: self.loading for n in self.scene.estimators}
+            self._predictions = p.predict(self.scene, self.state)
         return self._predictions
 
     @property

@@ -30,6 +30,7 @@ def make_window(qtbot, tmp_path):
         win.show()
         qtbot.waitExposed(win)
         win.fit_inset()
+        win.jobs.wait()  # estimators load on a worker thread
         made.append(win)
         return win
 

@@ -282,3 +282,29 @@ def test_space_with_a_checkbox_focused_does_not_play_real_x_input(make_window, q
     qtbot.waitUntil(win.plotter.hasFocus, timeout=3000)
     subprocess.run(["xdotool", "key", "--window", wid, "space"], check=True)
     qtbot.waitUntil(lambda: win.model.player.playing, timeout=3000)
+
+
+def test_estimators_load_off_the_gui_thread(make_window, monkeypatch):
+    import threading
+
+    from eyeviz import estimators
+
+    win = make_window(scene2())
+    threads = []
+    real_load = estimators.load
+
+    def load(name, *a, **k):
+        threads.append(threading.current_thread())
+        return real_load(name, *a, **k)
+
+    monkeypatch.setattr(estimators, "load", load)
+    win.model.set_layer("predictions", True)  # the first use loads compact (and torch)
+    assert win.jobs.busy() and win.model.loading
+    assert all(isinstance(v, str) and "loading" in v for v in win.model.predictions.values())
+    win.model.set_feature(0, x=25.0)  # edits stay live meanwhile
+    assert win.model.scene.features[0].x == 25.0
+    win.jobs.wait()
+    assert not win.model.loading
+    preds = win.model.predictions
+    assert set(preds) == {"compact"} and not isinstance(preds["compact"], str)
+    assert threads and all(t is not threading.main_thread() for t in threads)
