@@ -1,4 +1,4 @@
-"""``eyeviz app [SCENE] [--screenshot PNG]``: the desktop app (issue 5)."""
+"""``eyeviz app [SCENE] [--screenshot IMAGE] [--settings JSON]``: the desktop app (issue 5)."""
 
 from __future__ import annotations
 
@@ -10,14 +10,19 @@ def add_arguments(parser) -> None:
     parser.add_argument("scene", nargs="?", help="scene file (.toml); default: the paper's setting")
     parser.add_argument(
         "--screenshot",
-        metavar="PNG",
-        help="show the window, render it, save it to PNG and exit (needs a display or xvfb-run)",
+        metavar="IMAGE",
+        help="show the window, render it, save it (.png, .jpg or .jpeg) and exit "
+        "(needs a display or xvfb-run)",
     )
-    parser.add_argument("--settings", metavar="INI", help=argparse_settings_help())
+    parser.add_argument("--settings", metavar="JSON", help=argparse_settings_help())
 
 
 def argparse_settings_help() -> str:
-    return "settings file for window layout and recent files (default: the user's config)"
+    return (
+        "JSON settings file for window layout and recent files (default: $EYEVIZ_SETTINGS, "
+        "else ~/.config/eyeviz/settings.json); a file holding Qt @Variant/pickled values is "
+        "refused and ignored"
+    )
 
 
 def run(args) -> int:

@@ -62,6 +62,9 @@ class AppModel:
         self.inset_view = View((0.0, 0.0), 1.0)  # the magnified eyes (camera.fit_inset)
         self.inset_auto = True  # the inset follows h and l until the user pans/zooms it
         self.player = TrajectoryPlayer(self)
+        # set by the window: load estimators off the GUI thread (issue 12 item 9)
+        self.load_in_background: Callable[[object, list[str]], None] | None = None
+        self.loading = ""  # a message while estimators load
 
     # --- state ------------------------------------------------------------------------
     @property
@@ -81,7 +84,18 @@ class AppModel:
 
             if self.predictor is None:
                 self.predictor = Predictor()
-            self._predictions = self.predictor.predict(self.scene, self.state)
+            p = self.predictor
+            missing = [
+                n for n in self.scene.estimators if n not in p._loaded and n not in p._failed
+            ]
+            if missing and self.load_in_background is not None:
+                # the window loads them on a worker thread and notifies "predictions" when
+                # done; meanwhile each estimator is a one-line "loading" message
+                if not self.loading:
+                    self.loading = f"loading {', '.join(missing)}…"
+                    self.load_in_background(p, missing)
+                return {n: self.loading for n in self.scene.estimators}
+            self._predictions = p.predict(self.scene, self.state)
         return self._predictions
 
     @property
@@ -223,7 +237,7 @@ class AppModel:
         return f"{base} {i}"
 
     def _copy_name(self, name: str) -> str:
-        """"feature 1" -> "feature 1 (copy)", then "(copy 2)", ...; a copy of a copy keeps
+        """ "feature 1" -> "feature 1 (copy)", then "(copy 2)", ...; a copy of a copy keeps
         one suffix ("a (copy)" -> "a (copy 2)")."""
         base = name
         if base.endswith(")") and " (copy" in base:
@@ -304,7 +318,9 @@ def hit_test(scene: Scene, selected: int | None, x: float, y: float, units_per_p
     return (body, "body") if body is not None else (None, None)
 
 
-def drag_feature(model: AppModel, event: MouseEvent, index: int, part: str) -> Generator:
+def drag_feature(
+    model: AppModel, event: MouseEvent, index: int, part: str
+) -> Generator[None, MouseEvent, None]:
     """A whole drag of feature ``index`` (napari-style): press, moves, release.
 
     Send each following event with ``gen.send(event)``. Moving the body keeps the grab

@@ -83,7 +83,9 @@ def wheel(
     return "zoom"
 
 
-def pan_drag(model: AppModel, which: str, vp: Viewport, event: MouseEvent) -> Generator:
+def pan_drag(
+    model: AppModel, which: str, vp: Viewport, event: MouseEvent
+) -> Generator[None, MouseEvent, None]:
     """A pan of ``which``: the content follows the cursor until the release."""
     v0 = view_of(model, which)
     px0, py0 = event.px, event.py
@@ -100,7 +102,7 @@ def press(
     vp: Viewport,
     button: str = "left",
     main_vp: Viewport | None = None,
-) -> Generator | None:
+) -> Generator[None, MouseEvent, None] | None:
     """What a press starts: a feature drag (left on a feature), else a pan of ``which``.
 
     A press inside the inset is first tried on the main view's features (``main_vp``):
@@ -126,7 +128,9 @@ def press(
     return gen
 
 
-def _feature_drag(model, event, index, part, which, vp) -> Generator:
+def _feature_drag(
+    model: AppModel, event: MouseEvent, index: int, part: str, which: str, vp: Viewport
+) -> Generator[None, MouseEvent, None]:
     """drag_feature with the events' model coordinates taken in the view it started in."""
     from eyeviz.model.app_model import drag_feature
 
@@ -185,4 +189,3 @@ def set_trajectory(model: AppModel, kind: str | None = None) -> None:
     if "trajectory" not in after.layers:
         after.layers.append("trajectory")
     model.commit(after, f"Trajectory {after.trajectory.kind}")
-

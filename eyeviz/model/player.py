@@ -93,7 +93,9 @@ class TrajectoryPlayer:
         if p is None or p.n == 0:
             self.stop("no trajectory to play")
             return None
-        i = self._choose() if not self.playing else self.index()
+        # outside a play, a first step picks the selected feature; a played feature that
+        # was deleted is never replaced by another one behind the user's back
+        i = self.index() if self.feature is not None else self._choose()
         if i is None:
             self.stop(f"{self.feature} was deleted: playback stopped")
             return None

@@ -24,14 +24,16 @@ def make_window(qtbot, tmp_path):
     made = []
 
     def make(scene, path=None):
-        win = MainWindow(scene, path, settings=make_settings(tmp_path / "settings.ini"))
+        win = MainWindow(scene, path, settings=make_settings(tmp_path / "settings.json"))
+        win._force_close = True  # teardown closes without the unsaved-changes prompt
         qtbot.addWidget(win)
         win.show()
         qtbot.waitExposed(win)
         win.fit_inset()
+        win.jobs.wait()  # estimators load on a worker thread
         made.append(win)
         return win
 
     yield make
     for w in made:
-        w.close()
+        w.force_close()

@@ -159,7 +159,7 @@ def test_torch_is_imported_only_with_the_predictions_layer(tmp_path):
         "w.show(); app.processEvents(); w.render()\n"
         "print('torch' in sys.modules)\n"
         "w.model.set_layer('predictions', True)\n"
-        "app.processEvents()\n"
+        "app.processEvents(); w.jobs.wait()\n"
         "print('torch' in sys.modules, sorted(w.model.predictions))\n"
     )
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=90)

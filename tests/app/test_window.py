@@ -91,7 +91,22 @@ def test_click_selects_without_an_undo_step(make_window):
     assert win.model.scene.features[1].x == -1200.0
 
 
-def test_drag_on_handle_changes_radius_and_wheel_too(make_window):
+def wheel_at(win, pos, notches=1, modifiers=QtCore.Qt.NoModifier):
+    for _ in range(notches):
+        ev = QtGui.QWheelEvent(
+            QtCore.QPointF(pos),
+            QtCore.QPointF(win.plotter.mapToGlobal(pos)),
+            QtCore.QPoint(),
+            QtCore.QPoint(0, 120),
+            QtCore.Qt.NoButton,
+            modifiers,
+            QtCore.Qt.NoScrollPhase,
+            False,
+        )
+        QtCore.QCoreApplication.sendEvent(win.plotter, ev)
+
+
+def test_drag_on_handle_changes_radius_and_ctrl_wheel_too(make_window):
     win = make_window(two_features())
     win.model.select(1)
     start = pixel_of(win, -1200.0 + 200.0, 3000.0)
@@ -101,18 +116,7 @@ def test_drag_on_handle_changes_radius_and_wheel_too(make_window):
     assert abs(f.g - 500.0) <= 2 * win.units_per_px() and (f.x, f.y) == (-1200.0, 3000.0)
     g = f.g
     pos = pixel_of(win, -1200.0, 3000.0)
-    for _ in range(3):
-        wheel = QtGui.QWheelEvent(
-            QtCore.QPointF(pos),
-            QtCore.QPointF(win.plotter.mapToGlobal(pos)),
-            QtCore.QPoint(),
-            QtCore.QPoint(0, 120),
-            QtCore.Qt.NoButton,
-            QtCore.Qt.NoModifier,
-            QtCore.Qt.NoScrollPhase,
-            False,
-        )
-        QtCore.QCoreApplication.sendEvent(win.plotter, wheel)
+    wheel_at(win, pos, 3, QtCore.Qt.ControlModifier)
     assert win.model.scene.features[1].g == pytest.approx(g * 1.08**3)
     assert win.undo_stack.count() == 2  # the drag, then the three wheel steps merged
     check_lit(win)

@@ -1,0 +1,109 @@
+"""Menus, actions and the undo command of the main window.
+
+Play / pause: Space works only while the view has the keyboard focus (a focused check box
+or button keeps its own Space); the menu's shortcut P works everywhere except in text
+fields.
+"""
+
+from __future__ import annotations
+
+from PyQt5 import QtCore, QtGui, QtWidgets
+
+from eyeviz.model.app_model import AppModel
+from eyeviz.model.scene import Scene, View
+
+__all__ = ["PLAY_SHORTCUT", "SceneCommand", "build_menus"]
+
+PLAY_SHORTCUT = "P"
+
+
+class SceneCommand(QtWidgets.QUndoCommand):
+    """One undo step: the scene before and after (the view is left where the user put it)."""
+
+    def __init__(self, model: AppModel, before: Scene, after: Scene, text: str, merge_key=None):
+        super().__init__(text)
+        self.model, self.before, self.after, self.merge_key = model, before, after, merge_key
+
+    def _set(self, scene: Scene) -> None:
+        s = scene.copy()
+        s.view = View(self.model.scene.view.center, self.model.scene.view.width)
+        self.model.set_scene(s)
+
+    def redo(self) -> None:
+        self._set(self.after)
+
+    def undo(self) -> None:
+        self._set(self.before)
+
+    def id(self) -> int:  # noqa: A003 (Qt name)
+        return 1 if self.merge_key is not None else -1
+
+    def mergeWith(self, other) -> bool:  # noqa: N802 (Qt name)
+        if other.merge_key != self.merge_key:
+            return False
+        self.after = other.after
+        return True
+
+
+def _action(win, menu, text, slot, shortcut=None) -> QtWidgets.QAction:
+    a = QtWidgets.QAction(text, win)
+    if shortcut is not None:
+        a.setShortcut(QtGui.QKeySequence(shortcut))
+        a.setShortcutContext(QtCore.Qt.WindowShortcut)
+    a.triggered.connect(slot)
+    menu.addAction(a)
+    win.addAction(a)
+    return a
+
+
+def _undo_actions(win, menu) -> None:
+    """Undo / Redo that first end a running gesture or playback (one step each)."""
+    stack = win.undo_stack
+
+    def undo() -> None:
+        win.model.finish_gestures()
+        stack.undo()
+
+    def redo() -> None:
+        win.model.finish_gestures()
+        stack.redo()
+
+    u = _action(win, menu, "&Undo", undo, QtGui.QKeySequence.Undo)
+    r = _action(win, menu, "&Redo", redo, QtGui.QKeySequence.Redo)
+    u.setEnabled(stack.canUndo())
+    r.setEnabled(stack.canRedo())
+    stack.canUndoChanged.connect(u.setEnabled)
+    stack.canRedoChanged.connect(r.setEnabled)
+    stack.undoTextChanged.connect(lambda t: u.setText(f"&Undo {t}".strip()))
+    stack.redoTextChanged.connect(lambda t: r.setText(f"&Redo {t}".strip()))
+    win.undo_action, win.redo_action = u, r
+
+
+def build_menus(win) -> None:
+    mb = win.menuBar()
+    f = mb.addMenu("&File")
+    _action(win, f, "&Open…", win.open_dialog, QtGui.QKeySequence.Open)
+    win.recent_menu = f.addMenu("Open &recent")
+    _action(win, f, "&Save", win.save_current, QtGui.QKeySequence.Save)
+    _action(win, f, "Save &as…", win.save_dialog, QtGui.QKeySequence.SaveAs)
+    f.addSeparator()
+    _action(win, f, "&Export figure…", win.export_dialog, "Ctrl+E")
+    f.addSeparator()
+    _action(win, f, "&Quit", win.close, QtGui.QKeySequence.Quit)
+    e = mb.addMenu("&Edit")
+    _undo_actions(win, e)
+    e.addSeparator()
+    _action(win, e, "&Add feature at view centre", win.add_at_center, "Ctrl+N")
+    _action(win, e, "&Duplicate feature", win.duplicate_selected, "Ctrl+D")
+    _action(win, e, "De&lete feature", win.delete_selected, QtGui.QKeySequence.Delete)
+    v = mb.addMenu("&View")
+    _action(win, v, "&Fit view", win.fit_view, "F")
+    _action(win, v, "Fit &inset to the eyes", win.fit_inset, "Shift+F")
+    v.addSeparator()
+    t = v.addMenu("&Trajectory")
+    for kind in ("horizontal", "circular", "vertical"):
+        t.addAction(kind.capitalize(), lambda k=kind: win.show_trajectory(k))
+    win.play_action = _action(
+        win, v, "&Play / pause trajectory (Space in the view)", win.toggle_play, PLAY_SHORTCUT
+    )
+    win._refresh_recent()

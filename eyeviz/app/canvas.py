@@ -1,0 +1,207 @@
+"""The canvas event bridge: Qt events on the view -> model gestures; model cameras -> VTK.
+
+Only translation lives here: pixels are measured from the widgets and handed to
+:mod:`eyeviz.model.interactions` (press, wheel, pan, fit) and :mod:`eyeviz.model.camera`
+(pixel <-> model); no scene edit or camera maths is done in Qt code.
+"""
+
+from __future__ import annotations
+
+import math
+
+from PyQt5 import QtCore, QtWidgets
+
+from eyeviz.model import camera, interactions
+from eyeviz.model.app_model import MouseEvent, hit_test
+from eyeviz.model.camera import Viewport
+from eyeviz.model.scene import View
+from eyeviz.render.vtk.actors import inset_viewport
+
+__all__ = ["CanvasMixin"]
+
+CAMERA_DISTANCE = 1000.0
+INSET_HIDE_EYE_PX = 40.0  # eyes at least this wide on screen: no magnified inset
+RESIZE_MODIFIERS = QtCore.Qt.ShiftModifier | QtCore.Qt.ControlModifier
+
+
+class CanvasMixin:
+    """Mixed into MainWindow: needs ``plotter``, ``model``, ``main_ren``, ``inset_ren``,
+    ``actors``, ``render`` and ``request_frame``."""
+
+    _drag = None
+    _drag_which = "main"
+
+    # --- pixels <-> model ------------------------------------------------------------
+    def viewport(self, which: str) -> Viewport:
+        """A renderer's rectangle in widget pixels (y down)."""
+        w, h = max(self.plotter.width(), 1), max(self.plotter.height(), 1)
+        if which == "main":
+            return Viewport(0.0, 0.0, float(w), float(h))
+        x0, y0, x1, y1 = inset_viewport(w, h)
+        return Viewport(x0 * w, (1.0 - y1) * h, (x1 - x0) * w, (y1 - y0) * h)
+
+    def _viewport_px(self, which: str) -> tuple[float, float, float, float]:
+        vp = self.viewport(which)
+        return vp.left, vp.top, vp.width, vp.height
+
+    def _view(self, which: str) -> View:
+        return interactions.view_of(self.model, which)
+
+    @property
+    def inset_view(self) -> View:
+        return self.model.inset_view
+
+    @property
+    def inset_auto(self) -> bool:
+        return self.model.inset_auto
+
+    def units_per_px(self, which: str = "main") -> float:
+        return camera.units_per_px(self._view(which), self.viewport(which))
+
+    def which_at(self, px: float, py: float) -> str:
+        return "inset" if self.inset_shown and self.viewport("inset").contains(px, py) else "main"
+
+    def to_model(self, px: float, py: float, which: str | None = None):
+        """Widget pixel -> (which renderer, x, y) in model units."""
+        which = which or self.which_at(px, py)
+        x, y = camera.to_model(self._view(which), self.viewport(which), px, py)
+        return which, x, y
+
+    def to_pixel(self, x: float, y: float, which: str = "main") -> tuple[float, float]:
+        return camera.to_pixel(self._view(which), self.viewport(which), x, y)
+
+    # --- model cameras -> VTK -----------------------------------------------------------
+    def apply_cameras(self) -> None:
+        w, h = max(self.plotter.width(), 1), max(self.plotter.height(), 1)
+        self.inset_ren.SetViewport(*inset_viewport(w, h))
+        self._update_inset_visibility()
+        for which, ren in (("main", self.main_ren), ("inset", self.inset_ren)):
+            vp = self.viewport(which)
+            v = self._view(which)
+            cam = ren.GetActiveCamera()
+            cam.ParallelProjectionOn()
+            cx, cy = v.center
+            cam.SetFocalPoint(cx, cy, 0.0)
+            cam.SetPosition(cx, cy, CAMERA_DISTANCE)
+            cam.SetViewUp(0.0, 1.0, 0.0)
+            cam.SetParallelScale(v.width * vp.height / vp.width / 2.0)
+            cam.SetClippingRange(1.0, 2.0 * CAMERA_DISTANCE)
+        e = self.model.scene.eyes
+        self.actors.set_zoom(
+            1.0 / self.units_per_px("main"), 1.0 / self.units_per_px("inset"), e.l, e.m
+        )
+
+    def _update_inset_visibility(self) -> None:
+        """The inset magnifies the eyes; where they are already large on screen (or the
+        scene has no eyes) it would only duplicate the main view, so it is hidden."""
+        e = self.model.scene.eyes
+        eye_px = 2.0 * e.l / self.units_per_px("main")
+        want = self.model.scene.shows("eyes") and eye_px < INSET_HIDE_EYE_PX
+        if want != self.inset_shown or self.inset_ren.GetDraw() != want:
+            self.inset_shown = want
+            self.inset_ren.SetDraw(want)
+            self.actors.set_inset_shown(want)
+
+    def fit_view(self) -> None:
+        """F: every feature and the eyes in view, none under the inset."""
+        self._update_inset_visibility()
+        avoid = self.viewport("inset") if self.inset_shown else None
+        interactions.fit_view(self.model, self.viewport("main"), avoid)
+        # fitting may hide the inset (large eyes): then fit the whole view
+        self._update_inset_visibility()
+        if avoid is not None and not self.inset_shown:
+            interactions.fit_view(self.model, self.viewport("main"))
+
+    def fit_inset(self) -> None:
+        interactions.fit_inset(self.model, self.viewport("inset"))
+
+    def _resized(self) -> None:
+        if self.inset_auto:
+            self.fit_inset()
+        else:
+            self.apply_cameras()
+            self.render()
+
+    # --- events ---------------------------------------------------------------------
+    def _status(self, which: str, x: float, y: float) -> None:
+        r = math.hypot(x, y)
+        phi = math.degrees(math.atan2(y, x)) % 360.0
+        self.cursor_label.setText(f"x {x:,.1f}   y {y:,.1f}     r {r:,.1f}   φ {phi:.2f}°")
+
+    def eventFilter(self, obj, ev) -> bool:  # noqa: N802 (Qt name)
+        if obj is not self.plotter:
+            return False
+        t = ev.type()
+        E = QtCore.QEvent
+        if t == E.MouseButtonPress:
+            self.plotter.setFocus(QtCore.Qt.MouseFocusReason)
+            self._press(ev)
+            return True
+        if t == E.MouseMove:
+            which, x, y = self.to_model(ev.x(), ev.y(), self._drag_which if self._drag else None)
+            self._status(which, x, y)
+            if self._drag is not None:
+                self._send(MouseEvent("move", x, y, ev.x(), ev.y()))
+            return True
+        if t == E.MouseButtonRelease:
+            if self._drag is not None:
+                _, x, y = self.to_model(ev.x(), ev.y(), self._drag_which)
+                self._send(MouseEvent("release", x, y, ev.x(), ev.y()))
+                self._drag = None
+            return True
+        if t == E.Wheel:
+            self._wheel(ev)
+            return True
+        if t == E.ContextMenu:
+            self._context_menu(ev.pos(), ev.globalPos())
+            return True
+        if t == E.KeyPress and ev.key() == QtCore.Qt.Key_Space and not ev.isAutoRepeat():
+            self.toggle_play()  # Space plays only while the view has the focus
+            return True
+        if t in (E.MouseButtonDblClick, E.KeyPress, E.KeyRelease):
+            return True
+        if t == E.Resize:
+            QtCore.QTimer.singleShot(0, self._resized)
+        return False
+
+    def _press(self, ev) -> None:
+        which, x, y = self.to_model(ev.x(), ev.y())
+        me = MouseEvent("press", x, y, ev.x(), ev.y())
+        if self._drag is not None:  # a press while another button drags: end that drag
+            self._send(MouseEvent("release", x, y, ev.x(), ev.y()))
+        button = {QtCore.Qt.LeftButton: "left", QtCore.Qt.MiddleButton: "middle"}.get(
+            ev.button(), "other"
+        )
+        main_vp = self.viewport("main") if which == "inset" else None
+        self._drag = interactions.press(
+            self.model, me, which, self.viewport(which), button, main_vp
+        )
+        self._drag_which = which
+
+    def _send(self, me: MouseEvent) -> None:
+        try:
+            self._drag.send(me)
+        except StopIteration:
+            self._drag = None
+
+    def _wheel(self, ev) -> None:
+        d = ev.angleDelta()
+        steps = (d.y() or d.x()) / 120.0  # Shift+wheel may arrive as a horizontal wheel
+        px, py = ev.pos().x(), ev.pos().y()
+        which = self.which_at(px, py)
+        resize = bool(ev.modifiers() & RESIZE_MODIFIERS)
+        interactions.wheel(self.model, which, self.viewport(which), px, py, steps, resize)
+
+    def _context_menu(self, pos: QtCore.QPoint, global_pos: QtCore.QPoint) -> QtWidgets.QMenu:
+        which, x, y = self.to_model(pos.x(), pos.y())
+        sc = self.model.scene
+        i, _ = hit_test(sc, self.model.selected, x, y, self.units_per_px(which))
+        menu = QtWidgets.QMenu(self)
+        menu.addAction(f"Add feature at ({x:,.0f}, {y:,.0f})", lambda: self.model.add_feature(x, y))
+        if i is not None:
+            name = sc.features[i].name
+            menu.addAction(f"Duplicate {name}", lambda: self.model.duplicate_feature(i))
+            menu.addAction(f"Delete {name}", lambda: self.model.delete_feature(i))
+        menu.popup(global_pos)
+        self.context_menu = menu
+        return menu

@@ -1,0 +1,171 @@
+"""File handling of the window: open, save, recent files, unsaved-changes prompts.
+
+Nothing is lost silently (issue 12 item 2): Quit, closing the window, Open and Open recent
+ask Save / Discard / Cancel when the scene has unsaved changes; a scene shipped with eyeviz
+(``assets/``) opens as "untitled", so Ctrl+S acts as Save As and never writes into the
+installed assets.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PyQt5 import QtWidgets
+
+from eyeviz.model.scene import SceneError, load, save
+from eyeviz.resources import assets_dir
+
+__all__ = ["FilesMixin", "RECENT_MAX", "is_bundled"]
+
+RECENT_MAX = 8
+
+
+def is_bundled(path) -> bool:
+    """True for a file inside eyeviz's shipped assets (never saved over)."""
+    try:
+        Path(path).resolve().relative_to(assets_dir().resolve())
+    except (ValueError, OSError):
+        return False
+    return True
+
+
+class FilesMixin:
+    """Mixed into MainWindow: needs ``model``, ``undo_stack``, ``settings``, ``statusBar``."""
+
+    path: Path | None = None
+    source: Path | None = None  # the file the scene came from (a bundled one included)
+
+    def _set_path(self, path) -> None:
+        self.source = Path(path) if path else None
+        self.path = None if path is None or is_bundled(path) else Path(path)
+
+    # --- title and dirty state --------------------------------------------------------
+    def _clean_changed(self, _clean: bool) -> None:
+        try:
+            self._update_title()
+        except RuntimeError:  # the stack is being destroyed with the window
+            pass
+
+    def is_modified(self) -> bool:
+        return self.model.live_open or not self.undo_stack.isClean()
+
+    def _update_title(self) -> None:
+        if self.path:
+            name = self.path.name
+        elif self.source:
+            name = f"untitled (from {self.source.name})"
+        else:
+            name = "untitled"
+        star = "" if self.undo_stack.isClean() else " *"
+        self.setWindowTitle(f"eyeviz — {name}{star}")
+
+    def maybe_save(self) -> bool:
+        """Unsaved changes: ask Save / Discard / Cancel. True when it is fine to go on."""
+        self.model.finish_gestures()
+        if self.undo_stack.isClean():
+            return True
+        box = QtWidgets.QMessageBox(
+            QtWidgets.QMessageBox.Warning,
+            "Unsaved changes",
+            "The scene has unsaved changes. Save them first?",
+            QtWidgets.QMessageBox.Save
+            | QtWidgets.QMessageBox.Discard
+            | QtWidgets.QMessageBox.Cancel,
+            self,
+        )
+        box.setDefaultButton(QtWidgets.QMessageBox.Save)
+        box.setObjectName("unsaved_prompt")
+        self.unsaved_box = box
+        answer = box.exec_()
+        self.unsaved_box = None
+        if answer == QtWidgets.QMessageBox.Save:
+            return self.save_current()
+        return answer == QtWidgets.QMessageBox.Discard
+
+    # --- recent files -----------------------------------------------------------------
+    def recent_files(self) -> list[str]:
+        v = self.settings.value("recent", [])
+        if isinstance(v, str):
+            v = [v]
+        return [str(p) for p in (v or []) if isinstance(p, str)]
+
+    def _add_recent(self, path: Path) -> None:
+        p = str(Path(path).resolve())
+        rec = [p] + [r for r in self.recent_files() if r != p]
+        self.settings.setValue("recent", rec[:RECENT_MAX])
+        self.settings.sync()
+        self._refresh_recent()
+
+    def _refresh_recent(self) -> None:
+        self.recent_menu.clear()
+        for p in self.recent_files():
+            a = self.recent_menu.addAction(p)
+            a.triggered.connect(lambda _c=False, p=p: self.open_file(p))
+        self.recent_menu.setEnabled(bool(self.recent_files()))
+
+    # --- open and save ------------------------------------------------------------------
+    def show_error(self, title: str, text: str) -> None:
+        """A window-modal, non-blocking dialog (tests can read and close it)."""
+        self.last_error = text
+        self.statusBar().showMessage(text, 10000)
+        box = QtWidgets.QMessageBox(
+            QtWidgets.QMessageBox.Critical, title, text, QtWidgets.QMessageBox.Ok, self
+        )
+        box.open()
+        self.error_box = box
+
+    def open_dialog(self) -> None:
+        if not self.maybe_save():
+            return
+        start = str(self.path.parent) if self.path else str(Path.cwd())
+        p, _ = QtWidgets.QFileDialog.getOpenFileName(self, "Open scene", start, "Scenes (*.toml)")
+        if p:
+            self.open_path(p)
+
+    def open_file(self, path) -> bool:
+        """Open recent: ask about unsaved changes, then open."""
+        return self.maybe_save() and self.open_path(path)
+
+    def open_path(self, path) -> bool:
+        """Load a scene; an invalid file shows a dialog and the open scene is kept."""
+        try:
+            scene = load(path)
+        except SceneError as exc:
+            self.show_error("Cannot open scene", str(exc))
+            return False
+        self.model.finish_gestures()
+        self._set_path(path)
+        self.undo_stack.clear()
+        self.model.selected = None
+        self.model.set_scene(scene)
+        self.fit_inset()
+        if not is_bundled(path):
+            self._add_recent(Path(path))
+        self._update_title()
+        return True
+
+    def save_dialog(self) -> bool:
+        start = str(self.path) if self.path else str(Path.cwd() / "scene.toml")
+        p, _ = QtWidgets.QFileDialog.getSaveFileName(self, "Save scene", start, "Scenes (*.toml)")
+        return self.save_path(p) if p else False
+
+    def save_current(self) -> bool:
+        """Ctrl+S: save over the scene's file; untitled or bundled scenes ask for a name."""
+        return self.save_path(self.path) if self.path else self.save_dialog()
+
+    def save_path(self, path) -> bool:
+        if is_bundled(path):
+            self.show_error("Cannot save scene", f"{path}: eyeviz's shipped scenes are read-only")
+            return False
+        self.model.finish_gestures()
+        try:
+            save(self.model.scene, path)
+        except (OSError, SceneError) as exc:
+            self.show_error("Cannot save scene", f"{path}: {exc}")
+            return False
+        self._set_path(path)
+        self.undo_stack.setClean()
+        self._add_recent(Path(path))
+        self._update_title()
+        self.statusBar().showMessage(f"saved {path}", 5000)
+        return True

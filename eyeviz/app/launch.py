@@ -1,0 +1,89 @@
+"""Starting the app: the display check, the QApplication, ``eyeviz app``'s run."""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import os
+
+from PyQt5 import QtCore, QtWidgets
+
+from eyeviz import EyevizError
+
+__all__ = ["APP_FONT_PT", "check_display", "make_app", "run_app"]
+
+APP_FONT_PT = 13
+
+
+def check_display() -> None:
+    """EyevizError (one line) when no display can be reached, before Qt aborts the process.
+
+    An X display named in $DISPLAY is opened with Xlib itself (and closed again): a stale
+    DISPLAY (a closed ssh -X session, a stopped Xvfb) becomes a message, not Qt's
+    "could not connect to display ... Reinstalling the application may fix this problem".
+    """
+    display = os.environ.get("DISPLAY")
+    if not display and not os.environ.get("WAYLAND_DISPLAY"):
+        raise EyevizError(
+            "no display: run under `xvfb-run -a eyeviz app --screenshot OUT.png` "
+            "or use scripts/run.sh"
+        )
+    if not display or os.environ.get("QT_QPA_PLATFORM", "xcb") not in ("xcb", ""):
+        return
+    lib = ctypes.util.find_library("X11")
+    if lib is None:
+        return  # cannot check without Xlib; Qt will try
+    x11 = ctypes.CDLL(lib)
+    x11.XOpenDisplay.restype = ctypes.c_void_p
+    x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
+    dpy = x11.XOpenDisplay(display.encode())
+    if not dpy:
+        raise EyevizError(
+            f"cannot connect to the X display {display!r} (stale DISPLAY?): "
+            "unset it and use `xvfb-run -a eyeviz app --screenshot OUT.png`, or fix DISPLAY"
+        )
+    x11.XCloseDisplay(dpy)
+
+
+def make_app() -> QtWidgets.QApplication:
+    app = QtWidgets.QApplication.instance()
+    if app is None:
+        QtWidgets.QApplication.setAttribute(QtCore.Qt.AA_ShareOpenGLContexts)
+        app = QtWidgets.QApplication(["eyeviz"])
+    font = app.font()
+    font.setPointSize(APP_FONT_PT)
+    app.setFont(font)
+    return app
+
+
+def run_app(scene_path=None, screenshot=None, settings_path=None) -> int:
+    from eyeviz.app.screenshot import screenshot_format
+    from eyeviz.app.settings import make_settings
+    from eyeviz.app.window import MainWindow
+    from eyeviz.model.scene import load
+    from eyeviz.resources import scene_path as scene_path_of
+
+    if screenshot is not None:
+        screenshot_format(screenshot)  # refuse a wrong suffix before any window opens
+    check_display()
+    if scene_path is None:
+        scene_path = scene_path_of("default")
+    scene = load(scene_path)
+    settings = make_settings(settings_path)
+    app = make_app()
+    win = MainWindow(scene, scene_path, settings=settings)
+    if settings.refused:
+        win.statusBar().showMessage(settings.refused, 15000)
+    win.show()
+    app.processEvents()
+    win.fit_inset()
+    win.render()
+    if screenshot is not None:
+        for _ in range(3):
+            app.processEvents()
+        out = win.save_screenshot(screenshot)
+        print(out)
+        win.force_close()
+        return 0
+    return app.exec_()

@@ -1,0 +1,73 @@
+"""Screenshots of the whole window, the VTK view composited from its framebuffer."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from PyQt5 import QtCore, QtGui, QtWidgets
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
+
+from eyeviz import EyevizError
+from eyeviz.files.atomic import atomic_output
+
+__all__ = ["FORMATS", "grab_image", "qimage_to_array", "save_screenshot", "screenshot_format"]
+
+FORMATS = {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG"}
+
+
+def screenshot_format(path) -> str:
+    """Qt's image format for ``path``'s suffix; EyevizError for any other suffix."""
+    fmt = FORMATS.get(Path(path).suffix.lower())
+    if fmt is None:
+        raise EyevizError(
+            f"screenshot {str(path)!r}: the file name must end in .png, .jpg or .jpeg"
+        )
+    return fmt
+
+
+def grab_image(win) -> QtGui.QImage:
+    """The whole window as shown, with the VTK view composited from its framebuffer."""
+    QtWidgets.QApplication.processEvents()
+    win.apply_cameras()
+    win.render()
+    w2i = vtkWindowToImageFilter()
+    w2i.SetInput(win.ren_win)
+    w2i.SetInputBufferTypeToRGB()
+    w2i.ReadFrontBufferOff()
+    w2i.Update()
+    data = w2i.GetOutput()
+    vw, vh, _ = data.GetDimensions()
+    arr = vtk_to_numpy(data.GetPointData().GetScalars()).reshape(vh, vw, 3)[::-1].copy()
+    vtk_img = QtGui.QImage(arr.data, vw, vh, 3 * vw, QtGui.QImage.Format_RGB888).copy()
+    img = win.grab().toImage().convertToFormat(QtGui.QImage.Format_RGB888)
+    p = QtGui.QPainter(img)
+    top_left = win.plotter.mapTo(win, QtCore.QPoint(0, 0))
+    p.drawImage(QtCore.QRect(top_left, win.plotter.size()), vtk_img)
+    p.end()
+    return img
+
+
+def save_screenshot(win, path) -> Path:
+    """Write the window as PNG or JPEG (by the suffix), atomically."""
+    path = Path(path)
+    fmt = screenshot_format(path)
+    img = grab_image(win)
+    with atomic_output(path) as tmp:
+        if not img.save(str(tmp), fmt, 95 if fmt == "JPEG" else -1):
+            raise OSError(f"cannot write {path}")
+    return path
+
+
+def qimage_to_array(img: QtGui.QImage) -> np.ndarray:
+    img = img.convertToFormat(QtGui.QImage.Format_RGB888)
+    w, h = img.width(), img.height()
+    ptr = img.constBits()
+    ptr.setsize(img.byteCount())
+    return (
+        np.frombuffer(ptr, np.uint8)
+        .reshape(h, img.bytesPerLine())[:, : 3 * w]
+        .reshape(h, w, 3)
+        .copy()
+    )

@@ -1,0 +1,200 @@
+"""The app's model driven with plain events and no display (issue 9 item 3): drags as
+press/move/release sequences, the wheel, pan, fit, undo/redo, picking, names."""
+
+import pytest
+
+from eyeviz.model import camera, interactions
+from eyeviz.model.app_model import HANDLE_PX, AppModel, MouseEvent, hit_test
+from eyeviz.model.camera import Viewport
+from eyeviz.model.scene import Eyes, Feature, Scene, View
+
+VP = Viewport(0.0, 0.0, 1000.0, 700.0)
+
+
+class Undo:
+    """A minimal undo stack (before, after, text) like the window's QUndoStack."""
+
+    def __init__(self, model):
+        self.steps = []
+        self.model = model
+        model.push = self.push
+
+    def push(self, before, after, text, merge_key=None):
+        self.steps.append((before.copy(), after.copy(), text))
+        self.model.set_scene(after)
+
+    def undo(self):
+        before, _, _ = self.steps.pop()
+        self.model.set_scene(before)
+
+
+def make(view=None):
+    sc = Scene(
+        Eyes(40.0, 20.0, 720),
+        [
+            Feature("target", 0.0, 1500.0, 50.0, "#D55E00"),
+            Feature("other", -1200.0, 3000.0, 200.0, "#0072B2"),
+        ],
+        view=view or View((0.0, 2300.0), 7000.0),
+    )
+    m = AppModel(sc)
+    return m, Undo(m)
+
+
+def ev(m, kind, x, y):
+    px, py = camera.to_pixel(m.scene.view, VP, x, y)
+    return MouseEvent(kind, x, y, px, py)
+
+
+def gesture(m, points, which="main"):
+    """press at points[0], moves through points[1:], release at the last one."""
+    g = interactions.press(m, ev(m, "press", *points[0]), which, VP)
+    for p in points[1:]:
+        try:
+            g.send(ev(m, "move", *p))
+        except StopIteration:
+            pass
+    try:
+        g.send(ev(m, "release", *points[-1]))
+    except StopIteration:
+        pass
+
+
+def test_drag_moves_the_feature_as_one_undo_step_and_undo_restores():
+    m, undo = make()
+    path = [(0.0, 1500.0)] + [(30.0 * k, 1500.0 + 20.0 * k) for k in range(1, 11)]
+    gesture(m, path)
+    f = m.scene.features[0]
+    assert (f.x, f.y) == pytest.approx((300.0, 1700.0))
+    assert [t for _, _, t in undo.steps] == ["Move target"]
+    assert not m.live_open
+    undo.undo()
+    assert (m.scene.features[0].x, m.scene.features[0].y) == (0.0, 1500.0)
+
+
+def test_click_selects_without_an_undo_step():
+    m, undo = make()
+    gesture(m, [(-1200.0, 3000.0), (-1199.0, 3000.0)])  # under the drag threshold
+    assert m.selected == 1 and undo.steps == []
+
+
+def test_handle_drag_resizes():
+    m, undo = make()
+    m.select(1)
+    gesture(m, [(-1000.0, 3000.0), (-900.0, 3000.0), (-700.0, 3000.0)])
+    assert m.scene.features[1].g == pytest.approx(500.0)
+    assert undo.steps[-1][2] == "Resize other"
+
+
+def test_press_on_empty_space_pans():
+    m, undo = make()
+    c0 = m.scene.view.center
+    u = camera.units_per_px(m.scene.view, VP)
+    gesture(m, [(2000.0, 500.0), (2000.0 + 50 * u, 500.0)])
+    assert m.scene.view.center == pytest.approx((c0[0] - 50 * u, c0[1]))
+    assert undo.steps == []  # a camera move is not an edit
+
+
+def test_wheel_zooms_about_the_cursor_even_over_a_feature():
+    m, undo = make()
+    px, py = camera.to_pixel(m.scene.view, VP, 0.0, 1500.0)  # over "target"
+    g = m.scene.features[0].g
+    for _ in range(4):
+        assert interactions.wheel(m, "main", VP, px, py, 1.0, resize=False) == "zoom"
+    assert m.scene.features[0].g == g and undo.steps == []
+    assert camera.to_model(m.scene.view, VP, px, py) == pytest.approx((0.0, 1500.0))
+    assert m.scene.view.width == pytest.approx(7000.0 / 1.15**4)
+
+
+def test_zooming_out_never_resizes_a_feature_drifting_under_the_cursor():
+    m, undo = make()
+    px, py = camera.to_pixel(m.scene.view, VP, 600.0, 1500.0)  # empty space beside target
+    for _ in range(12):
+        interactions.wheel(m, "main", VP, px, py, -1.0, resize=False)
+    assert m.scene.features[0].g == 50.0 and undo.steps == []
+
+
+def test_modified_wheel_over_a_feature_resizes_in_one_merged_step():
+    m, undo = make()
+    steps = []
+    m.push = lambda b, a, t, k=None: (steps.append(k), m.set_scene(a))
+    px, py = camera.to_pixel(m.scene.view, VP, -1200.0, 3000.0)
+    for _ in range(3):
+        assert interactions.wheel(m, "main", VP, px, py, 1.0, resize=True) == "resize"
+    assert m.scene.features[1].g == pytest.approx(200.0 * 1.08**3)
+    assert m.selected == 1 and steps == [("wheel", 1)] * 3  # one merge key: one undo step
+    # the modifier over empty space zooms
+    qx, qy = camera.to_pixel(m.scene.view, VP, 3000.0, 0.0)
+    assert interactions.wheel(m, "main", VP, qx, qy, 1.0, resize=True) == "zoom"
+
+
+def test_zoomed_out_a_press_on_a_neighbour_never_grabs_the_selected_handle():
+    m, _ = make(View((0.0, 2300.0), 1e6))  # 1000 units per px: discs are sub-pixel
+    sc = Scene(features=[Feature("a", 0.0, 5000.0, 50.0), Feature("b", 4000.0, 5000.0, 50.0)])
+    m.set_scene(sc)
+    m.scene.view = View((0.0, 5000.0), 1e6)
+    m.select(0)
+    u = camera.units_per_px(m.scene.view, VP)
+    # the press lands 4 px from a's centre, 4 px from b's centre; a's handle is 0.05 px off
+    assert hit_test(m.scene, 0, 4000.0, 5000.0, u) == (1, "body")
+    gesture(m, [(4000.0, 5000.0), (4000.0 + 20 * u, 5000.0)])
+    assert m.scene.features[0].g == 50.0  # not 101,423
+    assert m.scene.features[1].x == pytest.approx(4000.0 + 20 * u)
+
+
+def test_handle_is_grabbable_where_it_is_drawn_apart():
+    m, _ = make()
+    u = camera.units_per_px(m.scene.view, VP)
+    f = m.scene.features[1]
+    assert f.g / u >= HANDLE_PX
+    assert hit_test(m.scene, 1, f.x + f.g + 2 * u, f.y, u) == (1, "handle")
+
+
+def test_press_in_the_inset_reaches_a_feature_under_it():
+    m, _ = make()
+    inset = Viewport(700.0, 0.0, 300.0, 200.0)
+    m.inset_view = camera.fit_inset(m.scene.eyes, inset)
+    # put "other" under the inset in the main view
+    x, y = camera.to_model(m.scene.view, VP, 850.0, 100.0)
+    m.scene.features[1].x, m.scene.features[1].y = x, y
+    e = MouseEvent("press", 0.0, 0.0, 850.0, 100.0)
+    g = interactions.press(m, e, "inset", inset, "left", main_vp=VP)
+    g.send(MouseEvent("move", 0, 0, 900.0, 100.0))
+    g.send(MouseEvent("move", 0, 0, 950.0, 100.0))
+    with pytest.raises(StopIteration):
+        g.send(MouseEvent("release", 0, 0, 950.0, 100.0))
+    u = camera.units_per_px(m.scene.view, VP)
+    assert m.selected == 1 and m.scene.features[1].x == pytest.approx(x + 100 * u)
+
+
+def test_fit_view_then_undo_redo_of_edits_keep_working():
+    m, undo = make()
+    interactions.fit_view(m, VP, Viewport(700.0, 0.0, 300.0, 200.0))
+    v = m.scene.view
+    for f in m.scene.features:
+        px, py = camera.to_pixel(v, VP, f.x, f.y)
+        assert 0 <= px <= 700 or py >= 200
+    m.set_feature(0, x=10.0)
+    interactions.toggle_estimator(m, "analytic", True)
+    assert m.scene.estimators[-1] == "analytic"
+    assert [t for _, _, t in undo.steps] == ["Edit target", "Show analytic predictions"]
+    undo.undo()
+    assert "analytic" not in m.scene.estimators
+
+
+def test_set_trajectory_and_bad_kind():
+    m, undo = make()
+    interactions.set_trajectory(m, "circular")
+    assert m.scene.trajectory.kind == "circular" and m.scene.shows("trajectory")
+    with pytest.raises(ValueError, match="trajectory kind"):
+        interactions.set_trajectory(m, "spiral")
+
+
+def test_duplicate_names_are_copies_not_numbers():
+    m, _ = make()
+    m.duplicate_feature(0)
+    m.duplicate_feature(0)
+    m.duplicate_feature(2)
+    names = [f.name for f in m.scene.features]
+    assert names[2:] == ["target (copy)", "target (copy 2)", "target (copy 3)"]
+    assert m.selected == 4

@@ -1,0 +1,64 @@
+"""Camera maths without a display: pixel <-> model, zoom about the cursor, pan, fit."""
+
+import math
+
+import pytest
+
+from eyeviz.model import camera
+from eyeviz.model.camera import Viewport
+from eyeviz.model.scene import Eyes, Feature, Scene, View
+
+VP = Viewport(0.0, 0.0, 1000.0, 600.0)
+
+
+def test_pixel_model_round_trip_and_centre():
+    v = View((10.0, 2000.0), 5000.0)
+    assert camera.to_model(v, VP, 500.0, 300.0) == (10.0, 2000.0)
+    x, y = camera.to_model(v, VP, 0.0, 0.0)  # top left
+    assert (x, y) == pytest.approx((10.0 - 2500.0, 2000.0 + 1500.0))
+    for px, py in ((3.0, 7.0), (999.0, 1.0), (250.5, 599.0)):
+        assert camera.to_pixel(v, VP, *camera.to_model(v, VP, px, py)) == pytest.approx((px, py))
+
+
+def test_zoom_keeps_the_point_under_the_cursor():
+    v = View((0.0, 2500.0), 8000.0)
+    px, py = 830.0, 120.0
+    before = camera.to_model(v, VP, px, py)
+    z = camera.zoom_about(v, VP, px, py, 1 / 1.15)
+    assert z.width == pytest.approx(8000.0 / 1.15)
+    assert camera.to_model(z, VP, px, py) == pytest.approx(before)
+    with pytest.raises(ValueError, match="zoom factor"):
+        camera.zoom_about(v, VP, px, py, 0.0)
+    assert camera.zoom_about(v, VP, px, py, 1e30).width == camera.MAX_WIDTH
+
+
+def test_pan_follows_the_cursor():
+    v = View((0.0, 0.0), 1000.0)  # 1 unit per px
+    p = camera.pan(v, VP, 10.0, -20.0)
+    assert p.center == (-10.0, -20.0)
+
+
+def test_fit_view_shows_everything_clear_of_the_inset():
+    sc = Scene(
+        Eyes(40, 20, 720),
+        [Feature("a", 0.0, 3000.0, 50.0), Feature("b", 2500.0, 1000.0, 300.0)],
+    )
+    inset = Viewport(700.0, 0.0, 300.0, 200.0)  # top-right corner
+    v = camera.fit_view(sc, VP, inset)
+    for f in sc.features:
+        for dx, dy in ((f.g, 0), (-f.g, 0), (0, f.g), (0, -f.g)):
+            px, py = camera.to_pixel(v, VP, f.x + dx, f.y + dy)
+            assert 0 <= px <= VP.width and 0 <= py <= VP.height
+            assert not inset.contains(px, py), (f.name, px, py)
+    # without an inset the same content fits in a smaller width
+    assert camera.fit_view(sc, VP).width <= v.width
+
+
+def test_fit_inset_shows_both_eyes():
+    e = Eyes(40, 20, 720)
+    vp = Viewport(700.0, 0.0, 300.0, 200.0)
+    v = camera.fit_inset(e, vp)
+    for x in (-(e.h + e.l), e.h + e.l):
+        px, py = camera.to_pixel(v, vp, x, 0.0)
+        assert vp.contains(px, py)
+    assert math.isfinite(v.width) and v.width > 2 * (e.h + e.l)

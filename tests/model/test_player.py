@@ -1,0 +1,95 @@
+"""The trajectory player as model state, without a display (issue 12 item 1)."""
+
+import numpy as np
+
+from eyeviz.model.app_model import AppModel
+from eyeviz.model.scene import Feature, Scene
+
+
+class Undo:
+    """A minimal undo stack (before, after, text) like the window's QUndoStack."""
+
+    def __init__(self, model):
+        self.steps = []
+        self.model = model
+        model.push = self.push
+
+    def push(self, before, after, text, merge_key=None):
+        self.steps.append((before.copy(), after.copy(), text))
+        self.model.set_scene(after)
+
+    def undo(self):
+        before, _, _ = self.steps.pop()
+        self.model.set_scene(before)
+
+
+class Path:
+    def __init__(self, n=50, y=2000.0, g=30.0):
+        self.x = np.linspace(-500.0, 500.0, n)
+        self.y = np.full(n, y)
+        self.g = g
+        self.n = n
+
+
+def model3():
+    m = AppModel(
+        Scene(
+            features=[
+                Feature("a", 0.0, 1000.0, 50.0),
+                Feature("b", 100.0, 3000.0, 70.0),
+                Feature("c", -300.0, 1500.0, 90.0),
+            ]
+        )
+    )
+    return m, Undo(m)
+
+
+def test_play_step_pause_is_one_undo_step():
+    m, undo = model3()
+    m.select(1)
+    m.player.set_path(Path())
+    assert m.player.start() and m.player.playing
+    for _ in range(5):
+        m.player.step(3)
+    b = m.scene.features[1]
+    assert (b.x, b.y, b.g) == (Path().x[15], 2000.0, 30.0)
+    m.player.stop()
+    assert not m.player.playing and len(undo.steps) == 1 and undo.steps[0][2] == "Animate b"
+    undo.undo()
+    assert (m.scene.features[1].x, m.scene.features[1].y) == (100.0, 3000.0)
+
+
+def test_deleting_the_played_feature_stops_playback_and_touches_no_other():
+    m, undo = model3()
+    m.select(0)
+    m.player.set_path(Path())
+    m.player.start()
+    m.player.step(2)
+    others = [(f.x, f.y, f.g) for f in m.scene.features[1:]]
+    m.delete_feature(0)  # Del while playing
+    assert not m.player.playing
+    assert "deleted" in m.player.message
+    assert m.player.step() is None  # a timer tick after the deletion moves nothing
+    assert [(f.x, f.y, f.g) for f in m.scene.features] == others
+    assert [t for _, _, t in undo.steps] == ["Animate a", "Delete a"]
+
+
+def test_deleting_another_feature_keeps_playing_the_same_one():
+    m, undo = model3()
+    m.select(2)  # play "c", the last one
+    m.player.set_path(Path())
+    m.player.start()
+    m.player.step(1)
+    m.delete_feature(0)  # indices shift: c is now index 1
+    assert m.player.playing and m.player.index() == 1
+    b_before = (m.scene.features[0].x, m.scene.features[0].y)
+    m.player.step(4)
+    assert (m.scene.features[0].x, m.scene.features[0].y) == b_before  # b untouched
+    assert m.scene.features[1].name == "c" and m.scene.features[1].x == Path().x[5]
+    m.player.stop()
+    assert [t for _, _, t in undo.steps] == ["Animate c", "Delete a", "Animate c"]
+
+
+def test_no_path_no_play():
+    m, _ = model3()
+    assert not m.player.start() and "no trajectory" in m.player.message
