@@ -3,8 +3,8 @@
 Run it: ``python examples/add_an_estimator.py``. It registers ``edges``, a tiny estimator
 that triangulates the rays through the centres of the two eyes' *first* lit sectors
 (L_A and L_B, Prop. 2: each holds a tangent, not the centre) instead of the interval
-mid-angles the analytic estimator uses, so it is cruder on purpose; it checks it with :func:`eyeviz.estimators.checks.check_estimator`, and compares both on
-2000 elements of Algorithm 1.
+mid-angles the analytic estimator uses, so it is cruder on purpose; it checks it with
+:func:`eyeviz.estimators.checks.check_estimator`, and compares both on 2000 elements of Algorithm 1.
 """
 
 from __future__ import annotations
