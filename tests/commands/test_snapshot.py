@@ -123,7 +123,7 @@ def test_snapshot_hostile_scenes_are_one_line(tmp_path):
     many.write_text(rows)
     far = tmp_path / "far.toml"
     far.write_text('[[features]]\nname = "far"\nx = 1e308\ny = 1500.0\ng = 50.0\n')
-    for scene, words in ((many, "at most 10000 features"), (far, "cannot be drawn")):
+    for scene, words in ((many, "10000"), (far, "1e+308")):
         t = time.perf_counter()
         run = subprocess.run(
             [sys.executable, "-m", "eyeviz", "snapshot", str(scene), "-o", str(tmp_path / "o.png")],
