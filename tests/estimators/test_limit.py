@@ -9,7 +9,7 @@ import pytest
 
 from eyeviz import dataset, estimators
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain
-from eyeviz.estimators.limit import LimitEstimator, posterior_samples
+from eyeviz.estimators.limit import LimitEstimator, posterior_nodes, posterior_samples
 
 
 def _wquantile(v, w, q):
@@ -75,6 +75,13 @@ def test_matches_brute_force_posterior(feature, prior):
     assert r.min() > box[0][0] * 1.01 and r.max() < box[0][1] * 0.99
     assert phi.min() > box[1][0] + 1e-3 and phi.max() < box[1][1] - 1e-3
     assert g.min() > box[2][0] * 1.01 and g.max() < box[2][1] * 0.99
+    # the key's prior mass: quadrature (u-grid cell (gamma/n)^2, (t-, t+) -> (phi_A, delta)
+    # Jacobian 1/2) against the MC estimate (r1 - r0) * mean(weight * [key])
+    n = 12
+    mass = float(posterior_nodes([key], PAPER_DOMAIN, prior, n, 6).w.sum()) * eyes.gamma**2
+    mass /= 2 * n * n
+    mc = (box[0][1] - box[0][0]) * w.sum() / 4_000_000
+    assert abs(mass / mc - 1) < 5 / math.sqrt(w.sum() ** 2 / (w * w).sum()) + 0.01, (mass, mc)
     wr, wp = w / r, w / phi
     for v, ww, est_v in ((r, wr, r_est), (phi, wp, phi_est)):
         n_eff = ww.sum() ** 2 / (ww * ww).sum()
