@@ -233,8 +233,9 @@ def limit_estimates(keys, domain: Domain, prior: str = "single", n: int = 12, k:
 class LimitEstimator(Estimator):
     """MAPE-optimal posterior medians per key for any design and prior; cached per key.
 
-    ``last_flagged`` holds, after each prediction, the rows answered by triangulation
-    because the prior cannot produce their key (empty posterior).
+    Predictions carry ``flagged`` (also ``last_flagged``): the rows answered by
+    triangulation because the prior cannot produce their key (empty posterior); False on
+    invalid rows.
     """
 
     name = "limit"
@@ -257,6 +258,7 @@ class LimitEstimator(Estimator):
         self._cache: OrderedDict[tuple, tuple[float, float, bool]] = OrderedDict()
         self._fallback = AnalyticEstimator(domain)
         self.last_flagged = np.zeros(0, bool)
+        self._parts: list[np.ndarray] = []
         self.hits = 0
         self.misses = 0
 
@@ -300,12 +302,28 @@ class LimitEstimator(Estimator):
             while len(cache) > self.cache_size:
                 cache.popitem(last=False)
         self.last_flagged = e_u[inv]
+        self._parts.append(self.last_flagged)
         return r_u[inv], p_u[inv]
 
-    def flagged(self, LA, RA, LB, RB) -> np.ndarray:
-        """True where the key's posterior is empty (answered by triangulation)."""
-        self._predict_intervals(LA, RA, LB, RB)
-        return self.last_flagged.copy()
+    def _with_flags(self, call, *args):
+        self._parts = []
+        p = call(*args)
+        valid = np.atleast_1d(p.valid)
+        flagged = np.zeros(valid.shape, bool)
+        if self._parts:
+            flagged[valid] = np.concatenate(self._parts)
+        p.flagged = flagged[0] if np.ndim(p.valid) == 0 else flagged
+        self.last_flagged = p.flagged
+        return p
+
+    def predict(self, omega_a, omega_b):
+        """As :meth:`Estimator.predict`, plus ``flagged``: rows with an empty posterior,
+        answered by analytic triangulation (also in :attr:`last_flagged`)."""
+        return self._with_flags(super().predict, omega_a, omega_b)
+
+    def predict_intervals(self, LA, RA, LB, RB):
+        """As :meth:`Estimator.predict_intervals`, plus the ``flagged`` mask."""
+        return self._with_flags(super().predict_intervals, LA, RA, LB, RB)
 
     def __repr__(self) -> str:
         d = self.domain
@@ -342,7 +360,8 @@ def posterior_samples(
     tot = w.sum()
     keep = w > 0
     est = LimitEstimator(domain, prior, n, k)
-    r, phi = est._predict_intervals(*(np.array([v]) for v in key))
+    pred = est.predict_intervals(*key)
+    r, phi = np.atleast_1d(pred.r), np.atleast_1d(pred.phi)
     return {
         "x": nd.x[0][keep],
         "y": nd.y[0][keep],
@@ -350,7 +369,7 @@ def posterior_samples(
         "weight": (w[keep] / tot) if tot > 0 else w[keep],
         "r": float(r[0]),
         "phi": float(phi[0]),
-        "empty": bool(est.last_flagged[0]),
+        "empty": bool(pred.flagged),
     }
 
 

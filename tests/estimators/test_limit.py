@@ -61,7 +61,7 @@ def test_matches_brute_force_posterior(feature, prior):
     key = tuple(int(v) for v in eyes.intervals(*feature))
     est = LimitEstimator(PAPER_DOMAIN, prior)
     r_est, phi_est = est.predict_intervals(*key)
-    assert not est.last_flagged[0]
+    assert not est.last_flagged
     r_f = math.hypot(feature[0], feature[1])
     phi_f = math.atan2(feature[1], feature[0])
     box = (
@@ -124,7 +124,15 @@ def test_empty_posterior_is_triangulated_and_flagged():
     LA, RA, LB, RB = eyes.intervals(x, y, g)
     est = LimitEstimator()
     p = est.predict_intervals(LA, RA, LB, RB)
-    assert est.last_flagged.tolist() == [True, False]
+    assert est.last_flagged.tolist() == [True, False] == p.flagged.tolist()
+    # row-aligned through bitmaps too, with an invalid (empty) row in between
+    w = PAPER_DOMAIN.width
+    oa, ob = eyes.bitmaps(x, y, g)
+    oa = np.vstack([oa[:1, :w], np.zeros((1, w), bool), oa[1:, :w]])
+    ob = np.vstack([ob[:1, :w], np.zeros((1, w), bool), ob[1:, :w]])
+    q = est.predict(oa, ob)
+    assert q.flagged.tolist() == [True, False, False] and q.valid.tolist() == [True, False, True]
+    assert est.predict(oa[0], ob[0]).flagged
     ana = estimators.load("analytic").predict_intervals(LA, RA, LB, RB)
     assert p.r[0] == ana.r[0] and p.phi[0] == ana.phi[0] and np.isfinite(p.r).all()
     s = posterior_samples((int(LA[0]), int(RA[0]), int(LB[0]), int(RB[0])))
