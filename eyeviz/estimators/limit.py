@@ -28,7 +28,9 @@ K = 6 (864 nodes per key) against n = 48, K = 16 on 400 distinct keys of a fresh
 paper-design test set, the estimate of r differs by a median 1.1e-3 relative (99th
 percentile 8e-3, max 9e-3) and phi by at most 3.4e-5 rad (99th percentile); the DD MAPE
 of a 2*10^4-row test set moves by under 0.001 points between n = 12, K = 6 and
-n = 24, K = 10 (the limit's own MAPE is about 7 %). Node arithmetic is float32.
+n = 24, K = 10 (the limit's own MAPE is about 7 %). Node arithmetic is float32. A key
+whose polyhedron is a sliver the grid misses is retried on a 4n x 4n grid before it is
+called empty.
 Keys the prior cannot produce (empty posterior, e.g. g = 5
 beyond r = 1146, or a run touching the end of the half bitmap) are answered by analytic
 triangulation and flagged in :attr:`LimitEstimator.last_flagged` /
@@ -227,14 +229,20 @@ def limit_estimates(keys, domain: Domain, prior: str = "single", n: int = 12, k:
         r_out[sl] = np.where(e, np.nan, r_out[sl])
         p_out[sl] = np.where(e, np.nan, p_out[sl])
         empty[sl] = e
+    # a sliver polyhedron can fall between the grid's rays: retry those keys on a 4x grid
+    again = np.flatnonzero(empty)
+    if again.size and n < 48:
+        r2, p2, e2 = limit_estimates(keys[again], domain, prior, 4 * n, k)
+        r_out[again], p_out[again], empty[again] = r2, p2, e2
     return r_out, p_out, empty
 
 
 class LimitEstimator(Estimator):
     """MAPE-optimal posterior medians per key for any design and prior; cached per key.
 
-    ``last_flagged`` holds, after each prediction, the rows answered by triangulation
-    because the prior cannot produce their key (empty posterior).
+    Predictions carry ``flagged`` (also ``last_flagged``): the rows answered by
+    triangulation because the prior cannot produce their key (empty posterior); False on
+    invalid rows.
     """
 
     name = "limit"
@@ -257,6 +265,7 @@ class LimitEstimator(Estimator):
         self._cache: OrderedDict[tuple, tuple[float, float, bool]] = OrderedDict()
         self._fallback = AnalyticEstimator(domain)
         self.last_flagged = np.zeros(0, bool)
+        self._parts: list[np.ndarray] = []
         self.hits = 0
         self.misses = 0
 
@@ -300,12 +309,28 @@ class LimitEstimator(Estimator):
             while len(cache) > self.cache_size:
                 cache.popitem(last=False)
         self.last_flagged = e_u[inv]
+        self._parts.append(self.last_flagged)
         return r_u[inv], p_u[inv]
 
-    def flagged(self, LA, RA, LB, RB) -> np.ndarray:
-        """True where the key's posterior is empty (answered by triangulation)."""
-        self._predict_intervals(LA, RA, LB, RB)
-        return self.last_flagged.copy()
+    def _with_flags(self, call, *args):
+        self._parts = []
+        p = call(*args)
+        valid = np.atleast_1d(p.valid)
+        flagged = np.zeros(valid.shape, bool)
+        if self._parts:
+            flagged[valid] = np.concatenate(self._parts)
+        p.flagged = flagged[0] if np.ndim(p.valid) == 0 else flagged
+        self.last_flagged = p.flagged
+        return p
+
+    def predict(self, omega_a, omega_b):
+        """As :meth:`Estimator.predict`, plus ``flagged``: rows with an empty posterior,
+        answered by analytic triangulation (also in :attr:`last_flagged`)."""
+        return self._with_flags(super().predict, omega_a, omega_b)
+
+    def predict_intervals(self, LA, RA, LB, RB):
+        """As :meth:`Estimator.predict_intervals`, plus the ``flagged`` mask."""
+        return self._with_flags(super().predict_intervals, LA, RA, LB, RB)
 
     def __repr__(self) -> str:
         d = self.domain
@@ -342,7 +367,8 @@ def posterior_samples(
     tot = w.sum()
     keep = w > 0
     est = LimitEstimator(domain, prior, n, k)
-    r, phi = est._predict_intervals(*(np.array([v]) for v in key))
+    pred = est.predict_intervals(*key)
+    r, phi = np.atleast_1d(pred.r), np.atleast_1d(pred.phi)
     return {
         "x": nd.x[0][keep],
         "y": nd.y[0][keep],
@@ -350,7 +376,7 @@ def posterior_samples(
         "weight": (w[keep] / tot) if tot > 0 else w[keep],
         "r": float(r[0]),
         "phi": float(phi[0]),
-        "empty": bool(est.last_flagged[0]),
+        "empty": bool(pred.flagged),
     }
 
 

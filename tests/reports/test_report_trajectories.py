@@ -88,3 +88,23 @@ def test_bad_counts(tmp_path, capsys):
         == 2
     )
     assert "--max-count" in capsys.readouterr().err
+
+
+def test_limit_uses_the_wide_prior_flags_impossible_keys_and_names_low_levels():
+    points, missing = rep.measure(
+        ["limit"], lo=20, hi=20, kinds=("vertical",), g_values=(5.0, 50.0)
+    )
+    assert not missing
+    by = {(p.g, p.r): p for p in points}
+    # g = 5 lies below r sin(gamma/2) beyond r = 1146: the prior cannot draw it
+    assert by[(5.0, 9500.0)].n_flagged == by[(5.0, 9500.0)].n
+    assert by[(50.0, 9500.0)].n_flagged == 0  # prior r in [1000, 10000] covers g = 50
+    assert by[(50.0, 9500.0)].dd_accuracy > by[(5.0, 9500.0)].dd_accuracy - 50
+    below = rep.limit_below_paper(points)
+    low = [p for p in points if p.dd_accuracy < 70.0]
+    assert bool(below) == bool(low)
+    for p in low:
+        assert any(f"g = {p.g:g}" in s and f"{p.r:g}: {p.dd_accuracy:.1f} %" in s for s in below)
+    md = rep.to_markdown(points, {}, ["limit"], 20, 20, {})
+    assert "information limit" in md and "r in [1000, 10000]" in md
+    assert "n_flagged" in rep.to_csv(points).splitlines()[0]

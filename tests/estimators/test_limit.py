@@ -1,0 +1,169 @@
+"""The `limit` estimator: quadrature against a brute-force posterior, contract, flags, cache."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from eyeviz import dataset, estimators
+from eyeviz.estimators.base import PAPER_DOMAIN, Domain
+from eyeviz.estimators.limit import LimitEstimator, posterior_nodes, posterior_samples
+
+
+def _wquantile(v, w, q):
+    o = np.argsort(v)
+    cw = np.cumsum(w[o])
+    return v[o][np.searchsorted(cw, q * cw[-1])]
+
+
+def _mc_posterior(domain: Domain, key, prior: str, box, n: int, seed: int):
+    """Algorithm 1's prior sampled in a box of (r, phi, g), reweighted exactly.
+
+    Restricting r to [r0, r1] keeps the conditional of the uniform r (multi: weight r);
+    restricting g and phi to sub-ranges is corrected by the ratio of the allowed range to
+    the prior's full range at that (r, g). Keeps the samples whose intervals are the key.
+    """
+    rng = np.random.default_rng(seed)
+    eyes = domain.eyes
+    s = math.sin(eyes.gamma / 2)
+    psi = eyes.psi
+    (r0, r1), (p0, p1), (g0, g1) = box
+    r = rng.uniform(r0, r1, n)
+    glo = np.maximum(r * s, g0)
+    ghi = np.minimum(domain.g_max, g1)
+    g = glo + (ghi - glo) * rng.random(n)
+    a = np.arcsin(np.minimum(g / r, 1.0))
+    flo = np.maximum(psi + a, p0)
+    fhi = np.minimum(math.pi - psi - a, p1)
+    phi = flo + (fhi - flo) * rng.random(n)
+    w = (ghi - glo) / (domain.g_max - r * s) * (fhi - flo) / (math.pi - 2 * psi - 2 * a)
+    if prior == "multi":
+        w = w * r
+    ok = (ghi > glo) & (fhi > flo) & (r * s <= domain.g_max)
+    x, y = r * np.cos(phi), r * np.sin(phi)
+    iv = eyes.intervals(x, y, g)
+    ok &= np.all(np.stack(iv, 1) == np.asarray(key), axis=1)
+    return r[ok], phi[ok], g[ok], w[ok]
+
+
+@pytest.mark.parametrize(
+    "feature, prior",
+    [
+        ((0.0, 1200.0, 150.0), "single"),
+        ((700.0, 2400.0, 300.0), "single"),
+        ((-900.0, 3200.0, 420.0), "multi"),
+    ],  # fmt: skip
+)
+def test_matches_brute_force_posterior(feature, prior):
+    eyes = PAPER_DOMAIN.eyes
+    key = tuple(int(v) for v in eyes.intervals(*feature))
+    est = LimitEstimator(PAPER_DOMAIN, prior)
+    r_est, phi_est = est.predict_intervals(*key)
+    assert not est.last_flagged
+    r_f = math.hypot(feature[0], feature[1])
+    phi_f = math.atan2(feature[1], feature[0])
+    box = (
+        (0.6 * r_f, 1.6 * r_f),
+        (phi_f - 0.02, phi_f + 0.02),
+        (0.4 * feature[2], 2.0 * feature[2]),
+    )
+    r, phi, g, w = _mc_posterior(PAPER_DOMAIN, key, prior, box, 4_000_000, seed=3)
+    # the box holds the whole posterior: no sample lies on its edges in r or g
+    assert r.size > 400
+    assert r.min() > box[0][0] * 1.01 and r.max() < box[0][1] * 0.99
+    assert phi.min() > box[1][0] + 1e-3 and phi.max() < box[1][1] - 1e-3
+    assert g.min() > box[2][0] * 1.01 and g.max() < box[2][1] * 0.99
+    # the key's prior mass: quadrature (u-grid cell (gamma/n)^2, (t-, t+) -> (phi_A, delta)
+    # Jacobian 1/2) against the MC estimate (r1 - r0) * mean(weight * [key])
+    n = 12
+    mass = float(posterior_nodes([key], PAPER_DOMAIN, prior, n, 6).w.sum()) * eyes.gamma**2
+    mass /= 2 * n * n
+    mc = (box[0][1] - box[0][0]) * w.sum() / 4_000_000
+    assert abs(mass / mc - 1) < 5 / math.sqrt(w.sum() ** 2 / (w * w).sum()) + 0.01, (mass, mc)
+    wr, wp = w / r, w / phi
+    for v, ww, est_v in ((r, wr, r_est), (phi, wp, phi_est)):
+        n_eff = ww.sum() ** 2 / (ww * ww).sum()
+        z = 4 * 0.5 / math.sqrt(n_eff)  # four standard errors of the median's rank
+        lo, hi = _wquantile(v, ww, 0.5 - z), _wquantile(v, ww, 0.5 + z)
+        slack = 0.004 * abs(est_v) if v is r else 1e-4  # integration precision (docstring)
+        assert lo - slack <= est_v <= hi + slack, (v is r, lo, est_v, hi)
+
+
+@pytest.mark.parametrize("design", [dict(m=1440), dict(h=80.0), dict(l=10.0)])
+def test_contract_other_designs(design):
+    dom = Domain(**design)
+    est = estimators.load("limit", domain=dom, prior="single")
+    assert "limit" in estimators.available()
+    assert est.domain == dom and est.prior == "single" and est.n_weights == 0
+    ds = dataset.generate(400, eyes=dom.eyes, seed=11)
+    p = est.predict(ds.omega_a, ds.omega_b)
+    assert p.r.shape == (400,) and p.phi.shape == (400,)
+    assert p.valid.all() and p.in_domain.dtype == bool and p.in_domain.mean() > 0.95
+    assert np.isfinite(p.r).all() and not est.last_flagged.any()
+    ana = estimators.load("analytic", domain=dom).predict(ds.omega_a, ds.omega_b)
+    err = lambda r: np.mean(np.abs(r - ds.r) / ds.r)  # noqa: E731
+    assert err(p.r) < err(ana.r)  # the limit beats triangulation on any eyes
+    one = est.predict(ds.omega_a[0], ds.omega_b[0])
+    assert np.ndim(one.r) == 0 and one.r == p.r[0]
+    with pytest.raises(ValueError, match="m/2"):
+        est.predict(ds.omega_a[:, :10], ds.omega_b[:, :10])
+
+
+def test_bad_prior_refused():
+    with pytest.raises(ValueError, match="prior"):
+        estimators.load("limit", prior="uniform")
+
+
+def test_empty_posterior_is_triangulated_and_flagged():
+    eyes = PAPER_DOMAIN.eyes
+    # g = 5 at r = 3000: below r sin(gamma/2) = 13, the prior never draws it; lights one
+    # ommatidium per eye (not visible by Def. 1)
+    x, y, g = np.array([0.0, 0.0]), np.array([3000.0, 1500.0]), np.array([5.0, 150.0])
+    LA, RA, LB, RB = eyes.intervals(x, y, g)
+    est = LimitEstimator()
+    p = est.predict_intervals(LA, RA, LB, RB)
+    assert est.last_flagged.tolist() == [True, False] == p.flagged.tolist()
+    # row-aligned through bitmaps too, with an invalid (empty) row in between
+    w = PAPER_DOMAIN.width
+    oa, ob = eyes.bitmaps(x, y, g)
+    oa = np.vstack([oa[:1, :w], np.zeros((1, w), bool), oa[1:, :w]])
+    ob = np.vstack([ob[:1, :w], np.zeros((1, w), bool), ob[1:, :w]])
+    q = est.predict(oa, ob)
+    assert q.flagged.tolist() == [True, False, False] and q.valid.tolist() == [True, False, True]
+    assert est.predict(oa[0], ob[0]).flagged
+    ana = estimators.load("analytic").predict_intervals(LA, RA, LB, RB)
+    assert p.r[0] == ana.r[0] and p.phi[0] == ana.phi[0] and np.isfinite(p.r).all()
+    s = posterior_samples((int(LA[0]), int(RA[0]), int(LB[0]), int(RB[0])))
+    assert s["empty"] and s["x"].size == 0 and s["r"] == p.r[0]
+
+
+def test_cache_and_determinism():
+    ds = dataset.generate(300, seed=4)
+    a = LimitEstimator(cache_size=50)
+    p1 = a.predict(ds.omega_a, ds.omega_b)
+    misses = a.misses
+    assert len(a._cache) == 50 and misses > 250
+    b = LimitEstimator()
+    p2 = b.predict(ds.omega_a, ds.omega_b)
+    np.testing.assert_array_equal(p1.r, p2.r)
+    np.testing.assert_array_equal(p1.phi, p2.phi)
+    hits = b.hits
+    p3 = b.predict(ds.omega_a, ds.omega_b)
+    assert b.misses == misses and b.hits == hits + misses  # all from the cache
+    np.testing.assert_array_equal(p3.r, p2.r)
+
+
+def test_posterior_samples_for_the_app():
+    eyes = PAPER_DOMAIN.eyes
+    om_a, om_b = eyes.bitmaps(np.array([300.0]), np.array([2500.0]), np.array([200.0]))
+    w = PAPER_DOMAIN.width
+    s = posterior_samples((om_a[0, :w], om_b[0, :w]), PAPER_DOMAIN, "multi")
+    assert not s["empty"] and abs(s["weight"].sum() - 1) < 1e-5
+    assert s["x"].shape == s["y"].shape == s["g"].shape == s["weight"].shape
+    r = np.hypot(s["x"], s["y"])
+    assert r.min() < s["r"] < r.max() and s["g"].max() - s["g"].min() > 5  # over all g
+    key = np.array([int(v) for v in eyes.intervals(300.0, 2500.0, 200.0)])
+    iv = np.stack(eyes.intervals(s["x"], s["y"], s["g"]), 1)
+    assert np.mean(np.all(iv == key, axis=1)) > 0.99  # the points are the key's polyhedron
