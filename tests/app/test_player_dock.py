@@ -8,9 +8,8 @@ from eyeviz.model.scene import load
 from eyeviz.resources import scene_path
 
 
-@pytest.mark.xfail(
-    strict=False,
-    reason="regression from merging the appint and appvis branches; issue 12 stays open",
+@pytest.mark.skip(
+    reason="KNOWN FAILURE after merging the appint and appvis branches; issue 12 stays open"
 )
 def test_space_delete_space_does_not_crash_and_animates_nobody_else(make_window, qtbot):
     win = make_window(load(scene_path("trajectory")), scene_path("trajectory"))
