@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from eyeviz import EyevizError
 from eyeviz.estimators import analytic
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
 from eyeviz.files.atomic import atomic_output
@@ -145,7 +146,7 @@ def save_table(table: dict, path) -> None:
         "key0": np.array([key[0]], np.int64),
         "dkey": np.diff(key).astype(np.uint32),
         "count": np.minimum(table["count"], np.iinfo(np.uint32).max).astype(np.uint32),
-        "meta": np.array(json.dumps(table["meta"])),
+        "meta": np.array(json.dumps({**table["meta"], "keys_sha256": _keys_digest(key)})),
     }
     for t in TARGETS:
         arrays[f"logr_{t}"] = np.log(table[f"r_{t}"] / ra).astype(np.float16)
@@ -155,17 +156,101 @@ def save_table(table: dict, path) -> None:
         np.savez_compressed(tmp, **arrays)
 
 
+#: Largest m of a table: every key (LA, RA, LB, RB) packs into w^4 <= 2^62 (w = m/2).
+MAX_TABLE_M = 2 * 46340
+#: Slack around [r_min, r_max] and [0, pi] for the float16 rounding of stored medians.
+_STORED_TOL = 2e-3
+
+
+def _keys_digest(key: np.ndarray) -> str:
+    import hashlib
+
+    return hashlib.sha256(np.ascontiguousarray(key, np.int64).tobytes()).hexdigest()
+
+
 def load_table(path) -> dict:
-    with np.load(path, allow_pickle=False) as z:
-        meta = json.loads(str(z["meta"]))
-        domain = Domain.from_dict(meta["domain"])
-        key = np.cumsum(np.r_[z["key0"], z["dkey"].astype(np.int64)])
-        ra, pa = _analytic(key, domain)
-        table = {"key": key, "count": z["count"].astype(np.int64), "meta": meta}
+    """The table of ``path``, every member bounded and checked before use: one
+    EyevizError line naming the file and the problem for anything else (never unpickles).
+
+    Checked: the file size; each member's dtype and declared shape (before reading it);
+    the meta (a JSON object with a valid domain, ``n`` and ``keys``); keys strictly
+    increasing inside [0, w^4) and each a pair of valid intervals (LA <= RA, LB <= RB,
+    Prop. 2); every stored median inside the domain ([r_min, r_max], [0, pi]), which is
+    what a corrupted ``key0`` or value breaks; the keys' SHA-256 when the meta has one."""
+    from eyeviz.files import limits
+    from eyeviz.files.npz import NpzReader, one_line
+
+    path = Path(path)
+    what = f"bayes table {str(path)!r}"
+    limits.check_file_size(path, limits.MAX_MODEL_FILE_BYTES, "bayes table")
+    K = limits.MAX_TABLE_KEYS
+    with NpzReader(path, what) as z:
+        meta_arr = z.read_member("meta", 1, ("U",), ndim=0, max_bytes=limits.MAX_MODEL_META_BYTES)
+        try:
+            meta = json.loads(str(meta_arr[()]))
+            if not isinstance(meta, dict) or not isinstance(meta.get("domain"), dict):
+                raise TypeError("meta is not an object with a 'domain' object")
+            domain = Domain.from_dict(meta["domain"])
+            n = limits.check_int("n", meta.get("n"), 0, 10**15)
+            nkeys = limits.check_int("keys", meta.get("keys"), 1, K)
+            seconds = float(meta.get("build_seconds", 0.0))
+        except Exception as exc:  # noqa: BLE001 - any bad meta is one message
+            raise z.fail(f"bad meta ({one_line(exc)})") from None
+        if domain.m > MAX_TABLE_M:
+            raise z.fail(f"domain m = {domain.m} exceeds {MAX_TABLE_M} (keys would overflow)")
+        key0 = z.read_member("key0", 1, ("int64",), ndim=1)
+        dkey = z.read_member("dkey", K, ("uint32",), ndim=1)
+        count = z.read_member("count", K, ("uint32",), ndim=1)
+        stored = {
+            f"{v}_{t}": z.read_member(f"{v}_{t}", K, ("float16",), ndim=1)
+            for t in TARGETS
+            for v in ("logr", "dphi")
+        }
+    sizes = {"key0 + dkey": key0.size + dkey.size, "count": count.size}
+    sizes.update({k: v.size for k, v in stored.items()})
+    for name, size in sizes.items():
+        if size != nkeys:
+            raise EyevizError(f"{what}: {name} has {size} entries, meta says keys = {nkeys}")
+    w = domain.width
+    if not 0 <= int(key0[0]) < w**4:
+        raise EyevizError(f"{what}: key0 = {int(key0[0])} outside [0, {w**4})")
+    if dkey.size and not dkey.min() > 0:
+        raise EyevizError(f"{what}: keys not strictly increasing (dkey has 0)")
+    key = np.cumsum(np.r_[key0, dkey.astype(np.int64)])
+    if int(key[-1]) >= w**4:
+        raise EyevizError(f"{what}: last key {int(key[-1])} outside [0, {w**4})")
+    digest = meta.get("keys_sha256")
+    if digest is not None and digest != _keys_digest(key):
+        raise EyevizError(f"{what}: keys do not match the meta's keys_sha256 (corrupted)")
+    LA, RA, LB, RB = _decode(key, w)
+    bad = np.flatnonzero((LA > RA) | (LB > RB))
+    if bad.size:
+        i = int(bad[0])
+        raise EyevizError(
+            f"{what}: key {i} = {(int(LA[i]), int(RA[i]), int(LB[i]), int(RB[i]))} is not a "
+            "pair of intervals (LA <= RA, LB <= RB); the keys are corrupted"
+        )
+    with np.errstate(all="ignore"):
+        ra, pa = analytic.estimate(LA, RA, LB, RB, domain)
+        values: dict[str, np.ndarray] = {}
         for t in TARGETS:
-            table[f"r_{t}"] = ra * np.exp(z[f"logr_{t}"].astype(np.float64))
-            table[f"phi_{t}"] = pa + z[f"dphi_{t}"].astype(np.float64)
-    return table
+            values[f"r_{t}"] = ra * np.exp(stored[f"logr_{t}"].astype(np.float64))
+            values[f"phi_{t}"] = pa + stored[f"dphi_{t}"].astype(np.float64)
+    lo, hi = domain.r_min * (1 - _STORED_TOL), domain.r_max * (1 + _STORED_TOL)
+    tol = _STORED_TOL
+    for t in TARGETS:
+        for name, vlo, vhi in ((f"r_{t}", lo, hi), (f"phi_{t}", -tol, math.pi + tol)):
+            v = values[name]
+            out = np.flatnonzero(~((v >= vlo) & (v <= vhi)))
+            if out.size:
+                i = int(out[0])
+                raise EyevizError(
+                    f"{what}: {name} of key {i} is {v[i]:.6g}, outside [{vlo:.6g}, {vhi:.6g}] "
+                    "(corrupted keys or values)"
+                )
+    meta["build_seconds"] = seconds
+    meta["n"] = n
+    return {"key": key, "count": count.astype(np.int64), "meta": meta, **values}
 
 
 class BayesEstimator(Estimator):
@@ -175,7 +260,7 @@ class BayesEstimator(Estimator):
 
     def __init__(self, table: dict, target: str = "mape") -> None:
         if target not in TARGETS:
-            raise ValueError(f"target must be one of {TARGETS}, got {target!r}")
+            raise EyevizError(f"target must be one of {TARGETS}, got {target!r}")
         meta = table["meta"]
         domain = Domain.from_dict(meta["domain"])
         super().__init__(
@@ -228,7 +313,7 @@ def load(
         return BayesEstimator(build_table(n, domain, seed), target)
     path = Path(path) if path is not None else default_path()
     if not path.is_file():
-        raise ValueError(
+        raise EyevizError(
             f"bayes table {path} not found; build it with `eyeviz train bayes -o {path}`"
         )
     return BayesEstimator(load_table(path), target)
@@ -249,7 +334,6 @@ def fit(
     limit needs its own large single-pass sample, so ``data`` must be None), build the
     posterior table and write ``out_dir/filename`` (default the user models directory),
     staged then swapped in. Returns the .npz path for ``load(path=...)``."""
-    from eyeviz import EyevizError
     from eyeviz.core.validation import check_int
     from eyeviz.estimators.store import staged, user_models_dir
 

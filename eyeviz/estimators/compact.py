@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import math
+import zipfile
 from collections.abc import Callable
 from pathlib import Path
 
@@ -28,9 +29,12 @@ import numpy as np
 import torch
 from torch import nn
 
+from eyeviz import EyevizError
 from eyeviz.estimators import analytic
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
+from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
+from eyeviz.files.npz import one_line
 from eyeviz.resources import models_dir
 
 __all__ = ["CompactEstimator", "CompactNet", "features", "load", "train", "default_dir"]
@@ -139,29 +143,127 @@ def _save_net(net: CompactNet, hidden: int, path: Path) -> None:
     _atomic(path, lambda tmp: torch.save(state, tmp))
 
 
+def _expected_shapes(hidden: int) -> dict[str, tuple[int, ...]]:
+    """The state of ``CompactNet(hidden)``: parameter name -> shape."""
+    return {
+        "net.0.weight": (hidden, N_FEATURES),
+        "net.0.bias": (hidden,),
+        "net.2.weight": (hidden, hidden),
+        "net.2.bias": (hidden,),
+        "net.4.weight": (1, hidden),
+        "net.4.bias": (1,),
+    }
+
+
+def _check_zip(path: Path) -> None:
+    """A torch zip file whose every member matches its CRC-32: torch itself reads the
+    records without checking them, so a flipped bit in the weights would load silently."""
+    try:
+        with zipfile.ZipFile(path) as zf:
+            bad = zf.testzip()
+    except Exception as exc:  # noqa: BLE001 - BadZipFile, EOFError, zlib.error, ...
+        raise EyevizError(
+            f"{str(path)!r}: not a torch zip weights file ({one_line(exc, 120)})"
+        ) from None
+    if bad is not None:
+        raise EyevizError(f"{str(path)!r}: member {bad!r} fails its CRC check (corrupted)")
+
+
 def _load_net(path: Path) -> CompactNet:
-    obj = torch.load(path, map_location="cpu", weights_only=True)
-    net = CompactNet(int(obj["hidden"]))
-    net.load_state_dict(obj["state"])
+    """One network file, checked before anything it declares is built: a bounded regular
+    file, read by ``torch.load(weights_only=True)`` (no code can run), holding
+    ``{"hidden": int, "state": {name: finite float tensor}}`` with exactly the shapes of
+    ``CompactNet(hidden)``; ``hidden`` at most :data:`limits.MAX_HIDDEN`."""
+    name = path.name
+    limits.check_file_size(path, limits.MAX_MODEL_FILE_BYTES, "compact weights file")
+    _check_zip(path)
+    try:
+        obj = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as exc:  # noqa: BLE001 - UnpicklingError, EOFError, zip damage, ...
+        raise EyevizError(
+            f"{str(path)!r}: not a readable weights file ({type(exc).__name__}: "
+            f"{one_line(exc, 120)})"
+        ) from None
+    if not isinstance(obj, dict) or "hidden" not in obj or not isinstance(obj.get("state"), dict):
+        raise EyevizError(f"{str(path)!r}: expected {{'hidden': int, 'state': {{...}}}}")
+    hidden = limits.check_hidden(name, obj["hidden"])
+    state = obj["state"]
+    want = _expected_shapes(hidden)
+    if set(state) != set(want):
+        raise EyevizError(
+            f"{str(path)!r}: state has parameters {sorted(map(str, state))[:8]}, "
+            f"expected {sorted(want)}"
+        )
+    for key, shape in want.items():
+        t = state[key]
+        if not isinstance(t, torch.Tensor) or not t.is_floating_point():
+            raise EyevizError(f"{str(path)!r}: {key} is not a float tensor")
+        if tuple(t.shape) != shape:
+            raise EyevizError(
+                f"{str(path)!r}: {key} has shape {tuple(t.shape)}, expected {shape} "
+                f"for hidden = {hidden}"
+            )
+        if not bool(torch.isfinite(t).all()):
+            raise EyevizError(f"{str(path)!r}: {key} holds NaN or infinite weights")
+    net = CompactNet(hidden)
+    try:
+        net.load_state_dict(state)
+    except (RuntimeError, TypeError, ValueError) as exc:
+        raise EyevizError(f"{str(path)!r}: {one_line(exc, 160)}") from None
     return net
 
 
+def _member(d: Path, files, key: str) -> Path:
+    """``files[key]`` of compact.json: a relative path inside the model directory."""
+    meta_f = d / "compact.json"
+    name = files.get(key) if isinstance(files, dict) else None
+    if not isinstance(name, str) or not name or "\0" in name:
+        raise EyevizError(f"{str(meta_f)!r}: files.{key} must be a file name, got {name!r}")
+    rel = Path(name)
+    if rel.is_absolute() or ".." in rel.parts:
+        raise EyevizError(
+            f"{str(meta_f)!r}: files.{key} = {name!r} must stay inside the model directory"
+        )
+    if not (d / rel).is_file():
+        raise EyevizError(f"{str(meta_f)!r}: files.{key} = {name!r} is not a file in {str(d)!r}")
+    return d / rel
+
+
 def load(path=None, domain: Domain | None = None) -> CompactEstimator:
-    """Weights from ``path`` (a directory with compact.json), default assets/models/."""
+    """Weights from ``path`` (a directory with compact.json), default assets/models/.
+
+    Every problem with the directory is one EyevizError line naming the file: compact.json
+    (bounded size, a JSON object, ``files.dd`` / ``files.ad`` inside the directory,
+    ``data`` a valid domain with m <= :data:`limits.MAX_M`) and each weights file
+    (:func:`_load_net`). Nothing is unpickled."""
     d = Path(path) if path is not None else default_dir()
     meta_f = d / "compact.json"
     if not meta_f.is_file():
-        raise ValueError(
+        raise EyevizError(
             f"compact weights not found in {d} (no compact.json); "
             f"train them with `eyeviz train compact -o {d}`"
         )
-    meta = json.loads(meta_f.read_text())
+    raw = limits.read_bounded(meta_f, limits.MAX_MODEL_META_BYTES, "model metadata")
     try:
-        dd = _load_net(d / meta["files"]["dd"])
-        ad = _load_net(d / meta["files"]["ad"])
-    except (OSError, KeyError, RuntimeError) as exc:
-        raise ValueError(f"cannot load compact weights from {d}: {exc}") from None
-    dom = domain or Domain.from_dict(meta["data"])
+        meta = json.loads(raw)
+    except (ValueError, RecursionError) as exc:
+        raise EyevizError(f"{str(meta_f)!r}: not valid JSON ({one_line(exc, 120)})") from None
+    if not isinstance(meta, dict):
+        raise EyevizError(f"{str(meta_f)!r}: expected a JSON object, got {type(meta).__name__}")
+    files = meta.get("files")
+    dd = _load_net(_member(d, files, "dd"))
+    ad = _load_net(_member(d, files, "ad"))
+    if domain is None:
+        data = meta.get("data")
+        if not isinstance(data, dict):
+            raise EyevizError(f"{str(meta_f)!r}: 'data' must be an object with the domain")
+        try:
+            dom = Domain.from_dict(data)
+            limits.check_m(dom.m)
+        except (ValueError, TypeError, OverflowError) as exc:
+            raise EyevizError(f"{str(meta_f)!r}: bad data ({one_line(exc, 160)})") from None
+    else:
+        dom = domain
     return CompactEstimator(dd, ad, dom, meta)
 
 

@@ -29,6 +29,11 @@ MAX_FEATURES = 10**4
 #: Width of a hidden layer read from a model directory, and total parameters of a model.
 MAX_HIDDEN = 4096
 MAX_MODEL_PARAMS = 50_000_000
+#: Size of one model file (weights, a posterior table) and of its JSON metadata.
+MAX_MODEL_FILE_BYTES = 1 << 30
+MAX_MODEL_META_BYTES = 1 << 20
+#: Keys of a posterior table (bayes.npz; the shipped one has 371,494).
+MAX_TABLE_KEYS = 50_000_000
 #: Length of a feature name in a scene.
 MAX_NAME_CHARS = 200
 #: Largest r and g of a data set row, and |phi| (radians): beyond these no bitmap can

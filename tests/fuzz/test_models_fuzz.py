@@ -1,10 +1,9 @@
 """Model directories (compact: compact.json + two .pt files; bayes: one .npz): mutated
 files give an estimator that predicts, or one error line; the loader never unpickles.
 
-Estimator loading is owned by eyeviz/estimators (another owner). Each example's outcome is
-recorded (ok, refused, or ``bug: <exception type>``) and the last test of the file fails
-while any bug was seen; it is marked xfail(strict=True) until the loaders are fixed, so
-it turns red (XPASS) the day they are and the marker must go."""
+Each example's outcome is recorded (ok, refused, or ``bug: <stage>: <exception type>``)
+and the last test of the file fails while any bug was seen: a refusal must be one
+EyevizError line, and a loader's refusal must name the file it is about."""
 
 from __future__ import annotations
 
@@ -13,12 +12,11 @@ import shutil
 from pathlib import Path
 
 import numpy as np
-import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from eyeviz import EyevizError, estimators
 from eyeviz import dataset as D
-from eyeviz import estimators
 
 from .conftest import assert_one_line, count, digest, fuzz_settings
 from .test_dataset_fuzz import mutated
@@ -27,28 +25,53 @@ MODELS = Path(__file__).resolve().parents[2] / "assets" / "models"
 ROWS = D.generate(8, seed=4)
 
 
-def _predicts(est) -> None:
+def _predicts(est) -> tuple:
     pred = est.predict(ROWS.omega_a, ROWS.omega_b)
     assert np.shape(pred.r) == (8,) and np.shape(pred.phi) == (8,)
+    return np.asarray(pred.r), np.asarray(pred.phi)
 
 
 BUGS: dict[str, int] = {}
 
 
-def _try_load(name: str, category: str, **kw) -> None:
+_REF: dict[str, tuple] = {}
+
+
+def _reference(name: str) -> tuple:
+    """The shipped model's prediction of ROWS (what an intact file must still give)."""
+    if name not in _REF:
+        _REF[name] = _predicts(estimators.load(name))
+    return _REF[name]
+
+
+def _try_load(
+    name: str, category: str, names: tuple[str, ...] = (), exact: bool = False, **kw
+) -> None:
+    """Load then predict; a refusal must be one EyevizError line, and a refusal by the
+    loader must name the file (one of ``names``) it is about. With ``exact`` (the bytes
+    of a weights file were mutated), a model that loads must predict exactly what the
+    shipped one does: a changed weight is refused, never used."""
+    stage = "load"
     try:
         est = estimators.load(name, **kw)
-        _predicts(est)
-    except ValueError as exc:  # EyevizError is a ValueError
+        stage = "predict"
+        pred = _predicts(est)
+    except EyevizError as exc:
         msg = str(exc)
         if "\n" in msg.strip() or len(msg) >= 1000:
             _bug(category, "multi-line message")
             return
         assert_one_line(msg)
+        if stage == "load" and names and not any(n in msg for n in names):
+            _bug(category, f"message names no file: {msg[:80]}")
+            return
         count(category, "refused")
         return
     except Exception as exc:  # noqa: BLE001 - recorded, asserted in test_no_loader_bugs
-        _bug(category, type(exc).__name__)
+        _bug(category, f"{stage}: {type(exc).__name__}")
+        return
+    if exact and not all(np.array_equal(a, b) for a, b in zip(pred, _reference(name), strict=True)):
+        _bug(category, "silently different predictions")
         return
     count(category, "ok")
 
@@ -99,7 +122,7 @@ def _compact_dir(tmp: Path) -> Path:
 def test_compact_json(tmp_path_factory, meta):
     d = _compact_dir(tmp_path_factory.mktemp("cj"))
     (d / "compact.json").write_text(json.dumps(meta))
-    _try_load("compact", "models: compact.json", path=d)
+    _try_load("compact", "models: compact.json", ("compact.json", ".pt"), path=d)
 
 
 @fuzz_settings(120)
@@ -109,7 +132,7 @@ def test_compact_weights_bytes(tmp_path_factory, which, data):
     blob = data.draw(mutated((MODELS / which).read_bytes()))
     (d / which).write_bytes(blob)
     before = digest(d / which)
-    _try_load("compact", "models: compact .pt bytes", path=d)
+    _try_load("compact", "models: compact .pt bytes", (which,), exact=True, path=d)
     assert digest(d / which) == before
 
 
@@ -122,13 +145,8 @@ def test_bayes_table_bytes(tmp_path_factory, data):
     blob = data.draw(mutated(src, region=region))
     p = tmp_path_factory.mktemp("b") / "bayes.npz"
     p.write_bytes(blob)
-    _try_load("bayes", "models: bayes.npz bytes", path=p)
+    _try_load("bayes", "models: bayes.npz bytes", ("bayes.npz",), exact=True, path=p)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 13: eyeviz/estimators loaders raise TypeError/KeyError/IndexError/EOFError/"
-    "UnpicklingError/zlib.error on malformed model files (owner: plugins)",
-)
 def test_no_loader_bugs():
     assert not BUGS, BUGS
