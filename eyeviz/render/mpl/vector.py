@@ -22,6 +22,7 @@ from eyeviz.model.frame import build_frame, runs, state_for
 from eyeviz.model.palette import estimator_colors
 from eyeviz.model.scene import Scene
 from eyeviz.model.state import SceneState, compute_state
+from eyeviz.render.mpl.bounded import bound_figure
 from eyeviz.render.mpl.canvas import make_canvas
 from eyeviz.render.mpl.layers import (
     ambiguity,
@@ -68,6 +69,10 @@ __all__ = [
 
 MAX_FEATURES = 10_000  # a snapshot with more features is refused (drawing would take minutes)
 MAX_COORD = 1e15  # |x|, |y|, g and the view beyond this cannot be drawn by Agg
+#: The view's width relative to its centre's distance from the origin, at least (about
+#: 4,500 float64 steps across the view); far below it float64 cannot even tell the view's
+#: edges from its centre (1e12 +- 5e-7 == 1e12).
+MIN_VIEW_REL = 1e-12
 
 eye_runs = runs  # maximal runs of equal values (eyeviz.model.frame.runs)
 
@@ -96,8 +101,9 @@ def resolve_width(width) -> float:
 
 
 def check_drawable(scene: Scene) -> None:
-    """EyevizError (one line) for a scene no figure can show: too many features, or
-    coordinates beyond :data:`MAX_COORD`."""
+    """EyevizError (one line) for a scene no figure can show: too many features,
+    coordinates beyond :data:`MAX_COORD`, or a view narrower than :data:`MIN_VIEW_REL`
+    times its centre's distance from the origin."""
     n = len(scene.features)
     if n > MAX_FEATURES:
         raise EyevizError(f"a figure shows at most {MAX_FEATURES} features; this scene has {n}")
@@ -106,6 +112,13 @@ def check_drawable(scene: Scene) -> None:
     for k, v in vals.items():
         if not (math.isfinite(v) and abs(v) <= MAX_COORD):
             raise EyevizError(f"{k} = {v:g} cannot be drawn (|value| must be <= {MAX_COORD:g})")
+    least = MIN_VIEW_REL * max(abs(cx), abs(cy))
+    if scene.view.width < least:
+        raise EyevizError(
+            f"view width = {scene.view.width:g} cannot be drawn at centre ({cx:g}, {cy:g}): "
+            f"below float64 resolution there (need width >= {MIN_VIEW_REL:g} * |centre| = "
+            f"{least:g})"
+        )
     for f in scene.features:
         for k, v in (("x", f.x), ("y", f.y), ("g", f.g)):
             if not (math.isfinite(v) and abs(v) <= MAX_COORD):
@@ -230,6 +243,7 @@ def figure(
             bitmaps_layer.paint(cv)
         if "readout" in lay_names:
             table_layer.paint(cv)
+        bound_figure(cv.fig)  # nothing Agg/FreeType cannot raster in bounded time
         cv.fig._eyeviz_rc = dict(RC)  # savefig must run under the same rc (fonttype)
         cv.fig._eyeviz_merged = cv.merged
         cv.fig._eyeviz_frame = fr

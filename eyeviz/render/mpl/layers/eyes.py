@@ -26,6 +26,22 @@ def merges(cv: Canvas) -> bool:
     return base * cv.dpi < 1.0
 
 
+def _in_view(ax, center: tuple[float, float], rim: np.ndarray) -> np.ndarray:
+    """Per cell (triangle centre, rim[i], rim[i + 1]): does its bounding box meet the
+    axes' view (expanded by 5 %)?"""
+    x0, x1 = sorted(ax.get_xlim())
+    y0, y1 = sorted(ax.get_ylim())
+    dx, dy = 0.05 * (x1 - x0), 0.05 * (y1 - y0)
+    xs = np.column_stack([np.full(len(rim) - 1, center[0]), rim[:-1, 0], rim[1:, 0]])
+    ys = np.column_stack([np.full(len(rim) - 1, center[1]), rim[:-1, 1], rim[1:, 1]])
+    return (
+        (xs.max(axis=1) >= x0 - dx)
+        & (xs.min(axis=1) <= x1 + dx)
+        & (ys.max(axis=1) >= y0 - dy)
+        & (ys.min(axis=1) <= y1 + dy)
+    )
+
+
 def paint(cv: Canvas) -> None:
     p, fr, ax = cv.pair, cv.frame, cv.eye_ax
     merge = merges(cv)
@@ -52,7 +68,10 @@ def paint(cv: Canvas) -> None:
         else:
             k = np.arange(p.m + 1) * gam
             rim = np.column_stack([cx + p.l * np.cos(k), cy + p.l * np.sin(k)])
+            seen = _in_view(ax, (cx, cy), rim)
             for i, c in enumerate(eye.color_index.tolist()):
+                if not seen[i]:  # zoomed in on a few cells: the others are not drawn
+                    continue
                 tri = Polygon(
                     [(cx, cy), rim[i], rim[i + 1]],
                     closed=True,
