@@ -84,3 +84,39 @@ def test_report_bad_input(files, tmp_path):
     )
     assert res.returncode == 2 and "no such data set file" in res.stderr
     assert "Traceback" not in res.stderr and not (tmp_path / "r").exists()
+
+
+def test_summary_is_streamed_and_matches_the_whole_file(files, monkeypatch):
+    """summarise reads blocks (never the whole data set) and agrees with the figures
+    computed on the loaded rows, including the exact count of distinct bitmap pairs."""
+    import numpy as np
+
+    from eyeviz.dataset import reader as R
+    from eyeviz.reports import dataset as rep
+
+    whole = D.load(files / "single.npz")
+    keys = np.concatenate([np.packbits(whole.omega_a, 1), np.packbits(whole.omega_b, 1)], 1)
+    distinct = len(np.unique(keys, axis=0))
+    real = R.iter_blocks
+    monkeypatch.setattr(rep, "_reader", lambda p: real(p, block_rows=997))
+    monkeypatch.setattr(D, "load", lambda *a, **k: pytest.fail("report loaded a whole file"))
+    s = rep.summarise(files / "single.npz", "x")
+    assert s.n == len(whole) and s.distinct_pairs == distinct
+    assert s.r_min == whole.r.min() and s.r_max == whole.r.max()
+    assert s.r_mean == pytest.approx(whole.r.mean(), rel=1e-12)
+    assert s.g_max == whole.g.max() and s.phi_min_deg == pytest.approx(np.degrees(whole.phi.min()))
+
+
+@pytest.mark.parametrize(
+    ("flag", "value", "match"),
+    [("--bins", "1000000000", "bins must be in"), ("--max-points", "0", "--max-points must be")],
+)
+def test_bins_and_points_are_bounded(files, tmp_path, flag, value, match):
+    res = subprocess.run(
+        [*EYEVIZ, "report", "dataset", str(files / "single.npz"), flag, value, "-o", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert res.returncode == 2 and match in res.stderr, res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1
