@@ -9,8 +9,20 @@ whatever its size.
 The data set's eye design (h, l, m) must be the estimator's: an NPZ carries it, a CSV is
 described by ``--h --l --m`` (default Tables 3-4). An estimator for any design (analytic,
 limit) gets its domain from those flags (and ``--r-min --r-max --g-max``); the other
-options come from the estimator's registry entry. ``-o`` may not be the input file
+options come from the estimator's registry entry; an option the chosen estimator does
+not take (``--weights`` for analytic, ``--target`` for compact, ``--r-min`` for a
+fixed-design estimator) is refused, never ignored. ``-o`` may not be the input file
 (compared by device and inode, so links count).
+
+Exit status (also in ``--help``):
+
+- **0**: the output was written. Rows that are not a single feature (an eye with no lit
+  ommatidium, or two separate lit runs) have no answer by definition: they are written as
+  ``nan`` and counted on stderr.
+- **2**: refused with one line (bad input, options, design mismatch); nothing written.
+- **3**: the output was written, but the estimator gave no finite answer (``nan`` or
+  ``inf``) for some rows that *are* a single feature; one line on stderr counts them.
+  Nothing is lost, but a script should not take the file as complete.
 """
 
 from __future__ import annotations
@@ -22,12 +34,20 @@ from pathlib import Path
 
 NAME = "predict"
 HELP = "predict distance and azimuth for every row of a data set"
+EPILOG = (
+    "exit status: 0 written (rows that are not a single feature are nan, counted on "
+    "stderr); 2 refused, nothing written; 3 written, but the estimator left some "
+    "single-feature rows without a finite answer (counted on stderr)"
+)
+#: Exit status when the output is written but some valid rows got no finite prediction.
+EXIT_UNANSWERED = 3
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from eyeviz.estimators import registry
 
     names = registry.available()
+    parser.epilog = EPILOG
     parser.add_argument("data", help="data set (.csv or .npz, as `eyeviz generate` writes)")
     parser.add_argument(
         "-e",
@@ -88,6 +108,39 @@ def _reader(args, registry):
     return iter_blocks(path, eyes=EyePair(dom.h, dom.l, dom.m)), dom.design
 
 
+def _refuse_foreign_options(entry, args, registry) -> None:
+    """EyevizError for an option given on the command line that ``entry`` does not take:
+    another estimator's option, ``--weights`` for an estimator without weights, or the
+    object ranges (``--r-min --r-max --g-max``) for an estimator of a fixed design."""
+    from eyeviz import EyevizError
+
+    name = entry.name
+    if args.weights is not None and not entry.weights_hint:
+        raise EyevizError(
+            f"estimator {name!r} has no weights: --weights is not an option of it "
+            f"(estimators with weights: {', '.join(_with_weights(registry))})"
+        )
+    own = {o.dest for o in entry.load_options}
+    for other in registry.entries():
+        for opt in other.load_options:
+            if opt.dest not in own and getattr(args, opt.dest, None) is not None:
+                flag = next((f for f in opt.flags if f.startswith("--")), opt.flags[0])
+                raise EyevizError(
+                    f"{flag} is an option of estimator {other.name!r}, not of {name!r}"
+                )
+    if not entry.any_design:
+        for k in ("r_min", "r_max", "g_max"):
+            if getattr(args, k, None) is not None:
+                raise EyevizError(
+                    f"--{k.replace('_', '-')} is for estimators of any design; {name!r} "
+                    "answers for the ranges it was trained on"
+                )
+
+
+def _with_weights(registry) -> list[str]:
+    return [e.name for e in registry.entries() if e.weights_hint]
+
+
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -98,6 +151,7 @@ def run(args: argparse.Namespace) -> int:
     from eyeviz.files.atomic import atomic_output
 
     entry = registry.get(args.estimator)
+    _refuse_foreign_options(entry, args, registry)
     out = Path(args.out)
     if not Path(args.data).is_file():
         raise EyevizError(f"data file {args.data} not found")
@@ -118,7 +172,7 @@ def run(args: argparse.Namespace) -> int:
             f"data set {args.data} has design {_design_text(*design)}, but estimator "
             f"{entry.name!r} answers for {_design_text(*est.domain.design)}"
         )
-    n = invalid = outside = 0
+    n = invalid = outside = unanswered = 0
     dd, ad = RunningSummary(), RunningSummary()
     with atomic_output(out) as tmp, open(tmp, "w", encoding="ascii") as fh:
         fh.write("r_hat,phi_hat\n")
@@ -126,11 +180,13 @@ def run(args: argparse.Namespace) -> int:
             pred = est.predict(b.omega_a, b.omega_b)
             np.savetxt(fh, np.column_stack([pred.r, pred.phi]), fmt="%.17g", delimiter=",")
             valid = np.asarray(pred.valid)
+            answered = valid & np.isfinite(pred.r) & np.isfinite(pred.phi)
             n += len(valid)
             invalid += int((~valid).sum())
+            unanswered += int((valid & ~answered).sum())
             outside += int((valid & ~np.asarray(pred.in_domain)).sum())
-            dd.update(b.r[valid], pred.r[valid])
-            ad.update(b.phi[valid], pred.phi[valid])
+            dd.update(b.r[answered], pred.r[answered])
+            ad.update(b.phi[answered], pred.phi[answered])
     msg = f"{args.estimator}: {n} rows -> {out}"
     if invalid:
         msg += f"; {invalid} not a single feature (nan)"
@@ -141,10 +197,19 @@ def run(args: argparse.Namespace) -> int:
         try:
             d, a = dd.result(), ad.result()
         except ValueError:
-            return 0
+            d = a = None
+        if d is not None and a is not None:
+            print(
+                f"DD MAPE {d['mape']:.3f} %  MAE {d['mae']:.2f}  R^2 {d['r2']:.4f} | "
+                f"AD MAPE {a['mape']:.4f} %  MAE {a['mae']:.3g} rad  R^2 {a['r2']:.6f}",
+                file=sys.stderr,
+            )
+    if unanswered:
         print(
-            f"DD MAPE {d['mape']:.3f} %  MAE {d['mae']:.2f}  R^2 {d['r2']:.4f} | "
-            f"AD MAPE {a['mape']:.4f} %  MAE {a['mae']:.3g} rad  R^2 {a['r2']:.6f}",
+            f"eyeviz: warning: {out} written, but {args.estimator} gave no finite answer "
+            f"for {unanswered} of {n - invalid} single-feature rows (nan there; exit "
+            f"{EXIT_UNANSWERED})",
             file=sys.stderr,
         )
+        return EXIT_UNANSWERED
     return 0

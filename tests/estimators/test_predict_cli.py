@@ -137,3 +137,78 @@ def test_limit_domain_and_prior_from_flags(data, tmp_path):
     assert not np.allclose(got[:, 0], single.r, equal_nan=True)  # --prior reached the estimator
     res = _run("predict", "-e", "limit", "--prior", "triple", data / "m360.csv", "-o", out)
     assert res.returncode == 2 and "triple" in res.stderr
+
+
+@pytest.mark.parametrize(
+    ("extra", "parts"),
+    [
+        (["--weights", "x"], ("'analytic' has no weights", "--weights", "compact")),
+        (["--target", "mae"], ("--target is an option of estimator 'bayes'", "'analytic'")),
+        (["--device", "cpu"], ("--device is an option of estimator 'paper'",)),
+    ],
+)
+def test_options_the_estimator_does_not_take_are_refused(data, tmp_path, extra, parts):
+    out = tmp_path / "p.csv"
+    res = _run("predict", "-e", "analytic", *extra, data / "paper.npz", "-o", out)
+    _one_line_error(res, *parts)
+    assert not out.exists()
+
+
+def test_ranges_for_a_fixed_design_estimator_are_refused(data, tmp_path):
+    res = _run("predict", "-e", "bayes", "--r-min", "10", data / "paper.npz", "-o", tmp_path / "p")
+    _one_line_error(res, "--r-min is for estimators of any design", "'bayes'")
+
+
+def test_rows_without_a_single_feature_are_nan_and_exit_0(data, tmp_path, capsys):
+    """Invalid bitmaps (no lit ommatidium) have no answer by definition: nan, counted."""
+    from eyeviz.cli import main
+
+    ds = dataset.load(data / "paper.npz")
+    ds.omega_a[[3, 7]] = False
+    src = tmp_path / "d.npz"
+    dataset.save(ds, src)
+    out = tmp_path / "p.csv"
+    code = main(["predict", "-e", "analytic", str(src), "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code == 0, err
+    got = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert np.isnan(got[[3, 7]]).all() and np.isfinite(np.delete(got, [3, 7], 0)).all()
+    assert "2 not a single feature (nan)" in err and "warning" not in err
+
+
+def test_valid_rows_left_unanswered_exit_3_after_writing(data, tmp_path, capsys):
+    """An estimator that returns nan for rows that are a single feature: the output is
+    written (nothing lost), one warning line counts them, exit 3 (documented in --help)."""
+    from eyeviz.cli import main
+    from eyeviz.estimators import analytic, registry
+
+    class Holes(analytic.AnalyticEstimator):
+        name = "holes"
+
+        def _predict_intervals(self, LA, RA, LB, RB):
+            r, phi = super()._predict_intervals(LA, RA, LB, RB)
+            r = r.copy()
+            r[::100] = np.nan
+            return r, phi
+
+    registry.register(
+        registry.Entry("holes", "test: nan for every 100th row", lambda: Holes()),
+        replace=True,
+    )
+    try:
+        out = tmp_path / "p.csv"
+        code = main(["predict", "-e", "holes", str(data / "paper.npz"), "-o", str(out)])
+    finally:
+        registry.unregister("holes")
+    err = capsys.readouterr().err
+    assert code == 3, err
+    got = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert got.shape == (300, 2) and np.isnan(got[::100, 0]).all()
+    warn = [ln for ln in err.splitlines() if "warning" in ln]
+    assert len(warn) == 1 and "no finite answer for 3 of 300 single-feature rows" in warn[0]
+    assert "DD MAPE" in err  # the metrics still cover the answered rows
+
+
+def test_help_documents_the_exit_status():
+    res = _run("predict", "--help")
+    assert res.returncode == 0 and "exit status: 0 written" in " ".join(res.stdout.split())

@@ -199,9 +199,11 @@ def test_predict_cli(tmp_path_factory, fmt, data):
     out = d / "pred.csv"
     code, err = _cli(["predict", "-e", "analytic", str(p), "-o", str(out)])
     assert digest(p) == before
-    if code == 0:
+    if code in (0, 3):  # 3: written, some single-feature rows unanswered (documented)
         lines = out.read_text().splitlines()
         assert lines[0] == "r_hat,phi_hat" and len(lines) == len(D.load(p)) + 1
+        if code == 3:
+            assert_one_line(next(ln for ln in err.splitlines() if "warning" in ln))
         count(f"cli: predict {fmt}", "ok")
     else:
         assert code == 2, err
