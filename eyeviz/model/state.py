@@ -24,7 +24,7 @@ __all__ = ["SceneState", "compute_state", "owners"]
 # Layers that need the lit intervals; the ownership arrays; the per-feature readout.
 _NEED_INTERVALS = {"eyes", "bitmaps", "sectors", "readout", "labels", "predictions", "ambiguity"}
 _NEED_OWNERS = {"eyes"}
-_NEED_READOUT = {"readout", "labels", "predictions", "tangents", "ambiguity", "features"}
+_NEED_READOUT = {"readout", "labels", "predictions", "tangents", "ambiguity", "features", "sectors"}
 
 
 @dataclass

@@ -65,3 +65,18 @@ def test_no_features():
     st = compute_state(Scene(features=[]))
     assert st.n == 0
     assert (st.owner_a == -1).all() and st.owner_a.shape == (720,)
+
+
+def test_sectors_alone_get_the_eye_distances_they_draw_with():
+    """The sectors layer reaches rE + 1.6 g: its state must carry rA/rB even when no other
+    layer asks for them (a scene showing only sectors crashed the frame, issue 13 fuzz)."""
+    from eyeviz.model import scene as S
+    from eyeviz.model.frame import build_frame
+    from eyeviz.model.state import compute_state
+
+    sc = S.loads('[[features]]\nname = "a"\nx = 0.0\ny = 1500.0\ng = 50.0\n', "t.toml")
+    sc.layers = ["sectors"]
+    st = compute_state(sc)
+    assert st.rA is not None and st.rB is not None
+    fr = build_frame(sc, st, rect=(-100.0, 100.0, 0.0, 2000.0))
+    assert len(fr.sectors) == 2
