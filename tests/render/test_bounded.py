@@ -154,3 +154,41 @@ def test_wedge_patch_huge_is_clipped():
     bounded.bound_figure(fig)
     (p,) = ax.patches
     assert isinstance(p, Polygon) and np.abs(p.get_xy()).max() < 20
+
+
+def test_readout_of_extreme_values_does_not_overlap_or_overflow():
+    """Distances of 1e12 and a 200-character name: the table's cells in each row are
+    apart and inside the figure, the long lines cut with an ellipsis (was: run together)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from eyeviz.render.mpl import vector
+
+    feats = "".join(
+        f'[[features]]\nname = "{n}"\nx = {x!r}\ny = {y!r}\ng = {g!r}\n'
+        for n, x, y, g in (
+            ("$\\\\undefined$", -5525.0, -1e12, 1e6),
+            ("n" * 200, 1e12, 123456789.125, 1e-6),
+            ("a", 1833.46, 0.0, 1e6),
+            ("exact", 1728.97, 123456789.125, 1e12),
+        )
+    )
+    sc = _scene(feats, "center = [-4172.86, 0.0]\nwidth = 8000.0", ALL)
+    fig = vector.figure(sc, dpi=100)
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    width = fig.bbox.width
+    rows: dict[str, list] = {}
+    for ax in fig.axes:
+        for t in ax.texts:
+            gid = t.get_gid() or ""
+            if not t.get_text():
+                continue
+            bb = t.get_window_extent(renderer)
+            if gid.startswith("readout-"):
+                assert bb.x1 <= width + 1 and bb.x0 >= -1, (t.get_text(), bb)
+            if gid.startswith("readout-") and gid.split("-")[1].isdigit():
+                rows.setdefault(gid.split("-")[2], []).append(bb)
+    assert len(rows) == 4
+    for boxes in rows.values():
+        boxes.sort(key=lambda b: b.x0)
+        for a, b in zip(boxes, boxes[1:], strict=False):
+            assert a.x1 <= b.x0 + 0.5, (a, b)

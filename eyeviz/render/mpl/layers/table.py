@@ -7,7 +7,7 @@ import math
 
 from eyeviz.model.frame import PredictionFrame
 from eyeviz.model.palette import estimator_color
-from eyeviz.render.mpl.canvas import Canvas
+from eyeviz.render.mpl.canvas import Canvas, fit_text
 from eyeviz.render.mpl.style import GREY, LIGHT, OUT_OF_DOMAIN, SMALL, dark, distance, short, slug
 
 # (header, alignment); the x positions follow the widest cell of each column
@@ -26,15 +26,15 @@ CHAR_IN = 0.6 * SMALL / 72  # a generous width of one 6 pt character, inches
 GAP_IN = 0.1  # at least this much between two cells
 
 
-def column_x(cells: list[list[str]], width_in: float):
+def column_x(cells: list[list[str]], width_in: float, gap: float = GAP_IN, name_min: float = 0.55):
     """(x, left, right) of each column as fractions of the table's width (x is the text
     anchor: the right edge for right-aligned columns), from the widest cell; None when the
-    columns cannot fit."""
+    columns cannot fit with ``gap`` inches between them."""
     widths = [
         max([len(h)] + [len(row[j]) for row in cells]) * CHAR_IN for j, (h, _) in enumerate(COLUMNS)
     ]
-    widths[0] = max(widths[0], 0.55)
-    need = sum(widths) + GAP_IN * (len(widths) - 1)
+    widths[0] = max(widths[0], name_min)
+    need = sum(widths) + gap * (len(widths) - 1)
     if need > width_in:
         return None
     spare = min((width_in - need) / (len(widths) - 1), 0.3)  # compact on a wide figure
@@ -43,17 +43,17 @@ def column_x(cells: list[list[str]], width_in: float):
         xs.append({"left": x, "right": x + w, "center": x + w / 2}[ha] / width_in)
         lefts.append(x / width_in)
         rights.append((x + w) / width_in)
-        x += w + GAP_IN + spare
+        x += w + gap + spare
     return xs, lefts, rights
 
 
-def row_values(fr, i: int, compact: bool = False) -> list[str]:
+def row_values(fr, i: int, compact: bool = False, name_chars: int = 15) -> list[str]:
     """The table's cells for feature i, from the Frame's readout arrays (distances in full,
-    or in at most 7 characters when ``compact``)."""
+    or in at most 7 characters when ``compact``; the name cut to ``name_chars``)."""
     dist = distance if compact else _full
     seen = " ".join(e for e, v in (("A", fr.vis_a[i]), ("B", fr.vis_b[i])) if v) or "none"
     return [
-        short(fr.names[i], 15),
+        short(fr.names[i], name_chars),
         dist(float(fr.r[i])),
         f"{math.degrees(fr.phi[i]):.1f}\u00b0",
         dist(float(fr.rA[i])),
@@ -109,11 +109,18 @@ def paint(cv: Canvas) -> None:
     ax.set_xlim(0, 1)
     ax.set_ylim(0, 1)
     dy = 1.0 / cv.lay.readout_rows
-    cells = [row_values(fr, i) for i in range(fr.n)]
-    cols = column_x(cells, box.w)
-    if cols is None:  # distances too long for the width: 3 significant digits
-        cells = [row_values(fr, i, compact=True) for i in range(fr.n)]
-        cols = column_x(cells, box.w)
+    line_pt = 0.97 * box.w * 72  # a prediction or ambiguity line is cut to the table
+    # full distances; else 3 significant digits; else shorter names and tighter gaps
+    for compact, name_chars, gap, name_min in (
+        (False, 15, GAP_IN, 0.55),
+        (True, 15, GAP_IN, 0.55),
+        (True, 10, 0.05, 0.4),
+        (True, 6, 0.03, 0.3),
+    ):
+        cells = [row_values(fr, i, compact, name_chars) for i in range(fr.n)]
+        cols = column_x(cells, box.w, gap, name_min)
+        if cols is not None:
+            break
     if cols is None:
         xs = [0.0, 0.29, 0.395, 0.5, 0.605, 0.71, 0.815, 0.862, 1.0]
         lefts, rights = [x - 0.09 for x in xs], xs
@@ -153,7 +160,7 @@ def paint(cv: Canvas) -> None:
                 ax.text(
                     0.03,
                     y,
-                    prediction_line(fr, i, name),
+                    fit_text(prediction_line(fr, i, name), SMALL, line_pt),
                     ha="left",
                     va="center",
                     fontsize=SMALL,
@@ -165,7 +172,7 @@ def paint(cv: Canvas) -> None:
             ax.text(
                 0.03,
                 y,
-                ambiguity_line(fr, i),
+                fit_text(ambiguity_line(fr, i), SMALL, line_pt),
                 ha="left",
                 va="center",
                 fontsize=SMALL,
