@@ -192,3 +192,13 @@ def test_readout_of_extreme_values_does_not_overlap_or_overflow():
         boxes.sort(key=lambda b: b.x0)
         for a, b in zip(boxes, boxes[1:], strict=False):
             assert a.x1 <= b.x0 + 0.5, (a, b)
+
+
+def test_tick_labels_of_a_tiny_view_far_from_the_origin_differ():
+    from eyeviz.render.mpl.layout import tick_format
+
+    assert tick_format(0.0, 8000.0) == "%.0f"
+    assert tick_format(-0.5, 0.5) == "%g"
+    fmt = tick_format(2056.8355445, 2056.8355455)
+    ticks = [fmt % v for v in (2056.835545, 2056.8355452, 2056.8355454)]
+    assert len(set(ticks)) == 3, ticks

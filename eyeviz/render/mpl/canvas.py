@@ -11,7 +11,7 @@ from matplotlib.ticker import FormatStrFormatter, MaxNLocator
 
 from eyeviz.model.frame import Frame
 from eyeviz.model.scene import Scene
-from eyeviz.render.mpl.layout import Layout, tick_chars
+from eyeviz.render.mpl.layout import Layout, tick_chars, tick_format
 from eyeviz.render.mpl.style import (
     FONT,
     GREY,
@@ -83,7 +83,8 @@ def make_canvas(scene: Scene, frame: Frame, lay: Layout, dpi: float, merge, titl
     ax.xaxis.set_major_locator(MaxNLocator(nbins=min(nbins, 8)))
     ax.yaxis.set_major_locator(MaxNLocator(nbins=min(nbins, 8)))
     for axis in (ax.xaxis, ax.yaxis):
-        axis.set_major_formatter(FormatStrFormatter("%.0f" if (x1 - x0) >= 10 else "%g"))
+        lo, hi = (x0, x1) if axis is ax.xaxis else (y0, y1)
+        axis.set_major_formatter(FormatStrFormatter(tick_format(lo, hi)))
     ax.set_xlabel("x", labelpad=1.0)
     ax.set_ylabel("y", labelpad=1.0)
     for s in ax.spines.values():

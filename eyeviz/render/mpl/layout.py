@@ -75,10 +75,27 @@ def interval_lanes(L, R, m: int, strip_in: float) -> list[tuple[int, str, float,
     return [(i, t, c, ln) for i, t, c, ln, _ in placed]
 
 
+def tick_format(lo: float, hi: float) -> str:
+    """The printf format of the tick labels between lo and hi: whole numbers for a view at
+    least 10 wide; else %g near the origin; else as many decimals as tell ticks about a
+    tenth of the view apart (a view 1e-6 wide at x = 2056 read "2056.84" on every tick)."""
+    span = hi - lo
+    if span >= 10:
+        return "%.0f"
+    big = max(abs(lo), abs(hi))
+    if not span > 0 or big <= 1000 * span:
+        return "%g"
+    decimals = min(15, max(1, math.ceil(-math.log10(span / 10)) + 1))
+    return f"%.{decimals}f"
+
+
 def tick_chars(lo: float, hi: float) -> int:
     """Characters of the longest plain tick label between lo and hi."""
-    big = max(abs(lo), abs(hi), 1.0)
-    return len(f"{big:.0f}") + (1 if lo < 0 else 0)
+    fmt = tick_format(lo, hi)
+    if fmt == "%g":
+        big = max(abs(lo), abs(hi), 1.0)
+        return len(f"{big:.0f}") + (1 if lo < 0 else 0)
+    return max(len(fmt % v) for v in (lo, hi, max(abs(lo), abs(hi), 1.0)))
 
 
 def layout(
