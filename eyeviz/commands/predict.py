@@ -196,9 +196,10 @@ def run(args: argparse.Namespace) -> int:
     if dd.n >= 2:
         try:
             d, a = dd.result(), ad.result()
+            ok = True
         except ValueError:
-            d = a = None
-        if d is not None and a is not None:
+            ok = False
+        if ok:
             print(
                 f"DD MAPE {d['mape']:.3f} %  MAE {d['mae']:.2f}  R^2 {d['r2']:.4f} | "
                 f"AD MAPE {a['mape']:.4f} %  MAE {a['mae']:.3g} rad  R^2 {a['r2']:.6f}",
