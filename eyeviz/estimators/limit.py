@@ -45,7 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from eyeviz.estimators.analytic import AnalyticEstimator
+from eyeviz.estimators import analytic
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
 
 __all__ = ["LimitEstimator", "load", "PRIORS", "posterior_nodes", "posterior_samples"]
@@ -263,7 +263,6 @@ class LimitEstimator(Estimator):
         self.k = int(k)
         self.cache_size = int(cache_size)
         self._cache: OrderedDict[tuple, tuple[float, float, bool]] = OrderedDict()
-        self._fallback = AnalyticEstimator(domain)
         self.last_flagged = np.zeros(0, bool)
         self._parts: list[np.ndarray] = []
         self.hits = 0
@@ -299,7 +298,7 @@ class LimitEstimator(Estimator):
             keys = np.stack([LA[f], RA[f], LB[f], RB[f]], axis=1)
             rr, pp, ee = limit_estimates(keys, self.domain, self.prior, self.n, self.k)
             if ee.any():
-                fr, fp = self._fallback._predict_intervals(*keys[ee].T)
+                fr, fp = analytic.estimate(*keys[ee].T, self.domain)
                 rr[ee], pp[ee] = fr, fp
             r_u[t], p_u[t], e_u[t] = rr, pp, ee
             for c, a, b, e in zip(
