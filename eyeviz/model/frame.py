@@ -331,7 +331,7 @@ def trajectory_path(
         ob = intervals_to_bitmap(LB, RB, m, m // 2)
         r, phi = np.hypot(x, y), np.arctan2(y, x)
         for name in estimators:
-            res = predictor.predict_bitmaps(name, oa, ob)
+            res = predictor.predict_bitmaps(name, oa, ob, pair)
             if isinstance(res, str):
                 acc[name] = res
                 continue

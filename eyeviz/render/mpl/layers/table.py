@@ -74,6 +74,8 @@ def prediction_line(fr, i: int, name: str) -> str:
         return f"{name}: outside the networks' domain (not in the BFV or not seen by both)"
     pred = fr.predictions.get(name)
     if not isinstance(pred, PredictionFrame):
+        if isinstance(pred, str) and pred.startswith("cannot answer: trained for "):
+            return f"{name}: {pred.removeprefix('cannot answer: ')}"  # made for other eyes
         return f"{name}: no answer for this eye design"  # never the reason's text (paths)
     r_hat, phi_hat = float(pred.r_hat[i]), float(pred.phi_hat[i])
     if not (math.isfinite(r_hat) and math.isfinite(phi_hat)):
