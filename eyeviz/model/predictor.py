@@ -151,8 +151,10 @@ class Predictor:
         ok = np.flatnonzero(state.in_domain()) if n else np.zeros(0, int)
         out: dict[str, Result] = {}
         if ok.size:
-            oa = intervals_to_bitmap(state.LA[ok], state.RA[ok], m, m // 2)
-            ob = intervals_to_bitmap(state.LB[ok], state.RB[ok], m, m // 2)
+            LA, RA, LB, RB = state.LA, state.RA, state.LB, state.RB
+            assert LA is not None and RA is not None and LB is not None and RB is not None
+            oa = intervals_to_bitmap(LA[ok], RA[ok], m, m // 2)
+            ob = intervals_to_bitmap(LB[ok], RB[ok], m, m // 2)
         for name in scene.estimators:
             r_hat, phi_hat = np.full(n, np.nan), np.full(n, np.nan)
             if ok.size:
