@@ -38,7 +38,15 @@ import numpy as np
 from eyeviz.core.domain import Domain
 from eyeviz.core.geometry import EyePair
 
-__all__ = ["N_PHI", "N_R", "Posterior", "key_of", "posterior_for_key", "posterior_of"]
+__all__ = [
+    "N_PHI",
+    "N_R",
+    "Posterior",
+    "key_of",
+    "posterior_for_key",
+    "posterior_of",
+    "readout",
+]
 
 N_R = 72  # radial cells
 N_PHI = 18  # angular cells
@@ -85,6 +93,17 @@ class Posterior:
     @property
     def n(self) -> int:
         return int(self.x.shape[0])
+
+    def r_interval(self, mass: float = 0.9) -> tuple[float, float]:
+        """The central interval of r holding ``mass`` of the posterior (cell centres)."""
+        if self.empty or self.n == 0:
+            return (math.nan, math.nan)
+        r = np.hypot(self.x, self.y)
+        o = np.argsort(r)
+        cw = np.cumsum(self.weight[o])
+        lo = float(np.interp((1 - mass) / 2, cw, r[o]))
+        hi = float(np.interp((1 + mass) / 2, cw, r[o]))
+        return lo, hi
 
     @property
     def estimate(self) -> tuple[float, float]:
@@ -214,3 +233,17 @@ def posterior_of(
     if dom.design != (float(pair.h), float(pair.l), int(pair.m)):
         raise ValueError(f"domain {dom.design} is not the eyes' design")
     return posterior_for_key(key_of(pair, x, y, g), dom, prior)
+
+
+def readout(pair: EyePair, x: float, y: float, g: float) -> str:
+    """Two short lines for the app's readout: where the posterior's mass is and the limit's
+    answer, or why there is no posterior."""
+    try:
+        post = posterior_of(pair, x, y, g)
+    except (ValueError, ArithmeticError):
+        return "none: not one lit run per eye"
+    if post.empty:
+        return "none: the prior never makes these bitmaps\n(g below r sin(γ/2), or r out of range)"
+    lo, hi = post.r_interval(0.9)
+    deg = math.degrees(post.phi_hat)
+    return f"90 % in r ∈ [{lo:.0f}, {hi:.0f}]\nlimit r {post.r_hat:.0f}, φ {deg:.2f}°"

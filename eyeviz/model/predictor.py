@@ -73,6 +73,13 @@ class Predictor:
         self._designs: dict[tuple[str, Design], object] = {}
         self._kinds: dict[str, bool] = {}
 
+    def peek(self, name: str):
+        """The estimator if loaded, the reason if it failed, None if not tried yet: never
+        loads (the GUI thread asks this; loading runs on a worker, issue 12 item 9)."""
+        if name in self._loaded:
+            return self._loaded[name]
+        return self._failed.get(name)
+
     def any_design(self, name: str) -> bool:
         """Whether ``name`` answers for any eyes (loaded per design)."""
         if name not in self._kinds:

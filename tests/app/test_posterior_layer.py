@@ -59,6 +59,8 @@ def test_turning_the_posterior_layer_on_draws_the_cells(make_window, monkeypatch
     mark = np.asarray(act.mark.GetMapper().GetInput().GetPoint(0))[:2]
     np.testing.assert_allclose(mark, [r * math.cos(phi), r * math.sin(phi)], rtol=1e-9)
     assert _brown_pixels(win) > before + 20  # the dense cells are on screen
+    lo, hi = want.r_interval(0.9)
+    assert win.readout.texts["posterior"].startswith(f"90 % in r ∈ [{lo:.0f}, {hi:.0f}]")
     # another feature: its own posterior
     win.model.select(1)
     f1 = win.model.scene.features[1]
@@ -90,6 +92,9 @@ def test_a_drag_computes_the_posterior_once_per_key(make_window, monkeypatch):
     for _ in range(3):  # frames with the same bitmaps: from the cache
         win._refresh("feature", 0)
     assert len(seen) == n_seen + 3 and len(calls) == n_calls
+    # end the live refreshes as a drag's release does (stops the table's 100 ms timer:
+    # left pending, it fired into the closed window during the next test and crashed)
+    win._refresh("selection", 0)
     key = post_mod.key_of(Eyes().pair(), *(getattr(win.model.scene.features[0], k) for k in "xyg"))
     assert win.posterior_actors.posterior.key == key
 
@@ -102,3 +107,4 @@ def test_a_feature_the_prior_cannot_make_draws_nothing(make_window):
     win.model.select(0)
     assert not win.posterior_actors.cells.GetVisibility()
     assert win.posterior_actors.posterior is None
+    assert win.readout.texts["posterior"].startswith("none: the prior never makes")

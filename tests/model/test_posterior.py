@@ -100,3 +100,18 @@ def test_a_key_outside_the_half_bitmaps_is_refused():
         pm.posterior_for_key((10, 9, 20, 21), PAPER)
     with pytest.raises(ValueError, match="half bitmaps"):
         pm.posterior_for_key((350, 365, 352, 366), PAPER)
+
+
+def test_r_interval_and_readout():
+    pair = PAPER.eyes
+    post = pm.posterior_of(pair, 1700.0, 2200.0, 120.0)
+    lo, hi = post.r_interval(0.9)
+    r = np.hypot(post.x, post.y)
+    inside = post.weight[(r >= lo) & (r <= hi)].sum()
+    assert 0.85 < inside < 0.95 and lo < post.r_hat < hi
+    # over every g: far wider than the feature's own-g region (r in [2674, 2894])
+    assert hi - lo > 1000
+    text = pm.readout(pair, 1700.0, 2200.0, 120.0)
+    assert text.startswith(f"90 % in r ∈ [{lo:.0f}, {hi:.0f}]") and f"r {post.r_hat:.0f}" in text
+    assert pm.readout(pair, 0.0, 3000.0, 5.0).startswith("none: the prior never")
+    assert all(math.isnan(v) for v in pm.posterior_of(pair, 0.0, 3000.0, 5.0).r_interval())

@@ -106,3 +106,12 @@ def test_frame_and_trajectory_use_the_scenes_eyes():
     ad, dd = path.accuracy["analytic"]
     assert np.nanmedian(dd) > 80 and math.isfinite(np.nanmedian(ad))
     assert path.accuracy["compact"] == NOTE
+
+
+def test_peek_never_loads():
+    p = Predictor()
+    assert p.peek("analytic") is None
+    est = p.estimator("analytic")
+    assert p.peek("analytic") is est
+    assert p.peek("nonesuch") is None
+    assert isinstance(p.estimator("nonesuch"), str) and p.peek("nonesuch").startswith("unavail")
