@@ -49,6 +49,10 @@ def test_svg_has_one_posterior_per_feature_that_has_one(tmp_path):
         assert all(POSTERIOR_COLOR.lower() in p.get("style") for p in filled)
     texts = " ".join("".join(t.itertext()) for t in root.iter(f"{SVG}text"))
     assert "posterior of the centre" in texts and "limit's estimate" in texts
+    # the table: where the mass is over every g, beside the own-g "same bitmaps" range
+    lo, hi = posterior_of(pair, 1700.0, 2200.0, 120.0).r_interval(0.9)
+    assert f"posterior over every g: 90 % at r \u2208 [{lo:.0f}, {hi:.0f}]" in texts
+    assert "posterior: none (the prior never makes these bitmaps)" in texts
 
 
 def test_figure_draws_the_frames_posterior_at_the_limits_estimate():
@@ -84,3 +88,20 @@ def test_shades_darken_with_density():
 def test_frame_without_the_layer_computes_nothing():
     sc = scene(("features", "ambiguity"))
     assert build_frame(sc).posterior == {}
+
+
+def test_posterior_table_lines_fit_a_single_column():
+    sc = scene(("eyes", "bfv", "features", "ambiguity", "posterior", "readout", "labels"))
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig = vector.figure(sc, width="single")
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    r = canvas.get_renderer()
+    lines = [t for t in fig.findobj(lambda a: (getattr(a, "get_gid", lambda: "")() or "")
+             .startswith("readout-posterior"))]  # fmt: skip
+    assert len(lines) == 3
+    for t in lines:
+        bb = t.get_window_extent(r)
+        assert t.get_fontsize() >= 6.0
+        assert bb.x0 >= 0 and bb.x1 <= fig.bbox.width and bb.y0 >= 0, t.get_text()

@@ -87,6 +87,15 @@ def prediction_line(fr, i: int, name: str) -> str:
     )
 
 
+def posterior_line(fr, i: int) -> str:
+    """Where the limit's posterior puts the centre, over every g (eyeviz.model.posterior)."""
+    post = fr.posterior.get(i)
+    if post is None or post.empty:
+        return "posterior: none (the prior never makes these bitmaps)"
+    lo, hi = post.r_interval(0.9)
+    return f"posterior over every g: 90 % at r \u2208 [{distance(lo)}, {distance(hi)}]"
+
+
 def ambiguity_line(fr, i: int) -> str:
     reg = fr.ambiguity.get(i)
     if reg is None:
@@ -173,4 +182,16 @@ def paint(cv: Canvas) -> None:
                 fontsize=SMALL,
                 color=col,
                 gid=f"readout-ambiguity-{i}",
+            )
+        if "posterior" in cv.layers:
+            y -= dy
+            ax.text(
+                0.03,
+                y,
+                posterior_line(fr, i),
+                ha="left",
+                va="center",
+                fontsize=SMALL,
+                color=col,
+                gid=f"readout-posterior-{i}",
             )
