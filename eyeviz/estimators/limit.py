@@ -157,9 +157,18 @@ def posterior_nodes(keys, domain: Domain, prior: str = "single", n: int = 12, k:
     # r^2 = rho^2 + 2 rho (A.u) + h^2 with A.u = -h cu
     au = -h * cu
     for rr, keep_above in ((domain.r_min, True), (domain.r_max, False)):
-        root = -au + np.sqrt(au * au - h * h + rr * rr)
-        lo = np.maximum(lo, root) if keep_above else lo
-        hi = hi if keep_above else np.minimum(hi, root)
+        disc = au * au - h * h + rr * rr
+        # disc < 0 (eyes farther apart than rr, ray missing the circle): every point of
+        # the ray is beyond rr, so r >= r_min holds everywhere and r <= r_max nowhere.
+        # r <= r_max is rho in [near, far] (near > 0 only when h > r_max); r >= r_min is
+        # rho >= far (plus rho <= near when h > r_min: that stretch beside eye A is left
+        # out, a limitation for designs with the eyes farther apart than 2 r_min)
+        sq = np.sqrt(np.maximum(disc, 0.0))
+        if keep_above:
+            lo = np.where(disc >= 0, np.maximum(lo, -au + sq), lo)
+        else:
+            hi = np.where(disc >= 0, np.minimum(hi, -au + sq), -np.inf)
+            lo = np.where(disc >= 0, np.maximum(lo, -au - sq), lo)
     # g >= r sin(gamma/2):  (sd^2 - s^2) rho^2 - 2 s^2 (A.u) rho - s^2 h^2 >= 0
     qlo, qhi = _interval_quadratic(
         sd * sd - s * s, -2 * s * s * au, np.full_like(au, -s * s * h * h)
