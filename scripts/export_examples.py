@@ -42,6 +42,17 @@ def ambiguity_scene() -> scene_mod.Scene:
     return sc
 
 
+def posterior_scene() -> scene_mod.Scene:
+    """The default scene with the limit's posterior over centres (issue 10): for "side" the
+    same bitmaps come from centres at r ~ 2700-5000 (every g), not only its own g's needle."""
+    sc = copy.deepcopy(scene_mod.load(SCENES / "default.toml"))
+    sc.title = "The limit's posterior over centres, over every g"
+    sc.layers = ["eyes", "bfv", "features", "ambiguity", "posterior", "predictions", "readout"]
+    sc.layers.append("labels")
+    sc.estimators = ["limit"]
+    return sc
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--all", action="store_true", help="also write .svg and .pdf")
@@ -57,6 +68,7 @@ def main() -> int:
         "figure_2": scene_mod.load(SCENES / "figure2.toml"),
         "figure_predictions": predictions_scene(),
         "figure_ambiguity": ambiguity_scene(),
+        "figure_posterior": posterior_scene(),
     }
     for name, sc in figures.items():
         for suffix in (".png", ".svg", ".pdf") if args.all else (".png",):

@@ -514,6 +514,11 @@ class ReadoutPanel(QtWidgets.QWidget):
             rows += self._prediction_rows(i)
         if sc.shows("ambiguity"):
             rows.append(self._ambiguity_row())
+        if sc.shows("posterior"):  # the limit's posterior (cached per key, issue 10)
+            from eyeviz.model.posterior import readout
+
+            text = readout(sc.eyes.pair(), f.x, f.y, f.g)
+            rows.append(("posterior", "posterior", text, GREY if text[:5] == "none:" else ink))
         self._set(rows)
 
     def _prediction_rows(self, i: int) -> list[tuple[str, str, str, str]]:

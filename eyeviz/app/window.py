@@ -37,6 +37,7 @@ from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import Scene
 from eyeviz.render.vtk.actors import BACKGROUND, INSET_BACKGROUND, SceneActors, style_text
 from eyeviz.render.vtk.overlays import OverlayActors
+from eyeviz.render.vtk.posterior import PosteriorActors
 
 __all__ = [
     "APP_FONT_PT",
@@ -91,6 +92,7 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         self.ren_win.AddRenderer(self.inset_ren)
         self.actors = SceneActors(self.main_ren, self.inset_ren)
         self.overlays = OverlayActors(self.main_ren)
+        self.posterior_actors = PosteriorActors(self.main_ren)  # issue 10: the limit's posterior
         self.picker = None  # docks built on first use (issue 6 layers)
         self.trajectory_panel = None
         self._docks: dict[str, QtWidgets.QDockWidget] = {}
@@ -284,6 +286,7 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         i = self.model.selected
         sel_color = scene.features[i].color if i is not None and i < st.n else None
         self.overlays.update_ambiguity(scene, self.model.ambiguity, sel_color)
+        self.posterior_actors.update(scene, i)  # cached per key: a drag rarely recomputes it
         path = self.trajectory_panel.path if self.trajectory_panel is not None else None
         self.overlays.update_trajectory(scene, path)
 

@@ -45,7 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from eyeviz.estimators.analytic import AnalyticEstimator
+from eyeviz.estimators import analytic
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
 
 __all__ = ["LimitEstimator", "load", "PRIORS", "posterior_nodes", "posterior_samples"]
@@ -157,9 +157,18 @@ def posterior_nodes(keys, domain: Domain, prior: str = "single", n: int = 12, k:
     # r^2 = rho^2 + 2 rho (A.u) + h^2 with A.u = -h cu
     au = -h * cu
     for rr, keep_above in ((domain.r_min, True), (domain.r_max, False)):
-        root = -au + np.sqrt(au * au - h * h + rr * rr)
-        lo = np.maximum(lo, root) if keep_above else lo
-        hi = hi if keep_above else np.minimum(hi, root)
+        disc = au * au - h * h + rr * rr
+        # disc < 0 (eyes farther apart than rr, ray missing the circle): every point of
+        # the ray is beyond rr, so r >= r_min holds everywhere and r <= r_max nowhere.
+        # r <= r_max is rho in [near, far] (near > 0 only when h > r_max); r >= r_min is
+        # rho >= far (plus rho <= near when h > r_min: that stretch beside eye A is left
+        # out, a limitation for designs with the eyes farther apart than 2 r_min)
+        sq = np.sqrt(np.maximum(disc, 0.0))
+        if keep_above:
+            lo = np.where(disc >= 0, np.maximum(lo, -au + sq), lo)
+        else:
+            hi = np.where(disc >= 0, np.minimum(hi, -au + sq), -np.inf)
+            lo = np.where(disc >= 0, np.maximum(lo, -au - sq), lo)
     # g >= r sin(gamma/2):  (sd^2 - s^2) rho^2 - 2 s^2 (A.u) rho - s^2 h^2 >= 0
     qlo, qhi = _interval_quadratic(
         sd * sd - s * s, -2 * s * s * au, np.full_like(au, -s * s * h * h)
@@ -263,7 +272,6 @@ class LimitEstimator(Estimator):
         self.k = int(k)
         self.cache_size = int(cache_size)
         self._cache: OrderedDict[tuple, tuple[float, float, bool]] = OrderedDict()
-        self._fallback = AnalyticEstimator(domain)
         self.last_flagged = np.zeros(0, bool)
         self._parts: list[np.ndarray] = []
         self.hits = 0
@@ -299,7 +307,7 @@ class LimitEstimator(Estimator):
             keys = np.stack([LA[f], RA[f], LB[f], RB[f]], axis=1)
             rr, pp, ee = limit_estimates(keys, self.domain, self.prior, self.n, self.k)
             if ee.any():
-                fr, fp = self._fallback._predict_intervals(*keys[ee].T)
+                fr, fp = analytic.estimate(*keys[ee].T, self.domain)
                 rr[ee], pp[ee] = fr, fp
             r_u[t], p_u[t], e_u[t] = rr, pp, ee
             for c, a, b, e in zip(

@@ -35,6 +35,8 @@ Fields of :class:`Frame` (``None`` / empty when no layer needs them):
   dr_pct, dphi_deg arrays, NaN outside the domain) or a one-line reason str}.
 - ``ambiguity``: {feature index: dict(polygon, bounded, r_range, phi_range, g_range) or
   None (the disc covers an eye centre)}.
+- ``posterior``: {feature index: :class:`eyeviz.model.posterior.Posterior` (the limit's
+  posterior over centres, every g) or None (none: the prior cannot make the bitmaps)}.
 - ``trajectory``: :class:`TrajectoryPath` (points in the BFV and each estimator's accuracy)
   or None; ``trajectory_error``: why there is none.
 """
@@ -47,6 +49,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from eyeviz.core.geometry import EyePair, intervals_to_bitmap
+from eyeviz.model.posterior import Posterior
 from eyeviz.model.predictor import Predictor
 from eyeviz.model.scene import Scene, Trajectory
 from eyeviz.model.state import SceneState, compute_state, owners
@@ -265,6 +268,7 @@ class Frame:
     out_of_domain: np.ndarray | None = None
     predictions: dict[str, PredictionFrame | str] = field(default_factory=dict)
     ambiguity: dict[int, dict | None] = field(default_factory=dict)
+    posterior: dict[int, Posterior | None] = field(default_factory=dict)
     trajectory: TrajectoryPath | None = None
     trajectory_error: str | None = None
 
@@ -331,7 +335,7 @@ def trajectory_path(
         ob = intervals_to_bitmap(LB, RB, m, m // 2)
         r, phi = np.hypot(x, y), np.arctan2(y, x)
         for name in estimators:
-            res = predictor.predict_bitmaps(name, oa, ob)
+            res = predictor.predict_bitmaps(name, oa, ob, pair)
             if isinstance(res, str):
                 acc[name] = res
                 continue
@@ -344,6 +348,25 @@ def trajectory_path(
 
 # --- building ----------------------------------------------------------------------------
 
+
+def _posteriors(pair: EyePair, st: SceneState) -> dict[int, Posterior | None]:
+    """Each feature's posterior over centres (eyeviz.model.posterior; cached per key), None
+    where it has none (an empty key, or a feature the intervals cannot describe)."""
+    from eyeviz.core.domain import Domain
+    from eyeviz.model.posterior import posterior_for_key
+
+    out: dict[int, Posterior | None] = {}
+    dom = Domain.from_eyes(pair)
+    for i in range(st.n):
+        key = tuple(int(v[i]) for v in (st.LA, st.RA, st.LB, st.RB))
+        try:
+            p = posterior_for_key(key, dom)
+        except (ValueError, ArithmeticError):
+            p = None
+        out[i] = None if p is None or p.empty else p
+    return out
+
+
 _NEED = {
     "eyes": ("LA", "owner_a"),
     "bitmaps": ("LA",),
@@ -353,6 +376,7 @@ _NEED = {
     "predictions": ("LA", "in_bfv"),
     "labels": ("r",),
     "ambiguity": ("r",),
+    "posterior": ("LA",),
 }
 
 
@@ -518,6 +542,8 @@ def build_frame(
         box = (x0 - w, x1 + w, y0 - w, y1 + w)
         for i, f in enumerate(scene.features):
             fr.ambiguity[i] = ambiguity_of(pair, f.x, f.y, f.g, box)
+    if "posterior" in lay and n:
+        fr.posterior = _posteriors(pair, st)
     if "trajectory" in lay and scene.trajectory is not None:
         try:
             stop = max(scene.trajectory.distance, box[3])

@@ -20,6 +20,8 @@ __all__ = [
     "estimator_color",
     "estimator_colors",
     "feature_color",
+    "POSTERIOR_COLOR",
+    "posterior_rgba",
 ]
 
 # Okabe & Ito (2008), in the order new features take them (same as eyeviz.model.scene)
@@ -33,6 +35,10 @@ ESTIMATOR_COLORS = {
     "compact": "#999933",  # olive
     "paper": "#757575",  # mid grey
 }
+#: the posterior layer: the limit's colour (it is the limit's posterior), shaded by density
+POSTERIOR_COLOR = ESTIMATOR_COLORS["limit"]
+POSTERIOR_FLOOR = 0.06  # opacity of the faintest cell
+POSTERIOR_TOP = 0.9  # opacity of the densest cell
 FALLBACK_ESTIMATOR = "#000000"  # an estimator not named above (a plug-in)
 MIN_DELTA_E = 30.0
 
@@ -70,3 +76,13 @@ def _lab(color: str) -> tuple[float, float, float]:
 def delta_e(c1: str, c2: str) -> float:
     """CIE76 colour difference between two '#RRGGBB' colours."""
     return math.dist(_lab(c1), _lab(c2))
+
+
+def posterior_rgba(density) -> list[tuple[float, float, float, float]]:
+    """Shades (0..1 RGBA) for posterior densities in [0, 1]: :data:`POSTERIOR_COLOR` with
+    opacity from :data:`POSTERIOR_FLOOR` (faintest) to :data:`POSTERIOR_TOP` (densest), so
+    what lies under a faint cell (the BFV, a feature's disc) shows through."""
+    c = POSTERIOR_COLOR.lstrip("#")
+    r, g, b = (int(c[i : i + 2], 16) / 255.0 for i in (0, 2, 4))
+    span = POSTERIOR_TOP - POSTERIOR_FLOOR
+    return [(r, g, b, POSTERIOR_FLOOR + span * min(max(float(d), 0.0), 1.0)) for d in density]

@@ -3,11 +3,23 @@
 :class:`Predictor` keeps each estimator loaded once (``eyeviz.estimators`` is imported on
 the first prediction, so torch only when the predictions layer is on and a network is
 chosen). An estimator that cannot be loaded or cannot answer for the scene (weights
-missing, another m) becomes a one-line message, never an exception. Used by the app and
+missing, other eyes) becomes a one-line message, never an exception. Used by the app and
 by the vector export alike.
+
+Eye designs (issue 10 item 4). Every answer is for the scene's eyes (h, l, m):
+
+- an estimator that answers for any eyes (its registry entry says ``any_design``:
+  analytic, limit) is loaded for ``Domain(h, l, m)`` of the scene, with Table 4's r and g
+  ranges, once per design (a cache keyed by name and design);
+- an estimator made for one design (compact, bayes, paper: trained on the paper's
+  h = 40, l = 20, m = 720) answers only for that design; for other eyes its result is
+  the line ``"cannot answer: trained for h = 40, l = 20, m = 720"``, never a silent
+  answer for the wrong eyes.
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 
@@ -15,39 +27,123 @@ from eyeviz.core.geometry import intervals_to_bitmap
 from eyeviz.model.scene import Scene
 from eyeviz.model.state import SceneState
 
-__all__ = ["Predictor", "Result"]
+__all__ = ["Predictor", "Result", "Design", "design_of", "trained_for"]
 
 Result = tuple[np.ndarray, np.ndarray] | str
+Design = tuple[float, float, int]  # (h, l, m)
+
+
+def design_of(obj: Any) -> Design | None:
+    """(h, l, m) of an EyePair, scene Eyes, Domain or (h, l, m) triple; None for None."""
+    if obj is None:
+        return None
+    if isinstance(obj, tuple | list):
+        h, l, m = obj  # noqa: E741  (the paper's name)
+    else:
+        h, l, m = obj.h, obj.l, obj.m  # noqa: E741
+    return (float(h), float(l), int(m))
+
+
+def trained_for(est: Any) -> str:
+    """The short line for an estimator made for other eyes ("trained for h = 40, ...")."""
+    d = est.domain
+    return f"trained for h = {d.h:g}, l = {d.l:g}, m = {int(d.m)}"
+
+
+def _any_design(name: str) -> bool:
+    from eyeviz.estimators import registry
+
+    try:
+        return bool(registry.get(name).any_design)
+    except Exception:  # noqa: BLE001  (unknown names fail in load, with their message)
+        return False
 
 
 class Predictor:
-    """name -> (r_hat, phi_hat) per feature, NaN outside the networks' domain."""
+    """name -> (r_hat, phi_hat) per feature, NaN outside the estimators' domain.
+
+    ``_loaded`` / ``_failed`` hold each estimator as first loaded (the paper's design for
+    the any-design ones; the app reads them to know what is still to load);
+    ``_designs`` holds the any-design estimators loaded for other eyes.
+    """
 
     def __init__(self) -> None:
         self._loaded: dict[str, object] = {}
         self._failed: dict[str, str] = {}
+        self._designs: dict[tuple[str, Design], object] = {}
+        self._kinds: dict[str, bool] = {}
 
-    def estimator(self, name: str):
-        """The loaded estimator, or a str saying why it is unavailable."""
+    def peek(self, name: str):
+        """The estimator if loaded, the reason if it failed, None if not tried yet: never
+        loads (the GUI thread asks this; loading runs on a worker, issue 12 item 9)."""
         if name in self._loaded:
             return self._loaded[name]
-        if name in self._failed:
-            return self._failed[name]
+        return self._failed.get(name)
+
+    def any_design(self, name: str) -> bool:
+        """Whether ``name`` answers for any eyes (loaded per design)."""
+        if name not in self._kinds:
+            self._kinds[name] = _any_design(name)
+        return self._kinds[name]
+
+    def _load(self, name: str, **kw):
         from eyeviz import estimators
 
         try:
-            est = estimators.load(name)
+            return estimators.load(name, **kw)
         except Exception as exc:  # noqa: BLE001  (any failure is shown, never raised)
             msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-            self._failed[name] = f"unavailable: {msg}"
-            return self._failed[name]
-        self._loaded[name] = est
-        return est
+            return f"unavailable: {msg}"
 
-    def predict_bitmaps(self, name: str, oa: np.ndarray, ob: np.ndarray) -> Result:
+    def estimator(self, name: str, design: Any = None):
+        """The loaded estimator for ``design`` (h, l, m; None: as first loaded), or a str
+        saying why it is unavailable. Fixed-design estimators ignore ``design`` here
+        (see :meth:`design_note`)."""
+        if name in self._failed:
+            return self._failed[name]
+        if name not in self._loaded:
+            est = self._load(name)
+            if isinstance(est, str):
+                self._failed[name] = est
+                return est
+            self._loaded[name] = est
+        base = self._loaded[name]
+        d = design_of(design)
+        dom = getattr(base, "domain", None)
+        if d is None or dom is None or not self.any_design(name) or design_of(dom) == d:
+            return base
+        key = (name, d)
+        if key not in self._designs:
+            from eyeviz.core.domain import Domain
+
+            try:
+                domain = Domain(d[0], d[1], d[2], dom.r_min, dom.r_max, dom.g_max)
+            except Exception as exc:  # noqa: BLE001
+                return f"cannot answer: {str(exc).splitlines()[0]}"
+            kw = {"prior": base.prior} if hasattr(base, "prior") else {}
+            self._designs[key] = self._load(name, domain=domain, **kw)
+        return self._designs[key]
+
+    def design_note(self, name: str, design: Any) -> str | None:
+        """ "trained for h = 40, l = 20, m = 720" when ``name`` was made for other eyes
+        than ``design``, else None (also None when it cannot be loaded at all)."""
+        d = design_of(design)
+        if d is None or self.any_design(name):
+            return None
         est = self.estimator(name)
+        if isinstance(est, str) or getattr(est, "domain", None) is None:
+            return None
+        return None if design_of(est.domain) == d else trained_for(est)
+
+    def predict_bitmaps(self, name: str, oa: np.ndarray, ob: np.ndarray, design=None) -> Result:
+        """(r_hat, phi_hat) for half bitmaps ``oa``, ``ob`` of eyes ``design`` (an EyePair,
+        Eyes, Domain or (h, l, m); None: the estimator's own), or a one-line reason."""
+        est = self.estimator(name, design)
         if isinstance(est, str):
             return est
+        note = self.design_note(name, design)
+        if note is not None:
+            return f"cannot answer: {note}"
         try:
             r, phi = est.predict(oa, ob)
         except (ValueError, RuntimeError) as exc:
@@ -55,25 +151,33 @@ class Predictor:
         return np.asarray(r, dtype=np.float64), np.asarray(phi, dtype=np.float64)
 
     def predict(self, scene: Scene, state: SceneState) -> dict[str, Result]:
-        """Each of the scene's estimators on the in-domain features' Omega (m/2 each)."""
+        """Each of the scene's estimators on the in-domain features' Omega (m/2 each), for
+        the scene's eyes."""
         n, m = state.n, state.m
+        design = design_of(scene.eyes)
         ok = np.flatnonzero(state.in_domain()) if n else np.zeros(0, int)
         out: dict[str, Result] = {}
         if ok.size:
-            oa = intervals_to_bitmap(state.LA[ok], state.RA[ok], m, m // 2)
-            ob = intervals_to_bitmap(state.LB[ok], state.RB[ok], m, m // 2)
+            LA, RA, LB, RB = state.LA, state.RA, state.LB, state.RB
+            assert LA is not None and RA is not None and LB is not None and RB is not None
+            oa = intervals_to_bitmap(LA[ok], RA[ok], m, m // 2)
+            ob = intervals_to_bitmap(LB[ok], RB[ok], m, m // 2)
         for name in scene.estimators:
             r_hat, phi_hat = np.full(n, np.nan), np.full(n, np.nan)
             if ok.size:
-                res = self.predict_bitmaps(name, oa, ob)
+                res = self.predict_bitmaps(name, oa, ob, design)
                 if isinstance(res, str):
                     out[name] = res
                     continue
                 r_hat[ok], phi_hat[ok] = res
             else:
-                est = self.estimator(name)
+                est = self.estimator(name, design)
                 if isinstance(est, str):
                     out[name] = est
+                    continue
+                note = self.design_note(name, design)
+                if note is not None:
+                    out[name] = f"cannot answer: {note}"
                     continue
             out[name] = (r_hat, phi_hat)
         return out

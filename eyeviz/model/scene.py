@@ -60,6 +60,7 @@ LAYERS = (
     "labels",
     "predictions",
     "ambiguity",
+    "posterior",
     "trajectory",
 )
 TRAJECTORY_KINDS = ("horizontal", "circular", "vertical")

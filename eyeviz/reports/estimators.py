@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from eyeviz.core.domain import DEFAULTS as _D
+from eyeviz.model.palette import ESTIMATOR_COLORS, estimator_color
 
 HELP = "estimators' AD/DD error, training and inference time (error against run time)"
 
@@ -408,7 +409,9 @@ def to_markdown(results: list[Result], n_test: int, seed: int, png: str | None) 
     return "\n".join(lines)
 
 
-_COLORS = {"analytic": "#1f77b4", "bayes": "#2ca02c", "compact": "#d62728", "paper": "#9467bd"}
+# one colour per estimator name, the same in the app, the figures and every report
+# (eyeviz.model.palette); kept under this name for the reports that import it
+_COLORS = ESTIMATOR_COLORS
 
 
 def plot(results: list[Result]):
@@ -430,7 +433,7 @@ def plot(results: list[Result]):
     handles: dict[str, Line2D] = {}
     for ax, (key, title) in zip(axes, (("ad", "AD: azimuth"), ("dd", "DD: distance")), strict=True):
         for i, r in enumerate(ok):
-            c = _COLORS.get(r.name, "#7f7f7f")
+            c = estimator_color(r.name)
             size = 45 + 45 * (len(ok) - 1 - i)  # coincident points show as concentric rings
             x = r.batched_us * 1e-6
             y = r.metrics["single"][key]["mape"]
@@ -467,7 +470,7 @@ def plot(results: list[Result]):
         if lim is not None:
             ax.axhline(
                 lim.metrics["single"][key]["mape"],
-                color=_COLORS["bayes"],
+                color=estimator_color("bayes"),
                 ls="--",
                 lw=1.0,
                 alpha=0.8,
@@ -512,7 +515,7 @@ def plot(results: list[Result]):
                 [],
                 [],
                 ls="--",
-                color=_COLORS["bayes"],
+                color=estimator_color("bayes"),
                 label="information limit (bayes, single-pass)",
             )
         )

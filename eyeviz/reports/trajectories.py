@@ -33,8 +33,8 @@ from pathlib import Path
 
 import numpy as np
 
+from eyeviz.model.palette import estimator_color
 from eyeviz.reports.estimators import (
-    _COLORS,
     parse_names,
     save_figure,
     try_load,
@@ -336,7 +336,7 @@ def plot(points: list[Point], kind: str, names: list[str]):
                     marker="o",
                     ms=3.5 + 0.8 * (len(names) - 1 - i),
                     lw=1.4 + 0.6 * (len(names) - 1 - i),
-                    color=_COLORS.get(name, "#7f7f7f"),
+                    color=estimator_color(name),
                     label=name,
                     zorder=2 + i,
                 )
@@ -370,7 +370,7 @@ def plot(points: list[Point], kind: str, names: list[str]):
                         marker="v",
                         ms=8,
                         clip_on=False,
-                        color=_COLORS.get(name, "#7f7f7f"),
+                        color=estimator_color(name),
                     )
             ax.set_xlim(500, 10500)
             ax.grid(True, alpha=0.3)

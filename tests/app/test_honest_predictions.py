@@ -29,6 +29,8 @@ def test_changing_h_greys_compact_and_removes_its_ring(make_window):
     assert "compact" not in win.overlays.ghosts  # no ring for other eyes
     assert "analytic" in win.overlays.ghosts  # analytic answers for any eyes
     assert np.isfinite(win.overlays.ghosts["analytic"][0]).all()
+    # for these eyes (h = 80), not the paper's: near the truth, not at half its distance
+    assert abs(np.hypot(*win.overlays.ghosts["analytic"][0]) / np.hypot(300, 3000) - 1) < 0.1
     box = win.picker.boxes["compact"]
     assert "8a8a8a" in box.styleSheet() and "trained for h = 40" in win.picker.note.text()
     assert win.picker.boxes["analytic"].styleSheet() == ""

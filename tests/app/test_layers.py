@@ -77,10 +77,13 @@ def test_out_of_domain_feature_is_flagged_and_greyed(make_window):
 
 
 def test_an_estimator_that_cannot_answer_is_a_message(make_window):
-    win = make_window(scene(m=360, est=("analytic",)))
-    assert "cannot answer" in win.readout.texts["pred:analytic"]
-    assert "m/2 = 360" in win.picker.note.text() or "360" in win.picker.note.text()
-    assert not win.overlays.ghost_actor.GetVisibility()
+    """m = 360: compact (trained for m = 720) is one line and no ring; analytic
+    triangulation answers for these eyes (issue 10 item 4)."""
+    win = make_window(scene(m=360, est=("analytic", "compact")))
+    assert win.readout.texts["pred:compact"] == "trained for h = 40, l = 20, m = 720"
+    assert "trained for" in win.picker.note.text()
+    assert "compact" not in win.overlays.ghosts
+    assert "Δr" in win.readout.texts["pred:analytic"] and "analytic" in win.overlays.ghosts
 
 
 def _inside(poly, x, y):

@@ -167,3 +167,16 @@ def test_posterior_samples_for_the_app():
     key = np.array([int(v) for v in eyes.intervals(300.0, 2500.0, 200.0)])
     iv = np.stack(eyes.intervals(s["x"], s["y"], s["g"]), 1)
     assert np.mean(np.all(iv == key, axis=1)) > 0.99  # the points are the key's polyhedron
+
+
+def test_eyes_farther_apart_than_the_prior_range_warn_nothing():
+    """h beyond r_min/r_max: rays that miss the r circles are handled, not NaN-warned."""
+    import warnings
+
+    dom = Domain(h=1e6, l=1.0, m=720)
+    key = [int(v) for v in dom.eyes.intervals(0.0, 3000.0, 60.0)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        nd = posterior_nodes([key], dom)
+        r = nd.r[0][nd.w[0] > 0]
+    assert r.size and r.min() >= dom.r_min * (1 - 1e-6) and r.max() <= dom.r_max * (1 + 1e-6)

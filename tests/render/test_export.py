@@ -340,3 +340,29 @@ def test_too_many_features_refused_quickly(tmp_path, default_scene):
     with pytest.raises(EyevizError, match="at most 10000 features"):
         export(sc, tmp_path / "many.png")
     assert time.perf_counter() - t < 2
+
+
+def test_svg_predictions_for_other_eyes(tmp_path):
+    """h = 80: analytic and limit answer for these eyes (within a few %, not -50 %);
+    compact, trained for the paper's eyes, says so and draws no ring (issue 10 item 4)."""
+    import re
+    import xml.etree.ElementTree as ET
+
+    sc = scene_mod.Scene(
+        scene_mod.Eyes(80.0, 20.0, 720),
+        [scene_mod.Feature("target", 300.0, 3000.0, 60.0, "#D55E00")],
+        ["eyes", "features", "readout", "predictions"],
+        estimators=["analytic", "limit", "compact"],
+    )
+    out = export(sc, tmp_path / "h80.svg", width="double")
+    root = ET.parse(out).getroot()
+    ns = "{http://www.w3.org/2000/svg}"
+    texts = " ".join("".join(t.itertext()) for t in root.iter(f"{ns}text"))
+    gids = {g.get("id") for g in root.iter(f"{ns}g")}
+    assert "compact: trained for h = 40, l = 20, m = 720" in texts
+    assert "prediction-compact-target" not in gids
+    for name in ("analytic", "limit"):
+        assert f"prediction-{name}-target" in gids
+        m = re.search(name + r": r\u0302 = [^(]*\(\u0394r [^,]*, ([+\-\u2212]?[\d.]+) %\)", texts)
+        assert m, (name, texts)
+        assert abs(float(m.group(1).replace("\u2212", "-"))) < 10, (name, m.group(0))

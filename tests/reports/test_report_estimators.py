@@ -80,3 +80,21 @@ def test_accuracy_metrics_ignore_nan_rows():
     got = rep.accuracy_metrics(y, np.array([1100.0, np.nan, 4000.0]))
     assert got["mape"] == pytest.approx(5.0)
     assert math.isnan(rep.accuracy_metrics(y, np.full(3, np.nan))["mape"])
+
+
+def test_plot_colours_come_from_the_palette_by_name():
+    """Every estimator, limit included, has its palette colour in the report figure."""
+    from matplotlib.colors import to_hex
+
+    from eyeviz.model.palette import estimator_color
+
+    m = {"ad": {"mape": 1.0}, "dd": {"mape": 7.0}}
+    results = [
+        rep.Result(n, batched_us=t, single_ms=0.5, metrics={"single": m, "multi": m})
+        for n, t in (("limit", 2.0), ("analytic", 0.1), ("bayes", 0.3))
+    ]
+    fig = rep.plot(results)
+    seen = {to_hex(c) for ax in fig.axes for coll in ax.collections for c in coll.get_edgecolors()}
+    for name in ("limit", "analytic", "bayes"):
+        assert to_hex(estimator_color(name)) in seen, name
+    assert rep._COLORS["limit"] == estimator_color("limit")

@@ -52,6 +52,8 @@ def readout_rows(layers, n_features: int, n_estimators: int) -> int:
         rows += n_features * n_estimators
     if "ambiguity" in layers:
         rows += n_features
+    if "posterior" in layers:
+        rows += n_features
     return rows
 
 

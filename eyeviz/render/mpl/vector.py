@@ -37,6 +37,9 @@ from eyeviz.render.mpl.layers import (
     bitmaps as bitmaps_layer,
 )
 from eyeviz.render.mpl.layers import (
+    posterior as posterior_layer,
+)
+from eyeviz.render.mpl.layers import (
     predictions as predictions_layer,
 )
 from eyeviz.render.mpl.layers import (
@@ -237,6 +240,8 @@ def figure(
             features.paint(cv)
         if "predictions" in lay_names:
             predictions_layer.paint(cv)
+        if "posterior" in lay_names:
+            posterior_layer.paint(cv)  # after predictions: it extends their legend
         if "labels" in lay_names:
             features.labels(cv)
         if "bitmaps" in lay_names:

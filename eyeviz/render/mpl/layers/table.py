@@ -74,6 +74,8 @@ def prediction_line(fr, i: int, name: str) -> str:
         return f"{name}: outside the networks' domain (not in the BFV or not seen by both)"
     pred = fr.predictions.get(name)
     if not isinstance(pred, PredictionFrame):
+        if isinstance(pred, str) and pred.startswith("cannot answer: trained for "):
+            return f"{name}: {pred.removeprefix('cannot answer: ')}"  # made for other eyes
         return f"{name}: no answer for this eye design"  # never the reason's text (paths)
     r_hat, phi_hat = float(pred.r_hat[i]), float(pred.phi_hat[i])
     if not (math.isfinite(r_hat) and math.isfinite(phi_hat)):
@@ -83,6 +85,15 @@ def prediction_line(fr, i: int, name: str) -> str:
         f"{pred.dr_pct[i]:+.1f} %),  \u03c6\u0302 = {math.degrees(phi_hat):.2f}\u00b0 "
         f"(\u0394\u03c6 {pred.dphi_deg[i]:+.2f}\u00b0)"
     )
+
+
+def posterior_line(fr, i: int) -> str:
+    """Where the limit's posterior puts the centre, over every g (eyeviz.model.posterior)."""
+    post = fr.posterior.get(i)
+    if post is None or post.empty:
+        return "posterior: none (the prior never makes these bitmaps)"
+    lo, hi = post.r_interval(0.9)
+    return f"posterior over every g: 90 % at r \u2208 [{distance(lo)}, {distance(hi)}]"
 
 
 def ambiguity_line(fr, i: int) -> str:
@@ -178,4 +189,16 @@ def paint(cv: Canvas) -> None:
                 fontsize=SMALL,
                 color=col,
                 gid=f"readout-ambiguity-{i}",
+            )
+        if "posterior" in cv.layers:
+            y -= dy
+            ax.text(
+                0.03,
+                y,
+                posterior_line(fr, i),
+                ha="left",
+                va="center",
+                fontsize=SMALL,
+                color=col,
+                gid=f"readout-posterior-{i}",
             )

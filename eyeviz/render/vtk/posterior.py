@@ -1,0 +1,78 @@
+"""The ``posterior`` layer in the app's main view: the selected feature's posterior density
+over centres (every g its bitmaps allow) as shaded polar cells, and the limit's estimate
+(:mod:`eyeviz.model.posterior`), drawn over the ambiguity region and under the features.
+
+The posterior is computed once per key (the model caches it) and the mesh is rebuilt only
+when the key changes, so a drag that keeps the bitmaps costs one interval lookup.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+from vtkmodules.vtkRenderingCore import vtkRenderer
+
+from eyeviz.core.domain import Domain
+from eyeviz.model.palette import POSTERIOR_COLOR, posterior_rgba
+from eyeviz.model.posterior import Posterior, key_of, posterior_for_key
+from eyeviz.render.vtk.actors import Z_POINT, _actor, hex_rgb
+
+__all__ = ["PosteriorActors", "Z_POSTERIOR"]
+
+Z_POSTERIOR = -1.2  # above the ambiguity fill (-1.5), below the eyes (0) and features (1)
+
+
+class PosteriorActors:
+    """Shaded cells (one quad each, RGBA: opacity grows with density) and a marker at the
+    limit's estimate."""
+
+    def __init__(self, main: vtkRenderer):
+        self.main = main
+        self.cells = _actor(pv.PolyData(), rgb=True)
+        self.mark = _actor(pv.PolyData(), tuple(v / 255.0 for v in hex_rgb(POSTERIOR_COLOR)))
+        mp = self.mark.GetProperty()
+        mp.SetRepresentationToPoints()
+        mp.SetPointSize(11)
+        mp.SetRenderPointsAsSpheres(True)
+        for a in (self.cells, self.mark):
+            a.SetVisibility(False)
+            main.AddActor(a)
+        self.posterior: Posterior | None = None  # what is drawn (None: nothing)
+        self.mesh = pv.PolyData()
+        self._key: tuple | None = None
+
+    def update(self, scene, selected: int | None) -> None:
+        """Show the posterior of feature ``selected`` when the scene shows the layer."""
+        post = None
+        if scene.shows("posterior") and selected is not None and selected < len(scene.features):
+            f = scene.features[selected]
+            pair = scene.eyes.pair()
+            try:
+                post = posterior_for_key(key_of(pair, f.x, f.y, f.g), Domain.from_eyes(pair))
+            except (ValueError, ArithmeticError):
+                post = None
+        if post is None or post.empty:
+            self.posterior = None
+            self._key = None
+            self.cells.SetVisibility(False)
+            self.mark.SetVisibility(False)
+            return
+        self.posterior = post
+        key = (post.domain, post.key, post.prior)
+        if key != self._key:
+            self._key = key
+            self._build(post)
+        self.cells.SetVisibility(True)
+        self.mark.SetVisibility(True)
+
+    def _build(self, post: Posterior) -> None:
+        n = post.n
+        pts = np.concatenate([post.cells.reshape(-1, 2), np.full((4 * n, 1), Z_POSTERIOR)], 1)
+        faces = np.column_stack([np.full(n, 4), np.arange(4 * n).reshape(n, 4)]).ravel()
+        mesh = pv.PolyData(pts.astype(np.float64), faces=faces)
+        rgba = np.asarray(posterior_rgba(post.density)) * 255.0
+        mesh.cell_data["rgb"] = np.round(rgba).astype(np.uint8)
+        self.cells.GetMapper().SetInputData(mesh)
+        self.mesh = mesh
+        ex, ey = post.estimate
+        self.mark.GetMapper().SetInputData(pv.PolyData(np.array([[ex, ey, Z_POINT - 0.1]])))
