@@ -78,6 +78,7 @@ class DesignPanel(QtWidgets.QWidget):
         self.jobs_started = 0
         self.compute_threads: list[int] = []  # thread ids of the computations (tests)
         self.marker_r: float | None = None
+        self.marker_blits = 0  # marker-only redraws (tests: a drag blits, never recomputes)
         self._marker_note = ""
 
         self.debounce = QtCore.QTimer(self)
@@ -114,9 +115,13 @@ class DesignPanel(QtWidgets.QWidget):
         self.ax_ad = self.fig.add_subplot(2, 1, 2, sharex=self.ax_dd)
         self.lines: dict[str, list] = {"current": [], "paper": []}
         self.markers = [
-            ax.axvline(0, color="#333333", lw=1.4, zorder=5, visible=False)
+            ax.axvline(0, color="#333333", lw=1.4, zorder=5, visible=False, animated=True)
             for ax in (self.ax_dd, self.ax_ad)
         ]
+        # the markers are blitted over a saved background: a full draw of this figure costs
+        # ~90 ms, far too much for every move of a drag (issue 11: a drag never waits)
+        self._bg = None
+        self.canvas.mpl_connect("draw_event", self._after_draw)
         self.computing = self.ax_dd.text(
             0.5,
             0.5,
@@ -295,7 +300,7 @@ class DesignPanel(QtWidgets.QWidget):
         set_message(self.info, self.error)
         self.info.setVisible(bool(self.error))
         self.info.setStyleSheet("color: #b00020;")
-        self._draw_marker()
+        self._draw_marker(full=True)
 
     def _legend_text(self, cur, paper, stale: bool, same: bool) -> None:
         parts = []
@@ -315,8 +320,25 @@ class DesignPanel(QtWidgets.QWidget):
             parts.append(self._marker_note)
         self.legend.setText("<br>".join(parts))
 
-    def _draw_marker(self) -> None:
-        """The selected feature's distance as a vertical line (no recomputation)."""
+    def _after_draw(self, _event) -> None:
+        """After a full draw (inside Qt's paint): keep the background, add the markers to
+        the buffer being painted (no blit here: that would repaint recursively)."""
+        self._bg = self.canvas.copy_from_bbox(self.fig.bbox)
+        for ax, ln in zip((self.ax_dd, self.ax_ad), self.markers, strict=True):
+            ax.draw_artist(ln)
+
+    def _blit_markers(self) -> None:
+        if self._bg is None:
+            return
+        self.canvas.restore_region(self._bg)
+        for ax, ln in zip((self.ax_dd, self.ax_ad), self.markers, strict=True):
+            ax.draw_artist(ln)
+        self.canvas.blit(self.fig.bbox)
+        self.marker_blits += 1
+
+    def _draw_marker(self, full: bool = False) -> None:
+        """The selected feature's distance as a vertical line (no recomputation); blitted
+        over the last full draw unless ``full``."""
         sc, i = self.model.scene, self.model.selected
         r = None
         if i is not None and i < len(sc.features):
@@ -340,7 +362,10 @@ class DesignPanel(QtWidgets.QWidget):
         if note != self._marker_note:
             self._marker_note = note
             self._set_legend()
-        self.canvas.draw_idle()
+        if full or self._bg is None:
+            self.canvas.draw_idle()
+        else:
+            self._blit_markers()
 
 
 def _esc(text: str) -> str:

@@ -45,7 +45,9 @@ def set_m_in_panel(win, m):
 
 def test_dock_exists_and_shows_the_new_curve_after_m_changes(make_window, qtbot):
     win = make_window(scene())
-    panel = win.show_design()
+    act = next(a for a in win.actions() if a.text().startswith("Eye &design"))
+    act.trigger()  # View > Eye design
+    panel = win.design_panel
     dock = win._docks["design"]
     assert dock.windowTitle() == "Eye design" and dock.isVisible()
     assert win.show_design() is panel  # built once
@@ -96,6 +98,7 @@ def test_drag_moves_the_marker_without_recomputing(make_window, qtbot):
     assert panel.markers[0].get_xdata()[0] == r0
     assert "other: r = 3,231" in panel.legend.text()
     started = panel.jobs_started
+    blits = panel.marker_blits
     w = win.plotter
     start, end = pixel_of(win, -1200.0, 3000.0), pixel_of(win, -400.0, 2000.0)
     QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
@@ -112,6 +115,7 @@ def test_drag_moves_the_marker_without_recomputing(make_window, qtbot):
     r1 = math.hypot(f.x, f.y)
     assert panel.markers[0].get_xdata()[0] == r1 and panel.markers[1].get_xdata()[0] == r1
     assert panel.jobs_started == started and not panel.stale  # nothing recomputed
+    assert panel.marker_blits > blits  # the marker alone was redrawn (no full draw)
     assert panel.debounce.isActive() is False and panel.running is None
 
 
