@@ -589,7 +589,10 @@ def markdown(table, fit, designs, l_of, best, args_d, figures) -> str:
         "",
     ]
     paper = designs.get(PAPER)
-    if paper is not None:
+    if paper is None:
+        lines += ["The paper's eyes (h 40, l 20, m 720) are not in this table: no figure marks "
+                  "them.", ""]  # fmt: skip
+    else:
         lines += [
             f"The paper's eyes (h 40, l 20, m 720): DD {paper.all.dd_mape:.2f} %, "
             f"AD {paper.all.ad_mape:.3f} % over r in [{paper.all.r_min:g}, "

@@ -227,6 +227,16 @@ def test_one_m_only_still_draws_everything(tmp_path):
     assert "720" in svg
 
 
+def test_a_table_without_the_papers_eyes_says_so(tmp_path):
+    path = write_table(tmp_path / "s.csv", synthetic_rows(ms=(1440, 2880)))
+    out = tmp_path / "r"
+    study.write_report(path, out)
+    assert "are not in this table" in (out / "study.md").read_text()
+    assert json.loads((out / "summary.json").read_text())["paper_design"] is None
+    svg = "".join(ET.fromstring((out / "study_dd.svg").read_text()).itertext())
+    assert "paper's eyes" not in svg  # nothing claims to mark a design that is absent
+
+
 # --- bad input -------------------------------------------------------------------------
 
 
