@@ -479,7 +479,7 @@ def law_figure(points: Sequence[LawPoint], fit: LawFit):
     else:
         ax.text(0.5, 0.5, "too few points to fit C", transform=ax.transAxes, ha="center")
     handles.append(Line2D([], [], ls="", marker="o", ms=3, mfc="none", mec="#7A7A7A", mew=0.5))
-    labels.append("not fitted (edge bin, x > limit)")
+    labels.append(f"not fitted (edge bin or x > {fit.x_max:g})")
     if pp:
         handles.append(Line2D([], [], ls="", marker="D", ms=4, mfc="none", mec="black"))
         labels.append(_paper_label())
@@ -533,7 +533,7 @@ def summary_csv(table: list[dict], fit: LawFit) -> str:
     w = csv.DictWriter(buf, fieldnames=cols, lineterminator="\n")
     w.writeheader()
     for t in table:
-        x = t["gamma"] * t["at"] / (2 * t["h"])
+        x = t["gamma"] * 0.5 * (t["r_lo"] + t["r_hi"]) / (2 * t["h"])  # the bin centre
         w.writerow({**t, "law_dd_mape": "" if fit.C is None else round(100 * fit.C * x, 6)})
     return buf.getvalue()
 
