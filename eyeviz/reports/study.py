@@ -624,7 +624,7 @@ def write_report(
     path: Path,
     outdir: Path,
     at: float = 3000.0,
-    prior: str = "single",
+    prior: str | None = None,
     l_wanted: float = PAPER[1],
     law_max: float = LAW_MAX,
     target: float = 5.0,
@@ -634,6 +634,9 @@ def write_report(
         if not (math.isfinite(v) and v > 0):
             raise EyevizError(f"{name} must be a finite number > 0, got {v!r}")
     rows = read_study(path)
+    if prior is None:  # the table's only prior, else the single-pass one
+        have = sorted({r.prior for r in rows})
+        prior = have[0] if len(have) == 1 else "single"
     designs = designs_of(rows, prior)
     l_of = l_per_h(designs, l_wanted)
     table = heatmap_table(designs, l_of, at)
@@ -672,9 +675,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--prior",
-        default="single",
+        default=None,
         choices=("single", "multi"),
-        help="which prior's rows to draw (default single)",
+        help="which prior's rows to draw (default: the table's only prior, else single)",
     )
     parser.add_argument(
         "--l",

@@ -307,6 +307,7 @@ def test_cli_one_line_errors_and_nothing_written(tmp_path):
             "--at 9000 lies outside the study's distances [1000, 5000]",
         ),
         ([str(tmp_path / "ok.csv"), "--prior", "multi"], "no rows of prior 'multi'"),
+        ([str(tmp_path / "ok.csv"), "--law-max", "-1"], "--law-max must be a finite number"),
         ([str(tmp_path / "ok.csv"), "--at", "nan"], "--at must be a finite number"),
     ):
         res = subprocess.run(
@@ -318,6 +319,20 @@ def test_cli_one_line_errors_and_nothing_written(tmp_path):
         err = res.stderr.strip()
         assert err.startswith("eyeviz: error:") and want in err and "\n" not in err, err
         assert not out.exists() or not list(out.iterdir())
+
+
+def test_the_prior_is_the_tables_own_unless_chosen(tmp_path):
+    rows = [{**r, "prior": "multi"} for r in synthetic_rows(C=0.3)]
+    path = write_table(tmp_path / "m.csv", rows)
+    study.write_report(path, tmp_path / "a", law_max=10.0)
+    js = json.loads((tmp_path / "a" / "summary.json").read_text())
+    assert js["source"]["prior"] == "multi" and js["law"]["C"] == pytest.approx(0.3)
+    both = write_table(tmp_path / "b.csv", rows + synthetic_rows(C=0.2))
+    study.write_report(both, tmp_path / "b", law_max=10.0)
+    js = json.loads((tmp_path / "b" / "summary.json").read_text())
+    assert js["source"]["prior"] == "single" and js["law"]["C"] == pytest.approx(0.2)
+    with pytest.raises(EyevizError, match="no rows of prior 'single'"):
+        study.write_report(path, tmp_path / "c", prior="single")
 
 
 def test_the_largest_run_of_a_design_is_drawn(tmp_path):
