@@ -81,6 +81,8 @@ class Row:
 
 
 def _num(line: int, col: str, text: str, *, positive=False, nan_ok=False, lo=None) -> float:
+    if nan_ok and not text.strip():  # pandas and None write a missing value as ""
+        return math.nan
     try:
         v = float(text)
     except ValueError:

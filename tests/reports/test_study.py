@@ -112,8 +112,20 @@ def test_columns_and_version_match_the_study_layer():
     assert study_table.PRIORS == tuple(PRIORS)
 
 
-def test_reader_reads_a_real_table(real_table):
+def test_reader_reads_a_real_table(real_table, tmp_path):
+    import pandas as pd
+
     rows = read_study(real_table)
+    # the same table written back by pandas (NaN as "") reads the same
+    again = tmp_path / "pandas.csv"
+    df = pd.read_csv(real_table, dtype={"bin": str})
+    df.loc[1, "dd_r2"] = float("nan")  # a missing R^2: pandas writes ""
+    df.to_csv(again, index=False)
+    assert ",," in again.read_text()
+    rows2 = read_study(again)
+    assert math.isnan(rows2[1].dd_r2)
+    assert [(r.design, r.bin, r.count) for r in rows2] == [(r.design, r.bin, r.count) for r in rows]
+    assert [r.dd_mape for r in rows2] == pytest.approx([r.dd_mape for r in rows], nan_ok=True)
     # 3 designs x 2 m x (all + 8 bins)
     assert len(rows) == 6 * 9
     assert {r.design for r in rows} >= {(40.0, 20.0, 720), (20.0, 10.0, 360)}
