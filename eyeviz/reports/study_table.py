@@ -3,8 +3,10 @@
 The table is the CSV ``eyeviz study`` writes: the header is exactly :data:`COLUMNS`, one
 row per design point and distance bin (``bin = "all"`` then "0", "1", ...). The reader
 refuses, with a one-line :class:`eyeviz.EyevizError` naming the first bad line: a file
-larger than :data:`MAX_STUDY_BYTES` (checked before reading), another header, a row of
-another ``version``, a field that is not the number its column needs, a duplicated row.
+larger than :data:`eyeviz.files.limits.MAX_STUDY_BYTES` (checked before reading), another
+header, a row of another ``version``, a field that is not the number its column needs, a
+duplicated row. (``eyeviz.study.table`` reads the same file for the runner; the reports
+layer may not import it.)
 
 The reports layer may not import :mod:`eyeviz.study` (sibling layers), so the columns and
 the version are repeated here; ``tests/reports/test_study.py`` checks they stay equal to
@@ -20,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from eyeviz import EyevizError
-from eyeviz.files.limits import MAX_M, read_bounded
+from eyeviz.files.limits import MAX_M, MAX_STUDY_BYTES, read_bounded
 
 __all__ = ["COLUMNS", "MAX_STUDY_BYTES", "MAX_STUDY_ROWS", "STUDY_VERSION", "Row", "read_study"]
 
@@ -31,8 +33,6 @@ COLUMNS = (
     "seconds",
 )  # fmt: skip
 PRIORS = ("single", "multi")
-#: A study table larger than this is refused before it is read (a row is ~200 bytes).
-MAX_STUDY_BYTES = 64 << 20
 #: Rows of a study table (design points x bins).
 MAX_STUDY_ROWS = 1_000_000
 #: Distance bins of one design point.
@@ -166,10 +166,15 @@ def _row(line: int, f: dict[str, str]) -> Row:
     return row
 
 
-def read_study(path) -> list[Row]:
-    """The rows of a study table; EyevizError (naming the first bad line) otherwise."""
+def read_study(path, max_bytes: int | None = None) -> list[Row]:
+    """The rows of a study table; EyevizError (naming the first bad line) otherwise.
+
+    The file is refused unread when larger than ``max_bytes`` (default
+    :data:`eyeviz.files.limits.MAX_STUDY_BYTES`, the bound ``eyeviz study`` writes under).
+    """
+    max_bytes = MAX_STUDY_BYTES if max_bytes is None else max_bytes
     name = str(Path(path))
-    raw = read_bounded(path, MAX_STUDY_BYTES, "study table")
+    raw = read_bounded(path, max_bytes, "study table")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

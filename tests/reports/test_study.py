@@ -299,7 +299,9 @@ def test_empty_and_oversized_and_binary_tables(tmp_path, monkeypatch):
     _raises(write_table(tmp_path / "h.csv", []), "header but no rows")
     _raises(tmp_path, "not a regular file")
     big = write_table(tmp_path / "big.csv", synthetic_rows())
-    monkeypatch.setattr(study_table, "MAX_STUDY_BYTES", 1000)
+    with pytest.raises(EyevizError, match=r"more than 1000"):
+        read_study(big, max_bytes=1000)
+    monkeypatch.setattr(study_table, "MAX_STUDY_BYTES", 1000)  # the default bound
     _raises(big, r"more than 1000")
     monkeypatch.undo()
     b = tmp_path / "bin.csv"
