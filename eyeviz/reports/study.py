@@ -346,6 +346,12 @@ def curves_figure(designs: dict, l_of: dict, target: str, wanted: float = PAPER[
     return fig
 
 
+def _cell(v: float) -> str:
+    """Three significant digits, trailing zeros kept (18.0, 2.50, 0.864)."""
+    s = f"{v:#.3g}"
+    return s[:-1] if s.endswith(".") else s
+
+
 def heatmap_figure(table: list[dict], l_of: dict, at: float, wanted: float = PAPER[1]):
     """DD MAPE at ``at`` over (h, m); values in the cells; the paper's design boxed."""
     from matplotlib.colors import LogNorm, Normalize
@@ -376,7 +382,7 @@ def heatmap_figure(table: list[dict], l_of: dict, at: float, wanted: float = PAP
             rgb = cmap(norm(v))[:3] if finite.size else (1, 1, 1)
             lum = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
             ax.text(
-                j, i, f"{v:.3g}", ha="center", va="center", color="black" if lum > 0.45 else "white"
+                j, i, _cell(v), ha="center", va="center", color="black" if lum > 0.45 else "white"
             )
     paper = [t for t in table if t["paper_design"]]
     for t in paper:
@@ -389,7 +395,7 @@ def heatmap_figure(table: list[dict], l_of: dict, at: float, wanted: float = PAP
     )
     paper = [t for t in table if t["paper_design"]]
     ax.set_xlabel("ommatidia m" + ("\n(boxed: " + _paper_label() + ")" if paper else ""))
-    ax.set_ylabel("h (half the eye separation)")
+    ax.set_ylabel("h (eye centres at x = ±h)")
     ax.tick_params(length=0)
     for s in ax.spines.values():
         s.set_visible(False)

@@ -172,7 +172,8 @@ def test_report_writes_figures_a_paper_can_use(real_table, tmp_path):
         r for r in rows if r.design == (40.0, 20.0, 720) and r.r_lo == 3000.0 and r.bin != "all"
     )
     assert float(paper["dd_mape"]) == pytest.approx(truth.dd_mape)
-    assert f"{truth.dd_mape:.3g}" in heat_text.split()
+    assert study._cell(truth.dd_mape) in heat_text.split()
+    assert [study._cell(v) for v in (18.0, 2.5, 0.8641, 123.4)] == ["18.0", "2.50", "0.864", "123"]
 
     js = json.loads((out / "summary.json").read_text())
     assert 0.1 < js["law"]["C"] < 1.0  # the limit's constant (about 0.36 at n = 20000)
