@@ -178,3 +178,23 @@ def test_a_refused_computation_is_a_message_not_a_crash(make_window, qtbot):
     qtbot.waitUntil(lambda: bool(panel.error), timeout=5000)
     assert "no prior for these eyes" in panel.info.text() and panel.info.isVisible()
     assert not panel.computing.get_visible()
+
+
+def test_closing_the_window_during_a_computation_is_clean(make_window, qtbot):
+    win = make_window(scene())
+    panel = win.show_design()
+    assert panel.wait()
+    gate = threading.Event()
+
+    def slow(h, l, m):
+        gate.wait(20)
+        return design_dock.compute_curve(h, l, m)
+
+    panel.compute = slow
+    win.model.set_eyes(40.0, 20.0, 1440)
+    qtbot.waitUntil(lambda: panel.running is not None, timeout=5000)
+    win.force_close()
+    gate.set()
+    assert panel.pool.waitForDone(20000)
+    QTest.qWait(50)  # the result arrives after the close: drawn into a hidden dock, no error
+    assert panel.running is None and (40.0, 20.0, 1440) in panel.cache
