@@ -55,6 +55,12 @@ PT = 7.0  # every text in these figures, ticks included
 OKABE_ITO = ("#E69F00", "#56B4E9", "#009E73", "#0072B2", "#D55E00", "#CC79A7", "#000000")
 DASHES = ("-", "--", ":", "-.")
 TWO_COLUMNS, ONE_COLUMN = 7.2, 3.5  # inches
+CAPTIONS = {
+    "study_dd": "DD limit (MAPE %) against distance, a panel per h, a curve per m",
+    "study_ad": "AD limit (MAPE %) against distance, a panel per h, a curve per m",
+    "study_heatmap": "DD limit at --at over (h, m), values in the cells",
+    "study_law": "relative DD error against gamma r / (2h) with the fitted C",
+}
 
 
 # --- analysis ---------------------------------------------------------------------------
@@ -622,7 +628,8 @@ def markdown(table, fit, designs, l_of, best, args_d, figures) -> str:
     for h, m in best.items():
         lines.append(f"| {h:g} | {l_of[h]:g} | {m if m is not None else 'none in the grid'} |")
     lines += ["", "Figures (each as PDF, SVG and PNG):", ""]
-    lines += [f"- `{f}`" for f in figures]
+    for f in figures:
+        lines += [f"**{f}**: {CAPTIONS.get(f, '')}", "", f"![{f}]({f}.png)", ""]
     return "\n".join(lines) + "\n"
 
 
@@ -666,7 +673,7 @@ def write_report(
     written.append(
         _write_text(outdir / "summary.json", summary_json(table, fit, args_d, designs, best))
     )
-    figs = sorted({p.stem for p in written if p.suffix == ".png"})
+    figs = [p.stem for p in written if p.suffix == ".png"]  # in the order drawn
     written.append(
         _write_text(outdir / "study.md", markdown(table, fit, designs, l_of, best, args_d, figs))
     )

@@ -228,6 +228,8 @@ def test_report_on_a_synthetic_table_states_c_everywhere(tmp_path):
     assert "C = 0.25" in svg
     md = (out / "study.md").read_text()
     assert "C = 0.25" in md and "Fewest ommatidia" in md
+    for stem in ("study_dd", "study_ad", "study_heatmap", "study_law"):
+        assert f"]({stem}.png)" in md and (out / f"{stem}.png").exists()
 
 
 def test_one_m_only_still_draws_everything(tmp_path):
