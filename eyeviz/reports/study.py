@@ -309,7 +309,10 @@ def curves_figure(designs: dict, l_of: dict, target: str, wanted: float = PAPER[
     ncols = min(len(hs), 3)
     spare = (-len(hs)) % ncols
     nrows = math.ceil(len(hs) / ncols)
-    fig = Figure(figsize=(TWO_COLUMNS, 0.4 + 1.75 * nrows), layout="constrained")
+    width = TWO_COLUMNS if ncols > 1 else ONE_COLUMN  # one h: one column of a paper
+    fig = Figure(
+        figsize=(width, 0.4 + 1.75 * nrows + (0.6 if ncols == 1 else 0)), layout="constrained"
+    )
     axes = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False).ravel()
     paper_drawn = False
     for ax, h in zip(axes, hs, strict=False):
@@ -348,7 +351,9 @@ def curves_figure(designs: dict, l_of: dict, target: str, wanted: float = PAPER[
             handles, labels, loc="center left", frameon=False, title=title, alignment="left"
         )
     else:
-        fig.legend(handles, labels, loc="outside lower center", ncol=3, frameon=False)
+        fig.legend(
+            handles, labels, loc="outside lower center", ncol=3 if ncols > 1 else 1, frameon=False
+        )
     return fig
 
 
@@ -370,7 +375,7 @@ def heatmap_figure(table: list[dict], l_of: dict, at: float, wanted: float = PAP
     for t in table:
         grid[hs.index(t["h"]), ms.index(t["m"])] = t["dd_mape"]
     finite = grid[np.isfinite(grid) & (grid > 0)]
-    fig = Figure(figsize=(ONE_COLUMN, 0.9 + 0.42 * len(hs)), layout="constrained")
+    fig = Figure(figsize=(ONE_COLUMN, max(2.4, 0.9 + 0.42 * len(hs))), layout="constrained")
     ax = fig.add_subplot()
     norm = (
         LogNorm(finite.min(), finite.max())
