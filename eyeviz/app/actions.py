@@ -100,6 +100,7 @@ def build_menus(win) -> None:
     _action(win, v, "&Fit view", win.fit_view, "F")
     _action(win, v, "Fit &inset to the eyes", win.fit_inset, "Shift+F")
     v.addSeparator()
+    _action(win, v, "Eye &design: limit against distance", win.show_design)
     t = v.addMenu("&Trajectory")
     for kind in ("horizontal", "circular", "vertical"):
         t.addAction(kind.capitalize(), lambda k=kind: win.show_trajectory(k))

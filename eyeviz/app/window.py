@@ -322,6 +322,27 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
             QtCore.QTimer.singleShot(0, d.raise_)
         return self.trajectory_panel
 
+    def show_design(self):
+        """View > Eye design: the limit curves of the current eyes and the paper's (issue 11)."""
+        if getattr(self, "design_panel", None) is None:
+            from eyeviz.app.design_dock import DesignPanel
+
+            self.design_panel = DesignPanel(self.model)
+            d = self._dock("Eye design", self.design_panel, "design")
+            self.tabifyDockWidget(self._docks["features"], d)
+            self._docks["design"] = d
+            # the plots get most of the side column (the readout needs ~260 px)
+            QtCore.QTimer.singleShot(0, self._fit_design_dock)
+        self._docks["design"].show()
+        self._docks["design"].raise_()
+        return self.design_panel
+
+    def _fit_design_dock(self) -> None:
+        read, d = self._docks["readout"], self._docks["design"]
+        tall = read.height() + d.height()
+        self.resizeDocks([read, d], [min(270, tall // 2), max(tall - 270, tall // 2)],
+                         QtCore.Qt.Vertical)  # fmt: skip
+
     def show_trajectory(self, kind: str) -> None:
         """View > Trajectory: a path of this kind for the selected feature, with its plot."""
         panel = self._trajectory_dock()

@@ -11,7 +11,7 @@ import importlib
 
 NAME = "report"
 HELP = "write a report (Markdown, CSV and plots) into a directory"
-KINDS = ("stability", "dataset", "estimators", "trajectories")
+KINDS = ("stability", "dataset", "estimators", "trajectories", "study")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
