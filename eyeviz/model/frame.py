@@ -17,7 +17,9 @@ Fields of :class:`Frame` (``None`` / empty when no layer needs them):
 - ``eyes``: two :class:`EyeFrame` (A, B): ``center``, ``owner`` (feature index lighting
   each ommatidium, -1 unlit; the last feature wins), ``color_index`` (0 unlit, else
   1 + index into ``palette``), ``runs`` (starts, stops exclusive, color index: maximal runs
-  of equal colour for merged drawing and the bitmap strips).
+  of equal colour for merged drawing and the bitmap strips), ``l``, ``m`` and
+  ``rim(k)``: the rim vertices at j*gamma (Figure 2, Eq. 6) of every k-th ommatidium and
+  ``pooled_owner(k)``: the owner of each run of k ommatidia (the app's level of detail).
 - ``intervals``: {"A": (L, R), "B": (L, R)} per feature (Prop. 2, ``EyePair.intervals``).
 - ``bfv``: :class:`BFVFrame`: ``psi`` (Eq. 15), ``theta`` (Eq. 16), ``polygon`` the wedge
   clipped to ``rect`` (an (k, 2) array; empty when the wedge misses the rectangle) and the
@@ -27,7 +29,8 @@ Fields of :class:`Frame` (``None`` / empty when no layer needs them):
   ``ends`` the two tangent points (2, 2)); none for an eye inside a disc.
 - ``sectors``: list of :class:`SectorFrame` (feature i, eye, center, L, R, ``reach``,
   ``rays`` the sector boundary indices k (angles k*gamma, Eq. 8, 11): L..R+1, or only L and
-  R+1 when the run is 24 cells or longer); whole-eye runs are omitted.
+  R+1 when the run is 24 cells or longer) and ``ends`` their far points at ``reach``;
+  whole-eye runs are omitted.
 - readout arrays ``r, phi, rA, phiA, rB, phiB`` (polar about O, A, B; angles in rad),
   ``in_bfv``, ``vis_a``, ``vis_b``, ``in_domain`` (BFV and seen by both),
   ``out_of_domain`` (greyed features: the predictions layer is on and not in domain).
@@ -37,6 +40,9 @@ Fields of :class:`Frame` (``None`` / empty when no layer needs them):
   None (the disc covers an eye centre)}.
 - ``trajectory``: :class:`TrajectoryPath` (points in the BFV and each estimator's accuracy)
   or None; ``trajectory_error``: why there is none.
+- ``labels``: :class:`LabelFrame` anchors (text, x, y, kind, feature) of the ``labels``
+  layer: the eyes A, B and the origin O under them, each feature's name up-right of its
+  disc (the app's view places them at these points; the exported figure lays its own out).
 """
 
 from __future__ import annotations
@@ -55,6 +61,7 @@ __all__ = [
     "BFVFrame",
     "EyeFrame",
     "Frame",
+    "LabelFrame",
     "PredictionFrame",
     "SectorFrame",
     "TangentFrame",
@@ -62,6 +69,7 @@ __all__ = [
     "ambiguity_of",
     "build_frame",
     "clip_wedge",
+    "rim_points",
     "errors",
     "runs",
     "state_for",
@@ -70,6 +78,8 @@ __all__ = [
 ]
 
 WIDE_SECTOR = 24  # runs this long draw only their two boundary rays
+EYE_LABEL_DROP = 1.35  # eye and origin labels sit this many eye radii under the axis
+FEATURE_LABEL_OFFSET = 0.75  # a feature's name sits this many radii up-right of its centre
 
 
 # --- small pure helpers ------------------------------------------------------------------
@@ -102,7 +112,19 @@ def view_rect(scene: Scene, aspect: float = 0.86) -> tuple[float, float, float, 
     return (cx - w / 2, cx + w / 2, cy - h / 2, cy + h / 2)
 
 
-def _clip_half_plane(poly: list[tuple[float, float]], nx: float, ny: float):
+def rim_points(
+    center: tuple[float, float], l: float, m: int, starts: np.ndarray | None = None
+) -> np.ndarray:
+    """(c + 1, 2) points of an eye's rim at j*gamma, gamma = 2 pi / m, for j in ``starts``
+    (default 0..m-1) and m (Figure 2, Eq. 6): ommatidium cell i spans rim[i] .. rim[i + 1]."""
+    j = np.append(np.arange(m) if starts is None else starts, m).astype(np.float64)
+    t = j * (2.0 * math.pi / m)
+    return np.column_stack([center[0] + l * np.cos(t), center[1] + l * np.sin(t)])
+
+
+def _clip_half_plane(
+    poly: list[tuple[float, float]], nx: float, ny: float
+) -> list[tuple[float, float]]:
     """Sutherland-Hodgman: keep the part of ``poly`` with nx*x + ny*y >= 0."""
     out: list[tuple[float, float]] = []
     n = len(poly)
@@ -134,7 +156,9 @@ def clip_wedge(psi: float, rect: tuple[float, float, float, float]) -> np.ndarra
     return np.array(poly, dtype=np.float64).reshape(-1, 2)
 
 
-def _ray_to_rect(angle: float, rect) -> tuple[float, float, float, float] | None:
+def _ray_to_rect(
+    angle: float, rect: tuple[float, float, float, float]
+) -> tuple[float, float, float, float] | None:
     """The part of the ray from the origin at ``angle`` inside ``rect``, or None."""
     x0, x1, y0, y1 = rect
     dx, dy = math.cos(angle), math.sin(angle)
@@ -164,6 +188,23 @@ class EyeFrame:
     owner: np.ndarray
     color_index: np.ndarray
     runs: tuple[np.ndarray, np.ndarray, np.ndarray]
+    l: float = 0.0
+    m: int = 0
+
+    def starts(self, k: int = 1) -> np.ndarray:
+        """First ommatidium of each run of k (the cells of the level of detail k)."""
+        return np.arange(0, self.m, max(1, int(k)))
+
+    def rim(self, k: int = 1) -> np.ndarray:
+        """(c + 1, 2) rim vertices at j*gamma for j in ``starts(k)`` and m (Figure 2,
+        Eq. 6): cell i is the triangle centre, rim[i], rim[i + 1]."""
+        return rim_points(self.center, self.l, self.m, self.starts(k))
+
+    def pooled_owner(self, k: int = 1) -> np.ndarray:
+        """Owner of each run of k ommatidia: the last feature lighting any of them, or -1."""
+        if k <= 1:
+            return self.owner
+        return np.maximum.reduceat(self.owner, self.starts(k))
 
 
 @dataclass
@@ -201,6 +242,18 @@ class SectorFrame:
     R: int
     reach: float
     rays: list[int]  # boundary k of the ray at angle k * gamma
+    ends: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (len(rays), 2)
+
+
+@dataclass
+class LabelFrame:
+    """A text anchored at (x, y): an eye (A, B), the origin (O) or a feature's name."""
+
+    text: str
+    x: float
+    y: float
+    kind: str  # "eye" (A, B, O) or "feature"
+    feature: int | None = None
 
 
 @dataclass
@@ -267,6 +320,7 @@ class Frame:
     ambiguity: dict[int, dict | None] = field(default_factory=dict)
     trajectory: TrajectoryPath | None = None
     trajectory_error: str | None = None
+    labels: list[LabelFrame] = field(default_factory=list)
 
     @property
     def n(self) -> int:
@@ -276,7 +330,9 @@ class Frame:
 # --- derived quantities (formerly eyeviz.model.derived) ----------------------------------
 
 
-def ambiguity_of(pair: EyePair, x: float, y: float, g: float, box) -> dict | None:
+def ambiguity_of(
+    pair: EyePair, x: float, y: float, g: float, box: tuple[float, float, float, float] | None
+) -> dict | None:
     """The ambiguity region of one feature (eyeviz.core.ambiguity) with its ranges, or None
     when the feature covers an eye centre (no polygon then)."""
     from eyeviz.core.ambiguity import ambiguity_radius_range, ambiguity_region
@@ -365,7 +421,9 @@ def state_for(scene: Scene, state: SceneState | None) -> SceneState:
     return state
 
 
-def _eye_frames(pair: EyePair, st: SceneState, palette: list[str], colors: list[str]):
+def _eye_frames(
+    pair: EyePair, st: SceneState, palette: list[str], colors: list[str]
+) -> list[EyeFrame]:
     uniq = {c: i + 1 for i, c in enumerate(palette)}
     lut = np.array([0] + [uniq[c] for c in colors], dtype=np.int64)
     out = []
@@ -374,20 +432,32 @@ def _eye_frames(pair: EyePair, st: SceneState, palette: list[str], colors: list[
         ("B", pair.centers[1], st.owner_b, st.LB, st.RB),
     ):
         if owner is None:
-            owner = owners(L, R, pair.m) if L is not None else np.full(pair.m, -1, np.int64)
+            if L is not None and R is not None:
+                owner = owners(L, R, pair.m)
+            else:
+                owner = np.full(pair.m, -1, np.int64)
         cidx = lut[owner + 1]
         s, e = runs(cidx)
-        out.append(EyeFrame(name, center, owner, cidx, (s, e, cidx[s])))
+        out.append(EyeFrame(name, center, owner, cidx, (s, e, cidx[s]), pair.l, pair.m))
     return out
 
 
-def _tangents(pair: EyePair, st: SceneState) -> list[TangentFrame]:
+def _polar(st: SceneState) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(rA, phiA, rB, phiB); ValueError when the state has no readout (a state_for bug)."""
+    rA, phiA, rB, phiB = st.rA, st.phiA, st.rB, st.phiB
+    if rA is None or phiA is None or rB is None or phiB is None:
+        raise ValueError("this state has no polar coordinates about the eyes")
+    return rA, phiA, rB, phiB
+
+
+def _tangents(pair: EyePair, st: SceneState, only: list[int]) -> list[TangentFrame]:
     out = []
-    for i in range(st.n):
+    rA, phiA, rB, phiB = _polar(st)
+    for i in only:
         g = float(st.g[i])
         for name, center, rE, phE in (
-            ("A", pair.centers[0], float(st.rA[i]), float(st.phiA[i])),
-            ("B", pair.centers[1], float(st.rB[i]), float(st.phiB[i])),
+            ("A", pair.centers[0], float(rA[i]), float(phiA[i])),
+            ("B", pair.centers[1], float(rB[i]), float(phiB[i])),
         ):
             if not rE > g:
                 continue
@@ -399,24 +469,33 @@ def _tangents(pair: EyePair, st: SceneState) -> list[TangentFrame]:
     return out
 
 
-def _sectors(pair: EyePair, st: SceneState) -> list[SectorFrame]:
+def _sectors(pair: EyePair, st: SceneState, only: list[int]) -> list[SectorFrame]:
     out = []
     m = pair.m
-    for i in range(st.n):
+    LA, RA, LB, RB = st.intervals()
+    rA, _, rB, _ = _polar(st)
+    for i in only:
         g = float(st.g[i])
-        for name, center, L, R, rE in (
-            ("A", pair.centers[0], st.LA[i], st.RA[i], st.rA[i]),
-            ("B", pair.centers[1], st.LB[i], st.RB[i], st.rB[i]),
+        for name, center, Li, Ri, rE in (
+            ("A", pair.centers[0], LA[i], RA[i], rA[i]),
+            ("B", pair.centers[1], LB[i], RB[i], rB[i]),
         ):
-            L, R = int(L), int(R)
+            L, R = int(Li), int(Ri)
             if R - L >= m - 1 or R < L:
                 continue
             rays = list(range(L, R + 2)) if R - L < WIDE_SECTOR else [L, R + 1]
-            out.append(SectorFrame(i, name, center, L, R, float(rE) + 1.6 * g, rays))
+            reach = float(rE) + 1.6 * g
+            t = np.asarray(rays, dtype=np.float64) * pair.gamma
+            ends = np.column_stack([center[0] + reach * np.cos(t), center[1] + reach * np.sin(t)])
+            out.append(SectorFrame(i, name, center, L, R, reach, rays, ends))
     return out
 
 
-def _predictions(scene, st, predictor, given) -> dict[str, PredictionFrame | str]:
+def _predictions(
+    scene: Scene, st: SceneState, predictor: Predictor | None, given: dict | None
+) -> dict[str, PredictionFrame | str]:
+    if st.r is None or st.phi is None:
+        raise ValueError("this state has no polar coordinates")
     if given is None:
         predictor = predictor if predictor is not None else Predictor()
         given = predictor.predict(scene, st)
@@ -442,6 +521,21 @@ def _predictions(scene, st, predictor, given) -> dict[str, PredictionFrame | str
     return out
 
 
+def _labels(pair: EyePair, scene: Scene, st: SceneState) -> list[LabelFrame]:
+    y = -EYE_LABEL_DROP * pair.l
+    out = [
+        LabelFrame("A", -pair.h, y, "eye"),
+        LabelFrame("B", pair.h, y, "eye"),
+        LabelFrame("O", 0.0, y, "eye"),
+    ]
+    if "features" in scene.layers:
+        d = FEATURE_LABEL_OFFSET * st.g
+        for i, f in enumerate(scene.features):
+            x, y_ = float(st.x[i] + d[i]), float(st.y[i] + d[i])
+            out.append(LabelFrame(f.name, x, y_, "feature", i))
+    return out
+
+
 def build_frame(
     scene: Scene,
     state: SceneState | None = None,
@@ -449,6 +543,9 @@ def build_frame(
     *,
     rect: tuple[float, float, float, float] | None = None,
     predictions: dict | None = None,
+    only: int | None = None,
+    ambiguity: dict[int, dict | None] | None = None,
+    trajectory: TrajectoryPath | None = None,
 ) -> Frame:
     """The :class:`Frame` of ``scene`` for its layers.
 
@@ -456,6 +553,10 @@ def build_frame(
     ambiguity regions are bounded by (default: the scene's view at the export's aspect).
     ``predictions`` (estimator -> (r_hat, phi_hat) or a reason) skips the estimators;
     otherwise ``predictor`` (made when None) answers, only if the predictions layer is on.
+    ``only`` limits the per-feature teaching layers (tangents, sectors) to one feature (the
+    app's selection). ``ambiguity`` ({feature: region or None}, e.g. the app model's cached
+    region) and ``trajectory`` (a :class:`TrajectoryPath` already made) are taken as given
+    instead of being computed.
     """
     st = state_for(scene, state)
     pair = st.pair
@@ -480,7 +581,8 @@ def build_frame(
     )
     n = st.n
     if st.LA is not None:
-        fr.intervals = {"A": (st.LA, st.RA), "B": (st.LB, st.RB)}
+        LA, RA, LB, RB = st.intervals()
+        fr.intervals = {"A": (LA, RA), "B": (LB, RB)}
         fr.vis_a, fr.vis_b = st.vis_a, st.vis_b
     if st.r is not None:
         fr.r, fr.phi, fr.rA, fr.phiA, fr.rB, fr.phiB = (
@@ -497,6 +599,7 @@ def build_frame(
     fr.out_of_domain = np.zeros(n, bool)
     if "predictions" in lay and n and fr.in_domain is not None:
         fr.out_of_domain = ~fr.in_domain
+    teach = list(range(n)) if only is None else [only] if 0 <= only < n else []
     if {"eyes", "bitmaps"} & lay:
         fr.eyes = _eye_frames(pair, st, fr.palette, colors)
     if "bfv" in lay:
@@ -506,19 +609,25 @@ def build_frame(
             clip_wedge(pair.psi, box),
             [_ray_to_rect(pair.psi, box), _ray_to_rect(math.pi - pair.psi, box)],
         )
-    if "tangents" in lay and n:
-        fr.tangents = _tangents(pair, st)
-    if "sectors" in lay and n:
-        fr.sectors = _sectors(pair, st)
+    if "tangents" in lay and teach:
+        fr.tangents = _tangents(pair, st, teach)
+    if "sectors" in lay and teach:
+        fr.sectors = _sectors(pair, st, teach)
+    if "labels" in lay:
+        fr.labels = _labels(pair, scene, st)
     if "predictions" in lay and n:
         fr.predictions = _predictions(scene, st, predictor, predictions)
-    if "ambiguity" in lay and n:
+    if "ambiguity" in lay and ambiguity is not None:
+        fr.ambiguity = {i: a for i, a in ambiguity.items() if 0 <= i < n}
+    elif "ambiguity" in lay and n:
         x0, x1, y0, y1 = box
         w = x1 - x0
         box = (x0 - w, x1 + w, y0 - w, y1 + w)
         for i, f in enumerate(scene.features):
             fr.ambiguity[i] = ambiguity_of(pair, f.x, f.y, f.g, box)
-    if "trajectory" in lay and scene.trajectory is not None:
+    if "trajectory" in lay and trajectory is not None:
+        fr.trajectory = trajectory
+    elif "trajectory" in lay and scene.trajectory is not None:
         try:
             stop = max(scene.trajectory.distance, box[3])
             fr.trajectory = trajectory_path(pair, scene.trajectory, [], None, n=400, stop=stop)
