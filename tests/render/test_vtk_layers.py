@@ -42,6 +42,8 @@ def test_eye_triangles_are_the_frames_rim(rig):
     fr = view_frame(sc, compute_state(sc), 0)
     eye = fr.eyes[0]
     eye.center = (eye.center[0] + SHIFT[0], eye.center[1] + SHIFT[1])  # injected
+    rim = eye.rim
+    eye.rim = lambda k=1: rim(k) * 1.01  # a rim that is not the centre's circle of radius l
     act.draw(fr, 0)
     pts = _xy(act.eye_meshes[0])
     np.testing.assert_allclose(pts[0], eye.center)
