@@ -72,8 +72,16 @@ class OverlayActors:
         ambiguity: dict | None,
         path: TrajectoryPath | None,
         skip=frozenset(),
-    ) -> Frame:
-        """Build the overlay Frame and draw it; returns the Frame."""
+    ) -> Frame | None:
+        """Build the overlay Frame and draw it; returns the Frame (None, and everything
+        hidden, when the scene shows none of these layers: a drag builds nothing then)."""
+        if not any(n in _LAYERS for n in scene.layers):
+            for layer in (self.ambiguity, self.trajectory, self.predictions):
+                for a in layer.actors:
+                    a.SetVisibility(False)
+            self.predictions.ghosts = {}
+            self.ambiguity.polygon = None
+            return None
         frame = overlay_frame(scene, state, selected, predictions, ambiguity, path)
         self.draw(frame, selected, skip)
         return frame

@@ -35,6 +35,15 @@ def mesh_of_rim(center: tuple[float, float], rim: np.ndarray) -> pv.PolyData:
     return mesh
 
 
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    """a == b everywhere (bytes for a small eye: ~4x faster than np.array_equal there)."""
+    if a is b:
+        return True
+    if a.shape != b.shape:
+        return False
+    return a.tobytes() == b.tobytes() if a.size <= 4096 else bool(np.array_equal(a, b))
+
+
 class EyesLayer:
     """Eye meshes (main A, B; inset A, B), rim outlines and the origin point."""
 
@@ -50,6 +59,7 @@ class EyesLayer:
         self._eyes: list[EyeFrame] = []
         self._owners: tuple[np.ndarray, ...] | None = None
         self._palette: np.ndarray | None = None
+        self._colors: tuple[str, ...] = ()
 
     def build(self, frame: Frame) -> None:
         """New meshes (the eyes' h, l, m or the layers changed)."""
@@ -88,12 +98,16 @@ class EyesLayer:
         if not self.meshes or not frame.eyes:
             return
         self._eyes = list(frame.eyes)
-        palette = np.vstack([UNLIT] + [hex_rgb(c) for c in frame.colors]).astype(np.uint8)
-        same_palette = self._palette is not None and np.array_equal(palette, self._palette)
-        self._palette = palette
+        colors = tuple(frame.colors)
+        same_palette = self._palette is not None and colors == self._colors
+        if not same_palette:
+            self._colors = colors
+            self._palette = np.vstack([UNLIT] + [hex_rgb(c) for c in colors]).astype(np.uint8)
+        palette = self._palette
+        assert palette is not None
         old = self._owners
         for e, (mesh, eye) in enumerate(zip(self.meshes, self._eyes, strict=True)):
-            if same_palette and old is not None and np.array_equal(old[e], eye.owner):
+            if same_palette and old is not None and _same(old[e], eye.owner):
                 continue  # unchanged: no colour write, so no buffer upload at the next render
             mesh.cell_data["rgb"][:] = palette[eye.owner + 1]
             for (which, k), lod in self.lod.items():

@@ -92,9 +92,11 @@ class LabelsLayer:
         few = frame.n <= LABEL_ALL_MAX
         feats = [lab for lab in frame.labels if lab.kind == "feature"]
         for label, lab in zip(self.feature_labels, feats, strict=False):
-            label.SetVisibility(few or lab.feature == selected)
-            label.SetInput(f" {lab.text}")  # no-op (no Modified) when unchanged
-            label.SetPosition(lab.x, lab.y, Z_POINT)
+            shown = few or lab.feature == selected
+            label.SetVisibility(shown)
+            if shown:  # a hidden label is placed when it is shown
+                label.SetInput(f" {lab.text}")  # no-op (no Modified) when unchanged
+                label.SetPosition(lab.x, lab.y, Z_POINT)
 
     def set_inset_shown(self, shown: bool) -> None:
         self.inset_shown = bool(shown)
