@@ -64,7 +64,6 @@ from eyeviz.model.frame_parts import (
     SectorFrame,
     TangentFrame,
     TrajectoryPath,
-    _ray_to_rect,
     clip_wedge,
     errors,
     rim_points,
@@ -374,12 +373,7 @@ def build_frame(
     if {"eyes", "bitmaps"} & lay:
         fr.eyes = _eye_frames(pair, st, fr.palette, colors)
     if "bfv" in lay:
-        fr.bfv = BFVFrame(
-            pair.psi,
-            pair.theta,
-            clip_wedge(pair.psi, box),
-            [_ray_to_rect(pair.psi, box), _ray_to_rect(math.pi - pair.psi, box)],
-        )
+        fr.bfv = BFVFrame(pair.psi, pair.theta, box)
     if "tangents" in lay and teach:
         fr.tangents = _tangents(pair, st, teach)
     if "sectors" in lay and teach:

@@ -178,12 +178,22 @@ class EyeFrame:
 
 @dataclass
 class BFVFrame:
-    """The BFV wedge (Definition 2, Eq. 15-16) clipped to the view rectangle."""
+    """The BFV wedge (Definition 2, Eq. 15-16) clipped to the view rectangle ``rect``
+    (the polygon and the edges computed when first read: the app's per-frame Frame only
+    needs psi and theta for its labels)."""
 
     psi: float
     theta: float
-    polygon: np.ndarray
-    edges: list[tuple[float, float, float, float] | None]  # right (psi), left (pi - psi)
+    rect: tuple[float, float, float, float]
+
+    @cached_property
+    def polygon(self) -> np.ndarray:
+        return clip_wedge(self.psi, self.rect)
+
+    @cached_property
+    def edges(self) -> list[tuple[float, float, float, float] | None]:
+        """Right (psi) and left (pi - psi) edges from the origin to the rectangle's border."""
+        return [_ray_to_rect(self.psi, self.rect), _ray_to_rect(math.pi - self.psi, self.rect)]
 
 
 @dataclass

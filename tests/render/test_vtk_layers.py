@@ -147,3 +147,17 @@ def test_overlays_are_the_frames_predictions_ambiguity_and_path(rig):
     ov.update(sc, st, 0, preds, amb, path)
     np.testing.assert_allclose(ov.amb_polygon, square)
     np.testing.assert_allclose(ov.ghosts["analytic"][:, 0], r * 1.01 * np.cos(phi))
+
+
+def test_the_bfv_line_is_the_frames_theta_and_psi(rig):
+    _, act, _ = rig
+    sc = _scene(["eyes", "bfv", "features", "labels"])
+    fr = view_frame(sc, compute_state(sc), None)
+    act.draw(fr, None)
+    text = act.labels.bfv_text["inset"].GetInput()
+    assert text == "m = 72  θ = 120°  ψ = 30°"  # h = 2 l: theta = 120°, psi = 30° (Eq. 15-16)
+    assert act.labels.bfv_text["inset"].GetVisibility()
+    sc.layers.remove("bfv")  # without the bfv layer: m only, and the line is hidden
+    act.draw(view_frame(sc, compute_state(sc), None), None)
+    assert act.labels.bfv_text["inset"].GetInput() == "m = 72"
+    assert not act.labels.bfv_text["inset"].GetVisibility()

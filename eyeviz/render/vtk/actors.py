@@ -54,7 +54,7 @@ __all__ = ["SceneActors", "hex_rgb", "eye_mesh", "inset_viewport", "view_frame"]
 
 INSET_MIN_PX, INSET_MAX_PX, INSET_FRACTION = 230.0, 340.0, 0.3  # inset width on screen
 INSET_ASPECT = 0.66  # height / width: the eyes, their labels and a line of text
-_NOT_HERE = ("ambiguity", "trajectory", "bfv")  # drawn from their own Frames
+_NOT_HERE = ("ambiguity", "trajectory")  # drawn from their own Frame (overlays.py)
 
 
 def inset_viewport(w: float, h: float) -> tuple[float, float, float, float]:
@@ -76,7 +76,9 @@ def eye_mesh(cx: float, l: float, m: int, starts=None) -> pv.PolyData:
 
 def view_frame(scene: Scene, state: SceneState, selected: int | None) -> Frame:
     """The Frame of the view's own layers (eyes, features, labels, teaching layers of the
-    selected feature; the predictions layer only greys features here)."""
+    selected feature; the predictions layer only greys features here; the bfv layer gives
+    the labels psi and theta, its wedge is drawn by :meth:`SceneActors.fit_bfv` from a
+    Frame clipped to the visible rectangle)."""
     light = dataclasses.replace(
         scene,
         layers=[n for n in scene.layers if n not in _NOT_HERE],
