@@ -151,7 +151,7 @@ class BlockReader:
 
     def _npz_rows(self) -> int:
         """The NPZ's row count (known once its header is read); EyevizError for a CSV."""
-        if self.n is None:
+        if self.fmt != "npz" or self.n is None:
             raise EyevizError(f"{self.path}: reading every row at once needs an NPZ data set")
         return self.n
 
@@ -183,8 +183,9 @@ class BlockReader:
     def read_all(self) -> np.ndarray:
         """Every row of an NPZ in one structured array (its size checked against the file
         when the reader was made), floats validated."""
+        n = self._npz_rows()
         dt = self._dtype
-        rows = np.empty(self._npz_rows(), dt)
+        rows = np.empty(n, dt)
         try:
             with zipfile.ZipFile(self.path) as zf, zf.open(self._rows_info) as f:
                 f.read(self._data_offset)
