@@ -52,6 +52,8 @@ from eyeviz.render.vtk.style import (  # noqa: F401  (the view's public style na
 
 __all__ = ["SceneActors", "hex_rgb", "eye_mesh", "inset_viewport", "view_frame"]
 
+_actor = actor  # the name other modules (e.g. a posterior layer) imported before the split
+
 INSET_MIN_PX, INSET_MAX_PX, INSET_FRACTION = 230.0, 340.0, 0.3  # inset width on screen
 INSET_ASPECT = 0.66  # height / width: the eyes, their labels and a line of text
 _NOT_HERE = ("ambiguity", "trajectory")  # drawn from their own Frame (overlays.py)

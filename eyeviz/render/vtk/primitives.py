@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pyvista as pv
-from vtkmodules.util.numpy_support import numpy_to_vtk
+from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
 from vtkmodules.vtkRenderingCore import (
@@ -33,6 +33,7 @@ __all__ = [
     "border_actor",
     "ring",
     "set_rgb",
+    "write_rgb",
     "unit_ring",
     "unit_fan",
     "fans",
@@ -144,6 +145,14 @@ def set_rgb(data, rgb: np.ndarray) -> None:
     arr = numpy_to_vtk(np.ascontiguousarray(rgb, dtype=np.uint8).reshape(-1, 3), deep=1)
     arr.SetName("rgb")
     data.AddArray(arr)
+
+
+def write_rgb(mesh, rgb: np.ndarray) -> None:
+    """Overwrite a mesh's cell "rgb" array in place (a drag frame: pyvista's cell_data
+    lookup costs ~0.1 ms a call)."""
+    arr = mesh.GetCellData().GetAbstractArray("rgb")
+    vtk_to_numpy(arr)[:] = rgb
+    arr.Modified()
 
 
 def unit_ring(z: float) -> pv.PolyData:

@@ -15,7 +15,7 @@ import numpy as np
 import pyvista as pv
 
 from eyeviz.model.frame import EyeFrame, Frame
-from eyeviz.render.vtk.primitives import CIRCLE_N, UNIT, Store, actor, points_actor
+from eyeviz.render.vtk.primitives import CIRCLE_N, UNIT, Store, actor, points_actor, write_rgb
 from eyeviz.render.vtk.style import EDGE_MIN_PX, INK, UNLIT, Z_EYES, Z_LINE, Z_POINT, hex_rgb
 
 __all__ = ["EyesLayer", "mesh_of_rim"]
@@ -109,10 +109,10 @@ class EyesLayer:
         for e, (mesh, eye) in enumerate(zip(self.meshes, self._eyes, strict=True)):
             if same_palette and old is not None and _same(old[e], eye.owner):
                 continue  # unchanged: no colour write, so no buffer upload at the next render
-            mesh.cell_data["rgb"][:] = palette[eye.owner + 1]
+            write_rgb(mesh, palette[eye.owner + 1])
             for (which, k), lod in self.lod.items():
                 if which == e:
-                    lod.cell_data["rgb"][:] = palette[eye.pooled_owner(k) + 1]
+                    write_rgb(lod, palette[eye.pooled_owner(k) + 1])
         self._owners = tuple(eye.owner for eye in self._eyes)
 
     def set_zoom(self, main_px_per_unit: float, inset_px_per_unit: float, l: float, m: int):
