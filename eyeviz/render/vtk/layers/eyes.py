@@ -122,6 +122,8 @@ class EyesLayer:
         """
         if not self.meshes:
             return
+        if self._eyes:  # the Frame's eyes are what is drawn (l and m given are the scene's)
+            l, m = self._eyes[0].l, self._eyes[0].m
         rim_px = {
             "main": 2 * math.pi * l * main_px_per_unit,
             "inset": 2 * math.pi * l * inset_px_per_unit,
