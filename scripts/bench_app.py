@@ -133,7 +133,7 @@ def bench_drag(m: int, n: int, events: int, settings: str, backend: str = "vtk")
     QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, p)
     moved = win.model.scene.features[-1].x != 0.0
     steps = win.undo_stack.count()
-    win.close()
+    win.force_close()  # the drag is an unsaved change: no prompt (it hung here)
     app.processEvents()
     return {
         "p50": _pct(lat, 50),

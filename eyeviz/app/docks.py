@@ -14,16 +14,21 @@ from eyeviz.app.panels import _Unelide, design_note, set_message, wrap_label
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import TRAJECTORY_KINDS
 
-__all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel", "PLOT_PT"]
+__all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel", "PLOT_PT", "estimator_help"]
 
 PLOT_PT = 10  # the smallest text of the accuracy plot (projector-readable)
 
-ESTIMATOR_HELP = {
-    "analytic": "triangulation of the two eyes' centre rays (no weights)",
-    "compact": "small networks on the lit intervals",
-    "bayes": "the information limit (posterior mean)",
-    "paper": "the paper's networks (needs their weights)",
-}
+
+def estimator_help(name: str) -> str:
+    """The registry's one-line help of estimator ``name`` (one place for names and help:
+    :mod:`eyeviz.estimators.registry`); "" for a name the registry does not know."""
+    from eyeviz import EyevizError
+    from eyeviz.estimators import registry
+
+    try:
+        return registry.get(name).help
+    except EyevizError:  # an uninstalled or unregistered name: no help, never a crash
+        return ""
 
 
 class EstimatorPicker(QtWidgets.QWidget):
@@ -41,7 +46,7 @@ class EstimatorPicker(QtWidgets.QWidget):
         self.boxes: dict[str, QtWidgets.QCheckBox] = {}
         for name in estimators.available():
             b = QtWidgets.QCheckBox(name)
-            b.setToolTip(ESTIMATOR_HELP.get(name, ""))
+            b.setToolTip(estimator_help(name))
             b.toggled.connect(lambda on, n=name: self._toggled(n, on))
             lay.addWidget(b)
             self.boxes[name] = b
@@ -69,7 +74,7 @@ class EstimatorPicker(QtWidgets.QWidget):
         for name, b in self.boxes.items():
             note = design_note(self.model, name) if name in chosen else None
             b.setStyleSheet("color: #8a8a8a;" if note else "")
-            b.setToolTip(ESTIMATOR_HELP.get(name, "") + (f"\n{name}: {note}" if note else ""))
+            b.setToolTip(estimator_help(name) + (f"\n{name}: {note}" if note else ""))
             if note:  # this one line replaces any "cannot answer" of the same estimator
                 bad = [t for t in bad if not t.startswith(f"{name}: ")]
                 bad.append(f"{name}: {note}")

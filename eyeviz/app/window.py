@@ -276,19 +276,11 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
 
     def _refresh_overlays(self, scene: Scene, st) -> None:
         preds = self.model.predictions  # {} unless the predictions layer is shown
-        colors = {}
-        if preds:
-            from eyeviz.render.mpl.vector import estimator_colors
-
-            colors = estimator_colors(scene.estimators)
         skip = design_skips(self.model) if preds else set()
-        self.overlays.update_predictions(scene, st, preds, colors, skip=skip)
-        i = self.model.selected
-        sel_color = scene.features[i].color if i is not None and i < st.n else None
-        self.overlays.update_ambiguity(scene, self.model.ambiguity, sel_color)
-        self.posterior_actors.update(scene, i)  # cached per key: a drag rarely recomputes it
         path = self.trajectory_panel.path if self.trajectory_panel is not None else None
-        self.overlays.update_trajectory(scene, path)
+        amb = self.model.ambiguity
+        self.overlays.update(scene, st, self.model.selected, preds, amb, path, skip=skip)
+        self.posterior_actors.update(scene, self.model.selected)  # cached per key
 
     def _refresh_docks(self, scene: Scene) -> None:
         """The predictions and trajectory docks, built the first time they are needed."""
@@ -304,8 +296,7 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
             self._docks["predictions"].setVisible(scene.shows("predictions"))
         if scene.shows("trajectory"):
             self._trajectory_dock().refresh()
-            path = self.trajectory_panel.path
-            self.overlays.update_trajectory(scene, path)
+            self._refresh_overlays(scene, self.model.state)
         if "trajectory" in self._docks:
             self._docks["trajectory"].setVisible(scene.shows("trajectory"))
             if not scene.shows("trajectory") and self.model.player.playing:

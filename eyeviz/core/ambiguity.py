@@ -196,8 +196,8 @@ def _checked(pair: EyePair, x, y, g) -> tuple[float, float, float, tuple[int, in
                 f"the feature covers eye {name}'s centre: that eye sees it everywhere, "
                 "so its ambiguity region is not a polygon"
             )
-    iv = tuple(int(v) for v in pair.intervals(x, y, g))
-    return x, y, g, iv
+    la, ra, lb, rb = (int(v) for v in pair.intervals(x, y, g))
+    return x, y, g, (la, ra, lb, rb)
 
 
 def _corners(a: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -21,13 +21,13 @@ from math import gcd
 import numpy as np
 
 #: cos(30k deg) = a + b*sqrt(3), k = 0..11, as (a, b)
-_COS30 = [
+_COS30: list[tuple[int | Fraction, int | Fraction]] = [
     (1, 0), (0, Fraction(1, 2)), (Fraction(1, 2), 0), (0, 0),
     (Fraction(-1, 2), 0), (0, Fraction(-1, 2)), (-1, 0), (0, Fraction(-1, 2)),
     (Fraction(-1, 2), 0), (0, 0), (Fraction(1, 2), 0), (0, Fraction(1, 2)),
 ]  # fmt: skip
 #: cos(45k deg) = a + b*sqrt(2), k = 0..7, as (a, b)
-_COS45 = [
+_COS45: list[tuple[int | Fraction, int | Fraction]] = [
     (1, 0), (0, Fraction(1, 2)), (0, 0), (0, Fraction(-1, 2)),
     (-1, 0), (0, Fraction(-1, 2)), (0, 0), (0, Fraction(1, 2)),
 ]  # fmt: skip

@@ -146,7 +146,7 @@ class EyePair:
         try:
             mi = operator.index(m)
         except TypeError:
-            if isinstance(m, float) and math.isfinite(m) and m.is_integer():
+            if isinstance(m, float) and math.isfinite(m) and float(m).is_integer():
                 mi = int(m)
             else:
                 raise ValueError(bad_m) from None
@@ -226,7 +226,9 @@ class EyePair:
             out[idx[res >= 0]] = (n - 1 + res)[res >= 0]
             idx = idx[res < 0]
         for i in idx:
-            out[i] = exact.exact_floor_pair(float(xa[i]), float(ya[i]), 0.0, cx, self.m)[1]
+            fl = exact.exact_floor_pair(float(xa[i]), float(ya[i]), 0.0, cx, self.m)
+            assert fl is not None  # g = 0 and (x, y) is not the eye centre (excluded above)
+            out[i] = fl[1]
         return np.mod(out, self.m).reshape(shape)
 
     # --- features ---------------------------------------------------------------------
@@ -383,11 +385,11 @@ class EyePair:
         FALLBACK_COUNTS["ties"] += todo.size - todo_s.size
         FALLBACK_COUNTS["mpmath"] += todo_s.size
         for j in todo_s:
-            res = exact.exact_floor_pair(float(xs[j]), float(ys[j]), float(gs[j]), cx, self.m)
-            if res is None:
+            fl = exact.exact_floor_pair(float(xs[j]), float(ys[j]), float(gs[j]), cx, self.m)
+            if fl is None:
                 whole[j] = True
             else:
-                lo[j], hi[j] = res
+                lo[j], hi[j] = fl
 
     def _normalised(self, f_lo, f_hi, whole) -> tuple[np.ndarray, np.ndarray]:
         m = self.m
@@ -406,13 +408,16 @@ class EyePair:
         """
         return self._intervals(x, y, g)
 
-    def _intervals(self, x, y, g, refine: bool = True) -> tuple[np.ndarray, ...]:
+    def _intervals(
+        self, x, y, g, refine: bool = True
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         xa, ya, ga = validate_features(x, y, g)
         shape = xa.shape
         xf, yf, gf = (np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, ga))
         outs = tuple(np.empty(xf.shape[0], np.int64) for _ in range(4))
         self._fast_intervals(xf, yf, gf, refine, outs)
-        return tuple(o.reshape(shape) for o in outs)
+        la, ra, lb, rb = (o.reshape(shape) for o in outs)
+        return la, ra, lb, rb
 
     def bitmaps(self, x, y, g) -> tuple[np.ndarray, np.ndarray]:
         """Whole-eye bitmaps (omega_a, omega_b), bool of shape (..., m)."""

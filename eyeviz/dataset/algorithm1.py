@@ -212,7 +212,8 @@ class _Sampler:
     def fill(self, n: int, lo: float | np.ndarray, hi: float | np.ndarray) -> Chunk:
         """n accepted elements; slot i draws r in [lo_i, hi_i] (scalars: every slot)."""
         p, rng, eyes = self.p, self.rng, self.p.eyes
-        per_slot = isinstance(lo, np.ndarray)
+        lo_a, hi_a = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+        per_slot = lo_a.ndim > 0
         out_r = np.empty(n)
         out_phi = np.empty(n)
         out_g = np.empty(n)
@@ -223,7 +224,7 @@ class _Sampler:
             k = pending.size
             self.drawn += k
             u = rng.random((3, k))
-            lo_p, hi_p = (lo[pending], hi[pending]) if per_slot else (lo, hi)
+            lo_p, hi_p = (lo_a[pending], hi_a[pending]) if per_slot else (lo_a, hi_a)
             r = lo_p + (hi_p - lo_p) * u[0]  # step 7
             g_min = r * self.sin_half  # step 8
             ok = g_min <= p.g_max  # step 9
@@ -264,6 +265,7 @@ class _Sampler:
     def _new_only(self, sel, la, ra, lb, rb) -> np.ndarray:
         keys = self._keys(la[sel], ra[sel], lb[sel], rb[sel])
         seen = self.seen
+        assert seen is not None  # only called with unique_bitmaps
         keep = []
         for i, key in zip(sel.tolist(), keys, strict=True):
             if key not in seen:

@@ -149,15 +149,22 @@ class BlockReader:
             )
         return eyes
 
+    def _npz_rows(self) -> int:
+        """The NPZ's row count (known once its header is read); EyevizError for a CSV."""
+        if self.fmt != "npz" or self.n is None:
+            raise EyevizError(f"{self.path}: reading every row at once needs an NPZ data set")
+        return self.n
+
     def _iter_npz(self) -> Iterator[Block]:
         m, dt = self.eyes.m, self._dtype
         w = m // 2
+        n = self._npz_rows()
         try:
             with zipfile.ZipFile(self.path) as zf, zf.open(self._rows_info) as f:
                 f.read(self._data_offset)
                 start = 0
-                while start < self.n:
-                    k = min(self.block_rows, self.n - start)
+                while start < n:
+                    k = min(self.block_rows, n - start)
                     buf = f.read(k * dt.itemsize)
                     if len(buf) != k * dt.itemsize:
                         raise self._npz_fail(f"rows end early at row {start + 1}")
@@ -176,12 +183,13 @@ class BlockReader:
     def read_all(self) -> np.ndarray:
         """Every row of an NPZ in one structured array (its size checked against the file
         when the reader was made), floats validated."""
+        n = self._npz_rows()
         dt = self._dtype
-        rows = np.empty(self.n, dt)
+        rows = np.empty(n, dt)
         try:
             with zipfile.ZipFile(self.path) as zf, zf.open(self._rows_info) as f:
                 f.read(self._data_offset)
-                buf = memoryview(rows.view(np.uint8).reshape(-1))
+                buf = rows.view(np.uint8).reshape(-1).data
                 got = 0
                 while got < len(buf):
                     k = f.readinto(buf[got:]) if hasattr(f, "readinto") else 0
@@ -279,8 +287,8 @@ def load(path, eyes: EyePair | None = None):
     if len(blocks) == 1:
         b = blocks[0]
         return Dataset(b.omega_a, b.omega_b, b.r, b.phi, b.g, reader.eyes, {})
-    cat = [np.concatenate([getattr(b, f) for b in blocks]) for f in Block._fields[:5]]
-    return Dataset(*cat, reader.eyes, {})
+    oa, ob, r, phi, g = (np.concatenate([getattr(b, f) for b in blocks]) for f in Block._fields[:5])
+    return Dataset(oa, ob, r, phi, g, reader.eyes, {})
 
 
 def _show(field: bytes) -> str:

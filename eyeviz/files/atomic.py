@@ -56,7 +56,7 @@ def sweep_stale(folder, now: float | None = None) -> list[Path]:
     older than SWEEP_AGE_LEGACY_S. Errors (a file vanished, no permission) are ignored.
     """
     now = time.time() if now is None else now
-    removed = []
+    removed: list[Path] = []
     try:
         entries = list(os.scandir(folder))
     except OSError:

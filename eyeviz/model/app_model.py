@@ -15,10 +15,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Generator
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from eyeviz.model.player import TrajectoryPlayer
 from eyeviz.model.scene import OKABE_ITO, Feature, Scene, View
 from eyeviz.model.state import SceneState, compute_state
+
+if TYPE_CHECKING:
+    from eyeviz.model.predictor import Predictor
 
 __all__ = ["AppModel", "MouseEvent", "DRAG_THRESHOLD_PX", "drag_feature", "hit_test"]
 
@@ -55,8 +59,8 @@ class AppModel:
         self.listeners: list[Callable[[str, int | None], None]] = []
         self._state: SceneState | None = None
         self._predictions: dict | None = None
-        self._ambiguity: dict | None | bool = False  # False: not computed yet
-        self.predictor = None  # eyeviz.model.derived.Predictor, made on first use
+        self._ambiguity: tuple[dict | None] | None = None  # None: not computed yet
+        self.predictor: Predictor | None = None  # eyeviz.model.derived.Predictor, made on first use
         self.push: Callable[..., None] = self._push_plain
         self._live: _Live | None = None
         self.inset_view = View((0.0, 0.0), 1.0)  # the magnified eyes (camera.fit_inset)
@@ -104,22 +108,22 @@ class AppModel:
         i = self.selected
         if not self.scene.shows("ambiguity") or i is None or i >= len(self.scene.features):
             return None
-        if self._ambiguity is False:
+        if self._ambiguity is None:
             from eyeviz.model.derived import ambiguity_of
 
             f, v = self.scene.features[i], self.scene.view
             half = 1.5 * v.width + math.hypot(f.x - v.center[0], f.y - v.center[1])
             box = (v.center[0] - half, v.center[0] + half, v.center[1] - half, v.center[1] + half)
-            self._ambiguity = ambiguity_of(self.scene.eyes.pair(), f.x, f.y, f.g, box)
-        return self._ambiguity
+            self._ambiguity = (ambiguity_of(self.scene.eyes.pair(), f.x, f.y, f.g, box),)
+        return self._ambiguity[0]
 
     def _notify(self, what: str, index: int | None = None) -> None:
         if what not in ("view", "player", "selection"):
             self._state = None
             self._predictions = None
-            self._ambiguity = False
+            self._ambiguity = None
         elif what == "selection":
-            self._ambiguity = False
+            self._ambiguity = None
         for fn in list(self.listeners):
             fn(what, index)
 
@@ -200,7 +204,7 @@ class AppModel:
 
     def set_eyes(self, h: float, l: float, m: int) -> None:
         """New eye parameters; ValueError (naming the parameter) leaves the scene as it was."""
-        if isinstance(m, float) and m.is_integer():
+        if isinstance(m, float) and float(m).is_integer():
             m = int(m)
         if isinstance(m, int) and m > M_MAX:
             raise ValueError(f"m must be <= {M_MAX} to be drawn live, got {m}")

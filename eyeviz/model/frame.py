@@ -1,7 +1,7 @@
 """One Frame: every derived drawing quantity of a scene, for every renderer (issue 9 item 2).
 
-(About 500 lines on purpose: the Frame's parts, their builders and the helpers folded in
-from ``eyeviz.model.derived`` are read together by both renderers; each builder is short.)
+The Frame's parts (dataclasses) and the small pure helpers they use live in
+:mod:`eyeviz.model.frame_parts` and are re-exported here; this module builds them.
 
 ``build_frame(scene, state=None, predictor=None, rect=...)`` runs the geometry once and
 returns a :class:`Frame`; the matplotlib figure (and the VTK view) only *draw* a Frame.
@@ -17,7 +17,9 @@ Fields of :class:`Frame` (``None`` / empty when no layer needs them):
 - ``eyes``: two :class:`EyeFrame` (A, B): ``center``, ``owner`` (feature index lighting
   each ommatidium, -1 unlit; the last feature wins), ``color_index`` (0 unlit, else
   1 + index into ``palette``), ``runs`` (starts, stops exclusive, color index: maximal runs
-  of equal colour for merged drawing and the bitmap strips).
+  of equal colour for merged drawing and the bitmap strips), ``l``, ``m`` and
+  ``rim(k)``: the rim vertices at j*gamma (Figure 2, Eq. 6) of every k-th ommatidium and
+  ``pooled_owner(k)``: the owner of each run of k ommatidia (the app's level of detail).
 - ``intervals``: {"A": (L, R), "B": (L, R)} per feature (Prop. 2, ``EyePair.intervals``).
 - ``bfv``: :class:`BFVFrame`: ``psi`` (Eq. 15), ``theta`` (Eq. 16), ``polygon`` the wedge
   clipped to ``rect`` (an (k, 2) array; empty when the wedge misses the rectangle) and the
@@ -27,7 +29,8 @@ Fields of :class:`Frame` (``None`` / empty when no layer needs them):
   ``ends`` the two tangent points (2, 2)); none for an eye inside a disc.
 - ``sectors``: list of :class:`SectorFrame` (feature i, eye, center, L, R, ``reach``,
   ``rays`` the sector boundary indices k (angles k*gamma, Eq. 8, 11): L..R+1, or only L and
-  R+1 when the run is 24 cells or longer); whole-eye runs are omitted.
+  R+1 when the run is 24 cells or longer) and ``ends`` their far points at ``reach``;
+  whole-eye runs are omitted.
 - readout arrays ``r, phi, rA, phiA, rB, phiB`` (polar about O, A, B; angles in rad),
   ``in_bfv``, ``vis_a``, ``vis_b``, ``in_domain`` (BFV and seen by both),
   ``out_of_domain`` (greyed features: the predictions layer is on and not in domain).
@@ -39,16 +42,36 @@ Fields of :class:`Frame` (``None`` / empty when no layer needs them):
   posterior over centres, every g) or None (none: the prior cannot make the bitmaps)}.
 - ``trajectory``: :class:`TrajectoryPath` (points in the BFV and each estimator's accuracy)
   or None; ``trajectory_error``: why there is none.
+- ``labels``: :class:`LabelFrame` anchors (text, x, y, kind, feature) of the ``labels``
+  layer: the eyes A, B and the origin O under them, each feature's name up-right of its
+  disc (the app's view places them at these points; the exported figure lays its own out).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from eyeviz.core.geometry import EyePair, intervals_to_bitmap
+from eyeviz.model.frame_parts import (
+    EYE_LABEL_DROP,
+    FEATURE_LABEL_OFFSET,
+    WIDE_SECTOR,
+    BFVFrame,
+    EyeFrame,
+    Frame,
+    LabelFrame,
+    PredictionFrame,
+    SectorFrame,
+    TangentFrame,
+    TrajectoryPath,
+    clip_wedge,
+    errors,
+    rim_points,
+    runs,
+    view_rect,
+)
 from eyeviz.model.posterior import Posterior
 from eyeviz.model.predictor import Predictor
 from eyeviz.model.scene import Scene, Trajectory
@@ -58,6 +81,7 @@ __all__ = [
     "BFVFrame",
     "EyeFrame",
     "Frame",
+    "LabelFrame",
     "PredictionFrame",
     "SectorFrame",
     "TangentFrame",
@@ -65,222 +89,23 @@ __all__ = [
     "ambiguity_of",
     "build_frame",
     "clip_wedge",
+    "rim_points",
     "errors",
     "runs",
     "state_for",
     "trajectory_path",
     "view_rect",
+    "EYE_LABEL_DROP",
+    "FEATURE_LABEL_OFFSET",
+    "WIDE_SECTOR",
 ]
-
-WIDE_SECTOR = 24  # runs this long draw only their two boundary rays
-
-
-# --- small pure helpers ------------------------------------------------------------------
-
-
-def runs(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Maximal runs of equal values: (starts, stops) with stops exclusive."""
-    values = np.asarray(values)
-    n = len(values)
-    if n == 0:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    change = np.flatnonzero(values[1:] != values[:-1]) + 1
-    starts = np.concatenate([[0], change])
-    stops = np.concatenate([change, [n]])
-    return starts.astype(np.int64), stops.astype(np.int64)
-
-
-def errors(r: float, phi: float, r_hat: float, phi_hat: float) -> tuple[float, float, float]:
-    """(delta r, delta r in % of r, delta phi in degrees wrapped to (-180, 180])."""
-    dr = r_hat - r
-    dphi = math.degrees(math.remainder(phi_hat - phi, 2 * math.pi))
-    return dr, 100.0 * dr / r, dphi
-
-
-def view_rect(scene: Scene, aspect: float = 0.86) -> tuple[float, float, float, float]:
-    """The scene's view as (x0, x1, y0, y1) for a canvas of height/width ``aspect``."""
-    cx, cy = scene.view.center
-    w = scene.view.width
-    h = w * aspect
-    return (cx - w / 2, cx + w / 2, cy - h / 2, cy + h / 2)
-
-
-def _clip_half_plane(poly: list[tuple[float, float]], nx: float, ny: float):
-    """Sutherland-Hodgman: keep the part of ``poly`` with nx*x + ny*y >= 0."""
-    out: list[tuple[float, float]] = []
-    n = len(poly)
-    for i in range(n):
-        p, q = poly[i], poly[(i + 1) % n]
-        dp, dq = nx * p[0] + ny * p[1], nx * q[0] + ny * q[1]
-        if dp >= 0:
-            out.append(p)
-        if (dp >= 0) != (dq >= 0):
-            t = dp / (dp - dq)
-            out.append((p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])))
-    return out
-
-
-def clip_wedge(psi: float, rect: tuple[float, float, float, float]) -> np.ndarray:
-    """The BFV wedge {psi <= angle <= pi - psi} (Definition 2) clipped to ``rect``.
-
-    The exact intersection of the rectangle with the two half-planes bounding the wedge,
-    so the drawn wedge covers the whole view however far it is from the origin.
-    """
-    x0, x1, y0, y1 = rect
-    poly = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
-    c, s = math.cos(psi), math.sin(psi)
-    # right edge direction (c, s): keep the left side, normal (-s, c);
-    # left edge direction (-c, s): keep the right side, normal (s, c)
-    poly = _clip_half_plane(poly, -s, c)
-    if poly:
-        poly = _clip_half_plane(poly, s, c)
-    return np.array(poly, dtype=np.float64).reshape(-1, 2)
-
-
-def _ray_to_rect(angle: float, rect) -> tuple[float, float, float, float] | None:
-    """The part of the ray from the origin at ``angle`` inside ``rect``, or None."""
-    x0, x1, y0, y1 = rect
-    dx, dy = math.cos(angle), math.sin(angle)
-    t0, t1 = 0.0, math.inf
-    for d, lo, hi in ((dx, x0, x1), (dy, y0, y1)):
-        if abs(d) < 1e-300:
-            if not lo <= 0.0 <= hi:
-                return None
-            continue
-        a, b = lo / d, hi / d
-        a, b = min(a, b), max(a, b)
-        t0, t1 = max(t0, a), min(t1, b)
-    if t1 <= t0:
-        return None
-    return (t0 * dx, t0 * dy, t1 * dx, t1 * dy)
-
-
-# --- the frame's parts -------------------------------------------------------------------
-
-
-@dataclass
-class EyeFrame:
-    """One eye: centre, per-ommatidium owner and colour index, merged colour runs."""
-
-    name: str
-    center: tuple[float, float]
-    owner: np.ndarray
-    color_index: np.ndarray
-    runs: tuple[np.ndarray, np.ndarray, np.ndarray]
-
-
-@dataclass
-class BFVFrame:
-    """The BFV wedge (Definition 2, Eq. 15-16) clipped to the view rectangle."""
-
-    psi: float
-    theta: float
-    polygon: np.ndarray
-    edges: list[tuple[float, float, float, float] | None]  # right (psi), left (pi - psi)
-
-
-@dataclass
-class TangentFrame:
-    """The tangents from an eye centre to feature i's disc (Prop. 2, Figure 3b)."""
-
-    feature: int
-    eye: str
-    center: tuple[float, float]
-    r_e: float
-    phi_e: float
-    alpha: float  # asin(g / r_E)
-    length: float  # sqrt(r_E^2 - g^2)
-    ends: np.ndarray  # (2, 2): the tangent points, angle phi_E - alpha then phi_E + alpha
-
-
-@dataclass
-class SectorFrame:
-    """The ommatidium sectors of a lit interval [L, R] (Eq. 8, 11)."""
-
-    feature: int
-    eye: str
-    center: tuple[float, float]
-    L: int
-    R: int
-    reach: float
-    rays: list[int]  # boundary k of the ray at angle k * gamma
-
-
-@dataclass
-class PredictionFrame:
-    """One estimator's answers per feature (NaN outside the networks' domain)."""
-
-    r_hat: np.ndarray
-    phi_hat: np.ndarray
-    x_hat: np.ndarray
-    y_hat: np.ndarray
-    dr: np.ndarray
-    dr_pct: np.ndarray
-    dphi_deg: np.ndarray
-
-
-@dataclass
-class TrajectoryPath:
-    """Points of a Figure 14 trajectory and the estimators' accuracy along it."""
-
-    kind: str
-    x: np.ndarray
-    y: np.ndarray
-    g: float
-    axis: np.ndarray  # the abscissa of the accuracy plot
-    axis_label: str
-    accuracy: dict[str, tuple[np.ndarray, np.ndarray] | str]  # name -> (AD %, DD %) or why not
-
-    @property
-    def n(self) -> int:
-        return int(self.x.shape[0])
-
-
-@dataclass
-class Frame:
-    """Everything a renderer draws for one scene (see the module docstring)."""
-
-    pair: EyePair
-    layers: set[str]
-    rect: tuple[float, float, float, float]
-    state: SceneState
-    names: list[str]
-    colors: list[str]
-    x: np.ndarray
-    y: np.ndarray
-    g: np.ndarray
-    palette: list[str] = field(default_factory=list)
-    eyes: list[EyeFrame] = field(default_factory=list)
-    intervals: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
-    bfv: BFVFrame | None = None
-    tangents: list[TangentFrame] = field(default_factory=list)
-    sectors: list[SectorFrame] = field(default_factory=list)
-    r: np.ndarray | None = None
-    phi: np.ndarray | None = None
-    rA: np.ndarray | None = None
-    phiA: np.ndarray | None = None
-    rB: np.ndarray | None = None
-    phiB: np.ndarray | None = None
-    in_bfv: np.ndarray | None = None
-    vis_a: np.ndarray | None = None
-    vis_b: np.ndarray | None = None
-    in_domain: np.ndarray | None = None
-    out_of_domain: np.ndarray | None = None
-    predictions: dict[str, PredictionFrame | str] = field(default_factory=dict)
-    ambiguity: dict[int, dict | None] = field(default_factory=dict)
-    posterior: dict[int, Posterior | None] = field(default_factory=dict)
-    trajectory: TrajectoryPath | None = None
-    trajectory_error: str | None = None
-
-    @property
-    def n(self) -> int:
-        return int(self.x.shape[0])
-
 
 # --- derived quantities (formerly eyeviz.model.derived) ----------------------------------
 
 
-def ambiguity_of(pair: EyePair, x: float, y: float, g: float, box) -> dict | None:
+def ambiguity_of(
+    pair: EyePair, x: float, y: float, g: float, box: tuple[float, float, float, float] | None
+) -> dict | None:
     """The ambiguity region of one feature (eyeviz.core.ambiguity) with its ranges, or None
     when the feature covers an eye centre (no polygon then)."""
     from eyeviz.core.ambiguity import ambiguity_radius_range, ambiguity_region
@@ -356,6 +181,8 @@ def _posteriors(pair: EyePair, st: SceneState) -> dict[int, Posterior | None]:
     from eyeviz.model.posterior import posterior_for_key
 
     out: dict[int, Posterior | None] = {}
+    if st.LA is None or st.RA is None or st.LB is None or st.RB is None:
+        return out
     dom = Domain.from_eyes(pair)
     for i in range(st.n):
         key = tuple(int(v[i]) for v in (st.LA, st.RA, st.LB, st.RB))
@@ -389,7 +216,9 @@ def state_for(scene: Scene, state: SceneState | None) -> SceneState:
     return state
 
 
-def _eye_frames(pair: EyePair, st: SceneState, palette: list[str], colors: list[str]):
+def _eye_frames(
+    pair: EyePair, st: SceneState, palette: list[str], colors: list[str]
+) -> list[EyeFrame]:
     uniq = {c: i + 1 for i, c in enumerate(palette)}
     lut = np.array([0] + [uniq[c] for c in colors], dtype=np.int64)
     out = []
@@ -398,20 +227,30 @@ def _eye_frames(pair: EyePair, st: SceneState, palette: list[str], colors: list[
         ("B", pair.centers[1], st.owner_b, st.LB, st.RB),
     ):
         if owner is None:
-            owner = owners(L, R, pair.m) if L is not None else np.full(pair.m, -1, np.int64)
-        cidx = lut[owner + 1]
-        s, e = runs(cidx)
-        out.append(EyeFrame(name, center, owner, cidx, (s, e, cidx[s])))
+            if L is not None and R is not None:
+                owner = owners(L, R, pair.m)
+            else:
+                owner = np.full(pair.m, -1, np.int64)
+        out.append(EyeFrame(name, center, owner, lut, pair.l, pair.m))
     return out
 
 
-def _tangents(pair: EyePair, st: SceneState) -> list[TangentFrame]:
+def _polar(st: SceneState) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(rA, phiA, rB, phiB); ValueError when the state has no readout (a state_for bug)."""
+    rA, phiA, rB, phiB = st.rA, st.phiA, st.rB, st.phiB
+    if rA is None or phiA is None or rB is None or phiB is None:
+        raise ValueError("this state has no polar coordinates about the eyes")
+    return rA, phiA, rB, phiB
+
+
+def _tangents(pair: EyePair, st: SceneState, only: list[int]) -> list[TangentFrame]:
     out = []
-    for i in range(st.n):
+    rA, phiA, rB, phiB = _polar(st)
+    for i in only:
         g = float(st.g[i])
         for name, center, rE, phE in (
-            ("A", pair.centers[0], float(st.rA[i]), float(st.phiA[i])),
-            ("B", pair.centers[1], float(st.rB[i]), float(st.phiB[i])),
+            ("A", pair.centers[0], float(rA[i]), float(phiA[i])),
+            ("B", pair.centers[1], float(rB[i]), float(phiB[i])),
         ):
             if not rE > g:
                 continue
@@ -423,24 +262,33 @@ def _tangents(pair: EyePair, st: SceneState) -> list[TangentFrame]:
     return out
 
 
-def _sectors(pair: EyePair, st: SceneState) -> list[SectorFrame]:
+def _sectors(pair: EyePair, st: SceneState, only: list[int]) -> list[SectorFrame]:
     out = []
     m = pair.m
-    for i in range(st.n):
+    LA, RA, LB, RB = st.intervals()
+    rA, _, rB, _ = _polar(st)
+    for i in only:
         g = float(st.g[i])
-        for name, center, L, R, rE in (
-            ("A", pair.centers[0], st.LA[i], st.RA[i], st.rA[i]),
-            ("B", pair.centers[1], st.LB[i], st.RB[i], st.rB[i]),
+        for name, center, Li, Ri, rE in (
+            ("A", pair.centers[0], LA[i], RA[i], rA[i]),
+            ("B", pair.centers[1], LB[i], RB[i], rB[i]),
         ):
-            L, R = int(L), int(R)
+            L, R = int(Li), int(Ri)
             if R - L >= m - 1 or R < L:
                 continue
             rays = list(range(L, R + 2)) if R - L < WIDE_SECTOR else [L, R + 1]
-            out.append(SectorFrame(i, name, center, L, R, float(rE) + 1.6 * g, rays))
+            reach = float(rE) + 1.6 * g
+            t = np.asarray(rays, dtype=np.float64) * pair.gamma
+            ends = np.column_stack([center[0] + reach * np.cos(t), center[1] + reach * np.sin(t)])
+            out.append(SectorFrame(i, name, center, L, R, reach, rays, ends))
     return out
 
 
-def _predictions(scene, st, predictor, given) -> dict[str, PredictionFrame | str]:
+def _predictions(
+    scene: Scene, st: SceneState, predictor: Predictor | None, given: dict | None
+) -> dict[str, PredictionFrame | str]:
+    if st.r is None or st.phi is None:
+        raise ValueError("this state has no polar coordinates")
     if given is None:
         predictor = predictor if predictor is not None else Predictor()
         given = predictor.predict(scene, st)
@@ -466,6 +314,23 @@ def _predictions(scene, st, predictor, given) -> dict[str, PredictionFrame | str
     return out
 
 
+def _labels(pair: EyePair, scene: Scene, st: SceneState) -> list[LabelFrame]:
+    y = -EYE_LABEL_DROP * pair.l
+    out = [
+        LabelFrame("A", -pair.h, y, "eye"),
+        LabelFrame("B", pair.h, y, "eye"),
+        LabelFrame("O", 0.0, y, "eye"),
+    ]
+    if "features" in scene.layers:
+        d = FEATURE_LABEL_OFFSET * st.g
+        xs, ys = (st.x + d).tolist(), (st.y + d).tolist()
+        out += [
+            LabelFrame(f.name, x, y_, "feature", i)
+            for i, (f, x, y_) in enumerate(zip(scene.features, xs, ys, strict=True))
+        ]
+    return out
+
+
 def build_frame(
     scene: Scene,
     state: SceneState | None = None,
@@ -473,6 +338,9 @@ def build_frame(
     *,
     rect: tuple[float, float, float, float] | None = None,
     predictions: dict | None = None,
+    only: int | None = None,
+    ambiguity: dict[int, dict | None] | None = None,
+    trajectory: TrajectoryPath | None = None,
 ) -> Frame:
     """The :class:`Frame` of ``scene`` for its layers.
 
@@ -480,6 +348,10 @@ def build_frame(
     ambiguity regions are bounded by (default: the scene's view at the export's aspect).
     ``predictions`` (estimator -> (r_hat, phi_hat) or a reason) skips the estimators;
     otherwise ``predictor`` (made when None) answers, only if the predictions layer is on.
+    ``only`` limits the per-feature teaching layers (tangents, sectors) to one feature (the
+    app's selection). ``ambiguity`` ({feature: region or None}, e.g. the app model's cached
+    region) and ``trajectory`` (a :class:`TrajectoryPath` already made) are taken as given
+    instead of being computed.
     """
     st = state_for(scene, state)
     pair = st.pair
@@ -504,7 +376,8 @@ def build_frame(
     )
     n = st.n
     if st.LA is not None:
-        fr.intervals = {"A": (st.LA, st.RA), "B": (st.LB, st.RB)}
+        LA, RA, LB, RB = st.intervals()
+        fr.intervals = {"A": (LA, RA), "B": (LB, RB)}
         fr.vis_a, fr.vis_b = st.vis_a, st.vis_b
     if st.r is not None:
         fr.r, fr.phi, fr.rA, fr.phiA, fr.rB, fr.phiB = (
@@ -521,22 +394,22 @@ def build_frame(
     fr.out_of_domain = np.zeros(n, bool)
     if "predictions" in lay and n and fr.in_domain is not None:
         fr.out_of_domain = ~fr.in_domain
+    teach = list(range(n)) if only is None else [only] if 0 <= only < n else []
     if {"eyes", "bitmaps"} & lay:
         fr.eyes = _eye_frames(pair, st, fr.palette, colors)
     if "bfv" in lay:
-        fr.bfv = BFVFrame(
-            pair.psi,
-            pair.theta,
-            clip_wedge(pair.psi, box),
-            [_ray_to_rect(pair.psi, box), _ray_to_rect(math.pi - pair.psi, box)],
-        )
-    if "tangents" in lay and n:
-        fr.tangents = _tangents(pair, st)
-    if "sectors" in lay and n:
-        fr.sectors = _sectors(pair, st)
+        fr.bfv = BFVFrame(pair.psi, pair.theta, box)
+    if "tangents" in lay and teach:
+        fr.tangents = _tangents(pair, st, teach)
+    if "sectors" in lay and teach:
+        fr.sectors = _sectors(pair, st, teach)
+    if "labels" in lay:
+        fr.labels = _labels(pair, scene, st)
     if "predictions" in lay and n:
         fr.predictions = _predictions(scene, st, predictor, predictions)
-    if "ambiguity" in lay and n:
+    if "ambiguity" in lay and ambiguity is not None:
+        fr.ambiguity = {i: a for i, a in ambiguity.items() if 0 <= i < n}
+    elif "ambiguity" in lay and n:
         x0, x1, y0, y1 = box
         w = x1 - x0
         box = (x0 - w, x1 + w, y0 - w, y1 + w)
@@ -544,7 +417,9 @@ def build_frame(
             fr.ambiguity[i] = ambiguity_of(pair, f.x, f.y, f.g, box)
     if "posterior" in lay and n:
         fr.posterior = _posteriors(pair, st)
-    if "trajectory" in lay and scene.trajectory is not None:
+    if "trajectory" in lay and trajectory is not None:
+        fr.trajectory = trajectory
+    elif "trajectory" in lay and scene.trajectory is not None:
         try:
             stop = max(scene.trajectory.distance, box[3])
             fr.trajectory = trajectory_path(pair, scene.trajectory, [], None, n=400, stop=stop)

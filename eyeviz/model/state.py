@@ -63,17 +63,26 @@ class SceneState:
 
     def bitmaps(self, i: int, width: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Feature i's bitmaps (omega_a, omega_b); width m//2 is the paper's Omega."""
-        if self.LA is None:
-            raise ValueError("this state has no intervals (no layer needed them)")
+        LA, RA, LB, RB = self.intervals()
         m = self.m
         return (
-            intervals_to_bitmap(self.LA[i], self.RA[i], m, width),
-            intervals_to_bitmap(self.LB[i], self.RB[i], m, width),
+            intervals_to_bitmap(LA[i], RA[i], m, width),
+            intervals_to_bitmap(LB[i], RB[i], m, width),
         )
+
+    def intervals(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(LA, RA, LB, RB); ValueError when no layer needed them."""
+        LA, RA, LB, RB = self.LA, self.RA, self.LB, self.RB
+        if LA is None or RA is None or LB is None or RB is None:
+            raise ValueError("this state has no intervals (no layer needed them)")
+        return LA, RA, LB, RB
 
     def in_domain(self) -> np.ndarray:
         """Features the networks were trained on: in the BFV and visible to both eyes."""
-        return self.in_bfv & self.vis_a & self.vis_b
+        in_bfv, vis_a, vis_b = self.in_bfv, self.vis_a, self.vis_b
+        if in_bfv is None or vis_a is None or vis_b is None:
+            raise ValueError("this state has no BFV or visibility (no layer needed them)")
+        return in_bfv & vis_a & vis_b
 
 
 def owners(L: np.ndarray, R: np.ndarray, m: int) -> np.ndarray:
@@ -106,8 +115,9 @@ def compute_state(scene: Scene, layers=None) -> SceneState:
         st.LA, st.RA, st.LB, st.RB = pair.intervals(x, y, g)
         st.vis_a, st.vis_b = st.RA > st.LA, st.RB > st.LB
     if shown & _NEED_OWNERS:
-        st.owner_a = owners(st.LA, st.RA, pair.m)
-        st.owner_b = owners(st.LB, st.RB, pair.m)
+        LA, RA, LB, RB = st.intervals()
+        st.owner_a = owners(LA, RA, pair.m)
+        st.owner_b = owners(LB, RB, pair.m)
     if shown & _NEED_READOUT:
         st.in_bfv = pair.in_bfv(x, y, g)
         st.overlap_a, st.overlap_b = pair.overlaps_eye(x, y, g)

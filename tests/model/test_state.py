@@ -61,6 +61,23 @@ def test_only_needed_fields_are_computed():
     assert st.LA is not None and st.owner_a is None and st.r is None
 
 
+def test_a_state_without_the_arrays_says_so():
+    """No layer needed the intervals or the BFV: one ValueError naming what is missing
+    (before: a TypeError on None from deep inside)."""
+    sc = Scene(Eyes(40.0, 20.0, 72), [Feature("a", 10.0, 500.0, 20.0)], ["features"])
+    st = compute_state(sc)
+    with pytest.raises(ValueError, match="no intervals"):
+        st.intervals()
+    with pytest.raises(ValueError, match="no intervals"):
+        st.bitmaps(0)
+    with pytest.raises(ValueError, match="no BFV or visibility"):
+        st.in_domain()
+    sc.layers.append("readout")
+    st = compute_state(sc)
+    LA, RA, LB, RB = st.intervals()
+    assert st.in_domain().tolist() == [bool(st.in_bfv[0] and RA[0] > LA[0] and RB[0] > LB[0])]
+
+
 def test_no_features():
     st = compute_state(Scene(features=[]))
     assert st.n == 0

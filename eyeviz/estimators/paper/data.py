@@ -26,8 +26,8 @@ def _columns(data) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
             f"got {oa.shape} and {ob.shape}"
         )
     x = np.concatenate([oa, ob], axis=1).astype(np.uint8)
-    as_f = [np.asarray(v, dtype=np.float64).reshape(-1) for v in (r, phi, g)]
-    return x, *as_f
+    r_f, phi_f, g_f = (np.asarray(v, dtype=np.float64).reshape(-1) for v in (r, phi, g))
+    return x, r_f, phi_f, g_f
 
 
 def _metrics(y: np.ndarray, yhat: np.ndarray) -> dict[str, float]:

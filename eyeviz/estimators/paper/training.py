@@ -11,6 +11,7 @@ import sys
 import time
 from dataclasses import asdict
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import torch
@@ -119,7 +120,7 @@ def train_net(
                 ckpt_seconds += time.perf_counter() - tc
     if bar is not None:
         bar.close()
-    info = {
+    info: dict[str, Any] = {
         "train_seconds": round(elapsed, 2),
         "epochs_reached": round(seen / n, 4),
         "full_epochs": epoch,

@@ -1,38 +1,52 @@
 """Issue 6 layers in the app's main view: prediction ghosts, ambiguity region, trajectory.
 
-Each layer is one or two actors whose PolyData is replaced when its content changes (a
-few hundred points at most); nothing is drawn for a layer the scene does not show.
-Colours are fixed by estimator name (:func:`eyeviz.model.palette.estimator_color`), never
-by list position and never a feature's colour.
+:class:`OverlayActors` builds one :class:`eyeviz.model.frame.Frame` of these layers from
+what the app model already holds (predictions, the selected feature's ambiguity region,
+the trajectory path) and hands it to the layer painters in
+:mod:`eyeviz.render.vtk.layers` (``predictions``, ``ambiguity``, ``trajectory``), which
+draw only the Frame. Nothing is drawn for a layer the scene does not show.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
-import pyvista as pv
 from vtkmodules.vtkRenderingCore import vtkRenderer
 
-from eyeviz.model.frame import build_frame
-from eyeviz.model.palette import estimator_color
-from eyeviz.render.vtk.actors import INK, Z_LINE, Z_POINT, _actor, hex_rgb
+from eyeviz.model.frame import Frame, TrajectoryPath, build_frame
+from eyeviz.model.scene import Scene
+from eyeviz.model.state import SceneState
+from eyeviz.render.vtk.layers.ambiguity import AmbiguityLayer
+from eyeviz.render.vtk.layers.predictions import GHOST_N, PredictionsLayer
+from eyeviz.render.vtk.layers.trajectory import TrajectoryLayer
+from eyeviz.render.vtk.style import Z_AMBIGUITY
 
-__all__ = ["OverlayActors", "Z_AMBIGUITY", "GHOST_N"]
+__all__ = ["OverlayActors", "Z_AMBIGUITY", "GHOST_N", "overlay_frame"]
 
-Z_AMBIGUITY = -1.5  # above the BFV wedge, below the eyes and the features
-Z_GHOST = Z_LINE + 0.3
-GHOST_N = 96  # points of a ghost circle
-
-
-def _mix(rgb, amount: float) -> tuple[float, float, float]:
-    """``rgb`` (0..255) blended with white: opaque light tints (no translucent passes)."""
-    return tuple((amount * c + (1 - amount) * 255) / 255.0 for c in rgb)
+_LAYERS = ("predictions", "ambiguity", "trajectory")
 
 
-def _dark(rgb) -> tuple[float, float, float]:
-    return tuple(0.7 * c / 255.0 for c in rgb)
+def overlay_frame(
+    scene: Scene,
+    state: SceneState,
+    selected: int | None,
+    predictions: dict,
+    ambiguity: dict | None,
+    path: TrajectoryPath | None,
+) -> Frame:
+    """The Frame of the overlay layers, with the app model's cached parts taken as given."""
+    light = dataclasses.replace(
+        scene, layers=[n for n in scene.layers if n in _LAYERS], trajectory=None
+    )
+    return build_frame(
+        light,
+        state,
+        rect=(0.0, 1.0, 0.0, 1.0),  # no wedge here: the rect only bounds computed regions
+        predictions=predictions,
+        ambiguity={} if selected is None else {selected: ambiguity},
+        trajectory=path,
+    )
 
 
 class OverlayActors:
@@ -41,130 +55,60 @@ class OverlayActors:
 
     def __init__(self, main: vtkRenderer):
         self.main = main
-        self.ghost_mesh = pv.PolyData()
-        self.ghost_actor = _actor(self.ghost_mesh, rgb=True)
-        self.ghost_actor.GetProperty().SetLineWidth(3.0)
-        self.ghost_points = pv.PolyData()
-        self.ghost_point_actor = _actor(self.ghost_points, rgb=True)
-        gp = self.ghost_point_actor.GetProperty()
-        gp.SetRepresentationToPoints()
-        gp.SetPointSize(9)
-        self.amb_fill = _actor(pv.PolyData())
-        self.amb_line = _actor(pv.PolyData())
-        self.amb_line.GetProperty().SetLineWidth(3.5)
-        self.path_actor = _actor(pv.PolyData(), (0.35, 0.35, 0.35))
-        self.path_actor.GetProperty().SetLineWidth(2.5)
-        for a in (
-            self.amb_fill,
-            self.amb_line,
-            self.path_actor,
-            self.ghost_actor,
-            self.ghost_point_actor,
-        ):
-            a.SetVisibility(False)
-            main.AddActor(a)
-        self.ghosts: dict[str, np.ndarray] = {}  # estimator -> (n, 2) ghost centres (NaN: none)
-        self.amb_polygon: np.ndarray | None = None
-        self._path_key = None
+        self.predictions = PredictionsLayer(main)
+        self.ambiguity = AmbiguityLayer(main)
+        self.trajectory = TrajectoryLayer(main)
+        for layer in (self.ambiguity, self.trajectory, self.predictions):
+            for a in layer.actors:
+                a.SetVisibility(False)
+                main.AddActor(a)
 
-    # --- predictions ------------------------------------------------------------------
-    def update_predictions(
-        self, scene, state, preds: dict, colors: dict[str, str], skip=frozenset()
-    ) -> None:
-        """Ghost discs of radius g at each estimator's (r_hat, phi_hat), linked to the truth.
+    def update(
+        self,
+        scene: Scene,
+        state: SceneState,
+        selected: int | None,
+        predictions: dict,
+        ambiguity: dict | None,
+        path: TrajectoryPath | None,
+        skip=frozenset(),
+    ) -> Frame | None:
+        """Build the overlay Frame and draw it; returns the Frame (None, and everything
+        hidden, when the scene shows none of these layers: a drag builds nothing then)."""
+        if not any(n in _LAYERS for n in scene.layers):
+            for layer in (self.ambiguity, self.trajectory, self.predictions):
+                for a in layer.actors:
+                    a.SetVisibility(False)
+            self.predictions.ghosts = {}
+            self.ambiguity.polygon = None
+            return None
+        frame = overlay_frame(scene, state, selected, predictions, ambiguity, path)
+        self.draw(frame, selected, skip)
+        return frame
 
-        Each estimator is drawn in its own colour, fixed by name (``colors`` is ignored);
-        estimators in ``skip`` (made for other eyes) draw no ring.
-        """
-        self.ghosts = {}
-        show = scene.shows("predictions") and bool(scene.features)
-        if not show:
-            self.ghost_actor.SetVisibility(False)
-            self.ghost_point_actor.SetVisibility(False)
-            return
-        t = np.linspace(0.0, 2 * math.pi, GHOST_N, endpoint=False)
-        pts, lines, cols, centres, ccols = [], [], [], [], []
-        k = 0
-        light = dataclasses.replace(scene, layers=["predictions"], trajectory=None)
-        frame = build_frame(light, state, rect=(0.0, 1.0, 0.0, 1.0), predictions=preds)
-        for name in scene.estimators:
-            pf = frame.predictions.get(name)
-            if name in skip or pf is None or isinstance(pf, str):
-                continue
-            gx, gy = pf.x_hat, pf.y_hat  # the Frame's (r_hat, phi_hat) in the plane
-            self.ghosts[name] = np.column_stack([gx, gy])
-            rgb = hex_rgb(estimator_color(name))
-            for i in np.flatnonzero(np.isfinite(gx) & np.isfinite(gy)):
-                g = state.g[i]
-                ring = np.column_stack(
-                    [gx[i] + g * np.cos(t), gy[i] + g * np.sin(t), np.full(GHOST_N, Z_GHOST)]
-                )
-                pts.append(ring)
-                lines.append(np.concatenate([[GHOST_N + 1], k + np.arange(GHOST_N), [k]]))
-                k += GHOST_N
-                pts.append([[state.x[i], state.y[i], Z_GHOST], [gx[i], gy[i], Z_GHOST]])
-                lines.append([2, k, k + 1])
-                k += 2
-                cols += [rgb, rgb]
-                centres.append([gx[i], gy[i], Z_POINT])
-                ccols.append(rgb)
-        if not pts:
-            self.ghost_actor.SetVisibility(False)
-            self.ghost_point_actor.SetVisibility(False)
-            return
-        mesh = pv.PolyData(
-            np.vstack(pts).astype(np.float64),
-            lines=np.concatenate([np.asarray(li) for li in lines]),
-        )
-        mesh.cell_data["rgb"] = np.array(cols, dtype=np.uint8)
-        self.ghost_actor.GetMapper().SetInputData(mesh)
-        self.ghost_mesh = mesh
-        cp = pv.PolyData(np.array(centres, dtype=np.float64))
-        cp.point_data["rgb"] = np.array(ccols, dtype=np.uint8)
-        mapper = self.ghost_point_actor.GetMapper()
-        mapper.SetInputData(cp)
-        mapper.SetScalarModeToUsePointFieldData()
-        mapper.SelectColorArray("rgb")
-        mapper.SetColorModeToDirectScalars()
-        mapper.ScalarVisibilityOn()
-        self.ghost_points = cp
-        self.ghost_actor.SetVisibility(True)
-        self.ghost_point_actor.SetVisibility(True)
+    def draw(self, frame: Frame, selected: int | None, skip=frozenset()) -> None:
+        """Draw ``frame`` (estimators in ``skip``, made for other eyes, draw no ring)."""
+        self.predictions.update(frame, skip)
+        self.ambiguity.update(frame, selected)
+        self.trajectory.update(frame)
 
-    # --- ambiguity --------------------------------------------------------------------
-    def update_ambiguity(self, scene, amb: dict | None, color: str | None) -> None:
-        poly = None if amb is None else amb["polygon"]
-        ok = scene.shows("ambiguity") and poly is not None and len(poly) >= 3
-        self.amb_polygon = poly if ok else None
-        self.amb_fill.SetVisibility(ok)
-        self.amb_line.SetVisibility(ok)
-        if not ok:
-            return
-        k = len(poly)
-        pts = np.column_stack([poly, np.full(k, Z_AMBIGUITY)])
-        fill = pv.PolyData(pts, faces=np.concatenate([[k], np.arange(k)]))
-        line = pv.PolyData(
-            pts + [0, 0, Z_LINE + 0.1 - Z_AMBIGUITY],  # over the discs
-            lines=np.concatenate([[k + 1], np.arange(k), [0]]),
-        )
-        self.amb_fill.GetMapper().SetInputData(fill)
-        self.amb_line.GetMapper().SetInputData(line)
-        rgb = hex_rgb(color or "#555555")
-        self.amb_fill.GetProperty().SetColor(*_mix(rgb, 0.28))
-        self.amb_line.GetProperty().SetColor(*_dark(rgb))
+    # --- what the tests and the window read -------------------------------------------
+    @property
+    def ghosts(self) -> dict[str, np.ndarray]:
+        return self.predictions.ghosts
 
-    # --- trajectory -------------------------------------------------------------------
-    def update_trajectory(self, scene, path) -> None:
-        """The path of the animated feature (x, y arrays), or hidden."""
-        ok = scene.shows("trajectory") and path is not None and path.n >= 2
-        self.path_actor.SetVisibility(ok)
-        if not ok:
-            return
-        key = (id(path), path.n)
-        if key == self._path_key:
-            return
-        self._path_key = key
-        pts = np.column_stack([path.x, path.y, np.full(path.n, Z_LINE - 0.2)])
-        mesh = pv.PolyData(pts, lines=np.concatenate([[path.n], np.arange(path.n)]))
-        self.path_actor.GetMapper().SetInputData(mesh)
-        self.path_actor.GetProperty().SetColor(*INK)
+    @property
+    def ghost_actor(self):
+        return self.predictions.ghost_actor
+
+    @property
+    def ghost_points(self):
+        return self.predictions.ghost_points
+
+    @property
+    def amb_fill(self):
+        return self.ambiguity.amb_fill
+
+    @property
+    def amb_polygon(self) -> np.ndarray | None:
+        return self.ambiguity.polygon

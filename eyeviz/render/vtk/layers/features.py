@@ -1,0 +1,213 @@
+"""``features``: the discs (Frame ``x``, ``y``, ``g``, colours; grey outside the networks'
+domain: Frame ``out_of_domain``) and the selected feature's ring, handle and sight lines.
+
+All discs but the selected one are ONE fill mesh (triangle fans) and ONE outline mesh with
+cell colours: few draw calls. The selected disc is drawn by template actors placed by
+transforms, so a drag uploads no geometry (a transform is a uniform, not a buffer).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkCommonCore import vtkPoints
+from vtkmodules.vtkCommonMath import vtkMatrix4x4
+
+from eyeviz.model.frame import Frame
+from eyeviz.render.vtk.primitives import (
+    CIRCLE_N,
+    UNIT,
+    Store,
+    actor,
+    fans,
+    points_actor,
+    set_rgb,
+    unit_fan,
+    unit_ring,
+)
+from eyeviz.render.vtk.style import (
+    FILL_ALPHA,
+    INK,
+    OUT_FILL,
+    OUT_LINE,
+    Z_FEAT,
+    Z_LINE,
+    Z_POINT,
+    hex_rgb,
+    rgbf,
+)
+
+__all__ = ["FeaturesLayer"]
+
+
+class FeaturesLayer:
+    """The merged discs of the unselected features and the selected one's live actors."""
+
+    def __init__(self, main):
+        self.main = main
+        self.store = Store()
+        self.fill_mesh: pv.PolyData | None = None
+        self.line_mesh: pv.PolyData | None = None
+        self.centers_mesh: pv.PolyData | None = None
+        self.grey = np.zeros(0, bool)
+        self.fan = CIRCLE_N - 2
+        self._merged_key: tuple | None = None
+        self.handle_actor = points_actor(pv.PolyData(np.zeros((1, 3))), 13, (0.35, 0.35, 0.35))
+        # sight lines (-h, 0) -> (x, y) -> (h, 0): the template (-1, 0) -> (0, 1) -> (1, 0)
+        # under the linear map [[h, x], [0, y]]
+        self.sight_mesh = pv.PolyData(
+            np.array([[-1.0, 0.0, Z_LINE], [0.0, 1.0, Z_LINE], [1.0, 0.0, Z_LINE]]),
+            lines=[3, 0, 1, 2],
+        )
+        self.sight_matrix = vtkMatrix4x4()
+        self.sight_actors = [actor(self.sight_mesh, INK), actor(self.sight_mesh, INK)]
+        for a in self.sight_actors:
+            a.GetProperty().SetLineWidth(2.0)
+            a.GetProperty().SetLineStipplePattern(0xF0F0)
+            a.SetUserMatrix(self.sight_matrix)
+        self.sel_actor = actor(unit_ring(0.0), INK)
+        self.sel_actor.GetProperty().SetLineWidth(5.0)
+        self.live_fill = actor(unit_fan())
+        self.live_line = actor(unit_ring(0.0))
+        self.live_line.GetProperty().SetLineWidth(3.0)
+        self.live_center = points_actor(pv.PolyData(np.zeros((1, 3))), 11, INK)
+        self.live_actors = (self.live_fill, self.live_line, self.live_center)
+        for a in self.live_actors:
+            a.SetVisibility(False)
+            main.AddActor(a)
+        main.AddActor(self.sel_actor)
+        main.AddActor(self.handle_actor)
+        main.AddActor(self.sight_actors[0])
+        self._feat_rgb = self._rgb_now = (np.zeros((0, 3), np.uint8), np.zeros((0, 3), np.uint8))
+
+    def build(self, frame: Frame) -> None:
+        """New merged meshes (the features' names or colours, or the layers, changed)."""
+        self.store.clear()
+        self.centers_mesh = self.fill_mesh = self.line_mesh = None
+        self._merged_key = None
+        if "features" not in frame.layers or not frame.n:
+            return
+        n, c = frame.n, CIRCLE_N
+        cols = np.array([hex_rgb(col) for col in frame.colors], dtype=np.float64)
+        # an opaque tint, not alpha: translucency costs whole extra passes in software GL
+        tint = np.round(FILL_ALPHA * cols + (1 - FILL_ALPHA) * 255).astype(np.uint8)
+        self._feat_rgb = (tint, cols.astype(np.uint8))
+        self._rgb_now = self._feat_rgb
+        self.grey = np.zeros(n, bool)
+        pts = vtkPoints()
+        pts.SetDataTypeToDouble()  # features lie far from the origin: keep float64
+        pts.SetNumberOfPoints(n * c)
+        self._idx = np.arange(n * c).reshape(n, c)
+        # triangle fans, not c-gons: VTK would re-triangulate every polygon at each upload
+        self._fan_cells = fans(self._idx)
+        self.fill_mesh = pv.PolyData()
+        self.fill_mesh.SetPoints(pts)
+        self.line_mesh = pv.PolyData()
+        self.line_mesh.SetPoints(pts)
+        fa = actor(self.fill_mesh, rgb=True)
+        la = actor(self.line_mesh, rgb=True)
+        la.GetProperty().SetLineWidth(3.0)
+        self.store.add(self.main, fa)
+        self.store.add(self.main, la)
+        self.centers_mesh = pv.PolyData(np.zeros((n, 3)))
+        self._centers_actor = points_actor(self.centers_mesh, 11, None)
+        mapper = self._centers_actor.GetMapper()
+        mapper.SetScalarModeToUsePointFieldData()
+        mapper.SelectColorArray("rgb")
+        mapper.SetColorModeToDirectScalars()
+        mapper.ScalarVisibilityOn()
+        self.store.add(self.main, self._centers_actor)
+
+    def update(self, frame: Frame, selected: int | None) -> None:
+        n = frame.n
+        has_sel = selected is not None and 0 <= selected < n and "features" in frame.layers
+        sel = selected if has_sel and self.fill_mesh is not None else None
+        if self.fill_mesh is not None:
+            self._grey(frame)
+            tint, cols = self._rgb_now
+            others = np.ones(n, bool)
+            if sel is not None:
+                others[sel] = False
+            geo = np.column_stack([frame.x, frame.y, frame.g])[others]
+            key = (sel, geo.tobytes(), tint.tobytes(), cols.tobytes())
+            if key != self._merged_key:  # not while only the selected feature moves
+                self._merged_key = key
+                self._write_merged(frame, others, tint, cols)
+        for a in self.live_actors:
+            a.SetVisibility(sel is not None)
+        self.handle_actor.SetVisibility(has_sel)
+        self.sel_actor.SetVisibility(has_sel)
+        for a in self.sight_actors:
+            a.SetVisibility(has_sel)
+        if not has_sel or selected is None:
+            return
+        x, y, g = float(frame.x[selected]), float(frame.y[selected]), float(frame.g[selected])
+        if sel is not None:
+            z = Z_FEAT + 0.9 * sel / n
+            tint, cols = self._rgb_now
+            self.live_fill.SetPosition(x, y, z)
+            self.live_line.SetPosition(x, y, z)
+            self.live_center.SetPosition(x, y, Z_POINT)
+            for a in (self.live_fill, self.live_line):
+                a.SetScale(g, g, 1.0)
+            self.live_fill.GetProperty().SetColor(*(tint[sel] / 255.0))
+            for a in (self.live_line, self.live_center):
+                a.GetProperty().SetColor(*(cols[sel] / 255.0))
+        self.handle_actor.SetPosition(x + g, y, Z_POINT + 0.5)
+        self.sel_actor.SetPosition(x, y, Z_LINE)
+        self.sel_actor.SetScale(g, g, 1.0)
+        h = frame.pair.h
+        mat = self.sight_matrix
+        if (mat.GetElement(0, 0), mat.GetElement(0, 1), mat.GetElement(1, 1)) != (h, x, y):
+            mat.SetElement(0, 0, h)
+            mat.SetElement(0, 1, x)
+            mat.SetElement(1, 1, y)
+            mat.Modified()
+        col = rgbf(frame.colors[selected])
+        self.sel_actor.GetProperty().SetColor(*col)
+        for a in self.sight_actors:
+            a.GetProperty().SetColor(*col)
+
+    def _write_merged(self, frame: Frame, others: np.ndarray, tint, cols) -> None:
+        """The merged fill/outline/centre meshes of every feature but the selected one."""
+        assert self.fill_mesh is not None and self.line_mesh is not None
+        n = frame.n
+        zf = Z_FEAT + 0.9 * np.arange(n) / n
+        ring = np.empty((n, CIRCLE_N, 3))
+        ring[..., 0] = frame.x[:, None] + frame.g[:, None] * UNIT[None, :, 0]
+        ring[..., 1] = frame.y[:, None] + frame.g[:, None] * UNIT[None, :, 1]
+        ring[..., 2] = zf[:, None]
+        pts = self.fill_mesh.GetPoints()
+        vtk_to_numpy(pts.GetData())[:] = ring.reshape(-1, 3)
+        pts.Modified()
+        idx = self._idx[others]
+        self.fill_mesh.faces = self._fan_cells[others].reshape(-1)
+        set_rgb(self.fill_mesh.GetCellData(), np.repeat(tint[others], self.fan, axis=0))
+        self.line_mesh.lines = np.column_stack(
+            [np.full(len(idx), CIRCLE_N + 1), idx, idx[:, :1]]
+        ).ravel()
+        set_rgb(self.line_mesh.GetCellData(), cols[others])
+        self.fill_mesh.Modified()
+        self.line_mesh.Modified()
+        centers = pv.PolyData(np.column_stack([frame.x, frame.y, np.full(n, Z_POINT)])[others])
+        set_rgb(centers.GetPointData(), cols[others])
+        self.centers_mesh = centers
+        self._centers_actor.GetMapper().SetInputData(centers)
+
+    def fill_rgb(self, i: int) -> np.ndarray:
+        """The fill colour feature i is drawn in."""
+        return self._rgb_now[0][i]
+
+    def _grey(self, frame: Frame) -> None:
+        """Features the Frame marks out of the networks' domain (predictions layer) are grey."""
+        grey = frame.out_of_domain
+        if grey is None or not grey.any():
+            self._rgb_now = self._feat_rgb
+            self.grey = np.zeros(frame.n, bool)
+            return
+        tint, cols = (a.copy() for a in self._feat_rgb)
+        tint[grey] = OUT_FILL
+        cols[grey] = OUT_LINE
+        self._rgb_now = (tint, cols)
+        self.grey = grey

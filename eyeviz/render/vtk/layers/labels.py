@@ -1,0 +1,110 @@
+"""``labels``: the eyes A, B and the origin O, each feature's name (at the Frame's
+:class:`eyeviz.model.frame.LabelFrame` anchors) and the line "m, θ, ψ" of the BFV
+(Eq. 15-16, from the Frame's ``bfv`` / ``pair``), in the inset or in the main view."""
+
+from __future__ import annotations
+
+import math
+
+from vtkmodules.vtkRenderingCore import vtkBillboardTextActor3D, vtkTextActor
+
+from eyeviz.model.frame import Frame
+from eyeviz.render.vtk.primitives import Store, border_actor, screen_text, text3d
+from eyeviz.render.vtk.style import BFV_LINE, INK, LABEL_ALL_MAX, Z_POINT, rgbf, style_text
+
+__all__ = ["LabelsLayer", "bfv_line"]
+
+
+def bfv_line(frame: Frame) -> str:
+    """'m = ...' and, with the bfv and labels layers, 'θ = ...°  ψ = ...°'."""
+    text = f"m = {frame.pair.m}"
+    if {"bfv", "labels"} <= frame.layers:
+        deg = 180.0 / math.pi
+        text += f"  θ = {frame.pair.theta * deg:.4g}°  ψ = {frame.pair.psi * deg:.4g}°"
+    return text
+
+
+class LabelsLayer:
+    """Eye labels (inset, and main without the inset), feature names, the BFV line."""
+
+    def __init__(self, main, inset):
+        self.main, self.inset = main, inset
+        self.eye_store = Store()
+        self.feature_store = Store()
+        self.inset_shown = True
+        self.main_eye_labels: list[vtkBillboardTextActor3D] = []
+        self.feature_labels: list[vtkBillboardTextActor3D] = []
+        self.bfv_text = {
+            "inset": screen_text(14, BFV_LINE, (0.5, 0.03), center=True),
+            "main": screen_text(20, BFV_LINE, (0.985, 0.02), right=True),
+        }
+        inset.AddViewProp(self.bfv_text["inset"])
+        main.AddViewProp(self.bfv_text["main"])
+        self.inset_label = vtkTextActor()
+        style_text(self.inset_label.GetTextProperty(), 16, INK)
+        self.inset_label.GetTextProperty().SetVerticalJustificationToTop()
+        self.inset_label.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+        self.inset_label.SetPosition(0.03, 0.96)
+        inset.AddViewProp(self.inset_label)
+        self.inset_border = border_actor()
+        inset.AddViewProp(self.inset_border)
+
+    def build_eyes(self, frame: Frame) -> None:
+        """Eye and origin labels and the BFV line (the eyes or the layers changed)."""
+        self.eye_store.clear()
+        self.main_eye_labels = []
+        for lab in frame.labels:
+            if lab.kind != "eye":
+                continue
+            for ren in (self.inset, self.main):
+                t = text3d(22, INK, center=True)
+                t.SetInput(lab.text)
+                t.SetPosition(lab.x, lab.y, Z_POINT)
+                self.eye_store.add(ren, t)
+                if ren is self.main:
+                    t.SetVisibility(not self.inset_shown)
+                    self.main_eye_labels.append(t)
+        self.inset_label.SetInput("")
+        text = bfv_line(frame)
+        self.bfv_text["inset"].SetInput(text)
+        self.bfv_text["main"].SetInput(text if "θ" in text else "")
+        self.place_bfv_text()
+
+    def build_features(self, frame: Frame) -> None:
+        """One name label per feature (the features' names or colours changed)."""
+        self.feature_store.clear()
+        self.feature_labels = []
+        if "features" not in frame.layers:
+            return
+        for lab in frame.labels:
+            if lab.kind != "feature" or lab.feature is None:
+                continue
+            label = vtkBillboardTextActor3D()
+            tp = label.GetTextProperty()
+            style_text(tp, 22, rgbf(frame.colors[lab.feature]))
+            tp.SetJustificationToLeft()
+            tp.SetVerticalJustificationToBottom()
+            self.feature_store.add(self.main, label)
+            self.feature_labels.append(label)
+
+    def update(self, frame: Frame, selected: int | None) -> None:
+        """Feature names at the Frame's anchors (all for a few features, else the selected)."""
+        few = frame.n <= LABEL_ALL_MAX
+        feats = [lab for lab in frame.labels if lab.kind == "feature"]
+        for label, lab in zip(self.feature_labels, feats, strict=False):
+            shown = few or lab.feature == selected
+            label.SetVisibility(shown)
+            if shown:  # a hidden label is placed when it is shown
+                label.SetInput(f" {lab.text}")  # no-op (no Modified) when unchanged
+                label.SetPosition(lab.x, lab.y, Z_POINT)
+
+    def set_inset_shown(self, shown: bool) -> None:
+        self.inset_shown = bool(shown)
+        for t in self.main_eye_labels:
+            t.SetVisibility(not shown)
+        self.place_bfv_text()
+
+    def place_bfv_text(self) -> None:
+        has = bool(self.bfv_text["main"].GetInput())
+        self.bfv_text["inset"].SetVisibility(has and self.inset_shown)
+        self.bfv_text["main"].SetVisibility(has and not self.inset_shown)

@@ -1,0 +1,191 @@
+"""VTK building blocks shared by the layers: unlit actors, point and text actors, unit
+circle templates, triangle fans. Drawing primitives only: no scene geometry is derived
+here (every position a layer draws comes from a :class:`eyeviz.model.frame.Frame`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pyvista as pv
+from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+from vtkmodules.vtkCommonCore import vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+from vtkmodules.vtkRenderingCore import (
+    vtkActor,
+    vtkActor2D,
+    vtkBillboardTextActor3D,
+    vtkCoordinate,
+    vtkPolyDataMapper,
+    vtkPolyDataMapper2D,
+    vtkTextActor,
+)
+
+from eyeviz.render.vtk.style import INK, style_text
+
+__all__ = [
+    "CIRCLE_N",
+    "UNIT",
+    "actor",
+    "points_actor",
+    "text3d",
+    "screen_text",
+    "border_actor",
+    "ring",
+    "set_rgb",
+    "write_rgb",
+    "unit_ring",
+    "unit_fan",
+    "fans",
+    "Store",
+]
+
+CIRCLE_N = 160  # vertices of a drawn circle
+
+
+def actor(mesh, color=None, rgb: bool = False) -> vtkActor:
+    """An unlit actor of ``mesh`` in ``color``, or coloured by its cell "rgb" array."""
+    mapper = vtkPolyDataMapper()
+    mapper.SetInputData(mesh)
+    if rgb:
+        mapper.SetScalarModeToUseCellFieldData()
+        mapper.SelectColorArray("rgb")
+        mapper.SetColorModeToDirectScalars()
+        mapper.ScalarVisibilityOn()
+    else:
+        mapper.ScalarVisibilityOff()
+    a = vtkActor()
+    a.SetMapper(mapper)
+    prop = a.GetProperty()
+    prop.LightingOff()
+    prop.SetAmbient(1.0)
+    prop.SetDiffuse(0.0)
+    if color is not None:
+        prop.SetColor(*color)
+    return a
+
+
+def points_actor(mesh, size: float, color) -> vtkActor:
+    a = actor(mesh, color)
+    p = a.GetProperty()
+    p.SetRepresentationToPoints()
+    p.SetPointSize(size)
+    p.RenderPointsAsSpheresOn()
+    return a
+
+
+def text3d(size: int, color, center: bool = False) -> vtkBillboardTextActor3D:
+    t = vtkBillboardTextActor3D()
+    tp = t.GetTextProperty()
+    style_text(tp, size, color)
+    if center:
+        tp.SetJustificationToCentered()
+        tp.SetVerticalJustificationToCentered()
+    return t
+
+
+def screen_text(size, color, pos, top=False, center=False, right=False) -> vtkTextActor:
+    t = vtkTextActor()
+    tp = t.GetTextProperty()
+    style_text(tp, size, color)
+    if top:
+        tp.SetVerticalJustificationToTop()
+    if center:
+        tp.SetJustificationToCentered()
+    if right:
+        tp.SetJustificationToRight()
+    t.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+    t.SetPosition(*pos)
+    return t
+
+
+def border_actor() -> vtkActor2D:
+    """A frame around a viewport (the inset's border)."""
+    pts = vtkPoints()
+    for x, y in ((0.002, 0.004), (0.998, 0.004), (0.998, 0.996), (0.002, 0.996)):
+        pts.InsertNextPoint(x, y, 0)
+    lines = vtkCellArray()
+    lines.InsertNextCell(5)
+    for i in (0, 1, 2, 3, 0):
+        lines.InsertCellPoint(i)
+    poly = vtkPolyData()
+    poly.SetPoints(pts)
+    poly.SetLines(lines)
+    coord = vtkCoordinate()
+    coord.SetCoordinateSystemToNormalizedViewport()
+    mapper = vtkPolyDataMapper2D()
+    mapper.SetInputData(poly)
+    mapper.SetTransformCoordinate(coord)
+    a = vtkActor2D()
+    a.SetMapper(mapper)
+    a.GetProperty().SetColor(*INK)
+    a.GetProperty().SetLineWidth(3)
+    return a
+
+
+def _circle(n: int = CIRCLE_N) -> np.ndarray:
+    t = np.linspace(0.0, 2.0 * math.pi, n, endpoint=False)
+    return np.column_stack([np.cos(t), np.sin(t)])
+
+
+UNIT = _circle()  # the unit circle's CIRCLE_N vertices
+
+
+def ring(x: float, y: float, r: float, z: float) -> np.ndarray:
+    """The CIRCLE_N vertices of the circle of radius r about (x, y) at height z."""
+    pts = np.empty((CIRCLE_N, 3))
+    pts[:, 0] = x + r * UNIT[:, 0]
+    pts[:, 1] = y + r * UNIT[:, 1]
+    pts[:, 2] = z
+    return pts
+
+
+def set_rgb(data, rgb: np.ndarray) -> None:
+    """Set the uint8 "rgb" array of point or cell data (may be empty: pyvista refuses)."""
+    arr = numpy_to_vtk(np.ascontiguousarray(rgb, dtype=np.uint8).reshape(-1, 3), deep=1)
+    arr.SetName("rgb")
+    data.AddArray(arr)
+
+
+def write_rgb(mesh, rgb: np.ndarray) -> None:
+    """Overwrite a mesh's cell "rgb" array in place (a drag frame: pyvista's cell_data
+    lookup costs ~0.1 ms a call)."""
+    arr = mesh.GetCellData().GetAbstractArray("rgb")
+    vtk_to_numpy(arr)[:] = rgb
+    arr.Modified()
+
+
+def unit_ring(z: float) -> pv.PolyData:
+    """The closed unit circle at height z (an outline template)."""
+    mesh = pv.PolyData(ring(0.0, 0.0, 1.0, z))
+    mesh.lines = np.concatenate([[CIRCLE_N + 1], np.arange(CIRCLE_N), [0]])
+    return mesh
+
+
+def fans(idx: np.ndarray) -> np.ndarray:
+    """Triangle fans (VTK cell array) over rings of point ids idx (n, c)."""
+    j = np.arange(1, idx.shape[1] - 1)
+    return np.stack(np.broadcast_arrays(3, idx[:, :1], idx[:, j], idx[:, j + 1]), axis=-1)
+
+
+def unit_fan() -> pv.PolyData:
+    """The unit disc as one triangle fan (a fill template)."""
+    mesh = pv.PolyData(ring(0.0, 0.0, 1.0, 0.0))
+    mesh.faces = fans(np.arange(CIRCLE_N)[None, :]).reshape(-1)
+    return mesh
+
+
+class Store:
+    """Props added to renderers by one layer, removed together on a rebuild."""
+
+    def __init__(self):
+        self.items: list = []
+
+    def add(self, renderer, prop) -> None:
+        renderer.AddActor(prop)
+        self.items.append((renderer, prop))
+
+    def clear(self) -> None:
+        for renderer, prop in self.items:
+            renderer.RemoveActor(prop)
+        self.items.clear()
