@@ -24,6 +24,8 @@ MAX_SEGMENTS = 10**5
 MAX_BINS = 10**5
 #: Scene TOML files, and any other small text file a user hands in.
 MAX_SCENE_BYTES = 1 << 20
+#: A study table (``eyeviz study -o STUDY.csv``; one row per design point and distance bin).
+MAX_STUDY_BYTES = 1 << 28
 #: Features drawn in one scene / snapshot.
 MAX_FEATURES = 10**4
 #: Width of a hidden layer read from a model directory, and total parameters of a model.
