@@ -27,31 +27,67 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from eyeviz.study.grid import DEFAULT_H, DEFAULT_L, DEFAULT_M
 
     parser.add_argument(
-        "-o", "--output", metavar="STUDY.csv", required=True,
+        "-o",
+        "--output",
+        metavar="STUDY.csv",
+        required=True,
         help="study table (CSV); an existing one of this version is resumed",
-    )  # fmt: skip
-    parser.add_argument("--h", default=_csv(DEFAULT_H), metavar="LIST",
-                        help=f"distances between the eyes; default {_csv(DEFAULT_H)}")  # fmt: skip
-    parser.add_argument("--l", default=_csv(DEFAULT_L), metavar="LIST",
-                        help=f"eye diameters (designs need l < h); default {_csv(DEFAULT_L)}")  # fmt: skip
-    parser.add_argument("--m", default=_csv(DEFAULT_M), metavar="LIST",
-                        help=f"ommatidia per eye pair (even, >= 4); default {_csv(DEFAULT_M)}")  # fmt: skip
-    parser.add_argument("--n", default="100000", metavar="N",
-                        help="test elements per design point; default 100000")  # fmt: skip
-    parser.add_argument("--prior", default="single", choices=("single", "multi"),
-                        help="Algorithm 1 prior of the test sets; default single")  # fmt: skip
+    )
+    parser.add_argument(
+        "--h",
+        default=_csv(DEFAULT_H),
+        metavar="LIST",
+        help=f"distances between the eyes; default {_csv(DEFAULT_H)}",
+    )
+    parser.add_argument(
+        "--l",
+        default=_csv(DEFAULT_L),
+        metavar="LIST",
+        help=f"eye diameters (designs need l < h); default {_csv(DEFAULT_L)}",
+    )
+    parser.add_argument(
+        "--m",
+        default=_csv(DEFAULT_M),
+        metavar="LIST",
+        help=f"ommatidia per eye pair (even, >= 4); default {_csv(DEFAULT_M)}",
+    )
+    parser.add_argument(
+        "--n", default="100000", metavar="N", help="test elements per design point; default 100000"
+    )
+    parser.add_argument(
+        "--prior",
+        default="single",
+        choices=("single", "multi"),
+        help="Algorithm 1 prior of the test sets; default single",
+    )
     parser.add_argument("--seed", default="0", metavar="S", help="random seed; default 0")
-    parser.add_argument("--r-min", default=DEFAULTS["r_min"], metavar="R",
-                        help=f"nearest object distance; default {DEFAULTS['r_min']:g}")  # fmt: skip
-    parser.add_argument("--r-max", default=DEFAULTS["r_max"], metavar="R",
-                        help=f"farthest object distance; default {DEFAULTS['r_max']:g}")  # fmt: skip
-    parser.add_argument("--g-max", default=DEFAULTS["g_max"], metavar="G",
-                        help=f"largest object size; default {DEFAULTS['g_max']:g}")  # fmt: skip
-    parser.add_argument("--workers", default=None, metavar="N",
-                        help="local worker processes; default one per core")  # fmt: skip
-    parser.add_argument("--scheduler", default=None, metavar="ADDR",
-                        help="address of an existing Dask scheduler (tcp://HOST:8786) "
-                        "instead of local processes")  # fmt: skip
+    parser.add_argument(
+        "--r-min",
+        default=DEFAULTS["r_min"],
+        metavar="R",
+        help=f"nearest object distance; default {DEFAULTS['r_min']:g}",
+    )
+    parser.add_argument(
+        "--r-max",
+        default=DEFAULTS["r_max"],
+        metavar="R",
+        help=f"farthest object distance; default {DEFAULTS['r_max']:g}",
+    )
+    parser.add_argument(
+        "--g-max",
+        default=DEFAULTS["g_max"],
+        metavar="G",
+        help=f"largest object size; default {DEFAULTS['g_max']:g}",
+    )
+    parser.add_argument(
+        "--workers", default=None, metavar="N", help="local worker processes; default one per core"
+    )
+    parser.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDR",
+        help="address of an existing Dask scheduler (tcp://HOST:8786) instead of local processes",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 

@@ -169,7 +169,8 @@ def run_study(
     ):
         raise EyevizError(f"workers must be an integer in [1, {MAX_WORKERS}], got {workers!r}")
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
-        raise EyevizError(f"scheduler must be an address such as tcp://host:8786, got {scheduler!r}")
+        msg = f"scheduler must be an address such as tcp://host:8786, got {scheduler!r}"
+        raise EyevizError(msg)
 
     def summary(computed: int, n_workers: int, failures: list[str]) -> StudySummary:
         return StudySummary(
@@ -240,4 +241,3 @@ def run_study(
     if failures:
         raise StudyFailed(result)
     return result
-
