@@ -18,6 +18,7 @@ should a cluster give up on it (``KilledWorker``) the point is submitted again, 
 from __future__ import annotations
 
 import contextlib
+import itertools
 import logging
 import os
 import secrets
@@ -54,6 +55,8 @@ class StudySummary:
     seconds: float
     scheduler: str | None = None
     failures: tuple[str, ...] = field(default=())
+    #: Points submitted again after the cluster gave them up (their workers kept dying).
+    resubmitted: int = 0
 
     def __str__(self) -> str:
         where = f"on {self.scheduler}" if self.scheduler else f"{self.workers} local worker(s)"
@@ -172,7 +175,9 @@ def run_study(
         msg = f"scheduler must be an address such as tcp://host:8786, got {scheduler!r}"
         raise EyevizError(msg)
 
-    def summary(computed: int, n_workers: int, failures: list[str]) -> StudySummary:
+    def summary(
+        computed: int, n_workers: int, failures: list[str], resubmitted: int = 0
+    ) -> StudySummary:
         return StudySummary(
             str(path),
             len(unique),
@@ -182,6 +187,7 @@ def run_study(
             time.perf_counter() - t0,
             scheduler,
             tuple(failures),
+            resubmitted,
         )
 
     if not todo:
@@ -194,21 +200,26 @@ def run_study(
     config = {
         "distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
         "distributed.comm.timeouts.connect": f"{connect_timeout}s",
+        # points take seconds: a worker holds only the point it computes (no prefetch),
+        # so the last points spread over every worker and a killed worker loses just one
+        "distributed.scheduler.worker-saturation": 1.0,
     }
     with dask.config.set(config):
         client, cluster = _connect(scheduler, workers, connect_timeout)
     computed = 0
     failures: list[str] = []
+    resubmitted = 0
     bar = None
     try:
         n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {}))
         tag = secrets.token_hex(4)
         owner: dict = {}
         attempts: dict[tuple, int] = {}
+        serial = itertools.count()  # a resubmitted point gets a key of its own
 
         def submit(p: DesignPoint):
             attempts[p.key] = attempts.get(p.key, 0) + 1
-            key = f"eyeviz-study-h{p.h:g}-l{p.l:g}-m{p.m}-{tag}-{len(owner)}"
+            key = f"eyeviz-study-h{p.h:g}-l{p.l:g}-m{p.m}-{tag}-{next(serial)}"
             fut = client.submit(evaluate, p, key=key, pure=False, retries=1)
             owner[fut.key] = p
             return fut
@@ -226,6 +237,7 @@ def run_study(
                 killed = type(exc).__name__ == "KilledWorker" or fut.status == "cancelled"
                 if killed and attempts[p.key] <= RESUBMITS:
                     ac.add(submit(p))
+                    resubmitted += 1
                 else:
                     hint = ""
                     if isinstance(exc, ModuleNotFoundError):
@@ -237,7 +249,7 @@ def run_study(
         if bar is not None:
             bar.close()
         _close(client, cluster)
-    result = summary(computed, n_workers, failures)
+    result = summary(computed, n_workers, failures, resubmitted)
     if failures:
         raise StudyFailed(result)
     return result
