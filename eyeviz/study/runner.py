@@ -110,6 +110,7 @@ def _connect(scheduler: str | None, workers: int | None, timeout: float):
         processes=True,
         dashboard_address=None,
         silence_logs=logging.CRITICAL,
+        preload=["eyeviz.study._worker"],  # workers ignore Ctrl-C, restarted ones too
     )
     try:
         client = Client(cluster, set_as_default=False)
@@ -117,6 +118,35 @@ def _connect(scheduler: str | None, workers: int | None, timeout: float):
         cluster.close()
         raise
     return client, cluster
+
+
+@contextlib.contextmanager
+def _signals_deferred():
+    """Hold Ctrl-C, SIGTERM and SIGHUP while a cluster starts, then deliver them.
+
+    Interrupted half-way, distributed can neither close the cluster nor stop its worker
+    processes (they outlive eyeviz). A signal arriving meanwhile is noted and raised
+    again on leaving, when the cluster is whole and the caller's ``finally`` closes it.
+    (Ignoring SIGINT instead would let the worker processes inherit the ignoring, but a
+    Ctrl-C could then be lost: multiprocessing unblocks signals in the spawning thread.)
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    names = ("SIGINT", "SIGTERM", "SIGHUP")
+    sigs = [getattr(signal, n) for n in names if hasattr(signal, n)]
+    got: list[int] = []
+    old = {s: signal.signal(s, lambda signum, _frame: got.append(signum)) for s in sigs}
+    try:
+        yield
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
+        if got:
+            signal.raise_signal(got[0])
 
 
 def _close(client, cluster) -> None:
@@ -204,13 +234,15 @@ def run_study(
         # so the last points spread over every worker and a killed worker loses just one
         "distributed.scheduler.worker-saturation": 1.0,
     }
-    with dask.config.set(config):
-        client, cluster = _connect(scheduler, workers, connect_timeout)
     computed = 0
     failures: list[str] = []
     resubmitted = 0
     bar = None
+    client = cluster = None
+    n_workers = 0
     try:
+        with dask.config.set(config), _signals_deferred():
+            client, cluster = _connect(scheduler, workers, connect_timeout)
         n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {}))
         tag = secrets.token_hex(4)
         owner: dict = {}
@@ -248,7 +280,8 @@ def run_study(
     finally:
         if bar is not None:
             bar.close()
-        _close(client, cluster)
+        if client is not None:
+            _close(client, cluster)
     result = summary(computed, n_workers, failures, resubmitted)
     if failures:
         raise StudyFailed(result)

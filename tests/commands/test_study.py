@@ -160,3 +160,24 @@ def test_ctrl_c_or_a_crash_mid_study_keeps_whole_points_and_resumes(tmp_path, si
     assert f"{6 - len(kept)} point(s) computed, {len(kept)} skipped" in out.stdout
     assert path.read_text().splitlines()[: len(lines_before)] == lines_before
     assert len(StudyTable.open(path).keys) == 6
+
+
+@pytest.mark.parametrize("delay", [0.7, 2.0])
+def test_ctrl_c_while_the_cluster_starts_leaves_no_process_behind(tmp_path, delay):
+    # interrupted half-way, a LocalCluster cannot be closed: the runner holds the
+    # signal until the cluster is whole, then closes it
+    path = tmp_path / "s.csv"
+    proc, _ = start_study(path)
+    try:
+        time.sleep(delay)
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 130, err
+    # (worker processes still starting may print their own KeyboardInterrupt first)
+    assert err.strip().splitlines()[-1].startswith("eyeviz: interrupted;"), err
+    assert group_gone(proc.pid, timeout=30), "worker processes outlived the study"
+    if path.exists():
+        StudyTable.open(path)  # whole points only

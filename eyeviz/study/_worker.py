@@ -1,0 +1,16 @@
+"""Preloaded into the study's local worker processes (``LocalCluster(preload=...)``).
+
+A Ctrl-C in the terminal reaches the whole process group: the workers ignore it (the
+parent closes the cluster and keeps the finished points); a worker the nanny restarts
+after a crash starts with the default handler, and this puts it right.
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+
+
+def dask_setup(worker=None) -> None:
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
