@@ -90,6 +90,14 @@ def _one_line(exc: BaseException) -> str:
     return text[:300]
 
 
+def _cores() -> int:
+    """Cores this process may run on (its CPU affinity where the OS tells)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 def _connect(scheduler: str | None, workers: int | None, timeout: float):
     """A Client (and the LocalCluster it owns, or None on a user's cluster)."""
     from distributed import Client, LocalCluster
@@ -103,7 +111,7 @@ def _connect(scheduler: str | None, workers: int | None, timeout: float):
                 f"({_one_line(exc)})"
             ) from None
         return client, None
-    n = workers if workers is not None else (os.cpu_count() or 1)
+    n = workers if workers is not None else _cores()
     cluster = LocalCluster(
         n_workers=n,
         threads_per_worker=1,
