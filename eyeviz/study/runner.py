@@ -23,6 +23,7 @@ import logging
 import os
 import secrets
 import time
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -201,7 +202,9 @@ def run_study(
         if not isinstance(p, DesignPoint):
             raise EyevizError(f"a study point must be a DesignPoint, got {type(p).__name__}")
         unique.setdefault(p.key, p)
-    todo = [p for p in unique.values() if p not in table]
+    # largest first (the cost grows with n and m, and h): the last points to finish are
+    # small ones, so no worker waits long at the end of the study
+    todo = sorted((p for p in unique.values() if p not in table), key=lambda p: (-p.n * p.m, -p.h))
     skipped = len(unique) - len(todo)
     if scheduler is not None and workers is not None:
         raise EyevizError("--workers sets up a local cluster; with --scheduler leave it out")
@@ -249,7 +252,9 @@ def run_study(
     client = cluster = None
     n_workers = 0
     try:
-        with dask.config.set(config), _signals_deferred():
+        with dask.config.set(config), _signals_deferred(), warnings.catch_warnings():
+            # the scheduler's HTTP routes move off a busy port 8787: no reason to warn
+            warnings.filterwarnings("ignore", r"Port \d+ is already in use", UserWarning)
             client, cluster = _connect(scheduler, workers, connect_timeout)
         n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {}))
         tag = secrets.token_hex(4)

@@ -144,3 +144,31 @@ def test_killing_a_worker_mid_study_loses_only_its_point(tmp_path, allowed_failu
         again = run_study(path, points, scheduler=cluster.scheduler_address, progress=False)
         assert (again.computed, again.skipped) == (0, 6)
         assert path.read_bytes() == before
+
+
+def _fails_for_m16(point):
+    from eyeviz.study.point import evaluate
+
+    if point.m == 16:
+        raise ValueError("boom for the test")
+    return evaluate(point)
+
+
+def test_a_failing_point_is_named_and_the_others_kept(tmp_path, monkeypatch):
+    from distributed import LocalCluster
+
+    from eyeviz.study import runner
+    from eyeviz.study.runner import StudyFailed
+
+    monkeypatch.setattr(runner, "evaluate", _fails_for_m16)
+    path = tmp_path / "s.csv"
+    points = design_grid("20", "10", "8,16,32", n=200)
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        with pytest.raises(StudyFailed) as err:
+            run_study(path, points, scheduler=cluster.scheduler_address, progress=False)
+    msg = str(err.value)
+    assert "\n" not in msg
+    assert "1 design point(s) failed, the other 2 are in" in msg
+    assert "h=20, l=10, m=16" in msg and "boom for the test" in msg
+    assert err.value.summary.computed == 2
+    assert StudyTable.open(path).finished == {points[0].key, points[2].key}
