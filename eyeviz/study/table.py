@@ -35,6 +35,7 @@ MAX_LINE_CHARS = 4096
 
 _INT = frozenset({"version", "m", "n", "seed", "count", "flagged"})
 _STR = frozenset({"prior", "bin"})
+_METRICS = frozenset({"dd_mape", "ad_mape", "dd_r2", "ad_r2"})
 _DESIGN = ("h", "l", "m", "r_min", "r_max", "g_max", "prior", "n", "seed")
 
 
@@ -65,6 +66,9 @@ def _parse(where: str, values: list[str]) -> dict:
     for name, text in zip(COLUMNS, values, strict=True):
         if name in _STR:
             row[name] = text
+            continue
+        if name in _METRICS and not text.strip():
+            row[name] = math.nan  # pandas writes NaN as an empty field
             continue
         try:
             row[name] = int(text) if name in _INT else float(text)

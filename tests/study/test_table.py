@@ -66,6 +66,21 @@ def test_nan_and_inf_round_trip(tmp_path, rows):
     assert math.isnan(df["dd_r2"][3]) and df["ad_mape"][4] == math.inf
 
 
+def test_a_table_written_back_by_pandas_reads_the_same(tmp_path, rows):
+    r = [dict(x) for x in rows[P1.key]]
+    r[2]["dd_r2"] = math.nan
+    path = tmp_path / "s.csv"
+    StudyTable.open(path).append(r)
+    back = tmp_path / "back.csv"
+    pd.read_csv(path).to_csv(back, index=False)  # NaN becomes an empty field
+    assert ",," in back.read_text()
+    a, _ = read_rows(path)
+    b, _ = read_rows(back)
+    assert [x["_key"] for x in a] == [x["_key"] for x in b]
+    assert math.isnan(b[2]["dd_r2"])
+    assert [x["dd_mape"] for x in a] == [x["dd_mape"] for x in b]
+
+
 def test_empty_file_is_an_empty_study(tmp_path):
     path = tmp_path / "s.csv"
     path.write_bytes(b"")
