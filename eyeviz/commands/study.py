@@ -37,19 +37,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--h",
         default=_csv(DEFAULT_H),
         metavar="LIST",
-        help=f"distances between the eyes; default {_csv(DEFAULT_H)}",
+        help=f"eye positions h (eyes 2h apart; Table 3); default {_csv(DEFAULT_H)}",
     )
     parser.add_argument(
         "--l",
         default=_csv(DEFAULT_L),
         metavar="LIST",
-        help=f"eye diameters (designs need l < h); default {_csv(DEFAULT_L)}",
+        help=f"eye radii l (designs need l < h); default {_csv(DEFAULT_L)}",
     )
     parser.add_argument(
         "--m",
         default=_csv(DEFAULT_M),
         metavar="LIST",
-        help=f"ommatidia per eye pair (even, >= 4); default {_csv(DEFAULT_M)}",
+        help=f"ommatidia m per eye (even, >= 4); default {_csv(DEFAULT_M)}",
     )
     parser.add_argument(
         "--n", default="100000", metavar="N", help="test elements per design point; default 100000"

@@ -1,7 +1,7 @@
 """The design grid of the eye-design study: every (h, l, m) with l < h (Section 8).
 
 The paper closes with the question of how azimuth and distance accuracy depend on the
-distance between the eyes h, the eye size l and the number of ommatidia m (Table 3).
+eye position h (eyes 2h apart), the eye radius l and the ommatidia per eye m (Table 3).
 A grid is the product of lists of h, l and m, keeping the designs whose eyes do not
 overlap (l < h), each with the same object ranges (Table 4), prior, n and seed.
 

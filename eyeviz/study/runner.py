@@ -172,6 +172,10 @@ def _check_rows(p: DesignPoint, rows) -> list[dict]:
     for r in rows:
         if not isinstance(r, dict) or tuple(r) != COLUMNS:
             raise EyevizError(f"a worker returned malformed rows for {_describe(p)}")
+        if (r["h"], r["l"], r["m"], r["n"], r["seed"], r["prior"]) != (
+            p.h, p.l, p.m, p.n, p.seed, p.prior,
+        ):  # fmt: skip
+            raise EyevizError(f"a worker returned the rows of another point for {_describe(p)}")
     return rows
 
 
