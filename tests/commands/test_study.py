@@ -140,20 +140,24 @@ def group_gone(pgid, timeout=60) -> bool:
     return False
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
 def test_ctrl_c_or_a_crash_mid_study_keeps_whole_points_and_resumes(tmp_path, sig):
     path = tmp_path / "s.csv"
     proc, args = start_study(path)
     try:
         n, _ = wait_for_points(proc, path, 1)
-        os.killpg(proc.pid, sig)  # Ctrl-C reaches the whole foreground group
+        if sig == signal.SIGTERM:
+            os.kill(proc.pid, sig)  # `kill PID`, as a batch system's job end does
+        else:
+            os.killpg(proc.pid, sig)  # Ctrl-C reaches the whole foreground group
         _, err = proc.communicate(timeout=120)
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
-    if sig == signal.SIGINT:
-        assert proc.returncode == 130, err
-        assert "eyeviz: interrupted;" in err and "finished point(s) kept in" in err, err
+    if sig in (signal.SIGINT, signal.SIGTERM):
+        code, what = (130, "interrupted") if sig == signal.SIGINT else (143, "terminated by")
+        assert proc.returncode == code, err
+        assert f"eyeviz: {what}" in err and "finished point(s) kept in" in err, err
         assert "Traceback" not in err, err
         assert group_gone(proc.pid), "worker processes outlived the interrupted study"
     else:
