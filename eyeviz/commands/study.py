@@ -1,0 +1,150 @@
+"""``eyeviz study -o STUDY.csv``: the eye-design study (issue 11) on Dask.
+
+For every design (h, l, m) of the grid with l < h, the information limit's DD and AD
+error (MAPE, Eq. 34; R^2, Eq. 35) overall and per distance bin, one row per design and
+bin in a CSV table appended as points finish; re-running skips finished points. dask is
+imported only when the study runs (:mod:`eyeviz.study.runner`), not by ``--help``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+NAME = "study"
+HELP = (
+    "the eye-design study: the information limit's distance and azimuth error over a "
+    "grid of (h, l, m), on Dask (local processes or an existing cluster); resumable"
+)
+
+
+def _csv(values) -> str:
+    return ",".join(f"{v:g}" for v in values)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from eyeviz.core.domain import DEFAULTS
+    from eyeviz.study.grid import DEFAULT_H, DEFAULT_L, DEFAULT_M
+
+    parser.add_argument(
+        "-o",
+        "--output",
+        metavar="STUDY.csv",
+        required=True,
+        help="study table (CSV); an existing one of this version is resumed",
+    )
+    parser.add_argument(
+        "--h",
+        default=_csv(DEFAULT_H),
+        metavar="LIST",
+        help=f"eye positions h (eyes 2h apart; Table 3); default {_csv(DEFAULT_H)}",
+    )
+    parser.add_argument(
+        "--l",
+        default=_csv(DEFAULT_L),
+        metavar="LIST",
+        help=f"eye radii l (designs need l < h); default {_csv(DEFAULT_L)}",
+    )
+    parser.add_argument(
+        "--m",
+        default=_csv(DEFAULT_M),
+        metavar="LIST",
+        help=f"ommatidia m per eye (even, >= 4); default {_csv(DEFAULT_M)}",
+    )
+    parser.add_argument(
+        "--n", default="100000", metavar="N", help="test elements per design point; default 100000"
+    )
+    parser.add_argument(
+        "--prior",
+        default="single",
+        choices=("single", "multi"),
+        help="Algorithm 1 prior of the test sets; default single",
+    )
+    parser.add_argument("--seed", default="0", metavar="S", help="random seed; default 0")
+    parser.add_argument(
+        "--r-min",
+        default=DEFAULTS["r_min"],
+        metavar="R",
+        help=f"nearest object distance; default {DEFAULTS['r_min']:g}",
+    )
+    parser.add_argument(
+        "--r-max",
+        default=DEFAULTS["r_max"],
+        metavar="R",
+        help=f"farthest object distance; default {DEFAULTS['r_max']:g}",
+    )
+    parser.add_argument(
+        "--g-max",
+        default=DEFAULTS["g_max"],
+        metavar="G",
+        help=f"largest object size; default {DEFAULTS['g_max']:g}",
+    )
+    parser.add_argument(
+        "--workers", default=None, metavar="N", help="local worker processes; default one per core"
+    )
+    parser.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDR",
+        help="address of an existing Dask scheduler (tcp://HOST:8786) instead of local processes",
+    )
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def _int(name: str, text) -> int:
+    from eyeviz import EyevizError
+
+    try:
+        return int(str(text).strip())
+    except ValueError:
+        raise EyevizError(f"{name} must be an integer, got {text!r}") from None
+
+
+def _float(name: str, text) -> float:
+    from eyeviz.core.validation import check_real
+
+    return check_real(name, text)
+
+
+def run(args: argparse.Namespace) -> int:
+    import logging
+
+    from eyeviz.study import design_grid, run_study
+    from eyeviz.study.table import StudyTable
+
+    points = design_grid(
+        args.h,
+        args.l,
+        args.m,
+        r_min=_float("r_min", args.r_min),
+        r_max=_float("r_max", args.r_max),
+        g_max=_float("g_max", args.g_max),
+        prior=args.prior,
+        n=_int("n", args.n),
+        seed=_int("seed", args.seed),
+    )
+    workers = None if args.workers is None else _int("workers", args.workers)
+    logging.getLogger("distributed").setLevel(logging.ERROR)  # a killed worker: no log spam
+    try:
+        summary = run_study(
+            args.output,
+            points,
+            workers=workers,
+            scheduler=args.scheduler,
+            progress=not args.no_progress,
+        )
+    except KeyboardInterrupt as exc:
+        kept = "the finished points"
+        try:
+            kept = f"{len(StudyTable.open(args.output).keys)} finished point(s)"
+        except Exception:  # noqa: BLE001 - the message only
+            pass
+        name = getattr(exc, "signame", "SIGINT")
+        what = "interrupted" if name == "SIGINT" else f"terminated by {name}"
+        print(
+            f"eyeviz: {what}; {kept} kept in {args.output} (run the same command to resume)",
+            file=sys.stderr,
+        )
+        return int(getattr(exc, "exit_code", 130))
+    print(summary)
+    return 0

@@ -1,0 +1,174 @@
+"""The Dask runner: real LocalClusters with worker processes (no mocks). Resuming skips
+finished points, an unreachable scheduler ends in one line, and killing a worker process
+mid-study still gives every point, none recomputed on a re-run."""
+
+import os
+import signal
+import socket
+import threading
+import time
+
+import pytest
+
+from eyeviz import EyevizError
+from eyeviz.study import run_study
+from eyeviz.study.grid import design_grid
+from eyeviz.study.table import StudyTable, read_rows
+
+distributed = pytest.importorskip("distributed")  # the `study` extra
+
+
+def seconds_by_point(path):
+    rows, _ = read_rows(path)
+    return {r["_key"]: r["seconds"] for r in rows if r["bin"] == "all"}
+
+
+def test_a_study_resumes_and_skips_finished_points(tmp_path):
+    path = tmp_path / "study.csv"
+    first = design_grid("20,40", "10", "8,16", n=300)
+    s1 = run_study(path, first, workers=1, progress=False)
+    assert (s1.computed, s1.skipped, s1.failures) == (4, 0, ())
+    assert set(seconds_by_point(path)) == {p.key for p in first}
+    before = seconds_by_point(path)
+    lines_before = path.read_text().splitlines()
+
+    # the same grid plus one more m: only the new points run; finished rows stay byte-equal
+    more = design_grid("20,40", "10", "8,16,32", n=300)
+    s2 = run_study(path, more, workers=1, progress=False)
+    assert (s2.computed, s2.skipped, s2.points) == (2, 4, 6)
+    after = seconds_by_point(path)
+    assert {k: after[k] for k in before} == before  # 'seconds' unchanged: not recomputed
+    assert path.read_text().splitlines()[: len(lines_before)] == lines_before
+
+    # everything finished: nothing runs, no cluster is started
+    t0 = time.perf_counter()
+    s3 = run_study(path, more, workers=1, progress=False)
+    assert (s3.computed, s3.skipped) == (0, 6)
+    assert time.perf_counter() - t0 < 2
+    assert "0 point(s) computed, 6 skipped" in str(s3)
+
+
+def unused_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_an_unreachable_scheduler_ends_in_one_line_quickly(tmp_path):
+    addr = f"tcp://127.0.0.1:{unused_port()}"
+    path = tmp_path / "s.csv"
+    t0 = time.perf_counter()
+    with pytest.raises(EyevizError) as err:
+        run_study(path, design_grid("20", "10", "8", n=10), scheduler=addr, connect_timeout=2)
+    assert time.perf_counter() - t0 < 30
+    msg = str(err.value)
+    assert "\n" not in msg
+    assert f"cannot reach the Dask scheduler at '{addr}' within 2 s" in msg
+    assert not path.exists()
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "words"),
+    [
+        ({"workers": 0}, ["workers must be an integer in [1,", "got 0"]),
+        ({"workers": 2, "scheduler": "tcp://127.0.0.1:1"}, ["--workers", "--scheduler"]),
+        ({"scheduler": " "}, ["scheduler must be an address"]),
+    ],
+)
+def test_bad_runner_arguments(tmp_path, kwargs, words):
+    with pytest.raises(EyevizError) as err:
+        run_study(tmp_path / "s.csv", design_grid("20", "10", "8", n=10), **kwargs)
+    for w in words:
+        assert w in str(err.value)
+
+
+@pytest.mark.parametrize("allowed_failures", [None, 0])
+def test_killing_a_worker_mid_study_loses_only_its_point(tmp_path, allowed_failures):
+    """Two worker processes, six points of ~1-2 s each; one worker is SIGKILLed while it
+    computes a point. Dask reschedules that point (the nanny restarts the worker); the
+    study ends with every point, and a re-run computes nothing. With allowed-failures 0
+    the scheduler gives the point up at once (KilledWorker): the runner submits it again.
+    """
+    import dask
+    from distributed import Client, LocalCluster
+
+    config = {}
+    if allowed_failures is not None:
+        config["distributed.scheduler.allowed-failures"] = allowed_failures
+
+    path = tmp_path / "study.csv"
+    points = design_grid("20,40,80", "10", "360,720", n=30_000)
+    assert len(points) == 6
+    killed: dict = {}
+    with (
+        dask.config.set(config),
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+        pids = client.run(os.getpid)
+        assert len(pids) == 2
+
+        def killer():
+            deadline = time.monotonic() + 120
+            while time.monotonic() < deadline and not killed:
+                busy = {a: ks for a, ks in client.processing().items() if ks}
+                # wait until one point is done and both workers are computing
+                done = len(StudyTable.open(path).keys) if path.exists() else 0
+                if done >= 1 and len(busy) == 2:
+                    time.sleep(0.3)  # well inside the point being computed
+                    addr = sorted(busy)[0]
+                    killed.update(addr=addr, pid=pids[addr], done_before=done)
+                    os.kill(pids[addr], signal.SIGKILL)
+                    return
+                time.sleep(0.05)
+
+        t = threading.Thread(target=killer, daemon=True)
+        t.start()
+        summary = run_study(path, points, scheduler=cluster.scheduler_address, progress=False)
+        t.join(5)
+        assert killed, "the worker was never killed: the test proved nothing"
+        with pytest.raises(ProcessLookupError):
+            os.kill(killed["pid"], 0)
+        assert killed["done_before"] < 6
+        assert summary.computed == 6 and summary.failures == ()
+        # the scheduler rescheduled the point itself, or gave it up (with any point queued
+        # on that worker) and the runner sent it again
+        if allowed_failures == 0:
+            assert 1 <= summary.resubmitted <= 2
+        else:
+            assert summary.resubmitted == 0
+        assert StudyTable.open(path).finished == {p.key for p in points}
+        before = path.read_bytes()
+        again = run_study(path, points, scheduler=cluster.scheduler_address, progress=False)
+        assert (again.computed, again.skipped) == (0, 6)
+        assert path.read_bytes() == before
+
+
+def _fails_for_m16(point):
+    from eyeviz.study.point import evaluate
+
+    if point.m == 16:
+        raise ValueError("boom for the test")
+    return evaluate(point)
+
+
+def test_a_failing_point_is_named_and_the_others_kept(tmp_path, monkeypatch):
+    from distributed import LocalCluster
+
+    from eyeviz.study import runner
+    from eyeviz.study.runner import StudyFailed
+
+    monkeypatch.setattr(runner, "evaluate", _fails_for_m16)
+    path = tmp_path / "s.csv"
+    points = design_grid("20", "10", "8,16,32", n=200)
+    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        with pytest.raises(StudyFailed) as err:
+            run_study(path, points, scheduler=cluster.scheduler_address, progress=False)
+    msg = str(err.value)
+    assert "\n" not in msg
+    assert "1 design point(s) failed, the other 2 are in" in msg
+    assert "h=20, l=10, m=16" in msg and "boom for the test" in msg
+    assert err.value.summary.computed == 2
+    assert StudyTable.open(path).finished == {points[0].key, points[2].key}
