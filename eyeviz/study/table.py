@@ -109,8 +109,8 @@ def read_rows(path, max_bytes: int = MAX_STUDY_BYTES) -> tuple[list[dict], list[
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        line = data[: exc.start].count(b"\n") + 1
-        raise EyevizError(f"{name} line {line}: not UTF-8 text (byte {exc.start})") from None
+        bad = data[: exc.start].count(b"\n") + 1
+        raise EyevizError(f"{name} line {bad}: not UTF-8 text (byte {exc.start})") from None
     lines = text.split("\n")
     if lines and lines[-1] == "":
         lines.pop()
