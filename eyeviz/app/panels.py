@@ -52,7 +52,7 @@ def design_note(model: AppModel, name: str) -> str | None:
     estimator's declared ``domain``; analytic and limit answer for any eyes."""
     if name in ANY_DESIGN or model.predictor is None:
         return None
-    est = model.predictor.estimator(name)
+    est = model.predictor.peek(name)  # never loads here: loading runs on a worker
     d = getattr(est, "domain", None)
     if isinstance(est, str) or d is None or getattr(est, "any_design", False):
         return None
@@ -64,7 +64,7 @@ def design_note(model: AppModel, name: str) -> str | None:
 
 def range_note(model: AppModel, name: str, r: float, g: float) -> str | None:
     """Why feature (r, g) lies outside estimator ``name``'s declared r and g range, or None."""
-    est = model.predictor.estimator(name) if model.predictor is not None else None
+    est = model.predictor.peek(name) if model.predictor is not None else None
     d = getattr(est, "domain", None)
     if d is None or isinstance(est, str):
         return None

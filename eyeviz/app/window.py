@@ -334,6 +334,8 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         if not self.model.scene.shows("trajectory"):
             self.show_trajectory("horizontal")
         panel.set_playing(not self.model.player.playing)
+        if not self.model.player.playing and self.model.player.message:
+            self.statusBar().showMessage(self.model.player.message, 8000)
 
     def _load_estimators(self, predictor, names: list[str]) -> None:
         """Load estimators (torch, weights) on a worker thread; the window stays live."""

@@ -27,6 +27,13 @@ class Predictor:
         self._loaded: dict[str, object] = {}
         self._failed: dict[str, str] = {}
 
+    def peek(self, name: str):
+        """The estimator if loaded, the reason if it failed, None if not tried yet: never
+        loads (the GUI thread asks this; loading runs on a worker, issue 12 item 9)."""
+        if name in self._loaded:
+            return self._loaded[name]
+        return self._failed.get(name)
+
     def estimator(self, name: str):
         """The loaded estimator, or a str saying why it is unavailable."""
         if name in self._loaded:

@@ -284,9 +284,6 @@ def test_space_with_a_checkbox_focused_does_not_play_real_x_input(make_window, q
     qtbot.waitUntil(lambda: win.model.player.playing, timeout=3000)
 
 
-@pytest.mark.skip(
-    reason="KNOWN FAILURE after merging the appint and appvis branches; issue 12 stays open"
-)
 def test_estimators_load_off_the_gui_thread(make_window, monkeypatch):
     import threading
 
