@@ -78,8 +78,10 @@ def run_app(scene_path=None, screenshot=None, settings_path=None) -> int:
     win.show()
     app.processEvents()
     win.fit_inset()
+    win.frame_bundled()
     win.render()
     if screenshot is not None:
+        win.jobs.wait()  # estimators loading: the picture shows their answers
         for _ in range(3):
             app.processEvents()
         out = win.save_screenshot(screenshot)

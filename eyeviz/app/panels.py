@@ -543,7 +543,10 @@ class ReadoutPanel(QtWidgets.QWidget):
                 )
                 continue
             if isinstance(res, str):
-                rows.append((f"pred:{name}", key, user_message(res, 120), GREY))
+                loading = self.model.loading and res == self.model.loading
+                rows.append(
+                    (f"pred:{name}", key, "loading…" if loading else user_message(res, 120), GREY)
+                )
                 continue
             r_hat, phi_hat = float(res[0][i]), float(res[1][i])
             if not (math.isfinite(r_hat) and math.isfinite(phi_hat)):
