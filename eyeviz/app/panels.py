@@ -145,6 +145,9 @@ class BitmapPanel(QtWidgets.QWidget):
         self.texts: dict[tuple[str, bool], str] = {}
         self.sel_masks: dict[tuple[str, bool], np.ndarray] = {}
         self._row_keys: dict[tuple[str, bool], bytes] = {}
+        self._runs: dict[tuple[str, bool], list[tuple[int, int]]] = {}
+        self._geo_key: tuple | None = None
+        self._geo = (0, 0, 0)
         self._shown = None
         self.setAttribute(QtCore.Qt.WA_OpaquePaintEvent)  # paints every pixel itself
         self.setMinimumHeight(150)
@@ -185,6 +188,11 @@ class BitmapPanel(QtWidgets.QWidget):
         shown = sc.shows("bitmaps") and bool(strips)
         self.strips, self.intervals, self.colors, self.selected = strips, intervals, colors, sel
         self.sel_masks = masks
+        self._runs = {
+            (eye, whole): _interval_runs(intervals[eye], st.m, whole)
+            for (eye, whole) in self.ROWS
+            if intervals[eye] is not None
+        }
         self.sel_color = QtGui.QColor(sc.features[sel].color if sel is not None else "#222")
         m = st.m
         self.texts = {
@@ -196,13 +204,19 @@ class BitmapPanel(QtWidgets.QWidget):
         }
         whole_panel = shown != self._shown
         self._shown = shown
+        # a row is a function of its eye's intervals (L, R of every feature: the owners),
+        # the selection, the colours and m: a key of a few hundred bytes, not the strip's
+        # m int64 owners (288 kB a row at m = 36,000, built every drag frame)
+        lr = {"A": (st.LA, st.RA), "B": (st.LB, st.RB)}
         for r, row in enumerate(self.ROWS):
             if row not in strips:
                 continue
+            lo, hi = lr[row[0]]
             key = b"".join(
                 (
-                    strips[row].tobytes(),
-                    masks[row].tobytes(),
+                    np.asarray(lo, np.int64).tobytes(),
+                    np.asarray(hi, np.int64).tobytes(),
+                    np.array([m, -1 if sel is None else sel, row[1]], np.int64).tobytes(),
                     colors.tobytes(),
                     self.texts[row].encode(),
                     self.sel_color.name().encode(),
@@ -220,10 +234,13 @@ class BitmapPanel(QtWidgets.QWidget):
         return self.strips[(eye, whole)] >= 0
 
     def _geometry(self, fm: QtGui.QFontMetrics) -> tuple[int, int, int]:
-        label_w = fm.horizontalAdvance("Ω_B  whole eye ") + 8
-        right_w = fm.horizontalAdvance("[35999, 35999] ∪ [0, 0]") + 8
-        row_h = max(fm.height() + 10, (self.height() - 8) // 4)
-        return label_w, right_w, row_h
+        key = (fm.height(), fm.averageCharWidth(), self.height())
+        if self._geo_key != key:  # text widths measured once per font and height
+            label_w = fm.horizontalAdvance("Ω_B  whole eye ") + 8
+            right_w = fm.horizontalAdvance("[35999, 35999] ∪ [0, 0]") + 8
+            row_h = max(fm.height() + 10, (self.height() - 8) // 4)
+            self._geo_key, self._geo = key, (label_w, right_w, row_h)
+        return self._geo
 
     def _row_rect(self, r: int) -> QtCore.QRect:
         _, _, row_h = self._geometry(self.fontMetrics())
@@ -273,11 +290,11 @@ class BitmapPanel(QtWidgets.QWidget):
                         str(k),
                     )
                 p.setFont(self.font())
-            mask = self.sel_masks.get((eye, whole))
-            if mask is not None and mask.any():  # outline the selected feature's cells
+            runs = self._runs.get((eye, whole), [])
+            if runs:  # outline the selected feature's cells
                 p.setPen(QtGui.QPen(self.sel_color.darker(130), 2))
                 p.setBrush(QtCore.Qt.NoBrush)
-                for a, b in _runs(mask):
+                for a, b in runs:
                     xa, xb = x0 + a * width / n, x0 + (b + 1) * width / n
                     p.drawRect(
                         QtCore.QRectF(xa, target.top() + 1, max(xb - xa, 2.0), target.height() - 2)
@@ -306,6 +323,24 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(
         zip(np.flatnonzero(d == 1).tolist(), (np.flatnonzero(d == -1) - 1).tolist(), strict=True)
     )
+
+
+def _interval_runs(iv: tuple[int, int] | None, m: int, whole: bool) -> list[tuple[int, int]]:
+    """(first, last) of each run of the lit set {k mod m : L <= k <= R} (L <= R < L + m,
+    eyeviz.core.bits) in a strip of m cells (``whole``) or of the first m/2: what _runs
+    finds in the mask, without building it."""
+    if iv is None:
+        return []
+    lo, hi = int(iv[0]), int(iv[1])
+    width = m if whole else m // 2
+    runs = [(lo, min(hi, m - 1))] + ([(0, hi - m)] if hi >= m else [])
+    out: list[tuple[int, int]] = []
+    for a, b in sorted((a, min(b, width - 1)) for a, b in runs if a < width and a <= b):
+        if out and a <= out[-1][1] + 1:  # the wrapped run meets the first one
+            out[-1] = (out[-1][0], max(out[-1][1], b))
+        else:
+            out.append((a, b))
+    return out
 
 
 def _half_text(iv: tuple[int, int], m: int) -> str:
