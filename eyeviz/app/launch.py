@@ -71,6 +71,8 @@ def run_app(scene_path=None, screenshot=None, settings_path=None) -> int:
         scene_path = scene_path_of("default")
     scene = load(scene_path)
     settings = make_settings(settings_path)
+    # a screenshot reads the saved window state but never changes it (nor recent files)
+    settings.read_only = screenshot is not None
     app = make_app()
     win = MainWindow(scene, scene_path, settings=settings)
     if settings.refused:

@@ -199,6 +199,7 @@ def test_cli_screenshot_jpeg_and_refused_format(tmp_path):
     )
     assert r.returncode == 0, r.stderr
     assert out.read_bytes()[:3] == b"\xff\xd8\xff"  # JPEG, not PNG bytes
+    assert not (tmp_path / "s.json").exists()  # a screenshot leaves the settings alone
     r = run_cli(["--screenshot", str(tmp_path / "x.bmp")])
     assert r.returncode == 2 and ".png, .jpg or .jpeg" in r.stderr and "Traceback" not in r.stderr
 
