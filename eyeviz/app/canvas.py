@@ -22,6 +22,9 @@ __all__ = ["CanvasMixin"]
 CAMERA_DISTANCE = 1000.0
 INSET_HIDE_EYE_PX = 40.0  # eyes at least this wide on screen: no magnified inset
 RESIZE_MODIFIERS = QtCore.Qt.ShiftModifier | QtCore.Qt.ControlModifier
+TITLE_MARGIN_PX = 10.0  # the title's distance from the view's top-left corner
+LABEL_CHAR_PX = 14.0  # a character of a feature's label (22 px bold DejaVu Sans)
+TITLE_BAND_PX = 48.0  # the band a fit keeps free for the title (24 px text + margins)
 
 
 class CanvasMixin:
@@ -30,6 +33,7 @@ class CanvasMixin:
 
     _drag = None
     _drag_which = "main"
+    _fitted_view: View | None = None  # the main view as the last fit left it
 
     # --- pixels <-> model ------------------------------------------------------------
     def viewport(self, which: str) -> Viewport:
@@ -74,6 +78,8 @@ class CanvasMixin:
     def apply_cameras(self) -> None:
         w, h = max(self.plotter.width(), 1), max(self.plotter.height(), 1)
         self.inset_ren.SetViewport(*inset_viewport(w, h))
+        # the title's top-left corner a fixed number of pixels from the view's corner
+        self.title_actor.SetPosition(TITLE_MARGIN_PX / w, 1.0 - TITLE_MARGIN_PX / h)
         self._update_inset_visibility()
         for which, ren in (("main", self.main_ren), ("inset", self.inset_ren)):
             vp = self.viewport(which)
@@ -102,15 +108,29 @@ class CanvasMixin:
             self.inset_ren.SetDraw(want)
             self.actors.set_inset_shown(want)
 
+    def title_band_px(self) -> float:
+        """Pixels at the top of the view taken by the scene's title (none without one)."""
+        return TITLE_BAND_PX if self.model.scene.title.strip() else 0.0
+
+    def label_band_px(self) -> float:
+        """About the widest feature label in pixels (22 px bold text, see SceneActors)."""
+        sc = self.model.scene
+        if not (sc.shows("labels") and sc.shows("features")) or not sc.features:
+            return 0.0
+        return LABEL_CHAR_PX * (1 + max(len(f.name) for f in sc.features))
+
     def fit_view(self) -> None:
-        """F: every feature and the eyes in view, none under the inset."""
+        """F: every feature and the eyes in view, none under the inset or the title. The
+        view then follows the window's size until the user zooms or pans it."""
         self._update_inset_visibility()
         avoid = self.viewport("inset") if self.inset_shown else None
-        interactions.fit_view(self.model, self.viewport("main"), avoid)
+        top, right = self.title_band_px(), self.label_band_px()
+        interactions.fit_view(self.model, self.viewport("main"), avoid, top, right)
         # fitting may hide the inset (large eyes): then fit the whole view
         self._update_inset_visibility()
         if avoid is not None and not self.inset_shown:
-            interactions.fit_view(self.model, self.viewport("main"))
+            interactions.fit_view(self.model, self.viewport("main"), None, top, right)
+        self._fitted_view = self.model.scene.view
 
     def fit_inset(self) -> None:
         interactions.fit_inset(self.model, self.viewport("inset"))
@@ -118,7 +138,9 @@ class CanvasMixin:
     def _resized(self) -> None:
         if self.inset_auto:
             self.fit_inset()
-        else:
+        if self._fitted_view is not None and self.model.scene.view == self._fitted_view:
+            self.fit_view()  # fitted and not zoomed or panned since: stay fitted
+        elif not self.inset_auto:
             self.apply_cameras()
             self.render()
 

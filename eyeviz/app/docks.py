@@ -70,7 +70,12 @@ class EstimatorPicker(QtWidgets.QWidget):
         finally:
             self._filling = False
         preds = self.model.predictions
-        bad = [f"{n}: {v}" for n, v in preds.items() if isinstance(v, str)]
+        loading = self.model.loading
+        bad = [
+            f"{n}: {v}"
+            for n, v in preds.items()
+            if isinstance(v, str) and not (loading and v == loading)
+        ]
         for name, b in self.boxes.items():
             note = design_note(self.model, name) if name in chosen else None
             b.setStyleSheet("color: #8a8a8a;" if note else "")
@@ -78,8 +83,12 @@ class EstimatorPicker(QtWidgets.QWidget):
             if note:  # this one line replaces any "cannot answer" of the same estimator
                 bad = [t for t in bad if not t.startswith(f"{name}: ")]
                 bad.append(f"{name}: {note}")
-        set_message(self.note, "\n".join(bad))
-        self.note.setStyleSheet("color: #b00020;" if bad else "")
+        if bad:
+            set_message(self.note, "\n".join(bad))
+            self.note.setStyleSheet("color: #b00020;")
+        else:  # loading is no error: one grey line
+            set_message(self.note, loading)
+            self.note.setStyleSheet("color: #777777;")
 
     def _toggled(self, name: str, on: bool) -> None:
         if self._filling:
@@ -122,9 +131,12 @@ class TrajectoryPanel(QtWidgets.QWidget):
         row.addWidget(QtWidgets.QLabel("path"))
         row.addWidget(self.kind)
         row.addWidget(self.play_button)
-        row.addWidget(QtWidgets.QLabel("speed"))
-        row.addWidget(self.speed, 1)
+        row.addStretch(1)
         lay.addLayout(row)
+        row2 = QtWidgets.QHBoxLayout()  # a row of its own: the first fits a narrow panel
+        row2.addWidget(QtWidgets.QLabel("speed"))
+        row2.addWidget(self.speed, 1)
+        lay.addLayout(row2)
         self.info = wrap_label(QtWidgets.QLabel(""))
         lay.addWidget(self.info)
         self.fig = Figure(figsize=(4.2, 3.0), dpi=100, layout="constrained")
@@ -236,12 +248,10 @@ class TrajectoryPanel(QtWidgets.QWidget):
                 0, f"{t.kind} path, distance {t.distance:g}, g = {t.g:g}: {p.n} points in the BFV"
             )
             if any(not isinstance(a, str) for a in p.accuracy.values()):
-                self.ax_ad.legend(
-                    loc="lower right",
-                    bbox_to_anchor=(1.0, 1.0),
-                    fontsize=PLOT_PT,
-                    ncol=4,
-                    frameon=False,
+                # inside the lower axes' bottom right, where accuracy is rarely low: the
+                # titles above the axes keep their line (a legend there overlapped them)
+                self.ax_dd.legend(
+                    loc="lower right", fontsize=PLOT_PT, ncol=2, framealpha=0.85, borderpad=0.3
                 )
             self.ax_ad.set_title("AD accuracy (%)", fontsize=PLOT_PT, loc="left")
             self.ax_dd.set_title("DD accuracy (%)", fontsize=PLOT_PT, loc="left")

@@ -103,6 +103,12 @@ class FilesMixin:
             a.triggered.connect(lambda _c=False, p=p: self.open_file(p))
         self.recent_menu.setEnabled(bool(self.recent_files()))
 
+    def frame_bundled(self) -> None:
+        """A scene shipped with eyeviz is framed to the window (its saved view was made for
+        another window size: features fell under the title); a user's file keeps its view."""
+        if self.source is not None and is_bundled(self.source) and self.isVisible():
+            self.fit_view()
+
     # --- open and save ------------------------------------------------------------------
     def show_error(self, title: str, text: str) -> None:
         """A window-modal, non-blocking dialog (tests can read and close it)."""
@@ -139,6 +145,7 @@ class FilesMixin:
         self.model.selected = None
         self.model.set_scene(scene)
         self.fit_inset()
+        self.frame_bundled()
         if not is_bundled(path):
             self._add_recent(Path(path))
         self._update_title()

@@ -71,6 +71,8 @@ def run_app(scene_path=None, screenshot=None, settings_path=None) -> int:
         scene_path = scene_path_of("default")
     scene = load(scene_path)
     settings = make_settings(settings_path)
+    # a screenshot reads the saved window state but never changes it (nor recent files)
+    settings.read_only = screenshot is not None
     app = make_app()
     win = MainWindow(scene, scene_path, settings=settings)
     if settings.refused:
@@ -78,8 +80,10 @@ def run_app(scene_path=None, screenshot=None, settings_path=None) -> int:
     win.show()
     app.processEvents()
     win.fit_inset()
+    win.frame_bundled()
     win.render()
     if screenshot is not None:
+        win.jobs.wait()  # estimators loading: the picture shows their answers
         for _ in range(3):
             app.processEvents()
         out = win.save_screenshot(screenshot)

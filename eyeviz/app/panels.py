@@ -52,7 +52,7 @@ def design_note(model: AppModel, name: str) -> str | None:
     estimator's declared ``domain``; analytic and limit answer for any eyes."""
     if name in ANY_DESIGN or model.predictor is None:
         return None
-    est = model.predictor.estimator(name)
+    est = model.predictor.peek(name)  # never loads here: loading runs on a worker
     d = getattr(est, "domain", None)
     if isinstance(est, str) or d is None or getattr(est, "any_design", False):
         return None
@@ -64,7 +64,7 @@ def design_note(model: AppModel, name: str) -> str | None:
 
 def range_note(model: AppModel, name: str, r: float, g: float) -> str | None:
     """Why feature (r, g) lies outside estimator ``name``'s declared r and g range, or None."""
-    est = model.predictor.estimator(name) if model.predictor is not None else None
+    est = model.predictor.peek(name) if model.predictor is not None else None
     d = getattr(est, "domain", None)
     if d is None or isinstance(est, str):
         return None
@@ -145,6 +145,9 @@ class BitmapPanel(QtWidgets.QWidget):
         self.texts: dict[tuple[str, bool], str] = {}
         self.sel_masks: dict[tuple[str, bool], np.ndarray] = {}
         self._row_keys: dict[tuple[str, bool], bytes] = {}
+        self._runs: dict[tuple[str, bool], list[tuple[int, int]]] = {}
+        self._geo_key: tuple | None = None
+        self._geo = (0, 0, 0)
         self._shown = None
         self.setAttribute(QtCore.Qt.WA_OpaquePaintEvent)  # paints every pixel itself
         self.setMinimumHeight(150)
@@ -185,6 +188,11 @@ class BitmapPanel(QtWidgets.QWidget):
         shown = sc.shows("bitmaps") and bool(strips)
         self.strips, self.intervals, self.colors, self.selected = strips, intervals, colors, sel
         self.sel_masks = masks
+        self._runs = {
+            (eye, whole): _interval_runs(intervals[eye], st.m, whole)
+            for (eye, whole) in self.ROWS
+            if intervals[eye] is not None
+        }
         self.sel_color = QtGui.QColor(sc.features[sel].color if sel is not None else "#222")
         m = st.m
         self.texts = {
@@ -196,13 +204,19 @@ class BitmapPanel(QtWidgets.QWidget):
         }
         whole_panel = shown != self._shown
         self._shown = shown
+        # a row is a function of its eye's intervals (L, R of every feature: the owners),
+        # the selection, the colours and m: a key of a few hundred bytes, not the strip's
+        # m int64 owners (288 kB a row at m = 36,000, built every drag frame)
+        lr = {"A": (st.LA, st.RA), "B": (st.LB, st.RB)}
         for r, row in enumerate(self.ROWS):
             if row not in strips:
                 continue
+            lo, hi = lr[row[0]]
             key = b"".join(
                 (
-                    strips[row].tobytes(),
-                    masks[row].tobytes(),
+                    np.asarray(lo, np.int64).tobytes(),
+                    np.asarray(hi, np.int64).tobytes(),
+                    np.array([m, -1 if sel is None else sel, row[1]], np.int64).tobytes(),
                     colors.tobytes(),
                     self.texts[row].encode(),
                     self.sel_color.name().encode(),
@@ -220,10 +234,13 @@ class BitmapPanel(QtWidgets.QWidget):
         return self.strips[(eye, whole)] >= 0
 
     def _geometry(self, fm: QtGui.QFontMetrics) -> tuple[int, int, int]:
-        label_w = fm.horizontalAdvance("Ω_B  whole eye ") + 8
-        right_w = fm.horizontalAdvance("[35999, 35999] ∪ [0, 0]") + 8
-        row_h = max(fm.height() + 10, (self.height() - 8) // 4)
-        return label_w, right_w, row_h
+        key = (fm.height(), fm.averageCharWidth(), self.height())
+        if self._geo_key != key:  # text widths measured once per font and height
+            label_w = fm.horizontalAdvance("Ω_B  whole eye ") + 8
+            right_w = fm.horizontalAdvance("[35999, 35999] ∪ [0, 0]") + 8
+            row_h = max(fm.height() + 10, (self.height() - 8) // 4)
+            self._geo_key, self._geo = key, (label_w, right_w, row_h)
+        return self._geo
 
     def _row_rect(self, r: int) -> QtCore.QRect:
         _, _, row_h = self._geometry(self.fontMetrics())
@@ -273,11 +290,11 @@ class BitmapPanel(QtWidgets.QWidget):
                         str(k),
                     )
                 p.setFont(self.font())
-            mask = self.sel_masks.get((eye, whole))
-            if mask is not None and mask.any():  # outline the selected feature's cells
+            runs = self._runs.get((eye, whole), [])
+            if runs:  # outline the selected feature's cells
                 p.setPen(QtGui.QPen(self.sel_color.darker(130), 2))
                 p.setBrush(QtCore.Qt.NoBrush)
-                for a, b in _runs(mask):
+                for a, b in runs:
                     xa, xb = x0 + a * width / n, x0 + (b + 1) * width / n
                     p.drawRect(
                         QtCore.QRectF(xa, target.top() + 1, max(xb - xa, 2.0), target.height() - 2)
@@ -306,6 +323,24 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(
         zip(np.flatnonzero(d == 1).tolist(), (np.flatnonzero(d == -1) - 1).tolist(), strict=True)
     )
+
+
+def _interval_runs(iv: tuple[int, int] | None, m: int, whole: bool) -> list[tuple[int, int]]:
+    """(first, last) of each run of the lit set {k mod m : L <= k <= R} (L <= R < L + m,
+    eyeviz.core.bits) in a strip of m cells (``whole``) or of the first m/2: what _runs
+    finds in the mask, without building it."""
+    if iv is None:
+        return []
+    lo, hi = int(iv[0]), int(iv[1])
+    width = m if whole else m // 2
+    runs = [(lo, min(hi, m - 1))] + ([(0, hi - m)] if hi >= m else [])
+    out: list[tuple[int, int]] = []
+    for a, b in sorted((a, min(b, width - 1)) for a, b in runs if a < width and a <= b):
+        if out and a <= out[-1][1] + 1:  # the wrapped run meets the first one
+            out[-1] = (out[-1][0], max(out[-1][1], b))
+        else:
+            out.append((a, b))
+    return out
 
 
 def _half_text(iv: tuple[int, int], m: int) -> str:
@@ -548,7 +583,10 @@ class ReadoutPanel(QtWidgets.QWidget):
                 )
                 continue
             if isinstance(res, str):
-                rows.append((f"pred:{name}", key, user_message(res, 120), GREY))
+                loading = self.model.loading and res == self.model.loading
+                rows.append(
+                    (f"pred:{name}", key, "loading…" if loading else user_message(res, 120), GREY)
+                )
                 continue
             r_hat, phi_hat = float(res[0][i]), float(res[1][i])
             if not (math.isfinite(r_hat) and math.isfinite(phi_hat)):
@@ -582,8 +620,28 @@ class ReadoutPanel(QtWidgets.QWidget):
         return ("ambiguity", "same bitmaps", text, "#1e1e1e")
 
 
+def _num(v: float) -> str:
+    """A float as typed back: the shortest text that reads as the same float ("40", not
+    "40.0"; 40.123456789 in full, never rounded to "40.1235")."""
+    t = repr(float(v))
+    return t[:-2] if t.endswith(".0") else t
+
+
+EYE_FIELDS = (("h", "origin to eye centre"), ("l", "eye radius"), ("m", "ommatidia per eye"))
+PENDING_STYLE = "background: #fff4c2;"  # a typed value not applied yet
+
+
 class EyesPanel(QtWidgets.QWidget):
-    """h, l, m; a value the model forbids is refused with a message and nothing changes."""
+    """h, l, m entered together (issue 12 item 11).
+
+    Enter in any field (or Apply) checks the triple as
+    :class:`~eyeviz.core.geometry.EyePair` does (0 < l < h, m an even integer >= 4, finite
+    numbers; m <= the live limit) and changes the eyes in one undo step. Moving between
+    fields applies nothing, so with l = 20 one can type h = 10, then l = 5, then Enter. A
+    refused triple leaves the scene as it was, keeps what was typed (never clamped or
+    reset behind the user's back) and says why in one line; Revert shows the scene's
+    values again. Fields holding a value not applied yet are tinted.
+    """
 
     def __init__(self, model: AppModel, parent=None):
         super().__init__(parent)
@@ -592,43 +650,92 @@ class EyesPanel(QtWidgets.QWidget):
         self.installEventFilter(self._unelide)
         form = QtWidgets.QFormLayout(self)
         self.edits: dict[str, QtWidgets.QLineEdit] = {}
-        for key, tip in (("h", "origin to eye centre"), ("l", "eye radius"), ("m", "ommatidia")):
+        for key, tip in EYE_FIELDS:
             e = QtWidgets.QLineEdit()
-            e.setToolTip(tip)
-            e.editingFinished.connect(self.apply)
+            e.setObjectName(f"eyes_{key}")
+            e.setToolTip(f"{tip}; Enter applies h, l and m together")
+            e.returnPressed.connect(self.apply)
+            e.textEdited.connect(self._mark)
             form.addRow(f"{key}  ({tip})", e)
             self.edits[key] = e
+        row = QtWidgets.QHBoxLayout()
+        self.apply_button = QtWidgets.QPushButton("Apply")
+        self.apply_button.setToolTip("set h, l and m together (Enter in a field does the same)")
+        self.apply_button.clicked.connect(self.apply)
+        self.revert_button = QtWidgets.QPushButton("Revert")
+        self.revert_button.setToolTip("show the scene's h, l and m again")
+        self.revert_button.clicked.connect(self.revert)
+        row.addWidget(self.apply_button)
+        row.addWidget(self.revert_button)
+        row.addStretch(1)
+        form.addRow(row)
         self.message = wrap_label(QtWidgets.QLabel(""))
         self.message.setStyleSheet(ERROR_STYLE)
         form.addRow(self.message)
+        self._shown: dict[str, str] | None = None  # the scene's values last filled in
+
+    def scene_texts(self) -> dict[str, str]:
+        e = self.model.scene.eyes
+        return {"h": _num(e.h), "l": _num(e.l), "m": str(int(e.m))}
+
+    def texts(self) -> dict[str, str]:
+        return {k: w.text().strip() for k, w in self.edits.items()}
 
     def refresh(self) -> None:
-        e = self.model.scene.eyes
-        for key, val in (("h", f"{e.h:g}"), ("l", f"{e.l:g}"), ("m", str(e.m))):
-            if not self.edits[key].hasFocus() or self.edits[key].text() == "":
+        """Show the scene's h, l, m when they changed (an edit, undo, a file opened); a
+        value typed and not applied survives other refreshes (a drag, a layer toggle)."""
+        now = self.scene_texts()
+        if now != self._shown:
+            self._shown = now
+            for key, val in now.items():
                 self.edits[key].setText(val)
+            self.message.setText("")
+        self._mark()
 
-    def apply(self) -> None:
-        e = self.model.scene.eyes
-        texts = {k: w.text().strip() for k, w in self.edits.items()}
-        if texts == {"h": f"{e.h:g}", "l": f"{e.l:g}", "m": str(e.m)}:
-            return
+    def pending(self) -> bool:
+        return self.texts() != self.scene_texts()
+
+    def _mark(self, *_args) -> None:
+        now = self.scene_texts()
+        for key, w in self.edits.items():
+            w.setStyleSheet(PENDING_STYLE if w.text().strip() != now[key] else "")
+        on = self.pending()
+        self.apply_button.setEnabled(on)
+        self.revert_button.setEnabled(on)
+
+    def revert(self) -> None:
+        self._shown = None
+        self.refresh()
+
+    def parse(self) -> tuple[float, float, int]:
+        """The typed triple as numbers; ValueError naming the field otherwise."""
+        t = self.texts()
+        vals: list[float] = []
+        for key in ("h", "l"):
+            try:
+                vals.append(float(t[key]))
+            except ValueError:
+                raise ValueError(f"{key} must be a number, got {t[key]!r}") from None
         try:
-            try:
-                h, l = float(texts["h"]), float(texts["l"])
-            except ValueError:
-                raise ValueError("h and l must be numbers") from None
-            try:
-                m = int(texts["m"])
-            except ValueError:
-                raise ValueError(f"m must be an even integer >= 4, got {texts['m']!r}") from None
-            self.model.set_eyes(h, l, m)
+            m = int(t["m"])
+        except ValueError:
+            raise ValueError(f"m must be an even integer >= 4, got {t['m']!r}") from None
+        return vals[0], vals[1], m
+
+    def apply(self) -> bool:
+        """Check the typed triple together; True if the scene now has it."""
+        before = self.scene_texts()
+        try:
+            h, l, m = self.parse()
+            self.model.set_eyes(h, l, m)  # EyePair's checks; nothing changes if refused
         except ValueError as exc:
-            set_message(self.message, f"Refused: {exc}")
-            for key, val in (("h", f"{e.h:g}"), ("l", f"{e.l:g}"), ("m", str(e.m))):
-                self.edits[key].setText(val)
-            return
+            keep = ", ".join(f"{k} = {v}" for k, v in before.items())
+            set_message(self.message, f"Refused: {exc} (the eyes stay {keep})")
+            self._mark()
+            return False
         self.message.setText("")
+        self.revert()  # the applied values as the scene holds them
+        return True
 
 
 class FeaturePanel(QtWidgets.QWidget):

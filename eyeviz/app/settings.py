@@ -47,6 +47,7 @@ class Settings:
         self.path = Path(path) if path else default_path()
         self.data: dict = {}
         self.refused: str = ""  # why the file was ignored, one line
+        self.read_only = False  # read, never written (``eyeviz app --screenshot``)
         self._read()
 
     def _refuse(self, why: str) -> None:
@@ -101,8 +102,9 @@ class Settings:
         self.data[key] = value
 
     def sync(self) -> None:
-        """Write the file (atomically); a refused file is never overwritten."""
-        if self.refused:
+        """Write the file (atomically); a refused file is never overwritten, a read-only
+        one never written."""
+        if self.refused or self.read_only:
             return
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)

@@ -52,7 +52,17 @@ __all__ = [
 
 SIDE_MAX_FRACTION = 0.45  # the side panels never take more than this of the window width
 SIDE_MIN_PX = 260
+SIDE_START_PX = 460  # the side panels' first width: the readout's values and all tabs show
 DOCK_MIN_PX = 120
+
+
+class _SideScroll(QtWidgets.QScrollArea):
+    """A side panel's scroll area asking for SIDE_START_PX of width: the dock area starts
+    wide enough for the readout's values and every tab name (Qt sizes docks by their
+    hints; resizeDocks did not hold)."""
+
+    def sizeHint(self) -> QtCore.QSize:  # noqa: N802 (Qt name)
+        return QtCore.QSize(SIDE_START_PX, super().sizeHint().height())
 
 
 class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
@@ -60,6 +70,9 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         self, scene: Scene, path: str | os.PathLike | None = None, settings: Settings | None = None
     ):
         super().__init__()
+        # first: each dock's maximum width is a fraction of this (a default 640 px window
+        # capped the side panels at 288 px for good)
+        self.resize(1280, 720)
         self.settings = settings if settings is not None else make_settings()
         self._set_path(path)
         self.model = AppModel(scene)
@@ -98,8 +111,8 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         self._docks: dict[str, QtWidgets.QDockWidget] = {}
         self.title_actor = vtkTextActor()
         style_text(self.title_actor.GetTextProperty(), 24, (0.1, 0.1, 0.1))
+        self.title_actor.GetTextProperty().SetVerticalJustificationToTop()
         self.title_actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
-        self.title_actor.SetPosition(0.015, 0.93)
         self.main_ren.AddViewProp(self.title_actor)
         self.plotter.setMouseTracking(True)
         self.plotter.installEventFilter(self)
@@ -139,7 +152,6 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         self.model.listeners.append(self._on_model)
         self.model.load_in_background = self._load_estimators
         self.undo_stack.cleanChanged.connect(self._clean_changed)
-        self.resize(1280, 720)
         self._restore_settings()
         if path is not None and not is_bundled(path):
             self._add_recent(Path(path))  # the file named on the command line too
@@ -153,7 +165,7 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         d.setObjectName(f"dock_{name}")
         # in a scroll area: a tall panel scrolls instead of making the window taller than a
         # 1280x720 projector (issue 12 item 7)
-        scroll = QtWidgets.QScrollArea()
+        scroll = _SideScroll()
         scroll.setWidgetResizable(True)
         scroll.setFrameShape(QtWidgets.QFrame.NoFrame)
         scroll.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarAlwaysOff)
@@ -307,7 +319,7 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
             from eyeviz.app.docks import TrajectoryPanel
 
             self.trajectory_panel = TrajectoryPanel(self.model)
-            d = self._dock("Trajectory (Figure 14)", self.trajectory_panel, "trajectory")
+            d = self._dock("Trajectory", self.trajectory_panel, "trajectory")
             self.tabifyDockWidget(self._docks["features"], d)
             self._docks["trajectory"] = d
             QtCore.QTimer.singleShot(0, d.raise_)
@@ -349,6 +361,8 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         if not self.model.scene.shows("trajectory"):
             self.show_trajectory("horizontal")
         panel.set_playing(not self.model.player.playing)
+        if not self.model.player.playing and self.model.player.message:
+            self.statusBar().showMessage(self.model.player.message, 8000)
 
     def _load_estimators(self, predictor, names: list[str]) -> None:
         """Load estimators (torch, weights) on a worker thread; the window stays live."""

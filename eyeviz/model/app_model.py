@@ -89,9 +89,7 @@ class AppModel:
             if self.predictor is None:
                 self.predictor = Predictor()
             p = self.predictor
-            missing = [
-                n for n in self.scene.estimators if n not in p._loaded and n not in p._failed
-            ]
+            missing = [n for n in self.scene.estimators if p.peek(n) is None]
             if missing and self.load_in_background is not None:
                 # the window loads them on a worker thread and notifies "predictions" when
                 # done; meanwhile each estimator is a one-line "loading" message
@@ -198,6 +196,7 @@ class AppModel:
         self._notify("feature", index)
 
     def select(self, index: int | None) -> None:
+        self.player.user_selected()
         if index != self.selected:
             self.selected = index
             self._notify("selection", index)

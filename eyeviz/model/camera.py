@@ -117,16 +117,29 @@ def _fit_box(box, vp: Viewport, free: Viewport) -> View:
     return View((cx, cy), min(max(u * vp.width, MIN_WIDTH), MAX_WIDTH))
 
 
-def fit_view(scene: Scene, vp: Viewport, avoid: Viewport | None = None) -> View:
-    """The main view showing the eyes and every feature, clear of ``avoid`` (the inset).
+def fit_view(
+    scene: Scene,
+    vp: Viewport,
+    avoid: Viewport | None = None,
+    top: float = 0.0,
+    right: float = 0.0,
+) -> View:
+    """The main view showing the eyes and every feature, clear of ``avoid`` (the inset),
+    of a band of ``top`` pixels at the top of ``vp`` (the title) and of ``right`` pixels
+    at its right (the features' labels, written right of each disc).
 
     With an inset in a corner the content goes into the larger of the two rectangles the
     inset leaves free (beside it, full height, or below/above it, full width), so that F
-    never places a feature under the inset.
+    never places a feature under the inset or the title.
     """
     box = scene_bounds(scene)
+    top = min(max(top, 0.0), 0.5 * vp.height)
+    right = min(max(right, 0.0), 0.3 * vp.width)
+    full = vp
+    if top > 0 or right > 0:  # the rectangles below are all taken inside the free part
+        vp = Viewport(vp.left, vp.top + top, vp.width - right, vp.height - top)
     if avoid is None or avoid.width <= 0 or avoid.height <= 0:
-        return _fit_box(box, vp, vp)
+        return _fit_box(box, full, vp)
     cands = []
     # beside the inset (full height)
     if avoid.left - vp.left > vp.left + vp.width - (avoid.left + avoid.width):
@@ -142,8 +155,8 @@ def fit_view(scene: Scene, vp: Viewport, avoid: Viewport | None = None) -> View:
         cands.append(Viewport(vp.left, bottom, vp.width, vp.top + vp.height - bottom))
     cands = [c for c in cands if c.width >= 1 and c.height >= 1]
     if not cands:
-        return _fit_box(box, vp, vp)
-    views = [_fit_box(box, vp, c) for c in cands]
+        return _fit_box(box, full, vp)
+    views = [_fit_box(box, full, c) for c in cands]
     return min(views, key=lambda v: v.width)  # the larger picture
 
 

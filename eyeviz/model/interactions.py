@@ -146,9 +146,16 @@ def _feature_drag(
             return
 
 
-def fit_view(model: AppModel, vp: Viewport, avoid: Viewport | None = None) -> None:
-    """F: the eyes and every feature in view, clear of the inset (``avoid``)."""
-    set_view(model, "main", camera.fit_view(model.scene, vp, avoid))
+def fit_view(
+    model: AppModel,
+    vp: Viewport,
+    avoid: Viewport | None = None,
+    top: float = 0.0,
+    right: float = 0.0,
+) -> None:
+    """F: the eyes and every feature in view, clear of the inset (``avoid``), the title
+    (a band of ``top`` pixels) and the labels (``right`` pixels)."""
+    set_view(model, "main", camera.fit_view(model.scene, vp, avoid, top, right))
 
 
 def fit_inset(model: AppModel, vp: Viewport) -> None:

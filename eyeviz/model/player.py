@@ -28,6 +28,7 @@ class TrajectoryPlayer:
         self.speed = 4.0
         self.path = None
         self.message = ""
+        self.gone = ""  # the played feature's name after its deletion, until a selection
 
     def index(self) -> int | None:
         """The played feature's current index in the scene, or None if it is gone."""
@@ -59,6 +60,10 @@ class TrajectoryPlayer:
             return True
         if self.path is None:
             self.message = "no trajectory to play"
+            return False
+        if self.gone and self.index() is None:
+            # the played feature was deleted: Space does not pick another one by itself
+            self.message = f"{self.gone} was deleted: select a feature to play it"
             return False
         i = self._choose()
         if i is None:
@@ -110,6 +115,14 @@ class TrajectoryPlayer:
         return self.step() if self.playing else None
 
     def scene_changed(self) -> None:
-        """Called by the model after every scene replacement: stop if the feature left."""
+        """Called by the model after every scene replacement: stop if the feature left
+        (and remember it: the next start waits for the user to select a feature)."""
         if self.playing and self.index() is None:
+            self.gone = self.feature or ""
             self.stop(f"{self.feature} was deleted: playback stopped")
+        elif self.gone and self.index() is not None:  # undo brought it back
+            self.gone = ""
+
+    def user_selected(self) -> None:
+        """The user selected a feature: a start may play it (after a deletion too)."""
+        self.gone = ""

@@ -67,11 +67,19 @@ class Predictor:
     ``_designs`` holds the any-design estimators loaded for other eyes.
     """
 
+    ROW_CACHE_MAX = 4096  # answers kept per estimator (rows of distinct lit intervals)
+
     def __init__(self) -> None:
         self._loaded: dict[str, object] = {}
         self._failed: dict[str, str] = {}
         self._designs: dict[tuple[str, Design], object] = {}
         self._kinds: dict[str, bool] = {}
+        # (estimator, design) -> {a row's (m, LA, RA, LB, RB) bytes: (r_hat, phi_hat)}: a
+        # drag frame asks again for every feature; only the dragged one has new bitmaps.
+        # Valid because every registered estimator answers each row alone and
+        # deterministically (eyeviz.estimators.checks: check_rows_independent,
+        # check_deterministic).
+        self._rows: dict[tuple[str, Design], dict[bytes, tuple[float, float]]] = {}
 
     def peek(self, name: str):
         """The estimator if loaded, the reason if it failed, None if not tried yet: never
@@ -162,14 +170,25 @@ class Predictor:
             assert LA is not None and RA is not None and LB is not None and RB is not None
             oa = intervals_to_bitmap(LA[ok], RA[ok], m, m // 2)
             ob = intervals_to_bitmap(LB[ok], RB[ok], m, m // 2)
+            lr = np.column_stack([np.full(ok.size, m), LA[ok], RA[ok], LB[ok], RB[ok]])
+            keys = [row.tobytes() for row in lr.astype(np.int64)]
         for name in scene.estimators:
             r_hat, phi_hat = np.full(n, np.nan), np.full(n, np.nan)
             if ok.size:
-                res = self.predict_bitmaps(name, oa, ob, design)
-                if isinstance(res, str):
-                    out[name] = res
-                    continue
-                r_hat[ok], phi_hat[ok] = res
+                cache = self._rows.setdefault((name, design), {})
+                if len(cache) + len(keys) > self.ROW_CACHE_MAX:
+                    cache.clear()  # bounded: start again (this frame's rows recomputed)
+                new = [j for j, k in enumerate(keys) if k not in cache]
+                if new:
+                    res = self.predict_bitmaps(name, oa[new], ob[new], design)
+                    if isinstance(res, str):
+                        out[name] = res
+                        continue
+                    for j, rr, pp in zip(new, res[0], res[1], strict=True):
+                        cache[keys[j]] = (float(rr), float(pp))
+                got = [cache[k] for k in keys]
+                r_hat[ok] = [g[0] for g in got]
+                phi_hat[ok] = [g[1] for g in got]
             else:
                 est = self.estimator(name, design)
                 if isinstance(est, str):

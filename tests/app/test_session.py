@@ -199,6 +199,7 @@ def test_cli_screenshot_jpeg_and_refused_format(tmp_path):
     )
     assert r.returncode == 0, r.stderr
     assert out.read_bytes()[:3] == b"\xff\xd8\xff"  # JPEG, not PNG bytes
+    assert not (tmp_path / "s.json").exists()  # a screenshot leaves the settings alone
     r = run_cli(["--screenshot", str(tmp_path / "x.bmp")])
     assert r.returncode == 2 and ".png, .jpg or .jpeg" in r.stderr and "Traceback" not in r.stderr
 
@@ -284,9 +285,6 @@ def test_space_with_a_checkbox_focused_does_not_play_real_x_input(make_window, q
     qtbot.waitUntil(lambda: win.model.player.playing, timeout=3000)
 
 
-@pytest.mark.skip(
-    reason="KNOWN FAILURE after merging the appint and appvis branches; issue 12 stays open"
-)
 def test_estimators_load_off_the_gui_thread(make_window, monkeypatch):
     import threading
 

@@ -126,7 +126,7 @@ def test_changing_m_rebuilds_the_eyes(make_window, qtbot):
     win = make_window(two_features())
     edit = win.eyes_panel.edits["m"]
     edit.setText("36")
-    edit.editingFinished.emit()
+    QTest.keyClick(edit, QtCore.Qt.Key_Return)  # Enter applies h, l, m together
     assert win.model.scene.eyes.m == 36
     assert [mesh.n_cells for mesh in win.actors.eye_meshes] == [36, 36]
     check_lit(win)
@@ -138,10 +138,17 @@ def test_changing_m_rebuilds_the_eyes(make_window, qtbot):
     "key, text, words",
     [
         ("m", "7", "even integer"),
+        ("m", "2", "even integer"),
+        ("m", "7.5", "even integer"),
         ("h", "10", "h must be > l"),
+        ("h", "20", "h must be > l"),  # h = l: the eyes would touch the y-axis
         ("l", "-1", "l"),
+        ("l", "0", "l"),
+        ("h", "nan", "h"),
+        ("l", "inf", "l"),
         ("m", "1000000", "<= 200000"),
         ("h", "abc", "number"),
+        ("m", "", "even integer"),
     ],
 )
 def test_forbidden_parameter_is_refused(make_window, key, text, words):
@@ -149,10 +156,12 @@ def test_forbidden_parameter_is_refused(make_window, key, text, words):
     before = win.model.scene.copy()
     edit = win.eyes_panel.edits[key]
     edit.setText(text)
-    edit.editingFinished.emit()
+    QTest.keyClick(edit, QtCore.Qt.Key_Return)
     assert win.model.scene == before
-    assert words in win.eyes_panel.message.text() and "Refused" in win.eyes_panel.message.text()
-    assert edit.text() == {"h": "40", "l": "20", "m": "720"}[key]
+    msg = win.eyes_panel.message.text()
+    assert words in msg and msg.startswith("Refused") and "\n" not in msg, msg
+    assert "h = 40, l = 20, m = 720" in msg  # what the scene keeps
+    assert edit.text() == text  # what was typed stays, to be fixed (never clamped)
     assert win.undo_stack.count() == 0
     assert [mesh.n_cells for mesh in win.actors.eye_meshes] == [720, 720]
 

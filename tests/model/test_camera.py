@@ -54,6 +54,22 @@ def test_fit_view_shows_everything_clear_of_the_inset():
     assert camera.fit_view(sc, VP).width <= v.width
 
 
+def test_fit_view_keeps_the_title_band_and_the_label_band_free():
+    sc = Scene(
+        Eyes(40, 20, 720),
+        [Feature("far", -1400.0, 3800.0, 250.0), Feature("side", 1700.0, 2200.0, 120.0)],
+    )
+    inset = Viewport(0.0, 400.0, 300.0, 200.0)  # bottom-left corner
+    v = camera.fit_view(sc, VP, inset, top=48.0, right=120.0)
+    for f in sc.features:
+        for dx, dy in ((f.g, 0), (-f.g, 0), (0, f.g), (0, -f.g)):
+            px, py = camera.to_pixel(v, VP, f.x + dx, f.y + dy)
+            assert py >= 48.0, (f.name, py)  # not under the title
+            assert px <= VP.width - 120.0, (f.name, px)  # room for its label
+            assert not inset.contains(px, py)
+    assert camera.fit_view(sc, VP, inset).width <= v.width
+
+
 def test_fit_inset_shows_both_eyes():
     e = Eyes(40, 20, 720)
     vp = Viewport(700.0, 0.0, 300.0, 200.0)

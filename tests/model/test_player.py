@@ -93,3 +93,18 @@ def test_deleting_another_feature_keeps_playing_the_same_one():
 def test_no_path_no_play():
     m, _ = model3()
     assert not m.player.start() and "no trajectory" in m.player.message
+
+
+def test_after_the_played_feature_is_deleted_start_waits_for_a_selection():
+    m, undo = model3()
+    m.select(0)
+    m.player.set_path(Path())
+    m.player.start()
+    m.player.step(2)
+    m.delete_feature(0)  # "b" is now selected by the clamp, not by the user
+    others = [(f.x, f.y, f.g) for f in m.scene.features]
+    assert not m.player.start() and "select a feature" in m.player.message
+    assert m.player.step() is None and [(f.x, f.y, f.g) for f in m.scene.features] == others
+    m.select(1)  # the user picks "c": Space plays it
+    assert m.player.start() and m.player.feature == "c"
+    m.player.stop()
