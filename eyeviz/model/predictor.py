@@ -79,7 +79,7 @@ class Predictor:
         # Valid because every registered estimator answers each row alone and
         # deterministically (eyeviz.estimators.checks: check_rows_independent,
         # check_deterministic).
-        self._rows: dict[tuple[str, Design], dict[bytes, tuple[float, float]]] = {}
+        self._rows: dict[tuple[str, Design | None], dict[bytes, tuple[float, float]]] = {}
 
     def peek(self, name: str):
         """The estimator if loaded, the reason if it failed, None if not tried yet: never
