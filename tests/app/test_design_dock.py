@@ -37,10 +37,10 @@ def curve_on_screen(panel):
 
 
 def set_m_in_panel(win, m):
-    """Type m into the Eyes panel and finish the edit (as a user does)."""
+    """Type m into the Eyes panel and press Enter (as a user does: Enter applies h, l, m)."""
     e = win.eyes_panel.edits["m"]
     e.setText(str(m))
-    e.editingFinished.emit()
+    e.returnPressed.emit()
 
 
 def test_dock_exists_and_shows_the_new_curve_after_m_changes(make_window, qtbot):

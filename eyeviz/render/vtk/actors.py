@@ -56,7 +56,7 @@ _actor = actor  # the name other modules (e.g. a posterior layer) imported befor
 
 INSET_MIN_PX, INSET_MAX_PX, INSET_FRACTION = 230.0, 340.0, 0.3  # inset width on screen
 INSET_ASPECT = 0.66  # height / width: the eyes, their labels and a line of text
-_NOT_HERE = ("ambiguity", "trajectory")  # drawn from their own Frame (overlays.py)
+_NOT_HERE = ("ambiguity", "trajectory", "posterior")  # overlays.py, posterior.py draw these
 
 
 def inset_viewport(w: float, h: float) -> tuple[float, float, float, float]:
