@@ -179,6 +179,28 @@ def _check_rows(p: DesignPoint, rows) -> list[dict]:
     return rows
 
 
+def dask_config(connect_timeout: float = CONNECT_TIMEOUT_S) -> dict:
+    """The dask settings a study runs under (``dask.config.set``)."""
+    import dask
+
+    return {
+        "distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
+        "distributed.comm.timeouts.connect": f"{connect_timeout}s",
+        # points take seconds: a worker holds only the point it computes (no prefetch),
+        # so the last points spread over every worker and a killed worker loses just one
+        "distributed.scheduler.worker-saturation": 1.0,
+        # Dask's default MALLOC_TRIM_THRESHOLD_=65536 pins glibc's mmap threshold at
+        # 128 kB: every temporary array of the limit's integration is mmap'd and
+        # page-faulted afresh, 2.6x slower per point (measured: 2.5 s -> 6.5 s, sys time
+        # 0.1 s -> 3.0 s). Local workers start without it (the other defaults kept).
+        "distributed.nanny.pre-spawn-environ": {
+            k: v
+            for k, v in dask.config.get("distributed.nanny.pre-spawn-environ").items()
+            if k != "MALLOC_TRIM_THRESHOLD_"
+        },
+    }
+
+
 def run_study(
     path,
     points: Iterable[DesignPoint],
@@ -242,13 +264,7 @@ def run_study(
     from distributed import as_completed
     from tqdm import tqdm
 
-    config = {
-        "distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
-        "distributed.comm.timeouts.connect": f"{connect_timeout}s",
-        # points take seconds: a worker holds only the point it computes (no prefetch),
-        # so the last points spread over every worker and a killed worker loses just one
-        "distributed.scheduler.worker-saturation": 1.0,
-    }
+    config = dask_config(connect_timeout)
     computed = 0
     failures: list[str] = []
     resubmitted = 0

@@ -8,14 +8,13 @@ import socket
 import threading
 import time
 
+import distributed  # the `study` extra (scripts/setup.sh installs it)
 import pytest
 
 from eyeviz import EyevizError
 from eyeviz.study import run_study
 from eyeviz.study.grid import design_grid
 from eyeviz.study.table import StudyTable, read_rows
-
-distributed = pytest.importorskip("distributed")  # the `study` extra
 
 
 def seconds_by_point(path):
@@ -172,3 +171,24 @@ def test_a_failing_point_is_named_and_the_others_kept(tmp_path, monkeypatch):
     assert "h=20, l=10, m=16" in msg and "boom for the test" in msg
     assert err.value.summary.computed == 2
     assert StudyTable.open(path).finished == {points[0].key, points[2].key}
+
+
+def test_local_workers_start_without_dasks_malloc_trim_threshold():
+    """Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536 in its workers, which makes every
+    large temporary array of the limit a fresh mmap (2.6x slower points); the study's
+    settings drop it and keep the nanny's other variables."""
+    import dask
+
+    from eyeviz.study.runner import dask_config
+
+    with dask.config.set(dask_config()):
+        with (
+            distributed.LocalCluster(
+                n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+            ) as cluster,
+            distributed.Client(cluster) as client,
+        ):
+            env = client.run(lambda: dict(os.environ))
+    (worker_env,) = env.values()
+    assert "MALLOC_TRIM_THRESHOLD_" not in worker_env
+    assert worker_env.get("OMP_NUM_THREADS") == "1"
