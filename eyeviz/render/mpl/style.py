@@ -6,7 +6,7 @@ import numpy as np
 
 from eyeviz.model.palette import estimator_colors
 
-__all__ = ["RC", "FONT", "SMALL", "estimator_colors", "mix", "dark", "slug", "short"]
+__all__ = ["RC", "FONT", "SMALL", "estimator_colors", "mix", "dark", "slug", "short", "legend"]
 
 BASE_DPI = 300.0  # PNG pixels per inch at scale 1
 VECTOR_DPI = 600.0  # the print resolution vector output is judged at (merging runs)
@@ -156,3 +156,23 @@ def subscripted(ax, x, y, parts, size, ha, color, **kw) -> None:
         if gid:
             txt.set_gid(f"{gid}-{len(ax.texts)}")
         x_pt += w
+
+
+def legend(ax, handles, labels=None):
+    """The figure's one legend style: upper right, small text, a thin light frame."""
+    kw = {} if labels is None else {"labels": labels}
+    leg = ax.legend(
+        handles=handles,
+        **kw,
+        loc="upper right",
+        fontsize=SMALL,
+        frameon=True,
+        framealpha=0.9,
+        edgecolor=LIGHT,
+        handlelength=2.2,
+        borderpad=0.4,
+        labelspacing=0.3,
+    )
+    leg.set_zorder(12)
+    leg.get_frame().set_linewidth(0.4)
+    return leg

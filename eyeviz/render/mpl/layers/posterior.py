@@ -14,7 +14,7 @@ from matplotlib.patches import Patch, Polygon
 
 from eyeviz.model.palette import POSTERIOR_COLOR, posterior_rgba
 from eyeviz.render.mpl.canvas import Canvas
-from eyeviz.render.mpl.style import LIGHT, SMALL, dark, slug
+from eyeviz.render.mpl.style import dark, legend, slug
 
 Z_POSTERIOR = 8.6  # over the ambiguity region (8.5), under its centre mark and predictions
 
@@ -105,17 +105,4 @@ def _legend(ax) -> None:
     old = ax.get_legend()
     handles = list(old.legend_handles) if old is not None else []
     labels = [t.get_text() for t in old.get_texts()] if old is not None else []
-    leg = ax.legend(
-        handles=handles + mine,
-        labels=labels + [str(h.get_label()) for h in mine],
-        loc="upper right",
-        fontsize=SMALL,
-        frameon=True,
-        framealpha=0.9,
-        edgecolor=LIGHT,
-        handlelength=2.2,
-        borderpad=0.4,
-        labelspacing=0.3,
-    )
-    leg.set_zorder(12)
-    leg.get_frame().set_linewidth(0.4)
+    legend(ax, handles + mine, labels + [str(h.get_label()) for h in mine])

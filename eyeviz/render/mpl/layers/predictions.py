@@ -11,7 +11,7 @@ from matplotlib.patches import Circle
 from eyeviz.model.frame import PredictionFrame
 from eyeviz.model.palette import estimator_color
 from eyeviz.render.mpl.canvas import Canvas
-from eyeviz.render.mpl.style import LIGHT, OUT_OF_DOMAIN, SMALL, slug
+from eyeviz.render.mpl.style import OUT_OF_DOMAIN, legend, slug
 
 
 def paint(cv: Canvas) -> None:
@@ -73,16 +73,4 @@ def paint(cv: Canvas) -> None:
             )
         )
     if handles:
-        leg = ax.legend(
-            handles=handles,
-            loc="upper right",
-            fontsize=SMALL,
-            frameon=True,
-            framealpha=0.9,
-            edgecolor=LIGHT,
-            handlelength=2.2,
-            borderpad=0.4,
-            labelspacing=0.3,
-        )
-        leg.set_zorder(12)
-        leg.get_frame().set_linewidth(0.4)
+        legend(ax, handles)
