@@ -12,8 +12,11 @@ state): drag p50 and p95 are reported as ratios to the bare render's p50 and p95
 Both view widgets are measured in the same run (eyeviz.app.view: VTK's own
 QVTKRenderWindowInteractor and pyvistaqt 0.12.0's QtInteractor), interleaved per case.
 Window-up: whole process, start to first rendered frame (median of 3), target <= 3 s.
+With ``--predictions`` the scenes also show the predictions layer (estimators analytic and
+compact: at m = 36,000 compact is its one-line "trained for" message): every drag frame
+then asks the Predictor and redraws the prediction ghosts.
 
-    xvfb-run -a .venv/bin/python scripts/bench_app.py [--events 240]
+    xvfb-run -a .venv/bin/python scripts/bench_app.py [--events 240] [--predictions]
 """
 
 from __future__ import annotations
@@ -33,6 +36,9 @@ ROOT = Path(__file__).resolve().parents[1]
 CASES = ((720, 10), (36_000, 50))
 P50_RATIO, P95_RATIO = 1.4, 1.45
 UP_TARGET_S = 3.0
+
+
+PREDICTIONS = False  # --predictions: the scenes show the predictions layer
 
 
 def _scene(m: int, n: int):
@@ -58,7 +64,12 @@ def _scene(m: int, n: int):
     # a random disc overlaps it
     fs[-1] = Feature("dragged", 0.0, 1500.0, 50.0, OKABE_ITO[0])
     layers = ["eyes", "bfv", "features", "bitmaps", "readout", "labels"]
-    return Scene(Eyes(40.0, 20.0, m), fs, layers, view=View((0.0, 2600.0), 9000.0))
+    est = ["analytic", "compact"] if PREDICTIONS else []
+    if PREDICTIONS:
+        layers.append("predictions")
+    sc = Scene(Eyes(40.0, 20.0, m), fs, layers, view=View((0.0, 2600.0), 9000.0))
+    sc.estimators = est
+    return sc
 
 
 def _pct(v, q):
@@ -107,6 +118,13 @@ def bench_drag(m: int, n: int, events: int, settings: str, backend: str = "vtk")
         rw.WaitForCompletion()
         base.append(1e3 * (time.perf_counter() - t0))
 
+    if PREDICTIONS:  # the estimators load on a worker thread: wait for the ghosts
+        t_end = time.perf_counter() + 60.0
+        while win.model.loading and time.perf_counter() < t_end:
+            app.processEvents()
+            time.sleep(0.01)
+        assert not win.model.loading, "the estimators did not load"
+        assert win.overlays.ghosts, "no prediction ghost drawn"
     for _ in range(10):  # warm-up
         win.render()
         rw.WaitForCompletion()
@@ -191,7 +209,12 @@ def main() -> int:
         choices=["vtk", "pyvistaqt"],
         help="view widgets to measure (the first one is checked against the targets)",
     )
+    ap.add_argument(
+        "--predictions", action="store_true", help="the scenes show the predictions layer"
+    )
     args = ap.parse_args()
+    global PREDICTIONS
+    PREDICTIONS = args.predictions
     if args.events < 200:
         ap.error("--events must be >= 200")
     if not os.environ.get("DISPLAY"):
@@ -203,6 +226,8 @@ def main() -> int:
     os.environ.setdefault("QT_API", "pyqt5")
     with tempfile.TemporaryDirectory() as tmp:
         settings = str(Path(tmp) / "bench.ini")
+        if PREDICTIONS:
+            print("scenes with the predictions layer (analytic, compact)")
         print(
             f"{'case':<24}{'view':<11}{'events':>7}{'p50 ms':>8}{'p95 ms':>8}{'bare50':>8}"
             f"{'bare95':>8}{'p50/bare':>10}{'p95/bare':>10}"

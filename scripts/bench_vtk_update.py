@@ -10,7 +10,12 @@ load than wall time). With ``--against DIR`` (another checkout, e.g. the commit 
 change) both run in alternating subprocesses, several rounds, and the ratio
 this / against is printed per case: the figure to compare, measured in the same run.
 
+With ``--predictions`` the scenes show the predictions layer (estimators analytic and
+compact) and the timed step also asks the Predictor (as a drag frame of the app does) and
+redraws the prediction ghosts.
+
     .venv/bin/python scripts/bench_vtk_update.py [--steps 300] [--rounds 3] [--against DIR]
+        [--predictions]
 """
 
 from __future__ import annotations
@@ -46,20 +51,22 @@ def _scene(m: int, n: int):
     return Scene(Eyes(40.0, 20.0, m), fs, layers, view=View((0.0, 2600.0), 9000.0))
 
 
-def _overlays(ov, sc, st, sel: int) -> None:
-    """What the window calls per frame, without predictions, ambiguity or a path."""
+def _overlays(ov, sc, st, sel: int, preds=None) -> None:
+    """What the window calls per frame (predictions as given), no ambiguity or path."""
+    preds = {} if preds is None else preds
     if hasattr(ov, "update"):
-        ov.update(sc, st, sel, {}, None, None)
+        ov.update(sc, st, sel, preds, None, None)
     else:  # the API before the split
         ov.update_predictions(sc, st, {}, {})
         ov.update_ambiguity(sc, None, None)
         ov.update_trajectory(sc, None)
 
 
-def measure(steps: int) -> dict[str, float]:
+def measure(steps: int, predictions: bool = False) -> dict[str, float]:
     """Median microseconds of SceneActors.update per drag step, per case."""
     import pyvista as pv
 
+    from eyeviz.model.predictor import Predictor
     from eyeviz.model.state import compute_state
     from eyeviz.render.vtk.actors import SceneActors
     from eyeviz.render.vtk.overlays import OverlayActors
@@ -72,9 +79,18 @@ def measure(steps: int) -> dict[str, float]:
         act = SceneActors(pl.renderer, inset)
         ov = OverlayActors(pl.renderer)
         sc = _scene(m, n)
+        predictor = Predictor() if predictions else None
+        if predictor is not None:
+            sc.layers.append("predictions")
+            sc.estimators = ["analytic", "compact"]
+
+        def preds(st, sc=sc, predictor=predictor):
+            return None if predictor is None else predictor.predict(sc, st)
+
         sel = n - 1
-        act.update(sc, compute_state(sc), sel)
-        _overlays(ov, sc, compute_state(sc), sel)
+        st0 = compute_state(sc)
+        act.update(sc, st0, sel)
+        _overlays(ov, sc, st0, sel, preds(st0))
         times = []
         for k in range(steps + 10):
             a = 2 * math.pi * k / 80
@@ -83,7 +99,7 @@ def measure(steps: int) -> dict[str, float]:
             st = compute_state(sc)
             t0 = time.process_time()
             act.update(sc, st, sel)
-            _overlays(ov, sc, st, sel)
+            _overlays(ov, sc, st, sel, preds(st))
             if k >= 10:
                 times.append(1e6 * (time.process_time() - t0))
         pl.close()
@@ -91,14 +107,15 @@ def measure(steps: int) -> dict[str, float]:
     return out
 
 
-def _run(root: Path, steps: int) -> dict[str, float]:
+def _run(root: Path, steps: int, predictions: bool) -> dict[str, float]:
     env = dict(os.environ, PYTHONPATH=str(root))
     code = (
         "import json, sys; sys.path.insert(0, sys.argv[1]); "
-        "from bench_vtk_update import measure; print(json.dumps(measure(int(sys.argv[2]))))"
+        "from bench_vtk_update import measure; "
+        "print(json.dumps(measure(int(sys.argv[2]), sys.argv[3] == '1')))"
     )
     res = subprocess.run(
-        [sys.executable, "-c", code, str(ROOT / "scripts"), str(steps)],
+        [sys.executable, "-c", code, str(ROOT / "scripts"), str(steps), str(int(predictions))],
         env=env,
         cwd=str(root),
         capture_output=True,
@@ -113,16 +130,19 @@ def main() -> int:
     ap.add_argument("--steps", type=int, default=300, help="timed drag steps per case")
     ap.add_argument("--rounds", type=int, default=3, help="alternating rounds with --against")
     ap.add_argument("--against", type=Path, help="a baseline checkout to compare with")
+    ap.add_argument(
+        "--predictions", action="store_true", help="the scenes show the predictions layer"
+    )
     args = ap.parse_args()
     if args.against is None:
-        for case, us in measure(args.steps).items():
+        for case, us in measure(args.steps, args.predictions).items():
             print(f"{case:24s} update {us:8.0f} µs (median)")
         return 0
     this: dict[str, list[float]] = {}
     base: dict[str, list[float]] = {}
     for _ in range(args.rounds):
         for root, store in ((args.against, base), (ROOT, this)):
-            for case, us in _run(root, args.steps).items():
+            for case, us in _run(root, args.steps, args.predictions).items():
                 store.setdefault(case, []).append(us)
     print(f"{'case':24s} {'this µs':>9s} {'base µs':>9s}  ratio (median of rounds)")
     for case in this:

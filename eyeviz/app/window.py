@@ -215,6 +215,7 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         self.settings.setValue("window/state", bytes(self.saveState()))
         self.settings.sync()
         self._frame_pending = True  # no frame after close
+        self._table_timer.stop()  # nor a table refresh (it fired into a closed window)
         self.plotter.close()
         super().closeEvent(event)
 

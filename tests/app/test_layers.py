@@ -170,3 +170,54 @@ def test_torch_is_imported_only_with_the_predictions_layer(tmp_path):
     lines = r.stdout.strip().splitlines()
     assert lines[-2] == "False"
     assert lines[-1] == "True ['compact']"
+
+
+def test_a_drag_rewrites_only_the_dragged_features_ghosts(make_window, qtbot):
+    """Issue 12 drag latency, counted not timed: during a drag the other features' ghost
+    rings are neither rebuilt nor rewritten (their points stay bit for bit), the meshes and
+    mappers are the same objects, and the dragged feature's ring follows its prediction."""
+    from PyQt5 import QtCore
+    from PyQt5.QtTest import QTest
+
+    sc = scene()
+    sc.features[1] = Feature("near", -900.0, 2000.0, 80.0, "#0072B2")
+    sc.features += [
+        Feature("third", 900.0, 3300.0, 70.0, "#009E73"),
+        Feature("fourth", -400.0, 3700.0, 50.0, "#CC79A7"),
+    ]
+    win = make_window(sc)
+    assert win.model.state.in_domain().all()
+    layer = win.overlays.predictions
+    builds, mesh = layer.builds, layer.ghost_mesh
+    mapper = layer.ghost_actor.GetMapper()
+    mapper_mtime = mapper.GetMTime()
+    before = np.asarray(mesh.points).reshape(4, -1, 3).copy()
+    written = []
+    update = layer.update
+
+    def recording(frame, skip=frozenset()):
+        update(frame, skip)
+        written.append({n: list(i) for n, i in layer.written.items()})
+
+    layer.update = recording
+    w = win.plotter
+    start = pixel_of(win, -900.0, 2000.0)
+    QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
+    for k in range(1, 9):
+        QTest.mouseMove(w, start + QtCore.QPoint(12 * k, -9 * k))
+        qtbot.wait(5)  # the pending frame is drawn
+    end = start + QtCore.QPoint(96, -72)
+    QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, end)
+    qtbot.wait(5)
+    f = win.model.scene.features[1]
+    assert f.x > -900.0 + 40 * win.units_per_px()  # it was dragged
+    moves = [wr for wr in written if wr["analytic"]]
+    assert len(moves) >= 4, written  # one frame per move (or coalesced), each drawn
+    assert all(wr == {"analytic": [1]} or wr == {"analytic": []} for wr in written), written
+    assert layer.builds == builds and layer.ghost_mesh is mesh
+    assert mapper.GetMTime() == mapper_mtime
+    after = np.asarray(mesh.points).reshape(4, -1, 3)
+    others = [0, 2, 3]
+    np.testing.assert_array_equal(after[others], before[others])
+    r, phi = analytic_answer(f)
+    np.testing.assert_allclose(after[1, -1, :2], [r * math.cos(phi), r * math.sin(phi)], rtol=1e-9)

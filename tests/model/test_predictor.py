@@ -164,3 +164,36 @@ def test_the_row_cache_is_bounded_and_stays_right():
         fresh = Predictor().predict(sc, compute_state(sc))["analytic"]
         np.testing.assert_array_equal(got[0], fresh[0])
         assert max(len(c) for c in p._rows.values()) <= 8
+
+
+def test_a_drag_frame_makes_bitmaps_only_for_rows_the_cache_lacks(monkeypatch):
+    """The m/2-wide bitmaps cost ~2 ms a frame for 50 features at m = 36,000: a drag frame
+    makes them for the moved feature only, and none for an estimator made for other eyes."""
+    import eyeviz.model.predictor as predictor_module
+
+    made: list[int] = []
+    real = predictor_module.intervals_to_bitmap
+
+    def counting(L, R, m, width):
+        made.append(len(L))
+        return real(L, R, m, width)
+
+    monkeypatch.setattr(predictor_module, "intervals_to_bitmap", counting)
+    p = Predictor()
+    sc = drag_scene()
+    p.predict(sc, compute_state(sc))
+    assert made == [6, 6]  # eye A's rows, eye B's rows
+    for x0 in (50.0, 120.0):
+        made.clear()
+        sc = drag_scene(x0)
+        got = p.predict(sc, compute_state(sc))["analytic"]
+        assert made == [1, 1]
+        fresh = Predictor().predict(sc, compute_state(sc))["analytic"]
+        np.testing.assert_array_equal(got[0], fresh[0])
+    # compact (trained for m = 720) at m = 1440: its one line, and no bitmap made
+    sc = drag_scene()
+    sc.eyes = Eyes(40.0, 20.0, 1440)
+    sc.estimators = ["compact"]
+    made.clear()
+    assert p.predict(sc, compute_state(sc)) == {"compact": NOTE}
+    assert made == []

@@ -62,6 +62,8 @@ class OverlayActors:
             for a in layer.actors:
                 a.SetVisibility(False)
                 main.AddActor(a)
+        self.frame: Frame | None = None  # the Frame drawn last
+        self._inputs: tuple | None = None  # what update() built it from
 
     def update(
         self,
@@ -76,18 +78,43 @@ class OverlayActors:
         """Build the overlay Frame and draw it; returns the Frame (None, and everything
         hidden, when the scene shows none of these layers: a drag builds nothing then)."""
         if not any(n in _LAYERS for n in scene.layers):
-            for layer in (self.ambiguity, self.trajectory, self.predictions):
+            for layer in (self.ambiguity, self.trajectory):
                 for a in layer.actors:
                     a.SetVisibility(False)
-            self.predictions.ghosts = {}
+            self.predictions.hide()
             self.ambiguity.polygon = None
+            self._inputs = None
             return None
+        # the same inputs (a refresh that changed nothing here: a selection, a panel, the
+        # second call of a refresh): the Frame drawn last is still what is shown
+        inputs = (state, predictions, ambiguity, path)
+        plain = (
+            selected,
+            tuple(scene.layers),
+            tuple(scene.estimators),
+            tuple(f.color for f in scene.features),
+            frozenset(skip),
+        )
+        last = self._inputs
+        if (
+            last is not None
+            and self.frame is not None
+            and all(a is b for a, b in zip(inputs, last[0], strict=True))
+            and plain == last[1]
+        ):
+            return self.frame
         frame = overlay_frame(scene, state, selected, predictions, ambiguity, path)
-        self.draw(frame, selected, skip)
+        self._draw(frame, selected, skip)
+        self._inputs = (inputs, plain)
         return frame
 
     def draw(self, frame: Frame, selected: int | None, skip=frozenset()) -> None:
         """Draw ``frame`` (estimators in ``skip``, made for other eyes, draw no ring)."""
+        self._inputs = None  # a Frame from elsewhere: the next update draws its own
+        self._draw(frame, selected, skip)
+
+    def _draw(self, frame: Frame, selected: int | None, skip) -> None:
+        self.frame = frame
         self.predictions.update(frame, skip)
         self.ambiguity.update(frame, selected)
         self.trajectory.update(frame)

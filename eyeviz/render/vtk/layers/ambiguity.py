@@ -25,12 +25,18 @@ def _dark(rgb) -> tuple[float, float, float]:
 
 
 class AmbiguityLayer:
+    """One fill and one outline mesh, made once: a new polygon is written into them (the
+    mappers' inputs are never replaced); an unchanged polygon and colour write nothing."""
+
     def __init__(self, main):
-        self.amb_fill = actor(pv.PolyData())
-        self.amb_line = actor(pv.PolyData())
+        self.fill = pv.PolyData()
+        self.line = pv.PolyData()
+        self.amb_fill = actor(self.fill)
+        self.amb_line = actor(self.line)
         self.amb_line.GetProperty().SetLineWidth(3.5)
         self.actors = (self.amb_fill, self.amb_line)
         self.polygon: np.ndarray | None = None
+        self._key: tuple | None = None
 
     def update(self, frame: Frame, selected: int | None) -> None:
         amb = frame.ambiguity.get(selected) if selected is not None else None
@@ -41,16 +47,18 @@ class AmbiguityLayer:
         self.amb_line.SetVisibility(ok)
         if not ok or poly is None or selected is None:
             return
+        color = frame.colors[selected] if 0 <= selected < frame.n else "#555555"
+        poly = np.asarray(poly, dtype=np.float64)
+        key = (poly.shape, poly.tobytes(), color)
+        if key == self._key:
+            return
+        self._key = key
         k = len(poly)
         pts = np.column_stack([poly, np.full(k, Z_AMBIGUITY)])
-        fill = pv.PolyData(pts, faces=np.concatenate([[k], np.arange(k)]))
-        line = pv.PolyData(
-            pts + [0, 0, Z_LINE + 0.1 - Z_AMBIGUITY],  # over the discs
-            lines=np.concatenate([[k + 1], np.arange(k), [0]]),
-        )
-        self.amb_fill.GetMapper().SetInputData(fill)
-        self.amb_line.GetMapper().SetInputData(line)
-        color = frame.colors[selected] if 0 <= selected < frame.n else "#555555"
+        self.fill.points = pts
+        self.fill.faces = np.concatenate([[k], np.arange(k)])
+        self.line.points = pts + [0, 0, Z_LINE + 0.1 - Z_AMBIGUITY]  # over the discs
+        self.line.lines = np.concatenate([[k + 1], np.arange(k), [0]])
         rgb = hex_rgb(color)
         self.amb_fill.GetProperty().SetColor(*_mix(rgb, 0.28))
         self.amb_line.GetProperty().SetColor(*_dark(rgb))
