@@ -2,6 +2,7 @@
 the widgets whose content changed (real window, real VTK, counted by an event filter)."""
 
 import collections
+import time
 
 from mouse import pixel_of
 from PyQt5 import QtCore, QtWidgets
@@ -47,7 +48,11 @@ def test_a_drag_move_lays_out_nothing_and_paints_little(make_window):
         counter.on = True
         for k in range(n):
             QTest.mouseMove(w, start + QtCore.QPoint(30 + 4 * k, -10 - 3 * k))
+            # the move's (coalesced) frame: on a loaded machine three passes may not reach it
+            target, deadline = w.frames + 1, time.monotonic() + 0.5
             for _ in range(3):
+                app.processEvents()
+            while w.frames < target and time.monotonic() < deadline:
                 app.processEvents()
         counter.on = False
         QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
