@@ -26,6 +26,7 @@ import time
 import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from eyeviz import EyevizError
 from eyeviz.study.point import COLUMNS, DesignPoint, evaluate
@@ -227,6 +228,46 @@ def dask_config(connect_timeout: float = CONNECT_TIMEOUT_S) -> dict:
     }
 
 
+@contextlib.contextmanager
+def _exclusive(path):
+    """Hold ``.NAME.lock`` beside the table: a second study into the same file is refused
+    at once (one line) instead of both rewriting the table and losing points. The lock is
+    the kernel's (``flock``): a crashed study leaves none held."""
+    try:
+        import fcntl
+    except ImportError:  # no flock (Windows): no protection, as before
+        yield
+        return
+    target = Path(path)
+    lock = target.with_name(f".{target.name}.lock")
+    while True:
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise EyevizError(f"cannot create the study's lock file {str(lock)!r}: {exc}") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise EyevizError(
+                f"another study is writing {str(target)!r} (its lock {lock.name} is held); "
+                "wait for it or write to another -o"
+            ) from None
+        try:  # the file we locked may have been removed by a study that just finished
+            same = os.path.samestat(os.fstat(fd), os.stat(lock))
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
+        os.close(fd)
+    try:
+        yield
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(lock)
+        os.close(fd)
+
+
 def run_study(
     path,
     points: Iterable[DesignPoint],
@@ -247,6 +288,11 @@ def run_study(
     or an unreachable scheduler, and lets KeyboardInterrupt through after closing the
     cluster (the finished points are kept).
     """
+    with _exclusive(path):
+        return _run(path, points, workers, scheduler, progress, connect_timeout)
+
+
+def _run(path, points, workers, scheduler, progress, connect_timeout) -> StudySummary:
     t0 = time.perf_counter()
     table = StudyTable.open(path)  # a bad or foreign file is refused before any work
     unique: dict[tuple, DesignPoint] = {}

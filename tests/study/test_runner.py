@@ -201,3 +201,22 @@ def test_a_worker_under_dasks_malloc_trim_threshold_does_not_refault_every_array
 
     plain, tuned = faults("plain"), faults("tuned")
     assert tuned * 10 < plain, (tuned, plain)
+
+
+def test_a_second_study_into_the_same_file_is_refused_and_the_lock_goes_away(tmp_path):
+    import fcntl
+
+    path = tmp_path / "study.csv"
+    grid = design_grid("40", "20", "8", n=200)
+    run_study(path, grid, workers=1, progress=False)
+    before = path.read_bytes()
+    lock = tmp_path / ".study.csv.lock"
+    assert not lock.exists()  # removed when a study ends
+    with open(lock, "w") as held:  # another study holds it
+        fcntl.flock(held, fcntl.LOCK_EX)
+        with pytest.raises(EyevizError, match="another study is writing") as ei:
+            run_study(path, design_grid("40", "20", "8,16", n=200), workers=1, progress=False)
+        assert "\n" not in str(ei.value)
+    assert path.read_bytes() == before  # nothing written by the refused study
+    s = run_study(path, design_grid("40", "20", "8,16", n=200), workers=1, progress=False)
+    assert (s.computed, s.skipped) == (1, 1) and not lock.exists()
