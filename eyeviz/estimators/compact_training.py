@@ -4,11 +4,14 @@ one training shape. Imports torch."""
 
 from __future__ import annotations
 
+import functools
 import json
 import math
+import os
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -27,10 +30,13 @@ from eyeviz.estimators.compact import (
 )
 from eyeviz.estimators.store import staged, user_models_dir
 
+if TYPE_CHECKING:
+    from eyeviz.dataset import Dataset
+
 __all__ = ["train", "fit"]
 
 
-def _generate(n: int, domain: Domain, seed: int, mode: str = "single"):
+def _generate(n: int, domain: Domain, seed: int, mode: str = "single") -> dict[str, np.ndarray]:
     from eyeviz import dataset
 
     p = dataset.make_params(domain.eyes, domain.r_min, domain.r_max, domain.g_max, mode, seed)
@@ -43,11 +49,11 @@ def _generate(n: int, domain: Domain, seed: int, mode: str = "single"):
 
 def _fit(
     net: CompactNet,
-    x,
-    y,
-    xv,
-    yv,
-    predict: Callable,
+    x: torch.Tensor,
+    y: torch.Tensor,
+    xv: torch.Tensor,
+    yv: torch.Tensor,
+    predict: Callable[[torch.Tensor, torch.Tensor], torch.Tensor],
     epochs: int,
     batch: int,
     lr: float,
@@ -94,7 +100,7 @@ def _fit(
 
 
 def train(
-    out_dir=None,
+    out_dir: str | os.PathLike | None = None,
     n_train: int = 1_000_000,
     n_val: int = 100_000,
     seed: int = 0,
@@ -108,7 +114,7 @@ def train(
     threads: int = 2,
     command: str | None = None,
     progress: Callable[[str, int, int, float], None] | None = None,
-    data=None,
+    data: Dataset | None = None,
 ) -> dict:
     """Generate data (single pass, seeds ``seed`` and ``seed + 1``), train both nets, save.
 
@@ -165,7 +171,7 @@ def train(
         )
 
 
-def _split(data, seed: int, domain: Domain) -> tuple[dict, dict]:
+def _split(data: Dataset, seed: int, domain: Domain) -> tuple[dict, dict]:
     """Single-feature rows of a data set as interval columns, split 90/10 (seeded)."""
     from eyeviz.estimators.base import bitmaps_to_intervals
 
@@ -187,30 +193,32 @@ def _split(data, seed: int, domain: Domain) -> tuple[dict, dict]:
 
 def _train_into(
     out: Path,
-    tr,
-    va,
-    t0,
-    t_gen,
-    n_train,
-    n_val,
-    seed,
-    epochs,
-    hidden,
-    hidden_ad,
-    batch,
-    lr,
-    patience,
-    domain,
-    threads,
-    command,
-    progress,
-    source,
+    tr: dict[str, np.ndarray],
+    va: dict[str, np.ndarray],
+    t0: float,
+    t_gen: float,
+    n_train: int,
+    n_val: int,
+    seed: int,
+    epochs: int,
+    hidden: int,
+    hidden_ad: int,
+    batch: int,
+    lr: float,
+    patience: int,
+    domain: Domain,
+    threads: int,
+    command: str | None,
+    progress: Callable[[str, int, int, float], None] | None,
+    source: str,
 ) -> dict:
     """The body of :func:`train`, writing into the staging directory ``out``."""
     torch.set_num_threads(threads)
     torch.manual_seed(seed)
 
-    def prep(d):
+    def prep(
+        d: dict[str, np.ndarray],
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
         x, log_r0, p0 = features(d["la"], d["ra"], d["lb"], d["rb"], domain)
         return (
             torch.from_numpy(x),
@@ -222,14 +230,14 @@ def _train_into(
     x, yd, ya, sa = prep(tr)
     xv, ydv, yav, sav = prep(va)
 
-    def dd_loss(out, y):
+    def dd_loss(out: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
         return (torch.exp(out - y) - 1.0).abs().mean()
 
     # AD: |phi_hat - phi| / phi with phi_hat - phi = AD_SCALE * (out - y)
     ya_pair = torch.stack([ya, sa], 1)
     yav_pair = torch.stack([yav, sav], 1)
 
-    def ad_loss(out, y):
+    def ad_loss(out: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
         return ((out - y[:, 0]).abs() / y[:, 1]).mean()
 
     files = {"dd": "compact_dd.pt", "ad": "compact_ad.pt"}
@@ -255,7 +263,7 @@ def _train_into(
             lr,
             patience,
             seed,
-            lambda n_, p=path, w=width: _save_net(n_, w, p),
+            functools.partial(_save_net, hidden=width, path=path),
             progress,
             name.upper(),
         )
@@ -307,8 +315,8 @@ def _train_into(
 
 
 def fit(
-    data=None,
-    out_dir=None,
+    data: Dataset | str | os.PathLike | None = None,
+    out_dir: str | os.PathLike | None = None,
     *,
     domain: Domain | None = None,
     n: int = 1_000_000,
@@ -325,7 +333,6 @@ def fit(
     """The registry's training shape: train on ``data`` (a Dataset or a .csv/.npz path;
     None: generate ``n`` + ``n_val`` elements in ``domain``) into ``out_dir`` (default the
     user models directory), staged then swapped in. Returns the directory for ``load``."""
-    import os
 
     for k, v in (("hidden", hidden), ("hidden_ad", hidden_ad), ("patience", patience)):
         check_int(k, v, ge=1)
