@@ -29,6 +29,7 @@ from eyeviz.estimators.compact import (
     features,
 )
 from eyeviz.estimators.store import staged, user_models_dir
+from eyeviz.files import limits
 
 if TYPE_CHECKING:
     from eyeviz.dataset import Dataset
@@ -126,10 +127,11 @@ def train(
     Returns the metadata.
     """
     batch = check_int("batch", batch, ge=1)
-    n_train = check_int("n_train", n_train, ge=1)
-    n_val = check_int("n_val", n_val, ge=1)
+    n_train = check_int("n_train", n_train, ge=1, le=limits.MAX_ROWS)
+    n_val = check_int("n_val", n_val, ge=1, le=limits.MAX_ROWS)
     epochs = check_int("epochs", epochs, ge=1)
     lr = check_real("lr", lr, gt=0)
+    threads = check_int("threads", threads, ge=1, le=limits.MAX_THREADS)
     t0 = time.perf_counter()
     if data is None:
         if n_train < batch:
@@ -334,9 +336,10 @@ def fit(
     None: generate ``n`` + ``n_val`` elements in ``domain``) into ``out_dir`` (default the
     user models directory), staged then swapped in. Returns the directory for ``load``."""
 
-    for k, v in (("hidden", hidden), ("hidden_ad", hidden_ad), ("patience", patience)):
-        check_int(k, v, ge=1)
-    threads = check_int("threads", threads, ge=1)
+    for k, v in (("hidden", hidden), ("hidden_ad", hidden_ad)):
+        check_int(k, v, ge=1, le=limits.MAX_HIDDEN)  # what load() reads back
+    check_int("patience", patience, ge=1)
+    threads = check_int("threads", threads, ge=1, le=limits.MAX_THREADS)
     dom = PAPER_DOMAIN if domain is None else domain
     if isinstance(data, str | os.PathLike):
         from eyeviz import dataset

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from eyeviz.core.domain import DEFAULTS as _D
+from eyeviz.files import limits
 from eyeviz.model.palette import ESTIMATOR_COLORS, estimator_color
 
 HELP = "estimators' AD/DD error, training and inference time (error against run time)"
@@ -567,8 +568,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    if args.n_test < 10:
-        raise ValueError(f"--n-test must be >= 10, got {args.n_test}")
+    limits.check_int("--n-test", args.n_test, 10, limits.MAX_ROWS)
     names = parse_names(args.estimators)
     bar = tqdm(total=len(names), desc="estimators", unit="est", leave=False)
 

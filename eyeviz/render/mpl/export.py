@@ -15,6 +15,7 @@ from pathlib import Path
 
 from eyeviz import EyevizError
 from eyeviz.files.atomic import atomic_output
+from eyeviz.render.mpl.style import BASE_DPI
 
 __all__ = ["FORMATS", "export", "format_of"]
 
@@ -30,6 +31,10 @@ def format_of(path) -> str:
     return FORMATS[suffix]
 
 
+#: PNG scale bounds (the app's export dialog offers the same range).
+SCALE_MIN, SCALE_MAX = 0.25, 20.0
+
+
 def _check_scale(scale) -> float:
     try:
         s = float(scale)
@@ -37,8 +42,15 @@ def _check_scale(scale) -> float:
         raise EyevizError(f"scale must be a number > 0, got {scale!r}") from None
     if not math.isfinite(s) or s <= 0:
         raise EyevizError(f"scale must be a finite number > 0, got {scale!r}")
-    if s > 20:
-        raise EyevizError(f"scale must be <= 20 (a {s:g}x PNG would be huge), got {scale!r}")
+    if s < SCALE_MIN:
+        raise EyevizError(
+            f"scale must be >= {SCALE_MIN:g} ({BASE_DPI * SCALE_MIN:g} dpi; a smaller "
+            f"PNG has no readable text), got {scale!r}"
+        )
+    if s > SCALE_MAX:
+        raise EyevizError(
+            f"scale must be <= {SCALE_MAX:g} (a {s:g}x PNG would be huge), got {scale!r}"
+        )
     return s
 
 
