@@ -135,7 +135,7 @@ def measure(
             from eyeviz.estimators import load
             from eyeviz.estimators.base import Domain
 
-            loaded[name] = load("limit", domain=Domain(**LIMIT_DOMAIN_KW), prior="single")
+            loaded[name] = load("limit", domain=Domain.from_dict(LIMIT_DOMAIN_KW), prior="single")
             continue
         est, why = try_load(name)
         if est is None:
