@@ -26,7 +26,7 @@ import functools
 import json
 import os
 import zipfile
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from types import TracebackType
@@ -429,8 +429,23 @@ class _Overlapped(Generic[_B]):
             self._pool.shutdown(wait=True)
 
 
-def _encode_csv_chunk(enc: CsvEncoder, c: Chunk) -> list:
-    return enc.encode_intervals(c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb)
+#: Bytes of one encode buffer (CSV bits or NPZ rows). A chunk of wide rows (m up to
+#: limits.MAX_M) is written in blocks of at most this much, so memory does not grow with m
+#: (a 16384-row CSV buffer at m = 2^20 would be 32 GiB); the bytes written are the same.
+_BLOCK_BYTES = 64 << 20
+
+
+def block_rows(row_bytes: int, cap: int) -> int:
+    """Rows per encode block: ``cap``, fewer when rows of ``row_bytes`` would exceed
+    :data:`_BLOCK_BYTES`; at least 1."""
+    return max(1, min(cap, _BLOCK_BYTES // max(1, row_bytes)))
+
+
+def _blocks(c: Chunk, rows: int) -> Iterator[tuple[np.ndarray, ...]]:
+    """``(r, phi, g, la, ra, lb, rb)`` of ``c`` in consecutive blocks of ``rows``."""
+    cols = (c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb)
+    for s in range(0, len(c), rows):
+        yield tuple(a[s : s + rows] for a in cols)
 
 
 def write_chunks(
@@ -449,20 +464,26 @@ def write_chunks(
         if fmt == "csv":
             # two buffers: chunk k+1 is encoded while chunk k is written; encoding k+2
             # into k's buffer starts only after out() has waited for k's write
-            encs = (CsvEncoder(m, CHUNK), CsvEncoder(m, CHUNK))
+            rows = block_rows(2 * m, CHUNK)
+            encs = (CsvEncoder(m, rows), CsvEncoder(m, rows))
+            k = 0
             with (
                 open(tmp, "wb", buffering=0) as f,
                 _Overlapped(functools.partial(write_parts, f)) as out,
             ):
-                for i, c in enumerate(chunks):
-                    out(_encode_csv_chunk(encs[i % 2], c))
+                for c in chunks:
+                    for cols in _blocks(c, rows):
+                        out(encs[k % 2].encode_intervals(*cols))
+                        k += 1
                     if progress:
                         progress(len(c))
         else:
             meta = {"version": NPZ_VERSION, "m": m, "n": n, "params": params}
+            rows = block_rows(npz_dtype(m).itemsize, CHUNK)
             with _NpzWriter(tmp, m, n, meta) as wr, _Overlapped(wr.write) as out:
                 for c in chunks:
-                    out(wr.rows_from_intervals(c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb))
+                    for cols in _blocks(c, rows):
+                        out(wr.rows_from_intervals(*cols))
                     if progress:
                         progress(len(c))
 
@@ -474,7 +495,7 @@ def save(ds: Dataset, path: str | os.PathLike) -> None:
     fmt = format_of(path)
     n, m = len(ds), ds.eyes.m
     check_rows(ds.omega_a, ds.omega_b, ds.r, ds.phi, ds.g, m)
-    step = 1 << 14
+    step = block_rows(2 * m if fmt == "csv" else npz_dtype(m).itemsize, 1 << 14)
     with atomic_output(path) as tmp:
         if fmt == "csv":
             with_g = not bool(np.all(np.isnan(ds.g))) if n else True
