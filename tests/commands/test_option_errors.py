@@ -105,14 +105,21 @@ def test_degenerate_option_named(tmp_path, argv, words):
 @pytest.mark.parametrize(
     "argv,words",
     [
-        (["train", "bayes", "-n", BIG], ["n", BIG]),
-        (["train", "compact", "-n", BIG], ["n_train", BIG]),
+        (["train", "bayes", "-o", "{out}", "-n", BIG], ["n", BIG]),
+        (["train", "compact", "-o", "{out}", "-n", BIG], ["n_train", BIG]),
+        (
+            ["snapshot", SCENE, "-o", "{out}.png", "--width", "10", "--scale", "20"],
+            ["scale 20", "width 10", "60,000 px"],
+        ),
     ],
+    ids=["bayes -n", "compact -n", "snapshot 60000 px"],
 )
-def test_huge_n_refused_before_generating(tmp_path, argv, words):
-    """These used to start generating 10^12 rows (hours, then out of memory)."""
+def test_refused_before_unbounded_work(tmp_path, argv, words):
+    """These used to start generating 10^12 rows (hours, then out of memory), or drawing
+    a 60000 px wide PNG (gigabytes of pixels); now one line before any work."""
+    argv = [a.format(out=tmp_path / "out") for a in argv]
     proc = subprocess.run(
-        [sys.executable, "-m", "eyeviz", *argv[:2], "-o", str(tmp_path / "m"), *argv[2:]],
+        [sys.executable, "-m", "eyeviz", *argv],
         capture_output=True,
         text=True,
         timeout=120,
@@ -124,6 +131,7 @@ def test_huge_n_refused_before_generating(tmp_path, argv, words):
     line = errors[0]
     for w in words:
         assert w in line, (w, line)
+    assert not list(tmp_path.glob("out*")), "a refused command wrote output"
 
 
 def test_domain_refuses_a_bad_design_with_eyeviz_error():

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from eyeviz import EyevizError
 from eyeviz.files.atomic import atomic_output
-from eyeviz.render.mpl.style import BASE_DPI
+from eyeviz.render.mpl.style import BASE_DPI, WIDTHS
 
 __all__ = ["FORMATS", "export", "format_of"]
 
@@ -33,6 +33,10 @@ def format_of(path) -> str:
 
 #: PNG scale bounds (the app's export dialog offers the same range).
 SCALE_MIN, SCALE_MAX = 0.25, 20.0
+#: Widest PNG, in pixels: a single column at the largest scale (21000 x 28740 px, 15 s).
+#: A double-width or 10 inch figure gets a smaller largest scale (a 10 in figure at scale
+#: 20 was 60000 px wide: gigabytes of pixels, minutes of drawing).
+MAX_PNG_PX = round(WIDTHS["single"] * BASE_DPI * SCALE_MAX)
 
 
 def _check_scale(scale) -> float:
@@ -88,6 +92,14 @@ def export(
 
     from eyeviz.render.mpl import vector
 
+    if fmt == "png":
+        w_in = vector.resolve_width(width)
+        px = w_in * BASE_DPI * scale
+        if px > MAX_PNG_PX:
+            raise EyevizError(
+                f"scale {scale:g} at width {w_in:g} in makes a PNG {px:,.0f} px wide; at most "
+                f"{MAX_PNG_PX} px: scale <= {MAX_PNG_PX / (w_in * BASE_DPI):.3g} at this width"
+            )
     dpi = vector.BASE_DPI * scale if fmt == "png" else vector.VECTOR_DPI
     fig = vector.figure(
         scene,
