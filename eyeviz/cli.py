@@ -4,7 +4,8 @@ Sub-commands are discovered from :mod:`eyeviz.commands`. Every error a user can 
 ends in a one-line message on stderr and a non-zero exit, never a traceback:
 
 - :class:`EyevizError`, ValueError, OSError, OverflowError, RecursionError: exit 2;
-- any other exception (a bug: KeyError, TypeError...): exit 2 with one line starting
+- any other exception (a bug: KeyError, TypeError, and ZeroDivisionError or
+  FloatingPointError, whose text names no input): exit 2 with one line starting
   ``eyeviz: error: unexpected <type>`` (``EYEVIZ_DEBUG=1`` re-raises it);
 - Ctrl-C (SIGINT) exit 130, SIGHUP exit 129, SIGTERM exit 143: each raises
   :class:`Interrupted` (a KeyboardInterrupt) in the main thread, so every
@@ -183,6 +184,8 @@ def _run(args) -> int:
         return int(args._run(args) or 0)
     except EyevizError as exc:
         _error(str(exc))
+    except (ZeroDivisionError, FloatingPointError) as exc:  # never names a problem: a bug
+        _unexpected(exc)
     except (ValueError, OSError, OverflowError, ArithmeticError) as exc:
         _error(str(exc) or type(exc).__name__)
     except RecursionError:
@@ -192,10 +195,15 @@ def _run(args) -> int:
     except KeyboardInterrupt as exc:
         return _interrupted(exc)
     except Exception as exc:  # the last resort: a bug, but never a traceback for a user
-        if os.environ.get("EYEVIZ_DEBUG"):
-            raise
-        _error(f"unexpected {type(exc).__name__}: {exc} (EYEVIZ_DEBUG=1 shows the traceback)")
+        _unexpected(exc)
     return 2
+
+
+def _unexpected(exc: Exception) -> None:
+    """A bug's one line (``EYEVIZ_DEBUG=1``: the traceback instead)."""
+    if os.environ.get("EYEVIZ_DEBUG"):
+        raise exc
+    _error(f"unexpected {type(exc).__name__}: {exc} (EYEVIZ_DEBUG=1 shows the traceback)")
 
 
 def _interrupted(exc: BaseException) -> int:

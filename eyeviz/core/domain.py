@@ -42,7 +42,10 @@ class Domain:
     g_max: float = DEFAULTS["g_max"]
 
     def __post_init__(self) -> None:
-        EyePair(self.h, self.l, self.m)  # validates h, l, m with named messages
+        try:  # validates h, l, m with named messages
+            EyePair(self.h, self.l, self.m)
+        except ValueError as exc:  # the geometry's own ValueError, as the boundary's error
+            raise EyevizError(str(exc)) from None
         r_min = check_real("r_min", self.r_min, gt=0)
         r_max = check_real("r_max", self.r_max, gt=0)
         if r_min >= r_max:

@@ -26,14 +26,19 @@ import functools
 import json
 import os
 import zipfile
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
+from types import TracebackType
+from typing import TYPE_CHECKING, Any, BinaryIO, Generic, TypeVar
 
 import numpy as np
 
 from eyeviz import EyevizError
 from eyeviz.files.atomic import atomic_output
+
+if TYPE_CHECKING:
+    from eyeviz.dataset.records import Chunk, Dataset
 
 FORMATS = ("csv", "npz")
 NPZ_VERSION = 1
@@ -41,7 +46,7 @@ _ZERO, _ONE, _COMMA, _NEWLINE = 48, 49, 44, 10
 _TABLE_MAX_W = 4096  # packed lookup tables up to 2 x 2 MB
 
 
-def format_of(path) -> str:
+def format_of(path: str | os.PathLike) -> str:
     suffix = Path(path).suffix.lower().lstrip(".")
     if suffix not in FORMATS:
         raise EyevizError(f"output must end in .csv or .npz, got {str(path)!r}")
@@ -181,11 +186,11 @@ class CsvEncoder:
         self.buf[:, 0::2] = _ZERO
         self.buf[:, 1::2] = _COMMA
         self.flat = self.buf.reshape(-1)
-        mv = memoryview(self.flat)
+        mv = self.flat.data  # memoryview(self.flat)
         self.row_views = [mv[i * self.rb : (i + 1) * self.rb] for i in range(rows)]
         self._lit: np.ndarray | None = None
 
-    def _tails(self, r, phi, g) -> list[bytes]:
+    def _tails(self, r: np.ndarray, phi: np.ndarray, g: np.ndarray) -> list[bytes]:
         """Per row ``r,phi,g\n`` (``%.17g``), built as one NUL-padded matrix."""
         cols = [format_g17(r), format_g17(phi)]
         if self.with_g:
@@ -218,7 +223,16 @@ class CsvEncoder:
         excl = np.cumsum(cnt) - cnt
         return np.repeat(base - 2 * excl, cnt) + 2 * np.arange(tot, dtype=np.int64)
 
-    def encode_intervals(self, r, phi, g, la, ra, lb, rb) -> list:
+    def encode_intervals(
+        self,
+        r: np.ndarray,
+        phi: np.ndarray,
+        g: np.ndarray,
+        la: np.ndarray,
+        ra: np.ndarray,
+        lb: np.ndarray,
+        rb: np.ndarray,
+    ) -> list:
         """Rows whose eye E lights bits L_E..R_E (0 <= L <= R < m/2)."""
         if self._lit is not None:
             self.flat[self._lit] = _ZERO
@@ -227,7 +241,14 @@ class CsvEncoder:
         self._lit = pos
         return self._parts(r.shape[0], self._tails(r, phi, g))
 
-    def encode_bitmaps(self, omega_a, omega_b, r, phi, g) -> list:
+    def encode_bitmaps(
+        self,
+        omega_a: np.ndarray,
+        omega_b: np.ndarray,
+        r: np.ndarray,
+        phi: np.ndarray,
+        g: np.ndarray,
+    ) -> list:
         if self._lit is not None:  # invariant: the buffer is "0," except at self._lit
             self.flat[self._lit] = _ZERO
         n = r.shape[0]
@@ -242,7 +263,7 @@ class CsvEncoder:
 _IOV = 1024  # buffers per writev call (IOV_MAX on Linux)
 
 
-def write_parts(f, parts: list) -> None:
+def write_parts(f: BinaryIO, parts: list) -> None:
     """Write a list of buffers to an unbuffered binary file, without joining them."""
     if not hasattr(os, "writev"):
         f.write(b"".join(parts))
@@ -284,7 +305,7 @@ def _pack_tables(w: int) -> tuple[np.ndarray, np.ndarray]:
     )
 
 
-def _packed_from_intervals(lo, hi, w: int) -> np.ndarray:
+def _packed_from_intervals(lo: np.ndarray, hi: np.ndarray, w: int) -> np.ndarray:
     """np.packbits of the bitmap lit on lo..hi (0 <= lo <= hi < w), without building it."""
     if w > _TABLE_MAX_W:
         return _packed_clip(lo, hi, w)
@@ -294,7 +315,7 @@ def _packed_from_intervals(lo, hi, w: int) -> np.ndarray:
     return out
 
 
-def _packed_clip(lo, hi, w: int) -> np.ndarray:
+def _packed_clip(lo: np.ndarray, hi: np.ndarray, w: int) -> np.ndarray:
     start = np.arange((w + 7) // 8, dtype=np.int64) * 8
     a = np.clip(lo[:, None] - start, 0, 8)
     b = np.clip(hi[:, None] + 1 - start, 0, 8)
@@ -317,7 +338,16 @@ class _NpzWriter:
         header = {"descr": np.lib.format.dtype_to_descr(dt), "fortran_order": False, "shape": (n,)}
         np.lib.format.write_array_header_1_0(self.f, header)
 
-    def rows_from_intervals(self, r, phi, g, la, ra, lb, rb) -> np.ndarray:
+    def rows_from_intervals(
+        self,
+        r: np.ndarray,
+        phi: np.ndarray,
+        g: np.ndarray,
+        la: np.ndarray,
+        ra: np.ndarray,
+        lb: np.ndarray,
+        rb: np.ndarray,
+    ) -> np.ndarray:
         rows = _npz_rows(self.m, r.shape[0])
         w = self.m // 2
         rows["omega_a"] = _packed_from_intervals(la, ra, w)
@@ -325,17 +355,28 @@ class _NpzWriter:
         rows["r"], rows["phi"], rows["g"] = r, phi, g
         return rows
 
-    def rows_from_bitmaps(self, omega_a, omega_b, r, phi, g) -> np.ndarray:
+    def rows_from_bitmaps(
+        self,
+        omega_a: np.ndarray,
+        omega_b: np.ndarray,
+        r: np.ndarray,
+        phi: np.ndarray,
+        g: np.ndarray,
+    ) -> np.ndarray:
         rows = _npz_rows(self.m, r.shape[0])
         rows["omega_a"] = np.packbits(omega_a, axis=1)
         rows["omega_b"] = np.packbits(omega_b, axis=1)
         rows["r"], rows["phi"], rows["g"] = r, phi, g
         return rows
 
+    def write(self, rows: np.ndarray) -> None:
+        """Append ``rows`` (from ``rows_from_*``) to ``rows.npy``, as its raw buffer."""
+        self.f.write(rows.data)
+
     def __enter__(self) -> _NpzWriter:
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         try:
             self.f.close()
         finally:
@@ -345,19 +386,22 @@ class _NpzWriter:
 # --- writing -------------------------------------------------------------------------
 
 
-class _Overlapped:
+_B = TypeVar("_B")  # what one write call takes
+
+
+class _Overlapped(Generic[_B]):
     """Runs ``write`` calls on one worker thread, one at a time, so the file write of a
     chunk overlaps the generation and encoding of the next (I/O releases the GIL).
 
     Every call gets a fresh buffer; errors surface at the next call or at ``wait``.
     """
 
-    def __init__(self, write: Callable[[object], object]):
+    def __init__(self, write: Callable[[_B], object]):
         self._write = write
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="eyeviz-write")
-        self._pending: Future | None = None
+        self._pending: Future[object] | None = None
 
-    def __call__(self, buf) -> None:
+    def __call__(self, buf: _B) -> None:
         self.wait()
         self._pending = self._pool.submit(self._write, buf)
 
@@ -366,10 +410,15 @@ class _Overlapped:
             pending, self._pending = self._pending, None
             pending.result()
 
-    def __enter__(self) -> _Overlapped:
+    def __enter__(self) -> _Overlapped[_B]:
         return self
 
-    def __exit__(self, exc_type, exc, tb) -> None:
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
         try:
             if exc_type is None:
                 self.wait()
@@ -380,17 +429,32 @@ class _Overlapped:
             self._pool.shutdown(wait=True)
 
 
-def _encode_csv_chunk(enc: CsvEncoder, c) -> list:
-    return enc.encode_intervals(c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb)
+#: Bytes of one encode buffer (CSV bits or NPZ rows). A chunk of wide rows (m up to
+#: limits.MAX_M) is written in blocks of at most this much, so memory does not grow with m
+#: (a 16384-row CSV buffer at m = 2^20 would be 32 GiB); the bytes written are the same.
+_BLOCK_BYTES = 64 << 20
+
+
+def block_rows(row_bytes: int, cap: int) -> int:
+    """Rows per encode block: ``cap``, fewer when rows of ``row_bytes`` would exceed
+    :data:`_BLOCK_BYTES`; at least 1."""
+    return max(1, min(cap, _BLOCK_BYTES // max(1, row_bytes)))
+
+
+def _blocks(c: Chunk, rows: int) -> Iterator[tuple[np.ndarray, ...]]:
+    """``(r, phi, g, la, ra, lb, rb)`` of ``c`` in consecutive blocks of ``rows``."""
+    cols = (c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb)
+    for s in range(0, len(c), rows):
+        yield tuple(a[s : s + rows] for a in cols)
 
 
 def write_chunks(
-    path,
+    path: str | os.PathLike,
     fmt: str,
     n: int,
     m: int,
     params: dict,
-    chunks: Iterable,
+    chunks: Iterable[Chunk],
     progress: Callable[[int], None] | None = None,
 ) -> None:
     """Stream generated :class:`eyeviz.dataset.Chunk` objects into ``path``."""
@@ -400,32 +464,38 @@ def write_chunks(
         if fmt == "csv":
             # two buffers: chunk k+1 is encoded while chunk k is written; encoding k+2
             # into k's buffer starts only after out() has waited for k's write
-            encs = (CsvEncoder(m, CHUNK), CsvEncoder(m, CHUNK))
+            rows = block_rows(2 * m, CHUNK)
+            encs = (CsvEncoder(m, rows), CsvEncoder(m, rows))
+            k = 0
             with (
                 open(tmp, "wb", buffering=0) as f,
                 _Overlapped(functools.partial(write_parts, f)) as out,
             ):
-                for i, c in enumerate(chunks):
-                    out(_encode_csv_chunk(encs[i % 2], c))
+                for c in chunks:
+                    for cols in _blocks(c, rows):
+                        out(encs[k % 2].encode_intervals(*cols))
+                        k += 1
                     if progress:
                         progress(len(c))
         else:
             meta = {"version": NPZ_VERSION, "m": m, "n": n, "params": params}
-            with _NpzWriter(tmp, m, n, meta) as wr, _Overlapped(wr.f.write) as out:
+            rows = block_rows(npz_dtype(m).itemsize, CHUNK)
+            with _NpzWriter(tmp, m, n, meta) as wr, _Overlapped(wr.write) as out:
                 for c in chunks:
-                    out(wr.rows_from_intervals(c.r, c.phi, c.g, c.la, c.ra, c.lb, c.rb))
+                    for cols in _blocks(c, rows):
+                        out(wr.rows_from_intervals(*cols))
                     if progress:
                         progress(len(c))
 
 
-def save(ds, path) -> None:
+def save(ds: Dataset, path: str | os.PathLike) -> None:
     """Write a data set; refuses rows :func:`load` would refuse (NaN r, bits 3 or 255)."""
     from eyeviz.dataset.reader import check_rows
 
     fmt = format_of(path)
     n, m = len(ds), ds.eyes.m
     check_rows(ds.omega_a, ds.omega_b, ds.r, ds.phi, ds.g, m)
-    step = 1 << 14
+    step = block_rows(2 * m if fmt == "csv" else npz_dtype(m).itemsize, 1 << 14)
     with atomic_output(path) as tmp:
         if fmt == "csv":
             with_g = not bool(np.all(np.isnan(ds.g))) if n else True
@@ -450,7 +520,7 @@ def save(ds, path) -> None:
             with _NpzWriter(tmp, m, n, meta) as wr:
                 for s in range(0, n, step):
                     sl = slice(s, s + step)
-                    wr.f.write(
+                    wr.write(
                         wr.rows_from_bitmaps(
                             ds.omega_a[sl], ds.omega_b[sl], ds.r[sl], ds.phi[sl], ds.g[sl]
                         )
@@ -462,7 +532,7 @@ def save(ds, path) -> None:
 _READER_NAMES = ("BLOCK_ROWS", "Block", "BlockReader", "check_rows", "iter_blocks", "load")
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> Any:
     if name in _READER_NAMES:
         from eyeviz.dataset import reader
 

@@ -336,6 +336,7 @@ def fit(
     staged then swapped in. Returns the .npz path for ``load(path=...)``."""
     from eyeviz.core.validation import check_int
     from eyeviz.estimators.store import staged, user_models_dir
+    from eyeviz.files import limits
 
     if data is not None:
         raise EyevizError(
@@ -343,7 +344,7 @@ def fit(
         )
     if not filename.endswith(".npz") or "/" in filename:
         raise EyevizError(f"bayes output must be a .npz file name, got {filename!r}")
-    n = check_int("n", n, ge=1)
+    n = check_int("n", n, ge=1, le=limits.MAX_ROWS)
     dom = PAPER_DOMAIN if domain is None else domain
     out = Path(out_dir) if out_dir is not None else user_models_dir()
     table = build_table(n, dom, seed, progress)

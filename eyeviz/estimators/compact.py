@@ -21,9 +21,11 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import torch
@@ -37,6 +39,9 @@ from eyeviz.files.atomic import atomic_output
 from eyeviz.files.npz import one_line
 from eyeviz.resources import models_dir
 
+if TYPE_CHECKING:
+    from eyeviz.dataset import Dataset
+
 __all__ = ["CompactEstimator", "CompactNet", "features", "load", "train", "default_dir"]
 
 N_FEATURES = 11
@@ -47,7 +52,9 @@ def default_dir() -> Path:
     return models_dir()
 
 
-def features(LA, RA, LB, RB, domain: Domain = PAPER_DOMAIN):
+def features(
+    LA: np.ndarray, RA: np.ndarray, LB: np.ndarray, RB: np.ndarray, domain: Domain = PAPER_DOMAIN
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(X float32 (N, 11), log r_analytic, phi_analytic) from interval arrays."""
     la, ra, lb, rb = (np.asarray(v, np.float64) for v in (LA, RA, LB, RB))
     gam = 2.0 * math.pi / domain.m
@@ -86,8 +93,10 @@ class CompactNet(nn.Module):
             nn.Linear(hidden, 1),
         )
         if zero_last:
-            nn.init.zeros_(self.net[-1].weight)
-            nn.init.zeros_(self.net[-1].bias)
+            last = self.net[-1]
+            assert isinstance(last, nn.Linear)
+            nn.init.zeros_(last.weight)
+            nn.init.zeros_(last.bias)
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         return self.net(x).squeeze(-1)
@@ -113,7 +122,9 @@ class CompactEstimator(Estimator):
         self.dd = dd.eval()
         self.ad = ad.eval()
 
-    def _predict_intervals(self, LA, RA, LB, RB):
+    def _predict_intervals(
+        self, LA: np.ndarray, RA: np.ndarray, LB: np.ndarray, RB: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
         x, log_r0, p0 = features(LA, RA, LB, RB, self.domain)
         # Blocks of <= 65536 rows through nets this small run fastest on one thread:
         # the intra-op thread pool costs more in synchronisation than it saves.
@@ -131,7 +142,7 @@ class CompactEstimator(Estimator):
         return np.exp(log_r0 + d), p0 + AD_SCALE * a
 
 
-def _atomic(path: Path, write: Callable[[str], None]) -> None:
+def _atomic(path: Path, write: Callable[[str], object]) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_output(path) as tmp:
         write(str(tmp))
@@ -213,7 +224,7 @@ def _load_net(path: Path) -> CompactNet:
     return net
 
 
-def _member(d: Path, files, key: str) -> Path:
+def _member(d: Path, files: object, key: str) -> Path:
     """``files[key]`` of compact.json: a relative path inside the model directory."""
     meta_f = d / "compact.json"
     name = files.get(key) if isinstance(files, dict) else None
@@ -229,7 +240,7 @@ def _member(d: Path, files, key: str) -> Path:
     return d / rel
 
 
-def load(path=None, domain: Domain | None = None) -> CompactEstimator:
+def load(path: str | os.PathLike | None = None, domain: Domain | None = None) -> CompactEstimator:
     """Weights from ``path`` (a directory with compact.json), default assets/models/.
 
     Every problem with the directory is one EyevizError line naming the file: compact.json
@@ -270,14 +281,18 @@ def load(path=None, domain: Domain | None = None) -> CompactEstimator:
 # --- training (eyeviz.estimators.compact_training) -------------------------------------------
 
 
-def train(*args, **kw) -> dict:
+def train(*args: Any, **kw: Any) -> dict:
     """Train both nets and save them; see :func:`eyeviz.estimators.compact_training.train`."""
     from eyeviz.estimators import compact_training
 
     return compact_training.train(*args, **kw)
 
 
-def fit(data=None, out_dir=None, **options) -> Path:
+def fit(
+    data: Dataset | str | os.PathLike | None = None,
+    out_dir: str | os.PathLike | None = None,
+    **options: Any,
+) -> Path:
     """The registry's training shape; see :func:`eyeviz.estimators.compact_training.fit`."""
     from eyeviz.estimators import compact_training
 

@@ -4,11 +4,14 @@ one training shape. Imports torch."""
 
 from __future__ import annotations
 
+import functools
 import json
 import math
+import os
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -26,11 +29,15 @@ from eyeviz.estimators.compact import (
     features,
 )
 from eyeviz.estimators.store import staged, user_models_dir
+from eyeviz.files import limits
+
+if TYPE_CHECKING:
+    from eyeviz.dataset import Dataset
 
 __all__ = ["train", "fit"]
 
 
-def _generate(n: int, domain: Domain, seed: int, mode: str = "single"):
+def _generate(n: int, domain: Domain, seed: int, mode: str = "single") -> dict[str, np.ndarray]:
     from eyeviz import dataset
 
     p = dataset.make_params(domain.eyes, domain.r_min, domain.r_max, domain.g_max, mode, seed)
@@ -43,11 +50,11 @@ def _generate(n: int, domain: Domain, seed: int, mode: str = "single"):
 
 def _fit(
     net: CompactNet,
-    x,
-    y,
-    xv,
-    yv,
-    predict: Callable,
+    x: torch.Tensor,
+    y: torch.Tensor,
+    xv: torch.Tensor,
+    yv: torch.Tensor,
+    predict: Callable[[torch.Tensor, torch.Tensor], torch.Tensor],
     epochs: int,
     batch: int,
     lr: float,
@@ -94,7 +101,7 @@ def _fit(
 
 
 def train(
-    out_dir=None,
+    out_dir: str | os.PathLike | None = None,
     n_train: int = 1_000_000,
     n_val: int = 100_000,
     seed: int = 0,
@@ -108,7 +115,7 @@ def train(
     threads: int = 2,
     command: str | None = None,
     progress: Callable[[str, int, int, float], None] | None = None,
-    data=None,
+    data: Dataset | None = None,
 ) -> dict:
     """Generate data (single pass, seeds ``seed`` and ``seed + 1``), train both nets, save.
 
@@ -120,10 +127,11 @@ def train(
     Returns the metadata.
     """
     batch = check_int("batch", batch, ge=1)
-    n_train = check_int("n_train", n_train, ge=1)
-    n_val = check_int("n_val", n_val, ge=1)
+    n_train = check_int("n_train", n_train, ge=1, le=limits.MAX_ROWS)
+    n_val = check_int("n_val", n_val, ge=1, le=limits.MAX_ROWS)
     epochs = check_int("epochs", epochs, ge=1)
     lr = check_real("lr", lr, gt=0)
+    threads = check_int("threads", threads, ge=1, le=limits.MAX_THREADS)
     t0 = time.perf_counter()
     if data is None:
         if n_train < batch:
@@ -165,7 +173,7 @@ def train(
         )
 
 
-def _split(data, seed: int, domain: Domain) -> tuple[dict, dict]:
+def _split(data: Dataset, seed: int, domain: Domain) -> tuple[dict, dict]:
     """Single-feature rows of a data set as interval columns, split 90/10 (seeded)."""
     from eyeviz.estimators.base import bitmaps_to_intervals
 
@@ -187,30 +195,32 @@ def _split(data, seed: int, domain: Domain) -> tuple[dict, dict]:
 
 def _train_into(
     out: Path,
-    tr,
-    va,
-    t0,
-    t_gen,
-    n_train,
-    n_val,
-    seed,
-    epochs,
-    hidden,
-    hidden_ad,
-    batch,
-    lr,
-    patience,
-    domain,
-    threads,
-    command,
-    progress,
-    source,
+    tr: dict[str, np.ndarray],
+    va: dict[str, np.ndarray],
+    t0: float,
+    t_gen: float,
+    n_train: int,
+    n_val: int,
+    seed: int,
+    epochs: int,
+    hidden: int,
+    hidden_ad: int,
+    batch: int,
+    lr: float,
+    patience: int,
+    domain: Domain,
+    threads: int,
+    command: str | None,
+    progress: Callable[[str, int, int, float], None] | None,
+    source: str,
 ) -> dict:
     """The body of :func:`train`, writing into the staging directory ``out``."""
     torch.set_num_threads(threads)
     torch.manual_seed(seed)
 
-    def prep(d):
+    def prep(
+        d: dict[str, np.ndarray],
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
         x, log_r0, p0 = features(d["la"], d["ra"], d["lb"], d["rb"], domain)
         return (
             torch.from_numpy(x),
@@ -222,14 +232,14 @@ def _train_into(
     x, yd, ya, sa = prep(tr)
     xv, ydv, yav, sav = prep(va)
 
-    def dd_loss(out, y):
+    def dd_loss(out: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
         return (torch.exp(out - y) - 1.0).abs().mean()
 
     # AD: |phi_hat - phi| / phi with phi_hat - phi = AD_SCALE * (out - y)
     ya_pair = torch.stack([ya, sa], 1)
     yav_pair = torch.stack([yav, sav], 1)
 
-    def ad_loss(out, y):
+    def ad_loss(out: torch.Tensor, y: torch.Tensor) -> torch.Tensor:
         return ((out - y[:, 0]).abs() / y[:, 1]).mean()
 
     files = {"dd": "compact_dd.pt", "ad": "compact_ad.pt"}
@@ -255,7 +265,7 @@ def _train_into(
             lr,
             patience,
             seed,
-            lambda n_, p=path, w=width: _save_net(n_, w, p),
+            functools.partial(_save_net, hidden=width, path=path),
             progress,
             name.upper(),
         )
@@ -307,8 +317,8 @@ def _train_into(
 
 
 def fit(
-    data=None,
-    out_dir=None,
+    data: Dataset | str | os.PathLike | None = None,
+    out_dir: str | os.PathLike | None = None,
     *,
     domain: Domain | None = None,
     n: int = 1_000_000,
@@ -325,11 +335,11 @@ def fit(
     """The registry's training shape: train on ``data`` (a Dataset or a .csv/.npz path;
     None: generate ``n`` + ``n_val`` elements in ``domain``) into ``out_dir`` (default the
     user models directory), staged then swapped in. Returns the directory for ``load``."""
-    import os
 
-    for k, v in (("hidden", hidden), ("hidden_ad", hidden_ad), ("patience", patience)):
-        check_int(k, v, ge=1)
-    threads = check_int("threads", threads, ge=1)
+    for k, v in (("hidden", hidden), ("hidden_ad", hidden_ad)):
+        check_int(k, v, ge=1, le=limits.MAX_HIDDEN)  # what load() reads back
+    check_int("patience", patience, ge=1)
+    threads = check_int("threads", threads, ge=1, le=limits.MAX_THREADS)
     dom = PAPER_DOMAIN if domain is None else domain
     if isinstance(data, str | os.PathLike):
         from eyeviz import dataset

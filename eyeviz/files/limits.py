@@ -16,6 +16,11 @@ from eyeviz import EyevizError
 
 #: Rows of a generated data set (``eyeviz generate -n``).
 MAX_ROWS = 10**9
+#: Threads of one process (``--threads``; torch overflows on larger counts).
+MAX_THREADS = 1024
+#: Largest learning rate a training option takes (beyond it the nets only diverge, and
+#: above 3.4e38 torch cannot even hold it as a float32).
+MAX_LR = 10.0
 #: Ommatidia per eye pair m (exactness of the interval formulas ends near 2**53 / 2; the
 #: app and the bitmaps need m/2 bytes per row and eye, so the practical bound is far lower).
 MAX_M = 1 << 20

@@ -124,7 +124,9 @@ class LegacyEyePair:
             if dx[i] == 0 and ya[i] == 0:
                 out[i] = 0
                 continue
-            out[i] = exact.exact_floor_pair(float(xa[i]), float(ya[i]), 0.0, cx, self.m)[1]
+            pair = exact.exact_floor_pair(float(xa[i]), float(ya[i]), 0.0, cx, self.m)
+            assert pair is not None  # a point (g = 0) off the eye centre is never around it
+            out[i] = pair[1]
         return np.mod(out, self.m).reshape(shape)
 
     # --- features ---------------------------------------------------------------------
@@ -217,7 +219,9 @@ class LegacyEyePair:
         """
         return self._intervals(x, y, g)
 
-    def _intervals(self, x, y, g, refine: bool = True) -> tuple[np.ndarray, ...]:
+    def _intervals(
+        self, x, y, g, refine: bool = True
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         xa, ya, ga = validate_features(x, y, g)
         shape = xa.shape
         xf, yf, gf = (np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, ga))
@@ -225,7 +229,7 @@ class LegacyEyePair:
         for cx in (-self.h, self.h):
             L, R = self._normalised(*self._eye_floors(xf, yf, gf, cx, refine))
             out += [L.reshape(shape), R.reshape(shape)]
-        return tuple(out)
+        return out[0], out[1], out[2], out[3]
 
     def bitmaps(self, x, y, g) -> tuple[np.ndarray, np.ndarray]:
         """Whole-eye bitmaps (omega_a, omega_b), bool of shape (..., m)."""

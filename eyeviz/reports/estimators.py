@@ -24,11 +24,16 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from eyeviz.core.domain import DEFAULTS as _D
+from eyeviz.files import limits
 from eyeviz.model.palette import ESTIMATOR_COLORS, estimator_color
+
+if TYPE_CHECKING:
+    from eyeviz.estimators.base import Estimator, Prediction
 
 HELP = "estimators' AD/DD error, training and inference time (error against run time)"
 
@@ -37,7 +42,7 @@ TEST_SETS = ("single", "multi")
 TARGETS = (("ad", "phi"), ("dd", "r"))
 
 # Table 5 of the paper, quoted. Its R^2 is Eq. 35 (spread of the predictions).
-PAPER_TABLE5 = {
+PAPER_TABLE5: dict[str, Any] = {
     "ad": {
         "mape": 0.832,
         "r2": 0.998,
@@ -156,7 +161,7 @@ def make_test_sets(n: int, seed: int = TEST_SEED) -> dict:
     return {mode: dataset.generate(n, mode=mode, seed=seed + i) for i, mode in enumerate(TEST_SETS)}
 
 
-def _time_batched(est, oa, ob) -> tuple[object, float]:
+def _time_batched(est: Estimator, oa: np.ndarray, ob: np.ndarray) -> tuple[Prediction, float]:
     t = time.perf_counter()
     pred = est.predict(oa, ob)
     best = time.perf_counter() - t
@@ -201,7 +206,7 @@ def measure_one(name: str, est, test_sets: dict) -> Result:
         pred, secs = _time_batched(est, data.omega_a, data.omega_b)
         r_hat, phi_hat = pred
         valid = np.asarray(getattr(pred, "valid", np.isfinite(r_hat)))
-        entry = {"n": int(len(data.r)), "n_valid": int(valid.sum())}
+        entry: dict[str, Any] = {"n": int(len(data.r)), "n_valid": int(valid.sum())}
         for key, col in TARGETS:
             truth = data.phi if col == "phi" else data.r
             entry[key] = accuracy_metrics(truth, phi_hat if col == "phi" else r_hat)
@@ -435,6 +440,7 @@ def plot(results: list[Result]):
         for i, r in enumerate(ok):
             c = estimator_color(r.name)
             size = 45 + 45 * (len(ok) - 1 - i)  # coincident points show as concentric rings
+            assert r.batched_us is not None  # ok keeps only timed results
             x = r.batched_us * 1e-6
             y = r.metrics["single"][key]["mape"]
             if r.single_ms and math.isfinite(y):
@@ -567,8 +573,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    if args.n_test < 10:
-        raise ValueError(f"--n-test must be >= 10, got {args.n_test}")
+    limits.check_int("--n-test", args.n_test, 10, limits.MAX_ROWS)
     names = parse_names(args.estimators)
     bar = tqdm(total=len(names), desc="estimators", unit="est", leave=False)
 

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
 
 HELP = "numerical stability of the geometry against an 80-digit reference"
@@ -26,6 +27,8 @@ HELP = "numerical stability of the geometry against an 80-digit reference"
 METHODS = ("paper float64", "paper float32", "eyeviz core")
 OLD = "eyeviz core, before issue 14"
 TIMED = (*METHODS, OLD, "reference (mpmath)")
+#: Most features per case class (-n): each needs an 80-digit mpmath reference.
+MAX_N = 100_000
 
 
 @dataclass
@@ -205,8 +208,7 @@ def write(rows: list[Row], outdir: Path) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.n < 1:
-        raise ValueError(f"-n must be >= 1, got {args.n}")
+    limits.check_int("-n", args.n, 1, MAX_N)
     from tqdm import tqdm
 
     from eyeviz.reference import stability_cases

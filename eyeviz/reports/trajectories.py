@@ -33,6 +33,8 @@ from pathlib import Path
 
 import numpy as np
 
+from eyeviz import EyevizError
+from eyeviz.files import limits
 from eyeviz.model.palette import estimator_color
 from eyeviz.reports.estimators import (
     parse_names,
@@ -46,6 +48,8 @@ HELP = "accuracy along the paper's test trajectories (Section 6, Figures 15-17)"
 G_VALUES = (5.0, 50.0, 500.0)
 DISTANCES = tuple(float(r) for r in range(1000, 10001, 1000))
 KINDS = ("horizontal", "circular", "vertical")
+#: Most features per trajectory (--min-count, --max-count).
+MAX_COUNT = 100_000
 TRAIN_R = (1000.0, 5000.0)
 LIMIT_DOMAIN_KW = dict(r_min=1000.0, r_max=10000.0)  # the limit's prior covers every trajectory
 
@@ -131,7 +135,7 @@ def measure(
             from eyeviz.estimators import load
             from eyeviz.estimators.base import Domain
 
-            loaded[name] = load("limit", domain=Domain(**LIMIT_DOMAIN_KW), prior="single")
+            loaded[name] = load("limit", domain=Domain.from_dict(LIMIT_DOMAIN_KW), prior="single")
             continue
         est, why = try_load(name)
         if est is None:
@@ -442,10 +446,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    if args.min_count < 1:
-        raise ValueError(f"--min-count must be >= 1, got {args.min_count}")
+    limits.check_int("--min-count", args.min_count, 1, MAX_COUNT)
+    limits.check_int("--max-count", args.max_count, 1, MAX_COUNT)
     if args.max_count < args.min_count:
-        raise ValueError(
+        raise EyevizError(
             f"--max-count must be >= --min-count, got {args.max_count} < {args.min_count}"
         )
     names = parse_names(args.estimators)

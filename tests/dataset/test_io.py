@@ -294,3 +294,37 @@ def test_iter_blocks_memory_is_bounded(tmp_path):
     assert total == int(whole.omega_a.sum())
     print(f"peak traced: blocks {peak_blocks / 1e6:.1f} MB, load {peak_load / 1e6:.1f} MB")
     assert peak_blocks * 10 < peak_load
+
+
+@pytest.mark.parametrize("fmt", ["csv", "npz"])
+def test_wide_rows_written_in_blocks_give_the_same_bytes(tmp_path, monkeypatch, fmt):
+    """Chunks are cut into blocks of at most _BLOCK_BYTES (memory bounded at any m); a
+    tiny budget (blocks of a few rows, across chunk ends) writes the same file."""
+    kw = dict(eyes=EYES, r_min=100.0, r_max=400.0, g_max=60.0, seed=5)
+    whole, blocks = tmp_path / f"a.{fmt}", tmp_path / f"b.{fmt}"
+    D.write(whole, 20_000, **kw)  # two generated chunks (CHUNK = 16384)
+    monkeypatch.setattr(dio, "_BLOCK_BYTES", 700)  # 5 CSV rows, 7 NPZ rows at m = 64
+    assert dio.block_rows(2 * EYES.m, 1 << 14) == 5
+    D.write(blocks, 20_000, **kw)
+    assert blocks.read_bytes() == whole.read_bytes()
+    ds = D.load(whole)
+    D.save(ds, saved := tmp_path / f"c.{fmt}")  # save() blocks the same way
+    assert D.load(saved).r.tobytes() == ds.r.tobytes()
+
+
+@pytest.mark.parametrize("fmt", ["csv", "npz"])
+def test_generate_at_the_largest_m_stays_in_bounded_memory(tmp_path, fmt):
+    """m = limits.MAX_M used to need a 16384-row buffer of 2m bytes per row (32 GiB for
+    CSV: `out of memory`); the write now works in blocks of <= 64 MiB."""
+    from eyeviz.files import limits
+
+    m = limits.MAX_M
+    eyes = EyePair(40.0, 20.0, m)
+    p = tmp_path / f"wide.{fmt}"
+    tracemalloc.start()
+    D.write(p, 3, eyes=eyes, seed=1)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    assert peak < 600 << 20, peak
+    ds = D.load(p)
+    assert ds.omega_a.shape == (3, m // 2) and ds.eyes.m == m

@@ -155,15 +155,15 @@ def test_train_bayes_npz_name_into_user_dir(tmp_path):
 @pytest.mark.parametrize(
     "args, message",
     [
-        (["paper", "--ad-lr", "nan"], "ad_lr must be a finite number > 0, got nan"),
-        (["paper", "--ad-lr", "inf"], "ad_lr must be a finite number > 0, got inf"),
-        (["paper", "--ad-lr", "0"], "ad_lr must be a finite number > 0, got 0.0"),
+        (["paper", "--ad-lr", "nan"], "ad_lr must be a finite number > 0 and <= 10, got nan"),
+        (["paper", "--ad-lr", "inf"], "ad_lr must be a finite number > 0 and <= 10, got inf"),
+        (["paper", "--ad-lr", "0"], "ad_lr must be a finite number > 0 and <= 10, got 0.0"),
         (["paper", "--dd-momentum", "1", "-n", "20"], "dd_momentum must be"),
         (["paper", "-n", "5"], "n must be an integer >= 10, got 5"),
         (["paper", "--budget", "-3"], "budget must be a finite number > 0"),
         (["compact", "-n", "1000"], "-n must be >= 4096 (one batch"),
-        (["compact", "--threads", "0"], "threads must be an integer >= 1, got 0"),
-        (["bayes", "-n", "0"], "n must be an integer >= 1, got 0"),
+        (["compact", "--threads", "0"], "threads must be an integer >= 1 and <= 1024, got 0"),
+        (["bayes", "-n", "0"], "n must be an integer >= 1 and <= 1e+09, got 0"),
     ],
 )
 def test_bad_training_options_one_line(tmp_path, args, message):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import FormatStrFormatter, MaxNLocator
@@ -38,9 +39,9 @@ class Canvas:
     fig: Figure
     dpi: float
     merge: bool | None
-    ax: object = None
-    inset: object = None
-    eye_ax: object = None
+    ax: Axes = field(init=False)  # set by make_canvas
+    inset: Axes | None = None
+    eye_ax: Axes = field(init=False)  # the inset if there is one, else ax
     xlim: tuple[float, float] = (0.0, 1.0)
     ylim: tuple[float, float] = (0.0, 1.0)
     units_per_in: float = 1.0
@@ -56,7 +57,7 @@ class Canvas:
     def pair(self):
         return self.frame.pair
 
-    def eye_axes(self) -> list:
+    def eye_axes(self) -> list[Axes]:
         return [self.ax] + ([self.inset] if self.inset is not None else [])
 
     def to_inches(self, x: float, y: float) -> tuple[float, float]:

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from eyeviz import EyevizError
 from eyeviz.files.atomic import atomic_output
+from eyeviz.render.mpl.style import BASE_DPI, WIDTHS
 
 __all__ = ["FORMATS", "export", "format_of"]
 
@@ -30,6 +31,14 @@ def format_of(path) -> str:
     return FORMATS[suffix]
 
 
+#: PNG scale bounds (the app's export dialog offers the same range).
+SCALE_MIN, SCALE_MAX = 0.25, 20.0
+#: Widest PNG, in pixels: a single column at the largest scale (21000 x 28740 px, 15 s).
+#: A double-width or 10 inch figure gets a smaller largest scale (a 10 in figure at scale
+#: 20 was 60000 px wide: gigabytes of pixels, minutes of drawing).
+MAX_PNG_PX = round(WIDTHS["single"] * BASE_DPI * SCALE_MAX)
+
+
 def _check_scale(scale) -> float:
     try:
         s = float(scale)
@@ -37,8 +46,15 @@ def _check_scale(scale) -> float:
         raise EyevizError(f"scale must be a number > 0, got {scale!r}") from None
     if not math.isfinite(s) or s <= 0:
         raise EyevizError(f"scale must be a finite number > 0, got {scale!r}")
-    if s > 20:
-        raise EyevizError(f"scale must be <= 20 (a {s:g}x PNG would be huge), got {scale!r}")
+    if s < SCALE_MIN:
+        raise EyevizError(
+            f"scale must be >= {SCALE_MIN:g} ({BASE_DPI * SCALE_MIN:g} dpi; a smaller "
+            f"PNG has no readable text), got {scale!r}"
+        )
+    if s > SCALE_MAX:
+        raise EyevizError(
+            f"scale must be <= {SCALE_MAX:g} (a {s:g}x PNG would be huge), got {scale!r}"
+        )
     return s
 
 
@@ -76,6 +92,14 @@ def export(
 
     from eyeviz.render.mpl import vector
 
+    if fmt == "png":
+        w_in = vector.resolve_width(width)
+        px = w_in * BASE_DPI * scale
+        if px > MAX_PNG_PX:
+            raise EyevizError(
+                f"scale {scale:g} at width {w_in:g} in makes a PNG {px:,.0f} px wide; at most "
+                f"{MAX_PNG_PX} px: scale <= {MAX_PNG_PX / (w_in * BASE_DPI):.3g} at this width"
+            )
     dpi = vector.BASE_DPI * scale if fmt == "png" else vector.VECTOR_DPI
     fig = vector.figure(
         scene,

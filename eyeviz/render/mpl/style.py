@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from eyeviz.model.palette import estimator_colors
+
+if TYPE_CHECKING:
+    from matplotlib.typing import RcKeyType
 
 __all__ = ["RC", "FONT", "SMALL", "estimator_colors", "mix", "dark", "slug", "short", "legend"]
 
@@ -28,7 +33,7 @@ BFV_FILL = "#EDE8CC"
 BFV_LINE = "#736B4D"
 OUT_OF_DOMAIN = "#A6A6A6"
 
-RC = {
+RC: dict[RcKeyType, Any] = {
     "svg.fonttype": "none",
     "pdf.fonttype": 42,
     "ps.fonttype": 42,

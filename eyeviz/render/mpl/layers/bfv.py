@@ -58,6 +58,7 @@ def _angles(cv: Canvas) -> None:
     """psi and theta (Figures 5-6), where the origin is in the view; theta's label goes to
     the first radius along the bisector where it covers no feature."""
     b, ax, upi = cv.frame.bfv, cv.ax, cv.units_per_in
+    assert b is not None  # paint() returned before when the frame has no BFV
     p = cv.pair
     vh = cv.ylim[1] - cv.ylim[0]
     if not (cv.xlim[0] <= 0 <= cv.xlim[1] and cv.ylim[0] <= 0 <= cv.ylim[1]):

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from matplotlib.patches import Circle, Polygon, Wedge
+from matplotlib.patches import Circle, Patch, Polygon, Wedge
 
 from eyeviz.render.mpl.canvas import Canvas
 from eyeviz.render.mpl.style import EDGE, GREY, INK, SMALL, UNLIT
@@ -54,6 +54,7 @@ def paint(cv: Canvas) -> None:
         cx, cy = eye.center
         if merge:
             for s, e, c in zip(*(a.tolist() for a in eye.runs), strict=True):
+                patch: Patch
                 if e - s == p.m:
                     patch = Circle((cx, cy), p.l)
                 else:

@@ -12,7 +12,9 @@ from eyeviz.render.mpl.style import FONT, HALO, INK, OUT_OF_DOMAIN, SMALL, dark,
 
 
 def color_of(cv: Canvas, i: int) -> str:
-    return OUT_OF_DOMAIN if cv.frame.out_of_domain[i] else cv.frame.colors[i]
+    ood = cv.frame.out_of_domain
+    assert ood is not None  # build_frame always sets it
+    return OUT_OF_DOMAIN if ood[i] else cv.frame.colors[i]
 
 
 def paint(cv: Canvas) -> None:

@@ -18,6 +18,8 @@ def paint(cv: Canvas) -> None:
     fr, ax = cv.frame, cv.ax
     if not fr.n:
         return
+    ood = fr.out_of_domain
+    assert ood is not None  # build_frame always sets it
     handles = []
     for name, pred in fr.predictions.items():
         if not isinstance(pred, PredictionFrame):
@@ -25,7 +27,7 @@ def paint(cv: Canvas) -> None:
         col = estimator_color(name)
         for i, fname in enumerate(fr.names):
             px, py = float(pred.x_hat[i]), float(pred.y_hat[i])
-            if fr.out_of_domain[i] or not (math.isfinite(px) and math.isfinite(py)):
+            if ood[i] or not (math.isfinite(px) and math.isfinite(py)):
                 continue
             ax.plot(
                 [fr.x[i], px],
@@ -60,7 +62,7 @@ def paint(cv: Canvas) -> None:
                 label=f"{name} (predicted)",
             )
         )
-    if fr.out_of_domain.any():
+    if ood.any():
         handles.append(
             Line2D(
                 [],

@@ -114,6 +114,8 @@ def paint(cv: Canvas) -> None:
     if box is None:
         return
     fr = cv.frame
+    ood = fr.out_of_domain
+    assert ood is not None  # build_frame always sets it
     ax = cv.fig.add_axes(box.frac(cv.lay.width, cv.lay.height))
     ax.set_gid("readout")
     ax.axis("off")
@@ -152,7 +154,7 @@ def paint(cv: Canvas) -> None:
     ax.plot([0, rights[-1]], [y - dy / 2, y - dy / 2], color=LIGHT, lw=0.4)
     for i in range(fr.n):
         y -= dy
-        col = OUT_OF_DOMAIN if fr.out_of_domain[i] else dark(fr.colors[i])
+        col = OUT_OF_DOMAIN if ood[i] else dark(fr.colors[i])
         for j, ((_, ha), x, v) in enumerate(zip(COLUMNS, xs, cells[i], strict=True)):
             ax.text(
                 x,
@@ -175,7 +177,7 @@ def paint(cv: Canvas) -> None:
                     ha="left",
                     va="center",
                     fontsize=SMALL,
-                    color=OUT_OF_DOMAIN if fr.out_of_domain[i] else estimator_color(name),
+                    color=OUT_OF_DOMAIN if ood[i] else estimator_color(name),
                     gid=f"readout-prediction-{slug(name)}-{i}",
                 )
         if "ambiguity" in cv.layers:

@@ -13,6 +13,8 @@ from eyeviz.render.mpl.style import HALO, SMALL, arc, dark, slug, subscripted
 
 def paint(cv: Canvas) -> None:
     fr = cv.frame
+    rA, rB = fr.rA, fr.rB
+    assert rA is not None and rB is not None  # the tangents layer needs the readout
     for t in fr.tangents:
         i = t.feature
         col = dark(fr.colors[i])
@@ -33,7 +35,7 @@ def paint(cv: Canvas) -> None:
             if not thin:
                 ax.plot([cx, fr.x[i]], [cy, fr.y[i]], color=col, lw=0.4, ls=(0, (3, 2)), zorder=7)
         # the angle arcsin(g/r_E) for the nearer eye, where it reads
-        if (t.eye == "A") != (fr.rA[i] < fr.rB[i]):
+        if (t.eye == "A") != (rA[i] < rB[i]):
             continue
         upi = cv.eye_units_per_in
         rad = min(0.5 * (t.r_e - fr.g[i]), 0.6 * upi)
