@@ -5,7 +5,8 @@ Flow (DESIGN.md §2): a Qt event becomes a model call (canvas.py -> eyeviz.model
 -> the model notifies -> ``compute_state`` -> :class:`SceneActors` and the panels redraw.
 The other jobs live beside it: menus and undo (actions.py), files and unsaved changes
 (files.py), the canvas event bridge and cameras (canvas.py), screenshots (screenshot.py),
-background work (jobs.py), settings (settings.py) and start-up (launch.py).
+background work (jobs.py), settings (settings.py), start-up (launch.py) and the side
+docks (side_docks.py).
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ from eyeviz.app.panels import (
 )
 from eyeviz.app.screenshot import qimage_to_array
 from eyeviz.app.settings import Settings, make_settings
+from eyeviz.app.side_docks import SideDocksMixin
 from eyeviz.app.view import VtkView, fast_renderer
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import Scene
@@ -50,22 +52,8 @@ __all__ = [
     "run_app",
 ]
 
-SIDE_MAX_FRACTION = 0.45  # the side panels never take more than this of the window width
-SIDE_MIN_PX = 260
-SIDE_START_PX = 460  # the side panels' first width: the readout's values and all tabs show
-DOCK_MIN_PX = 120
 
-
-class _SideScroll(QtWidgets.QScrollArea):
-    """A side panel's scroll area asking for SIDE_START_PX of width: the dock area starts
-    wide enough for the readout's values and every tab name (Qt sizes docks by their
-    hints; resizeDocks did not hold)."""
-
-    def sizeHint(self) -> QtCore.QSize:  # noqa: N802 (Qt name)
-        return QtCore.QSize(SIDE_START_PX, super().sizeHint().height())
-
-
-class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
+class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow):
     def __init__(
         self, scene: Scene, path: str | os.PathLike | None = None, settings: Settings | None = None
     ):
@@ -158,37 +146,6 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         self.fit_inset()
         self._on_model("scene", None)
         self._update_title()
-
-    # --- construction ---------------------------------------------------------------
-    def _dock(self, title: str, widget: QtWidgets.QWidget, name: str) -> QtWidgets.QDockWidget:
-        d = QtWidgets.QDockWidget(title, self)
-        d.setObjectName(f"dock_{name}")
-        # in a scroll area: a tall panel scrolls instead of making the window taller than a
-        # 1280x720 projector (issue 12 item 7)
-        scroll = _SideScroll()
-        scroll.setWidgetResizable(True)
-        scroll.setFrameShape(QtWidgets.QFrame.NoFrame)
-        scroll.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarAlwaysOff)
-        scroll.setWidget(widget)
-        scroll.setMinimumWidth(min(widget.minimumSizeHint().width(), SIDE_MIN_PX))
-        scroll.setMinimumHeight(DOCK_MIN_PX)
-        d.setWidget(scroll)
-        d.setFeatures(
-            QtWidgets.QDockWidget.DockWidgetMovable | QtWidgets.QDockWidget.DockWidgetFloatable
-        )
-        self.addDockWidget(QtCore.Qt.RightDockWidgetArea, d)
-        self._limit_dock(d)
-        return d
-
-    def _limit_dock(self, d: QtWidgets.QDockWidget) -> None:
-        """A dock never takes more than SIDE_MAX_FRACTION of the window's width: a long
-        message wraps inside it instead of widening the side panel (issue 12 item 7)."""
-        d.setMaximumWidth(max(SIDE_MIN_PX, int(self.width() * SIDE_MAX_FRACTION)))
-
-    def resizeEvent(self, ev) -> None:  # noqa: N802 (Qt name)
-        for d in self._docks.values():
-            self._limit_dock(d)
-        super().resizeEvent(ev)
 
     # --- settings -------------------------------------------------------------------
     def _restore_settings(self) -> None:
@@ -294,76 +251,6 @@ class MainWindow(CanvasMixin, FilesMixin, QtWidgets.QMainWindow):
         amb = self.model.ambiguity
         self.overlays.update(scene, st, self.model.selected, preds, amb, path, skip=skip)
         self.posterior_actors.update(scene, self.model.selected)  # cached per key
-
-    def _refresh_docks(self, scene: Scene) -> None:
-        """The predictions and trajectory docks, built the first time they are needed."""
-        if scene.shows("predictions"):
-            if self.picker is None:
-                from eyeviz.app.docks import EstimatorPicker
-
-                self.picker = EstimatorPicker(self.model)
-                self._docks["predictions"] = self._dock("Estimators", self.picker, "predictions")
-                self.tabifyDockWidget(self._docks["features"], self._docks["predictions"])
-            self.picker.refresh()
-        if "predictions" in self._docks:
-            self._docks["predictions"].setVisible(scene.shows("predictions"))
-        if scene.shows("trajectory"):
-            self._trajectory_dock().refresh()
-            self._refresh_overlays(scene, self.model.state)
-        if "trajectory" in self._docks:
-            self._docks["trajectory"].setVisible(scene.shows("trajectory"))
-            if not scene.shows("trajectory") and self.model.player.playing:
-                self.model.player.stop()
-
-    def _trajectory_dock(self):
-        if self.trajectory_panel is None:
-            from eyeviz.app.docks import TrajectoryPanel
-
-            self.trajectory_panel = TrajectoryPanel(self.model)
-            d = self._dock("Trajectory", self.trajectory_panel, "trajectory")
-            self.tabifyDockWidget(self._docks["features"], d)
-            self._docks["trajectory"] = d
-            QtCore.QTimer.singleShot(0, d.raise_)
-        return self.trajectory_panel
-
-    def show_design(self):
-        """View > Eye design: the limit curves of the current eyes and the paper's (issue 11)."""
-        if getattr(self, "design_panel", None) is None:
-            from eyeviz.app.design_dock import DesignPanel
-
-            self.design_panel = DesignPanel(self.model)
-            d = self._dock("Eye design", self.design_panel, "design")
-            self.tabifyDockWidget(self._docks["features"], d)
-            self._docks["design"] = d
-            # the plots get most of the side column (the readout needs ~260 px)
-            QtCore.QTimer.singleShot(0, self._fit_design_dock)
-        self._docks["design"].show()
-        self._docks["design"].raise_()
-        return self.design_panel
-
-    def _fit_design_dock(self) -> None:
-        read, d = self._docks["readout"], self._docks["design"]
-        tall = read.height() + d.height()
-        self.resizeDocks([read, d], [min(270, tall // 2), max(tall - 270, tall // 2)],
-                         QtCore.Qt.Vertical)  # fmt: skip
-
-    def show_trajectory(self, kind: str) -> None:
-        """View > Trajectory: a path of this kind for the selected feature, with its plot."""
-        panel = self._trajectory_dock()
-        panel.ensure_trajectory(kind)
-        if not self.model.scene.shows("trajectory"):
-            self.model.set_layer("trajectory", True)
-        self._docks["trajectory"].show()
-        panel.refresh()
-
-    def toggle_play(self) -> None:
-        """Space (in the view) or P: play / pause the model's trajectory player."""
-        panel = self._trajectory_dock()
-        if not self.model.scene.shows("trajectory"):
-            self.show_trajectory("horizontal")
-        panel.set_playing(not self.model.player.playing)
-        if not self.model.player.playing and self.model.player.message:
-            self.statusBar().showMessage(self.model.player.message, 8000)
 
     def _load_estimators(self, predictor, names: list[str]) -> None:
         """Load estimators (torch, weights) on a worker thread; the window stays live."""

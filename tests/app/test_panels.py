@@ -1,4 +1,4 @@
-"""The Eyes panel (eyeviz/app/panels.py) on a real window: h, l and m are entered as a
+"""The Eyes panel (eyeviz/app/panels/eyes.py) on a real window: h, l and m are entered as a
 triple and checked together as EyePair checks them (issue 12 item 11)."""
 
 import shutil

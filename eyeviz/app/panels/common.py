@@ -1,0 +1,60 @@
+"""What every panel shares: user-facing messages (one line, no local paths, no
+Python names), word-wrapped labels that never widen their panel, tab names in full."""
+
+from __future__ import annotations
+
+import re
+
+from PyQt5 import QtCore, QtWidgets
+
+ERROR_STYLE = "color: #b00020; font-weight: bold;"
+_PATH = re.compile(r"(?:[A-Za-z]:)?(?:[\\/][^\s\\/:'\"()\[\],]+){2,}[\\/]?")
+_DEV = re.compile(
+    r"\b(?:Traceback|\w*Error|\w*Exception)\b:?\s*|\[Errno \d+\]\s*|\b\w+\.py\b(?::\d+)?"
+)
+
+
+def user_message(text: str, limit: int = 160) -> str:
+    """A message fit for a user: one line, local paths reduced to their file name,
+    Python exception names and file:line references removed, at most ``limit`` chars."""
+    line = str(text).strip().splitlines()[0] if str(text).strip() else ""
+    line = _PATH.sub(lambda mt: "‘" + re.split(r"[\\/]", mt.group(0).rstrip("\\/"))[-1] + "’", line)
+    line = _DEV.sub("", line).strip(" :")
+    return line if len(line) <= limit else line[: limit - 1] + "…"
+
+
+def wrap_label(label: QtWidgets.QLabel) -> QtWidgets.QLabel:
+    """A word-wrapped message label that never widens its panel: its width is the
+    panel's (a long word is cut, the whole text is in the tooltip)."""
+    label.setWordWrap(True)
+    label.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Minimum)
+    label.setMinimumWidth(0)
+    return label
+
+
+def unelide_tabs(widget: QtWidgets.QWidget) -> None:
+    """Tab names of the window's tabbed docks in full (scroll buttons when they do not all
+    fit) instead of "Fe…", "E…"."""
+    win = widget.window()
+    for bar in win.findChildren(QtWidgets.QTabBar):
+        if bar.elideMode() != QtCore.Qt.ElideNone:
+            bar.setElideMode(QtCore.Qt.ElideNone)
+            bar.setUsesScrollButtons(True)
+
+
+class _Unelide(QtCore.QObject):
+    """Re-applies :func:`unelide_tabs` whenever a tabbed dock appears or is re-tabbed."""
+
+    def eventFilter(self, obj, ev) -> bool:  # noqa: N802 (Qt name)
+        if ev.type() in (QtCore.QEvent.Show, QtCore.QEvent.ParentChange):
+            unelide_tabs(obj)
+        return False
+
+
+def set_message(label: QtWidgets.QLabel, text: str) -> None:
+    """Show ``text`` (several lines allowed) in a :func:`wrap_label`, tooltip = full text."""
+    lines = [user_message(t, 400) for t in str(text).splitlines() if t.strip()]
+    full = "\n".join(lines)
+    if label.text() != full:
+        label.setText(full)
+        label.setToolTip(full)

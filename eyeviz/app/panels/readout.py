@@ -1,0 +1,270 @@
+"""The readout panel: the selected feature's values, each estimator's answer and the
+ambiguity range, in plain-text rows that repaint only themselves."""
+
+from __future__ import annotations
+
+import math
+
+from PyQt5 import QtCore, QtGui, QtWidgets
+
+from eyeviz.app.panels.common import _Unelide, user_message
+from eyeviz.app.panels.notes import design_note, range_note
+from eyeviz.model.app_model import AppModel
+
+
+def f_g(scene, i: int) -> float:
+    return scene.features[i].g
+
+
+GOOD, BAD, GREY = "#1b7837", "#b00020", "#777777"
+READOUT_MIN_WIDTH = 420
+
+
+class ValueText(QtWidgets.QWidget):
+    """Plain text painted by the widget itself: a new text repaints this widget only.
+
+    A QLabel's ``setText`` asks its parent layout to re-lay out (``updateGeometry``) on
+    every change, which re-laid out the whole window on every drag event; this widget
+    asks for a new geometry only when its number of lines changes.
+    """
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self._text = ""
+        self._lines = 1
+        self._color = QtGui.QColor("#1e1e1e")
+        self.setAutoFillBackground(True)  # opaque: its repaint does not repaint the dock
+        self.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Fixed)
+        self.setFixedHeight(self._height(1))
+
+    def _height(self, lines: int) -> int:
+        return self.fontMetrics().lineSpacing() * lines + 2
+
+    def text(self) -> str:
+        return self._text
+
+    def setText(self, text: str) -> None:  # noqa: N802 (Qt name)
+        if text == self._text:
+            return
+        self._text = text
+        lines = text.count("\n") + 1
+        if lines != self._lines:
+            self._lines = lines
+            self.setFixedHeight(self._height(lines))  # a layout only when the shape changes
+        self.setToolTip(text if len(text) > 40 else "")
+        self.update()
+
+    def set_style(self, color: str, bold: bool) -> None:
+        f = self.font()
+        if f.bold() != bold:
+            f.setBold(bold)
+            self.setFont(f)
+            self.setFixedHeight(self._height(self._lines))
+        self._color = QtGui.QColor(color)
+        self.update()
+
+    def sizeHint(self) -> QtCore.QSize:  # noqa: N802 (Qt name)
+        return QtCore.QSize(120, self._height(self._lines))
+
+    def paintEvent(self, event) -> None:  # noqa: N802 (Qt name)
+        p = QtGui.QPainter(self)
+        p.setPen(self._color)
+        flags = QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop
+        fm = self.fontMetrics()
+        y = 0
+        for line in self._text.split("\n"):
+            p.drawText(
+                QtCore.QRect(0, y, self.width(), fm.lineSpacing()),
+                flags,
+                fm.elidedText(line, QtCore.Qt.ElideRight, self.width()),
+            )
+            y += fm.lineSpacing()
+        p.end()
+
+
+class ReadoutPanel(QtWidgets.QWidget):
+    """The selected feature: r, phi, r_A, phi_A, r_B, phi_B, BFV, visibility, overlap; with
+    the predictions layer each estimator's answer and errors, with the ambiguity layer the
+    range of centres and radii giving the same bitmaps.
+
+    A grid of plain-text labels, each re-set only when its text changes: a rich-text
+    QLabel re-laid out on every drag event cost ~5 ms a frame.
+    """
+
+    def __init__(self, model: AppModel, parent=None):
+        super().__init__(parent)
+        self.model = model
+        self._unelide = _Unelide(self)
+        self.installEventFilter(self._unelide)
+        self.texts: dict[str, str] = {}  # row key -> value text (what tests read)
+        lay = QtWidgets.QVBoxLayout(self)
+        lay.setContentsMargins(8, 8, 8, 8)
+        self.title = QtWidgets.QLabel("")
+        font = self.title.font()
+        font.setPointSize(17)
+        font.setBold(True)
+        self.title.setFont(font)
+        lay.addWidget(self.title)
+        self.grid = QtWidgets.QGridLayout()
+        self.grid.setHorizontalSpacing(14)
+        self.grid.setVerticalSpacing(3)
+        self.grid.setColumnStretch(0, 0)
+        self.grid.setColumnStretch(1, 1)
+        lay.addLayout(self.grid)
+        lay.addStretch(1)
+        self._rows: list[tuple[QtWidgets.QLabel, QtWidgets.QLabel]] = []
+        self._cache: dict[int, tuple] = {}
+        self._title_key = None
+        self.setMinimumWidth(READOUT_MIN_WIDTH)
+        self.title.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Preferred)
+
+    def _row(self, k: int) -> tuple[QtWidgets.QLabel, QtWidgets.QLabel]:
+        while len(self._rows) <= k:
+            key, val = QtWidgets.QLabel(), ValueText()
+            key.setTextFormat(QtCore.Qt.RichText)
+            key.setAlignment(QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop)
+            r = len(self._rows)
+            self.grid.addWidget(key, r, 0)
+            self.grid.addWidget(val, r, 1)
+            self._rows.append((key, val))
+        return self._rows[k]
+
+    def _set(self, rows: list[tuple[str, str, str, str]]) -> None:
+        """rows of (id, key html, value text, value colour)."""
+        self.texts = {rid: text for rid, _, text, _ in rows}
+        for k, row in enumerate(rows):
+            if self._cache.get(k) == row:
+                continue
+            key, val = self._row(k)
+            old = self._cache.get(k)
+            _, key_html, text, color = row
+            if old is None or old[1] != key_html:
+                key.setText(key_html)
+            if old is None or old[2] != text:
+                val.setText(text)
+            if old is None or old[3] != color:
+                val.set_style(color, color in (GOOD, BAD))
+            if old is None:
+                key.show()
+                val.show()
+            self._cache[k] = row
+        for k in range(len(rows), len(self._rows)):
+            if self._cache.pop(k, None) is not None:
+                self._rows[k][0].hide()
+                self._rows[k][1].hide()
+
+    def _set_title(self, text: str, color: str) -> None:
+        if self._title_key != (text, color):
+            self._title_key = (text, color)
+            self.title.setText(text)
+            pal = self.title.palette()
+            pal.setColor(QtGui.QPalette.WindowText, QtGui.QColor(color))
+            self.title.setPalette(pal)
+
+    def refresh(self) -> None:
+        st, sc, i = self.model.state, self.model.scene, self.model.selected
+        if i is None or i >= len(sc.features):
+            self._set_title("no feature selected", "#555555")
+            self._set([])
+            return
+        f = sc.features[i]
+        self._set_title(f"● {f.name}", f.color)
+        if not sc.shows("readout") or st.r is None:
+            # the layer is off: no value at all (other layers may still compute them)
+            self._set([("hidden", "", "readout layer hidden\n(tick it in Layers)", GREY)])
+            return
+
+        def yes(v, good=True):
+            return ("yes" if v else "no"), (GOOD if bool(v) == good else BAD)
+
+        def pair(a, b, good=True):
+            (ta, ca), (tb, cb) = yes(a, good), yes(b, good)
+            return f"{ta} / {tb}", (ca if ca == cb else "#444444")
+
+        deg = 180.0 / math.pi
+        ink = "#1e1e1e"
+        vis, vis_c = pair(st.vis_a[i], st.vis_b[i])
+        ovl, ovl_c = pair(st.overlap_a[i], st.overlap_b[i], False)
+        bfv, bfv_c = yes(st.in_bfv[i])
+        rows = [
+            ("r", "r, φ", f"{st.r[i]:.1f}, {st.phi[i] * deg:.2f}°", ink),
+            ("rA", "r<sub>A</sub>, φ<sub>A</sub>", f"{st.rA[i]:.1f}, {st.phiA[i] * deg:.2f}°", ink),
+            ("rB", "r<sub>B</sub>, φ<sub>B</sub>", f"{st.rB[i]:.1f}, {st.phiB[i] * deg:.2f}°", ink),
+            ("g", "g", f"{f.g:g}", ink),
+            ("bfv", "in BFV", bfv, bfv_c),
+            ("visible", "visible A / B", vis, vis_c),
+            ("overlap", "overlaps A / B", ovl, ovl_c),
+        ]
+        if sc.shows("predictions"):
+            rows += self._prediction_rows(i)
+        if sc.shows("ambiguity"):
+            rows.append(self._ambiguity_row())
+        if sc.shows("posterior"):  # the limit's posterior (cached per key, issue 10)
+            from eyeviz.model.posterior import readout
+
+            text = readout(sc.eyes.pair(), f.x, f.y, f.g)
+            rows.append(("posterior", "posterior", text, GREY if text[:5] == "none:" else ink))
+        self._set(rows)
+
+    def _prediction_rows(self, i: int) -> list[tuple[str, str, str, str]]:
+        from eyeviz.model.derived import errors
+        from eyeviz.model.palette import estimator_colors
+
+        st, sc = self.model.state, self.model.scene
+        preds = self.model.predictions
+        cols = estimator_colors(sc.estimators)
+        if not bool(st.in_domain()[i]):
+            return [
+                (
+                    "domain",
+                    "predictions",
+                    "outside the networks' domain\n(not in the BFV or not seen by both eyes)",
+                    BAD,
+                )
+            ]
+        rows = []
+        for name in sc.estimators:
+            res = preds.get(name, "no prediction")
+            key = f"<b style='color:{cols[name]}'>{name}</b>"
+            note = design_note(self.model, name)
+            if note is not None:  # made for other eyes: no answer shown (greyed)
+                rows.append(
+                    (f"pred:{name}", f"<span style='color:{GREY}'>{name}</span>", note, GREY)
+                )
+                continue
+            if isinstance(res, str):
+                loading = self.model.loading and res == self.model.loading
+                rows.append(
+                    (f"pred:{name}", key, "loading…" if loading else user_message(res, 120), GREY)
+                )
+                continue
+            r_hat, phi_hat = float(res[0][i]), float(res[1][i])
+            if not (math.isfinite(r_hat) and math.isfinite(phi_hat)):
+                rows.append((f"pred:{name}", key, "no answer for these bitmaps", GREY))
+                continue
+            dr, pct, dphi = errors(float(st.r[i]), float(st.phi[i]), r_hat, phi_hat)
+            text = (
+                f"r {r_hat:.1f}   Δr {dr:+.1f} ({pct:+.2f} %)\n"
+                f"φ {math.degrees(phi_hat):.2f}°   Δφ {dphi:+.3f}°"
+            )
+            out = range_note(self.model, name, float(st.r[i]), float(f_g(sc, i)))
+            if out is not None:
+                rows.append((f"pred:{name}", key, f"{text}\n{out}", BAD))
+                continue
+            rows.append((f"pred:{name}", key, text, "#1e1e1e"))
+        return rows
+
+    def _ambiguity_row(self) -> tuple[str, str, str, str]:
+        amb = self.model.ambiguity
+        if amb is None:
+            return ("ambiguity", "same bitmaps", "the feature covers an eye centre", GREY)
+        lo, hi = amb["r_range"]
+        a0, a1 = amb["phi_range"]
+        g0, g1 = amb["g_range"]
+        more = "" if amb["bounded"] else " (unbounded)"
+        text = (
+            f"r ∈ [{lo:.0f}, {hi:.0f}]{more}\n"
+            f"φ ∈ [{math.degrees(a0):.2f}°, {math.degrees(a1):.2f}°]\n"
+            f"g ∈ [{g0:.3g}, {g1:.3g}]"
+        )
+        return ("ambiguity", "same bitmaps", text, "#1e1e1e")
