@@ -45,6 +45,10 @@ Fields of :class:`Frame` (``None`` / empty when no layer needs them):
 - ``labels``: :class:`LabelFrame` anchors (text, x, y, kind, feature) of the ``labels``
   layer: the eyes A, B and the origin O under them, each feature's name up-right of its
   disc (the app's view places them at these points; the exported figure lays its own out).
+
+It is over 400 lines because this docstring lists every field of the Frame (the renderers'
+contract) and :func:`build_frame` calls one builder per layer over a single geometry pass;
+the parts and helpers are already in :mod:`eyeviz.model.frame_parts`.
 """
 
 from __future__ import annotations

@@ -14,6 +14,10 @@ MIN_VIEW_WIDTH); names without control characters (a newline or NUL could never 
 and would break an SVG) and at most MAX_NAME_CHARS long.
 
 This module imports the standard library and tomli_w only (no Qt, VTK or torch).
+
+It is over 400 lines because every rule of the scene contract is checked in one place
+(:class:`_Checker`, :func:`_scene_from_doc`, :func:`_line_of`) beside the writer that must
+round-trip it (``loads(dumps(s)) == s``); split, the rules and the writer would drift apart.
 """
 
 from __future__ import annotations

@@ -1,0 +1,308 @@
+"""The figures of the eye-design study (:mod:`eyeviz.reports.study`) and their saving.
+
+DD/AD limit against distance, the heatmap over (h, m) and the law's log-log plot, in the
+house style of :mod:`eyeviz.render.mpl.style` (Okabe-Ito colours, text >= 7 pt at print
+size), each saved as PDF, SVG and PNG.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from eyeviz.files.atomic import atomic_output
+from eyeviz.reports.study_design import MIN_COUNT, PAPER
+from eyeviz.reports.study_law import LawFit, LawPoint
+
+FORMATS = ("pdf", "svg", "png")
+PNG_DPI = 300
+PT = 7.0  # every text in these figures, ticks included
+OKABE_ITO = ("#E69F00", "#56B4E9", "#009E73", "#0072B2", "#D55E00", "#CC79A7", "#000000")
+DASHES = ("-", "--", ":", "-.")
+TWO_COLUMNS, ONE_COLUMN = 7.2, 3.5  # inches
+
+
+def _rc() -> dict:
+    from eyeviz.render.mpl.style import RC
+
+    return {
+        **RC,
+        "font.size": PT,
+        "axes.labelsize": PT,
+        "xtick.labelsize": PT,
+        "ytick.labelsize": PT,
+        "legend.fontsize": PT,
+        "axes.titlesize": PT,
+    }
+
+
+def _m_style(ms: Sequence[int]) -> dict[int, dict]:
+    return {
+        m: {"color": OKABE_ITO[i % len(OKABE_ITO)], "ls": DASHES[(i // len(OKABE_ITO)) % 4]}
+        for i, m in enumerate(sorted(ms))
+    }
+
+
+def _log_helps(values) -> bool:
+    v = np.asarray([x for x in values if np.isfinite(x) and x > 0])
+    return v.size > 1 and v.max() / v.min() > 5
+
+
+def _fmt_axis(ax, log: bool) -> None:
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    if log:
+        ax.set_yscale("log")
+        ax.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(NullFormatter())
+    ax.grid(True, which="major", color="#E6E6E6", lw=0.5)
+    ax.set_axisbelow(True)
+
+
+def _paper_label() -> str:
+    h, l_, m = PAPER
+    return f"paper's eyes (h {h:g}, l {l_:g}, m {m})"
+
+
+def curves_figure(designs: dict, l_of: dict, target: str, wanted: float = PAPER[1]):
+    """DD or AD limit against distance: a panel per h (its l), a curve per m."""
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    hs = sorted(l_of)
+    ms = sorted({k[2] for k in designs})
+    style = _m_style(ms)
+    col = f"{target}_mape"
+    vals = [getattr(b, col) for d in designs.values() for b in d.bins if b.count >= MIN_COUNT]
+    log = _log_helps(vals)
+    ncols = min(len(hs), 3)
+    spare = (-len(hs)) % ncols
+    nrows = math.ceil(len(hs) / ncols)
+    width = TWO_COLUMNS if ncols > 1 else ONE_COLUMN  # one h: one column of a paper
+    fig = Figure(
+        figsize=(width, 0.4 + 1.75 * nrows + (0.6 if ncols == 1 else 0)), layout="constrained"
+    )
+    axes = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False).ravel()
+    paper_drawn = False
+    for ax, h in zip(axes, hs, strict=False):
+        l_ = l_of[h]
+        for m in ms:
+            d = designs.get((h, l_, m))
+            if d is None:
+                continue
+            bins = [b for b in d.bins if b.count >= MIN_COUNT]
+            r = [b.r_mid for b in bins]
+            v = [getattr(b, col) for b in bins]
+            if d.is_paper:
+                ax.plot(r, v, color="black", lw=3.2, ls="-", zorder=2, solid_capstyle="round")
+                paper_drawn = True
+            ax.plot(r, v, lw=1.4, marker="o", ms=2.4, zorder=3, **style[m], label=f"m = {m}")
+        note = "" if l_ == wanted else f"  (no l {wanted:g} at this h)"
+        ax.set_title(f"h = {h:g}, l = {l_:g}{note}", loc="left", pad=2)
+        _fmt_axis(ax, log)
+    for ax in axes[len(hs) :]:
+        ax.set_axis_off()
+    name = "distance" if target == "dd" else "azimuth"
+    for i, ax in enumerate(axes[: len(hs)]):
+        if i % ncols == 0:
+            ax.set_ylabel(f"{target.upper()} limit: MAPE (%)")
+        if i >= len(hs) - ncols:
+            ax.set_xlabel("distance r")
+            ax.tick_params(labelbottom=True)
+    handles = [Line2D([], [], lw=1.4, marker="o", ms=2.4, **style[m]) for m in ms]
+    labels = [f"m = {m}  (γ = {360 / m:.3g}°)" for m in ms]
+    if paper_drawn:
+        handles.append(Line2D([], [], color="black", lw=3.2))
+        labels.append(_paper_label() + ": black underlay")
+    title = f"{name} limit (the best\nany estimator can do)"
+    if spare:
+        axes[-1].legend(
+            handles, labels, loc="center left", frameon=False, title=title, alignment="left"
+        )
+    else:
+        fig.legend(
+            handles, labels, loc="outside lower center", ncol=3 if ncols > 1 else 1, frameon=False
+        )
+    return fig
+
+
+def _cell(v: float) -> str:
+    """Three significant digits, trailing zeros kept (18.0, 2.50, 0.864)."""
+    s = f"{v:#.3g}"
+    return s[:-1] if s.endswith(".") else s
+
+
+def heatmap_figure(table: list[dict], l_of: dict, at: float, wanted: float = PAPER[1]):
+    """DD MAPE at ``at`` over (h, m); values in the cells; the paper's design boxed."""
+    from matplotlib.colors import LogNorm, Normalize
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Rectangle
+
+    hs = sorted({t["h"] for t in table})
+    ms = sorted({t["m"] for t in table})
+    grid = np.full((len(hs), len(ms)), np.nan)
+    for t in table:
+        grid[hs.index(t["h"]), ms.index(t["m"])] = t["dd_mape"]
+    finite = grid[np.isfinite(grid) & (grid > 0)]
+    fig = Figure(figsize=(ONE_COLUMN, max(2.4, 0.9 + 0.42 * len(hs))), layout="constrained")
+    ax = fig.add_subplot()
+    norm = (
+        LogNorm(finite.min(), finite.max())
+        if finite.size > 1 and finite.max() / finite.min() > 3
+        else Normalize(*(finite.min(), finite.max()) if finite.size else (0, 1))
+    )
+    im = ax.imshow(grid, origin="lower", cmap="cividis", norm=norm, aspect="auto")
+    cmap = im.get_cmap()
+    for i in range(len(hs)):
+        for j in range(len(ms)):
+            v = grid[i, j]
+            if not np.isfinite(v):
+                ax.text(j, i, "–", ha="center", va="center", color="#7A7A7A")
+                continue
+            rgb = cmap(norm(v))[:3] if finite.size else (1, 1, 1)
+            lum = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+            ax.text(
+                j, i, _cell(v), ha="center", va="center", color="black" if lum > 0.45 else "white"
+            )
+    paper = [t for t in table if t["paper_design"]]
+    for t in paper:
+        i, j = hs.index(t["h"]), ms.index(t["m"])
+        ax.add_patch(Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, ec="black", lw=1.8))
+        ax.add_patch(Rectangle((j - 0.44, i - 0.44), 0.88, 0.88, fill=False, ec="white", lw=0.7))
+    ax.set_xticks(range(len(ms)), [str(m) for m in ms])
+    ax.set_yticks(
+        range(len(hs)), [f"{h:g}" + ("" if l_of[h] == wanted else f" (l {l_of[h]:g})") for h in hs]
+    )
+    paper = [t for t in table if t["paper_design"]]
+    ax.set_xlabel("ommatidia m" + ("\n(boxed: " + _paper_label() + ")" if paper else ""))
+    ax.set_ylabel("h (eye centres at x = ±h)")
+    ax.tick_params(length=0)
+    for s in ax.spines.values():
+        s.set_visible(False)
+    t0 = table[0]
+    ax.set_title(
+        f"DD limit: MAPE (%) at r = {at:g} (bin {t0['r_lo']:g}–{t0['r_hi']:g}), l = {wanted:g}",
+        loc="left",
+        pad=3,
+    )
+    cb = fig.colorbar(im, ax=ax, shrink=0.9, pad=0.02, aspect=25)
+    cb.ax.tick_params(labelsize=PT, length=2)
+    cb.outline.set_visible(False)
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    if isinstance(norm, LogNorm):
+        cb.ax.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    cb.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    cb.ax.yaxis.set_minor_formatter(NullFormatter())
+    return fig
+
+
+def law_figure(points: Sequence[LawPoint], fit: LawFit):
+    """Measured relative DD error per bin against gamma r / (2h), log-log, with C x."""
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    ms = sorted({p.m for p in points})
+    style = _m_style(ms)
+    fig = Figure(figsize=(ONE_COLUMN, 3.9), layout="constrained")
+    ax = fig.add_subplot()
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    for m in ms:
+        sel = [p for p in points if p.m == m]
+        on = [p for p in sel if p.fitted]
+        off = [p for p in sel if not p.fitted]
+        c = style[m]["color"]
+        ax.scatter([p.x for p in on], [p.y for p in on], s=7, color=c, lw=0, alpha=0.85, zorder=3)
+        ax.scatter(
+            [p.x for p in off],
+            [p.y for p in off],
+            s=7,
+            facecolor="none",
+            edgecolor=c,
+            lw=0.5,
+            alpha=0.85,
+            zorder=3,
+        )
+    pp = [p for p in points if p.paper]
+    if pp:
+        ax.scatter(
+            [p.x for p in pp],
+            [p.y for p in pp],
+            s=22,
+            marker="D",
+            facecolor="none",
+            edgecolor="black",
+            lw=0.9,
+            zorder=4,
+        )
+    xs = np.array([p.x for p in points])
+    handles = [Line2D([], [], ls="", marker="o", ms=3, color=style[m]["color"]) for m in ms]
+    labels = [f"m = {m}" for m in ms]
+    ys = np.array([p.y for p in points])
+    if ys.size:
+        ax.set_ylim(ys.min() / 1.6, ys.max() * 1.6)
+    if fit.C is not None and xs.size:
+        f = fit.factor or 1.0
+        x_fit = max(p.x for p in points if p.fitted)
+        xx = np.geomspace(xs.min(), x_fit, 50)
+        ax.fill_between(xx, fit.C * xx / f, fit.C * xx * f, color="#D9D9D9", lw=0, zorder=1)
+        ax.plot(xx, fit.C * xx, color="black", lw=1.0, zorder=2)
+        x_end = min(xs.max(), ys.max() * 1.5 / fit.C)
+        if x_end > x_fit:  # the law extrapolated beyond the fitted range: dashed
+            xe = np.geomspace(x_fit, x_end, 20)
+            ax.plot(xe, fit.C * xe, color="black", lw=0.8, ls=(0, (3, 2)), zorder=2)
+        ax.axvline(fit.x_max, color="#7A7A7A", lw=0.6, ls=":", zorder=1)
+        handles.append(Line2D([], [], color="black", lw=1.0))
+        labels.append(f"C·γr/(2h), C = {fit.C:.3g} (×÷{f:.2f})")
+        text = (
+            f"least squares in log space, slope 1;\n{fit.n} filled points (x ≤ {fit.x_max:g}),"
+            f" band ×÷ 1 s.d.;\na free fit has slope {fit.slope:.2f}"
+            if fit.slope is not None
+            else ""
+        )
+        ax.text(0.98, 0.03, text, transform=ax.transAxes, ha="right", va="bottom")
+    else:
+        ax.text(0.5, 0.5, "too few points to fit C", transform=ax.transAxes, ha="center")
+    handles.append(Line2D([], [], ls="", marker="o", ms=3, mfc="none", mec="#7A7A7A", mew=0.5))
+    labels.append(f"not fitted (edge bin or x > {fit.x_max:g})")
+    if pp:
+        handles.append(Line2D([], [], ls="", marker="D", ms=4, mfc="none", mec="black"))
+        labels.append(_paper_label())
+    fig.legend(
+        handles,
+        labels,
+        loc="outside lower center",
+        ncol=2,
+        frameon=False,
+        handlelength=1.2,
+        labelspacing=0.25,
+        columnspacing=1.0,
+    )
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    ax.yaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{100 * v:g} %"))
+    ax.yaxis.set_minor_formatter(NullFormatter())
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    ax.set_xlabel("γ r / (2h)   (γ = 2π/m)")
+    ax.set_ylabel("relative DD error of the limit (MAPE)")
+    ax.grid(True, which="major", color="#E6E6E6", lw=0.5)
+    ax.set_axisbelow(True)
+    return fig
+
+
+def save(fig, outdir: Path, stem: str) -> list[Path]:
+    """The figure as PDF, SVG and PNG (300 dpi), each written atomically."""
+    paths = []
+    for ext in FORMATS:
+        path = outdir / f"{stem}.{ext}"
+        meta = {"CreationDate": None} if ext == "pdf" else {"Date": None} if ext == "svg" else {}
+        with atomic_output(path) as tmp:
+            fig.savefig(tmp, format=ext, dpi=PNG_DPI, metadata=meta, facecolor="white")
+        paths.append(path)
+    return paths

@@ -1,0 +1,125 @@
+"""The summary files of the eye-design study (:mod:`eyeviz.reports.study`).
+
+``summary.csv`` (the table behind the heatmap with the law's value per cell),
+``summary.json`` (the fitted constant, its spread and the paper's design) and the
+Markdown text of ``study.md``.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from pathlib import Path
+
+from eyeviz.files.atomic import atomic_output
+from eyeviz.reports.study_design import MIN_COUNT, PAPER
+from eyeviz.reports.study_law import LawFit
+
+CAPTIONS = {
+    "study_dd": "DD limit (MAPE %) against distance, a panel per h, a curve per m",
+    "study_ad": "AD limit (MAPE %) against distance, a panel per h, a curve per m",
+    "study_heatmap": "DD limit at --at over (h, m), values in the cells",
+    "study_law": "relative DD error against gamma r / (2h) with the fitted C",
+}
+
+
+def _write_text(path: Path, text: str) -> Path:
+    with atomic_output(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return path
+
+
+def summary_csv(table: list[dict], fit: LawFit) -> str:
+    buf = io.StringIO()
+    cols = [*table[0].keys(), "law_dd_mape"]
+    w = csv.DictWriter(buf, fieldnames=cols, lineterminator="\n")
+    w.writeheader()
+    for t in table:
+        x = t["gamma"] * 0.5 * (t["r_lo"] + t["r_hi"]) / (2 * t["h"])  # the bin centre
+        w.writerow({**t, "law_dd_mape": "" if fit.C is None else round(100 * fit.C * x, 6)})
+    return buf.getvalue()
+
+
+def _clean(v):
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    return v
+
+
+def summary_json(table, fit: LawFit, args_d: dict, designs: dict, best: dict) -> str:
+    paper = designs.get(PAPER)
+    out = {
+        "source": args_d,
+        "law": {
+            "formula": "relative DD error (MAPE/100) = C * gamma * r / (2h), gamma = 2 pi / m",
+            "C": fit.C,
+            "method": fit.method,
+            "log_sd": fit.log_sd,
+            "factor_1sd": fit.factor,
+            "points_fitted": fit.n,
+            "x_max": fit.x_max,
+            "min_count": MIN_COUNT,
+            "excluded": "the first and last bin of each design (the prior's bounds truncate "
+            "the posterior there) and bins with gamma r / (2h) > x_max (saturation)",
+            "free_slope": fit.slope,
+            "free_C": fit.C_free,
+        },
+        "paper_design": None
+        if paper is None
+        else {
+            "h": PAPER[0],
+            "l": PAPER[1],
+            "m": PAPER[2],
+            "dd_mape": paper.all.dd_mape,
+            "ad_mape": paper.all.ad_mape,
+            "n": paper.all.n,
+        },
+        "smallest_m_for_target": {f"{h:g}": m for h, m in best.items()},
+        "heatmap": [{k: _clean(v) for k, v in t.items()} for t in table],
+    }
+    return json.dumps(out, indent=1, allow_nan=False) + "\n"
+
+
+def markdown(table, fit, designs, l_of, best, args_d, figures) -> str:
+    at, target = args_d["at"], args_d["target"]
+    lines = [
+        "# The eye-design study: the information limit against h, l, m and distance",
+        "",
+        f"Source: `{args_d['table']}`, prior `{args_d['prior']}`, {len(designs)} designs. "
+        "MAPE (Eq. 34) of the information limit: no estimator that sees only the two "
+        "bitmaps has a lower expected error under the prior.",
+        "",
+    ]
+    paper = designs.get(PAPER)
+    if paper is None:
+        lines += ["The paper's eyes (h 40, l 20, m 720) are not in this table: no figure marks "
+                  "them.", ""]  # fmt: skip
+    else:
+        lines += [
+            f"The paper's eyes (h 40, l 20, m 720): DD {paper.all.dd_mape:.2f} %, "
+            f"AD {paper.all.ad_mape:.3f} % over r in [{paper.all.r_min:g}, "
+            f"{paper.all.r_max:g}] (n = {paper.all.n}).",
+            "",
+        ]
+    if fit.C is not None:
+        lines += [
+            f"**The law**: relative DD error = C γ r / (2h) with C = {fit.C:.3g} "
+            f"(×÷ {fit.factor:.2f} for one standard deviation, {fit.n} bins; {fit.method}; "
+            f"bins with γ r/(2h) <= {fit.x_max:g}, not the first or last bin of a design). "
+            f"A free log-log fit gives slope {fit.slope:.2f}.",
+            "",
+        ]
+    lines += [
+        f"Fewest ommatidia m for a DD error <= {target:g} % at r = {at:g}:",
+        "",
+        "| h | l | m |",
+        "|---:|---:|---:|",
+    ]
+    for h, m in best.items():
+        lines.append(f"| {h:g} | {l_of[h]:g} | {m if m is not None else 'none in the grid'} |")
+    lines += ["", "Figures (each as PDF, SVG and PNG):", ""]
+    for f in figures:
+        lines += [f"**{f}**: {CAPTIONS.get(f, '')}", "", f"![{f}]({f}.png)", ""]
+    return "\n".join(lines) + "\n"
