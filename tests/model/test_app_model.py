@@ -2,6 +2,7 @@
 press/move/release sequences, the wheel, pan, fit, undo/redo, picking, names."""
 
 import pytest
+from undo_stack import Undo
 
 from eyeviz.model import camera, interactions
 from eyeviz.model.app_model import HANDLE_PX, AppModel, MouseEvent, hit_test
@@ -9,23 +10,6 @@ from eyeviz.model.camera import Viewport
 from eyeviz.model.scene import Eyes, Feature, Scene, View
 
 VP = Viewport(0.0, 0.0, 1000.0, 700.0)
-
-
-class Undo:
-    """A minimal undo stack (before, after, text) like the window's QUndoStack."""
-
-    def __init__(self, model):
-        self.steps = []
-        self.model = model
-        model.push = self.push
-
-    def push(self, before, after, text, merge_key=None):
-        self.steps.append((before.copy(), after.copy(), text))
-        self.model.set_scene(after)
-
-    def undo(self):
-        before, _, _ = self.steps.pop()
-        self.model.set_scene(before)
 
 
 def make(view=None):

@@ -1,26 +1,10 @@
 """The trajectory player as model state, without a display (issue 12 item 1)."""
 
 import numpy as np
+from undo_stack import Undo
 
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import Feature, Scene
-
-
-class Undo:
-    """A minimal undo stack (before, after, text) like the window's QUndoStack."""
-
-    def __init__(self, model):
-        self.steps = []
-        self.model = model
-        model.push = self.push
-
-    def push(self, before, after, text, merge_key=None):
-        self.steps.append((before.copy(), after.copy(), text))
-        self.model.set_scene(after)
-
-    def undo(self):
-        before, _, _ = self.steps.pop()
-        self.model.set_scene(before)
 
 
 class Path:
