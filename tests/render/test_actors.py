@@ -187,3 +187,30 @@ def test_bfv_wedge_is_the_frames_clipped_polygon_at_any_distance(rig):
         np.testing.assert_allclose(pts[: len(poly)], poly)
         # the visible centre is inside the drawn wedge's bounds (the old one stopped at 5e6)
         assert pts[:, 1].max() >= cy and pts[:, 0].min() <= cx <= pts[:, 0].max()
+
+
+def test_eye_colours_written_cell_by_cell_equal_a_full_rewrite(rig):
+    """A drag rewrites only the cells whose owner changed (issue 12, drag latency): after
+    every move, colour change and zoom, each mesh equals the colours written afresh."""
+    pl, act = rig
+    sc = scene(3600)
+    sc.features.append(Feature("c", -40.0, 1400.0, 120.0, "#009E73"))
+    act.update(sc, compute_state(sc), 2)
+    act.set_zoom(main_px_per_unit=0.05, inset_px_per_unit=3.0, l=20.0, m=3600)
+    k = act._lod_k["main"]
+    assert k > 1
+    rng = np.random.default_rng(3)
+    for step in range(40):
+        f = sc.features[step % 3]
+        f.x += float(rng.normal(0, 40))
+        f.y += float(rng.normal(0, 40))
+        if step == 20:
+            sc.features[0].color = "#CC79A7"  # a new palette: every cell is rewritten
+        act.update(sc, compute_state(sc), step % 3)
+        for e in (0, 1):
+            rgb, owner = expected_rgb(sc, e)
+            np.testing.assert_array_equal(act.eye_meshes[e].cell_data["rgb"], rgb)
+            lod = pv.wrap(act._eye_actors[e].GetMapper().GetInput()).cell_data["rgb"]
+            pooled = np.maximum.reduceat(owner, np.arange(0, 3600, k))
+            palette = np.vstack([UNLIT] + [hex_rgb(f.color) for f in sc.features])
+            np.testing.assert_array_equal(lod, palette[pooled + 1])

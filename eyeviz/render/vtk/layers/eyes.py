@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 import pyvista as pv
+from vtkmodules.util.numpy_support import vtk_to_numpy
 
 from eyeviz.model.frame import EyeFrame, Frame
 from eyeviz.render.vtk.primitives import CIRCLE_N, UNIT, Store, actor, points_actor, write_rgb
@@ -35,13 +36,21 @@ def mesh_of_rim(center: tuple[float, float], rim: np.ndarray) -> pv.PolyData:
     return mesh
 
 
-def _same(a: np.ndarray, b: np.ndarray) -> bool:
-    """a == b everywhere (bytes for a small eye: ~4x faster than np.array_equal there)."""
-    if a is b:
+def _write_changed(mesh, palette: np.ndarray, before: np.ndarray | None, owner: np.ndarray) -> bool:
+    """Colour the mesh's cells by ``owner`` (index into ``palette`` minus one), writing only
+    the cells whose owner differs from ``before`` (all of them without one); False when
+    nothing changed. A drag moves one feature: at m = 36,000 it rewrites a few hundred
+    cells instead of gathering 36,000 colours per eye and frame."""
+    if before is None or before.shape != owner.shape:
+        write_rgb(mesh, palette[owner + 1])
         return True
-    if a.shape != b.shape:
+    changed = np.flatnonzero(before != owner)
+    if changed.size == 0:
         return False
-    return a.tobytes() == b.tobytes() if a.size <= 4096 else bool(np.array_equal(a, b))
+    arr = mesh.GetCellData().GetAbstractArray("rgb")
+    vtk_to_numpy(arr)[changed] = palette[owner[changed] + 1]
+    arr.Modified()
+    return True
 
 
 class EyesLayer:
@@ -59,6 +68,7 @@ class EyesLayer:
         self._eyes: list[EyeFrame] = []
         self._owners: tuple[np.ndarray, ...] | None = None
         self._palette: np.ndarray | None = None
+        self._pooled: dict[tuple[int, int], np.ndarray] = {}
         self._colors: tuple[str, ...] = ()
 
     def build(self, frame: Frame) -> None:
@@ -66,6 +76,7 @@ class EyesLayer:
         self.store.clear()
         self.meshes, self.actors, self.outlines = [], [], []
         self._owners = self._palette = None
+        self._pooled = {}
         self._eyes = list(frame.eyes) if "eyes" in frame.layers else []
         self.lod = {}
         self.lod_k = {"main": 1, "inset": 1}
@@ -107,12 +118,17 @@ class EyesLayer:
         assert palette is not None
         old = self._owners
         for e, (mesh, eye) in enumerate(zip(self.meshes, self._eyes, strict=True)):
-            if same_palette and old is not None and _same(old[e], eye.owner):
+            before = old[e] if same_palette and old is not None else None
+            if before is not None and before is eye.owner:
+                continue
+            if not _write_changed(mesh, palette, before, eye.owner):
                 continue  # unchanged: no colour write, so no buffer upload at the next render
-            write_rgb(mesh, palette[eye.owner + 1])
             for (which, k), lod in self.lod.items():
                 if which == e:
-                    write_rgb(lod, palette[eye.pooled_owner(k) + 1])
+                    pooled = eye.pooled_owner(k)
+                    was = self._pooled.get((e, k)) if before is not None else None
+                    _write_changed(lod, palette, was, pooled)
+                    self._pooled[(e, k)] = pooled
         self._owners = tuple(eye.owner for eye in self._eyes)
 
     def set_zoom(self, main_px_per_unit: float, inset_px_per_unit: float, l: float, m: int):
@@ -142,12 +158,15 @@ class EyesLayer:
         used = {(e, k) for k in self.lod_k.values() for e in (0, 1)}
         for key in [key for key in self.lod if key not in used]:
             del self.lod[key]
+            self._pooled.pop(key, None)
 
     def _lod_mesh(self, e: int, k: int) -> pv.PolyData:
         if (e, k) not in self.lod:
             eye = self._eyes[e]
             mesh = mesh_of_rim(eye.center, eye.rim(k))
             if self._owners is not None and self._palette is not None:
-                mesh.cell_data["rgb"][:] = self._palette[eye.pooled_owner(k) + 1]
+                pooled = eye.pooled_owner(k)
+                mesh.cell_data["rgb"][:] = self._palette[pooled + 1]
+                self._pooled[(e, k)] = pooled
             self.lod[(e, k)] = mesh
         return self.lod[(e, k)]
