@@ -51,6 +51,10 @@ def make_app() -> QtWidgets.QApplication:
     if app is None:
         QtWidgets.QApplication.setAttribute(QtCore.Qt.AA_ShareOpenGLContexts)
         app = QtWidgets.QApplication(["eyeviz"])
+    # the view is a native X window (VTK renders into it); without this Qt makes every
+    # sibling on its way up native too (docks, status bar, bitmaps panel, menu bar), and a
+    # drag frame then flushed each repainted panel to X on its own (issue 12, drag latency)
+    app.setAttribute(QtCore.Qt.AA_DontCreateNativeWidgetSiblings)
     font = app.font()
     font.setPointSize(APP_FONT_PT)
     app.setFont(font)

@@ -72,8 +72,8 @@ class BitmapPanel(QtWidgets.QWidget):
         self.sel_color = INK
         self.selected: int | None = None
         self.texts: dict[tuple[str, bool], str] = {}
-        self.sel_masks: dict[tuple[str, bool], np.ndarray] = {}
-        self._row_keys: dict[tuple[str, bool], bytes] = {}
+        self._eye_keys: dict[str, bytes] = {}
+        self._row_keys: dict[tuple[str, bool], tuple] = {}
         self._runs: dict[tuple[str, bool], list[tuple[int, int]]] = {}
         self._geo_key: tuple | None = None
         self._geo = (0, 0, 0)
@@ -90,46 +90,35 @@ class BitmapPanel(QtWidgets.QWidget):
         self.setSizePolicy(QtWidgets.QSizePolicy.Expanding, QtWidgets.QSizePolicy.Fixed)
 
     def refresh(self) -> None:
-        """Take the state's owners and the selected intervals; repaint the changed rows."""
-        from eyeviz.core.geometry import intervals_to_bitmap
+        """Take the state's owners and the selected intervals; repaint the changed rows.
 
+        An eye's rows are a function of its intervals (L, R of every feature: the owners),
+        the selection, the colours and m: a key of a few hundred bytes, compared before
+        anything of m elements is built (288 kB a row at m = 36,000)."""
         st = self.model.state
         sc = self.model.scene
-        strips: dict[tuple[str, bool], np.ndarray] = {}
-        masks: dict[tuple[str, bool], np.ndarray] = {}
-        intervals: dict[str, tuple[int, int] | None] = {"A": None, "B": None}
         i = self.model.selected
         sel = i if i is not None and i < st.n else None
-        if st.LA is not None:
-            m = st.m
-            oa = st.owner_a if st.owner_a is not None else _owners_of(st, "A")
-            ob = st.owner_b if st.owner_b is not None else _owners_of(st, "B")
-            if sel is not None:
-                intervals = {
-                    "A": (int(st.LA[sel]), int(st.RA[sel])),
-                    "B": (int(st.LB[sel]), int(st.RB[sel])),
-                }
-            for eye, own in (("A", oa), ("B", ob)):
-                iv = intervals[eye]
-                mask = intervals_to_bitmap(iv[0], iv[1], m) if iv is not None else np.zeros(m, bool)
-                if sel is not None and mask.any():
-                    own = own.copy()
-                    own[mask] = sel  # the selected feature on top where features overlap
-                strips[(eye, True)] = own
-                strips[(eye, False)] = own[: m // 2]
-                masks[(eye, True)] = mask
-                masks[(eye, False)] = mask[: m // 2]
         colors = self._palette(tuple(f.color for f in sc.features))
-        shown = sc.shows("bitmaps") and bool(strips)
-        self.strips, self.intervals, self.colors, self.selected = strips, intervals, colors, sel
-        self.sel_masks = masks
+        self.colors, self.selected = colors, sel
+        self.sel_color = QtGui.QColor(sc.features[sel].color if sel is not None else "#222")
+        intervals: dict[str, tuple[int, int] | None] = {"A": None, "B": None}
+        if st.LA is None or st.RA is None or st.LB is None or st.RB is None:
+            self.strips, self.intervals, self._runs = {}, intervals, {}
+            self.texts = {row: "" for row in self.ROWS}
+            self._eye_keys = {}
+            self._shown_changed(False)
+            return
+        m = st.m
+        lr = {"A": (st.LA, st.RA), "B": (st.LB, st.RB)}
+        if sel is not None:
+            intervals = {e: (int(lr[e][0][sel]), int(lr[e][1][sel])) for e in ("A", "B")}
+        self.intervals = intervals
         self._runs = {
-            (eye, whole): _interval_runs(intervals[eye], st.m, whole)
+            (eye, whole): _interval_runs(intervals[eye], m, whole)
             for (eye, whole) in self.ROWS
             if intervals[eye] is not None
         }
-        self.sel_color = QtGui.QColor(sc.features[sel].color if sel is not None else "#222")
-        m = st.m
         self.texts = {
             (eye, whole): (
                 ""
@@ -139,34 +128,48 @@ class BitmapPanel(QtWidgets.QWidget):
             for (eye, whole) in self.ROWS
             for iv in (intervals[eye],)
         }
-        whole_panel = shown != self._shown
-        self._shown = shown
-        # a row is a function of its eye's intervals (L, R of every feature: the owners),
-        # the selection, the colours and m: a key of a few hundred bytes, not the strip's
-        # m int64 owners (288 kB a row at m = 36,000, built every drag frame)
-        lr = {"A": (st.LA, st.RA), "B": (st.LB, st.RB)}
-        for r, row in enumerate(self.ROWS):
-            if row not in strips:
-                continue
-            lo, hi = lr[row[0]]
-            key = b"".join(
-                (
-                    np.asarray(lo, np.int64).tobytes(),
-                    np.asarray(hi, np.int64).tobytes(),
-                    np.array([m, -1 if sel is None else sel, row[1]], np.int64).tobytes(),
-                    colors.tobytes(),
-                    self.texts[row].encode(),
-                    self.sel_color.name().encode(),
-                )
+        tail = b"".join(
+            (
+                np.array([m, -1 if sel is None else sel], np.int64).tobytes(),
+                colors.tobytes(),
+                self.sel_color.name().encode(),
             )
+        )
+        strips = dict(self.strips)
+        changed: list[tuple[str, bool]] = []
+        for eye in ("A", "B"):
+            lo, hi = lr[eye]
+            key = b"".join(
+                (np.asarray(lo, np.int64).tobytes(), np.asarray(hi, np.int64).tobytes(), tail)
+            )
+            if self._eye_keys.get(eye) != key or (eye, True) not in strips:
+                self._eye_keys[eye] = key
+                own = _owners_on_top(st, eye, intervals[eye], sel)
+                strips[(eye, True)] = own
+                strips[(eye, False)] = own[: m // 2]
+        self.strips = strips
+        whole_panel = self._shown_changed(sc.shows("bitmaps"))
+        for r, row in enumerate(self.ROWS):
+            key = (self._eye_keys[row[0]], row[1], self.texts[row])
             if self._row_keys.get(row) != key:
                 self._row_keys[row] = key
+                changed.append(row)
                 if not whole_panel:  # the strip and its text; the row's label never changes
                     rect = self._row_rect(r)
                     rect.setLeft(self._geometry(self.fontMetrics())[0])
                     self.update(rect)
-        if whole_panel:
+        if self.isVisible() and not whole_panel:  # drawn now, before the view renders
+            label_w, right_w, row_h = self._geometry(self.fontMetrics())
+            for row in changed:
+                self._strip_image(row, max(self.width() - right_w - label_w, 1), row_h - 8)
+
+    def _shown_changed(self, shown: bool) -> bool:
+        """Whether the panel shows strips now; a change repaints all of it (True)."""
+        if shown != self._shown:
+            self._shown = shown
             self.update()
+            return True
+        return False
 
     def _palette(self, colors: tuple[str, ...]) -> np.ndarray:
         """UNLIT, then each feature's colour (uint8 rgb rows), rebuilt only when they change."""
@@ -335,6 +338,23 @@ def _runs_text(runs: list[tuple[int, int]]) -> str:
     if not runs:
         return "none"
     return " ∪ ".join(f"[{a}, {b}]" for a, b in runs)
+
+
+def _owners_on_top(st, eye: str, iv: tuple[int, int] | None, sel: int | None) -> np.ndarray:
+    """The eye's owner per ommatidium with the selected feature drawn over the others
+    where they overlap (its lit cells {k mod m : L <= k <= R} written as slices)."""
+    own = st.owner_a if eye == "A" else st.owner_b
+    if own is None:
+        own = _owners_of(st, eye)
+    if sel is None or iv is None:
+        return own
+    m = st.m
+    lo, hi = iv
+    own = own.copy()
+    own[lo : min(hi, m - 1) + 1] = sel
+    if hi >= m:
+        own[: hi - m + 1] = sel
+    return own
 
 
 def _owners_of(st, eye: str) -> np.ndarray:
