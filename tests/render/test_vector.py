@@ -150,6 +150,9 @@ def test_predictions_drawn_as_ghosts_and_out_of_domain_greyed():
     assert set(ghosts) == want
     texts = " ".join("".join(t.itertext()) for t in root.iter(f"{SVG}text"))
     assert "outside the networks' domain" in texts
+    for i in np.flatnonzero(~domain):  # the reason in full, short enough for one column
+        why = "not in the BFV" if not st.in_bfv[i] else "not seen by both eyes"
+        assert f"analytic: outside the networks' domain ({why})" in texts
     assert "+5.0 %" in texts
 
 

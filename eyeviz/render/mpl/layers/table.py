@@ -71,7 +71,8 @@ def _full(v: float) -> str:
 
 def prediction_line(fr, i: int, name: str) -> str:
     if fr.out_of_domain[i]:
-        return f"{name}: outside the networks' domain (not in the BFV or not seen by both)"
+        why = "not in the BFV" if not fr.in_bfv[i] else "not seen by both eyes"
+        return f"{name}: outside the networks' domain ({why})"  # fits a single column
     pred = fr.predictions.get(name)
     if not isinstance(pred, PredictionFrame):
         if isinstance(pred, str) and pred.startswith("cannot answer: trained for "):
