@@ -3,6 +3,7 @@ widget behind EYEVIZ_VIEW=vtk; both drive the same drag and draw the same pictur
 no sibling widget becomes a native window (issue 12, drag latency)."""
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -65,3 +66,40 @@ def test_an_unknown_view_is_refused_in_one_line(tmp_path):
     lines = [ln for ln in r.stderr.splitlines() if "XDG_RUNTIME_DIR" not in ln]
     assert len(lines) == 1 and "EYEVIZ_VIEW" in lines[0] and "opengl" in lines[0], r.stderr
     assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize("backend", ["pyvistaqt", "vtk"])
+def test_a_real_x_pointer_drags_a_feature_and_ctrl_z_undoes_it(
+    make_window, qtbot, monkeypatch, backend
+):
+    """The pointer and keys through the X server (xdotool), as a user's hand would."""
+    if shutil.which("xdotool") is None:
+        pytest.fail("xdotool is needed for this test: apt-get install xdotool")
+    monkeypatch.setattr(view, "BACKEND", backend)
+    win = make_window(load(ROOT / "assets" / "scenes" / "default.toml"))
+    win.activateWindow()
+    win.raise_()
+    f = win.model.scene.features[0]
+    x0, y0 = f.x, f.y
+    p = win.plotter.mapToGlobal(pixel_of(win, f.x, f.y))
+
+    def xdo(*args):
+        subprocess.run(["xdotool", *map(str, args)], check=True)
+        qtbot.wait(30)
+
+    xdo("mousemove", p.x(), p.y())
+    xdo("mousedown", 1)
+    for k in range(1, 9):
+        xdo("mousemove", p.x() + 8 * k, p.y() + 3 * k)
+    xdo("mouseup", 1)
+    qtbot.waitUntil(lambda: win.undo_stack.count() == 1, timeout=3000)
+    moved = win.model.scene.features[0]
+    assert (moved.x, moved.y) != (x0, y0)
+    # the disc is drawn where the model says, through the same camera the pointer used
+    end = win.plotter.mapToGlobal(pixel_of(win, moved.x, moved.y))
+    assert abs(end.x() - (p.x() + 64)) <= 2 and abs(end.y() - (p.y() + 24)) <= 2
+    wid = str(int(win.winId()))
+    xdo("key", "--window", wid, "ctrl+z")
+    qtbot.waitUntil(lambda: win.undo_stack.index() == 0, timeout=3000)
+    back = win.model.scene.features[0]
+    assert (back.x, back.y) == (x0, y0)
