@@ -5,6 +5,7 @@ scene without them imports neither matplotlib nor the estimators.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -304,27 +305,80 @@ class TrajectoryPanel(QtWidgets.QWidget):
         return xy
 
 
-class ExportDialog(QtWidgets.QDialog):
-    """File > Export: path (.png, .svg or .pdf), PNG scale, transparent background."""
+@dataclass
+class ExportChoice:
+    """What File > Export asks for (eyeviz.render.mpl.export.export's arguments)."""
 
-    def __init__(self, parent, start: str):
+    path: Path
+    scale: float = 1.0
+    transparent: bool = False
+    width: float | str = "single"
+    title: bool = True
+    table: bool = True
+    bitmaps: bool = True
+
+
+class ExportDialog(QtWidgets.QDialog):
+    """File > Export: path (.png, .svg or .pdf), the journal's width (single column
+    3.5 in, double column 7.2 in, or inches), the parts to include, PNG scale and a
+    transparent background. ``last`` (the window's previous choice) fills the fields."""
+
+    WIDTH_ITEMS = (
+        ("single column (3.5 in)", "single"),
+        ("double column (7.2 in)", "double"),
+        ("other width (inches)", None),
+    )
+
+    def __init__(self, parent, start: str, last: ExportChoice | None = None):
         super().__init__(parent)
+        last = last or ExportChoice(Path(start))
         self.setWindowTitle("Export figure")
         form = QtWidgets.QFormLayout(self)
         self.path = QtWidgets.QLineEdit(start)
+        self.path.setMinimumWidth(self.path.fontMetrics().horizontalAdvance("x" * 40))
         browse = QtWidgets.QPushButton("Browse…")
         browse.clicked.connect(self._browse)
         row = QtWidgets.QHBoxLayout()
         row.addWidget(self.path, 1)
         row.addWidget(browse)
         form.addRow("file (.png, .svg, .pdf)", row)
+        self.width = QtWidgets.QComboBox()
+        for text, _ in self.WIDTH_ITEMS:
+            self.width.addItem(text)
+        self.inches = QtWidgets.QDoubleSpinBox()
+        self.inches.setRange(3.0, 10.0)  # what eyeviz.render.mpl.vector.resolve_width takes
+        self.inches.setSingleStep(0.1)
+        self.inches.setDecimals(2)
+        self.inches.setSuffix(" in")
+        if isinstance(last.width, str):
+            self.width.setCurrentIndex(0 if last.width == "single" else 1)
+            self.inches.setValue(3.5 if last.width == "single" else 7.2)
+        else:
+            self.width.setCurrentIndex(2)
+            self.inches.setValue(float(last.width))
+        self.width.currentIndexChanged.connect(self._width_changed)
+        self._width_changed(self.width.currentIndex())
+        wrow = QtWidgets.QHBoxLayout()
+        wrow.addWidget(self.width, 1)
+        wrow.addWidget(self.inches)
+        form.addRow("width", wrow)
+        self.parts = {}
+        prow = QtWidgets.QHBoxLayout()
+        for key, text in (("title", "title"), ("table", "table"), ("bitmaps", "bitmaps")):
+            box = QtWidgets.QCheckBox(text)
+            box.setChecked(bool(getattr(last, key)))
+            self.parts[key] = box
+            prow.addWidget(box)
+        prow.addStretch(1)
+        form.addRow("include", prow)
         self.scale = QtWidgets.QDoubleSpinBox()
         self.scale.setRange(0.25, 20.0)
         self.scale.setSingleStep(0.5)
-        self.scale.setValue(1.0)
-        self.scale.setToolTip("PNG only: 1 = 300 dpi at a 3.5 inch column")
+        self.scale.setValue(last.scale)
+        self.scale.setToolTip("PNG only: 1 = 300 dpi")
         form.addRow("PNG scale", self.scale)
         self.transparent = QtWidgets.QCheckBox("transparent background")
+        self.transparent.setChecked(last.transparent)
         form.addRow(self.transparent)
         buttons = QtWidgets.QDialogButtonBox(
             QtWidgets.QDialogButtonBox.Ok | QtWidgets.QDialogButtonBox.Cancel
@@ -332,6 +386,19 @@ class ExportDialog(QtWidgets.QDialog):
         buttons.accepted.connect(self.accept)
         buttons.rejected.connect(self.reject)
         form.addRow(buttons)
+
+    def _width_changed(self, index: int) -> None:
+        self.inches.setEnabled(self.WIDTH_ITEMS[index][1] is None)
+
+    def choice(self) -> ExportChoice:
+        named = self.WIDTH_ITEMS[self.width.currentIndex()][1]
+        return ExportChoice(
+            Path(self.path.text()),
+            float(self.scale.value()),
+            self.transparent.isChecked(),
+            named if named is not None else float(self.inches.value()),
+            **{k: box.isChecked() for k, box in self.parts.items()},
+        )
 
     def _browse(self) -> None:
         p, _ = QtWidgets.QFileDialog.getSaveFileName(
@@ -341,4 +408,5 @@ class ExportDialog(QtWidgets.QDialog):
             self.path.setText(p)
 
     def values(self) -> tuple[Path, float, bool]:
-        return Path(self.path.text()), float(self.scale.value()), self.transparent.isChecked()
+        c = self.choice()
+        return c.path, c.scale, c.transparent

@@ -81,6 +81,8 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         self._table_timer.timeout.connect(lambda: self.features_panel.refresh(self._table_index))
         self._frame_pending = False
         self.inset_shown = True
+        self._export_choice = None  # File > Export's last choice (eyeviz.app.docks.ExportChoice)
+        self.export_dialog_box = None
 
         self.plotter = VtkView(self)
         self.plotter.set_background(BACKGROUND)
@@ -268,18 +270,46 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
 
     # --- export (off the GUI thread) ------------------------------------------------
     def export_dialog(self) -> None:
+        """File > Export: the dialog starts from the previous choice (width, parts, scale)."""
+        from dataclasses import replace
+
         from eyeviz.app.docks import ExportDialog
 
         src = self.path or self.source
         base = src.with_suffix(".png") if self.path else Path.cwd() / "figure.png"
-        dlg = ExportDialog(self, str(base))
+        last = replace(self._export_choice, path=base) if self._export_choice else None
+        dlg = ExportDialog(self, str(base), last)
+        self.export_dialog_box = dlg  # tests and xdotool reach the open dialog
         if dlg.exec_() == QtWidgets.QDialog.Accepted:
-            self.export_to(*dlg.values())
+            c = dlg.choice()
+            self._export_choice = c
+            self.export_to(
+                c.path,
+                c.scale,
+                c.transparent,
+                wait=False,
+                width=c.width,
+                title=c.title,
+                table=c.table,
+                bitmaps=c.bitmaps,
+            )
 
-    def export_to(self, path, scale: float = 1.0, transparent: bool = False, wait: bool = True):
-        """The scene as a figure (eyeviz.render.mpl.export: PNG, SVG, PDF), written on a
-        worker thread with a busy cursor; errors in a dialog. ``wait``: block until done
-        and return the path (None on error); otherwise return the job at once."""
+    def export_to(
+        self,
+        path,
+        scale: float = 1.0,
+        transparent: bool = False,
+        wait: bool = True,
+        *,
+        width: float | str = "single",
+        title: bool = True,
+        table: bool = True,
+        bitmaps: bool = True,
+    ):
+        """The scene as a figure (eyeviz.render.mpl.export: PNG, SVG, PDF) ``width`` wide
+        (single, double or inches) with or without its title, table and bitmaps, written
+        on a worker thread with a busy cursor; errors in a dialog. ``wait``: block until
+        done and return the path (None on error); otherwise return the job at once."""
         from eyeviz import EyevizError
         from eyeviz.render.mpl.export import export
 
@@ -298,7 +328,17 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
                 self.show_error("Cannot export", f"{type(exc).__name__}: {exc}")
 
         job = self.jobs.start(
-            lambda: export(scene, path, scale, transparent, predictions=preds),
+            lambda: export(
+                scene,
+                path,
+                scale,
+                transparent,
+                predictions=preds,
+                width=width,
+                title=title,
+                table=table,
+                bitmaps=bitmaps,
+            ),
             f"exporting {Path(path).name}…",
             done,
             failed,

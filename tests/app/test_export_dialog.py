@@ -1,0 +1,85 @@
+"""File > Export through the real dialog (eyeviz/app/docks.py ExportDialog): the journal's
+width and the parts to include reach the file; the window never blocks on the export
+(issue 12, "export for journals" and "long work never freezes the window")."""
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from PyQt5 import QtCore, QtWidgets
+
+from eyeviz.model.scene import load
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _answer(win, fill):
+    """Fill the dialog File > Export opens, then press OK (as the user would)."""
+
+    def run():
+        dlg = win.export_dialog_box
+        if dlg is None or not dlg.isVisible():
+            QtCore.QTimer.singleShot(20, run)
+            return
+        fill(dlg)
+        ok = dlg.findChild(QtWidgets.QDialogButtonBox).button(QtWidgets.QDialogButtonBox.Ok)
+        ok.click()
+
+    QtCore.QTimer.singleShot(0, run)
+
+
+def test_width_and_parts_chosen_in_the_dialog_reach_the_file(make_window, tmp_path):
+    win = make_window(load(ROOT / "assets" / "scenes" / "default.toml"))
+    out = tmp_path / "fig.svg"
+
+    def fill(dlg):
+        dlg.path.setText(str(out))
+        dlg.width.setCurrentIndex(1)  # double column
+        dlg.parts["title"].setChecked(False)
+        dlg.parts["table"].setChecked(False)
+
+    _answer(win, fill)
+    win.export_dialog()
+    win.jobs.wait()
+    root = ET.parse(out).getroot()
+    assert root.get("width") == "518.4pt"  # 7.2 in
+    texts = " ".join("".join(t.itertext()) for t in root.iter("{http://www.w3.org/2000/svg}text"))
+    assert win.model.scene.title not in texts  # no title
+    assert "about eye A" not in texts  # no table
+    assert "m/2" in texts  # the bitmaps are kept
+
+    seen = {}
+
+    def check(dlg):  # the dialog opens on the previous choice
+        seen.update(
+            width=dlg.width.currentIndex(),
+            title=dlg.parts["title"].isChecked(),
+            table=dlg.parts["table"].isChecked(),
+            bitmaps=dlg.parts["bitmaps"].isChecked(),
+        )
+        dlg.width.setCurrentIndex(2)
+        dlg.inches.setValue(5.0)
+        dlg.path.setText(str(tmp_path / "fig5.pdf"))
+
+    _answer(win, check)
+    win.export_dialog()
+    win.jobs.wait()
+    assert seen == {"width": 1, "title": False, "table": False, "bitmaps": True}
+    head = (tmp_path / "fig5.pdf").read_bytes()
+    assert head.startswith(b"%PDF") and b"/MediaBox [ 0 0 360 " in head  # 5 in = 360 pt
+
+
+def test_the_dialog_returns_while_the_export_runs(make_window, tmp_path):
+    win = make_window(load(ROOT / "assets" / "scenes" / "default.toml"))
+    out = tmp_path / "big.png"
+
+    def fill(dlg):
+        dlg.path.setText(str(out))
+        dlg.scale.setValue(3.0)
+
+    _answer(win, fill)
+    win.export_dialog()
+    # back in the event loop at once: the window repaints and takes drags meanwhile
+    assert win.jobs.busy(), "File > Export blocked the window until the file was written"
+    assert QtWidgets.QApplication.overrideCursor() is not None
+    win.jobs.wait()
+    assert out.stat().st_size > 10_000 and not win.jobs.busy()
