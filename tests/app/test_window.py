@@ -203,6 +203,9 @@ def test_feature_table_edit_and_bad_value(make_window):
     assert win.model.scene == before
     assert "g (feature radius) must be > 0" in win.features_panel.message.text()
     assert table.item(0, 3).text() == "75"
+    table.item(0, 3).setText("80")  # a success clears the old refusal (issue 12 item 11)
+    assert win.model.scene.features[0].g == 80.0
+    assert win.features_panel.message.text() == ""
 
 
 def test_add_duplicate_delete(make_window):
