@@ -29,6 +29,7 @@ __all__ = ["AppModel", "MouseEvent", "DRAG_THRESHOLD_PX", "drag_feature", "hit_t
 DRAG_THRESHOLD_PX = 4.0  # a press released closer than this to where it started is a click
 HANDLE_PX = 14.0  # radius of the grab zone of the radius handle (drawn at this size)
 BODY_PX = 8.0  # grab margin around a disc (and the minimum grab radius for tiny features)
+DOT_PX = 6.0  # radius of a feature's centre dot (drawn 11 px wide): a disc is at least this
 M_MAX = 200_000  # larger m cannot be redrawn live
 
 
@@ -293,8 +294,9 @@ def hit_test(scene: Scene, selected: int | None, x: float, y: float, units_per_p
     first. The selected feature's radius handle (at (x + g, y), drawn HANDLE_PX wide) is
     grabbable only where it is drawn apart from its disc's centre (g >= HANDLE_PX on
     screen), when the cursor is within HANDLE_PX of it, nearer to it than to the centre,
-    and not inside another disc: zoomed out, a press on a neighbour selects the neighbour
-    instead of resizing the selected feature (issue 12, item 3).
+    and not inside another disc as drawn (at least its DOT_PX centre dot): zoomed out, a
+    press on a neighbour selects the neighbour instead of resizing the selected feature
+    (issue 12, item 3).
     """
     fs = scene.features
     u = max(units_per_px, 1e-300)
@@ -314,7 +316,7 @@ def hit_test(scene: Scene, selected: int | None, x: float, y: float, units_per_p
             and not (
                 body is not None
                 and body != selected
-                and math.hypot(x - fs[body].x, y - fs[body].y) <= fs[body].g
+                and math.hypot(x - fs[body].x, y - fs[body].y) <= max(fs[body].g, DOT_PX * u)
             )
         ):
             return selected, "handle"

@@ -126,6 +126,21 @@ def test_zoomed_out_a_press_on_a_neighbour_never_grabs_the_selected_handle():
     assert m.scene.features[1].x == pytest.approx(4000.0 + 20 * u)
 
 
+def test_a_press_on_a_tiny_neighbours_dot_beside_the_handle_grabs_the_neighbour():
+    # 10 units per px: a (g = 300) selected, its handle at (300, 0); b (g = 5, half a pixel)
+    # drawn as its 11 px centre dot at (340, 0), 4 px past a's handle
+    m, _ = make(View((0.0, 0.0), 10.0 * VP.width))
+    m.set_scene(Scene(features=[Feature("a", 0.0, 0.0, 300.0), Feature("b", 340.0, 0.0, 5.0)]))
+    m.scene.view = View((0.0, 0.0), 10.0 * VP.width)
+    m.select(0)
+    u = camera.units_per_px(m.scene.view, VP)
+    assert u == pytest.approx(10.0)
+    for off_px in (2.0, 4.0, 5.5):  # on b's dot, off its centre
+        assert hit_test(m.scene, 0, 340.0 - off_px * u, 0.0, u) == (1, "body"), off_px
+    # a's handle, pressed clear of b's dot, still resizes a
+    assert hit_test(m.scene, 0, 300.0 - 8 * u, 0.0, u) == (0, "handle")
+
+
 def test_handle_is_grabbable_where_it_is_drawn_apart():
     m, _ = make()
     u = camera.units_per_px(m.scene.view, VP)
