@@ -30,6 +30,7 @@ from eyeviz.app.panels import (
     LayersPanel,
     ReadoutPanel,
     design_skips,
+    user_message,
 )
 from eyeviz.app.screenshot import qimage_to_array
 from eyeviz.app.settings import Settings, make_settings
@@ -322,10 +323,12 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
             self.statusBar().showMessage(f"exported {out}", 8000)
 
         def failed(exc) -> None:
+            # one line, local paths cut to their file name (an estimator's reason can name
+            # a weights file under the user's home)
             if isinstance(exc, (EyevizError, OSError, ValueError)):
-                self.show_error("Cannot export", str(exc))
+                self.show_error("Cannot export", user_message(str(exc), 300))
             else:
-                self.show_error("Cannot export", f"{type(exc).__name__}: {exc}")
+                self.show_error("Cannot export", f"unexpected error: {user_message(str(exc))}")
 
         job = self.jobs.start(
             lambda: export(

@@ -221,3 +221,24 @@ def test_a_drag_rewrites_only_the_dragged_features_ghosts(make_window, qtbot):
     np.testing.assert_array_equal(after[others], before[others])
     r, phi = analytic_answer(f)
     np.testing.assert_allclose(after[1, -1, :2], [r * math.cos(phi), r * math.sin(phi)], rtol=1e-9)
+
+
+def test_an_export_refused_for_an_unavailable_estimator_names_no_local_path(
+    make_window, tmp_path, monkeypatch
+):
+    from eyeviz import estimators
+
+    def missing(name, **kw):
+        raise FileNotFoundError("no weights at /home/someone/.cache/eyeviz/paper.npz")
+
+    monkeypatch.setattr(estimators, "load", missing)
+    sc = scene()
+    sc.layers = [*sc.layers, "predictions"]
+    sc.estimators = ["paper"]
+    win = make_window(sc)
+    win.jobs.wait()
+    out = tmp_path / "fig.pdf"
+    assert win.export_to(out) is None and not out.exists()  # refused, nothing written
+    assert "/home/someone" not in win.last_error and "paper.npz" in win.last_error
+    assert "\n" not in win.last_error
+    win.error_box.close()
