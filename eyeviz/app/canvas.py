@@ -12,7 +12,7 @@ import math
 from PyQt5 import QtCore, QtWidgets
 
 from eyeviz.model import camera, interactions
-from eyeviz.model.app_model import MouseEvent, hit_test
+from eyeviz.model.app_model import DOT_PX, MouseEvent, hit_test
 from eyeviz.model.camera import Viewport
 from eyeviz.model.scene import View
 from eyeviz.render.vtk.actors import inset_viewport
@@ -97,12 +97,26 @@ class CanvasMixin:
             1.0 / self.units_per_px("main"), 1.0 / self.units_per_px("inset"), e.l, e.m
         )
 
-    def _update_inset_visibility(self) -> None:
+    def _inset_wanted(self) -> bool:
         """The inset magnifies the eyes; where they are already large on screen (or the
-        scene has no eyes) it would only duplicate the main view, so it is hidden."""
+        scene has no eyes) it would only duplicate the main view."""
         e = self.model.scene.eyes
         eye_px = 2.0 * e.l / self.units_per_px("main")
-        want = self.model.scene.shows("eyes") and eye_px < INSET_HIDE_EYE_PX
+        return self.model.scene.shows("eyes") and eye_px < INSET_HIDE_EYE_PX
+
+    def _feature_under_inset(self) -> bool:
+        """A feature's disc (or its centre dot) drawn where the inset sits."""
+        sc = self.model.scene
+        if not sc.features or not sc.shows("features"):
+            return False
+        st = self.model.state
+        rect = self.viewport("inset")
+        return camera.discs_meet(sc.view, self.viewport("main"), st.x, st.y, st.g, rect, DOT_PX)
+
+    def _update_inset_visibility(self) -> None:
+        """Show the inset where it is wanted and hides no feature: a feature dragged or
+        fitted under it hides the inset instead (it comes back once the corner is free)."""
+        want = self._inset_wanted() and not self._feature_under_inset()
         if want != self.inset_shown or self.inset_ren.GetDraw() != want:
             self.inset_shown = want
             self.inset_ren.SetDraw(want)
@@ -122,14 +136,13 @@ class CanvasMixin:
     def fit_view(self) -> None:
         """F: every feature and the eyes in view, none under the inset or the title. The
         view then follows the window's size until the user zooms or pans it."""
-        self._update_inset_visibility()
-        avoid = self.viewport("inset") if self.inset_shown else None
+        avoid = self.viewport("inset") if self._inset_wanted() else None
         top, right = self.title_band_px(), self.label_band_px()
         interactions.fit_view(self.model, self.viewport("main"), avoid, top, right)
-        # fitting may hide the inset (large eyes): then fit the whole view
-        self._update_inset_visibility()
-        if avoid is not None and not self.inset_shown:
+        # fitting may make the eyes large (no inset wanted): then fit the whole view
+        if avoid is not None and not self._inset_wanted():
             interactions.fit_view(self.model, self.viewport("main"), None, top, right)
+        self._update_inset_visibility()
         self._fitted_view = self.model.scene.view
 
     def fit_inset(self) -> None:

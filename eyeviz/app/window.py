@@ -228,6 +228,8 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         scene = self.model.scene
         st = self.model.state
         self.actors.update(scene, st, self.model.selected)
+        if what == "feature":  # a feature moved under the inset hides it (and back)
+            self._update_inset_visibility()
         self._refresh_overlays(scene, st)
         self.title_actor.SetInput(scene.title)
         self.readout.refresh()

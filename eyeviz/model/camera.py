@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from eyeviz.model.scene import Eyes, Scene, View
 
 __all__ = [
@@ -19,6 +21,7 @@ __all__ = [
     "MIN_WIDTH",
     "ZOOM_STEP",
     "Viewport",
+    "discs_meet",
     "fit_inset",
     "fit_view",
     "pan",
@@ -70,6 +73,24 @@ def to_pixel(view: View, vp: Viewport, x: float, y: float) -> tuple[float, float
     u = units_per_px(view, vp)
     cx, cy = view.center
     return vp.left + vp.width / 2.0 + (x - cx) / u, vp.top + vp.height / 2.0 - (y - cy) / u
+
+
+def discs_meet(view: View, vp: Viewport, x, y, g, rect: Viewport, min_px: float = 0.0) -> bool:
+    """Whether any disc (centres x, y and radii g, model units; drawn at least ``min_px``
+    pixels in radius) shown in ``vp`` overlaps the pixel rectangle ``rect``: the app hides
+    its magnified inset rather than a feature under it (issue 12, item 4)."""
+    x, y, g = (np.asarray(a, dtype=np.float64) for a in (x, y, g))
+    if x.size == 0:
+        return False
+    u = units_per_px(view, vp)
+    cx, cy = view.center
+    with np.errstate(over="ignore", invalid="ignore"):
+        px = vp.left + vp.width / 2.0 + (x - cx) / u
+        py = vp.top + vp.height / 2.0 - (y - cy) / u
+        r = np.maximum(g / u, min_px)
+        dx = np.clip(px, rect.left, rect.left + rect.width) - px
+        dy = np.clip(py, rect.top, rect.top + rect.height) - py
+        return bool((np.hypot(dx, dy) <= r).any())
 
 
 def zoom_about(view: View, vp: Viewport, px: float, py: float, factor: float) -> View:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 from mouse import drag, pixel_of
-from PyQt5 import QtCore, QtWidgets
+from PyQt5 import QtCore, QtGui, QtWidgets
 from PyQt5.QtTest import QTest
 
 from eyeviz.model.scene import Eyes, Feature, Scene, View, load
@@ -310,3 +310,29 @@ def test_estimators_load_off_the_gui_thread(make_window, monkeypatch):
     preds = win.model.predictions
     assert set(preds) == {"compact"} and not isinstance(preds["compact"], str)
     assert threads and all(t is not threading.main_thread() for t in threads)
+
+
+def test_a_feature_under_the_inset_is_drawn_and_the_inset_steps_aside(make_window):
+    """Issue 12 item 4: a feature dragged under the magnified inset was hidden by it."""
+    win = make_window(load(ROOT / "assets" / "scenes" / "default.toml"))
+    assert win.inset_shown
+    left, top, w, h = win._viewport_px("inset")
+    start = pixel_of(win, *(lambda f: (f.x, f.y))(win.model.scene.features[0]))
+    drag(win, start, QtCore.QPoint(round(left + w / 2), round(top + h / 2)), steps=20)
+    QtWidgets.QApplication.processEvents()
+    f = win.model.scene.features[0]
+    px, py = win.to_pixel(f.x, f.y, "main")
+    assert left <= px <= left + w and top <= py <= top + h  # it is where the inset was
+    assert not win.inset_shown and not win.inset_ren.GetDraw()
+    img = win.grab_image()  # the window as drawn: the disc's centre dot
+    at = win.plotter.mapTo(win, QtCore.QPoint(round(px), round(py)))
+    got = QtGui.QColor(img.pixel(at.x(), at.y()))
+    want = QtGui.QColor(f.color)
+    assert max(abs(got.red() - want.red()), abs(got.green() - want.green())) <= 24, got.name()
+    # a press there reaches the feature (no inset to pan)
+    assert win.which_at(px, py) == "main"
+    win.undo_stack.undo()  # back out of the corner: the inset returns
+    QtWidgets.QApplication.processEvents()
+    assert win.inset_shown and win.inset_ren.GetDraw()
+    win.fit_view()  # F never places a feature under it
+    assert win.inset_shown
