@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 from eyeviz import EyevizError
 from eyeviz.model import scene as scene_mod
 from eyeviz.render.mpl.export import export
+from eyeviz.render.mpl.layers.table import GROUPS
 
 SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 
@@ -366,3 +367,27 @@ def test_svg_predictions_for_other_eyes(tmp_path):
         m = re.search(name + r": r\u0302 = [^(]*\(\u0394r [^,]*, ([+\-\u2212]?[\d.]+) %\)", texts)
         assert m, (name, texts)
         assert abs(float(m.group(1).replace("\u2212", "-"))) < 10, (name, m.group(0))
+
+
+@pytest.mark.parametrize("name", ["figure5", "trajectory", "default"])
+def test_column_group_headers_stay_apart(name):
+    """'about the origin O' ran into 'about eye A' at 3.5 in (a 1.4 pt gap)."""
+    sc = scene_mod.load(SCENES / f"{name}.toml")
+    for width in ("single", "double"):
+        fig = vector.figure(sc, width=width)
+        r = _renderer(fig)
+        table = next(a for a in fig.axes if a.get_gid() == "readout")
+        heads = sorted(
+            (t for t in table.texts if (t.get_gid() or "").startswith("readout-group-")),
+            key=lambda t: t.get_window_extent(r).x0,
+        )
+        assert len(heads) == 3
+        word = fig.dpi * 6 / 72 * 0.6  # about a 6 pt space
+        for a, b in zip(heads, heads[1:], strict=False):
+            assert a.get_window_extent(r).x1 + word <= b.get_window_extent(r).x0, (
+                width,
+                a.get_text(),
+                b.get_text(),
+            )
+        got = [h.get_text() for h in heads]
+        assert got in ([g[0] for g in GROUPS], [g[1] for g in GROUPS])  # all long or all short

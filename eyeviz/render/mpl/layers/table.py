@@ -22,6 +22,12 @@ COLUMNS = [
     ("BFV", "center"),
     ("seen by", "right"),
 ]
+# the groups of columns over the header row: (header, short header, first, last column)
+GROUPS = (
+    ("about the origin O", "origin O", 1, 2),
+    ("about eye A", "eye A", 3, 4),
+    ("about eye B", "eye B", 5, 6),
+)
 CHAR_IN = 0.6 * SMALL / 72  # a generous width of one 6 pt character, inches
 GAP_IN = 0.1  # at least this much between two cells
 
@@ -141,13 +147,23 @@ def paint(cv: Canvas) -> None:
     else:
         xs, lefts, rights = cols
     y = 1 - dy / 2
-    for text, a, b in (
-        ("about the origin O", 1, 2),
-        ("about eye A", 3, 4),
-        ("about eye B", 5, 6),
-    ):
-        x0, x1 = min(lefts[a], rights[b] - 0.17), rights[b]
-        ax.text((x0 + x1) / 2, y, text, ha="center", va="center", fontsize=SMALL, color=GREY)
+    # each group's header within its own columns; the short ones (all of them, alike)
+    # where a long one would reach its neighbour ("about the origin O" ran into
+    # "about eye A" at 3.5 in)
+    fits = all(len(t) * CHAR_IN <= (rights[b_] - lefts[a_]) * box.w for t, _, a_, b_ in GROUPS)
+    for long_text, short_text, a, b in GROUPS:
+        x0, x1 = lefts[a], rights[b]
+        text = long_text if fits else short_text
+        ax.text(
+            (x0 + x1) / 2,
+            y,
+            text,
+            ha="center",
+            va="center",
+            fontsize=SMALL,
+            color=GREY,
+            gid=f"readout-group-{a}",
+        )
         ax.plot([x0 + 0.01, x1], [y - 0.42 * dy] * 2, color=LIGHT, lw=0.4)
     y -= dy
     for (text, ha), x in zip(COLUMNS, xs, strict=True):
