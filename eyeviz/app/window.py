@@ -315,8 +315,12 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         done and return the path (None on error); otherwise return the job at once."""
         from eyeviz import EyevizError
         from eyeviz.render.mpl.export import export
+        from eyeviz.render.mpl.layout import ASPECT_RANGE
 
         scene = self.model.scene.copy()  # the job never sees later edits
+        vp = self.viewport("main")  # the figure frames what the window shows
+        lo, hi = ASPECT_RANGE
+        aspect = min(max(vp.height / max(vp.width, 1.0), lo), hi)
         preds = dict(self.model.predictions) if scene.shows("predictions") else None
         result: list = []
 
@@ -343,6 +347,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
                 title=title,
                 table=table,
                 bitmaps=bitmaps,
+                aspect=aspect,
             ),
             f"exporting {Path(path).name}…",
             done,

@@ -5,6 +5,7 @@ width and the parts to include reach the file; the window never blocks on the ex
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import pytest
 from PyQt5 import QtCore, QtWidgets
 
 from eyeviz.model.scene import load
@@ -83,3 +84,33 @@ def test_the_dialog_returns_while_the_export_runs(make_window, tmp_path):
     assert QtWidgets.QApplication.overrideCursor() is not None
     win.jobs.wait()
     assert out.stat().st_size > 10_000 and not win.jobs.busy()
+
+
+def test_the_exported_frame_is_the_windows(make_window, tmp_path, monkeypatch):
+    """Issue 12 item 10: the exported frame differed from the window's (taller)."""
+    from eyeviz.render.mpl import vector
+
+    made = []
+    real = vector.figure
+
+    def spy(*a, **kw):
+        made.append(real(*a, **kw))
+        return made[-1]
+
+    monkeypatch.setattr(vector, "figure", spy)
+    win = make_window(load(ROOT / "assets" / "scenes" / "default.toml"))
+    for size in ((1400, 900), (1280, 720)):
+        win.resize(*size)
+        QtWidgets.QApplication.processEvents()
+        win.fit_view()
+        assert win.export_to(tmp_path / "frame.pdf") is not None
+        ax = next(a for a in made[-1].axes if a.get_gid() == "main")
+        v, vp = win.model.scene.view, win.viewport("main")
+        half_h = v.width * vp.height / vp.width / 2
+        (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+        assert (x0, x1) == (
+            pytest.approx(v.center[0] - v.width / 2),
+            pytest.approx(v.center[0] + v.width / 2),
+        )
+        assert y0 == pytest.approx(v.center[1] - half_h, rel=1e-3, abs=v.width * 2e-3)
+        assert y1 == pytest.approx(v.center[1] + half_h, rel=1e-3, abs=v.width * 2e-3)

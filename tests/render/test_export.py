@@ -211,6 +211,24 @@ def test_framing_follows_the_scene_view(default_scene):
     assert sum(ax.get_ylim()) / 2 == pytest.approx(cy)
 
 
+@pytest.mark.parametrize("aspect", [0.45, 0.69, 1.3])
+def test_an_aspect_frames_what_a_window_of_that_shape_shows(default_scene, aspect):
+    fig = vector.figure(default_scene, width="single", aspect=aspect)
+    ax = next(a for a in fig.axes if a.get_gid() == "main")
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    assert x1 - x0 == pytest.approx(default_scene.view.width)
+    assert (y1 - y0) / (x1 - x0) == pytest.approx(aspect, rel=2e-3)
+    pos = ax.get_position()  # the axes have that shape on the page too
+    w_in, h_in = fig.get_size_inches()
+    assert pos.height * h_in / (pos.width * w_in) == pytest.approx(aspect, rel=2e-3)
+
+
+@pytest.mark.parametrize("bad", [0.1, 2.0, float("nan"), "tall"])
+def test_an_aspect_outside_its_range_is_refused(default_scene, bad):
+    with pytest.raises(EyevizError, match=r"aspect .* must be in \[0\.3, 1\.6\]"):
+        vector.figure(default_scene, aspect=bad)
+
+
 def test_inset_leader_stays_inside_the_axes():
     for sc in _all_scenes() + [_origin_below_view()]:
         fig = vector.figure(sc)

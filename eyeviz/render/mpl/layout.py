@@ -11,9 +11,10 @@ from dataclasses import dataclass
 
 from eyeviz.render.mpl.style import SMALL
 
-__all__ = ["ASPECT", "Box", "Layout", "interval_lanes", "layout"]
+__all__ = ["ASPECT", "ASPECT_RANGE", "Box", "Layout", "interval_lanes", "layout"]
 
-ASPECT = 0.86  # main view height / width
+ASPECT = 0.86  # main view height / width (a scene's own figure)
+ASPECT_RANGE = (0.3, 1.6)  # what a window's framing may ask for (eyeviz.render.mpl.vector)
 TEXT_ROW = 0.118  # inches per readout row at 6 pt
 LANE = 7.0 / 72  # one interval-label lane above/below a bitmap strip, inches
 LABEL_PT = SMALL
@@ -111,8 +112,10 @@ def layout(
     m: int = 0,
     ylim: tuple[float, float] = (0.0, 1.0),
     xlim: tuple[float, float] = (0.0, 1.0),
+    aspect: float = ASPECT,
 ) -> Layout:
-    """The figure's boxes for a ``width``-inch figure."""
+    """The figure's boxes for a ``width``-inch figure whose main view is ``aspect`` (height
+    / width) as tall as it is wide."""
     left = max(0.42, tick_chars(*ylim) * 0.6 * SMALL / 72 + 0.2)
     right = max(0.1, tick_chars(*xlim) * 0.6 * SMALL / 72 / 2 + 0.03)  # half a tick label
     main_w = width - left - right
@@ -123,7 +126,7 @@ def layout(
         a = interval_lanes(LA, RA, m, main_w)
         b = interval_lanes(LB, RB, m, main_w)
         lanes = (1 + max(ln for *_, ln in a), 1 + max(ln for *_, ln in b))
-    main_h = round(main_w * ASPECT, 3)
+    main_h = round(main_w * aspect, 3)
     rows = readout_rows(layers, n_features, n_estimators)
     readout_h = rows * TEXT_ROW + (0.06 if rows else 0.0)
     bitmaps_h = sum(lanes) * LANE + 0.02 + 0.12 * 2 + 0.15 if shows_bitmaps else 0.0

@@ -45,7 +45,7 @@ from eyeviz.render.mpl.layers import (
 from eyeviz.render.mpl.layers import (
     table as table_layer,
 )
-from eyeviz.render.mpl.layout import ASPECT, interval_lanes, layout
+from eyeviz.render.mpl.layout import ASPECT, ASPECT_RANGE, interval_lanes, layout
 from eyeviz.render.mpl.style import (
     BASE_DPI,
     MAX_WIDTH,
@@ -157,6 +157,23 @@ def _refuse(name: str, reason: str) -> None:
     raise EyevizError(f"predictions layer: cannot load estimator {name!r}: {reason}")
 
 
+def resolve_aspect(aspect: float | None) -> float:
+    """The main view's height / width: ``None`` is the default 0.86; a number must lie in
+    [0.3, 1.6] (refused, not clamped: the figure would not show what was asked)."""
+    if aspect is None:
+        return ASPECT
+    lo, hi = ASPECT_RANGE
+    try:
+        a = float(aspect)
+    except (TypeError, ValueError):
+        a = math.nan
+    if not lo <= a <= hi:
+        raise EyevizError(
+            f"aspect (view height / width) must be in [{lo:g}, {hi:g}], got {aspect!r}"
+        )
+    return a
+
+
 def figure(
     scene: Scene,
     state: SceneState | None = None,
@@ -169,9 +186,14 @@ def figure(
     table: bool = True,
     bitmaps: bool = True,
     predictor=None,
+    aspect: float | None = None,
 ) -> Figure:
     """The scene as a matplotlib Figure (no pyplot, no GUI), ``width`` inches wide
     ('single' = 3.5, 'double' = 7.2, or a number in [3, 10]).
+
+    ``aspect`` (height / width of the main view, in [0.3, 1.6]; default 0.86) frames the
+    figure as a window of that shape shows the scene's view: the app's File > Export
+    passes its view's, so the figure shows what the window shows.
 
     ``dpi`` is the resolution the figure will be rendered at (decides, with ``merge=None``,
     whether ommatidium triangles are below a pixel and merged into runs; pass
@@ -184,6 +206,7 @@ def figure(
     import matplotlib
 
     w = resolve_width(width)
+    aspect = resolve_aspect(aspect)
     check_drawable(scene)
     drop = set()
     if not table:
@@ -216,8 +239,9 @@ def figure(
             n_estimators=n_est,
             intervals=_intervals(state),
             m=state.pair.m,
-            ylim=(cy - scene.view.width * ASPECT / 2, cy + scene.view.width * ASPECT / 2),
+            ylim=(cy - scene.view.width * aspect / 2, cy + scene.view.width * aspect / 2),
             xlim=(cx - scene.view.width / 2, cx + scene.view.width / 2),
+            aspect=aspect,
         )
         vw = scene.view.width
         vh = vw * lay0.main.h / lay0.main.w
