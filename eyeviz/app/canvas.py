@@ -104,19 +104,27 @@ class CanvasMixin:
         eye_px = 2.0 * e.l / self.units_per_px("main")
         return self.model.scene.shows("eyes") and eye_px < INSET_HIDE_EYE_PX
 
-    def _feature_under_inset(self) -> bool:
-        """A feature's disc (or its centre dot) drawn where the inset sits."""
+    def _feature_under_inset(self, only: int | None = None) -> bool:
+        """A feature's disc (or its centre dot) drawn where the inset sits (``only``: that
+        feature's)."""
         sc = self.model.scene
         if not sc.features or not sc.shows("features"):
             return False
         st = self.model.state
+        x, y, g = st.x, st.y, st.g
+        if only is not None:
+            x, y, g = x[only : only + 1], y[only : only + 1], g[only : only + 1]
         rect = self.viewport("inset")
-        return camera.discs_meet(sc.view, self.viewport("main"), st.x, st.y, st.g, rect, DOT_PX)
+        return camera.discs_meet(sc.view, self.viewport("main"), x, y, g, rect, DOT_PX)
 
-    def _update_inset_visibility(self) -> None:
+    def _update_inset_visibility(self, moved: int | None = None) -> None:
         """Show the inset where it is wanted and hides no feature: a feature dragged or
-        fitted under it hides the inset instead (it comes back once the corner is free)."""
-        want = self._inset_wanted() and not self._feature_under_inset()
+        fitted under it hides the inset instead (it comes back once the corner is free).
+        ``moved``: only that feature changed, so a shown inset asks only about it."""
+        only = moved if moved is not None and self.inset_shown else None
+        if only is not None and only >= len(self.model.scene.features):
+            only = None
+        want = self._inset_wanted() and not self._feature_under_inset(only)
         if want != self.inset_shown or self.inset_ren.GetDraw() != want:
             self.inset_shown = want
             self.inset_ren.SetDraw(want)

@@ -81,6 +81,10 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         self._table_timer.setInterval(100)
         self._table_timer.timeout.connect(lambda: self.features_panel.refresh(self._table_index))
         self._frame_pending = False
+        self._frame_timer = QtCore.QTimer(self)
+        self._frame_timer.setSingleShot(True)
+        self._frame_timer.setInterval(0)
+        self._frame_timer.timeout.connect(self._frame)
         self.inset_shown = True
         self._export_choice = None  # File > Export's last choice (eyeviz.app.docks.ExportChoice)
         self.export_dialog_box = None
@@ -175,6 +179,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         self.settings.setValue("window/state", bytes(self.saveState()))
         self.settings.sync()
         self._frame_pending = True  # no frame after close
+        self._frame_timer.stop()
         self._table_timer.stop()  # nor a table refresh (it fired into a closed window)
         self.plotter.close()
         super().closeEvent(event)
@@ -229,7 +234,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         st = self.model.state
         self.actors.update(scene, st, self.model.selected)
         if what == "feature":  # a feature moved under the inset hides it (and back)
-            self._update_inset_visibility()
+            self._update_inset_visibility(index)
         self._refresh_overlays(scene, st)
         self.title_actor.SetInput(scene.title)
         self.readout.refresh()
@@ -368,7 +373,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         """Draw once the pending events are handled (moves arriving meanwhile coalesce)."""
         if not self._frame_pending:
             self._frame_pending = True
-            QtCore.QTimer.singleShot(0, self._frame)
+            self._frame_timer.start()  # one timer kept: QTimer.singleShot cost ~25 us a move
 
     def _frame(self) -> None:
         self._frame_pending = False
