@@ -406,7 +406,3 @@ class ExportDialog(QtWidgets.QDialog):
         )
         if p:
             self.path.setText(p)
-
-    def values(self) -> tuple[Path, float, bool]:
-        c = self.choice()
-        return c.path, c.scale, c.transparent

@@ -11,11 +11,12 @@ Two implementations behind one switch (``BACKEND``, or ``$EYEVIZ_VIEW`` = ``pyvi
   lighting="none"``, OIT and depth peeling off, and frames go through ``plotter.render()``;
 - ``vtk``: VTK's own ``QVTKRenderWindowInteractor``.
 
-``scripts/bench_app.py`` measures both in the same run, interleaved. Over six runs on a
-quiet 2-core machine (issue 12) pyvistaqt's drag p50 was 0.89-1.10x of the native widget's
-at m = 720 (mean 0.98x) and 0.89-1.08x at m = 36,000 (mean 0.99x): equal within the
-run-to-run noise, so the design's choice is the default; ``EYEVIZ_VIEW=vtk`` selects VTK's
-own widget.
+``scripts/bench_app.py`` measures both in the same run, in the order a, b, b, a (the
+first window of a run measured up to ~10 % slower). Over four such runs on a quiet
+2-core machine (issue 12) pyvistaqt's drag p50 was 0.98-1.09x of the native widget's at
+m = 720 and 0.95-1.12x at m = 36,000 (mean 1.04x at both): equal within the run-to-run
+noise, so the design's choice is the default; ``EYEVIZ_VIEW=vtk`` selects VTK's own
+widget.
 
 The window never lets VTK's interactor styles see a mouse event (the main window filters
 them), so this widget only renders.

@@ -82,12 +82,9 @@ def discs_meet(view: View, vp: Viewport, x, y, g, rect: Viewport, min_px: float 
     x, y, g = (np.asarray(a, dtype=np.float64) for a in (x, y, g))
     if x.size == 0:
         return False
-    u = units_per_px(view, vp)
-    cx, cy = view.center
     with np.errstate(over="ignore", invalid="ignore"):
-        px = vp.left + vp.width / 2.0 + (x - cx) / u
-        py = vp.top + vp.height / 2.0 - (y - cy) / u
-        r = np.maximum(g / u, min_px)
+        px, py = to_pixel(view, vp, x, y)  # elementwise on arrays
+        r = np.maximum(g / units_per_px(view, vp), min_px)
         dx = np.clip(px, rect.left, rect.left + rect.width) - px
         dy = np.clip(py, rect.top, rect.top + rect.height) - py
         return bool((np.hypot(dx, dy) <= r).any())
