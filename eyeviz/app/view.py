@@ -12,9 +12,9 @@ Two implementations behind one switch (``BACKEND``, or ``$EYEVIZ_VIEW`` = ``pyvi
 - ``vtk``: VTK's own ``QVTKRenderWindowInteractor``.
 
 ``scripts/bench_app.py`` measures both in the same run, in the order a, b, b, a (the
-first window of a run measured up to ~10 % slower). Over four such runs on a quiet
-2-core machine (issue 12) pyvistaqt's drag p50 was 0.98-1.09x of the native widget's at
-m = 720 and 0.95-1.12x at m = 36,000 (mean 1.04x at both): equal within the run-to-run
+first window of a run measured up to ~10 % slower). Over five such runs on a quiet
+2-core machine (issue 12) pyvistaqt's drag p50 was 0.98-1.11x of the native widget's at
+m = 720 (mean 1.05x) and 0.95-1.12x at m = 36,000 (mean 1.03x): equal within the run-to-run
 noise, so the design's choice is the default; ``EYEVIZ_VIEW=vtk`` selects VTK's own
 widget.
 
