@@ -35,15 +35,27 @@ class Interrupted(KeyboardInterrupt):
 
 
 def _raise_interrupted(signum, _frame) -> None:
-    raise Interrupted(signal.Signals(signum).name)
+    exc = Interrupted(signal.Signals(signum).name)
+    _note_interruption(exc)  # kept: a library may swallow the exception (eyeviz.files.atomic)
+    raise exc
+
+
+def _note_interruption(exc: BaseException) -> None:
+    """Replaced by :func:`eyeviz.files.atomic.note_interruption` once handlers are set."""
 
 
 def install_signal_handlers() -> dict:
-    """SIGTERM and SIGHUP end like Ctrl-C (an exception that unwinds every ``with``).
+    """SIGINT, SIGTERM and SIGHUP end the command alike: an exception that unwinds every
+    ``with``, and is remembered so no output is kept even where a library swallows it.
 
     Returns the previous handlers (for :func:`signal.signal` to put back)."""
+    global _note_interruption
+    from eyeviz.files import atomic  # imported here, never inside the handler
+
+    atomic.clear_interruptions()
+    _note_interruption = atomic.note_interruption
     old = {}
-    for name in ("SIGTERM", "SIGHUP"):
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
         sig = getattr(signal, name, None)
         if sig is not None:
             old[sig] = signal.signal(sig, _raise_interrupted)

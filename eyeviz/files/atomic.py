@@ -26,6 +26,23 @@ SWEEP_AGE_S = 600.0
 #: Temporary files of earlier eyeviz versions (no PID in the name): swept after a day.
 SWEEP_AGE_LEGACY_S = 86400.0
 
+#: Interruptions (SIGINT, SIGTERM, SIGHUP under :func:`eyeviz.cli.main`) since the command
+#: began. A library can swallow the exception a signal handler raises (one raised inside
+#: numpy's lazy import of ``numpy.random`` was lost, and the whole output was kept):
+#: :func:`atomic_output` raises it again rather than keep the file.
+_interruptions: list[BaseException] = []
+
+
+def note_interruption(exc: BaseException) -> None:
+    """Remember a signal's exception (called by the signal handler before it raises it)."""
+    _interruptions.append(exc)
+
+
+def clear_interruptions() -> None:
+    """Forget earlier interruptions (a new command begins)."""
+    _interruptions.clear()
+
+
 _PART = re.compile(r"^\.(?P<name>.+)\.(?P<pid>\d+)\.(?P<rand>[0-9a-f]{16})\.part(\.[^.]*)?$")
 _LEGACY = re.compile(r"^\.(?P<name>.+)\.(?P<rand>[A-Za-z0-9_]{8})\.part(\.[^.]*)?$")
 
@@ -112,6 +129,8 @@ def atomic_output(path) -> Iterator[Path]:
     try:
         os.close(fd)
         yield tmp
+        if _interruptions:  # a signal arrived and something swallowed its exception
+            raise _interruptions[0]
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(OSError):

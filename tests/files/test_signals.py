@@ -98,3 +98,34 @@ def test_closed_stderr_and_stdout_do_not_fail_a_finished_command(tmp_path):
     os.close(w)
     assert proc.returncode == 0, proc.stderr
     assert "Broken pipe" not in proc.stderr and (tmp_path / "y.csv").stat().st_size > 0
+
+
+def test_a_signal_a_library_swallowed_still_keeps_no_output(tmp_path):
+    """A SIGHUP landing in numpy's lazy import of numpy.random was lost (its exception
+    swallowed), and `generate` kept the whole file with exit 0 (1 run in ~15). The
+    exception is remembered and raised again before the file would be kept."""
+    from eyeviz import cli
+    from eyeviz.files.atomic import atomic_output
+
+    out = tmp_path / "x.csv"
+    old = cli.install_signal_handlers()
+    try:
+        with pytest.raises(cli.Interrupted) as exc:
+            with atomic_output(out) as tmp:
+                tmp.write_text("half\n")
+                try:  # what the swallowing library did
+                    os.kill(os.getpid(), signal.SIGHUP)
+                    time.sleep(1.0)  # the handler runs here
+                except BaseException:  # noqa: BLE001
+                    pass
+                tmp.write_text("whole\n")
+        assert exc.value.exit_code == 129
+        assert list(tmp_path.iterdir()) == []
+        # the next command starts clean
+        cli.install_signal_handlers()
+        with atomic_output(out) as tmp:
+            tmp.write_text("kept\n")
+        assert out.read_text() == "kept\n"
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
