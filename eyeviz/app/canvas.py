@@ -124,11 +124,19 @@ class CanvasMixin:
         only = moved if moved is not None and self.inset_shown else None
         if only is not None and only >= len(self.model.scene.features):
             only = None
-        want = self._inset_wanted() and not self._feature_under_inset(only)
-        if want != self.inset_shown or self.inset_ren.GetDraw() != want:
+        wanted = self._inset_wanted()
+        want = wanted and not self._feature_under_inset(only)
+        # the main view names the eyes only where they are large on screen: a tiny pair
+        # whose inset stepped aside for a feature would carry A, O, B on top of each other
+        labels = not wanted
+        if (
+            want != self.inset_shown
+            or self.inset_ren.GetDraw() != want
+            or labels != self.actors.labels.main_eye_labels_shown
+        ):
             self.inset_shown = want
             self.inset_ren.SetDraw(want)
-            self.actors.set_inset_shown(want)
+            self.actors.set_inset_shown(want, main_eye_labels=labels)
 
     def title_band_px(self) -> float:
         """Pixels at the top of the view taken by the scene's title (none without one)."""

@@ -324,6 +324,8 @@ def test_a_feature_under_the_inset_is_drawn_and_the_inset_steps_aside(make_windo
     px, py = win.to_pixel(f.x, f.y, "main")
     assert left <= px <= left + w and top <= py <= top + h  # it is where the inset was
     assert not win.inset_shown and not win.inset_ren.GetDraw()
+    # the eyes are still tiny: the main view does not pile A, O, B on top of each other
+    assert not any(t.GetVisibility() for t in win.actors.labels.main_eye_labels)
     img = win.grab_image()  # the window as drawn: the disc's centre dot
     at = win.plotter.mapTo(win, QtCore.QPoint(round(px), round(py)))
     got = QtGui.QColor(img.pixel(at.x(), at.y()))

@@ -229,8 +229,10 @@ def test_screenshot_is_not_blank_and_shows_the_lit_colour(make_window, tmp_path)
     img = qimage_to_array(QtGui.QImage(str(out)))
     assert img.shape[0] >= 600 and img.std() > 20
     assert len(np.unique(img.reshape(-1, 3), axis=0)) > 50
-    # the eyes are large on screen here: no inset duplicating them
+    # the eyes are large on screen here: no inset duplicating them, the main view names them
     assert not win.inset_shown and not win.inset_ren.GetDraw()
+    labels = win.actors.labels.main_eye_labels
+    assert labels and all(t.GetVisibility() for t in labels)
     # the lit ommatidia of eye B (1..3) drawn in the feature's colour in the main view
     f = sc.features[0]
     col = np.array(hex_rgb(f.color))

@@ -214,10 +214,11 @@ class SceneActors:
         self.fit_bfv()
         self.eyes.set_zoom(main_px_per_unit, inset_px_per_unit, l, m)
 
-    def set_inset_shown(self, shown: bool) -> None:
+    def set_inset_shown(self, shown: bool, main_eye_labels: bool | None = None) -> None:
         """Labels of the eyes and of the BFV go to the inset when it is shown, else to the
-        main view (where the eyes are then large enough to carry them)."""
-        self.labels.set_inset_shown(shown)
+        main view; the eyes' A, O, B there only where ``main_eye_labels`` (the eyes large
+        enough on screen to carry them; default: whenever the inset is hidden)."""
+        self.labels.set_inset_shown(shown, main_eye_labels)
 
     @property
     def inset_shown(self) -> bool:

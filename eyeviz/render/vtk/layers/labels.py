@@ -32,6 +32,7 @@ class LabelsLayer:
         self.eye_store = Store()
         self.feature_store = Store()
         self.inset_shown = True
+        self.main_eye_labels_shown = False  # the eyes' A, O, B in the main view
         self.main_eye_labels: list[vtkBillboardTextActor3D] = []
         self.feature_labels: list[vtkBillboardTextActor3D] = []
         self.bfv_text = {
@@ -62,7 +63,7 @@ class LabelsLayer:
                 t.SetPosition(lab.x, lab.y, Z_POINT)
                 self.eye_store.add(ren, t)
                 if ren is self.main:
-                    t.SetVisibility(not self.inset_shown)
+                    t.SetVisibility(self.main_eye_labels_shown)
                     self.main_eye_labels.append(t)
         self.inset_label.SetInput("")
         text = bfv_line(frame)
@@ -98,10 +99,13 @@ class LabelsLayer:
                 label.SetInput(f" {lab.text}")  # no-op (no Modified) when unchanged
                 label.SetPosition(lab.x, lab.y, Z_POINT)
 
-    def set_inset_shown(self, shown: bool) -> None:
+    def set_inset_shown(self, shown: bool, main_eye_labels: bool | None = None) -> None:
+        """The eye labels go to the inset when it is shown; the main view carries them
+        where ``main_eye_labels`` (default: whenever the inset is hidden)."""
         self.inset_shown = bool(shown)
+        self.main_eye_labels_shown = not shown if main_eye_labels is None else main_eye_labels
         for t in self.main_eye_labels:
-            t.SetVisibility(not shown)
+            t.SetVisibility(self.main_eye_labels_shown)
         self.place_bfv_text()
 
     def place_bfv_text(self) -> None:
