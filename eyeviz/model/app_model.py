@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 from eyeviz.model.player import TrajectoryPlayer
 from eyeviz.model.scene import OKABE_ITO, Feature, Scene, View
-from eyeviz.model.state import SceneState, compute_state
+from eyeviz.model.state import SceneState, compute_state, update_state
 
 if TYPE_CHECKING:
     from eyeviz.model.predictor import Predictor
@@ -59,6 +59,7 @@ class AppModel:
         self.selected: int | None = 0 if scene.features else None
         self.listeners: list[Callable[[str, int | None], None]] = []
         self._state: SceneState | None = None
+        self._moved: set[int] = set()  # rows of _state whose feature moved since (live)
         self._predictions: dict | None = None
         self._ambiguity: tuple[dict | None] | None = None  # None: not computed yet
         self.predictor: Predictor | None = None  # eyeviz.model.derived.Predictor, made on first use
@@ -76,6 +77,9 @@ class AppModel:
     def state(self) -> SceneState:
         if self._state is None:
             self._state = compute_state(self.scene)
+        elif self._moved:  # a drag frame: only the moved rows (eyeviz.core.single)
+            moved, self._moved = self._moved, set()
+            self._state = update_state(self._state, self.scene, moved)
         return self._state
 
     @property
@@ -117,8 +121,13 @@ class AppModel:
         return self._ambiguity[0]
 
     def _notify(self, what: str, index: int | None = None) -> None:
-        if what not in ("view", "player", "selection"):
+        if what == "feature" and index is not None and self._state is not None:
+            self._moved.add(index)  # live(): only x, y, g of this feature changed
+            self._predictions = None
+            self._ambiguity = None
+        elif what not in ("view", "player", "selection"):
             self._state = None
+            self._moved = set()
             self._predictions = None
             self._ambiguity = None
         elif what == "selection":
@@ -190,7 +199,11 @@ class AppModel:
         self.end_live()
 
     def live(self, index: int, **values: float) -> None:
-        """Change a feature during a gesture (part of the gesture's one undo step)."""
+        """Move or resize a feature during a gesture (part of the gesture's one undo step);
+        only x, y and g (the state then updates that row alone)."""
+        bad = set(values) - {"x", "y", "g"}
+        if bad:
+            raise ValueError(f"live() changes x, y or g only, got {', '.join(sorted(bad))}")
         f = self.scene.features[index]
         for k, v in values.items():
             setattr(f, k, float(v))

@@ -6,6 +6,10 @@ membership (Prop. 4), overlap with the eyes, polar coordinates about the origin 
 eye centre, and per-eye ownership of every ommatidium. Only what the scene's layers need
 is computed; fields a scene does not need are ``None``.
 
+``update_state(state, scene, rows)`` is the same state after the features ``rows`` moved
+(a drag frame): those rows through the one-feature path of :mod:`eyeviz.core.single`,
+equal field by field to ``compute_state(scene)``.
+
 Pure numpy; no Qt, VTK or torch.
 """
 
@@ -16,10 +20,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from eyeviz.core import single
 from eyeviz.core.geometry import EyePair, intervals_to_bitmap
 from eyeviz.model.scene import Scene
 
-__all__ = ["SceneState", "compute_state", "owners"]
+__all__ = ["SceneState", "compute_state", "owners", "update_state"]
 
 # Layers that need the lit intervals; the ownership arrays; the per-feature readout.
 _NEED_INTERVALS = {"eyes", "bitmaps", "sectors", "readout", "labels", "predictions", "ambiguity"}
@@ -124,4 +129,89 @@ def compute_state(scene: Scene, layers=None) -> SceneState:
         st.r, st.phi = _polar(x, y, 0.0)
         st.rA, st.phiA = pair.eye_polar(x, y, "A")
         st.rB, st.phiB = pair.eye_polar(x, y, "B")
+    return st
+
+
+#: More moved rows than this: one vectorised pass is cheaper than the rows one by one.
+_ROWS_MAX = 8
+
+
+def _needs(scene: Scene) -> tuple[bool, bool, bool]:
+    shown = set(scene.layers)
+    return bool(shown & _NEED_INTERVALS), bool(shown & _NEED_OWNERS), bool(shown & _NEED_READOUT)
+
+
+def _polar_row(x: float, y: float, cx: float) -> tuple[float, float, float, float]:
+    """(r, phi) as :func:`_polar` and (r_E, phi_E) as ``EyePair.eye_polar`` give them: the
+    same numpy ufuncs (the same inner loops) on 0-d values."""
+    dx = np.float64(x) - cx
+    yy = np.float64(y)
+    r = np.hypot(dx, yy)
+    phi = np.arctan2(yy, dx)
+    phi_o = np.mod(phi, 2.0 * math.pi)
+    phi_e = phi + 2 * math.pi if phi < 0 else phi
+    phi_e = np.minimum(phi_e, np.nextafter(2 * math.pi, 0))
+    return float(r), float(phi_o), float(r), float(phi_e)
+
+
+def update_state(state: SceneState, scene: Scene, rows) -> SceneState:
+    """``compute_state(scene)`` where only the features ``rows`` moved (x, y or g) since
+    ``state`` was computed for the same eyes and layers; a new state, ``state`` is kept.
+
+    Each moved row goes through :mod:`eyeviz.core.single` (Prop. 2, 4 in Python floats,
+    ~20 µs a row against ~300 µs for a vectorised pass) and, where its rounding bound does
+    not clear the intervals, through ``EyePair.intervals`` on that row. Falls back to
+    :func:`compute_state` when the feature count, the eyes or the needed fields differ, or
+    when more than a few rows moved.
+    """
+    fs = scene.features
+    rows = sorted(set(rows))
+    pair = scene.eyes.pair()
+    need_iv, need_own, need_read = _needs(scene)
+    same = (
+        len(fs) == state.n
+        and pair == state.pair
+        and need_iv == (state.LA is not None)
+        and need_own == (state.owner_a is not None)
+        and need_read == (state.r is not None)
+        and all(0 <= i < state.n for i in rows)
+    )
+    if not same or len(rows) > _ROWS_MAX:
+        return compute_state(scene)
+    st = SceneState(pair, state.x.copy(), state.y.copy(), state.g.copy())
+    for name in (
+        "LA", "RA", "LB", "RB", "vis_a", "vis_b", "in_bfv", "overlap_a", "overlap_b",
+        "r", "phi", "rA", "phiA", "rB", "phiB",
+    ):  # fmt: skip
+        v = getattr(state, name)
+        setattr(st, name, None if v is None else v.copy())
+    for i in rows:
+        f = fs[i]
+        x, y, g = float(f.x), float(f.y), float(f.g)
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(g) and g > 0):
+            return compute_state(scene)  # refuses it with the core's own message
+        st.x[i], st.y[i], st.g[i] = x, y, g
+        if need_iv:
+            LA, RA, LB, RB = st.intervals()
+            iv = single.intervals_one(pair, x, y, g)
+            if iv is None:  # near a boundary (or invalid): the vectorised, exact path
+                la, ra, lb, rb = pair.intervals(st.x[i : i + 1], st.y[i : i + 1], st.g[i : i + 1])
+                iv = (int(la[0]), int(ra[0]), int(lb[0]), int(rb[0]))
+            LA[i], RA[i], LB[i], RB[i] = iv
+            assert st.vis_a is not None and st.vis_b is not None
+            st.vis_a[i], st.vis_b[i] = iv[1] > iv[0], iv[3] > iv[2]
+        if need_read:
+            assert st.in_bfv is not None and st.overlap_a is not None
+            assert st.overlap_b is not None and st.r is not None and st.phi is not None
+            assert st.rA is not None and st.phiA is not None
+            assert st.rB is not None and st.phiB is not None
+            st.in_bfv[i] = single.in_bfv_one(pair, x, y, g)
+            st.overlap_a[i], st.overlap_b[i] = single.overlaps_one(pair, x, y, g)
+            st.r[i], st.phi[i], _, _ = _polar_row(x, y, 0.0)
+            _, _, st.rA[i], st.phiA[i] = _polar_row(x, y, -pair.h)
+            _, _, st.rB[i], st.phiB[i] = _polar_row(x, y, pair.h)
+    if need_own:
+        LA, RA, LB, RB = st.intervals()
+        st.owner_a = owners(LA, RA, pair.m)
+        st.owner_b = owners(LB, RB, pair.m)
     return st

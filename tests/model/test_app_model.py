@@ -56,6 +56,44 @@ def test_drag_moves_the_feature_as_one_undo_step_and_undo_restores():
     assert (m.scene.features[0].x, m.scene.features[0].y) == (0.0, 1500.0)
 
 
+def test_a_drag_frame_updates_only_the_moved_row_of_the_state(monkeypatch):
+    """Each frame of a drag recomputes the dragged feature alone (eyeviz.core.single), and
+    the state it reads equals a whole new one; an undo recomputes it whole."""
+    import dataclasses
+
+    import numpy as np
+
+    import eyeviz.model.app_model as am
+    from eyeviz.model.state import compute_state
+
+    m, undo = make()
+    m.scene.layers = ["eyes", "bitmaps", "readout", "features"]
+    m._notify("layers")
+    assert m.state.n == 2
+    whole = []
+    monkeypatch.setattr(am, "compute_state", lambda s: whole.append(1) or compute_state(s))
+    path = [(0.0, 1500.0)] + [(-130.0 * k, 1500.0 - 90.0 * k) for k in range(1, 12)]
+    g = interactions.press(m, ev(m, "press", *path[0]), "main", VP)
+    for p in path[1:]:
+        g.send(ev(m, "move", *p))
+        got, want = m.state, compute_state(m.scene)
+        for f in dataclasses.fields(want):
+            a, b = getattr(want, f.name), getattr(got, f.name)
+            if isinstance(a, np.ndarray):
+                np.testing.assert_array_equal(b, a, err_msg=f.name)
+    assert whole == []
+    with pytest.raises(StopIteration):
+        g.send(ev(m, "release", *path[-1]))
+    undo.undo()
+    assert m.state.x[0] == 0.0 and whole == [1]
+
+
+def test_live_changes_only_position_and_radius():
+    m, _ = make()
+    with pytest.raises(ValueError, match="x, y or g only, got name"):
+        m.live(0, name="x")
+
+
 def test_click_selects_without_an_undo_step():
     m, undo = make()
     gesture(m, [(-1200.0, 3000.0), (-1199.0, 3000.0)])  # under the drag threshold

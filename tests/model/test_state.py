@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from eyeviz.core.geometry import EyePair
 from eyeviz.model.scene import Eyes, Feature, Scene
@@ -97,3 +99,83 @@ def test_sectors_alone_get_the_eye_distances_they_draw_with():
     assert st.rA is not None and st.rB is not None
     fr = build_frame(sc, st, rect=(-100.0, 100.0, 0.0, 2000.0))
     assert len(fr.sectors) == 2
+
+
+# --- update_state: a drag frame's rows against a whole new state -------------------------
+def _assert_same_state(got, want):
+    import dataclasses
+
+    for f in dataclasses.fields(want):
+        a, b = getattr(want, f.name), getattr(got, f.name)
+        if isinstance(a, np.ndarray):
+            assert isinstance(b, np.ndarray) and a.dtype == b.dtype, f.name
+            np.testing.assert_array_equal(b, a, err_msg=f.name)
+        else:
+            assert a == b, f.name
+
+
+ALL_LAYERS = ("eyes", "bitmaps", "readout", "features")
+
+
+@pytest.mark.parametrize("name", ["paper", "ground", "vertical", "grazing", "extreme", "huge_m"])
+def test_update_state_equals_compute_state_on_stability_cases(name):
+    """Every moved row (ties, grazing, extreme scales included) gives the state that a
+    whole vectorised pass gives, field by field and bit for bit."""
+    from eyeviz.model.state import update_state
+    from eyeviz.reference import stability_cases as sc
+
+    cs = sc.make(name, 120, seed=4)
+    eyes = Eyes(cs.eyes.h, cs.eyes.l, cs.eyes.m)
+    fs = [Feature(f"f{i}", float(cs.x[i]), float(cs.y[i]), float(cs.g[i])) for i in range(6)]
+    scene = Scene(eyes, fs, list(ALL_LAYERS))
+    st = compute_state(scene)
+    for j in range(6, cs.x.size):
+        i = j % 6
+        fs[i].x, fs[i].y, fs[i].g = float(cs.x[j]), float(cs.y[j]), float(cs.g[j])
+        st = update_state(st, scene, {i})
+        _assert_same_state(st, compute_state(scene))
+
+
+def test_update_state_follows_a_drag_and_keeps_the_old_state():
+    from eyeviz.model.state import update_state
+
+    s = _scene(720, ALL_LAYERS)
+    st0 = compute_state(s)
+    before = st0.LA.copy()
+    s.features[0].x, s.features[0].y = 2000.0, 40.0  # out of the BFV, a different interval
+    st1 = update_state(st0, s, [0])
+    _assert_same_state(st1, compute_state(s))
+    np.testing.assert_array_equal(st0.LA, before)  # the old state is not written into
+    assert st1.LA[0] != before[0]
+
+
+def test_update_state_takes_the_whole_pass_when_it_must():
+    from eyeviz.model.state import update_state
+
+    s = _scene(720, ALL_LAYERS)
+    st = compute_state(s)
+    s.features.append(Feature("z", 0.0, 900.0, 9.0))  # another count
+    _assert_same_state(update_state(st, s, [0]), compute_state(s))
+    s2 = _scene(720, ("bfv",))  # other layers: other fields
+    _assert_same_state(update_state(st, s2, [0]), compute_state(s2))
+    s.features[0].g = -1.0  # refused with the core's own message
+    with pytest.raises(ValueError, match="g \\(feature radius\\) must be > 0"):
+        update_state(compute_state(_scene(720, ALL_LAYERS)), s, [0])
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    st.integers(0, 4),
+    st.floats(-1e5, 1e5),
+    st.floats(-1e5, 1e5),
+    st.floats(1e-2, 3e3),
+    st.sampled_from([16, 720, 36000]),
+)
+def test_update_state_equals_compute_state_anywhere(i, x, y, g, m):
+    from eyeviz.model.state import update_state
+
+    s = _scene(m, ALL_LAYERS + ("labels",))
+    st0 = compute_state(s)
+    f = s.features[i]
+    f.x, f.y, f.g = x, y, g
+    _assert_same_state(update_state(st0, s, {i}), compute_state(s))
