@@ -185,6 +185,7 @@ def update_state(state: SceneState, scene: Scene, rows) -> SceneState:
     ):  # fmt: skip
         v = getattr(state, name)
         setattr(st, name, None if v is None else v.copy())
+    lit_changed = False
     for i in rows:
         f = fs[i]
         x, y, g = float(f.x), float(f.y), float(f.g)
@@ -197,6 +198,7 @@ def update_state(state: SceneState, scene: Scene, rows) -> SceneState:
             if iv is None:  # near a boundary (or invalid): the vectorised, exact path
                 la, ra, lb, rb = pair.intervals(st.x[i : i + 1], st.y[i : i + 1], st.g[i : i + 1])
                 iv = (int(la[0]), int(ra[0]), int(lb[0]), int(rb[0]))
+            lit_changed = lit_changed or iv != (int(LA[i]), int(RA[i]), int(LB[i]), int(RB[i]))
             LA[i], RA[i], LB[i], RB[i] = iv
             assert st.vis_a is not None and st.vis_b is not None
             st.vis_a[i], st.vis_b[i] = iv[1] > iv[0], iv[3] > iv[2]
@@ -210,8 +212,10 @@ def update_state(state: SceneState, scene: Scene, rows) -> SceneState:
             st.r[i], st.phi[i], _, _ = _polar_row(x, y, 0.0)
             _, _, st.rA[i], st.phiA[i] = _polar_row(x, y, -pair.h)
             _, _, st.rB[i], st.phiB[i] = _polar_row(x, y, pair.h)
-    if need_own:
+    if need_own and lit_changed:
         LA, RA, LB, RB = st.intervals()
         st.owner_a = owners(LA, RA, pair.m)
         st.owner_b = owners(LB, RB, pair.m)
+    elif need_own:  # the same lit cells: the same (never written) arrays, so views skip them
+        st.owner_a, st.owner_b = state.owner_a, state.owner_b
     return st

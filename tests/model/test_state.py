@@ -147,6 +147,11 @@ def test_update_state_follows_a_drag_and_keeps_the_old_state():
     _assert_same_state(st1, compute_state(s))
     np.testing.assert_array_equal(st0.LA, before)  # the old state is not written into
     assert st1.LA[0] != before[0]
+    assert st1.owner_a is not st0.owner_a
+    s.features[0].x += 1e-6  # the same lit cells: the owners are the same arrays
+    st2 = update_state(st1, s, [0])
+    _assert_same_state(st2, compute_state(s))
+    assert st2.owner_a is st1.owner_a and st2.owner_b is st1.owner_b
 
 
 def test_update_state_takes_the_whole_pass_when_it_must():
