@@ -129,6 +129,7 @@ class SceneActors:
         self.bfv: BfvPainter | None = None
         self._bfv_actors: list = []
         self._bfv_scene: Scene | None = None
+        self._bfv_key: tuple | None = None
         self.frame: Frame | None = None
 
     # --- entry points -----------------------------------------------------------------

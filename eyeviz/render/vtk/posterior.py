@@ -16,6 +16,7 @@ from eyeviz.core.domain import Domain
 from eyeviz.model.palette import POSTERIOR_COLOR, posterior_rgba
 from eyeviz.model.posterior import Posterior, key_of, posterior_for_key
 from eyeviz.render.vtk.actors import Z_POINT, _actor, hex_rgb
+from eyeviz.render.vtk.primitives import set_input
 
 __all__ = ["PosteriorActors", "Z_POSTERIOR"]
 
@@ -72,7 +73,7 @@ class PosteriorActors:
         mesh = pv.PolyData(pts.astype(np.float64), faces=faces)
         rgba = np.asarray(posterior_rgba(post.density)) * 255.0
         mesh.cell_data["rgb"] = np.round(rgba).astype(np.uint8)
-        self.cells.GetMapper().SetInputData(mesh)
+        set_input(self.cells, mesh)
         self.mesh = mesh
         ex, ey = post.estimate
-        self.mark.GetMapper().SetInputData(pv.PolyData(np.array([[ex, ey, Z_POINT - 0.1]])))
+        set_input(self.mark, pv.PolyData(np.array([[ex, ey, Z_POINT - 0.1]])))

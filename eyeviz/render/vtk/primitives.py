@@ -155,6 +155,19 @@ def write_rgb(mesh, rgb: np.ndarray) -> None:
     arr.Modified()
 
 
+def write_points(mesh: pv.PolyData, pts: np.ndarray) -> None:
+    """Overwrite a mesh's points in place (pyvista's array marks the VTK points modified)."""
+    target: np.ndarray = mesh.points
+    target[:] = pts
+
+
+def set_input(a: vtkActor, mesh) -> None:
+    """Give an actor's polydata mapper new input."""
+    mapper = a.GetMapper()
+    assert isinstance(mapper, vtkPolyDataMapper)
+    mapper.SetInputData(mesh)
+
+
 def unit_ring(z: float) -> pv.PolyData:
     """The closed unit circle at height z (an outline template)."""
     mesh = pv.PolyData(ring(0.0, 0.0, 1.0, z))

@@ -8,6 +8,7 @@ import numpy as np
 import pyvista as pv
 
 from eyeviz.model.frame import Frame
+from eyeviz.render.vtk.primitives import write_points
 
 __all__ = ["BfvPainter", "BFV_SLOTS"]
 
@@ -41,11 +42,11 @@ class BfvPainter:
         if len(poly):
             pts[: len(poly), :2] = poly
             pts[len(poly) :, :2] = poly[-1]  # degenerate triangles fill the spare slots
-        self.mesh.points[:] = pts
+        write_points(self.mesh, pts)
         ep = np.zeros((4, 3))
         ep[:, 2] = self.z_line
         for j, seg in enumerate([] if bfv is None else bfv.edges):
             if seg is not None:
                 ep[2 * j] = (seg[0], seg[1], self.z_line)
                 ep[2 * j + 1] = (seg[2], seg[3], self.z_line)
-        self.edges.points[:] = ep
+        write_points(self.edges, ep)

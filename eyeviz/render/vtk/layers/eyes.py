@@ -16,7 +16,15 @@ import pyvista as pv
 from vtkmodules.util.numpy_support import vtk_to_numpy
 
 from eyeviz.model.frame import EyeFrame, Frame
-from eyeviz.render.vtk.primitives import CIRCLE_N, UNIT, Store, actor, points_actor, write_rgb
+from eyeviz.render.vtk.primitives import (
+    CIRCLE_N,
+    UNIT,
+    Store,
+    actor,
+    points_actor,
+    set_input,
+    write_rgb,
+)
 from eyeviz.render.vtk.style import EDGE_MIN_PX, INK, UNLIT, Z_EYES, Z_LINE, Z_POINT, hex_rgb
 
 __all__ = ["EyesLayer", "mesh_of_rim"]
@@ -150,7 +158,7 @@ class EyesLayer:
             for e, a in enumerate(ren_actors):
                 mesh = self.meshes[e] if k == 1 else self._lod_mesh(e, k)
                 if a.GetMapper().GetInput() is not mesh:
-                    a.GetMapper().SetInputData(mesh)
+                    set_input(a, mesh)
                 cell_px = rim_px[which] * k / m
                 a.GetProperty().SetEdgeVisibility(cell_px >= EDGE_MIN_PX)
         self.edges_main = bool(self.actors[0].GetProperty().GetEdgeVisibility())
@@ -166,7 +174,7 @@ class EyesLayer:
             mesh = mesh_of_rim(eye.center, eye.rim(k))
             if self._owners is not None and self._palette is not None:
                 pooled = eye.pooled_owner(k)
-                mesh.cell_data["rgb"][:] = self._palette[pooled + 1]
+                write_rgb(mesh, self._palette[pooled + 1])
                 self._pooled[(e, k)] = pooled
             self.lod[(e, k)] = mesh
         return self.lod[(e, k)]

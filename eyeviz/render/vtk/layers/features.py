@@ -22,6 +22,7 @@ from eyeviz.render.vtk.primitives import (
     actor,
     fans,
     points_actor,
+    set_input,
     set_rgb,
     unit_fan,
     unit_ring,
@@ -193,7 +194,7 @@ class FeaturesLayer:
         centers = pv.PolyData(np.column_stack([frame.x, frame.y, np.full(n, Z_POINT)])[others])
         set_rgb(centers.GetPointData(), cols[others])
         self.centers_mesh = centers
-        self._centers_actor.GetMapper().SetInputData(centers)
+        set_input(self._centers_actor, centers)
 
     def fill_rgb(self, i: int) -> np.ndarray:
         """The fill colour feature i is drawn in."""

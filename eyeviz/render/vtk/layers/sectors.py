@@ -7,6 +7,7 @@ import numpy as np
 import pyvista as pv
 
 from eyeviz.model.frame import WIDE_SECTOR, Frame
+from eyeviz.render.vtk.primitives import write_points
 
 __all__ = ["SectorPainter", "RAY_SLOTS"]
 
@@ -43,6 +44,6 @@ class SectorPainter:
                 self.rays[eye] = [int(v) for v in s.rays[:RAY_SLOTS]]
                 ends = np.asarray(s.ends)[:RAY_SLOTS]
                 pts[c + 1 : c + 1 + len(ends), :2] = ends
-        self.mesh.points[:] = pts
+        write_points(self.mesh, pts)
         self.shown = bool(secs)
         return self.shown

@@ -9,6 +9,7 @@ import numpy as np
 import pyvista as pv
 
 from eyeviz.model.frame import Frame
+from eyeviz.render.vtk.primitives import write_points
 
 __all__ = ["TangentPainter"]
 
@@ -33,7 +34,7 @@ class TangentPainter:
             for t in tans:
                 if t.eye == eye:
                     pts[3 * e + 1 : 3 * e + 3, :2] = t.ends
-        self.mesh.points[:] = pts
+        write_points(self.mesh, pts)
         self.shown = bool(tans)
         if len(tans) == 2:
             a, b = (math.degrees(t.alpha) for t in sorted(tans, key=lambda t: t.eye))

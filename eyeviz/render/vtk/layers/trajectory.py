@@ -6,7 +6,7 @@ import numpy as np
 import pyvista as pv
 
 from eyeviz.model.frame import Frame
-from eyeviz.render.vtk.primitives import actor
+from eyeviz.render.vtk.primitives import actor, set_input
 from eyeviz.render.vtk.style import INK, Z_LINE
 
 __all__ = ["TrajectoryLayer"]
@@ -32,4 +32,4 @@ class TrajectoryLayer:
         self._key = key
         pts = np.column_stack([path.x, path.y, np.full(path.n, Z_LINE - 0.2)])
         self.mesh = pv.PolyData(pts, lines=np.concatenate([[path.n], np.arange(path.n)]))
-        self.path_actor.GetMapper().SetInputData(self.mesh)
+        set_input(self.path_actor, self.mesh)
