@@ -121,10 +121,12 @@ class AppModel:
         return self._ambiguity[0]
 
     def _notify(self, what: str, index: int | None = None) -> None:
-        if what == "feature" and index is not None and self._state is not None:
-            self._moved.add(index)  # live(): only x, y, g of this feature changed
+        if what == "feature" and index is not None:  # live(): only x, y, g of index changed
+            if self._state is not None:
+                self._moved.add(index)
             self._predictions = None
-            self._ambiguity = None
+            if index == self.selected:  # the region is the selected feature's alone
+                self._ambiguity = None
         elif what not in ("view", "player", "selection"):
             self._state = None
             self._moved = set()

@@ -88,6 +88,19 @@ def test_a_drag_frame_updates_only_the_moved_row_of_the_state(monkeypatch):
     assert m.state.x[0] == 0.0 and whole == [1]
 
 
+def test_moving_another_feature_keeps_the_selected_ones_ambiguity_region():
+    m, _ = make()
+    m.scene.layers = ["features", "ambiguity"]
+    m._notify("layers")
+    m.select(0)
+    region = m.ambiguity
+    assert region is not None
+    m.live(1, x=-1100.0)  # the player animating another feature
+    assert m.ambiguity is region
+    m.live(0, x=10.0)  # the selected one: a new region
+    assert m.ambiguity is not region
+
+
 def test_live_changes_only_position_and_radius():
     m, _ = make()
     with pytest.raises(ValueError, match="x, y or g only, got name"):
