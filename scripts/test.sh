@@ -12,7 +12,7 @@ echo "== ruff (lint, format)" >&2
 .venv/bin/ruff format --check eyeviz tests scripts examples
 echo "== import-linter (layers)" >&2
 .venv/bin/lint-imports --no-cache
-echo "== mypy (every layer but the Qt app and the VTK renderer)" >&2
+echo "== mypy (the whole package)" >&2
 .venv/bin/mypy
 echo "== display-free tests" >&2
 env -u DISPLAY .venv/bin/python -m pytest --ignore=tests/app -p no:cacheprovider "$@"

@@ -7,10 +7,15 @@ fields.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from PyQt5 import QtCore, QtGui, QtWidgets
 
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import Scene, View
+
+if TYPE_CHECKING:
+    from eyeviz.app.window import MainWindow
 
 __all__ = ["PLAY_SHORTCUT", "SceneCommand", "build_menus"]
 
@@ -20,7 +25,9 @@ PLAY_SHORTCUT = "P"
 class SceneCommand(QtWidgets.QUndoCommand):
     """One undo step: the scene before and after (the view is left where the user put it)."""
 
-    def __init__(self, model: AppModel, before: Scene, after: Scene, text: str, merge_key=None):
+    def __init__(
+        self, model: AppModel, before: Scene, after: Scene, text: str, merge_key: object = None
+    ) -> None:
         super().__init__(text)
         self.model, self.before, self.after, self.merge_key = model, before, after, merge_key
 
@@ -49,14 +56,14 @@ def _action(win, menu, text, slot, shortcut=None) -> QtWidgets.QAction:
     a = QtWidgets.QAction(text, win)
     if shortcut is not None:
         a.setShortcut(QtGui.QKeySequence(shortcut))
-        a.setShortcutContext(QtCore.Qt.WindowShortcut)
+        a.setShortcutContext(QtCore.Qt.ShortcutContext.WindowShortcut)
     a.triggered.connect(slot)
     menu.addAction(a)
     win.addAction(a)
     return a
 
 
-def _undo_actions(win, menu) -> None:
+def _undo_actions(win: MainWindow, menu: QtWidgets.QMenu) -> None:
     """Undo / Redo that first end a running gesture or playback (one step each)."""
     stack = win.undo_stack
 
@@ -79,29 +86,36 @@ def _undo_actions(win, menu) -> None:
     win.undo_action, win.redo_action = u, r
 
 
-def build_menus(win) -> None:
+def _menu(parent: QtWidgets.QMenuBar | QtWidgets.QMenu, title: str) -> QtWidgets.QMenu:
+    menu = parent.addMenu(title)
+    assert menu is not None  # addMenu(title) returns the menu it made
+    return menu
+
+
+def build_menus(win: MainWindow) -> None:
     mb = win.menuBar()
-    f = mb.addMenu("&File")
+    assert mb is not None  # a QMainWindow makes its menu bar on first use
+    f = _menu(mb, "&File")
     _action(win, f, "&Open…", win.open_dialog, QtGui.QKeySequence.Open)
-    win.recent_menu = f.addMenu("Open &recent")
+    win.recent_menu = _menu(f, "Open &recent")
     _action(win, f, "&Save", win.save_current, QtGui.QKeySequence.Save)
     _action(win, f, "Save &as…", win.save_dialog, QtGui.QKeySequence.SaveAs)
     f.addSeparator()
     _action(win, f, "&Export figure…", win.export_dialog, "Ctrl+E")
     f.addSeparator()
     _action(win, f, "&Quit", win.close, QtGui.QKeySequence.Quit)
-    e = mb.addMenu("&Edit")
+    e = _menu(mb, "&Edit")
     _undo_actions(win, e)
     e.addSeparator()
     _action(win, e, "&Add feature at view centre", win.add_at_center, "Ctrl+N")
     _action(win, e, "&Duplicate feature", win.duplicate_selected, "Ctrl+D")
     _action(win, e, "De&lete feature", win.delete_selected, QtGui.QKeySequence.Delete)
-    v = mb.addMenu("&View")
+    v = _menu(mb, "&View")
     _action(win, v, "&Fit view", win.fit_view, "F")
     _action(win, v, "Fit &inset to the eyes", win.fit_inset, "Shift+F")
     v.addSeparator()
     _action(win, v, "Eye &design: limit against distance", win.show_design)
-    t = v.addMenu("&Trajectory")
+    t = _menu(v, "&Trajectory")
     for kind in ("horizontal", "circular", "vertical"):
         t.addAction(kind.capitalize(), lambda k=kind: win.show_trajectory(k))
     win.play_action = _action(

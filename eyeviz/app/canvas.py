@@ -8,6 +8,8 @@ Only translation lives here: pixels are measured from the widgets and handed to
 from __future__ import annotations
 
 import math
+from collections.abc import Generator
+from typing import TYPE_CHECKING
 
 from PyQt5 import QtCore, QtWidgets
 
@@ -17,21 +19,52 @@ from eyeviz.model.camera import Viewport
 from eyeviz.model.scene import View
 from eyeviz.render.vtk.actors import inset_viewport
 
+if TYPE_CHECKING:
+    from vtkmodules.vtkRenderingCore import vtkRenderer, vtkTextActor
+
+    from eyeviz.app.view import _Frames
+    from eyeviz.model.app_model import AppModel
+    from eyeviz.render.vtk.actors import SceneActors
+
+    _MainWindow = QtWidgets.QMainWindow
+else:
+    _MainWindow = object  # MainWindow brings QMainWindow
+
 __all__ = ["CanvasMixin"]
 
 CAMERA_DISTANCE = 1000.0
 INSET_HIDE_EYE_PX = 40.0  # eyes at least this wide on screen: no magnified inset
-RESIZE_MODIFIERS = QtCore.Qt.ShiftModifier | QtCore.Qt.ControlModifier
+RESIZE_MODIFIERS = (
+    QtCore.Qt.KeyboardModifier.ShiftModifier | QtCore.Qt.KeyboardModifier.ControlModifier
+)
 TITLE_MARGIN_PX = 10.0  # the title's distance from the view's top-left corner
 LABEL_CHAR_PX = 14.0  # a character of a feature's label (22 px bold DejaVu Sans)
 TITLE_BAND_PX = 48.0  # the band a fit keeps free for the title (24 px text + margins)
 
 
-class CanvasMixin:
+class CanvasMixin(_MainWindow):
     """Mixed into MainWindow: needs ``plotter``, ``model``, ``main_ren``, ``inset_ren``,
-    ``actors``, ``render`` and ``request_frame``."""
+    ``actors``, ``title_actor``, ``cursor_label``, ``inset_shown``, ``render`` and
+    ``toggle_play``."""
 
-    _drag = None
+    # MainWindow's (set in its __init__)
+    model: AppModel
+    plotter: _Frames
+    main_ren: vtkRenderer
+    inset_ren: vtkRenderer
+    actors: SceneActors
+    title_actor: vtkTextActor
+    cursor_label: QtWidgets.QLabel
+    inset_shown: bool
+    context_menu: QtWidgets.QMenu  # the last one shown (tests)
+
+    if TYPE_CHECKING:  # for mypy only: at run time MainWindow's and SideDocksMixin's
+
+        def render(self) -> None: ...  # type: ignore[override]  # MainWindow's, not QWidget's
+
+        def toggle_play(self) -> None: ...
+
+    _drag: Generator[None, MouseEvent, None] | None = None
     _drag_which = "main"
     _fitted_view: View | None = None  # the main view as the last fit left it
 
@@ -65,7 +98,7 @@ class CanvasMixin:
     def which_at(self, px: float, py: float) -> str:
         return "inset" if self.inset_shown and self.viewport("inset").contains(px, py) else "main"
 
-    def to_model(self, px: float, py: float, which: str | None = None):
+    def to_model(self, px: float, py: float, which: str | None = None) -> tuple[str, float, float]:
         """Widget pixel -> (which renderer, x, y) in model units."""
         which = which or self.which_at(px, py)
         x, y = camera.to_model(self._view(which), self.viewport(which), px, py)
@@ -183,9 +216,9 @@ class CanvasMixin:
         if obj is not self.plotter:
             return False
         t = ev.type()
-        E = QtCore.QEvent
+        E = QtCore.QEvent.Type
         if t == E.MouseButtonPress:
-            self.plotter.setFocus(QtCore.Qt.MouseFocusReason)
+            self.plotter.setFocus(QtCore.Qt.FocusReason.MouseFocusReason)
             self._press(ev)
             return True
         if t == E.MouseMove:
@@ -206,7 +239,7 @@ class CanvasMixin:
         if t == E.ContextMenu:
             self._context_menu(ev.pos(), ev.globalPos())
             return True
-        if t == E.KeyPress and ev.key() == QtCore.Qt.Key_Space and not ev.isAutoRepeat():
+        if t == E.KeyPress and ev.key() == QtCore.Qt.Key.Key_Space and not ev.isAutoRepeat():
             self.toggle_play()  # Space plays only while the view has the focus
             return True
         if t in (E.MouseButtonDblClick, E.KeyPress, E.KeyRelease):
@@ -220,9 +253,10 @@ class CanvasMixin:
         me = MouseEvent("press", x, y, ev.x(), ev.y())
         if self._drag is not None:  # a press while another button drags: end that drag
             self._send(MouseEvent("release", x, y, ev.x(), ev.y()))
-        button = {QtCore.Qt.LeftButton: "left", QtCore.Qt.MiddleButton: "middle"}.get(
-            ev.button(), "other"
-        )
+        button = {
+            QtCore.Qt.MouseButton.LeftButton: "left",
+            QtCore.Qt.MouseButton.MiddleButton: "middle",
+        }.get(ev.button(), "other")
         main_vp = self.viewport("main") if which == "inset" else None
         self._drag = interactions.press(
             self.model, me, which, self.viewport(which), button, main_vp
@@ -230,6 +264,7 @@ class CanvasMixin:
         self._drag_which = which
 
     def _send(self, me: MouseEvent) -> None:
+        assert self._drag is not None  # called only while a drag runs
         try:
             self._drag.send(me)
         except StopIteration:

@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Callable
+from typing import Any
 
 from PyQt5 import QtCore, QtWidgets
 
@@ -49,7 +50,7 @@ def compute_curve(h: float, l: float, m: int) -> dict:  # noqa: E741 (the paper'
     from eyeviz.study.point import limit_curve
 
     d = Domain(h, l, m, DEFAULTS["r_min"], DEFAULTS["r_max"], DEFAULTS["g_max"])
-    out = limit_curve(d, "single", N_CURVE, seed=0)
+    out: dict[str, Any] = limit_curve(d, "single", N_CURVE, seed=0)
     out["r_min"], out["r_max"] = d.r_min, d.r_max
     return out
 
@@ -60,10 +61,11 @@ class DesignPanel(QtWidgets.QWidget):
 
     _paper: dict | None = None  # the paper's curve, once per process
 
-    def __init__(self, model: AppModel, parent=None):
+    def __init__(self, model: AppModel, parent: QtWidgets.QWidget | None = None) -> None:
         super().__init__(parent)
         from matplotlib.backends.backend_qt5agg import FigureCanvasQTAgg
         from matplotlib.figure import Figure
+        from matplotlib.layout_engine import ConstrainedLayoutEngine
 
         self.model = model
         self.compute: Callable[[float, float, int], dict] = compute_curve  # tests slow it
@@ -94,7 +96,7 @@ class DesignPanel(QtWidgets.QWidget):
         lay.setContentsMargins(4, 4, 4, 4)
         lay.setSpacing(2)
         self.legend = QtWidgets.QLabel("")  # the curves' key, crisp Qt text above the plot
-        self.legend.setTextFormat(QtCore.Qt.RichText)
+        self.legend.setTextFormat(QtCore.Qt.TextFormat.RichText)
         self.legend.setWordWrap(True)
         self.legend.setToolTip(
             "The information limit: the least MAPE (Eq. 34) any estimator that sees only the "
@@ -105,7 +107,9 @@ class DesignPanel(QtWidgets.QWidget):
         self.info = wrap_label(QtWidgets.QLabel(""))
         lay.addWidget(self.info)
         self.fig = Figure(figsize=(3.0, 2.8), dpi=100, layout="constrained")
-        self.fig.get_layout_engine().set(h_pad=0.02, w_pad=0.02)
+        engine = self.fig.get_layout_engine()
+        assert isinstance(engine, ConstrainedLayoutEngine)  # layout="constrained"
+        engine.set(h_pad=0.02, w_pad=0.02)
         self.canvas = FigureCanvasQTAgg(self.fig)
         self.canvas.setMinimumHeight(200)
         self.canvas.setMinimumWidth(220)
@@ -188,8 +192,9 @@ class DesignPanel(QtWidgets.QWidget):
         self.running = key
         self.jobs_started += 1
         job = Job(work)
-        job.signals.finished.connect(
-            lambda res, err, k=key: self._finished(k, res, err), QtCore.Qt.QueuedConnection
+        job.signals.finished.connect(  # type: ignore[call-arg]  # the stub lacks connect's type
+            lambda res, err, k=key: self._finished(k, res, err),
+            QtCore.Qt.ConnectionType.QueuedConnection,
         )
         self.job = job
         self.pool.start(job)
@@ -220,7 +225,7 @@ class DesignPanel(QtWidgets.QWidget):
         while self.debounce.isActive() or self.running is not None:
             if timer.elapsed() > msecs:
                 return False
-            QtWidgets.QApplication.processEvents(QtCore.QEventLoop.AllEvents, 20)
+            QtWidgets.QApplication.processEvents(QtCore.QEventLoop.ProcessEventsFlag.AllEvents, 20)
             QtCore.QThread.msleep(5)
         return True
 
@@ -263,6 +268,7 @@ class DesignPanel(QtWidgets.QWidget):
                 self.lines["paper"].append(ln)
                 ys[col[:2]] += [float(v) for v in paper[col] if math.isfinite(v)]
             if cur is not None:
+                assert self.shown is not None  # cur is its curve
                 sh, sl, sm = self.shown
                 label = f"{'current = paper: ' if same else ''}h {sh:g}, l {sl:g}, m {sm}"
                 (ln,) = ax.plot(
@@ -291,8 +297,8 @@ class DesignPanel(QtWidgets.QWidget):
             else:
                 ax.set_yscale("linear")
                 ax.set_ylim(0, hi * 1.12)
-        if cur is not None or paper is not None:
-            ref = cur if cur is not None else paper
+        ref = cur if cur is not None else paper
+        if ref is not None:
             self.ax_dd.set_xlim(ref["r_min"], ref["r_max"])
         self._legend_text(cur, paper, old, same)
         self.computing.set_text(f"computing…\nh {h:g}, l {l_:g}, m {m}" if stale else "")
@@ -305,6 +311,7 @@ class DesignPanel(QtWidgets.QWidget):
     def _legend_text(self, cur, paper, stale: bool, same: bool) -> None:
         parts = []
         if cur is not None:
+            assert self.shown is not None  # cur is its curve
             h, l_, m = self.shown
             color = STALE if stale else CURRENT
             what = "old: " if stale else ("= paper's: " if same else "")
@@ -350,6 +357,7 @@ class DesignPanel(QtWidgets.QWidget):
         for ln in self.markers:
             ln.set_visible(inside)
             if inside:
+                assert r is not None  # inside the plot
                 ln.set_xdata([r, r])
                 if i is not None:
                     ln.set_color(sc.features[i].color)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
@@ -14,6 +15,11 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from eyeviz.app.panels import _Unelide, design_note, set_message, wrap_label
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import TRAJECTORY_KINDS
+
+if TYPE_CHECKING:
+    from matplotlib.lines import Line2D
+
+    from eyeviz.model.derived import TrajectoryPath
 
 __all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel", "PLOT_PT", "estimator_help"]
 
@@ -36,7 +42,7 @@ class EstimatorPicker(QtWidgets.QWidget):
     """A check box per estimator (several at once); each chosen one gets its colour
     (eyeviz.model.palette: fixed by name, as in exported figures)."""
 
-    def __init__(self, model: AppModel, parent=None):
+    def __init__(self, model: AppModel, parent: QtWidgets.QWidget | None = None) -> None:
         super().__init__(parent)
         from eyeviz import estimators
 
@@ -103,7 +109,7 @@ class TrajectoryPanel(QtWidgets.QWidget):
     """Figure 14: play / pause / speed along a horizontal, circular or vertical path, with
     a live plot of AD and DD accuracy (100 % - APE) along it for the chosen estimators."""
 
-    def __init__(self, model: AppModel, parent=None):
+    def __init__(self, model: AppModel, parent: QtWidgets.QWidget | None = None) -> None:
         super().__init__(parent)
         from matplotlib.backends.backend_qt5agg import FigureCanvasQTAgg
         from matplotlib.figure import Figure
@@ -111,11 +117,11 @@ class TrajectoryPanel(QtWidgets.QWidget):
         self.model = model
         self._unelide = _Unelide(self)
         self.installEventFilter(self._unelide)
-        self.path = None
+        self.path: TrajectoryPath | None = None
         self.message = ""
         self.timer = QtCore.QTimer(self)
         self.timer.setInterval(40)
-        self.timer.timeout.connect(self.step)
+        self.timer.timeout.connect(self.step)  # type: ignore[arg-type]  # its result unused
 
         lay = QtWidgets.QVBoxLayout(self)
         row = QtWidgets.QHBoxLayout()
@@ -125,7 +131,7 @@ class TrajectoryPanel(QtWidgets.QWidget):
         self.play_button = QtWidgets.QPushButton("▶ Play")
         self.play_button.setCheckable(True)
         self.play_button.toggled.connect(self.set_playing)
-        self.speed = QtWidgets.QSlider(QtCore.Qt.Horizontal)
+        self.speed = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
         self.speed.setRange(1, 20)
         self.speed.setValue(4)
         self.speed.setToolTip("points of the path per tick (25 ticks a second)")
@@ -149,13 +155,13 @@ class TrajectoryPanel(QtWidgets.QWidget):
         self.placeholder = self.fig.text(
             0.5, 0.5, "", ha="center", va="center", fontsize=PLOT_PT + 1, color="#555555"
         )
-        self.cursors = []
-        self._key = None
+        self.cursors: list[Line2D] = []
+        self._key: tuple | None = None
         self._before = None
 
     # --- model (the player's state lives in eyeviz.model.player) ---------------------
     @property
-    def pos(self) -> float:
+    def pos(self) -> float:  # type: ignore[override]  # shadows QWidget.pos() (tests read it)
         return self.model.player.pos
 
     @property
@@ -244,6 +250,7 @@ class TrajectoryPanel(QtWidgets.QWidget):
             )
             self.ax_dd.set_ylim(max(0.0, min(lo, 90.0)) - 2, 101)
             t = self.model.scene.trajectory
+            assert t is not None  # p is its path (refresh)
             self.ax_dd.set_xlabel(p.axis_label, fontsize=PLOT_PT)
             notes.insert(
                 0, f"{t.kind} path, distance {t.distance:g}, g = {t.g:g}: {p.n} points in the BFV"
@@ -299,6 +306,7 @@ class TrajectoryPanel(QtWidgets.QWidget):
             self.sync_player()
             return None
         p, k = self.path, int(player.pos)
+        assert p is not None  # the player moves only along this panel's path (set_path)
         for c in self.cursors:
             c.set_xdata([p.axis[k], p.axis[k]])
         self.canvas.draw_idle()
@@ -328,8 +336,11 @@ class ExportDialog(QtWidgets.QDialog):
         ("double column (7.2 in)", "double"),
         ("other width (inches)", None),
     )
+    width: QtWidgets.QComboBox  # shadows QWidget.width() (tests use it)
 
-    def __init__(self, parent, start: str, last: ExportChoice | None = None):
+    def __init__(
+        self, parent: QtWidgets.QWidget | None, start: str, last: ExportChoice | None = None
+    ) -> None:
         super().__init__(parent)
         last = last or ExportChoice(Path(start))
         self.setWindowTitle("Export figure")
@@ -362,7 +373,7 @@ class ExportDialog(QtWidgets.QDialog):
         wrow.addWidget(self.width, 1)
         wrow.addWidget(self.inches)
         form.addRow("width", wrow)
-        self.parts = {}
+        self.parts: dict[str, QtWidgets.QCheckBox] = {}
         prow = QtWidgets.QHBoxLayout()
         for key, text in (("title", "title"), ("table", "table"), ("bitmaps", "bitmaps")):
             box = QtWidgets.QCheckBox(text)

@@ -8,19 +8,29 @@ installed assets.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from PyQt5 import QtWidgets
 
 from eyeviz.model.scene import SceneError, load, save
 from eyeviz.resources import assets_dir
 
+if TYPE_CHECKING:
+    from eyeviz.app.settings import Settings
+    from eyeviz.model.app_model import AppModel
+
+    _MainWindow = QtWidgets.QMainWindow
+else:
+    _MainWindow = object  # MainWindow brings QMainWindow
+
 __all__ = ["FilesMixin", "RECENT_MAX", "is_bundled"]
 
 RECENT_MAX = 8
 
 
-def is_bundled(path) -> bool:
+def is_bundled(path: str | os.PathLike) -> bool:
     """True for a file inside eyeviz's shipped assets (never saved over)."""
     try:
         Path(path).resolve().relative_to(assets_dir().resolve())
@@ -29,13 +39,31 @@ def is_bundled(path) -> bool:
     return True
 
 
-class FilesMixin:
-    """Mixed into MainWindow: needs ``model``, ``undo_stack``, ``settings``, ``statusBar``."""
+class FilesMixin(_MainWindow):
+    """Mixed into MainWindow: needs ``model``, ``undo_stack``, ``settings``,
+    ``recent_menu``, ``statusBar``, ``fit_view`` and ``fit_inset``."""
+
+    # MainWindow's (set in its __init__ and build_menus)
+    model: AppModel
+    undo_stack: QtWidgets.QUndoStack
+    settings: Settings
+    recent_menu: QtWidgets.QMenu
+    last_error: str
+    error_box: QtWidgets.QMessageBox | None
+    unsaved_box: QtWidgets.QMessageBox | None
+
+    if TYPE_CHECKING:  # for mypy only: at run time QMainWindow's and CanvasMixin's
+
+        def statusBar(self) -> QtWidgets.QStatusBar: ...  # noqa: N802 (never None in a QMainWindow)
+
+        def fit_view(self) -> None: ...
+
+        def fit_inset(self) -> None: ...
 
     path: Path | None = None
     source: Path | None = None  # the file the scene came from (a bundled one included)
 
-    def _set_path(self, path) -> None:
+    def _set_path(self, path: str | os.PathLike | None) -> None:
         self.source = Path(path) if path else None
         self.path = None if path is None or is_bundled(path) else Path(path)
 
@@ -100,7 +128,12 @@ class FilesMixin:
         self.recent_menu.clear()
         for p in self.recent_files():
             a = self.recent_menu.addAction(p)
-            a.triggered.connect(lambda _c=False, p=p: self.open_file(p))
+            assert a is not None  # addAction(text) returns the action it made
+
+            def open_recent(_checked: bool = False, p: str = p) -> None:
+                self.open_file(p)
+
+            a.triggered.connect(open_recent)
         self.recent_menu.setEnabled(bool(self.recent_files()))
 
     def frame_bundled(self) -> None:
@@ -128,11 +161,11 @@ class FilesMixin:
         if p:
             self.open_path(p)
 
-    def open_file(self, path) -> bool:
+    def open_file(self, path: str | os.PathLike) -> bool:
         """Open recent: ask about unsaved changes, then open."""
         return self.maybe_save() and self.open_path(path)
 
-    def open_path(self, path) -> bool:
+    def open_path(self, path: str | os.PathLike) -> bool:
         """Load a scene; an invalid file shows a dialog and the open scene is kept."""
         try:
             scene = load(path)
@@ -160,7 +193,7 @@ class FilesMixin:
         """Ctrl+S: save over the scene's file; untitled or bundled scenes ask for a name."""
         return self.save_path(self.path) if self.path else self.save_dialog()
 
-    def save_path(self, path) -> bool:
+    def save_path(self, path: str | os.PathLike) -> bool:
         if is_bundled(path):
             self.show_error("Cannot save scene", f"{path}: eyeviz's shipped scenes are read-only")
             return False

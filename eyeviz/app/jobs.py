@@ -21,7 +21,7 @@ class _Signals(QtCore.QObject):
 
 
 class Job(QtCore.QRunnable):
-    def __init__(self, fn: Callable[[], object]):
+    def __init__(self, fn: Callable[[], object]) -> None:
         super().__init__()
         self.fn = fn
         self.signals = _Signals()
@@ -41,7 +41,9 @@ class Job(QtCore.QRunnable):
 class JobRunner(QtCore.QObject):
     """Runs jobs one at a time on a private thread pool; shows a busy cursor meanwhile."""
 
-    def __init__(self, status: Callable[[str, int], None], parent=None):
+    def __init__(
+        self, status: Callable[[str, int], None], parent: QtCore.QObject | None = None
+    ) -> None:
         super().__init__(parent)
         self.pool = QtCore.QThreadPool(self)
         self.pool.setMaxThreadCount(1)
@@ -68,9 +70,11 @@ class JobRunner(QtCore.QObject):
             else:
                 failed(err)
 
-        job.signals.finished.connect(finish, QtCore.Qt.QueuedConnection)
+        job.signals.finished.connect(  # type: ignore[call-arg]  # the stub lacks connect's type
+            finish, QtCore.Qt.ConnectionType.QueuedConnection
+        )
         self.running.append(job)
-        QtWidgets.QApplication.setOverrideCursor(QtCore.Qt.BusyCursor)
+        QtWidgets.QApplication.setOverrideCursor(QtCore.Qt.CursorShape.BusyCursor)
         self.status(message, 0)
         self.pool.start(job)
         return job

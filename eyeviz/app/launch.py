@@ -49,19 +49,24 @@ def check_display() -> None:
 def make_app() -> QtWidgets.QApplication:
     app = QtWidgets.QApplication.instance()
     if app is None:
-        QtWidgets.QApplication.setAttribute(QtCore.Qt.AA_ShareOpenGLContexts)
+        QtWidgets.QApplication.setAttribute(QtCore.Qt.ApplicationAttribute.AA_ShareOpenGLContexts)
         app = QtWidgets.QApplication(["eyeviz"])
+    assert isinstance(app, QtWidgets.QApplication)  # a widgets app, never a bare QCoreApplication
     # the view is a native X window (VTK renders into it); without this Qt makes every
     # sibling on its way up native too (docks, status bar, bitmaps panel, menu bar), and a
     # drag frame then flushed each repainted panel to X on its own (issue 12, drag latency)
-    app.setAttribute(QtCore.Qt.AA_DontCreateNativeWidgetSiblings)
+    app.setAttribute(QtCore.Qt.ApplicationAttribute.AA_DontCreateNativeWidgetSiblings)
     font = app.font()
     font.setPointSize(APP_FONT_PT)
     app.setFont(font)
     return app
 
 
-def run_app(scene_path=None, screenshot=None, settings_path=None) -> int:
+def run_app(
+    scene_path: str | os.PathLike | None = None,
+    screenshot: str | os.PathLike | None = None,
+    settings_path: str | os.PathLike | None = None,
+) -> int:
     from eyeviz.app.screenshot import screenshot_format
     from eyeviz.app.settings import make_settings
     from eyeviz.app.window import MainWindow

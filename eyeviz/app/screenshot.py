@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
@@ -12,12 +14,15 @@ from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
 from eyeviz import EyevizError
 from eyeviz.files.atomic import atomic_output
 
+if TYPE_CHECKING:
+    from eyeviz.app.window import MainWindow
+
 __all__ = ["FORMATS", "grab_image", "qimage_to_array", "save_screenshot", "screenshot_format"]
 
 FORMATS = {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG"}
 
 
-def screenshot_format(path) -> str:
+def screenshot_format(path: str | os.PathLike) -> str:
     """Qt's image format for ``path``'s suffix; EyevizError for any other suffix."""
     fmt = FORMATS.get(Path(path).suffix.lower())
     if fmt is None:
@@ -27,7 +32,7 @@ def screenshot_format(path) -> str:
     return fmt
 
 
-def grab_image(win) -> QtGui.QImage:
+def grab_image(win: MainWindow) -> QtGui.QImage:
     """The whole window as shown, with the VTK view composited from its framebuffer."""
     QtWidgets.QApplication.processEvents()
     win.apply_cameras()
@@ -49,7 +54,7 @@ def grab_image(win) -> QtGui.QImage:
     return img
 
 
-def save_screenshot(win, path) -> Path:
+def save_screenshot(win: MainWindow, path: str | os.PathLike) -> Path:
     """Write the window as PNG or JPEG (by the suffix), atomically."""
     path = Path(path)
     fmt = screenshot_format(path)
@@ -64,9 +69,10 @@ def qimage_to_array(img: QtGui.QImage) -> np.ndarray:
     img = img.convertToFormat(QtGui.QImage.Format_RGB888)
     w, h = img.width(), img.height()
     ptr = img.constBits()
+    assert ptr is not None  # None only for a null image
     ptr.setsize(img.byteCount())
     return (
-        np.frombuffer(ptr, np.uint8)
+        np.frombuffer(ptr, np.uint8)  # type: ignore[call-overload]  # voidptr is a buffer
         .reshape(h, img.bytesPerLine())[:, : 3 * w]
         .reshape(h, w, 3)
         .copy()

@@ -19,6 +19,7 @@ import json
 import os
 import sys
 from pathlib import Path
+from typing import Any
 
 from eyeviz.files.atomic import atomic_output
 
@@ -43,7 +44,7 @@ def _plain(v) -> bool:
 class Settings:
     """A QSettings-like store (``value``, ``setValue``, ``sync``) backed by JSON."""
 
-    def __init__(self, path: str | os.PathLike | None = None):
+    def __init__(self, path: str | os.PathLike | None = None) -> None:
         self.path = Path(path) if path else default_path()
         self.data: dict = {}
         self.refused: str = ""  # why the file was ignored, one line
@@ -77,7 +78,7 @@ class Settings:
             return self._refuse("not an object of strings, numbers and lists of strings")
         self.data = doc
 
-    def value(self, key: str, default=None):
+    def value(self, key: str, default: Any = None) -> Any:
         """The stored value; keys ending in ``@bytes`` are decoded from base64."""
         if key in self.data:
             return self.data[key]
@@ -89,7 +90,7 @@ class Settings:
                 return default
         return default
 
-    def setValue(self, key: str, value) -> None:  # noqa: N802 (QSettings' name)
+    def setValue(self, key: str, value: Any) -> None:  # noqa: N802 (QSettings' name)
         if isinstance(value, (bytes, bytearray, memoryview)) or type(value).__name__ == (
             "QByteArray"
         ):

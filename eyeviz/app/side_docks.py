@@ -5,9 +5,21 @@ trajectory player, eye design).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from PyQt5 import QtCore, QtWidgets
 
 from eyeviz.model.scene import Scene
+
+if TYPE_CHECKING:
+    from eyeviz.app.design_dock import DesignPanel
+    from eyeviz.app.docks import EstimatorPicker, TrajectoryPanel
+    from eyeviz.model.app_model import AppModel
+    from eyeviz.model.state import SceneState
+
+    _MainWindow = QtWidgets.QMainWindow
+else:
+    _MainWindow = object  # MainWindow brings QMainWindow
 
 __all__ = ["DOCK_MIN_PX", "SIDE_MAX_FRACTION", "SIDE_MIN_PX", "SIDE_START_PX", "SideDocksMixin"]
 
@@ -26,9 +38,22 @@ class _SideScroll(QtWidgets.QScrollArea):
         return QtCore.QSize(SIDE_START_PX, super().sizeHint().height())
 
 
-class SideDocksMixin:
+class SideDocksMixin(_MainWindow):
     """Mixed into MainWindow: needs ``model``, ``_docks``, ``picker``, ``trajectory_panel``,
     ``_refresh_overlays`` and QMainWindow's dock methods."""
+
+    # MainWindow's (set in its __init__)
+    model: AppModel
+    _docks: dict[str, QtWidgets.QDockWidget]
+    picker: EstimatorPicker | None
+    trajectory_panel: TrajectoryPanel | None
+    design_panel: DesignPanel  # set by show_design on first use
+
+    if TYPE_CHECKING:  # for mypy only: at run time QMainWindow's and MainWindow's
+
+        def statusBar(self) -> QtWidgets.QStatusBar: ...  # noqa: N802 (never None in a QMainWindow)
+
+        def _refresh_overlays(self, scene: Scene, st: SceneState) -> None: ...
 
     def _dock(self, title: str, widget: QtWidgets.QWidget, name: str) -> QtWidgets.QDockWidget:
         d = QtWidgets.QDockWidget(title, self)
@@ -38,7 +63,7 @@ class SideDocksMixin:
         scroll = _SideScroll()
         scroll.setWidgetResizable(True)
         scroll.setFrameShape(QtWidgets.QFrame.NoFrame)
-        scroll.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarAlwaysOff)
+        scroll.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
         scroll.setWidget(widget)
         scroll.setMinimumWidth(min(widget.minimumSizeHint().width(), SIDE_MIN_PX))
         scroll.setMinimumHeight(DOCK_MIN_PX)
@@ -46,7 +71,7 @@ class SideDocksMixin:
         d.setFeatures(
             QtWidgets.QDockWidget.DockWidgetMovable | QtWidgets.QDockWidget.DockWidgetFloatable
         )
-        self.addDockWidget(QtCore.Qt.RightDockWidgetArea, d)
+        self.addDockWidget(QtCore.Qt.DockWidgetArea.RightDockWidgetArea, d)
         self._limit_dock(d)
         return d
 
@@ -80,7 +105,7 @@ class SideDocksMixin:
             if not scene.shows("trajectory") and self.model.player.playing:
                 self.model.player.stop()
 
-    def _trajectory_dock(self):
+    def _trajectory_dock(self) -> TrajectoryPanel:
         if self.trajectory_panel is None:
             from eyeviz.app.docks import TrajectoryPanel
 
@@ -91,7 +116,7 @@ class SideDocksMixin:
             QtCore.QTimer.singleShot(0, d.raise_)
         return self.trajectory_panel
 
-    def show_design(self):
+    def show_design(self) -> DesignPanel:
         """View > Eye design: the limit curves of the current eyes and the paper's (issue 11)."""
         if getattr(self, "design_panel", None) is None:
             from eyeviz.app.design_dock import DesignPanel
@@ -110,7 +135,7 @@ class SideDocksMixin:
         read, d = self._docks["readout"], self._docks["design"]
         tall = read.height() + d.height()
         self.resizeDocks([read, d], [min(270, tall // 2), max(tall - 270, tall // 2)],
-                         QtCore.Qt.Vertical)  # fmt: skip
+                         QtCore.Qt.Orientation.Vertical)  # fmt: skip
 
     def show_trajectory(self, kind: str) -> None:
         """View > Trajectory: a path of this kind for the selected feature, with its plot."""

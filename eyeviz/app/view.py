@@ -25,11 +25,18 @@ them), so this widget only renders.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import vtkmodules.vtkRenderingFreeType  # noqa: F401  (text actors)
 import vtkmodules.vtkRenderingOpenGL2  # noqa: F401  (the OpenGL render window)
 from vtkmodules.qt.QVTKRenderWindowInteractor import QVTKRenderWindowInteractor
-from vtkmodules.vtkRenderingCore import vtkRenderer
+from vtkmodules.vtkRenderingCore import vtkRenderer, vtkRenderWindow
+
+if TYPE_CHECKING:
+    from PyQt5.QtWidgets import QWidget as _QWidget
+else:
+    _QWidget = object  # the views' Qt base comes from VTK's or pyvistaqt's class
 
 __all__ = ["BACKEND", "BACKENDS", "NativeView", "VtkView", "fast_renderer", "make_view"]
 
@@ -37,7 +44,7 @@ BACKENDS = ("pyvistaqt", "vtk")
 BACKEND = os.environ.get("EYEVIZ_VIEW", "pyvistaqt")
 
 
-def fast_renderer(background=(1.0, 1.0, 1.0)) -> vtkRenderer:
+def fast_renderer(background: tuple[float, float, float] = (1.0, 1.0, 1.0)) -> vtkRenderer:
     """A renderer without order-independent translucency (VTK 9's default).
 
     OIT renders every frame with translucent props (all text actors are) through extra
@@ -55,13 +62,15 @@ def _plain(ren: vtkRenderer) -> None:
     ren.SetUseDepthPeeling(False)
 
 
-class _Frames:
+class _Frames(_QWidget):
     """What the window needs of a view: ``draw``, ``frames``, ``before_render``."""
 
-    ren_win = None
+    backend: str
+    ren_win: vtkRenderWindow
+    renderer: vtkRenderer
     closed = False
     frames = 0  # renders completed: the bench's "frame that reflects the event"
-    before_render = None  # callable run before each render (pending updates)
+    before_render: Callable[[], None] | None = None  # run before each render (pending updates)
 
     def _init_frames(self) -> None:
         self.frames = 0
@@ -72,7 +81,7 @@ class _Frames:
         self.ren_win.SetPointSmoothing(False)
         self.ren_win.SetPolygonSmoothing(False)
 
-    def set_background(self, color) -> None:
+    def set_background(self, color: tuple[float, float, float]) -> None:
         self.renderer.SetBackground(*color)
 
     def _render_now(self) -> None:
@@ -97,7 +106,7 @@ class NativeView(_Frames, QVTKRenderWindowInteractor):
 
     backend = "vtk"
 
-    def __init__(self, parent=None):
+    def __init__(self, parent: _QWidget | None = None) -> None:
         QVTKRenderWindowInteractor.__init__(self, parent)
         self.ren_win = self.GetRenderWindow()
         self._init_frames()
@@ -112,14 +121,17 @@ class NativeView(_Frames, QVTKRenderWindowInteractor):
         return super().close()
 
 
-def _pyvistaqt_view(parent=None):
+def _pyvistaqt_view(parent: _QWidget | None = None) -> _Frames:
     """pyvistaqt 0.12.0's ``QtInteractor`` set up for one render per frame."""
     from pyvistaqt import QtInteractor
 
-    class PyvistaView(_Frames, QtInteractor):
+    # pyvista types ren_win as Optional and renderer as a property (this class sets and
+    # reads both as _Frames declares them); QWidget.update and BasePlotter.update clash in
+    # QtInteractor itself
+    class PyvistaView(_Frames, QtInteractor):  # type: ignore[misc]
         backend = "pyvistaqt"
 
-        def __init__(self, parent=None):
+        def __init__(self, parent: _QWidget | None = None) -> None:
             QtInteractor.__init__(self, parent, multi_samples=0, auto_update=False, lighting="none")
             self._init_frames()
             for ren in self.renderers:
@@ -127,7 +139,8 @@ def _pyvistaqt_view(parent=None):
                 ren.SetBackground(1.0, 1.0, 1.0)
             self.iren.interactor.SetInteractorStyle(None)
 
-        def set_background(self, color, *args, **kwargs) -> None:
+        # pyvista's is a functools.wraps object no def can match
+        def set_background(self, color, *args, **kwargs) -> None:  # type: ignore[override]
             """The main renderer only (pyvista's would paint the inset too)."""
             import pyvista as pv
 
@@ -136,7 +149,8 @@ def _pyvistaqt_view(parent=None):
         def _render_now(self) -> None:
             self.render()  # pyvista's path: BasePlotter.render -> one ren_win.Render()
 
-        def close(self) -> bool:
+        # QWidget.close's bool (pyvistaqt's returns None)
+        def close(self) -> bool:  # type: ignore[override]
             if not self.closed:
                 self.closed = True
                 QtInteractor.close(self)
@@ -145,7 +159,7 @@ def _pyvistaqt_view(parent=None):
     return PyvistaView(parent)
 
 
-def make_view(parent=None, backend: str | None = None):
+def make_view(parent: _QWidget | None = None, backend: str | None = None) -> _Frames:
     """The view widget of ``backend`` (default: :data:`BACKEND`)."""
     backend = backend or BACKEND
     if backend == "pyvistaqt":
@@ -157,6 +171,6 @@ def make_view(parent=None, backend: str | None = None):
     return NativeView(parent)
 
 
-def VtkView(parent=None):  # noqa: N802 (kept: the window's call site)
+def VtkView(parent: _QWidget | None = None) -> _Frames:  # noqa: N802 (the window's call site)
     """The view of the configured backend (see :func:`make_view`)."""
     return make_view(parent)

@@ -13,15 +13,16 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from PyQt5 import QtCore, QtWidgets
+from PyQt5 import QtCore, QtGui, QtWidgets
 from vtkmodules.vtkRenderingCore import vtkTextActor
 
 from eyeviz.app import screenshot as _shot
 from eyeviz.app.actions import SceneCommand, build_menus
 from eyeviz.app.canvas import CanvasMixin
 from eyeviz.app.files import RECENT_MAX, FilesMixin, is_bundled
-from eyeviz.app.jobs import JobRunner
+from eyeviz.app.jobs import Job, JobRunner
 from eyeviz.app.launch import APP_FONT_PT, check_display, make_app, run_app
 from eyeviz.app.panels import (
     BitmapPanel,
@@ -38,9 +39,13 @@ from eyeviz.app.side_docks import SideDocksMixin
 from eyeviz.app.view import VtkView, fast_renderer
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import Scene
+from eyeviz.model.state import SceneState
 from eyeviz.render.vtk.actors import BACKGROUND, INSET_BACKGROUND, SceneActors, style_text
 from eyeviz.render.vtk.overlays import OverlayActors
 from eyeviz.render.vtk.posterior import PosteriorActors
+
+if TYPE_CHECKING:
+    from eyeviz.app.docks import ExportChoice, ExportDialog
 
 __all__ = [
     "APP_FONT_PT",
@@ -55,9 +60,14 @@ __all__ = [
 
 
 class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow):
+    # made by build_menus (eyeviz.app.actions)
+    undo_action: QtWidgets.QAction
+    redo_action: QtWidgets.QAction
+    play_action: QtWidgets.QAction
+
     def __init__(
         self, scene: Scene, path: str | os.PathLike | None = None, settings: Settings | None = None
-    ):
+    ) -> None:
         super().__init__()
         # first: each dock's maximum width is a fraction of this (a default 640 px window
         # capped the side panels at 288 px for good)
@@ -86,13 +96,14 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         self._frame_timer.setInterval(0)
         self._frame_timer.timeout.connect(self._frame)
         self.inset_shown = True
-        self._export_choice = None  # File > Export's last choice (eyeviz.app.docks.ExportChoice)
-        self.export_dialog_box = None
+        self._export_choice: ExportChoice | None = None  # File > Export's last choice
+        self.export_dialog_box: ExportDialog | None = None
 
         self.plotter = VtkView(self)
         self.plotter.set_background(BACKGROUND)
         self.plotter.before_render = self._flush
-        self.plotter.setFocusPolicy(QtCore.Qt.StrongFocus)  # Space plays while it has focus
+        # Space plays while it has focus
+        self.plotter.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         self.ren_win = self.plotter.ren_win
         self.main_ren = self.plotter.renderer
         self.inset_ren = fast_renderer(INSET_BACKGROUND)
@@ -113,7 +124,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         self.plotter.installEventFilter(self)
 
         self.bitmaps = BitmapPanel(self.model)
-        split = QtWidgets.QSplitter(QtCore.Qt.Vertical)
+        split = QtWidgets.QSplitter(QtCore.Qt.Orientation.Vertical)
         split.addWidget(self.plotter)
         split.addWidget(self.bitmaps)
         split.setStretchFactor(0, 1)
@@ -185,7 +196,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         super().closeEvent(event)
 
     # --- edits ----------------------------------------------------------------------
-    def _push(self, before: Scene, after: Scene, text: str, merge_key=None) -> None:
+    def _push(self, before: Scene, after: Scene, text: str, merge_key: object = None) -> None:
         self.undo_stack.push(SceneCommand(self.model, before, after, text, merge_key))
 
     def add_at_center(self) -> None:
@@ -254,7 +265,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
             self._refresh_docks(scene)
             self.apply_cameras()
 
-    def _refresh_overlays(self, scene: Scene, st) -> None:
+    def _refresh_overlays(self, scene: Scene, st: SceneState) -> None:
         preds = self.model.predictions  # {} unless the predictions layer is shown
         skip = design_skips(self.model) if preds else set()
         path = self.trajectory_panel.path if self.trajectory_panel is not None else None
@@ -283,8 +294,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
 
         from eyeviz.app.docks import ExportDialog
 
-        src = self.path or self.source
-        base = src.with_suffix(".png") if self.path else Path.cwd() / "figure.png"
+        base = self.path.with_suffix(".png") if self.path else Path.cwd() / "figure.png"
         last = replace(self._export_choice, path=base) if self._export_choice else None
         dlg = ExportDialog(self, str(base), last)
         self.export_dialog_box = dlg  # tests and xdotool reach the open dialog
@@ -304,7 +314,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
 
     def export_to(
         self,
-        path,
+        path: str | os.PathLike,
         scale: float = 1.0,
         transparent: bool = False,
         wait: bool = True,
@@ -313,7 +323,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         title: bool = True,
         table: bool = True,
         bitmaps: bool = True,
-    ):
+    ) -> Job | Path | None:
         """The scene as a figure (eyeviz.render.mpl.export: PNG, SVG, PDF) ``width`` wide
         (single, double or inches) with or without its title, table and bitmaps, written
         on a worker thread with a busy cursor; errors in a dialog. ``wait``: block until
@@ -379,7 +389,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         self._frame_pending = False
         self.render()
 
-    def render(self) -> None:
+    def render(self) -> None:  # type: ignore[override]  # shadows QWidget.render(target)
         """Draw now (with any pending live changes)."""
         self.plotter.draw()
 
@@ -388,8 +398,8 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         self._flush()
 
     # --- screenshots ----------------------------------------------------------------
-    def grab_image(self):
+    def grab_image(self) -> QtGui.QImage:
         return _shot.grab_image(self)
 
-    def save_screenshot(self, path) -> Path:
+    def save_screenshot(self, path: str | os.PathLike) -> Path:
         return _shot.save_screenshot(self, path)

@@ -63,7 +63,7 @@ class BitmapPanel(QtWidgets.QWidget):
     CELL_PX = 6.0  # cell boundaries from this width on
     _small_base = 0.0
 
-    def __init__(self, model: AppModel, parent=None):
+    def __init__(self, model: AppModel, parent: QtWidgets.QWidget | None = None) -> None:
         super().__init__(parent)
         self.model = model
         self.strips: dict[tuple[str, bool], np.ndarray] = {}
@@ -77,14 +77,15 @@ class BitmapPanel(QtWidgets.QWidget):
         self._runs: dict[tuple[str, bool], list[tuple[int, int]]] = {}
         self._geo_key: tuple | None = None
         self._geo = (0, 0, 0)
-        self._shown = None
+        self._shown: bool | None = None  # the bitmaps layer shown at the last refresh
         self._palette_key: tuple[str, ...] | None = None
         self._palette_rgb = np.array([UNLIT], dtype=np.uint8)
-        self._argb = np.zeros(1, np.uint32)
+        self._argb: np.ndarray = np.zeros(1, np.uint32)
         self._images: dict[tuple[str, bool], tuple[tuple, QtGui.QImage, np.ndarray]] = {}
         self._static: dict[str, QtGui.QStaticText] = {}
         self._small: QtGui.QFont | None = None
-        self.setAttribute(QtCore.Qt.WA_OpaquePaintEvent)  # paints every pixel itself
+        # paints every pixel itself
+        self.setAttribute(QtCore.Qt.WidgetAttribute.WA_OpaquePaintEvent)
         self.setMinimumHeight(150)
         self.setMaximumHeight(190)
         self.setSizePolicy(QtWidgets.QSizePolicy.Expanding, QtWidgets.QSizePolicy.Fixed)
@@ -150,9 +151,9 @@ class BitmapPanel(QtWidgets.QWidget):
         self.strips = strips
         whole_panel = self._shown_changed(sc.shows("bitmaps"))
         for r, row in enumerate(self.ROWS):
-            key = (self._eye_keys[row[0]], row[1], self.texts[row])
-            if self._row_keys.get(row) != key:
-                self._row_keys[row] = key
+            row_key = (self._eye_keys[row[0]], row[1], self.texts[row])
+            if self._row_keys.get(row) != row_key:
+                self._row_keys[row] = row_key
                 changed.append(row)
                 if not whole_panel:  # the strip and its text; the row's label never changes
                     rect = self._row_rect(r)
@@ -241,7 +242,7 @@ class BitmapPanel(QtWidgets.QWidget):
             if len(self._static) > 64:
                 self._static.clear()
             st = self._static[text] = QtGui.QStaticText(text)
-            st.setTextFormat(QtCore.Qt.PlainText)
+            st.setTextFormat(QtCore.Qt.TextFormat.PlainText)
         return st
 
     def paintEvent(self, event) -> None:  # noqa: N802 (Qt name)
@@ -250,7 +251,7 @@ class BitmapPanel(QtWidgets.QWidget):
         p.fillRect(area, QtGui.QColor("white"))
         if not self.model.scene.shows("bitmaps") or not self.strips:
             p.setPen(INK)
-            p.drawText(self.rect(), QtCore.Qt.AlignCenter, "bitmaps layer hidden")
+            p.drawText(self.rect(), QtCore.Qt.AlignmentFlag.AlignCenter, "bitmaps layer hidden")
             p.end()
             return
         fm = p.fontMetrics()
@@ -275,7 +276,7 @@ class BitmapPanel(QtWidgets.QWidget):
             text = self.texts.get((eye, whole), "")
             if text:
                 p.setPen(self.sel_color)
-                text = fm.elidedText(text, QtCore.Qt.ElideRight, right_w - 8)
+                text = fm.elidedText(text, QtCore.Qt.TextElideMode.ElideRight, right_w - 8)
                 p.drawStaticText(x1 + 8, y + text_dy, self._text(text))
         p.end()
 
@@ -300,7 +301,7 @@ class BitmapPanel(QtWidgets.QWidget):
             p.setPen(QtGui.QColor("#ffffff" if own[k] >= 0 else "#555555"))
             p.drawText(
                 QtCore.QRectF(x0 + k * cell, target.top(), cell, target.height()),
-                QtCore.Qt.AlignCenter,
+                QtCore.Qt.AlignmentFlag.AlignCenter,
                 str(k),
             )
         p.setFont(base)

@@ -36,9 +36,10 @@ def unelide_tabs(widget: QtWidgets.QWidget) -> None:
     """Tab names of the window's tabbed docks in full (scroll buttons when they do not all
     fit) instead of "Fe…", "E…"."""
     win = widget.window()
+    assert win is not None  # a widget's window is itself at worst
     for bar in win.findChildren(QtWidgets.QTabBar):
-        if bar.elideMode() != QtCore.Qt.ElideNone:
-            bar.setElideMode(QtCore.Qt.ElideNone)
+        if bar.elideMode() != QtCore.Qt.TextElideMode.ElideNone:
+            bar.setElideMode(QtCore.Qt.TextElideMode.ElideNone)
             bar.setUsesScrollButtons(True)
 
 
@@ -46,7 +47,7 @@ class _Unelide(QtCore.QObject):
     """Re-applies :func:`unelide_tabs` whenever a tabbed dock appears or is re-tabbed."""
 
     def eventFilter(self, obj, ev) -> bool:  # noqa: N802 (Qt name)
-        if ev.type() in (QtCore.QEvent.Show, QtCore.QEvent.ParentChange):
+        if ev.type() in (QtCore.QEvent.Type.Show, QtCore.QEvent.Type.ParentChange):
             unelide_tabs(obj)
         return False
 

@@ -31,7 +31,7 @@ class EyesPanel(QtWidgets.QWidget):
     values again. Fields holding a value not applied yet are tinted.
     """
 
-    def __init__(self, model: AppModel, parent=None):
+    def __init__(self, model: AppModel, parent: QtWidgets.QWidget | None = None) -> None:
         super().__init__(parent)
         self.model = model
         self._unelide = _Unelide(self)
@@ -42,14 +42,14 @@ class EyesPanel(QtWidgets.QWidget):
             e = QtWidgets.QLineEdit()
             e.setObjectName(f"eyes_{key}")
             e.setToolTip(f"{tip}; Enter applies h, l and m together")
-            e.returnPressed.connect(self.apply)
+            e.returnPressed.connect(self.apply)  # type: ignore[arg-type]  # its bool unused
             e.textEdited.connect(self._mark)
             form.addRow(f"{key}  ({tip})", e)
             self.edits[key] = e
         row = QtWidgets.QHBoxLayout()
         self.apply_button = QtWidgets.QPushButton("Apply")
         self.apply_button.setToolTip("set h, l and m together (Enter in a field does the same)")
-        self.apply_button.clicked.connect(self.apply)
+        self.apply_button.clicked.connect(self.apply)  # type: ignore[arg-type]  # its bool unused
         self.revert_button = QtWidgets.QPushButton("Revert")
         self.revert_button.setToolTip("show the scene's h, l and m again")
         self.revert_button.clicked.connect(self.revert)

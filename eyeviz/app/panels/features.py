@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from PyQt5 import QtGui, QtWidgets
 
 from eyeviz.app.panels.common import ERROR_STYLE, _Unelide, set_message, wrap_label
@@ -13,7 +15,7 @@ class FeaturePanel(QtWidgets.QWidget):
 
     COLS = ("name", "x", "y", "g")
 
-    def __init__(self, model: AppModel, parent=None):
+    def __init__(self, model: AppModel, parent: QtWidgets.QWidget | None = None) -> None:
         super().__init__(parent)
         self.model = model
         self._unelide = _Unelide(self)
@@ -22,8 +24,10 @@ class FeaturePanel(QtWidgets.QWidget):
         lay.setContentsMargins(2, 2, 2, 2)
         self.table = QtWidgets.QTableWidget(0, 4)
         self.table.setHorizontalHeaderLabels(list(self.COLS))
-        self.table.verticalHeader().setVisible(False)
-        self.table.horizontalHeader().setSectionResizeMode(QtWidgets.QHeaderView.Stretch)
+        v_head, h_head = self.table.verticalHeader(), self.table.horizontalHeader()
+        assert v_head is not None and h_head is not None  # a QTableWidget has both
+        v_head.setVisible(False)
+        h_head.setSectionResizeMode(QtWidgets.QHeaderView.Stretch)
         self.table.setSelectionBehavior(QtWidgets.QAbstractItemView.SelectRows)
         self.table.setSelectionMode(QtWidgets.QAbstractItemView.SingleSelection)
         lay.addWidget(self.table)
@@ -42,6 +46,7 @@ class FeaturePanel(QtWidgets.QWidget):
         fs = self.model.scene.features
         self._filling = True
         try:
+            rows: Sequence[int]
             if index is not None and self.table.rowCount() == len(fs):
                 rows = [index]
             else:
@@ -57,6 +62,7 @@ class FeaturePanel(QtWidgets.QWidget):
                     if item.text() != val:
                         item.setText(val)
                 name_item = self.table.item(r, 0)
+                assert name_item is not None  # made by the loop above
                 name_item.setForeground(QtGui.QBrush(QtGui.QColor(f.color)))
                 font = name_item.font()
                 font.setBold(True)

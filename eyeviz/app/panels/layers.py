@@ -12,7 +12,7 @@ from eyeviz.model.scene import LAYERS
 class LayersPanel(QtWidgets.QWidget):
     """One check box per layer; toggling is an undoable edit of the scene's layers."""
 
-    def __init__(self, model: AppModel, parent=None):
+    def __init__(self, model: AppModel, parent: QtWidgets.QWidget | None = None) -> None:
         super().__init__(parent)
         self.model = model
         self._unelide = _Unelide(self)

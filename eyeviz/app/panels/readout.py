@@ -10,9 +10,10 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from eyeviz.app.panels.common import _Unelide, user_message
 from eyeviz.app.panels.notes import design_note, range_note
 from eyeviz.model.app_model import AppModel
+from eyeviz.model.scene import Scene
 
 
-def f_g(scene, i: int) -> float:
+def f_g(scene: Scene, i: int) -> float:
     return scene.features[i].g
 
 
@@ -28,7 +29,7 @@ class ValueText(QtWidgets.QWidget):
     asks for a new geometry only when its number of lines changes.
     """
 
-    def __init__(self, parent=None):
+    def __init__(self, parent: QtWidgets.QWidget | None = None) -> None:
         super().__init__(parent)
         self._text = ""
         self._lines = 1
@@ -69,14 +70,14 @@ class ValueText(QtWidgets.QWidget):
     def paintEvent(self, event) -> None:  # noqa: N802 (Qt name)
         p = QtGui.QPainter(self)
         p.setPen(self._color)
-        flags = QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop
+        flags = QtCore.Qt.AlignmentFlag.AlignLeft | QtCore.Qt.AlignmentFlag.AlignTop
         fm = self.fontMetrics()
         y = 0
         for line in self._text.split("\n"):
             p.drawText(
                 QtCore.QRect(0, y, self.width(), fm.lineSpacing()),
                 flags,
-                fm.elidedText(line, QtCore.Qt.ElideRight, self.width()),
+                fm.elidedText(line, QtCore.Qt.TextElideMode.ElideRight, self.width()),
             )
             y += fm.lineSpacing()
         p.end()
@@ -91,7 +92,7 @@ class ReadoutPanel(QtWidgets.QWidget):
     QLabel re-laid out on every drag event cost ~5 ms a frame.
     """
 
-    def __init__(self, model: AppModel, parent=None):
+    def __init__(self, model: AppModel, parent: QtWidgets.QWidget | None = None) -> None:
         super().__init__(parent)
         self.model = model
         self._unelide = _Unelide(self)
@@ -112,17 +113,20 @@ class ReadoutPanel(QtWidgets.QWidget):
         self.grid.setColumnStretch(1, 1)
         lay.addLayout(self.grid)
         lay.addStretch(1)
-        self._rows: list[tuple[QtWidgets.QLabel, QtWidgets.QLabel]] = []
+        self._rows: list[tuple[QtWidgets.QLabel, ValueText]] = []
         self._cache: dict[int, tuple] = {}
-        self._title_key = None
+        self._title_key: tuple[str, str] | None = None
         self.setMinimumWidth(READOUT_MIN_WIDTH)
         self.title.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Preferred)
 
-    def _row(self, k: int) -> tuple[QtWidgets.QLabel, QtWidgets.QLabel]:
+    def _row(self, k: int) -> tuple[QtWidgets.QLabel, ValueText]:
         while len(self._rows) <= k:
             key, val = QtWidgets.QLabel(), ValueText()
-            key.setTextFormat(QtCore.Qt.RichText)
-            key.setAlignment(QtCore.Qt.AlignLeft | QtCore.Qt.AlignTop)
+            key.setTextFormat(QtCore.Qt.TextFormat.RichText)
+            key.setAlignment(
+                QtCore.Qt.Alignment(QtCore.Qt.AlignmentFlag.AlignLeft)
+                | QtCore.Qt.AlignmentFlag.AlignTop
+            )
             r = len(self._rows)
             self.grid.addWidget(key, r, 0)
             self.grid.addWidget(val, r, 1)
@@ -173,11 +177,16 @@ class ReadoutPanel(QtWidgets.QWidget):
             # the layer is off: no value at all (other layers may still compute them)
             self._set([("hidden", "", "readout layer hidden\n(tick it in Layers)", GREY)])
             return
+        # with r, compute_state sets every array below (the readout layer needs them all)
+        assert st.phi is not None and st.rA is not None and st.phiA is not None
+        assert st.rB is not None and st.phiB is not None and st.in_bfv is not None
+        assert st.vis_a is not None and st.vis_b is not None
+        assert st.overlap_a is not None and st.overlap_b is not None
 
-        def yes(v, good=True):
+        def yes(v: object, good: bool = True) -> tuple[str, str]:
             return ("yes" if v else "no"), (GOOD if bool(v) == good else BAD)
 
-        def pair(a, b, good=True):
+        def pair(a: object, b: object, good: bool = True) -> tuple[str, str]:
             (ta, ca), (tb, cb) = yes(a, good), yes(b, good)
             return f"{ta} / {tb}", (ca if ca == cb else "#444444")
 
@@ -222,6 +231,8 @@ class ReadoutPanel(QtWidgets.QWidget):
                     BAD,
                 )
             ]
+        r, phi = st.r, st.phi
+        assert r is not None and phi is not None  # refresh's readout arrays
         rows = []
         for name in sc.estimators:
             res = preds.get(name, "no prediction")
@@ -242,12 +253,12 @@ class ReadoutPanel(QtWidgets.QWidget):
             if not (math.isfinite(r_hat) and math.isfinite(phi_hat)):
                 rows.append((f"pred:{name}", key, "no answer for these bitmaps", GREY))
                 continue
-            dr, pct, dphi = errors(float(st.r[i]), float(st.phi[i]), r_hat, phi_hat)
+            dr, pct, dphi = errors(float(r[i]), float(phi[i]), r_hat, phi_hat)
             text = (
                 f"r {r_hat:.1f}   Δr {dr:+.1f} ({pct:+.2f} %)\n"
                 f"φ {math.degrees(phi_hat):.2f}°   Δφ {dphi:+.3f}°"
             )
-            out = range_note(self.model, name, float(st.r[i]), float(f_g(sc, i)))
+            out = range_note(self.model, name, float(r[i]), float(f_g(sc, i)))
             if out is not None:
                 rows.append((f"pred:{name}", key, f"{text}\n{out}", BAD))
                 continue
