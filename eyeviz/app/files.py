@@ -102,6 +102,13 @@ class FilesMixin(_MainWindow):
             self,
         )
         box.setDefaultButton(QtWidgets.QMessageBox.Save)
+        # keys for each answer: Enter saves, Escape cancels, Alt+S / Alt+D (Qt's standard
+        # texts carry no mnemonics: a keyboard user had to Tab to Discard)
+        for button, text in ((QtWidgets.QMessageBox.Save, "&Save"),
+                             (QtWidgets.QMessageBox.Discard, "&Discard")):  # fmt: skip
+            b = box.button(button)
+            assert b is not None
+            b.setText(text)
         box.setObjectName("unsaved_prompt")
         self.unsaved_box = box
         answer = box.exec_()
