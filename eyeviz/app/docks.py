@@ -157,11 +157,11 @@ class TrajectoryPanel(QtWidgets.QWidget):
         )
         self.cursors: list[Line2D] = []
         self._key: tuple | None = None
-        self._before = None
 
     # --- model (the player's state lives in eyeviz.model.player) ---------------------
     @property
-    def pos(self) -> float:  # type: ignore[override]  # shadows QWidget.pos() (tests read it)
+    def player_pos(self) -> float:
+        """Where the player is along the path (eyeviz.model.player)."""
         return self.model.player.pos
 
     @property
@@ -353,24 +353,24 @@ class ExportDialog(QtWidgets.QDialog):
         row.addWidget(self.path, 1)
         row.addWidget(browse)
         form.addRow("file (.png, .svg, .pdf)", row)
-        self.width = QtWidgets.QComboBox()
+        self.width_box = QtWidgets.QComboBox()
         for text, _ in self.WIDTH_ITEMS:
-            self.width.addItem(text)
+            self.width_box.addItem(text)
         self.inches = QtWidgets.QDoubleSpinBox()
         self.inches.setRange(3.0, 10.0)  # what eyeviz.render.mpl.vector.resolve_width takes
         self.inches.setSingleStep(0.1)
         self.inches.setDecimals(2)
         self.inches.setSuffix(" in")
         if isinstance(last.width, str):
-            self.width.setCurrentIndex(0 if last.width == "single" else 1)
+            self.width_box.setCurrentIndex(0 if last.width == "single" else 1)
             self.inches.setValue(3.5 if last.width == "single" else 7.2)
         else:
-            self.width.setCurrentIndex(2)
+            self.width_box.setCurrentIndex(2)
             self.inches.setValue(float(last.width))
-        self.width.currentIndexChanged.connect(self._width_changed)
-        self._width_changed(self.width.currentIndex())
+        self.width_box.currentIndexChanged.connect(self._width_changed)
+        self._width_changed(self.width_box.currentIndex())
         wrow = QtWidgets.QHBoxLayout()
-        wrow.addWidget(self.width, 1)
+        wrow.addWidget(self.width_box, 1)
         wrow.addWidget(self.inches)
         form.addRow("width", wrow)
         self.parts: dict[str, QtWidgets.QCheckBox] = {}
@@ -402,7 +402,7 @@ class ExportDialog(QtWidgets.QDialog):
         self.inches.setEnabled(self.WIDTH_ITEMS[index][1] is None)
 
     def choice(self) -> ExportChoice:
-        named = self.WIDTH_ITEMS[self.width.currentIndex()][1]
+        named = self.WIDTH_ITEMS[self.width_box.currentIndex()][1]
         return ExportChoice(
             Path(self.path.text()),
             float(self.scale.value()),

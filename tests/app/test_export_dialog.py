@@ -34,7 +34,7 @@ def test_width_and_parts_chosen_in_the_dialog_reach_the_file(make_window, tmp_pa
 
     def fill(dlg):
         dlg.path.setText(str(out))
-        dlg.width.setCurrentIndex(1)  # double column
+        dlg.width_box.setCurrentIndex(1)  # double column
         dlg.parts["title"].setChecked(False)
         dlg.parts["table"].setChecked(False)
 
@@ -52,12 +52,12 @@ def test_width_and_parts_chosen_in_the_dialog_reach_the_file(make_window, tmp_pa
 
     def check(dlg):  # the dialog opens on the previous choice
         seen.update(
-            width=dlg.width.currentIndex(),
+            width=dlg.width_box.currentIndex(),
             title=dlg.parts["title"].isChecked(),
             table=dlg.parts["table"].isChecked(),
             bitmaps=dlg.parts["bitmaps"].isChecked(),
         )
-        dlg.width.setCurrentIndex(2)
+        dlg.width_box.setCurrentIndex(2)
         dlg.inches.setValue(5.0)
         dlg.path.setText(str(tmp_path / "fig5.pdf"))
 

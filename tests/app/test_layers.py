@@ -130,9 +130,9 @@ def test_trajectory_animation_steps_the_feature_along_the_path(make_window, qtbo
     # the timer drives it; pausing makes the whole animation one undo step
     n0 = win.undo_stack.count()
     panel.set_playing(True)
-    qtbot.waitUntil(lambda: int(panel.pos) >= 12 + 3 * panel.speed.value(), timeout=5000)
+    qtbot.waitUntil(lambda: int(panel.player_pos) >= 12 + 3 * panel.speed.value(), timeout=5000)
     panel.set_playing(False)
-    k = int(panel.pos)
+    k = int(panel.player_pos)
     assert win.model.scene.features[0].x == pytest.approx(x[k])
     assert win.undo_stack.count() == n0 + 1
     win.undo_stack.undo()

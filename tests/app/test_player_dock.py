@@ -16,7 +16,7 @@ def test_space_delete_space_does_not_crash_and_animates_nobody_else(make_window,
     win.toggle_play()  # Space (View > Play / pause)
     panel = win.trajectory_panel
     qtbot.waitUntil(lambda: panel.timer.isActive(), timeout=3000)
-    qtbot.waitUntil(lambda: panel.pos > 0, timeout=3000)
+    qtbot.waitUntil(lambda: panel.player_pos > 0, timeout=3000)
     win.model.select(0)
     win.delete_selected()  # Del
     assert played not in [f.name for f in win.model.scene.features]
