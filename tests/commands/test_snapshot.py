@@ -112,6 +112,38 @@ def test_snapshot_width_and_toggles(tmp_path):
     assert run.returncode == 2 and run.stderr.count("\n") == 1 and "width" in run.stderr
 
 
+def test_snapshot_aspect_frames_the_view_and_bad_ones_are_refused(tmp_path):
+    """--aspect sets the main view's height / width (a wide scene wastes less of the
+    figure); outside [0.3, 1.6] it is refused in one line and nothing is written."""
+    exe = [sys.executable, "-m", "eyeviz", "snapshot", str(SCENES / "figure5.toml")]
+    heights = {}
+    for a in ("0.5", "0.86"):
+        out = tmp_path / f"f{a}.png"
+        run = subprocess.run(
+            [*exe, "-o", str(out), "--aspect", a, "--no-table", "--no-title"],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            cwd=ROOT,
+        )
+        assert run.returncode == 0, run.stderr
+        heights[a] = struct.unpack(">II", out.read_bytes()[16:24])[1]
+    # the same width: only the view's height changes, by (0.86 - 0.5) of the view width
+    w = 3.5 * 300
+    assert heights["0.86"] - heights["0.5"] > 0.25 * w
+    for bad in ("0.1", "2", "nan"):
+        run = subprocess.run(
+            [*exe, "-o", str(tmp_path / "bad.png"), "--aspect", bad],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            cwd=ROOT,
+        )
+        assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr
+        assert "aspect" in run.stderr
+    assert not (tmp_path / "bad.png").exists()
+
+
 def test_snapshot_hostile_scenes_are_one_line(tmp_path):
     """Too many features, a feature at 1e308: a quick one-line refusal, no file."""
     import time

@@ -302,6 +302,25 @@ def test_theta_label_not_on_a_feature():
         assert math.hypot(dx, dy) >= f.g, f.name
 
 
+@pytest.mark.parametrize("aspect", [0.4, 0.5, 0.58, 0.86, 1.3])
+def test_angle_labels_never_under_the_inset(aspect):
+    """psi and theta stay readable at any window shape: at 0.5 the inset took the lower
+    right corner of Figures 5-6 and psi's label was cut under it ("psi = 3")."""
+    for sc in _all_scenes():
+        fig = vector.figure(sc, aspect=aspect)
+        r = _renderer(fig)
+        inset = next((a for a in fig.axes if a.get_gid() == "inset"), None)
+        ax = next(a for a in fig.axes if a.get_gid() == "main")
+        if inset is None:
+            continue
+        box = inset.get_window_extent(r)
+        for t in ax.texts:
+            if t.get_gid() in ("bfv-theta-label", "bfv-psi-label"):
+                bb = t.get_window_extent(r)
+                overlap = bb.x0 < box.x1 and box.x0 < bb.x1 and bb.y0 < box.y1 and box.y0 < bb.y1
+                assert not overlap, (sc.title, aspect, t.get_text())
+
+
 def test_unavailable_estimator_refused_never_written(tmp_path, default_scene):
     sc = default_scene.copy()
     sc.layers = [*sc.layers, "predictions"]

@@ -66,6 +66,15 @@ class Canvas:
         fy = (y - self.ylim[0]) / (self.ylim[1] - self.ylim[0])
         return lay.main.x + fx * lay.main.w, lay.main.y + fy * lay.main.h
 
+    def under_inset(self, x0: float, y0: float, x1: float, y1: float) -> bool:
+        """Whether the box (data units of the main view) meets the inset of the eyes."""
+        if self.inset is None:
+            return False
+        b = self.inset.get_position()
+        w, h = self.lay.width, self.lay.height
+        (ax0, ay0), (ax1, ay1) = self.to_inches(x0, y0), self.to_inches(x1, y1)
+        return ax0 < b.x1 * w and b.x0 * w < ax1 and ay0 < b.y1 * h and b.y0 * h < ay1
+
 
 def make_canvas(scene: Scene, frame: Frame, lay: Layout, dpi: float, merge, title: bool):
     fig = Figure(figsize=(lay.width, lay.height), dpi=dpi)

@@ -44,7 +44,9 @@ def paint(cv: Canvas) -> None:
 
 
 def _free(cv: Canvas, x0, y0, x1, y1) -> bool:
-    """True when the box (data units) touches no feature disc."""
+    """True when the box (data units) touches no feature disc and is not under the inset."""
+    if cv.under_inset(x0, y0, x1, y1):
+        return False
     fr = cv.frame
     for x, y, g in zip(fr.x.tolist(), fr.y.tolist(), fr.g.tolist(), strict=True):
         dx = max(x0 - x, 0, x - x1)
@@ -88,16 +90,27 @@ def _angles(cv: Canvas) -> None:
         gid="bfv-theta-label",
     )
     rpsi = 0.72 * rad
-    ax.plot([0, 1.3 * rpsi], [0, 0], color=BFV_LINE, lw=0.4, ls=(0, (1.5, 1.5)), zorder=1)
-    ax.add_patch(arc(rpsi, 0, th1, BFV_LINE, "bfv-psi-arc"))
+    # psi between the x-axis and the right tangent, or (the same angle, mirrored) between
+    # the left tangent and the negative x-axis when the inset or a feature covers the right
+    lw, lh = 0.45 * upi, 0.06 * upi
     mid = math.radians(th1 / 2)
-    lx, ly = 1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid)
-    cv.label_boxes.append((lx, ly - 0.06 * upi, lx + 0.45 * upi, ly + 0.06 * upi))
+    side = 1.0
+    for sgn in (1.0, -1.0):
+        lx, ly = sgn * 1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid)
+        box = (lx, ly - lh, lx + lw, ly + lh) if sgn > 0 else (lx - lw, ly - lh, lx, ly + lh)
+        if _free(cv, *box):
+            side = sgn
+            break
+    lx, ly = side * 1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid)
+    ax.plot([0, side * 1.3 * rpsi], [0, 0], color=BFV_LINE, lw=0.4, ls=(0, (1.5, 1.5)), zorder=1)
+    ax.add_patch(arc(rpsi, *((0, th1) if side > 0 else (th2, 180)), BFV_LINE, "bfv-psi-arc"))
+    box = (lx, ly - lh, lx + lw, ly + lh) if side > 0 else (lx - lw, ly - lh, lx, ly + lh)
+    cv.label_boxes.append(box)
     ax.text(
         lx,
         ly,
         f"\u03c8 = {math.degrees(b.psi):.0f}\u00b0",
-        ha="left",
+        ha="left" if side > 0 else "right",
         va="center",
         fontsize=SMALL,
         color=BFV_LINE,
