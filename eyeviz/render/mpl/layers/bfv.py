@@ -103,7 +103,8 @@ def _angles(cv: Canvas) -> None:
             break
     lx, ly = side * 1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid)
     ax.plot([0, side * 1.3 * rpsi], [0, 0], color=BFV_LINE, lw=0.4, ls=(0, (1.5, 1.5)), zorder=1)
-    ax.add_patch(arc(rpsi, *((0, th1) if side > 0 else (th2, 180)), BFV_LINE, "bfv-psi-arc"))
+    a0, a1 = (0.0, th1) if side > 0 else (th2, 180.0)
+    ax.add_patch(arc(rpsi, a0, a1, BFV_LINE, "bfv-psi-arc"))
     box = (lx, ly - lh, lx + lw, ly + lh) if side > 0 else (lx - lw, ly - lh, lx, ly + lh)
     cv.label_boxes.append(box)
     ax.text(
