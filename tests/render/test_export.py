@@ -302,11 +302,24 @@ def test_theta_label_not_on_a_feature():
         assert math.hypot(dx, dy) >= f.g, f.name
 
 
+def _with_blockers():
+    """Figures 5-6 with a feature on one side of psi's label or the other, or both."""
+    out = []
+    for spots in ([(-120.0, 20.0)], [(120.0, 20.0)], [(-120.0, 20.0), (120.0, 20.0)]):
+        sc = scene_mod.load(SCENES / "figure5.toml")
+        for k, (x, y) in enumerate(spots):
+            sc.features.append(scene_mod.Feature(f"blocker {k}", x, y, 50.0, "#CC79A7"))
+        out.append(sc)
+    return out
+
+
 @pytest.mark.parametrize("aspect", [0.4, 0.5, 0.58, 0.86, 1.3])
 def test_angle_labels_never_under_the_inset(aspect):
     """psi and theta stay readable at any window shape: at 0.5 the inset took the lower
-    right corner of Figures 5-6 and psi's label was cut under it ("psi = 3")."""
-    for sc in _all_scenes():
+    right corner of Figures 5-6 and psi's label was cut under it ("psi = 3"); with a
+    feature beside each place it can go, it goes over a feature, never under the inset."""
+    shipped = _all_scenes()
+    for sc in shipped + _with_blockers():
         fig = vector.figure(sc, aspect=aspect)
         r = _renderer(fig)
         inset = next((a for a in fig.axes if a.get_gid() == "inset"), None)
@@ -319,6 +332,12 @@ def test_angle_labels_never_under_the_inset(aspect):
                 bb = t.get_window_extent(r)
                 overlap = bb.x0 < box.x1 and box.x0 < bb.x1 and bb.y0 < box.y1 and box.y0 < bb.y1
                 assert not overlap, (sc.title, aspect, t.get_text())
+        # and, in the shipped scenes at a window's usual shapes, the inset never hides a
+        # feature to make room for the labels (the blockers leave no corner free, nor does
+        # Figures 5-6 at 0.4: its view is then 1.2 in high and every corner meets a disc)
+        for f in sc.features if sc in shipped and aspect >= 0.5 else []:
+            px, py = ax.transData.transform((f.x, f.y))
+            assert not (box.x0 < px < box.x1 and box.y0 < py < box.y1), (sc.title, f.name)
 
 
 def test_unavailable_estimator_refused_never_written(tmp_path, default_scene):

@@ -145,6 +145,34 @@ def fit_text(text: str, size: float, width_pt: float) -> str:
     return short(text, lo)
 
 
+#: The BFV's angle labels (Figures 5-6), width and height in inches: theta's, psi's.
+THETA_LABEL_IN = (0.55, 0.12)
+PSI_LABEL_IN = (0.45, 0.12)
+
+
+def angle_radii(cv: Canvas, inset: bool) -> tuple[float, float]:
+    """(theta's arc radius, psi's arc radius) in data units: a fifth of the view's height,
+    at least 1.5 h where no inset shows the eyes."""
+    rad = 0.2 * (cv.ylim[1] - cv.ylim[0])
+    if not inset:
+        rad = max(rad, 1.5 * cv.pair.h)
+    return rad, 0.72 * rad
+
+
+def _angle_labels_area(cv: Canvas) -> tuple[float, float, float, float] | None:
+    """The box (data units) holding theta's label and psi's on either side, None where
+    they are not drawn (no bfv layer, or the origin out of the view)."""
+    if "bfv" not in cv.layers:
+        return None
+    if not (cv.xlim[0] <= 0 <= cv.xlim[1] and cv.ylim[0] <= 0 <= cv.ylim[1]):
+        return None
+    rad, rpsi = angle_radii(cv, True)
+    upi = cv.units_per_in
+    half = max(1.08 * rpsi * math.cos(cv.pair.psi / 2) + PSI_LABEL_IN[0] * upi,
+               THETA_LABEL_IN[0] * upi / 2)  # fmt: skip
+    return (-half, 0.0, half, 1.04 * rad + THETA_LABEL_IN[1] * upi)
+
+
 def _crowding(cv: Canvas, bx, by, bw, bh) -> float:
     """How much of the scene an inset at (bx, by) would cover (features, the origin, BFV)."""
     fr = cv.frame
@@ -167,6 +195,11 @@ def _crowding(cv: Canvas, bx, by, bw, bh) -> float:
             mx = cv.xlim[0] + (xi - cv.lay.main.x) * cv.units_per_in
             my = cv.ylim[0] + (yi - cv.lay.main.y) * cv.units_per_in
             inside += psi <= math.atan2(my, mx) <= math.pi - psi
+    area = _angle_labels_area(cv)
+    if area is not None:  # theta and psi: they can move aside, a feature cannot (half a disc)
+        (ax0, ay0), (ax1, ay1) = cv.to_inches(area[0], area[1]), cv.to_inches(area[2], area[3])
+        if ax0 < bx + bw and bx < ax1 and ay0 < by + bh and by < ay1:
+            cost += 0.5
     return cost + 0.5 * inside / 20
 
 

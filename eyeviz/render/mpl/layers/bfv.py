@@ -7,7 +7,7 @@ import math
 from matplotlib.patches import Polygon
 
 from eyeviz.model.frame import clip_wedge
-from eyeviz.render.mpl.canvas import Canvas
+from eyeviz.render.mpl.canvas import PSI_LABEL_IN, THETA_LABEL_IN, Canvas, angle_radii
 from eyeviz.render.mpl.style import BFV_FILL, BFV_LINE, HALO, SMALL, arc
 
 
@@ -58,24 +58,24 @@ def _free(cv: Canvas, x0, y0, x1, y1) -> bool:
 
 def _angles(cv: Canvas) -> None:
     """psi and theta (Figures 5-6), where the origin is in the view; theta's label goes to
-    the first radius along the bisector where it covers no feature."""
+    the first radius along the bisector where it covers no feature and is not under the
+    inset, psi's to the right tangent or, mirrored, the left one by the same rule."""
     b, ax, upi = cv.frame.bfv, cv.ax, cv.units_per_in
     assert b is not None  # paint() returned before when the frame has no BFV
-    p = cv.pair
-    vh = cv.ylim[1] - cv.ylim[0]
     if not (cv.xlim[0] <= 0 <= cv.xlim[1] and cv.ylim[0] <= 0 <= cv.ylim[1]):
         return
-    rad = 0.2 * vh
-    if cv.inset is None:
-        rad = max(rad, 1.5 * p.h)
+    rad, rpsi = angle_radii(cv, cv.inset is not None)
     th1, th2 = math.degrees(b.psi), 180 - math.degrees(b.psi)
     ax.add_patch(arc(rad, th1, th2, BFV_LINE, "bfv-theta-arc"))
-    tw, th = 0.55 * upi, 0.12 * upi
-    ly = rad * 1.04
-    for f in (1.04, 0.7, 1.4, 0.45, 1.8):
-        if _free(cv, -tw / 2, rad * f, tw / 2, rad * f + th):
-            ly = rad * f
-            break
+    tw, th = THETA_LABEL_IN[0] * upi, THETA_LABEL_IN[1] * upi
+    # the first radius where the label covers no feature and is not under the inset; where
+    # every one covers a feature, the first not under the inset (over a disc, the haloed
+    # label still reads; under the inset it would be hidden)
+    fs = (1.04, 0.7, 1.4, 0.45, 1.8)
+    boxes = [(-tw / 2, rad * f, tw / 2, rad * f + th) for f in fs]
+    ok = [bx for bx in boxes if _free(cv, *bx)]
+    ok = ok or [bx for bx in boxes if not cv.under_inset(*bx)]
+    ly = (ok or boxes)[0][1]
     cv.label_boxes.append((-tw / 2, ly, tw / 2, ly + th))
     ax.text(
         0,
@@ -86,27 +86,29 @@ def _angles(cv: Canvas) -> None:
         fontsize=SMALL,
         color=BFV_LINE,
         bbox=HALO,
-        zorder=7,
+        zorder=9,  # over a disc where no free place is left (haloed: still read)
         gid="bfv-theta-label",
     )
-    rpsi = 0.72 * rad
     # psi between the x-axis and the right tangent, or (the same angle, mirrored) between
     # the left tangent and the negative x-axis when the inset or a feature covers the right
-    lw, lh = 0.45 * upi, 0.06 * upi
+    lw, lh = PSI_LABEL_IN[0] * upi, PSI_LABEL_IN[1] / 2 * upi
     mid = math.radians(th1 / 2)
-    side = 1.0
-    for sgn in (1.0, -1.0):
+
+    def psi_box(sgn: float) -> tuple[float, float, float, float]:
         lx, ly = sgn * 1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid)
-        box = (lx, ly - lh, lx + lw, ly + lh) if sgn > 0 else (lx - lw, ly - lh, lx, ly + lh)
-        if _free(cv, *box):
-            side = sgn
-            break
+        return (lx, ly - lh, lx + lw, ly + lh) if sgn > 0 else (lx - lw, ly - lh, lx, ly + lh)
+
+    def in_view(b: tuple[float, float, float, float]) -> bool:
+        return cv.xlim[0] <= b[0] and b[2] <= cv.xlim[1]
+
+    sides = [s for s in (1.0, -1.0) if in_view(psi_box(s))] or [1.0]
+    free = [s for s in sides if _free(cv, *psi_box(s))]
+    side = (free or [s for s in sides if not cv.under_inset(*psi_box(s))] or sides)[0]
     lx, ly = side * 1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid)
     ax.plot([0, side * 1.3 * rpsi], [0, 0], color=BFV_LINE, lw=0.4, ls=(0, (1.5, 1.5)), zorder=1)
     a0, a1 = (0.0, th1) if side > 0 else (th2, 180.0)
     ax.add_patch(arc(rpsi, a0, a1, BFV_LINE, "bfv-psi-arc"))
-    box = (lx, ly - lh, lx + lw, ly + lh) if side > 0 else (lx - lw, ly - lh, lx, ly + lh)
-    cv.label_boxes.append(box)
+    cv.label_boxes.append(psi_box(side))
     ax.text(
         lx,
         ly,
@@ -116,6 +118,6 @@ def _angles(cv: Canvas) -> None:
         fontsize=SMALL,
         color=BFV_LINE,
         bbox=HALO,
-        zorder=7,
+        zorder=9,  # over a disc where no free place is left (haloed: still read)
         gid="bfv-psi-label",
     )
