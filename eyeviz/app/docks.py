@@ -336,7 +336,7 @@ class ExportDialog(QtWidgets.QDialog):
         ("double column (7.2 in)", "double"),
         ("other width (inches)", None),
     )
-    width: QtWidgets.QComboBox  # shadows QWidget.width() (tests use it)
+    width_box: QtWidgets.QComboBox
 
     def __init__(
         self, parent: QtWidgets.QWidget | None, start: str, last: ExportChoice | None = None

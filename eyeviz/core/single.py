@@ -13,8 +13,8 @@ rounding bound. Whatever the bound cannot clear is not guessed:
 - :func:`in_bfv_one` and :func:`overlaps_one` hand it to the same exact predicates of
   :mod:`eyeviz.core.exact` the vectorised methods use.
 
-Inputs must be finite with g > 0 (:func:`intervals_one` returns ``None`` otherwise, so the
-vectorised method refuses them with its own message).
+Inputs are converted to float64 and must be finite with g > 0 (:func:`intervals_one`
+returns ``None`` otherwise, so the vectorised method refuses them with its own message).
 """
 
 from __future__ import annotations
@@ -36,6 +36,10 @@ def intervals_one(pair: EyePair, x: float, y: float, g: float) -> tuple[int, int
     of ``EyePair._fast_intervals`` does not clear it (an endpoint within the bound of a sector
     boundary, g / r_E > 0.75, r_E^2 out of range, or invalid input): then call
     ``pair.intervals``, which decides such features exactly."""
+    try:
+        x, y, g = float(x), float(y), float(g)  # float32 or int inputs: float64 arithmetic
+    except (TypeError, ValueError, OverflowError):
+        return None
     if not _finite_feature(x, y, g):
         return None
     k, m = pair._k, pair.m
@@ -67,6 +71,7 @@ def in_bfv_one(pair: EyePair, x: float, y: float, g: float) -> bool:
     """The closed disc lies in the binocular field of view (Prop. 4, Eq. 17): the
     expression and bound of ``EyePair.in_bfv``, the exact predicate where it is near."""
     h, l = pair.h, pair.l
+    x, y, g = float(x), float(y), float(g)
     w = math.sqrt((h - l) * (h + l))
     wy, lx, gh = w * y, l * x, g * h
     right = wy - lx - gh
@@ -83,6 +88,7 @@ def in_bfv_one(pair: EyePair, x: float, y: float, g: float) -> bool:
 def overlaps_one(pair: EyePair, x: float, y: float, g: float) -> tuple[bool, bool]:
     """Per eye (A, B): the closed feature disc meets the closed eye disc of radius l; the
     expression and bound of ``EyePair.overlaps_eye``, the exact predicate where it is near."""
+    x, y, g = float(x), float(y), float(g)
     res = []
     for cx in (-pair.h, pair.h):
         dx = x - cx

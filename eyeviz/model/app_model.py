@@ -78,8 +78,9 @@ class AppModel:
         if self._state is None:
             self._state = compute_state(self.scene)
         elif self._moved:  # a drag frame: only the moved rows (eyeviz.core.single)
-            moved, self._moved = self._moved, set()
-            self._state = update_state(self._state, self.scene, moved)
+            # cleared only once the update succeeded: a refused value raises on every read
+            self._state = update_state(self._state, self.scene, self._moved)
+            self._moved = set()
         return self._state
 
     @property
@@ -206,6 +207,12 @@ class AppModel:
         bad = set(values) - {"x", "y", "g"}
         if bad:
             raise ValueError(f"live() changes x, y or g only, got {', '.join(sorted(bad))}")
+        for k, v in values.items():  # refused, not clamped, and nothing changed
+            v = float(v)
+            if not math.isfinite(v):
+                raise ValueError(f"{k} must be finite, got {v!r}")
+            if k == "g" and v <= 0:
+                raise ValueError(f"g (feature radius) must be > 0, got {v!r}")
         f = self.scene.features[index]
         for k, v in values.items():
             setattr(f, k, float(v))

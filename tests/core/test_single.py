@@ -100,6 +100,21 @@ def test_invalid_input_is_left_to_the_vectorised_path(x, y, g):
         PAPER.intervals(x, y, g)
 
 
+def test_float32_and_int_inputs_are_computed_in_float64():
+    """numpy float32 scalars would otherwise run the arithmetic in float32 and pass the
+    float64 bound with a wrong interval (found in review)."""
+    eyes = EyePair(40.0, 20.0, 36000)
+    x, y, g = np.float32(2325.6523), np.float32(476.1301), np.float32(188.34451)
+    want = tuple(int(v[0]) for v in eyes.intervals([float(x)], [float(y)], [float(g)]))
+    assert single.intervals_one(eyes, x, y, g) in (None, want)
+    assert single.intervals_one(eyes, float(x), float(y), float(g)) == want
+    assert single.intervals_one(PAPER, 0, 1500, 50) == single.intervals_one(
+        PAPER, 0.0, 1500.0, 50.0
+    )
+    assert single.intervals_one(PAPER, 0, 10**400, 50) is None  # too large for a float
+    assert single.in_bfv_one(eyes, x, y, g) == bool(eyes.in_bfv(float(x), float(y), float(g)))
+
+
 @settings(max_examples=400, deadline=None)
 @given(
     st.floats(-1e6, 1e6),

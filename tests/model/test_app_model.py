@@ -105,6 +105,24 @@ def test_live_changes_only_position_and_radius():
     m, _ = make()
     with pytest.raises(ValueError, match="x, y or g only, got name"):
         m.live(0, name="x")
+    st = m.state
+    for bad, match in (({"x": float("inf")}, "x must be finite"), ({"g": 0.0}, "g .* > 0")):
+        with pytest.raises(ValueError, match=match):
+            m.live(0, **bad)
+    assert m.scene.features[0].x == 0.0 and m.scene.features[0].g == 50.0
+    assert m.state is st  # refused before anything changed
+
+
+def test_a_refused_row_update_raises_on_every_read_never_a_stale_state():
+    """A state update that fails keeps failing (review: the moved rows were forgotten
+    before the update, so the second read returned the old state silently)."""
+    m, _ = make()
+    _ = m.state
+    m.scene.features[0].x = float("nan")  # past live()'s checks, as a bug elsewhere might
+    m._notify("feature", 0)
+    for _ in range(2):
+        with pytest.raises(ValueError, match="non-finite"):
+            _ = m.state
 
 
 def test_click_selects_without_an_undo_step():
