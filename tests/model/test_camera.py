@@ -78,3 +78,26 @@ def test_fit_inset_shows_both_eyes():
         px, py = camera.to_pixel(v, vp, x, 0.0)
         assert vp.contains(px, py)
     assert math.isfinite(v.width) and v.width > 2 * (e.h + e.l)
+
+
+def test_discs_meet_one_disc_as_many():
+    """The plain-float path for a few discs (a drag frame) answers as the array path."""
+    import numpy as np
+
+    rng = np.random.default_rng(3)
+    view, vp = View((100.0, 2000.0), 5000.0), Viewport(0.0, 0.0, 900.0, 600.0)
+    rect = Viewport(0.0, 420.0, 270.0, 180.0)
+    far = ([1e7] * 4, [1e7] * 4, [1.0] * 4)  # four discs nowhere near: forces the array path
+    xs = list(rng.uniform(-3000, 3000, 400)) + [np.inf, -np.inf, np.nan, 0.0]
+    ys = list(rng.uniform(-1000, 5000, 400)) + [0.0, 1.0, 2.0, np.inf]
+    gs = list(rng.uniform(1, 800, 400)) + [5.0, 5.0, 5.0, 5.0]
+    hits = 0
+    for x, y, g in zip(xs, ys, gs, strict=True):
+        for min_px in (0.0, 6.0):
+            one = camera.discs_meet(view, vp, [x], [y], [g], rect, min_px)
+            many = camera.discs_meet(
+                view, vp, [x, *far[0]], [y, *far[1]], [g, *far[2]], rect, min_px
+            )
+            assert one == many, (x, y, g, min_px)
+            hits += one
+    assert 0 < hits < 800  # both answers occur
