@@ -24,10 +24,11 @@ import math
 from eyeviz.core import exact
 from eyeviz.core.geometry import _Q_SAFE, _TINY_SCALE, _TOL_BASE, _TOL_GRAZE, _U, EyePair
 
-__all__ = ["in_bfv_one", "intervals_one", "overlaps_one"]
+__all__ = ["in_bfv_one", "intervals_one", "overlaps_one", "valid_feature"]
 
 
-def _finite_feature(x: float, y: float, g: float) -> bool:
+def valid_feature(x: float, y: float, g: float) -> bool:
+    """Finite x, y, g with g > 0: what ``EyePair``'s methods accept."""
     return math.isfinite(x) and math.isfinite(y) and math.isfinite(g) and g > 0
 
 
@@ -40,7 +41,7 @@ def intervals_one(pair: EyePair, x: float, y: float, g: float) -> tuple[int, int
         x, y, g = float(x), float(y), float(g)  # float32 or int inputs: float64 arithmetic
     except (TypeError, ValueError, OverflowError):
         return None
-    if not _finite_feature(x, y, g):
+    if not valid_feature(x, y, g):
         return None
     k, m = pair._k, pair.m
     tol0 = (_TOL_BASE + _TOL_GRAZE / (1 - _Q_SAFE)) * _U * m

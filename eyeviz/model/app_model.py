@@ -51,6 +51,16 @@ class MouseEvent:
     py: float
 
 
+def _number(key: str, value) -> float:
+    """A feature's x, y or g as a float; refused (not clamped) when not finite, g when <= 0."""
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{key} must be finite, got {v!r}")
+    if key == "g" and v <= 0:
+        raise ValueError(f"g (feature radius) must be > 0, got {v!r}")
+    return v
+
+
 class AppModel:
     """The open scene plus the selection; notifies listeners ``fn(what, index)``."""
 
@@ -207,15 +217,10 @@ class AppModel:
         bad = set(values) - {"x", "y", "g"}
         if bad:
             raise ValueError(f"live() changes x, y or g only, got {', '.join(sorted(bad))}")
-        for k, v in values.items():  # refused, not clamped, and nothing changed
-            v = float(v)
-            if not math.isfinite(v):
-                raise ValueError(f"{k} must be finite, got {v!r}")
-            if k == "g" and v <= 0:
-                raise ValueError(f"g (feature radius) must be > 0, got {v!r}")
+        checked = {k: _number(k, v) for k, v in values.items()}  # refused before any change
         f = self.scene.features[index]
-        for k, v in values.items():
-            setattr(f, k, float(v))
+        for k, v in checked.items():
+            setattr(f, k, v)
         self._notify("feature", index)
 
     def select(self, index: int | None) -> None:
@@ -247,11 +252,7 @@ class AppModel:
                 if any(o.name == v for j, o in enumerate(after.features) if j != index):
                     raise ValueError(f"another feature is already named {v!r}")
             else:
-                v = float(v)
-                if not math.isfinite(v):
-                    raise ValueError(f"{k} must be finite, got {v!r}")
-                if k == "g" and v <= 0:
-                    raise ValueError(f"g (feature radius) must be > 0, got {v!r}")
+                v = _number(k, v)
             setattr(f, k, v)
         self.commit(after, f"Edit {f.name}")
 

@@ -107,23 +107,29 @@ def _polar(x: np.ndarray, y: np.ndarray, cx: float) -> tuple[np.ndarray, np.ndar
     return np.hypot(dx, y), np.mod(np.arctan2(y, dx), 2.0 * math.pi)
 
 
+def _needs(layers) -> tuple[bool, bool, bool]:
+    """Whether ``layers`` need the intervals, the owner arrays, the readout."""
+    shown = set(layers)
+    return bool(shown & _NEED_INTERVALS), bool(shown & _NEED_OWNERS), bool(shown & _NEED_READOUT)
+
+
 def compute_state(scene: Scene, layers=None) -> SceneState:
     """State of ``scene`` for its layers (or for ``layers`` when given)."""
     pair = scene.eyes.pair()
-    shown = set(scene.layers if layers is None else layers)
+    need_iv, need_own, need_read = _needs(scene.layers if layers is None else layers)
     fs = scene.features
     x = np.array([f.x for f in fs], dtype=np.float64)
     y = np.array([f.y for f in fs], dtype=np.float64)
     g = np.array([f.g for f in fs], dtype=np.float64)
     st = SceneState(pair, x, y, g)
-    if shown & _NEED_INTERVALS:
+    if need_iv:
         st.LA, st.RA, st.LB, st.RB = pair.intervals(x, y, g)
         st.vis_a, st.vis_b = st.RA > st.LA, st.RB > st.LB
-    if shown & _NEED_OWNERS:
+    if need_own:
         LA, RA, LB, RB = st.intervals()
         st.owner_a = owners(LA, RA, pair.m)
         st.owner_b = owners(LB, RB, pair.m)
-    if shown & _NEED_READOUT:
+    if need_read:
         st.in_bfv = pair.in_bfv(x, y, g)
         st.overlap_a, st.overlap_b = pair.overlaps_eye(x, y, g)
         st.r, st.phi = _polar(x, y, 0.0)
@@ -136,14 +142,9 @@ def compute_state(scene: Scene, layers=None) -> SceneState:
 _ROWS_MAX = 8
 
 
-def _needs(scene: Scene) -> tuple[bool, bool, bool]:
-    shown = set(scene.layers)
-    return bool(shown & _NEED_INTERVALS), bool(shown & _NEED_OWNERS), bool(shown & _NEED_READOUT)
-
-
-def _polar_row(x: float, y: float, cx: float) -> tuple[float, float, float, float]:
-    """(r, phi) as :func:`_polar` and (r_E, phi_E) as ``EyePair.eye_polar`` give them: the
-    same numpy ufuncs (the same inner loops) on 0-d values."""
+def _polar_row(x: float, y: float, cx: float) -> tuple[float, float, float]:
+    """(r, phi as :func:`_polar` gives it, phi as ``EyePair.eye_polar`` gives it) about
+    (cx, 0): the same numpy ufuncs (the same inner loops) on 0-d values."""
     dx = np.float64(x) - cx
     yy = np.float64(y)
     r = np.hypot(dx, yy)
@@ -151,7 +152,7 @@ def _polar_row(x: float, y: float, cx: float) -> tuple[float, float, float, floa
     phi_o = np.mod(phi, 2.0 * math.pi)
     phi_e = phi + 2 * math.pi if phi < 0 else phi
     phi_e = np.minimum(phi_e, np.nextafter(2 * math.pi, 0))
-    return float(r), float(phi_o), float(r), float(phi_e)
+    return float(r), float(phi_o), float(phi_e)
 
 
 def update_state(state: SceneState, scene: Scene, rows) -> SceneState:
@@ -167,7 +168,7 @@ def update_state(state: SceneState, scene: Scene, rows) -> SceneState:
     fs = scene.features
     rows = sorted(set(rows))
     pair = scene.eyes.pair()
-    need_iv, need_own, need_read = _needs(scene)
+    need_iv, need_own, need_read = _needs(scene.layers)
     same = (
         len(fs) == state.n
         and pair == state.pair
@@ -189,7 +190,7 @@ def update_state(state: SceneState, scene: Scene, rows) -> SceneState:
     for i in rows:
         f = fs[i]
         x, y, g = float(f.x), float(f.y), float(f.g)
-        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(g) and g > 0):
+        if not single.valid_feature(x, y, g):
             return compute_state(scene)  # refuses it with the core's own message
         st.x[i], st.y[i], st.g[i] = x, y, g
         if need_iv:
@@ -209,9 +210,9 @@ def update_state(state: SceneState, scene: Scene, rows) -> SceneState:
             assert st.rB is not None and st.phiB is not None
             st.in_bfv[i] = single.in_bfv_one(pair, x, y, g)
             st.overlap_a[i], st.overlap_b[i] = single.overlaps_one(pair, x, y, g)
-            st.r[i], st.phi[i], _, _ = _polar_row(x, y, 0.0)
-            _, _, st.rA[i], st.phiA[i] = _polar_row(x, y, -pair.h)
-            _, _, st.rB[i], st.phiB[i] = _polar_row(x, y, pair.h)
+            st.r[i], st.phi[i], _ = _polar_row(x, y, 0.0)
+            st.rA[i], _, st.phiA[i] = _polar_row(x, y, -pair.h)
+            st.rB[i], _, st.phiB[i] = _polar_row(x, y, pair.h)
     if need_own and lit_changed:
         LA, RA, LB, RB = st.intervals()
         st.owner_a = owners(LA, RA, pair.m)
