@@ -28,6 +28,8 @@ from eyeviz.render.mpl.style import (
 
 __all__ = ["Canvas", "make_canvas"]
 
+Box = tuple[float, float, float, float]  # (x0, y0, x1, y1)
+
 
 @dataclass
 class Canvas:
@@ -66,14 +68,20 @@ class Canvas:
         fy = (y - self.ylim[0]) / (self.ylim[1] - self.ylim[0])
         return lay.main.x + fx * lay.main.w, lay.main.y + fy * lay.main.h
 
+    def origin_in_view(self) -> bool:
+        return self.xlim[0] <= 0 <= self.xlim[1] and self.ylim[0] <= 0 <= self.ylim[1]
+
+    def box_inches(self, x0: float, y0: float, x1: float, y1: float) -> Box:
+        """A box in data units of the main view, in figure inches."""
+        return (*self.to_inches(x0, y0), *self.to_inches(x1, y1))
+
     def under_inset(self, x0: float, y0: float, x1: float, y1: float) -> bool:
         """Whether the box (data units of the main view) meets the inset of the eyes."""
         if self.inset is None:
             return False
         b = self.inset.get_position()
         w, h = self.lay.width, self.lay.height
-        (ax0, ay0), (ax1, ay1) = self.to_inches(x0, y0), self.to_inches(x1, y1)
-        return ax0 < b.x1 * w and b.x0 * w < ax1 and ay0 < b.y1 * h and b.y0 * h < ay1
+        return boxes_meet(self.box_inches(x0, y0, x1, y1), (b.x0 * w, b.y0 * h, b.x1 * w, b.y1 * h))
 
 
 def make_canvas(scene: Scene, frame: Frame, lay: Layout, dpi: float, merge, title: bool):
@@ -150,6 +158,18 @@ THETA_LABEL_IN = (0.55, 0.12)
 PSI_LABEL_IN = (0.45, 0.12)
 
 
+def boxes_meet(a: Box, b: Box) -> bool:
+    """Whether two boxes (x0, y0, x1, y1) overlap (edges that only touch do not)."""
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def psi_label_at(cv: Canvas, rpsi: float, side: float) -> tuple[float, float]:
+    """Where psi's label starts (data units): beside its arc of radius ``rpsi``, halfway up
+    the angle, at the right tangent (side 1) or mirrored at the left one (side -1)."""
+    half = cv.pair.psi / 2
+    return side * 1.08 * rpsi * math.cos(half), 1.08 * rpsi * math.sin(half)
+
+
 def angle_radii(cv: Canvas, inset: bool) -> tuple[float, float]:
     """(theta's arc radius, psi's arc radius) in data units: a fifth of the view's height,
     at least 1.5 h where no inset shows the eyes."""
@@ -162,14 +182,11 @@ def angle_radii(cv: Canvas, inset: bool) -> tuple[float, float]:
 def _angle_labels_area(cv: Canvas) -> tuple[float, float, float, float] | None:
     """The box (data units) holding theta's label and psi's on either side, None where
     they are not drawn (no bfv layer, or the origin out of the view)."""
-    if "bfv" not in cv.layers:
-        return None
-    if not (cv.xlim[0] <= 0 <= cv.xlim[1] and cv.ylim[0] <= 0 <= cv.ylim[1]):
+    if "bfv" not in cv.layers or not cv.origin_in_view():
         return None
     rad, rpsi = angle_radii(cv, True)
     upi = cv.units_per_in
-    half = max(1.08 * rpsi * math.cos(cv.pair.psi / 2) + PSI_LABEL_IN[0] * upi,
-               THETA_LABEL_IN[0] * upi / 2)  # fmt: skip
+    half = max(psi_label_at(cv, rpsi, 1.0)[0] + PSI_LABEL_IN[0] * upi, THETA_LABEL_IN[0] * upi / 2)
     return (-half, 0.0, half, 1.04 * rad + THETA_LABEL_IN[1] * upi)
 
 
@@ -196,10 +213,9 @@ def _crowding(cv: Canvas, bx, by, bw, bh) -> float:
             my = cv.ylim[0] + (yi - cv.lay.main.y) * cv.units_per_in
             inside += psi <= math.atan2(my, mx) <= math.pi - psi
     area = _angle_labels_area(cv)
-    if area is not None:  # theta and psi: they can move aside, a feature cannot (half a disc)
-        (ax0, ay0), (ax1, ay1) = cv.to_inches(area[0], area[1]), cv.to_inches(area[2], area[3])
-        if ax0 < bx + bw and bx < ax1 and ay0 < by + bh and by < ay1:
-            cost += 0.5
+    # theta and psi: they can move aside, a feature cannot (half a disc)
+    if area is not None and boxes_meet(cv.box_inches(*area), (bx, by, bx + bw, by + bh)):
+        cost += 0.5
     return cost + 0.5 * inside / 20
 
 
@@ -250,9 +266,8 @@ def _make_inset(cv: Canvas) -> None:
     # a leader from the inset to the eyes' true place, drawn only when the origin is in
     # the view, so it never leaves the axes
     ox, oy = cv.to_inches(0.0, 0.0)
-    inside_view = main.x <= ox <= main.x + main.w and main.y <= oy <= main.y + main.h
     in_box = bx <= ox <= bx + box_w and by <= oy <= by + box_h
-    if inside_view and not in_box:
+    if cv.origin_in_view() and not in_box:
         ex = min(max(ox, bx), bx + box_w)
         ey = by + box_h if oy > by + box_h else (by if oy < by else by + box_h / 2)
         cv.fig.add_artist(

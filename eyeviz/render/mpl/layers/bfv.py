@@ -7,7 +7,14 @@ import math
 from matplotlib.patches import Polygon
 
 from eyeviz.model.frame import clip_wedge
-from eyeviz.render.mpl.canvas import PSI_LABEL_IN, THETA_LABEL_IN, Canvas, angle_radii
+from eyeviz.render.mpl.canvas import (
+    PSI_LABEL_IN,
+    THETA_LABEL_IN,
+    Box,
+    Canvas,
+    angle_radii,
+    psi_label_at,
+)
 from eyeviz.render.mpl.style import BFV_FILL, BFV_LINE, HALO, SMALL, arc
 
 
@@ -62,7 +69,7 @@ def _angles(cv: Canvas) -> None:
     inset, psi's to the right tangent or, mirrored, the left one by the same rule."""
     b, ax, upi = cv.frame.bfv, cv.ax, cv.units_per_in
     assert b is not None  # paint() returned before when the frame has no BFV
-    if not (cv.xlim[0] <= 0 <= cv.xlim[1] and cv.ylim[0] <= 0 <= cv.ylim[1]):
+    if not cv.origin_in_view():
         return
     rad, rpsi = angle_radii(cv, cv.inset is not None)
     th1, th2 = math.degrees(b.psi), 180 - math.degrees(b.psi)
@@ -92,19 +99,18 @@ def _angles(cv: Canvas) -> None:
     # psi between the x-axis and the right tangent, or (the same angle, mirrored) between
     # the left tangent and the negative x-axis when the inset or a feature covers the right
     lw, lh = PSI_LABEL_IN[0] * upi, PSI_LABEL_IN[1] / 2 * upi
-    mid = math.radians(th1 / 2)
 
-    def psi_box(sgn: float) -> tuple[float, float, float, float]:
-        lx, ly = sgn * 1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid)
+    def psi_box(sgn: float) -> Box:
+        lx, ly = psi_label_at(cv, rpsi, sgn)
         return (lx, ly - lh, lx + lw, ly + lh) if sgn > 0 else (lx - lw, ly - lh, lx, ly + lh)
 
-    def in_view(b: tuple[float, float, float, float]) -> bool:
+    def in_view(b: Box) -> bool:
         return cv.xlim[0] <= b[0] and b[2] <= cv.xlim[1]
 
     sides = [s for s in (1.0, -1.0) if in_view(psi_box(s))] or [1.0]
     free = [s for s in sides if _free(cv, *psi_box(s))]
     side = (free or [s for s in sides if not cv.under_inset(*psi_box(s))] or sides)[0]
-    lx, ly = side * 1.08 * rpsi * math.cos(mid), 1.08 * rpsi * math.sin(mid)
+    lx, ly = psi_label_at(cv, rpsi, side)
     ax.plot([0, side * 1.3 * rpsi], [0, 0], color=BFV_LINE, lw=0.4, ls=(0, (1.5, 1.5)), zorder=1)
     a0, a1 = (0.0, th1) if side > 0 else (th2, 180.0)
     ax.add_patch(arc(rpsi, a0, a1, BFV_LINE, "bfv-psi-arc"))

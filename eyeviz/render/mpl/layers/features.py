@@ -6,7 +6,7 @@ import math
 
 from matplotlib.patches import Circle
 
-from eyeviz.render.mpl.canvas import Canvas
+from eyeviz.render.mpl.canvas import Canvas, boxes_meet
 from eyeviz.render.mpl.layers import eyes
 from eyeviz.render.mpl.style import FONT, HALO, INK, OUT_OF_DOMAIN, SMALL, dark, mix, short, slug
 
@@ -58,8 +58,8 @@ def _feature_label(cv: Canvas, i: int, col: str) -> None:
             dy = max(y0 - oy, 0, oy - (y0 + th))
             if math.hypot(dx, dy) < og + 0.3 * gap:
                 cost += 2
-        for bx0, by0, bx1, by1 in cv.label_boxes:
-            if x0 < bx1 and bx0 < x0 + tw and y0 < by1 and by0 < y0 + th:
+        for box in cv.label_boxes:
+            if boxes_meet(box, (x0, y0, x0 + tw, y0 + th)):
                 cost += 3
         if cost < best_cost:
             best, best_cost = (x0, y0), cost
