@@ -178,6 +178,27 @@ class EyePair:
         """((-h, 0), (h, 0)): the centres of eye A (left) and eye B (right)."""
         return ((-self.h, 0.0), (self.h, 0.0))
 
+    # --- the eye-model seam (eyeviz.core.eyes.EyeModel) --------------------------------
+    @property
+    def kind(self) -> str:
+        """``"planar"``: rings of m ommatidia in the plane (Section 3)."""
+        return "planar"
+
+    @property
+    def dims(self) -> int:
+        """Coordinates of a feature centre: 2 (x, y)."""
+        return 2
+
+    @property
+    def facets(self) -> int:
+        """Ommatidia per eye, m."""
+        return self.m
+
+    @property
+    def design(self) -> dict[str, float | int]:
+        """{"h", "l", "m"}: what a scene, a data set or an estimator must agree on."""
+        return {"h": self.h, "l": self.l, "m": self.m}
+
     def _cx(self, eye: str) -> float:
         if eye == "A":
             return -self.h
