@@ -1,7 +1,8 @@
 """``eyeviz report KIND ... -o DIR``: reports as Markdown + CSV + PNG.
 
-Each kind is a module ``eyeviz.reports.<kind>`` with ``HELP``, ``add_arguments`` and
-``run(args) -> int``; kinds whose module is absent are not offered.
+Each kind is a module with ``HELP``, ``add_arguments`` and ``run(args) -> int``: the
+package's own live in ``eyeviz.reports.<kind>``; :func:`register` adds another (a plug-in
+module of any name, docs/extending.md). Kinds whose module is absent are not offered.
 """
 
 from __future__ import annotations
@@ -12,15 +13,27 @@ import importlib
 NAME = "report"
 HELP = "write a report (Markdown, CSV and plots) into a directory"
 KINDS = ("stability", "dataset", "estimators", "trajectories", "study")
+#: kind -> module path: the package's reports, then any registered with :func:`register`.
+MODULES: dict[str, str] = {kind: f"eyeviz.reports.{kind}" for kind in KINDS}
+
+
+def register(kind: str, module: str) -> None:
+    """Offer ``eyeviz report KIND``, run by ``module`` (importable, with ``HELP``,
+    ``add_arguments(parser)`` and ``run(args) -> int``). ValueError for a taken kind."""
+    if not kind.isidentifier():
+        raise ValueError(f"a report kind must be an identifier, got {kind!r}")
+    if kind in MODULES and MODULES[kind] != module:
+        raise ValueError(f"report kind {kind!r} is taken by {MODULES[kind]}")
+    MODULES[kind] = module
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     sub = parser.add_subparsers(dest="kind", metavar="KIND", required=True)
-    for kind in KINDS:
+    for kind, path in MODULES.items():
         try:
-            mod = importlib.import_module(f"eyeviz.reports.{kind}")
+            mod = importlib.import_module(path)
         except ModuleNotFoundError as exc:
-            if exc.name == f"eyeviz.reports.{kind}":
+            if exc.name == path:
                 continue
             raise
         p = sub.add_parser(kind, help=mod.HELP, description=mod.HELP)
