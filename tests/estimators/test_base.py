@@ -123,3 +123,34 @@ def test_domain_validation():
         Domain(r_min=10.0, r_max=5.0)
     with pytest.raises(ValueError, match="m must be an even integer"):
         Domain(m=7)
+
+
+def test_predict_intervals_takes_runs_inside_the_half_bitmap_only():
+    """Issue 20 item 7, mutant 3: a run ends at m/2 - 1 at most (R = m/2 is past the half
+    bitmap) and starts at 0 at least, in either eye; a one-ommatidium run (L = R) is a run."""
+    est = estimators.load("analytic")
+    ok = [(100, 110, 300, W - 1), (100, W - 1, 300, 310), (0, 110, 300, 310), (100, 110, 0, 310)]
+    ok += [(100, 100, 300, 310), (100, 110, 300, 300)]
+    bad = [(100, 110, 300, W), (100, W, 300, 310), (-1, 110, 300, 310), (100, 110, -1, 310)]
+    bad += [(111, 110, 300, 310), (100, 110, 311, 310)]
+    p = est.predict_intervals(*np.array(ok + bad).T)
+    assert p.valid.tolist() == [True] * len(ok) + [False] * len(bad)
+    assert np.isfinite(p.r[: len(ok)]).all() and np.isnan(p.r[len(ok) :]).all()
+    assert np.isnan(p.phi[len(ok) :]).all() and not p.in_domain[len(ok) :].any()
+    for iv in bad:  # one row at a time (no neighbour to share a mask with)
+        q = est.predict_intervals(*iv)
+        assert not q.valid and np.isnan(q.r) and np.isnan(q.phi), iv
+
+
+def test_in_domain_refuses_a_run_touching_either_end_of_either_eye():
+    """Issue 20 item 7, mutant 4: a run that touches an end of the half bitmap (index 0 or
+    m/2 - 1) may go on past it, so it is out of the domain in eye A and in eye B alike;
+    one ommatidium in from the end it is in (a domain wide enough for the rest)."""
+    wide = Domain(r_min=1.0, r_max=1e9, g_max=1e9)
+    inner = (100, 110, 300, 310)
+    assert bool(in_domain(*inner, wide))
+    for k, (end, one_in) in enumerate(((0, 1), (W - 1, W - 2), (0, 1), (W - 1, W - 2))):
+        touching, inside = list(inner), list(inner)
+        touching[k], inside[k] = end, one_in
+        assert not bool(in_domain(*touching, wide)), touching
+        assert bool(in_domain(*inside, wide)), inside

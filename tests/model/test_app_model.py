@@ -266,3 +266,32 @@ def test_duplicate_names_are_copies_not_numbers():
     names = [f.name for f in m.scene.features]
     assert names[2:] == ["target (copy)", "target (copy 2)", "target (copy 3)"]
     assert m.selected == 4
+
+
+def test_a_live_move_of_another_feature_updates_that_row_not_the_selected_one():
+    """Issue 20 item 7, mutant 1: live(i) with j selected marks row i as moved (the
+    player animates a feature that is not the selection); the state then equals a whole
+    new one, and listeners hear about row i."""
+    import dataclasses
+
+    import numpy as np
+
+    from eyeviz.model.state import compute_state
+
+    m, _ = make()
+    m.scene.layers = ["eyes", "bitmaps", "readout", "features"]
+    m._notify("layers")
+    heard = []
+    m.listeners.append(lambda what, i: heard.append((what, i)))
+    for selected, moved in ((1, 0), (0, 1), (None, 1)):
+        m.select(selected)
+        before = m.state
+        f = m.scene.features[moved]
+        m.live(moved, x=f.x + 700.0, y=f.y - 300.0, g=f.g * 1.5)
+        assert heard[-1] == ("feature", moved)
+        got, want = m.state, compute_state(m.scene)
+        assert got.x[moved] != before.x[moved]
+        for fld in dataclasses.fields(want):
+            a, b = getattr(want, fld.name), getattr(got, fld.name)
+            if isinstance(a, np.ndarray):
+                np.testing.assert_array_equal(b, a, err_msg=f"{fld.name}, moved {moved}")

@@ -184,3 +184,40 @@ def test_update_state_equals_compute_state_anywhere(i, x, y, g, m):
     f = s.features[i]
     f.x, f.y, f.g = x, y, g
     _assert_same_state(update_state(st0, s, {i}), compute_state(s))
+
+
+def test_update_state_with_several_moved_rows_reads_each_rows_own_feature():
+    """Issue 20 item 7, mutant 2: several rows moved at once (a drag frame where the
+    player moved another feature too) each read their own feature, in any order given."""
+    from eyeviz.model.state import update_state
+
+    s = _scene(720, ALL_LAYERS)
+    st0 = compute_state(s)
+    moves = {3: (-300.0, 2500.0, 80.0), 0: (900.0, 1200.0, 30.0), 2: (50.0, 4000.0, 400.0)}
+    for i, (x, y, g) in moves.items():
+        f = s.features[i]
+        f.x, f.y, f.g = x, y, g
+    for rows in ([3, 0, 2], {0, 2, 3}, (2, 3, 0, 3)):
+        st = update_state(st0, s, rows)
+        _assert_same_state(st, compute_state(s))
+        assert [st.x[i] for i in sorted(moves)] == [moves[i][0] for i in sorted(moves)]
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.integers(0, 4), st.floats(-1e4, 1e4), st.floats(-1e4, 1e4), st.floats(1, 2e3)),
+        min_size=2,
+        max_size=5,
+    ),
+    st.sampled_from([16, 720]),
+)
+def test_update_state_equals_compute_state_for_several_rows(moves, m):
+    from eyeviz.model.state import update_state
+
+    s = _scene(m, ALL_LAYERS)
+    st0 = compute_state(s)
+    for i, x, y, g in moves:
+        f = s.features[i]
+        f.x, f.y, f.g = x, y, g
+    _assert_same_state(update_state(st0, s, [i for i, *_ in moves]), compute_state(s))
