@@ -1,4 +1,4 @@
-"""The ``eyeviz`` command line (DESIGN.md §3).
+"""The ``eyeviz`` command line (docs/contract.md).
 
 Sub-commands are discovered from :mod:`eyeviz.commands`. Every error a user can cause
 ends in a one-line message on stderr and a non-zero exit, never a traceback:

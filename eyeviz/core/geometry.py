@@ -1,7 +1,7 @@
 """The paper's planar binocular compound-eye model, vectorised and exact.
 
 Two circular eyes of radius l, each a ring of m ommatidia, centred at A = (-h, 0) (left)
-and B = (h, 0) (right) (DESIGN.md §4 fixes the paper's Prop. 5 typo). Ommatidia are
+and B = (h, 0) (right) (docs/conventions.md fixes the paper's Prop. 5 typo). Ommatidia are
 numbered counter-clockwise from the +x direction; sector k is the half-open angle
 [k*gamma, (k+1)*gamma) (Eq. 6, 8).
 
@@ -210,7 +210,7 @@ class EyePair:
     def eye_polar(self, x, y, eye: str) -> tuple[np.ndarray, np.ndarray]:
         """Polar coordinates (r_E, phi_E) about an eye centre, phi_E in [0, 2*pi).
 
-        The atan2 form of Eq. 22-25 (DESIGN.md §4: arccos loses precision near 0, pi).
+        The atan2 form of Eq. 22-25 (docs/conventions.md: arccos loses precision near 0, pi).
         """
         cx = self._cx(eye)
         xa, ya = validate_points(x, y)

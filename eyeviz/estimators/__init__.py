@@ -1,4 +1,4 @@
-"""Estimators of distance r and azimuth phi from the two bitmaps (DESIGN.md §3).
+"""Estimators of distance r and azimuth phi from the two bitmaps (docs/contract.md).
 
 >>> from eyeviz import estimators
 >>> estimators.available()

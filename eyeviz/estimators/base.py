@@ -1,4 +1,4 @@
-"""The estimator protocol: bitmaps (Omega_A, Omega_B) -> (r, phi) (DESIGN.md §3).
+"""The estimator protocol: bitmaps (Omega_A, Omega_B) -> (r, phi) (docs/contract.md).
 
 Every estimator sees the paper's half bitmaps of length m/2 (ommatidia 0..m/2-1, Section 4).
 A feature lights one contiguous run of ommatidia per eye (Prop. 2, Eq. 11), so a bitmap
@@ -156,7 +156,7 @@ def triangulate(theta_a, theta_b, h: float, min_disparity: float = 0.0):
     Law of sines in triangle A B P (angle at P is the disparity theta_b - theta_a):
     r_A = 2h sin(theta_b) / sin(theta_b - theta_a). Disparities below ``min_disparity``
     are raised to it (parallel rays would meet at infinity). Returns (r, phi) about the
-    origin, phi by atan2 (DESIGN.md §4).
+    origin, phi by atan2 (docs/conventions.md).
     """
     theta_a = np.asarray(theta_a, np.float64)
     theta_b = np.asarray(theta_b, np.float64)

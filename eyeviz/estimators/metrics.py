@@ -2,7 +2,7 @@
 
 R^2 is the standard coefficient of determination, 1 - SS_res / SS_tot with SS_tot the
 spread of the TRUE values (as scikit-learn's ``r2_score``); the paper's Eq. 35-36 divide
-by the spread of the predictions, which DESIGN.md §4 lists as an erratum.
+by the spread of the predictions, which docs/conventions.md lists as an erratum.
 NaN predictions are refused: filter them with the estimator's ``valid`` mask first.
 """
 

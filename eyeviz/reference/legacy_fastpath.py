@@ -92,7 +92,7 @@ class LegacyEyePair:
     def eye_polar(self, x, y, eye: str) -> tuple[np.ndarray, np.ndarray]:
         """Polar coordinates (r_E, phi_E) about an eye centre, phi_E in [0, 2*pi).
 
-        The atan2 form of Eq. 22-25 (DESIGN.md §4: arccos loses precision near 0, pi).
+        The atan2 form of Eq. 22-25 (docs/conventions.md: arccos loses precision near 0, pi).
         """
         cx = self._cx(eye)
         xa, ya = validate_points(x, y)

@@ -4,7 +4,7 @@ On fresh test sets generated with the paper's parameters (Tables 3 and 4; single
 multi-pass, seeds unlike any training seed), each estimator is scored on azimuth (AD, phi)
 and distance (DD, r): MAPE (Eq. 34), MAE (Eq. 33) and R^2. R^2 is the standard one
 (1 - SS_res/SS_tot with SS_tot the spread of the TRUE values, as scikit-learn's
-``r2_score``), not Eq. 35-36's spread of the predictions (DESIGN.md §4).
+``r2_score``), not Eq. 35-36's spread of the predictions (docs/conventions.md).
 Beside the metrics: training time (from the estimator's metadata), inference time per
 sample when batched and for one sample alone, and the number of learned weights. The
 paper's Table 5 is quoted as a reference row; the bayes estimator is the information

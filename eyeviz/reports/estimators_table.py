@@ -126,7 +126,7 @@ def to_markdown(results: list[Result], n_test: int, seed: int, png: str | None) 
         f"{_D['r_max']:g}], g <= {_D['g_max']:g}), single-pass (seed {seed}) "
         f"and multi-pass (seed {seed + 1}). AD = azimuth phi (radians), DD = distance r.",
         "MAPE is Eq. 34; R^2 is the **standard** coefficient of determination (spread of the "
-        "true values, as scikit-learn's `r2_score`), not Eq. 35-36 (DESIGN.md §4).",
+        "true values, as scikit-learn's `r2_score`), not Eq. 35-36 (docs/conventions.md).",
         "Inference time: per sample when the whole single-pass set is passed at once "
         "(best of 3 for fast estimators), and the median time of one call with one sample.",
         "",

@@ -6,7 +6,7 @@ is drawn from that design's Algorithm 1 (:func:`eyeviz.dataset.algorithm1.iter_c
 interval form, no bitmaps held), and every element is estimated by the information
 limit (:class:`eyeviz.estimators.limit.LimitEstimator`): the MAPE-optimal posterior
 median given the bitmaps, the best any estimator can do (issue 10). The errors are MAPE
-(Eq. 34) and R^2 (Eq. 35, standard form, DESIGN.md §4), overall and per distance bin.
+(Eq. 34) and R^2 (Eq. 35, standard form, docs/conventions.md), overall and per distance bin.
 
 Pure: the same point gives the same rows except ``seconds``. No dask here: workers call
 :func:`evaluate` with the point (a few numbers), never with arrays.

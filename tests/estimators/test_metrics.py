@@ -1,4 +1,4 @@
-"""Eq. 33-35 with the standard R^2 (DESIGN.md §4)."""
+"""Eq. 33-35 with the standard R^2 (docs/conventions.md)."""
 
 import numpy as np
 import pytest

@@ -11,7 +11,7 @@ epsilon = 1e-7 inside the square root (TF's ApplyRMSProp); SGD learning-rate dec
 Choices the paper leaves open (stated in the metadata of every trained net):
 
 - AD learning rate: the Appendix code says 0.003, Table 5 says 0.004. The default is the
-  Appendix (DESIGN.md §4: the code is the architecture); ``ad_lr`` selects the other.
+  Appendix (docs/conventions.md: the code is the architecture); ``ad_lr`` selects the other.
 - DD optimiser: ``SGD(learning_rate=0.001, decay=1e-5, nesterov=True)`` with Keras' default
   momentum 0. Keras' Nesterov update with momentum 0 is plain SGD, so that is what runs
   (torch refuses nesterov without momentum); ``dd_momentum`` > 0 gives torch's Nesterov SGD.

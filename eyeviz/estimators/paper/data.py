@@ -31,7 +31,7 @@ def _columns(data) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _metrics(y: np.ndarray, yhat: np.ndarray) -> dict[str, float]:
-    """MAPE (Eq. 34), MAE (Eq. 33), standard R^2 (DESIGN.md §4); NaN if the net diverged."""
+    """MAPE (Eq. 34), MAE (Eq. 33), standard R^2 (docs/conventions.md); NaN if the net diverged."""
     from eyeviz.estimators import metrics
 
     if not np.all(np.isfinite(yhat)):
