@@ -1,8 +1,9 @@
 """The eyeviz main window, assembled: the 2D top view (VTK's Qt widget, see view.py), the
 bitmaps strip and the side panels, kept up to date from the model.
 
-Flow (docs/architecture.md): a Qt event becomes a model call (canvas.py -> eyeviz.model.interactions)
--> the model notifies -> ``compute_state`` -> :class:`SceneActors` and the panels redraw.
+Flow (docs/architecture.md): a Qt event becomes a model call (canvas.py ->
+eyeviz.model.interactions) -> the model notifies -> ``compute_state`` ->
+:class:`SceneActors` and the panels redraw.
 The other jobs live beside it: menus and undo (actions.py), files and unsaved changes
 (files.py), the canvas event bridge and cameras (canvas.py), screenshots (screenshot.py),
 background work (jobs.py), settings (settings.py), start-up (launch.py) and the side
