@@ -1,10 +1,13 @@
 """Estimators of distance r and azimuth phi from the two bitmaps (docs/contract.md).
 
->>> from eyeviz import estimators
+>>> from eyeviz import dataset, estimators
 >>> estimators.available()
 ['analytic', 'bayes', 'compact', 'limit', 'paper']
+>>> ds = dataset.generate(200, seed=1)              # Algorithm 1, the paper's design
 >>> est = estimators.load("analytic")
->>> r, phi = est.predict(omega_a, omega_b)
+>>> r, phi = est.predict(ds.omega_a, ds.omega_b)    # Omega bitmaps, (N, m/2) each
+>>> r.shape
+(200,)
 
 Every estimator is an entry of :mod:`eyeviz.estimators.registry` (name, help, design,
 load, fit, command-line options); its module is imported only when loaded: importing

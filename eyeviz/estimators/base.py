@@ -9,8 +9,13 @@ Rows that are not a single feature (an eye with nothing lit, or more than one li
 get NaN and ``valid = False``; rows whose intervals could not come from the training
 domain (Table 3, Table 4) get ``in_domain = False``. Both masks travel with the result:
 
->>> r, phi = est.predict(omega_a, omega_b)           # unpacks like a pair
->>> p = est.predict(omega_a, omega_b); p.valid, p.in_domain
+>>> from eyeviz import dataset, estimators
+>>> ds = dataset.generate(50, seed=2)
+>>> est = estimators.load("analytic")
+>>> r, phi = est.predict(ds.omega_a, ds.omega_b)     # unpacks like a pair
+>>> p = est.predict(ds.omega_a, ds.omega_b)
+>>> bool(p.valid.all()), bool(p.in_domain.all())    # Algorithm 1's rows are in the domain
+(True, True)
 
 This module imports numpy and the standard library only (no torch).
 """
