@@ -19,7 +19,7 @@ from eyeviz.model.scene import TRAJECTORY_KINDS
 if TYPE_CHECKING:
     from matplotlib.lines import Line2D
 
-    from eyeviz.model.derived import TrajectoryPath
+    from eyeviz.model.frame_parts import TrajectoryPath
 
 __all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel", "PLOT_PT", "estimator_help"]
 
@@ -180,7 +180,8 @@ class TrajectoryPanel(QtWidgets.QWidget):
     def refresh(self) -> None:
         """Recompute the path and its accuracy curves when the scene's trajectory, eyes or
         estimators change (not when the animated feature moves)."""
-        from eyeviz.model.derived import Predictor, trajectory_path
+        from eyeviz.model.frame import trajectory_path
+        from eyeviz.model.predictor import Predictor
 
         sc = self.model.scene
         t = sc.trajectory

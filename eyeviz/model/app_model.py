@@ -72,7 +72,7 @@ class AppModel:
         self._moved: set[int] = set()  # rows of _state whose feature moved since (live)
         self._predictions: dict | None = None
         self._ambiguity: tuple[dict | None] | None = None  # None: not computed yet
-        self.predictor: Predictor | None = None  # eyeviz.model.derived.Predictor, made on first use
+        self.predictor: Predictor | None = None  # made on first use
         self.push: Callable[..., None] = self._push_plain
         self._live: _Live | None = None
         self.inset_view = View((0.0, 0.0), 1.0)  # the magnified eyes (camera.fit_inset)
@@ -100,7 +100,7 @@ class AppModel:
         if not self.scene.shows("predictions") or not self.scene.features:
             return {}
         if self._predictions is None:
-            from eyeviz.model.derived import Predictor
+            from eyeviz.model.predictor import Predictor
 
             if self.predictor is None:
                 self.predictor = Predictor()
@@ -118,12 +118,12 @@ class AppModel:
 
     @property
     def ambiguity(self) -> dict | None:
-        """The selected feature's ambiguity region (eyeviz.model.derived.ambiguity_of)."""
+        """The selected feature's ambiguity region (eyeviz.model.frame.ambiguity_of)."""
         i = self.selected
         if not self.scene.shows("ambiguity") or i is None or i >= len(self.scene.features):
             return None
         if self._ambiguity is None:
-            from eyeviz.model.derived import ambiguity_of
+            from eyeviz.model.frame import ambiguity_of
 
             f, v = self.scene.features[i], self.scene.view
             half = 1.5 * v.width + math.hypot(f.x - v.center[0], f.y - v.center[1])

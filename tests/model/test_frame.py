@@ -203,10 +203,7 @@ def test_estimator_colours_fixed_and_far_from_feature_colours():
     assert delta_e("#000000", "#FFFFFF") == pytest.approx(100.0, abs=0.1)
 
 
-def test_derived_is_an_alias():
-    from eyeviz.model import derived, frame
+def test_errors_wrap_phi_across_zero():
+    from eyeviz.model.frame_parts import errors
 
-    assert derived.trajectory_path is frame.trajectory_path
-    assert derived.errors(100.0, 0.0, 110.0, math.radians(359.0)) == pytest.approx(
-        (10.0, 10.0, -1.0)
-    )
+    assert errors(100.0, 0.0, 110.0, math.radians(359.0)) == pytest.approx((10.0, 10.0, -1.0))

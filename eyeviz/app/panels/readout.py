@@ -216,7 +216,7 @@ class ReadoutPanel(QtWidgets.QWidget):
         self._set(rows)
 
     def _prediction_rows(self, i: int) -> list[tuple[str, str, str, str]]:
-        from eyeviz.model.derived import errors
+        from eyeviz.model.frame_parts import errors
         from eyeviz.model.palette import estimator_colors
 
         st, sc = self.model.state, self.model.scene
