@@ -118,3 +118,72 @@ def test_battery_catches_broken_estimators(broken, failing):
         getattr(checks, failing)(broken)
     with pytest.raises(AssertionError, match=f"{broken.name}: check_"):
         checks.check_estimator(broken)
+
+
+# --- phi slips (issue 20 item 7): the battery compares phi wherever it compares r -------
+class _PhiSlipInIntervals(AnalyticEstimator):
+    """predict_intervals answers phi + 0.01 rad (about one sector at m = 720)."""
+
+    name = "phislip-intervals"
+
+    def predict_intervals(self, LA, RA, LB, RB):
+        p = super().predict_intervals(LA, RA, LB, RB)
+        return type(p)(p.r, p.phi + 0.01, p.valid, p.in_domain)
+
+
+class _MirroredPhiForIntegers(AnalyticEstimator):
+    """Integer bitmaps get the azimuth of the mirrored side, pi - phi."""
+
+    name = "phimirror-int"
+
+    def predict(self, a, b):
+        p = super().predict(a, b)
+        if np.asarray(a).dtype != bool:
+            return type(p)(p.r, np.pi - p.phi, p.valid, p.in_domain)
+        return p
+
+
+class _PhiSlipInBigBatches(AnalyticEstimator):
+    """A 'fast path' for batches over 8 rows adds 0.01 rad to phi."""
+
+    name = "phislip-batch"
+
+    def _predict_intervals(self, LA, RA, LB, RB):
+        r, phi = super()._predict_intervals(LA, RA, LB, RB)
+        return r, phi + (0.01 if len(LA) > 8 else 0.0)
+
+
+class _MirroredPhi(AnalyticEstimator):
+    """Every path answers the azimuth of the mirrored side, pi - phi."""
+
+    name = "phimirror"
+
+    def _predict_intervals(self, LA, RA, LB, RB):
+        r, phi = super()._predict_intervals(LA, RA, LB, RB)
+        return r, np.pi - phi
+
+
+@pytest.mark.parametrize(
+    "broken, failing",
+    [
+        (_PhiSlipInIntervals(), "check_predict_intervals"),
+        (_MirroredPhiForIntegers(), "check_accepts_bool_and_int"),
+        (_PhiSlipInBigBatches(), "check_rows_independent"),
+        (_PhiSlipInBigBatches(), "check_shapes_and_dtypes"),
+        (_MirroredPhi(), "check_sensible_answers"),
+    ],
+)
+def test_battery_catches_a_phi_slip(broken, failing):
+    with pytest.raises(AssertionError, match="phi"):
+        getattr(checks, failing)(broken)
+    with pytest.raises(AssertionError, match=f"{broken.name}: check_.*phi"):
+        checks.check_estimator(broken)
+
+
+def test_phi_tolerance_is_an_angle_far_below_a_sector():
+    """Float32 rounding of phi ~ 1.5 passes; a hundredth of a sector at m = 2880 fails."""
+    phi = np.linspace(0.1, 3.0, 7)
+    assert checks._same_phi(phi.astype(np.float32).astype(np.float64), phi)
+    assert not checks._same_phi(phi + 0.01 * 2 * np.pi / 2880, phi)
+    assert checks._same_phi(np.array([np.nan, 1.0]), np.array([np.nan, 1.0]))
+    assert not checks._same_phi(np.array([np.nan, 1.0]), np.array([1.0, 1.0]))
