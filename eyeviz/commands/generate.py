@@ -49,6 +49,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
             help=f"{what} (default: {DEFAULTS[flag]:g}, Table {table})",
         )
     parser.add_argument(
+        "--nside",
+        type=int,
+        default=None,
+        metavar="N",
+        help="spherical (3D) eyes with HEALPix facets: nside, even (12 nside^2 facets per "
+        "eye; 180 matches m = 720); writes the sparse 3D data set (.npz only)",
+    )
+    parser.add_argument(
+        "--el-max",
+        type=float,
+        default=None,
+        help="with --nside: largest |elevation| of a feature centre, in radians, in "
+        "(0, pi/2) (default: pi/6)",
+    )
+    parser.add_argument(
         "--segments",
         type=int,
         default=None,
@@ -64,6 +79,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.nside is not None or args.el_max is not None:
+        return _run3d(args)
     from eyeviz import EyevizError, dataset
     from eyeviz.core.geometry import EyePair
     from eyeviz.dataset import io as dataset_io
@@ -113,5 +130,64 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"wrote {args.n:,} elements ({args.mode} pass, seed {args.seed}) to "
             f"{args.output} ({size:.1f} MB) in {time.perf_counter() - t0:.2f} s"
+        )
+    return 0
+
+
+_PROGRESS_MIN_3D = 2_000  # rows; a 3D row (thousands of lit facets) costs far more
+
+
+def _run3d(args: argparse.Namespace) -> int:
+    """``--nside``: Algorithm 1 in 3D, written as the sparse 3D data set."""
+    from eyeviz import EyevizError
+    from eyeviz.core.domain import DEFAULTS
+    from eyeviz.core.domain3d import DEFAULTS3D, Domain3D
+    from eyeviz.dataset import algorithm1_3d, sparse3d
+    from eyeviz.files import limits
+
+    if args.nside is None:
+        raise EyevizError("--el-max needs --nside (the planar model has no elevation)")
+    if args.m != DEFAULTS["m"]:
+        raise EyevizError("--m is the planar eye's; with --nside the equator has 4*nside facets")
+    if args.unique_bitmaps:
+        raise EyevizError("--unique-bitmaps is for the planar data set only, not with --nside")
+    sparse3d.check_output_path(args.output)
+    el_max = DEFAULTS3D["el_max"] if args.el_max is None else args.el_max
+    domain = Domain3D(args.h, args.l, args.nside, args.r_min, args.r_max, args.g_max, el_max)
+    n = algorithm1_3d.check_n(args.n)
+    algorithm1_3d.make_params3d(domain, args.mode, args.seed, args.segments)
+    limits.check_free_space(args.output, sparse3d.estimated_bytes3d(n, domain))
+    bar = None
+    if not args.quiet and n >= _PROGRESS_MIN_3D:
+        from tqdm import tqdm
+
+        bar = tqdm(
+            total=n,
+            unit="rows",
+            unit_scale=True,
+            file=sys.stderr,
+            desc=f"generate {args.output}",
+            leave=False,
+            mininterval=0.5,
+        )
+    t0 = time.perf_counter()
+    try:
+        sparse3d.write3d(
+            args.output,
+            n,
+            domain,
+            mode=args.mode,
+            seed=args.seed,
+            segments=args.segments,
+            progress=bar.update if bar else None,
+        )
+    finally:
+        if bar is not None:
+            bar.close()
+    if not args.quiet:
+        size = os.path.getsize(args.output) / 1e6
+        print(
+            f"wrote {n:,} 3D elements (nside {domain.nside}, {args.mode} pass, seed "
+            f"{args.seed}) to {args.output} ({size:.1f} MB) in {time.perf_counter() - t0:.2f} s"
         )
     return 0

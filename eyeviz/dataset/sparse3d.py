@@ -1,0 +1,474 @@
+"""The sparse 3D data set file (NPZ): streamed, atomic writer and a reader that checks all.
+
+A dense bitmap at nside 180 is 388,800 bits per eye and row; a ball lights a few thousand
+facets, so each eye's lit facets are stored as CSR lists. The file is an uncompressed zip
+of ``.npy`` members (numpy's NPZ, readable by ``numpy.load`` without pickles):
+
+- ``meta``: a JSON string: ``format`` (:data:`FORMAT`), ``version``
+  (:data:`VERSION`), ``n``, ``nnz_a``, ``nnz_b``, ``index_dtype``, ``domain`` (h, l,
+  nside, r_min, r_max, g_max, el_max: :class:`eyeviz.core.domain3d.Domain3D`) and
+  ``params`` (mode, seed, segments);
+- ``indptr_a``, ``indptr_b``: int64 (n + 1,), 0 first, nnz last, non-decreasing;
+- ``indices_a``, ``indices_b``: the RING indices (int32 while 12 nside^2 <= 2^31, int64
+  beyond), strictly increasing within a row: row i of eye A is
+  ``indices_a[indptr_a[i]:indptr_a[i + 1]]``;
+- ``r``, ``azimuth``, ``elevation``, ``g`` (radians for the angles) and ``x``, ``y``,
+  ``z`` (the centre the lit sets were computed at): float64 (n,).
+
+Writing streams chunk by chunk in bounded memory: each chunk's arrays are appended to
+one spool file per member next to the output, and the zip is assembled at the end by
+copying the spools into members whose headers now know their lengths. Spools and the
+zip are temporary files of :mod:`eyeviz.files.atomic`'s naming (swept if a writer is
+killed); the zip is renamed over the output only when complete, so an interruption
+leaves nothing. Reading (:class:`Sparse3DReader`) never unpickles, checks every size the
+file declares against the file before allocating, and checks every row.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import shutil
+import struct
+import zipfile
+from collections.abc import Callable, Iterable, Iterator
+from pathlib import Path
+from typing import Any, BinaryIO
+
+import numpy as np
+
+from eyeviz import EyevizError
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.validation import check_int
+from eyeviz.dataset.algorithm1_3d import check_n, iter_chunks3d, make_params3d
+from eyeviz.dataset.records3d import Dataset3D, index_dtype
+from eyeviz.files import limits
+from eyeviz.files.atomic import atomic_output, part_name
+
+__all__ = [
+    "FORMAT",
+    "VERSION",
+    "Sparse3DReader",
+    "check_output_path",
+    "estimated_bytes3d",
+    "load3d",
+    "write3d",
+    "write_chunks3d",
+]
+
+FORMAT = "eyeviz.sparse3d"
+VERSION = 1
+FLOATS = ("r", "azimuth", "elevation", "g", "x", "y", "z")
+EYES = ("a", "b")
+MEMBERS = ("indptr_a", "indices_a", "indptr_b", "indices_b", *FLOATS)
+_COPY = 8 << 20  # bytes per copy from a spool into the zip
+_META_MAX_BYTES = 1 << 16
+_MAX_HEADER = 10_000
+#: rows and lit indices (per eye) of one block read
+BLOCK_ROWS = 1 << 14
+BLOCK_LIT = 1 << 23
+
+
+def check_output_path(path: str | os.PathLike) -> Path:
+    """A 3D data set is an NPZ: refuse any other suffix (.csv holds planar bitmaps)."""
+    p = Path(path)
+    if p.suffix.lower() != ".npz":
+        raise EyevizError(
+            f"a 3D data set (--nside) is written as .npz (sparse lit lists), got {str(path)!r}"
+        )
+    return p
+
+
+def estimated_bytes3d(n: int, domain: Domain3D) -> int:
+    """Disk space a run needs at its peak (the spools and the zip side by side), roughly.
+
+    A ball of angular radius a ~ g/r lights about npix a^2 / 4 facets; over g uniform in
+    [0, g_max] and r uniform in [r_min, r_max] that averages npix g_max^2 / (12 r_min
+    r_max), plus a rim of about 8 pi (g/r) / (cell width) facets.
+    """
+    d = domain
+    npix = d.npix
+    mean_a = d.g_max / 2 / math.sqrt(d.r_min * d.r_max)
+    rim = 8 * math.pi * mean_a / math.sqrt(4 * math.pi / npix)
+    lit = min(npix, npix * d.g_max**2 / (12 * d.r_min * d.r_max) + rim + 2)
+    per_row = 2 * lit * index_dtype(npix).itemsize + 8 * (2 + len(FLOATS))
+    return int(2 * n * per_row)
+
+
+# --- writing -------------------------------------------------------------------------
+
+
+class _Spools:
+    """One append-only raw file per member, next to the output (removed by :meth:`close`)."""
+
+    def __init__(self, target: Path):
+        d = target.parent if str(target.parent) else Path(".")
+        self.paths: dict[str, Path] = {}
+        self.files: dict[str, BinaryIO] = {}
+        self.counts = dict.fromkeys(MEMBERS, 0)
+        self.dtypes: dict[str, np.dtype] = {}
+        try:
+            for name in MEMBERS:
+                p = d / part_name(target)
+                self.files[name] = open(p, "xb")  # noqa: SIM115 - closed in close()
+                self.paths[name] = p
+        except BaseException:
+            self.close()
+            raise
+
+    def append(self, name: str, a: np.ndarray) -> None:
+        a = np.ascontiguousarray(a)
+        self.dtypes.setdefault(name, a.dtype)
+        self.files[name].write(a.data)
+        self.counts[name] += a.shape[0]
+
+    def close(self) -> None:
+        for f in self.files.values():
+            with contextlib.suppress(OSError):
+                f.close()
+        for p in self.paths.values():
+            with contextlib.suppress(OSError):
+                p.unlink()
+
+    def copy_into(self, zf: zipfile.ZipFile, name: str) -> None:
+        """Member ``name.npy`` from the spool (header from its dtype and count)."""
+        self.files[name].flush()
+        header = {
+            "descr": np.lib.format.dtype_to_descr(self.dtypes[name]),
+            "fortran_order": False,
+            "shape": (self.counts[name],),
+        }
+        with zf.open(name + ".npy", "w", force_zip64=True) as out:
+            np.lib.format.write_array_header_1_0(out, header)
+            with open(self.paths[name], "rb") as src:
+                shutil.copyfileobj(src, out, _COPY)
+
+
+def write_chunks3d(
+    path: str | os.PathLike,
+    n: int,
+    domain: Domain3D,
+    params: dict,
+    chunks: Iterable[Dataset3D],
+    progress: Callable[[int], None] | None = None,
+) -> None:
+    """Stream generated chunks (:class:`Dataset3D`) into ``path``, atomically."""
+    target = check_output_path(path)
+    idt = index_dtype(domain.npix)
+    with atomic_output(target) as tmp:
+        spools = _Spools(target)
+        try:
+            base = dict.fromkeys(EYES, 0)
+            for e in EYES:
+                spools.append(f"indptr_{e}", np.zeros(1, np.int64))
+                spools.dtypes[f"indices_{e}"] = idt
+            rows = 0
+            for c in chunks:
+                for e in EYES:
+                    ptr = getattr(c, f"indptr_{e}")
+                    spools.append(f"indptr_{e}", ptr[1:].astype(np.int64) + base[e])
+                    spools.append(f"indices_{e}", getattr(c, f"indices_{e}").astype(idt))
+                    base[e] += int(ptr[-1])
+                for name in FLOATS:
+                    spools.append(name, getattr(c, name).astype(np.float64))
+                rows += len(c)
+                if progress:
+                    progress(len(c))
+            if rows != n:
+                raise EyevizError(f"the generator gave {rows} rows, not n={n}")
+            meta = {
+                "format": FORMAT,
+                "version": VERSION,
+                "n": n,
+                "nnz_a": base["a"],
+                "nnz_b": base["b"],
+                "index_dtype": idt.name,
+                "domain": domain.to_dict(),
+                "params": {k: v for k, v in params.items() if k not in domain.to_dict()},
+            }
+            with zipfile.ZipFile(tmp, "w", zipfile.ZIP_STORED, allowZip64=True) as zf:
+                with zf.open("meta.npy", "w") as f:
+                    np.lib.format.write_array(f, np.array(json.dumps(meta)), allow_pickle=False)
+                for name in MEMBERS:
+                    spools.copy_into(zf, name)
+        finally:
+            spools.close()
+
+
+def write3d(
+    path: str | os.PathLike,
+    n: int,
+    domain: Domain3D | None = None,
+    mode: str = "single",
+    seed: int = 0,
+    segments: int | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> None:
+    """Generate n elements of Algorithm 1 in 3D straight into ``path`` (.npz), streamed
+    and atomic. Every parameter is checked before the file is touched; ``progress(k)`` is
+    called after each chunk of k elements."""
+    check_output_path(path)
+    n = check_n(n)
+    p = make_params3d(domain, mode, seed, segments)
+    write_chunks3d(path, n, p.domain, p.as_dict(), iter_chunks3d(n, p), progress)
+
+
+# --- reading -------------------------------------------------------------------------
+
+
+class _Member:
+    """A stored ``.npy`` member: its dtype, length and absolute data offset in the file."""
+
+    def __init__(self, dtype: np.dtype, length: int, offset: int):
+        self.dtype, self.length, self.offset = dtype, length, offset
+
+
+class Sparse3DReader:
+    """A sparse 3D data set opened for reading; everything it declares is checked here.
+
+    ``.domain`` (:class:`Domain3D`), ``.params``, ``.n``, ``.nnz_a``, ``.nnz_b``; iterate
+    for validated :class:`Dataset3D` blocks of at most ``block_rows`` rows and
+    ``block_lit`` lit indices per eye (one row at least), or :meth:`read_all`.
+    """
+
+    def __init__(self, path, block_rows: int = BLOCK_ROWS, block_lit: int = BLOCK_LIT):
+        self.path = Path(path)
+        self.block_rows = check_int("block_rows", block_rows, ge=1, le=1 << 30)
+        self.block_lit = check_int("block_lit", block_lit, ge=1, le=1 << 40)
+        try:
+            self.size = limits.check_file_size(self.path, 1 << 62, "data set")
+            with zipfile.ZipFile(self.path) as zf:
+                infos = {i.filename: i for i in zf.infolist()}
+                meta_arr = self._read_meta(zf, infos)
+            with open(self.path, "rb") as f:
+                self.members = {name: self._member(f, infos, name) for name in MEMBERS}
+        except EyevizError:
+            raise
+        except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as exc:
+            raise self.fail(f"not a readable .npz ({_one_line(exc)})") from None
+        self._check_meta(meta_arr)
+
+    def fail(self, msg: str) -> EyevizError:
+        return EyevizError(f"{self.path}: {msg}")
+
+    def _read_meta(self, zf: zipfile.ZipFile, infos: dict) -> np.ndarray:
+        mi = infos.get("meta.npy")
+        if mi is None:
+            raise self.fail("member 'meta' is missing")
+        if mi.file_size > _META_MAX_BYTES:
+            raise self.fail(f"member 'meta' declares {mi.file_size} bytes")
+        with zf.open(mi) as f:
+            arr = np.lib.format.read_array(f, allow_pickle=False)
+        if arr.dtype.kind != "U" or arr.shape != ():
+            raise self.fail(f"member 'meta' has dtype {arr.dtype} shape {arr.shape}")
+        return arr
+
+    def _member(self, f: BinaryIO, infos: dict, name: str) -> _Member:
+        """The header of member ``name``, its bytes checked to lie inside the file."""
+        info = infos.get(name + ".npy")
+        if info is None:
+            raise self.fail(f"member {name!r} is missing")
+        if info.compress_type != zipfile.ZIP_STORED or info.flag_bits & 1:
+            raise self.fail(f"member {name!r} is compressed or encrypted; only stored")
+        if info.compress_size != info.file_size:
+            raise self.fail(f"member {name!r} declares {info.file_size} bytes stored in "
+                            f"{info.compress_size}")  # fmt: skip
+        f.seek(info.header_offset)
+        local = f.read(30)
+        if len(local) != 30 or local[:4] != b"PK\x03\x04":
+            raise self.fail(f"member {name!r}: bad local header")
+        name_len, extra_len = struct.unpack("<HH", local[26:30])
+        start = info.header_offset + 30 + name_len + extra_len
+        if start + info.file_size > self.size:
+            raise self.fail(f"member {name!r} declares {info.file_size} bytes the file lacks")
+        f.seek(start)
+        version = np.lib.format.read_magic(f)
+        if version == (1, 0):
+            hdr = np.lib.format.read_array_header_1_0(f, max_header_size=_MAX_HEADER)
+        elif version in ((2, 0), (3, 0)):
+            hdr = np.lib.format.read_array_header_2_0(f, max_header_size=_MAX_HEADER)
+        else:
+            raise self.fail(f"member {name!r} has .npy version {version}")
+        shape, fortran, dtype = hdr
+        if dtype.hasobject or dtype.fields is not None or dtype.subdtype is not None:
+            raise self.fail(f"member {name!r} has dtype {dtype}, not a plain array")
+        if len(shape) != 1 or fortran:
+            raise self.fail(f"member {name!r} has shape {shape}, expected 1-D")
+        body = info.file_size - (f.tell() - start)
+        if shape[0] * dtype.itemsize != body:
+            raise self.fail(
+                f"member {name!r} declares shape {shape} ({shape[0] * dtype.itemsize} bytes) "
+                f"but holds {body} bytes"
+            )
+        return _Member(dtype, int(shape[0]), f.tell())
+
+    def _check_meta(self, meta_arr: np.ndarray) -> None:
+        try:
+            meta = json.loads(str(meta_arr[()]))
+            if not isinstance(meta, dict):
+                raise TypeError("meta is not an object")
+            if meta.get("format") != FORMAT:
+                raise ValueError(f"format is {meta.get('format')!r}, not {FORMAT!r}")
+            if meta.get("version") != VERSION:
+                raise ValueError(f"version {meta.get('version')!r}; this eyeviz reads {VERSION}")
+            dom = meta["domain"]
+            if not isinstance(dom, dict):
+                raise TypeError("domain is not an object")
+            missing = [k for k in Domain3D.__dataclass_fields__ if k not in dom]
+            if missing:
+                raise KeyError(missing[0])
+            self.domain = Domain3D.from_dict(dom)
+            self.n = check_int("n", meta["n"], ge=0, le=limits.MAX_ROWS)
+            self.nnz_a = check_int("nnz_a", meta["nnz_a"], ge=0, le=1 << 62)
+            self.nnz_b = check_int("nnz_b", meta["nnz_b"], ge=0, le=1 << 62)
+            params = meta.get("params", {})
+            if not isinstance(params, dict):
+                raise TypeError("params is not an object")
+            self.params = params
+        except EyevizError as exc:
+            raise self.fail(f"bad meta: {exc}") from None
+        except (ValueError, KeyError, TypeError, OverflowError, IndexError) as exc:
+            raise self.fail(f"bad meta: {_one_line(exc)}") from None
+        self.npix = self.domain.npix
+        want: dict[str, tuple[np.dtype, int]] = {
+            f"indptr_{e}": (np.dtype("<i8"), self.n + 1) for e in EYES
+        }
+        for e in EYES:
+            nnz = self.nnz_a if e == "a" else self.nnz_b
+            want[f"indices_{e}"] = (index_dtype(self.npix).newbyteorder("<"), nnz)
+        for name in FLOATS:
+            want[name] = (np.dtype("<f8"), self.n)
+        for name, (dt, length) in want.items():
+            m = self.members[name]
+            if m.dtype != dt or m.length != length:
+                raise self.fail(
+                    f"member {name!r} has dtype {m.dtype} length {m.length}, "
+                    f"expected {dt} length {length}"
+                )
+
+    # -- rows --
+
+    def _read(self, f: BinaryIO, name: str, start: int, count: int) -> np.ndarray:
+        m = self.members[name]
+        out = np.empty(count, m.dtype)
+        f.seek(m.offset + start * m.dtype.itemsize)
+        buf = out.view(np.uint8).reshape(-1).data
+        got = 0
+        while got < len(buf):
+            k = f.readinto(buf[got:])  # type: ignore[attr-defined]
+            if not k:
+                raise self.fail(f"member {name!r} ends early")
+            got += k
+        return out
+
+    def _ptr_block(self, f: BinaryIO, e: str, start: int, k: int, prev: int) -> np.ndarray:
+        """indptr_e[start .. start + k] checked: starts where the last block ended (0 at
+        row 0), non-decreasing, at most nnz, and each row at most npix long."""
+        nnz = self.nnz_a if e == "a" else self.nnz_b
+        ptr = self._read(f, f"indptr_{e}", start, k + 1)
+        if ptr[0] != prev:
+            raise self.fail(f"indptr_{e}: row {start + 1} starts at {int(ptr[0])}, not {prev}")
+        d = np.diff(ptr)
+        bad = (d < 0) | (d > self.npix)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise self.fail(
+                f"indptr_{e}: row {start + i + 1} has {int(d[i])} indices "
+                f"(need 0..{self.npix}: indptr must not decrease)"
+            )
+        if ptr[-1] > nnz or (start + k == self.n and ptr[-1] != nnz):
+            raise self.fail(f"indptr_{e} ends at {int(ptr[-1])}, but nnz_{e} is {nnz}")
+        return ptr
+
+    def _check_indices(self, e: str, start: int, ptr: np.ndarray, ind: np.ndarray) -> None:
+        """Every index in [0, npix), strictly increasing within each row."""
+        bad = (ind < 0) | (ind >= self.npix)
+        if ind.size > 1:
+            step_bad = np.diff(ind) <= 0
+            first = ptr[1:-1] - ptr[0]  # where rows 2.. begin: no order across rows
+            first = first[(first > 0) & (first < ind.size)]
+            step_bad[first - 1] = False
+            bad[1:] |= step_bad
+        if bad.any():
+            j = int(np.flatnonzero(bad)[0])
+            row = int(np.searchsorted(ptr - ptr[0], j, side="right")) - 1
+            v = int(ind[j])
+            why = f"outside [0, {self.npix})" if not 0 <= v < self.npix else "not increasing"
+            raise self.fail(f"indices_{e}: row {start + row + 1}: index {v} {why}")
+
+    def _check_floats(self, start: int, cols: dict[str, np.ndarray]) -> None:
+        d = self.domain
+        r, az, el, g = cols["r"], cols["azimuth"], cols["elevation"], cols["g"]
+        with np.errstate(invalid="ignore", over="ignore"):
+            ok = (r >= d.r_min) & (r <= d.r_max)
+            ok &= (az >= 0) & (az <= math.pi)
+            ok &= (np.abs(el) <= d.el_max) & (g > 0) & (g <= d.g_max)
+            c = np.cos(el)
+            for name, want in (
+                ("x", r * c * np.cos(az)),
+                ("y", r * c * np.sin(az)),
+                ("z", r * np.sin(el)),
+            ):
+                ok &= np.abs(cols[name] - want) <= 1e-9 * r
+        if not ok.all():
+            i = int(np.flatnonzero(~ok)[0])
+            vals = ", ".join(f"{k}={float(v[i])!r}" for k, v in cols.items())
+            raise self.fail(
+                f"row {start + i + 1}: {vals} (need r in [{d.r_min:g}, {d.r_max:g}], "
+                f"0 <= azimuth <= pi, |elevation| <= el_max={d.el_max:.6g}, "
+                f"0 < g <= {d.g_max:g}, x, y, z the centre of r, azimuth, elevation)"
+            )
+
+    def __iter__(self) -> Iterator[Dataset3D]:
+        try:
+            with open(self.path, "rb") as f:
+                yield from self._blocks(f)
+        except EyevizError:
+            raise
+        except (OSError, ValueError) as exc:
+            raise self.fail(_one_line(exc)) from None
+
+    def _blocks(self, f: BinaryIO) -> Iterator[Dataset3D]:
+        start, prev = 0, dict.fromkeys(EYES, 0)
+        while start < self.n:
+            k = min(self.block_rows, self.n - start)
+            ptrs = {e: self._ptr_block(f, e, start, k, prev[e]) for e in EYES}
+            # fewer rows when their lit lists exceed block_lit (one row at least)
+            for e in EYES:
+                p = ptrs[e]
+                fit = int(np.searchsorted(p - p[0], self.block_lit, side="right")) - 1
+                k = max(1, min(k, fit))
+            out: dict[str, Any] = {}
+            for e in EYES:
+                p = ptrs[e][: k + 1]
+                ind = self._read(f, f"indices_{e}", int(p[0]), int(p[-1] - p[0]))
+                self._check_indices(e, start, p, ind)
+                out[f"indptr_{e}"], out[f"indices_{e}"] = p - p[0], ind
+                prev[e] = int(p[-1])
+            cols = {name: self._read(f, name, start, k) for name in FLOATS}
+            self._check_floats(start, cols)
+            yield Dataset3D(**out, **cols, domain=self.domain, params=dict(self.params))
+            start += k
+
+    def read_all(self) -> Dataset3D:
+        """Every row, checked (an empty data set has n = 0 rows)."""
+        blocks = list(self)
+        if blocks:
+            return Dataset3D.concat(blocks)
+        ptr = np.zeros(1, np.int64)
+        idx = np.zeros(0, index_dtype(self.npix))
+        empty = np.zeros(0)
+        floats = dict.fromkeys(FLOATS, empty)
+        return Dataset3D(ptr, idx, ptr, idx, **floats, domain=self.domain, params=self.params)
+
+
+def load3d(path) -> Dataset3D:
+    """A whole sparse 3D data set in memory, every row checked (first bad one named)."""
+    return Sparse3DReader(path).read_all()
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return text[0][:200] if text else type(exc).__name__
