@@ -5,6 +5,9 @@ Stable public path ``eyeviz.dataset``: :mod:`eyeviz.dataset.records` holds the r
 :mod:`eyeviz.dataset.io` reads and writes. Every generator function takes the one
 parameter record, :class:`eyeviz.core.domain.Domain`, in place of ``eyes`` (or the eyes
 and ranges separately); the defaults are Tables 3-4 (``eyeviz.core.domain.DEFAULTS``).
+The spherical (3D) model's sparse data set: :mod:`eyeviz.dataset.algorithm1_3d` samples,
+:mod:`eyeviz.dataset.sparse3d` writes and reads (:class:`Dataset3D`, over the record
+:class:`eyeviz.core.domain3d.Domain3D`).
 """
 
 from eyeviz.core.domain import Domain
@@ -26,6 +29,9 @@ from eyeviz.dataset.algorithm1 import (
     segment_plan,
     write,
 )
+from eyeviz.dataset.algorithm1_3d import generate3d, iter_chunks3d, make_params3d
+from eyeviz.dataset.records3d import Dataset3D
+from eyeviz.dataset.sparse3d import Sparse3DReader, load3d, write3d
 
 __all__ = [
     "Domain",
@@ -45,4 +51,11 @@ __all__ = [
     "load",
     "save",
     "write",
+    "Dataset3D",
+    "Sparse3DReader",
+    "generate3d",
+    "iter_chunks3d",
+    "load3d",
+    "make_params3d",
+    "write3d",
 ]
