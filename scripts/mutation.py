@@ -1,0 +1,322 @@
+"""Mutation testing of eyeviz's core, model and estimators: single-line mutants against
+the tests that mirror each package (a tool, never part of the test suite).
+
+Each mutant changes one token on one line:
+
+- comparisons: ``<`` <-> ``<=``, ``>`` <-> ``>=``, ``==`` <-> ``!=``, ``is`` -> ``is not``,
+  ``in`` -> ``not in``;
+- arithmetic: binary ``+`` <-> ``-``, ``*`` -> ``/``, ``/`` -> ``*``, ``//`` -> ``/``,
+  ``%`` -> ``//``; augmented ``+=`` <-> ``-=``;
+- logic: ``and`` <-> ``or``, ``True`` <-> ``False``, ``not x`` -> ``x``;
+- constants: an integer n -> n + 1 (off by one); a unary minus dropped (``-x`` -> ``x``).
+
+Mutants that do not compile are dropped. From each module's mutants ``--per-module``
+are drawn at random (seeded; all of them when there are fewer); each is written into the
+copy, the mirroring tests run (``tests/<package>``, the module's own ``test_<name>.py``
+first) with ``-x -q`` and a timeout, and the copy is restored byte for byte. A mutant is
+*killed* when the tests fail (exit 1, or 2 when the mutant breaks collection), *survived*
+when they pass, *timeout* when they run past ``--timeout-factor`` times the unmutated
+run (+ 20 s).
+
+It never mutates the checkout it lives in: ``--root`` must be a copy, e.g.
+
+    git worktree add /tmp/mut HEAD
+    .venv/bin/python scripts/mutation.py --root /tmp/mut --per-module 8 --json out.json
+    git worktree remove --force /tmp/mut
+
+and it checks first that ``import eyeviz`` resolves into the copy (PYTHONPATH=root).
+Results: docs/mutation.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
+import tokenize
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parents[1]
+PACKAGES = ("eyeviz/core", "eyeviz/model", "eyeviz/estimators")
+SKIP_MARK = "pragma: no mutate"
+
+_OPS = {
+    "<": ["<="],
+    "<=": ["<"],
+    ">": [">="],
+    ">=": [">"],
+    "==": ["!="],
+    "!=": ["=="],
+    "*": ["/"],
+    "/": ["*"],
+    "//": ["/"],
+    "%": ["//"],
+    "+=": ["-="],
+    "-=": ["+="],
+}
+_NAMES = {"and": ["or"], "or": ["and"], "True": ["False"], "False": ["True"]}
+# a '-' or '+' after one of these (or at the start of a line) is unary
+_BEFORE_UNARY = {"(", "[", "{", ",", "=", ":", "return", "lambda", "**", "*", "/", "+", "-"}
+_BEFORE_UNARY |= {"<", "<=", ">", ">=", "==", "!=", "and", "or", "not", "in", "if", "else"}
+_BEFORE_UNARY |= {"+=", "-=", "*=", "/=", "yield", "->", "%", "//", "@", "is"}
+
+
+@dataclass(frozen=True)
+class Mutant:
+    path: str  # relative to the root
+    line: int  # 1-based
+    col: int
+    end: int
+    old: str
+    new: str
+    kind: str
+
+    def apply(self, source: str) -> str:
+        lines = source.splitlines(keepends=True)
+        s = lines[self.line - 1]
+        assert s[self.col : self.end] == self.old, (self, s)
+        lines[self.line - 1] = s[: self.col] + self.new + s[self.end :]
+        return "".join(lines)
+
+    def label(self) -> str:
+        return f"{self.path}:{self.line}: {self.old!r} -> {self.new!r} ({self.kind})"
+
+
+def mutants_of(path: str, source: str) -> list[Mutant]:
+    """Every single-token mutant of ``source`` that still compiles."""
+    out: list[Mutant] = []
+    lines = source.splitlines()
+    toks = [
+        t
+        for t in tokenize.generate_tokens(io.StringIO(source).readline)
+        if t.type not in (tokenize.COMMENT, tokenize.NL, tokenize.INDENT, tokenize.DEDENT)
+    ]
+    prev = "\n"
+    for k, t in enumerate(toks):
+        (ln, c0), (ln1, c1) = t.start, t.end
+        text = t.string
+        if t.type in (tokenize.STRING, tokenize.NEWLINE, tokenize.ENDMARKER) or ln != ln1:
+            prev = text if t.type != tokenize.NEWLINE else "\n"
+            continue
+        if SKIP_MARK in lines[ln - 1] or lines[ln - 1].lstrip().startswith("__all__"):
+            prev = text if t.type != tokenize.NEWLINE else "\n"
+            continue
+        nxt = toks[k + 1].string if k + 1 < len(toks) else ""
+        cands: list[tuple[str, str]] = []
+        unary = prev in _BEFORE_UNARY or prev == "\n"
+        if t.type == tokenize.OP:
+            if text in ("+", "-"):
+                if unary:
+                    if text == "-":
+                        cands.append(("", "drop unary minus"))
+                else:
+                    cands.append(("-" if text == "+" else "+", "arithmetic"))
+            elif text in ("*", "/") and nxt in (",", ")"):
+                pass  # a signature's keyword-only / positional-only marker
+            elif text in _OPS:
+                kind = "comparison" if text in ("<", "<=", ">", ">=", "==", "!=") else "arithmetic"
+                cands += [(n, kind) for n in _OPS[text]]
+        elif t.type == tokenize.NAME:
+            if text in _NAMES:
+                cands += [(n, "logic") for n in _NAMES[text]]
+            elif text == "not" and prev not in ("is",) and nxt != "in":
+                cands.append(("", "drop not"))
+            elif text == "is" and nxt != "not":
+                cands.append(("is not", "comparison"))
+            elif text == "in" and prev not in ("not", "for") and not _in_for(toks, k):
+                cands.append(("not in", "comparison"))
+        elif t.type == tokenize.NUMBER:
+            try:
+                v = int(text, 0)
+            except ValueError:
+                v = None
+            if v is not None and "_" not in text and text.isdigit():
+                cands.append((str(v + 1), "constant + 1"))
+        for new, kind in cands:
+            end = c1
+            if kind == "drop not" and lines[ln - 1][c1 : c1 + 1] == " ":
+                end += 1  # 'not x' -> 'x'
+            m = Mutant(path, ln, c0, end, lines[ln - 1][c0:end], new, kind)
+            try:
+                compile(m.apply(source), path, "exec")
+            except SyntaxError:
+                continue
+            out.append(m)
+        prev = text if t.type != tokenize.NEWLINE else "\n"
+    return out
+
+
+def _in_for(toks, k: int) -> bool:
+    """Whether the ``in`` at toks[k] belongs to a ``for`` on the same line."""
+    ln = toks[k].start[0]
+    j = k - 1
+    while j >= 0 and toks[j].start[0] == ln:
+        if toks[j].string == "for":
+            # 'x in y' inside a comprehension's condition still counts as a for-in here
+            return True
+        j -= 1
+    return False
+
+
+# --- running -------------------------------------------------------------------------------
+def _env(root: Path) -> dict[str, str]:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(root)
+    env.setdefault("QT_API", "pyqt5")
+    env.setdefault("MPLBACKEND", "Agg")
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    return env
+
+
+def check_root(root: Path, package: str, python: str) -> None:
+    """Refuse to mutate this checkout, and check that the package imports from root."""
+    if root.resolve() == HERE:
+        raise SystemExit(
+            f"--root {root} is the checkout this script lives in: mutate a copy "
+            "(git worktree add /tmp/mut HEAD)"
+        )
+    mod = package.replace("/", ".")
+    r = subprocess.run(
+        [python, "-c", f"import {mod} as m; print(m.__file__)"],
+        cwd=root,
+        env=_env(root),
+        capture_output=True,
+        text=True,
+    )
+    got = Path(r.stdout.strip() or "?").resolve()
+    if r.returncode or root.resolve() not in got.parents:
+        raise SystemExit(f"{mod} does not import from {root} (got {got}): {r.stderr.strip()}")
+
+
+def _drop_pyc(path: Path) -> None:
+    """Remove the module's bytecode: a mutant of the same size written in the same second
+    as the original would otherwise be shadowed by a stale .pyc (or leave one behind)."""
+    cache = path.parent / "__pycache__"
+    if cache.is_dir():
+        for p in cache.glob(f"{path.stem}.*.pyc"):
+            p.unlink(missing_ok=True)
+
+
+def run_tests(root: Path, tests: list[str], python: str, timeout: float) -> tuple[str, float]:
+    cmd = [python, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-p", "no:randomly"]
+    cmd += ["-o", "addopts=--import-mode=importlib", "--hypothesis-seed=0", *tests]
+    t0 = time.monotonic()
+    proc = subprocess.Popen(
+        cmd,
+        cwd=root,
+        env=_env(root),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    try:
+        rc = proc.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+        return "timeout", time.monotonic() - t0
+    dt = time.monotonic() - t0
+    if rc == 0:
+        return "survived", dt
+    if rc in (1, 2):
+        return "killed", dt
+    return f"error (pytest exit {rc})", dt
+
+
+def tests_for(root: Path, module: Path, tests_dir: str) -> list[str]:
+    own = Path(tests_dir) / f"test_{module.stem}.py"
+    return ([str(own)] if (root / own).exists() else []) + [tests_dir]
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--root", type=Path, required=True, help="a copy of the repository")
+    ap.add_argument("--packages", nargs="+", default=list(PACKAGES))
+    ap.add_argument("--tests", nargs="+", default=None, help="test dir per package")
+    ap.add_argument("--per-module", type=int, default=8, help="mutants drawn per module")
+    ap.add_argument("--modules", nargs="*", default=None, help="only these module stems")
+    ap.add_argument("--seed", type=int, default=20)
+    ap.add_argument("--timeout-factor", type=float, default=3.0)
+    ap.add_argument("--python", default=sys.executable)
+    ap.add_argument("--json", type=Path, default=None, help="write every result here")
+    ap.add_argument("--list", action="store_true", help="count the mutants, run nothing")
+    a = ap.parse_args(argv)
+    if a.per_module < 1:
+        ap.error(f"--per-module must be an integer >= 1, got {a.per_module}")
+    root = a.root.resolve()
+    tests = a.tests or ["tests/" + Path(p).name for p in a.packages]
+    if len(tests) != len(a.packages):
+        ap.error("--tests needs one directory per package")
+    results: list[dict] = []
+    totals = {"sites": 0, "sampled": 0}
+    rng = random.Random(a.seed)
+    for package, tdir in zip(a.packages, tests, strict=True):
+        if not a.list:
+            check_root(root, package, a.python)
+        modules = sorted((root / package).glob("*.py"))
+        if a.modules:
+            modules = [m for m in modules if m.stem in a.modules]
+        plan: list[tuple[Path, list[Mutant], int]] = []
+        for mod in modules:
+            rel = str(mod.relative_to(root))
+            every = mutants_of(rel, mod.read_text())
+            pick = sorted(
+                rng.sample(every, min(a.per_module, len(every))),
+                key=lambda m: (m.line, m.col),
+            )
+            plan.append((mod, pick, len(every)))
+            totals["sites"] += len(every)
+            totals["sampled"] += len(pick)
+            print(f"{rel}: {len(pick)} of {len(every)} mutants", flush=True)
+        if a.list:
+            continue
+        status, base = run_tests(root, [tdir], a.python, 3600.0)
+        if status != "survived":
+            raise SystemExit(f"{tdir} fails without any mutant ({status}): fix that first")
+        timeout = a.timeout_factor * base + 20.0
+        print(f"{tdir}: {base:.1f} s unmutated, timeout {timeout:.0f} s", flush=True)
+        for mod, pick, _ in plan:
+            original = mod.read_bytes()
+            src = original.decode()
+            try:
+                for m in pick:
+                    mod.write_text(m.apply(src))
+                    _drop_pyc(mod)
+                    st, dt = run_tests(root, tests_for(root, mod, tdir), a.python, timeout)
+                    mod.write_bytes(original)
+                    _drop_pyc(mod)
+                    results.append({**asdict(m), "status": st, "seconds": round(dt, 1)})
+                    print(f"  {st:9s} {dt:6.1f} s  {m.label()}", flush=True)
+            finally:
+                mod.write_bytes(original)
+                _drop_pyc(mod)
+            assert mod.read_bytes() == original
+    if a.list:
+        print(f"{totals['sampled']} mutants of {totals['sites']} would run")
+        return 0
+    print(f"{totals['sampled']} mutants of {totals['sites']} run", flush=True)
+    counts: dict[str, int] = {}
+    for r in results:
+        counts[r["status"]] = counts.get(r["status"], 0) + 1
+    n = len(results)
+    killed = counts.get("killed", 0) + counts.get("timeout", 0)
+    print("  ".join(f"{k}: {v}" for k, v in sorted(counts.items())))
+    if n:
+        print(f"kill rate {killed}/{n} = {100 * killed / n:.1f} % (timeouts count as killed)")
+    for r in results:
+        if r["status"] == "survived":
+            print(f"SURVIVED {r['path']}:{r['line']}: {r['old']!r} -> {r['new']!r}")
+    if a.json:
+        a.json.write_text(json.dumps({"totals": totals, "results": results}, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
