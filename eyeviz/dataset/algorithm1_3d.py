@@ -264,14 +264,19 @@ class _Sampler3D:
             dst = pending[sel]
             out[:, dst] = r[sel], az[sel], el[sel], g[sel], x[good], y[good], z[good]
             got_slots.append(dst)
-            got_a.append(_take_rows(pa, ia.astype(self.dtype, copy=False), good))
-            got_b.append(_take_rows(pb, ib.astype(self.dtype, copy=False), good))
+            for got, ptr, ind in ((got_a, pa, ia), (got_b, pb, ib)):
+                ind = ind.astype(self.dtype, copy=False)
+                got.append((ptr, ind) if good.size == ptr.size - 1 else _take_rows(ptr, ind, good))
             keep = np.ones(k, bool)
             keep[sel] = False
             pending = pending[keep]
         # rows were accepted round by round: put them in slot order
-        order = np.argsort(np.concatenate(got_slots), kind="stable")
-        csr = [_take_rows(*_concat_csr(parts), order) for parts in (got_a, got_b)]
+        slots = np.concatenate(got_slots)
+        if np.all(slots[1:] > slots[:-1]):  # one round took every slot
+            csr = [_concat_csr(parts) for parts in (got_a, got_b)]
+        else:
+            order = np.argsort(slots, kind="stable")
+            csr = [_take_rows(*_concat_csr(parts), order) for parts in (got_a, got_b)]
         r, az, el, g, x, y, z = out
         (pa, ia), (pb, ib) = csr
         return Dataset3D(pa, ia, pb, ib, r, az, el, g, x, y, z, self.d, self.p.as_dict())

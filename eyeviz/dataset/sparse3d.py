@@ -169,7 +169,9 @@ def write_chunks3d(
                 for e in EYES:
                     ptr = getattr(c, f"indptr_{e}")
                     spools.append(f"indptr_{e}", ptr[1:].astype(np.int64) + base[e])
-                    spools.append(f"indices_{e}", getattr(c, f"indices_{e}").astype(idt))
+                    spools.append(
+                        f"indices_{e}", getattr(c, f"indices_{e}").astype(idt, copy=False)
+                    )
                     base[e] += int(ptr[-1])
                 for name in FLOATS:
                     spools.append(name, getattr(c, name).astype(np.float64))
