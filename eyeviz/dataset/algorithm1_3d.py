@@ -233,7 +233,9 @@ class _Sampler3D:
         lo_a, hi_a = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
         per_slot = lo_a.ndim > 0
         out = np.empty((7, n))
-        got_slots, got_a, got_b = [], [], []
+        got_slots: list[np.ndarray] = []
+        got_a: list[tuple[np.ndarray, np.ndarray]] = []
+        got_b: list[tuple[np.ndarray, np.ndarray]] = []
         pending = np.arange(n)
         idle = idle_draws = 0
         while pending.size:
