@@ -7,7 +7,6 @@ selected feature's distance a vertical line that follows a drag without recomput
 
 import math
 import threading
-import time
 
 import numpy as np
 from mouse import pixel_of
@@ -126,9 +125,13 @@ def test_the_gui_thread_is_not_blocked_and_stale_results_are_not_drawn(make_wind
     gate = threading.Event()
     seen = []
 
+    held = threading.Event()
+
     def slow(h, l, m):  # the real computation, held until the test lets it go
         seen.append((m, threading.get_ident()))
+        held.set()
         gate.wait(20)
+        held.clear()
         return design_dock.compute_curve(h, l, m)
 
     panel.compute = slow
@@ -142,17 +145,18 @@ def test_the_gui_thread_is_not_blocked_and_stale_results_are_not_drawn(make_wind
     # and a drag moves the marker
     ticks = []
     timer = QtCore.QTimer()
-    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.timeout.connect(lambda: held.is_set() and ticks.append(len(ticks)))
     timer.start(10)
     win.model.set_eyes(40.0, 20.0, 360)  # a newer change while 1440 is computed
     win.model.select(0)
     win.model.begin_live("move")
     win.model.live(0, y=2600.0)
-    qtbot.waitUntil(lambda: panel.markers[0].get_xdata()[0] == 2600.0, timeout=2000)
-    QTest.qWait(300)
+    qtbot.waitUntil(lambda: panel.markers[0].get_xdata()[0] == 2600.0, timeout=10000)
+    # the GUI was live while the curve was computed: ticks counted while the worker is
+    # held at the gate (a GUI thread waiting on it would not tick until it was let go)
+    qtbot.waitUntil(lambda: len(ticks) >= 10, timeout=10000)
     win.model.end_live()
     timer.stop()
-    assert len(ticks) >= 10, ticks  # the GUI was live while the curve was computed
     assert panel.stale and panel.running == (40.0, 20.0, 1440)
     assert seen and all(t != threading.get_ident() for _, t in seen)
     gate.set()

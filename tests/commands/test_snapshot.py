@@ -145,9 +145,8 @@ def test_snapshot_aspect_frames_the_view_and_bad_ones_are_refused(tmp_path):
 
 
 def test_snapshot_hostile_scenes_are_one_line(tmp_path):
-    """Too many features, a feature at 1e308: a quick one-line refusal, no file."""
-    import time
-
+    """Too many features, a feature at 1e308: a one-line refusal, no file (refused before
+    any figure is made: tests/render/test_export.py counts them)."""
     many = tmp_path / "many.toml"
     rows = "".join(
         f'[[features]]\nname = "f{i}"\nx = {i}.0\ny = 1500.0\ng = 1.0\n\n' for i in range(10_001)
@@ -156,7 +155,6 @@ def test_snapshot_hostile_scenes_are_one_line(tmp_path):
     far = tmp_path / "far.toml"
     far.write_text('[[features]]\nname = "far"\nx = 1e308\ny = 1500.0\ng = 50.0\n')
     for scene, words in ((many, "10000"), (far, "1e+308")):
-        t = time.perf_counter()
         run = subprocess.run(
             [sys.executable, "-m", "eyeviz", "snapshot", str(scene), "-o", str(tmp_path / "o.png")],
             capture_output=True,
@@ -164,7 +162,6 @@ def test_snapshot_hostile_scenes_are_one_line(tmp_path):
             timeout=120,
             cwd=ROOT,
         )
-        assert time.perf_counter() - t < 60
         assert run.returncode == 2, run.stderr
         lines = run.stderr.strip().splitlines()
         assert len(lines) == 1 and words in lines[0], run.stderr

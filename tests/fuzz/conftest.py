@@ -1,6 +1,6 @@
 """Fuzz suite (issue 13): hypothesis over scene TOML, CSV/NPZ data sets and model
 directories. Property: a correct result, or an EyevizError (API) / one line and exit 2
-(CLI); never a traceback, a hang past the deadline, or a changed input file.
+(CLI); never a traceback, a hang, or a changed input file.
 
 Examples are derandomised (the same inputs every run) and budgeted so the whole suite
 runs in well under a minute; ``EYEVIZ_FUZZ_SCALE=10`` multiplies every budget. Each test
@@ -20,10 +20,12 @@ SCALE = float(os.environ.get("EYEVIZ_FUZZ_SCALE", "1"))
 TALLY: dict[str, collections.Counter] = collections.defaultdict(collections.Counter)
 
 
-def fuzz_settings(examples: int, deadline_ms: int = 5000):
+def fuzz_settings(examples: int):
+    """No per-example deadline: a wall-clock limit fails on a loaded machine. A hang is
+    caught by pytest-timeout (pyproject), and a subprocess by its own timeout."""
     return settings(
         max_examples=max(1, int(examples * SCALE)),
-        deadline=deadline_ms,
+        deadline=None,
         derandomize=True,
         database=None,
         suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],

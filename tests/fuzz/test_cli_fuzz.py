@@ -10,7 +10,6 @@ import io
 import os
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -24,27 +23,26 @@ from .test_dataset_fuzz import CSV_PAPER, NPZ_PAPER, mutated
 from .test_scene_fuzz import mutated_scene
 
 BUGS: dict[str, int] = {}
-SLOW_S = 20.0
+HANG_S = 120.0  # a snapshot subprocess still running after this is recorded as a hang
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _cli(argv) -> tuple[int, str, float]:
+def _cli(argv) -> tuple[int, str]:
     err, out = io.StringIO(), io.StringIO()
-    t = time.monotonic()
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
         code = main(argv)
-    return code, err.getvalue(), time.monotonic() - t
+    return code, err.getvalue()
 
 
 EXAMPLES: dict[str, str] = {}
 
 
 def _record(
-    category: str, code: int, err: str, secs: float, output_exists: bool, example: str = ""
+    category: str, code: int, err: str, output_exists: bool, example: str = "", hung=False
 ) -> None:
     lines = [ln for ln in err.strip().splitlines() if ln.strip()]
-    if secs > SLOW_S:
-        what = f"slow ({secs:.0f} s)"
+    if hung:
+        what = f"hangs (still running after {HANG_S:.0f} s)"
     elif code == 0 and output_exists:
         count(category, "ok")
         return
@@ -61,7 +59,7 @@ def _record(
         EXAMPLES.setdefault(f"{category}: {what}", f"{example}\n--- stderr:\n{err[-3000:]}")
 
 
-@fuzz_settings(25, deadline_ms=None)
+@fuzz_settings(25)
 @given(mutated_scene())
 def test_snapshot_mutated_scene(tmp_path_factory, text):
     d = tmp_path_factory.mktemp("snap")
@@ -69,9 +67,9 @@ def test_snapshot_mutated_scene(tmp_path_factory, text):
     p.write_text(text, encoding="utf-8", errors="surrogatepass")
     before = digest(p)
     out = d / "o.svg"
-    code, err, secs = _cli(["snapshot", str(p), "-o", str(out)])
+    code, err = _cli(["snapshot", str(p), "-o", str(out)])
     assert digest(p) == before
-    _record("cli: snapshot scene", code, err, secs, out.exists(), text)
+    _record("cli: snapshot scene", code, err, out.exists(), text)
 
 
 COORD = st.one_of(
@@ -116,7 +114,7 @@ def extreme_scene(draw):
     )
 
 
-@fuzz_settings(8, deadline_ms=None)
+@fuzz_settings(8)
 @given(extreme_scene())
 def test_snapshot_extreme_valid_scene(tmp_path_factory, text):
     """In a subprocess with a time limit: a renderer that hangs (Agg on huge coordinates)
@@ -126,23 +124,22 @@ def test_snapshot_extreme_valid_scene(tmp_path_factory, text):
     p = d / "s.toml"
     p.write_text(text, encoding="utf-8", errors="surrogatepass")
     out = d / "o.png"
-    t = time.monotonic()
     try:
         proc = subprocess.run(
             [sys.executable, "-m", "eyeviz", "snapshot", str(p), "-o", str(out)],
             env={**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"},
             capture_output=True,
             text=True,
-            timeout=SLOW_S,
+            timeout=HANG_S,
         )
-        code, err = proc.returncode, proc.stderr
+        code, err, hung = proc.returncode, proc.stderr, False
     except subprocess.TimeoutExpired:
-        code, err = -1, ""
-    _record("cli: snapshot extreme scene", code, err, time.monotonic() - t, out.exists(), text)
+        code, err, hung = -1, "", True
+    _record("cli: snapshot extreme scene", code, err, out.exists(), text, hung=hung)
 
 
 @pytest.mark.parametrize("fmt", ["csv", "npz"])
-@fuzz_settings(6, deadline_ms=None)
+@fuzz_settings(6)
 @given(data=st.data())
 def test_report_dataset(tmp_path_factory, fmt, data):
     src = CSV_PAPER if fmt == "csv" else NPZ_PAPER
@@ -152,9 +149,9 @@ def test_report_dataset(tmp_path_factory, fmt, data):
     p.write_bytes(blob)
     before = digest(p)
     out = d / "report"
-    code, err, secs = _cli(["report", "dataset", str(p), "-o", str(out)])
+    code, err = _cli(["report", "dataset", str(p), "-o", str(out)])
     assert digest(p) == before
-    _record(f"cli: report dataset {fmt}", code, err, secs, out.exists())
+    _record(f"cli: report dataset {fmt}", code, err, out.exists())
 
 
 def test_no_cli_bugs():

@@ -187,7 +187,7 @@ def _cli(argv) -> tuple[int, str]:
 
 
 @pytest.mark.parametrize("fmt", ["csv", "npz"])
-@fuzz_settings(40, deadline_ms=20000)
+@fuzz_settings(40)
 @given(data=st.data())
 def test_predict_cli(tmp_path_factory, fmt, data):
     src = CSV_PAPER if fmt == "csv" else NPZ_PAPER

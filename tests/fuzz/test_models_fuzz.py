@@ -136,7 +136,7 @@ def test_compact_weights_bytes(tmp_path_factory, which, data):
     assert digest(d / which) == before
 
 
-@fuzz_settings(60, deadline_ms=20000)
+@fuzz_settings(60)
 @given(st.data())
 def test_bayes_table_bytes(tmp_path_factory, data):
     src = (MODELS / "bayes.npz").read_bytes()

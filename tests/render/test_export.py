@@ -356,18 +356,18 @@ def test_unavailable_estimator_refused_never_written(tmp_path, default_scene):
     assert "/home/someone" not in text and "no answer for this eye design" in text
 
 
-def test_hostile_names_and_coordinates(tmp_path, default_scene):
-    import time
-
+def test_hostile_names_and_coordinates(tmp_path, default_scene, monkeypatch):
     sc = default_scene.copy()
     sc.features[0].name = r"$\undefined$ x"
     sc.features[1].name = "n" * 1_000_000
     sc.title = "$\\frac{1}{0}$ " + "t" * 1_000_000
-    t = time.perf_counter()
     out = export(sc, tmp_path / "names.png")
     export(sc, tmp_path / "names.svg")
-    assert time.perf_counter() - t < 30
     assert png_size(out)[0] == 1050
+    # the million-character names are cut before they are laid out: no text in the
+    # figure is longer than a few hundred characters
+    texts = vector.figure(sc).findobj(lambda a: hasattr(a, "get_text"))
+    assert texts and max(len(t.get_text()) for t in texts) < 500
     fig = vector.figure(sc)
     r = _renderer(fig)
     title = next(t for t in fig.texts if t.get_gid() == "title")
@@ -378,25 +378,46 @@ def test_hostile_names_and_coordinates(tmp_path, default_scene):
     assert "n" * 39 + "\u2026" in svg and "n" * 1000 not in svg
     far = default_scene.copy()
     far.features[0].x = 1e308
-    t = time.perf_counter()
+    made = _count_figures(monkeypatch)
     with pytest.raises(EyevizError, match="cannot be drawn") as exc:
         export(far, tmp_path / "far.png")
-    assert time.perf_counter() - t < 5 and "\n" not in str(exc.value)
+    assert "\n" not in str(exc.value)
+    assert made == []  # refused before any figure is made or drawn
     assert not (tmp_path / "far.png").exists()
 
 
-def test_too_many_features_refused_quickly(tmp_path, default_scene):
-    import time
+def _count_figures(monkeypatch) -> list:
+    """Every matplotlib Figure made from now on appends to the returned list."""
+    from matplotlib.figure import Figure
 
+    made: list = []
+    real = Figure.__init__
+
+    def init(self, *a, **kw):
+        made.append(self)
+        real(self, *a, **kw)
+
+    monkeypatch.setattr(Figure, "__init__", init)
+    return made
+
+
+def test_the_figure_counter_counts(monkeypatch, default_scene, tmp_path):
+    made = _count_figures(monkeypatch)
+    export(default_scene, tmp_path / "ok.svg")
+    assert len(made) >= 1
+
+
+def test_too_many_features_refused_quickly(tmp_path, default_scene, monkeypatch):
     sc = default_scene.copy()
     f = sc.features[0]
     sc.features = [
         scene_mod.Feature(f"f{i}", f.x + i, f.y, f.g) for i in range(vector.MAX_FEATURES + 1)
     ]
-    t = time.perf_counter()
+    made = _count_figures(monkeypatch)
     with pytest.raises(EyevizError, match="at most 10000 features"):
         export(sc, tmp_path / "many.png")
-    assert time.perf_counter() - t < 2
+    assert made == []  # refused before any figure is made or drawn
+    assert not (tmp_path / "many.png").exists()
 
 
 def test_svg_predictions_for_other_eyes(tmp_path):
