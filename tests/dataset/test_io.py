@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import io
 import json
-import time
 import tracemalloc
 import zipfile
 from dataclasses import replace
@@ -129,12 +128,13 @@ def test_npz_bomb_refused_before_allocating(tmp_path):
     p = tmp_path / "bomb.npz"
     _write_npz(p, {"version": 1, "m": m, "n": n, "params": {}}, hdr, b"\0" * (3 << 20))
     tracemalloc.start()
-    t = time.perf_counter()
-    with pytest.raises(EyevizError, match="bytes but the member holds"):
-        D.load(p)
-    _, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    assert time.perf_counter() - t < 5 and peak < 50 << 20
+    try:
+        with pytest.raises(EyevizError, match="bytes but the member holds"):
+            D.load(p)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 50 << 20  # the 3.4 GB the header declares is never allocated
 
 
 def test_npz_compressed_member_refused(small, tmp_path):

@@ -105,7 +105,7 @@ def test_deep_nesting(depth, opener):
     _check("a = " + opener * depth + "1" + closer * depth, "scene: deep nesting")
 
 
-@fuzz_settings(60, deadline_ms=10000)
+@fuzz_settings(60)
 @given(mutated_scene())
 def test_scene_files_through_load(tmp_path_factory, text):
     p = tmp_path_factory.mktemp("s") / "s.toml"
