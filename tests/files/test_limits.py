@@ -6,7 +6,6 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -19,7 +18,6 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def _eyeviz(*args, cwd):
-    t = time.monotonic()
     p = subprocess.run(
         [sys.executable, "-m", "eyeviz", *args],
         cwd=cwd,
@@ -28,7 +26,7 @@ def _eyeviz(*args, cwd):
         text=True,
         timeout=120,
     )
-    return p.returncode, p.stderr.strip().splitlines(), time.monotonic() - t
+    return p.returncode, p.stderr.strip().splitlines()
 
 
 @pytest.mark.parametrize(
@@ -45,9 +43,9 @@ def _eyeviz(*args, cwd):
     ],
 )
 def test_generate_bounds(tmp_path, args, words):
-    code, err, secs = _eyeviz("generate", *args, "-o", "x.csv", cwd=tmp_path)
+    code, err = _eyeviz("generate", *args, "-o", "x.csv", cwd=tmp_path)
     assert code == 2 and words in err[-1], err
-    assert err[-1].startswith("eyeviz") and secs < 60
+    assert err[-1].startswith("eyeviz")
     assert list(tmp_path.iterdir()) == []
 
 
@@ -105,6 +103,6 @@ def test_snapshot_hostile_scene_files(tmp_path, scene, words):
     }
     if scene in files:
         (tmp_path / scene).write_text(files[scene])
-    code, err, secs = _eyeviz("snapshot", scene, "-o", "out.png", cwd=tmp_path)
+    code, err = _eyeviz("snapshot", scene, "-o", "out.png", cwd=tmp_path)
     assert code == 2 and len(err) == 1 and words in err[0], err
-    assert secs < 60 and not (tmp_path / "out.png").exists()
+    assert not (tmp_path / "out.png").exists()
