@@ -43,7 +43,6 @@ from eyeviz.model.scene import Scene
 from eyeviz.model.state import SceneState
 from eyeviz.render.vtk.actors import BACKGROUND, INSET_BACKGROUND, SceneActors, style_text
 from eyeviz.render.vtk.overlays import OverlayActors
-from eyeviz.render.vtk.posterior import PosteriorActors
 
 if TYPE_CHECKING:
     from eyeviz.app.docks import ExportChoice, ExportDialog
@@ -111,8 +110,8 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         self.inset_ren.InteractiveOff()
         self.ren_win.AddRenderer(self.inset_ren)
         self.actors = SceneActors(self.main_ren, self.inset_ren)
-        self.overlays = OverlayActors(self.main_ren)
-        self.posterior_actors = PosteriorActors(self.main_ren)  # issue 10: the limit's posterior
+        self.overlays = OverlayActors(self.main_ren, self.inset_ren)
+        self.posterior_actors = self.actors.layer("posterior")  # issue 10: the limit's posterior
         self.picker = None  # docks built on first use (issue 6 layers)
         self.trajectory_panel = None
         self._docks: dict[str, QtWidgets.QDockWidget] = {}
@@ -272,7 +271,6 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         path = self.trajectory_panel.path if self.trajectory_panel is not None else None
         amb = self.model.ambiguity
         self.overlays.update(scene, st, self.model.selected, preds, amb, path, skip=skip)
-        self.posterior_actors.update(scene, self.model.selected)  # cached per key
 
     def _load_estimators(self, predictor, names: list[str]) -> None:
         """Load estimators (torch, weights) on a worker thread; the window stays live."""

@@ -96,11 +96,12 @@ class AppModel:
     @property
     def predictions(self) -> dict:
         """estimator -> (r_hat, phi_hat) per feature, or a one-line reason; {} when the
-        predictions layer is off (nothing is imported then)."""
+        predictions layer is off (nothing is imported then). Computed by
+        :func:`eyeviz.model.predictor.scene_predictions`, kept until the scene changes."""
         if not self.scene.shows("predictions") or not self.scene.features:
             return {}
         if self._predictions is None:
-            from eyeviz.model.predictor import Predictor
+            from eyeviz.model.predictor import Predictor, scene_predictions
 
             if self.predictor is None:
                 self.predictor = Predictor()
@@ -113,7 +114,7 @@ class AppModel:
                     self.loading = f"loading {', '.join(missing)}…"
                     self.load_in_background(p, missing)
                 return {n: self.loading for n in self.scene.estimators}
-            self._predictions = p.predict(self.scene, self.state)
+            self._predictions = scene_predictions(self.scene, self.state, p)
         return self._predictions
 
     @property

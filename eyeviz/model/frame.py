@@ -5,6 +5,9 @@ The Frame's parts (dataclasses) and the small pure helpers they use live in
 
 ``build_frame(scene, state=None, predictor=None, rect=...)`` runs the geometry once and
 returns a :class:`Frame`; the matplotlib figure (and the VTK view) only *draw* a Frame.
+It fills the readout every layer shares, then runs the frame builder of each layer the
+scene shows, as the layer table (:mod:`eyeviz.model.layers`) names them: ``build_eyes``,
+``build_bfv``, ... below; each reads a :class:`FrameInputs` and fills its part.
 Qt-, VTK- and matplotlib-free; only what the scene's layers need is computed (a drag frame
 with the default layers costs the intervals plus a few array operations).
 
@@ -45,15 +48,17 @@ Fields of :class:`Frame` (``None`` / empty when no layer needs them):
 - ``labels``: :class:`LabelFrame` anchors (text, x, y, kind, feature) of the ``labels``
   layer: the eyes A, B and the origin O under them, each feature's name up-right of its
   disc (the app's view places them at these points; the exported figure lays its own out).
+- ``parts``: {layer name: part} of layers registered outside this module.
 
 It is over 400 lines because this docstring lists every field of the Frame (the renderers'
-contract) and :func:`build_frame` calls one builder per layer over a single geometry pass;
-the parts and helpers are already in :mod:`eyeviz.model.frame_parts`.
+contract) and it holds one builder per shipped layer; the parts and helpers are already in
+:mod:`eyeviz.model.frame_parts`.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -76,8 +81,8 @@ from eyeviz.model.frame_parts import (
     runs,
     view_rect,
 )
-from eyeviz.model.posterior import Posterior
-from eyeviz.model.predictor import Predictor
+from eyeviz.model.layers import needs_of, ordered, resolve
+from eyeviz.model.predictor import Predictor, scene_predictions
 from eyeviz.model.scene import Scene, Trajectory
 from eyeviz.model.state import SceneState, compute_state, owners
 
@@ -85,13 +90,23 @@ __all__ = [
     "BFVFrame",
     "EyeFrame",
     "Frame",
+    "FrameInputs",
     "LabelFrame",
     "PredictionFrame",
     "SectorFrame",
     "TangentFrame",
     "TrajectoryPath",
     "ambiguity_of",
+    "build_ambiguity",
+    "build_bfv",
+    "build_eyes",
     "build_frame",
+    "build_labels",
+    "build_posterior",
+    "build_predictions",
+    "build_sectors",
+    "build_tangents",
+    "build_trajectory",
     "clip_wedge",
     "rim_points",
     "errors",
@@ -178,65 +193,39 @@ def trajectory_path(
 # --- building ----------------------------------------------------------------------------
 
 
-def _posteriors(pair: EyePair, st: SceneState) -> dict[int, Posterior | None]:
-    """Each feature's posterior over centres (eyeviz.model.posterior; cached per key), None
-    where it has none (an empty key, or a feature the intervals cannot describe)."""
-    from eyeviz.core.domain import Domain
-    from eyeviz.model.posterior import posterior_for_key
-
-    out: dict[int, Posterior | None] = {}
-    if st.LA is None or st.RA is None or st.LB is None or st.RB is None:
-        return out
-    dom = Domain.from_eyes(pair)
-    for i in range(st.n):
-        key = tuple(int(v[i]) for v in (st.LA, st.RA, st.LB, st.RB))
-        try:
-            p = posterior_for_key(key, dom)
-        except (ValueError, ArithmeticError):
-            p = None
-        out[i] = None if p is None or p.empty else p
-    return out
-
-
-_NEED = {
-    "eyes": ("LA", "owner_a"),
-    "bitmaps": ("LA",),
-    "sectors": ("LA", "rA"),
-    "tangents": ("rA",),
-    "readout": ("LA", "r"),
-    "predictions": ("LA", "in_bfv"),
-    "labels": ("r",),
-    "ambiguity": ("r",),
-    "posterior": ("LA",),
-}
+#: The state's field that holds each need of :data:`eyeviz.model.layers.NEEDS`.
+_NEED_FIELD = {"intervals": "LA", "owners": "owner_a", "readout": "r"}
 
 
 def state_for(scene: Scene, state: SceneState | None) -> SceneState:
+    """``state`` when it holds what the scene's layers need (the layer table), else
+    ``compute_state(scene)``."""
     if state is None:
         return compute_state(scene)
-    for layer, attrs in _NEED.items():
-        if layer in scene.layers and any(getattr(state, a) is None for a in attrs):
+    for need in needs_of(scene.layers):
+        if getattr(state, _NEED_FIELD[need]) is None:
             return compute_state(scene)
     return state
 
 
-def _eye_frames(
-    pair: EyePair, st: SceneState, palette: list[str], colors: list[str]
-) -> list[EyeFrame]:
-    uniq = {c: i + 1 for i, c in enumerate(palette)}
-    lut = np.array([0] + [uniq[c] for c in colors], dtype=np.int64)
-    out = []
-    for name, center, owner, L, R in (
-        ("A", pair.centers[0], st.owner_a, st.LA, st.RA),
-        ("B", pair.centers[1], st.owner_b, st.LB, st.RB),
-    ):
-        if owner is None:
-            if L is not None and R is not None:
-                owner = owners(L, R, pair.m)
-            else:
-                owner = np.full(pair.m, -1, np.int64)
-        out.append(EyeFrame(name, center, owner, lut, pair.l, pair.m))
-    return out
+@dataclass
+class FrameInputs:
+    """What a layer's frame builder (:data:`eyeviz.model.layers.LayerSpec.frame`) reads.
+
+    ``box`` is the view rectangle (x0, x1, y0, y1); ``teach`` the features the per-feature
+    teaching layers draw (all, or the app's selection); ``predictor``, ``predictions``,
+    ``ambiguity`` and ``trajectory`` are :func:`build_frame`'s arguments of those names.
+    """
+
+    scene: Scene
+    state: SceneState
+    pair: EyePair
+    box: tuple[float, float, float, float]
+    teach: list[int]
+    predictor: Predictor | None = None
+    predictions: dict | None = None
+    ambiguity: dict[int, dict | None] | None = None
+    trajectory: TrajectoryPath | None = None
 
 
 def _polar(st: SceneState) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -247,10 +236,38 @@ def _polar(st: SceneState) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarr
     return rA, phiA, rB, phiB
 
 
-def _tangents(pair: EyePair, st: SceneState, only: list[int]) -> list[TangentFrame]:
-    out = []
+# --- one builder per layer (named in eyeviz.model.layers.LAYERS) -------------------------
+
+
+def build_eyes(fr: Frame, inp: FrameInputs) -> None:
+    """``eyes`` and ``bitmaps``: each eye's :class:`EyeFrame` (owners, colour runs, rim)."""
+    if fr.eyes:  # the other of the two layers made them already
+        return
+    pair, st = inp.pair, inp.state
+    uniq = {c: i + 1 for i, c in enumerate(fr.palette)}
+    lut = np.array([0] + [uniq[c] for c in fr.colors], dtype=np.int64)
+    for name, center, owner, L, R in (
+        ("A", pair.centers[0], st.owner_a, st.LA, st.RA),
+        ("B", pair.centers[1], st.owner_b, st.LB, st.RB),
+    ):
+        if owner is None:
+            if L is not None and R is not None:
+                owner = owners(L, R, pair.m)
+            else:
+                owner = np.full(pair.m, -1, np.int64)
+        fr.eyes.append(EyeFrame(name, center, owner, lut, pair.l, pair.m))
+
+
+def build_bfv(fr: Frame, inp: FrameInputs) -> None:
+    """``bfv``: psi (Eq. 15), theta (Eq. 16) and the wedge clipped to the view rectangle."""
+    fr.bfv = BFVFrame(inp.pair.psi, inp.pair.theta, inp.box)
+
+
+def build_tangents(fr: Frame, inp: FrameInputs) -> None:
+    """``tangents``: from each eye centre to each taught feature's disc (Prop. 2, Fig. 3b)."""
+    pair, st = inp.pair, inp.state
     rA, phiA, rB, phiB = _polar(st)
-    for i in only:
+    for i in inp.teach:
         g = float(st.g[i])
         for name, center, rE, phE in (
             ("A", pair.centers[0], float(rA[i]), float(phiA[i])),
@@ -262,16 +279,16 @@ def _tangents(pair: EyePair, st: SceneState, only: list[int]) -> list[TangentFra
             t = math.sqrt(rE * rE - g * g)
             ang = np.array([phE - alpha, phE + alpha])
             ends = np.column_stack([center[0] + t * np.cos(ang), center[1] + t * np.sin(ang)])
-            out.append(TangentFrame(i, name, center, rE, phE, alpha, t, ends))
-    return out
+            fr.tangents.append(TangentFrame(i, name, center, rE, phE, alpha, t, ends))
 
 
-def _sectors(pair: EyePair, st: SceneState, only: list[int]) -> list[SectorFrame]:
-    out = []
+def build_sectors(fr: Frame, inp: FrameInputs) -> None:
+    """``sectors``: the boundary rays k*gamma of each taught feature's lit run (Eq. 8, 11)."""
+    pair, st = inp.pair, inp.state
     m = pair.m
     LA, RA, LB, RB = st.intervals()
     rA, _, rB, _ = _polar(st)
-    for i in only:
+    for i in inp.teach:
         g = float(st.g[i])
         for name, center, Li, Ri, rE in (
             ("A", pair.centers[0], LA[i], RA[i], rA[i]),
@@ -284,29 +301,52 @@ def _sectors(pair: EyePair, st: SceneState, only: list[int]) -> list[SectorFrame
             reach = float(rE) + 1.6 * g
             t = np.asarray(rays, dtype=np.float64) * pair.gamma
             ends = np.column_stack([center[0] + reach * np.cos(t), center[1] + reach * np.sin(t)])
-            out.append(SectorFrame(i, name, center, L, R, reach, rays, ends))
-    return out
+            fr.sectors.append(SectorFrame(i, name, center, L, R, reach, rays, ends))
 
 
-def _predictions(
-    scene: Scene, st: SceneState, predictor: Predictor | None, given: dict | None
-) -> dict[str, PredictionFrame | str]:
+def build_labels(fr: Frame, inp: FrameInputs) -> None:
+    """``labels``: A, B and O under the eyes; each feature's name up-right of its disc."""
+    pair, st = inp.pair, inp.state
+    y = -EYE_LABEL_DROP * pair.l
+    fr.labels = [
+        LabelFrame("A", -pair.h, y, "eye"),
+        LabelFrame("B", pair.h, y, "eye"),
+        LabelFrame("O", 0.0, y, "eye"),
+    ]
+    if "features" in fr.layers:
+        d = FEATURE_LABEL_OFFSET * st.g
+        xs, ys = (st.x + d).tolist(), (st.y + d).tolist()
+        fr.labels += [
+            LabelFrame(f.name, x, y_, "feature", i)
+            for i, (f, x, y_) in enumerate(zip(inp.scene.features, xs, ys, strict=True))
+        ]
+
+
+def build_predictions(fr: Frame, inp: FrameInputs) -> None:
+    """``predictions``: each estimator's :class:`PredictionFrame` or its one-line reason,
+    from :func:`eyeviz.model.predictor.scene_predictions` (the one place a scene's
+    predictions are computed) unless :func:`build_frame` was given them; features outside
+    the estimators' domain are marked ``out_of_domain`` (drawn grey)."""
+    st, scene = inp.state, inp.scene
+    if not fr.n:
+        return
+    if fr.in_domain is not None:
+        fr.out_of_domain = ~fr.in_domain
     if st.r is None or st.phi is None:
         raise ValueError("this state has no polar coordinates")
+    given = inp.predictions
     if given is None:
-        predictor = predictor if predictor is not None else Predictor()
-        given = predictor.predict(scene, st)
-    out: dict[str, PredictionFrame | str] = {}
+        given = scene_predictions(scene, st, inp.predictor)
     for name in scene.estimators:
         res = given.get(name, "no prediction")
         if isinstance(res, str):
-            out[name] = res
+            fr.predictions[name] = res
             continue
         r_hat, phi_hat = (np.asarray(v, dtype=np.float64) for v in res)
         with np.errstate(invalid="ignore", divide="ignore"):
             dr = r_hat - st.r
             dphi = np.degrees(np.remainder(phi_hat - st.phi + math.pi, 2 * math.pi) - math.pi)
-            out[name] = PredictionFrame(
+            fr.predictions[name] = PredictionFrame(
                 r_hat,
                 phi_hat,
                 r_hat * np.cos(phi_hat),
@@ -315,24 +355,56 @@ def _predictions(
                 100.0 * dr / st.r,
                 dphi,
             )
-    return out
 
 
-def _labels(pair: EyePair, scene: Scene, st: SceneState) -> list[LabelFrame]:
-    y = -EYE_LABEL_DROP * pair.l
-    out = [
-        LabelFrame("A", -pair.h, y, "eye"),
-        LabelFrame("B", pair.h, y, "eye"),
-        LabelFrame("O", 0.0, y, "eye"),
-    ]
-    if "features" in scene.layers:
-        d = FEATURE_LABEL_OFFSET * st.g
-        xs, ys = (st.x + d).tolist(), (st.y + d).tolist()
-        out += [
-            LabelFrame(f.name, x, y_, "feature", i)
-            for i, (f, x, y_) in enumerate(zip(scene.features, xs, ys, strict=True))
-        ]
-    return out
+def build_ambiguity(fr: Frame, inp: FrameInputs) -> None:
+    """``ambiguity``: each feature's region (the given ones if any), bounded by the view
+    rectangle widened by its width on every side."""
+    n = fr.n
+    if inp.ambiguity is not None:
+        fr.ambiguity = {i: a for i, a in inp.ambiguity.items() if 0 <= i < n}
+        return
+    x0, x1, y0, y1 = inp.box
+    w = x1 - x0
+    box = (x0 - w, x1 + w, y0 - w, y1 + w)
+    for i, f in enumerate(inp.scene.features):
+        fr.ambiguity[i] = ambiguity_of(inp.pair, f.x, f.y, f.g, box)
+
+
+def build_posterior(fr: Frame, inp: FrameInputs) -> None:
+    """``posterior``: each taught feature's posterior over centres (eyeviz.model.posterior;
+    cached per key), None where it has none (an empty key, or a feature the intervals
+    cannot describe)."""
+    from eyeviz.core.domain import Domain
+    from eyeviz.model.posterior import posterior_for_key
+
+    st = inp.state
+    if st.LA is None or st.RA is None or st.LB is None or st.RB is None or not inp.teach:
+        return
+    dom = Domain.from_eyes(inp.pair)
+    for i in inp.teach:
+        key = tuple(int(v[i]) for v in (st.LA, st.RA, st.LB, st.RB))
+        try:
+            p = posterior_for_key(key, dom)
+        except (ValueError, ArithmeticError):
+            p = None
+        fr.posterior[i] = None if p is None or p.empty else p
+
+
+def build_trajectory(fr: Frame, inp: FrameInputs) -> None:
+    """``trajectory``: the given path, or the scene's (points only), or why there is none."""
+    traj = inp.scene.trajectory
+    if inp.trajectory is not None:
+        fr.trajectory = inp.trajectory
+    elif traj is not None:
+        try:
+            stop = max(traj.distance, inp.box[3])
+            fr.trajectory = trajectory_path(inp.pair, traj, [], None, n=400, stop=stop)
+        except ValueError as exc:
+            fr.trajectory_error = str(exc).splitlines()[0]
+
+
+# --- building ----------------------------------------------------------------------------
 
 
 def build_frame(
@@ -346,16 +418,18 @@ def build_frame(
     ambiguity: dict[int, dict | None] | None = None,
     trajectory: TrajectoryPath | None = None,
 ) -> Frame:
-    """The :class:`Frame` of ``scene`` for its layers.
+    """The :class:`Frame` of ``scene`` for its layers: the readout every layer shares,
+    then the frame builder of each layer shown (the layer table,
+    :data:`eyeviz.model.layers.LAYERS`).
 
     ``rect`` is the view rectangle (x0, x1, y0, y1) the BFV wedge is clipped to and the
     ambiguity regions are bounded by (default: the scene's view at the export's aspect).
     ``predictions`` (estimator -> (r_hat, phi_hat) or a reason) skips the estimators;
     otherwise ``predictor`` (made when None) answers, only if the predictions layer is on.
-    ``only`` limits the per-feature teaching layers (tangents, sectors) to one feature (the
-    app's selection). ``ambiguity`` ({feature: region or None}, e.g. the app model's cached
-    region) and ``trajectory`` (a :class:`TrajectoryPath` already made) are taken as given
-    instead of being computed.
+    ``only`` limits the per-feature teaching layers (tangents, sectors, posterior) to one
+    feature (the app's selection). ``ambiguity`` ({feature: region or None}, e.g. the app
+    model's cached region) and ``trajectory`` (a :class:`TrajectoryPath` already made) are
+    taken as given instead of being computed.
     """
     st = state_for(scene, state)
     pair = st.pair
@@ -396,37 +470,8 @@ def build_frame(
     if fr.in_bfv is not None and fr.vis_a is not None:
         fr.in_domain = st.in_domain()
     fr.out_of_domain = np.zeros(n, bool)
-    if "predictions" in lay and n and fr.in_domain is not None:
-        fr.out_of_domain = ~fr.in_domain
     teach = list(range(n)) if only is None else [only] if 0 <= only < n else []
-    if {"eyes", "bitmaps"} & lay:
-        fr.eyes = _eye_frames(pair, st, fr.palette, colors)
-    if "bfv" in lay:
-        fr.bfv = BFVFrame(pair.psi, pair.theta, box)
-    if "tangents" in lay and teach:
-        fr.tangents = _tangents(pair, st, teach)
-    if "sectors" in lay and teach:
-        fr.sectors = _sectors(pair, st, teach)
-    if "labels" in lay:
-        fr.labels = _labels(pair, scene, st)
-    if "predictions" in lay and n:
-        fr.predictions = _predictions(scene, st, predictor, predictions)
-    if "ambiguity" in lay and ambiguity is not None:
-        fr.ambiguity = {i: a for i, a in ambiguity.items() if 0 <= i < n}
-    elif "ambiguity" in lay and n:
-        x0, x1, y0, y1 = box
-        w = x1 - x0
-        box = (x0 - w, x1 + w, y0 - w, y1 + w)
-        for i, f in enumerate(scene.features):
-            fr.ambiguity[i] = ambiguity_of(pair, f.x, f.y, f.g, box)
-    if "posterior" in lay and n:
-        fr.posterior = _posteriors(pair, st)
-    if "trajectory" in lay and trajectory is not None:
-        fr.trajectory = trajectory
-    elif "trajectory" in lay and scene.trajectory is not None:
-        try:
-            stop = max(scene.trajectory.distance, box[3])
-            fr.trajectory = trajectory_path(pair, scene.trajectory, [], None, n=400, stop=stop)
-        except ValueError as exc:
-            fr.trajectory_error = str(exc).splitlines()[0]
+    inp = FrameInputs(scene, st, pair, box, teach, predictor, predictions, ambiguity, trajectory)
+    for spec in ordered("frame", lay):
+        resolve(spec.frame)(fr, inp)
     return fr

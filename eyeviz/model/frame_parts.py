@@ -302,6 +302,8 @@ class Frame:
     trajectory: TrajectoryPath | None = None
     trajectory_error: str | None = None
     labels: list[LabelFrame] = field(default_factory=list)
+    #: parts of layers registered outside eyeviz.model.frame, by layer name
+    parts: dict[str, object] = field(default_factory=dict)
 
     @property
     def n(self) -> int:

@@ -3,8 +3,9 @@
 :class:`Predictor` keeps each estimator loaded once (``eyeviz.estimators`` is imported on
 the first prediction, so torch only when the predictions layer is on and a network is
 chosen). An estimator that cannot be loaded or cannot answer for the scene (weights
-missing, other eyes) becomes a one-line message, never an exception. Used by the app and
-by the vector export alike.
+missing, other eyes) becomes a one-line message, never an exception. :func:`scene_predictions`
+is the one place a scene's predictions are computed: the app model, the Frame (and so the
+vector export) call it, and both renderers only draw its answers.
 
 Eye designs (issue 10 item 4). Every answer is for the scene's eyes (h, l, m):
 
@@ -25,9 +26,9 @@ import numpy as np
 
 from eyeviz.core.geometry import intervals_to_bitmap
 from eyeviz.model.scene import Scene
-from eyeviz.model.state import SceneState
+from eyeviz.model.state import SceneState, compute_state
 
-__all__ = ["Predictor", "Result", "Design", "design_of", "trained_for"]
+__all__ = ["Predictor", "Result", "Design", "design_of", "scene_predictions", "trained_for"]
 
 Result = tuple[np.ndarray, np.ndarray] | str
 Design = tuple[float, float, int]  # (h, l, m)
@@ -208,3 +209,23 @@ class Predictor:
                 phi_hat[ok] = [g[1] for g in got]
             out[name] = (r_hat, phi_hat)
         return out
+
+
+def scene_predictions(
+    scene: Scene, state: SceneState, predictor: Predictor | None = None
+) -> dict[str, Result]:
+    """Each of the scene's estimators on its in-domain features (:meth:`Predictor.predict`):
+    name -> (r_hat, phi_hat) per feature (NaN outside the domain) or a one-line reason;
+    {} when the scene does not show the predictions layer or has no feature.
+
+    The one function that computes a scene's predictions: :class:`eyeviz.model.app_model.
+    AppModel` caches its answer, :func:`eyeviz.model.frame.build_frame` carries it in the
+    Frame, and the renderers draw the Frame. ``state`` without the intervals or the readout
+    is recomputed for them; ``predictor`` (a new one when None) keeps the estimators loaded.
+    """
+    if not scene.shows("predictions") or not scene.features:
+        return {}
+    if state.LA is None or state.in_bfv is None:
+        state = compute_state(scene, ["predictions"])
+    predictor = Predictor() if predictor is None else predictor
+    return predictor.predict(scene, state)

@@ -36,9 +36,9 @@ from eyeviz import EyevizError
 from eyeviz.core.geometry import EyePair
 from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
+from eyeviz.model.layers import layer_names
 
 __all__ = [
-    "LAYERS",
     "OKABE_ITO",
     "TRAJECTORY_KINDS",
     "Eyes",
@@ -53,20 +53,6 @@ __all__ = [
     "save",
 ]
 
-LAYERS = (
-    "eyes",
-    "bfv",
-    "features",
-    "bitmaps",
-    "readout",
-    "tangents",
-    "sectors",
-    "labels",
-    "predictions",
-    "ambiguity",
-    "posterior",
-    "trajectory",
-)
 TRAJECTORY_KINDS = ("horizontal", "circular", "vertical")
 # Okabe & Ito (2008) colour-blind-safe palette, black left out (it is the eyes' ink).
 OKABE_ITO = ("#D55E00", "#0072B2", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#F0E442")
@@ -313,9 +299,10 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
     layers_t = c.table(doc, "layers")
     c.keys(layers_t, "layers.", ("show",))
     layers = c.strings(layers_t, "show", "layers.", DEFAULT_LAYERS)
+    known = layer_names()  # the layer table (eyeviz.model.layers), registered layers too
     for name in layers:
-        if name not in LAYERS:
-            raise c.fail("layers.show", f"unknown layer {name!r} (known: {', '.join(LAYERS)})")
+        if name not in known:
+            raise c.fail("layers.show", f"unknown layer {name!r} (known: {', '.join(known)})")
     if len(set(layers)) != len(layers):
         raise c.fail("layers.show", "a layer is named twice")
 

@@ -22,14 +22,10 @@ import numpy as np
 
 from eyeviz.core import single
 from eyeviz.core.geometry import EyePair, intervals_to_bitmap
+from eyeviz.model.layers import needs_of
 from eyeviz.model.scene import Scene
 
 __all__ = ["SceneState", "compute_state", "owners", "update_state"]
-
-# Layers that need the lit intervals; the ownership arrays; the per-feature readout.
-_NEED_INTERVALS = {"eyes", "bitmaps", "sectors", "readout", "labels", "predictions", "ambiguity"}
-_NEED_OWNERS = {"eyes"}
-_NEED_READOUT = {"readout", "labels", "predictions", "tangents", "ambiguity", "features", "sectors"}
 
 
 @dataclass
@@ -108,9 +104,10 @@ def _polar(x: np.ndarray, y: np.ndarray, cx: float) -> tuple[np.ndarray, np.ndar
 
 
 def _needs(layers) -> tuple[bool, bool, bool]:
-    """Whether ``layers`` need the intervals, the owner arrays, the readout."""
-    shown = set(layers)
-    return bool(shown & _NEED_INTERVALS), bool(shown & _NEED_OWNERS), bool(shown & _NEED_READOUT)
+    """Whether ``layers`` need the intervals, the owner arrays, the readout (each layer's
+    ``needs`` in the layer table, :mod:`eyeviz.model.layers`)."""
+    need = needs_of(layers)
+    return "intervals" in need, "owners" in need, "readout" in need
 
 
 def compute_state(scene: Scene, layers=None) -> SceneState:

@@ -71,15 +71,20 @@ def test_turning_the_posterior_layer_on_draws_the_cells(make_window, monkeypatch
 
 
 def test_a_drag_computes_the_posterior_once_per_key(make_window, monkeypatch):
-    from eyeviz.render.vtk import posterior as vtk_post
-
     win = make_window(scene())
     win.model.set_layer("posterior", True)
     win.model.select(0)
     calls, seen = [], []
-    real, real_key = post_mod._compute, vtk_post.key_of
+    real, painter = post_mod._compute, win.posterior_actors
     monkeypatch.setattr(post_mod, "_compute", lambda *a: calls.append(a[1]) or real(*a))
-    monkeypatch.setattr(vtk_post, "key_of", lambda *a: seen.append(real_key(*a)) or seen[-1])
+    draw = painter.draw
+
+    def spy(frame, selected):  # the key of each posterior the view is handed
+        post = frame.posterior.get(selected)
+        seen.append(None if post is None else post.key)
+        draw(frame, selected)
+
+    monkeypatch.setattr(painter, "draw", spy)
     post_mod._CACHE.clear()
     x0 = win.model.scene.features[0].x
     start = pixel_of(win, x0, 2500.0)

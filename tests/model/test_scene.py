@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from eyeviz import EyevizError
+from eyeviz.model.layers import layer_names
 from eyeviz.model.scene import (
-    LAYERS,
     Eyes,
     Feature,
     Scene,
@@ -45,7 +45,7 @@ g = 20.0
 @pytest.mark.parametrize("name", ["default", "figure2", "figure3b", "figure5"])
 def test_shipped_scenes_load_and_round_trip(name, tmp_path):
     s = load(SCENES / f"{name}.toml")
-    assert s.features and set(s.layers) <= set(LAYERS)
+    assert s.features and set(s.layers) <= set(layer_names())
     out = tmp_path / "s.toml"
     save(s, out)
     assert load(out) == s

@@ -144,7 +144,7 @@ def test_tangents_touch_the_feature_and_sectors_bound_the_lit_interval(rig):
         assert angles == pytest.approx([(k * gamma) % (2 * math.pi) for k in range(L, R + 2)])
     sc.layers.remove("tangents")
     act.update(sc, compute_state(sc), 0)
-    assert not act.overlay_actors["tangents"][0].GetVisibility()
+    assert not act.tangents.actors[0].GetVisibility()
 
 
 def test_inset_is_a_small_bottom_left_corner():

@@ -83,7 +83,7 @@ def test_discs_labels_and_selection_are_the_frames_arrays(rig):
     # eye labels are built from the Frame too (rebuild with a shifted anchor)
     fr2 = view_frame(sc, compute_state(sc), 0)
     fr2.labels[0].x += 3.0
-    act._eyes_key = None
+    act.labels._eyes_key = None
     act.draw(fr2, 0)
     eye_pos = [t.GetPosition()[0] for t in act.labels.main_eye_labels]
     assert eye_pos[0] == pytest.approx(fr2.labels[0].x)

@@ -1,4 +1,4 @@
-"""The layers panel: one check box per layer of the scene."""
+"""The layers panel: one check box per layer of the layer table (its help as the tip)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from PyQt5 import QtWidgets
 
 from eyeviz.app.panels.common import _Unelide
 from eyeviz.model.app_model import AppModel
-from eyeviz.model.scene import LAYERS
+from eyeviz.model.layers import LAYERS
 
 
 class LayersPanel(QtWidgets.QWidget):
@@ -19,8 +19,10 @@ class LayersPanel(QtWidgets.QWidget):
         self.installEventFilter(self._unelide)
         grid = QtWidgets.QGridLayout(self)
         self.boxes: dict[str, QtWidgets.QCheckBox] = {}
-        for i, name in enumerate(LAYERS):
+        for i, spec in enumerate(LAYERS):
+            name = spec.name
             b = QtWidgets.QCheckBox(name)
+            b.setToolTip(spec.help)
             b.toggled.connect(lambda on, n=name: self._toggled(n, on))
             grid.addWidget(b, i // 2, i % 2)
             self.boxes[name] = b

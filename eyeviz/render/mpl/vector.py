@@ -2,11 +2,13 @@
 
 :func:`figure` builds the scene's :class:`eyeviz.model.frame.Frame` (every derived
 quantity: tangents, sectors, the BFV wedge, runs, readout, predictions, ambiguity,
-trajectory) and hands it to one small painter per layer (:mod:`eyeviz.render.mpl.layers`);
-no geometry is computed here. SVG and PDF hold one path per ommatidium (Figure 2), feature
-disc and the BFV wedge (Definition 2), with text kept as text (never below 6 pt). The
-layout (:mod:`eyeviz.render.mpl.layout`) follows the width: a journal column (3.5 in), a
-double column (7.2 in) or any width between 3 and 10 in.
+trajectory) and hands it to the matplotlib painter of each layer shown, in the layer
+table's order (:mod:`eyeviz.model.layers`; the painters are in
+:mod:`eyeviz.render.mpl.layers`); no geometry and no prediction is computed here. SVG and
+PDF hold one path per ommatidium (Figure 2), feature disc and the BFV wedge (Definition
+2), with text kept as text (never below 6 pt). The layout (:mod:`eyeviz.render.mpl.layout`)
+follows the width: a journal column (3.5 in), a double column (7.2 in) or any width
+between 3 and 10 in.
 
 matplotlib is imported when this module is; callers that must stay light import it late.
 """
@@ -19,32 +21,13 @@ from matplotlib.figure import Figure
 
 from eyeviz import EyevizError
 from eyeviz.model.frame import build_frame, runs, state_for
+from eyeviz.model.layers import ordered, resolve
 from eyeviz.model.palette import estimator_colors
+from eyeviz.model.predictor import Predictor
 from eyeviz.model.scene import Scene
-from eyeviz.model.state import SceneState, compute_state
+from eyeviz.model.state import SceneState
 from eyeviz.render.mpl.bounded import bound_figure
 from eyeviz.render.mpl.canvas import make_canvas
-from eyeviz.render.mpl.layers import (
-    ambiguity,
-    bfv,
-    eyes,
-    features,
-    sectors,
-    tangents,
-    trajectory,
-)
-from eyeviz.render.mpl.layers import (
-    bitmaps as bitmaps_layer,
-)
-from eyeviz.render.mpl.layers import (
-    posterior as posterior_layer,
-)
-from eyeviz.render.mpl.layers import (
-    predictions as predictions_layer,
-)
-from eyeviz.render.mpl.layers import (
-    table as table_layer,
-)
 from eyeviz.render.mpl.layout import ASPECT, ASPECT_RANGE, interval_lanes, layout
 from eyeviz.render.mpl.style import (
     BASE_DPI,
@@ -66,7 +49,7 @@ __all__ = [
     "eye_runs",
     "figure",
     "interval_lanes",
-    "predict_scene",
+    "refuse_unloadable",
     "resolve_width",
 ]
 
@@ -132,24 +115,22 @@ def check_drawable(scene: Scene) -> None:
                 )
 
 
-def predict_scene(scene: Scene, state: SceneState, predictor=None) -> dict:
-    """Each of the scene's estimators on the in-domain features' Omega bitmaps (m/2 each).
-
-    Returns name -> (r_hat, phi_hat) per feature (NaN outside the networks' domain) or
-    name -> a one-line reason when it cannot answer for this scene (another m, say). An
-    estimator that cannot be loaded at all is an :class:`EyevizError`, for the CLI and
-    the app's export alike (its message never goes into a figure).
-    """
-    from eyeviz.model.predictor import Predictor
-
-    if state.LA is None or state.in_bfv is None:
-        state = compute_state(scene, ["bitmaps", "readout"])
-    predictor = Predictor() if predictor is None else predictor
-    for name in scene.estimators:
-        est = predictor.estimator(name)
-        if isinstance(est, str):
-            _refuse(name, est)
-    return predictor.predict(scene, state)
+def refuse_unloadable(scene: Scene, predictor: Predictor, predictions: dict | None) -> None:
+    """EyevizError (one line) when the scene shows predictions and one of its estimators
+    cannot be loaded at all, for the CLI and the app's export alike (that message never
+    goes into a figure; an estimator that cannot answer for these eyes is drawn as its
+    reason). ``predictions`` given: their "unavailable" answers are refused."""
+    if not scene.shows("predictions") or not scene.features:
+        return
+    if predictions is None:
+        for name in scene.estimators:
+            est = predictor.estimator(name)
+            if isinstance(est, str):
+                _refuse(name, est)
+        return
+    for name, res in predictions.items():
+        if isinstance(res, str) and res.startswith("unavailable"):
+            _refuse(name, res)
 
 
 def _refuse(name: str, reason: str) -> None:
@@ -216,18 +197,10 @@ def figure(
     if drop:
         scene = scene.copy()
         scene.layers = [k for k in scene.layers if k not in drop]
-    state = compute_state(scene) if state is None else state
-    lay_names = set(scene.layers)
-    if "predictions" in lay_names and scene.features:
-        if predictions is None:
-            if state.LA is None or state.in_bfv is None:
-                state = compute_state(scene)
-            predictions = predict_scene(scene, state, predictor)
-        else:
-            for name, res in predictions.items():
-                if isinstance(res, str) and res.startswith("unavailable"):
-                    _refuse(name, res)
     state = state_for(scene, state)
+    lay_names = set(scene.layers)
+    predictor = Predictor() if predictor is None else predictor
+    refuse_unloadable(scene, predictor, predictions)
     n_est = len(scene.estimators)
     cx, cy = scene.view.center
     with matplotlib.rc_context(RC):
@@ -248,30 +221,8 @@ def figure(
         rect = (cx - vw / 2, cx + vw / 2, cy - vh / 2, cy + vh / 2)
         fr = build_frame(scene, state, predictor, rect=rect, predictions=predictions)
         cv = make_canvas(scene, fr, lay0, dpi, merge, title)
-        if "bfv" in lay_names:
-            bfv.paint(cv)
-        if "sectors" in lay_names:
-            sectors.paint(cv)
-        if "eyes" in lay_names:
-            eyes.paint(cv)
-        if "tangents" in lay_names:
-            tangents.paint(cv)
-        if "ambiguity" in lay_names:
-            ambiguity.paint(cv)
-        if "trajectory" in lay_names:
-            trajectory.paint(cv)
-        if "features" in lay_names:
-            features.paint(cv)
-        if "predictions" in lay_names:
-            predictions_layer.paint(cv)
-        if "posterior" in lay_names:
-            posterior_layer.paint(cv)  # after predictions: it extends their legend
-        if "labels" in lay_names:
-            features.labels(cv)
-        if "bitmaps" in lay_names:
-            bitmaps_layer.paint(cv)
-        if "readout" in lay_names:
-            table_layer.paint(cv)
+        for spec in ordered("mpl", lay_names):  # the layer table, in its matplotlib order
+            resolve(spec.mpl)(cv)
         bound_figure(cv.fig)  # nothing Agg/FreeType cannot raster in bounded time
         cv.fig._eyeviz_rc = dict(RC)  # savefig must run under the same rc (fonttype)
         cv.fig._eyeviz_merged = cv.merged

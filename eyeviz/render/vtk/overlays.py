@@ -1,10 +1,11 @@
-"""Issue 6 layers in the app's main view: prediction ghosts, ambiguity region, trajectory.
+"""The "overlay"-stage layers of the layer table in the app's main view (prediction
+ghosts, the ambiguity region, the trajectory path, and any such layer registered).
 
 :class:`OverlayActors` builds one :class:`eyeviz.model.frame.Frame` of these layers from
 what the app model already holds (predictions, the selected feature's ambiguity region,
-the trajectory path) and hands it to the layer painters in
-:mod:`eyeviz.render.vtk.layers` (``predictions``, ``ambiguity``, ``trajectory``), which
-draw only the Frame. Nothing is drawn for a layer the scene does not show.
+the trajectory path) and hands it to each layer's VTK painter
+(:mod:`eyeviz.render.vtk.layers`), which draws only the Frame. Nothing is drawn for a
+layer the scene does not show.
 """
 
 from __future__ import annotations
@@ -15,8 +16,10 @@ import numpy as np
 from vtkmodules.vtkRenderingCore import vtkRenderer
 
 from eyeviz.model.frame import Frame, TrajectoryPath, build_frame
+from eyeviz.model.layers import ordered
 from eyeviz.model.scene import Scene
 from eyeviz.model.state import SceneState
+from eyeviz.render.vtk.layers import Painter, painters
 from eyeviz.render.vtk.layers.ambiguity import AmbiguityLayer
 from eyeviz.render.vtk.layers.predictions import GHOST_N, PredictionsLayer
 from eyeviz.render.vtk.layers.trajectory import TrajectoryLayer
@@ -24,7 +27,9 @@ from eyeviz.render.vtk.style import Z_AMBIGUITY
 
 __all__ = ["OverlayActors", "Z_AMBIGUITY", "GHOST_N", "overlay_frame"]
 
-_LAYERS = ("predictions", "ambiguity", "trajectory")
+
+def _overlay_layers() -> set[str]:
+    return {s.name for s in ordered("vtk") if s.vtk_stage == "overlay"}
 
 
 def overlay_frame(
@@ -36,8 +41,9 @@ def overlay_frame(
     path: TrajectoryPath | None,
 ) -> Frame:
     """The Frame of the overlay layers, with the app model's cached parts taken as given."""
+    overlay = _overlay_layers()
     light = dataclasses.replace(
-        scene, layers=[n for n in scene.layers if n in _LAYERS], trajectory=None
+        scene, layers=[n for n in scene.layers if n in overlay], trajectory=None
     )
     return build_frame(
         light,
@@ -53,15 +59,10 @@ class OverlayActors:
     """Prediction ghosts (rings at (r_hat, phi_hat) joined to the truth), the selected
     feature's ambiguity polygon and the trajectory path, in the main renderer."""
 
-    def __init__(self, main: vtkRenderer):
+    def __init__(self, main: vtkRenderer, inset: vtkRenderer | None = None):
         self.main = main
-        self.predictions = PredictionsLayer(main)
-        self.ambiguity = AmbiguityLayer(main)
-        self.trajectory = TrajectoryLayer(main)
-        for layer in (self.ambiguity, self.trajectory, self.predictions):
-            for a in layer.actors:
-                a.SetVisibility(False)
-                main.AddActor(a)
+        self.painters: dict[str, Painter] = painters("overlay", main, inset)
+        self._names = set(self.painters)
         self.frame: Frame | None = None  # the Frame drawn last
         self._inputs: tuple | None = None  # what update() built it from
 
@@ -76,13 +77,13 @@ class OverlayActors:
         skip=frozenset(),
     ) -> Frame | None:
         """Build the overlay Frame and draw it; returns the Frame (None, and everything
-        hidden, when the scene shows none of these layers: a drag builds nothing then)."""
-        if not any(n in _LAYERS for n in scene.layers):
-            for layer in (self.ambiguity, self.trajectory):
-                for a in layer.actors:
-                    a.SetVisibility(False)
-            self.predictions.hide()
-            self.ambiguity.polygon = None
+        hidden, when the scene shows none of these layers: a drag builds only a Frame
+        without layers then)."""
+        if not self._names & set(scene.layers):
+            # none of these layers: each painter hides (a Frame without layers)
+            none = build_frame(dataclasses.replace(scene, layers=[], trajectory=None), state)
+            for p in self.painters.values():
+                p.draw(none, selected)
             self._inputs = None
             return None
         # the same inputs (a refresh that changed nothing here: a selection, a panel, the
@@ -115,9 +116,21 @@ class OverlayActors:
 
     def _draw(self, frame: Frame, selected: int | None, skip) -> None:
         self.frame = frame
-        self.predictions.update(frame, skip)
-        self.ambiguity.update(frame, selected)
-        self.trajectory.update(frame)
+        self.predictions.skip = frozenset(skip)
+        for p in self.painters.values():
+            p.draw(frame, selected)
+
+    @property
+    def predictions(self) -> PredictionsLayer:
+        return self.painters["predictions"]  # type: ignore[return-value]
+
+    @property
+    def ambiguity(self) -> AmbiguityLayer:
+        return self.painters["ambiguity"]  # type: ignore[return-value]
+
+    @property
+    def trajectory(self) -> TrajectoryLayer:
+        return self.painters["trajectory"]  # type: ignore[return-value]
 
     # --- what the tests and the window read -------------------------------------------
     @property

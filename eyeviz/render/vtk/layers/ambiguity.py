@@ -28,15 +28,21 @@ class AmbiguityLayer:
     """One fill and one outline mesh, made once: a new polygon is written into them (the
     mappers' inputs are never replaced); an unchanged polygon and colour write nothing."""
 
-    def __init__(self, main):
+    def __init__(self, main, inset):
         self.fill = pv.PolyData()
         self.line = pv.PolyData()
         self.amb_fill = actor(self.fill)
         self.amb_line = actor(self.line)
         self.amb_line.GetProperty().SetLineWidth(3.5)
         self.actors = (self.amb_fill, self.amb_line)
+        for a in self.actors:
+            a.SetVisibility(False)
+            main.AddActor(a)
         self.polygon: np.ndarray | None = None
         self._key: tuple | None = None
+
+    def draw(self, frame: Frame, selected: int | None) -> None:
+        self.update(frame, selected)
 
     def update(self, frame: Frame, selected: int | None) -> None:
         amb = frame.ambiguity.get(selected) if selected is not None else None

@@ -78,6 +78,16 @@ class EyesLayer:
         self._palette: np.ndarray | None = None
         self._pooled: dict[tuple[int, int], np.ndarray] = {}
         self._colors: tuple[str, ...] = ()
+        self._key: tuple | None = None
+
+    def draw(self, frame: Frame, selected: int | None) -> None:
+        """New meshes when the eyes (h, l, m) or the layers changed, then the colours."""
+        pair = frame.pair
+        key = (pair.h, pair.l, pair.m, tuple(sorted(frame.layers)))
+        if key != self._key:
+            self.build(frame)
+            self._key = key
+        self.update(frame)
 
     def build(self, frame: Frame) -> None:
         """New meshes (the eyes' h, l, m or the layers changed)."""

@@ -45,9 +45,10 @@ __all__ = ["FeaturesLayer"]
 class FeaturesLayer:
     """The merged discs of the unselected features and the selected one's live actors."""
 
-    def __init__(self, main):
+    def __init__(self, main, inset):
         self.main = main
         self.store = Store()
+        self._key: tuple | None = None
         self.fill_mesh: pv.PolyData | None = None
         self.line_mesh: pv.PolyData | None = None
         self.centers_mesh: pv.PolyData | None = None
@@ -80,7 +81,17 @@ class FeaturesLayer:
         main.AddActor(self.sel_actor)
         main.AddActor(self.handle_actor)
         main.AddActor(self.sight_actors[0])
+        inset.AddActor(self.sight_actors[1])  # the sight lines reach the eyes in the inset
         self._feat_rgb = self._rgb_now = (np.zeros((0, 3), np.uint8), np.zeros((0, 3), np.uint8))
+
+    def draw(self, frame: Frame, selected: int | None) -> None:
+        """New meshes when the features' names or colours or the layers changed; then the
+        discs' points and colours and the selected feature's actors."""
+        key = (tuple(frame.names), tuple(frame.colors), tuple(sorted(frame.layers)))
+        if key != self._key:
+            self.build(frame)
+            self._key = key
+        self.update(frame, selected)
 
     def build(self, frame: Frame) -> None:
         """New merged meshes (the features' names or colours, or the layers, changed)."""

@@ -49,6 +49,24 @@ class LabelsLayer:
         inset.AddViewProp(self.inset_label)
         self.inset_border = border_actor()
         inset.AddViewProp(self.inset_border)
+        self._eyes_key: tuple | None = None
+        self._feat_key: tuple | None = None
+
+    def draw(self, frame: Frame, selected: int | None) -> None:
+        """Eye labels and the BFV line when the eyes or the layers changed, feature labels
+        when the features' names or colours did; then the labels' places. Runs whatever
+        the layers (the BFV line "m = ..." is always shown; the names with ``labels``)."""
+        layers = tuple(sorted(frame.layers))
+        pair = frame.pair
+        eyes_key = (pair.h, pair.l, pair.m, layers)
+        feat_key = (tuple(frame.names), tuple(frame.colors), layers)
+        if eyes_key != self._eyes_key:
+            self.build_eyes(frame)
+            self._eyes_key = eyes_key
+        if feat_key != self._feat_key:
+            self.build_features(frame)
+            self._feat_key = feat_key
+        self.update(frame, selected)
 
     def build_eyes(self, frame: Frame) -> None:
         """Eye and origin labels and the BFV line (the eyes or the layers changed)."""

@@ -59,9 +59,10 @@ class PredictionsLayer:
 
     Read by tests: ``builds`` counts structure rebuilds (new cells and colours) and
     ``written`` holds, per estimator, the features whose ring the last update wrote.
+    ``skip``: estimators that draw no ring (made for other eyes; the view sets it).
     """
 
-    def __init__(self, main):
+    def __init__(self, main, inset):
         self.ghost_mesh = pv.PolyData()
         self.ghost_actor = actor(self.ghost_mesh, rgb=True)
         self.ghost_actor.GetProperty().SetLineWidth(3.0)
@@ -73,6 +74,10 @@ class PredictionsLayer:
         mapper = self.ghost_point_actor.GetMapper()
         mapper.SetScalarModeToUsePointFieldData()
         self.actors = (self.ghost_actor, self.ghost_point_actor)
+        for a in self.actors:
+            a.SetVisibility(False)
+            main.AddActor(a)
+        self.skip: frozenset[str] = frozenset()
         self.ghosts: dict[str, np.ndarray] = {}  # estimator -> (n, 2) ghost centres (NaN: none)
         self.builds = 0
         self.written: dict[str, np.ndarray] = {}
@@ -80,6 +85,9 @@ class PredictionsLayer:
         self._geo: dict[str, np.ndarray] = {}  # name -> (k, 5) rows drawn (see _blocks)
         self._view = np.zeros((0, 3))  # the line mesh's points
         self._cview = np.zeros((0, 3))  # the centre mesh's points
+
+    def draw(self, frame: Frame, selected: int | None) -> None:
+        self.update(frame, self.skip)
 
     def hide(self) -> None:
         """Nothing drawn (the next update rebuilds)."""

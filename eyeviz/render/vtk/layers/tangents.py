@@ -1,5 +1,6 @@
 """``tangents``: the selected feature's tangents from each eye centre to the tangent points
-(:class:`eyeviz.model.frame.TangentFrame`, Prop. 2, Figure 3b) and their angles as text."""
+(:class:`eyeviz.model.frame.TangentFrame`, Prop. 2, Figure 3b), in the main view and the
+inset, and their angles as a screen-space note under the title (never over the rays)."""
 
 from __future__ import annotations
 
@@ -9,19 +10,38 @@ import numpy as np
 import pyvista as pv
 
 from eyeviz.model.frame import Frame
-from eyeviz.render.vtk.primitives import write_points
+from eyeviz.render.vtk.primitives import actor, screen_text, write_points
+from eyeviz.render.vtk.style import INK, Z_LINE
 
-__all__ = ["TangentPainter"]
+__all__ = ["TangentsLayer"]
 
 
-class TangentPainter:
-    """The selected feature's four tangent segments, eye centre -> tangent point."""
+class TangentsLayer:
+    """The selected feature's four tangent segments, eye centre -> tangent point (one mesh,
+    its points written in place)."""
 
-    def __init__(self, z: float):
-        self.z = z
+    def __init__(self, main, inset):
+        self.z = Z_LINE
         self.mesh = pv.PolyData(np.zeros((6, 3)), lines=[2, 0, 1, 2, 0, 2, 2, 3, 4, 2, 3, 5])
         self.text = ""
         self.shown = False
+        self.actors = []
+        for ren in (main, inset):
+            a = actor(self.mesh, INK)
+            a.GetProperty().SetLineWidth(2.5)
+            ren.AddActor(a)
+            self.actors.append(a)
+        self.text_actor = screen_text(20, INK, (0.015, 0.90), top=True)
+        main.AddViewProp(self.text_actor)
+
+    def draw(self, frame: Frame, selected: int | None) -> None:
+        ok = selected is not None and 0 <= selected < frame.n and "tangents" in frame.layers
+        show = ok and self.update(frame, selected)
+        for a in self.actors:
+            a.SetVisibility(show)
+        self.text_actor.SetVisibility(show and bool(self.text))
+        if show and self.text:
+            self.text_actor.SetInput(self.text)
 
     def update(self, frame: Frame, selected: int | None) -> bool:
         """Write the points; returns whether there is anything to show."""

@@ -13,12 +13,19 @@ __all__ = ["TrajectoryLayer"]
 
 
 class TrajectoryLayer:
-    def __init__(self, main):
+    """The path as one polyline, in the main view (rebuilt when the path changes)."""
+
+    def __init__(self, main, inset):
         self.path_actor = actor(pv.PolyData(), INK)
         self.path_actor.GetProperty().SetLineWidth(2.5)
         self.actors = (self.path_actor,)
+        self.path_actor.SetVisibility(False)
+        main.AddActor(self.path_actor)
         self.mesh: pv.PolyData | None = None
         self._key: tuple | None = None
+
+    def draw(self, frame: Frame, selected: int | None) -> None:
+        self.update(frame)
 
     def update(self, frame: Frame) -> None:
         path = frame.trajectory

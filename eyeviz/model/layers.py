@@ -1,0 +1,279 @@
+"""The layer table: one entry per layer, read by the scene file, the state, the Frame and
+both renderers (docs/architecture.md, "The layer table"; napari's layer-to-visual map).
+
+A :class:`LayerSpec` says everything about one layer: its name and one-line help, what it
+needs from the state (:data:`NEEDS`: the lit intervals, the per-ommatidium owners, the
+per-feature readout), the function that builds its part of the
+:class:`eyeviz.model.frame.Frame`, its matplotlib painter, its VTK painter, and its draw
+order in each renderer. ``build_frame``, ``compute_state``, the vector figure and the VTK
+view iterate :data:`LAYERS`; the scene file accepts exactly its names. A new layer is one
+module (a frame builder and its painters) and one :func:`register_layer` call.
+
+Builders and painters are named by ``"module:attribute"`` strings resolved on first use
+(:func:`resolve`), so this module imports nothing of eyeviz: the model never imports a
+renderer, and a matplotlib-only export never imports VTK. A callable is accepted too (a
+layer defined in a test or a notebook).
+
+Hooks (each optional):
+
+- ``frame(frame, inputs) -> None`` fills the layer's part of the Frame from
+  :class:`eyeviz.model.frame.FrameInputs` (a layer of its own puts it in
+  ``frame.parts[name]``); run only when the scene shows the layer.
+- ``mpl(canvas) -> None`` paints the part on a :class:`eyeviz.render.mpl.canvas.Canvas`.
+- ``vtk``: a class made once per view as ``cls(main_renderer, inset_renderer)`` whose
+  ``draw(frame, selected)`` draws the part (and hides its actors when the layer is off).
+  ``vtk_stage`` says which Frame it gets in the app: ``"scene"`` (built from the state at
+  each update) or ``"overlay"`` (the parts the app model caches: predictions, the
+  selected feature's ambiguity region, the trajectory path).
+
+>>> from eyeviz.model.layers import layer, layer_names
+>>> layer("tangents").needs
+frozenset({'readout'})
+>>> "bfv" in layer_names()
+True
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+__all__ = [
+    "LAYERS",
+    "NEEDS",
+    "LayerSpec",
+    "Ref",
+    "layer",
+    "layer_names",
+    "needs_of",
+    "ordered",
+    "register_layer",
+    "resolve",
+    "unregister_layer",
+]
+
+#: What a layer can need from the state (:func:`eyeviz.model.state.compute_state`).
+NEEDS = ("intervals", "owners", "readout")
+#: How the app's VTK view feeds a painter (see the module docstring).
+VTK_STAGES = ("scene", "overlay")
+
+Ref = str | Callable[..., Any]  # "package.module:attribute", or the object itself
+
+
+@dataclass(frozen=True)
+class LayerSpec:
+    """One layer: what it needs, how its Frame part is built and how it is painted."""
+
+    name: str
+    help: str
+    needs: frozenset[str] = field(default_factory=frozenset)
+    frame: Ref | None = None
+    mpl: Ref | None = None
+    vtk: Ref | None = None
+    mpl_order: float = 0.0
+    vtk_order: float = 0.0
+    vtk_stage: str = "scene"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.isidentifier():
+            raise ValueError(f"name must be an identifier, got {self.name!r}")
+        if not isinstance(self.help, str) or not self.help.strip() or "\n" in self.help:
+            raise ValueError(f"help must be one non-empty line, got {self.help!r}")
+        needs = frozenset(self.needs)
+        bad = sorted(needs - set(NEEDS))
+        if bad:
+            raise ValueError(f"needs must be among {', '.join(NEEDS)}, got {', '.join(bad)}")
+        object.__setattr__(self, "needs", needs)
+        if self.vtk_stage not in VTK_STAGES:
+            raise ValueError(f"vtk_stage must be 'scene' or 'overlay', got {self.vtk_stage!r}")
+
+
+_F, _M, _V = "eyeviz.model.frame:", "eyeviz.render.mpl.layers.", "eyeviz.render.vtk.layers."
+
+#: The table, in the order the scene file and the app's Layers panel list the layers.
+#: ``bitmaps`` and ``readout`` have no VTK painter: the app draws them in Qt panels.
+LAYERS: list[LayerSpec] = [
+    LayerSpec(
+        "eyes",
+        "the two eyes' ommatidia, lit in the colour of the feature they see (Figure 2)",
+        needs=frozenset({"intervals", "owners"}),
+        frame=_F + "build_eyes",
+        mpl=_M + "eyes:paint",
+        vtk=_V + "eyes:EyesLayer",
+        mpl_order=30,
+        vtk_order=10,
+    ),
+    LayerSpec(
+        "bfv",
+        "the binocular field of view: the wedge both eyes see (Definition 2)",
+        frame=_F + "build_bfv",
+        mpl=_M + "bfv:paint",
+        vtk=_V + "bfv:BFVLayer",
+        mpl_order=10,
+        vtk_order=5,
+    ),
+    LayerSpec(
+        "features",
+        "the circular features (discs), grey outside the estimators' domain",
+        needs=frozenset({"readout"}),
+        mpl=_M + "features:paint",
+        vtk=_V + "features:FeaturesLayer",
+        mpl_order=70,
+        vtk_order=20,
+    ),
+    LayerSpec(
+        "bitmaps",
+        "each eye's bitmap as a strip of lit ommatidia",
+        needs=frozenset({"intervals"}),
+        frame=_F + "build_eyes",
+        mpl=_M + "bitmaps:paint",
+        mpl_order=110,
+    ),
+    LayerSpec(
+        "readout",
+        "the table of each feature's r, phi, lit intervals and predictions",
+        needs=frozenset({"intervals", "readout"}),
+        mpl=_M + "table:paint",
+        mpl_order=120,
+    ),
+    LayerSpec(
+        "tangents",
+        "the tangents from each eye centre to a feature's disc (Prop. 2, Figure 3b)",
+        needs=frozenset({"readout"}),
+        frame=_F + "build_tangents",
+        mpl=_M + "tangents:paint",
+        vtk=_V + "tangents:TangentsLayer",
+        mpl_order=40,
+        vtk_order=40,
+    ),
+    LayerSpec(
+        "sectors",
+        "the ommatidium sectors a feature's lit interval spans (Eq. 8, 11)",
+        needs=frozenset({"intervals", "readout"}),
+        frame=_F + "build_sectors",
+        mpl=_M + "sectors:paint",
+        vtk=_V + "sectors:SectorsLayer",
+        mpl_order=20,
+        vtk_order=45,
+    ),
+    LayerSpec(
+        "labels",
+        "the names of the eyes, the origin and the features",
+        needs=frozenset({"intervals", "readout"}),
+        frame=_F + "build_labels",
+        mpl=_M + "features:labels",
+        vtk=_V + "labels:LabelsLayer",
+        mpl_order=100,
+        vtk_order=30,
+    ),
+    LayerSpec(
+        "predictions",
+        "each estimator's answer as a ghost disc joined to the true centre",
+        needs=frozenset({"intervals", "readout"}),
+        frame=_F + "build_predictions",
+        mpl=_M + "predictions:paint",
+        vtk=_V + "predictions:PredictionsLayer",
+        mpl_order=80,
+        vtk_order=80,
+        vtk_stage="overlay",
+    ),
+    LayerSpec(
+        "ambiguity",
+        "the region of centres that light the same ommatidia as a feature",
+        needs=frozenset({"intervals", "readout"}),
+        frame=_F + "build_ambiguity",
+        mpl=_M + "ambiguity:paint",
+        vtk=_V + "ambiguity:AmbiguityLayer",
+        mpl_order=50,
+        vtk_order=60,
+        vtk_stage="overlay",
+    ),
+    LayerSpec(
+        "posterior",
+        "the limit estimator's posterior over a feature's centre, shaded",
+        needs=frozenset({"intervals"}),
+        frame=_F + "build_posterior",
+        mpl=_M + "posterior:paint",
+        vtk=_V + "posterior:PosteriorLayer",
+        mpl_order=90,
+        vtk_order=90,
+    ),
+    LayerSpec(
+        "trajectory",
+        "a feature's path and the estimators' accuracy along it (Figure 14)",
+        frame=_F + "build_trajectory",
+        mpl=_M + "trajectory:paint",
+        vtk=_V + "trajectory:TrajectoryLayer",
+        mpl_order=60,
+        vtk_order=70,
+        vtk_stage="overlay",
+    ),
+]
+
+_RESOLVED: dict[str, Any] = {}
+
+
+def layer_names() -> tuple[str, ...]:
+    """The names of every layer, in table order."""
+    return tuple(s.name for s in LAYERS)
+
+
+def layer(name: str) -> LayerSpec:
+    """The entry of layer ``name``; KeyError (one line) for an unknown name."""
+    for s in LAYERS:
+        if s.name == name:
+            return s
+    raise KeyError(f"unknown layer {name!r} (known: {', '.join(layer_names())})")
+
+
+def register_layer(spec: LayerSpec) -> LayerSpec:
+    """Add ``spec`` to the table (after the others); ValueError if the name is taken."""
+    if not isinstance(spec, LayerSpec):
+        raise TypeError(f"spec must be a LayerSpec, got {type(spec).__name__}")
+    if spec.name in layer_names():
+        raise ValueError(f"a layer named {spec.name!r} is already registered")
+    LAYERS.append(spec)
+    return spec
+
+
+def unregister_layer(name: str) -> None:
+    """Remove layer ``name`` from the table (a test's layer, say)."""
+    LAYERS.remove(layer(name))
+
+
+def ordered(hook: str, shown: Iterable[str] | None = None) -> list[LayerSpec]:
+    """The entries with a ``hook`` ("frame", "mpl" or "vtk"), in that renderer's draw order
+    (``mpl_order`` / ``vtk_order``, then table order); only the names in ``shown`` if given."""
+    keep = None if shown is None else set(shown)
+    specs = [s for s in LAYERS if getattr(s, hook) is not None]
+    if keep is not None:
+        specs = [s for s in specs if s.name in keep]
+    key = {"mpl": "mpl_order", "vtk": "vtk_order"}.get(hook)
+    return specs if key is None else sorted(specs, key=lambda s: getattr(s, key))
+
+
+def needs_of(shown: Iterable[str]) -> frozenset[str]:
+    """What the layers ``shown`` need from the state (unknown names need nothing)."""
+    names = set(shown)
+    out: frozenset[str] = frozenset()
+    for s in LAYERS:
+        if s.name in names:
+            out |= s.needs
+    return out
+
+
+def resolve(ref: Ref | None) -> Any:
+    """The object a ``"module:attribute"`` string names (imported on first use), or ``ref``
+    itself when it is already an object; ValueError for a missing hook (None)."""
+    if ref is None:
+        raise ValueError("this layer has no such hook (None); iterate ordered(hook)")
+    if not isinstance(ref, str):
+        return ref
+    if ref not in _RESOLVED:
+        mod, sep, attr = ref.partition(":")
+        if not sep or not mod or not attr:
+            raise ValueError(f"a layer hook must read 'package.module:attribute', got {ref!r}")
+        _RESOLVED[ref] = getattr(importlib.import_module(mod), attr)
+    return _RESOLVED[ref]
