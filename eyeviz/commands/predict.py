@@ -100,7 +100,9 @@ def _reader(args, registry):
         if bad:
             raise EyevizError(
                 f"{path} has design {_design_text(*design)}, but "
-                + ", ".join(f"--{k} {v:g}" for k, v in bad.items())
+                + ", ".join(
+                    f"--{k} {v:g}" if isinstance(v, float) else f"--{k} {v}" for k, v in bad.items()
+                )
                 + " was given"
             )
         return reader, design

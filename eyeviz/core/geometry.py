@@ -19,13 +19,13 @@ over 400 lines because EyePair's public methods and the block-wise fast path the
 from __future__ import annotations
 
 import math
-import operator
 from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from eyeviz.core import bits, exact
+from eyeviz.core.bounds import check_m
 
 __all__ = ["EyePair", "intervals_to_bitmap", "validate_features", "validate_points"]
 
@@ -39,11 +39,6 @@ _Q_SAFE = 0.75  # g / r_E below this uses one scalar rounding bound per block
 _TOL_BASE = 64.0
 _TOL_GRAZE = 16.0
 
-#: Largest m: sector indices and the floors of Eq. 11 (|t| < m) are held in float64 and
-#: int64 and must be exact to the unit, so m <= 2^53. From about m = 2^45 the rounding
-#: bound of the fast path exceeds half a sector and every element takes the exact path:
-#: right, but slow. ``EyePair(..., m)`` refuses larger m with a one-line message.
-M_MAX = 2**53
 
 #: Diagnostics for the stability report: elements the fast path flagged near a boundary
 #: ("flagged") and those of them decided by the exact predicates ("exact").
@@ -122,7 +117,7 @@ class EyePair:
     ----------
     h : distance from the origin to each eye centre (eyes are 2h apart), h > l.
     l : eye radius (the ommatidium legs), l > 0.
-    m : ommatidia per eye, an even integer >= 4 (Eq. 6, 7).
+    m : ommatidia per eye, an even integer in [4, MAX_M] (Eq. 6, 7; eyeviz.core.bounds).
     """
 
     h: float = 40.0
@@ -139,19 +134,7 @@ class EyePair:
             raise ValueError(
                 f"h must be > l (eyes may not touch the y-axis), got h={self.h!r}, l={self.l!r}"
             )
-        m = self.m
-        bad_m = f"m must be an even integer >= 4 and <= {M_MAX} (2^53), got {_short(m)}"
-        if isinstance(m, bool):
-            raise ValueError(bad_m)
-        try:
-            mi = operator.index(m)
-        except TypeError:
-            if isinstance(m, float) and math.isfinite(m) and float(m).is_integer():
-                mi = int(m)
-            else:
-                raise ValueError(bad_m) from None
-        if mi < 4 or mi % 2 or mi > M_MAX:
-            raise ValueError(bad_m)
+        mi = check_m(self.m)  # the one bound of m (eyeviz.core.bounds.MAX_M)
         object.__setattr__(self, "h", h)
         object.__setattr__(self, "l", l)
         object.__setattr__(self, "m", mi)

@@ -6,7 +6,20 @@ eyeviz.EyevizError: m must be an even integer >= 4, got 7
 
 Every function returns the checked value converted (``float`` / ``int``) and raises
 :class:`eyeviz.EyevizError` (a ValueError) naming the parameter, the rule and the value.
-A forbidden value is refused, never clamped.
+A forbidden value is refused, never clamped. The bounds of the model (the largest m,
+nside, ...) live beside these checkers in :mod:`eyeviz.core.bounds`; the limits of files
+(bytes, rows, declared shapes) in :mod:`eyeviz.files.limits`.
+
+The integer rule, for every integer the package takes (API, CLI, scene and data files):
+an integer is a Python or numpy integer, or a float holding a whole number. JSON, TOML
+and numpy arrays hand numbers over as floats, so ``720.0`` is accepted as ``720``;
+``720.5``, NaN, inf, bools, strings and None are refused:
+
+>>> check_int("m", 720.0, ge=4, even=True)
+720
+>>> check_int("m", 720.5, ge=4, even=True)
+Traceback (most recent call last):
+eyeviz.EyevizError: m must be an even integer >= 4, got 720.5
 """
 
 from __future__ import annotations
@@ -17,19 +30,18 @@ from numbers import Integral, Real
 
 from eyeviz import EyevizError
 
-__all__ = ["check_real", "check_positive", "check_int", "check_choice"]
+__all__ = ["check_real", "check_positive", "check_int", "check_choice", "shown"]
+
+
+def _num(v: float) -> str:
+    return str(v) if isinstance(v, int) else f"{v:g}"
 
 
 def _rule(gt: float | None, ge: float | None, lt: float | None, le: float | None) -> str:
     parts = []
-    if gt is not None:
-        parts.append(f"> {gt:g}")
-    if ge is not None:
-        parts.append(f">= {ge:g}")
-    if lt is not None:
-        parts.append(f"< {lt:g}")
-    if le is not None:
-        parts.append(f"<= {le:g}")
+    for op, bound in ((">", gt), (">=", ge), ("<", lt), ("<=", le)):
+        if bound is not None:
+            parts.append(f"{op} {_num(bound)}")
     return " and ".join(parts)
 
 
@@ -47,16 +59,16 @@ def check_real(
     and values outside the bounds: "g_max must be a finite number > 0, got nan"."""
     rule = _rule(gt, ge, lt, le)
     what = "a finite number" if finite else "a number"
-    msg = f"{name} must be {what}{' ' + rule if rule else ''}, got {value!r}"
+    msg = f"{name} must be {what}{' ' + rule if rule else ''}, got {shown(value)}"
     if isinstance(value, bool) or not isinstance(value, Real | str):
         try:
             v = float(value)  # numpy 0-d arrays and the like
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise EyevizError(msg) from None
     else:
         try:
             v = float(value)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise EyevizError(msg) from None
     if isinstance(value, bool) or math.isnan(v) or (finite and math.isinf(v)):
         raise EyevizError(msg)
@@ -75,6 +87,31 @@ def check_positive(name: str, value) -> float:
     return check_real(name, value, gt=0)
 
 
+def shown(value) -> str:
+    """``repr(value)`` cut to one short line (an int of 10**5000 digits has no repr)."""
+    try:
+        text = repr(value)
+    except ValueError:  # an int beyond Python's int-to-str digit limit
+        return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
+    return text if len(text) <= 40 else f"{text[:20]}...({len(text)} characters)"
+
+
+def _as_int(value) -> int | None:
+    """``value`` as an int under the integer rule (module docstring); None if it is none."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, Integral):
+        return int(value)
+    if isinstance(value, Real):  # float, numpy floating, Fraction
+        try:
+            v = float(value)
+        except (OverflowError, ValueError):
+            return None
+        if math.isfinite(v) and v == value and v.is_integer():
+            return int(v)
+    return None
+
+
 def check_int(
     name: str,
     value,
@@ -83,16 +120,14 @@ def check_int(
     le: int | None = None,
     even: bool = False,
 ) -> int:
-    """``value`` as an int (bools and non-integral floats refused):
-    "m must be an even integer >= 4, got 7"."""
-    rule = _rule(None, ge, None, le)
-    msg = f"{name} must be {'an even' if even else 'an'} integer{' ' + rule if rule else ''}"
-    msg += f", got {value!r}"
-    if isinstance(value, bool) or not isinstance(value, Integral):
-        raise EyevizError(msg)
-    v = int(value)
-    if (ge is not None and v < ge) or (le is not None and v > le) or (even and v % 2):
-        raise EyevizError(msg)
+    """``value`` as an int: an integer, or a float holding a whole number (the integer
+    rule of the module docstring); anything else, or a value outside the bounds, is
+    refused: "m must be an even integer >= 4 and <= 1048576, got 7"."""
+    v = _as_int(value)
+    if v is None or (ge is not None and v < ge) or (le is not None and v > le) or (even and v % 2):
+        rule = _rule(None, ge, None, le)
+        what = "an even integer" if even else "an integer"
+        raise EyevizError(f"{name} must be {what}{' ' + rule if rule else ''}, got {shown(value)}")
     return v
 
 

@@ -39,9 +39,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from eyeviz import EyevizError
+from eyeviz.core.bounds import check_r_min, check_segments
 from eyeviz.core.domain import DEFAULTS, Domain
 from eyeviz.core.geometry import EyePair
 from eyeviz.core.validation import check_choice, check_int, check_real
+from eyeviz.dataset import io as dataset_io
 from eyeviz.dataset.records import CHUNK, PAPER_EYES, Chunk, Dataset
 from eyeviz.files import limits
 
@@ -139,8 +141,7 @@ def make_params(
     r_min = check_real("r_min", DEFAULTS["r_min"] if r_min is None else r_min, gt=0)
     r_max = check_real("r_max", DEFAULTS["r_max"] if r_max is None else r_max, gt=0)
     g_max = check_real("g_max", DEFAULTS["g_max"] if g_max is None else g_max, gt=0)
-    limits.check_r_min(r_min, eyes.h)
-    limits.check_m(eyes.m)
+    check_r_min(r_min, eyes.h)
     if r_min >= r_max:
         raise EyevizError(f"r_min must be < r_max, got r_min={r_min!r}, r_max={r_max!r}")
     check_choice("mode", mode, MODES)
@@ -158,12 +159,12 @@ def make_params(
             f"(m={eyes.m} too small for h={eyes.h:g}, l={eyes.l:g})"
         )
     if segments is not None:
-        segments = limits.check_segments(check_int("segments", segments, ge=1))
+        segments = check_segments(segments)
     return GenParams(eyes, r_min, r_max, g_max, mode, int(seed), bool(unique_bitmaps), segments)
 
 
 def check_n(n) -> int:
-    return limits.check_rows(check_int("n", n, ge=1))
+    return limits.check_rows(n)
 
 
 # --- multi-pass plan -----------------------------------------------------------------
@@ -380,8 +381,6 @@ def write(
     Every parameter is checked before the file is touched; ``progress(k)`` is called
     after each chunk of k elements.
     """
-    from eyeviz.dataset import io as dataset_io
-
     n = check_n(n)
     p = make_params(eyes, r_min, r_max, g_max, mode, seed, unique_bitmaps, segments)
     fmt = dataset_io.format_of(path)
@@ -390,8 +389,6 @@ def write(
 
 def save(ds: Dataset, path) -> None:
     """Write an in-memory data set to ``path`` (.csv or .npz), atomically."""
-    from eyeviz.dataset import io as dataset_io
-
     dataset_io.save(ds, path)
 
 
@@ -402,6 +399,4 @@ def load(path, eyes: EyePair | None = None) -> Dataset:
     of columns (m + 3 with g, m + 2 without). A malformed CSV raises an error naming the
     line and column.
     """
-    from eyeviz.dataset import io as dataset_io
-
     return dataset_io.load(path, eyes)

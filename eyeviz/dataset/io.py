@@ -14,9 +14,10 @@ any size is streamed chunk by chunk.
 
 Both are written to a temporary file in the target directory and renamed at the end,
 so an interruption or a full disk leaves no partial output. Reading (validated, whole or
-in blocks) is :mod:`eyeviz.dataset.reader`, re-exported here. This module is over 400
-lines because the vectorised ``%.17g`` formatting and the CSV encoder belong with the
-writers they serve.
+in blocks) is :mod:`eyeviz.dataset.reader`, re-exported here; what both share (format
+names, byte codes, the NPZ row dtype, the row checks) is :mod:`eyeviz.dataset.formats`.
+This module is over 400 lines because the vectorised ``%.17g`` formatting and the CSV
+encoder belong with the writers they serve.
 """
 
 from __future__ import annotations
@@ -30,27 +31,26 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from types import TracebackType
-from typing import TYPE_CHECKING, Any, BinaryIO, Generic, TypeVar
+from typing import BinaryIO, Generic, TypeVar
 
 import numpy as np
 
-from eyeviz import EyevizError
+from eyeviz.dataset.formats import (
+    COMMA,
+    FORMATS,
+    NEWLINE,
+    NPZ_VERSION,
+    ONE,
+    ZERO,
+    check_rows,
+    format_of,
+    npz_dtype,
+)
+from eyeviz.dataset.reader import BLOCK_ROWS, Block, BlockReader, iter_blocks, load
+from eyeviz.dataset.records import CHUNK, Chunk, Dataset
 from eyeviz.files.atomic import atomic_output
 
-if TYPE_CHECKING:
-    from eyeviz.dataset.records import Chunk, Dataset
-
-FORMATS = ("csv", "npz")
-NPZ_VERSION = 1
-_ZERO, _ONE, _COMMA, _NEWLINE = 48, 49, 44, 10
 _TABLE_MAX_W = 4096  # packed lookup tables up to 2 x 2 MB
-
-
-def format_of(path: str | os.PathLike) -> str:
-    suffix = Path(path).suffix.lower().lstrip(".")
-    if suffix not in FORMATS:
-        raise EyevizError(f"output must end in .csv or .npz, got {str(path)!r}")
-    return suffix
 
 
 # --- float formatting ----------------------------------------------------------------
@@ -183,8 +183,8 @@ class CsvEncoder:
         self.rb = 2 * m  # bytes of the bit columns of one row (m bits, each "b,")
         self.with_g = with_g
         self.buf = np.empty((rows, self.rb), np.uint8)
-        self.buf[:, 0::2] = _ZERO
-        self.buf[:, 1::2] = _COMMA
+        self.buf[:, 0::2] = ZERO
+        self.buf[:, 1::2] = COMMA
         self.flat = self.buf.reshape(-1)
         mv = self.flat.data  # memoryview(self.flat)
         self.row_views = [mv[i * self.rb : (i + 1) * self.rb] for i in range(rows)]
@@ -205,7 +205,7 @@ class CsvEncoder:
                 sel = at == o
                 tail[sel, o : o + _FW] = chars[sel]
             at = at + lens
-            tail[rows, at] = _NEWLINE if j == len(cols) - 1 else _COMMA
+            tail[rows, at] = NEWLINE if j == len(cols) - 1 else COMMA
             at += 1
         return tail.view(f"S{width}").ravel().tolist()
 
@@ -235,9 +235,9 @@ class CsvEncoder:
     ) -> list:
         """Rows whose eye E lights bits L_E..R_E (0 <= L <= R < m/2)."""
         if self._lit is not None:
-            self.flat[self._lit] = _ZERO
+            self.flat[self._lit] = ZERO
         pos = np.concatenate([self._lit_positions(la, ra, 0), self._lit_positions(lb, rb, self.w)])
-        self.flat[pos] = _ONE
+        self.flat[pos] = ONE
         self._lit = pos
         return self._parts(r.shape[0], self._tails(r, phi, g))
 
@@ -250,13 +250,13 @@ class CsvEncoder:
         g: np.ndarray,
     ) -> list:
         if self._lit is not None:  # invariant: the buffer is "0," except at self._lit
-            self.flat[self._lit] = _ZERO
+            self.flat[self._lit] = ZERO
         n = r.shape[0]
         view = self.buf[:n]
         w = self.w
-        view[:, 0 : 2 * w : 2] = _ZERO + omega_a.view(np.uint8)
-        view[:, 2 * w :: 2] = _ZERO + omega_b.view(np.uint8)
-        self._lit = np.flatnonzero(self.buf[:n].reshape(-1) == _ONE)
+        view[:, 0 : 2 * w : 2] = ZERO + omega_a.view(np.uint8)
+        view[:, 2 * w :: 2] = ZERO + omega_b.view(np.uint8)
+        self._lit = np.flatnonzero(self.buf[:n].reshape(-1) == ONE)
         return self._parts(n, self._tails(r, phi, g))
 
 
@@ -280,19 +280,6 @@ def write_parts(f: BinaryIO, parts: list) -> None:
 
 
 # --- NPZ -----------------------------------------------------------------------------
-
-
-def npz_dtype(m: int) -> np.dtype:
-    nb = (m // 2 + 7) // 8
-    return np.dtype(
-        [
-            ("omega_a", np.uint8, (nb,)),
-            ("omega_b", np.uint8, (nb,)),
-            ("r", "<f8"),
-            ("phi", "<f8"),
-            ("g", "<f8"),
-        ]
-    )
 
 
 @functools.lru_cache(maxsize=8)
@@ -430,7 +417,7 @@ class _Overlapped(Generic[_B]):
 
 
 #: Bytes of one encode buffer (CSV bits or NPZ rows). A chunk of wide rows (m up to
-#: limits.MAX_M) is written in blocks of at most this much, so memory does not grow with m
+#: core.bounds.MAX_M) is written in blocks of at most this much, so memory does not grow with m
 #: (a 16384-row CSV buffer at m = 2^20 would be 32 GiB); the bytes written are the same.
 _BLOCK_BYTES = 64 << 20
 
@@ -458,8 +445,6 @@ def write_chunks(
     progress: Callable[[int], None] | None = None,
 ) -> None:
     """Stream generated :class:`eyeviz.dataset.Chunk` objects into ``path``."""
-    from eyeviz.dataset.records import CHUNK
-
     with atomic_output(path) as tmp:
         if fmt == "csv":
             # two buffers: chunk k+1 is encoded while chunk k is written; encoding k+2
@@ -490,8 +475,6 @@ def write_chunks(
 
 def save(ds: Dataset, path: str | os.PathLike) -> None:
     """Write a data set; refuses rows :func:`load` would refuse (NaN r, bits 3 or 255)."""
-    from eyeviz.dataset.reader import check_rows
-
     fmt = format_of(path)
     n, m = len(ds), ds.eyes.m
     check_rows(ds.omega_a, ds.omega_b, ds.r, ds.phi, ds.g, m)
@@ -527,19 +510,6 @@ def save(ds: Dataset, path: str | os.PathLike) -> None:
                     )
 
 
-# Reading lives in eyeviz.dataset.reader; re-exported here (the stable path), lazily so
-# that either module can be imported first.
-_READER_NAMES = ("BLOCK_ROWS", "Block", "BlockReader", "check_rows", "iter_blocks", "load")
-
-
-def __getattr__(name: str) -> Any:
-    if name in _READER_NAMES:
-        from eyeviz.dataset import reader
-
-        return getattr(reader, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
 __all__ = [
     "CsvEncoder",
     "FORMATS",
@@ -550,4 +520,11 @@ __all__ = [
     "save",
     "write_chunks",
     "write_parts",
-] + list(_READER_NAMES)
+    "NPZ_VERSION",
+    "BLOCK_ROWS",
+    "Block",
+    "BlockReader",
+    "check_rows",
+    "iter_blocks",
+    "load",
+]

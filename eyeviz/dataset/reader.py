@@ -5,10 +5,11 @@ Every reader validates per row and field and names the first bad line (CSV) or r
 allocated, compressed members and short packed rows are refused, and ``np.load``-style
 pickles are never read (the members are parsed with ``np.lib.format`` headers only).
 :func:`iter_blocks` streams a file of any size in bounded memory; :func:`load` reads it
-whole. Both are re-exported by :mod:`eyeviz.dataset.io` (the stable path).
+whole. Both are re-exported by :mod:`eyeviz.dataset.io` (the stable path); what readers and
+writers share is :mod:`eyeviz.dataset.formats`.
 
-It is just over 400 lines because the CSV and NPZ readers share the block reader and the
-per-row checks that name the first bad line; split, each half would import the other's.
+The CSV and NPZ readers share the block reader and the per-line diagnosis that names the
+first bad line and column.
 """
 
 from __future__ import annotations
@@ -23,8 +24,19 @@ from typing import NamedTuple
 import numpy as np
 
 from eyeviz import EyevizError
+from eyeviz.core.bounds import MAX_M, check_m
 from eyeviz.core.geometry import EyePair
-from eyeviz.dataset.io import _COMMA, _ONE, _ZERO, format_of, npz_dtype
+from eyeviz.core.validation import check_int
+from eyeviz.dataset.formats import (
+    COMMA,
+    ONE,
+    ZERO,
+    check_floats,
+    check_rows,
+    format_of,
+    npz_dtype,
+)
+from eyeviz.dataset.records import Dataset
 from eyeviz.files import limits
 
 __all__ = ["BLOCK_ROWS", "Block", "BlockReader", "check_rows", "iter_blocks", "load"]
@@ -111,8 +123,8 @@ class BlockReader:
             meta = json.loads(str(meta_arr[()]))
             if not isinstance(meta, dict):
                 raise TypeError("meta is not an object")
-            m = limits.check_m(meta["m"])
-            n = limits.check_int("n", meta["n"], 0, limits.MAX_ROWS)
+            m = check_m(meta["m"])
+            n = check_int("n", meta["n"], ge=0, le=limits.MAX_ROWS)
             params = meta.get("params", {})
             if not isinstance(params, dict):
                 raise TypeError("params is not an object")
@@ -175,7 +187,7 @@ class BlockReader:
                     oa = np.unpackbits(rows["omega_a"], axis=1, count=w).view(bool)
                     ob = np.unpackbits(rows["omega_b"], axis=1, count=w).view(bool)
                     r, phi, g = rows["r"].copy(), rows["phi"].copy(), rows["g"].copy()
-                    _check_floats(self.path, start, r, phi, g, "row")
+                    check_floats(self.path, start, r, phi, g, "row")
                     yield Block(oa, ob, r, phi, g, start)
                     start += k
         except EyevizError:
@@ -203,17 +215,17 @@ class BlockReader:
             raise
         except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
             raise self._npz_fail(_one_line(exc)) from None
-        _check_floats(self.path, 0, rows["r"], rows["phi"], rows["g"], "row")
+        check_floats(self.path, 0, rows["r"], rows["phi"], rows["g"], "row")
         return rows
 
     # -- CSV --
 
     def _open_csv(self, eyes: EyePair | None) -> None:
         with open(self.path, "rb") as f:
-            first = f.readline(limits.MAX_M * 4 + 1000)
+            first = f.readline(MAX_M * 4 + 1000)
         if not first.strip():
             raise EyevizError(f"{self.path}: the CSV file is empty")
-        if not first.endswith(b"\n") and len(first) >= limits.MAX_M * 4 + 1000:
+        if not first.endswith(b"\n") and len(first) >= MAX_M * 4 + 1000:
             raise _csv_error(self.path, 1, 1, "line too long for a data set row")
         ncols = first.count(b",") + 1
         self.with_g = ncols % 2 == 1
@@ -249,7 +261,7 @@ class BlockReader:
                     _diagnose(self.path, block, start, m, self.ncols)
                     raise EyevizError(f"{self.path}: line {start + 1}: bad row") from None
                 g = floats[2] if self.with_g else np.full(k, np.nan)
-                _check_floats(self.path, start, floats[0], floats[1], g, "line")
+                check_floats(self.path, start, floats[0], floats[1], g, "line")
                 yield Block(oa.view(bool), ob.view(bool), floats[0], floats[1], g, start)
                 start += k
         if start == 0:
@@ -275,8 +287,6 @@ def iter_blocks(path, block_rows: int = BLOCK_ROWS, eyes: EyePair | None = None)
 
 def load(path, eyes: EyePair | None = None):
     """The whole data set in memory (validated row by row, first bad line named)."""
-    from eyeviz.dataset.records import Dataset
-
     reader = iter_blocks(path, BLOCK_ROWS, eyes)
     if reader.fmt == "npz":
         rows = reader.read_all()
@@ -304,49 +314,6 @@ def _one_line(exc: BaseException) -> str:
     return text[0][:200] if text else type(exc).__name__
 
 
-def _check_floats(path: Path, start: int, r, phi, g, unit: str) -> None:
-    """0 <= r <= MAX_DATA_R, |phi| <= MAX_DATA_PHI, 0 <= g <= MAX_DATA_R (or g NaN: a CSV
-    without g). Beyond these no bitmap can describe the row, and sums of squares of r
-    overflow in the metrics (r = 1e308)."""
-    R = limits.MAX_DATA_R
-    with np.errstate(invalid="ignore"):
-        ok_g = ((g >= 0) & (g <= R)) | np.isnan(g)
-        bad = ~((r >= 0) & (r <= R) & (np.abs(phi) <= limits.MAX_DATA_PHI) & ok_g)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        raise EyevizError(
-            f"{path}: {unit} {start + i + 1}: r, phi, g = {float(r[i])!r}, {float(phi[i])!r}, "
-            f"{float(g[i])!r} "
-            f"(need 0 <= r <= {R:g}, |phi| <= {limits.MAX_DATA_PHI:g} rad, 0 <= g <= {R:g})"
-        )
-
-
-def check_rows(omega_a, omega_b, r, phi, g, m: int) -> None:
-    """What :func:`save` refuses to write: anything :func:`load` would refuse."""
-    w = m // 2
-    n = np.shape(r)[0] if np.ndim(r) else -1
-    for name, a in (("omega_a", omega_a), ("omega_b", omega_b)):
-        a = np.asarray(a)
-        if a.ndim != 2 or a.shape != (n, w):
-            raise EyevizError(f"{name} must have shape ({n}, {w}), got {a.shape}")
-        if a.dtype != bool:
-            bad = (a != 0) & (a != 1)
-            if bad.any():
-                i, j = (int(v[0]) for v in np.nonzero(bad))
-                raise EyevizError(f"{name} row {i + 1}, bit {j}: {a[i, j].item()!r} is not 0 or 1")
-    for name, a in (("phi", phi), ("g", g)):
-        if np.shape(a) != (n,):
-            raise EyevizError(f"{name} must have shape ({n},), got {np.shape(a)}")
-    r, phi, g = (np.asarray(a, dtype=np.float64) for a in (r, phi, g))
-    fin = np.isfinite(g)
-    if n and not (fin.all() or np.isnan(g).all()):
-        i = int(np.flatnonzero(~fin)[0])
-        raise EyevizError(
-            f"row {i + 1}: g = {float(g[i])!r} (g must be finite, or NaN in every row)"
-        )
-    _check_floats(Path("data set"), 0, r, phi, g, "row")
-
-
 def _csv_error(path: Path, line: int, col: int, msg: str) -> EyevizError:
     return EyevizError(f"{path}: line {line}, column {col}: {msg}")
 
@@ -361,11 +328,11 @@ def _parse_block(
     if head.size != len(block) * rb:
         raise ValueError("short line")
     head = head.reshape(len(block), m, 2)
-    if not (np.all(head[:, :, 1] == _COMMA) and np.all((head[:, :, 0] | 1) == _ONE)):
+    if not (np.all(head[:, :, 1] == COMMA) and np.all((head[:, :, 0] | 1) == ONE)):
         raise ValueError("bad bits")
     w = m // 2
-    np.subtract(head[:, :w, 0], _ZERO, out=oa)
-    np.subtract(head[:, w:, 0], _ZERO, out=ob)
+    np.subtract(head[:, :w, 0], ZERO, out=oa)
+    np.subtract(head[:, w:, 0], ZERO, out=ob)
     tails = [ln[rb:] for ln in block]
     if any(t.count(b",") != nf - 1 for t in tails):
         raise ValueError("bad field count")

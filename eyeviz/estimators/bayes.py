@@ -177,6 +177,7 @@ def load_table(path) -> dict:
     increasing inside [0, w^4) and each a pair of valid intervals (LA <= RA, LB <= RB,
     Prop. 2); every stored median inside the domain ([r_min, r_max], [0, pi]), which is
     what a corrupted ``key0`` or value breaks; the keys' SHA-256 when the meta has one."""
+    from eyeviz.core.validation import check_int
     from eyeviz.files import limits
     from eyeviz.files.npz import NpzReader, one_line
 
@@ -191,8 +192,8 @@ def load_table(path) -> dict:
             if not isinstance(meta, dict) or not isinstance(meta.get("domain"), dict):
                 raise TypeError("meta is not an object with a 'domain' object")
             domain = Domain.from_dict(meta["domain"])
-            n = limits.check_int("n", meta.get("n"), 0, 10**15)
-            nkeys = limits.check_int("keys", meta.get("keys"), 1, K)
+            n = check_int("n", meta.get("n"), ge=0, le=10**15)
+            nkeys = check_int("keys", meta.get("keys"), ge=1, le=K)
             seconds = float(meta.get("build_seconds", 0.0))
         except Exception as exc:  # noqa: BLE001 - any bad meta is one message
             raise z.fail(f"bad meta ({one_line(exc)})") from None

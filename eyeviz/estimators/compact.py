@@ -14,144 +14,42 @@ correction to the triangulation:
 
 Weights: ``assets/models/compact_dd.pt`` and ``compact_ad.pt`` (a few kB each) with
 ``compact.json`` (data parameters, seed, metrics, training time, command).
-This is the only estimator module besides ``paper`` that imports torch.
+This module loads them; the features, the network and the estimator class are
+:mod:`eyeviz.estimators.compact_net`, training is :mod:`eyeviz.estimators.compact_training`
+(``train`` and ``fit`` are re-exported here). These three and ``paper`` are the only
+estimator modules that import torch.
 """
 
 from __future__ import annotations
 
 import json
-import math
 import os
 import zipfile
-from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
 
-import numpy as np
 import torch
-from torch import nn
 
 from eyeviz import EyevizError
-from eyeviz.estimators import analytic
-from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
+from eyeviz.estimators.base import Domain
+from eyeviz.estimators.compact_net import N_FEATURES, CompactEstimator, CompactNet, features
+from eyeviz.estimators.compact_training import fit, train
 from eyeviz.files import limits
-from eyeviz.files.atomic import atomic_output
 from eyeviz.files.npz import one_line
 from eyeviz.resources import models_dir
 
-if TYPE_CHECKING:
-    from eyeviz.dataset import Dataset
-
-__all__ = ["CompactEstimator", "CompactNet", "features", "load", "train", "default_dir"]
-
-N_FEATURES = 11
-AD_SCALE = 1e-3  # radians per unit of the AD network's output
+__all__ = [
+    "CompactEstimator",
+    "CompactNet",
+    "default_dir",
+    "features",
+    "fit",
+    "load",
+    "train",
+]
 
 
 def default_dir() -> Path:
     return models_dir()
-
-
-def features(
-    LA: np.ndarray, RA: np.ndarray, LB: np.ndarray, RB: np.ndarray, domain: Domain = PAPER_DOMAIN
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(X float32 (N, 11), log r_analytic, phi_analytic) from interval arrays."""
-    la, ra, lb, rb = (np.asarray(v, np.float64) for v in (LA, RA, LB, RB))
-    gam = 2.0 * math.pi / domain.m
-    wa = ra - la + 1.0
-    wb = rb - lb + 1.0
-    dl = lb - la
-    dr = rb - ra
-    c = (la + ra + lb + rb + 2.0) * (0.25 * gam)
-    r0, p0 = analytic.estimate(la, ra, lb, rb, domain)
-    log_r0 = np.log(r0)
-    x = np.empty((la.shape[0], N_FEATURES), np.float32)
-    x[:, 0] = dl * 0.25
-    x[:, 1] = dr * 0.25
-    x[:, 2] = (wb - wa) * 0.5
-    x[:, 3] = np.log(wa) - 3.0
-    x[:, 4] = np.log(wb) - 3.0
-    x[:, 5] = c - 0.5 * math.pi
-    x[:, 6] = np.sin(c) - 0.8
-    x[:, 7] = log_r0 - math.log(math.sqrt(domain.r_min * domain.r_max))
-    x[:, 8] = 1.0 / (0.5 * (dl + dr) + 1.0)
-    x[:, 9] = 1.0 / (dl + 1.5)
-    x[:, 10] = 1.0 / (dr + 1.5)
-    return x, log_r0, p0
-
-
-class CompactNet(nn.Module):
-    """Linear(11, H) - SiLU - Linear(H, H) - SiLU - Linear(H, 1)."""
-
-    def __init__(self, hidden: int = 32, zero_last: bool = False) -> None:
-        super().__init__()
-        self.net = nn.Sequential(
-            nn.Linear(N_FEATURES, hidden),
-            nn.SiLU(),
-            nn.Linear(hidden, hidden),
-            nn.SiLU(),
-            nn.Linear(hidden, 1),
-        )
-        if zero_last:
-            last = self.net[-1]
-            assert isinstance(last, nn.Linear)
-            nn.init.zeros_(last.weight)
-            nn.init.zeros_(last.bias)
-
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        return self.net(x).squeeze(-1)
-
-
-def count_weights(net: nn.Module) -> int:
-    return sum(p.numel() for p in net.parameters())
-
-
-class CompactEstimator(Estimator):
-    name = "compact"
-
-    def __init__(
-        self,
-        dd: CompactNet,
-        ad: CompactNet,
-        domain: Domain = PAPER_DOMAIN,
-        metadata: dict | None = None,
-    ) -> None:
-        meta = dict(metadata or {})
-        meta["n_weights"] = count_weights(dd) + count_weights(ad)
-        super().__init__(domain, meta)
-        self.dd = dd.eval()
-        self.ad = ad.eval()
-
-    def _predict_intervals(
-        self, LA: np.ndarray, RA: np.ndarray, LB: np.ndarray, RB: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        x, log_r0, p0 = features(LA, RA, LB, RB, self.domain)
-        # Blocks of <= 65536 rows through nets this small run fastest on one thread:
-        # the intra-op thread pool costs more in synchronisation than it saves.
-        threads = torch.get_num_threads()
-        if threads != 1:
-            torch.set_num_threads(1)
-        try:
-            with torch.inference_mode():
-                xt = torch.from_numpy(x)
-                d = self.dd(xt).numpy()
-                a = self.ad(xt).numpy()
-        finally:
-            if threads != 1:
-                torch.set_num_threads(threads)
-        return np.exp(log_r0 + d), p0 + AD_SCALE * a
-
-
-def _atomic(path: Path, write: Callable[[str], object]) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_output(path) as tmp:
-        write(str(tmp))
-
-
-def _save_net(net: CompactNet, hidden: int, path: Path) -> None:
-    weights = {k: v.detach().clone() for k, v in net.state_dict().items()}
-    state = {"hidden": hidden, "state": weights}
-    _atomic(path, lambda tmp: torch.save(state, tmp))
 
 
 def _expected_shapes(hidden: int) -> dict[str, tuple[int, ...]]:
@@ -245,7 +143,7 @@ def load(path: str | os.PathLike | None = None, domain: Domain | None = None) ->
 
     Every problem with the directory is one EyevizError line naming the file: compact.json
     (bounded size, a JSON object, ``files.dd`` / ``files.ad`` inside the directory,
-    ``data`` a valid domain with m <= :data:`limits.MAX_M`) and each weights file
+    ``data`` a valid domain, m within :data:`eyeviz.core.bounds.MAX_M`) and each weights file
     (:func:`_load_net`). Nothing is unpickled."""
     d = Path(path) if path is not None else default_dir()
     meta_f = d / "compact.json"
@@ -269,31 +167,9 @@ def load(path: str | os.PathLike | None = None, domain: Domain | None = None) ->
         if not isinstance(data, dict):
             raise EyevizError(f"{str(meta_f)!r}: 'data' must be an object with the domain")
         try:
-            dom = Domain.from_dict(data)
-            limits.check_m(dom.m)
+            dom = Domain.from_dict(data)  # EyePair's checks: m <= core.bounds.MAX_M
         except (ValueError, TypeError, OverflowError) as exc:
             raise EyevizError(f"{str(meta_f)!r}: bad data ({one_line(exc, 160)})") from None
     else:
         dom = domain
     return CompactEstimator(dd, ad, dom, meta)
-
-
-# --- training (eyeviz.estimators.compact_training) -------------------------------------------
-
-
-def train(*args: Any, **kw: Any) -> dict:
-    """Train both nets and save them; see :func:`eyeviz.estimators.compact_training.train`."""
-    from eyeviz.estimators import compact_training
-
-    return compact_training.train(*args, **kw)
-
-
-def fit(
-    data: Dataset | str | os.PathLike | None = None,
-    out_dir: str | os.PathLike | None = None,
-    **options: Any,
-) -> Path:
-    """The registry's training shape; see :func:`eyeviz.estimators.compact_training.fit`."""
-    from eyeviz.estimators import compact_training
-
-    return compact_training.fit(data, out_dir, **options)

@@ -17,16 +17,18 @@ import numpy as np
 import torch
 
 from eyeviz import EyevizError
+from eyeviz.core.bounds import MAX_THREADS
 from eyeviz.core.validation import check_int, check_real
-from eyeviz.estimators.base import PAPER_DOMAIN, Domain
-from eyeviz.estimators.compact import (
+from eyeviz.estimators import metrics
+from eyeviz.estimators.base import PAPER_DOMAIN, Domain, bitmaps_to_intervals
+from eyeviz.estimators.compact_net import (
     AD_SCALE,
     N_FEATURES,
     CompactEstimator,
     CompactNet,
-    _atomic,
-    _save_net,
     features,
+    save_net,
+    write_atomic,
 )
 from eyeviz.estimators.store import staged, user_models_dir
 from eyeviz.files import limits
@@ -131,7 +133,7 @@ def train(
     n_val = check_int("n_val", n_val, ge=1, le=limits.MAX_ROWS)
     epochs = check_int("epochs", epochs, ge=1)
     lr = check_real("lr", lr, gt=0)
-    threads = check_int("threads", threads, ge=1, le=limits.MAX_THREADS)
+    threads = check_int("threads", threads, ge=1, le=MAX_THREADS)
     t0 = time.perf_counter()
     if data is None:
         if n_train < batch:
@@ -175,8 +177,6 @@ def train(
 
 def _split(data: Dataset, seed: int, domain: Domain) -> tuple[dict, dict]:
     """Single-feature rows of a data set as interval columns, split 90/10 (seeded)."""
-    from eyeviz.estimators.base import bitmaps_to_intervals
-
     if (data.eyes.h, data.eyes.l, data.eyes.m) != domain.design:
         raise EyevizError(
             f"data design h={data.eyes.h:g}, l={data.eyes.l:g}, m={data.eyes.m} differs from "
@@ -265,17 +265,15 @@ def _train_into(
             lr,
             patience,
             seed,
-            functools.partial(_save_net, hidden=width, path=path),
+            functools.partial(save_net, hidden=width, path=path),
             progress,
             name.upper(),
         )
         info[name]["seconds"] = round(time.perf_counter() - ts, 1)
-        _save_net(net, width, path)
+        save_net(net, width, path)
         nets[name] = net
     est = CompactEstimator(nets["dd"], nets["ad"], domain)
     pv = est.predict_intervals(va["la"], va["ra"], va["lb"], va["rb"])
-    from eyeviz.estimators import metrics
-
     meta = {
         "estimator": "compact",
         "files": files,
@@ -312,7 +310,7 @@ def _train_into(
         "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
     }
     text = json.dumps(meta, indent=2)
-    _atomic(out / "compact.json", lambda tmp: Path(tmp).write_text(text))
+    write_atomic(out / "compact.json", lambda tmp: Path(tmp).write_text(text))
     return meta
 
 
@@ -339,7 +337,7 @@ def fit(
     for k, v in (("hidden", hidden), ("hidden_ad", hidden_ad)):
         check_int(k, v, ge=1, le=limits.MAX_HIDDEN)  # what load() reads back
     check_int("patience", patience, ge=1)
-    threads = check_int("threads", threads, ge=1, le=limits.MAX_THREADS)
+    threads = check_int("threads", threads, ge=1, le=MAX_THREADS)
     dom = PAPER_DOMAIN if domain is None else domain
     if isinstance(data, str | os.PathLike):
         from eyeviz import dataset

@@ -1,4 +1,8 @@
-"""Bounds on every size a user or a file controls (issue 13), as named constants.
+"""Bounds on the files a user hands in or a run writes (issue 13), as named constants.
+
+Only limits about *files* live here: bytes, rows, declared array shapes and counts a file
+controls. The bounds of the model (m, nside, r, phi) and of a run's options are
+:mod:`eyeviz.core.bounds`; the integer rule is :func:`eyeviz.core.validation.check_int`.
 
 Each ``check_*`` raises :class:`eyeviz.EyevizError` with a one-line message naming the
 value and the bound; a value beyond a bound is refused, never clamped. Readers call
@@ -7,26 +11,16 @@ these *before* allocating anything the file declares.
 
 from __future__ import annotations
 
-import math
 import shutil
 import stat
 from pathlib import Path
 
 from eyeviz import EyevizError
+from eyeviz.core import bounds
+from eyeviz.core.validation import check_int
 
 #: Rows of a generated data set (``eyeviz generate -n``).
 MAX_ROWS = 10**9
-#: Threads of one process (``--threads``; torch overflows on larger counts).
-MAX_THREADS = 1024
-#: Largest learning rate a training option takes (beyond it the nets only diverge, and
-#: above 3.4e38 torch cannot even hold it as a float32).
-MAX_LR = 10.0
-#: Ommatidia per eye pair m (exactness of the interval formulas ends near 2**53 / 2; the
-#: app and the bitmaps need m/2 bytes per row and eye, so the practical bound is far lower).
-MAX_M = 1 << 20
-#: Multi-pass segments (``--segments``) and histogram bins (``--bins``).
-MAX_SEGMENTS = 10**5
-MAX_BINS = 10**5
 #: Scene TOML files, and any other small text file a user hands in.
 MAX_SCENE_BYTES = 1 << 20
 #: A study table (``eyeviz study -o STUDY.csv``; one row per design point and distance bin).
@@ -43,54 +37,14 @@ MAX_MODEL_META_BYTES = 1 << 20
 MAX_TABLE_KEYS = 50_000_000
 #: Length of a feature name in a scene.
 MAX_NAME_CHARS = 200
-#: Largest r and g of a data set row, and |phi| (radians): beyond these no bitmap can
-#: describe the row and the metrics' sums of squares overflow (r = 1e308 in a CSV).
-MAX_DATA_R = 1e15
-MAX_DATA_PHI = 8.0
-#: Smallest r_min of a generated data set, relative to the eye pair's h (below it the
-#: exact path works with numbers so far apart that it takes hours).
-MIN_R_OVER_H = 1e-6
 
 
-def check_int(name: str, value, lo: int, hi: int) -> int:
-    """``value`` as an int in ``[lo, hi]``; floats such as 1e23 or inf are refused."""
-    if isinstance(value, bool):
-        raise EyevizError(f"{name} must be an integer, got {value!r}")
-    if isinstance(value, float):
-        if not math.isfinite(value) or value != int(value):
-            raise EyevizError(f"{name} must be a whole number, got {value!r}")
-        value = int(value)
-    try:
-        v = int(value)
-    except (TypeError, ValueError, OverflowError):
-        raise EyevizError(f"{name} must be an integer, got {value!r}") from None
-    if not lo <= v <= hi:
-        raise EyevizError(f"{name} must be in [{lo}, {hi}], got {_short(v)}")
-    return v
+def check_rows(n, name: str = "n") -> int:
+    """Rows of a data set: an integer in [1, MAX_ROWS]."""
+    return check_int(name, n, ge=1, le=MAX_ROWS)
 
 
-def _short(v) -> str:
-    s = str(v)
-    return s if len(s) <= 40 else f"{s[:20]}...({len(s)} digits)"
-
-
-def check_rows(n) -> int:
-    return check_int("n (rows)", n, 1, MAX_ROWS)
-
-
-def check_m(m) -> int:
-    return check_int("m", m, 4, MAX_M)
-
-
-def check_segments(k) -> int:
-    return check_int("segments", k, 1, MAX_SEGMENTS)
-
-
-def check_bins(k) -> int:
-    return check_int("bins", k, 1, MAX_BINS)
-
-
-def check_model_shape(name: str, shape, max_dim: int = MAX_M) -> tuple[int, ...]:
+def check_model_shape(name: str, shape, max_dim: int = bounds.MAX_M) -> tuple[int, ...]:
     """A tensor shape read from a model file, checked before anything is allocated:
     every dimension in [1, max_dim] and at most MAX_MODEL_PARAMS elements in all.
 
@@ -113,7 +67,7 @@ def check_model_shape(name: str, shape, max_dim: int = MAX_M) -> tuple[int, ...]
 
 def check_hidden(name: str, hidden) -> int:
     """A hidden width declared by a model directory (e.g. ``compact_dd.pt`` hidden=30000)."""
-    return check_int(f"model {name}: hidden width", hidden, 1, MAX_HIDDEN)
+    return check_int(f"model {name}: hidden width", hidden, ge=1, le=MAX_HIDDEN)
 
 
 def check_file_size(path, max_bytes: int, what: str = "file") -> int:
@@ -160,11 +114,3 @@ def estimated_output_bytes(n: int, m: int, fmt: str) -> int:
     if fmt == "csv":
         return n * (2 * m + 60)
     return n * (2 * ((m // 2 + 7) // 8) + 24)
-
-
-def check_r_min(r_min: float, h: float) -> float:
-    """r_min must be >= MIN_R_OVER_H * h (near 1e-300 the exact path takes hours)."""
-    if not r_min >= MIN_R_OVER_H * h:
-        bound = MIN_R_OVER_H * h
-        raise EyevizError(f"r_min = {r_min!r} is below {MIN_R_OVER_H:g} * h = {bound:g}")
-    return r_min

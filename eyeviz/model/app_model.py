@@ -30,7 +30,6 @@ DRAG_THRESHOLD_PX = 4.0  # a press released closer than this to where it started
 HANDLE_PX = 14.0  # radius of the grab zone of the radius handle (drawn at this size)
 BODY_PX = 8.0  # grab margin around a disc (and the minimum grab radius for tiny features)
 DOT_PX = 6.0  # radius of a feature's centre dot (drawn 11 px wide): a disc is at least this
-M_MAX = 200_000  # larger m cannot be redrawn live
 
 
 @dataclass
@@ -232,14 +231,10 @@ class AppModel:
 
     def set_eyes(self, h: float, l: float, m: int) -> None:
         """New eye parameters; ValueError (naming the parameter) leaves the scene as it was."""
-        if isinstance(m, float) and float(m).is_integer():
-            m = int(m)
-        if isinstance(m, int) and m > M_MAX:
-            raise ValueError(f"m must be <= {M_MAX} to be drawn live, got {m}")
         after = self.scene.copy()
         after.eyes.h, after.eyes.l, after.eyes.m = h, l, m
-        after.eyes.pair()  # raises before anything changes
-        after.eyes.h, after.eyes.l = float(h), float(l)
+        pair = after.eyes.pair()  # EyePair's checks (m <= core.bounds.MAX_M): raises first
+        after.eyes.h, after.eyes.l, after.eyes.m = pair.h, pair.l, pair.m
         self.commit(after, "Change eyes")
 
     def set_feature(self, index: int, **values) -> None:

@@ -8,7 +8,8 @@ written to TOML; every rule is checked at this boundary and a broken one raises
 rule.
 
 Bounds (issue 13, :mod:`eyeviz.files.limits`): a scene file is a regular file of at most
-MAX_SCENE_BYTES; m <= MAX_SCENE_M; at most MAX_FEATURES features; coordinates, radii and the
+MAX_SCENE_BYTES; m within the model's one bound (:data:`eyeviz.core.bounds.MAX_M`, as for
+every entry point); at most MAX_FEATURES features; coordinates, radii and the
 view width within [-MAX_SCENE_COORD, MAX_SCENE_COORD] (the view width at least
 MIN_VIEW_WIDTH); names without control characters (a newline or NUL could never be saved
 and would break an SVG) and at most MAX_NAME_CHARS long.
@@ -33,6 +34,7 @@ from pathlib import Path
 import tomli_w
 
 from eyeviz import EyevizError
+from eyeviz.core.bounds import check_m
 from eyeviz.core.geometry import EyePair
 from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
@@ -59,7 +61,6 @@ OKABE_ITO = ("#D55E00", "#0072B2", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "
 DEFAULT_LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout"]
 _COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
 #: Bounds of what a scene may ask the app to draw (see the module docstring).
-MAX_SCENE_M = 100_000
 MAX_SCENE_COORD = 1e12
 MIN_VIEW_WIDTH = 1e-6
 MAX_STRINGS = 100
@@ -257,11 +258,10 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
     c.keys(eyes_t, "eyes.", ("h", "l", "m"))
     h = c.number(eyes_t, "h", "eyes.", default=40.0)
     l = c.number(eyes_t, "l", "eyes.", default=20.0)
-    m = eyes_t.get("m", 720)
-    if isinstance(m, bool) or not isinstance(m, int):
-        raise c.fail("eyes.m", f"must be an even integer >= 4, got {_short(m)}")
-    if m > MAX_SCENE_M:
-        raise c.fail("eyes.m", f"must be <= {MAX_SCENE_M} (what the app can draw), got {_short(m)}")
+    try:
+        m = check_m(eyes_t.get("m", 720))
+    except EyevizError as exc:
+        raise c.fail("eyes.m", str(exc)) from None
     try:
         EyePair(h, l, m)
     except ValueError as exc:

@@ -301,10 +301,11 @@ def _markdown(summaries: list[Summary]) -> str:
 
 def run(args: argparse.Namespace) -> int:
     from eyeviz import EyevizError
-    from eyeviz.files import limits
+    from eyeviz.core.bounds import check_bins
+    from eyeviz.core.validation import check_int
 
-    bins = limits.check_bins(args.bins)
-    max_points = limits.check_int("--max-points", args.max_points, 1, MAX_POINTS)
+    bins = check_bins(args.bins)
+    max_points = check_int("--max-points", args.max_points, ge=1, le=MAX_POINTS)
     labels = args.labels or [p.name for p in args.data]
     if len(labels) != len(args.data):
         raise EyevizError(

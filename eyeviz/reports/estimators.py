@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from eyeviz.core.validation import check_int
 from eyeviz.files import limits
 from eyeviz.reports.common import (
     accuracy_metrics,
@@ -125,7 +126,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    limits.check_int("--n-test", args.n_test, 10, limits.MAX_ROWS)
+    check_int("--n-test", args.n_test, ge=10, le=limits.MAX_ROWS)
     names = parse_names(args.estimators)
     bar = tqdm(total=len(names), desc="estimators", unit="est", leave=False)
 

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from eyeviz.files import limits
+from eyeviz.core.validation import check_int
 from eyeviz.files.atomic import atomic_output
 
 HELP = "numerical stability of the geometry against an 80-digit reference"
@@ -208,7 +208,7 @@ def write(rows: list[Row], outdir: Path) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    limits.check_int("-n", args.n, 1, MAX_N)
+    check_int("-n", args.n, ge=1, le=MAX_N)
     from tqdm import tqdm
 
     from eyeviz.reference import stability_cases

@@ -28,7 +28,7 @@ import argparse
 from pathlib import Path
 
 from eyeviz import EyevizError
-from eyeviz.files import limits
+from eyeviz.core.validation import check_int
 from eyeviz.reports.common import parse_names, save_figure, try_load, write_atomic
 from eyeviz.reports.trajectories_measure import (
     DISTANCES,
@@ -120,8 +120,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    limits.check_int("--min-count", args.min_count, 1, MAX_COUNT)
-    limits.check_int("--max-count", args.max_count, 1, MAX_COUNT)
+    check_int("--min-count", args.min_count, ge=1, le=MAX_COUNT)
+    check_int("--max-count", args.max_count, ge=1, le=MAX_COUNT)
     if args.max_count < args.min_count:
         raise EyevizError(
             f"--max-count must be >= --min-count, got {args.max_count} < {args.min_count}"

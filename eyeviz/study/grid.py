@@ -15,10 +15,11 @@ import math
 from collections.abc import Iterable, Sequence
 
 from eyeviz import EyevizError
+from eyeviz.core.bounds import MAX_BINS, check_m, check_r_min
 from eyeviz.core.domain import DEFAULTS
 from eyeviz.core.validation import check_choice, check_real
 from eyeviz.estimators.limit import PRIORS
-from eyeviz.files.limits import MAX_BINS, MAX_M, MAX_ROWS, check_r_min
+from eyeviz.files.limits import MAX_ROWS
 from eyeviz.study.point import BIN_WIDTH, DesignPoint
 
 __all__ = ["MAX_GRID_POINTS", "design_grid", "parse_list", "DEFAULT_H", "DEFAULT_L", "DEFAULT_M"]
@@ -64,12 +65,8 @@ def parse_list(name: str, text: str | Iterable) -> list[float]:
 
 
 def _check_m(values: Sequence[float]) -> list[int]:
-    ms = []
-    for v in values:
-        if v != int(v) or int(v) % 2 or not 4 <= v <= MAX_M:
-            raise EyevizError(f"m must be an even integer in [4, {MAX_M}], got {v:g}")
-        ms.append(int(v))
-    return ms
+    # the one bound of m (eyeviz.core.bounds.MAX_M); a list's 720.0 is shown as 720
+    return [check_m(int(v) if float(v).is_integer() else v) for v in values]
 
 
 def _unique(values: Iterable) -> list:

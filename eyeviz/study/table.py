@@ -24,8 +24,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from eyeviz import EyevizError
+from eyeviz.core.bounds import MAX_BINS
 from eyeviz.files.atomic import atomic_output
-from eyeviz.files.limits import MAX_BINS, MAX_STUDY_BYTES, read_bounded
+from eyeviz.files.limits import MAX_STUDY_BYTES, read_bounded
 from eyeviz.study.point import BIN_WIDTH, COLUMNS, STUDY_VERSION, DesignPoint
 
 __all__ = ["MAX_LINE_CHARS", "MAX_STUDY_BYTES", "StudyTable", "format_row", "read_rows"]

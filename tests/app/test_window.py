@@ -146,7 +146,7 @@ def test_changing_m_rebuilds_the_eyes(make_window, qtbot):
         ("l", "0", "l"),
         ("h", "nan", "h"),
         ("l", "inf", "l"),
-        ("m", "1000000", "<= 200000"),
+        ("m", "1048578", "<= 1048576, got 1048578"),
         ("h", "abc", "number"),
         ("m", "", "even integer"),
     ],

@@ -32,7 +32,7 @@ def test_constants_of_the_paper():
     assert PAPER.centers == ((-40.0, 0.0), (40.0, 0.0))
 
 
-M_RULE = "m must be an even integer >= 4 and <= 9007199254740992 (2^53), got "
+M_RULE = "m must be an even integer >= 4 and <= 1048576, got "
 
 
 @pytest.mark.parametrize(

@@ -18,7 +18,22 @@ from eyeviz.core.validation import check_choice, check_int, check_positive, chec
         (lambda: check_int("m", 7, ge=4, even=True), "m must be an even integer >= 4, got 7"),
         (lambda: check_int("m", 2, ge=4, even=True), "m must be an even integer >= 4, got 2"),
         (lambda: check_int("n", True, ge=1), "n must be an integer >= 1, got True"),
-        (lambda: check_int("n", 3.0, ge=1), "n must be an integer >= 1, got 3.0"),
+        (lambda: check_int("n", 3.5, ge=1), "n must be an integer >= 1, got 3.5"),
+        (lambda: check_int("n", math.nan), "n must be an integer, got nan"),
+        (lambda: check_int("n", math.inf, ge=1), "n must be an integer >= 1, got inf"),
+        (lambda: check_int("n", "5", ge=1), "n must be an integer >= 1, got '5'"),
+        (lambda: check_int("n", None), "n must be an integer, got None"),
+        (lambda: check_int("n", np.bool_(True)), "n must be an integer, got "),
+        (lambda: check_int("n", 11, ge=1, le=10), "n must be an integer >= 1 and <= 10, got 11"),
+        (lambda: check_int("n", 1e23, le=10), "n must be an integer <= 10, got 1e+23"),
+        (
+            lambda: check_int("m", 10**5000, le=10),
+            "m must be an integer <= 10, got an integer of about 5001 digits",
+        ),
+        (
+            lambda: check_int("m", 10**60, le=9),
+            "m must be an integer <= 9, got 10000000000000000000...(61",
+        ),
         (lambda: check_real("g_max", math.nan, gt=0), "g_max must be a finite number > 0, got nan"),
         (lambda: check_real("r", math.inf), "r must be a finite number, got inf"),
         (lambda: check_real("x", "abc"), "x must be a finite number, got 'abc'"),
@@ -37,6 +52,20 @@ def test_refusals_are_one_line_naming_the_parameter(call, message):
 def test_accepted_values_are_converted_not_clamped():
     assert check_int("m", np.int64(720), ge=4, even=True) == 720
     assert type(check_int("m", np.int64(720))) is int
+
+
+@pytest.mark.parametrize("value", [720, 720.0, np.int32(720), np.float64(720.0), np.float32(720)])
+def test_the_integer_rule_takes_whole_number_floats(value):
+    """One rule for every integer (API, CLI, scene and data files): an integer, or a float
+    holding a whole number (JSON, TOML and numpy hand numbers over as floats)."""
+    got = check_int("m", value, ge=4, le=720, even=True)
+    assert got == 720 and type(got) is int
+
+
+@pytest.mark.parametrize("value", [720.5, 721.0, 722.0, True, "720", None, [720], math.nan])
+def test_the_integer_rule_refuses_the_rest(value):
+    with pytest.raises(EyevizError, match="^m must be an even integer >= 4 and <= 720, got "):
+        check_int("m", value, ge=4, le=720, even=True)
     assert check_real("r", "2.5", gt=0) == 2.5
     assert check_real("r", np.float32(0.5), le=0.5) == 0.5
     assert check_real("r", math.inf, finite=False) == math.inf

@@ -259,7 +259,7 @@ def test_load_refuses_wrong_files(tmp_path):
 @pytest.mark.parametrize(
     "kw, msg",
     [
-        (dict(n=0), "n must be an integer >= 1, got 0"),
+        (dict(n=0), "n must be an integer >= 1 and <= 1000000000, got 0"),
         (dict(n=10, r_min=5000, r_max=1000), "r_min must be < r_max"),
         (dict(n=10, r_min=1000, r_max=1000), "r_min must be < r_max"),
         (dict(n=10, g_max=0), "g_max must be a finite number > 0, got 0"),
@@ -281,7 +281,7 @@ def test_bad_parameters_refused(kw, msg):
 def test_cli_refuses_bad_parameters_before_any_work(tmp_path):
     out = tmp_path / "x.csv"
     for args, msg in [
-        (["-n", "0"], "n must be an integer >= 1, got 0"),
+        (["-n", "0"], "n must be an integer >= 1 and <= 1000000000, got 0"),
         (["-n", "5", "--r-min", "3000", "--r-max", "2000"], "r_min must be < r_max"),
         (["-n", "5", "--g-max", "-1"], "g_max must be a finite number > 0"),
         (["-n", "5", "--g-max", "1"], "no feature can be visible"),

@@ -314,11 +314,11 @@ def test_wide_rows_written_in_blocks_give_the_same_bytes(tmp_path, monkeypatch, 
 
 @pytest.mark.parametrize("fmt", ["csv", "npz"])
 def test_generate_at_the_largest_m_stays_in_bounded_memory(tmp_path, fmt):
-    """m = limits.MAX_M used to need a 16384-row buffer of 2m bytes per row (32 GiB for
+    """m = MAX_M used to need a 16384-row buffer of 2m bytes per row (32 GiB for
     CSV: `out of memory`); the write now works in blocks of <= 64 MiB."""
-    from eyeviz.files import limits
+    from eyeviz.core.bounds import MAX_M
 
-    m = limits.MAX_M
+    m = MAX_M
     eyes = EyePair(40.0, 20.0, m)
     p = tmp_path / f"wide.{fmt}"
     tracemalloc.start()

@@ -62,7 +62,7 @@ def test_declared_hidden_30000_is_refused_before_allocating(tmp_path, monkeypatc
         real(self, hidden, *a, **kw)
 
     monkeypatch.setattr(compact.CompactNet, "__init__", counting_init)
-    msg = _load_compact(d, r"hidden width must be in \[1, 4096\], got 30000")
+    msg = _load_compact(d, r"hidden width must be an integer >= 1 and <= 4096, got 30000")
     assert "compact_dd.pt" in msg
     assert built == []  # refused before any network (30000 x 30000 weights) is built
     # the spy does see a network being built: the shipped weights build two

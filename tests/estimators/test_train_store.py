@@ -163,7 +163,7 @@ def test_train_bayes_npz_name_into_user_dir(tmp_path):
         (["paper", "--budget", "-3"], "budget must be a finite number > 0"),
         (["compact", "-n", "1000"], "-n must be >= 4096 (one batch"),
         (["compact", "--threads", "0"], "threads must be an integer >= 1 and <= 1024, got 0"),
-        (["bayes", "-n", "0"], "n must be an integer >= 1 and <= 1e+09, got 0"),
+        (["bayes", "-n", "0"], "n must be an integer >= 1 and <= 1000000000, got 0"),
     ],
 )
 def test_bad_training_options_one_line(tmp_path, args, message):

@@ -32,12 +32,12 @@ def _eyeviz(*args, cwd):
 @pytest.mark.parametrize(
     "args, words",
     [
-        (["-n", "10000000000"], "n (rows) must be in [1, 1000000000]"),
+        (["-n", "10000000000"], "n must be an integer >= 1 and <= 1000000000"),
         (["-n", "1000000000"], "would need about 1.5e+03 GB"),
-        (["-n", "10", "--mode", "multi", "--segments", "1000000000"], "segments must be in"),
+        (["-n", "10", "--mode", "multi", "--segments", "1000000000"], "segments must be an"),
         (["-n", "10", "--r-min", "1e-300", "--r-max", "1e-299"], "r_min = 1e-300 is below"),
         (["-n", "10", "--r-min", "1e-300"], "r_min = 1e-300 is below"),
-        (["-n", "1", "--m", "2000000000"], "m must be in [4, 1048576]"),
+        (["-n", "1", "--m", "2000000000"], "m must be an even integer >= 4 and <= 1048576"),
         (["-n", "1e23"], "invalid int value"),
         (["-n", "inf"], "invalid int value"),
     ],
@@ -59,7 +59,7 @@ def test_check_functions():
         limits.check_model_shape("compact", (30000, 720), max_dim=limits.MAX_HIDDEN)
     with pytest.raises(EyevizError, match="parameters exceed"):
         limits.check_model_shape("compact", (30000, 30000))
-    with pytest.raises(EyevizError, match="hidden width must be in"):
+    with pytest.raises(EyevizError, match="hidden width must be an integer >= 1 and <= 4096"):
         limits.check_hidden("compact", 30000)
     with pytest.raises(EyevizError, match="parameters exceed"):
         limits.check_model_shape("big", (4096, 4096, 4096))
@@ -76,9 +76,9 @@ def test_read_bounded(tmp_path):
 
 
 def test_api_generate_bounds():
-    with pytest.raises(EyevizError, match="n \\(rows\\) must be in"):
+    with pytest.raises(EyevizError, match="n must be an integer >= 1 and <= 1000000000"):
         D.generate(10**10)
-    with pytest.raises(EyevizError, match="segments must be in"):
+    with pytest.raises(EyevizError, match="segments must be an integer >= 1 and <= 100000"):
         D.make_params(mode="multi", segments=10**9)
 
 
@@ -86,7 +86,7 @@ def test_api_generate_bounds():
     "scene, words",
     [
         ("/dev/zero", "is not a regular file"),
-        ("m2e9.toml", "eyes.m: must be <= 100000"),
+        ("m2e9.toml", "eyes.m: m must be an even integer >= 4 and <= 1048576"),
         ("deep.toml", "nested too deeply"),
         ("big.toml", "more than 1048576"),
         ("width.toml", "view.width: must be >= 1e-06"),
@@ -106,3 +106,14 @@ def test_snapshot_hostile_scene_files(tmp_path, scene, words):
     code, err = _eyeviz("snapshot", scene, "-o", "out.png", cwd=tmp_path)
     assert code == 2 and len(err) == 1 and words in err[0], err
     assert not (tmp_path / "out.png").exists()
+
+
+def test_files_keep_only_limits_about_files():
+    """The model's bounds (m, nside, r, phi) and the run options' live in core.bounds."""
+    from eyeviz.core import bounds, validation
+
+    moved = [n for n in dir(bounds) if n.startswith(("MAX_", "MIN_", "check_"))]
+    assert "MAX_M" in moved and "check_m" in moved
+    assert not [n for n in moved if hasattr(limits, n) and n != "check_int"]
+    # one integer checker: limits uses core.validation's, it has none of its own
+    assert getattr(limits, "check_int", validation.check_int) is validation.check_int

@@ -8,6 +8,7 @@ import math
 from hypothesis import given
 from hypothesis import strategies as st
 
+from eyeviz.core.bounds import MAX_M
 from eyeviz.model import scene as S
 
 from .conftest import assert_one_line, count, fuzz_settings
@@ -77,7 +78,7 @@ def _check(text: str, category: str) -> None:
         count(category, "refused")
         return
     # a correct result: every rule holds and it round-trips
-    assert 4 <= sc.eyes.m <= S.MAX_SCENE_M and sc.eyes.m % 2 == 0
+    assert 4 <= sc.eyes.m <= MAX_M and sc.eyes.m % 2 == 0 and type(sc.eyes.m) is int
     for f in sc.features:
         assert all(math.isfinite(v) and abs(v) <= S.MAX_SCENE_COORD for v in (f.x, f.y, f.g))
         assert f.g > 0 and S._bad_text(f.name) is None

@@ -141,8 +141,10 @@ def test_scene_module_imports_nothing_heavy():
 @pytest.mark.parametrize(
     "edit, words",
     [
-        (("m = 720", "m = 2000000000"), ["<t>:5: eyes.m", "<= 100000"]),
-        (("m = 720", "m = 9223372036854775807"), ["eyes.m", "<= 100000"]),
+        (("m = 720", "m = 2000000000"), ["<t>:5: eyes.m", "<= 1048576, got 2000000000"]),
+        (("m = 720", "m = 9223372036854775807"), ["eyes.m", "<= 1048576"]),
+        (("m = 720", "m = 1048578"), ["<t>:5: eyes.m: m must be an even integer", "<= 1048576"]),
+        (("m = 720", "m = 720.5"), ["<t>:5: eyes.m", "even integer", "got 720.5"]),
         (("x = 0.0", "x = " + "9" * 400), ["features[0].x", "within"]),
         (("x = 0.0", "x = 1e300"), ["<t>:9: features[0].x", "within +-1e+12"]),
         (("g = 50.0", "g = 1e308"), ["features[0].g", "within"]),

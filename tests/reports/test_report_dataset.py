@@ -109,7 +109,10 @@ def test_summary_is_streamed_and_matches_the_whole_file(files, monkeypatch):
 
 @pytest.mark.parametrize(
     ("flag", "value", "match"),
-    [("--bins", "1000000000", "bins must be in"), ("--max-points", "0", "--max-points must be")],
+    [
+        ("--bins", "1000000000", "bins must be an integer"),
+        ("--max-points", "0", "--max-points must be"),
+    ],
 )
 def test_bins_and_points_are_bounded(files, tmp_path, flag, value, match):
     res = subprocess.run(

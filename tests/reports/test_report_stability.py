@@ -45,7 +45,7 @@ def test_bad_n_is_refused_in_one_line(tmp_path):
         text=True,
     )
     assert res.returncode == 2
-    assert res.stderr.strip() == "eyeviz: error: -n must be in [1, 100000], got 0"
+    assert res.stderr.strip() == "eyeviz: error: -n must be an integer >= 1 and <= 100000, got 0"
 
 
 def test_measure_times_every_method():

@@ -5,6 +5,7 @@ from __future__ import annotations
 from PyQt5 import QtWidgets
 
 from eyeviz.app.panels.common import ERROR_STYLE, _Unelide, set_message, wrap_label
+from eyeviz.core.bounds import check_m
 from eyeviz.model.app_model import AppModel
 
 
@@ -23,8 +24,9 @@ class EyesPanel(QtWidgets.QWidget):
     """h, l, m entered together (issue 12 item 11).
 
     Enter in any field (or Apply) checks the triple as
-    :class:`~eyeviz.core.geometry.EyePair` does (0 < l < h, m an even integer >= 4, finite
-    numbers; m <= the live limit) and changes the eyes in one undo step. Moving between
+    :class:`~eyeviz.core.geometry.EyePair` does (0 < l < h, finite numbers, m an even
+    integer in [4, :data:`~eyeviz.core.bounds.MAX_M`], the bound of every entry point, so a
+    scene the window draws can be saved) and changes the eyes in one undo step. Moving between
     fields applies nothing, so with l = 20 one can type h = 10, then l = 5, then Enter. A
     refused triple leaves the scene as it was, keeps what was typed (never clamped or
     reset behind the user's back) and says why in one line; Revert shows the scene's
@@ -104,11 +106,14 @@ class EyesPanel(QtWidgets.QWidget):
                 vals.append(float(t[key]))
             except ValueError:
                 raise ValueError(f"{key} must be a number, got {t[key]!r}") from None
-        try:
-            m = int(t["m"])
-        except ValueError:
-            raise ValueError(f"m must be an even integer >= 4, got {t['m']!r}") from None
-        return vals[0], vals[1], m
+        m: int | float | str = t["m"]
+        for number in (int, float):  # "720", or "720.0" (the integer rule of check_int)
+            try:
+                m = number(t["m"])
+                break
+            except ValueError:
+                pass
+        return vals[0], vals[1], check_m(m)
 
     def apply(self) -> bool:
         """Check the typed triple together; True if the scene now has it."""

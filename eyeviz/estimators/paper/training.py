@@ -17,6 +17,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from eyeviz.core.bounds import MAX_LR, MAX_THREADS
 from eyeviz.core.validation import check_int, check_real
 from eyeviz.estimators.paper.data import _columns, _metrics, _resolve_device, predict_net
 from eyeviz.estimators.paper.nets import (
@@ -30,7 +31,6 @@ from eyeviz.estimators.paper.nets import (
 )
 from eyeviz.estimators.paper.weights import _atomic_write, _save_json, _sha256, default_out_dir
 from eyeviz.estimators.store import staged
-from eyeviz.files import limits
 
 
 def train_net(
@@ -171,7 +171,7 @@ def train(
     Returns the metadata per net.
     """
     if ad_lr is not None:
-        ad_lr = check_real("ad_lr", ad_lr, gt=0, le=limits.MAX_LR)
+        ad_lr = check_real("ad_lr", ad_lr, gt=0, le=MAX_LR)
     if dd_momentum is not None:
         dd_momentum = check_real("dd_momentum", dd_momentum, ge=0, lt=1)
     try:
@@ -327,10 +327,10 @@ def fit(
     if isinstance(nets, str):
         nets = tuple(s.strip() for s in nets.split(",") if s.strip())
     if ad_lr is not None:
-        ad_lr = check_real("ad_lr", ad_lr, gt=0, le=limits.MAX_LR)
+        ad_lr = check_real("ad_lr", ad_lr, gt=0, le=MAX_LR)
     budget = check_real("budget", budget, gt=0)
     if threads is not None:
-        torch.set_num_threads(check_int("threads", threads, ge=1, le=limits.MAX_THREADS))
+        torch.set_num_threads(check_int("threads", threads, ge=1, le=MAX_THREADS))
     if data is None:
         n = check_int("n", n, ge=10)
         data = dataset.generate(n, dom.eyes, dom.r_min, dom.r_max, dom.g_max, mode, seed)
