@@ -14,8 +14,10 @@ azimuths where the ball is outside both tangent cones from the origin, half-angl
 psi = asin(l/h) about the x-axis, i.e. |cos(el) cos(az)| <= cos(psi + asin(g/r)), in
 front: 0 < az < pi). Reject it on step 9 (g_min > g_max), step 11 (g > r), an empty
 azimuth range, or when the exact geometry says the ball is not in the 3D binocular field
-(``in_bfv``) or is not visible to both eyes (Definition 1 in 3D: at least two facets lit
-per eye); rejected elements are drawn again until every slot is filled.
+(``EyePair3D.in_bfv``: outside both cones and in front, y >= g; the azimuth range above
+is the cones' part, y >= g only cuts near az = 0 and pi at the top of the band) or is not
+visible to both eyes (Definition 1 in 3D: at least two facets lit per eye, counted on the
+lit lists written out); rejected elements are drawn again until every slot is filled.
 
 ``mode="multi"``: uniform density over the field's volume. The range of r is cut into
 segments (of length :data:`SEGMENT_WIDTH`, as the planar multi-pass) whose counts are

@@ -141,3 +141,13 @@ def test_interrupted_generation_leaves_no_file(tmp_path):
     with pytest.raises(KeyboardInterrupt):
         sparse3d.write3d(tmp_path / "d.npz", 50, DOM, progress=stop)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "dom", [DOM, Domain3D(nside=16), Domain3D(nside=64, el_max=1.0)], ids=["small", "16", "64"]
+)
+def test_the_free_space_estimate_covers_the_spools_and_the_file(tmp_path, dom):
+    out = tmp_path / "d.npz"
+    sparse3d.write3d(out, 300, dom, seed=1)
+    need = 2 * out.stat().st_size  # spools and zip side by side
+    assert need <= sparse3d.estimated_bytes3d(300, dom) <= 4 * need
