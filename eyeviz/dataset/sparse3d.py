@@ -46,6 +46,7 @@ from eyeviz.dataset.algorithm1_3d import check_n, iter_chunks3d, make_params3d
 from eyeviz.dataset.records3d import Dataset3D, index_dtype
 from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output, part_name
+from eyeviz.files.npz import NpzReader
 
 __all__ = [
     "FORMAT",
@@ -243,7 +244,12 @@ class Sparse3DReader:
             self.size = limits.check_file_size(self.path, 1 << 62, "data set")
             with zipfile.ZipFile(self.path) as zf:
                 infos = {i.filename: i for i in zf.infolist()}
-                meta_arr = self._read_meta(zf, infos)
+            if "meta.npy" not in infos:
+                raise self.fail("member 'meta' is missing")
+            with NpzReader(self.path) as npz:
+                meta_arr = npz.read_member(
+                    "meta", 1, dtypes=("U",), ndim=0, max_bytes=_META_MAX_BYTES
+                )
             with open(self.path, "rb") as f:
                 self.members = {name: self._member(f, infos, name) for name in MEMBERS}
         except EyevizError:
@@ -254,18 +260,6 @@ class Sparse3DReader:
 
     def fail(self, msg: str) -> EyevizError:
         return EyevizError(f"{self.path}: {msg}")
-
-    def _read_meta(self, zf: zipfile.ZipFile, infos: dict) -> np.ndarray:
-        mi = infos.get("meta.npy")
-        if mi is None:
-            raise self.fail("member 'meta' is missing")
-        if mi.file_size > _META_MAX_BYTES:
-            raise self.fail(f"member 'meta' declares {mi.file_size} bytes")
-        with zf.open(mi) as f:
-            arr = np.lib.format.read_array(f, allow_pickle=False)
-        if arr.dtype.kind != "U" or arr.shape != ():
-            raise self.fail(f"member 'meta' has dtype {arr.dtype} shape {arr.shape}")
-        return arr
 
     def _member(self, f: BinaryIO, infos: dict, name: str) -> _Member:
         """The header of member ``name``, its bytes checked to lie inside the file."""

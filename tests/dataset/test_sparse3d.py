@@ -405,3 +405,25 @@ def test_compressed_and_lying_members(tmp_path):
 def test_non_regular_file_is_refused(tmp_path):
     with pytest.raises(EyevizError, match="not a regular file|not a readable"):
         sparse3d.load3d(tmp_path)
+
+
+@pytest.mark.parametrize(
+    "header",
+    [
+        {"descr": "<U100", "fortran_order": False, "shape": (10**9,)},
+        {"descr": "<U100000000", "fortran_order": False, "shape": ()},
+        {"descr": "<f8", "fortran_order": False, "shape": ()},
+    ],
+)
+def test_a_meta_declaring_too_much_or_the_wrong_kind_is_refused(tmp_path, header):
+    m = _members(rows(20))
+    path = tmp_path / "meta.npz"
+    with zipfile.ZipFile(path, "w") as zf:
+        for name, arr in m.items():
+            with zf.open(name + ".npy", "w") as f:
+                if name == "meta":
+                    np.lib.format.write_array_header_1_0(f, header)
+                    f.write(b"\0" * 400)
+                else:
+                    np.lib.format.write_array(f, arr, allow_pickle=False)
+    _refused(path, "'meta'")
