@@ -265,3 +265,32 @@ def test_unbounded_region_reports_infinite_distance():
     assert reg.distance_range()[1] == math.inf
     lo, hi = reg.azimuth_range()
     assert lo < math.pi / 2 < hi
+
+
+@pytest.mark.parametrize("x, y, g", [(0.0, 0.0, 1.0), (0.0, 0.1, 5.0), (1.0, 0.0, 2.0)])
+def test_a_region_around_the_origin_has_distance_range_from_zero(x, y, g):
+    """A feature on the origin (between the eyes): its region holds the origin, so the
+    nearest distance is 0 and the feature's own distance lies in the range."""
+    r0, r1 = ambiguity_region(PAIR, x, y, g).distance_range()
+    assert r0 == 0.0 and r0 <= math.hypot(x, y) <= r1
+
+
+def _nearest_distance(poly):
+    """0 when the convex polygon holds the origin (winding by angles), else the least
+    distance from the origin to its edges, sampled finely (an oracle apart from the code)."""
+    ang = np.arctan2(poly[:, 1], poly[:, 0])
+    turn = np.angle(np.exp(1j * (np.roll(ang, -1) - ang))).sum()
+    if abs(turn) > np.pi:
+        return 0.0
+    t = np.linspace(0.0, 1.0, 2001)[:, None, None]
+    pts = poly[None] + t * (np.roll(poly, -1, axis=0) - poly)[None]
+    return float(np.hypot(pts[..., 0], pts[..., 1]).min())
+
+
+@pytest.mark.parametrize("x", [-30.0, -3.0, 0.0, 2.0, 25.0])
+@pytest.mark.parametrize("y, g", [(0.0, 1.0), (0.3, 2.0), (1.0, 0.5), (4.0, 6.0), (20.0, 3.0)])
+def test_nearest_distance_of_regions_near_the_origin(x, y, g):
+    reg = ambiguity_region(PAIR, x, y, g)
+    poly = reg.polygon if reg.hull is None else reg.hull
+    want = _nearest_distance(poly)
+    assert reg.distance_range()[0] == pytest.approx(want, rel=1e-5, abs=1e-6 * (1 + want))

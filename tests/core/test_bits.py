@@ -65,3 +65,14 @@ def test_bitmaps_of_features_keep_shape_and_agree_with_packed():
     LA, RA, LB, RB = eyes.intervals(x, y, g)
     assert (intervals_to_bitmap(LB, RB, 720) == b).all()
     assert (bits.packed_bitmaps(LA, RA, 720, 360) == np.packbits(a[..., :360], axis=-1)).all()
+
+
+def test_packed_per_byte_path_keeps_a_wrap_that_ends_on_ommatidium_zero():
+    """Widths past the packed tables (> bits._PACKED_TABLE_MAX_W) wrap a run past m - 1
+    onto 0, 1, ...; a run ending exactly on m (ommatidium 0) lights ommatidium 0 too."""
+    m = 2 * (bits._PACKED_TABLE_MAX_W + 8)
+    L = np.array([m - 3, m - 3, m - 1, 5])
+    R = np.array([m, m + 1, m, 9])
+    for w in (m, m // 2):
+        want = np.packbits(_direct(L, R, m, w), axis=-1)
+        np.testing.assert_array_equal(bits.packed_bitmaps(L, R, m, w), want)

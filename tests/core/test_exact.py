@@ -136,3 +136,19 @@ def test_expansion_sign_is_exact_where_float_sums_cancel():
         for p, q, r in zip(a, b, c, strict=True)
     ]
     assert signs.tolist() == want == [1, 1, -1]
+
+
+def test_the_cosine_tables_are_the_cosines():
+    """cos(30 k deg) = a + b sqrt 3 and cos(45 k deg) = a + b sqrt 2, in the Fraction
+    tables and the doubled float tables alike (entries no other test reaches included)."""
+    for table, doubled, full, root in (
+        (exact._COS30, exact._COS30_2, 12, 3),
+        (exact._COS45, exact._COS45_2, 8, 2),
+    ):
+        assert len(table) == len(doubled) == full
+        for k in range(full):
+            want = math.cos(2 * math.pi * k / full)
+            a, b = table[k]
+            assert float(a) + float(b) * math.sqrt(root) == pytest.approx(want, abs=1e-15), k
+            a2, b2 = doubled[k]
+            assert a2 + b2 * math.sqrt(root) == pytest.approx(2 * want, abs=1e-15), k
