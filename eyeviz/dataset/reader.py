@@ -71,9 +71,7 @@ class BlockReader:
     def __init__(self, path, block_rows: int = BLOCK_ROWS, eyes: EyePair | None = None):
         self.path = Path(path)
         self.fmt = format_of(self.path)
-        if not isinstance(block_rows, int) or block_rows < 1:
-            raise EyevizError(f"block_rows must be an integer >= 1, got {block_rows!r}")
-        self.block_rows = block_rows
+        self.block_rows = check_int("block_rows", block_rows, ge=1)
         if not self.path.is_file():
             raise EyevizError(f"no such data set file: {str(self.path)!r}")
         self.params: dict = {}

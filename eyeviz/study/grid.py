@@ -17,7 +17,7 @@ from collections.abc import Iterable, Sequence
 from eyeviz import EyevizError
 from eyeviz.core.bounds import MAX_BINS, check_m, check_r_min
 from eyeviz.core.domain import DEFAULTS
-from eyeviz.core.validation import check_choice, check_real
+from eyeviz.core.validation import check_choice, check_int, check_real
 from eyeviz.estimators.limit import PRIORS
 from eyeviz.files.limits import MAX_ROWS
 from eyeviz.study.point import BIN_WIDTH, DesignPoint
@@ -101,12 +101,8 @@ def design_grid(
     for name, vals in (("h", hs), ("l", ls)):
         for v in vals:
             check_real(name, v, gt=0)
-    if isinstance(n, bool) or not isinstance(n, int | float) or n != int(n):
-        raise EyevizError(f"n must be an integer >= 1, got {n!r}")
-    if not 1 <= n <= MAX_ROWS:
-        raise EyevizError(f"n must be an integer in [1, {MAX_ROWS}], got {n!r}")
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise EyevizError(f"seed must be an integer >= 0, got {seed!r}")
+    n = check_int("n", n, ge=1, le=MAX_ROWS)
+    seed = check_int("seed", seed, ge=0)
     check_choice("prior", prior, PRIORS)
     r_lo = check_real("r_min", r_min, gt=0)
     r_hi = check_real("r_max", r_max, gt=r_lo)
