@@ -47,7 +47,15 @@ else:
     dataset.write(out, n, seed=1)
 wall, cpu_s = time.perf_counter() - t0, time.process_time() - c0
 rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-print(json.dumps({"wall": wall, "cpu": cpu_s, "rss": rss, "bytes": os.path.getsize(out)}))
+read = rss_read = None
+if kind == "3d":  # read it back, every row and CRC checked, in bounded blocks
+    t0 = time.perf_counter()
+    rows = sum(len(b) for b in sparse3d.Sparse3DReader(out))
+    assert rows == n
+    read = time.perf_counter() - t0
+    rss_read = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+print(json.dumps({"wall": wall, "cpu": cpu_s, "rss": rss, "bytes": os.path.getsize(out),
+                  "read": read, "rss_read": rss_read}))
 """
 
 
@@ -80,23 +88,28 @@ def main() -> None:
         print(f"\n1. generating {args.n:,} rows (one core)")
         print(
             f"   3D, nside 180:     {main3d['wall']:7.2f} s wall, {main3d['cpu']:7.2f} s CPU, "
-            f"{main3d['bytes'] / 1e6:8.1f} MB   (target <= 60 s: "
-            f"{'met' if main3d['wall'] <= 60 else 'NOT met'})"
+            f"{main3d['bytes'] / 1e6:8.1f} MB"
         )
+        if args.n == 100_000:
+            verdict = "met" if main3d["wall"] <= 60 else "NOT met"
+            print(f"   target 10^5 rows <= 60 s: {verdict} on wall time; CPU time "
+                  f"{main3d['cpu']:.1f} s (what one free core would take)")  # fmt: skip
         print(
             f"   planar, m = 720:   {planar['wall']:7.2f} s wall, {planar['cpu']:7.2f} s CPU, "
             f"{planar['bytes'] / 1e6:8.1f} MB"
         )
         print(f"   ratio 3D / planar: {main3d['wall'] / planar['wall']:.1f}x (wall)")
+        print(f"   reading it back (every row and CRC checked): {main3d['read']:.2f} s")
         runs = [(max(1, args.n // 10), flat), (args.n, main3d)]
         if args.big:
             runs.append((args.n * 10, run("3d", args.n * 10, folder)))
-        print("\n2. peak RSS of the 3D generator (each run its own process)")
-        base = runs[0][1]["rss"]
+        print("\n2. peak RSS of the 3D generator (each run its own process), then reading")
+        base, base_read = runs[0][1]["rss"], runs[0][1]["rss_read"]
         for n, r in runs:
             print(
-                f"   n = {n:>9,}: {r['rss'] / 2**20:7.1f} MiB  ({r['rss'] / base:.2f}x the "
-                f"smallest; file {r['bytes'] / 1e6:.0f} MB, {r['wall']:.1f} s)"
+                f"   n = {n:>9,}: writing {r['rss'] / 2**20:6.1f} MiB ({r['rss'] / base:.2f}x), "
+                f"reading {r['rss_read'] / 2**20:6.1f} MiB ({r['rss_read'] / base_read:.2f}x); "
+                f"file {r['bytes'] / 1e6:.0f} MB, {r['wall']:.1f} s"
             )
     finally:
         shutil.rmtree(folder, ignore_errors=True)
