@@ -70,3 +70,13 @@ def test_dict_round_trip_and_unknown_keys():
         Domain3D.from_dict({"nside": 9})
     with pytest.raises(EyevizError, match="must be a dict"):
         Domain3D.from_dict([("nside", 8)])  # type: ignore[arg-type]
+
+
+def test_eyes_are_the_spherical_pair_of_the_design():
+    from eyeviz.core.geometry3d import EyePair3D
+
+    d = Domain3D(h=30, l=10, nside=16)
+    eyes = d.eyes
+    assert isinstance(eyes, EyePair3D)
+    assert (eyes.h, eyes.l, eyes.nside, eyes.npix, eyes.m) == (30.0, 10.0, 16, d.npix, d.m)
+    assert math.isclose(eyes.psi, d.psi)
