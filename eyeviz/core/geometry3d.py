@@ -1,0 +1,623 @@
+"""The spherical binocular eye: two HEALPix eyes, features are balls (docs/spherical.md).
+
+Two spherical eyes of radius l at A = (-h, 0, 0) and B = (h, 0, 0); x right, y forward,
+z up; the plane z = 0 is the paper's planar model (Section 8 names this as its next goal).
+Facets are HEALPix cells in RING order (:mod:`eyeviz.core.healpix`), 12 nside^2 per eye.
+
+A facet is lit iff some direction of the closed tangent cone from the eye centre to the
+ball (the cap of half-angle alpha = asin(g / |d|) about d / |d|; the whole eye when
+|d| <= g) maps to it under ang2pix, in exact real arithmetic on the float inputs: the 3D
+Proposition 2. The cap is closed with interior and a cell is the closure of its interior
+minus part of its boundary, so a cell is lit iff the distance from the cap centre to the
+cell's closure is < alpha, or = alpha with a touch point that ang2pix maps to the cell.
+
+The float64 fast path, per ball and eye: the rings the cap's z-range meets; per ring the
+candidate cells from the cap's widest longitude span over the ring's z-band and the
+surely lit cells from its span on the ring's own z (where each cell's W-E diagonal lies);
+the few cells between are tested on their vertices and edges with a proven
+second-derivative bound of the edge curves plus the rounding bound of float64. Only the
+cells that stay within both bounds of the cap's boundary reach :mod:`eyeviz.core.exact3d`.
+Lit sets come out as per-ring runs, hence sorted without a sort of the indices.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+
+from eyeviz.core import exact3d, healpix
+from eyeviz.core.bounds import MAX_NSIDE, check_nside
+from eyeviz.core.geometry import _check_param, _first_index
+
+__all__ = ["EyePair3D", "validate_balls", "MAX_NSIDE", "MAX_LIT", "FALLBACK_COUNTS"]
+
+_EPS = 2.0**-52
+_DP = 64 * _EPS  # error of a facet vertex vector from healpix.xyf2vec
+_STAGES = (16, 256)  # samples per edge in the second and third stages
+_SQ6 = math.sqrt(6.0)
+#: Largest number of lit indices one call may return (2^28 int64: 2 GiB). A whole eye at
+#: nside 2^20 is 1.3e13 facets: such a lit set exists only as runs, not as indices.
+MAX_LIT = 1 << 28
+
+#: Diagnostics: cells the vertex/edge test could not clear ("tested"), cells that needed
+#: edge sampling ("sampled") and cells decided in mpmath ("exact").
+FALLBACK_COUNTS: Counter[str] = Counter()
+
+
+def validate_balls(x, y, z, g) -> tuple[np.ndarray, ...]:
+    """Broadcast x, y, z, g to float64; refuse non-finite values and g <= 0."""
+    try:
+        arrs = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (x, y, z, g)))
+    except (TypeError, ValueError) as exc:
+        raise ValueError(
+            f"x, y, z, g must be real numbers of broadcastable shapes: {exc}"
+        ) from None
+    for name, a in zip("xyzg", arrs, strict=True):
+        bad = ~np.isfinite(a)
+        if bad.any():
+            raise ValueError(
+                f"{name} has {int(bad.sum())} non-finite value(s) (NaN or inf); "
+                f"first at index {_first_index(bad)}"
+            )
+    bad = arrs[3] <= 0
+    if bad.any():
+        raise ValueError(
+            f"g (feature radius) must be > 0: {int(bad.sum())} value(s) are not; "
+            f"first at index {_first_index(bad)}"
+        )
+    return tuple(arrs)
+
+
+def _jr_of_theta(theta: np.ndarray) -> np.ndarray:
+    """Height in rings / nside of the colatitude theta (the inverse of the rings' z)."""
+    c = np.cos(theta)
+    return np.where(
+        c >= 2.0 / 3.0,
+        _SQ6 * np.sin(0.5 * theta),
+        np.where(c <= -2.0 / 3.0, 4.0 - _SQ6 * np.cos(0.5 * theta), 2.0 - 1.5 * c),
+    )
+
+
+def _edge_bounds(n: int, face, fixed_is_y: bool, fixed, lo) -> np.ndarray:
+    """Vectorised :func:`eyeviz.core.exact3d.edge_bound`."""
+    fx = fixed / n
+    hi_f = (lo + 1) / n
+    lo_f = lo / n
+    north, south = face < 4, face >= 8
+    a = np.where(north, 1.0 - fx, np.where(south, fx, 0.0))
+    nr_min = np.where(north, 2.0 - fx - hi_f, np.where(south, fx + lo_f, 1.0))
+    polar = (north | south) & (nr_min < 1.0) & (a > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        extra = np.where(polar, 7.2 * a / np.maximum(nr_min, 1e-300) ** 2, 0.0)
+    return (2.0 + extra) / (n * n)
+
+
+def _runs_to_pieces(first, nr, lo, hi):
+    """Cyclic runs [lo, hi] (unwrapped, hi - lo < nr) of rings -> up to two pieces each,
+    (start index, length) in RING order."""
+    lo_w = np.mod(lo, nr)
+    length = hi - lo + 1
+    end = lo_w + length
+    split = end > nr
+    len1 = np.where(split, nr - lo_w, length)
+    start1 = first + lo_w
+    start2 = first
+    len2 = np.where(split, end - nr, 0)
+    return start1, len1, start2, len2
+
+
+def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
+    """(indptr, indices) of the lit facets of one eye for flat float64 arrays of balls."""
+    nb = x.shape[0]
+    npix = 12 * n * n
+    with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
+        dx0 = x - cx
+        errabs0 = _EPS * (np.abs(x) + abs(cx))  # dx = x - cx rounds once
+        # scale every ball by a power of two (exact) so that |d| ~ 1
+        big = np.maximum(np.maximum(np.abs(dx0), np.abs(y)), np.maximum(np.abs(z), g))
+        ex = np.frexp(big)[1]
+        dx, dy, dz, gs = (np.ldexp(v, -ex) for v in (dx0, y, z, g))
+        errabs = np.ldexp(errabs0, -ex)
+        d2 = dx * dx + dy * dy + dz * dz
+        d = np.sqrt(d2)
+        errdir = 8 * _EPS + 4 * errabs / d
+        # the whole eye: decided exactly where float cannot tell
+        dmg = (d - gs) * (d + gs)
+        sep = 8 * _EPS * (d + gs) ** 2 + 4 * errabs * (d + gs)
+        whole = dmg < -sep
+        near = np.abs(dmg) <= sep
+        for i in np.flatnonzero(near):
+            whole[i] = exact3d.whole_eye(
+                Fraction(float(x[i])) - Fraction(cx),
+                Fraction(float(y[i])),
+                Fraction(float(z[i])),
+                Fraction(float(g[i])),
+            )
+        part = ~whole
+        q = gs / d
+        # the output is materialised: refuse a call whose lit sets cannot fit
+        frac = np.where(part, 0.5 * q * q, 1.0)  # >= (1 - cos alpha) / 2, the cap's share
+        est = float(frac.sum()) * npix
+        if est > MAX_LIT:
+            raise ValueError(
+                f"the lit sets would hold about {est:.3g} facets (more than {MAX_LIT}): "
+                "use fewer or smaller balls per call, or a smaller nside"
+            )
+        cosa = np.sqrt(np.maximum(dmg, 0.0)) / d
+        dcos = (4 * _EPS * d + 4 * errabs) * (d + gs) / (np.sqrt(np.maximum(dmg, 0.0)) * d)
+        dcos = np.where(np.isfinite(dcos), dcos + 4 * _EPS, 4.0)
+        s2 = 2 * q * q / (1 + cosa)
+        ds2 = 2 * dcos + 8 * _EPS * s2
+        alpha = np.arctan2(q, cosa)
+        dalpha = dcos / np.maximum(q, 1e-300) + 8 * _EPS
+        rxy = np.hypot(dx, dy)
+        rho_c = rxy / d
+        z_c = dz / d
+        theta_c = np.arctan2(rxy, dz)
+        phi_c = np.arctan2(dy, dx)
+        dphi = 4 * errdir / np.maximum(rho_c, 1e-300) + 1e-12
+        pad_t = dalpha + 4 * errdir + 1e-12
+        th_lo = np.clip(theta_c - alpha - pad_t, 0.0, math.pi)
+        th_hi = np.clip(theta_c + alpha + pad_t, 0.0, math.pi)
+        i_min = np.floor(n * _jr_of_theta(th_lo) * (1 - 1e-12)).astype(np.int64) - 1
+        i_max = np.ceil(n * _jr_of_theta(th_hi) * (1 + 1e-12)).astype(np.int64) + 1
+        i_min = np.clip(i_min, 1, 4 * n - 1)
+        i_max = np.clip(i_max, 1, 4 * n - 1)
+        i_max = np.where(part, i_max, i_min - 1)  # whole-eye balls: no rings
+        zc_hi = np.cos(th_lo)
+        zc_lo = np.cos(th_hi)
+
+        # --- (ball, ring) pairs -------------------------------------------------------
+        cnt = np.maximum(i_max - i_min + 1, 0)
+        pb = np.repeat(np.arange(nb), cnt)
+        offs = np.arange(pb.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        ring = i_min[pb] + offs
+        first, nr, shifted = healpix.ring_info(n, ring)
+        delta = 2 * math.pi / nr
+        o = np.where(shifted, 0.0, -0.5)
+        zb_lo, zb_hi = healpix.ring_z_range(n, ring)
+        z_i = healpix.ring_z(n, ring)
+        za = np.maximum(zb_lo, zc_lo[pb])
+        zb = np.minimum(zb_hi, zc_hi[pb])
+        empty = za > zb
+        cos_p, zc_p, rc_p = cosa[pb], z_c[pb], rho_c[pb]
+        dnum = dcos[pb] + 2 * errdir[pb] + 4 * _EPS
+        drel = 2 * errdir[pb] / np.maximum(rc_p, 1e-300) + 8 * _EPS
+
+        def arg_bounds(zz):
+            rr = np.sqrt(np.maximum(1.0 - zz * zz, 0.0))
+            den = rc_p * rr
+            num = cos_p - zc_p * zz
+            a = num / den
+            da = dnum / den + np.abs(a) * drel
+            lo_ = np.where(np.isnan(a) | np.isnan(da), -np.inf, a - da)
+            hi_ = np.where(np.isnan(a) | np.isnan(da), np.inf, a + da)
+            return lo_, hi_
+
+        zstar = zc_p / cos_p
+        zs_in = (zstar >= za) & (zstar <= zb)
+        lo_a, _ = arg_bounds(za)
+        lo_b, _ = arg_bounds(zb)
+        lo_s, _ = arg_bounds(np.where(zs_in, zstar, za))
+        amin = np.minimum(np.minimum(lo_a, lo_b), lo_s)
+        dph = dphi[pb] + 1e-9
+        W = np.arccos(np.clip(amin, -1.0, 1.0)) + dph
+        no_cand = empty | (amin > 1.0)
+        full_c = (W >= math.pi) | (amin <= -1.0)
+        pc = phi_c[pb]
+        jc_lo = np.ceil((pc - W) / delta - o - 1).astype(np.int64)
+        jc_hi = np.floor((pc + W) / delta - o).astype(np.int64)
+        full_c |= jc_hi - jc_lo + 1 >= nr
+        # surely lit: the cell's W-E diagonal (on z_i) meets the cap's interior
+        _, hi_i = arg_bounds(z_i)
+        in_z = (z_i > zc_lo[pb]) & (z_i < zc_hi[pb])
+        has_s = in_z & (hi_i < 1.0) & ~no_cand
+        ws = np.arccos(np.clip(hi_i, -1.0, 1.0)) - dph
+        has_s &= ws > 0
+        full_s = has_s & (hi_i <= -1.0)
+        js_lo = np.floor((pc - ws) / delta - o - 1).astype(np.int64) + 1
+        js_hi = np.ceil((pc + ws) / delta - o).astype(np.int64) - 1
+        has_s &= js_hi >= js_lo
+        full_s |= has_s & (js_hi - js_lo + 1 >= nr)
+        js_lo = np.where(full_s, 0, js_lo)
+        js_hi = np.where(full_s, nr - 1, js_hi)
+        # clip the sure range into the candidate range (it lies inside it in exact terms)
+        part_c = ~full_c & ~no_cand
+        js_lo = np.where(has_s & part_c, np.maximum(js_lo, jc_lo), js_lo)
+        js_hi = np.where(has_s & part_c, np.minimum(js_hi, jc_hi), js_hi)
+        has_s &= js_hi >= js_lo
+
+        # --- undecided cells: (pair, j) ---------------------------------------------------
+        # left block [u1_lo, u1_hi] and right block [u2_lo, u2_hi] in unwrapped j
+        u1_lo = np.where(full_c, np.where(has_s, js_hi + 1, 0), jc_lo)
+        u1_hi = np.where(
+            full_c,
+            np.where(has_s, js_lo + nr - 1, nr - 1),
+            np.where(has_s, js_lo - 1, jc_hi),
+        )
+        u2_lo = np.where(full_c | ~has_s, 1, js_hi + 1)
+        u2_hi = np.where(full_c | ~has_s, 0, jc_hi)
+        kill = no_cand | full_s
+        u1_hi = np.where(kill, u1_lo - 1, u1_hi)
+        u2_hi = np.where(kill, u2_lo - 1, u2_hi)
+        has_s &= ~no_cand
+        c1 = np.maximum(u1_hi - u1_lo + 1, 0)
+        c2 = np.maximum(u2_hi - u2_lo + 1, 0)
+        cc = c1 + c2
+        up = np.repeat(np.arange(pb.size), cc)
+        k = np.arange(up.size) - np.repeat(np.cumsum(cc) - cc, cc)
+        uj = np.where(k < c1[up], u1_lo[up] + k, u2_lo[up] + k - c1[up])
+        upix = first[up] + np.mod(uj, nr[up])
+        ub = pb[up]
+        lit_u = _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g, cx)
+
+    # --- assemble: per pair the lit j's are one cyclic run (else explicit pieces) ----------
+    big_i = np.iinfo(np.int64).max
+    uj_lit = uj[lit_u]
+    up_lit = up[lit_u]
+    lo = np.where(has_s, js_lo, big_i)
+    hi = np.where(has_s, js_hi, -big_i)
+    num = np.where(has_s, js_hi - js_lo + 1, 0)
+    np.minimum.at(lo, up_lit, uj_lit)
+    np.maximum.at(hi, up_lit, uj_lit)
+    np.add.at(num, up_lit, 1)
+    anyl = num > 0
+    contig = anyl & (hi - lo + 1 == num)
+    cp = np.flatnonzero(contig)
+    s1, l1, s2_, l2 = _runs_to_pieces(first[cp], nr[cp], lo[cp], hi[cp])
+    starts = [s1, s2_]
+    lens = [l1, l2]
+    balls = [pb[cp], pb[cp]]
+    # pairs whose lit cells are not one run (not expected; kept exact all the same)
+    odd = np.flatnonzero(anyl & ~contig)
+    if odd.size:
+        so = np.flatnonzero(has_s[odd])
+        a1, b1, a2, b2 = _runs_to_pieces(
+            first[odd[so]], nr[odd[so]], js_lo[odd[so]], js_hi[odd[so]]
+        )
+        starts += [a1, a2]
+        lens += [b1, b2]
+        balls += [pb[odd[so]], pb[odd[so]]]
+        sel = np.isin(up_lit, odd)
+        starts.append(first[up_lit[sel]] + np.mod(uj_lit[sel], nr[up_lit[sel]]))
+        lens.append(np.ones(int(sel.sum()), np.int64))
+        balls.append(pb[up_lit[sel]])
+        FALLBACK_COUNTS["non-run rings"] += odd.size
+    # whole-eye balls: one piece of every pixel
+    wb = np.flatnonzero(whole)
+    starts.append(np.zeros(wb.size, np.int64))
+    lens.append(np.full(wb.size, npix, np.int64))
+    balls.append(wb)
+    st = np.concatenate(starts).astype(np.int64)
+    ln = np.concatenate(lens).astype(np.int64)
+    bl = np.concatenate(balls).astype(np.int64)
+    keep = ln > 0
+    st, ln, bl = st[keep], ln[keep], bl[keep]
+    order = np.lexsort((st, bl))
+    st, ln, bl = st[order], ln[order], bl[order]
+    per_ball = np.bincount(bl, weights=ln, minlength=nb).astype(np.int64)
+    indptr = np.zeros(nb + 1, np.int64)
+    np.cumsum(per_ball, out=indptr[1:])
+    total = int(indptr[-1])
+    base = np.repeat(st - (np.cumsum(ln) - ln), ln)
+    indices = base + np.arange(total, dtype=np.int64)
+    return indptr, indices
+
+
+def _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g, cx):
+    """Lit flags of the undecided cells: vertices, then edges, then exact3d."""
+    m = upix.size
+    out = np.zeros(m, bool)
+    if m == 0:
+        return out
+    FALLBACK_COUNTS["tested"] += m
+    ix, iy, face = healpix.pix2xyf(n, upix)
+    cxv = dx[ub] / d[ub]
+    cyv = dy[ub] / d[ub]
+    czv = dz[ub] / d[ub]
+    s2u, ds2u, edu = s2[ub], ds2[ub], errdir[ub]
+    cpix = healpix.vec2pix_ring(n, dx, dy, dz)
+    own = (upix == cpix[ub]) & (alpha[ub] > 1e6 * errdir[ub])
+    out |= own
+
+    def chord(px, py, f):
+        v = healpix.xyf2vec(n, px, py, f)
+        return (v[..., 0] - cxv) ** 2 + (v[..., 1] - cyv) ** 2 + (v[..., 2] - czv) ** 2
+
+    fx = ix.astype(np.float64)
+    fy = iy.astype(np.float64)
+    fN = chord(fx + 1, fy + 1, face)
+    fW = chord(fx, fy + 1, face)
+    fS = chord(fx, fy, face)
+    fE = chord(fx + 1, fy, face)
+
+    def tol(f):
+        return 4 * (np.sqrt(f) + np.sqrt(s2u)) * (_DP + edu) + ds2u + 1e-300
+
+    vmin = np.minimum(np.minimum(fN, fW), np.minimum(fS, fE))
+    out |= vmin < s2u - tol(vmin)
+    # edges: (fixed_is_y, fixed, lo, f_a, f_b)
+    edges = (
+        (True, fy + 1, fx, fW, fN),
+        (False, fx, fy, fS, fW),
+        (True, fy, fx, fS, fE),
+        (False, fx + 1, fy, fE, fN),
+    )
+    clear_all = ~out
+    open_edges = []
+    for fixed_is_y, fixed, lo, fa, fb in edges:
+        mf = 2.5 * _edge_bounds(n, face, fixed_is_y, fixed, lo)
+        lower = np.minimum(fa, fb) - mf / 8
+        clear = lower > s2u + tol(np.maximum(lower, 0.0))
+        clear_all &= clear
+        open_edges.append((fixed_is_y, fixed, lo, fa, fb, mf, ~clear & ~out))
+    undecided = ~out & ~clear_all
+    idx = np.flatnonzero(undecided)
+    if idx.size:
+        FALLBACK_COUNTS["sampled"] += idx.size
+        lit_now = np.zeros(idx.size, bool)
+        # rows: (cell, edge) pairs still open; each stage samples them K times
+        rows = [(k, need[idx]) for k, (*_, need) in enumerate(open_edges)]
+        for samples in _STAGES:
+            t = np.arange(1, samples) / samples
+            still = np.zeros(idx.size, bool)
+            new_rows = []
+            for k, nd in rows:
+                nd = nd & ~lit_now
+                if not nd.any():
+                    continue
+                fixed_is_y, fixed, lo, fa, fb, mf, _ = open_edges[k]
+                e = idx[nd]
+                fix = np.broadcast_to(fixed[e, None], (e.size, t.size))
+                run = lo[e, None] + t
+                px, py = (run, fix) if fixed_is_y else (fix, run)
+                v = healpix.xyf2vec(n, px, py, face[e, None])
+                f = (
+                    (v[..., 0] - cxv[e, None]) ** 2
+                    + (v[..., 1] - cyv[e, None]) ** 2
+                    + (v[..., 2] - czv[e, None]) ** 2
+                )
+                s2e = s2u[e, None]
+                tl = 4 * (np.sqrt(f) + np.sqrt(s2e)) * (_DP + edu[e, None]) + ds2u[e, None]
+                lit_now[nd] |= (f < s2e - tl).any(axis=1)
+                fmin = np.minimum(f.min(axis=1), np.minimum(fa[e], fb[e]))
+                lower = fmin - mf[e] / (8 * samples * samples)
+                lw = np.maximum(lower, 0.0)
+                tle = 4 * (np.sqrt(lw) + np.sqrt(s2u[e])) * (_DP + edu[e]) + ds2u[e] + 1e-300
+                open_ = np.zeros(idx.size, bool)
+                open_[nd] = ~(lower > s2u[e] + tle)
+                still |= open_
+                new_rows.append((k, open_))
+            rows = new_rows
+        still &= ~lit_now
+        out[idx[lit_now]] = True
+        rest = idx[~lit_now & still]
+        for i in rest:
+            FALLBACK_COUNTS["exact"] += 1
+            b = int(ub[i])
+            out[i] = exact3d.cell_lit(
+                n,
+                Fraction(float(x[b])) - Fraction(cx),
+                Fraction(float(y[b])),
+                Fraction(float(z[b])),
+                Fraction(float(g[b])),
+                int(face[i]),
+                int(ix[i]),
+                int(iy[i]),
+                int(upix[i]),
+            )
+    return out
+
+
+@dataclass(frozen=True)
+class EyePair3D:
+    """Two spherical HEALPix eyes (docs/spherical.md; the paper's Section 8 goal).
+
+    Parameters
+    ----------
+    h : distance from the origin to each eye centre (eyes 2h apart), h > l.
+    l : eye radius, l > 0.
+    nside : HEALPix resolution, an even integer in [2, MAX_NSIDE]; 12 nside^2 facets per
+        eye, m = 4 nside of them on the equator (the planar eye EyePair(h, l, 4 nside)).
+    """
+
+    h: float = 40.0
+    l: float = 20.0
+    nside: int = 180
+
+    def __post_init__(self) -> None:
+        l = _check_param("l", self.l, "0 < l < h")
+        h = _check_param("h", self.h, "0 < l < h")
+        if l <= 0:
+            raise ValueError(f"l (eye radius) must be > 0, got {self.l!r}")
+        if h <= l:
+            raise ValueError(
+                f"h must be > l (eyes may not touch the y-axis), got h={self.h!r}, l={self.l!r}"
+            )
+        n = check_nside(self.nside)
+        object.__setattr__(self, "h", h)
+        object.__setattr__(self, "l", l)
+        object.__setattr__(self, "nside", n)
+
+    @property
+    def npix(self) -> int:
+        """Facets per eye, 12 nside^2."""
+        return 12 * self.nside * self.nside
+
+    @property
+    def m(self) -> int:
+        """Facets on the equator, 4 nside (the planar eye's m)."""
+        return 4 * self.nside
+
+    @property
+    def psi(self) -> float:
+        """Half-angle of each eye's tangent cone from the origin, asin(l / h) (Eq. 15)."""
+        return math.asin(self.l / self.h)
+
+    @property
+    def centers(self) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        """((-h, 0, 0), (h, 0, 0)): eye A (left) and eye B (right)."""
+        return ((-self.h, 0.0, 0.0), (self.h, 0.0, 0.0))
+
+    # --- the eye-model seam (eyeviz.core.eyes.EyeModel) --------------------------------
+    @property
+    def kind(self) -> str:
+        """``"spherical"``: HEALPix eyes in space (docs/spherical.md)."""
+        return "spherical"
+
+    @property
+    def dims(self) -> int:
+        """Coordinates of a feature centre: 3 (x, y, z)."""
+        return 3
+
+    @property
+    def facets(self) -> int:
+        """Facets per eye, 12 nside^2."""
+        return self.npix
+
+    @property
+    def design(self) -> dict[str, float | int]:
+        """{"h", "l", "nside"}: what a scene, a data set or an estimator must agree on."""
+        return {"h": self.h, "l": self.l, "nside": self.nside}
+
+    def _cx(self, eye: str) -> float:
+        if eye == "A":
+            return -self.h
+        if eye == "B":
+            return self.h
+        raise ValueError(f"eye must be 'A' or 'B', got {eye!r}")
+
+    def facet(self, x, y, z, eye: str) -> np.ndarray:
+        """RING index of the direction from the eye centre to the point (Prop. 1 in 3D).
+
+        Exact on the float inputs: a point within rounding of a cell edge is decided by
+        ang2pix in mpmath with the floors snapped (:func:`exact3d.ang2pix_snap`); the eye
+        centre itself is given the facet of the north pole (0), as atan2(0, 0) = 0.
+        """
+        cx = self._cx(eye)
+        xa, ya, za, _ = validate_balls(x, y, z, 1.0)
+        shape = xa.shape
+        xa, ya, za = xa.ravel(), ya.ravel(), za.ravel()
+        n = self.nside
+        dx = xa - cx
+        out = healpix.vec2pix_ring(n, dx, ya, za)
+        # a point is near a boundary when a cap of the rounding radius about it is not
+        # inside one cell: the lit set of a tiny ball says so, exactly
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            r = np.sqrt(dx * dx + ya * ya + za * za)
+        ok = (r > 1e-150) & (r < 1e150)
+        i = np.flatnonzero(ok)
+        # the lit set of a ball of angular radius 1e-8 about the point is exact: one cell
+        # means the point's direction lies inside it
+        ip, idx = _lit_eye(n, xa[i], ya[i], za[i], 1e-8 * r[i], cx)
+        one = np.diff(ip) == 1
+        out[i[one]] = idx[ip[:-1][one]]
+        todo = i[~one]
+        todo = np.concatenate([todo, np.flatnonzero(~ok)])
+        import mpmath
+
+        for j in todo:
+            X = Fraction(float(xa[j])) - Fraction(cx)
+            Y, Z = Fraction(float(ya[j])), Fraction(float(za[j]))
+            if X == 0 and Y == 0 and Z == 0:
+                out[j] = 0
+                continue
+            prec = 200 + 2 * max(
+                abs(v.numerator).bit_length() + v.denominator.bit_length() for v in (X, Y, Z)
+            )
+            with mpmath.workprec(prec):
+                v = tuple(mpmath.mpf(q.numerator) / q.denominator for q in (X, Y, Z))
+                out[j] = exact3d.ang2pix_snap(n, v, mpmath.ldexp(1, -prec // 2))
+        return out.reshape(shape)
+
+    def lit_csr(self, x, y, z, g) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+        """Per eye (A, B): (indptr, indices) of the lit facets, CSR over the flattened
+        balls; indices sorted int64 RING indices per row (the 3D Proposition 2)."""
+        xa, ya, za, ga = validate_balls(x, y, z, g)
+        xf, yf, zf, gf = (np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, za, ga))
+        out = []
+        for cx in (-self.h, self.h):
+            out.append(_lit_eye(self.nside, xf, yf, zf, gf, cx))
+        return out[0], out[1]
+
+    def lit(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
+        """One ball: (lit_a, lit_b), sorted int64 RING indices of the lit facets."""
+        for name, v in zip("xyzg", (x, y, z, g), strict=True):
+            if np.ndim(v) != 0:
+                raise ValueError(f"{name} must be a scalar for lit(); use lit_csr for arrays")
+        (pa, ia), (pb, ib) = self.lit_csr(x, y, z, g)
+        return ia[pa[0] : pa[1]], ib[pb[0] : pb[1]]
+
+    def bitmaps(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
+        """(omega_a, omega_b) bool of shape (..., npix)."""
+        xa, _, _, _ = validate_balls(x, y, z, g)
+        shape = xa.shape
+        res = []
+        for indptr, idx in self.lit_csr(x, y, z, g):
+            nb = indptr.size - 1
+            bm = np.zeros((nb, self.npix), bool)
+            rows = np.repeat(np.arange(nb), np.diff(indptr))
+            bm[rows, idx] = True
+            res.append(bm.reshape(shape + (self.npix,)))
+        return res[0], res[1]
+
+    def visible(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
+        """Definition 1 per eye: the ball lights at least two facets (vis_a, vis_b)."""
+        xa, _, _, _ = validate_balls(x, y, z, g)
+        (pa, _), (pb, _) = self.lit_csr(x, y, z, g)
+        return (np.diff(pa) >= 2).reshape(xa.shape), (np.diff(pb) >= 2).reshape(xa.shape)
+
+    def in_bfv(self, x, y, z, g) -> np.ndarray:
+        """The closed ball lies in the 3D binocular field of view (Prop. 4 generalised).
+
+        In front (y >= g) and outside both open tangent cones from the origin to the eyes:
+        w * sqrt(y^2 + z^2) - l * |x| >= g * h with w = sqrt(h^2 - l^2); on z = 0 this is
+        Eq. 17 (docs/spherical.md derives it).
+        """
+        xa, ya, za, ga = validate_balls(x, y, z, g)
+        shape = xa.shape
+        xa, ya, za, ga = xa.ravel(), ya.ravel(), za.ravel(), ga.ravel()
+        h, l = self.h, self.l
+        with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+            w = math.sqrt((h - l) * (h + l))
+            b = np.hypot(ya, za)
+            lhs = w * b
+            rhs = l * np.abs(xa) + ga * h
+            tol = 16 * _EPS * (lhs + rhs)
+            near = (np.abs(lhs - rhs) <= tol) | ~np.isfinite(lhs + rhs)
+            near |= ~(lhs + rhs >= 2.0**-900) & (ya >= ga)
+        out = (ya >= ga) & (lhs >= rhs)
+        for i in np.flatnonzero(near & (ya >= ga)):
+            X, Y, Z, G = (Fraction(float(v[i])) for v in (xa, ya, za, ga))
+            H, L = Fraction(h), Fraction(l)
+            # w b >= l|x| + g h  <=>  (h^2 - l^2)(y^2 + z^2) >= (l|x| + g h)^2, both >= 0
+            out[i] = (H * H - L * L) * (Y * Y + Z * Z) >= (L * abs(X) + G * H) ** 2
+        return out.reshape(shape)
+
+    def overlaps_eye(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
+        """Per eye: the closed ball meets the closed eye ball of radius l."""
+        xa, ya, za, ga = validate_balls(x, y, z, g)
+        shape = xa.shape
+        xa, ya, za, ga = xa.ravel(), ya.ravel(), za.ravel(), ga.ravel()
+        res = []
+        for cx in (-self.h, self.h):
+            with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+                dx = xa - cx
+                d2 = dx * dx + ya * ya + za * za
+                s = ga + self.l
+                rhs = s * s
+                tot = d2 + rhs
+                near = np.abs(d2 - rhs) <= 16 * _EPS * tot + 8 * _EPS * (np.abs(xa) + self.h) * s
+                near |= ~(tot >= 2.0**-900) | ~np.isfinite(tot)
+            out = d2 <= rhs
+            for i in np.flatnonzero(near):
+                X = Fraction(float(xa[i])) - Fraction(cx)
+                Y, Z = Fraction(float(ya[i])), Fraction(float(za[i]))
+                S = Fraction(float(ga[i])) + Fraction(self.l)
+                out[i] = X * X + Y * Y + Z * Z <= S * S
+            res.append(out.reshape(shape))
+        return res[0], res[1]
