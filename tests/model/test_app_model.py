@@ -295,3 +295,25 @@ def test_a_live_move_of_another_feature_updates_that_row_not_the_selected_one():
             a, b = getattr(want, fld.name), getattr(got, fld.name)
             if isinstance(a, np.ndarray):
                 np.testing.assert_array_equal(b, a, err_msg=f"{fld.name}, moved {moved}")
+
+
+def test_the_ambiguity_region_is_clipped_to_a_square_about_the_view_centre(monkeypatch):
+    """The selected feature's region is clipped to a box centred on the view's centre (x
+    and y each from their own coordinate), wide enough to hold the feature and the view."""
+    import eyeviz.core.ambiguity as amb
+
+    boxes = []
+    real = amb.ambiguity_region
+    monkeypatch.setattr(
+        amb, "ambiguity_region", lambda *a, box: boxes.append(box) or real(*a, box=box)
+    )
+    m, _ = make(view=View((-800.0, 2600.0), 5000.0))
+    m.scene.layers = ["features", "ambiguity"]
+    m._notify("layers")
+    m.select(0)
+    assert m.ambiguity is not None and boxes
+    x0, x1, y0, y1 = boxes[-1]
+    assert ((x0 + x1) / 2, (y0 + y1) / 2) == pytest.approx((-800.0, 2600.0))
+    assert x1 - x0 == pytest.approx(y1 - y0)
+    f = m.scene.features[0]
+    assert x0 < f.x < x1 and y0 < f.y < y1 and x1 - x0 >= 3 * 5000.0
