@@ -317,3 +317,39 @@ def test_the_ambiguity_region_is_clipped_to_a_square_about_the_view_centre(monke
     assert x1 - x0 == pytest.approx(y1 - y0)
     f = m.scene.features[0]
     assert x0 < f.x < x1 and y0 < f.y < y1 and x1 - x0 >= 3 * 5000.0
+
+
+def test_selecting_another_feature_gives_that_features_region_and_a_camera_move_keeps_it():
+    m, _ = make()
+    m.scene.layers = ["features", "ambiguity"]
+    m._notify("layers")
+    m.select(0)
+    r0 = m.ambiguity
+    m.notify_view("main")
+    m.notify_view("inset")
+    assert m.ambiguity is r0  # a camera move keeps the region
+    m.select(1)
+    r1 = m.ambiguity
+    assert r1 is not r0 and r1["r_range"] != r0["r_range"]
+    f = m.scene.features[1]
+    assert r1["r_range"][0] <= (f.x**2 + f.y**2) ** 0.5 <= r1["r_range"][1]
+
+
+def test_a_camera_move_tells_listeners_which_view_moved():
+    m, _ = make()
+    heard = []
+    m.listeners.append(lambda what, i: heard.append((what, i)))
+    m.notify_view("main")
+    m.notify_view("inset")
+    m.notify_view()
+    assert heard == [("view", 0), ("view", 1), ("view", 0)]
+
+
+def test_hit_test_ignores_a_selection_past_the_last_feature():
+    m, _ = make()
+    sc = m.scene
+    n = len(sc.features)
+    f = sc.features[0]
+    for sel in (n, n + 3, -1):  # a stale index (the feature was deleted) is no selection
+        assert hit_test(sc, sel, f.x, f.y, 1.0) == (0, "body")
+        assert hit_test(sc, sel, 9e6, 9e6, 1.0) == (None, None)
