@@ -101,3 +101,14 @@ def test_discs_meet_one_disc_as_many():
             assert one == many, (x, y, g, min_px)
             hits += one
     assert 0 < hits < 800  # both answers occur
+
+
+def test_fit_view_ignores_a_hidden_inset_of_zero_size():
+    """An inset of zero width or height (hidden) leaves the whole viewport to the scene."""
+    sc = Scene(
+        Eyes(40, 20, 720),
+        [Feature("a", 0.0, 3000.0, 50.0), Feature("b", 2500.0, 1000.0, 300.0)],
+    )
+    free = camera.fit_view(sc, VP)
+    for hidden in (Viewport(700.0, 0.0, 0.0, 200.0), Viewport(700.0, 0.0, 300.0, 0.0)):
+        assert camera.fit_view(sc, VP, hidden) == free
