@@ -112,3 +112,17 @@ def test_fit_view_ignores_a_hidden_inset_of_zero_size():
     free = camera.fit_view(sc, VP)
     for hidden in (Viewport(700.0, 0.0, 0.0, 200.0), Viewport(700.0, 0.0, 300.0, 0.0)):
         assert camera.fit_view(sc, VP, hidden) == free
+
+
+def test_fit_view_puts_a_wide_scene_below_a_top_corner_inset_full_width():
+    """A wide, flat scene gets the full-width band below the inset (the larger picture),
+    not the narrower full-height band beside it."""
+    sc = Scene(
+        Eyes(40, 20, 720),
+        [Feature("a", -6000.0, 1200.0, 50.0), Feature("b", 6000.0, 1500.0, 50.0)],
+    )
+    inset = Viewport(700.0, 0.0, 300.0, 200.0)
+    v = camera.fit_view(sc, VP, inset)
+    px = [camera.to_pixel(v, VP, f.x, f.y) for f in sc.features]
+    assert max(p[0] for p in px) > inset.left  # wider than the band beside the inset
+    assert all(p[1] > inset.top + inset.height for p in px)  # and below it
