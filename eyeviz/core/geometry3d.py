@@ -194,9 +194,10 @@ def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
             num = cos_p - zc_p * zz
             a = num / den
             da = dnum / den + np.abs(a) * drel
-            lo_ = np.where(np.isnan(a) | np.isnan(da), -np.inf, a - da)
-            hi_ = np.where(np.isnan(a) | np.isnan(da), np.inf, a + da)
-            return lo_, hi_
+            lo_, hi_ = a - da, a + da
+            # at a pole (rho = 0) or about a cap centred on one: any longitude may be in
+            bad = ~(np.isfinite(lo_) & np.isfinite(hi_) & (den > 0))
+            return np.where(bad, -np.inf, lo_), np.where(bad, np.inf, hi_)
 
         zstar = zc_p / cos_p
         zs_in = (zstar >= za) & (zstar <= zb)
