@@ -83,17 +83,19 @@ def _jr_of_theta(theta: np.ndarray) -> np.ndarray:
 
 
 def _edge_bounds(n: int, face, fixed_is_y: bool, fixed, lo) -> np.ndarray:
-    """Vectorised :func:`eyeviz.core.exact3d.edge_bound`."""
-    fx = fixed / n
-    hi_f = (lo + 1) / n
-    lo_f = lo / n
-    north, south = face < 4, face >= 8
-    a = np.where(north, 1.0 - fx, np.where(south, fx, 0.0))
-    nr_min = np.where(north, 2.0 - fx - hi_f, np.where(south, fx + lo_f, 1.0))
-    polar = (north | south) & (nr_min < 1.0) & (a > 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        extra = np.where(polar, 7.2 * a / np.maximum(nr_min, 1e-300) ** 2, 0.0)
-    return (2.0 + extra) / (n * n)
+    """Vectorised :func:`eyeviz.core.exact3d.edge_bound` (2 / n^2 off the polar caps)."""
+    out = np.full(face.shape, 2.0 / (n * n))
+    pol = np.flatnonzero((face < 4) | (face >= 8))
+    if pol.size:
+        f, fx, lo_f = face[pol], fixed[pol] / n, lo[pol] / n
+        north = f < 4
+        a = np.where(north, 1.0 - fx, fx)
+        nr_min = np.where(north, 2.0 - fx - lo_f - 1.0 / n, fx + lo_f)
+        polar = (nr_min < 1.0) & (a > 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            extra = np.where(polar, 7.2 * a / np.maximum(nr_min, 1e-300) ** 2, 0.0)
+        out[pol] += extra / (n * n)
+    return out
 
 
 def _runs_to_pieces(first, nr, lo, hi):
@@ -304,8 +306,14 @@ def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
     indptr = np.zeros(nb + 1, np.int64)
     np.cumsum(per_ball, out=indptr[1:])
     total = int(indptr[-1])
-    base = np.repeat(st - (np.cumsum(ln) - ln), ln)
-    indices = base + np.arange(total, dtype=np.int64)
+    # runs -> indices in one pass: steps of 1 inside a run, a jump at each run's start
+    indices = np.ones(total, np.int64)
+    if total:
+        pos = np.cumsum(ln) - ln
+        jump = st.copy()
+        jump[1:] -= st[:-1] + ln[:-1] - 1
+        indices[pos] = jump
+        np.cumsum(indices, out=indices)
     return indptr, indices
 
 

@@ -226,3 +226,25 @@ def test_visible_counts_two_facets():
     e = EyePair3D(40.0, 20.0, 16)
     va, vb = e.visible([0.0, 0.0], [1000.0, 1e6], [0.0, 0.0], [100.0, 1.0])
     assert va.tolist() == [True, False] and vb.tolist() == [True, False]
+
+
+def test_the_edge_curvature_bound_holds():
+    """|P''| along every pixel edge (finite differences) stays under exact3d.edge_bound,
+    which the fast path and the fallback use (with a factor 2.5) to clear edges."""
+    from eyeviz.core.exact3d import edge_bound
+
+    t = np.linspace(0.0, 1.0, 801)
+    h = t[1] - t[0]
+    worst = 0.0
+    for n in (2, 4, 16):
+        for face in range(12):
+            for fixed_is_y in (True, False):
+                for fixed in range(n + 1):
+                    for lo in range(n):
+                        fix = np.full_like(t, fixed)
+                        px, py = (lo + t, fix) if fixed_is_y else (fix, lo + t)
+                        p = hp.xyf2vec(n, px, py, np.full(t.shape, face))
+                        d2 = np.linalg.norm(p[2:] - 2 * p[1:-1] + p[:-2], axis=1) / h**2
+                        bound = edge_bound(n, face, fixed_is_y, float(fixed), float(lo))
+                        worst = max(worst, float(d2.max()) / bound)
+    assert 0.5 < worst < 1.0
