@@ -1,6 +1,6 @@
 """``eyeviz predict --estimator NAME DATA.csv -o PRED.csv``: r_hat, phi_hat per row.
 
-Reads a data set of DESIGN.md §3 (.csv or .npz), writes a CSV with a header line
+Reads a data set of docs/contract.md (.csv or .npz), writes a CSV with a header line
 ``r_hat,phi_hat`` and one row per input row (``nan`` where a row is not a single
 feature), atomically. Prints the metrics against the data's own r and phi. The data set is
 read block by block (:func:`eyeviz.dataset.io.iter_blocks`), so memory stays bounded

@@ -2,20 +2,20 @@
 
 An element is (Omega_A, Omega_B, r, phi, g): a circular feature of radius g centred at
 polar (r, phi) about the origin, and the bitmaps of ommatidia 0..m/2-1 of the left (A)
-and right (B) eye that see it (Section 4; DESIGN.md §3).
+and right (B) eye that see it (Section 4; docs/contract.md).
 
 ``mode="single"`` is Algorithm 1 as written, run on whole batches: for every pending
 element, draw r (step 7), g in [r sin(gamma/2), g_max] (steps 8-10) and phi in the
 angular range that keeps the disc in the BFV (step 12, Prop. 4); reject it on step 9
 (g_min > g_max), step 11 (g > r), an empty phi range, or when the exact geometry core
-says the disc is not in the BFV or is not visible (Def. 1) to both eyes (DESIGN.md §4);
+says the disc is not in the BFV or is not visible (Def. 1) to both eyes (docs/conventions.md);
 rejected elements are drawn again (the repeat/until loop) until every slot is filled.
 
 ``mode="multi"`` is the paper's multi-pass generation (Section 5, Figure 11): the range of
 r is cut into equal segments and each segment gets a number of elements proportional to
 its mean radius, hence to its area, so that centres are (nearly) uniform over the BFV
 area and the histogram of r grows linearly with r. The paper's own counts do not add up
-(DESIGN.md §4): here they are apportioned exactly to the requested n. The segments are
+(docs/conventions.md): here they are apportioned exactly to the requested n. The segments are
 interleaved in a random order (a streamed uniform shuffle), not written one after another.
 
 Coordinates: x = r cos(phi), y = r sin(phi) (numpy float64); the bitmaps are those of the
@@ -393,7 +393,7 @@ def save(ds: Dataset, path) -> None:
 
 
 def load(path, eyes: EyePair | None = None) -> Dataset:
-    """Read a data set written by :func:`save`/:func:`write` (or any CSV of DESIGN.md §3).
+    """Read a data set written by :func:`save`/:func:`write` (or any CSV of docs/contract.md).
 
     A CSV does not record h and l: ``eyes`` defaults to Table 3's with m from the number
     of columns (m + 3 with g, m + 2 without). A malformed CSV raises an error naming the

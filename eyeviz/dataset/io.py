@@ -1,4 +1,4 @@
-"""CSV and NPZ files of data sets (DESIGN.md §3), streamed and written atomically.
+"""CSV and NPZ files of data sets (docs/contract.md), streamed and written atomically.
 
 CSV: no header, comma separated, ``Omega_A[0..m/2-1], Omega_B[0..m/2-1], r, phi, g``;
 bits as ``0``/``1``, floats as ``'%.17g'`` (17 significant digits: every float64 reads

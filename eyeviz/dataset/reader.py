@@ -1,4 +1,4 @@
-"""Reading data set files (DESIGN.md §3) row by row validated, whole or in blocks.
+"""Reading data set files (docs/contract.md) row by row validated, whole or in blocks.
 
 Every reader validates per row and field and names the first bad line (CSV) or row
 (NPZ); an NPZ's declared shape is checked against its member's size before anything is
@@ -273,9 +273,15 @@ class BlockReader:
 def iter_blocks(path, block_rows: int = BLOCK_ROWS, eyes: EyePair | None = None) -> BlockReader:
     """Read a CSV or NPZ data set block by block, validating as it goes.
 
-    >>> reader = iter_blocks("data.npz", eyes=est.domain.eyes)   # header checked here
-    >>> reader.eyes, reader.params, reader.n                     # the design metadata
-    >>> for b in reader: predict(b.omega_a, b.omega_b) ...       # Block(omega_a, ..., start)
+    >>> import pathlib, tempfile
+    >>> from eyeviz import dataset
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "data.npz"
+    >>> dataset.save(dataset.generate(100, seed=3), path)
+    >>> reader = iter_blocks(path, block_rows=40)        # the header is checked here
+    >>> reader.eyes.m, reader.n                          # the design metadata
+    (720, 100)
+    >>> [b.omega_a.shape for b in reader]                # Block(omega_a, omega_b, ..., start)
+    [(40, 360), (40, 360), (20, 360)]
 
     ``eyes``: the consumer's design; refused when its m (or, for an NPZ that carries them,
     h and l) differs from the file's.

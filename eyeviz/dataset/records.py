@@ -1,6 +1,6 @@
 """The data set records (a leaf module: numpy and the core geometry only).
 
-:class:`Dataset` holds rows (Omega_A, Omega_B, r, phi, g) of DESIGN.md §3; :class:`Chunk`
+:class:`Dataset` holds rows (Omega_A, Omega_B, r, phi, g) of docs/contract.md; :class:`Chunk`
 one generated chunk in interval form (Prop. 2, Eq. 11). Both the sampler
 (:mod:`eyeviz.dataset.algorithm1`) and the readers/writers (:mod:`eyeviz.dataset.io`)
 import them from here, so neither imports the other for its records.
@@ -23,7 +23,7 @@ CHUNK = 1 << 14  # elements per generated chunk; fixed, so the output never depe
 
 @dataclass
 class Dataset:
-    """Rows (Omega_A, Omega_B, r, phi, g) of the paper's data set (DESIGN.md §3).
+    """Rows (Omega_A, Omega_B, r, phi, g) of the paper's data set (docs/contract.md).
 
     ``omega_a``, ``omega_b``: bool (n, m/2), ommatidia 0..m/2-1 of eye A (left), B (right);
     ``r``, ``phi``: centre in polar coordinates about the origin (phi in radians);
