@@ -41,8 +41,9 @@ from eyeviz.app.view import VtkView, fast_renderer
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import Scene
 from eyeviz.model.state import SceneState
-from eyeviz.render.vtk.actors import BACKGROUND, INSET_BACKGROUND, SceneActors, style_text
+from eyeviz.render.vtk.actors import SceneActors
 from eyeviz.render.vtk.overlays import OverlayActors
+from eyeviz.render.vtk.style import BACKGROUND, INSET_BACKGROUND, style_text
 
 if TYPE_CHECKING:
     from eyeviz.app.docks import ExportChoice, ExportDialog

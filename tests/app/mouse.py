@@ -4,7 +4,7 @@ import vtk
 from PyQt5 import QtCore
 from PyQt5.QtTest import QTest
 
-from eyeviz.render.vtk.actors import Z_FEAT
+from eyeviz.render.vtk.style import Z_FEAT
 
 
 def pixel_of(win, x, y):

@@ -9,7 +9,7 @@ from PyQt5.QtTest import QTest
 from eyeviz.app.panels import user_message
 from eyeviz.model.palette import ESTIMATOR_COLORS, FEATURE_COLORS, estimator_color
 from eyeviz.model.scene import Eyes, Feature, Scene, View
-from eyeviz.render.vtk.actors import BFV_FILL, hex_rgb
+from eyeviz.render.vtk.style import BFV_FILL, hex_rgb
 
 LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout", "labels"]
 

@@ -15,7 +15,7 @@ from PyQt5 import QtGui
 from eyeviz import estimators
 from eyeviz.model import trajectories as tr
 from eyeviz.model.scene import Eyes, Feature, Scene, Trajectory, View
-from eyeviz.render.vtk.actors import OUT_FILL
+from eyeviz.render.vtk.style import OUT_FILL
 
 ROOT = Path(__file__).resolve().parents[2]
 LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout", "labels", "predictions", "ambiguity"]

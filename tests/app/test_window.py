@@ -15,7 +15,7 @@ from eyeviz.app.window import qimage_to_array
 from eyeviz.core.geometry import EyePair
 from eyeviz.model.app_model import DRAG_THRESHOLD_PX
 from eyeviz.model.scene import Eyes, Feature, Scene, View, load
-from eyeviz.render.vtk.actors import UNLIT, hex_rgb
+from eyeviz.render.vtk.style import UNLIT, hex_rgb
 
 ROOT = Path(__file__).resolve().parents[2]
 

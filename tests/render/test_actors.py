@@ -8,7 +8,8 @@ import pyvista as pv
 
 from eyeviz.model.scene import Eyes, Feature, Scene
 from eyeviz.model.state import compute_state
-from eyeviz.render.vtk.actors import UNLIT, SceneActors, eye_mesh, hex_rgb
+from eyeviz.render.vtk.actors import SceneActors, eye_mesh
+from eyeviz.render.vtk.style import UNLIT, hex_rgb
 
 
 @pytest.fixture

@@ -9,7 +9,7 @@ import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
 from eyeviz.model.app_model import AppModel
-from eyeviz.render.vtk.actors import UNLIT, hex_rgb
+from eyeviz.render.vtk.style import UNLIT, hex_rgb
 
 INK = QtGui.QColor(30, 30, 30)
 CELL_LINE = 0xFF9A9A9A  # cell boundaries (QImage.Format_RGB32)

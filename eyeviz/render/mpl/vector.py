@@ -20,15 +20,14 @@ import math
 from matplotlib.figure import Figure
 
 from eyeviz import EyevizError
-from eyeviz.model.frame import build_frame, runs, state_for
+from eyeviz.model.frame import build_frame, state_for
 from eyeviz.model.layers import ordered, resolve
-from eyeviz.model.palette import estimator_colors
 from eyeviz.model.predictor import Predictor
 from eyeviz.model.scene import Scene
 from eyeviz.model.state import SceneState
 from eyeviz.render.mpl.bounded import bound_figure
 from eyeviz.render.mpl.canvas import make_canvas
-from eyeviz.render.mpl.layout import ASPECT, ASPECT_RANGE, interval_lanes, layout
+from eyeviz.render.mpl.layout import ASPECT, ASPECT_RANGE, layout
 from eyeviz.render.mpl.style import (
     BASE_DPI,
     MAX_WIDTH,
@@ -45,10 +44,7 @@ __all__ = [
     "MAX_COORD",
     "VECTOR_DPI",
     "RC",
-    "estimator_colors",
-    "eye_runs",
     "figure",
-    "interval_lanes",
     "refuse_unloadable",
     "resolve_width",
 ]
@@ -59,8 +55,6 @@ MAX_COORD = 1e15  # |x|, |y|, g and the view beyond this cannot be drawn by Agg
 #: 4,500 float64 steps across the view); far below it float64 cannot even tell the view's
 #: edges from its centre (1e12 +- 5e-7 == 1e12).
 MIN_VIEW_REL = 1e-12
-
-eye_runs = runs  # maximal runs of equal values (eyeviz.model.frame.runs)
 
 
 def resolve_width(width) -> float:

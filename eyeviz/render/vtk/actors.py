@@ -15,6 +15,7 @@ otherwise colours and points are written in place.
 from __future__ import annotations
 
 import dataclasses
+from typing import cast
 
 import numpy as np
 import pyvista as pv
@@ -30,29 +31,8 @@ from eyeviz.render.vtk.layers.features import FeaturesLayer
 from eyeviz.render.vtk.layers.labels import LabelsLayer
 from eyeviz.render.vtk.layers.sectors import SectorsLayer
 from eyeviz.render.vtk.layers.tangents import TangentsLayer
-from eyeviz.render.vtk.style import (  # noqa: F401  (the view's public style names)
-    BACKGROUND,
-    BFV_FILL,
-    BFV_LINE,
-    EDGE_MIN_PX,
-    FILL_ALPHA,
-    FONT_FILE,
-    INK,
-    INSET_BACKGROUND,
-    LABEL_ALL_MAX,
-    OUT_FILL,
-    OUT_LINE,
-    UNLIT,
-    Z_BFV,
-    Z_EYES,
-    Z_FEAT,
-    Z_LINE,
-    Z_POINT,
-    hex_rgb,
-    style_text,
-)
 
-__all__ = ["SceneActors", "hex_rgb", "eye_mesh", "inset_viewport", "view_frame"]
+__all__ = ["SceneActors", "eye_mesh", "inset_viewport", "view_frame"]
 
 INSET_MIN_PX, INSET_MAX_PX, INSET_FRACTION = 230.0, 340.0, 0.3  # inset width on screen
 INSET_ASPECT = 0.66  # height / width: the eyes, their labels and a line of text
@@ -111,27 +91,27 @@ class SceneActors:
 
     @property
     def eyes(self) -> EyesLayer:
-        return self.painters["eyes"]  # type: ignore[return-value]
+        return cast(EyesLayer, self.painters["eyes"])
 
     @property
     def features(self) -> FeaturesLayer:
-        return self.painters["features"]  # type: ignore[return-value]
+        return cast(FeaturesLayer, self.painters["features"])
 
     @property
     def labels(self) -> LabelsLayer:
-        return self.painters["labels"]  # type: ignore[return-value]
+        return cast(LabelsLayer, self.painters["labels"])
 
     @property
     def bfv(self) -> BFVLayer:
-        return self.painters["bfv"]  # type: ignore[return-value]
+        return cast(BFVLayer, self.painters["bfv"])
 
     @property
     def tangents(self) -> TangentsLayer:
-        return self.painters["tangents"]  # type: ignore[return-value]
+        return cast(TangentsLayer, self.painters["tangents"])
 
     @property
     def sectors(self) -> SectorsLayer:
-        return self.painters["sectors"]  # type: ignore[return-value]
+        return cast(SectorsLayer, self.painters["sectors"])
 
     # --- entry points -----------------------------------------------------------------
     def update(self, scene: Scene, state: SceneState, selected: int | None) -> None:

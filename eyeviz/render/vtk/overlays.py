@@ -11,6 +11,7 @@ layer the scene does not show.
 from __future__ import annotations
 
 import dataclasses
+from typing import cast
 
 import numpy as np
 from vtkmodules.vtkRenderingCore import vtkRenderer
@@ -122,15 +123,15 @@ class OverlayActors:
 
     @property
     def predictions(self) -> PredictionsLayer:
-        return self.painters["predictions"]  # type: ignore[return-value]
+        return cast(PredictionsLayer, self.painters["predictions"])
 
     @property
     def ambiguity(self) -> AmbiguityLayer:
-        return self.painters["ambiguity"]  # type: ignore[return-value]
+        return cast(AmbiguityLayer, self.painters["ambiguity"])
 
     @property
     def trajectory(self) -> TrajectoryLayer:
-        return self.painters["trajectory"]  # type: ignore[return-value]
+        return cast(TrajectoryLayer, self.painters["trajectory"])
 
     # --- what the tests and the window read -------------------------------------------
     @property
