@@ -3,6 +3,7 @@ act, colours fixed by name, the selected feature visible in the bitmaps, small-m
 panels that fit 1280x720, messages without local paths."""
 
 import numpy as np
+import pytest
 from PyQt5 import QtCore, QtGui, QtWidgets
 from PyQt5.QtTest import QTest
 
@@ -55,6 +56,7 @@ def test_unticking_readout_hides_every_value(make_window):
     assert "2000.0" in win.readout.texts["r"]
 
 
+@pytest.mark.slow
 def test_trajectory_without_a_path_shows_a_placeholder_not_empty_axes(make_window):
     sc = Scene(Eyes(40.0, 20.0, 720), [Feature("f", 0.0, 2000.0, 50.0)], LAYERS + ["trajectory"])
     win = make_window(sc)

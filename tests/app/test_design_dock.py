@@ -9,6 +9,7 @@ import math
 import threading
 
 import numpy as np
+import pytest
 from mouse import pixel_of
 from PyQt5 import QtCore
 from PyQt5.QtTest import QTest
@@ -42,6 +43,7 @@ def set_m_in_panel(win, m):
     e.returnPressed.emit()
 
 
+@pytest.mark.slow
 def test_dock_exists_and_shows_the_new_curve_after_m_changes(make_window, qtbot):
     win = make_window(scene())
     act = next(a for a in win.actions() if a.text().startswith("Eye &design"))
@@ -118,6 +120,7 @@ def test_drag_moves_the_marker_without_recomputing(make_window, qtbot):
     assert panel.debounce.isActive() is False and panel.running is None
 
 
+@pytest.mark.slow
 def test_the_gui_thread_is_not_blocked_and_stale_results_are_not_drawn(make_window, qtbot):
     win = make_window(scene())
     panel = win.show_design()

@@ -28,6 +28,7 @@ def _answer(win, fill):
     QtCore.QTimer.singleShot(0, run)
 
 
+@pytest.mark.slow
 def test_width_and_parts_chosen_in_the_dialog_reach_the_file(make_window, tmp_path):
     win = make_window(load(ROOT / "assets" / "scenes" / "default.toml"))
     out = tmp_path / "fig.svg"

@@ -151,6 +151,7 @@ def test_file_export_writes_files_that_open(make_window, tmp_path):
     win.error_box.close()
 
 
+@pytest.mark.slow
 def test_torch_is_imported_only_with_the_predictions_layer(tmp_path):
     code = (
         "import sys\n"

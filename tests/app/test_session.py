@@ -186,6 +186,7 @@ def run_cli(args, env=None, timeout=90):
     )
 
 
+@pytest.mark.slow
 def test_cli_screenshot_jpeg_and_refused_format(tmp_path):
     out = tmp_path / "x.jpg"
     r = run_cli(
@@ -231,6 +232,7 @@ s.value("window/geometry")
 """
 
 
+@pytest.mark.slow
 def test_hostile_settings_file_runs_nothing(tmp_path):
     ini = tmp_path / "hostile.ini"
     marker = tmp_path / "PWNED"

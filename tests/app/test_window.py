@@ -222,6 +222,7 @@ def test_add_duplicate_delete(make_window):
     check_lit(win)
 
 
+@pytest.mark.slow
 def test_screenshot_is_not_blank_and_shows_the_lit_colour(make_window, tmp_path):
     sc = load(ROOT / "assets" / "scenes" / "figure3b.toml")
     win = make_window(sc)
@@ -249,6 +250,7 @@ def test_screenshot_is_not_blank_and_shows_the_lit_colour(make_window, tmp_path)
     assert np.abs(img[int(py) + top.y(), int(px) + top.x()].astype(int) - UNLIT).max() <= 12
 
 
+@pytest.mark.slow
 def test_app_does_not_import_torch(tmp_path):
     code = (
         "import sys\n"
@@ -265,6 +267,7 @@ def test_app_does_not_import_torch(tmp_path):
     assert r.stdout.strip().splitlines()[-1] == "False"
 
 
+@pytest.mark.slow
 def test_cli_screenshot(tmp_path):
     out = tmp_path / "cli.png"
     r = subprocess.run(
@@ -308,6 +311,7 @@ def test_inset_shows_tiny_eyes_in_a_corner_and_hides_for_large_ones(make_window)
     assert not win.inset_shown and win.to_model(left + w / 2, top + h / 2)[0] == "main"
 
 
+@pytest.mark.slow
 def test_dragged_disc_is_drawn_at_its_new_place_during_and_after_the_drag(make_window):
     """The selected disc is a separate actor moved by its transform: it must follow."""
     win = make_window(two_features())

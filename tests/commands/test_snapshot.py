@@ -6,6 +6,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "assets" / "scenes"
 
@@ -48,6 +50,7 @@ def test_snapshot_svg_and_pdf(tmp_path):
         assert out.stat().st_size > 1000
 
 
+@pytest.mark.slow
 def test_snapshot_bad_input_is_one_line(tmp_path):
     exe = [sys.executable, "-m", "eyeviz", "snapshot"]
     cases = [
@@ -69,6 +72,7 @@ def test_snapshot_bad_input_is_one_line(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
 
 
+@pytest.mark.slow
 def test_snapshot_width_and_toggles(tmp_path):
     exe = [sys.executable, "-m", "eyeviz", "snapshot", SCENES / "default.toml"]
     out = tmp_path / "d.png"
@@ -112,6 +116,7 @@ def test_snapshot_width_and_toggles(tmp_path):
     assert run.returncode == 2 and run.stderr.count("\n") == 1 and "width" in run.stderr
 
 
+@pytest.mark.slow
 def test_snapshot_aspect_frames_the_view_and_bad_ones_are_refused(tmp_path):
     """--aspect sets the main view's height / width (a wide scene wastes less of the
     figure); outside [0.3, 1.6] it is refused in one line and nothing is written."""

@@ -57,6 +57,7 @@ def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, words):
     assert os.listdir(tmp_path) == []
 
 
+@pytest.mark.slow
 def test_an_unreachable_scheduler_is_named(tmp_path):
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -78,6 +79,7 @@ def test_a_file_of_another_version_is_refused_untouched(tmp_path):
     assert path.read_bytes() == before
 
 
+@pytest.mark.slow
 def test_a_small_study_then_a_resume(tmp_path):
     path = tmp_path / "s.csv"
     args = ["-o", path, "--h", "20,40", "--l", "10,20", "--m", "8,16", "--n", "200"]
@@ -140,6 +142,7 @@ def group_gone(pgid, timeout=60) -> bool:
     return False
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
 def test_ctrl_c_or_a_crash_mid_study_keeps_whole_points_and_resumes(tmp_path, sig):
     path = tmp_path / "s.csv"
@@ -173,6 +176,7 @@ def test_ctrl_c_or_a_crash_mid_study_keeps_whole_points_and_resumes(tmp_path, si
     assert len(StudyTable.open(path).keys) == 6
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("delay", [0.7, 2.0])
 def test_ctrl_c_while_the_cluster_starts_leaves_no_process_behind(tmp_path, delay):
     # interrupted half-way, a LocalCluster cannot be closed: the runner holds the

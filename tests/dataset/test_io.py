@@ -296,6 +296,7 @@ def test_iter_blocks_memory_is_bounded(tmp_path):
     assert peak_blocks * 10 < peak_load
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["csv", "npz"])
 def test_wide_rows_written_in_blocks_give_the_same_bytes(tmp_path, monkeypatch, fmt):
     """Chunks are cut into blocks of at most _BLOCK_BYTES (memory bounded at any m); a

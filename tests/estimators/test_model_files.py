@@ -162,6 +162,7 @@ def test_round_trip_and_digest(small_table):
     assert est.metadata["keys"] == t["key"].size
 
 
+@pytest.mark.slow
 def test_corrupted_key0_is_refused(small_table, tmp_path):
     a = _members(small_table)
     for delta in (1, 360, 360**3):

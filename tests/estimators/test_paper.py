@@ -112,6 +112,7 @@ def test_sgd_decay_per_batch_like_keras():
     assert opt_n.param_groups[0]["nesterov"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("spec", [P.AD, P.DD], ids=["ad", "dd"])
 def test_few_training_steps_reduce_the_mae(spec):
     oa, ob, r, phi, _ = _data(8, seed=1)  # a small batch keeps this fast
@@ -153,6 +154,7 @@ def test_bad_device_and_budget(tmp_path):
             P.train(data, 1, device="cuda", out_dir=tmp_path)
 
 
+@pytest.mark.slow
 def test_train_save_load_predict_roundtrip(tmp_path):
     """Budgeted training writes labelled metadata; the estimator loads and predicts."""
     torch.set_num_threads(1)

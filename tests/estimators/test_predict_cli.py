@@ -61,12 +61,14 @@ def test_output_equal_to_input_refused(data, tmp_path, how):
     assert src.read_bytes() == before
 
 
+@pytest.mark.slow
 def test_npz_design_mismatch_names_both(data, tmp_path):
     res = _run("predict", "-e", "compact", data / "m360.npz", "-o", tmp_path / "p.csv")
     _one_line_error(res, "h=40, l=20, m=360", "'compact'", "h=40, l=20, m=720")
     assert not (tmp_path / "p.csv").exists()
 
 
+@pytest.mark.slow
 def test_csv_design_from_flags(data, tmp_path):
     res = _run("predict", "-e", "compact", "--m", "360", data / "m360.csv", "-o", tmp_path / "p")
     _one_line_error(res, "m=360", "'compact' answers for h=40, l=20, m=720")

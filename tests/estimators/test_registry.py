@@ -56,6 +56,7 @@ def test_bayes_help_says_median_not_mean():
     assert "mean" not in registry.get("bayes").help
 
 
+@pytest.mark.slow
 def test_needs_torch_is_true_exactly_for_torch_estimators():
     code = (
         "import sys; from eyeviz.estimators import registry as r;"

@@ -83,6 +83,7 @@ def test_interrupted_fit_leaves_previous_model_untouched(tmp_path):
     estimators.load("compact", path=out).predict([0] * 360, [0] * 360)
 
 
+@pytest.mark.slow
 def test_sigint_during_train_leaves_previous_output(tmp_path):
     home = tmp_path / "home"
     res = _run(["train", "compact", "-n", "4096", "--n-val", "500", "--epochs", "1"], home)
@@ -115,6 +116,7 @@ def test_sigint_during_train_leaves_previous_output(tmp_path):
     assert not list(home.glob(".models.staging-*"))
 
 
+@pytest.mark.slow
 def test_train_leaves_shipped_assets_unchanged(tmp_path):
     assets = models_dir()
     before = _hashes(assets)

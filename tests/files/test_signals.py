@@ -76,6 +76,7 @@ def test_existing_output_kept_on_sigterm(tmp_path):
     assert out.read_text() == "precious\n"
 
 
+@pytest.mark.slow
 def test_closed_stderr_and_stdout_do_not_fail_a_finished_command(tmp_path):
     out = tmp_path / "x.csv"
     # 2>&- and >&- : the progress bar and the summary line have nowhere to go

@@ -22,6 +22,9 @@ from .conftest import count, digest, fuzz_settings
 from .test_dataset_fuzz import CSV_PAPER, NPZ_PAPER, mutated
 from .test_scene_fuzz import mutated_scene
 
+# test_no_*_bugs reads what this module's other tests recorded in BUGS: under
+# pytest-xdist (--dist loadgroup) the whole module runs on one worker, in order
+pytestmark = pytest.mark.xdist_group("fuzz_cli")
 BUGS: dict[str, int] = {}
 HANG_S = 120.0  # a snapshot subprocess still running after this is recorded as a hang
 ROOT = Path(__file__).resolve().parents[2]
@@ -59,6 +62,7 @@ def _record(
         EXAMPLES.setdefault(f"{category}: {what}", f"{example}\n--- stderr:\n{err[-3000:]}")
 
 
+@pytest.mark.slow
 @fuzz_settings(25)
 @given(mutated_scene())
 def test_snapshot_mutated_scene(tmp_path_factory, text):
@@ -114,6 +118,7 @@ def extreme_scene(draw):
     )
 
 
+@pytest.mark.slow
 @fuzz_settings(8)
 @given(extreme_scene())
 def test_snapshot_extreme_valid_scene(tmp_path_factory, text):

@@ -12,6 +12,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -31,6 +32,9 @@ def _predicts(est) -> tuple:
     return np.asarray(pred.r), np.asarray(pred.phi)
 
 
+# test_no_*_bugs reads what this module's other tests recorded in BUGS: under
+# pytest-xdist (--dist loadgroup) the whole module runs on one worker, in order
+pytestmark = pytest.mark.xdist_group("fuzz_models")
 BUGS: dict[str, int] = {}
 
 

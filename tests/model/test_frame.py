@@ -193,6 +193,21 @@ def test_ambiguity_and_trajectory_in_the_frame():
     assert t.n > 10 and np.allclose(t.y, 3000.0)
 
 
+def test_each_layers_part_depends_on_its_inputs_only():
+    """A vertical trajectory ends at the view's top, with or without the ambiguity layer
+    (before the layer table, the ambiguity code widened the box the trajectory then read)."""
+    sc = scene_mod.load(scenes_dir() / "default.toml")
+    sc.trajectory = scene_mod.Trajectory("vertical", 1000.0, 50.0)
+    rect = (-500.0, 500.0, 0.0, 7000.0)
+    sc.layers = ["features", "trajectory"]
+    alone = build_frame(sc, rect=rect).trajectory
+    sc.layers = ["features", "ambiguity", "trajectory"]
+    both = build_frame(sc, rect=rect).trajectory
+    assert alone is not None and both is not None
+    np.testing.assert_array_equal(alone.y, both.y)
+    assert alone.y.max() <= 7000.0
+
+
 def test_estimator_colours_fixed_and_far_from_feature_colours():
     assert set(ESTIMATOR_COLORS) == {"analytic", "limit", "bayes", "compact", "paper"}
     assert estimator_colors(["compact", "bayes"]) == estimator_colors(["bayes", "compact"])

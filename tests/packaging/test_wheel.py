@@ -63,6 +63,7 @@ def run(clean_env, *args):
     )
 
 
+@pytest.mark.slow
 def test_the_wheel_is_imported_not_the_source_tree(clean_env):
     py, env, work = clean_env
     out = subprocess.check_output(
@@ -80,6 +81,7 @@ def test_the_wheel_is_imported_not_the_source_tree(clean_env):
     assert not out[1].startswith(str(ROOT)) and Path(out[1]).is_file(), out
 
 
+@pytest.mark.slow
 def test_snapshot_and_predict_from_the_wheel(clean_env):
     py, env, work = clean_env
     scene = subprocess.check_output(

@@ -161,6 +161,7 @@ def test_view_below_float_resolution_is_refused(tmp_path):
     assert not (tmp_path / "o.png").exists()
 
 
+@pytest.mark.slow
 def test_tiny_view_inside_an_eye_draws_only_the_cells_it_sees(tmp_path):
     sc = S.loads(
         '[eyes]\nm = 5000\n[layers]\nshow = ["eyes", "sectors", "labels"]\n'

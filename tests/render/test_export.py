@@ -313,6 +313,7 @@ def _with_blockers():
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("aspect", [0.4, 0.5, 0.58, 0.86, 1.3])
 def test_angle_labels_never_under_the_inset(aspect):
     """psi and theta stay readable at any window shape: at 0.5 the inset took the lower

@@ -21,6 +21,7 @@ def files(tmp_path_factory):
     return d
 
 
+@pytest.mark.slow
 def test_report_side_by_side(files, tmp_path):
     out = tmp_path / "rep"
     res = subprocess.run(

@@ -12,6 +12,7 @@ from eyeviz.model.trajectories import horizontal
 from eyeviz.reports import trajectories as rep
 
 
+@pytest.mark.slow
 def test_report_runs_all_trajectories(tmp_path, no_paper_weights):
     out = tmp_path / "traj"
     assert (

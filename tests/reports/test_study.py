@@ -123,6 +123,7 @@ def test_reader_reads_a_real_table(real_table, tmp_path):
     assert rows[0].line == 2 and rows[0].bin == "all"
 
 
+@pytest.mark.slow
 def test_report_writes_figures_a_paper_can_use(real_table, tmp_path):
     out = tmp_path / "report"
     res = subprocess.run(
@@ -205,6 +206,7 @@ def test_law_fit_recovers_the_constant_of_a_synthetic_table(tmp_path):
     assert 0.3 < fit2.C < 0.55
 
 
+@pytest.mark.slow
 def test_report_on_a_synthetic_table_states_c_everywhere(tmp_path):
     path = write_table(tmp_path / "s.csv", synthetic_rows(C=0.25))
     out = tmp_path / "r"
@@ -223,6 +225,7 @@ def test_report_on_a_synthetic_table_states_c_everywhere(tmp_path):
         assert f"]({stem}.png)" in md and (out / f"{stem}.png").exists()
 
 
+@pytest.mark.slow
 def test_one_m_only_still_draws_everything(tmp_path):
     path = write_table(tmp_path / "s.csv", synthetic_rows(ms=(720,), hs=(40.0,)))
     out = tmp_path / "r"
@@ -233,6 +236,7 @@ def test_one_m_only_still_draws_everything(tmp_path):
     assert "720" in svg
 
 
+@pytest.mark.slow
 def test_a_table_without_the_papers_eyes_says_so(tmp_path):
     path = write_table(tmp_path / "s.csv", synthetic_rows(ms=(1440, 2880)))
     out = tmp_path / "r"
@@ -329,6 +333,7 @@ def test_cli_one_line_errors_and_nothing_written(tmp_path):
         assert not out.exists() or not list(out.iterdir())
 
 
+@pytest.mark.slow
 def test_the_prior_is_the_tables_own_unless_chosen(tmp_path):
     rows = [{**r, "prior": "multi"} for r in synthetic_rows(C=0.3)]
     path = write_table(tmp_path / "m.csv", rows)

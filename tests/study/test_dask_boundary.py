@@ -5,6 +5,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 
 PROBE = """
@@ -36,6 +38,7 @@ def run(code, *args):
     return out.stdout.strip().splitlines()[-1].split()
 
 
+@pytest.mark.slow
 def test_no_module_but_the_runner_imports_dask(tmp_path):
     n, rc, dask = run(
         PROBE, "snapshot", ROOT / "assets" / "scenes" / "default.toml", "-o", tmp_path / "s.svg"

@@ -23,6 +23,7 @@ def seconds_by_point(path):
     return {r["_key"]: r["seconds"] for r in rows if r["bin"] == "all"}
 
 
+@pytest.mark.slow
 def test_a_study_resumes_and_skips_finished_points(tmp_path):
     path = tmp_path / "study.csv"
     first = design_grid("20,40", "10", "8,16", n=300)
@@ -62,6 +63,7 @@ def unused_port():
         return s.getsockname()[1]
 
 
+@pytest.mark.slow
 def test_an_unreachable_scheduler_ends_in_one_line_quickly(tmp_path):
     addr = f"tcp://127.0.0.1:{unused_port()}"
     path = tmp_path / "s.csv"
@@ -90,6 +92,7 @@ def test_bad_runner_arguments(tmp_path, kwargs, words):
         assert w in str(err.value)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("allowed_failures", [None, 0])
 def test_killing_a_worker_mid_study_loses_only_its_point(tmp_path, allowed_failures):
     """Two worker processes, six points of ~1-2 s each; one worker is SIGKILLed while it
@@ -162,6 +165,7 @@ def _fails_for_m16(point):
     return evaluate(point)
 
 
+@pytest.mark.slow
 def test_a_failing_point_is_named_and_the_others_kept(tmp_path, monkeypatch):
     from distributed import LocalCluster
 
@@ -194,6 +198,7 @@ print(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before)
 """
 
 
+@pytest.mark.slow
 def test_a_worker_under_dasks_malloc_trim_threshold_does_not_refault_every_array():
     """Dask's nanny sets MALLOC_TRIM_THRESHOLD_=65536 in its workers: every large
     temporary array becomes a fresh mmap (2.6x slower points). The task the runner submits
@@ -211,6 +216,7 @@ def test_a_worker_under_dasks_malloc_trim_threshold_does_not_refault_every_array
     assert tuned * 10 < plain, (tuned, plain)
 
 
+@pytest.mark.slow
 def test_a_second_study_into_the_same_file_is_refused_and_the_lock_goes_away(tmp_path):
     import fcntl
 
