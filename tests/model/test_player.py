@@ -92,3 +92,40 @@ def test_after_the_played_feature_is_deleted_start_waits_for_a_selection():
     m.select(1)  # the user picks "c": Space plays it
     assert m.player.start() and m.player.feature == "c"
     m.player.stop()
+
+
+def test_start_without_a_valid_selection_plays_the_first_feature():
+    for sel in (None, 3, 7):  # nothing selected, or a stale index past the last feature
+        m, _ = model3()
+        m.selected = sel
+        m.player.set_path(Path())
+        assert m.player.start() and m.player.feature == "a"
+        m.player.stop()
+
+
+def test_a_one_point_path_steps_onto_its_point_and_an_empty_one_stops():
+    m, _ = model3()
+    m.select(1)
+    m.player.set_path(Path(n=1))
+    assert m.player.start()
+    assert m.player.step() == (-500.0, 2000.0) and m.scene.features[1].x == -500.0
+    m.player.stop()
+    m.player.set_path(Path(n=0))
+    assert m.player.start()
+    assert m.player.step() is None and not m.player.playing
+    assert "no trajectory" in m.player.message
+
+
+def test_an_unrelated_edit_after_the_deletion_still_waits_for_a_selection():
+    m, undo = model3()
+    m.select(0)
+    m.player.set_path(Path())
+    m.player.start()
+    m.player.step(2)
+    m.delete_feature(0)
+    m.set_feature(1, x=-250.0)  # another edit: "a" is still gone
+    assert not m.player.start() and "select a feature" in m.player.message
+    undo.undo()
+    undo.undo()  # "a" is back: a start plays it again
+    assert m.player.start() and m.player.feature == "a"
+    m.player.stop()
