@@ -353,3 +353,36 @@ def test_hit_test_ignores_a_selection_past_the_last_feature():
     for sel in (n, n + 3, -1):  # a stale index (the feature was deleted) is no selection
         assert hit_test(sc, sel, f.x, f.y, 1.0) == (0, "body")
         assert hit_test(sc, sel, 9e6, 9e6, 1.0) == (None, None)
+
+
+def test_moving_the_inset_camera_stops_it_following_the_eyes_the_main_one_does_not():
+    m, _ = make()
+    assert m.inset_auto
+    interactions.set_view(m, "main", View((5.0, 6.0), 900.0))
+    assert m.inset_auto and m.scene.view == View((5.0, 6.0), 900.0)
+    interactions.set_view(m, "inset", View((1.0, 2.0), 90.0))
+    assert not m.inset_auto and m.inset_view == View((1.0, 2.0), 90.0)
+    interactions.fit_inset(m, VP)
+    assert m.inset_auto
+
+
+def test_toggle_estimator_hides_one_and_keeps_the_others():
+    m, undo = make()
+    m.scene.estimators = ["analytic", "bayes"]
+    interactions.toggle_estimator(m, "bayes", False)
+    assert m.scene.estimators == ["analytic"]
+    interactions.toggle_estimator(m, "compact", True)
+    interactions.toggle_estimator(m, "compact", True)  # shown once however often
+    assert m.scene.estimators == ["analytic", "compact"]
+    assert [t for _, _, t in undo.steps][-1] == "Show compact predictions"
+
+
+def test_set_trajectory_without_a_valid_selection_uses_the_defaults():
+    for sel in (None, 2, 9):
+        m, _ = make()
+        m.selected = sel
+        interactions.set_trajectory(m, "vertical")
+        t = m.scene.trajectory
+        assert (t.kind, t.distance, t.g) == ("vertical", 2000.0, 50.0) and m.scene.shows(
+            "trajectory"
+        )
