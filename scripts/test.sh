@@ -1,23 +1,99 @@
 #!/usr/bin/env bash
-# The README's test command: set up everything, run the guardrails (ruff lint and format,
-# import-linter's layer contracts, mypy on the typed layers), then the display-free tests,
-# then the GUI tests under a virtual X display (they drive a real Qt/VTK window).
-# Extra arguments go to both pytest runs (e.g. -q, -x).
-set -euo pipefail
+# The README's test command. Sets up everything (scripts/setup.sh), then runs three stages
+# and reports each, carrying on when one fails (the exit status is non-zero if any did):
+#   1. the guardrails: ruff lint and format, import-linter's layer contracts, mypy;
+#   2. the display-free tests (everything but tests/app);
+#   3. the GUI tests under a virtual X display (they drive a real Qt/VTK window).
+# The tests run on every core (pytest-xdist, `-n <cores>`; EYEVIZ_TEST_WORKERS=N sets
+# the number, 1 runs them in this process); under xdist each GUI worker starts an Xvfb
+# display of its own (tests/app/conftest.py), so real key presses never meet another
+# worker's window.
+#
+#   scripts/test.sh [pytest args]          every test (extra arguments go to both runs, e.g. -q)
+#   scripts/test.sh --quick [pytest args]  a tier under 2 minutes: ruff, then the
+#                                          display-free tests not marked slow or gui
+set -uo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
-export QT_API=pyqt5 MPLBACKEND=Agg
-echo "== ruff (lint, format)" >&2
-.venv/bin/ruff check eyeviz tests scripts examples
-.venv/bin/ruff format --check eyeviz tests scripts examples
-echo "== import-linter (layers)" >&2
-.venv/bin/lint-imports --no-cache
-echo "== mypy (the whole package)" >&2
-.venv/bin/mypy
-echo "== display-free tests" >&2
-env -u DISPLAY .venv/bin/python -m pytest --ignore=tests/app -p no:cacheprovider "$@"
-echo "== GUI tests (real Qt/VTK window under Xvfb)" >&2
-if [ -n "${DISPLAY:-}" ]; then
-    exec .venv/bin/python -m pytest tests/app -p no:cacheprovider "$@"
+
+quick=0
+if [ "${1:-}" = "--quick" ]; then
+    quick=1
+    shift
 fi
-exec xvfb-run -a -s "-screen 0 1920x1080x24" .venv/bin/python -m pytest tests/app -p no:cacheprovider "$@"
+
+bash scripts/setup.sh || exit 1
+export QT_API=pyqt5 MPLBACKEND=Agg
+
+workers=${EYEVIZ_TEST_WORKERS:-$(nproc 2>/dev/null || echo 1)}
+par=()
+if [ "$workers" -gt 1 ]; then
+    # loadgroup: tests spread one by one, but an xdist_group runs on one worker, in
+    # order (the fuzz modules' closing tests read what the module's other tests recorded)
+    par=(-n "$workers" --dist loadgroup)
+fi
+
+logs=$(mktemp -d)
+trap 'rm -rf "$logs"' EXIT
+summary=()
+failed=0
+start=$SECONDS
+
+# stage NAME LOG CMD...: run CMD, its output also to LOG; one summary line for NAME
+stage() {
+    local name=$1 log=$2 t0=$SECONDS rc
+    shift 2
+    echo "== $name" >&2
+    "$@" 2>&1 | tee "$log"
+    rc=${PIPESTATUS[0]}
+    local last
+    last=$(grep -E '^(=+ )?[0-9]+ (passed|failed|error|skipped|deselected).* in [0-9.]+s' "$log" |
+        tail -n 1 | sed -E 's/^=+ //; s/ =+$//')
+    if [ "$rc" -eq 0 ]; then
+        summary+=("$name: ok${last:+ ($last)}, $((SECONDS - t0)) s")
+    else
+        summary+=("$name: FAILED (exit $rc)${last:+ ($last)}, $((SECONDS - t0)) s")
+        failed=1
+    fi
+}
+
+guardrails() {
+    local rc=0
+    echo "-- ruff (lint, format)"
+    .venv/bin/ruff check eyeviz tests scripts examples || rc=1
+    .venv/bin/ruff format --check eyeviz tests scripts examples || rc=1
+    if [ "$quick" = 0 ]; then
+        echo "-- import-linter (layers)"
+        .venv/bin/lint-imports --no-cache || rc=1
+        echo "-- mypy (the whole package)"
+        .venv/bin/mypy || rc=1
+    fi
+    return $rc
+}
+
+gui_tests() {
+    if [ -n "${DISPLAY:-}" ]; then
+        .venv/bin/python -m pytest tests/app -p no:cacheprovider "${par[@]}" "$@"
+    else
+        xvfb-run -a -s "-screen 0 1920x1080x24" \
+            .venv/bin/python -m pytest tests/app -p no:cacheprovider "${par[@]}" "$@"
+    fi
+}
+
+if [ "$quick" = 1 ]; then
+    stage "guardrails (ruff)" "$logs/guard" guardrails
+    stage "display-free tests, quick tier (not slow, not gui)" "$logs/free" \
+        env -u DISPLAY .venv/bin/python -m pytest --ignore=tests/app -p no:cacheprovider \
+        -m "not slow and not gui" "${par[@]}" "$@"
+else
+    stage "guardrails (ruff, import-linter, mypy)" "$logs/guard" guardrails
+    stage "display-free tests" "$logs/free" \
+        env -u DISPLAY .venv/bin/python -m pytest --ignore=tests/app -p no:cacheprovider \
+        "${par[@]}" "$@"
+    stage "GUI tests (Xvfb)" "$logs/gui" gui_tests "$@"
+fi
+
+echo "== summary ($((SECONDS - start)) s, ${workers} worker(s))" >&2
+for line in "${summary[@]}"; do
+    echo "$line" >&2
+done
+exit $failed
