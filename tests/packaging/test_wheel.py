@@ -12,6 +12,9 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
+# the wheel is built in the source tree (build/, *.egg-info): under pytest-xdist both tests
+# run on one worker (--dist loadgroup), so one build at a time and once
+pytestmark = pytest.mark.xdist_group("wheel")
 
 
 @pytest.fixture(scope="module")
