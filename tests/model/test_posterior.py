@@ -115,3 +115,18 @@ def test_r_interval_and_readout():
     assert text.startswith(f"90 % in r ∈ [{lo:.0f}, {hi:.0f}]") and f"r {post.r_hat:.0f}" in text
     assert pm.readout(pair, 0.0, 3000.0, 5.0).startswith("none: the prior never")
     assert all(math.isnan(v) for v in pm.posterior_of(pair, 0.0, 3000.0, 5.0).r_interval())
+
+
+@pytest.mark.parametrize("domain, feature", CASES)
+def test_a_regular_key_gets_the_grid_filled_tightly_inside_the_bfv(domain, feature):
+    """Not the sliver fallback (nodes as points, density 1): cells with area, a density
+    that varies, at least 40 % of the grid's cells holding mass (the grid spans the
+    nodes' r and phi with one cell of margin), and the mean g of each cell in the BFV."""
+    pair = domain.eyes
+    post = pm.posterior_of(pair, *feature, domain=domain)
+    c = post.cells
+    d1, d2 = c[:, 2] - c[:, 0], c[:, 3] - c[:, 1]
+    area = 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+    assert (area > 0).all() and post.density.min() < 0.5
+    assert post.n >= 0.4 * pm.N_R * pm.N_PHI
+    assert pair.in_bfv(post.x, post.y, post.g).all()
