@@ -245,12 +245,18 @@ def cell_lit(
     if whole_eye(X, Y, Z, G):
         return True
     res = None
-    for prec in _PRECS:
+    # enough bits for the inputs' spread of exponents and for a cap of chord^2 ~ q^2
+    bits = max(max(abs(v.numerator).bit_length(), v.denominator.bit_length()) for v in (X, Y, Z))
+    ratio = G * G / (X * X + Y * Y + Z * Z)
+    scale = max(0, ratio.denominator.bit_length() - ratio.numerator.bit_length())
+    extra = max(0, 2 * bits - 128) + 3 * scale
+    for base in _PRECS:
+        prec = base + extra
         with mpmath.workprec(prec):
             res = _decide(n, X, Y, Z, G, face, ix, iy, pix, prec)
             if isinstance(res, bool):
                 return res
             _, point, tol = res
-            if prec == _PRECS[-1]:
+            if base == _PRECS[-1]:
                 return ang2pix_snap(n, point, tol) == pix
     raise AssertionError("unreachable")  # pragma: no cover

@@ -118,7 +118,10 @@ def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
     npix = 12 * n * n
     with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
         dx0 = x - cx
-        errabs0 = _EPS * (np.abs(x) + abs(cx))  # dx = x - cx rounds once
+        # the exact rounding error of dx = x - cx (two-sum): x - cx = dx0 + err
+        bv = dx0 - x
+        err = (x - (dx0 - bv)) + (-cx - bv)
+        errabs0 = np.abs(err) + 2.0**-1070
         # scale every ball by a power of two (exact) so that |d| ~ 1
         big = np.maximum(np.maximum(np.abs(dx0), np.abs(y)), np.maximum(np.abs(z), g))
         ex = np.frexp(big)[1]
@@ -152,6 +155,12 @@ def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
         cosa = np.sqrt(np.maximum(dmg, 0.0)) / d
         dcos = (4 * _EPS * d + 4 * errabs) * (d + gs) / (np.sqrt(np.maximum(dmg, 0.0)) * d)
         dcos = np.where(np.isfinite(dcos), dcos + 4 * _EPS, 4.0)
+        # grazing caps (g / |d| -> 1): cos(alpha) from the exact |d|^2 - g^2
+        for i in np.flatnonzero(part & (dcos > 1e-9)):
+            X = Fraction(float(x[i])) - Fraction(cx)
+            D2 = X * X + Fraction(float(y[i])) ** 2 + Fraction(float(z[i])) ** 2
+            cosa[i] = math.sqrt(float((D2 - Fraction(float(g[i])) ** 2) / D2))
+            dcos[i] = 8 * _EPS * cosa[i] + 1e-300
         s2 = 2 * q * q / (1 + cosa)
         ds2 = 2 * dcos + 8 * _EPS * s2
         alpha = np.arctan2(q, cosa)
@@ -380,6 +389,7 @@ def _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g
                 if not nd.any():
                     continue
                 fixed_is_y, fixed, lo, fa, fb, mf, _ = open_edges[k]
+                FALLBACK_COUNTS[f"edges sampled x{samples}"] += int(nd.sum())
                 e = idx[nd]
                 fix = np.broadcast_to(fixed[e, None], (e.size, t.size))
                 run = lo[e, None] + t

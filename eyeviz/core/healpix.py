@@ -99,9 +99,13 @@ def vec2pix_ring(nside: int, x, y, z) -> np.ndarray:
     lon = atan2(y, x) mod 2 pi (0 at the poles), z / |v| the cosine of the colatitude.
     """
     x, y, z = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (x, y, z)))
-    r = np.sqrt(x * x + y * y + z * z)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        zc = np.where(r > 0, z / r, 1.0)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore", under="ignore"):
+        # scale by a power of two (exact) so the squares neither overflow nor underflow
+        big = np.maximum(np.maximum(np.abs(x), np.abs(y)), np.abs(z))
+        ex = np.frexp(big)[1]
+        xs, ys, zs = (np.ldexp(v, -ex) for v in (x, y, z))
+        r = np.sqrt(xs * xs + ys * ys + zs * zs)
+        zc = np.where(r > 0, zs / r, 1.0)
     return ang2pix_ring(nside, np.clip(zc, -1.0, 1.0), np.arctan2(y, x))
 
 

@@ -243,10 +243,14 @@ def reference_lit(
         return np.arange(12 * n * n, dtype=np.int64)
     bits = max(max(abs(q.numerator).bit_length(), q.denominator.bit_length()) for q in (X, Y, Z))
     dps = dps + int(bits * 0.302)
+    # tiny caps: enough digits to resolve chord^2 ~ (g / |d|)^2 as well
+    ratio = G * G / (X * X + Y * Y + Z * Z)
+    dps += max(0, int(math.log10(ratio.denominator) - math.log10(ratio.numerator)))
     # float screening: chord^2 of the pixel centres and dense edge samples
-    dv = np.array([float(X), float(Y), float(Z)])
+    k = max(abs(X), abs(Y), abs(Z))  # > 0: the eye centre is not in the ball
+    dv = np.array([float(X / k), float(Y / k), float(Z / k)])
     c = dv / np.linalg.norm(dv)
-    q = float(G) / float(np.linalg.norm(dv))
+    q = float(G / k) / float(np.linalg.norm(dv))
     s2 = 2 * q * q / (1 + math.sqrt(max(1 - q * q, 0.0)))
     alpha = math.asin(min(q, 1.0))
     out = []

@@ -74,3 +74,28 @@ def test_reference_centres_are_exact_rationals():
     z, tt = pixel_centre(6, 12 * 36 // 2)  # the first pixel of ring 3n... or of the equator
     assert z.denominator % 3 == 0 or z == 0
     assert 0 <= tt < 4
+
+
+EXTREME = [
+    (1e15, 3e14, -2e14, 1e13),  # far away
+    (H + 1e-9, 1e-9, 0.0, 5e-10),  # tiny and next to the eye centre
+    (41.0, 0.0, 0.0, float(np.nextafter(1.0, 0.0))),  # grazing: the eye centre 1 ulp out
+    (H + 3.0, 4.0, 0.0, float(np.nextafter(5.0, 0.0))),  # grazing with a 3-4-5 triangle
+    (-1e6, 3.0, 1e6, 1.41e6),  # a huge cap
+    (H, 1e-310, 5.0, 4.995),  # subnormal y: a cap about the north pole
+    (0.1, 0.2, 0.3, 0.05),
+]
+
+
+@pytest.mark.parametrize("ball", EXTREME)
+def test_extreme_scales_agree_with_the_reference(ball):
+    _compare(4, *(np.array([v]) for v in ball))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "ball",
+    [(1e-200, 1e-200, 1e-200, 1e-210), (H, 0.0, 1e-300, 1e-301)],  # exponents 600 apart
+)
+def test_inputs_needing_thousands_of_bits_agree_with_the_reference(ball):
+    _compare(4, *(np.array([v]) for v in ball))
