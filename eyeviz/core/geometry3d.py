@@ -274,9 +274,12 @@ def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
     lo = np.where(has_s, js_lo, big_i)
     hi = np.where(has_s, js_hi, -big_i)
     num = np.where(has_s, js_hi - js_lo + 1, 0)
-    np.minimum.at(lo, up_lit, uj_lit)
-    np.maximum.at(hi, up_lit, uj_lit)
-    np.add.at(num, up_lit, 1)
+    if up_lit.size:  # up is sorted (cells are generated pair by pair): segment reductions
+        seg = np.flatnonzero(np.r_[True, up_lit[1:] != up_lit[:-1]])
+        keys = up_lit[seg]
+        lo[keys] = np.minimum(lo[keys], np.minimum.reduceat(uj_lit, seg))
+        hi[keys] = np.maximum(hi[keys], np.maximum.reduceat(uj_lit, seg))
+        num[keys] += np.diff(np.r_[seg, up_lit.size])
     anyl = num > 0
     contig = anyl & (hi - lo + 1 == num)
     cp = np.flatnonzero(contig)
