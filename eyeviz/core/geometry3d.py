@@ -42,6 +42,7 @@ _SQ6 = math.sqrt(6.0)
 #: Largest number of lit indices one call may return (2^28 int64: 2 GiB). A whole eye at
 #: nside 2^20 is 1.3e13 facets: such a lit set exists only as runs, not as indices.
 MAX_LIT = 1 << 28
+_BLOCK = 512  # balls per block of the fast path
 
 #: Diagnostics: cells the vertex/edge test could not clear ("tested"), cells that needed
 #: edge sampling ("sampled") and cells decided in mpmath ("exact").
@@ -561,9 +562,29 @@ class EyePair3D:
         balls; indices sorted int64 RING indices per row (the 3D Proposition 2)."""
         xa, ya, za, ga = validate_balls(x, y, z, g)
         xf, yf, zf, gf = (np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, za, ga))
+        nb, n = xf.shape[0], self.nside
+        est = 0.0
+        with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
+            for cx in (-self.h, self.h):
+                q = gf / np.hypot(np.hypot(xf - cx, yf), zf)
+                est += float(np.where(q >= 1, 1.0, 0.5 * q * q).sum()) * self.npix
+        if est > MAX_LIT:
+            raise ValueError(
+                f"the lit sets would hold about {est:.3g} facets (more than {MAX_LIT}): "
+                "use fewer or smaller balls per call, or a smaller nside"
+            )
         out = []
         for cx in (-self.h, self.h):
-            out.append(_lit_eye(self.nside, xf, yf, zf, gf, cx))
+            ptrs, idxs, base = [np.zeros(1, np.int64)], [], 0
+            # blocks of balls keep the temporaries in cache
+            for s in range(0, nb, _BLOCK):
+                e = min(nb, s + _BLOCK)
+                ip, ix = _lit_eye(n, xf[s:e], yf[s:e], zf[s:e], gf[s:e], cx)
+                ptrs.append(ip[1:] + base)
+                idxs.append(ix)
+                base += ix.size
+            ind = np.concatenate(idxs) if idxs else np.zeros(0, np.int64)
+            out.append((np.concatenate(ptrs), ind))
         return out[0], out[1]
 
     def lit(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
