@@ -130,3 +130,19 @@ def test_a_regular_key_gets_the_grid_filled_tightly_inside_the_bfv(domain, featu
     assert (area > 0).all() and post.density.min() < 0.5
     assert post.n >= 0.4 * pm.N_R * pm.N_PHI
     assert pair.in_bfv(post.x, post.y, post.g).all()
+
+
+@pytest.mark.parametrize("domain, feature", CASES)
+def test_the_grid_covers_every_node_of_the_limits_quadrature(domain, feature):
+    """The cells span the r and phi of every posterior node with weight (the grid's edges
+    lie one cell outside the nodes' extremes)."""
+    from eyeviz.estimators.limit import posterior_nodes
+
+    post = pm.posterior_of(domain.eyes, *feature, domain=domain)
+    nd = posterior_nodes([post.key], domain, "single")
+    keep = nd.w[0] > 0
+    rn, pn = nd.r[0][keep], nd.phi[0][keep]
+    rc = np.hypot(post.cells[..., 0], post.cells[..., 1])
+    pc = np.arctan2(post.cells[..., 1], post.cells[..., 0])
+    assert rc.min() < rn.min() and rc.max() > rn.max()
+    assert pc.min() < pn.min() and pc.max() > pn.max()

@@ -217,3 +217,24 @@ def test_dumps_is_tomli_w_quoted_and_stable():
     text = dumps(s)
     assert loads(text) == s and dumps(loads(text)) == text
     assert "[[features]]" in text and 'show = ["eyes", "bfv"' in text
+
+
+@pytest.mark.parametrize(
+    "table",
+    [
+        "[layers]\nshow = 'eyes'",  # a string is not a list of strings
+        "[layers]\nshow = ['eyes', 3]",
+        "[predictions]\nestimators = 'analytic'",
+    ],
+)
+def test_a_list_of_strings_must_be_a_list_of_strings(table):
+    with pytest.raises(SceneError, match="must be a list of strings"):
+        loads(BASE.replace("m = 720", "m = 720\n" + table), "<t>")
+
+
+def test_no_estimator_is_refused_only_when_the_predictions_layer_is_shown():
+    none = "m = 720\n[predictions]\nestimators = []\n[layers]\nshow = "
+    sc = loads(BASE.replace("m = 720", none + "['eyes', 'features']"), "<t>")
+    assert sc.estimators == [] and not sc.shows("predictions")
+    with pytest.raises(SceneError, match="needs at least one estimator"):
+        loads(BASE.replace("m = 720", none + "['eyes', 'predictions']"), "<t>")

@@ -68,3 +68,15 @@ def test_paper_counts_and_bad_input():
         horizontal(100, 500, 10)
     with pytest.raises(ValueError, match="stop"):
         vertical(5, 10, start=5000, stop=1000)
+
+
+def test_one_point_is_a_trajectory():
+    for make in (horizontal, circular):
+        x, y = make(2000.0, 50.0, 1)
+        assert x.shape == y.shape == (1,) and EYES.in_bfv(x, y, 50.0).all()
+
+
+def test_a_circle_no_larger_than_the_feature_is_refused_by_name():
+    for g in (100.0, 150.0):  # g = r included
+        with pytest.raises(ValueError, match="g must be < r"):
+            circular(100.0, g, 10)
