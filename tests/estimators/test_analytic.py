@@ -3,6 +3,7 @@
 import math
 
 import numpy as np
+import pytest
 
 from eyeviz import estimators
 from eyeviz.core.geometry import EyePair
@@ -35,3 +36,20 @@ def test_analytic_beats_constant_by_far():
     assert mape_r < 0.3 * const_r
     assert mape_phi < 0.01 * const_phi
     assert mape_phi < 0.002 and mape_r < 0.15
+
+
+@pytest.mark.parametrize("md", [0.25, 1.0])
+def test_parallel_centre_rays_meet_at_the_disparity_floor(md):
+    """Equal intervals in both eyes (zero disparity): the rays are raised to a disparity of
+    ``min_disparity`` sectors; r then follows from the law of sines in triangle A B P."""
+    m, h = 720, 40.0
+    est = estimators.load("analytic", min_disparity=md)
+    L, R = 170, 175
+    p = est.predict_intervals(L, R, L, R)
+    gam = 2 * np.pi / m
+    ta = (L + R + 1) * gam / 2
+    d = md * gam
+    ra = 2 * h * np.sin(ta + d) / np.sin(d)
+    x, y = -h + ra * np.cos(ta), ra * np.sin(ta)
+    assert p.valid and p.r == pytest.approx(np.hypot(x, y), rel=1e-9)
+    assert p.phi == pytest.approx(np.arctan2(y, x), abs=1e-12)
