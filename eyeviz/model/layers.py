@@ -20,8 +20,10 @@ Hooks (each optional):
   :class:`eyeviz.model.frame.FrameInputs` (a layer of its own puts it in
   ``frame.parts[name]``); run only when the scene shows the layer.
 - ``mpl(canvas) -> None`` paints the part on a :class:`eyeviz.render.mpl.canvas.Canvas`.
-- ``vtk``: a class made once per view as ``cls(main_renderer, inset_renderer)`` whose
-  ``draw(frame, selected)`` draws the part (and hides its actors when the layer is off).
+- ``vtk``: a class made once per view as ``cls(main_renderer, inset_renderer)`` (it adds
+  its actors; the inset may be None in an overlay view made without one) whose
+  ``draw(frame, selected)`` is called for every Frame the view draws: it draws the part,
+  or hides its actors when ``frame.layers`` does not show the layer.
   ``vtk_stage`` says which Frame it gets in the app: ``"scene"`` (built from the state at
   each update) or ``"overlay"`` (the parts the app model caches: predictions, the
   selected feature's ambiguity region, the trajectory path).
@@ -213,6 +215,7 @@ LAYERS: list[LayerSpec] = [
 ]
 
 _RESOLVED: dict[str, Any] = {}
+_CACHE: dict[tuple, Any] = {}  # ordered() and needs_of() answers; cleared when LAYERS changes
 
 
 def layer_names() -> tuple[str, ...]:
@@ -229,39 +232,50 @@ def layer(name: str) -> LayerSpec:
 
 
 def register_layer(spec: LayerSpec) -> LayerSpec:
-    """Add ``spec`` to the table (after the others); ValueError if the name is taken."""
+    """Add ``spec`` to the table (after the others); ValueError if the name is taken.
+
+    Scene files accept the name at once; the app's views and Layers panel made before the
+    call do not show the layer (they read the table when they are made)."""
     if not isinstance(spec, LayerSpec):
         raise TypeError(f"spec must be a LayerSpec, got {type(spec).__name__}")
     if spec.name in layer_names():
         raise ValueError(f"a layer named {spec.name!r} is already registered")
     LAYERS.append(spec)
+    _CACHE.clear()
     return spec
 
 
 def unregister_layer(name: str) -> None:
     """Remove layer ``name`` from the table (a test's layer, say)."""
     LAYERS.remove(layer(name))
+    _CACHE.clear()
 
 
 def ordered(hook: str, shown: Iterable[str] | None = None) -> list[LayerSpec]:
     """The entries with a ``hook`` ("frame", "mpl" or "vtk"), in that renderer's draw order
     (``mpl_order`` / ``vtk_order``, then table order); only the names in ``shown`` if given."""
-    keep = None if shown is None else set(shown)
-    specs = [s for s in LAYERS if getattr(s, hook) is not None]
-    if keep is not None:
-        specs = [s for s in specs if s.name in keep]
-    key = {"mpl": "mpl_order", "vtk": "vtk_order"}.get(hook)
-    return specs if key is None else sorted(specs, key=lambda s: getattr(s, key))
+    keep = None if shown is None else frozenset(shown)
+    ck = ("ordered", hook, keep)
+    if ck not in _CACHE:  # a drag frame asks again with the same layers
+        specs = [s for s in LAYERS if getattr(s, hook) is not None]
+        if keep is not None:
+            specs = [s for s in specs if s.name in keep]
+        key = {"mpl": "mpl_order", "vtk": "vtk_order"}.get(hook)
+        _CACHE[ck] = specs if key is None else sorted(specs, key=lambda s: getattr(s, key))
+    return list(_CACHE[ck])
 
 
 def needs_of(shown: Iterable[str]) -> frozenset[str]:
     """What the layers ``shown`` need from the state (unknown names need nothing)."""
-    names = set(shown)
-    out: frozenset[str] = frozenset()
-    for s in LAYERS:
-        if s.name in names:
-            out |= s.needs
-    return out
+    names = frozenset(shown)
+    ck = ("needs", names)
+    if ck not in _CACHE:
+        out: frozenset[str] = frozenset()
+        for s in LAYERS:
+            if s.name in names:
+                out |= s.needs
+        _CACHE[ck] = out
+    return _CACHE[ck]
 
 
 def resolve(ref: Ref | None) -> Any:

@@ -82,7 +82,9 @@ class SceneActors:
         self.main = main
         self.inset = inset
         self.painters: dict[str, Painter] = painters("scene", main, inset)
-        self._bfv_scene: Scene | None = None
+        self._bfv_scene: Scene | None = None  # the eyes alone, showing bfv or not
+        self._bfv_key: tuple | None = None  # (h, l, m, bfv shown) of _bfv_scene
+        self._rect: tuple[float, float, float, float] | None = None  # the wedge's, last fit
         self.frame: Frame | None = None
 
     def layer(self, name: str) -> Painter:
@@ -115,10 +117,17 @@ class SceneActors:
 
     # --- entry points -----------------------------------------------------------------
     def update(self, scene: Scene, state: SceneState, selected: int | None) -> None:
-        self._bfv_scene = dataclasses.replace(
-            scene, features=[], layers=["bfv"] if scene.shows("bfv") else []
-        )
-        self.draw(view_frame(scene, state, selected, self.visible_rect()), selected)
+        e = scene.eyes
+        key = (e.h, e.l, e.m, scene.shows("bfv"))
+        if key != self._bfv_key:
+            self._bfv_key = key
+            self._bfv_scene = dataclasses.replace(
+                scene, eyes=dataclasses.replace(e), features=[], layers=["bfv"] if key[3] else []
+            )
+        if self._rect is None:
+            self._rect = self.visible_rect()
+        # the wedge is clipped to the rectangle of the last fit (set_zoom refits it)
+        self.draw(view_frame(scene, state, selected, self._rect), selected)
 
     def draw(self, frame: Frame, selected: int | None) -> None:
         """Draw ``frame`` (the only source of what is drawn)."""
@@ -142,9 +151,10 @@ class SceneActors:
     def fit_bfv(self) -> None:
         """The BFV wedge as the Frame clips it to the visible rectangle (drawn to the
         view's edge at any zoom or pan; issue 12 item 5), points in place."""
+        self._rect = self.visible_rect()
         if self._bfv_scene is None or not self._bfv_scene.shows("bfv"):
             return
-        self.bfv.draw(build_frame(self._bfv_scene, rect=self.visible_rect()), None)
+        self.bfv.draw(build_frame(self._bfv_scene, rect=self._rect), None)
 
     # --- the window's other entry points -------------------------------------------------
     def set_zoom(self, main_px_per_unit: float, inset_px_per_unit: float, l: float, m: int):

@@ -66,6 +66,7 @@ class OverlayActors:
         self._names = set(self.painters)
         self.frame: Frame | None = None  # the Frame drawn last
         self._inputs: tuple | None = None  # what update() built it from
+        self._hidden = False  # every painter drew a Frame without layers since
 
     def update(
         self,
@@ -78,15 +79,18 @@ class OverlayActors:
         skip=frozenset(),
     ) -> Frame | None:
         """Build the overlay Frame and draw it; returns the Frame (None, and everything
-        hidden, when the scene shows none of these layers: a drag builds only a Frame
-        without layers then)."""
+        hidden, when the scene shows none of these layers: a drag builds nothing then)."""
         if not self._names & set(scene.layers):
-            # none of these layers: each painter hides (a Frame without layers)
-            none = build_frame(dataclasses.replace(scene, layers=[], trajectory=None), state)
-            for p in self.painters.values():
-                p.draw(none, selected)
+            # none of these layers: each painter hides, drawing a Frame without layers
+            # (once: a drag then builds nothing here)
+            if not self._hidden:
+                none = build_frame(dataclasses.replace(scene, layers=[], trajectory=None), state)
+                for p in self.painters.values():
+                    p.draw(none, selected)
+                self._hidden = True
             self._inputs = None
             return None
+        self._hidden = False
         # the same inputs (a refresh that changed nothing here: a selection, a panel, the
         # second call of a refresh): the Frame drawn last is still what is shown
         inputs = (state, predictions, ambiguity, path)
@@ -117,6 +121,7 @@ class OverlayActors:
 
     def _draw(self, frame: Frame, selected: int | None, skip) -> None:
         self.frame = frame
+        self._hidden = False
         self.predictions.skip = frozenset(skip)
         for p in self.painters.values():
             p.draw(frame, selected)

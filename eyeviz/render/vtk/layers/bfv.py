@@ -55,12 +55,12 @@ class BFVLayer:
     def update(self, frame: Frame) -> None:
         """Write the wedge and its edges (nothing when they are what is drawn)."""
         bfv = frame.bfv
-        poly = np.zeros((0, 2)) if bfv is None else np.asarray(bfv.polygon)
-        edges = [] if bfv is None else bfv.edges
-        key = (poly.shape, poly.tobytes(), tuple(edges))
-        if key == self._written:
+        key = None if bfv is None else (bfv.psi, bfv.rect)
+        if key == self._written:  # the same wedge and rectangle (a drag): nothing to clip
             return
         self._written = key
+        poly = np.zeros((0, 2)) if bfv is None else np.asarray(bfv.polygon)
+        edges = [] if bfv is None else bfv.edges
         self.polygon = poly
         pts = np.zeros((BFV_SLOTS, 3))
         pts[:, 2] = self.z_fill
