@@ -343,8 +343,10 @@ def _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g
     czv = dz[ub] / d[ub]
     s2u, ds2u, edu = s2[ub], ds2[ub], errdir[ub]
     cpix = healpix.vec2pix_ring(n, dx, dy, dz)
-    own = (upix == cpix[ub]) & (alpha[ub] > 1e6 * errdir[ub])
-    out |= own
+    # the float centre's pixel is the true centre's when the cap is far wider than the
+    # direction's error; a smaller cap's own cell is found exactly below
+    sure_centre = alpha[ub] > 1e6 * errdir[ub]
+    out |= (upix == cpix[ub]) & sure_centre
 
     def chord(px, py, f):
         v = healpix.xyf2vec(n, px, py, f)
@@ -419,6 +421,16 @@ def _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g
         still &= ~lit_now
         out[idx[lit_now]] = True
         rest = idx[~lit_now & still]
+    else:
+        rest = idx
+    # a cap that meets no edge of a cell lies inside it or outside it: its centre decides.
+    # Where the float centre cannot be trusted (a cap within 1e6 errors of a point), every
+    # candidate cell not yet lit goes to the exact test, or a tiny cap would light nothing.
+    pending = np.zeros(m, bool)
+    pending[rest] = True
+    tiny = np.flatnonzero(~out & ~pending & ~sure_centre)
+    rest = np.concatenate([rest, tiny]).astype(np.int64)
+    if rest.size:
         for i in rest:
             FALLBACK_COUNTS["exact"] += 1
             b = int(ub[i])

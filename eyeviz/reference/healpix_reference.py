@@ -62,6 +62,18 @@ def pixel_centre(n: int, p: int) -> tuple[Fraction, Fraction]:
     return Fraction(4 * n - 2 * ring, 3 * n), Fraction(4 * twice, 2 * num)
 
 
+@functools.lru_cache(maxsize=8)
+def _centre_vectors(n: int) -> np.ndarray:
+    """Unit vectors (12 n^2, 3) of every pixel centre (from :func:`pixel_centre`), for the
+    float screening; computed once per nside."""
+    out = np.empty((12 * n * n, 3))
+    for p in range(12 * n * n):
+        zc, ttc = (float(v) for v in pixel_centre(n, p))
+        rc = math.sqrt(max(1 - zc * zc, 0.0))
+        out[p] = (rc * math.cos(ttc * math.pi / 2), rc * math.sin(ttc * math.pi / 2), zc)
+    return out
+
+
 def _mpq(q: Fraction):
     return mpmath.mpf(q.numerator) / q.denominator
 
@@ -261,14 +273,12 @@ def reference_lit(
         qq = mp[3] / dd
         s2_mp = 2 * qq * qq / (1 + mpmath.sqrt(1 - qq * qq))
         own = _ang2pix(n, c_mp, mpmath.mpf(10) ** (20 - dps))  # the pixel of the centre
+        fcs = ((_centre_vectors(n) - c) ** 2).sum(axis=1)
         for p in range(12 * n * n):
             if p == own:
                 out.append(p)
                 continue
-            zc, ttc = (float(v) for v in pixel_centre(n, p))
-            rc = math.sqrt(max(1 - zc * zc, 0.0))
-            pc = np.array([rc * math.cos(ttc * math.pi / 2), rc * math.sin(ttc * math.pi / 2), zc])
-            fc = float(((pc - c) ** 2).sum())
+            fc = float(fcs[p])
             if fc < s2 - 1e-3:
                 out.append(p)  # the centre, an interior point, is well inside the cap
                 continue

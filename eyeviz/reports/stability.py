@@ -29,6 +29,8 @@ OLD = "eyeviz core, before issue 14"
 TIMED = (*METHODS, OLD, "reference (mpmath)")
 #: Most features per case class (-n): each needs an 80-digit mpmath reference.
 MAX_N = 100_000
+#: Most balls per case class of the spherical eyes (--n3d): their reference visits every facet.
+MAX_N3D = 10_000
 
 
 @dataclass
@@ -48,6 +50,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True, type=Path, help="output directory")
     parser.add_argument("-n", type=int, default=2000, help="features per case class (default 2000)")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--n3d",
+        type=int,
+        default=12,
+        help="balls per case class of the spherical eyes (default 12; 0 leaves them out: "
+        "their reference visits every facet, about 0.3-1.5 s a ball)",
+    )
 
 
 def _timed(fn, repeats: int = 3) -> tuple[object, float]:
@@ -209,6 +218,7 @@ def write(rows: list[Row], outdir: Path) -> None:
 
 def run(args: argparse.Namespace) -> int:
     check_int("-n", args.n, ge=1, le=MAX_N)
+    check_int("--n3d", args.n3d, ge=0, le=MAX_N3D)
     from tqdm import tqdm
 
     from eyeviz.reference import stability_cases
@@ -220,4 +230,18 @@ def run(args: argparse.Namespace) -> int:
     print(
         f"wrote {args.output / 'stability.md'} (.csv, .png); eyeviz core differences: {core_diffs}"
     )
+    if args.n3d:
+        from eyeviz.reference import stability_cases3d
+        from eyeviz.reports.stability3d import measure3d, write3d
+
+        classes = len(stability_cases3d.CLASSES)
+        with tqdm(total=classes, desc="stability 3D", unit="class") as bar:
+            rows3 = measure3d(args.n3d, args.seed, progress=lambda _name: bar.update())
+        write3d(rows3, args.output)
+        diffs3 = sum(r.diffs["eyeviz core"] for r in rows3)
+        print(
+            f"wrote {args.output / 'stability3d.md'} (.csv, .png); eyeviz core differences "
+            f"(spherical eyes): {diffs3}"
+        )
+        core_diffs += diffs3
     return 0 if core_diffs == 0 else 1

@@ -248,3 +248,30 @@ def test_the_edge_curvature_bound_holds():
                         bound = edge_bound(n, face, fixed_is_y, float(fixed), float(lo))
                         worst = max(worst, float(d2.max()) / bound)
     assert 0.5 < worst < 1.0
+
+
+@pytest.mark.parametrize(
+    "g", [1e-3, 1e-6, 1e-9, 1e-12, pytest.param(1e-300, marks=pytest.mark.slow)]
+)
+@pytest.mark.parametrize("nside", [8, 180])
+def test_a_tiny_cap_lights_the_cell_of_its_centre(g, nside):
+    """A cap far smaller than the float direction's error still lights its own cell (the
+    fast path once cleared every edge and lit nothing)."""
+    eyes = EyePair3D(40.0, 20.0, nside)
+    rng = np.random.default_rng(nside)
+    for x, y, z in rng.uniform(-3000, 3000, (4, 3)):
+        la, lb = eyes.lit(x, y, z, g)
+        for got, cx in ((la, -40.0), (lb, 40.0)):
+            centre = int(eyes.facet(x, y, z, "A" if cx < 0 else "B"))
+            assert got.tolist() == [centre]
+
+
+def test_far_tiny_ball_matches_the_reference():
+    """Found by `eyeviz report stability` (extreme scales): r ~ 6e14, g ~ 5e5."""
+    from eyeviz.reference.healpix_reference import reference_lit
+
+    eyes = EyePair3D(40.0, 20.0, 8)
+    ball = (556086480053557.3, 190659441615909.6, -56913132029480.01, 502579.43741302175)
+    la, lb = eyes.lit(*ball)
+    assert np.array_equal(la, reference_lit(8, *ball, -40.0))
+    assert np.array_equal(lb, reference_lit(8, *ball, 40.0))

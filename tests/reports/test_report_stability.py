@@ -12,7 +12,8 @@ from eyeviz.reports import stability
 def test_report_writes_table_csv_and_plot(tmp_path):
     out = tmp_path / "report"
     res = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "report", "stability", "-o", str(out), "-n", "150"],
+        [sys.executable, "-m", "eyeviz", "report", "stability", "-o", str(out), "-n", "150"]
+        + ["--n3d", "1"],
         capture_output=True,
         text=True,
     )
@@ -35,6 +36,12 @@ def test_report_writes_table_csv_and_plot(tmp_path):
     assert "speed-up vs before" in md and "eyeviz core, before issue 14 µs" in md
     png = (out / "stability.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
+    # the spherical eyes' part: one ball per class, every lit set equal to the reference
+    with open(out / "stability3d.csv") as f:
+        rows3 = list(csv.DictReader(f))
+    assert len(rows3) >= 7 and all(int(r["diffs eyeviz core"]) == 0 for r in rows3)
+    assert "spherical eyes): 0" in res.stdout
+    assert (out / "stability3d.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
 
 

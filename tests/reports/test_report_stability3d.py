@@ -1,0 +1,37 @@
+"""The spherical eyes' part of `eyeviz report stability` (eyeviz.reports.stability3d)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from eyeviz.reference import stability_cases3d
+from eyeviz.reports import stability3d
+
+
+def test_every_class_builds_valid_balls():
+    for name in stability_cases3d.CLASSES:
+        cs = stability_cases3d.make(name, 5, seed=1)
+        assert cs.x.shape == cs.y.shape == cs.z.shape == cs.g.shape == (5,)
+        assert np.all(np.isfinite([cs.x, cs.y, cs.z, cs.g])) and np.all(cs.g > 0)
+
+
+def test_equator_ties_are_on_the_plane_with_their_rims_on_vertices():
+    cs = stability_cases3d.make("equator_ties", 6, seed=2)
+    assert np.all(cs.z == 0.0)
+    row = stability3d.measure_case3d(cs)
+    assert row.diffs["eyeviz core"] == 0
+    assert row.exact + row.sampled > 0  # ties reach the core's slower stages
+
+
+def test_tiny_and_far_balls_match_the_reference():
+    row = stability3d.measure_case3d(stability_cases3d.make("extreme", 3, seed=106))
+    assert row.diffs["eyeviz core"] == 0
+
+
+def test_report_files(tmp_path):
+    rows = [stability3d.measure_case3d(stability_cases3d.make("poles", 2, seed=3))]
+    stability3d.write3d(rows, tmp_path)
+    md = (tmp_path / "stability3d.md").read_text()
+    assert "| over a pole | 2 | 8 |" in md
+    assert (tmp_path / "stability3d.png").read_bytes()[:4] == b"\x89PNG"
+    assert (tmp_path / "stability3d.csv").read_text().count("\n") == 2
