@@ -1,4 +1,4 @@
-"""Estimators' answers for a scene's features (the predictions layer, DESIGN.md §3).
+"""Estimators' answers for a scene's features (the predictions layer, docs/contract.md).
 
 :class:`Predictor` keeps each estimator loaded once (``eyeviz.estimators`` is imported on
 the first prediction, so torch only when the predictions layer is on and a network is

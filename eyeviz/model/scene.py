@@ -1,4 +1,4 @@
-"""Scenes: what the app shows and what a figure exports (DESIGN.md §3, scene contract).
+"""Scenes: what the app shows and what a figure exports (docs/contract.md, scene files).
 
 A :class:`Scene` is plain data: the eye pair's parameters (h, l, m of Table 3), circular
 features (name, centre, radius g, colour), the layers to show, the estimators of the
@@ -371,7 +371,7 @@ def loads(text: str, source: str = "<string>") -> Scene:
 
 
 def load(path) -> Scene:
-    """Read a scene file (TOML, DESIGN.md §3): a regular file of at most MAX_SCENE_BYTES."""
+    """Read a scene file (TOML, docs/contract.md): a regular file of at most MAX_SCENE_BYTES."""
     p = Path(path)
     if not p.exists():
         raise SceneError(f"{p}: no such scene file")
