@@ -56,6 +56,17 @@ class Block(NamedTuple):
     start: int
 
 
+def _read_header(f) -> tuple[tuple[int, ...], bool, np.dtype]:
+    """(shape, fortran order, dtype) of the .npy stream ``f``, nothing allocated."""
+    version = np.lib.format.read_magic(f)
+    read = (
+        np.lib.format.read_array_header_1_0
+        if version == (1, 0)
+        else np.lib.format.read_array_header_2_0
+    )
+    return read(f, max_header_size=10000)
+
+
 class BlockReader:
     """A data set file read block by block in bounded memory (:func:`iter_blocks`).
 
@@ -91,6 +102,11 @@ class BlockReader:
         try:
             with zipfile.ZipFile(self.path) as zf:
                 infos = {i.filename: i for i in zf.infolist()}
+                if "rows.npy" not in infos and "indptr_a.npy" in infos:
+                    raise EyevizError(
+                        f"{self.path}: a data set of the spherical eyes (3D), not of the "
+                        "planar ones: read it with eyeviz.dataset.load3d"
+                    )
                 for name in ("meta.npy", "rows.npy"):
                     if name not in infos:
                         raise self._npz_fail(f"no member {name!r}")
@@ -99,16 +115,14 @@ class BlockReader:
                 mi = infos["meta.npy"]
                 if mi.file_size > _META_MAX_BYTES:
                     raise self._npz_fail(f"meta member of {mi.file_size} bytes")
+                with zf.open(mi) as f:  # the header first: a 400-byte member may declare GBs
+                    shape, _fortran, dtype = _read_header(f)
+                if shape != () or dtype.kind != "U" or dtype.itemsize > _META_MAX_BYTES:
+                    raise self._npz_fail(f"meta member is {dtype} of shape {shape}, not a string")
                 with zf.open(mi) as f:
                     meta_arr = np.lib.format.read_array(f, allow_pickle=False)
                 with zf.open(infos["rows.npy"]) as f:
-                    version = np.lib.format.read_magic(f)
-                    read_header = (
-                        np.lib.format.read_array_header_1_0
-                        if version == (1, 0)
-                        else np.lib.format.read_array_header_2_0
-                    )
-                    shape, fortran, dtype = read_header(f, max_header_size=10000)
+                    shape, fortran, dtype = _read_header(f)
                     self._data_offset = f.tell()
         except EyevizError:
             raise

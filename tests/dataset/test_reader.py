@@ -24,3 +24,41 @@ def test_read_all_refuses_a_csv_with_one_line_naming_the_file(tmp_path):
     D.save(ds, q)
     rows = iter_blocks(q, eyes=EYES).read_all()
     assert len(rows) == 40
+
+
+def _npz_with_meta_header(path, header: dict) -> None:
+    """A data set NPZ whose meta member declares ``header`` over a few bytes of body."""
+    import io
+    import zipfile
+
+    import numpy as np
+
+    buf = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buf, header)
+    buf.write(b"x" * 400)
+    rows = io.BytesIO()
+    np.save(rows, np.zeros(0, np.uint8))
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED) as zf:
+        zf.writestr("meta.npy", buf.getvalue())
+        zf.writestr("rows.npy", rows.getvalue())
+
+
+def test_a_meta_member_declaring_gigabytes_is_refused_before_allocating(tmp_path):
+    path = tmp_path / "bomb.npz"
+    _npz_with_meta_header(path, {"descr": "<U100", "fortran_order": False, "shape": (10**9,)})
+    with pytest.raises(EyevizError, match="meta member is <U100 of shape") as exc:
+        D.load(path)
+    assert "\n" not in str(exc.value)
+
+
+def test_a_spherical_data_set_is_named_as_such(tmp_path):
+    path = tmp_path / "sky.npz"
+    D.write3d(path, 5, domain=_small_domain3d(), seed=1)
+    with pytest.raises(EyevizError, match="spherical eyes .*load3d"):
+        D.load(path)
+
+
+def _small_domain3d():
+    from eyeviz.core.domain3d import Domain3D
+
+    return Domain3D(nside=8, r_min=100.0, r_max=300.0, g_max=30.0)
