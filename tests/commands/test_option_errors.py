@@ -102,6 +102,7 @@ def test_degenerate_option_named(tmp_path, argv, words):
     assert not list(tmp_path.glob("out*")), "a refused command wrote output"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "argv,words",
     [

@@ -42,6 +42,7 @@ def test_snapshot_png_without_heavy_imports(tmp_path):
     assert struct.unpack(">II", data[16:24])[0] == 525
 
 
+@pytest.mark.slow
 def test_snapshot_svg_and_pdf(tmp_path):
     for suffix in (".svg", ".pdf"):
         out = tmp_path / f"s{suffix}"
@@ -149,6 +150,7 @@ def test_snapshot_aspect_frames_the_view_and_bad_ones_are_refused(tmp_path):
     assert not (tmp_path / "bad.png").exists()
 
 
+@pytest.mark.slow
 def test_snapshot_hostile_scenes_are_one_line(tmp_path):
     """Too many features, a feature at 1e308: a one-line refusal, no file (refused before
     any figure is made: tests/render/test_export.py counts them)."""

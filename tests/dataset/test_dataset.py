@@ -187,6 +187,7 @@ def test_npz_round_trip_keeps_parameters(tmp_path):
     assert back.params["seed"] == 2 and back.params["mode"] == "single"
 
 
+@pytest.mark.slow
 def test_csv_layout_and_appendix_loader(tmp_path, paper_single):
     path = tmp_path / "dataset.csv"
     D.save(paper_single, path)

@@ -274,6 +274,7 @@ def test_iter_blocks_bad_arguments(small, tmp_path):
         dio.iter_blocks(tmp_path / "none.csv")
 
 
+@pytest.mark.slow
 def test_iter_blocks_memory_is_bounded(tmp_path):
     """Peak traced memory reading 20,000 rows (m = 720) in blocks of 500 stays a small
     fraction of load()'s."""

@@ -64,6 +64,7 @@ def test_missing_weights_is_a_clear_error(tmp_path):
         estimators.load("compact", path=tmp_path)
 
 
+@pytest.mark.slow
 def test_load_compact_imports_torch():
     code = (
         "import sys, eyeviz.estimators as e; assert 'torch' not in sys.modules;"
@@ -73,6 +74,7 @@ def test_load_compact_imports_torch():
     assert out.stdout.strip() == "True"
 
 
+@pytest.mark.slow
 def test_training_runs_and_writes_atomically(tmp_path):
     from eyeviz.estimators import compact
 

@@ -202,6 +202,7 @@ def test_declared_shape_bomb_is_refused_before_reading(tmp_path):
     assert peak < 8 << 20  # refused at dkey's header: no member of MBs read, not 12 GB
 
 
+@pytest.mark.slow
 def test_object_members_and_bad_meta_are_refused(tmp_path):
     a = _members(MODELS / "bayes.npz")
     p = tmp_path / "bayes.npz"

@@ -154,6 +154,7 @@ def test_train_bayes_npz_name_into_user_dir(tmp_path):
     assert est.metadata["sample_size"] == 20000
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "args, message",
     [

@@ -31,6 +31,7 @@ def _wait_for_part(folder: Path, proc, timeout=60.0) -> Path:
     raise AssertionError("no temporary file appeared")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "sig, code, word",
     [

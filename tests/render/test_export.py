@@ -163,6 +163,7 @@ def _all_scenes():
     return scenes
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("width", ["single", "double", 5.0])
 def test_no_text_below_6pt_and_all_inside_the_figure(width):
     for sc in _all_scenes():
@@ -181,6 +182,7 @@ def test_no_text_below_6pt_and_all_inside_the_figure(width):
             )
 
 
+@pytest.mark.slow
 def test_width_single_double_and_inches(tmp_path, default_scene):
     for w, inches in (("single", 3.5), ("double", 7.2), (4.25, 4.25)):
         out = export(default_scene, tmp_path / f"w{w}.png", width=w)

@@ -69,6 +69,7 @@ def test_text_is_text_and_labels_present():
     assert "[173, 180]" in texts  # the lit interval beside the bitmap strip
 
 
+@pytest.mark.slow
 def test_unmerged_default_scene_has_every_triangle():
     sc = scene_mod.load(SCENES / "default.toml")
     omm = _groups(_svg(sc, merge=False), "ommatidium-")

@@ -6,9 +6,12 @@ import csv
 import subprocess
 import sys
 
+import pytest
+
 from eyeviz.reports import stability
 
 
+@pytest.mark.slow
 def test_report_writes_table_csv_and_plot(tmp_path):
     out = tmp_path / "report"
     res = subprocess.run(

@@ -307,6 +307,7 @@ def test_empty_and_oversized_and_binary_tables(tmp_path, monkeypatch):
     _raises(b, "line 2: not UTF-8")
 
 
+@pytest.mark.slow
 def test_cli_one_line_errors_and_nothing_written(tmp_path):
     rows = synthetic_rows()
     rows[0]["version"] = 7
