@@ -14,6 +14,17 @@ view width within [-MAX_SCENE_COORD, MAX_SCENE_COORD] (the view width at least
 MIN_VIEW_WIDTH); names without control characters (a newline or NUL could never be saved
 and would break an SVG) and at most MAX_NAME_CHARS long.
 
+Spherical scenes (issue 22, docs/spherical.md): ``[eyes] h, l, nside`` (instead of m)
+makes the scene's eyes the HEALPix pair :class:`eyeviz.core.geometry3d.EyePair3D`
+(:meth:`Eyes.model`); a scene giving both m and nside is refused (no m and no nside is the
+planar default, m = 720, as before). Features carry ``z`` (default 0.0), written only in a
+spherical scene, so a planar scene loads and saves exactly as before; a planar feature with
+z != 0 is refused. nside is bounded by :func:`eyeviz.core.bounds.check_nside`, z like x and
+y. A spherical scene may show only the layers in :data:`SPHERICAL_LAYERS` (eyes, features,
+bfv, bitmaps, readout, labels: what the headless 3D figure draws); the planar-only layers
+(tangents, sectors, ambiguity, posterior, trajectory, predictions, and any registered
+layer) and a ``[trajectory]`` table are refused in one line.
+
 This module imports the standard library and tomli_w only (no Qt, VTK or torch).
 
 It is over 400 lines because every rule of the scene contract is checked in one place
@@ -34,7 +45,8 @@ from pathlib import Path
 import tomli_w
 
 from eyeviz import EyevizError
-from eyeviz.core.bounds import check_m
+from eyeviz.core.bounds import check_m, check_nside
+from eyeviz.core.eyes import EyeModel, design_kind, eyes_from_design
 from eyeviz.core.geometry import EyePair
 from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
@@ -42,6 +54,7 @@ from eyeviz.model.layers import layer_names
 
 __all__ = [
     "OKABE_ITO",
+    "SPHERICAL_LAYERS",
     "TRAJECTORY_KINDS",
     "Eyes",
     "Feature",
@@ -59,6 +72,8 @@ TRAJECTORY_KINDS = ("horizontal", "circular", "vertical")
 # Okabe & Ito (2008) colour-blind-safe palette, black left out (it is the eyes' ink).
 OKABE_ITO = ("#D55E00", "#0072B2", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#F0E442")
 DEFAULT_LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout"]
+#: The layers a spherical scene may show (see the module docstring).
+SPHERICAL_LAYERS = ("eyes", "features", "bfv", "bitmaps", "readout", "labels")
 _COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
 #: Bounds of what a scene may ask the app to draw (see the module docstring).
 MAX_SCENE_COORD = 1e12
@@ -94,18 +109,46 @@ class Feature:
     y: float
     g: float
     color: str = "#d62728"
+    z: float = 0.0  # a ball's height above the plane z = 0 (spherical scenes only)
 
 
 @dataclass
 class Eyes:
-    """EyePair parameters: h origin-to-centre, l eye radius, m ommatidia (Table 3)."""
+    """EyePair parameters: h origin-to-centre, l eye radius, m ommatidia (Table 3); or,
+    with ``nside`` set, the spherical pair EyePair3D(h, l, nside) (docs/spherical.md)."""
 
     h: float = 40.0
     l: float = 20.0
     m: int = 720
+    nside: int | None = None  # set: spherical eyes, and m is the equator's 4 nside
+
+    def __post_init__(self) -> None:
+        if self.nside is not None:
+            self.m = 4 * self.nside
+
+    @property
+    def kind(self) -> str:
+        """``"planar"`` or ``"spherical"`` (:data:`eyeviz.core.eyes.KINDS`)."""
+        return "planar" if self.nside is None else "spherical"
+
+    @property
+    def design(self) -> dict[str, float | int]:
+        """{"h", "l", "m"} or {"h", "l", "nside"}: the design of :mod:`eyeviz.core.eyes`."""
+        if self.nside is None:
+            return {"h": self.h, "l": self.l, "m": self.m}
+        return {"h": self.h, "l": self.l, "nside": self.nside}
 
     def pair(self) -> EyePair:
+        """The planar EyePair; a spherical scene's eyes are :meth:`model`'s EyePair3D."""
+        if self.nside is not None:
+            raise EyevizError(
+                f"the scene's eyes are spherical (nside = {self.nside}): use Eyes.model()"
+            )
         return EyePair(self.h, self.l, self.m)
+
+    def model(self) -> EyeModel:
+        """EyePair (planar) or EyePair3D (spherical), through ``eyes_from_design``."""
+        return eyes_from_design(self.design)
 
 
 @dataclass
@@ -140,6 +183,11 @@ class Scene:
 
     def shows(self, layer: str) -> bool:
         return layer in self.layers
+
+    @property
+    def kind(self) -> str:
+        """``"planar"`` or ``"spherical"``: the kind of the scene's eyes."""
+        return self.eyes.kind
 
 
 # --- validation ------------------------------------------------------------------------
@@ -255,19 +303,39 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
     title = c.string(doc, "title", "", default="")
 
     eyes_t = c.table(doc, "eyes")
-    c.keys(eyes_t, "eyes.", ("h", "l", "m"))
+    c.keys(eyes_t, "eyes.", ("h", "l", "m", "nside"))
     h = c.number(eyes_t, "h", "eyes.", default=40.0)
     l = c.number(eyes_t, "l", "eyes.", default=20.0)
-    try:
-        m = check_m(eyes_t.get("m", 720))
-    except EyevizError as exc:
-        raise c.fail("eyes.m", str(exc)) from None
-    try:
-        EyePair(h, l, m)
-    except ValueError as exc:
-        first = str(exc).split(" ")[0]
-        raise c.fail(f"eyes.{first if first in ('h', 'l', 'm') else 'h'}", str(exc)) from None
-    eyes = Eyes(h, l, m)
+    # no m and no nside: the planar default (m = 720), as before spherical scenes
+    kind = "planar"
+    if "m" in eyes_t or "nside" in eyes_t:
+        try:
+            kind = design_kind(eyes_t)
+        except EyevizError as exc:
+            raise c.fail("eyes.nside", str(exc)) from None
+    if kind == "spherical":
+        try:
+            nside = check_nside(eyes_t["nside"])
+        except EyevizError as exc:
+            raise c.fail("eyes.nside", str(exc)) from None
+        try:
+            eyes_from_design({"h": h, "l": l, "nside": nside})
+        except ValueError as exc:
+            first = str(exc).split(" ")[0]
+            raise c.fail(f"eyes.{first if first in ('h', 'l') else 'h'}", str(exc)) from None
+        eyes = Eyes(h, l, nside=nside)
+    else:
+        try:
+            m = check_m(eyes_t.get("m", 720))
+        except EyevizError as exc:
+            raise c.fail("eyes.m", str(exc)) from None
+        try:
+            EyePair(h, l, m)
+        except ValueError as exc:
+            first = str(exc).split(" ")[0]
+            where = first if first in ("h", "l", "m") else "h"
+            raise c.fail(f"eyes.{where}", str(exc)) from None
+        eyes = Eyes(h, l, m)
 
     raw_features = doc.get("features", [])
     if not isinstance(raw_features, list):
@@ -279,7 +347,7 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
         p = f"features[{i}]."
         if not isinstance(ft, dict):
             raise c.fail(f"features[{i}]", "must be a table")
-        c.keys(ft, p, ("name", "x", "y", "g", "color"))
+        c.keys(ft, p, ("name", "x", "y", "z", "g", "color"))
         name = c.string(ft, "name", p, default=f"feature {i + 1}")
         if not name.strip():
             raise c.fail(f"{p}name", "must not be empty")
@@ -288,13 +356,20 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
         names.add(name)
         x = c.number(ft, "x", p, rule="centre x in model units")
         y = c.number(ft, "y", p, rule="centre y in model units")
+        z = c.number(ft, "z", p, default=0.0)
+        if z != 0.0 and kind == "planar":
+            raise c.fail(
+                f"{p}z",
+                f"feature {name!r} has z = {z!r}, but a planar scene's features lie on "
+                "z = 0 (give [eyes] nside for spherical eyes)",
+            )
         g = c.number(ft, "g", p, rule="radius g > 0")
         if g <= 0:
             raise c.fail(f"{p}g", f"feature radius must be > 0, got {g!r}")
         color = c.string(ft, "color", p, default=OKABE_ITO[i % len(OKABE_ITO)])
         if not _COLOR.match(color):
             raise c.fail(f"{p}color", f"must be a colour '#rrggbb', got {color!r}")
-        features.append(Feature(name, x, y, g, color))
+        features.append(Feature(name, x, y, g, color, z + 0.0))  # -0.0 -> 0.0
 
     layers_t = c.table(doc, "layers")
     c.keys(layers_t, "layers.", ("show",))
@@ -305,6 +380,14 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
             raise c.fail("layers.show", f"unknown layer {name!r} (known: {', '.join(known)})")
     if len(set(layers)) != len(layers):
         raise c.fail("layers.show", "a layer is named twice")
+    if kind == "spherical":
+        for name in layers:
+            if name not in SPHERICAL_LAYERS:
+                raise c.fail(
+                    "layers.show",
+                    f"layer {name!r} is planar-only; a spherical scene shows "
+                    f"{', '.join(SPHERICAL_LAYERS)}",
+                )
 
     pred_t = c.table(doc, "predictions")
     c.keys(pred_t, "predictions.", ("estimators",))
@@ -331,6 +414,8 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
     view = View((float(center[0]), float(center[1])), width)
 
     trajectory = None
+    if "trajectory" in doc and kind == "spherical":
+        raise c.fail("trajectory", "a spherical scene has no trajectory (Figure 14 is planar)")
     if "trajectory" in doc:
         tt = c.table(doc, "trajectory")
         c.keys(tt, "trajectory.", ("kind", "distance", "g"))
@@ -394,10 +479,22 @@ def _doc(scene: Scene) -> dict:
     if scene.title:
         doc["title"] = scene.title
     e = scene.eyes
-    doc["eyes"] = {"h": float(e.h), "l": float(e.l), "m": int(e.m)}
+    if e.nside is None:
+        doc["eyes"] = {"h": float(e.h), "l": float(e.l), "m": int(e.m)}
+    else:
+        doc["eyes"] = {"h": float(e.h), "l": float(e.l), "nside": int(e.nside)}
     if scene.features:
         doc["features"] = [
             {"name": f.name, "x": float(f.x), "y": float(f.y), "g": float(f.g), "color": f.color}
+            if e.nside is None  # a planar scene's file never gains a z key
+            else {
+                "name": f.name,
+                "x": float(f.x),
+                "y": float(f.y),
+                "z": float(f.z),
+                "g": float(f.g),
+                "color": f.color,
+            }
             for f in scene.features
         ]
     doc["layers"] = {"show": list(scene.layers)}
