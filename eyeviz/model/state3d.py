@@ -1,0 +1,106 @@
+"""The computed state of a spherical scene: what the 3D figure (and later the 3D view) draws.
+
+``compute_state3d(scene)`` runs :class:`eyeviz.core.geometry3d.EyePair3D` once for all
+balls, vectorised (docs/spherical.md): the lit facets per eye as CSR (``lit_csr``, the 3D
+Proposition 2), the facets lit per eye and visibility (Definition 1: at least two facets,
+taken from the CSR row lengths, not recomputed), membership of the 3D binocular field of
+view (Prop. 4 generalised), overlap with each eye, and the polar coordinates about the
+origin: r, azimuth (longitude from +x counter-clockwise seen from above, in [0, 2 pi), the
+planar phi, docs/conventions.md) and elevation (from the plane z = 0, in [-pi/2, pi/2]).
+
+Only what the scene's layers need is computed; fields it does not need are ``None``: the
+lit sets for eyes, bitmaps or readout; the BFV for bfv or readout; the overlaps for
+readout. A scene whose lit sets would be too large (``lit_csr``'s bound) is refused in one
+line naming the scene's nside.
+
+Pure numpy; no Qt, VTK or matplotlib.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from eyeviz import EyevizError
+from eyeviz.core.geometry3d import EyePair3D
+from eyeviz.model.scene import Scene
+
+__all__ = ["SceneState3D", "compute_state3d"]
+
+_LIT_LAYERS = frozenset({"eyes", "bitmaps", "readout"})
+_BFV_LAYERS = frozenset({"bfv", "readout"})
+
+
+@dataclass
+class SceneState3D:
+    """Per-ball arrays (length n, the scene's feature order) and the lit sets per eye."""
+
+    pair: EyePair3D
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    g: np.ndarray
+    r: np.ndarray
+    azimuth: np.ndarray
+    elevation: np.ndarray
+    #: (indptr, indices) per eye: row i holds ball i's lit RING indices, sorted
+    lit_a: tuple[np.ndarray, np.ndarray] | None = None
+    lit_b: tuple[np.ndarray, np.ndarray] | None = None
+    facets_a: np.ndarray | None = None
+    facets_b: np.ndarray | None = None
+    vis_a: np.ndarray | None = None
+    vis_b: np.ndarray | None = None
+    in_bfv: np.ndarray | None = None
+    overlap_a: np.ndarray | None = None
+    overlap_b: np.ndarray | None = None
+
+    @property
+    def n(self) -> int:
+        return int(self.x.shape[0])
+
+    def lit(self, i: int, eye: str) -> np.ndarray:
+        """Ball ``i``'s lit facets on eye ``"A"`` or ``"B"`` (sorted RING indices)."""
+        csr = {"A": self.lit_a, "B": self.lit_b}.get(eye, ())
+        if csr is None:
+            raise EyevizError("the lit sets were not computed (no eyes, bitmaps or readout)")
+        if not csr:
+            raise EyevizError(f"eye must be 'A' or 'B', got {eye!r}")
+        indptr, idx = csr
+        return idx[indptr[i] : indptr[i + 1]]
+
+
+def compute_state3d(scene: Scene) -> SceneState3D:
+    """The state of a spherical scene (see the module docstring); EyevizError (one line)
+    for a planar scene or lit sets beyond ``lit_csr``'s bound."""
+    if scene.kind != "spherical":
+        raise EyevizError("compute_state3d needs a spherical scene ([eyes] nside)")
+    pair = scene.eyes.model()
+    assert isinstance(pair, EyePair3D)
+    f = scene.features
+    x, y, z, g = (np.array([getattr(ft, k) for ft in f], dtype=np.float64) for k in "xyzg")
+    horiz = np.hypot(x, y)
+    st = SceneState3D(
+        pair,
+        x,
+        y,
+        z,
+        g,
+        r=np.hypot(horiz, z),
+        azimuth=np.mod(np.arctan2(y, x), 2.0 * np.pi),
+        elevation=np.arctan2(z, horiz),
+    )
+    shown = set(scene.layers)
+    if shown & _LIT_LAYERS:
+        try:
+            st.lit_a, st.lit_b = pair.lit_csr(x, y, z, g)
+        except ValueError as exc:
+            raise EyevizError(f"nside = {pair.nside}: {exc}") from None
+        st.facets_a = np.diff(st.lit_a[0])
+        st.facets_b = np.diff(st.lit_b[0])
+        st.vis_a, st.vis_b = st.facets_a >= 2, st.facets_b >= 2
+    if shown & _BFV_LAYERS:
+        st.in_bfv = pair.in_bfv(x, y, z, g)
+    if "readout" in shown:
+        st.overlap_a, st.overlap_b = pair.overlaps_eye(x, y, z, g)
+    return st
