@@ -49,6 +49,7 @@ def test_mutants_are_single_tokens_of_code_that_compile():
         compile(m.apply(SOURCE), "f.py", "exec")
 
 
+@pytest.mark.slow
 def test_a_tiny_run_reports_a_kill_and_restores_the_copy(tmp_path, capsys):
     mut = _load()
     (tmp_path / "tinypkg" / "sub").mkdir(parents=True)

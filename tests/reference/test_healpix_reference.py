@@ -87,6 +87,7 @@ EXTREME = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("ball", EXTREME)
 def test_extreme_scales_agree_with_the_reference(ball):
     _compare(4, *(np.array([v]) for v in ball))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from eyeviz.reference import stability_cases3d
 from eyeviz.reports import stability3d
@@ -15,6 +16,7 @@ def test_every_class_builds_valid_balls():
         assert np.all(np.isfinite([cs.x, cs.y, cs.z, cs.g])) and np.all(cs.g > 0)
 
 
+@pytest.mark.slow
 def test_equator_ties_are_on_the_plane_with_their_rims_on_vertices():
     cs = stability_cases3d.make("equator_ties", 6, seed=2)
     assert np.all(cs.z == 0.0)
@@ -23,6 +25,7 @@ def test_equator_ties_are_on_the_plane_with_their_rims_on_vertices():
     assert row.exact + row.sampled > 0  # ties reach the core's slower stages
 
 
+@pytest.mark.slow
 def test_tiny_and_far_balls_match_the_reference():
     row = stability3d.measure_case3d(stability_cases3d.make("extreme", 3, seed=106))
     assert row.diffs["eyeviz core"] == 0
