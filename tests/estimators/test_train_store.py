@@ -182,3 +182,17 @@ def test_into_assets_and_out_together_refused(tmp_path):
     res = _run(["train", "compact", "-o", str(tmp_path), "--into-assets"], tmp_path)
     assert res.returncode == 2
     assert "not allowed with" in res.stderr
+
+
+def test_staged_moves_the_json_metadata_last(tmp_path, monkeypatch):
+    """A reader that finds the metadata finds the weights it describes: *.json is moved
+    into place after every other file."""
+    moved = []
+    real = os.replace
+    monkeypatch.setattr(store.os, "replace", lambda a, b: moved.append(Path(b).name) or real(a, b))
+    with store.staged(tmp_path / "out") as tmp:
+        for name in ("z_meta.json", "a_weights.pt", "m.npz", "b_meta.json"):
+            (tmp / name).write_text(name)
+    assert moved[-2:] == ["b_meta.json", "z_meta.json"]
+    assert sorted(moved[:-2]) == ["a_weights.pt", "m.npz"]
+    assert (tmp_path / "out" / "m.npz").read_text() == "m.npz"
