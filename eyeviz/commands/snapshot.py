@@ -2,6 +2,8 @@
 
 No window, no Qt, no VTK: the figure is drawn by matplotlib (Agg) from the scene model
 (:mod:`eyeviz.render.mpl.vector`). torch is imported only when the scene shows predictions.
+A spherical scene (``[eyes] nside``) is drawn by :mod:`eyeviz.render.mpl.figure3d`: each
+eye's facets on a Mollweide map, a readout table and a perspective view of the eyes.
 """
 
 from __future__ import annotations
@@ -64,6 +66,23 @@ def run(args: argparse.Namespace) -> int:
     width = resolve_width(args.width)
     aspect = resolve_aspect(args.aspect)
     sc = scene_mod.load(args.scene)
+    if sc.kind == "spherical":  # HEALPix eyes: maps, table and perspective (figure3d)
+        from eyeviz.render.mpl.figure3d import check_drawable3d, export3d
+
+        check_drawable3d(sc)
+        out = export3d(
+            sc,
+            args.output,
+            scale=args.scale,
+            transparent=args.transparent,
+            width=width,
+            title=not args.no_title,
+            table=not args.no_table,
+            bitmaps=not args.no_bitmaps,
+            aspect=None if args.aspect is None else aspect,
+        )
+        print(out)
+        return 0
     check_drawable(sc)  # too many features or undrawable coordinates: refused at once
     out = export(
         sc,

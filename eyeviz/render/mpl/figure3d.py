@@ -1,0 +1,444 @@
+"""A spherical scene (issue 22, docs/spherical.md) as a matplotlib figure: headless, no VTK.
+
+:func:`figure3d` draws, from one :class:`eyeviz.model.state3d.SceneState3D`:
+
+- a perspective view of the two eyes (layer "eyes"): each eye's facets as polygons through
+  a fixed camera in front of, right of and above the eyes, back faces culled (an eye is
+  convex, so its front faces never overlap) and the two eyes painted far to near
+  (painter's algorithm); lit facets in their features' colours and, from each eye towards
+  each ball (layer "features"), the start of its line of sight. The balls themselves are
+  not drawn there: at the paper's distances (25 to 125 eye radii) they are specks beyond
+  or behind the camera, and a near ball hides the eyes; the maps and the table place them;
+- each eye's facets on a Mollweide map seen from inside the eye (layer "bitmaps"; forward
+  at the centre, the eye's right on the right, the equator drawn: that row is the planar
+  bitmap), lit facets in the features' colours. Above
+  :data:`eyeviz.render.mpl.healpix_map.MAX_ALL_FACETS` facets per eye (nside > 32) only the
+  lit facets are drawn as polygons, over a solid background of the unlit sphere (nside 180
+  is 388,800 facets per eye: far too heavy for SVG or PDF); the perspective view then
+  draws the unlit sphere at nside 16 and the lit facets at the scene's nside over it;
+- a readout table (layer "readout"): per ball r, azimuth and elevation (degrees; azimuth
+  from +x counter-clockwise seen from above, forward = 90), g, in the 3D BFV, visible
+  per eye (Definition 1), overlaps per eye and facets lit per eye.
+
+SVG and PDF are true vectors (one path per drawn facet, text as text, nothing rasterised).
+matplotlib is imported when this module is; callers that must stay light import it late.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from matplotlib.collections import PolyCollection
+from matplotlib.figure import Figure
+from matplotlib.projections.geo import MollweideAxes
+
+from eyeviz import EyevizError
+from eyeviz.core import healpix
+from eyeviz.files.atomic import atomic_output
+from eyeviz.model.scene import Scene
+from eyeviz.model.state3d import SceneState3D, compute_state3d
+from eyeviz.render.mpl.healpix_map import MAX_ALL_FACETS, draw_eye_view, view_lonlat
+from eyeviz.render.mpl.style import (
+    BASE_DPI,
+    EDGE,
+    FONT,
+    GREY,
+    INK,
+    RC,
+    SMALL,
+    UNLIT,
+    VECTOR_DPI,
+    short,
+)
+
+__all__ = ["MAX_BALLS", "check_drawable3d", "export3d", "figure3d", "project"]
+
+#: A 3D figure shows at most this many balls (the table holds a row per ball).
+MAX_BALLS = 40
+#: |x|, |y|, |z| and g a 3D figure can draw (as the planar figure's MAX_COORD).
+MAX_COORD3D = 1e15
+#: The nside of the perspective view's unlit spheres when the scene's is larger.
+COARSE_NSIDE = 16
+#: The camera: looking at the origin from this direction, at CAMERA_DIST * h.
+CAMERA_DIR = (0.45, 1.0, 0.55)
+CAMERA_DIST = 9.0
+#: A ball's line of sight is drawn this many eye radii out from the eye's surface.
+SIGHT = 1.6
+ROW_IN = 0.14  # a table row, inches
+
+
+class _MapAxes(MollweideAxes):
+    """Mollweide axes that do not resample paths: matplotlib's split every segment into 75
+    (a facet of 8 vertices became 600, an SVG of the teaching scene 23 MB); the facets'
+    outlines are already sampled along their edges, and curved lines are drawn sampled."""
+
+    name = "eyeviz_mollweide"
+    RESOLUTION = 1
+
+
+def check_drawable3d(scene: Scene) -> None:
+    """EyevizError (one line) for a spherical scene the figure cannot show."""
+    n = len(scene.features)
+    if n > MAX_BALLS:
+        raise EyevizError(f"a 3D figure shows at most {MAX_BALLS} balls; this scene has {n}")
+    for f in scene.features:
+        for k, v in (("x", f.x), ("y", f.y), ("z", f.z), ("g", f.g)):
+            if not (math.isfinite(v) and abs(v) <= MAX_COORD3D):
+                raise EyevizError(
+                    f"feature {short(f.name)!r}: {k} = {v:g} cannot be drawn "
+                    f"(|{k}| must be <= {MAX_COORD3D:g})"
+                )
+
+
+# --- the camera ------------------------------------------------------------------------
+
+
+class _Camera:
+    """A pinhole camera at ``pos`` looking at ``target``, z up; image plane at distance 1."""
+
+    def __init__(self, pos, target):
+        self.pos = np.asarray(pos, np.float64)
+        f = np.asarray(target, np.float64) - self.pos
+        self.fwd = f / np.linalg.norm(f)
+        r = np.cross(self.fwd, (0.0, 0.0, 1.0))
+        self.right = r / np.linalg.norm(r)
+        self.up = np.cross(self.right, self.fwd)
+
+    def depth(self, p) -> np.ndarray:
+        return (np.asarray(p) - self.pos) @ self.fwd
+
+    def project(self, p) -> np.ndarray:
+        """(..., 2) image coordinates of points (..., 3) in front of the camera."""
+        d = np.asarray(p, np.float64) - self.pos
+        z = d @ self.fwd
+        return np.stack([d @ self.right / z, d @ self.up / z], axis=-1)
+
+
+def project(points, pos, target) -> np.ndarray:
+    """Image coordinates (..., 2) of ``points`` (..., 3) seen from ``pos`` towards
+    ``target`` (z up, focal length 1): the camera of the 3D panel."""
+    return _Camera(pos, target).project(points)
+
+
+def _camera(h: float) -> _Camera:
+    d = np.asarray(CAMERA_DIR, np.float64)
+    return _Camera(d / np.linalg.norm(d) * CAMERA_DIST * h, (0.0, 0.0, 0.0))
+
+
+def _front_polys(cam: _Camera, centre, radius: float, nside: int, pix, step: int):
+    """Projected outlines of the facets ``pix`` of a sphere that face the camera, and
+    which of ``pix`` they are."""
+    pix = np.asarray(pix, np.int64)
+    nrm = healpix.centers(nside, pix)
+    c = np.asarray(centre, np.float64)
+    facing = ((cam.pos - (c + radius * nrm)) * nrm).sum(axis=-1) > 0
+    pts = c + radius * healpix.boundaries(nside, pix[facing], step)
+    return cam.project(pts), pix[facing]
+
+
+def _sight(ax, cam: _Camera, a, c, l: float, g: float, length: float | None, color: str):
+    """The line of sight from the eye at ``a`` (radius l) towards the ball at ``c``: from
+    the eye's surface, ``length`` long (None: up to the ball's surface); only where its
+    start faces the camera."""
+    u = np.asarray(c, np.float64) - a
+    dist = float(np.linalg.norm(u))
+    if dist <= l + g:
+        return
+    u /= dist
+    p0 = a + l * u
+    if float((cam.pos - p0) @ u) <= 0:  # the start is on the eye's far side
+        return
+    t1 = dist - g if length is None else l + length
+    seg = cam.project(np.stack([p0, a + t1 * u]))
+    ax.plot(seg[:, 0], seg[:, 1], color=color, lw=0.7, solid_capstyle="butt")
+
+
+def _draw_perspective(ax, st: SceneState3D, scene: Scene, show_balls: bool, ratio: float) -> None:
+    pair = st.pair
+    cam = _camera(pair.h)
+    n = pair.nside
+    colors = [f.color for f in scene.features]
+    centres = [np.asarray(c, np.float64) for c in pair.centers]
+    balls = [np.array([f.x, f.y, f.z]) for f in scene.features]
+    items = []  # (depth, draw): painted far to near
+    for e, centre in enumerate(centres):
+        csr = (st.lit_a, st.lit_b)[e]
+
+        def draw_eye(centre=centre, csr=csr, e=e):
+            coarse = n if pair.npix <= MAX_ALL_FACETS else COARSE_NSIDE
+            owner: dict[int, str] = {}
+            if csr is not None:
+                ip, ix = csr
+                for i, col in enumerate(colors):
+                    owner.update(dict.fromkeys(ix[ip[i] : ip[i + 1]].tolist(), col))
+            allpix = np.arange(healpix.npix(coarse))
+            polys, vis = _front_polys(cam, centre, pair.l, coarse, allpix, 3)
+            if coarse == n:
+                fc = [owner.get(int(p), UNLIT) for p in vis]
+                ax.add_collection(
+                    PolyCollection(list(polys), facecolors=fc, edgecolors=EDGE, linewidths=0.25),
+                    autolim=False,
+                )
+            else:
+                ax.add_collection(
+                    PolyCollection(
+                        list(polys), facecolors=UNLIT, edgecolors="#d4d4d4", linewidths=0.2
+                    ),
+                    autolim=False,
+                )
+                if owner:
+                    pix = np.fromiter(owner, np.int64, len(owner))
+                    polys, vis = _front_polys(cam, centre, pair.l, n, pix, 1)
+                    fc = [owner[int(p)] for p in vis]
+                    ax.add_collection(
+                        PolyCollection(list(polys), facecolors=fc, edgecolors="none"),
+                        autolim=False,
+                    )
+            if show_balls:
+                for c, f in zip(balls, scene.features, strict=True):
+                    _sight(ax, cam, centre, c, pair.l, f.g, SIGHT * pair.l, f.color)
+            x0, y0 = cam.project(centre + np.array([0.0, 0.0, -1.3 * pair.l]))
+            ax.text(x0, y0, f"eye {'AB'[e]}", ha="center", va="top", fontsize=SMALL, color=INK)
+
+        items.append((float(cam.depth(centre)), draw_eye))
+    for _, draw in sorted(items, key=lambda t: -t[0]):  # far first
+        draw()
+    # frame: the eyes and the balls drawn (within 4 times the eyes' extent)
+    reach = pair.l * (1.0 + SIGHT)  # the eyes and their lines of sight
+    xy = cam.project(np.concatenate([c + reach * healpix.centers(4) for c in centres]))
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    span = (hi - lo).max()
+    pad = 0.04 * span
+    lo, hi = lo - pad, hi + pad
+    # equal scales: widen the short side to the panel's height / width
+    w, h = hi - lo
+    if h / w < ratio:
+        lo[1], hi[1] = (lo[1] + hi[1]) / 2 - w * ratio / 2, (lo[1] + hi[1]) / 2 + w * ratio / 2
+    else:
+        lo[0], hi[0] = (lo[0] + hi[0]) / 2 - h / ratio / 2, (lo[0] + hi[0]) / 2 + h / ratio / 2
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_axis_off()
+    ax.text(
+        0.0, 1.0, "seen from front right, above", transform=ax.transAxes, fontsize=SMALL,
+        color=GREY, ha="left", va="top",
+    )  # fmt: skip
+
+
+# --- the readout ---------------------------------------------------------------------
+
+
+def _yes(v) -> str:
+    return "yes" if bool(v) else "no"
+
+
+def _pair(a, b) -> str:
+    return ("A" if a else "") + ("B" if b else "") or "no"
+
+
+def readout_rows(st: SceneState3D, scene: Scene) -> list[tuple[str, ...]]:
+    """The table's rows (strings), one per ball: name, r, azimuth and elevation (degrees),
+    g, in the BFV, visible per eye, overlaps per eye, facets lit per eye."""
+    rows: list[tuple[str, ...]] = []
+    for i, f in enumerate(scene.features):
+        rows.append(
+            (
+                short(f.name, 14),
+                f"{st.r[i]:.0f}",
+                f"{math.degrees(st.azimuth[i]):.1f}",
+                f"{math.degrees(st.elevation[i]):.1f}",
+                f"{f.g:g}",
+                _yes(st.in_bfv[i]) if st.in_bfv is not None else "",
+                _pair(st.vis_a[i], st.vis_b[i])
+                if st.vis_a is not None and st.vis_b is not None
+                else "",
+                _pair(st.overlap_a[i], st.overlap_b[i])
+                if st.overlap_a is not None and st.overlap_b is not None
+                else "",
+                f"{st.facets_a[i]}/{st.facets_b[i]}"
+                if st.facets_a is not None and st.facets_b is not None
+                else "",
+            )
+        )
+    return rows
+
+
+def _draw_table(ax, st: SceneState3D, scene: Scene) -> None:
+    ax.set_axis_off()
+    ax.set_xlim(0, 1)
+    n = len(scene.features)
+    ax.set_ylim(-(n + 0.5), 1.0)
+    # column left edges as fractions of the width: the name column widest
+    edges = [0.0, 0.2, 0.28, 0.37, 0.46, 0.53, 0.63, 0.74, 0.86]
+    heads = ("ball", "r", "az\u00b0", "el\u00b0", "g", "BFV", "visible", "overlap", "facets A/B")
+    for x, t in zip(edges, heads, strict=True):
+        ax.text(x, 0.0, t, fontsize=SMALL, color=GREY, ha="left", va="center")
+    ax.plot([0, 1], [-0.5, -0.5], color=GREY, lw=0.4)
+    for i, row in enumerate(readout_rows(st, scene)):
+        y = -(i + 1)
+        ax.plot([0.008], [y], marker="s", ms=3.5, mew=0, color=scene.features[i].color)
+        for j, (x, t) in enumerate(zip(edges, row, strict=True)):
+            ax.text(x + (0.02 if j == 0 else 0.0), y, t, fontsize=SMALL, color=INK, va="center")
+
+
+# --- the figure --------------------------------------------------------------------------
+
+
+def figure3d(
+    scene: Scene,
+    state: SceneState3D | None = None,
+    *,
+    width: float = 3.5,
+    title: bool = True,
+    table: bool = True,
+    bitmaps: bool = True,
+    aspect: float | None = None,
+) -> Figure:
+    """The spherical scene as a Figure ``width`` inches wide (see the module docstring).
+    ``title``, ``table`` and ``bitmaps`` (False) leave those parts out; ``aspect`` is the
+    perspective panel's height / width (default 0.6; 0.38 from 6 inches wide, where the
+    two maps stand side by side)."""
+    import matplotlib
+
+    if scene.kind != "spherical":
+        raise EyevizError("figure3d draws a spherical scene ([eyes] nside)")
+    check_drawable3d(scene)
+    st = compute_state3d(scene) if state is None else state
+    shown = set(scene.layers)
+    persp = "eyes" in shown
+    maps = bitmaps and "bitmaps" in shown and st.lit_a is not None
+    tab = table and "readout" in shown and bool(scene.features)
+    side = width >= 6.0  # the two maps side by side
+    if aspect is None:
+        aspect = 0.38 if side else 0.6
+    m = 0.08  # margin, inches
+    map_w = (width - 3 * m) / 2 if side else width - 2 * m
+    map_h = map_w / 2 + 0.3  # Mollweide is 2:1, a caption above and directions below
+    parts: list[tuple[str, float]] = []
+    if title and scene.title:
+        parts.append(("title", 0.26))
+    if persp:
+        parts.append(("persp", (width - 2 * m) * aspect))
+    if maps:
+        parts += [("maps", map_h)] if side else [("mapA", map_h), ("mapB", map_h)]
+    if tab:
+        parts.append(("table", ROW_IN * (len(scene.features) + 1.3)))
+    if not parts:
+        parts.append(("empty", 0.3))
+    height = sum(h for _, h in parts) + 2 * m
+    with matplotlib.rc_context(RC):
+        fig = Figure(figsize=(width, height))
+        top = height - m
+
+        def rect(x0: float, w: float, h: float, down: float = 0.0):
+            """(left, bottom, width, height) in figure fractions of a box ``w`` x ``h``
+            inches at ``x0``, ``down`` inches below the current top."""
+            return (x0 / width, (top - down - h) / height, w / width, h / height)
+
+        for name, h in parts:
+            if name == "title":
+                fig.text(
+                    0.5, (top - h / 2) / height, short(scene.title, 90), ha="center",
+                    va="center", fontsize=FONT + 1, color=INK, gid="title",
+                )  # fmt: skip
+            elif name == "persp":
+                ax = fig.add_axes(rect(m, width - 2 * m, h))
+                ax.set_gid("perspective")
+                _draw_perspective(ax, st, scene, "features" in shown, aspect)
+            elif name in ("maps", "mapA", "mapB"):
+                eyes = "AB" if name == "maps" else name[-1]
+                for k, eye in enumerate(eyes):
+                    x0 = m + k * (map_w + m)
+                    ax = fig.add_axes(rect(x0, map_w, map_w / 2, 0.18), axes_class=_MapAxes)
+                    ax.set_gid(f"map{eye}")
+                    _draw_map(ax, st, scene, eye)
+            elif name == "table":
+                ax = fig.add_axes(rect(m, width - 2 * m, h))
+                ax.set_gid("readout")
+                _draw_table(ax, st, scene)
+            elif name == "empty":
+                fig.text(0.5, 0.5, "(no layer to draw)", ha="center", fontsize=FONT, color=GREY)
+            top -= h
+        fig._eyeviz_rc = dict(RC)  # type: ignore[attr-defined]
+    return fig
+
+
+def _draw_map(ax, st: SceneState3D, scene: Scene, eye: str) -> None:
+    pair = st.pair
+    lits = [st.lit(i, eye) for i in range(st.n)]
+    draw_eye_view(ax, pair.nside, lits, [f.color for f in scene.features])
+    count = np.unique(np.concatenate(lits)).size if lits else 0
+    side = "left" if eye == "A" else "right"
+    ax.set_title(
+        f"eye {eye} ({side}), nside {pair.nside}: {count:,} of {pair.npix:,} facets lit",
+        fontsize=SMALL, color=INK, pad=3,
+    )  # fmt: skip
+    for deg in (-60, -30, 30, 60):  # a faint graticule: elevation seen from the eye
+        la = math.radians(deg)
+        ax.plot([-math.pi, math.pi], [la, la], color="#cccccc", lw=0.3)
+    mer = np.linspace(-math.pi / 2, math.pi / 2, 61)
+    for deg in (-90, 90):
+        ax.plot(np.full_like(mer, math.radians(deg)), mer, color="#cccccc", lw=0.3)
+    for x, t in ((0.25, "left"), (0.5, "forward"), (0.75, "right")):
+        ax.text(x, -0.01, t, transform=ax.transAxes, fontsize=SMALL, color=GREY, ha="center",
+                va="top")  # fmt: skip
+    if "labels" in scene.layers:
+        cx = pair.centers[0 if eye == "A" else 1][0]
+        for f in scene.features:
+            lon = math.atan2(f.y, f.x - cx)
+            lat = math.atan2(f.z, math.hypot(f.x - cx, f.y))
+            mx, my = view_lonlat(lon, lat)
+            west = float(mx) > 1.5  # near the map's right edge: the label goes left
+            ax.annotate(
+                short(f.name, 16), (float(mx), float(my)), xytext=(-4 if west else 4, 3),
+                textcoords="offset points", fontsize=SMALL, color=INK,
+                ha="right" if west else "left",
+            )  # fmt: skip
+
+
+# --- export ------------------------------------------------------------------------------
+
+
+def export3d(
+    scene: Scene,
+    path,
+    scale: float = 1.0,
+    transparent: bool = False,
+    *,
+    width: float = 3.5,
+    title: bool = True,
+    table: bool = True,
+    bitmaps: bool = True,
+    aspect: float | None = None,
+) -> Path:
+    """Write the spherical scene's figure to ``path`` (.png, .svg or .pdf) atomically, as
+    :func:`eyeviz.render.mpl.export.export` writes a planar one."""
+    import matplotlib
+
+    from eyeviz.render.mpl.export import MAX_PNG_PX, _check_scale, _metadata, format_of
+
+    fmt = format_of(path)
+    scale = _check_scale(scale)
+    if fmt == "png" and width * BASE_DPI * scale > MAX_PNG_PX:
+        raise EyevizError(
+            f"scale {scale:g} at width {width:g} in makes a PNG "
+            f"{width * BASE_DPI * scale:,.0f} px wide; at most {MAX_PNG_PX} px: "
+            f"scale <= {MAX_PNG_PX / (width * BASE_DPI):.3g} at this width"
+        )
+    target = Path(path)
+    parent = target.parent if str(target.parent) else Path(".")
+    if not parent.is_dir():
+        raise EyevizError(f"{target}: directory {parent} does not exist")
+    fig = figure3d(scene, width=width, title=title, table=table, bitmaps=bitmaps, aspect=aspect)
+    dpi = BASE_DPI * scale if fmt == "png" else VECTOR_DPI
+    with atomic_output(target) as tmp, matplotlib.rc_context(RC):
+        fig.savefig(
+            tmp,
+            format=fmt,
+            dpi=dpi if fmt == "png" else 72,
+            transparent=transparent,
+            metadata=_metadata(fmt, scene),
+        )
+    return target

@@ -1,0 +1,196 @@
+"""`eyeviz snapshot` of a spherical scene: PNG, true-vector SVG/PDF, one-line refusals;
+the planar path unchanged; `eyeviz app` refuses a spherical scene in one line."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import matplotlib.image as mpimg
+import numpy as np
+import pytest
+from matplotlib.collections import PolyCollection
+
+from eyeviz.cli import main
+from eyeviz.core import healpix
+from eyeviz.model.scene import load
+from eyeviz.model.state3d import compute_state3d
+from eyeviz.render.mpl.figure3d import MAX_BALLS, figure3d, readout_rows
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENES = ROOT / "assets" / "scenes"
+SVG = "{http://www.w3.org/2000/svg}"
+
+CASES = [
+    pytest.param(name, fmt, marks=[pytest.mark.slow] if slow else [])
+    for name in ("sphere_teaching", "sphere_paper", "sphere_equator")
+    for fmt in ("png", "svg", "pdf")
+    # nside 180 in SVG/PDF takes 2-3 s each: slow; its PNG stays in the quick run
+    for slow in [name != "sphere_teaching" and fmt != "png"]
+]
+
+
+def _one_line_error(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("eyeviz: error:"), err
+    return err[0]
+
+
+@pytest.mark.parametrize(("name", "fmt"), CASES)
+def test_snapshot3d_written_and_opened(name, fmt, tmp_path, capsys):
+    out = tmp_path / f"s.{fmt}"
+    args = ["snapshot", str(SCENES / f"{name}.toml"), "-o", str(out)]
+    assert main(args + (["--scale", "0.5"] if fmt == "png" else [])) == 0
+    assert capsys.readouterr().out.strip() == str(out)
+    if fmt == "png":
+        img = mpimg.imread(out)
+        assert img.shape[1] == 525 and img.shape[0] > img.shape[1]  # 3.5 in at 150 dpi
+        # not blank: the lit facets' colours are in it (the first ball's, #D55E00)
+        rgb = (img[..., :3] * 255).round().astype(int).reshape(-1, 3)
+        assert (np.abs(rgb - [0xD5, 0x5E, 0x00]).sum(axis=1) < 30).sum() > 20
+    elif fmt == "svg":
+        root = ET.parse(out).getroot()
+        assert root.tag == f"{SVG}svg"
+        assert len(root.findall(f".//{SVG}path")) > 100
+        assert not root.findall(f".//{SVG}image")  # true vector: nothing rasterised
+        texts = "".join("".join(t.itertext()) for t in root.iter(f"{SVG}text"))
+        assert "facets lit" in texts and "BFV" in texts  # text kept as text
+    else:
+        data = out.read_bytes()
+        assert data.startswith(b"%PDF") and b"/Subtype /Image" not in data
+
+
+def test_bad_spherical_scene_refused_in_one_line(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[eyes]\nnside = 8\n\n[layers]\nshow = ["eyes", "tangents"]\n')
+    out = tmp_path / "x.png"
+    assert main(["snapshot", str(bad), "-o", str(out)]) == 2
+    line = _one_line_error(capsys)
+    assert "layers.show" in line and "'tangents'" in line and "planar-only" in line
+    bad.write_text("[eyes]\nnside = 8\nm = 32\n")
+    assert main(["snapshot", str(bad), "-o", str(out)]) == 2
+    assert "eyes.nside" in _one_line_error(capsys)
+    many = "[eyes]\nnside = 4\n" + "".join(
+        f'[[features]]\nname = "b{i}"\nx = 0.0\ny = {100 + i}.0\nz = 1.0\ng = 1.0\n'
+        for i in range(MAX_BALLS + 1)
+    )
+    bad.write_text(many)
+    assert main(["snapshot", str(bad), "-o", str(out)]) == 2
+    assert f"at most {MAX_BALLS} balls" in _one_line_error(capsys)
+    assert (
+        main(["snapshot", str(SCENES / "sphere_teaching.toml"), "-o", str(out), "--scale", "30"])
+        == 2
+    )
+    assert "scale" in _one_line_error(capsys)
+    assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]  # no file written
+
+
+def test_bad_spherical_scene_exit_2_in_a_process(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(
+        '[eyes]\nm = 720\n\n[[features]]\nname = "up"\nx = 0.0\ny = 9.0\nz = 3.0\ng = 1.0\n'
+    )
+    out = subprocess.run(
+        [sys.executable, "-m", "eyeviz", "snapshot", str(bad), "-o", str(tmp_path / "x.svg")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=ROOT,
+    )
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and "features[0].z" in lines[0] and "'up'" in lines[0], lines
+    assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
+
+
+def test_snapshot3d_imports_no_vtk_qt_or_torch(tmp_path):
+    probe = (
+        "import json, sys\nfrom eyeviz.cli import main\nrc = main(sys.argv[1:])\n"
+        "heavy = sorted(m for m in ('torch', 'PyQt5', 'vtk', 'pyvista', 'matplotlib.pyplot')"
+        " if m in sys.modules)\nprint(json.dumps({'rc': rc, 'heavy': heavy}))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", probe, "snapshot", str(SCENES / "sphere_teaching.toml"),
+         "-o", str(tmp_path / "t.png"), "--scale", "0.25"],
+        capture_output=True, text=True, timeout=120, cwd=ROOT,
+    )  # fmt: skip
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == {"rc": 0, "heavy": []}, out.stderr
+
+
+def _maps(fig):
+    return {a.get_gid(): a for a in fig.axes}
+
+
+def test_maps_draw_the_lit_facets_in_their_colours():
+    """nside 8: every facet drawn, the lit ones in their ball's colour; nside 180: only the
+    lit facets (the unlit sphere is the map's background)."""
+    sc = load(SCENES / "sphere_teaching.toml")
+    st = compute_state3d(sc)
+    axes = _maps(figure3d(sc))
+    for eye in "AB":
+        (coll,) = [c for c in axes[f"map{eye}"].collections if isinstance(c, PolyCollection)]
+        n = healpix.npix(8)
+        fc = coll.get_facecolors()
+        assert len(fc) >= n  # plus the facets across the map's edge, drawn twice
+        owner = {}
+        for i, f in enumerate(sc.features):
+            owner.update(dict.fromkeys(st.lit(i, eye).tolist(), f.color))
+        lit_rgba = {tuple(np.round(c, 4)) for c in fc[list(owner)]} if owner else set()
+        from matplotlib.colors import to_rgba
+
+        assert lit_rgba == {tuple(np.round(to_rgba(c), 4)) for c in owner.values()}
+    sc = load(SCENES / "sphere_paper.toml")
+    st = compute_state3d(sc)
+    axes = _maps(figure3d(sc, table=False))
+    for eye in "AB":
+        (coll,) = [c for c in axes[f"map{eye}"].collections if isinstance(c, PolyCollection)]
+        lit = np.unique(np.concatenate([st.lit(i, eye) for i in range(st.n)]))
+        assert len(coll.get_paths()) == lit.size  # no facet of these balls crosses the edge
+        assert lit.size < 2000 < healpix.npix(180)
+    assert "readout" not in axes
+
+
+def test_readout_rows_and_table():
+    sc = load(SCENES / "sphere_equator.toml")
+    st = compute_state3d(sc)
+    rows = readout_rows(st, sc)
+    assert [r[0] for r in rows] == [f.name for f in sc.features]
+    mid = rows[0]
+    assert mid[1:5] == ("1500", "90.0", "0.0", "50")
+    assert mid[5:8] == ("yes", "AB", "no")
+    assert mid[8] == f"{st.facets_a[0]}/{st.facets_b[0]}" == "126/126"
+    up = rows[1]
+    assert float(up[3]) == pytest.approx(np.degrees(np.arctan2(600, 1500)), abs=0.05)
+    fig = figure3d(sc)
+    texts = {t.get_text() for t in _maps(fig)["readout"].texts}
+    assert {"126/126", "mid up", "1616", "-21.8"} <= texts
+
+
+def test_perspective_culls_back_faces():
+    sc = load(SCENES / "sphere_teaching.toml")
+    ax = _maps(figure3d(sc))["perspective"]
+    polys = [c for c in ax.collections if isinstance(c, PolyCollection)]
+    assert len(polys) == 2  # one per eye, nside 8: every facet facing the camera
+    for c in polys:
+        assert 0.35 * healpix.npix(8) < len(c.get_paths()) < 0.6 * healpix.npix(8)
+
+
+def test_planar_snapshot_still_the_planar_figure(tmp_path, capsys):
+    """The dispatch leaves a planar scene to the planar export: the same pixels."""
+    from eyeviz.render.mpl.export import export
+
+    a, b = tmp_path / "cli.png", tmp_path / "api.png"
+    assert main(["snapshot", str(SCENES / "default.toml"), "-o", str(a), "--scale", "0.25"]) == 0
+    export(load(SCENES / "default.toml"), b, scale=0.25)
+    assert np.array_equal(mpimg.imread(a), mpimg.imread(b))
+
+
+def test_app_refuses_a_spherical_scene_in_one_line(capsys, monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    assert main(["app", str(SCENES / "sphere_paper.toml")]) == 2
+    line = _one_line_error(capsys)
+    assert "the app's 3D view is not built yet; use eyeviz snapshot" in line
+    assert "sphere_paper.toml" in line  # before the display check: no window was tried
