@@ -179,6 +179,13 @@ class FilesMixin(_MainWindow):
         except SceneError as exc:
             self.show_error("Cannot open scene", str(exc))
             return False
+        if scene.kind == "spherical":  # issue 22: the app draws planar eyes only, so far
+            self.show_error(
+                "Cannot open scene",
+                f"{path}: spherical eyes ([eyes] nside): the app's 3D view is not built "
+                "yet; use eyeviz snapshot",
+            )
+            return False
         self.model.finish_gestures()
         self._set_path(path)
         self.undo_stack.clear()
