@@ -390,7 +390,9 @@ def _draw_map(ax, st: SceneState3D, scene: Scene, eye: str) -> None:
             lon = math.atan2(f.y, f.x - cx)
             lat = math.atan2(f.z, math.hypot(f.x - cx, f.y))
             mx, my = view_lonlat(lon, lat)
-            west = float(mx) > 1.5  # near the map's right edge: the label goes left
+            # a label on the side away from the map's centre (balls ahead of the eyes
+            # crowd there), and inwards near the map's edge
+            west = float(mx) > 1.5 or -1.5 <= float(mx) <= 0.0
             ax.annotate(
                 short(f.name, 16), (float(mx), float(my)), xytext=(-4 if west else 4, 3),
                 textcoords="offset points", fontsize=SMALL, color=INK,

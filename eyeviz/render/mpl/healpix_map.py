@@ -136,7 +136,16 @@ def draw_eye_view(
         for idx, color in zip(lit, colors, strict=True):
             face[np.asarray(idx, np.int64)] = color
     else:
-        ax.patch.set_facecolor(UNLIT)  # the unlit sphere: the map's outline filled
+        # the unlit sphere: the map's outline filled, as an artist of its own (a figure
+        # saved transparent empties the axes' background patch), edges sampled
+        lat = np.linspace(-math.pi / 2, math.pi / 2, 91)
+        outline = np.concatenate(
+            [np.stack([np.full_like(lat, math.pi), lat], -1),
+             np.stack([np.full_like(lat, -math.pi), lat[::-1]], -1)]
+        )  # fmt: skip
+        ax.add_collection(
+            PolyCollection([outline], facecolors=UNLIT, edgecolors="none"), autolim=False
+        )
         owner: dict[int, str] = {}
         for idx, color in zip(lit, colors, strict=True):
             owner.update(dict.fromkeys(np.asarray(idx, np.int64).tolist(), color))
