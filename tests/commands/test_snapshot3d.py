@@ -146,7 +146,8 @@ def test_maps_draw_the_lit_facets_in_their_colours():
     st = compute_state3d(sc)
     axes = _maps(figure3d(sc, table=False))
     for eye in "AB":
-        (coll,) = [c for c in axes[f"map{eye}"].collections if isinstance(c, PolyCollection)]
+        back, coll = [c for c in axes[f"map{eye}"].collections if isinstance(c, PolyCollection)]
+        assert len(back.get_paths()) == 1  # the unlit sphere, one solid outline
         lit = np.unique(np.concatenate([st.lit(i, eye) for i in range(st.n)]))
         assert len(coll.get_paths()) == lit.size  # no facet of these balls crosses the edge
         assert lit.size < 2000 < healpix.npix(180)
