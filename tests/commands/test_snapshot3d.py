@@ -195,3 +195,19 @@ def test_app_refuses_a_spherical_scene_in_one_line(capsys, monkeypatch):
     line = _one_line_error(capsys)
     assert "the app's 3D view is not built yet; use eyeviz snapshot" in line
     assert "sphere_paper.toml" in line  # before the display check: no window was tried
+
+
+def test_transparent_export_keeps_the_unlit_sphere(tmp_path, capsys):
+    """At nside 180 the unlit sphere is an artist, not the axes' background (which a
+    transparent export empties): the map's centre stays opaque grey, its corner clear."""
+    out = tmp_path / "t.png"
+    args = ["snapshot", str(SCENES / "sphere_paper.toml"), "-o", str(out), "--scale", "0.25"]
+    assert main(args + ["--transparent", "--no-table"]) == 0
+    img = mpimg.imread(out)
+    fig = figure3d(load(SCENES / "sphere_paper.toml"), table=False)
+    box = _maps(fig)["mapA"].get_position()  # figure fractions, origin at the bottom
+    h, w = img.shape[:2]
+    x = int((box.x0 + 0.1 * box.width) * w)  # left of centre, off the equator and graticule
+    y = int((1 - (box.y0 + 0.55 * box.height)) * h)
+    assert img[y, x, 3] == 1.0 and np.allclose(img[y, x, :3], 0xEE / 255, atol=0.02)
+    assert img[int((1 - box.y1) * h) + 1, int(box.x0 * w) + 1, 3] == 0.0  # outside the map
