@@ -251,6 +251,8 @@ def main(argv: list[str] | None = None) -> int:
     if a.per_module < 1:
         ap.error(f"--per-module must be an integer >= 1, got {a.per_module}")
     root = a.root.resolve()
+    # a SIGTERM ends the run through the finally below, which restores the mutated file
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit("mutation run stopped (SIGTERM)"))
     tests = a.tests or ["tests/" + Path(p).name for p in a.packages]
     if len(tests) != len(a.packages):
         ap.error("--tests needs one directory per package")
@@ -294,6 +296,8 @@ def main(argv: list[str] | None = None) -> int:
                     _drop_pyc(mod)
                     results.append({**asdict(m), "status": st, "seconds": round(dt, 1)})
                     print(f"  {st:9s} {dt:6.1f} s  {m.label()}", flush=True)
+                    if a.json:  # kept up to date: a stopped run keeps what it ran
+                        a.json.write_text(json.dumps({"totals": totals, "results": results}))
             finally:
                 mod.write_bytes(original)
                 _drop_pyc(mod)
