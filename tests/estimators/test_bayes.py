@@ -72,3 +72,17 @@ def test_shipped_table_is_the_limit():
     assert est.target == "mape"
     mae_est = estimators.load("bayes", target="mae")
     assert metrics.mae(ds.r, mae_est.predict(ds.omega_a, ds.omega_b).r) < metrics.mae(ds.r, p.r)
+
+
+def test_a_table_of_one_key_saves_loads_and_answers(tmp_path):
+    table = bayes.build_table(20_000, seed=5)
+    n = table["meta"]["keys"]
+    one = {
+        k: v[:1] if isinstance(v, np.ndarray) and v.shape == (n,) else v for k, v in table.items()
+    }
+    one["meta"] = {**table["meta"], "keys": 1}
+    bayes.save_table(one, tmp_path / "one.npz")
+    est = estimators.load("bayes", path=tmp_path / "one.npz")
+    p = est.predict_intervals(*bayes._decode(one["key"], est.domain.width))
+    np.testing.assert_allclose(p.r, one["r_mape"], rtol=1e-3)  # float16 storage
+    np.testing.assert_allclose(p.phi, one["phi_mape"], rtol=0, atol=1e-5)
