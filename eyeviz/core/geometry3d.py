@@ -42,7 +42,14 @@ _SQ6 = math.sqrt(6.0)
 #: Largest number of lit indices one call may return (2^28 int64: 2 GiB). A whole eye at
 #: nside 2^20 is 1.3e13 facets: such a lit set exists only as runs, not as indices.
 MAX_LIT = 1 << 28
-_BLOCK = 512  # balls per block of the fast path
+_BLOCK = 512  # balls per block of the fast path at nside 64 (more at smaller nside)
+
+
+def _block(n: int) -> int:
+    """Balls per block: about _BLOCK * 64 / nside (the (ball, ring) pairs and boundary
+    cells per ball grow like nside), within [256, 2048] (measured best at 16, 64, 180)."""
+    return int(min(2048, max(256, _BLOCK * 64 // n)))
+
 
 #: Diagnostics: cells the vertex/edge test could not clear ("tested"), cells that needed
 #: edge sampling ("sampled") and cells decided in mpmath ("exact").
@@ -99,6 +106,35 @@ def _edge_bounds(n: int, face, fixed_is_y: bool, fixed, lo) -> np.ndarray:
     return out
 
 
+_TABLES: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+
+
+def _ring_tables(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(sin theta, z, pi / (4 K)) of rings 0 .. 4 n (K: cells per quarter; 0 at poles)."""
+    tab = _TABLES.get(n)
+    if tab is None:
+        k = np.arange(4 * n + 1)
+        sth, zr = healpix.ring_sz(n, k)
+        q = np.minimum(np.minimum(k, n), 4 * n - k)
+        unit = np.where(q > 0, 0.25 * math.pi / np.maximum(q, 1), 0.0)
+        if len(_TABLES) > 64:
+            _TABLES.clear()
+        tab = _TABLES[n] = (sth, zr, unit)
+    return tab
+
+
+def _edge_lower(fa, fb, mf):
+    """A lower bound of f on [0, 1] from f(0) = fa, f(1) = fb and |f''| <= mf.
+
+    f(t) >= (1 - t) fa + t fb - mf t (1 - t) / 2 (the interpolation error of the chord),
+    whose minimum over [0, 1] is (fa + fb) / 2 - mf / 8 - (fb - fa)^2 / (2 mf) when
+    |fb - fa| <= mf / 2, else min(fa, fb). Never below min(fa, fb) - mf / 8.
+    """
+    dd = fb - fa
+    inner = 0.5 * (fa + fb) - 0.125 * mf - dd * dd / (2 * mf)
+    return np.where(np.abs(dd) <= 0.5 * mf, inner, np.minimum(fa, fb))
+
+
 def _runs_to_pieces(first, nr, lo, hi):
     """Cyclic runs [lo, hi] (unwrapped, hi - lo < nr) of rings -> up to two pieces each,
     (start index, length) in RING order."""
@@ -113,8 +149,9 @@ def _runs_to_pieces(first, nr, lo, hi):
     return start1, len1, start2, len2
 
 
-def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
-    """(indptr, indices) of the lit facets of one eye for flat float64 arrays of balls."""
+def _lit_runs(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The lit facets of one eye for flat float64 arrays of balls, as runs: (lit facets
+    per ball, run starts, run lengths), the runs sorted by ball, then start."""
     nb = x.shape[0]
     npix = 12 * n * n
     with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
@@ -266,7 +303,27 @@ def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
         uj = np.where(k < c1[up], u1_lo[up] + k, u2_lo[up] + k - c1[up])
         upix = first[up] + np.mod(uj, nr[up])
         ub = pb[up]
-        lit_u = _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g, cx)
+        lit_u = _decide_cells(
+            n,
+            upix,
+            ub,
+            ring[up],
+            np.mod(uj, nr[up]),
+            shifted[up],
+            dx,
+            dy,
+            dz,
+            d,
+            s2,
+            ds2,
+            errdir,
+            alpha,
+            x,
+            y,
+            z,
+            g,
+            cx,
+        )
 
     # --- assemble: per pair the lit j's are one cyclic run (else explicit pieces) ----------
     big_i = np.iinfo(np.int64).max
@@ -316,6 +373,12 @@ def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
     order = np.lexsort((st, bl))
     st, ln, bl = st[order], ln[order], bl[order]
     per_ball = np.bincount(bl, weights=ln, minlength=nb).astype(np.int64)
+    return per_ball, st, ln
+
+
+def _runs_to_csr(per_ball, st, ln) -> tuple[np.ndarray, np.ndarray]:
+    """(indptr, indices) from runs (start, length) sorted by ball, then start."""
+    nb = per_ball.size
     indptr = np.zeros(nb + 1, np.int64)
     np.cumsum(per_ball, out=indptr[1:])
     total = int(indptr[-1])
@@ -330,14 +393,24 @@ def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
     return indptr, indices
 
 
-def _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g, cx):
-    """Lit flags of the undecided cells: vertices, then edges, then exact3d."""
+def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
+    """(indptr, indices) of the lit facets of one eye for flat float64 arrays of balls."""
+    return _runs_to_csr(*_lit_runs(n, x, y, z, g, cx))
+
+
+def _decide_cells(
+    n, upix, ub, uring, uj, ushift, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g, cx
+):
+    """Lit flags of the undecided cells: vertices, then edges, then exact3d.
+
+    Cell i is pixel upix[i], cell uj[i] of ring uring[i] (``ushift``: the ring is
+    shifted), lit or not by ball ub[i].
+    """
     m = upix.size
     out = np.zeros(m, bool)
     if m == 0:
         return out
     FALLBACK_COUNTS["tested"] += m
-    ix, iy, face = healpix.pix2xyf(n, upix)
     cxv = dx[ub] / d[ub]
     cyv = dy[ub] / d[ub]
     czv = dz[ub] / d[ub]
@@ -348,39 +421,70 @@ def _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g
     sure_centre = alpha[ub] > 1e6 * errdir[ub]
     out |= (upix == cpix[ub]) & sure_centre
 
-    def chord(px, py, f):
-        v = healpix.xyf2vec(n, px, py, f)
-        return (v[..., 0] - cxv) ** 2 + (v[..., 1] - cyv) ** 2 + (v[..., 2] - czv) ** 2
-
-    fx = ix.astype(np.float64)
-    fy = iy.astype(np.float64)
-    fN = chord(fx + 1, fy + 1, face)
-    fW = chord(fx, fy + 1, face)
-    fS = chord(fx, fy, face)
-    fE = chord(fx + 1, fy, face)
+    # the 4 vertices from the rings' (sin theta, z) and longitudes L * unit (healpix.
+    # vertex_lon): W and E on the cell's ring, N and S on the rings above and below
+    sth, zr, unit = _ring_tables(n)
+    lw = 2 * uj - (~ushift)
+    ui = unit[uring]
+    ln, ls = lw + 1, lw + 1
+    un, us = ui, ui
+    pol = np.flatnonzero((uring <= n) | (uring >= 3 * n))
+    if pol.size:
+        ln, ls, un, us = ln.copy(), ls.copy(), un.copy(), us.copy()
+        pn, pun, _, _, _, pls, pus = healpix.vertex_lon(n, uring[pol], uj[pol])
+        ln[pol], un[pol], ls[pol], us[pol] = pn, pun, pls, pus
+    ph = np.empty((4, m))
+    np.multiply(ln, un, out=ph[0])
+    np.multiply(lw, ui, out=ph[1])
+    np.multiply(ls, us, out=ph[2])
+    np.multiply(lw + 2, ui, out=ph[3])
+    rk = np.stack([uring - 1, uring, uring + 1, uring])
+    sv, zv = sth[rk], zr[rk]
+    vx = sv * np.cos(ph)
+    vx -= cxv
+    vy = sv * np.sin(ph)
+    vy -= cyv
+    zv -= czv
+    vx *= vx
+    vy *= vy
+    zv *= zv
+    vx += vy
+    vx += zv
+    fN, fW, fS, fE = vx
 
     def tol(f):
         return 4 * (np.sqrt(f) + np.sqrt(s2u)) * (_DP + edu) + ds2u + 1e-300
 
     vmin = np.minimum(np.minimum(fN, fW), np.minimum(fS, fE))
     out |= vmin < s2u - tol(vmin)
-    # edges: (fixed_is_y, fixed, lo, f_a, f_b)
+    # edges (fixed_is_y, which of the 4 vertices: f_a, f_b); face coordinates, fixed and
+    # lo as offsets from (ix, iy): W-N, S-W, S-E, E-N
     edges = (
-        (True, fy + 1, fx, fW, fN),
-        (False, fx, fy, fS, fW),
-        (True, fy, fx, fS, fE),
-        (False, fx + 1, fy, fE, fN),
+        (True, 1, 0, fW, fN),
+        (False, 0, 0, fS, fW),
+        (True, 0, 0, fS, fE),
+        (False, 1, 0, fE, fN),
     )
+    # the curvature bound is 2 / n^2 off the polar caps (rings n < i < 3n, whose cells'
+    # closures lie in |z| <= 2/3); the cells of the other rings get their own
+    pol_xyf = healpix.pix2xyf(n, upix[pol]) if pol.size else None
     clear_all = ~out
     open_edges = []
-    for fixed_is_y, fixed, lo, fa, fb in edges:
-        mf = 2.5 * _edge_bounds(n, face, fixed_is_y, fixed, lo)
-        lower = np.minimum(fa, fb) - mf / 8
-        clear = lower > s2u + tol(np.maximum(lower, 0.0))
+    for fixed_is_y, dfix, dlo, fa, fb in edges:
+        mf = np.full(m, 2.5 * 2.0 / (n * n))
+        if pol_xyf is not None:
+            pix_, piy_, pface = pol_xyf
+            pfx, pfy = pix_.astype(np.float64), piy_.astype(np.float64)
+            fixed, lo = (pfy + dfix, pfx + dlo) if fixed_is_y else (pfx + dfix, pfy + dlo)
+            mf[pol] = 2.5 * _edge_bounds(n, pface, fixed_is_y, fixed, lo)
+        lower = _edge_lower(fa, fb, mf)
+        clear = lower > s2u + tol(np.maximum(lower, 0.0)) + 8 * _EPS * (fa + fb + mf)
         clear_all &= clear
-        open_edges.append((fixed_is_y, fixed, lo, fa, fb, mf, ~clear & ~out))
+        open_edges.append((fixed_is_y, dfix, dlo, fa, fb, mf, ~clear & ~out))
     undecided = ~out & ~clear_all
     idx = np.flatnonzero(undecided)
+    ix, iy, face = healpix.pix2xyf(n, upix[idx])
+    fx, fy = ix.astype(np.float64), iy.astype(np.float64)
     if idx.size:
         FALLBACK_COUNTS["sampled"] += idx.size
         lit_now = np.zeros(idx.size, bool)
@@ -394,13 +498,14 @@ def _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g
                 nd = nd & ~lit_now
                 if not nd.any():
                     continue
-                fixed_is_y, fixed, lo, fa, fb, mf, _ = open_edges[k]
+                fixed_is_y, dfix, dlo, fa, fb, mf, _ = open_edges[k]
                 FALLBACK_COUNTS[f"edges sampled x{samples}"] += int(nd.sum())
                 e = idx[nd]
-                fix = np.broadcast_to(fixed[e, None], (e.size, t.size))
-                run = lo[e, None] + t
+                fixed, lo = (fy + dfix, fx + dlo) if fixed_is_y else (fx + dfix, fy + dlo)
+                fix = np.broadcast_to(fixed[nd, None], (e.size, t.size))
+                run = lo[nd, None] + t
                 px, py = (run, fix) if fixed_is_y else (fix, run)
-                v = healpix.xyf2vec(n, px, py, face[e, None])
+                v = healpix.xyf2vec(n, px, py, face[nd, None])
                 f = (
                     (v[..., 0] - cxv[e, None]) ** 2
                     + (v[..., 1] - cyv[e, None]) ** 2
@@ -411,8 +516,8 @@ def _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g
                 lit_now[nd] |= (f < s2e - tl).any(axis=1)
                 fmin = np.minimum(f.min(axis=1), np.minimum(fa[e], fb[e]))
                 lower = fmin - mf[e] / (8 * samples * samples)
-                lw = np.maximum(lower, 0.0)
-                tle = 4 * (np.sqrt(lw) + np.sqrt(s2u[e])) * (_DP + edu[e]) + ds2u[e] + 1e-300
+                lw0 = np.maximum(lower, 0.0)
+                tle = 4 * (np.sqrt(lw0) + np.sqrt(s2u[e])) * (_DP + edu[e]) + ds2u[e] + 1e-300
                 open_ = np.zeros(idx.size, bool)
                 open_[nd] = ~(lower > s2u[e] + tle)
                 still |= open_
@@ -431,7 +536,8 @@ def _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g
     tiny = np.flatnonzero(~out & ~pending & ~sure_centre)
     rest = np.concatenate([rest, tiny]).astype(np.int64)
     if rest.size:
-        for i in rest:
+        rix, riy, rface = healpix.pix2xyf(n, upix[rest])
+        for k, i in enumerate(rest):
             FALLBACK_COUNTS["exact"] += 1
             b = int(ub[i])
             out[i] = exact3d.cell_lit(
@@ -440,9 +546,9 @@ def _decide_cells(n, upix, ub, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g
                 Fraction(float(y[b])),
                 Fraction(float(z[b])),
                 Fraction(float(g[b])),
-                int(face[i]),
-                int(ix[i]),
-                int(iy[i]),
+                int(rface[k]),
+                int(rix[k]),
+                int(riy[k]),
                 int(upix[i]),
             )
     return out
@@ -586,17 +692,19 @@ class EyePair3D:
                 "use fewer or smaller balls per call, or a smaller nside"
             )
         out = []
+        block = _block(n)
         for cx in (-self.h, self.h):
-            ptrs, idxs, base = [np.zeros(1, np.int64)], [], 0
-            # blocks of balls keep the temporaries in cache
-            for s in range(0, nb, _BLOCK):
-                e = min(nb, s + _BLOCK)
-                ip, ix = _lit_eye(n, xf[s:e], yf[s:e], zf[s:e], gf[s:e], cx)
-                ptrs.append(ip[1:] + base)
-                idxs.append(ix)
-                base += ix.size
-            ind = np.concatenate(idxs) if idxs else np.zeros(0, np.int64)
-            out.append((np.concatenate(ptrs), ind))
+            # blocks of balls keep the temporaries in cache; the indices are written once,
+            # from the runs of every block
+            runs = [
+                _lit_runs(n, xf[s:e], yf[s:e], zf[s:e], gf[s:e], cx)
+                for s, e in ((s, min(nb, s + block)) for s in range(0, nb, block))
+            ]
+            if runs:
+                cat = [np.concatenate(r) for r in zip(*runs, strict=True)]
+                out.append(_runs_to_csr(*cat))
+            else:
+                out.append((np.zeros(1, np.int64), np.zeros(0, np.int64)))
         return out[0], out[1]
 
     def lit(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:

@@ -273,3 +273,57 @@ def boundaries(nside: int, pix, step: int = 1) -> np.ndarray:
     dx = np.concatenate([1 - t, np.zeros(s), t, np.ones(s)])
     dy = np.concatenate([np.ones(s), 1 - t, np.zeros(s), t])
     return xyf2vec(n, ix[..., None] + dx, iy[..., None] + dy, f[..., None])
+
+
+def _ring_quarter(n: int, k):
+    """Cells per quarter of ring k (0 and 4 nside are the poles: 0)."""
+    return np.minimum(np.minimum(k, n), 4 * n - k)
+
+
+def ring_sz(nside: int, k) -> tuple[np.ndarray, np.ndarray]:
+    """(sin(theta), z) of ring k, k = 0 .. 4 nside (0 and 4 nside: the poles).
+
+    The same formulas as :func:`xyf2vec` (sin(theta) from the ring height in the polar
+    caps, so it keeps its relative precision there).
+    """
+    n = int(nside)
+    k = np.asarray(k, dtype=np.int64)
+    jr = k / n
+    z = _z_of_jr(jr)
+    nr = np.minimum(jr, 4.0 - jr)
+    polar = (k < n) | (k > 3 * n)
+    sth = np.where(
+        polar, nr * np.sqrt(np.maximum(2.0 - nr * nr / 3.0, 0.0) / 3.0), np.sqrt(1.0 - z * z)
+    )
+    return sth, z
+
+
+def vertex_lon(nside: int, ring, j) -> tuple[np.ndarray, ...]:
+    """Longitudes of the N, W, S, E vertices of cell j (0-based) of ring ``ring``.
+
+    Returns (L_N, u_N, L_W, L_E, u_i, L_S, u_S): integers L and units u with the
+    longitude L * u (u = pi / (4 K), K the cells per quarter of the vertex's ring; 0 at
+    a pole). W and E lie on the cell's own ring, N on ring - 1, S on ring + 1: every
+    vertex of a cell of ring i lies on ring i - 1, i or i + 1 (Gorski et al. 2005, the
+    face coordinates x + y are constant on a ring), at a multiple of half its spacing.
+    """
+    n = int(nside)
+    i = np.asarray(ring, dtype=np.int64)
+    j = np.asarray(j, dtype=np.int64)
+    K = _ring_quarter(n, i)
+    Kn = _ring_quarter(n, i - 1)
+    Ks = _ring_quarter(n, i + 1)
+    shifted = (i < n) | (i > 3 * n) | (((i - n) & 1) == 0)
+    o2 = np.where(shifted, 0, -1)
+    lw = 2 * j + o2
+    f = j // K
+    p = j - f * K
+    # N: same quarter count -> the cell's centre longitude; one fewer (north cap) or one
+    # more (south cap) -> the lattice of ring i - 1
+    ln = np.where(Kn == K, lw + 1, np.where(Kn < K, 2 * Kn * f + 2 * p, 2 * Kn * f + 2 * p + 2))
+    ls = np.where(Ks == K, lw + 1, np.where(Ks > K, 2 * Ks * f + 2 * p + 2, 2 * Ks * f + 2 * p))
+    with np.errstate(divide="ignore"):
+        un = np.where(Kn > 0, 0.25 * math.pi / np.maximum(Kn, 1), 0.0)
+        us = np.where(Ks > 0, 0.25 * math.pi / np.maximum(Ks, 1), 0.0)
+    ui = 0.25 * math.pi / K
+    return ln, un, lw, lw + 2, ui, ls, us

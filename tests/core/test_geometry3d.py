@@ -275,3 +275,56 @@ def test_far_tiny_ball_matches_the_reference():
     la, lb = eyes.lit(*ball)
     assert np.array_equal(la, reference_lit(8, *ball, -40.0))
     assert np.array_equal(lb, reference_lit(8, *ball, 40.0))
+
+
+# --- the fast path's mechanisms -----------------------------------------------------------
+@pytest.mark.parametrize("n", [2, 4, 6, 18, 64])
+def test_vertex_lon_gives_every_cells_boundary_vertices(n):
+    """The N, W, S, E vertices from the rings' (sin theta, z) and the longitudes L * unit
+    are healpix.boundaries' vertices (from the face coordinates), for every pixel."""
+    p = np.arange(hp.npix(n))
+    ring, first, _, _ = hp.pix2ring(n, p)
+    ln, un, lw, le, ui, ls, us = hp.vertex_lon(n, ring, p - first)
+    got = []
+    for k, lon, unit in ((ring - 1, ln, un), (ring, lw, ui), (ring + 1, ls, us), (ring, le, ui)):
+        s, z = hp.ring_sz(n, k)
+        ph = lon * unit
+        got.append(np.stack([s * np.cos(ph), s * np.sin(ph), z], -1))
+    want = hp.boundaries(n, p)
+    np.testing.assert_allclose(np.stack(got, 1), want, rtol=0, atol=1e-14)
+    # W and E lie on the cell's ring, at its edges: E of cell j is W of cell j + 1
+    assert np.all(le[:-1][np.diff(ring) == 0] == lw[1:][np.diff(ring) == 0])
+
+
+def test_edge_lower_bounds_every_function_of_bounded_curvature():
+    """_edge_lower(fa, fb, M) <= min f on [0, 1] for f with |f''| <= M (the worst case is
+    the parabola of curvature -M through the end values), and it is >= min - M / 8."""
+    from eyeviz.core.geometry3d import _edge_lower
+
+    rng = np.random.default_rng(5)
+    fa, fb = rng.uniform(0, 1, 4000), rng.uniform(0, 1, 4000)
+    M = rng.uniform(1e-3, 3, 4000)
+    t = np.linspace(0, 1, 2001)[:, None]
+    lower = _edge_lower(fa, fb, M)
+    for curv in (-1.0, -0.5, 0.0, 1.0):
+        f = (1 - t) * fa + t * fb + curv * M * t * (1 - t) / 2
+        assert np.all(lower <= f.min(axis=0) + 1e-12)
+    worst = ((1 - t) * fa + t * fb - M * t * (1 - t) / 2).min(axis=0)
+    assert np.all(lower >= worst - 1e-6)  # tight: the parabola attains it
+    assert np.all(lower >= np.minimum(fa, fb) - M / 8 - 1e-15)
+
+
+def test_lit_sets_do_not_depend_on_the_block_size(monkeypatch):
+    """Blocks of balls are cut by _block(nside); the lit sets are the same for any cut."""
+    import eyeviz.core.geometry3d as g3
+
+    rng = np.random.default_rng(9)
+    e = EyePair3D(40.0, 20.0, 16)
+    x, y, z = rng.uniform(-3000, 3000, 700), rng.uniform(100, 3000, 700), rng.normal(0, 800, 700)
+    g = rng.uniform(1, 400, 700)
+    want = e.lit_csr(x, y, z, g)
+    monkeypatch.setattr(g3, "_block", lambda n: 97)
+    got = e.lit_csr(x, y, z, g)
+    for (pa, ia), (pb, ib) in zip(want, got, strict=True):
+        np.testing.assert_array_equal(pa, pb)
+        np.testing.assert_array_equal(ia, ib)
