@@ -126,3 +126,28 @@ def test_float32_and_int_inputs_are_computed_in_float64():
 def test_agrees_anywhere(x, y, g, m, hl):
     eyes = EyePair(hl[0], hl[1], m)
     _check(eyes, np.array([x]), np.array([y]), np.array([g]))
+
+
+@pytest.mark.parametrize("q", [0.3, 0.7])
+def test_an_endpoint_within_the_rounding_bound_of_a_boundary_is_handed_back(q):
+    """The bound is the vectorised fast path's (module docstring), (64 + 16 / (1 - 0.75))
+    u m = 128 u m whatever g / r_E: a tangent computed 100 u m past a sector boundary (more
+    than the base term, less than the whole bound) is not answered here but left to
+    ``pair.intervals``, near grazing or not; one 300 u m past is answered."""
+    from eyeviz.core.geometry import _U
+
+    pair, k = PAPER, PAPER._k
+    r, phi = 1500.0, 1.1  # the centre seen from eye A
+    x, y = -pair.h + r * math.cos(phi), r * math.sin(phi)
+    dx = x + pair.h
+    for ulps, answered in ((100, False), (300, True)):
+        # g such that the upper tangent t = (phi + asin(g / r)) k is an integer + ulps u m
+        t = math.floor((math.atan2(y, dx) + math.asin(q)) * k) + ulps * _U * pair.m
+        g = math.sqrt(dx * dx + y * y) * math.sin(t / k - math.atan2(y, dx))
+        t_hi = (math.atan2(y, dx) + math.asin(g / math.sqrt(dx * dx + y * y))) * k
+        frac = (t_hi - math.floor(t_hi)) / (_U * pair.m)
+        assert ulps - 20 < frac < ulps + 20  # the case is what it claims
+        got = single.intervals_one(pair, x, y, g)
+        assert (got is not None) == answered, (ulps, frac, got)
+        if got is not None:
+            assert got == tuple(int(v[0]) for v in pair.intervals([x], [y], [g]))

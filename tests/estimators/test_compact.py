@@ -91,3 +91,41 @@ def test_training_runs_and_writes_atomically(tmp_path):
     ds = dataset.generate(2000, seed=9)
     p = est.predict(ds.omega_a, ds.omega_b)
     assert metrics.mape(ds.r, p.r) < 20
+
+
+@pytest.mark.slow
+def test_the_ad_network_starts_from_the_analytic_angle(tmp_path):
+    """The AD network's last layer starts at zero (module docstring): with a learning rate
+    too small to move it, the trained model's phi is the analytic triangulation's, while
+    the DD network (a random start) moves r off the analytic value."""
+    from eyeviz.estimators import analytic, compact
+
+    compact.train(
+        tmp_path, n_train=1024, n_val=256, seed=3, epochs=1, hidden=4, batch=1024, lr=1e-12
+    )
+    est = estimators.load("compact", path=tmp_path)
+    ds = dataset.generate(500, seed=9)
+    iv = est.domain.eyes.intervals(ds.x, ds.y, ds.g)
+    p = est.predict_intervals(*iv)
+    r0, phi0 = analytic.estimate(*iv, est.domain)
+    assert np.max(np.abs(p.phi - phi0)) < 1e-6
+    assert np.max(np.abs(np.log(p.r / r0))) > 1e-3
+
+
+@pytest.mark.slow
+def test_a_network_of_width_one_trains_and_loads(tmp_path):
+    """hidden = hidden_ad = 1, the smallest width fit() accepts, trains and loads back:
+    two MLPs N-1-1-1 of (N + 1) + 2 + 2 weights each."""
+    from eyeviz.estimators import compact
+    from eyeviz.estimators.compact_net import N_FEATURES
+
+    out = compact.fit(
+        None, tmp_path / "m", n=4096, n_val=500, epochs=1, threads=1, hidden=1, hidden_ad=1
+    )
+    est = estimators.load("compact", path=out)
+    assert est.n_weights == 2 * (N_FEATURES + 5)
+    meta = json.loads((Path(out) / "compact.json").read_text())
+    assert meta["architecture"].startswith(f"DD {N_FEATURES}-1-1-1, AD {N_FEATURES}-1-1-1")
+    ds = dataset.generate(200, seed=9)
+    p = est.predict(ds.omega_a, ds.omega_b)
+    assert np.isfinite(p.r).all() and np.isfinite(p.phi).all()

@@ -180,3 +180,23 @@ def test_eyes_farther_apart_than_the_prior_range_warn_nothing():
         nd = posterior_nodes([key], dom)
         r = nd.r[0][nd.w[0] > 0]
     assert r.size and r.min() >= dom.r_min * (1 - 1e-6) and r.max() <= dom.r_max * (1 + 1e-6)
+
+
+@pytest.mark.parametrize("phi_deg", [32.9, 180.0 - 32.9])
+def test_nodes_of_a_key_at_the_bfvs_edge_stay_inside_the_bfv(phi_deg):
+    """A feature 0.03 deg inside either edge of the BFV (r = 2000, g = 100): its key's
+    tangent sectors reach past the edge, and every node with weight satisfies
+    psi + asin(g/r) <= phi <= pi - psi - asin(g/r) (Prop. 4), up to float32 rounding;
+    some lie on the edge, so the bound is what cuts them."""
+    d = PAPER_DOMAIN
+    psi = math.asin(d.l / d.h)
+    t = math.radians(phi_deg)
+    iv = d.eyes.intervals(np.array([2000 * math.cos(t)]), np.array([2000 * math.sin(t)]), [100.0])
+    nd = posterior_nodes([[int(v[0]) for v in iv]], d)
+    on = nd.w[0] > 0
+    assert on.sum() > 20
+    a = np.arcsin(np.minimum(nd.g[0][on] / nd.r[0][on], 1.0))
+    phi = nd.phi[0][on]
+    beyond = np.maximum(psi + a - phi, phi - (math.pi - psi - a))  # > 0: outside the BFV
+    assert beyond.max() < 1e-5, beyond.max()
+    assert beyond.max() > -1e-3, beyond.max()

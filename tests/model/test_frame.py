@@ -222,3 +222,44 @@ def test_errors_wrap_phi_across_zero():
     from eyeviz.model.frame_parts import errors
 
     assert errors(100.0, 0.0, 110.0, math.radians(359.0)) == pytest.approx((10.0, 10.0, -1.0))
+
+
+def test_view_rect_is_the_views_width_about_its_centre():
+    from eyeviz.model.frame_parts import view_rect
+
+    sc = _scene()
+    sc.view = scene_mod.View(center=(120.0, 2600.0), width=4000.0)
+    assert view_rect(sc, aspect=0.5) == (-1880.0, 2120.0, 1600.0, 3600.0)
+    assert view_rect(sc) == pytest.approx((-1880.0, 2120.0, 880.0, 4320.0))
+
+
+def test_an_eyes_rim_and_owners_default_to_every_ommatidium():
+    """``rim()`` and ``pooled_owner()`` without a level of detail: one cell per
+    ommatidium, the rim at j * gamma for j = 0..m (Figure 2, Eq. 6)."""
+    fr = build_frame(_scene(m=360))
+    for eye, cx in zip(fr.eyes, (-H, H), strict=True):
+        rim = eye.rim()
+        t = np.arange(361) * (2 * math.pi / 360)
+        np.testing.assert_allclose(rim, np.column_stack([cx + L * np.cos(t), L * np.sin(t)]))
+        np.testing.assert_array_equal(eye.pooled_owner(), eye.owner)
+        assert eye.owner.shape == (360,) and (eye.owner >= 0).any()
+
+
+def test_sector_rays_reach_past_the_far_side_of_the_disc():
+    sc = _scene()
+    fr = build_frame(sc)
+    centres = {"A": (-H, 0.0), "B": (H, 0.0)}
+    assert fr.sectors
+    for s in fr.sectors:
+        f = sc.features[s.feature]
+        r_e = math.hypot(f.x - centres[s.eye][0], f.y - centres[s.eye][1])
+        assert s.reach > r_e + f.g, (s.feature, s.eye)
+        assert np.hypot(*(s.ends - np.array(centres[s.eye])).T) == pytest.approx(s.reach)
+
+
+def test_eye_labels_sit_under_the_eyes():
+    fr = build_frame(_scene(layers=("eyes", "features", "labels")))
+    eyes = {lab.text: lab for lab in fr.labels if lab.kind == "eye"}
+    assert set(eyes) == {"A", "B", "O"}
+    assert [eyes[k].x for k in "AOB"] == [-H, 0.0, H]
+    assert all(lab.y < -L for lab in eyes.values())  # below the eye discs (radius l)
