@@ -135,6 +135,22 @@ def _edge_lower(fa, fb, mf):
     return np.where(np.abs(dd) <= 0.5 * mf, inner, np.minimum(fa, fb))
 
 
+_INFO: dict[int, tuple[np.ndarray, ...]] = {}
+
+
+def _ring_info_tables(n: int) -> tuple[np.ndarray, ...]:
+    """Per ring 0 .. 4 n (0 and 4 n unused): first pixel, pixels, shifted, the longitude
+    spacing 2 pi / pixels and the offset o of the first cell's W edge (0 or -1/2)."""
+    tab = _INFO.get(n)
+    if tab is None:
+        k = np.clip(np.arange(4 * n + 1), 1, 4 * n - 1)
+        first, nr, shifted = healpix.ring_info(n, k)
+        if len(_INFO) > 64:
+            _INFO.clear()
+        tab = _INFO[n] = (first, nr, shifted, 2 * math.pi / nr, np.where(shifted, 0.0, -0.5))
+    return tab
+
+
 def _runs_to_pieces(first, nr, lo, hi):
     """Cyclic runs [lo, hi] (unwrapped, hi - lo < nr) of rings -> up to two pieces each,
     (start index, length) in RING order."""
@@ -225,11 +241,12 @@ def _lit_runs(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np
         pb = np.repeat(np.arange(nb), cnt)
         offs = np.arange(pb.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
         ring = i_min[pb] + offs
-        first, nr, shifted = healpix.ring_info(n, ring)
-        delta = 2 * math.pi / nr
-        o = np.where(shifted, 0.0, -0.5)
-        zb_lo, zb_hi = healpix.ring_z_range(n, ring)
-        z_i = healpix.ring_z(n, ring)
+        sth_t, zr_t, _ = _ring_tables(n)
+        first_t, nr_t, shifted_t, delta_t, o_t = _ring_info_tables(n)
+        first, nr, shifted = first_t[ring], nr_t[ring], shifted_t[ring]
+        delta, o = delta_t[ring], o_t[ring]
+        # the closures of a ring's cells lie between the centres' z of the rings around
+        zb_lo, zb_hi, z_i = zr_t[ring + 1], zr_t[ring - 1], zr_t[ring]
         za = np.maximum(zb_lo, zc_lo[pb])
         zb = np.minimum(zb_hi, zc_hi[pb])
         empty = za > zb
@@ -237,22 +254,24 @@ def _lit_runs(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np
         dnum = dcos[pb] + 2 * errdir[pb] + 4 * _EPS
         drel = 2 * errdir[pb] / np.maximum(rc_p, 1e-300) + 8 * _EPS
 
-        def arg_bounds(zz):
-            rr = np.sqrt(np.maximum(1.0 - zz * zz, 0.0))
+        def arg_bounds(zz, rr=None, upper=False):
+            """Lower (upper) bound of the acos argument on z = zz (rr: its sin theta)."""
+            if rr is None:
+                rr = np.sqrt(np.maximum(1.0 - zz * zz, 0.0))
             den = rc_p * rr
-            num = cos_p - zc_p * zz
-            a = num / den
+            a = (cos_p - zc_p * zz) / den
             da = dnum / den + np.abs(a) * drel
-            lo_, hi_ = a - da, a + da
+            out_ = a + da if upper else a - da
             # at a pole (rho = 0) or about a cap centred on one: any longitude may be in
-            bad = ~(np.isfinite(lo_) & np.isfinite(hi_) & (den > 0))
-            return np.where(bad, -np.inf, lo_), np.where(bad, np.inf, hi_)
+            bad = ~(np.isfinite(out_) & (den > 0))
+            out_[bad] = np.inf if upper else -np.inf
+            return out_
 
         zstar = zc_p / cos_p
         zs_in = (zstar >= za) & (zstar <= zb)
-        lo_a, _ = arg_bounds(za)
-        lo_b, _ = arg_bounds(zb)
-        lo_s, _ = arg_bounds(np.where(zs_in, zstar, za))
+        lo_a = arg_bounds(za)
+        lo_b = arg_bounds(zb)
+        lo_s = arg_bounds(np.where(zs_in, zstar, za))
         amin = np.minimum(np.minimum(lo_a, lo_b), lo_s)
         dph = dphi[pb] + 1e-9
         W = np.arccos(np.clip(amin, -1.0, 1.0)) + dph
@@ -263,7 +282,7 @@ def _lit_runs(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np
         jc_hi = np.floor((pc + W) / delta - o).astype(np.int64)
         full_c |= jc_hi - jc_lo + 1 >= nr
         # surely lit: the cell's W-E diagonal (on z_i) meets the cap's interior
-        _, hi_i = arg_bounds(z_i)
+        hi_i = arg_bounds(z_i, sth_t[ring], upper=True)
         in_z = (z_i > zc_lo[pb]) & (z_i < zc_hi[pb])
         has_s = in_z & (hi_i < 1.0) & ~no_cand
         ws = np.arccos(np.clip(hi_i, -1.0, 1.0)) - dph
