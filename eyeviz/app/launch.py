@@ -1,4 +1,4 @@
-"""Starting the app: the display check, the QApplication, ``eyeviz app``'s run."""
+"""Starting the app: the display check and the QApplication (``eyeviz.app.main`` runs it)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from PyQt5 import QtCore, QtWidgets
 
 from eyeviz import EyevizError
 
-__all__ = ["APP_FONT_PT", "check_display", "make_app", "run_app"]
+__all__ = ["APP_FONT_PT", "check_display", "make_app"]
 
 APP_FONT_PT = 13
 
@@ -60,43 +60,3 @@ def make_app() -> QtWidgets.QApplication:
     font.setPointSize(APP_FONT_PT)
     app.setFont(font)
     return app
-
-
-def run_app(
-    scene_path: str | os.PathLike | None = None,
-    screenshot: str | os.PathLike | None = None,
-    settings_path: str | os.PathLike | None = None,
-) -> int:
-    from eyeviz.app.screenshot import screenshot_format
-    from eyeviz.app.settings import make_settings
-    from eyeviz.app.window import MainWindow
-    from eyeviz.model.scene import load
-    from eyeviz.resources import scene_path as scene_path_of
-
-    if screenshot is not None:
-        screenshot_format(screenshot)  # refuse a wrong suffix before any window opens
-    check_display()
-    if scene_path is None:
-        scene_path = scene_path_of("default")
-    scene = load(scene_path)
-    settings = make_settings(settings_path)
-    # a screenshot reads the saved window state but never changes it (nor recent files)
-    settings.read_only = screenshot is not None
-    app = make_app()
-    win = MainWindow(scene, scene_path, settings=settings)
-    if settings.refused:
-        win.statusBar().showMessage(settings.refused, 15000)
-    win.show()
-    app.processEvents()
-    win.fit_inset()
-    win.frame_bundled()
-    win.render()
-    if screenshot is not None:
-        win.jobs.wait()  # estimators loading: the picture shows their answers
-        for _ in range(3):
-            app.processEvents()
-        out = win.save_screenshot(screenshot)
-        print(out)
-        win.force_close()
-        return 0
-    return app.exec_()

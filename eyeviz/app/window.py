@@ -24,7 +24,7 @@ from eyeviz.app.actions import SceneCommand, build_menus
 from eyeviz.app.canvas import CanvasMixin
 from eyeviz.app.files import RECENT_MAX, FilesMixin, is_bundled
 from eyeviz.app.jobs import Job, JobRunner
-from eyeviz.app.launch import APP_FONT_PT, check_display, make_app, run_app
+from eyeviz.app.launch import APP_FONT_PT, check_display, make_app
 from eyeviz.app.panels import (
     BitmapPanel,
     EyesPanel,
@@ -56,7 +56,6 @@ __all__ = [
     "make_app",
     "make_settings",
     "qimage_to_array",
-    "run_app",
 ]
 
 

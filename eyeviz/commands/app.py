@@ -28,7 +28,7 @@ def argparse_settings_help() -> str:
 def run(args) -> int:
     if args.scene is not None:
         refuse_spherical(args.scene)
-    from eyeviz.app.window import run_app
+    from eyeviz.app.main import run_app
 
     return run_app(args.scene, args.screenshot, args.settings)
 
