@@ -36,6 +36,8 @@ __all__ = ["CONNECT_TIMEOUT_S", "RESUBMITS", "StudyFailed", "StudySummary", "run
 
 #: Seconds to wait for a user's scheduler before giving up with a one-line error.
 CONNECT_TIMEOUT_S = 5.0
+#: The same for the worker processes of a local cluster (they start on this machine).
+LOCAL_CONNECT_S = 60.0
 #: How many times a point whose workers kept dying is submitted again.
 RESUBMITS = 3
 #: The local scheduler's ``allowed-failures``: workers that may die running one point.
@@ -217,6 +219,13 @@ def evaluate_on_worker(point: DesignPoint) -> list[dict]:
     return evaluate(point)
 
 
+def connect_timeout_for(scheduler: str | None, connect_timeout: float) -> float:
+    """Dask's connect timeout for a study: the short one for a user's scheduler, which may
+    not exist; at least :data:`LOCAL_CONNECT_S` for a local cluster, whose processes start
+    on this machine, which may be busy (a nanny took over 5 s in a loaded test run)."""
+    return connect_timeout if scheduler else max(connect_timeout, LOCAL_CONNECT_S)
+
+
 def dask_config(connect_timeout: float = CONNECT_TIMEOUT_S) -> dict:
     """The dask settings a study runs under (``dask.config.set``)."""
     return {
@@ -336,7 +345,7 @@ def _run(path, points, workers, scheduler, progress, connect_timeout) -> StudySu
     from distributed import as_completed
     from tqdm import tqdm
 
-    config = dask_config(connect_timeout)
+    config = dask_config(connect_timeout_for(scheduler, connect_timeout))
     computed = 0
     failures: list[str] = []
     resubmitted = 0

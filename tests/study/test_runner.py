@@ -234,3 +234,11 @@ def test_a_second_study_into_the_same_file_is_refused_and_the_lock_goes_away(tmp
     assert path.read_bytes() == before  # nothing written by the refused study
     s = run_study(path, design_grid("40", "20", "8,16", n=200), workers=1, progress=False)
     assert (s.computed, s.skipped) == (1, 1) and not lock.exists()
+
+
+def test_a_local_cluster_gets_time_to_start_a_users_scheduler_does_not():
+    from eyeviz.study import runner
+
+    assert runner.connect_timeout_for("tcp://10.0.0.1:8786", 5.0) == 5.0
+    assert runner.connect_timeout_for(None, 5.0) == runner.LOCAL_CONNECT_S >= 30.0
+    assert runner.dask_config(60.0)["distributed.comm.timeouts.connect"] == "60.0s"
