@@ -13,10 +13,11 @@ Each mutant changes one token on one line:
 Mutants that do not compile are dropped. From each module's mutants ``--per-module``
 are drawn at random (seeded; all of them when there are fewer); each is written into the
 copy, the mirroring tests run (``tests/<package>``, the module's own ``test_<name>.py``
-first) with ``-x -q`` and a timeout, and the copy is restored byte for byte. A mutant is
-*killed* when the tests fail (exit 1, or 2 when the mutant breaks collection), *survived*
-when they pass, *timeout* when they run past ``--timeout-factor`` times the unmutated
-run (+ 20 s).
+first; for the modules of ``EXTRA_TESTS`` also the directories named there, e.g.
+``tests/render`` for the frame's drawing data) with ``-x -q`` and a timeout, and the copy
+is restored byte for byte. A mutant is *killed* when the tests fail (exit 1, or 2 when
+the mutant breaks collection), *survived* when they pass, *timeout* when they run past
+``--timeout-factor`` times the unmutated run (+ 20 s).
 
 It never mutates the checkout it lives in: ``--root`` must be a copy, e.g.
 
@@ -45,6 +46,13 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parents[1]
 PACKAGES = ("eyeviz/core", "eyeviz/model", "eyeviz/estimators")
+#: Modules whose behaviour is also tested outside their package's mirror: run these test
+#: directories after it (the frame's drawing data is read by the painters in tests/render).
+EXTRA_TESTS = {
+    "eyeviz/model/frame.py": ("tests/render",),
+    "eyeviz/model/frame_parts.py": ("tests/render",),
+    "eyeviz/model/layers.py": ("tests/render",),
+}
 SKIP_MARK = "pragma: no mutate"
 
 _OPS = {
@@ -230,9 +238,15 @@ def run_tests(root: Path, tests: list[str], python: str, timeout: float) -> tupl
     return f"error (pytest exit {rc})", dt
 
 
+def extra_tests(root: Path, module: Path) -> list[str]:
+    """The directories of :data:`EXTRA_TESTS` for ``module`` that exist under root."""
+    rel = module.relative_to(root).as_posix()
+    return [d for d in EXTRA_TESTS.get(rel, ()) if (root / d).is_dir()]
+
+
 def tests_for(root: Path, module: Path, tests_dir: str) -> list[str]:
     own = Path(tests_dir) / f"test_{module.stem}.py"
-    return ([str(own)] if (root / own).exists() else []) + [tests_dir]
+    return ([str(own)] if (root / own).exists() else []) + [tests_dir, *extra_tests(root, module)]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -284,14 +298,22 @@ def main(argv: list[str] | None = None) -> int:
             raise SystemExit(f"{tdir} fails without any mutant ({status}): fix that first")
         timeout = a.timeout_factor * base + 20.0
         print(f"{tdir}: {base:.1f} s unmutated, timeout {timeout:.0f} s", flush=True)
+        extra_base: dict[str, float] = {}  # the unmutated run of each extra directory
+        for d in sorted({d for mod, pick, _ in plan if pick for d in extra_tests(root, mod)}):
+            status, extra_base[d] = run_tests(root, [d], a.python, 3600.0)
+            if status != "survived":
+                raise SystemExit(f"{d} fails without any mutant ({status}): fix that first")
+            print(f"{d}: {extra_base[d]:.1f} s unmutated (also run for some modules)", flush=True)
         for mod, pick, _ in plan:
+            more = sum(extra_base[d] for d in extra_tests(root, mod))
             original = mod.read_bytes()
             src = original.decode()
             try:
                 for m in pick:
                     mod.write_text(m.apply(src))
                     _drop_pyc(mod)
-                    st, dt = run_tests(root, tests_for(root, mod, tdir), a.python, timeout)
+                    t_out = timeout + a.timeout_factor * more
+                    st, dt = run_tests(root, tests_for(root, mod, tdir), a.python, t_out)
                     mod.write_bytes(original)
                     _drop_pyc(mod)
                     results.append({**asdict(m), "status": st, "seconds": round(dt, 1)})

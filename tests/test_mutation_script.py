@@ -80,3 +80,24 @@ def test_it_refuses_to_mutate_its_own_checkout():
     mut = _load()
     with pytest.raises(SystemExit, match="mutate a copy"):
         mut.main(["--root", str(SCRIPT.parents[1]), "--per-module", "1"])
+
+
+def test_the_frames_modules_also_run_the_render_tests(tmp_path):
+    """The frame's drawing data is read by the painters: tests/render runs after the
+    package's mirror for the modules EXTRA_TESTS names (when the copy has it), only those."""
+    mut = _load()
+    for d in ("eyeviz/model", "tests/model", "tests/render"):
+        (tmp_path / d).mkdir(parents=True)
+    (tmp_path / "tests/model/test_frame.py").write_text("")
+    frame, scene = tmp_path / "eyeviz/model/frame.py", tmp_path / "eyeviz/model/scene.py"
+    assert mut.tests_for(tmp_path, frame, "tests/model") == [
+        "tests/model/test_frame.py",
+        "tests/model",
+        "tests/render",
+    ]
+    assert mut.tests_for(tmp_path, scene, "tests/model") == ["tests/model"]
+    (tmp_path / "tests/render").rmdir()
+    assert mut.tests_for(tmp_path, frame, "tests/model") == [
+        "tests/model/test_frame.py",
+        "tests/model",
+    ]
