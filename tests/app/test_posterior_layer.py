@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 from mouse import drag, pixel_of
+from PyQt5 import QtWidgets
 
 from eyeviz import estimators
 from eyeviz.app.window import qimage_to_array
@@ -87,6 +88,10 @@ def test_a_drag_computes_the_posterior_once_per_key(make_window, monkeypatch):
     monkeypatch.setattr(painter, "draw", spy)
     post_mod._CACHE.clear()
     x0 = win.model.scene.features[0].x
+    # let the selection's deferred work (and any resize) settle before reading the camera:
+    # under a loaded parallel run the press once landed beside the feature
+    QtWidgets.QApplication.processEvents()
+    win.render()
     start = pixel_of(win, x0, 2500.0)
     drag(win, start, start + type(start)(8, 0), steps=24)
     win.flush()
