@@ -187,3 +187,21 @@ def test_phi_tolerance_is_an_angle_far_below_a_sector():
     assert not checks._same_phi(phi + 0.01 * 2 * np.pi / 2880, phi)
     assert checks._same_phi(np.array([np.nan, 1.0]), np.array([np.nan, 1.0]))
     assert not checks._same_phi(np.array([np.nan, 1.0]), np.array([1.0, 1.0]))
+
+
+class _DropsARow(AnalyticEstimator):
+    """Calls the third row of every batch invalid (NaN, out of the domain)."""
+
+    name = "dropsarow"
+
+    def predict(self, a, b):
+        p = super().predict(a, b)
+        r, phi, v, dom = (np.array(x) for x in (p.r, p.phi, p.valid, p.in_domain))
+        if v.size > 2:
+            r[2], phi[2], v[2], dom[2] = np.nan, np.nan, False, False
+        return type(p)(r, phi, v, dom)
+
+
+def test_battery_catches_a_valid_row_called_invalid():
+    with pytest.raises(AssertionError, match="must be valid"):
+        checks.check_masks(_DropsARow())

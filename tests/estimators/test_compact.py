@@ -129,3 +129,33 @@ def test_a_network_of_width_one_trains_and_loads(tmp_path):
     ds = dataset.generate(200, seed=9)
     p = est.predict(ds.omega_a, ds.omega_b)
     assert np.isfinite(p.r).all() and np.isfinite(p.phi).all()
+
+
+def test_the_networks_correct_the_analytic_estimate_as_documented():
+    """Module docstring: log r = log r_analytic + DD(x), phi = phi_analytic + 1e-3 AD(x)
+    (the shipped AD network's corrections are ~1e-4 rad: the sign is not seen in the
+    accuracy targets)."""
+    import torch
+
+    from eyeviz.estimators.compact_net import AD_SCALE, features
+
+    est = estimators.load("compact")
+    ds = dataset.generate(300, seed=4)
+    iv = est.domain.eyes.intervals(ds.x, ds.y, ds.g)
+    x, log_r0, p0 = features(*iv, est.domain)
+    with torch.inference_mode():
+        d = est.dd(torch.from_numpy(x)).numpy().astype(np.float64)
+        a = est.ad(torch.from_numpy(x)).numpy().astype(np.float64)
+    assert np.abs(a).max() > 1e-3  # the AD network does move phi
+    p = est.predict_intervals(*iv)
+    np.testing.assert_allclose(p.phi, p0 + AD_SCALE * a, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(p.r, np.exp(log_r0 + d), rtol=1e-6)
+
+
+@pytest.mark.slow
+def test_one_training_row_is_enough_with_a_batch_of_one(tmp_path):
+    from eyeviz.estimators import compact
+
+    meta = compact.train(tmp_path, n_train=1, n_val=50, batch=1, epochs=1, hidden=2, hidden_ad=1)
+    assert meta["data"]["n_train"] == 1
+    assert estimators.load("compact", path=tmp_path).n_weights == meta["n_weights"]

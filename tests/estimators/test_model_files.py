@@ -231,3 +231,14 @@ def test_object_members_and_bad_meta_are_refused(tmp_path):
     _refused("r_mape of key 10", name="bayes", path=p)
     p.write_bytes(b"PK\x03\x04 not really")
     _refused("not a readable .npz", name="bayes", path=p)
+
+
+def test_an_integer_tensor_is_refused_by_name(tmp_path):
+    """Every parameter must be a float tensor: an integer one of the right shape would
+    otherwise be cast silently by load_state_dict."""
+    d = _compact_dir(tmp_path)
+    good = torch.load(MODELS / "compact_dd.pt", weights_only=True)
+    state = dict(good["state"])
+    state["net.2.bias"] = torch.zeros_like(state["net.2.bias"], dtype=torch.int64)
+    torch.save({"hidden": 32, "state": state}, d / "compact_dd.pt")
+    _load_compact(d, r"net\.2\.bias is not a float tensor")

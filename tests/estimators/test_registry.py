@@ -97,3 +97,14 @@ def test_limit_entry_listed_only_when_its_module_exists():
     present = importlib.util.find_spec("eyeviz.estimators.limit") is not None
     assert ("limit" in estimators.available()) == present
     assert registry._REGISTRY["limit"].any_design
+
+
+@pytest.mark.slow
+def test_the_paper_entry_needs_torch():
+    """Its weights are not shipped, so it cannot be loaded here: its module imports torch."""
+    code = (
+        "import sys; from eyeviz.estimators import registry as r;"
+        "import eyeviz.estimators.paper;"
+        "print('torch' in sys.modules, r.get('paper').needs_torch)"
+    )
+    assert _run(code) == "True True"
