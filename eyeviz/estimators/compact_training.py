@@ -130,7 +130,8 @@ def train(
     """
     batch = check_int("batch", batch, ge=1)
     n_train = check_int("n_train", n_train, ge=1, le=limits.MAX_ROWS)
-    n_val = check_int("n_val", n_val, ge=1, le=limits.MAX_ROWS)
+    # R^2 (Eq. 35, standard form) of the validation set needs two values at least
+    n_val = check_int("n_val", n_val, ge=2, le=limits.MAX_ROWS)
     epochs = check_int("epochs", epochs, ge=1)
     lr = check_real("lr", lr, gt=0)
     threads = check_int("threads", threads, ge=1, le=MAX_THREADS)

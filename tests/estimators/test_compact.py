@@ -159,3 +159,14 @@ def test_one_training_row_is_enough_with_a_batch_of_one(tmp_path):
     meta = compact.train(tmp_path, n_train=1, n_val=50, batch=1, epochs=1, hidden=2, hidden_ad=1)
     assert meta["data"]["n_train"] == 1
     assert estimators.load("compact", path=tmp_path).n_weights == meta["n_weights"]
+
+
+def test_one_validation_element_is_refused_in_one_line():
+    """R^2 of a single validation value is undefined: refused at the boundary, naming
+    n_val, not deep inside the metrics."""
+    from eyeviz import EyevizError
+    from eyeviz.estimators import compact_training
+
+    with pytest.raises(EyevizError, match=r"n_val must be an integer >= 2") as exc:
+        compact_training.train(n_train=1000, n_val=1)
+    assert "\n" not in str(exc.value)
