@@ -83,8 +83,10 @@ class BlockReader:
         self.path = Path(path)
         self.fmt = format_of(self.path)
         self.block_rows = check_int("block_rows", block_rows, ge=1)
-        if not self.path.is_file():
+        if not self.path.exists():
             raise EyevizError(f"no such data set file: {str(self.path)!r}")
+        if not self.path.is_file():  # a folder, a FIFO, /dev/zero (or a link to one)
+            raise EyevizError(f"data set {str(self.path)!r} is not a regular file")
         self.params: dict = {}
         self.n: int | None = None
         self.with_g = True
@@ -354,6 +356,8 @@ def _parse_block(
     tails = [ln[rb:] for ln in block]
     if any(t.count(b",") != nf - 1 for t in tails):
         raise ValueError("bad field count")
+    if any(b"_" in t for t in tails):  # Python's float() reads "1_000"; a CSV number does not
+        raise ValueError("underscore in a number")
     floats[:] = np.array(list(map(float, b",".join(tails).split(b",")))).reshape(len(block), nf).T
     if not np.all(np.isfinite(floats)):
         raise ValueError("non-finite")
@@ -382,6 +386,8 @@ def _diagnose(path: Path, block: list[bytes], offset: int, m: int, ncols: int) -
                     )
             else:
                 try:
+                    if b"_" in fv:
+                        raise ValueError(fv)
                     v = float(fv)
                 except ValueError:
                     raise _csv_error(path, lineno, j + 1, f"not a number: {_show(fv)}") from None

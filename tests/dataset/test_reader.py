@@ -62,3 +62,27 @@ def _small_domain3d():
     from eyeviz.core.domain3d import Domain3D
 
     return Domain3D(nside=8, r_min=100.0, r_max=300.0, g_max=30.0)
+
+
+def test_a_number_with_an_underscore_is_refused_naming_its_line(tmp_path):
+    """Python's float() reads "1_000"; no CSV writer means that."""
+    ds = D.generate(3, seed=4)
+    path = tmp_path / "d.csv"
+    D.save(ds, path)
+    lines = path.read_bytes().splitlines(keepends=True)
+    fields = lines[1].rstrip(b"\n").split(b",")
+    fields[-3] = b"1_000"  # r
+    lines[1] = b",".join(fields) + b"\n"
+    path.write_bytes(b"".join(lines))
+    with pytest.raises(EyevizError, match=r"line 2.*not a number: .?1_000") as exc:
+        D.load(path)
+    assert "\n" not in str(exc.value)
+
+
+def test_a_data_file_that_is_not_a_regular_file_is_named_so(tmp_path):
+    link = tmp_path / "zero.csv"
+    link.symlink_to("/dev/zero")
+    with pytest.raises(EyevizError, match="is not a regular file"):
+        D.load(link)
+    with pytest.raises(EyevizError, match="no such data set file"):
+        D.load(tmp_path / "missing.csv")
