@@ -271,35 +271,46 @@ class LimitEstimator(Estimator):
         self.n = int(n)
         self.k = int(k)
         self.cache_size = int(cache_size)
-        self._cache: OrderedDict[tuple, tuple[float, float, bool]] = OrderedDict()
+        self._cache: OrderedDict[int | tuple, tuple[float, float, bool]] = OrderedDict()
         self.last_flagged = np.zeros(0, bool)
         self._parts: list[np.ndarray] = []
         self.hits = 0
         self.misses = 0
 
-    def _encode(self, LA, RA, LB, RB):
+    def _codes(self, LA, RA, LB, RB) -> tuple[list, np.ndarray]:
+        """The distinct keys of the rows (hashable: the cache's keys) and each row's index
+        into them. Each code is a function of its row alone: the four interval ends (each
+        in [0, m/2)) are packed into one int64 while (m/2)^4 fits, and kept as a tuple of
+        four beyond (m > about 110,000), where the packed code would overflow and make
+        different keys share an answer."""
         w = self.domain.width
-        return ((LA * w + RA) * w + LB) * w + RB
+        if w**4 < 2**63:
+            code = ((LA * w + RA) * w + LB) * w + RB
+            uniq, inv = np.unique(code, return_inverse=True)
+            return uniq.tolist(), inv
+        rows = np.stack([LA, RA, LB, RB], axis=1)
+        uniq, inv = np.unique(rows, axis=0, return_inverse=True)
+        return [tuple(k) for k in uniq.tolist()], inv.reshape(-1)
 
     def _predict_intervals(self, LA, RA, LB, RB):
         LA, RA, LB, RB = (np.asarray(v, np.int64) for v in (LA, RA, LB, RB))
-        code = self._encode(LA, RA, LB, RB)
-        uniq, inv = np.unique(code, return_inverse=True)
-        first = np.zeros(uniq.size, np.int64)
-        first[inv[::-1]] = np.arange(code.size)[::-1]
-        r_u = np.empty(uniq.size)
-        p_u = np.empty(uniq.size)
-        e_u = np.empty(uniq.size, bool)
+        codes, inv = self._codes(LA, RA, LB, RB)
+        nu = len(codes)
+        first = np.zeros(nu, np.int64)
+        first[inv[::-1]] = np.arange(inv.size)[::-1]
+        r_u = np.empty(nu)
+        p_u = np.empty(nu)
+        e_u = np.empty(nu, bool)
         todo = []
         cache = self._cache
-        for j, c in enumerate(uniq.tolist()):
+        for j, c in enumerate(codes):
             hit = cache.get(c)
             if hit is None:
                 todo.append(j)
             else:
                 cache.move_to_end(c)
                 r_u[j], p_u[j], e_u[j] = hit
-        self.hits += uniq.size - len(todo)
+        self.hits += nu - len(todo)
         self.misses += len(todo)
         if todo:
             t = np.asarray(todo)
@@ -311,7 +322,7 @@ class LimitEstimator(Estimator):
                 rr[ee], pp[ee] = fr, fp
             r_u[t], p_u[t], e_u[t] = rr, pp, ee
             for c, a, b, e in zip(
-                uniq[t].tolist(), rr.tolist(), pp.tolist(), ee.tolist(), strict=True
+                [codes[j] for j in todo], rr.tolist(), pp.tolist(), ee.tolist(), strict=True
             ):
                 cache[c] = (a, b, e)
             while len(cache) > self.cache_size:

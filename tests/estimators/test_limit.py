@@ -200,3 +200,29 @@ def test_nodes_of_a_key_at_the_bfvs_edge_stay_inside_the_bfv(phi_deg):
     beyond = np.maximum(psi + a - phi, phi - (math.pi - psi - a))  # > 0: outside the BFV
     assert beyond.max() < 1e-5, beyond.max()
     assert beyond.max() > -1e-3, beyond.max()
+
+
+def test_each_rows_answer_is_its_own_at_the_largest_m():
+    """At m = 2^20 the packed key ((LA w + RA) w + LB) w + RB overflows int64: LA = 10 and
+    LA = 138 (2^7 apart, times w^3 = 2^57) with the other three ends equal packed to the
+    same code, so the second row got the first row's answer (and its flag) when both were
+    in one batch (issue 25)."""
+    import numpy as np
+
+    from eyeviz import estimators
+    from eyeviz.core.bounds import MAX_M
+    from eyeviz.core.domain import Domain
+
+    rows = [(10, 200, 30, 40), (138, 200, 30, 40)]
+    alone = [
+        estimators.load("limit", domain=Domain(m=MAX_M)).predict_intervals(
+            *(np.array([v]) for v in k)
+        )
+        for k in rows
+    ]
+    both = estimators.load("limit", domain=Domain(m=MAX_M)).predict_intervals(
+        *(np.array(c) for c in zip(*rows, strict=True))
+    )
+    for i in range(2):
+        assert both.r[i] == alone[i].r[0] and both.phi[i] == alone[i].phi[0]
+    assert both.r[0] != both.r[1]
