@@ -302,8 +302,19 @@ def iter_chunks(n: int, p: GenParams, chunk: int = CHUNK) -> Iterator[Chunk]:
             yield sampler.fill(c, p.r_min, p.r_max)
         return
     edges, remaining = segment_plan(n, p)
-    left = n
-    for _ in range(0, n, chunk):
+    for labels in segment_labels(remaining, chunk, rng):
+        yield sampler.fill(labels.size, edges[labels], edges[labels + 1])
+
+
+def segment_labels(
+    counts: np.ndarray, chunk: int, rng: np.random.Generator
+) -> Iterator[np.ndarray]:
+    """Multi-pass chunks: each chunk's segment index per element, shuffled, drawn without
+    replacement from the plan's ``counts`` (a multivariate hypergeometric share per chunk,
+    the rest in the last), so the chunks together hold exactly ``counts``."""
+    remaining = counts
+    left = int(counts.sum())
+    for _ in range(0, left, chunk):
         c = min(chunk, left)
         if c == left:
             comp = remaining
@@ -313,7 +324,7 @@ def iter_chunks(n: int, p: GenParams, chunk: int = CHUNK) -> Iterator[Chunk]:
         left -= c
         labels = np.repeat(np.arange(comp.size), comp)
         rng.shuffle(labels)
-        yield sampler.fill(c, edges[labels], edges[labels + 1])
+        yield labels
 
 
 # --- public API ----------------------------------------------------------------------

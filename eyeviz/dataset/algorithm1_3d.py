@@ -47,7 +47,7 @@ from eyeviz import EyevizError
 from eyeviz.core.bounds import check_r_min, check_segments
 from eyeviz.core.domain3d import Domain3D
 from eyeviz.core.validation import check_choice, check_int
-from eyeviz.dataset.algorithm1 import SEGMENT_WIDTH
+from eyeviz.dataset.algorithm1 import SEGMENT_WIDTH, segment_labels
 from eyeviz.dataset.records3d import Dataset3D, index_dtype, spherical_to_xyz
 from eyeviz.files import limits
 
@@ -307,18 +307,8 @@ def iter_chunks3d(n: int, p: Gen3DParams) -> Iterator[Dataset3D]:
             yield sampler.fill(min(chunk, n - start), d.r_min, d.r_max)
         return
     edges, remaining = segment_plan3d(n, p)
-    left = n
-    for _ in range(0, n, chunk):
-        c = min(chunk, left)
-        if c == left:
-            comp = remaining
-        else:
-            comp = rng.multivariate_hypergeometric(remaining, c, method="marginals")
-        remaining = remaining - comp
-        left -= c
-        labels = np.repeat(np.arange(comp.size), comp)
-        rng.shuffle(labels)
-        yield sampler.fill(c, edges[labels], edges[labels + 1])
+    for labels in segment_labels(remaining, chunk, rng):
+        yield sampler.fill(labels.size, edges[labels], edges[labels + 1])
 
 
 def generate3d(
