@@ -109,6 +109,26 @@ def _check_param(name: str, value, rule: str) -> float:
     return v
 
 
+def check_h_l(h, l) -> tuple[float, float]:
+    """(h, l) as floats: finite, 0 < l < h (both eye models); ValueError naming them."""
+    lf = _check_param("l", l, "0 < l < h")
+    hf = _check_param("h", h, "0 < l < h")
+    if lf <= 0:
+        raise ValueError(f"l (eye radius) must be > 0, got {l!r}")
+    if hf <= lf:
+        raise ValueError(f"h must be > l (eyes may not touch the y-axis), got h={h!r}, l={l!r}")
+    return hf, lf
+
+
+def eye_x(h: float, eye: str) -> float:
+    """x of eye A (-h) or B (+h): both eye models put the centres on the x-axis."""
+    if eye == "A":
+        return -h
+    if eye == "B":
+        return h
+    raise ValueError(f"eye must be 'A' or 'B', got {eye!r}")
+
+
 @dataclass(frozen=True)
 class EyePair:
     """Two compound eyes of the paper's model (Section 3, Figure 2).
@@ -126,14 +146,7 @@ class EyePair:
     _k: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        l = _check_param("l", self.l, "0 < l < h")
-        h = _check_param("h", self.h, "0 < l < h")
-        if l <= 0:
-            raise ValueError(f"l (eye radius) must be > 0, got {self.l!r}")
-        if h <= l:
-            raise ValueError(
-                f"h must be > l (eyes may not touch the y-axis), got h={self.h!r}, l={self.l!r}"
-            )
+        h, l = check_h_l(self.h, self.l)
         mi = check_m(self.m)  # the one bound of m (eyeviz.core.bounds.MAX_M)
         object.__setattr__(self, "h", h)
         object.__setattr__(self, "l", l)
@@ -183,11 +196,7 @@ class EyePair:
         return {"h": self.h, "l": self.l, "m": self.m}
 
     def _cx(self, eye: str) -> float:
-        if eye == "A":
-            return -self.h
-        if eye == "B":
-            return self.h
-        raise ValueError(f"eye must be 'A' or 'B', got {eye!r}")
+        return eye_x(self.h, eye)
 
     # --- points -----------------------------------------------------------------------
     def eye_polar(self, x, y, eye: str) -> tuple[np.ndarray, np.ndarray]:

@@ -31,7 +31,7 @@ import numpy as np
 
 from eyeviz.core import exact3d, healpix
 from eyeviz.core.bounds import MAX_NSIDE, check_nside
-from eyeviz.core.geometry import _check_param, _first_index
+from eyeviz.core.geometry import _first_index, check_h_l, eye_x
 
 __all__ = ["EyePair3D", "validate_balls", "MAX_NSIDE", "MAX_LIT", "FALLBACK_COUNTS"]
 
@@ -590,14 +590,7 @@ class EyePair3D:
     nside: int = 180
 
     def __post_init__(self) -> None:
-        l = _check_param("l", self.l, "0 < l < h")
-        h = _check_param("h", self.h, "0 < l < h")
-        if l <= 0:
-            raise ValueError(f"l (eye radius) must be > 0, got {self.l!r}")
-        if h <= l:
-            raise ValueError(
-                f"h must be > l (eyes may not touch the y-axis), got h={self.h!r}, l={self.l!r}"
-            )
+        h, l = check_h_l(self.h, self.l)
         n = check_nside(self.nside)
         object.__setattr__(self, "h", h)
         object.__setattr__(self, "l", l)
@@ -645,11 +638,7 @@ class EyePair3D:
         return {"h": self.h, "l": self.l, "nside": self.nside}
 
     def _cx(self, eye: str) -> float:
-        if eye == "A":
-            return -self.h
-        if eye == "B":
-            return self.h
-        raise ValueError(f"eye must be 'A' or 'B', got {eye!r}")
+        return eye_x(self.h, eye)
 
     def facet(self, x, y, z, eye: str) -> np.ndarray:
         """RING index of the direction from the eye centre to the point (Prop. 1 in 3D).
