@@ -106,19 +106,7 @@ def run(args: argparse.Namespace) -> int:
 
     fmt = dataset_io.format_of(args.output)
     limits.check_free_space(args.output, limits.estimated_output_bytes(args.n, args.m, fmt))
-    bar = None
-    if not args.quiet and args.n >= _PROGRESS_MIN:
-        from tqdm import tqdm
-
-        bar = tqdm(
-            total=args.n,
-            unit="rows",
-            unit_scale=True,
-            file=sys.stderr,
-            desc=f"generate {args.output}",
-            leave=False,
-            mininterval=0.5,
-        )
+    bar = _progress(args, args.n, _PROGRESS_MIN)
     t0 = time.perf_counter()
     try:
         dataset.write(args.output, args.n, progress=bar.update if bar else None, **kw)
@@ -135,6 +123,23 @@ def run(args: argparse.Namespace) -> int:
 
 
 _PROGRESS_MIN_3D = 2_000  # rows; a 3D row (thousands of lit facets) costs far more
+
+
+def _progress(args: argparse.Namespace, n: int, least: int):
+    """A tqdm bar on stderr for ``n`` rows, or None when quiet or under ``least`` rows."""
+    if args.quiet or n < least:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(
+        total=n,
+        unit="rows",
+        unit_scale=True,
+        file=sys.stderr,
+        desc=f"generate {args.output}",
+        leave=False,
+        mininterval=0.5,
+    )
 
 
 def _run3d(args: argparse.Namespace) -> int:
@@ -157,19 +162,7 @@ def _run3d(args: argparse.Namespace) -> int:
     n = algorithm1_3d.check_n(args.n)
     algorithm1_3d.make_params3d(domain, args.mode, args.seed, args.segments)
     limits.check_free_space(args.output, sparse3d.estimated_bytes3d(n, domain))
-    bar = None
-    if not args.quiet and n >= _PROGRESS_MIN_3D:
-        from tqdm import tqdm
-
-        bar = tqdm(
-            total=n,
-            unit="rows",
-            unit_scale=True,
-            file=sys.stderr,
-            desc=f"generate {args.output}",
-            leave=False,
-            mininterval=0.5,
-        )
+    bar = _progress(args, n, _PROGRESS_MIN_3D)
     t0 = time.perf_counter()
     try:
         sparse3d.write3d(
