@@ -1,5 +1,8 @@
 """``eyeviz study -o STUDY.csv``: the eye-design study (issue 11) on Dask.
 
+With ``--nside LIST`` the 3D design study of the spherical eyes instead (issue 23;
+:mod:`eyeviz.study.point3d`): the same resumable runner, a table of its own.
+
 For every design (h, l, m) of the grid with l < h, the information limit's DD and AD
 error (MAPE, Eq. 34; R^2, Eq. 35) overall and per distance bin, one row per design and
 bin in a CSV table appended as points finish; re-running skips finished points. dask is
@@ -47,12 +50,35 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--m",
-        default=_csv(DEFAULT_M),
+        default=None,
         metavar="LIST",
         help=f"ommatidia m per eye (even, >= 4); default {_csv(DEFAULT_M)}",
     )
     parser.add_argument(
-        "--n", default="100000", metavar="N", help="test elements per design point; default 100000"
+        "--nside",
+        default=None,
+        metavar="LIST",
+        help="the 3D study instead: HEALPix nside of the spherical eyes (even, >= 2; "
+        "docs/spherical.md), e.g. 16,32,64; a table of its own",
+    )
+    parser.add_argument(
+        "--el-max",
+        default=None,
+        metavar="RAD",
+        help="3D only: elevation band |el| <= this (radians); default pi/6",
+    )
+    parser.add_argument(
+        "--estimator",
+        default=None,
+        metavar="NAME",
+        help="3D only: the estimator measured, 'limit' (the accuracy limit) or another "
+        "registry name, or 'triangulation' (built in); default triangulation",
+    )
+    parser.add_argument(
+        "--n",
+        default=None,
+        metavar="N",
+        help="test elements per design point; default 100000 (3D: 20000)",
     )
     parser.add_argument(
         "--prior",
@@ -109,20 +135,48 @@ def _float(name: str, text) -> float:
 def run(args: argparse.Namespace) -> int:
     import logging
 
+    from eyeviz import EyevizError
     from eyeviz.study import design_grid, run_study
+    from eyeviz.study.grid import DEFAULT_M
     from eyeviz.study.table import StudyTable
 
-    points = design_grid(
-        args.h,
-        args.l,
-        args.m,
-        r_min=_float("r_min", args.r_min),
-        r_max=_float("r_max", args.r_max),
-        g_max=_float("g_max", args.g_max),
-        prior=args.prior,
-        n=_int("n", args.n),
-        seed=_int("seed", args.seed),
-    )
+    r_min, r_max = _float("r_min", args.r_min), _float("r_max", args.r_max)
+    g_max, seed = _float("g_max", args.g_max), _int("seed", args.seed)
+    points: list = []
+    if args.nside is not None:
+        from eyeviz.core.domain3d import DEFAULT_EL_MAX
+        from eyeviz.study.grid3d import DEFAULT_N3D, design_grid3d
+        from eyeviz.study.point3d import BUILTIN
+
+        if args.m is not None:
+            raise EyevizError("--m is the planar study's, --nside the 3D study's: give one")
+        points = design_grid3d(
+            args.h,
+            args.l,
+            args.nside,
+            r_min=r_min,
+            r_max=r_max,
+            g_max=g_max,
+            el_max=DEFAULT_EL_MAX if args.el_max is None else _float("el_max", args.el_max),
+            prior=args.prior,
+            n=_int("n", args.n if args.n is not None else DEFAULT_N3D),
+            seed=seed,
+            estimator=args.estimator or BUILTIN,
+        )
+    else:
+        if args.el_max is not None or args.estimator is not None:
+            raise EyevizError("--el-max and --estimator belong to the 3D study (--nside)")
+        points = design_grid(
+            args.h,
+            args.l,
+            args.m if args.m is not None else _csv(DEFAULT_M),
+            r_min=r_min,
+            r_max=r_max,
+            g_max=g_max,
+            prior=args.prior,
+            n=_int("n", args.n if args.n is not None else 100_000),
+            seed=seed,
+        )
     workers = None if args.workers is None else _int("workers", args.workers)
     logging.getLogger("distributed").setLevel(logging.ERROR)  # a killed worker: no log spam
     try:

@@ -13,6 +13,9 @@ Okabe-Ito colours, text >= 7 pt at print size):
 ``study_law``  the law relative DD error = C * gamma * r / (2h) (gamma = 2 pi / m, Prop. 1):
     every measured bin against gamma r / (2h) on log-log axes with the fitted C.
 
+A 3D study table (``eyeviz study --nside``) gets the 3D figures instead
+(:mod:`eyeviz.reports.study3d`).
+
 For each h the panels and the heatmap use the paper's l (``--l``, default 20) when the
 table has it, else the l nearest to it (stated in the label). The paper's design
 (h = 40, l = 20, m = 720) is marked in every figure. ``summary.json`` holds the fitted
@@ -68,6 +71,7 @@ from eyeviz.reports.study_summary import (
     summary_json,
 )
 from eyeviz.reports.study_table import Row, read_study
+from eyeviz.study.table3d import is_table3d
 
 # The analysis, figures and summaries live in study_design, study_law, study_figures and
 # study_summary; their names stay importable from here (the tests use several of them).
@@ -125,6 +129,10 @@ def write_report(
     for name, v in (("--at", at), ("--l", l_wanted), ("--law-max", law_max), ("--target", target)):
         if not (math.isfinite(v) and v > 0):
             raise EyevizError(f"{name} must be a finite number > 0, got {v!r}")
+    if is_table3d(path):  # eyeviz study --nside: the 3D report (its own figures)
+        from eyeviz.reports.study3d import write_report3d
+
+        return write_report3d(path, outdir, prior, l_wanted)
     rows = read_study(path)
     if prior is None:  # the table's only prior, else the single-pass one
         have = sorted({r.prior for r in rows})

@@ -29,8 +29,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from eyeviz import EyevizError
-from eyeviz.study.point import COLUMNS, DesignPoint, evaluate
-from eyeviz.study.table import StudyTable
+from eyeviz.study.kinds import POINT_TYPES, Point, columns_of, evaluate3d, open_table
+from eyeviz.study.point import DesignPoint, evaluate
 
 __all__ = ["CONNECT_TIMEOUT_S", "RESUBMITS", "StudyFailed", "StudySummary", "run_study"]
 
@@ -85,8 +85,9 @@ class StudyFailed(EyevizError):
         self.summary = summary
 
 
-def _describe(p: DesignPoint) -> str:
-    return f"h={p.h:g}, l={p.l:g}, m={p.m}, n={p.n}, seed={p.seed}, prior={p.prior}"
+def _describe(p: Point) -> str:
+    res = f"nside={p.nside}" if hasattr(p, "nside") else f"m={p.m}"
+    return f"h={p.h:g}, l={p.l:g}, {res}, n={p.n}, seed={p.seed}, prior={p.prior}"
 
 
 def _one_line(exc: BaseException) -> str:
@@ -169,11 +170,11 @@ def _close(client, cluster) -> None:
             cluster.close(timeout=20)
 
 
-def _check_rows(p: DesignPoint, rows) -> list[dict]:
+def _check_rows(p: Point, rows) -> list[dict]:
     if not isinstance(rows, list) or not rows:
         raise EyevizError(f"a worker returned no rows for {_describe(p)}")
     for r in rows:
-        if not isinstance(r, dict) or tuple(r) != COLUMNS:
+        if not isinstance(r, dict) or tuple(r) != columns_of(p):
             raise EyevizError(f"a worker returned malformed rows for {_describe(p)}")
         if (r["h"], r["l"], r["m"], r["n"], r["seed"], r["prior"]) != (
             p.h, p.l, p.m, p.n, p.seed, p.prior,
@@ -212,11 +213,11 @@ def tune_malloc() -> bool:
     return ok
 
 
-def evaluate_on_worker(point: DesignPoint) -> list[dict]:
+def evaluate_on_worker(point: Point) -> list[dict]:
     """The task a worker runs: :func:`~eyeviz.study.point.evaluate` after
     :func:`tune_malloc`."""
     tune_malloc()
-    return evaluate(point)
+    return evaluate(point) if isinstance(point, DesignPoint) else evaluate3d(point)
 
 
 def connect_timeout_for(scheduler: str | None, connect_timeout: float) -> float:
@@ -279,7 +280,7 @@ def _exclusive(path):
 
 def run_study(
     path,
-    points: Iterable[DesignPoint],
+    points: Iterable[Point],
     workers: int | None = None,
     scheduler: str | None = None,
     progress: bool = True,
@@ -290,8 +291,9 @@ def run_study(
 
     ``workers``: local worker processes (default: one per core); ``scheduler``: the
     address of an existing Dask scheduler instead (then ``workers`` must be None).
-    Points already in the table (same :attr:`DesignPoint.key`) are skipped; each
-    finished point is appended atomically as it arrives. Returns a
+    Points (planar or 3D, :mod:`eyeviz.study.kinds`) already in the table (same
+    ``key``) are skipped; each finished point is appended atomically as it arrives.
+    Returns a
     :class:`StudySummary`; raises :class:`StudyFailed` when some points failed (the
     others are kept), :class:`EyevizError` for an unreadable table, a bad worker count
     or an unreachable scheduler, and lets KeyboardInterrupt through after closing the
@@ -303,15 +305,18 @@ def run_study(
 
 def _run(path, points, workers, scheduler, progress, connect_timeout) -> StudySummary:
     t0 = time.perf_counter()
-    table = StudyTable.open(path)  # a bad or foreign file is refused before any work
-    unique: dict[tuple, DesignPoint] = {}
+    unique: dict[tuple, Point] = {}
     for p in points:
-        if not isinstance(p, DesignPoint):
+        if not isinstance(p, POINT_TYPES):
             raise EyevizError(f"a study point must be a DesignPoint, got {type(p).__name__}")
         unique.setdefault(p.key, p)
+    # a bad or foreign file is refused before any work
+    table = open_table(path, list(unique.values()))
     # largest first (the cost grows with n and m, and h): the last points to finish are
     # small ones, so no worker waits long at the end of the study
-    todo = sorted((p for p in unique.values() if p not in table), key=lambda p: (-p.n * p.m, -p.h))
+    todo = sorted(
+        (p for p in unique.values() if p.key not in table.keys), key=lambda p: (-p.n * p.m, -p.h)
+    )
     skipped = len(unique) - len(todo)
     if scheduler is not None and workers is not None:
         raise EyevizError("--workers sets up a local cluster; with --scheduler leave it out")
@@ -363,7 +368,7 @@ def _run(path, points, workers, scheduler, progress, connect_timeout) -> StudySu
         attempts: dict[tuple, int] = {}
         serial = itertools.count()  # a resubmitted point gets a key of its own
 
-        def submit(p: DesignPoint):
+        def submit(p: Point):
             attempts[p.key] = attempts.get(p.key, 0) + 1
             key = f"eyeviz-study-h{p.h:g}-l{p.l:g}-m{p.m}-{tag}-{next(serial)}"
             fut = client.submit(evaluate_on_worker, p, key=key, pure=False, retries=1)

@@ -1,0 +1,229 @@
+"""``eyeviz report study STUDY3D.csv -o DIR`` for a 3D study table (``eyeviz study --nside``).
+
+The 3D table (:mod:`eyeviz.study.table3d`) holds, per design of the spherical eyes (h, l,
+nside) and estimator, the DD and AD error (MAPE, Eq. 34) and the elevation and azimuth
+error (mean absolute, degrees) overall, per distance bin and per elevation bin. This
+report answers the 3D study's questions:
+
+1. How does accuracy depend on h, l, nside, distance and elevation?
+   ``study3d_design``: DD MAPE and elevation error (overall) against h, l and nside.
+2. Does the planar law, relative DD error = C gamma r / (2h), carry over?
+   ``study3d_dd``: DD MAPE against r, a panel per h, a curve per nside, each with its law
+   line C gamma r / (2h) (gamma = 2 pi / (4 nside), the equatorial facet width; C fitted
+   in 3D with the slope fixed at 1, as the planar report does); ``study3d_law``: every
+   distance bin against gamma r / (2h) on log-log axes. ``summary3d.json`` adds a free
+   power law, relative DD = K gamma^a r^b h^c l^d, fitted by least squares in log space:
+   the planar law is a = b = 1, c = -1, d = 0.
+3. How does the elevation error behave (the baseline is horizontal, so each eye alone sees
+   the elevation)? ``study3d_elevation``: elevation and azimuth error against elevation
+   and against r, a curve per nside, at the paper's h and l (or the nearest).
+
+Fitted: distance bins with at least :data:`~eyeviz.reports.study_design.MIN_COUNT`
+elements, no flagged answer, not the first or last bin of a design (the prior's bounds
+truncate there) and a relative error <= :data:`FIT_MAX` (where it saturates, the prior's
+range bounds it). The estimator is named in every figure's title: only ``limit`` is the
+accuracy limit; any other (``triangulation``) is an upper bound on it.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from eyeviz import EyevizError
+from eyeviz.reports.study_design import MIN_COUNT
+from eyeviz.reports.study_law import LawFit, LawPoint, fit_law
+from eyeviz.study.table3d import read_rows3d
+
+__all__ = ["FIT_MAX", "PAPER3D", "Design3D", "fit_power", "law_points3d", "write_report3d"]
+
+#: The paper's eyes in 3D: h = 40, l = 20 and nside 180 (m = 720 on the equator).
+PAPER3D = (40.0, 20.0, 180)
+#: Largest relative DD error (a fraction) of a bin used in the fits.
+FIT_MAX = 0.10
+
+
+@dataclass
+class Design3D:
+    """One 3D design point's rows: overall, distance bins (by r), elevation bins (by el)."""
+
+    h: float
+    l: float  # noqa: E741
+    nside: int
+    gamma: float
+    all: dict
+    r_bins: list[dict]
+    el_bins: list[dict]
+
+    @property
+    def key(self) -> tuple[float, float, int]:
+        return (self.h, self.l, self.nside)
+
+
+def choose_estimator(rows: list[dict]) -> str:
+    """``limit`` when the table has it, else the only estimator, else the first by name."""
+    names = sorted({r["estimator"] for r in rows})
+    return "limit" if "limit" in names else names[0]
+
+
+def designs3d(rows: list[dict], estimator: str, prior: str) -> dict[tuple, Design3D]:
+    """The rows of ``estimator`` and ``prior`` per design; of several runs the largest n."""
+    runs: dict[tuple, list[dict]] = {}
+    for r in rows:
+        if r["estimator"] == estimator and r["prior"] == prior:
+            runs.setdefault(r["_key"], []).append(r)
+    if not runs:
+        raise EyevizError(
+            f"the 3D study table has no rows of estimator {estimator!r} and prior {prior!r}"
+        )
+    best: dict[tuple, list[dict]] = {}
+    for rr in runs.values():
+        k = (rr[0]["h"], rr[0]["l"], rr[0]["nside"])
+        if k not in best or rr[0]["n"] > best[k][0]["n"]:
+            best[k] = rr
+    out = {}
+    for k, rr in best.items():
+        alls = [r for r in rr if r["bin"] == "all"]
+        rb = sorted((r for r in rr if r["bin"].startswith("r")), key=lambda r: r["lo"])
+        eb = sorted((r for r in rr if r["bin"].startswith("e")), key=lambda r: r["lo"])
+        out[k] = Design3D(k[0], k[1], k[2], alls[0]["gamma"], alls[0], rb, eb)
+    return out
+
+
+def law_points3d(designs: dict[tuple, Design3D]) -> list[LawPoint]:
+    """Every distance bin as (x = gamma r_mid / (2h), y = relative DD error); ``fitted``
+    as this module's docstring says. ``m`` holds 4 nside."""
+    out = []
+    for d in designs.values():
+        n = len(d.r_bins)
+        for i, b in enumerate(d.r_bins):
+            if b["count"] < MIN_COUNT or not (b["dd_mape"] > 0):
+                continue
+            r_mid = 0.5 * (b["lo"] + b["hi"])
+            y = b["dd_mape"] / 100.0
+            interior = n < 3 or 0 < i < n - 1
+            fitted = interior and b["flagged"] == 0 and y <= FIT_MAX
+            paper = d.key == PAPER3D
+            out.append(
+                LawPoint(
+                    d.h, d.l, 4 * d.nside, r_mid, d.gamma * r_mid / (2 * d.h), y, fitted, paper
+                )  # fmt: skip
+            )
+    return out
+
+
+def fit_power(points: list[LawPoint]) -> dict | None:
+    """relative DD = K gamma^a r^b h^c l^d, least squares in log space over the fitted
+    points (a parameter that does not vary is left out and reported as None)."""
+    use = [p for p in points if p.fitted]
+    if len(use) < 3:
+        return None
+    gam = np.array([2 * math.pi / p.m for p in use])
+    cols = {"gamma": gam, "r": np.array([p.r for p in use]),
+            "h": np.array([p.h for p in use]), "l": np.array([p.l for p in use])}  # fmt: skip
+    names = [k for k, v in cols.items() if np.ptp(np.log(v)) > 0]
+    a = np.column_stack([np.ones(len(use))] + [np.log(cols[k]) for k in names])
+    y = np.log([p.y for p in use])
+    if len(use) <= a.shape[1]:
+        return None
+    coef, *_ = np.linalg.lstsq(a, y, rcond=None)
+    res = y - a @ coef
+    out: dict = {"K": float(math.exp(coef[0])), "n": len(use)}
+    for k in cols:
+        out[f"exp_{k}"] = float(coef[1 + names.index(k)]) if k in names else None
+    out["log_sd"] = float(res.std(ddof=a.shape[1]))
+    return out
+
+
+def _nearest(values, want: float) -> float:
+    return min(values, key=lambda v: (abs(math.log(v / want)), v))
+
+
+def write_report3d(
+    path: Path,
+    outdir: Path,
+    prior: str | None = None,
+    l_wanted: float = PAPER3D[1],
+    estimator: str | None = None,
+) -> list[Path]:
+    """Read the 3D study table at ``path`` and write the figures and summary into ``outdir``."""
+    import matplotlib
+
+    from eyeviz.reports.study3d_figures import (
+        dd_figure,
+        design_figure,
+        elevation_figure,
+        law_figure3d,
+    )
+    from eyeviz.reports.study_figures import _rc, save
+    from eyeviz.reports.study_summary import _write_text
+
+    rows, _ = read_rows3d(path)
+    if not rows:
+        raise EyevizError(f"{path}: the 3D study table has no rows")
+    if prior is None:
+        have = sorted({r["prior"] for r in rows})
+        prior = have[0] if len(have) == 1 else "single"
+    est = estimator or choose_estimator(rows)
+    designs = designs3d(rows, est, prior)
+    points = law_points3d(designs)
+    fit: LawFit = fit_law(points, x_max=math.inf)
+    power = fit_power(points)
+    hs = sorted({k[0] for k in designs})
+    l_of = {h: _nearest([k[1] for k in designs if k[0] == h], l_wanted) for h in hs}
+    h_star = _nearest(hs, PAPER3D[0])
+    label = est if est == "limit" else f"{est} (an upper bound on the limit, not the limit)"
+    outdir.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    with matplotlib.rc_context(_rc()):
+        for stem, fig in (
+            ("study3d_design", design_figure(designs, l_of, h_star, label)),
+            ("study3d_dd", dd_figure(designs, l_of, fit, label)),
+            ("study3d_law", law_figure3d(points, fit, power, label)),
+            ("study3d_elevation", elevation_figure(designs, h_star, l_of[h_star], label)),
+        ):
+            written += save(fig, outdir, stem)
+    summary = {
+        "table": str(path),
+        "estimator": est,
+        "is_the_limit": est == "limit",
+        "prior": prior,
+        "law_slope_1": {
+            "C": fit.C,
+            "factor_1sd": fit.factor,
+            "n": fit.n,
+            "free_slope": fit.slope,
+            "C_free": fit.C_free,
+        },  # fmt: skip
+        "power_law": power,
+        "fit_rule": f"interior distance bins, >= {MIN_COUNT} elements, no flagged answer, "
+        f"relative DD error <= {FIT_MAX:g}",
+        "designs": [
+            {
+                "h": d.h,
+                "l": d.l,
+                "nside": d.nside,
+                "gamma": d.gamma,
+                "n": d.all["n"],
+                **{
+                    k: d.all[k]
+                    for k in (
+                        "dd_mape",
+                        "ad_mape",
+                        "el_mae_deg",
+                        "az_mae_deg",
+                        "flagged",
+                        "seconds",
+                    )
+                },
+            }  # fmt: skip
+            for d in sorted(designs.values(), key=lambda d: d.key)
+        ],
+    }
+    text = json.dumps(summary, indent=1, allow_nan=False) + "\n"
+    written.append(_write_text(outdir / "summary3d.json", text))
+    return written

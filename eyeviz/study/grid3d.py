@@ -1,0 +1,103 @@
+"""The design grid of the 3D design study: every (h, l, nside) with l < h.
+
+The 3D form of :mod:`eyeviz.study.grid`: the product of lists of h, l and nside (the
+HEALPix resolution of each spherical eye, 12 nside^2 facets, 4 nside on the equator;
+docs/spherical.md), keeping the designs whose eyes do not overlap (l < h), each with the
+same object ranges (r, g and the elevation band |el| <= el_max), prior, n, seed and
+estimator (:class:`~eyeviz.study.point3d.DesignPoint3D`).
+
+Bad input ends in one :class:`eyeviz.EyevizError` naming it: ``design_grid3d(nside="7")``
+-> "nside must be an even integer ..."; a grid with no design where l < h; n < 1; a design
+where no ball can be visible (the 3D generator's checks, naming the design).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+
+from eyeviz import EyevizError
+from eyeviz.core.bounds import MAX_BINS, check_nside, check_r_min
+from eyeviz.core.domain import DEFAULTS
+from eyeviz.core.domain3d import DEFAULT_EL_MAX
+from eyeviz.core.validation import check_choice, check_int, check_real
+from eyeviz.files.limits import MAX_ROWS
+from eyeviz.study.grid import DEFAULT_H, DEFAULT_L, MAX_GRID_POINTS, _unique, parse_list
+from eyeviz.study.point import BIN_WIDTH
+from eyeviz.study.point3d import BUILTIN, DesignPoint3D
+
+__all__ = ["DEFAULT_NSIDE", "DEFAULT_N3D", "design_grid3d"]
+
+#: The default resolutions: m = 4 nside = 64, 128, 256 on the equator (the planar study's
+#: m = 180 ... 2880 span nside 45 ... 720; 3D lit sets grow as nside^2, so the default stays
+#: small; the paper's m = 720 is nside 180).
+DEFAULT_NSIDE = (16, 32, 64)
+#: Test elements per 3D design point by default.
+DEFAULT_N3D = 20_000
+
+
+def _check_nsides(values: list[float]) -> list[int]:
+    return [check_nside(int(v) if float(v).is_integer() else v) for v in values]
+
+
+def design_grid3d(
+    h: str | Iterable = DEFAULT_H,
+    l: str | Iterable = DEFAULT_L,  # noqa: E741  (the paper's name)
+    nside: str | Iterable = DEFAULT_NSIDE,
+    *,
+    r_min: float = DEFAULTS["r_min"],
+    r_max: float = DEFAULTS["r_max"],
+    g_max: float = DEFAULTS["g_max"],
+    el_max: float = DEFAULT_EL_MAX,
+    prior: str = "single",
+    n: int = DEFAULT_N3D,
+    seed: int = 0,
+    estimator: str = BUILTIN,
+) -> list[DesignPoint3D]:
+    """The 3D study's design points: every (h, l, nside) of the lists with l < h, in the
+    order h, then l, then nside (duplicates dropped). Lists may be texts ("16,32,64").
+
+    Raises a one-line :class:`EyevizError` for a non-number, an odd nside or one < 2, n < 1
+    (or beyond :data:`~eyeviz.files.limits.MAX_ROWS`), a bad range, el_max outside
+    (0, pi/2), a bad prior or estimator name, a grid where no design has l < h, or a
+    design where no ball can be visible in the binocular field.
+    """
+    hs = _unique(parse_list("h", h))
+    ls = _unique(parse_list("l", l))
+    ns = _unique(_check_nsides(parse_list("nside", nside)))
+    for name, vals in (("h", hs), ("l", ls)):
+        for v in vals:
+            check_real(name, v, gt=0)
+    n = check_int("n", n, ge=1, le=MAX_ROWS)
+    seed = check_int("seed", seed, ge=0)
+    check_choice("prior", prior, ("single", "multi"))
+    r_lo = check_real("r_min", r_min, gt=0)
+    r_hi = check_real("r_max", r_max, gt=r_lo)
+    check_real("g_max", g_max, gt=0)
+    check_real("el_max", el_max, gt=0, lt=math.pi / 2)
+    check_r_min(r_lo, max(hs))
+    if (r_hi - r_lo) / BIN_WIDTH > MAX_BINS:
+        raise EyevizError(
+            f"r_max - r_min = {r_hi - r_lo:g} gives more than {MAX_BINS} distance bins "
+            f"of {BIN_WIDTH:g}"
+        )
+    pairs = [(hv, lv) for hv in hs for lv in ls if lv < hv]
+    if not pairs:
+        raise EyevizError(
+            f"no design in the grid has l < h (h: {', '.join(f'{v:g}' for v in hs)}; "
+            f"l: {', '.join(f'{v:g}' for v in ls)})"
+        )
+    if len(pairs) * len(ns) > MAX_GRID_POINTS:
+        raise EyevizError(
+            f"the grid has {len(pairs) * len(ns)} design points, more than {MAX_GRID_POINTS}"
+        )
+    out = []
+    for hv, lv in pairs:
+        for nv in ns:
+            try:
+                p = DesignPoint3D(hv, lv, nv, r_lo, r_hi, g_max, el_max, prior, n, seed,
+                                  estimator)  # fmt: skip
+            except EyevizError as exc:
+                raise EyevizError(f"design h={hv:g}, l={lv:g}, nside={nv}: {exc}") from None
+            out.append(p)
+    return out

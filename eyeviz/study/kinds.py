@@ -1,0 +1,43 @@
+"""The two kinds of study the runner distributes: planar (h, l, m) and 3D (h, l, nside).
+
+:mod:`eyeviz.study.runner` is one resumable Dask runner for both; what differs per kind
+is here: the point type, its table (:class:`~eyeviz.study.table.StudyTable` or
+:class:`~eyeviz.study.table3d.StudyTable3D`, told apart by their headers), its columns
+and the function a worker evaluates. A study's points are all of one kind.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from eyeviz import EyevizError
+from eyeviz.study.point import COLUMNS, DesignPoint
+from eyeviz.study.point3d import COLUMNS3D, DesignPoint3D, evaluate3d
+from eyeviz.study.table import StudyTable
+from eyeviz.study.table3d import StudyTable3D, is_table3d
+
+__all__ = ["POINT_TYPES", "Point", "columns_of", "evaluate3d", "open_table"]
+
+POINT_TYPES = (DesignPoint, DesignPoint3D)
+#: A point of either kind.
+Point = DesignPoint | DesignPoint3D
+
+
+def columns_of(point: Point) -> tuple[str, ...]:
+    """The table columns of ``point``'s kind."""
+    return COLUMNS3D if isinstance(point, DesignPoint3D) else COLUMNS
+
+
+def open_table(path, points: Sequence) -> StudyTable | StudyTable3D:
+    """The table at ``path`` for ``points`` (all planar or all 3D; checked here)."""
+    kinds = {type(p) for p in points}
+    if len(kinds) > 1:
+        raise EyevizError("a study's points must be all planar (m) or all 3D (nside), not both")
+    if kinds == {DesignPoint3D}:
+        return StudyTable3D.open(path)
+    if is_table3d(path):
+        raise EyevizError(
+            f"{path}: a 3D study table (eyeviz study --nside); the planar study (--m) "
+            "writes its own: give another -o"
+        )
+    return StudyTable.open(path)

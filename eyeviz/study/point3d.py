@@ -1,0 +1,263 @@
+"""One design point of the 3D design study: DD, AD and elevation error of the spherical eyes.
+
+A 3D design point is a design of the two spherical eyes (h, l, nside; docs/spherical.md)
+with the object ranges (r, g and the elevation band |el| <= el_max), a prior ("single"
+or "multi" pass), a test-set size n, a seed and the *estimator* whose error is measured.
+Its test set is drawn from the design's Algorithm 1 in 3D
+(:func:`eyeviz.dataset.algorithm1_3d.iter_chunks3d`, sparse lit sets, no bitmaps held)
+and every element is estimated from the two lit sets alone.
+
+The estimator is a parameter of the point (the ``estimator`` column of the table):
+
+``"triangulation"``  built in here, for any design: each eye's direction to the ball is
+    the normalised mean of its lit facets' centres (the centre of the lit cap, to within
+    the facet size), and the ball is the midpoint of the two rays' closest approach
+    (from A = (-h, 0, 0) and B = (h, 0, 0)). No prior is used: an upper bound on the
+    information limit, not the limit.
+any other name  loaded from the estimator registry,
+    ``registry.load(name, domain=Domain3D(...))``, whose ``predict(lit_a, lit_b)`` takes
+    the CSR lit sets ``(indptr, indices)`` per eye and answers (r, azimuth, elevation, ...)
+    (``"limit"``: the exact posterior, the accuracy limit the study is for).
+
+The errors per row: DD and AD MAPE (%) and R^2 (Eqs. 34-35, docs/conventions.md, as the
+planar study), the mean absolute elevation and azimuth error in degrees (MAPE is no
+measure for an elevation that crosses 0) and the elevation's R^2; overall (bin
+``"all"``), per distance bin (``"r0"``, ``"r1"``, ... of :data:`~eyeviz.study.point.BIN_WIDTH`)
+and per elevation bin (``"e0"`` ... ``"e5"``: :data:`EL_BINS` equal bins of
+[-el_max, el_max]). ``gamma`` is the equatorial facet width 2 pi / (4 nside), the planar
+gamma of the z = 0 slice (the one the γ r / (2h) law is stated in).
+
+Pure: the same point gives the same rows except ``seconds``. No dask here.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from eyeviz import EyevizError
+from eyeviz.core.domain import DEFAULTS
+from eyeviz.core.domain3d import DEFAULT_EL_MAX, Domain3D
+from eyeviz.core.validation import check_choice, check_int
+from eyeviz.estimators.metrics import mape, r2
+from eyeviz.study.point import BIN_WIDTH, distance_bins
+
+__all__ = [
+    "BUILTIN",
+    "COLUMNS3D",
+    "EL_BINS",
+    "STUDY3D_VERSION",
+    "DesignPoint3D",
+    "elevation_bins",
+    "evaluate3d",
+    "triangulate",
+]
+
+#: Version of the 3D study table's columns; a file with another version is refused.
+STUDY3D_VERSION = 1
+#: Equal elevation bins over [-el_max, el_max] (10 degrees each at the default 30).
+EL_BINS = 6
+#: The estimator built into this module (every other name comes from the registry).
+BUILTIN = "triangulation"
+#: The 3D study table's columns, in order: one row per design point and bin ("all" first,
+#: then the distance bins "r0", "r1", ..., then the elevation bins "e0" ... "e5").
+#: ``lo``/``hi``: the bin's range of r (rows "all" and "r*") or of the elevation in
+#: radians (rows "e*").
+COLUMNS3D = (
+    "version", "h", "l", "nside", "m", "gamma", "r_min", "r_max", "g_max", "el_max",
+    "prior", "n", "seed", "estimator", "bin", "lo", "hi", "count", "dd_mape", "ad_mape",
+    "el_mae_deg", "az_mae_deg", "dd_r2", "ad_r2", "el_r2", "flagged", "seconds",
+)  # fmt: skip
+_PRIORS = ("single", "multi")
+_MAX_NAME = 40
+
+
+@dataclass(frozen=True)
+class DesignPoint3D:
+    """One design of the spherical eyes, its test set and the estimator measured."""
+
+    h: float = DEFAULTS["h"]
+    l: float = DEFAULTS["l"]  # noqa: E741  (the paper's name)
+    nside: int = int(DEFAULTS["m"]) // 4
+    r_min: float = DEFAULTS["r_min"]
+    r_max: float = DEFAULTS["r_max"]
+    g_max: float = DEFAULTS["g_max"]
+    el_max: float = DEFAULT_EL_MAX
+    prior: str = "single"
+    n: int = 20_000
+    seed: int = 0
+    estimator: str = BUILTIN
+
+    def __post_init__(self) -> None:
+        from eyeviz.dataset.algorithm1_3d import make_params3d
+
+        check_choice("prior", self.prior, _PRIORS)
+        check_int("n", self.n, ge=1)
+        check_int("seed", self.seed, ge=0)
+        e = self.estimator
+        if not (isinstance(e, str) and 0 < len(e) <= _MAX_NAME and e.isidentifier()):
+            raise EyevizError(f"estimator must be an estimator's name, got {e!r}")
+        make_params3d(self.domain, self.prior, self.seed)  # named messages: no ball fits
+
+    @property
+    def domain(self) -> Domain3D:
+        return Domain3D(self.h, self.l, self.nside, self.r_min, self.r_max, self.g_max,
+                        self.el_max)  # fmt: skip
+
+    @property
+    def m(self) -> int:
+        """Facets on the equator, 4 nside (the planar m of the z = 0 slice)."""
+        return 4 * int(self.nside)
+
+    @property
+    def key(self) -> tuple:
+        """What identifies a finished point in a 3D study file (resume skips it)."""
+        return (
+            float(self.h), float(self.l), int(self.nside), float(self.r_min),
+            float(self.r_max), float(self.g_max), float(self.el_max), self.prior,
+            int(self.n), int(self.seed), self.estimator,
+        )  # fmt: skip
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def elevation_bins(el_max: float, k: int = EL_BINS) -> np.ndarray:
+    """Edges of ``k`` equal elevation bins over [-el_max, el_max] (radians)."""
+    return np.linspace(-el_max, el_max, k + 1)
+
+
+def _cap_directions(nside: int, indptr: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """Per row, the normalised mean of its lit facets' centre vectors (rows, 3)."""
+    from eyeviz.core.healpix import centers
+
+    v = centers(nside, indices)
+    lens = np.diff(indptr)
+    if np.any(lens == 0):
+        raise EyevizError("a row lights no facet of an eye (not a visible ball)")
+    s = np.add.reduceat(v, indptr[:-1], axis=0)
+    return s / np.linalg.norm(s, axis=1, keepdims=True)
+
+
+def triangulate(
+    domain: Domain3D, lit_a: tuple[np.ndarray, np.ndarray], lit_b: tuple[np.ndarray, np.ndarray]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(r, azimuth, elevation, flagged) from the CSR lit sets ``(indptr, indices)`` per eye.
+
+    Each eye's direction u (A) and v (B) is its lit cap's centre (mean of the facet
+    centres); the ball is the midpoint of the closest approach of A + s u and B + t v
+    (the 3D form of the planar triangulation of Eqs. 20-21). Rays that do not meet in
+    front of both eyes (s or t <= 0, or parallel) are ``flagged``: the answer is then
+    r_max along the mean of u and v. r is clipped to [r_min, r_max].
+    """
+    u = _cap_directions(domain.nside, *lit_a)
+    v = _cap_directions(domain.nside, *lit_b)
+    a = np.array([-domain.h, 0.0, 0.0])
+    w0 = a - (-a)  # A - B
+    b = np.einsum("ij,ij->i", u, v)
+    d = u @ w0
+    e = v @ w0
+    den = 1.0 - b * b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = (b * e - d) / den
+        t = (e - b * d) / den
+    ok = (den > 1e-15) & (s > 0) & (t > 0) & np.isfinite(s) & np.isfinite(t)
+    s = np.where(ok, s, 1.0)
+    t = np.where(ok, t, 1.0)
+    p = 0.5 * ((a + s[:, None] * u) + (-a + t[:, None] * v))
+    mean_dir = u + v
+    mean_dir /= np.linalg.norm(mean_dir, axis=1, keepdims=True)
+    p = np.where(ok[:, None], p, domain.r_max * mean_dir)
+    rho = np.linalg.norm(p, axis=1)
+    r = np.clip(rho, domain.r_min, domain.r_max)
+    az = np.arctan2(p[:, 1], p[:, 0])
+    el = np.arcsin(np.clip(p[:, 2] / rho, -1.0, 1.0))
+    return r, az, el, ~ok
+
+
+def _load(point: DesignPoint3D):
+    """A ``predict(lit_a, lit_b) -> (r, azimuth, elevation, flagged)`` for the point."""
+    d = point.domain
+    if point.estimator == BUILTIN:
+        return lambda la, lb: triangulate(d, la, lb)
+    from eyeviz.estimators import registry
+
+    est = registry.load(point.estimator, domain=d)
+
+    def predict(la, lb):
+        p = est.predict(la, lb)
+        flagged = getattr(p, "flagged", None)
+        if hasattr(p, "r"):
+            r, az, el = p.r, p.azimuth, p.elevation
+        else:
+            r, az, el = p[0], p[1], p[2]
+        valid = getattr(p, "valid", None)
+        if valid is not None and not np.all(valid):
+            raise EyevizError(f"{point.estimator} could not answer a generated element")
+        fl = np.zeros(np.shape(r), bool) if flagged is None else np.asarray(flagged, bool)
+        return np.asarray(r, float), np.asarray(az, float), np.asarray(el, float), fl
+
+    return predict
+
+
+def _errors(r, az, el, rh, ah, eh) -> dict[str, float]:
+    deg = 180.0 / math.pi
+    out = {
+        "dd_mape": mape(r, rh),
+        "ad_mape": mape(az, ah),
+        "el_mae_deg": float(np.mean(np.abs(eh - el)) * deg),
+        "az_mae_deg": float(np.mean(np.abs(ah - az)) * deg),
+    }
+    for name, y, yh in (("dd_r2", r, rh), ("ad_r2", az, ah), ("el_r2", el, eh)):
+        out[name] = r2(y, yh) if y.size > 1 and np.ptp(y) > 0 else math.nan
+    return out
+
+
+_METRICS = ("dd_mape", "ad_mape", "el_mae_deg", "az_mae_deg", "dd_r2", "ad_r2", "el_r2")
+
+
+def evaluate3d(point: DesignPoint3D, bin_width: float = BIN_WIDTH) -> list[dict]:
+    """Rows of the 3D study table for one point: ``"all"``, the distance bins ``"r<i>"``,
+    the elevation bins ``"e<j>"`` (see this module's docstring for the columns)."""
+    from eyeviz.dataset.algorithm1_3d import iter_chunks3d, make_params3d
+
+    t0 = time.perf_counter()
+    d = point.domain
+    params = make_params3d(d, point.prior, point.seed)
+    predict = _load(point)
+    keys = ("r", "az", "el", "rh", "ah", "eh", "fl")
+    parts: dict[str, list[np.ndarray]] = {k: [] for k in keys}
+    for c in iter_chunks3d(point.n, params):
+        out = predict((c.indptr_a, c.indices_a), (c.indptr_b, c.indices_b))
+        for k, v in zip(keys, (c.r, c.azimuth, c.elevation, *out), strict=True):
+            parts[k].append(np.asarray(v))
+    r, az, el, rh, ah, eh, fl = (np.concatenate(v) for v in parts.values())
+    seconds = time.perf_counter() - t0
+    base = {"version": STUDY3D_VERSION, **point.to_dict(), "m": point.m,
+            "gamma": 2 * math.pi / point.m}  # fmt: skip
+    bins: list[tuple[str, float, float, np.ndarray]] = [
+        ("all", point.r_min, point.r_max, np.ones(r.size, bool))
+    ]
+    for prefix, values, edges in (
+        ("r", r, distance_bins(point.r_min, point.r_max, bin_width)),
+        ("e", el, elevation_bins(point.el_max)),
+    ):
+        for i in range(edges.size - 1):
+            lo, hi = float(edges[i]), float(edges[i + 1])
+            last = i == edges.size - 2
+            sel = (values >= lo) & ((values <= hi) if last else (values < hi))
+            bins.append((f"{prefix}{i}", lo, hi, sel))
+    rows = []
+    for name, lo, hi, sel in bins:
+        row = {**base, "bin": name, "lo": float(lo), "hi": float(hi), "count": int(sel.sum())}
+        if row["count"]:
+            row.update(_errors(r[sel], az[sel], el[sel], rh[sel], ah[sel], eh[sel]))
+        else:
+            row.update(dict.fromkeys(_METRICS, math.nan))
+        row["flagged"] = int(fl[sel].sum())
+        row["seconds"] = seconds
+        rows.append({k: row[k] for k in COLUMNS3D})
+    return rows
