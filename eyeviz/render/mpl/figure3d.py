@@ -32,14 +32,13 @@ from pathlib import Path
 import numpy as np
 from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
-from matplotlib.projections.geo import MollweideAxes
 
 from eyeviz import EyevizError
 from eyeviz.core import healpix
 from eyeviz.files.atomic import atomic_output
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
-from eyeviz.render.mpl.healpix_map import MAX_ALL_FACETS, draw_eye_view, view_lonlat
+from eyeviz.render.mpl.healpix_map import MAX_ALL_FACETS, MapAxes, draw_eye_view, view_lonlat
 from eyeviz.render.mpl.style import (
     BASE_DPI,
     EDGE,
@@ -67,15 +66,6 @@ CAMERA_DIST = 9.0
 #: A ball's line of sight is drawn this many eye radii out from the eye's surface.
 SIGHT = 1.6
 ROW_IN = 0.14  # a table row, inches
-
-
-class _MapAxes(MollweideAxes):
-    """Mollweide axes that do not resample paths: matplotlib's split every segment into 75
-    (a facet of 8 vertices became 600, an SVG of the teaching scene 23 MB); the facets'
-    outlines are already sampled along their edges, and curved lines are drawn sampled."""
-
-    name = "eyeviz_mollweide"
-    RESOLUTION = 1
 
 
 def check_drawable3d(scene: Scene) -> None:
@@ -351,7 +341,7 @@ def figure3d(
                 eyes = "AB" if name == "maps" else name[-1]
                 for k, eye in enumerate(eyes):
                     x0 = m + k * (map_w + m)
-                    ax = fig.add_axes(rect(x0, map_w, map_w / 2, 0.18), axes_class=_MapAxes)
+                    ax = fig.add_axes(rect(x0, map_w, map_w / 2, 0.18), axes_class=MapAxes)
                     ax.set_gid(f"map{eye}")
                     _draw_map(ax, st, scene, eye)
             elif name == "table":

@@ -14,6 +14,13 @@ map's centre and mirrored, so that the eye's right is on the map's right. Above
 polygons over a solid background of the unlit sphere: the whole eye at nside 180 is
 388,800 polygons, far too heavy for an SVG or PDF.
 
+The maps' axes are :class:`MapAxes` (Mollweide without resampling). The way back from a
+point of a map to a facet, for the app's hover (issue 22): :func:`mollweide_inverse` (the
+projection's closed-form inverse), :func:`model_lonlat` (the inverse of
+:func:`view_lonlat`) and :func:`pixel_at`, which maps the direction with
+:func:`eyeviz.core.healpix.ang2pix_ring` (exact; astropy-healpix's ``lonlat_to_healpix``
+agrees off the cells' boundaries, tests/app/test_panels3d.py).
+
 matplotlib is imported by the caller's figure; this module only adds artists to an axes.
 """
 
@@ -25,15 +32,37 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.collections import PolyCollection
+from matplotlib.projections.geo import MollweideAxes
 
 from eyeviz.core import healpix
 
-__all__ = ["MAX_ALL_FACETS", "draw_eye_map", "draw_eye_view", "facet_lonlat", "view_lonlat"]
+__all__ = [
+    "MAX_ALL_FACETS",
+    "MapAxes",
+    "draw_eye_map",
+    "draw_eye_view",
+    "facet_lonlat",
+    "model_lonlat",
+    "mollweide",
+    "mollweide_inverse",
+    "pixel_at",
+    "view_lonlat",
+    "view_polys",
+]
 
 UNLIT = "#eeeeee"
 EDGE = "#b0b0b0"
 #: Facets per eye above which :func:`draw_eye_view` draws only the lit facets (nside 32).
 MAX_ALL_FACETS = 12_288
+
+
+class MapAxes(MollweideAxes):
+    """Mollweide axes that do not resample paths: matplotlib's split every segment into 75
+    (a facet of 8 vertices became 600, an SVG of the teaching scene 23 MB); the facets'
+    outlines are already sampled along their edges, and curved lines are drawn sampled."""
+
+    name = "eyeviz_mollweide"
+    RESOLUTION = 1
 
 
 def facet_lonlat(nside: int, pix, step: int = 2) -> np.ndarray:
@@ -90,6 +119,77 @@ def view_lonlat(lon, lat, *, lon0: float = math.pi / 2, flip: bool = True):
     if flip:
         x = -x
     return (x + math.pi) % (2 * math.pi) - math.pi, np.asarray(lat, np.float64)
+
+
+def model_lonlat(x, y, *, lon0: float = math.pi / 2, flip: bool = True):
+    """The inverse of :func:`view_lonlat`: model (lon in [0, 2 pi), lat) of map
+    coordinates (x, y)."""
+    x = np.asarray(x, np.float64)
+    lon = lon0 - x if flip else lon0 + x
+    return np.mod(lon, 2 * math.pi), np.asarray(y, np.float64)
+
+
+def mollweide(lon, lat) -> tuple[np.ndarray, np.ndarray]:
+    """Mollweide plane coordinates of (lon, lat), laid out as matplotlib's (x in
+    [-2 sqrt 2, 2 sqrt 2], y in [-sqrt 2, sqrt 2]): x = (2 sqrt 2 / pi) lon cos theta,
+    y = sqrt 2 sin theta, 2 theta + sin 2 theta = pi sin lat solved to float64 precision
+    (matplotlib's own transform stops within about 5e-4 rad of theta, which folds a band
+    of the map near the equator; the app's maps are drawn with this one, so a point under
+    the mouse inverts exactly by :func:`mollweide_inverse`)."""
+    lon = np.asarray(lon, np.float64)
+    lat = np.asarray(lat, np.float64)
+    target = math.pi * np.sin(lat)
+    # near a pole 2 theta + sin 2 theta ~ pi - (4/3) e^3 (e = pi/2 - |theta|): a start
+    # from the series keeps Newton fast where the derivative 4 cos^2 theta vanishes
+    colat = math.pi / 2 - np.abs(lat)
+    theta = np.where(
+        colat < 0.2, np.sign(lat) * (math.pi / 2 - np.cbrt(3 * math.pi * colat**2 / 8)), lat
+    )
+    for _ in range(20):  # quadratic convergence: 3 to 5 steps from these starts
+        f = 2 * theta + np.sin(2 * theta) - target
+        df = 4 * np.cos(theta) ** 2
+        step = np.where(df > 1e-300, f / np.where(df > 1e-300, df, 1.0), 0.0)
+        theta = np.clip(theta - step, -math.pi / 2, math.pi / 2)
+        if not np.any(np.abs(step) > 1e-15):
+            break
+    theta = np.where(colat == 0, np.sign(lat) * (math.pi / 2), theta)
+    r2 = math.sqrt(2.0)
+    return (2 * r2 / math.pi) * lon * np.cos(theta), r2 * np.sin(theta)
+
+
+def mollweide_inverse(px, py) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(lon, lat, inside) of points of the Mollweide plane (see :func:`mollweide`):
+    theta = asin(y / sqrt 2), lon = pi x / (2 sqrt 2 cos theta), lat = asin((2 theta +
+    sin 2 theta) / pi). ``inside`` is False outside the map's ellipse (lon and lat are
+    then clipped, not meaningful)."""
+    px = np.asarray(px, np.float64)
+    py = np.asarray(py, np.float64)
+    r2 = math.sqrt(2.0)
+    inside = (px / (2 * r2)) ** 2 + (py / r2) ** 2 <= 1.0 + 1e-12  # the rim: rounding
+    theta = np.arcsin(np.clip(py / r2, -1.0, 1.0))
+    c = np.cos(theta)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lon = np.where(c > 0, math.pi * px / (2 * r2 * np.where(c > 0, c, 1.0)), 0.0)
+    lon = np.clip(lon, -math.pi, math.pi)
+    lat = np.arcsin(np.clip((2 * theta + np.sin(2 * theta)) / math.pi, -1.0, 1.0))
+    return lon, lat, inside
+
+
+def pixel_at(nside: int, px, py, *, lon0: float = math.pi / 2, flip: bool = True) -> np.ndarray:
+    """RING index of the facet under points (px, py) of a :func:`draw_eye_view` map in
+    the Mollweide plane (see :func:`mollweide_inverse`), -1 outside the map."""
+    lon, lat, inside = mollweide_inverse(px, py)
+    mlon, mlat = model_lonlat(lon, lat, lon0=lon0, flip=flip)
+    pix = healpix.ang2pix_ring(nside, np.sin(mlat), mlon)
+    return np.where(inside, pix, -1)
+
+
+def view_polys(
+    nside: int, pix, step: int = 2, *, lon0: float = math.pi / 2, flip: bool = True
+) -> tuple[np.ndarray, np.ndarray]:
+    """Map outlines (k', 4 step, 2) of the facets ``pix`` as :func:`draw_eye_view` draws
+    them and which of ``pix`` cross the map's edge (drawn a second time, appended)."""
+    return _view_polys(nside, pix, step, lon0, flip)
 
 
 def _view_polys(

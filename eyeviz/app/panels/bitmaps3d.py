@@ -1,0 +1,384 @@
+"""The spherical eyes' bitmaps beside the 3D view (issue 22 item 4, docs/spherical.md).
+
+Each eye's HEALPix facets on a Mollweide map seen from inside the eye (forward at the
+centre, the eye's right on the right, as the 3D figure draws them:
+:func:`eyeviz.render.mpl.healpix_map.draw_eye_view`), lit facets in their features'
+colours (a later feature wins), the equator drawn and labelled: that row of facets is the
+planar eye's bitmap (m = 4 nside).
+
+Fast updates: what does not change with the balls (the unlit sphere, at nside <= 32 every
+facet with its outline, otherwise one solid ellipse; the graticule) is drawn once and kept
+as a pixel background; a new state sets the lit facets' polygons in place and repaints
+them and the equator over that background (blitting). Only the lit facets
+are polygons: a ball at the paper's distances lights a few hundred of nside 180's 388,800
+facets per eye. The maps are drawn in the exact Mollweide projection
+(:func:`eyeviz.render.mpl.healpix_map.mollweide`) on plain axes, so the point under the
+mouse is inverted in closed form and mapped to its facet by
+:func:`eyeviz.core.healpix.ang2pix_ring` (:func:`~eyeviz.render.mpl.healpix_map.pixel_at`):
+hovering shows the facet's RING index, its direction (azimuth from +x counter-clockwise
+seen from above, forward = 90 deg, and elevation, docs/conventions.md) and its solid angle
+4 pi / npix.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from matplotlib.backends.backend_qt5agg import FigureCanvasQTAgg
+from matplotlib.collections import PathCollection, PolyCollection
+from matplotlib.colors import to_rgba_array
+from matplotlib.figure import Figure
+from matplotlib.patches import Polygon
+from matplotlib.path import Path
+from PyQt5 import QtCore, QtWidgets
+
+from eyeviz.app.panels.common import wrap_label
+from eyeviz.core import healpix
+from eyeviz.model.scene import Scene
+from eyeviz.model.state3d import SceneState3D
+from eyeviz.render.mpl.healpix_map import (
+    MAX_ALL_FACETS,
+    mollweide,
+    pixel_at,
+    view_lonlat,
+    view_polys,
+)
+from eyeviz.render.mpl.style import EDGE, GREY, INK, UNLIT
+
+__all__ = ["Bitmaps3DPanel", "facet_text", "lit_owners"]
+
+EYES = ("A", "B")
+STEP = 2  # outline points per facet edge
+R2 = math.sqrt(2.0)
+SQ_DEG = (180.0 / math.pi) ** 2
+
+
+def lit_owners(csr: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(lit facets sorted, the ball that colours each) from an eye's CSR lit sets; a later
+    ball wins where several light a facet (as the planar app and the 3D figure)."""
+    indptr, idx = csr
+    ball = np.repeat(np.arange(indptr.size - 1), np.diff(indptr))
+    pix, first = np.unique(idx[::-1], return_index=True)  # the last ball's occurrence
+    return pix, ball[::-1][first]
+
+
+def facet_text(nside: int, pix: int) -> str:
+    """One line: a facet's RING index, direction (azimuth, elevation in degrees) and solid
+    angle (4 pi / npix: every HEALPix facet has the same)."""
+    c = healpix.centers(nside, np.array([pix]))[0]
+    az = math.degrees(math.atan2(c[1], c[0])) % 360.0
+    el = math.degrees(math.asin(max(-1.0, min(1.0, c[2]))))
+    sr = 4.0 * math.pi / healpix.npix(nside)
+    return (
+        f"facet {pix:,}: azimuth {az:.2f}\N{DEGREE SIGN}, elevation {el:.2f}\N{DEGREE SIGN}, "
+        f"{sr:.3g} sr = {sr * SQ_DEG:.3g} deg\N{SUPERSCRIPT TWO}"
+    )
+
+
+def _map_polys(nside: int, pix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Facet outlines in the Mollweide plane, those across the map's edge twice."""
+    verts, over = view_polys(nside, pix, STEP)
+    x, y = mollweide(verts[..., 0], verts[..., 1])
+    return np.stack([x, y], axis=-1), over
+
+
+class _Outlines:
+    """Facet outlines in the Mollweide plane at one nside, the last call's kept: a drag
+    lights mostly the facets lit a frame before, and only the others are computed."""
+
+    def __init__(self, nside: int) -> None:
+        self.nside = nside
+        self.pix = np.zeros(0, np.int64)
+        self.base = np.zeros((0, 4 * STEP, 2))
+        self.dup = np.zeros((0, 4 * STEP, 2))  # the second copy (where ``over``)
+        self.over = np.zeros(0, bool)
+
+    def get(self, pix: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(outlines, across the edge, second copies) of the sorted facets ``pix``."""
+        k = pix.size
+        at = np.minimum(np.searchsorted(self.pix, pix), max(self.pix.size - 1, 0))
+        hit = self.pix[at] == pix if self.pix.size else np.zeros(k, bool)
+        base = np.empty((k, 4 * STEP, 2))
+        dup = np.empty((k, 4 * STEP, 2))
+        over = np.zeros(k, bool)
+        base[hit], dup[hit], over[hit] = self.base[at[hit]], self.dup[at[hit]], self.over[at[hit]]
+        new = np.flatnonzero(~hit)
+        if new.size:
+            verts, o = _map_polys(self.nside, pix[new])
+            base[new], over[new] = verts[: new.size], o
+            dup[new[o]] = verts[new.size :]
+        self.pix, self.base, self.dup, self.over = pix, base, dup, over
+        return base, over, dup
+
+
+def _by_ball(verts: np.ndarray, owner: np.ndarray, rgba: np.ndarray):
+    """One compound path per ball (its facets' outlines) and the balls' colours."""
+    if owner.size == 0:
+        return [], np.zeros((0, 4))
+    order = np.argsort(owner, kind="stable")
+    groups = np.split(order, np.flatnonzero(np.diff(owner[order])) + 1)
+    return [_compound(verts[g]) for g in groups], rgba[[int(owner[g[0]]) for g in groups]]
+
+
+def _compound(verts: np.ndarray) -> Path:
+    """One path of many closed polygons (k, n, 2): a single artist path to draw, not k."""
+    k, n = verts.shape[:2]
+    closed = np.concatenate([verts, verts[:, :1]], axis=1).reshape(-1, 2)
+    codes = np.full((k, n + 1), Path.LINETO, dtype=Path.code_type)
+    codes[:, 0] = Path.MOVETO
+    codes[:, -1] = Path.CLOSEPOLY
+    return Path(closed, codes.ravel())
+
+
+def _ellipse(n: int = 181) -> np.ndarray:
+    t = np.linspace(0.0, 2.0 * math.pi, n)
+    return np.stack([2 * R2 * np.cos(t), R2 * np.sin(t)], axis=-1)
+
+
+class Bitmaps3DPanel(QtWidgets.QWidget):
+    """Eye A over eye B, each a Mollweide map of its facets; see the module docstring.
+
+    ``set_state(state, scene)`` takes a computed :class:`SceneState3D`; ``update_ms``
+    holds the time of the last update (the lit polygons set and repainted)."""
+
+    def __init__(self, parent: QtWidgets.QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.nside: int | None = None
+        self.owners: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self.names: list[str] = []
+        self.update_ms = 0.0
+        self.hover_pix: tuple[str, int] | None = None
+        self._keys: dict[str, bytes] = {}
+        self._bg = None
+        self._lit: dict[str, tuple[PathCollection, ...]] = {}
+        self._outlines = {e: _Outlines(2) for e in EYES}
+        self._over: list = []  # animated artists drawn over the lit facets, in order
+        self._hover_coll: PolyCollection | None = None
+        self.fig = Figure(figsize=(3.6, 4.2), facecolor="white")
+        self.canvas = FigureCanvasQTAgg(self.fig)
+        self.canvas.setSizePolicy(QtWidgets.QSizePolicy.Expanding, QtWidgets.QSizePolicy.Expanding)
+        self.canvas.setMinimumSize(240, 260)
+        self.axes = {
+            "A": self.fig.add_axes((0.01, 0.535, 0.98, 0.40)),
+            "B": self.fig.add_axes((0.01, 0.045, 0.98, 0.40)),
+        }
+        for eye, ax in self.axes.items():
+            ax.set_gid(f"map{eye}")
+        self.counts = wrap_label(QtWidgets.QLabel(""))
+        self.hover = wrap_label(QtWidgets.QLabel(""))
+        self.hover.setObjectName("hover3d")
+        self.message = wrap_label(QtWidgets.QLabel("bitmaps layer hidden"))
+        self.message.setAlignment(QtCore.Qt.AlignmentFlag.AlignCenter)
+        lay = QtWidgets.QVBoxLayout(self)
+        lay.setContentsMargins(2, 2, 2, 2)
+        lay.addWidget(self.counts)
+        lay.addWidget(self.canvas, 1)
+        lay.addWidget(self.hover)
+        lay.addWidget(self.message)
+        self.canvas.hide()
+        self.canvas.mpl_connect("draw_event", self._on_draw)
+        self.canvas.mpl_connect("motion_notify_event", self._on_move)
+        self.canvas.mpl_connect("figure_leave_event", self._on_leave)
+
+    # --- state ---------------------------------------------------------------------------
+
+    def set_state(self, state: SceneState3D, scene: Scene) -> None:
+        """Show the lit facets of ``state`` (computed from ``scene``): the polygons of the
+        eyes whose lit sets or colours changed are set in place and repainted over the
+        kept background; a new nside redraws the whole figure."""
+        t0 = time.perf_counter()
+        if state.lit_a is None or state.lit_b is None or not scene.shows("bitmaps"):
+            self.canvas.hide()
+            self.counts.setText("")
+            self.hover.setText("")
+            self.message.setText(
+                "bitmaps layer hidden" if not scene.shows("bitmaps") else "no lit sets"
+            )
+            self.message.show()
+            self.owners, self._keys = {}, {}
+            return
+        self.message.hide()
+        self.canvas.show()
+        nside = state.pair.nside
+        if nside != self.nside:
+            self._build(nside)
+        self.names = [f.name for f in scene.features]
+        colors = [f.color for f in scene.features]
+        rgba = to_rgba_array(colors) if colors else np.zeros((0, 4))
+        changed = False
+        counts: list[str] = []
+        for eye, csr in zip(EYES, (state.lit_a, state.lit_b), strict=True):
+            pix, ball = lit_owners(csr)
+            key = b"".join((pix.tobytes(), ball.tobytes(), rgba.tobytes()))
+            self.owners[eye] = (pix, ball)
+            if self._keys.get(eye) == key:
+                counts.append(f"{eye} {pix.size:,}")
+                continue
+            self._keys[eye] = key
+            changed = True
+            base, over, dup = self._outlines[eye].get(pix)
+            # facets inside the map's outline need no clipping (2 ms a frame at nside 180)
+            inner, edge = self._lit[eye]
+            paths, fc = _by_ball(base[~over], ball[~over], rgba)
+            inner.set_paths(paths)
+            inner.set_facecolor(fc)
+            paths, fc = _by_ball(
+                np.concatenate([base[over], dup[over]]), np.tile(ball[over], 2), rgba
+            )
+            edge.set_paths(paths)
+            edge.set_facecolor(fc)
+            counts.append(f"{eye} {pix.size:,}")
+        self.counts.setText(
+            f"nside {nside}, {healpix.npix(nside):,} facets per eye\nlit: " + ", ".join(counts)
+        )
+        if changed:
+            self._repaint()
+        self.update_ms = (time.perf_counter() - t0) * 1e3
+
+    def lit_facets(self, eye: str) -> np.ndarray:
+        """The facets drawn lit on eye ``eye``'s map (sorted RING indices)."""
+        return self.owners[eye][0] if eye in self.owners else np.zeros(0, np.int64)
+
+    # --- drawing -------------------------------------------------------------------------
+
+    def _build(self, nside: int) -> None:
+        """The static parts for ``nside`` and empty lit collections."""
+        self.nside = nside
+        self._outlines = {e: _Outlines(nside) for e in EYES}
+        self._keys = {}
+        self._over = []
+        self._bg = None
+        n_pix = healpix.npix(nside)
+        ell = _ellipse()
+        for eye, ax in self.axes.items():
+            ax.clear()
+            ax.set_axis_off()
+            ax.set_xlim(-2 * R2 * 1.01, 2 * R2 * 1.01)
+            ax.set_ylim(-R2 * 1.01, R2 * 1.01)
+            ax.set_aspect("equal", adjustable="box", anchor="C")
+            clip = Polygon(ell, closed=True, transform=ax.transData)
+            if n_pix <= MAX_ALL_FACETS:  # every facet, outlined
+                verts, _ = _map_polys(nside, np.arange(n_pix))
+                back = PolyCollection(
+                    list(verts), facecolors=UNLIT, edgecolors=EDGE, linewidths=0.3
+                )
+            else:  # the unlit sphere as one solid ellipse
+                back = PolyCollection([ell], facecolors=UNLIT, edgecolors="none")
+            back.set_clip_path(clip)
+            ax.add_collection(back, autolim=False)
+            for deg in (-60, -30, 30, 60):  # a faint graticule: elevation seen from the eye
+                x, y = mollweide(np.linspace(-math.pi, math.pi, 2), np.full(2, math.radians(deg)))
+                ax.plot(x, y, color="#c8c8c8", lw=0.4)
+            for deg in (-90, 90):
+                lat = np.linspace(-math.pi / 2, math.pi / 2, 61)
+                x, y = mollweide(np.full_like(lat, math.radians(deg)), lat)
+                ax.plot(x, y, color="#c8c8c8", lw=0.4)
+            ax.plot(ell[:, 0], ell[:, 1], color=GREY, lw=0.6)
+            for tx, t in ((-R2, "left"), (0.0, "forward"), (R2, "right")):
+                ax.text(tx, -R2 * 1.01, t, fontsize=6.5, color=GREY, ha="center", va="top")
+            # the lit facets: outlined at nside <= 32 (as the unlit ones), plain above (a
+            # stroke of every facet cost 7 ms a frame at nside 180); those across the
+            # map's edge in a collection of their own, clipped to the outline
+            lit = tuple(
+                PathCollection(
+                    [], edgecolors=EDGE, linewidths=0.3 if nside <= 32 else 0.0, animated=True
+                )
+                for _ in range(2)
+            )
+            lit[1].set_clip_path(clip)
+            for c in lit:
+                ax.add_collection(c, autolim=False)
+            self._lit[eye] = lit
+            (eq,) = ax.plot([-2 * R2, 2 * R2], [0.0, 0.0], color=INK, lw=0.8, animated=True)
+            ax.text(
+                -2 * R2 * 0.97, -0.04, f"equator: the planar eye, m = {4 * nside:,}",
+                fontsize=6.5, color=INK, ha="left", va="top",
+            )  # fmt: skip
+            ax.text(
+                0.5, 1.0, f"eye {eye} ({'left' if eye == 'A' else 'right'}), seen from inside",
+                transform=ax.transAxes, fontsize=7.5, color=INK, ha="center", va="bottom",
+            )  # fmt: skip
+            self._over += [(ax, lit[0]), (ax, lit[1]), (ax, eq)]
+        self._hover_coll = PolyCollection(
+            [], facecolors="none", edgecolors="#000000", linewidths=1.2, animated=True
+        )
+        self._hover_ax = None
+        self.canvas.draw_idle()
+
+    def _draw_over(self) -> None:
+        for _, artist in self._over:
+            self.fig.draw_artist(artist)
+        if self.hover_pix is not None and self._hover_coll is not None:
+            self.fig.draw_artist(self._hover_coll)
+
+    def _on_draw(self, _event) -> None:
+        """After a full draw: keep the background, then paint the animated parts."""
+        self._bg = self.canvas.copy_from_bbox(self.fig.bbox)
+        self._draw_over()
+
+    def _repaint(self) -> None:
+        """The lit facets, the equator and the hover outline over the kept background."""
+        if self._bg is None or not self.canvas.isVisible():
+            self.canvas.draw_idle()
+            return
+        self.canvas.restore_region(self._bg)
+        self._draw_over()
+        self.canvas.blit(self.fig.bbox)
+
+    # --- hover ---------------------------------------------------------------------------
+
+    def facet_at(self, eye: str, x: float, y: float) -> int:
+        """The facet of eye ``eye`` drawn at (x, y) of its map (Mollweide plane), -1 off
+        the map."""
+        if self.nside is None:
+            return -1
+        return int(pixel_at(self.nside, x, y))
+
+    def _on_move(self, event) -> None:
+        eye = next((e for e, ax in self.axes.items() if event.inaxes is ax), None)
+        if eye is None or event.xdata is None or self.nside is None:
+            self._set_hover(None)
+            return
+        pix = self.facet_at(eye, event.xdata, event.ydata)
+        self._set_hover((eye, pix) if pix >= 0 else None)
+
+    def _on_leave(self, _event) -> None:
+        self._set_hover(None)
+
+    def _set_hover(self, hit: tuple[str, int] | None) -> None:
+        if hit == self.hover_pix:
+            return
+        self.hover_pix = hit
+        if hit is None or self.nside is None:
+            self.hover.setText("")
+            self.canvas.setToolTip("")
+            self._repaint()
+            return
+        eye, pix = hit
+        text = f"eye {eye}, " + facet_text(self.nside, pix)
+        lit, ball = self.owners.get(eye, (np.zeros(0, np.int64), np.zeros(0, np.int64)))
+        k = int(np.searchsorted(lit, pix))
+        if k < lit.size and lit[k] == pix:
+            text += f"; lit by {self.names[int(ball[k])]!r}"
+        self.hover.setText(text)
+        self.canvas.setToolTip(text)
+        assert self._hover_coll is not None
+        verts, _ = _map_polys(self.nside, np.array([pix]))
+        self._hover_coll.set_verts(list(verts))
+        ax = self.axes[eye]
+        if self._hover_coll.axes is not ax:
+            if self._hover_coll.axes is not None:
+                self._hover_coll.remove()
+            ax.add_collection(self._hover_coll, autolim=False)
+            self._hover_coll.set_clip_path(Polygon(_ellipse(), closed=True, transform=ax.transData))
+        self._repaint()
+
+    def map_point(self, eye: str, pix: int) -> tuple[float, float]:
+        """The Mollweide-plane point of facet ``pix``'s centre on eye ``eye``'s map."""
+        assert self.nside is not None
+        c = healpix.centers(self.nside, np.array([pix]))[0]
+        mx, my = view_lonlat(math.atan2(c[1], c[0]), math.asin(max(-1.0, min(1.0, c[2]))))
+        x, y = mollweide(mx, my)
+        return float(x), float(y)
