@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 APT_PACKAGES="xvfb xauth libxcb-icccm4 libxcb-keysyms1 libxcb-xinerama0 libxcb-image0 \
 libxcb-render-util0 libxcb-randr0 libxcb-shape0 libxcb-xfixes0 libxcb-xkb1 libxkbcommon-x11-0 \
 libgl1 libegl1 libxrender1 \
-libfontconfig1 libdbus-1-3 poppler-utils xdotool"
+libfontconfig1 libdbus-1-3 poppler-utils xdotool openbox"
 
 missing=""
 for p in $APT_PACKAGES; do

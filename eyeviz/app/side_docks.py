@@ -68,8 +68,12 @@ class SideDocksMixin(_MainWindow):
         scroll.setMinimumWidth(min(widget.minimumSizeHint().width(), SIDE_MIN_PX))
         scroll.setMinimumHeight(DOCK_MIN_PX)
         d.setWidget(scroll)
+        # closable: View > Panels (eyeviz.app.presenting) brings a closed one back; Qt
+        # disables a dock's toggleViewAction unless it is closable
         d.setFeatures(
-            QtWidgets.QDockWidget.DockWidgetMovable | QtWidgets.QDockWidget.DockWidgetFloatable
+            QtWidgets.QDockWidget.DockWidgetMovable
+            | QtWidgets.QDockWidget.DockWidgetFloatable
+            | QtWidgets.QDockWidget.DockWidgetClosable
         )
         self.addDockWidget(QtCore.Qt.DockWidgetArea.RightDockWidgetArea, d)
         self._limit_dock(d)

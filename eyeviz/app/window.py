@@ -34,9 +34,11 @@ from eyeviz.app.panels import (
     design_skips,
     user_message,
 )
+from eyeviz.app.presenting import install_presenting
 from eyeviz.app.screenshot import qimage_to_array
 from eyeviz.app.settings import Settings, make_settings
 from eyeviz.app.side_docks import SideDocksMixin
+from eyeviz.app.steps import StepsMixin
 from eyeviz.app.view import VtkView, fast_renderer
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import Scene
@@ -59,7 +61,7 @@ __all__ = [
 ]
 
 
-class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow):
+class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow):
     # made by build_menus (eyeviz.app.actions)
     undo_action: QtWidgets.QAction
     redo_action: QtWidgets.QAction
@@ -156,6 +158,7 @@ class MainWindow(CanvasMixin, FilesMixin, SideDocksMixin, QtWidgets.QMainWindow)
         self.statusBar().addPermanentWidget(self.cursor_label)
         build_menus(self)
         self.model.listeners.append(self._on_model)
+        install_presenting(self)  # View > Full screen, text scale, steps; Help (after the menus)
         self.model.load_in_background = self._load_estimators
         self.undo_stack.cleanChanged.connect(self._clean_changed)
         self._restore_settings()

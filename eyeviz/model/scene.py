@@ -51,6 +51,7 @@ from eyeviz.core.geometry import EyePair
 from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
 from eyeviz.model.layers import layer_names
+from eyeviz.model.steps import Step, check_steps, step_doc
 
 __all__ = [
     "OKABE_ITO",
@@ -177,6 +178,7 @@ class Scene:
     view: View = field(default_factory=View)
     title: str = ""
     trajectory: Trajectory | None = None
+    steps: list[Step] = field(default_factory=list)  # a lecture's steps (eyeviz.model.steps)
 
     def copy(self) -> Scene:
         return copy.deepcopy(self)
@@ -299,7 +301,11 @@ def _line_of(text: str, key: str) -> int | None:
 
 def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
     c = _Checker(text, source)
-    c.keys(doc, "", ("title", "eyes", "features", "layers", "predictions", "view", "trajectory"))
+    c.keys(
+        doc,
+        "",
+        ("title", "eyes", "features", "layers", "predictions", "view", "trajectory", "steps"),
+    )
     title = c.string(doc, "title", "", default="")
 
     eyes_t = c.table(doc, "eyes")
@@ -431,7 +437,14 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
             raise c.fail("trajectory.g", f"must be > 0, got {tg!r}")
         trajectory = Trajectory(kind, dist, tg)
 
-    return Scene(eyes, features, layers, estimators, view, title, trajectory)
+    steps = []
+    if "steps" in doc:
+        step_layers = SPHERICAL_LAYERS if eyes.kind == "spherical" else known
+        steps = check_steps(doc["steps"], c.fail, step_layers, sorted(names), _bad_text)
+        if not estimators and any("predictions" in st.layers for st in steps):
+            raise c.fail("predictions.estimators", "a step shows predictions: name an estimator")
+
+    return Scene(eyes, features, layers, estimators, view, title, trajectory, steps)
 
 
 # --- public I/O ------------------------------------------------------------------------
@@ -504,6 +517,8 @@ def _doc(scene: Scene) -> dict:
     if scene.trajectory is not None:
         t = scene.trajectory
         doc["trajectory"] = {"kind": t.kind, "distance": float(t.distance), "g": float(t.g)}
+    if scene.steps:
+        doc["steps"] = [step_doc(st) for st in scene.steps]
     return doc
 
 
@@ -533,6 +548,8 @@ def dumps(scene: Scene) -> str:
     for name in ("layers", "predictions", "view", "trajectory"):
         if name in doc:
             out += _table(name, doc[name])
+    for st in doc.get("steps", []):
+        out += _table("steps", st, aot=True)
     text = "\n".join(out)
     tomllib.loads(text)  # tomli_w's values, our layout: still TOML
     return text

@@ -1,0 +1,324 @@
+"""Presenting with eyeviz in a lecture hall: full screen, text scale, presentation mode,
+the list of panels, the lecture steps' keys and the Help menu.
+
+- View > Full screen (F11): the window fills the screen (the window manager's full-screen
+  state); again to leave.
+- View > Larger text / Smaller text / Normal text (Ctrl+= / Ctrl+- / Ctrl+0): the whole
+  UI's text and the view's labels are scaled; the scale is kept in the settings
+  (``ui/text_scale``) and restored at the next start.
+- View > Presentation mode (F5): side panels hidden, text PRESENT_FACTOR larger, a
+  high-contrast palette; again to leave (the panels come back as they were).
+- View > Panels: every dock's show/hide entry, so a closed panel comes back.
+- View > Steps: PageDown / PageUp / Esc walk a scene's lecture steps (eyeviz.app.steps).
+- Help > Keyboard shortcuts (F1), Help > About the model (eyeviz.app.help).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from PyQt5 import QtCore, QtGui, QtWidgets
+
+from eyeviz.app.help import AboutModelDialog, ShortcutsDialog
+from eyeviz.app.launch import APP_FONT_PT
+
+#: the main window (eyeviz.app.window.MainWindow; not imported: the window imports this)
+MainWindow = Any
+
+__all__ = [
+    "PRESENT_FACTOR",
+    "SCALE_KEY",
+    "TEXT_SCALES",
+    "Presenter",
+    "high_contrast_palette",
+    "install_presenting",
+    "step_scale",
+]
+
+TEXT_SCALES = (0.8, 0.9, 1.0, 1.15, 1.3, 1.5, 1.75, 2.0, 2.5, 3.0)
+PRESENT_FACTOR = 1.5
+SCALE_KEY = "ui/text_scale"
+_BASE_PT = "eyeviz_base_pt"  # a widget's own font size at text scale 1 (a Qt property)
+
+
+def step_scale(scale: float, direction: int) -> float:
+    """The next text scale up (+1) or down (-1) from ``scale``; 0 gives 1.0."""
+    if direction == 0:
+        return 1.0
+    if direction > 0:
+        return next((s for s in TEXT_SCALES if s > scale + 1e-9), TEXT_SCALES[-1])
+    return next((s for s in reversed(TEXT_SCALES) if s < scale - 1e-9), TEXT_SCALES[0])
+
+
+def _stored_scale(value: Any) -> float:
+    """A stored scale within TEXT_SCALES' range; anything else (a hand-edited settings
+    file) is 1.0."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        return 1.0
+    return float(value) if TEXT_SCALES[0] <= value <= TEXT_SCALES[-1] else 1.0
+
+
+def high_contrast_palette() -> QtGui.QPalette:
+    """Black on white, a saturated blue selection: readable from the back of a hall."""
+    pal = QtGui.QPalette()
+    white, black = QtGui.QColor("#ffffff"), QtGui.QColor("#000000")
+    for role, color in (
+        (QtGui.QPalette.Window, white),
+        (QtGui.QPalette.WindowText, black),
+        (QtGui.QPalette.Base, white),
+        (QtGui.QPalette.AlternateBase, QtGui.QColor("#eeeeee")),
+        (QtGui.QPalette.Text, black),
+        (QtGui.QPalette.Button, QtGui.QColor("#e6e6e6")),
+        (QtGui.QPalette.ButtonText, black),
+        (QtGui.QPalette.ToolTipBase, white),
+        (QtGui.QPalette.ToolTipText, black),
+        (QtGui.QPalette.Highlight, QtGui.QColor("#0033cc")),
+        (QtGui.QPalette.HighlightedText, white),
+    ):
+        pal.setColor(role, color)
+    return pal
+
+
+def _app() -> QtWidgets.QApplication:
+    app = QtWidgets.QApplication.instance()
+    assert isinstance(app, QtWidgets.QApplication)  # the window exists: so does the app
+    return app
+
+
+def _action(win, menu, text, slot, keys=(), checkable=False) -> QtWidgets.QAction:
+    a = QtWidgets.QAction(text, win)
+    if keys:
+        a.setShortcuts([QtGui.QKeySequence(k) for k in keys])
+        a.setShortcutContext(QtCore.Qt.ShortcutContext.WindowShortcut)
+    a.setCheckable(checkable)
+    a.triggered.connect(slot)
+    menu.addAction(a)
+    win.addAction(a)
+    return a
+
+
+class Presenter(QtCore.QObject):
+    """The window's presenting state and actions (made by :func:`install_presenting`)."""
+
+    def __init__(self, win: MainWindow) -> None:
+        super().__init__(win)
+        self.win = win
+        self.scale = _stored_scale(win.settings.value(SCALE_KEY, 1.0))
+        self.presenting = False
+        self._applied = 1.0  # the effective scale the widgets and labels have now
+        self._hidden_docks: list[QtWidgets.QDockWidget] = []
+        self._palette = _app().palette()
+        self._vtk_base: dict[Any, float] = {}
+        self.shortcuts_dialog: ShortcutsDialog | None = None
+        self.about_dialog: AboutModelDialog | None = None
+        self._build_menus()
+        win.installEventFilter(self)
+        win.model.listeners.append(self._on_model)
+        self._remember_fonts(1.0)  # the widgets made so far are at scale 1
+        self.apply()
+
+    # --- menus -------------------------------------------------------------------------
+    def _build_menus(self) -> None:
+        win = self.win
+        mb = win.menuBar()
+        assert mb is not None  # a QMainWindow makes its menu bar on first use
+        view = next(
+            (a.menu() for a in mb.actions() if a.text().replace("&", "") == "View"), None
+        ) or mb.addMenu("&View")
+        assert view is not None
+        view.addSeparator()
+        self.fullscreen_action = _action(
+            win, view, "F&ull screen", self.toggle_fullscreen, ("F11",), checkable=True
+        )
+        self.present_action = _action(
+            win, view, "P&resentation mode", self.toggle_presentation, ("F5",), checkable=True
+        )
+        _action(win, view, "&Larger text", lambda: self.set_scale(step_scale(self.scale, 1)),
+                ("Ctrl+=", "Ctrl++"))  # fmt: skip
+        _action(win, view, "&Smaller text", lambda: self.set_scale(step_scale(self.scale, -1)),
+                ("Ctrl+-",))  # fmt: skip
+        _action(win, view, "N&ormal text", lambda: self.set_scale(1.0), ("Ctrl+0",))
+        self.panels_menu = view.addMenu("Pa&nels")
+        assert self.panels_menu is not None
+        # filled as the View menu opens: a submenu filled in its own aboutToShow opened
+        # from the keyboard with no entry active and ignored the arrow keys
+        view.aboutToShow.connect(self.fill_panels_menu)
+        steps = view.addMenu("St&eps")
+        assert steps is not None
+        _action(win, steps, "&Next step", win.next_step, ("PgDown",))
+        _action(win, steps, "&Previous step", win.previous_step, ("PgUp",))
+        win.leave_steps_action = _action(
+            win, steps, "Show the &whole scene", win.leave_steps, ("Esc",)
+        )
+        win.leave_steps_action.setEnabled(False)
+        help_menu = mb.addMenu("&Help")
+        assert help_menu is not None
+        _action(win, help_menu, "&Keyboard shortcuts", self.show_shortcuts, ("F1",))
+        _action(win, help_menu, "&About the model", self.show_about)
+
+    def fill_panels_menu(self) -> None:
+        """Every dock's show/hide entry, docks made since included."""
+        menu = self.panels_menu
+        assert menu is not None
+        menu.clear()
+        docks = self.win.findChildren(QtWidgets.QDockWidget)
+        for d in sorted(docks, key=lambda d: d.windowTitle()):
+            a = d.toggleViewAction()
+            assert a is not None  # every dock has one
+            menu.addAction(a)
+
+    # --- help ----------------------------------------------------------------------------
+    def show_shortcuts(self) -> ShortcutsDialog:
+        if self.shortcuts_dialog is None:
+            self.shortcuts_dialog = ShortcutsDialog(self.win)
+        self.shortcuts_dialog.refresh()
+        self.shortcuts_dialog.show()
+        self.shortcuts_dialog.raise_()
+        self.shortcuts_dialog.activateWindow()
+        return self.shortcuts_dialog
+
+    def show_about(self) -> AboutModelDialog:
+        if self.about_dialog is None:
+            self.about_dialog = AboutModelDialog(self.win)
+        self.about_dialog.show()
+        self.about_dialog.raise_()
+        self.about_dialog.activateWindow()
+        return self.about_dialog
+
+    # --- full screen ---------------------------------------------------------------------
+    def toggle_fullscreen(self) -> None:
+        win = self.win
+        if win.isFullScreen():
+            win.showNormal()
+        else:
+            win.showFullScreen()
+
+    def eventFilter(self, obj, ev) -> bool:  # noqa: N802 (Qt name)
+        t = ev.type()
+        if t == QtCore.QEvent.Type.WindowStateChange:
+            self.fullscreen_action.setChecked(self.win.isFullScreen())
+        elif t == QtCore.QEvent.Type.Hide and not ev.spontaneous():
+            self._restore_app()  # closed: other windows get the app's own font and palette
+        elif t == QtCore.QEvent.Type.Show and not ev.spontaneous():
+            self.apply()
+        return False
+
+    # --- text scale ----------------------------------------------------------------------
+    @property
+    def effective_scale(self) -> float:
+        return self.scale * (PRESENT_FACTOR if self.presenting else 1.0)
+
+    def set_scale(self, scale: float) -> None:
+        """Ctrl+= / Ctrl+- / Ctrl+0: scale the UI's text and the view's labels; kept."""
+        self.scale = scale
+        self.win.settings.setValue(SCALE_KEY, scale)
+        self.win.settings.sync()
+        self.apply()
+        self.win.statusBar().showMessage(f"text {round(scale * 100)} %", 3000)
+
+    def _remember_fonts(self, eff: float) -> None:
+        for w in self.win.findChildren(QtWidgets.QWidget):
+            if (
+                w.testAttribute(QtCore.Qt.WidgetAttribute.WA_SetFont)
+                and w.property(_BASE_PT) is None
+            ):
+                w.setProperty(_BASE_PT, w.font().pointSizeF() / eff)
+
+    def apply(self) -> None:
+        """Give the app, the window's own-font widgets and the view's text the effective
+        scale (a widget that set its own font keeps its size relative to the rest)."""
+        eff = self.effective_scale
+        self._remember_fonts(self._applied)  # widgets made since the last apply
+        app = _app()
+        f = QtGui.QFont(app.font())
+        f.setPointSizeF(APP_FONT_PT * eff)
+        app.setFont(f)
+        for w in self.win.findChildren(QtWidgets.QWidget):
+            base = w.property(_BASE_PT)
+            if isinstance(base, float) and base > 0:
+                wf = w.font()
+                wf.setPointSizeF(base * eff)
+                w.setFont(wf)
+        self._applied = eff
+        app.setPalette(high_contrast_palette() if self.presenting else self._palette)
+        label = self.win.cursor_label
+        fm = QtGui.QFontMetrics(f)
+        label.setFixedSize(
+            fm.horizontalAdvance("x -00,000.0   y -00,000.0     r 00,000.0   φ 000.00°  "),
+            fm.height() + 4,
+        )
+        self._scale_view_text()
+        if self.win.isVisible():
+            self.win.render()
+
+    def _vtk_texts(self):
+        rens = self.win.ren_win.GetRenderers()
+        rens.InitTraversal()
+        for _ in range(rens.GetNumberOfItems()):
+            ren = rens.GetNextItem()
+            props = ren.GetViewProps()
+            props.InitTraversal()
+            for _ in range(props.GetNumberOfItems()):
+                p = props.GetNextProp()
+                if hasattr(p, "GetTextProperty"):
+                    yield p
+
+    def _scale_view_text(self) -> None:
+        """The view's labels and captions at the effective scale (their own size x it)."""
+        eff = self._applied
+        for actor in self._vtk_texts():
+            tp = actor.GetTextProperty()
+            if actor not in self._vtk_base:
+                # made at scale 1 by the renderer (style_text); a label made after a scale
+                # change still has its own size
+                self._vtk_base[actor] = float(tp.GetFontSize())
+            size = max(1, round(self._vtk_base[actor] * eff))
+            if tp.GetFontSize() != size:
+                tp.SetFontSize(size)
+
+    def _on_model(self, what: str, _index: int | None) -> None:
+        if what in ("feature", "view", "player", "selection"):
+            return  # no new widgets or labels: the drag path stays as it was
+        if self._applied != 1.0:
+            self._scale_view_text()
+            self._remember_fonts(self._applied)
+        if self.presenting:
+            QtCore.QTimer.singleShot(0, self._hide_docks)  # a layer that showed its dock
+
+    def _restore_app(self) -> None:
+        app = _app()
+        f = QtGui.QFont(app.font())
+        f.setPointSizeF(APP_FONT_PT)
+        app.setFont(f)
+        app.setPalette(self._palette)
+
+    # --- presentation mode ---------------------------------------------------------------
+    def _hide_docks(self) -> None:
+        for d in self.win.findChildren(QtWidgets.QDockWidget):
+            if d.isVisible():
+                self._hidden_docks.append(d)
+                d.hide()
+
+    def toggle_presentation(self) -> None:
+        """F5: large text, side panels hidden, high contrast; F5 again restores."""
+        self.presenting = not self.presenting
+        self.present_action.setChecked(self.presenting)
+        if self.presenting:
+            self._hidden_docks = []
+            self._hide_docks()
+        else:
+            for d in self._hidden_docks:
+                d.show()
+            self._hidden_docks = []
+        self.apply()
+        if self.presenting:
+            self.win.statusBar().showMessage(
+                "presentation mode: F5 to leave, F11 full screen, PageDown next step", 6000
+            )
+
+
+def install_presenting(win: MainWindow) -> Presenter:
+    """Add the presenting actions and the Help menu to ``win`` (after its menus)."""
+    win.presenter = Presenter(win)
+    return win.presenter

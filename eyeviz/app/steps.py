@@ -1,0 +1,143 @@
+"""Walking a scene's lecture steps (``[[steps]]``, :mod:`eyeviz.model.steps`) in the window.
+
+PageDown shows the next step, PageUp the previous one (a presenter's clicker sends the
+same keys), Esc shows the whole scene again. Each step's caption is shown in a bar under
+the view. Walking never edits the scene: the whole scene is kept aside and comes back on
+leaving, and saving while walking leaves the steps first, so the file gets the whole scene.
+An edit made while a step is shown changes that step's picture only.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING
+
+from PyQt5 import QtCore, QtWidgets
+
+from eyeviz.model.steps import apply_step
+
+if TYPE_CHECKING:
+    from eyeviz.app.presenting import Presenter
+    from eyeviz.model.app_model import AppModel
+    from eyeviz.model.scene import Scene
+
+    _MainWindow = QtWidgets.QMainWindow
+else:
+    _MainWindow = object  # MainWindow brings QMainWindow
+
+__all__ = ["CAPTION_PT", "StepsMixin"]
+
+CAPTION_PT = 18  # the caption bar's text at text scale 1
+
+
+class StepsMixin(_MainWindow):
+    """Mixed into MainWindow (before FilesMixin: its ``save_path`` leaves the steps)."""
+
+    model: AppModel
+    _steps_base: Scene | None = None  # the whole scene while walking
+    _steps_shown: Scene | None = None  # the scene a step put in the model
+    step_index = -1
+    caption_bar: QtWidgets.QLabel | None = None
+    leave_steps_action: QtWidgets.QAction | None = None  # View > Steps (eyeviz.app.presenting)
+    presenter: Presenter  # set by install_presenting
+
+    if TYPE_CHECKING:  # for mypy only
+
+        def statusBar(self) -> QtWidgets.QStatusBar: ...  # noqa: N802
+
+    # --- state ------------------------------------------------------------------------
+    @property
+    def walking(self) -> bool:
+        return self._steps_base is not None
+
+    def _steps(self) -> list:
+        base = self._steps_base if self._steps_base is not None else self.model.scene
+        return base.steps
+
+    def _caption_bar(self) -> QtWidgets.QLabel:
+        if self.caption_bar is None:
+            bar = QtWidgets.QLabel("")
+            bar.setObjectName("step_caption")
+            bar.setWordWrap(True)
+            bar.setMargin(8)
+            bar.setAlignment(QtCore.Qt.AlignmentFlag.AlignCenter)
+            bar.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Maximum)
+            f = bar.font()
+            f.setPointSize(CAPTION_PT)
+            f.setBold(True)
+            bar.setFont(f)
+            bar.setStyleSheet("background: #1a1a1a; color: #ffffff;")
+            split = self.centralWidget()
+            if isinstance(split, QtWidgets.QSplitter):
+                split.insertWidget(1, bar)  # under the view, above the bitmaps
+                split.setStretchFactor(1, 0)
+            else:  # a layout this mixin does not know: the status bar's left side
+                self.statusBar().addWidget(bar, 1)
+            self.caption_bar = bar
+        return self.caption_bar
+
+    # --- walking ------------------------------------------------------------------------
+    def next_step(self) -> None:
+        """PageDown: the next step (the first one when not walking)."""
+        self._go(self.step_index + 1 if self.walking else 0)
+
+    def previous_step(self) -> None:
+        """PageUp: the step before (stays on the first)."""
+        if not self.walking:
+            self._go(0)
+        else:
+            self._go(max(self.step_index - 1, 0))
+
+    def _go(self, i: int) -> None:
+        if self.walking and self._steps_shown is not self.model.scene:
+            self._check_scene()  # another file opened meanwhile: its own steps
+        steps = self._steps()
+        if not steps:
+            self.statusBar().showMessage("this scene has no steps ([[steps]] in its file)", 6000)
+            return
+        i = min(i, len(steps) - 1)
+        if self._steps_base is None:
+            self._steps_base = self.model.scene.copy()
+        self.step_index = i
+        shown = apply_step(self._steps_base, steps[i])
+        shown.view = self.model.scene.view  # where the presenter put it
+        self.model.set_scene(shown)
+        self._steps_shown = self.model.scene
+        bar = self._caption_bar()
+        bar.setText(f"{i + 1} / {len(steps)}   {steps[i].caption}")
+        bar.show()
+        if self.leave_steps_action is not None:
+            self.leave_steps_action.setEnabled(True)
+
+    def _check_scene(self) -> None:
+        """A scene with other steps in the model (a file opened while walking) ends the
+        walk without bringing the old scene back."""
+        base = self._steps_base
+        if base is not None and self.model.scene.steps != base.steps:
+            self._end(restore=False)
+
+    def leave_steps(self) -> None:
+        """Esc: the whole scene again, as it was before the first step."""
+        self._end(restore=True)
+
+    def _end(self, restore: bool) -> None:
+        base = self._steps_base
+        self._steps_base = None
+        self._steps_shown = None
+        self.step_index = -1
+        if self.caption_bar is not None:
+            self.caption_bar.hide()
+        if self.leave_steps_action is not None:
+            self.leave_steps_action.setEnabled(False)
+        if restore and base is not None:
+            base.view = self.model.scene.view
+            self.model.set_scene(base)
+
+    def save_path(self, path: str | os.PathLike) -> bool:
+        """Saving while walking writes the whole scene: the steps are left first."""
+        if self.walking:
+            self._check_scene()
+        if self.walking:
+            self.leave_steps()
+            self.statusBar().showMessage("left the steps: the whole scene is saved", 6000)
+        return super().save_path(path)  # FilesMixin's (after this mixin in the MRO)
