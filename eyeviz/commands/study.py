@@ -138,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
     from eyeviz import EyevizError
     from eyeviz.study import design_grid, run_study
     from eyeviz.study.grid import DEFAULT_M
-    from eyeviz.study.table import StudyTable
+    from eyeviz.study.kinds import open_table
 
     r_min, r_max = _float("r_min", args.r_min), _float("r_max", args.r_max)
     g_max, seed = _float("g_max", args.g_max), _int("seed", args.seed)
@@ -190,7 +190,7 @@ def run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt as exc:
         kept = "the finished points"
         try:
-            kept = f"{len(StudyTable.open(args.output).keys)} finished point(s)"
+            kept = f"{len(open_table(args.output, points).keys)} finished point(s)"
         except Exception:  # noqa: BLE001 - the message only
             pass
         name = getattr(exc, "signame", "SIGINT")

@@ -1,0 +1,74 @@
+"""`eyeviz report study` on a 3D study table: every figure written and readable, the
+summary names the estimator, and the power-law fit recovers known exponents."""
+
+import json
+import math
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from eyeviz.reports.study3d import fit_power
+from eyeviz.reports.study_law import LawPoint
+from eyeviz.study import run_study
+from eyeviz.study.grid3d import design_grid3d
+
+ROOT = Path(__file__).resolve().parents[2]
+STEMS = ("study3d_design", "study3d_dd", "study3d_law", "study3d_elevation")
+
+
+def test_report_study_draws_the_3d_figures_and_opens_them(tmp_path):
+    pytest.importorskip("distributed")
+    import matplotlib.image as mpimg
+
+    table = tmp_path / "s3.csv"
+    run_study(table, design_grid3d("20,40", "5,10", "16,32", n=800, seed=1), workers=1,
+              progress=False)  # fmt: skip
+    out = subprocess.run(
+        [sys.executable, "-m", "eyeviz", "report", "study", str(table), "-o", str(tmp_path / "f")],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
+        env={**os.environ, "MPLBACKEND": "Agg"},
+    )
+    assert out.returncode == 0, out.stderr
+    assert "wrote 13 files" in out.stdout
+    for stem in STEMS:
+        png = mpimg.imread(tmp_path / "f" / f"{stem}.png")
+        assert png.ndim == 3 and png.shape[0] > 300 and png.shape[1] > 300
+        assert png[..., :3].std() > 0.05  # not a blank page
+        assert (tmp_path / "f" / f"{stem}.pdf").read_bytes().startswith(b"%PDF")
+        ET.parse(tmp_path / "f" / f"{stem}.svg")  # well-formed
+    s = json.loads((tmp_path / "f" / "summary3d.json").read_text())
+    assert s["estimator"] == "triangulation" and s["is_the_limit"] is False
+    assert {(d["h"], d["l"], d["nside"]) for d in s["designs"]} == {
+        (h, l_, n) for h in (20, 40) for l_ in (5, 10) for n in (16, 32)
+    }
+    nside16 = [d["dd_mape"] for d in s["designs"] if d["nside"] == 16]
+    nside32 = [d["dd_mape"] for d in s["designs"] if d["nside"] == 32]
+    assert max(nside32) < max(nside16)
+
+
+def test_the_power_law_fit_recovers_known_exponents():
+    rng = np.random.default_rng(0)
+    pts = []
+    for nside in (16, 32, 64):
+        gam = 2 * math.pi / (4 * nside)
+        for h in (20.0, 40.0, 80.0):
+            for l_ in (5.0, 10.0):
+                for r in (1500.0, 2500.0, 3500.0):
+                    y = 0.01 * gam**1.5 * r**1.4 * h**-0.8 * l_**-0.1
+                    y *= math.exp(rng.normal(0, 1e-3))
+                    pts.append(LawPoint(h, l_, 4 * nside, r, gam * r / (2 * h), y, True, False))
+    fit = fit_power(pts)
+    assert fit is not None and fit["n"] == len(pts)
+    for k, want in (("exp_gamma", 1.5), ("exp_r", 1.4), ("exp_h", -0.8), ("exp_l", -0.1)):
+        assert fit[k] == pytest.approx(want, abs=0.01), (k, fit)
+    # a parameter that does not vary is left out, not fitted
+    same_l = [p for p in pts if p.l == 5.0]
+    assert fit_power(same_l)["exp_l"] is None
