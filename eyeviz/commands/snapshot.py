@@ -46,8 +46,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="A",
         help="the scene view's height / width, in [0.3, 1.6]: a wide scene (features beside "
-        "the eyes) wastes less of the figure at 0.5; default 0.86 (the app's File > Export "
-        "uses its window's)",
+        "the eyes) wastes less of the figure at 0.5; default 0.86 at a single column, 0.5 at "
+        "a double one, interpolated between (the app's File > Export uses its window's)",
+    )
+    parser.add_argument(
+        "--min-font",
+        default=None,
+        metavar="PT",
+        help="no text smaller than PT points, in [6, 12] (a journal asking for 7 or 8 pt); "
+        "table rows and label lanes grow to match; default: the figure's own sizes (6 pt "
+        "smallest)",
     )
     parser.add_argument("--no-title", action="store_true", help="leave the title out")
     parser.add_argument("--no-table", action="store_true", help="leave the readout table out")
@@ -60,14 +68,20 @@ def run(args: argparse.Namespace) -> int:
     os.environ.setdefault("MPLBACKEND", "Agg")
     from eyeviz.model import scene as scene_mod
     from eyeviz.render.mpl.export import export, format_of
+    from eyeviz.render.mpl.style import check_min_font
     from eyeviz.render.mpl.vector import check_drawable, resolve_aspect, resolve_width
 
     format_of(args.output)  # refuse a bad suffix, width or aspect before reading anything
     width = resolve_width(args.width)
-    aspect = resolve_aspect(args.aspect)
+    aspect = resolve_aspect(args.aspect, width)
+    min_font = None if args.min_font is None else check_min_font(args.min_font)
     sc = scene_mod.load(args.scene)
     if sc.kind == "spherical":  # HEALPix eyes: maps, table and perspective (figure3d)
+        from eyeviz import EyevizError
         from eyeviz.render.mpl.figure3d import check_drawable3d, export3d
+
+        if min_font is not None:
+            raise EyevizError("min-font: spherical scenes do not take it yet (planar only)")
 
         check_drawable3d(sc)
         out = export3d(
@@ -94,6 +108,7 @@ def run(args: argparse.Namespace) -> int:
         table=not args.no_table,
         bitmaps=not args.no_bitmaps,
         aspect=aspect,
+        min_font=min_font,
     )
     print(out)
     return 0

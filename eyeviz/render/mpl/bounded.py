@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 from matplotlib.patches import Circle, Polygon, Wedge
+from matplotlib.transforms import Bbox
 
 from eyeviz import EyevizError
 
@@ -177,11 +178,23 @@ def _check_resolution(patch, res: float, box: Box) -> None:
         )
 
 
+def _circle_extents(patch) -> Bbox | None:
+    """The data box of a finite Circle, None for any other patch."""
+    if type(patch) is not Circle:
+        return None
+    (cx, cy), r = patch.center, patch.radius
+    if not math.isfinite(cx + cy + r):
+        return None
+    return Bbox.from_extents(cx - r, cy - r, cx + r, cy + r)
+
+
 def _bound_patch(ax, patch, box: Box) -> None:
     if patch.get_data_transform() is not ax.transData:
         return
     try:
-        ext = patch.get_path().get_extents(patch.get_patch_transform())
+        ext = _circle_extents(patch)  # a disc's at once: its path's Bezier walk took 0.7 ms
+        if ext is None:
+            ext = patch.get_path().get_extents(patch.get_patch_transform())
     except (ValueError, OverflowError):
         return
     bx0, bx1, by0, by1 = box

@@ -22,6 +22,7 @@ from eyeviz.render.mpl.style import (
     LIGHT,
     SMALL,
     WHITE,
+    pt,
     round_sig,
     short,
 )
@@ -135,7 +136,7 @@ def fit_text(text: str, size: float, width_pt: float) -> str:
     from matplotlib.font_manager import FontProperties
 
     renderer = RendererAgg(10, 10, 72.0)  # 72 dpi: widths in points
-    prop = FontProperties(family="DejaVu Sans", size=size)
+    prop = FontProperties(family="DejaVu Sans", size=pt(size))  # as drawn (--min-font)
 
     def width(t: str) -> float:
         return renderer.get_text_width_height_descent(t, prop, ismath=False)[0]

@@ -73,6 +73,7 @@ def export(
     bitmaps: bool = True,
     predictor=None,
     aspect: float | None = None,
+    min_font: float | None = None,
 ) -> Path:
     """Write ``scene`` to ``path`` (.png, .svg or .pdf), atomically; returns the path.
 
@@ -80,8 +81,9 @@ def export(
     1050 px wide); SVG and PDF are resolution independent and ignore it. ``transparent``
     drops the white background. ``width`` is 'single' (3.5 in), 'double' (7.2 in) or
     inches; ``title``, ``table`` and ``bitmaps`` (False) leave those parts out. ``state``,
-    ``predictions``, ``merge``, ``predictor`` and ``aspect`` (the main view's height / width:
-    the app passes its window's) go to :func:`eyeviz.render.mpl.vector.figure`.
+    ``predictions``, ``merge``, ``predictor``, ``aspect`` (the main view's height / width:
+    the app passes its window's) and ``min_font`` (points) go to
+    :func:`eyeviz.render.mpl.vector.figure`.
     """
     fmt = format_of(path)
     scale = _check_scale(scale)
@@ -115,6 +117,7 @@ def export(
         bitmaps=bitmaps,
         predictor=predictor,
         aspect=aspect,
+        min_font=min_font,
     )
     with atomic_output(target) as tmp, matplotlib.rc_context(vector.RC):
         fig.savefig(

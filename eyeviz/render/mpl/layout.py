@@ -1,23 +1,70 @@
 """Where the figure's parts go, in inches: title, main view, bitmap strips, readout table.
 
 Pure arithmetic (no matplotlib): the height follows the width, the number of table rows
-and the interval-label lanes of the bitmap strips, so nothing is clipped at any width.
+and the interval-label lanes of the bitmap strips, so nothing is clipped at any width. Both
+are capped (:data:`MAX_TABLE_ROWS`, :data:`MAX_LANES`; what does not fit is counted in one
+"... and N more" line), so a figure's size never grows with the number of features: a
+10^4-feature scene is as tall as a 50-feature one, and placing its labels is
+O(n log n) (sort, then greedy lanes over a bounded number of lanes).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
-from eyeviz.render.mpl.style import SMALL
+import numpy as np
 
-__all__ = ["ASPECT", "ASPECT_RANGE", "Box", "Layout", "interval_lanes", "layout"]
+from eyeviz.render.mpl.style import SMALL, WIDTHS
 
-ASPECT = 0.86  # main view height / width (a scene's own figure)
+__all__ = [
+    "ASPECT",
+    "ASPECT_RANGE",
+    "ASPECTS",
+    "Box",
+    "Lanes",
+    "Layout",
+    "MAX_LABELS",
+    "MAX_LANES",
+    "MAX_TABLE_ROWS",
+    "default_aspect",
+    "interval_lanes",
+    "layout",
+    "more_text",
+    "table_features",
+]
+
+ASPECT = 0.86  # main view height / width of a single-column figure (a scene's own figure)
+#: The default main-view aspect per journal width: a single column keeps 0.86; a double
+#: column is 0.5 (at 0.86 a 7.2 in figure's view alone was 5.8 in tall, nearly a page);
+#: widths between are interpolated linearly, wider ones keep 0.5 (docs/conventions.md).
+ASPECTS = {"single": ASPECT, "double": 0.5}
 ASPECT_RANGE = (0.3, 1.6)  # what a window's framing may ask for (eyeviz.render.mpl.vector)
 TEXT_ROW = 0.118  # inches per readout row at 6 pt
 LANE = 7.0 / 72  # one interval-label lane above/below a bitmap strip, inches
 LABEL_PT = SMALL
+#: At most this many label lanes above (below) a bitmap strip; labels that fit in none
+#: are counted in one more lane ("... and N more").
+MAX_LANES = 3
+#: At most this many rows in the readout table, headers and the "... and N more" row
+#: included; features whose rows do not fit are counted, not listed.
+MAX_TABLE_ROWS = 24
+#: At most this many feature names beside their discs in the main view.
+MAX_LABELS = 40
+
+
+def default_aspect(width: float) -> float:
+    """The main view's height / width for a ``width``-inch figure when none is asked for:
+    :data:`ASPECTS` at the journal widths, linear between, constant beyond."""
+    w0, w1 = WIDTHS["single"], WIDTHS["double"]
+    a0, a1 = ASPECTS["single"], ASPECTS["double"]
+    t = min(max((float(width) - w0) / (w1 - w0), 0.0), 1.0)
+    return round(a0 + t * (a1 - a0), 3)
+
+
+def more_text(n: int, what: str = "more") -> str:
+    """The line that stands for ``n`` items left out: "\u2026 and 12 more"."""
+    return f"\u2026 and {n:,} {what}"
 
 
 @dataclass
@@ -43,39 +90,119 @@ class Layout:
     readout_rows: int
     title_y: float | None
     lanes: tuple[int, int] = (2, 2)
+    table_features: int = 0  # features listed in the readout table (the rest are counted)
+    min_font: float = 0.0  # no text smaller than this, points (0: the style's sizes)
+
+    def pt(self, size: float) -> float:
+        """A font size raised to the figure's minimum."""
+        return max(size, self.min_font)
+
+    @property
+    def font_scale(self) -> float:
+        """How much wider the smallest text is than the style's 6 pt (1 unless raised)."""
+        return max(1.0, self.min_font / SMALL)
 
 
-def readout_rows(layers, n_features: int, n_estimators: int) -> int:
-    if "readout" not in layers or not n_features:
-        return 0
-    rows = 2 + n_features
+def _rows_per_feature(layers, n_estimators: int) -> int:
+    rows = 1
     if "predictions" in layers:
-        rows += n_features * n_estimators
+        rows += n_estimators
     if "ambiguity" in layers:
-        rows += n_features
+        rows += 1
     if "posterior" in layers:
-        rows += n_features
+        rows += 1
     return rows
 
 
-def interval_lanes(L, R, m: int, strip_in: float) -> list[tuple[int, str, float, int]]:
-    """Place the [L, R] labels of one strip: (feature index, text, centre, lane) each.
+def table_features(layers, n_features: int, n_estimators: int) -> int:
+    """How many features the readout table lists: all of them while the table fits in
+    :data:`MAX_TABLE_ROWS` rows, else as many as fit beside a "... and N more" row (at
+    least one)."""
+    if "readout" not in layers or not n_features:
+        return 0
+    per = _rows_per_feature(layers, n_estimators)
+    if 2 + n_features * per <= MAX_TABLE_ROWS:
+        return n_features
+    return max(1, (MAX_TABLE_ROWS - 3) // per)
 
-    Labels go over their run; one that would overlap an earlier label moves to the
-    next lane out, so none collide.
+
+def readout_rows(layers, n_features: int, n_estimators: int) -> int:
+    """Rows of the readout table: two header rows, each listed feature's rows and one
+    "... and N more" row when some are left out; at most :data:`MAX_TABLE_ROWS` (more
+    only when one feature's rows alone exceed it)."""
+    shown = table_features(layers, n_features, n_estimators)
+    if not shown:
+        return 0
+    return 2 + shown * _rows_per_feature(layers, n_estimators) + (shown < n_features)
+
+
+@dataclass
+class Lanes:
+    """The labels of one bitmap strip: ``placed`` (feature index, text, centre, lane) each,
+    ``dropped`` labels that fit in none of the lanes."""
+
+    placed: list[tuple[int, str, float, int]] = field(default_factory=list)
+    dropped: int = 0
+    used: int = 0  # lanes holding a label
+
+    @property
+    def height(self) -> int:
+        """Lanes the strip needs: the used ones and one for "... and N more"."""
+        return self.used + (1 if self.dropped else 0)
+
+    def __iter__(self):
+        return iter(self.placed)
+
+
+def label_width(text: str, pt: float) -> float:
+    """A generous width of ``text`` at ``pt`` points, inches (0.6 em per character)."""
+    return len(text) * 0.6 * pt / 72 + 0.04
+
+
+def interval_lanes(
+    L, R, m: int, strip_in: float, *, max_lanes: int = MAX_LANES, pt: float = LABEL_PT
+) -> Lanes:
+    """Place the [L, R] labels of one strip over their runs, in at most ``max_lanes``
+    lanes, none overlapping another in its lane.
+
+    Interval partitioning: the labels sorted by their left edge, each goes to the first
+    lane whose last label ends at or before that edge (a lane's labels never overlap: the
+    one placed last ends furthest right). Unbounded, this uses the fewest lanes any
+    placement can (the most labels over one point); bounded, a label that fits in none is
+    counted in :attr:`Lanes.dropped`. O(n log n + n * max_lanes), where the previous
+    all-pairs scan per lane was cubic (78 s for 1000 labels).
     """
+    n = len(L)
+    out = Lanes()
+    if not n:
+        return out
+    lo = np.asarray(L, dtype=np.int64)
+    hi = np.asarray(R, dtype=np.int64)
+    whole = hi - lo >= m - 1
+    texts = [
+        "whole eye" if w else f"[{a}, {b % m}]"
+        for a, b, w in zip(lo.tolist(), hi.tolist(), whole.tolist(), strict=True)
+    ]
     idx_per_in = m / strip_in
-    placed: list[tuple[int, str, float, int, float]] = []
-    for i in sorted(range(len(L)), key=lambda j: int(L[j])):
-        lo, hi = int(L[i]), int(R[i])
-        text = "whole eye" if hi - lo >= m - 1 else f"[{lo}, {hi % m}]"
-        wid = (len(text) * 0.6 * LABEL_PT / 72 + 0.04) * idx_per_in
-        centre = min(max(((lo + hi + 1) / 2) % m, wid / 2), m - wid / 2)
-        lane = 0
-        while any(abs(centre - c) < (wid + w) / 2 and ln == lane for _, _, c, ln, w in placed):
-            lane += 1
-        placed.append((i, text, centre, lane, wid))
-    return [(i, t, c, ln) for i, t, c, ln, _ in placed]
+    wid = np.array([label_width(t, pt) for t in texts]) * idx_per_in
+    centre = np.minimum(np.maximum(((lo + hi + 1) / 2) % m, wid / 2), m - wid / 2)
+    left = centre - wid / 2
+    ends: list[float] = []  # right edge of each lane's last label
+    for i in np.lexsort((np.arange(n), left)).tolist():
+        a, b = float(left[i]), float(left[i] + wid[i])
+        for k, end in enumerate(ends):
+            if a >= end:
+                ends[k] = b
+                out.placed.append((i, texts[i], float(centre[i]), k))
+                break
+        else:
+            if len(ends) < max_lanes:
+                out.placed.append((i, texts[i], float(centre[i]), len(ends)))
+                ends.append(b)
+            else:
+                out.dropped += 1
+    out.used = len(ends)
+    return out
 
 
 def tick_format(lo: float, hi: float) -> str:
@@ -113,32 +240,39 @@ def layout(
     ylim: tuple[float, float] = (0.0, 1.0),
     xlim: tuple[float, float] = (0.0, 1.0),
     aspect: float = ASPECT,
+    min_font: float = 0.0,
 ) -> Layout:
     """The figure's boxes for a ``width``-inch figure whose main view is ``aspect`` (height
-    / width) as tall as it is wide."""
-    left = max(0.42, tick_chars(*ylim) * 0.6 * SMALL / 72 + 0.2)
-    right = max(0.1, tick_chars(*xlim) * 0.6 * SMALL / 72 / 2 + 0.03)  # half a tick label
+    / width) as tall as it is wide. ``min_font`` (points, 0 for the style's sizes) raises
+    the smallest text: rows, lanes and margins grow with it."""
+    k = max(1.0, min_font / SMALL)  # how much wider and taller the smallest text is
+    left = max(0.42, tick_chars(*ylim) * 0.6 * SMALL * k / 72 + 0.2)
+    right = max(0.1, tick_chars(*xlim) * 0.6 * SMALL * k / 72 / 2 + 0.03)  # half a tick
     main_w = width - left - right
     shows_bitmaps = "bitmaps" in layers and n_features and intervals is not None
     lanes = (0, 0)
     if shows_bitmaps:
         (LA, RA), (LB, RB) = intervals
-        a = interval_lanes(LA, RA, m, main_w)
-        b = interval_lanes(LB, RB, m, main_w)
-        lanes = (1 + max(ln for *_, ln in a), 1 + max(ln for *_, ln in b))
+        pt = max(LABEL_PT, min_font)
+        a = interval_lanes(LA, RA, m, main_w, pt=pt)
+        b = interval_lanes(LB, RB, m, main_w, pt=pt)
+        lanes = (max(1, a.height), max(1, b.height))
     main_h = round(main_w * aspect, 3)
     rows = readout_rows(layers, n_features, n_estimators)
-    readout_h = rows * TEXT_ROW + (0.06 if rows else 0.0)
-    bitmaps_h = sum(lanes) * LANE + 0.02 + 0.12 * 2 + 0.15 if shows_bitmaps else 0.0
-    title_h = 0.22 if title else 0.06
+    shown = table_features(layers, n_features, n_estimators)
+    readout_h = rows * TEXT_ROW * k + (0.06 if rows else 0.0)
+    bitmaps_h = sum(lanes) * LANE * k + 0.02 + 0.12 * 2 + 0.15 * k if shows_bitmaps else 0.0
+    title_h = 0.22 * k if title else 0.06
     y = 0.06
     readout = Box(0.1, y, width - 0.2, readout_h) if rows else None
     y += readout_h
     bitmaps = Box(left, y, main_w, bitmaps_h) if bitmaps_h else None
-    y += bitmaps_h + (0.05 if bitmaps_h else 0.0) + 0.3  # the main axes' x tick labels
+    y += bitmaps_h + (0.05 if bitmaps_h else 0.0) + 0.3 * k  # the main axes' x tick labels
     main = Box(left, y, main_w, main_h)
     y += main_h
     title_y = y + 0.06 if title else None
     # whole hundredths of an inch: the PNG's pixel size then scales exactly with --scale
     height = math.ceil((y + title_h) * 100 - 1e-9) / 100
-    return Layout(width, height, main, bitmaps, readout, rows, title_y, lanes)
+    return Layout(
+        width, height, main, bitmaps, readout, rows, title_y, lanes, shown, float(min_font)
+    )

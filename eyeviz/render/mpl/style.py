@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import math
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -122,6 +126,57 @@ def arc(radius, th1, th2, color, gid, center=(0.0, 0.0)):
     return a
 
 
+#: The smallest text a figure being drawn may have (``snapshot --min-font``); 0 keeps the
+#: style's sizes. Set for one figure with :func:`min_font`, read through :func:`pt`.
+_MIN_FONT: ContextVar[float] = ContextVar("eyeviz_min_font", default=0.0)
+MIN_FONT_RANGE = (SMALL, 12.0)
+
+
+def check_min_font(points) -> float:
+    """``points`` as a float in :data:`MIN_FONT_RANGE`; EyevizError (one line) otherwise."""
+    from eyeviz import EyevizError
+
+    lo, hi = MIN_FONT_RANGE
+    try:
+        v = float(points)
+    except (TypeError, ValueError):
+        v = math.nan
+    if not lo <= v <= hi:
+        raise EyevizError(f"min-font must be between {lo:g} and {hi:g} points, got {points!r}")
+    return v
+
+
+def pt(size: float) -> float:
+    """A font size raised to the minimum of the figure being drawn."""
+    return max(size, _MIN_FONT.get())
+
+
+@contextmanager
+def min_font(points: float) -> Iterator[None]:
+    """Draw with no text smaller than ``points`` (0: the style's sizes)."""
+    token = _MIN_FONT.set(float(points))
+    try:
+        yield
+    finally:
+        _MIN_FONT.reset(token)
+
+
+def raise_fonts(fig, points: float) -> None:
+    """Every text of ``fig`` (tick labels included) at least ``points`` tall."""
+    from matplotlib.text import Text
+
+    if points <= 0:
+        return
+    for t in fig.findobj(Text):
+        if t.get_fontsize() < points:
+            t.set_fontsize(points)
+    for ax in fig.axes:
+        for axis, which in ((ax.xaxis, "x"), (ax.yaxis, "y")):
+            ticks = axis.get_major_ticks()
+            if ticks and ticks[0].label1.get_fontsize() < points:
+                ax.tick_params(axis=which, labelsize=points)
+
+
 def subscripted(ax, x, y, parts, size, ha, color, **kw) -> None:
     """Text with subscripts as plain text objects (no mathtext: every SVG viewer reads it).
 
@@ -131,7 +186,8 @@ def subscripted(ax, x, y, parts, size, ha, color, **kw) -> None:
     from matplotlib.textpath import TextPath
     from matplotlib.transforms import offset_copy
 
-    sub_size = max(0.86 * size, SMALL)
+    size = pt(size)
+    sub_size = pt(max(0.86 * size, SMALL))
     widths = [
         TextPath((0, 0), t, size=sub_size if sub else size).get_extents().width
         + (0.6 if sub else 0.0)

@@ -27,7 +27,7 @@ from eyeviz.model.scene import Scene
 from eyeviz.model.state import SceneState
 from eyeviz.render.mpl.bounded import bound_figure
 from eyeviz.render.mpl.canvas import make_canvas
-from eyeviz.render.mpl.layout import ASPECT, ASPECT_RANGE, layout
+from eyeviz.render.mpl.layout import ASPECT_RANGE, default_aspect, layout
 from eyeviz.render.mpl.style import (
     BASE_DPI,
     MAX_WIDTH,
@@ -36,7 +36,10 @@ from eyeviz.render.mpl.style import (
     VECTOR_DPI,
     WIDTH_IN,
     WIDTHS,
+    check_min_font,
+    raise_fonts,
 )
+from eyeviz.render.mpl.style import min_font as font_floor
 
 __all__ = [
     "BASE_DPI",
@@ -132,11 +135,13 @@ def _refuse(name: str, reason: str) -> None:
     raise EyevizError(f"predictions layer: cannot load estimator {name!r}: {reason}")
 
 
-def resolve_aspect(aspect: float | None) -> float:
-    """The main view's height / width: ``None`` is the default 0.86; a number must lie in
-    [0.3, 1.6] (refused, not clamped: the figure would not show what was asked)."""
+def resolve_aspect(aspect: float | None, width: float = WIDTH_IN) -> float:
+    """The main view's height / width: ``None`` is the default for a ``width``-inch figure
+    (0.86 for a single column, 0.5 for a double one: :func:`layout.default_aspect`); a
+    number must lie in [0.3, 1.6] (refused, not clamped: the figure would not show what
+    was asked)."""
     if aspect is None:
-        return ASPECT
+        return default_aspect(width)
     lo, hi = ASPECT_RANGE
     try:
         a = float(aspect)
@@ -162,11 +167,13 @@ def figure(
     bitmaps: bool = True,
     predictor=None,
     aspect: float | None = None,
+    min_font: float | None = None,
 ) -> Figure:
     """The scene as a matplotlib Figure (no pyplot, no GUI), ``width`` inches wide
     ('single' = 3.5, 'double' = 7.2, or a number in [3, 10]).
 
-    ``aspect`` (height / width of the main view, in [0.3, 1.6]; default 0.86) frames the
+    ``aspect`` (height / width of the main view, in [0.3, 1.6]; default 0.86 for a single
+    column, 0.5 for a double one, interpolated between) frames the
     figure as a window of that shape shows the scene's view: the app's File > Export
     passes its view's, so the figure shows what the window shows.
 
@@ -176,12 +183,14 @@ def figure(
     phi_hat) arrays per feature; when None and the scene shows predictions, the scene's
     estimators are loaded (``predictor``, or a new :class:`Predictor`). An estimator that
     cannot load is refused (EyevizError). ``title``, ``table`` and ``bitmaps`` (False)
-    drop the title, the readout table and the bitmap strips.
+    drop the title, the readout table and the bitmap strips. ``min_font`` (points, in
+    [6, 12]) raises every smaller text to it; rows, lanes and margins grow to match.
     """
     import matplotlib
 
     w = resolve_width(width)
-    aspect = resolve_aspect(aspect)
+    aspect = resolve_aspect(aspect, w)
+    floor = 0.0 if min_font is None else check_min_font(min_font)
     check_drawable(scene)
     drop = set()
     if not table:
@@ -197,7 +206,7 @@ def figure(
     refuse_unloadable(scene, predictor, predictions)
     n_est = len(scene.estimators)
     cx, cy = scene.view.center
-    with matplotlib.rc_context(RC):
+    with matplotlib.rc_context(RC), font_floor(floor):
         lay0 = layout(
             w,
             layers=lay_names,
@@ -209,6 +218,7 @@ def figure(
             ylim=(cy - scene.view.width * aspect / 2, cy + scene.view.width * aspect / 2),
             xlim=(cx - scene.view.width / 2, cx + scene.view.width / 2),
             aspect=aspect,
+            min_font=floor,
         )
         vw = scene.view.width
         vh = vw * lay0.main.h / lay0.main.w
@@ -217,6 +227,7 @@ def figure(
         cv = make_canvas(scene, fr, lay0, dpi, merge, title)
         for spec in ordered("mpl", lay_names):  # the layer table, in its matplotlib order
             resolve(spec.mpl)(cv)
+        raise_fonts(cv.fig, floor)
         bound_figure(cv.fig)  # nothing Agg/FreeType cannot raster in bounded time
         cv.fig._eyeviz_rc = dict(RC)  # savefig must run under the same rc (fonttype)
         cv.fig._eyeviz_merged = cv.merged

@@ -6,7 +6,7 @@ from __future__ import annotations
 from matplotlib.patches import Rectangle
 
 from eyeviz.render.mpl.canvas import Canvas
-from eyeviz.render.mpl.layout import LABEL_PT, LANE, interval_lanes
+from eyeviz.render.mpl.layout import LABEL_PT, LANE, interval_lanes, more_text
 from eyeviz.render.mpl.style import FONT, GREY, INK, SMALL, UNLIT, dark, slug, subscripted
 
 STRIP = 0.12
@@ -24,8 +24,11 @@ def paint(cv: Canvas) -> None:
     ax.set_xlim(0, m)
     ax.set_ylim(0, box.h)  # y in inches
     ax.axis("off")
-    yB = cv.lay.lanes[1] * LANE + 0.01
-    yA = yB + STRIP + AXIS_H
+    k = cv.lay.font_scale  # lanes and the axis between the strips grow with --min-font
+    lane_h = LANE * k
+    label_pt = cv.lay.pt(LABEL_PT)
+    yB = cv.lay.lanes[1] * lane_h + 0.01
+    yA = yB + STRIP + AXIS_H * k
     fills = [None] + fr.palette
     for eye, y0 in zip(fr.eyes, (yA, yB), strict=True):
         name = eye.name
@@ -98,19 +101,32 @@ def paint(cv: Canvas) -> None:
         )
         L, R = fr.intervals[name]
         above = name == "A"
-        for i, text, centre, lane in interval_lanes(L, R, m, box.w):
-            dy = 0.008 + lane * LANE
+        lanes = interval_lanes(L, R, m, box.w, pt=label_pt)
+        for i, text, centre, lane in lanes:
+            dy = 0.008 + lane * lane_h
             ax.text(
                 centre,
                 y0 + STRIP + dy if above else y0 - dy,
                 text,
                 ha="center",
                 va="bottom" if above else "top",
-                fontsize=LABEL_PT,
+                fontsize=label_pt,
                 color=dark(fr.colors[i]),
                 gid=f"bitmap-interval-{name}-{slug(fr.names[i])}",
             )
-    ymid = yB + STRIP + AXIS_H / 2
+        if lanes.dropped:  # one line for the labels no lane could hold
+            dy = 0.008 + lanes.used * lane_h
+            ax.text(
+                m,
+                y0 + STRIP + dy if above else y0 - dy,
+                more_text(lanes.dropped, "more intervals"),
+                ha="right",
+                va="bottom" if above else "top",
+                fontsize=label_pt,
+                color=GREY,
+                gid=f"bitmap-interval-{name}-more",
+            )
+    ymid = yB + STRIP + AXIS_H * k / 2
     for k in (0, m // 4, half, 3 * m // 4, m):
         lab = f"{k}" if k != half else f"m/2 = {half}"
         ax.plot([k, k], [yA - 0.015, yA], color=GREY, lw=0.4)

@@ -8,6 +8,7 @@ import math
 from eyeviz.model.frame import PredictionFrame
 from eyeviz.model.palette import estimator_color
 from eyeviz.render.mpl.canvas import Canvas, fit_text
+from eyeviz.render.mpl.layout import more_text
 from eyeviz.render.mpl.style import GREY, LIGHT, OUT_OF_DOMAIN, SMALL, dark, distance, short, slug
 
 # (header, alignment); the x positions follow the widest cell of each column
@@ -129,6 +130,9 @@ def paint(cv: Canvas) -> None:
     ax.set_xlim(0, 1)
     ax.set_ylim(0, 1)
     dy = 1.0 / cv.lay.readout_rows
+    shown = cv.lay.table_features or fr.n  # the rest are counted in the last row
+    k = cv.lay.font_scale  # text raised by --min-font: the same table, k times narrower
+    width = box.w / k
     line_pt = 0.97 * box.w * 72  # a prediction or ambiguity line is cut to the table
     # full distances; else 3 significant digits; else shorter names and tighter gaps
     for compact, name_chars, gap, name_min in (
@@ -137,8 +141,8 @@ def paint(cv: Canvas) -> None:
         (True, 10, 0.05, 0.4),
         (True, 6, 0.03, 0.3),
     ):
-        cells = [row_values(fr, i, compact, name_chars) for i in range(fr.n)]
-        cols = column_x(cells, box.w, gap, name_min)
+        cells = [row_values(fr, i, compact, name_chars) for i in range(shown)]
+        cols = column_x(cells, width, gap, name_min)
         if cols is not None:
             break
     if cols is None:
@@ -150,7 +154,7 @@ def paint(cv: Canvas) -> None:
     # each group's header within its own columns; the short ones (all of them, alike)
     # where a long one would reach its neighbour ("about the origin O" ran into
     # "about eye A" at 3.5 in)
-    fits = all(len(t) * CHAR_IN <= (rights[b_] - lefts[a_]) * box.w for t, _, a_, b_ in GROUPS)
+    fits = all(len(t) * CHAR_IN <= (rights[b_] - lefts[a_]) * width for t, _, a_, b_ in GROUPS)
     for long_text, short_text, a, b in GROUPS:
         x0, x1 = lefts[a], rights[b]
         text = long_text if fits else short_text
@@ -169,7 +173,7 @@ def paint(cv: Canvas) -> None:
     for (text, ha), x in zip(COLUMNS, xs, strict=True):
         ax.text(x, y, text, ha=ha, va="center", fontsize=SMALL, color=GREY)
     ax.plot([0, rights[-1]], [y - dy / 2, y - dy / 2], color=LIGHT, lw=0.4)
-    for i in range(fr.n):
+    for i in range(shown):
         y -= dy
         col = OUT_OF_DOMAIN if ood[i] else dark(fr.colors[i])
         for j, ((_, ha), x, v) in enumerate(zip(COLUMNS, xs, cells[i], strict=True)):
@@ -221,3 +225,15 @@ def paint(cv: Canvas) -> None:
                 color=col,
                 gid=f"readout-posterior-{i}",
             )
+    if shown < fr.n:
+        y -= dy
+        ax.text(
+            0.0,
+            y,
+            more_text(fr.n - shown, "more features (not listed)"),
+            ha="left",
+            va="center",
+            fontsize=SMALL,
+            color=GREY,
+            gid="readout-more",
+        )
