@@ -21,9 +21,10 @@ planar default, m = 720, as before). Features carry ``z`` (default 0.0), written
 spherical scene, so a planar scene loads and saves exactly as before; a planar feature with
 z != 0 is refused. nside is bounded by :func:`eyeviz.core.bounds.check_nside`, z like x and
 y. A spherical scene may show only the layers in :data:`SPHERICAL_LAYERS` (eyes, features,
-bfv, bitmaps, readout, labels: what the headless 3D figure draws); the planar-only layers
-(tangents, sectors, ambiguity, posterior, trajectory, predictions, and any registered
-layer) and a ``[trajectory]`` table are refused in one line.
+bfv, bitmaps, readout, labels, and in the app's 3D view tangents: the tangent cones from
+each eye centre to each ball, and plane: the plane z = 0, a layer of spherical scenes only,
+:data:`SPHERICAL_ONLY`); the planar-only layers (sectors, ambiguity, posterior, trajectory,
+predictions, and any registered layer) and a ``[trajectory]`` table are refused in one line.
 
 This module imports the standard library and tomli_w only (no Qt, VTK or torch).
 
@@ -74,7 +75,9 @@ TRAJECTORY_KINDS = ("horizontal", "circular", "vertical")
 OKABE_ITO = ("#D55E00", "#0072B2", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#F0E442")
 DEFAULT_LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout"]
 #: The layers a spherical scene may show (see the module docstring).
-SPHERICAL_LAYERS = ("eyes", "features", "bfv", "bitmaps", "readout", "labels")
+SPHERICAL_LAYERS = ("eyes", "features", "bfv", "bitmaps", "readout", "labels", "tangents", "plane")
+#: Layers of spherical scenes only (not in the planar layer table, eyeviz.model.layers).
+SPHERICAL_ONLY = ("plane",)
 _COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
 #: Bounds of what a scene may ask the app to draw (see the module docstring).
 MAX_SCENE_COORD = 1e12
@@ -381,6 +384,8 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
     c.keys(layers_t, "layers.", ("show",))
     layers = c.strings(layers_t, "show", "layers.", DEFAULT_LAYERS)
     known = layer_names()  # the layer table (eyeviz.model.layers), registered layers too
+    if kind == "spherical":
+        known += SPHERICAL_ONLY
     for name in layers:
         if name not in known:
             raise c.fail("layers.show", f"unknown layer {name!r} (known: {', '.join(known)})")

@@ -157,7 +157,7 @@ def test_refusals_one_line_naming_the_key():
         BASE3D.replace("nside = 8", "m = 720"), "features[0].z", "'a'", "planar", "z = 0"
     )
     assert msg.startswith("s.toml:11:")  # the line of z
-    for layer in ("tangents", "sectors", "ambiguity", "posterior", "trajectory", "predictions"):
+    for layer in ("sectors", "ambiguity", "posterior", "trajectory", "predictions"):
         _refused(
             BASE3D.replace('"bitmaps"]', f'"bitmaps", "{layer}"]'),
             "layers.show",
@@ -169,6 +169,15 @@ def test_refusals_one_line_naming_the_key():
         "trajectory",
         "spherical",
     )
+
+
+def test_cones_and_the_plane_are_spherical_layers():
+    """tangents (the tangent cones) and plane (z = 0) are layers of the 3D view; plane is
+    not a planar layer."""
+    s = loads(BASE3D.replace('"bitmaps"]', '"bitmaps", "tangents", "plane"]'), "s.toml")
+    assert s.shows("tangents") and s.shows("plane")
+    planar = BASE3D.replace("nside = 8", "m = 720").replace("z = 40.0", "z = 0.0")
+    _refused(planar.replace('"bitmaps"]', '"bitmaps", "plane"]'), "layers.show", "'plane'")
 
 
 def test_scene_module_stays_light():
