@@ -2,20 +2,49 @@
 (:func:`eyeviz.model.frame.clip_wedge`, Definition 2) and its two edges, in the main view
 and the inset, in place: the mesh has a fixed number of points; unused slots collapse onto
 a point. The view hands it a Frame clipped to what its cameras show (and a new one after a
-zoom or a pan: :meth:`eyeviz.render.vtk.actors.SceneActors.fit_bfv`)."""
+zoom or a pan: :meth:`eyeviz.render.vtk.actors.SceneActors.fit_bfv`).
+
+Where the origin is in view, the main view also draws the BFV's angles as the exported
+figure does (Definition 2, Figures 5-6): theta's arc between the two edges with its label
+above it, psi's arc between the x-axis and the right edge with its label beside it, at a
+fifth of the view's height (at least 1.5 h)."""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 import pyvista as pv
 
 from eyeviz.model.frame import Frame
-from eyeviz.render.vtk.primitives import actor, write_points
+from eyeviz.render.vtk.primitives import actor, text3d, write_points
 from eyeviz.render.vtk.style import BFV_FILL, BFV_LINE, Z_BFV, Z_LINE
 
-__all__ = ["BFVLayer", "BFV_SLOTS"]
+__all__ = ["ANGLE_LABEL_PX", "ARC_POINTS", "BFVLayer", "BFV_SLOTS", "angle_marks"]
 
 BFV_SLOTS = 8  # a rectangle cut by two half-planes has at most 6 vertices
+ARC_POINTS = 49  # points of each angle's arc
+ANGLE_LABEL_PX = 18
+
+
+def angle_marks(psi: float, h: float, rect: tuple[float, float, float, float]) -> dict | None:
+    """Where theta's and psi's arcs and labels go in ``rect`` (x0, x1, y0, y1), or None when
+    the origin is not in it: {"theta": (N, 2) arc, "psi": (N, 2) arc, "axis": x-axis
+    segment, "theta_at" / "psi_at": label anchors}. theta = pi - 2 psi (Eq. 16)."""
+    x0, x1, y0, y1 = rect
+    if not (x0 <= 0.0 <= x1 and y0 <= 0.0 <= y1):
+        return None
+    rad = max(0.2 * (y1 - y0), 1.5 * h)
+    rpsi = 0.72 * rad
+    t = np.linspace(psi, math.pi - psi, ARC_POINTS)
+    u = np.linspace(0.0, psi, ARC_POINTS)
+    return {
+        "theta": np.column_stack([rad * np.cos(t), rad * np.sin(t)]),
+        "psi": np.column_stack([rpsi * np.cos(u), rpsi * np.sin(u)]),
+        "axis": np.array([[0.0, 0.0], [1.3 * rpsi, 0.0]]),
+        "theta_at": (0.0, 1.04 * rad),
+        "psi_at": (1.08 * rpsi * math.cos(psi / 2), 1.08 * rpsi * math.sin(psi / 2)),
+    }
 
 
 class BFVLayer:
@@ -36,6 +65,22 @@ class BFVLayer:
             b.GetProperty().SetLineWidth(2.5)
             self.actors.append((ren, a))
             self.actors.append((ren, b))
+        # theta and psi in the main view (the inset's footer line names them)
+        n = ARC_POINTS
+        lines = np.r_[n, np.arange(n), n, np.arange(n, 2 * n), 2, 2 * n, 2 * n + 1]
+        self.arcs = pv.PolyData(np.zeros((2 * n + 2, 3)), lines=lines)
+        self.arc_actor = actor(self.arcs, BFV_LINE)
+        self.arc_actor.GetProperty().SetLineWidth(2.0)
+        self.theta_label = text3d(ANGLE_LABEL_PX, BFV_LINE)
+        self.psi_label = text3d(ANGLE_LABEL_PX, BFV_LINE)
+        for lab in (self.theta_label, self.psi_label):
+            tp = lab.GetTextProperty()
+            tp.SetBackgroundColor(1.0, 1.0, 1.0)
+            tp.SetBackgroundOpacity(0.75)  # a halo: the label reads over a disc
+        self.theta_label.GetTextProperty().SetJustificationToCentered()
+        self.psi_label.GetTextProperty().SetVerticalJustificationToCentered()
+        for a in (self.arc_actor, self.theta_label, self.psi_label):
+            self.actors.append((main, a))
         self.shown = False
         self.polygon = np.zeros((0, 2))
         self._written: tuple | None = None
@@ -55,7 +100,7 @@ class BFVLayer:
     def update(self, frame: Frame) -> None:
         """Write the wedge and its edges (nothing when they are what is drawn)."""
         bfv = frame.bfv
-        key = None if bfv is None else (bfv.psi, bfv.rect)
+        key = None if bfv is None else (bfv.psi, bfv.rect, frame.pair.h)
         if key == self._written:  # the same wedge and rectangle (a drag): nothing to clip
             return
         self._written = key
@@ -75,3 +120,18 @@ class BFVLayer:
                 ep[2 * j] = (seg[0], seg[1], self.z_line)
                 ep[2 * j + 1] = (seg[2], seg[3], self.z_line)
         write_points(self.edges, ep)
+        marks = None if bfv is None else angle_marks(bfv.psi, frame.pair.h, bfv.rect)
+        for a in (self.arc_actor, self.theta_label, self.psi_label):
+            a.SetVisibility(marks is not None)
+        if marks is None or bfv is None:
+            return
+        ap = np.zeros((2 * ARC_POINTS + 2, 3))
+        ap[:, 2] = self.z_line
+        ap[:ARC_POINTS, :2] = marks["theta"]
+        ap[ARC_POINTS : 2 * ARC_POINTS, :2] = marks["psi"]
+        ap[2 * ARC_POINTS :, :2] = marks["axis"]
+        write_points(self.arcs, ap)
+        self.theta_label.SetInput(f"\u03b8 = {math.degrees(bfv.theta):.0f}\u00b0")
+        self.theta_label.SetPosition(*marks["theta_at"], self.z_line)
+        self.psi_label.SetInput(f"\u03c8 = {math.degrees(bfv.psi):.0f}\u00b0")
+        self.psi_label.SetPosition(*marks["psi_at"], self.z_line)
