@@ -110,13 +110,14 @@ def preset(name: str, h: float, l: float, extent: float) -> Camera3D:
     return _look(focal, direction, up, dist, 30.0)
 
 
-def eyes_camera(cam: Camera3D, h: float, l: float) -> Camera3D:
+def eyes_camera(cam: Camera3D, h: float, l: float, aspect: float = 1.0) -> Camera3D:
     """The close-up of the eyes seen from ``cam``'s direction (the 3D view's inset).
 
     The eyes are small beside the features they look at (l = 20 against r = 1000 in the
     paper), so the view shows them again at a scale where the facets are seen: same
     direction and view-up as ``cam``, framing both eyes, or one eye when ``cam`` looks at
-    that eye's centre (the ``eye_a`` / ``eye_b`` presets).
+    that eye's centre (the ``eye_a`` / ``eye_b`` presets), in a viewport ``aspect``
+    (width / height) wide.
     """
     pos = np.asarray(cam.position, dtype=float)
     foc = np.asarray(cam.focal_point, dtype=float)
@@ -131,7 +132,9 @@ def eyes_camera(cam: Camera3D, h: float, l: float) -> Camera3D:
     else:
         focal = np.zeros(3)
         radius = 1.1 * (h + l)
-    dist = _fit_distance(radius, cam.view_angle)
+    half = math.radians(cam.view_angle) / 2.0
+    half = min(half, math.atan(math.tan(half) * check_real("aspect", aspect, gt=0.0)))
+    dist = radius / math.sin(half)
     return _look(focal, direction, cam.view_up, dist, cam.view_angle)
 
 

@@ -1,0 +1,196 @@
+"""What the 3D view draws, as numpy arrays: facet polygons, tangent cones, the 3D BFV's
+cones, the plane z = 0 and the colour of every facet (no VTK, no matplotlib).
+
+The VTK painters (:mod:`eyeviz.render.vtk.scene3d`) and a vector figure draw these
+arrays only; the geometry is here, beside the model (docs/architecture.md: renderers never
+compute geometry). The eyes and the balls are those of docs/spherical.md: eye A at
+(-h, 0, 0), eye B at (h, 0, 0), facets the HEALPix cells in RING order.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+
+from eyeviz.core import healpix
+from eyeviz.model.state3d import SceneState3D
+
+__all__ = [
+    "FULL_MAX_NSIDE",
+    "bfv_cones",
+    "cone_faces",
+    "edge_step",
+    "facet_mesh",
+    "facet_owner",
+    "plane_z0",
+    "scene_extent",
+    "shorten_cones",
+    "tangent_cone",
+    "view_nside",
+]
+
+#: Up to this nside every facet of an eye is a cell of the view's mesh (nside 64: 49,152
+#: per eye). Beyond, the unlit sphere is drawn at :data:`COARSE_NSIDE` and the lit facets
+#: at the scene's nside over it (nside 180: 388,800 facets per eye, each under a pixel in
+#: the view; measured in scripts/bench_app3d.py).
+FULL_MAX_NSIDE = 64
+COARSE_NSIDE = 16
+
+
+def view_nside(nside: int) -> int:
+    """The nside of the mesh drawn for an eye's unlit sphere (see :data:`FULL_MAX_NSIDE`)."""
+    return int(nside) if nside <= FULL_MAX_NSIDE else COARSE_NSIDE
+
+
+def edge_step(nside: int) -> int:
+    """Points per facet edge: curved edges for the large facets of a small nside."""
+    return max(1, min(8, 16 // int(nside)))
+
+
+@lru_cache(maxsize=8)
+def _unit_mesh(nside: int, step: int) -> tuple[np.ndarray, np.ndarray]:
+    pts = healpix.boundaries(nside, np.arange(healpix.npix(nside)), step)
+    k = 4 * step
+    n = pts.shape[0]
+    faces = np.empty((n, k + 1), dtype=np.int64)
+    faces[:, 0] = k
+    faces[:, 1:] = np.arange(n * k, dtype=np.int64).reshape(n, k)
+    pts.setflags(write=False)
+    faces.setflags(write=False)
+    return pts.reshape(-1, 3), faces.ravel()
+
+
+def facet_mesh(
+    nside: int, centre, radius: float, pix=None, step: int | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(points (k, 3), VTK faces) of facets ``pix`` (all when None) of an eye: one polygon
+    per facet, counter-clockwise seen from outside, in ``pix`` order (so cell i is facet
+    ``pix[i]``; cell i is facet i for the whole eye)."""
+    step = edge_step(nside) if step is None else int(step)
+    c = np.asarray(centre, dtype=np.float64)
+    if pix is None:
+        unit, faces = _unit_mesh(int(nside), step)
+        return unit * radius + c, faces
+    pix = np.asarray(pix, dtype=np.int64)
+    k = 4 * step
+    pts = healpix.boundaries(nside, pix, step).reshape(-1, 3) * radius + c
+    faces = np.empty((pix.size, k + 1), dtype=np.int64)
+    faces[:, 0] = k
+    faces[:, 1:] = np.arange(pix.size * k, dtype=np.int64).reshape(pix.size, k)
+    return pts, faces.ravel()
+
+
+def facet_owner(state: SceneState3D, eye: str, out: np.ndarray | None = None) -> np.ndarray:
+    """Per facet of ``eye`` the index of the ball it is coloured for, -1 if unlit.
+
+    A facet lit by several balls takes the last one's (the scene's drawing order, as the
+    planar owner of an ommatidium and the 3D figure). ``out`` (int32, npix) is filled in
+    place when given.
+    """
+    npix = state.pair.npix
+    own = np.full(npix, -1, dtype=np.int32) if out is None else out
+    if out is not None:
+        own.fill(-1)
+    csr = state.lit_a if eye == "A" else state.lit_b
+    if csr is None:
+        return own
+    ip, ix = csr
+    for i in range(state.n):
+        own[ix[ip[i] : ip[i + 1]]] = i
+    return own
+
+
+def tangent_cone(apex, centre, g: float, res: int = 48) -> np.ndarray:
+    """Points (res + 1, 3): the apex, then the circle where the cone from ``apex`` touches
+    the ball (``centre``, ``g``): the closed tangent cone of the 3D Proposition 2.
+
+    The circle has centre apex + d (1 - g^2 / |d|^2) and radius g sqrt(|d|^2 - g^2) / |d|;
+    when the apex lies in the closed ball (the whole eye lit) the cone is degenerate: every
+    point is the apex.
+    """
+    a = np.asarray(apex, dtype=np.float64)
+    d = np.asarray(centre, dtype=np.float64) - a
+    dd = float(d @ d)
+    out = np.empty((res + 1, 3))
+    out[:] = a
+    if dd <= g * g:
+        return out
+    dn = math.sqrt(dd)
+    u = d / dn
+    # two unit vectors normal to u
+    ref = np.array([0.0, 0.0, 1.0]) if abs(u[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    e1 = np.cross(u, ref)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(u, e1)
+    c = a + d * (1.0 - g * g / dd)
+    rad = g * math.sqrt(dd - g * g) / dn
+    t = np.linspace(0.0, 2.0 * math.pi, res, endpoint=False)
+    out[1:] = c + rad * (np.cos(t)[:, None] * e1 + np.sin(t)[:, None] * e2)
+    return out
+
+
+def cone_faces(res: int = 48) -> np.ndarray:
+    """VTK faces of :func:`tangent_cone`'s points: ``res`` triangles apex, i, i + 1."""
+    i = np.arange(res)
+    return np.column_stack([np.full(res, 3), np.zeros(res, int), 1 + i, 1 + (i + 1) % res]).ravel()
+
+
+def shorten_cones(pts: np.ndarray, res: int, length: float) -> np.ndarray:
+    """Cones of :func:`tangent_cone` (blocks of res + 1 points) cut ``length`` from their
+    apex (a cone shorter than that is kept whole)."""
+    p = np.asarray(pts, dtype=np.float64).reshape(-1, res + 1, 3)
+    apex = p[:, :1, :]
+    axis = p[:, 1:, :].mean(axis=1, keepdims=True) - apex
+    d = np.linalg.norm(axis, axis=-1, keepdims=True)
+    s = np.where(d > length, length / np.maximum(d, 1e-300), 1.0)
+    return (apex + (p - apex) * s).reshape(-1, 3)
+
+
+def bfv_cones(h: float, l: float, reach: float, res: int = 48) -> tuple[np.ndarray, np.ndarray]:
+    """(points, VTK faces): the boundary of the 3D binocular field of view out to
+    ``reach`` from the origin (docs/spherical.md): the halves y >= 0 of the two tangent
+    cones from the origin, about +x and -x, of half-angle psi = asin(l / h). The field is
+    the region in front of the eyes outside both cones.
+    """
+    psi = math.asin(l / h)
+    t = np.linspace(-0.5 * math.pi, 0.5 * math.pi, res + 1)
+    pts = [np.zeros((1, 3))]
+    faces = []
+    for k, sx in enumerate((1.0, -1.0)):
+        ring = reach * np.column_stack(
+            [
+                np.full(t.size, sx * math.cos(psi)),
+                math.sin(psi) * np.cos(t),
+                math.sin(psi) * np.sin(t),
+            ]
+        )
+        base = 1 + k * t.size
+        pts.append(ring)
+        j = np.arange(res)
+        faces.append(np.column_stack([np.full(res, 3), np.zeros(res, int), base + j, base + j + 1]))
+    return np.concatenate(pts), np.concatenate(faces).ravel()
+
+
+def plane_z0(
+    x0: float, x1: float, y0: float, y1: float, lines: int = 8
+) -> tuple[np.ndarray, np.ndarray]:
+    """(corners (4, 3), grid segments (2 * (lines + 1), 2, 3)) of the rectangle
+    [x0, x1] x [y0, y1] of the plane z = 0 (the planar model's plane)."""
+    corners = np.array([[x0, y0, 0.0], [x1, y0, 0.0], [x1, y1, 0.0], [x0, y1, 0.0]])
+    xs = np.linspace(x0, x1, lines + 1)
+    ys = np.linspace(y0, y1, lines + 1)
+    seg = [((x, y0, 0.0), (x, y1, 0.0)) for x in xs] + [((x0, y, 0.0), (x1, y, 0.0)) for y in ys]
+    return corners, np.asarray(seg, dtype=np.float64)
+
+
+def scene_extent(state: SceneState3D) -> float:
+    """How far ahead the views reach: the farthest ball's |centre| + g (at least 8 (h + l))
+    -- the ``extent`` of :func:`eyeviz.model.camera3d.preset`."""
+    pair = state.pair
+    lo = 8.0 * (pair.h + pair.l)
+    if state.n == 0:
+        return lo
+    reach = np.sqrt(state.x**2 + state.y**2 + state.z**2) + state.g
+    return float(max(lo, reach.max()))

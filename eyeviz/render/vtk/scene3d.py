@@ -1,0 +1,463 @@
+"""A spherical scene -> VTK actors, updated in place (the app's 3D view and its PNG).
+
+:class:`Scene3DActors` draws a :class:`eyeviz.model.state3d.SceneState3D` in two
+renderers side by side: ``scene`` (the balls, the eyes, the binocular field's cones, the
+tangent cones and the plane z = 0, through the view's camera) and ``eyes`` (the two eyes
+close up, seen from the same direction: at the paper's distances an eye is a few pixels
+in the scene, so its facets are shown again where they can be seen;
+:func:`eyeviz.model.camera3d.eyes_camera`). Every position drawn comes from
+:mod:`eyeviz.model.shapes3d` or the state; nothing here computes geometry.
+
+Layers (:data:`eyeviz.model.scene.SPHERICAL_LAYERS`): ``eyes`` (the facets, lit in the
+colour of the ball they see; a facet lit by several balls takes the last one's), ``features``
+(the balls, the selected one ringed), ``bfv`` (the 3D field's boundary cones, translucent),
+``tangents`` (the tangent cone from each eye centre to each ball), ``plane`` (the plane z = 0
+and each eye's equator: that row of facets is the planar eye), ``labels`` (names).
+
+Level of detail: up to :data:`eyeviz.model.shapes3d.FULL_MAX_NSIDE` each eye is one mesh
+with one cell per facet, and a frame rewrites its cell colours in place. Beyond (nside 180:
+388,800 facets per eye, each under a pixel) the unlit sphere is a coarse mesh drawn once,
+and each ball's lit facets are a small mesh of their own (one cell per lit facet at the
+scene's nside) rebuilt only when that ball's lit set changes. Balls and their labels move
+by their actors' transforms; cones by writing their points in place.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import pyvista as pv
+from vtkmodules.vtkRenderingCore import vtkActor, vtkRenderer
+
+from eyeviz.files.atomic import atomic_output
+from eyeviz.model import shapes3d
+from eyeviz.model.camera3d import Camera3D, eyes_camera, preset
+from eyeviz.model.scene import Scene
+from eyeviz.model.state3d import SceneState3D, compute_state3d
+from eyeviz.render.vtk.primitives import (
+    Store,
+    actor,
+    screen_text,
+    set_rgb,
+    text3d,
+    write_points,
+    write_rgb,
+)
+from eyeviz.render.vtk.style import BACKGROUND, INK, INSET_BACKGROUND, UNLIT, hex_rgb, rgbf
+
+__all__ = [
+    "EYES_FRACTION",
+    "Scene3DActors",
+    "apply_camera",
+    "camera_of",
+    "default_camera",
+    "render_png3d",
+    "split_viewports",
+]
+
+#: The eyes' close-up takes this fraction of the view's width (left); the scene the rest.
+EYES_FRACTION = 0.4
+EDGE_RGB = (0.45, 0.45, 0.45)  # facet edges (nside <= EDGES_MAX_NSIDE)
+EDGES_MAX_NSIDE = 16
+BFV_RGB = (0.80, 0.72, 0.35)
+BFV_OPACITY = 0.16
+CONE_OPACITY = 0.28
+PLANE_RGB = (0.55, 0.62, 0.75)
+SELECT_RGB = INK
+CONE_RES = 40
+#: the lit patch of ball i lies at radius l (1 + PATCH_LIFT (1 + i / n)): above the
+#: coarse sphere, a later ball's above an earlier one's (the last one's colour wins)
+PATCH_LIFT = 0.004
+LABEL_PX = 20
+EYE_CONE = 4.0  # the eyes' close-up draws the tangent cones this many eye radii long
+
+
+def split_viewports(w: float, h: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(eyes, scene) viewports (xmin, ymin, xmax, ymax) of a ``w`` x ``h`` pixel view."""
+    f = EYES_FRACTION if w >= 2.0 * h * EYES_FRACTION else 0.5
+    return (0.0, 0.0, f, 1.0), (f, 0.0, 1.0, 1.0)
+
+
+def apply_camera(ren: vtkRenderer, cam: Camera3D) -> None:
+    """Put a :class:`Camera3D` into a VTK renderer (clipping range fitted to its props)."""
+    c = ren.GetActiveCamera()
+    c.SetPosition(*cam.position)
+    c.SetFocalPoint(*cam.focal_point)
+    c.SetViewUp(*cam.view_up)
+    c.SetViewAngle(cam.view_angle)
+    c.OrthogonalizeViewUp()
+    ren.ResetCameraClippingRange()
+
+
+def camera_of(ren: vtkRenderer) -> Camera3D:
+    """A VTK renderer's camera as a :class:`Camera3D`."""
+    c = ren.GetActiveCamera()
+    return Camera3D(
+        tuple(float(v) for v in c.GetPosition()),  # type: ignore[arg-type]
+        tuple(float(v) for v in c.GetFocalPoint()),  # type: ignore[arg-type]
+        tuple(float(v) for v in c.GetViewUp()),  # type: ignore[arg-type]
+        float(c.GetViewAngle()),
+    )
+
+
+def default_camera(state: SceneState3D, name: str = "default") -> Camera3D:
+    """The preset ``name`` framing the scene's balls (:func:`shapes3d.scene_extent`)."""
+    pair = state.pair
+    return preset(name, pair.h, pair.l, shapes3d.scene_extent(state))
+
+
+def _aspect(ren: vtkRenderer) -> float:
+    """A renderer's width / height in pixels (1 before it has a window)."""
+    w, h = ren.GetSize()
+    return w / h if w > 0 and h > 0 else 1.0
+
+
+def _lit(a: vtkActor, ambient: float = 0.45, diffuse: float = 0.6) -> vtkActor:
+    p = a.GetProperty()
+    p.LightingOn()
+    p.SetAmbient(ambient)
+    p.SetDiffuse(diffuse)
+    p.SetSpecular(0.0)
+    return a
+
+
+def _palette(scene: Scene) -> np.ndarray:
+    """(n + 1, 3) uint8: the balls' colours, then UNLIT (owner -1 indexes the last row)."""
+    rows = [hex_rgb(f.color) for f in scene.features] + [tuple(int(v) for v in UNLIT)]
+    return np.asarray(rows, dtype=np.uint8)
+
+
+class Scene3DActors:
+    """The actors of one 3D view (see the module docstring); ``update`` after each change."""
+
+    def __init__(self, scene_ren: vtkRenderer, eyes_ren: vtkRenderer | None) -> None:
+        self.scene_ren = scene_ren
+        self.eyes_ren = eyes_ren
+        self.renderers = [r for r in (scene_ren, eyes_ren) if r is not None]
+        self._eyes_key: tuple | None = None
+        self._balls_key: tuple | None = None
+        self.eye_store = Store()
+        self.ball_store = Store()
+        self.eye_meshes: list[pv.PolyData] = []  # full LOD: one per eye, cell i = facet i
+        self.patches: list[list[tuple[pv.PolyData, vtkActor, np.ndarray]]] = []
+        self.ball_actors: list[vtkActor] = []
+        self.ball_labels: list = []
+        self.cones: pv.PolyData | None = None
+        self.cone_actor: vtkActor | None = None
+        self.near_cones = pv.PolyData()
+        self.near_cone_actor: vtkActor = actor(self.near_cones)
+        self.select_actor: vtkActor | None = None
+        self.equators: list[vtkActor] = []
+        self.eye_labels: list = []
+        self.bfv_actor: vtkActor | None = None
+        self.plane_actors: list[vtkActor] = []
+        self._owner: list[np.ndarray] = []
+        self._last: tuple | None = None  # (x, y, z, g) drawn last, per ball
+        self.title = screen_text(22, INK, (0.01, 0.985), top=True)
+        scene_ren.AddViewProp(self.title)
+        self.eyes_caption = screen_text(16, (0.35, 0.35, 0.35), (0.03, 0.985), top=True)
+        if eyes_ren is not None:
+            eyes_ren.AddViewProp(self.eyes_caption)
+        self.unit_ball = pv.Sphere(radius=1.0, theta_resolution=40, phi_resolution=24)
+        self.unit_ring = pv.Sphere(radius=1.12, theta_resolution=24, phi_resolution=12)
+        self.nside = 0
+        self.full = True
+
+    # --- structure ---------------------------------------------------------------------
+    def _add(self, store: Store, a, scene: bool = True, eyes: bool = True) -> None:
+        if scene:
+            store.add(self.scene_ren, a)
+        if eyes and self.eyes_ren is not None:
+            store.add(self.eyes_ren, a)
+
+    def _build_eyes(self, scene: Scene, state: SceneState3D) -> None:
+        self.eye_store.clear()
+        pair = state.pair
+        n = pair.nside
+        self.nside = n
+        self.full = n <= shapes3d.FULL_MAX_NSIDE
+        self.eye_meshes = []
+        self._owner = []
+        self.equators = []
+        self.eye_labels = []
+        for cx in (-pair.h, pair.h):
+            centre = (cx, 0.0, 0.0)
+            if self.full:
+                pts, faces = shapes3d.facet_mesh(n, centre, pair.l)
+                mesh = pv.PolyData(pts, faces)
+                set_rgb(mesh.GetCellData(), np.broadcast_to(UNLIT, (mesh.n_cells, 3)))
+                a = _lit(actor(mesh, rgb=True))
+                if n <= EDGES_MAX_NSIDE:
+                    p = a.GetProperty()
+                    p.EdgeVisibilityOn()
+                    p.SetEdgeColor(*EDGE_RGB)
+                    p.SetLineWidth(1.0)
+                self.eye_meshes.append(mesh)
+                self._owner.append(np.full(pair.npix, -1, dtype=np.int32))
+            else:
+                cn = shapes3d.view_nside(n)
+                pts, faces = shapes3d.facet_mesh(cn, centre, pair.l * (1.0 - 1e-3), step=2)
+                a = _lit(actor(pv.PolyData(pts, faces), rgbf("#E1E1E1")))
+            self._add(self.eye_store, a)
+            # the equator (plane layer): that ring of facets is the planar eye
+            t = np.linspace(0.0, 2.0 * math.pi, 241)
+            r = pair.l * 1.012
+            ring = pv.lines_from_points(np.column_stack([cx + r * np.cos(t), r * np.sin(t), 0 * t]))
+            eq = actor(ring, (0.1, 0.1, 0.1))
+            eq.GetProperty().SetLineWidth(2.0)
+            self._add(self.eye_store, eq)
+            self.equators.append(eq)
+            if self.eyes_ren is not None:
+                lab = text3d(LABEL_PX, INK, center=True)
+                lab.SetInput(f"eye {'A' if cx < 0 else 'B'}")
+                lab.SetPosition(cx, 0.0, -1.55 * pair.l)
+                self.eye_store.add(self.eyes_ren, lab)
+                self.eye_labels.append(lab)
+        reach = 1.1 * shapes3d.scene_extent(state)
+        pts, faces = shapes3d.bfv_cones(pair.h, pair.l, reach)
+        self.bfv_actor = actor(pv.PolyData(pts, faces), BFV_RGB)
+        self.bfv_actor.GetProperty().SetOpacity(BFV_OPACITY)
+        self._add(self.eye_store, self.bfv_actor)
+        corners, segs = shapes3d.plane_z0(-reach * 0.8, reach * 0.8, -0.2 * reach, reach)
+        quad = pv.PolyData(corners, np.array([4, 0, 1, 2, 3]))
+        fill = actor(quad, PLANE_RGB)
+        fill.GetProperty().SetOpacity(0.10)
+        grid = pv.PolyData(segs.reshape(-1, 3))
+        grid.lines = np.column_stack(
+            [np.full(len(segs), 2), 2 * np.arange(len(segs)), 2 * np.arange(len(segs)) + 1]
+        ).ravel()
+        lines = actor(grid, PLANE_RGB)
+        lines.GetProperty().SetOpacity(0.6)
+        self.plane_actors = [fill, lines]
+        for a in self.plane_actors:
+            self._add(self.eye_store, a, eyes=False)
+        self.eyes_caption.SetInput(
+            f"the eyes, nside {n}: {pair.npix:,} facets each"
+            + ("" if self.full else "\n(lit facets at full resolution)")
+        )
+
+    def _build_balls(self, scene: Scene, state: SceneState3D) -> None:
+        self.ball_store.clear()
+        self.ball_actors, self.ball_labels, self.patches = [], [], [[], []]
+        self._last = None
+        for f in scene.features:
+            mapper_mesh = self.unit_ball
+            a = _lit(actor(mapper_mesh, rgbf(f.color)), 0.35, 0.7)
+            self._add(self.ball_store, a, eyes=False)
+            self.ball_actors.append(a)
+            lab = text3d(LABEL_PX, rgbf(f.color))
+            lab.GetTextProperty().SetJustificationToLeft()
+            lab.GetTextProperty().SetVerticalJustificationToBottom()
+            lab.SetInput(f" {f.name}")
+            self._add(self.ball_store, lab, eyes=False)
+            self.ball_labels.append(lab)
+        n = len(scene.features)
+        sel = actor(self.unit_ring, SELECT_RGB)
+        sel.GetProperty().SetRepresentationToWireframe()
+        sel.GetProperty().SetOpacity(0.55)
+        self._add(self.ball_store, sel, eyes=False)
+        self.select_actor = sel
+        # the tangent cones: 2 per ball, cells coloured by ball
+        res = CONE_RES
+        faces = shapes3d.cone_faces(res).reshape(res, 4)
+        allf = np.concatenate(
+            [faces + np.array([0, 1, 1, 1]) * k * (res + 1) for k in range(2 * n)]
+        )
+        self.cones = pv.PolyData(
+            np.zeros((max(2 * n, 1) * (res + 1), 3)), allf.ravel() if n else None
+        )
+        if n:
+            cols = np.repeat(_palette(scene)[:n], res, axis=0)
+            set_rgb(self.cones.GetCellData(), np.concatenate([cols, cols]))
+        self.cone_actor = actor(self.cones, rgb=bool(n))
+        self.cone_actor.GetProperty().SetOpacity(CONE_OPACITY)
+        self._add(self.ball_store, self.cone_actor, eyes=False)
+        # in the eyes' close-up, the cones' first EYE_CONE eye radii only
+        self.near_cones = pv.PolyData()
+        self.near_cones.ShallowCopy(self.cones)
+        self.near_cones.points = self.cones.points.copy()
+        self.near_cone_actor = actor(self.near_cones, rgb=bool(n))
+        self.near_cone_actor.GetProperty().SetOpacity(CONE_OPACITY)
+        self._add(self.ball_store, self.near_cone_actor, scene=False)
+        if not self.full:
+            for e in range(2):
+                for _ in range(n):
+                    mesh = pv.PolyData()
+                    a = _lit(actor(mesh, (0.5, 0.5, 0.5)))
+                    self._add(self.ball_store, a)
+                    self.patches[e].append((mesh, a, np.empty(0, np.int64)))
+
+    # --- per frame ---------------------------------------------------------------------
+    def update(self, scene: Scene, state: SceneState3D, selected: int | None) -> None:
+        """Draw ``state`` (of ``scene``): structure rebuilt only when it changed."""
+        pair = state.pair
+        eyes_key = (pair.h, pair.l, pair.nside, round(math.log(shapes3d.scene_extent(state)), 1))
+        balls_key = (
+            tuple((f.name, f.color) for f in scene.features),
+            pair.nside,
+        )
+        if eyes_key != self._eyes_key:
+            self._build_eyes(scene, state)
+            self._eyes_key = eyes_key
+            self._balls_key = None
+        if balls_key != self._balls_key:
+            self._build_balls(scene, state)
+            self._balls_key = balls_key
+        self.title.SetInput(scene.title)
+        shows = scene.shows
+        n = state.n
+        pal = _palette(scene)
+        # eyes
+        show_eyes = shows("eyes")
+        for a in (p for _r, p in self.eye_store.items):
+            a.SetVisibility(show_eyes)
+        csrs = (state.lit_a, state.lit_b)
+        if self.full:
+            for e, mesh in enumerate(self.eye_meshes):
+                own = self._owner[e]
+                shapes3d.facet_owner(state, "AB"[e], own)
+                write_rgb(mesh, pal[own])
+        else:
+            for e in range(2):
+                csr = csrs[e]
+                for i, (mesh, a, was) in enumerate(self.patches[e]):
+                    pix = csr[1][csr[0][i] : csr[0][i + 1]] if csr is not None else was[:0]
+                    a.SetVisibility(show_eyes and pix.size > 0)
+                    if pix.size == was.size and np.array_equal(pix, was):
+                        continue
+                    cx = (-pair.h, pair.h)[e]
+                    lift = pair.l * (1.0 + PATCH_LIFT * (1.0 + i / max(n, 1)))
+                    pts, faces = shapes3d.facet_mesh(pair.nside, (cx, 0.0, 0.0), lift, pix, step=1)
+                    fresh = pv.PolyData(pts, faces) if pix.size else pv.PolyData()
+                    mesh.ShallowCopy(fresh)
+                    a.GetProperty().SetColor(*(pal[i] / 255.0))
+                    self.patches[e][i] = (mesh, a, pix.copy())
+        for eq in self.equators:
+            eq.SetVisibility(show_eyes and shows("plane"))
+        for lab in self.eye_labels:
+            lab.SetVisibility(show_eyes and shows("labels"))
+        # balls
+        show_f = shows("features")
+        for i, a in enumerate(self.ball_actors):
+            a.SetVisibility(show_f)
+            a.SetPosition(state.x[i], state.y[i], state.z[i])
+            a.SetScale(state.g[i])
+            lab = self.ball_labels[i]
+            lab.SetVisibility(show_f and shows("labels"))
+            lab.SetPosition(state.x[i], state.y[i], state.z[i] + state.g[i])
+        sel = self.select_actor
+        if sel is not None:
+            on = show_f and selected is not None and 0 <= selected < n
+            sel.SetVisibility(on)
+            if on:
+                assert selected is not None
+                sel.SetPosition(state.x[selected], state.y[selected], state.z[selected])
+                sel.SetScale(state.g[selected])
+        # cones
+        if self.cones is not None and self.cone_actor is not None:
+            on = shows("tangents") and n > 0
+            self.cone_actor.SetVisibility(on)
+            self.near_cone_actor.SetVisibility(on)
+            if on:
+                pts = np.concatenate(
+                    [
+                        shapes3d.tangent_cone(
+                            (cx, 0.0, 0.0),
+                            (state.x[i], state.y[i], state.z[i]),
+                            float(state.g[i]),
+                            CONE_RES,
+                        )
+                        for cx in (-pair.h, pair.h)
+                        for i in range(n)
+                    ]
+                )
+                write_points(self.cones, pts)
+                write_points(
+                    self.near_cones, shapes3d.shorten_cones(pts, CONE_RES, EYE_CONE * pair.l)
+                )
+        if self.bfv_actor is not None:
+            self.bfv_actor.SetVisibility(shows("bfv"))
+        for a in self.plane_actors:
+            a.SetVisibility(shows("plane"))
+
+    def set_cameras(self, cam: Camera3D) -> None:
+        """The scene through ``cam``; the eyes from the same direction, framed."""
+        apply_camera(self.scene_ren, cam)
+        if self.eyes_ren is not None and self._eyes_key is not None:
+            h, l = self._eyes_key[0], self._eyes_key[1]
+            apply_camera(self.eyes_ren, eyes_camera(cam, h, l, _aspect(self.eyes_ren)))
+
+    def sync_eyes_camera(self, h: float, l: float) -> None:
+        """The eyes' camera follows the scene camera's direction (after a rotation)."""
+        if self.eyes_ren is not None:
+            cam = eyes_camera(camera_of(self.scene_ren), h, l, _aspect(self.eyes_ren))
+            apply_camera(self.eyes_ren, cam)
+
+
+def make_renderers(ren_win, scene_ren: vtkRenderer) -> vtkRenderer:
+    """Add the eyes' renderer beside ``scene_ren`` in ``ren_win``; returns it."""
+    eyes = vtkRenderer()
+    eyes.SetUseOIT(False)
+    eyes.SetUseDepthPeeling(False)
+    eyes.SetBackground(*INSET_BACKGROUND)
+    eyes.InteractiveOff()  # the mouse over it turns the scene's camera (it follows)
+    eyes.AutomaticLightCreationOn()
+    ren_win.AddRenderer(eyes)
+    scene_ren.SetBackground(*BACKGROUND)
+    return eyes
+
+
+def layout(scene_ren: vtkRenderer, eyes_ren: vtkRenderer, w: float, h: float) -> None:
+    left, right = split_viewports(w, h)
+    eyes_ren.SetViewport(*left)
+    scene_ren.SetViewport(*right)
+
+
+def render_png3d(
+    scene: Scene,
+    path: str | os.PathLike,
+    camera: Camera3D | None = None,
+    width: int = 1600,
+    height: int = 900,
+    *,
+    state: SceneState3D | None = None,
+    selected: int | None = None,
+) -> Path:
+    """Render a spherical scene off-screen (no display: EGL) to a PNG at ``camera`` (the
+    default preset framing the balls when None), ``width`` x ``height`` pixels, written
+    atomically; the same picture as the app's 3D view."""
+    from eyeviz import EyevizError
+    from eyeviz.core.validation import check_int
+
+    if Path(path).suffix.lower() != ".png":
+        raise EyevizError(f"render_png3d writes .png files, got {str(path)!r}")
+    width = check_int("width", width, ge=64, le=8192)
+    height = check_int("height", height, ge=64, le=8192)
+    target = Path(path)
+    if not (target.parent if str(target.parent) else Path(".")).is_dir():
+        raise EyevizError(f"{target}: directory {target.parent} does not exist")
+    st = compute_state3d(scene) if state is None else state
+    pl = pv.Plotter(off_screen=True, window_size=[width, height], lighting="light kit")
+    try:
+        ren_win = pl.ren_win
+        assert ren_win is not None
+        ren_win.SetMultiSamples(0)
+        main = pl.renderer
+        main.SetUseOIT(False)
+        main.SetUseDepthPeeling(False)
+        eyes = make_renderers(ren_win, main)
+        layout(main, eyes, width, height)
+        actors = Scene3DActors(main, eyes)
+        actors.update(scene, st, selected)
+        actors.set_cameras(camera if camera is not None else default_camera(st))
+        img = pl.screenshot(return_img=True)
+    finally:
+        pl.close()
+    from PIL import Image
+
+    with atomic_output(target) as tmp:
+        Image.fromarray(np.asarray(img)).save(str(tmp), format="PNG")
+    return target
