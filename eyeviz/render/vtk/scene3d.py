@@ -453,6 +453,7 @@ def render_png3d(
         actors = Scene3DActors(main, eyes)
         actors.update(scene, st, selected)
         actors.set_cameras(camera if camera is not None else default_camera(st))
+        main.camera.is_set = True  # else pyvista's first render resets it (an isometric fit)
         img = pl.screenshot(return_img=True)
     finally:
         pl.close()
