@@ -111,7 +111,7 @@ def law_points3d(designs: dict[tuple, Design3D]) -> list[LawPoint]:
             out.append(
                 LawPoint(
                     d.h, d.l, 4 * d.nside, r_mid, d.gamma * r_mid / (2 * d.h), y, fitted, paper
-                )  # fmt: skip
+                )
             )
     return out
 
@@ -123,8 +123,12 @@ def fit_power(points: list[LawPoint]) -> dict | None:
     if len(use) < 3:
         return None
     gam = np.array([2 * math.pi / p.m for p in use])
-    cols = {"gamma": gam, "r": np.array([p.r for p in use]),
-            "h": np.array([p.h for p in use]), "l": np.array([p.l for p in use])}  # fmt: skip
+    cols = {
+        "gamma": gam,
+        "r": np.array([p.r for p in use]),
+        "h": np.array([p.h for p in use]),
+        "l": np.array([p.l for p in use]),
+    }
     names = [k for k, v in cols.items() if np.ptp(np.log(v)) > 0]
     a = np.column_stack([np.ones(len(use))] + [np.log(cols[k]) for k in names])
     y = np.log([p.y for p in use])
@@ -198,7 +202,7 @@ def write_report3d(
             "n": fit.n,
             "free_slope": fit.slope,
             "C_free": fit.C_free,
-        },  # fmt: skip
+        },
         "power_law": power,
         "fit_rule": f"interior distance bins, >= {MIN_COUNT} elements, no flagged answer, "
         f"relative DD error <= {FIT_MAX:g}",
@@ -220,7 +224,8 @@ def write_report3d(
                         "seconds",
                     )
                 },
-            }  # fmt: skip
+                "el_mae_over_gamma": d.all["el_mae_deg"] / math.degrees(d.gamma),
+            }
             for d in sorted(designs.values(), key=lambda d: d.key)
         ],
     }

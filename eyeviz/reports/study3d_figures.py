@@ -47,8 +47,14 @@ def design_figure(designs: dict, l_of: dict, h_star: float, estimator: str):
                 (h, designs[(h, l_of[h], nv)].all[col]) for h in hs if (h, l_of[h], nv) in designs
             ]
             if pts:
-                ax_h.plot(*zip(*pts, strict=True), marker="o", ms=2.4, lw=1.2, **n_style[nv],
-                          label=_nside_label(nv))  # fmt: skip
+                ax_h.plot(
+                    *zip(*pts, strict=True),
+                    marker="o",
+                    ms=2.4,
+                    lw=1.2,
+                    **n_style[nv],
+                    label=_nside_label(nv),
+                )
             ls_ = sorted(k[1] for k in designs if k[0] == h_star and k[2] == nv)
             if ls_:
                 v = [designs[(h_star, lv, nv)].all[col] for lv in ls_]
@@ -58,8 +64,14 @@ def design_figure(designs: dict, l_of: dict, h_star: float, estimator: str):
                 (nv, designs[(h, l_of[h], nv)].all[col]) for nv in ns if (h, l_of[h], nv) in designs
             ]
             if pts:
-                ax_n.plot(*zip(*pts, strict=True), marker="o", ms=2.4, lw=1.2,
-                          **h_style[int(h * 1000)], label=f"h {h:g}, l {l_of[h]:g}")  # fmt: skip
+                ax_n.plot(
+                    *zip(*pts, strict=True),
+                    marker="o",
+                    ms=2.4,
+                    lw=1.2,
+                    **h_style[int(h * 1000)],
+                    label=f"h {h:g}, l {l_of[h]:g}",
+                )
         vals = [d.all[col] for d in designs.values()]
         for ax in (ax_h, ax_l, ax_n):
             ax.set_xscale("log")
@@ -94,8 +106,9 @@ def dd_figure(designs: dict, l_of: dict, fit: LawFit, estimator: str):
     vals = [b["dd_mape"] for d in designs.values() for b in d.r_bins if b["count"] >= MIN_COUNT]
     ncols = min(len(hs), 3)
     nrows = math.ceil(len(hs) / ncols)
-    fig = Figure(figsize=(TWO_COLUMNS if ncols > 1 else ONE_COLUMN, 0.9 + 1.8 * nrows),
-                 layout="constrained")  # fmt: skip
+    fig = Figure(
+        figsize=(TWO_COLUMNS if ncols > 1 else ONE_COLUMN, 0.9 + 1.8 * nrows), layout="constrained"
+    )
     axes = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False).ravel()
     for ax, h in zip(axes, hs, strict=False):
         for nv in ns:
@@ -135,7 +148,7 @@ def law_figure3d(points: Sequence[LawPoint], fit: LawFit, power: dict | None, es
 
     ms = sorted({p.m for p in points})
     style = _m_style(ms)
-    fig = Figure(figsize=(ONE_COLUMN, 3.9), layout="constrained")
+    fig = Figure(figsize=(ONE_COLUMN, 4.6), layout="constrained")
     ax = fig.add_subplot()
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -144,31 +157,44 @@ def law_figure3d(points: Sequence[LawPoint], fit: LawFit, power: dict | None, es
             sel = [p for p in points if p.m == m and p.fitted == filled]
             c = style[m]["color"]
             face = c if filled else "none"
-            ax.scatter([p.x for p in sel], [p.y for p in sel], s=7, facecolor=face, edgecolor=c,
-                       lw=0.5, zorder=3)  # fmt: skip
+            ax.scatter(
+                [p.x for p in sel],
+                [p.y for p in sel],
+                s=7,
+                facecolor=face,
+                edgecolor=c,
+                lw=0.5,
+                zorder=3,
+            )
     handles = [Line2D([], [], ls="", marker="o", ms=3, color=style[m]["color"]) for m in ms]
-    labels = [_nside_label(m // 4) for m in ms]
+    labels = [f"nside {m // 4}" for m in ms]
     xs = np.array([p.x for p in points])
     if fit.C is not None and xs.size:
         xx = np.geomspace(xs.min(), xs.max(), 50)
         ax.plot(xx, fit.C * xx, color="black", lw=1.0, zorder=2)
         handles.append(Line2D([], [], color="black", lw=1.0))
-        labels.append(f"C·γr/(2h), C = {fit.C:.3g} (slope 1, ×÷{fit.factor or 1:.2f})")
+        labels.append(f"C·γr/(2h): C = {fit.C:.3g}, ×÷{fit.factor or 1:.2f}")
         if fit.slope is not None and fit.C_free is not None:
             ax.plot(xx, fit.C_free * xx**fit.slope, color="#7A7A7A", lw=0.9, ls="--", zorder=2)
             handles.append(Line2D([], [], color="#7A7A7A", lw=0.9, ls="--"))
             labels.append(f"free slope {fit.slope:.2f}")
     if power is not None:
         sym = {"exp_gamma": "γ", "exp_r": "r", "exp_h": "h", "exp_l": "l"}
-        parts = [f"{sym[k]}^{power[k]:.2f}" for k in sym
-                 if power[k] is not None]  # fmt: skip
-        ax.text(0.02, 0.98, "power law fit:\nrel. DD ∝ " + " ".join(parts)
-                + f"\n(planar law: γ^1 r^1 h^-1 l^0)\n{power['n']} filled bins",
-                transform=ax.transAxes, va="top", ha="left")  # fmt: skip
+        parts = [f"{sym[k]}^{power[k]:.2f}" for k in sym if power[k] is not None]
+        ax.text(
+            0.02,
+            0.98,
+            "power law fit:\nrel. DD ∝ "
+            + " ".join(parts)
+            + f"\n(planar law: γ^1 r^1 h^-1 l^0)\n{power['n']} filled bins",
+            transform=ax.transAxes,
+            va="top",
+            ha="left",
+        )
     ax.set_xlabel("γ r / (2h)   (γ = 2π / (4 nside))")
     ax.set_ylabel("relative DD error (MAPE / 100)")
     _fmt_axis(ax, False)
-    ax.legend(handles, labels, loc="lower right", frameon=False)
+    fig.legend(handles, labels, loc="outside lower center", ncol=2, frameon=False)
     _title(fig, "Every distance bin (filled: fitted)", estimator)
     return fig
 

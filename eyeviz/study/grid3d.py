@@ -95,8 +95,7 @@ def design_grid3d(
     for hv, lv in pairs:
         for nv in ns:
             try:
-                p = DesignPoint3D(hv, lv, nv, r_lo, r_hi, g_max, el_max, prior, n, seed,
-                                  estimator)  # fmt: skip
+                p = DesignPoint3D(hv, lv, nv, r_lo, r_hi, g_max, el_max, prior, n, seed, estimator)
             except EyevizError as exc:
                 raise EyevizError(f"design h={hv:g}, l={lv:g}, nside={nv}: {exc}") from None
             out.append(p)

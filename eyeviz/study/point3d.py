@@ -67,10 +67,34 @@ BUILTIN = "triangulation"
 #: ``lo``/``hi``: the bin's range of r (rows "all" and "r*") or of the elevation in
 #: radians (rows "e*").
 COLUMNS3D = (
-    "version", "h", "l", "nside", "m", "gamma", "r_min", "r_max", "g_max", "el_max",
-    "prior", "n", "seed", "estimator", "bin", "lo", "hi", "count", "dd_mape", "ad_mape",
-    "el_mae_deg", "az_mae_deg", "dd_r2", "ad_r2", "el_r2", "flagged", "seconds",
-)  # fmt: skip
+    "version",
+    "h",
+    "l",
+    "nside",
+    "m",
+    "gamma",
+    "r_min",
+    "r_max",
+    "g_max",
+    "el_max",
+    "prior",
+    "n",
+    "seed",
+    "estimator",
+    "bin",
+    "lo",
+    "hi",
+    "count",
+    "dd_mape",
+    "ad_mape",
+    "el_mae_deg",
+    "az_mae_deg",
+    "dd_r2",
+    "ad_r2",
+    "el_r2",
+    "flagged",
+    "seconds",
+)
 _PRIORS = ("single", "multi")
 _MAX_NAME = 40
 
@@ -104,8 +128,7 @@ class DesignPoint3D:
 
     @property
     def domain(self) -> Domain3D:
-        return Domain3D(self.h, self.l, self.nside, self.r_min, self.r_max, self.g_max,
-                        self.el_max)  # fmt: skip
+        return Domain3D(self.h, self.l, self.nside, self.r_min, self.r_max, self.g_max, self.el_max)
 
     @property
     def m(self) -> int:
@@ -116,10 +139,18 @@ class DesignPoint3D:
     def key(self) -> tuple:
         """What identifies a finished point in a 3D study file (resume skips it)."""
         return (
-            float(self.h), float(self.l), int(self.nside), float(self.r_min),
-            float(self.r_max), float(self.g_max), float(self.el_max), self.prior,
-            int(self.n), int(self.seed), self.estimator,
-        )  # fmt: skip
+            float(self.h),
+            float(self.l),
+            int(self.nside),
+            float(self.r_min),
+            float(self.r_max),
+            float(self.g_max),
+            float(self.el_max),
+            self.prior,
+            int(self.n),
+            int(self.seed),
+            self.estimator,
+        )
 
     def to_dict(self) -> dict:
         return asdict(self)

@@ -26,8 +26,9 @@ def test_report_study_draws_the_3d_figures_and_opens_them(tmp_path):
     import matplotlib.image as mpimg
 
     table = tmp_path / "s3.csv"
-    run_study(table, design_grid3d("20,40", "5,10", "16,32", n=800, seed=1), workers=1,
-              progress=False)  # fmt: skip
+    run_study(
+        table, design_grid3d("20,40", "5,10", "16,32", n=800, seed=1), workers=1, progress=False
+    )
     out = subprocess.run(
         [sys.executable, "-m", "eyeviz", "report", "study", str(table), "-o", str(tmp_path / "f")],
         capture_output=True,

@@ -145,8 +145,9 @@ def test_a_3d_study_killed_mid_way_resumes_to_the_rows_of_an_uninterrupted_one(t
     assert f"{6 - len(kept)} point(s) computed, {len(kept)} skipped" in out.stdout
     assert path.read_text().splitlines()[: len(lines_before)] == lines_before
     whole = tmp_path / "whole.csv"
-    run_study(whole, design_grid3d("20,40,80", "10", "32,64", n=6000, seed=4), workers=2,
-              progress=False)  # fmt: skip
+    run_study(
+        whole, design_grid3d("20,40,80", "10", "32,64", n=6000, seed=4), workers=2, progress=False
+    )
     assert rows_without_seconds(path) == rows_without_seconds(whole)
 
 
