@@ -31,7 +31,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "of r with counts proportional to r, uniform over the BFV "
         "(default: single)",
     )
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=None,
+        help="random seed, >= 0 (default: a fresh one, printed and kept in an NPZ's "
+        "metadata; never a seed the shipped models were fitted on)",
+    )
     from eyeviz.core.domain import DEFAULTS
 
     for flag, typ, what, table in (
@@ -78,9 +84,41 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
+def _seed(args: argparse.Namespace) -> bool:
+    """Set ``args.seed`` to a fresh seed when none was given; whether it was drawn."""
+    if args.seed is not None:
+        return False
+    from eyeviz.commands._seeds import fresh_seed
+
+    args.seed = fresh_seed()
+    return True
+
+
+def _say_seed(args: argparse.Namespace, drawn: bool, domain: dict | None) -> None:
+    """The drawn seed on stdout, even with --quiet (a CSV has nowhere to keep it); on
+    stderr a warning when the given seed draws a set a shipped model was fitted on."""
+    if drawn:
+        print(
+            f"generate: seed {args.seed} (drawn afresh; --seed {args.seed} repeats this run)",
+            flush=True,
+        )
+        return
+    if domain is None:
+        return
+    from eyeviz.commands._seeds import same_sets
+
+    for what in same_sets(args.seed, domain, args.mode):
+        print(
+            f"generate: warning: seed {args.seed} with these parameters draws {what}; "
+            "it is not a held-out test set for that model",
+            file=sys.stderr,
+        )
+
+
 def run(args: argparse.Namespace) -> int:
+    drawn = _seed(args)
     if args.nside is not None or args.el_max is not None:
-        return _run3d(args)
+        return _run3d(args, drawn)
     from eyeviz import EyevizError, dataset
     from eyeviz.core.geometry import EyePair
     from eyeviz.dataset import io as dataset_io
@@ -106,6 +144,9 @@ def run(args: argparse.Namespace) -> int:
 
     fmt = dataset_io.format_of(args.output)
     limits.check_free_space(args.output, limits.estimated_output_bytes(args.n, args.m, fmt))
+    domain = {"h": eyes.h, "l": eyes.l, "m": eyes.m}
+    domain.update(r_min=args.r_min, r_max=args.r_max, g_max=args.g_max)
+    _say_seed(args, drawn, domain)
     bar = _progress(args, args.n, _PROGRESS_MIN)
     t0 = time.perf_counter()
     try:
@@ -142,7 +183,7 @@ def _progress(args: argparse.Namespace, n: int, least: int):
     )
 
 
-def _run3d(args: argparse.Namespace) -> int:
+def _run3d(args: argparse.Namespace, drawn: bool = False) -> int:
     """``--nside``: Algorithm 1 in 3D, written as the sparse 3D data set."""
     from eyeviz import EyevizError
     from eyeviz.core.domain import DEFAULTS
@@ -162,6 +203,7 @@ def _run3d(args: argparse.Namespace) -> int:
     n = algorithm1_3d.check_n(args.n)
     algorithm1_3d.make_params3d(domain, args.mode, args.seed, args.segments)
     limits.check_free_space(args.output, sparse3d.estimated_bytes3d(n, domain))
+    _say_seed(args, drawn, None)  # no shipped model was fitted on a 3D set
     bar = _progress(args, n, _PROGRESS_MIN_3D)
     t0 = time.perf_counter()
     try:

@@ -66,6 +66,18 @@ def run(args: argparse.Namespace) -> int:
     options = registry.options_from_args(e.fit_options, args)
     options["domain"] = registry.domain_from_args(args)
     options["command"] = _command()
+    if "seed" in {o.dest for o in e.fit_options} and options.get("seed") is None:
+        from eyeviz.commands._seeds import fresh_seed
+
+        # a fresh seed, not the one the shipped model was fitted on; kept in the model's
+        # metadata and in its recorded command, so the run can be repeated
+        options["seed"] = fresh_seed()
+        options["command"] += f" --seed {options['seed']}"
+        print(
+            f"{e.name}: seed {options['seed']} (drawn afresh; --seed {options['seed']} "
+            "repeats this run)",
+            file=sys.stderr,
+        )
     out_arg = args.out
     if e.name == "bayes" and out_arg is not None and out_arg.endswith(".npz"):
         options["filename"] = Path(out_arg).name
