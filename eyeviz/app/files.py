@@ -19,6 +19,7 @@ from eyeviz.resources import assets_dir
 
 if TYPE_CHECKING:
     from eyeviz.app.settings import Settings
+    from eyeviz.app.view3d import Scene3DHost
     from eyeviz.model.app_model import AppModel
 
     _MainWindow = QtWidgets.QMainWindow
@@ -51,6 +52,7 @@ class FilesMixin(_MainWindow):
     last_error: str
     error_box: QtWidgets.QMessageBox | None
     unsaved_box: QtWidgets.QMessageBox | None
+    host3d: Scene3DHost
 
     if TYPE_CHECKING:  # for mypy only: at run time QMainWindow's and CanvasMixin's
 
@@ -179,20 +181,17 @@ class FilesMixin(_MainWindow):
         except SceneError as exc:
             self.show_error("Cannot open scene", str(exc))
             return False
-        if scene.kind == "spherical":  # issue 22: the app draws planar eyes only, so far
-            self.show_error(
-                "Cannot open scene",
-                f"{path}: spherical eyes ([eyes] nside): the app's 3D view is not built "
-                "yet; use eyeviz snapshot",
-            )
-            return False
         self.model.finish_gestures()
         self._set_path(path)
         self.undo_stack.clear()
-        self.model.selected = None
-        self.model.set_scene(scene)
-        self.fit_inset()
-        self.frame_bundled()
+        if scene.kind == "spherical":  # issue 22: the 3D page (eyeviz.app.view3d)
+            self.host3d.open(scene)
+        else:
+            self.host3d.leave()
+            self.model.selected = None
+            self.model.set_scene(scene)
+            self.fit_inset()
+            self.frame_bundled()
         if not is_bundled(path):
             self._add_recent(Path(path))
         self._update_title()
@@ -213,7 +212,7 @@ class FilesMixin(_MainWindow):
             return False
         self.model.finish_gestures()
         try:
-            save(self.model.scene, path)
+            save(self.host3d.scene_or(self.model.scene), path)
         except (OSError, SceneError) as exc:
             self.show_error("Cannot save scene", f"{path}: {exc}")
             return False

@@ -35,10 +35,16 @@ def screenshot_format(path: str | os.PathLike) -> str:
 def grab_image(win: MainWindow) -> QtGui.QImage:
     """The whole window as shown, with the VTK view composited from its framebuffer."""
     QtWidgets.QApplication.processEvents()
-    win.apply_cameras()
-    win.render()
+    host = win.host3d
+    if host.active and host.view is not None:  # a spherical scene: the 3D page's view
+        host.draw()
+        ren_win, view = host.view.ren_win, host.view
+    else:
+        win.apply_cameras()
+        win.render()
+        ren_win, view = win.ren_win, win.plotter
     w2i = vtkWindowToImageFilter()
-    w2i.SetInput(win.ren_win)
+    w2i.SetInput(ren_win)
     w2i.SetInputBufferTypeToRGB()
     w2i.ReadFrontBufferOff()
     w2i.Update()
@@ -48,8 +54,8 @@ def grab_image(win: MainWindow) -> QtGui.QImage:
     vtk_img = QtGui.QImage(arr.data, vw, vh, 3 * vw, QtGui.QImage.Format_RGB888).copy()
     img = win.grab().toImage().convertToFormat(QtGui.QImage.Format_RGB888)
     p = QtGui.QPainter(img)
-    top_left = win.plotter.mapTo(win, QtCore.QPoint(0, 0))
-    p.drawImage(QtCore.QRect(top_left, win.plotter.size()), vtk_img)
+    top_left = view.mapTo(win, QtCore.QPoint(0, 0))
+    p.drawImage(QtCore.QRect(top_left, view.size()), vtk_img)
     p.end()
     return img
 

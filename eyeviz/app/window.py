@@ -40,8 +40,9 @@ from eyeviz.app.settings import Settings, make_settings
 from eyeviz.app.side_docks import SideDocksMixin
 from eyeviz.app.steps import StepsMixin
 from eyeviz.app.view import VtkView, fast_renderer
+from eyeviz.app.view3d import Scene3DHost
 from eyeviz.model.app_model import AppModel
-from eyeviz.model.scene import Scene
+from eyeviz.model.scene import Eyes, Scene
 from eyeviz.model.state import SceneState
 from eyeviz.render.vtk.actors import SceneActors
 from eyeviz.render.vtk.overlays import OverlayActors
@@ -76,7 +77,9 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self.resize(1280, 720)
         self.settings = settings if settings is not None else make_settings()
         self._set_path(path)
-        self.model = AppModel(scene)
+        # a spherical scene opens in the 3D page; the planar page keeps a planar scene
+        planar = scene if scene.kind == "planar" else Scene(Eyes(scene.eyes.h, scene.eyes.l, 720))
+        self.model = AppModel(planar)
         self.undo_stack = QtWidgets.QUndoStack(self)
         self.model.push = self._push
         self.last_error: str = ""
@@ -157,6 +160,7 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self.cursor_label.setAutoFillBackground(True)  # opaque: repaints only itself
         self.statusBar().addPermanentWidget(self.cursor_label)
         build_menus(self)
+        self.host3d = Scene3DHost(self, split)  # the 3D page (issue 22), built on first use
         self.model.listeners.append(self._on_model)
         install_presenting(self)  # View > Full screen, text scale, steps; Help (after the menus)
         self.model.load_in_background = self._load_estimators
@@ -166,6 +170,8 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
             self._add_recent(Path(path))  # the file named on the command line too
         self.fit_inset()
         self._on_model("scene", None)
+        if scene.kind == "spherical":
+            self.host3d.open(scene)
         self._update_title()
 
     # --- settings -------------------------------------------------------------------
@@ -195,6 +201,7 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self._frame_pending = True  # no frame after close
         self._frame_timer.stop()
         self._table_timer.stop()  # nor a table refresh (it fired into a closed window)
+        self.host3d.close()
         self.plotter.close()
         super().closeEvent(event)
 
@@ -203,13 +210,19 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self.undo_stack.push(SceneCommand(self.model, before, after, text, merge_key))
 
     def add_at_center(self) -> None:
+        if self.host3d.active:
+            return self.host3d.add_ball()
         self.model.add_feature(*self.model.scene.view.center)
 
     def duplicate_selected(self) -> None:
+        if self.host3d.active:
+            return self.host3d.duplicate_selected()
         if self.model.selected is not None:
             self.model.duplicate_feature(self.model.selected)
 
     def delete_selected(self) -> None:
+        if self.host3d.active:
+            return self.host3d.delete_selected()
         if self.model.selected is not None:
             self.model.delete_feature(self.model.selected)
 
@@ -330,6 +343,11 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         (single, double or inches) with or without its title, table and bitmaps, written
         on a worker thread with a busy cursor; errors in a dialog. ``wait``: block until
         done and return the path (None on error); otherwise return the job at once."""
+        if self.host3d.active:  # a spherical scene: the 3D view's PNG or vector figure
+            return self.host3d.export_to(
+                path, scale, transparent, wait, width=width, title=title, table=table,
+                bitmaps=bitmaps,
+            )  # fmt: skip
         from eyeviz import EyevizError
         from eyeviz.render.mpl.export import export
         from eyeviz.render.mpl.layout import ASPECT_RANGE

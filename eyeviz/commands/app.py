@@ -26,26 +26,8 @@ def argparse_settings_help() -> str:
 
 
 def run(args) -> int:
-    if args.scene is not None:
-        refuse_spherical(args.scene)
+    """A planar scene opens in the 2D top view, a spherical one ([eyes] nside) in the
+    3D view (eyeviz.app.view3d)."""
     from eyeviz.app.main import run_app
 
     return run_app(args.scene, args.screenshot, args.settings)
-
-
-def refuse_spherical(path) -> None:
-    """EyevizError (one line) for a spherical scene, before any window opens: the app
-    draws planar eyes only (issue 22's 3D view is not built yet); ``eyeviz snapshot``
-    draws a spherical scene. A scene that does not load is left to the app's own error."""
-    from eyeviz import EyevizError
-    from eyeviz.model.scene import SceneError, load
-
-    try:
-        kind = load(path).kind
-    except SceneError:
-        return
-    if kind == "spherical":
-        raise EyevizError(
-            f"{path}: spherical eyes ([eyes] nside): the app's 3D view is not built yet; "
-            "use eyeviz snapshot"
-        )

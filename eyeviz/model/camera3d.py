@@ -63,11 +63,6 @@ def _unit(v) -> np.ndarray:
     return a / n
 
 
-def _fit_distance(radius: float, view_angle: float) -> float:
-    """Distance at which a ball of ``radius`` fills the view's height (VTK's ResetCamera)."""
-    return radius / math.sin(math.radians(view_angle) / 2.0)
-
-
 def _look(
     focal: np.ndarray, direction: np.ndarray | Vec3, up: Vec3, dist: float, angle: float
 ) -> Camera3D:
@@ -80,7 +75,7 @@ def _look(
     )
 
 
-def preset(name: str, h: float, l: float, extent: float) -> Camera3D:
+def preset(name: str, h: float, l: float, extent: float, aspect: float = 1.0) -> Camera3D:
     """A named view of a scene with eyes ``h``, ``l`` whose features reach ``extent``.
 
     ``extent`` is the size of the region to show ahead of the eyes: the whole-scene
@@ -94,19 +89,24 @@ def preset(name: str, h: float, l: float, extent: float) -> Camera3D:
     - ``"side"``: from +x, y (forward) to the right, z up;
     - ``"eye_a"``, ``"eye_b"``: along the eye's forward axis (the line through its
       centre parallel to y), looking back at that eye from ahead.
+
+    ``aspect`` (the viewport's width / height) narrows the fit for a tall viewport.
     """
     name = check_choice("view", name, PRESETS)
     h = check_real("h", h, gt=0.0)
     l = check_real("l", l, gt=0.0)
     extent = check_real("extent", extent, gt=0.0)
+    aspect = check_real("aspect", aspect, gt=0.0)
     direction, up = _DIRS[name]
     radius = max(0.6 * extent, h + l)
+    half = math.radians(30.0) / 2.0
+    half = min(half, math.atan(math.tan(half) * aspect))
+    dist = radius / math.sin(half)
     if name in ("eye_a", "eye_b"):
         focal = np.array([-h if name == "eye_a" else h, 0.0, 0.0])
-        dist = _fit_distance(radius, 30.0) + extent / 2.0
+        dist += extent / 2.0
     else:
         focal = np.array([0.0, extent / 2.0, 0.0])
-        dist = _fit_distance(radius, 30.0)
     return _look(focal, direction, up, dist, 30.0)
 
 

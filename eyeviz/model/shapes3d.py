@@ -31,11 +31,11 @@ __all__ = [
     "view_nside",
 ]
 
-#: Up to this nside every facet of an eye is a cell of the view's mesh (nside 64: 49,152
+#: Up to this nside every facet of an eye is a cell of the view's mesh (nside 32: 12,288
 #: per eye). Beyond, the unlit sphere is drawn at :data:`COARSE_NSIDE` and the lit facets
 #: at the scene's nside over it (nside 180: 388,800 facets per eye, each under a pixel in
 #: the view; measured in scripts/bench_app3d.py).
-FULL_MAX_NSIDE = 64
+FULL_MAX_NSIDE = 32
 COARSE_NSIDE = 16
 
 

@@ -1,19 +1,170 @@
-"""The app draws planar eyes only (issue 22's 3D view is not built yet): File > Open of a
-spherical scene shows one line and keeps the open scene."""
+"""The app's 3D view (issue 22) in a real window: a spherical scene opens in the 3D page,
+a real X pointer (xdotool) drags a ball, the lit sets and the Mollweide maps follow, one
+Ctrl+Z undoes the drag, a planar scene swaps back, presets move the camera, File > Export
+writes a PNG and an SVG."""
 
+from __future__ import annotations
+
+import shutil
+import subprocess
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from eyeviz.model.scene import Eyes, Feature, Scene
+import matplotlib.image as mpimg
+import numpy as np
+import pytest
+from PyQt5 import QtCore, QtWidgets
+from PyQt5.QtTest import QTest
+
+from eyeviz.model.scene import Eyes, Feature, Scene, load
 
 SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 
 
-def test_open_spherical_scene_is_refused_in_one_line(make_window):
+def _xdo(qtbot, *args):
+    subprocess.run(["xdotool", *map(str, args)], check=True)
+    qtbot.wait(40)
+
+
+def _pixel(win, i):
+    """Global screen pixel of ball i's centre, through VTK's own camera (vtkCoordinate)."""
+    import vtk
+
+    host = win.host3d
+    f = host.model.scene.features[i]
+    c = vtk.vtkCoordinate()
+    c.SetCoordinateSystemToWorld()
+    c.SetValue(f.x, f.y, f.z)
+    dx, dy = c.GetComputedDoubleDisplayValue(host.actors.scene_ren)
+    h = host.view.ren_win.GetSize()[1]
+    return host.view.mapToGlobal(QtCore.QPoint(round(dx), round(h - dy)))
+
+
+def _lit(win, i):
+    st = win.host3d.model.state
+    return st.lit(i, "A").copy(), st.lit(i, "B").copy()
+
+
+def test_spherical_scene_opens_in_the_3d_page(make_window):
+    win = make_window(load(SCENES / "sphere_teaching.toml"), SCENES / "sphere_teaching.toml")
+    host = win.host3d
+    assert host.active and host.view.isVisible() and not win.plotter.isVisible()
+    assert host.docks["bitmaps3d"].isVisible() and host.docks["readout3d"].isVisible()
+    assert not win.features_panel.isVisible()  # the planar docks are hidden
+    assert host.bitmaps.nside == 8  # the Mollweide dock got the state
+    n_lit = sum(int(v) for v in host.model.state.facets_a)
+    assert n_lit > 0
+    img = win.grab_image()
+    assert img.width() > 500
+
+
+def test_a_real_x_pointer_drags_a_ball_and_ctrl_z_undoes_it(make_window, qtbot):
+    if shutil.which("xdotool") is None:
+        pytest.fail("xdotool is needed for this test: apt-get install xdotool")
+    win = make_window(load(SCENES / "sphere_teaching.toml"), SCENES / "sphere_teaching.toml")
+    win.activateWindow()
+    win.raise_()
+    host = win.host3d
+    host.set_preset("top")
+    qtbot.wait(50)
+    f0 = host.model.scene.features[0]
+    x0, y0, z0 = f0.x, f0.y, f0.z
+    lit0 = _lit(win, 0)
+    maps0 = host.bitmaps.lit_facets("A").copy()
+    p = _pixel(win, 0)
+    _xdo(qtbot, "mousemove", p.x(), p.y())
+    _xdo(qtbot, "mousedown", 1)
+    for k in range(1, 9):
+        _xdo(qtbot, "mousemove", p.x() + 6 * k, p.y() - 4 * k)
+    _xdo(qtbot, "mouseup", 1)
+    qtbot.waitUntil(lambda: win.undo_stack.count() == 1, timeout=5000)
+    f = host.model.scene.features[0]
+    assert (f.x, f.y) != (x0, y0) and f.z == pytest.approx(z0, abs=1e-6)  # top view: in z = z0
+    assert f.x > x0 and f.y > y0  # right and up on the screen of the top view
+    # the ball is drawn where the pointer left it (VTK's camera, not the model's maths)
+    end = _pixel(win, 0)
+    assert abs(end.x() - (p.x() + 48)) <= 2 and abs(end.y() - (p.y() - 32)) <= 2
+    lit1 = _lit(win, 0)
+    assert not np.array_equal(lit0[0], lit1[0])  # the lit set changed
+    qtbot.waitUntil(lambda: not np.array_equal(host.bitmaps.lit_facets("A"), maps0), timeout=3000)
+    _xdo(qtbot, "key", "--window", int(win.winId()), "ctrl+z")
+    qtbot.waitUntil(lambda: win.undo_stack.index() == 0, timeout=3000)
+    back = host.model.scene.features[0]
+    assert (back.x, back.y, back.z) == (x0, y0, z0)
+    assert np.array_equal(_lit(win, 0)[0], lit0[0])
+
+
+def test_shift_drag_moves_along_the_line_of_sight(make_window, qtbot):
+    win = make_window(load(SCENES / "sphere_teaching.toml"))
+    host = win.host3d
+    host.set_preset("default")
+    f0 = host.model.scene.features[0]
+    cam = host.camera()
+    d0 = np.linalg.norm(np.subtract((f0.x, f0.y, f0.z), cam.position))
+    p = host.view.mapFromGlobal(_pixel(win, 0))
+    w = host.view
+    QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.ShiftModifier, p)
+    for k in range(1, 7):
+        QTest.mouseMove(w, p + QtCore.QPoint(0, -10 * k))
+    QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.ShiftModifier, p + QtCore.QPoint(0, -60))
+    assert win.undo_stack.count() == 1
+    f = host.model.scene.features[0]
+    d1 = np.linalg.norm(np.subtract((f.x, f.y, f.z), cam.position))
+    assert d1 == pytest.approx(d0 * np.exp(60 / 200), rel=1e-6)  # up: farther, e per 200 px
+
+
+def test_keys_nudge_the_selected_ball(make_window, qtbot):
+    win = make_window(load(SCENES / "sphere_teaching.toml"))
+    host = win.host3d
+    host.set_preset("top")
+    host.view.setFocus()
+    f0 = host.model.scene.features[0]
+    x0, y0 = f0.x, f0.y
+    for _ in range(3):
+        QTest.keyClick(host.view, QtCore.Qt.Key_Right)
+    QTest.keyClick(host.view, QtCore.Qt.Key_Up)
+    f = host.model.scene.features[0]
+    assert f.x > x0 and f.y > y0
+    assert win.undo_stack.count() == 1  # consecutive nudges of one ball: one step
+    QTest.keyClick(host.view, QtCore.Qt.Key_Tab)
+    assert host.model.selected == 1
+
+
+def test_presets_move_the_camera(make_window):
+    win = make_window(load(SCENES / "sphere_paper.toml"))
+    host = win.host3d
+    seen = []
+    for name in ("front", "top", "side", "eye_a", "eye_b", "default"):
+        host.preset_actions[name].trigger()
+        seen.append(host.camera().position)
+    assert len({tuple(np.round(p, 6)) for p in seen}) == 6
+    host.preset_actions["top"].trigger()
+    top = host.camera()
+    assert top.position[2] > top.focal_point[2]
+    assert host.preset_actions["top"].shortcut().toString() == "2"
+
+
+def test_open_swaps_between_planar_and_3d(make_window):
     win = make_window(Scene(Eyes(40.0, 20.0, 720), [Feature("a", 0.0, 1500.0, 50.0)]))
-    before = win.model.scene.copy()
-    assert win.open_path(SCENES / "sphere_teaching.toml") is False
-    assert win.model.scene == before
-    text = win.error_box.text()
-    assert "\n" not in text and "sphere_teaching.toml" in text
-    assert "the app's 3D view is not built yet; use eyeviz snapshot" in text
-    win.error_box.close()
+    assert not win.host3d.active and win.plotter.isVisible()
+    assert win.open_path(SCENES / "sphere_equator.toml")
+    assert win.host3d.active and not win.plotter.isVisible()
+    assert win.host3d.model.scene.eyes.nside == 180
+    assert win.open_path(SCENES / "default.toml")
+    assert not win.host3d.active and win.plotter.isVisible() and not win.host3d.view.isVisible()
+    assert win.model.scene.kind == "planar"
+    assert win.features_panel.isVisibleTo(win)
+
+
+def test_export_png_and_svg(make_window, tmp_path):
+    win = make_window(load(SCENES / "sphere_teaching.toml"))
+    png = win.export_to(tmp_path / "v.png", scale=0.5)
+    svg = win.export_to(tmp_path / "v.svg")
+    assert png == tmp_path / "v.png" and svg == tmp_path / "v.svg"
+    img = mpimg.imread(png)
+    assert img.shape[1] == 525  # 3.5 in at 300 dpi, scale 0.5
+    rgb = (img[..., :3] * 255).round().astype(int).reshape(-1, 3)
+    assert len(np.unique(rgb, axis=0)) > 200  # not blank: shaded balls, eyes, facets
+    root = ET.parse(svg).getroot()
+    assert len(root.findall(".//{http://www.w3.org/2000/svg}path")) > 100
+    assert QtWidgets.QApplication.instance() is not None

@@ -103,10 +103,24 @@ def camera_of(ren: vtkRenderer) -> Camera3D:
     )
 
 
-def default_camera(state: SceneState3D, name: str = "default") -> Camera3D:
-    """The preset ``name`` framing the scene's balls (:func:`shapes3d.scene_extent`)."""
+def default_camera(state: SceneState3D, name: str = "default", aspect: float = 1.0) -> Camera3D:
+    """The preset ``name`` framing the scene's balls (:func:`shapes3d.scene_extent`) in a
+    viewport ``aspect`` (width / height) wide."""
     pair = state.pair
-    return preset(name, pair.h, pair.l, shapes3d.scene_extent(state))
+    return preset(name, pair.h, pair.l, shapes3d.scene_extent(state), aspect)
+
+
+def _great_circles(r: float, n: int = 96) -> pv.PolyData:
+    """Three great circles of radius ``r`` (the selected ball's marker)."""
+    t = np.linspace(0.0, 2.0 * math.pi, n + 1)
+    c, s, z = r * np.cos(t), r * np.sin(t), 0.0 * t
+    pts = np.concatenate([np.column_stack(v) for v in ((c, s, z), (c, z, s), (z, c, s))])
+    lines = np.concatenate(
+        [np.r_[n + 1, np.arange(k * (n + 1), (k + 1) * (n + 1))] for k in range(3)]
+    )
+    mesh = pv.PolyData(pts)
+    mesh.lines = lines
+    return mesh
 
 
 def _aspect(ren: vtkRenderer) -> float:
@@ -162,7 +176,7 @@ class Scene3DActors:
         if eyes_ren is not None:
             eyes_ren.AddViewProp(self.eyes_caption)
         self.unit_ball = pv.Sphere(radius=1.0, theta_resolution=40, phi_resolution=24)
-        self.unit_ring = pv.Sphere(radius=1.12, theta_resolution=24, phi_resolution=12)
+        self.unit_ring = _great_circles(1.3)
         self.nside = 0
         self.full = True
 
@@ -235,8 +249,8 @@ class Scene3DActors:
         for a in self.plane_actors:
             self._add(self.eye_store, a, eyes=False)
         self.eyes_caption.SetInput(
-            f"the eyes, nside {n}: {pair.npix:,} facets each"
-            + ("" if self.full else "\n(lit facets at full resolution)")
+            f"the eyes close up: nside {n}\n{pair.npix:,} facets each"
+            + ("" if self.full else ",\nthe lit ones drawn")
         )
 
     def _build_balls(self, scene: Scene, state: SceneState3D) -> None:
@@ -256,8 +270,7 @@ class Scene3DActors:
             self.ball_labels.append(lab)
         n = len(scene.features)
         sel = actor(self.unit_ring, SELECT_RGB)
-        sel.GetProperty().SetRepresentationToWireframe()
-        sel.GetProperty().SetOpacity(0.55)
+        sel.GetProperty().SetLineWidth(2.0)
         self._add(self.ball_store, sel, eyes=False)
         self.select_actor = sel
         # the tangent cones: 2 per ball, cells coloured by ball
@@ -386,6 +399,8 @@ class Scene3DActors:
     def set_cameras(self, cam: Camera3D) -> None:
         """The scene through ``cam``; the eyes from the same direction, framed."""
         apply_camera(self.scene_ren, cam)
+        if hasattr(self.scene_ren, "camera_set"):  # pyvista's: no reset at its first render
+            self.scene_ren.camera_set = True
         if self.eyes_ren is not None and self._eyes_key is not None:
             h, l = self._eyes_key[0], self._eyes_key[1]
             apply_camera(self.eyes_ren, eyes_camera(cam, h, l, _aspect(self.eyes_ren)))
@@ -452,7 +467,10 @@ def render_png3d(
         layout(main, eyes, width, height)
         actors = Scene3DActors(main, eyes)
         actors.update(scene, st, selected)
-        actors.set_cameras(camera if camera is not None else default_camera(st))
+        if camera is None:
+            left, _ = split_viewports(width, height)
+            camera = default_camera(st, aspect=(1.0 - left[2]) * width / height)
+        actors.set_cameras(camera)
         main.camera.is_set = True  # else pyvista's first render resets it (an isometric fit)
         img = pl.screenshot(return_img=True)
     finally:

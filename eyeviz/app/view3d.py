@@ -1,0 +1,560 @@
+"""The 3D view of the main window: a spherical scene in pyvistaqt, in the same window.
+
+Opening a spherical scene (``[eyes] nside``) swaps the planar view and its strip for this
+view (:class:`Scene3DHost`), hides the planar docks and shows the 3D ones (the facets on
+Mollweide maps, the readout); opening a planar scene swaps back. The flow is the planar
+one (docs/architecture.md): Qt events -> :mod:`eyeviz.model.app_model3d` (a drag is one
+generator, one undo step on the window's stack) -> ``compute_state3d`` ->
+:class:`eyeviz.render.vtk.scene3d.Scene3DActors` and the docks.
+
+Mouse and keys (also in Help > Keyboard shortcuts through the View menu):
+
+- standard VTK camera interaction (trackball): left-drag on the background turns the
+  view, middle-drag (or Shift+left on the background) pans, the wheel or right-drag
+  zooms; the eyes' close-up (left) always looks from the scene camera's direction;
+- left-drag on a ball moves it in the plane through its centre facing the camera;
+  Shift+ or Ctrl+left-drag on a ball moves it along the line of sight (up: farther);
+- with the view focused, the arrow keys nudge the selected ball across the screen,
+  Shift+Up / Shift+Down move it farther / nearer along the line of sight (Tab selects the
+  next ball);
+- View > 3D view: the camera presets (0 default, 1 front, 2 top, 3 side, 4 along eye A's
+  axis, 5 along eye B's axis) and the layers.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Generator
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from PyQt5 import QtCore, QtWidgets
+
+from eyeviz.app.panels.bitmaps3d import Bitmaps3DPanel
+from eyeviz.app.panels.readout3d import Readout3DPanel
+from eyeviz.app.view import make_view
+from eyeviz.model import app_model3d as m3
+from eyeviz.model.camera3d import PRESETS, Camera3D
+from eyeviz.model.scene import SPHERICAL_LAYERS, Scene
+from eyeviz.render.vtk.scene3d import (
+    Scene3DActors,
+    camera_of,
+    default_camera,
+    layout,
+    make_renderers,
+    render_png3d,
+    split_viewports,
+)
+
+if TYPE_CHECKING:
+    from eyeviz.app.view import _Frames
+    from eyeviz.app.window import MainWindow
+
+__all__ = ["PRESET_KEYS", "Scene3DCommand", "Scene3DHost"]
+
+#: View > 3D view presets: (name, menu text, shortcut)
+PRESET_KEYS = (
+    ("default", "&Default (3/4 view)", "0"),
+    ("front", "&Front", "1"),
+    ("top", "&Top", "2"),
+    ("side", "&Side", "3"),
+    ("eye_a", "Along eye &A's axis", "4"),
+    ("eye_b", "Along eye &B's axis", "5"),
+)
+PANEL_MS = 100  # the docks follow a drag at <= 10 Hz; its end refreshes them at once
+_MOD_DEPTH = QtCore.Qt.KeyboardModifier.ShiftModifier | QtCore.Qt.KeyboardModifier.ControlModifier
+
+
+class Scene3DCommand(QtWidgets.QUndoCommand):
+    """One undo step of the 3D view: the scene before and after."""
+
+    def __init__(
+        self, model: m3.AppModel3D, before: Scene, after: Scene, text: str, merge_key=None
+    ) -> None:
+        super().__init__(text)
+        self.model, self.before, self.after, self.merge_key = model, before, after, merge_key
+
+    def redo(self) -> None:
+        self.model.set_scene(self.after)
+
+    def undo(self) -> None:
+        self.model.set_scene(self.before)
+
+    def id(self) -> int:  # noqa: A003 (Qt name)
+        return 3 if self.merge_key is not None else -1
+
+    def mergeWith(self, other) -> bool:  # noqa: N802 (Qt name)
+        if getattr(other, "merge_key", None) != self.merge_key:
+            return False
+        self.after = other.after
+        return True
+
+
+class Scene3DHost(QtCore.QObject):
+    """The window's 3D page: the view widget, its actors and model, the 3D docks, the
+    View > 3D view menu. Built on the first spherical scene; ``active`` while shown."""
+
+    def __init__(self, win: MainWindow, split: QtWidgets.QSplitter) -> None:
+        super().__init__(win)
+        self.win = win
+        self.split = split
+        self.active = False
+        self.model: m3.AppModel3D | None = None
+        self.view: _Frames | None = None
+        self.actors: Scene3DActors | None = None
+        self.bitmaps: Bitmaps3DPanel | None = None
+        self.readout: Readout3DPanel | None = None
+        self.docks: dict[str, QtWidgets.QDockWidget] = {}
+        self._hidden: list[QtWidgets.QWidget] = []
+        self._drag: Generator[None, m3.Pointer, None] | None = None
+        self._dirty = False
+        self._frame_timer = QtCore.QTimer(self)
+        self._frame_timer.setSingleShot(True)
+        self._frame_timer.setInterval(0)
+        self._frame_timer.timeout.connect(self.draw)
+        self._panel_timer = QtCore.QTimer(self)
+        self._panel_timer.setSingleShot(True)
+        self._panel_timer.setInterval(PANEL_MS)
+        self._panel_timer.timeout.connect(self.refresh_panels)
+        self.preset: str | None = None  # the preset shown, until the user moves the camera
+        self.preset_actions: dict[str, QtWidgets.QAction] = {}
+        self.layer_actions: dict[str, QtWidgets.QAction] = {}
+        self.menu = self._build_menu()
+        self._menu_action(False)
+
+    # --- the page ------------------------------------------------------------------------
+    def _build(self) -> None:
+        view = make_view(None)
+        view.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
+        view.setObjectName("view3d")
+        from vtkmodules.vtkCommonCore import vtkCommand
+        from vtkmodules.vtkInteractionStyle import vtkInteractorStyleTrackballCamera
+
+        style = vtkInteractorStyleTrackballCamera()
+        iren = view.ren_win.GetInteractor()
+        iren.SetInteractorStyle(style)
+        self.style = style
+        # a preset is kept across resizes until the user turns or zooms the view
+        style.AddObserver(vtkCommand.StartInteractionEvent, lambda *_: self._forget_preset())
+        scene_ren = view.renderer
+        scene_ren.AutomaticLightCreationOn()
+        eyes_ren = make_renderers(view.ren_win, scene_ren)
+        self.view = view
+        self.actors = Scene3DActors(scene_ren, eyes_ren)
+        # the eyes' camera follows the scene's before every render (VTK's own too)
+        view.ren_win.AddObserver(vtkCommand.StartEvent, lambda *_: self._sync_eyes())
+        view.installEventFilter(self)
+        self.split.addWidget(view)
+        self.split.setStretchFactor(self.split.indexOf(view), 1)
+        self.bitmaps = Bitmaps3DPanel()
+        self.readout = Readout3DPanel()
+        self.docks["bitmaps3d"] = self._dock("Facets (Mollweide)", self.bitmaps, "bitmaps3d")
+        self.docks["readout3d"] = self._dock("Balls (3D readout)", self.readout, "readout3d")
+
+    def _dock(self, title: str, widget: QtWidgets.QWidget, name: str) -> QtWidgets.QDockWidget:
+        d = QtWidgets.QDockWidget(title, self.win)
+        d.setObjectName(f"dock_{name}")
+        d.setWidget(widget)
+        self.win.addDockWidget(QtCore.Qt.DockWidgetArea.RightDockWidgetArea, d)
+        d.hide()
+        return d
+
+    def _build_menu(self) -> QtWidgets.QMenu:
+        mb = self.win.menuBar()
+        assert mb is not None
+        menu = QtWidgets.QMenu("&3D view", self.win)
+        mb.addMenu(menu)
+        for name, text, key in PRESET_KEYS:
+            a = QtWidgets.QAction(text, self.win)
+            a.setShortcut(key)
+            a.setShortcutContext(QtCore.Qt.ShortcutContext.WindowShortcut)
+            a.triggered.connect(lambda _c=False, n=name: self.set_preset(n))
+            a.setEnabled(False)
+            menu.addAction(a)
+            self.win.addAction(a)
+            self.preset_actions[name] = a
+        menu.addSeparator()
+        for layer in SPHERICAL_LAYERS:
+            a = QtWidgets.QAction(f"Show {layer}", self.win)
+            a.setCheckable(True)
+            a.triggered.connect(lambda on, n=layer: self._set_layer(n, on))
+            menu.addAction(a)
+            self.layer_actions[layer] = a
+        return menu
+
+    def _menu_action(self, shown: bool) -> None:
+        a = self.menu.menuAction()
+        if a is not None:
+            a.setVisible(shown)
+
+    def _set_layer(self, layer: str, on: bool) -> None:
+        if self.model is not None:
+            self.model.set_layer(layer, bool(on))
+
+    # --- swapping ------------------------------------------------------------------------
+    def open(self, scene: Scene) -> None:
+        """Show ``scene`` (spherical) in the 3D page, swapping the planar page out."""
+        if self.view is None:
+            self._build()
+        assert self.view is not None
+        self.model = m3.AppModel3D(scene)
+        self.model.push = self._push
+        self.model.listeners.append(self._on_model)
+        if not self.active:
+            self._swap(True)
+        self._on_model("scene", None)
+        self.set_preset("default")
+
+    def leave(self) -> None:
+        """Back to the planar page (a planar scene was opened)."""
+        if self.active:
+            self._end_drag()
+            self._swap(False)
+        self.model = None
+
+    def _planar_widgets(self) -> list[QtWidgets.QWidget]:
+        out: list[QtWidgets.QWidget] = [self.win.plotter, self.win.bitmaps]
+        for d in self.win.findChildren(QtWidgets.QDockWidget):
+            if d not in self.docks.values():
+                out.append(d)
+        return out
+
+    def _swap(self, to3d: bool) -> None:
+        assert self.view is not None
+        self.active = to3d
+        if to3d:
+            self._hidden = [w for w in self._planar_widgets() if w.isVisible()]
+            for w in self._planar_widgets():
+                w.hide()
+            self.view.show()
+            for d in self.docks.values():
+                d.show()
+            self.view.setFocus()
+        else:
+            self.view.hide()
+            for d in self.docks.values():
+                d.hide()
+            for w in self._hidden:
+                w.show()
+            self._hidden = []
+        self._menu_action(to3d)
+        for a in self.preset_actions.values():
+            a.setEnabled(to3d)
+        for a in self.win.findChildren(QtWidgets.QAction):
+            if a.text().replace("&", "") in _PLANAR_ONLY:
+                a.setEnabled(not to3d)
+
+    # --- model -> view -------------------------------------------------------------------
+    def _push(self, before: Scene, after: Scene, text: str, merge_key=None) -> None:
+        assert self.model is not None
+        self.win.undo_stack.push(Scene3DCommand(self.model, before, after, text, merge_key))
+
+    def _on_model(self, what: str, index: int | None) -> None:
+        if what == "feature":  # a live move: one frame pending at most
+            self._dirty = True
+            if not self._frame_timer.isActive():
+                self._frame_timer.start()
+            return
+        self._dirty = True
+        self.draw()
+        self.refresh_panels()
+        if what == "scene" and self.model is not None:
+            for name, a in self.layer_actions.items():
+                a.setChecked(self.model.scene.shows(name))
+
+    def flush(self) -> None:
+        """Bring the actors up to the model (no render)."""
+        if self._dirty and self.model is not None and self.actors is not None:
+            self._dirty = False
+            self.actors.update(self.model.scene, self.model.state, self.model.selected)
+            if not self._panel_timer.isActive():
+                self._panel_timer.start()
+
+    def draw(self) -> None:
+        """Update and render now."""
+        if self.view is None or not self.active:
+            return
+        self.flush()
+        self.view.draw()
+
+    def refresh_panels(self) -> None:
+        self._panel_timer.stop()
+        m = self.model
+        if m is None or not self.active:
+            return
+        st = m.state
+        if self.bitmaps is not None:
+            self.bitmaps.set_state(st, m.scene)
+        if self.readout is not None:
+            self.readout.set_state(st, m.scene)
+        self.win.statusBar().showMessage(self._status(), 0)
+
+    def _status(self) -> str:
+        m = self.model
+        if m is None or m.selected is None or m.selected >= len(m.scene.features):
+            return ""
+        st, i = m.state, m.selected
+        f = m.scene.features[i]
+        lit = ""
+        if st.facets_a is not None and st.facets_b is not None:
+            lit = f"   facets lit A {int(st.facets_a[i]):,}  B {int(st.facets_b[i]):,}"
+        return f"{f.name}: x {f.x:,.1f}  y {f.y:,.1f}  z {f.z:,.1f}  g {f.g:,.1f}{lit}"
+
+    def _sync_eyes(self) -> None:
+        if self.actors is not None and self.model is not None:
+            e = self.model.scene.eyes
+            self.actors.sync_eyes_camera(e.h, e.l)
+
+    # --- camera --------------------------------------------------------------------------
+    def _layout(self) -> None:
+        if self.view is None or self.actors is None:
+            return
+        w, h = max(self.view.width(), 1), max(self.view.height(), 1)
+        assert self.actors.eyes_ren is not None
+        layout(self.actors.scene_ren, self.actors.eyes_ren, w, h)
+
+    def camera(self) -> Camera3D:
+        """The scene camera as shown now."""
+        assert self.actors is not None
+        return camera_of(self.actors.scene_ren)
+
+    def set_camera(self, cam: Camera3D) -> None:
+        assert self.actors is not None
+        self._layout()
+        self.actors.set_cameras(cam)
+        self.draw()
+
+    def set_preset(self, name: str) -> None:
+        """View > 3D view: a camera preset (eyeviz.model.camera3d.preset)."""
+        if self.model is None or name not in PRESETS:
+            return
+        self.flush()
+        self.preset = name
+        vp = self.pointer("move", 0, 0)
+        self.set_camera(default_camera(self.model.state, name, vp.w / max(vp.h, 1.0)))
+
+    # --- pixels ----------------------------------------------------------------------------
+    def pointer(self, kind: str, x: float, y: float) -> m3.Pointer:
+        """A widget pixel -> a :class:`Pointer` in the scene viewport's pixels."""
+        assert self.view is not None
+        w, h = max(self.view.width(), 1), max(self.view.height(), 1)
+        _, (x0, _y0, x1, _y1) = split_viewports(w, h)
+        return m3.Pointer(kind, x - x0 * w, y, (x1 - x0) * w, float(h))
+
+    def scene_pixel(self, point) -> tuple[float, float]:
+        """Widget pixel where a model point is drawn in the scene viewport (tests)."""
+        from eyeviz.model.camera3d import project, to_pixels
+
+        assert self.view is not None
+        w, h = max(self.view.width(), 1), max(self.view.height(), 1)
+        _, (x0, _y0, x1, _y1) = split_viewports(w, h)
+        vw = (x1 - x0) * w
+        xy, _ = project(self.camera(), point, vw / h)
+        c, r = to_pixels(xy, int(round(vw)), h)
+        return float(c + x0 * w), float(r)
+
+    # --- events ----------------------------------------------------------------------------
+    def eventFilter(self, obj, ev) -> bool:  # noqa: N802 (Qt name)
+        if obj is not self.view or self.model is None:
+            return False
+        t = ev.type()
+        E = QtCore.QEvent.Type
+        if t == E.MouseButtonPress and ev.button() == QtCore.Qt.MouseButton.LeftButton:
+            self.view.setFocus(QtCore.Qt.FocusReason.MouseFocusReason)
+            return self._press(ev)
+        if t == E.MouseMove and self._drag is not None:
+            self._send(self.pointer("move", ev.x(), ev.y()))
+            return True
+        if t == E.MouseButtonRelease and self._drag is not None:
+            self._send(self.pointer("release", ev.x(), ev.y()))
+            self._drag = None
+            return True
+        if t == E.KeyPress:
+            return self._key(ev)
+        if t == E.Resize:
+            QtCore.QTimer.singleShot(0, self._resized)
+        return False
+
+    def _forget_preset(self) -> None:
+        self.preset = None
+
+    def _resized(self) -> None:
+        if self.active and self.preset is not None:
+            self.set_preset(self.preset)
+        elif self.active and self.actors is not None:
+            self._layout()
+            self._sync_eyes()
+            self.draw()
+
+    def _press(self, ev) -> bool:
+        assert self.model is not None
+        self._end_drag()
+        p = self.pointer("press", ev.x(), ev.y())
+        if p.px < 0 or not self.model.scene.shows("features"):
+            return False  # the eyes' close-up: VTK turns the camera
+        st = self.model.state
+        cam = self.camera()
+        i = m3.pick_ball(cam, p, st.x, st.y, st.z, st.g)
+        if i is None:
+            return False  # the background: VTK's camera interaction
+        depth = bool(ev.modifiers() & _MOD_DEPTH)
+        self._drag = m3.drag_ball(self.model, cam, p, i, depth)
+        next(self._drag)
+        return True
+
+    def _send(self, p: m3.Pointer) -> None:
+        assert self._drag is not None
+        try:
+            self._drag.send(p)
+        except StopIteration:
+            self._drag = None
+
+    def _end_drag(self) -> None:
+        if self._drag is not None:
+            self._drag.close()
+            self._drag = None
+
+    def _key(self, ev) -> bool:
+        assert self.model is not None and self.view is not None
+        K = QtCore.Qt.Key
+        k = ev.key()
+        shift = bool(ev.modifiers() & QtCore.Qt.KeyboardModifier.ShiftModifier)
+        if k == K.Key_Tab:
+            n = len(self.model.scene.features)
+            if n:
+                cur = self.model.selected
+                self.model.select(0 if cur is None else (cur + 1) % n)
+                self._dirty = True
+                self.draw()
+                self.refresh_panels()
+            return True
+        steps = {
+            K.Key_Left: (-1, 0, 0),
+            K.Key_Right: (1, 0, 0),
+            K.Key_Up: (0, 0, 1) if shift else (0, 1, 0),
+            K.Key_Down: (0, 0, -1) if shift else (0, -1, 0),
+        }.get(k)
+        if steps is None:
+            return False
+        vp = self.pointer("move", 0, 0)
+        m3.nudge(self.model, self.camera(), vp.h, *steps)
+        return True
+
+    # --- edits from the window's Edit menu -------------------------------------------------
+    def add_ball(self) -> None:
+        """Edit > Add: a ball at the camera's focal point, 1/40 of its distance wide."""
+        assert self.model is not None
+        cam = self.camera()
+        import math
+
+        d = math.dist(cam.position, cam.focal_point)
+        self.model.add_ball(*cam.focal_point, g=max(d / 40.0, 1e-6))
+
+    def duplicate_selected(self) -> None:
+        if self.model is not None and self.model.selected is not None:
+            self.model.duplicate_ball(self.model.selected)
+
+    def delete_selected(self) -> None:
+        if self.model is not None and self.model.selected is not None:
+            self.model.delete_ball(self.model.selected)
+
+    # --- export ----------------------------------------------------------------------------
+    def export_to(
+        self,
+        path: str | os.PathLike,
+        scale: float = 1.0,
+        transparent: bool = False,
+        wait: bool = True,
+        *,
+        width: float | str = "single",
+        title: bool = True,
+        table: bool = True,
+        bitmaps: bool = True,
+    ):
+        """File > Export of a spherical scene: PNG from an off-screen VTK render at the
+        view's camera (:func:`render_png3d`), SVG/PDF the vector figure
+        (:func:`eyeviz.render.mpl.figure3d.export3d`), on a worker thread."""
+        import inspect
+
+        from eyeviz import EyevizError
+        from eyeviz.app.panels import user_message
+        from eyeviz.render.mpl.figure3d import export3d
+        from eyeviz.render.mpl.style import BASE_DPI
+        from eyeviz.render.mpl.vector import resolve_width
+
+        assert self.model is not None and self.view is not None
+        scene = self.model.scene.copy()
+        cam = self.camera()
+        win = self.win
+        fmt = Path(path).suffix.lower()
+        result: list = []
+        if fmt == ".png":
+            inches = resolve_width(width)
+            px_w = int(round(inches * BASE_DPI * scale))
+            vw, vh = max(self.view.width(), 1), max(self.view.height(), 1)
+            px_h = int(round(px_w * vh / vw))
+
+            def work():
+                return render_png3d(scene, path, cam, px_w, px_h)
+
+        else:
+            kw = {}
+            if "camera" in inspect.signature(export3d).parameters:
+                kw["camera"] = cam
+
+            def work():
+                return export3d(
+                    scene,
+                    path,
+                    scale,
+                    transparent,
+                    width=resolve_width(width),
+                    title=title,
+                    table=table,
+                    bitmaps=bitmaps,
+                    **kw,
+                )
+
+        def done(out) -> None:
+            result.append(Path(out))
+            win.statusBar().showMessage(f"exported {out}", 8000)
+
+        def failed(exc) -> None:
+            if isinstance(exc, (EyevizError, OSError, ValueError)):
+                win.show_error("Cannot export", user_message(str(exc), 300))
+            else:
+                win.show_error("Cannot export", f"unexpected error: {user_message(str(exc))}")
+
+        if fmt == ".png":  # VTK renders on this thread (its OpenGL context is per thread)
+            try:
+                done(work())
+            except Exception as exc:  # noqa: BLE001 (shown in a dialog, as the job's)
+                failed(exc)
+            return result[0] if result else None
+        job = win.jobs.start(work, f"exporting {Path(path).name}…", done, failed)
+        if not wait:
+            return job
+        win.jobs.wait()
+        return result[0] if result else None
+
+    def scene_or(self, planar: Scene) -> Scene:
+        """The scene the window shows: the 3D page's when active, else ``planar``."""
+        return self.model.scene if self.active and self.model is not None else planar
+
+    def close(self) -> None:
+        self._end_drag()
+        self._frame_timer.stop()
+        self._panel_timer.stop()
+        if self.view is not None:
+            self.view.close()
+
+
+#: the window's actions that act on the planar scene only (disabled in the 3D view)
+_PLANAR_ONLY = frozenset(
+    {
+        "Fit view",
+        "Fit inset to the eyes",
+        "Eye design: limit against distance",
+        "Play / pause trajectory (Space in the view)",
+    }
+)
