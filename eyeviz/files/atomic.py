@@ -11,6 +11,7 @@ of eyeviz's own naming that are older than :data:`SWEEP_AGE_S` and whose writer 
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import re
 import secrets
@@ -41,6 +42,25 @@ def note_interruption(exc: BaseException) -> None:
 def clear_interruptions() -> None:
     """Forget earlier interruptions (a new command begins)."""
     _interruptions.clear()
+
+
+#: errno values that mean the disk (or the user's quota, or the largest file) is full.
+_FULL = frozenset(
+    e for e in (errno.ENOSPC, getattr(errno, "EDQUOT", None), errno.EFBIG) if e is not None
+)
+
+
+def full_disk_error(path, exc: OSError) -> EyevizError | None:
+    """The one-line error naming ``path`` for a full disk (quota, file size limit), None
+    for any other error. ``os.write`` and the writers built on it (zipfile, numpy,
+    matplotlib) say only "[Errno 28] No space left on device", never which file."""
+    if exc.errno not in _FULL:
+        return None
+    what = os.strerror(exc.errno) if exc.errno is not None else "disk full"
+    return EyevizError(
+        f"{path}: cannot write: {what[:1].lower()}{what[1:]} (disk full?); nothing was "
+        "written and an existing file there is unchanged"
+    )
 
 
 _PART = re.compile(r"^\.(?P<name>.+)\.(?P<pid>\d+)\.(?P<rand>[0-9a-f]{16})\.part(\.[^.]*)?$")
@@ -126,13 +146,21 @@ def atomic_output(path) -> Iterator[Path]:
             break
         except FileExistsError:
             continue
+        except OSError as exc:  # no inode left
+            full = full_disk_error(path, exc)
+            if full is None:
+                raise
+            raise full from exc
     try:
         os.close(fd)
         yield tmp
         if _interruptions:  # a signal arrived and something swallowed its exception
             raise _interruptions[0]
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             tmp.unlink()
+        full = full_disk_error(path, exc) if isinstance(exc, OSError) else None
+        if full is not None:
+            raise full from exc
         raise

@@ -93,3 +93,89 @@ def test_missing_directory(tmp_path):
     with pytest.raises(EyevizError, match="output directory does not exist"):
         with atomic_output(tmp_path / "no" / "x.csv"):
             pass
+
+
+# --- a full disk names the file (issue 25, item 8) -------------------------------------
+
+
+@pytest.mark.parametrize("code", ["ENOSPC", "EDQUOT", "EFBIG"])
+def test_a_full_disk_names_the_output_and_keeps_the_old_file(tmp_path, code):
+    import errno
+
+    target = tmp_path / "table.csv"
+    target.write_text("previous")
+    err = getattr(errno, code)
+    with pytest.raises(EyevizError) as info, atomic_output(target) as tmp:
+        tmp.write_text("half")
+        raise OSError(err, os.strerror(err))  # what os.write says: no file name
+    msg = str(info.value)
+    assert msg.startswith(f"{target}: cannot write: ") and "\n" not in msg
+    assert os.strerror(err)[1:] in msg
+    assert target.read_text() == "previous"
+    assert [p.name for p in tmp_path.iterdir()] == ["table.csv"]
+
+
+def test_other_os_errors_pass_through_unchanged(tmp_path):
+    with pytest.raises(PermissionError), atomic_output(tmp_path / "x.csv"):
+        raise PermissionError(13, "Permission denied")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_no_inode_left_names_the_output(tmp_path, monkeypatch):
+    import errno
+
+    real_open = os.open
+
+    def full(path, *a, **k):
+        if ".part" in str(path):
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return real_open(path, *a, **k)
+
+    monkeypatch.setattr(atomic.os, "open", full)
+    with pytest.raises(EyevizError, match=r"x\.npz: cannot write: no space left"):
+        with atomic_output(tmp_path / "x.npz"):
+            pass
+
+
+def _limited(limit: int):
+    """preexec for a child whose files may not grow past ``limit`` bytes (EFBIG, as a
+    full disk: a write fails part-way)."""
+
+    def pre():
+        import resource
+        import signal
+
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    return pre
+
+
+@pytest.mark.parametrize(
+    ("args", "name"),
+    [
+        (["generate", "-n", "20000", "--seed", "5", "--quiet"], "data.csv"),
+        (["generate", "-n", "20000", "--seed", "5", "--quiet"], "data.npz"),
+        (["snapshot", "assets/scenes/default.toml"], "fig.png"),
+    ],
+)
+def test_a_real_write_past_the_limit_names_the_file(tmp_path, args, name):
+    """A real child process whose writes fail part-way (file size limit: EFBIG, the
+    same path as ENOSPC): one line naming the file, exit 2, no file left."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    out = tmp_path / name
+    res = subprocess.run(
+        [sys.executable, "-m", "eyeviz", *args, "-o", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=root,
+        env={**os.environ, "MPLBACKEND": "Agg"},
+        preexec_fn=_limited(20_000),
+    )
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and str(out) in lines[0] and "cannot write" in lines[0], res.stderr
+    assert list(tmp_path.iterdir()) == []
