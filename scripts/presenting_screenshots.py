@@ -20,6 +20,7 @@ def main() -> None:
     ap.add_argument("--present", action="store_true", help="presentation mode")
     ap.add_argument("--step", type=int, default=0, help="show lecture step N (1-based)")
     ap.add_argument("--scale", type=float, default=1.0, help="text scale")
+    ap.add_argument("--design", action="store_true", help="open View > Eye design too")
     a = ap.parse_args()
     w, h = (int(v) for v in a.size.lower().split("x"))
 
@@ -41,6 +42,11 @@ def main() -> None:
             app.processEvents()
         if a.scale != 1.0:
             win.presenter.set_scale(a.scale)
+        if a.design:
+            win.show_design()
+            win.design_panel.wait()
+            for _ in range(5):
+                app.processEvents()
         if a.present:
             win.presenter.toggle_presentation()
         for _ in range(a.step):

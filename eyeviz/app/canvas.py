@@ -40,6 +40,7 @@ RESIZE_MODIFIERS = (
 TITLE_MARGIN_PX = 10.0  # the title's distance from the view's top-left corner
 LABEL_CHAR_PX = 14.0  # a character of a feature's label (22 px bold DejaVu Sans)
 TITLE_BAND_PX = 48.0  # the band a fit keeps free for the title (24 px text + margins)
+TANGENT_NOTE_PX = 34.0  # the tangents' note (20 px text) and a margin under it
 
 
 class CanvasMixin(_MainWindow):
@@ -172,8 +173,16 @@ class CanvasMixin(_MainWindow):
             self.actors.set_inset_shown(want, main_eye_labels=labels)
 
     def title_band_px(self) -> float:
-        """Pixels at the top of the view taken by the scene's title (none without one)."""
-        return TITLE_BAND_PX if self.model.scene.title.strip() else 0.0
+        """Pixels at the top of the view taken by the scene's title (none without one) and
+        the tangents' note under it, at the window's text scale (eyeviz.app.presenting)."""
+        presenter = getattr(self, "presenter", None)
+        s = presenter.effective_scale if presenter is not None else 1.0
+        sc = self.model.scene
+        band = TITLE_BAND_PX * s if sc.title.strip() else 0.0
+        if sc.shows("tangents") and self.model.selected is not None:
+            # the note's top at a tenth of the view's height (render.vtk.layers.tangents)
+            band = max(band, 0.1 * self.plotter.height() + TANGENT_NOTE_PX * s)
+        return band
 
     def label_band_px(self) -> float:
         """About the widest feature label in pixels (22 px bold text, see SceneActors)."""
@@ -187,12 +196,27 @@ class CanvasMixin(_MainWindow):
         view then follows the window's size until the user zooms or pans it."""
         avoid = self.viewport("inset") if self._inset_wanted() else None
         top, right = self.title_band_px(), self.label_band_px()
-        interactions.fit_view(self.model, self.viewport("main"), avoid, top, right)
+        path = self._path_box()
+        interactions.fit_view(self.model, self.viewport("main"), avoid, top, right, path)
         # fitting may make the eyes large (no inset wanted): then fit the whole view
         if avoid is not None and not self._inset_wanted():
-            interactions.fit_view(self.model, self.viewport("main"), None, top, right)
+            interactions.fit_view(self.model, self.viewport("main"), None, top, right, path)
         self._update_inset_visibility()
         self._fitted_view = self.model.scene.view
+
+    def _path_box(self) -> tuple[float, float, float, float] | None:
+        """The shown trajectory's path with its disc's radius (F frames it too)."""
+        panel = getattr(self, "trajectory_panel", None)
+        p = panel.path if panel is not None else None
+        if p is None or not self.model.scene.shows("trajectory") or p.n == 0:
+            return None
+        g = p.g
+        return (
+            float(p.x.min()) - g,
+            float(p.x.max()) + g,
+            float(p.y.min()) - g,
+            float(p.y.max()) + g,
+        )
 
     def fit_inset(self) -> None:
         interactions.fit_inset(self.model, self.viewport("inset"))

@@ -24,6 +24,8 @@ if TYPE_CHECKING:
 __all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel", "PLOT_PT", "estimator_help"]
 
 PLOT_PT = 10  # the smallest text of the accuracy plot (projector-readable)
+PLOT_LW = 1.3  # the accuracy curves' width (thin: the curves' detail shows)
+LINE_STYLES = ("-", (0, (5, 2)), (0, (1.5, 1.5)), (0, (6, 2, 1.5, 2)))
 
 
 def estimator_help(name: str) -> str:
@@ -135,20 +137,17 @@ class TrajectoryPanel(QtWidgets.QWidget):
         self.speed.setRange(1, 20)
         self.speed.setValue(4)
         self.speed.setToolTip("points of the path per tick (25 ticks a second)")
-        row.addWidget(QtWidgets.QLabel("path"))
         row.addWidget(self.kind)
         row.addWidget(self.play_button)
-        row.addStretch(1)
+        row.addWidget(QtWidgets.QLabel("speed"))
+        self.speed.setMinimumWidth(60)
+        row.addWidget(self.speed, 1)  # one row: the plots keep the height (issue 24)
         lay.addLayout(row)
-        row2 = QtWidgets.QHBoxLayout()  # a row of its own: the first fits a narrow panel
-        row2.addWidget(QtWidgets.QLabel("speed"))
-        row2.addWidget(self.speed, 1)
-        lay.addLayout(row2)
         self.info = wrap_label(QtWidgets.QLabel(""))
         lay.addWidget(self.info)
-        self.fig = Figure(figsize=(4.2, 3.0), dpi=100, layout="constrained")
+        self.fig = Figure(figsize=(4.2, 2.0), dpi=100, layout="constrained")
         self.canvas = FigureCanvasQTAgg(self.fig)
-        self.canvas.setMinimumHeight(240)
+        self.canvas.setMinimumHeight(170)  # the dock's plots fit 1280x720 unscrolled
         lay.addWidget(self.canvas, 1)
         self.ax_ad = self.fig.add_subplot(2, 1, 1)
         self.ax_dd = self.fig.add_subplot(2, 1, 2, sharex=self.ax_ad)
@@ -157,6 +156,7 @@ class TrajectoryPanel(QtWidgets.QWidget):
         )
         self.cursors: list[Line2D] = []
         self._key: tuple | None = None
+        self.legend = None  # the figure's legend, above the axes (never on the data)
 
     # --- model (the player's state lives in eyeviz.model.player) ---------------------
     @property
@@ -218,6 +218,9 @@ class TrajectoryPanel(QtWidgets.QWidget):
         for ax in (self.ax_ad, self.ax_dd):
             ax.clear()
             ax.grid(True, color="#dddddd", lw=0.6)
+        if self.legend is not None:
+            self.legend.remove()
+            self.legend = None
         self.cursors = []
         p = self.path
         notes = [self.message] if self.message else []
@@ -235,9 +238,10 @@ class TrajectoryPanel(QtWidgets.QWidget):
                 if isinstance(acc, str):
                     notes.append(f"{name}: {acc}")
                     continue
-                lw = max(3.2 - 1.0 * j, 1.2)  # later curves thinner: equal ones stay visible
-                self.ax_ad.plot(p.axis, acc[0], color=cols[name], lw=lw, label=name)
-                self.ax_dd.plot(p.axis, acc[1], color=cols[name], lw=lw, label=name)
+                # thin lines; equal curves stay apart by their dashes
+                ls = LINE_STYLES[j % len(LINE_STYLES)]
+                self.ax_ad.plot(p.axis, acc[0], color=cols[name], lw=PLOT_LW, ls=ls, label=name)
+                self.ax_dd.plot(p.axis, acc[1], color=cols[name], lw=PLOT_LW, ls=ls, label=name)
             for ax in (self.ax_ad, self.ax_dd):
                 self.cursors.append(ax.axvline(p.axis[0], color="#333333", lw=1.2))
             lo = min(
@@ -257,10 +261,17 @@ class TrajectoryPanel(QtWidgets.QWidget):
                 0, f"{t.kind} path, distance {t.distance:g}, g = {t.g:g}: {p.n} points in the BFV"
             )
             if any(not isinstance(a, str) for a in p.accuracy.values()):
-                # inside the lower axes' bottom right, where accuracy is rarely low: the
-                # titles above the axes keep their line (a legend there overlapped them)
-                self.ax_dd.legend(
-                    loc="lower right", fontsize=PLOT_PT, ncol=2, framealpha=0.85, borderpad=0.3
+                # outside the data: one row above both axes (constrained layout makes room)
+                handles, labels = self.ax_ad.get_legend_handles_labels()
+                self.legend = self.fig.legend(
+                    handles,
+                    labels,
+                    loc="outside upper right",
+                    ncol=max(len(labels), 1),
+                    fontsize=PLOT_PT,
+                    frameon=False,
+                    handlelength=2.2,
+                    borderaxespad=0.1,
                 )
             self.ax_ad.set_title("AD accuracy (%)", fontsize=PLOT_PT, loc="left")
             self.ax_dd.set_title("DD accuracy (%)", fontsize=PLOT_PT, loc="left")

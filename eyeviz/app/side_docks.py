@@ -90,17 +90,20 @@ class SideDocksMixin(_MainWindow):
         super().resizeEvent(ev)
 
     def _refresh_docks(self, scene: Scene) -> None:
-        """The predictions and trajectory docks, built the first time they are needed."""
-        if scene.shows("predictions"):
-            if self.picker is None:
-                from eyeviz.app.docks import EstimatorPicker
+        """The estimators dock, always there (a tab beside the readout, greyed until the
+        predictions layer is on: issue 24), and the trajectory dock, built when needed."""
+        on = scene.shows("predictions")
+        if self.picker is None:
+            from eyeviz.app.docks import EstimatorPicker
 
-                self.picker = EstimatorPicker(self.model)
-                self._docks["predictions"] = self._dock("Estimators", self.picker, "predictions")
-                self.tabifyDockWidget(self._docks["features"], self._docks["predictions"])
+            self.picker = EstimatorPicker(self.model)
+            self._docks["predictions"] = self._dock("Estimators", self.picker, "predictions")
+            self.tabifyDockWidget(self._docks["readout"], self._docks["predictions"])
+            self._docks["readout"].raise_()
+        self.picker.setEnabled(on)
+        self.picker.setToolTip("" if on else "tick the predictions layer (Layers) to use these")
+        if on:
             self.picker.refresh()
-        if "predictions" in self._docks:
-            self._docks["predictions"].setVisible(scene.shows("predictions"))
         if scene.shows("trajectory"):
             self._trajectory_dock().refresh()
             self._refresh_overlays(scene, self.model.state)
@@ -118,7 +121,16 @@ class SideDocksMixin(_MainWindow):
             self.tabifyDockWidget(self._docks["features"], d)
             self._docks["trajectory"] = d
             QtCore.QTimer.singleShot(0, d.raise_)
+            QtCore.QTimer.singleShot(0, self._fit_trajectory_dock)
         return self.trajectory_panel
+
+    def _fit_trajectory_dock(self) -> None:
+        """The trajectory's plots get most of the side column: both fit unscrolled at
+        1280x720 (issue 24); the readout keeps the rest."""
+        read, d = self._docks["readout"], self._docks["trajectory"]
+        tall = read.height() + d.height()
+        self.resizeDocks([read, d], [tall * 2 // 5, tall - tall * 2 // 5],
+                         QtCore.Qt.Orientation.Vertical)  # fmt: skip
 
     def show_design(self) -> DesignPanel:
         """View > Eye design: the limit curves of the current eyes and the paper's (issue 11)."""
@@ -127,18 +139,22 @@ class SideDocksMixin(_MainWindow):
 
             self.design_panel = DesignPanel(self.model)
             d = self._dock("Eye design", self.design_panel, "design")
-            self.tabifyDockWidget(self._docks["features"], d)
+            # beside the Eyes tab (not one of its tabs): both show while h, l, m are typed
+            self.tabifyDockWidget(self._docks["readout"], d)
             self._docks["design"] = d
-            # the plots get most of the side column (the readout needs ~260 px)
+            # the plots get most of the side column, the Eyes tab the rest
             QtCore.QTimer.singleShot(0, self._fit_design_dock)
         self._docks["design"].show()
         self._docks["design"].raise_()
+        eyes = self.findChild(QtWidgets.QDockWidget, "dock_eyes")
+        if eyes is not None:
+            eyes.raise_()
         return self.design_panel
 
     def _fit_design_dock(self) -> None:
-        read, d = self._docks["readout"], self._docks["design"]
-        tall = read.height() + d.height()
-        self.resizeDocks([read, d], [min(270, tall // 2), max(tall - 270, tall // 2)],
+        d, low = self._docks["design"], self._docks["features"]
+        tall = d.height() + low.height()
+        self.resizeDocks([d, low], [tall * 3 // 5, tall - tall * 3 // 5],
                          QtCore.Qt.Orientation.Vertical)  # fmt: skip
 
     def show_trajectory(self, kind: str) -> None:

@@ -62,10 +62,13 @@ class StepsMixin(_MainWindow):
             bar.setMargin(8)
             bar.setAlignment(QtCore.Qt.AlignmentFlag.AlignCenter)
             bar.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Maximum)
+            presenter = getattr(self, "presenter", None)
+            scale = presenter.effective_scale if presenter is not None else 1.0
             f = bar.font()
-            f.setPointSize(CAPTION_PT)
+            f.setPointSizeF(CAPTION_PT * scale)
             f.setBold(True)
             bar.setFont(f)
+            bar.setProperty("eyeviz_base_pt", float(CAPTION_PT))  # the text scale's base
             bar.setStyleSheet("background: #1a1a1a; color: #ffffff;")
             split = self.centralWidget()
             if isinstance(split, QtWidgets.QSplitter):

@@ -152,8 +152,10 @@ def fit_view(
     avoid: Viewport | None = None,
     top: float = 0.0,
     right: float = 0.0,
+    extra: tuple[float, float, float, float] | None = None,
 ) -> View:
-    """The main view showing the eyes and every feature, clear of ``avoid`` (the inset),
+    """The main view showing the eyes, every feature and the box ``extra`` (xmin, xmax,
+    ymin, ymax: a trajectory's path), clear of ``avoid`` (the inset),
     of a band of ``top`` pixels at the top of ``vp`` (the title) and of ``right`` pixels
     at its right (the features' labels, written right of each disc).
 
@@ -162,6 +164,13 @@ def fit_view(
     never places a feature under the inset or the title.
     """
     box = scene_bounds(scene)
+    if extra is not None:
+        box = (
+            min(box[0], extra[0]),
+            max(box[1], extra[1]),
+            min(box[2], extra[2]),
+            max(box[3], extra[3]),
+        )
     top = min(max(top, 0.0), 0.5 * vp.height)
     right = min(max(right, 0.0), 0.3 * vp.width)
     full = vp

@@ -152,10 +152,12 @@ def fit_view(
     avoid: Viewport | None = None,
     top: float = 0.0,
     right: float = 0.0,
+    extra: tuple[float, float, float, float] | None = None,
 ) -> None:
-    """F: the eyes and every feature in view, clear of the inset (``avoid``), the title
-    (a band of ``top`` pixels) and the labels (``right`` pixels)."""
-    set_view(model, "main", camera.fit_view(model.scene, vp, avoid, top, right))
+    """F: the eyes, every feature and ``extra`` (a trajectory's path) in view, clear of
+    the inset (``avoid``), the title (a band of ``top`` pixels) and the labels (``right``
+    pixels)."""
+    set_view(model, "main", camera.fit_view(model.scene, vp, avoid, top, right, extra))
 
 
 def fit_inset(model: AppModel, vp: Viewport) -> None:

@@ -1,0 +1,128 @@
+"""The window's layout for a lecture hall (issue 24): the trajectory scene framed on its
+path (and F frames it), the trajectory plots unscrolled with thin lines and the legend
+off the data, Eye design beside Eyes, the Estimators panel always there, no cut tab."""
+
+import subprocess
+
+import pytest
+from PyQt5 import QtWidgets
+
+from eyeviz.model.camera import to_pixel
+from eyeviz.model.scene import load
+from eyeviz.resources import scene_path
+
+
+def _focus(win, qtbot):
+    win.activateWindow()
+    win.raise_()
+    win.plotter.setFocus()
+    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
+    qtbot.waitUntil(win.plotter.hasFocus, timeout=3000)
+
+
+def _path_in_view(win) -> bool:
+    p = win.trajectory_panel.path
+    vp = win.viewport("main")
+    view = win.model.scene.view
+    for x, y in ((p.x.min(), p.y.min()), (p.x.max(), p.y.max())):
+        px, py = to_pixel(view, vp, x, y)
+        if not (0 <= px <= vp.width and win.title_band_px() <= py <= vp.height):
+            return False
+    return True
+
+
+def _design(win, qtbot):
+    """View > Eye design, its curves computed (none lands in a closed window)."""
+    panel = win.show_design()
+    panel.wait()
+    qtbot.waitUntil(lambda: panel.running is None, timeout=30000)
+
+
+def _trajectory_window(make_window, qtbot):
+    path = scene_path("trajectory")
+    win = make_window(load(path), path)
+    win.resize(1280, 720)
+    qtbot.waitUntil(lambda: win.width() == 1280, timeout=3000)
+    qtbot.wait(50)
+    assert win.trajectory_panel is not None and win.trajectory_panel.path is not None
+    return win
+
+
+def test_the_trajectory_scene_opens_framed_on_its_path_and_f_frames_it(make_window, qtbot):
+    win = _trajectory_window(make_window, qtbot)
+    win.frame_bundled()  # as eyeviz app does once the window shows
+    assert _path_in_view(win)
+    # zoomed onto the eyes, the path is out of view; F (a real key) frames it again
+    from eyeviz.model.scene import View
+
+    win.model.scene.view = View((0.0, 0.0), 400.0)
+    win.model.notify_view()
+    assert not _path_in_view(win)
+    _focus(win, qtbot)
+    subprocess.run(["xdotool", "key", "f"], check=True)
+    qtbot.waitUntil(lambda: _path_in_view(win), timeout=5000)
+
+
+def test_the_trajectory_plots_fit_unscrolled_with_thin_lines_and_the_legend_outside(
+    make_window, qtbot
+):
+    win = _trajectory_window(make_window, qtbot)
+    dock = win._docks["trajectory"]
+    qtbot.waitUntil(dock.isVisible, timeout=3000)
+    qtbot.wait(100)
+    scroll = dock.widget()
+    assert isinstance(scroll, QtWidgets.QScrollArea)
+    assert not scroll.verticalScrollBar().isVisible()  # both plots above the fold
+    panel = win.trajectory_panel
+    lines = [ln for ln in panel.ax_dd.get_lines() if ln.get_label() in win.model.scene.estimators]
+    assert len(lines) == 2 and all(ln.get_linewidth() <= 1.5 for ln in lines)
+    assert len({str(ln.get_linestyle()) for ln in lines}) == 2  # equal curves stay apart
+    # the legend is the figure's, above both axes: on none of the data
+    panel.canvas.draw()
+    r = panel.canvas.get_renderer()
+    leg = panel.legend.get_window_extent(r)
+    for ax in (panel.ax_ad, panel.ax_dd):
+        assert not leg.overlaps(ax.get_window_extent(r))
+
+
+def test_eye_design_shows_beside_the_eyes_panel(make_window, qtbot):
+    win = _trajectory_window(make_window, qtbot)
+    _design(win, qtbot)
+    eyes = win.findChild(QtWidgets.QDockWidget, "dock_eyes")
+    design = win._docks["design"]
+    qtbot.waitUntil(
+        lambda: design.isVisible() and not design.visibleRegion().isEmpty(),
+        timeout=3000,
+    )
+    assert eyes.isVisible() and not eyes.visibleRegion().isEmpty()  # both shown at once
+    assert eyes not in win.tabifiedDockWidgets(design)
+
+
+def test_the_estimators_panel_is_always_there_greyed_until_predictions_are_on(make_window, qtbot):
+    sc = load(scene_path("default"))
+    assert "predictions" not in sc.layers
+    win = make_window(sc)
+    dock = win._docks["predictions"]
+    assert win.picker is not None and not win.picker.isEnabled()
+    assert dock.toggleViewAction().isEnabled()
+    win.model.set_layer("predictions", True)
+    assert win.picker.isEnabled()
+    win.model.set_layer("predictions", False)
+    assert not win.picker.isEnabled()
+
+
+@pytest.mark.parametrize("size", [(1280, 720), (1920, 1080)])
+def test_no_tab_is_cut_with_every_panel_open(make_window, qtbot, size):
+    win = _trajectory_window(make_window, qtbot)
+    win.resize(*size)
+    _design(win, qtbot)
+    qtbot.waitUntil(lambda: win.width() == size[0], timeout=3000)
+    qtbot.wait(100)
+    for bar in win.findChildren(QtWidgets.QTabBar):
+        if not bar.isVisible():
+            continue
+        for i in range(bar.count()):
+            text = bar.tabText(i)
+            need = bar.fontMetrics().horizontalAdvance(text)
+            assert bar.tabRect(i).width() >= need, text
+            assert bar.tabRect(i).right() <= bar.width(), text  # no scrolled-off tab
