@@ -2,20 +2,20 @@
 
 :func:`figure3d` draws, from one :class:`eyeviz.model.state3d.SceneState3D`:
 
-- a perspective view of the two eyes (layer "eyes"): each eye's facets as polygons through
-  a fixed camera in front of, right of and above the eyes, back faces culled (an eye is
-  convex, so its front faces never overlap) and the two eyes painted far to near
-  (painter's algorithm); lit facets in their features' colours and, from each eye towards
-  each ball (layer "features"), the start of its line of sight. The balls themselves are
-  not drawn there: at the paper's distances (25 to 125 eye radii) they are specks beyond
-  or behind the camera, and a near ball hides the eyes; the maps and the table place them;
+- the 3D view through a camera (:class:`eyeviz.model.camera3d.Camera3D`; default the
+  ``default`` preset framing the balls; the app's File > Export passes its view's), drawn
+  from the model by :mod:`eyeviz.render.mpl.perspective3d` as the VTK view draws it: the
+  eyes close up on the left, the scene on the right; the eyes' facets (layer "eyes"), the
+  balls ("features"), the tangent cones ("tangents"), the plane z = 0 ("plane") and the
+  boundary of the 3D binocular field ("bfv") as polygons projected as VTK projects them,
+  back faces of the eyes and balls culled, painted far to near (painter's algorithm);
 - each eye's facets on a Mollweide map seen from inside the eye (layer "bitmaps"; forward
   at the centre, the eye's right on the right, the equator drawn: that row is the planar
   bitmap), lit facets in the features' colours. Above
   :data:`eyeviz.render.mpl.healpix_map.MAX_ALL_FACETS` facets per eye (nside > 32) only the
   lit facets are drawn as polygons, over a solid background of the unlit sphere (nside 180
-  is 388,800 facets per eye: far too heavy for SVG or PDF); the perspective view then
-  draws the unlit sphere at nside 16 and the lit facets at the scene's nside over it;
+  is 388,800 facets per eye: far too heavy for SVG or PDF); the 3D view then draws the
+  unlit sphere at nside 16 and the lit facets at the scene's nside over it;
 - a readout table (layer "readout"): per ball r, azimuth and elevation (degrees; azimuth
   from +x counter-clockwise seen from above, forward = 90), g, in the 3D BFV, visible
   per eye (Definition 1), overlaps per eye and facets lit per eye.
@@ -30,41 +30,32 @@ import math
 from pathlib import Path
 
 import numpy as np
-from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 
 from eyeviz import EyevizError
-from eyeviz.core import healpix
 from eyeviz.files.atomic import atomic_output
+from eyeviz.model.camera3d import Camera3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
-from eyeviz.render.mpl.healpix_map import MAX_ALL_FACETS, MapAxes, draw_eye_view, view_lonlat
+from eyeviz.render.mpl.healpix_map import MapAxes, draw_eye_view, view_lonlat
+from eyeviz.render.mpl.perspective3d import VIEW_LAYERS, default_camera, draw_panel
 from eyeviz.render.mpl.style import (
     BASE_DPI,
-    EDGE,
     FONT,
     GREY,
     INK,
     RC,
     SMALL,
-    UNLIT,
     VECTOR_DPI,
     short,
 )
 
-__all__ = ["MAX_BALLS", "check_drawable3d", "export3d", "figure3d", "project"]
+__all__ = ["MAX_BALLS", "check_drawable3d", "export3d", "figure3d", "readout_rows"]
 
 #: A 3D figure shows at most this many balls (the table holds a row per ball).
 MAX_BALLS = 40
 #: |x|, |y|, |z| and g a 3D figure can draw (as the planar figure's MAX_COORD).
 MAX_COORD3D = 1e15
-#: The nside of the perspective view's unlit spheres when the scene's is larger.
-COARSE_NSIDE = 16
-#: The camera: looking at the origin from this direction, at CAMERA_DIST * h.
-CAMERA_DIR = (0.45, 1.0, 0.55)
-CAMERA_DIST = 9.0
-#: A ball's line of sight is drawn this many eye radii out from the eye's surface.
-SIGHT = 1.6
 ROW_IN = 0.14  # a table row, inches
 
 
@@ -82,139 +73,43 @@ def check_drawable3d(scene: Scene) -> None:
                 )
 
 
-# --- the camera ------------------------------------------------------------------------
+# --- the 3D view -------------------------------------------------------------------------
 
 
-class _Camera:
-    """A pinhole camera at ``pos`` looking at ``target``, z up; image plane at distance 1."""
-
-    def __init__(self, pos, target):
-        self.pos = np.asarray(pos, np.float64)
-        f = np.asarray(target, np.float64) - self.pos
-        self.fwd = f / np.linalg.norm(f)
-        r = np.cross(self.fwd, (0.0, 0.0, 1.0))
-        self.right = r / np.linalg.norm(r)
-        self.up = np.cross(self.right, self.fwd)
-
-    def depth(self, p) -> np.ndarray:
-        return (np.asarray(p) - self.pos) @ self.fwd
-
-    def project(self, p) -> np.ndarray:
-        """(..., 2) image coordinates of points (..., 3) in front of the camera."""
-        d = np.asarray(p, np.float64) - self.pos
-        z = d @ self.fwd
-        return np.stack([d @ self.right / z, d @ self.up / z], axis=-1)
-
-
-def project(points, pos, target) -> np.ndarray:
-    """Image coordinates (..., 2) of ``points`` (..., 3) seen from ``pos`` towards
-    ``target`` (z up, focal length 1): the camera of the 3D panel."""
-    return _Camera(pos, target).project(points)
-
-
-def _camera(h: float) -> _Camera:
-    d = np.asarray(CAMERA_DIR, np.float64)
-    return _Camera(d / np.linalg.norm(d) * CAMERA_DIST * h, (0.0, 0.0, 0.0))
-
-
-def _front_polys(cam: _Camera, centre, radius: float, nside: int, pix, step: int):
-    """Projected outlines of the facets ``pix`` of a sphere that face the camera, and
-    which of ``pix`` they are."""
-    pix = np.asarray(pix, np.int64)
-    nrm = healpix.centers(nside, pix)
-    c = np.asarray(centre, np.float64)
-    facing = ((cam.pos - (c + radius * nrm)) * nrm).sum(axis=-1) > 0
-    pts = c + radius * healpix.boundaries(nside, pix[facing], step)
-    return cam.project(pts), pix[facing]
-
-
-def _sight(ax, cam: _Camera, a, c, l: float, g: float, length: float | None, color: str):
-    """The line of sight from the eye at ``a`` (radius l) towards the ball at ``c``: from
-    the eye's surface, ``length`` long (None: up to the ball's surface); only where its
-    start faces the camera."""
-    u = np.asarray(c, np.float64) - a
-    dist = float(np.linalg.norm(u))
-    if dist <= l + g:
-        return
-    u /= dist
-    p0 = a + l * u
-    if float((cam.pos - p0) @ u) <= 0:  # the start is on the eye's far side
-        return
-    t1 = dist - g if length is None else l + length
-    seg = cam.project(np.stack([p0, a + t1 * u]))
-    ax.plot(seg[:, 0], seg[:, 1], color=color, lw=0.7, solid_capstyle="butt")
-
-
-def _draw_perspective(ax, st: SceneState3D, scene: Scene, show_balls: bool, ratio: float) -> None:
-    pair = st.pair
-    cam = _camera(pair.h)
-    n = pair.nside
-    colors = [f.color for f in scene.features]
-    centres = [np.asarray(c, np.float64) for c in pair.centers]
-    balls = [np.array([f.x, f.y, f.z]) for f in scene.features]
-    items = []  # (depth, draw): painted far to near
-    for e, centre in enumerate(centres):
-        csr = (st.lit_a, st.lit_b)[e]
-
-        def draw_eye(centre=centre, csr=csr, e=e):
-            coarse = n if pair.npix <= MAX_ALL_FACETS else COARSE_NSIDE
-            owner: dict[int, str] = {}
-            if csr is not None:
-                ip, ix = csr
-                for i, col in enumerate(colors):
-                    owner.update(dict.fromkeys(ix[ip[i] : ip[i + 1]].tolist(), col))
-            allpix = np.arange(healpix.npix(coarse))
-            polys, vis = _front_polys(cam, centre, pair.l, coarse, allpix, 3)
-            if coarse == n:
-                fc = [owner.get(int(p), UNLIT) for p in vis]
-                ax.add_collection(
-                    PolyCollection(list(polys), facecolors=fc, edgecolors=EDGE, linewidths=0.25),
-                    autolim=False,
-                )
-            else:
-                ax.add_collection(
-                    PolyCollection(
-                        list(polys), facecolors=UNLIT, edgecolors="#d4d4d4", linewidths=0.2
-                    ),
-                    autolim=False,
-                )
-                if owner:
-                    pix = np.fromiter(owner, np.int64, len(owner))
-                    polys, vis = _front_polys(cam, centre, pair.l, n, pix, 1)
-                    fc = [owner[int(p)] for p in vis]
-                    ax.add_collection(
-                        PolyCollection(list(polys), facecolors=fc, edgecolors="none"),
-                        autolim=False,
-                    )
-            if show_balls:
-                for c, f in zip(balls, scene.features, strict=True):
-                    _sight(ax, cam, centre, c, pair.l, f.g, SIGHT * pair.l, f.color)
-            x0, y0 = cam.project(centre + np.array([0.0, 0.0, -1.3 * pair.l]))
-            ax.text(x0, y0, f"eye {'AB'[e]}", ha="center", va="top", fontsize=SMALL, color=INK)
-
-        items.append((float(cam.depth(centre)), draw_eye))
-    for _, draw in sorted(items, key=lambda t: -t[0]):  # far first
-        draw()
-    # frame: the eyes and the balls drawn (within 4 times the eyes' extent)
-    reach = pair.l * (1.0 + SIGHT)  # the eyes and their lines of sight
-    xy = cam.project(np.concatenate([c + reach * healpix.centers(4) for c in centres]))
-    lo, hi = xy.min(axis=0), xy.max(axis=0)
-    span = (hi - lo).max()
-    pad = 0.04 * span
-    lo, hi = lo - pad, hi + pad
-    # equal scales: widen the short side to the panel's height / width
-    w, h = hi - lo
-    if h / w < ratio:
-        lo[1], hi[1] = (lo[1] + hi[1]) / 2 - w * ratio / 2, (lo[1] + hi[1]) / 2 + w * ratio / 2
-    else:
-        lo[0], hi[0] = (lo[0] + hi[0]) / 2 - h / ratio / 2, (lo[0] + hi[0]) / 2 + h / ratio / 2
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_axis_off()
-    ax.text(
-        0.0, 1.0, "seen from front right, above", transform=ax.transAxes, fontsize=SMALL,
+def _draw_view(
+    fig: Figure,
+    box: tuple[float, float, float, float],
+    st: SceneState3D,
+    scene: Scene,
+    cam: Camera3D,
+) -> None:
+    """The 3D view in ``box`` (figure fractions) as the VTK view lays it out: the eyes
+    close up on the left, the scene through ``cam`` on the right."""
+    eyes_ax, scene_ax = draw_panel(fig, box, st, scene, cam)
+    scene_ax.text(
+        0.01, 0.99, _view_caption(cam), transform=scene_ax.transAxes, fontsize=SMALL,
         color=GREY, ha="left", va="top",
     )  # fmt: skip
+    pair = st.pair
+    eyes_ax.text(
+        0.03, 0.98, f"the eyes, nside {pair.nside}: {pair.npix:,} facets each",
+        transform=eyes_ax.transAxes, fontsize=SMALL, color=GREY, ha="left", va="top",
+    )  # fmt: skip
+
+
+def _view_caption(cam: Camera3D) -> str:
+    """Where the camera looks from, in words (the model's axes)."""
+    d = np.asarray(cam.position, np.float64) - np.asarray(cam.focal_point, np.float64)
+    d /= np.linalg.norm(d)
+    words = []
+    for v, pos, neg in (
+        (d[1], "front", "behind"),
+        (d[0], "right", "left"),
+        (d[2], "above", "below"),
+    ):
+        if abs(v) > 0.25:
+            words.append(pos if v > 0 else neg)
+    return "seen from " + (", ".join(words) if words else "the focal point")
 
 
 # --- the readout ---------------------------------------------------------------------
@@ -285,11 +180,13 @@ def figure3d(
     table: bool = True,
     bitmaps: bool = True,
     aspect: float | None = None,
+    camera: Camera3D | None = None,
 ) -> Figure:
     """The spherical scene as a Figure ``width`` inches wide (see the module docstring).
     ``title``, ``table`` and ``bitmaps`` (False) leave those parts out; ``aspect`` is the
-    perspective panel's height / width (default 0.6; 0.38 from 6 inches wide, where the
-    two maps stand side by side)."""
+    3D view's height / width (default 0.6; 0.38 from 6 inches wide, where the two maps
+    stand side by side); ``camera`` is the view's (default: the ``default`` preset framing
+    the balls)."""
     import matplotlib
 
     if scene.kind != "spherical":
@@ -297,7 +194,7 @@ def figure3d(
     check_drawable3d(scene)
     st = compute_state3d(scene) if state is None else state
     shown = set(scene.layers)
-    persp = "eyes" in shown
+    persp = bool(shown & set(VIEW_LAYERS))
     maps = bitmaps and "bitmaps" in shown and st.lit_a is not None
     tab = table and "readout" in shown and bool(scene.features)
     side = width >= 6.0  # the two maps side by side
@@ -334,9 +231,8 @@ def figure3d(
                     va="center", fontsize=FONT + 1, color=INK, gid="title",
                 )  # fmt: skip
             elif name == "persp":
-                ax = fig.add_axes(rect(m, width - 2 * m, h))
-                ax.set_gid("perspective")
-                _draw_perspective(ax, st, scene, "features" in shown, aspect)
+                cam = default_camera(st) if camera is None else camera
+                _draw_view(fig, rect(m, width - 2 * m, h), st, scene, cam)
             elif name in ("maps", "mapA", "mapB"):
                 eyes = "AB" if name == "maps" else name[-1]
                 for k, eye in enumerate(eyes):
@@ -404,9 +300,11 @@ def export3d(
     table: bool = True,
     bitmaps: bool = True,
     aspect: float | None = None,
+    camera: Camera3D | None = None,
 ) -> Path:
-    """Write the spherical scene's figure to ``path`` (.png, .svg or .pdf) atomically, as
-    :func:`eyeviz.render.mpl.export.export` writes a planar one."""
+    """Write the spherical scene's figure (:func:`figure3d`, through ``camera``) to
+    ``path`` (.png, .svg or .pdf) atomically, as :func:`eyeviz.render.mpl.export.export`
+    writes a planar one."""
     import matplotlib
 
     from eyeviz.render.mpl.export import MAX_PNG_PX, _check_scale, _metadata, format_of
@@ -423,7 +321,10 @@ def export3d(
     parent = target.parent if str(target.parent) else Path(".")
     if not parent.is_dir():
         raise EyevizError(f"{target}: directory {parent} does not exist")
-    fig = figure3d(scene, width=width, title=title, table=table, bitmaps=bitmaps, aspect=aspect)
+    fig = figure3d(
+        scene, width=width, title=title, table=table, bitmaps=bitmaps, aspect=aspect,
+        camera=camera,
+    )  # fmt: skip
     dpi = BASE_DPI * scale if fmt == "png" else VECTOR_DPI
     with atomic_output(target) as tmp, matplotlib.rc_context(RC):
         fig.savefig(

@@ -1,0 +1,423 @@
+"""The 3D view drawn from the model, as matplotlib polygons: the vector twin of the VTK view
+(:mod:`eyeviz.render.vtk.scene3d`; issue 22 item 6, docs/spherical.md).
+
+The view has the VTK view's two parts side by side: the eyes close up on the left
+(:func:`eyeviz.model.camera3d.eyes_camera`, from the camera's direction) and the scene on
+the right, through the camera. Everything is projected by
+:func:`eyeviz.model.camera3d.project` (VTK's perspective projection, so the polygons land
+where the VTK render puts them) into normalised device coordinates, [-1, 1] across each
+part. The geometry is :mod:`eyeviz.model.shapes3d`'s, the arrays the VTK painters draw:
+
+- the eyes' facets (layer "eyes"): up to nside ``FULL_MAX_NSIDE`` every facet, else the
+  unlit sphere at nside 16 and the lit facets at the scene's nside over it; lit facets in
+  their ball's colour (a later ball wins);
+- the balls (layer "features"), spheres in their colours, named (layer "labels");
+- the tangent cones from each eye centre to each ball (layer "tangents"), translucent,
+  from the eye's surface on (the VTK cone starts at the centre, hidden by the eye), in
+  the close-up only their first ``EYE_CONE`` eye radii;
+- the plane z = 0 with a grid and each eye's equator (layer "plane");
+- the boundary of the 3D binocular field of view (layer "bfv"), translucent.
+
+Closed surfaces (eyes, balls) lose their back faces (culled: the face's outward normal
+points away from the camera); open ones (cones, plane, field) keep both sides, as VTK draws
+them. Every polygon is then painted far to near by the distance of its centroid from the
+camera (painter's algorithm) in one collection; long surfaces are cut in bands so that
+their pieces sort with what lies beside them. Polygons that reach behind the camera's
+near plane or lie wholly outside the view are left out. Shading is a headlight: a face's
+colour times ambient + diffuse cos(angle to the camera), with the VTK actors' ambient and
+diffuse.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.collections import LineCollection, PolyCollection
+from matplotlib.colors import to_rgba, to_rgba_array
+from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
+
+from eyeviz.core import healpix
+from eyeviz.model import shapes3d
+from eyeviz.model.camera3d import Camera3D, eyes_camera, preset, project
+from eyeviz.model.scene import Scene
+from eyeviz.model.state3d import SceneState3D
+from eyeviz.render.mpl.style import SMALL, short
+
+__all__ = [
+    "EYES_FRACTION",
+    "VIEW_LAYERS",
+    "Polygons",
+    "default_camera",
+    "draw_panel",
+    "draw_view",
+    "scene_polygons",
+    "split_viewports",
+]
+
+# The VTK view's looks (eyeviz/render/vtk/scene3d.py and style.py), mirrored here: this
+# module must not import VTK (snapshot runs without it); tests/render/test_figure3d_vtk.py
+# compares the two pictures.
+EYES_FRACTION = 0.4
+UNLIT_RGBA = (225 / 255, 225 / 255, 225 / 255, 1.0)
+EDGE_RGBA = (0.45, 0.45, 0.45, 1.0)
+EDGES_MAX_NSIDE = 16
+BFV_RGBA = (0.80, 0.72, 0.35, 0.16)
+PLANE_RGBA = (0.55, 0.62, 0.75, 0.10)
+GRID_RGBA = (0.55, 0.62, 0.75, 0.6)
+CONE_ALPHA = 0.28
+EYE_CONE = 4.0  # the close-up draws the cones this many eye radii long
+INSET_RGBA = (0.965, 0.965, 0.955, 1.0)
+INK_RGBA = (0.15, 0.15, 0.15, 1.0)
+EYE_LIGHT = (0.45, 0.6)  # ambient, diffuse
+BALL_LIGHT = (0.35, 0.7)
+#: The balls are HEALPix spheres of this nside (192 facets, the front ~96 drawn).
+BALL_NSIDE = 4
+CONE_RES = 32  # points around a tangent cone
+CONE_BANDS = 8  # pieces along it
+#: Layers the view draws (the others are drawn elsewhere or not at all).
+VIEW_LAYERS = ("eyes", "features", "tangents", "plane", "bfv")
+
+
+def split_viewports(w: float, h: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(eyes, scene) viewports (xmin, ymin, xmax, ymax), fractions of a ``w`` x ``h`` view:
+    the VTK view's split (``eyeviz.render.vtk.scene3d.split_viewports``)."""
+    f = EYES_FRACTION if w >= 2.0 * h * EYES_FRACTION else 0.5
+    return (0.0, 0.0, f, 1.0), (f, 0.0, 1.0, 1.0)
+
+
+@dataclass
+class Polygons:
+    """Polygons in normalised device coordinates, in painting order (far first)."""
+
+    verts: list[np.ndarray]
+    face: np.ndarray  # (n, 4) rgba
+    edge: np.ndarray  # (n, 4) rgba
+    width: np.ndarray  # (n,) line widths, points
+    depth: np.ndarray  # (n,) centroid distance from the camera
+    kind: np.ndarray  # (n,) "eye", "lit", "ball", "cone", "plane", "bfv"
+
+    def __len__(self) -> int:
+        return len(self.verts)
+
+
+def default_camera(state: SceneState3D) -> Camera3D:
+    """The view's default camera: the ``default`` preset framing the scene's balls."""
+    pair = state.pair
+    return preset("default", pair.h, pair.l, shapes3d.scene_extent(state))
+
+
+class _Batch:
+    """Polygons of one kind with the same number of vertices, in 3D."""
+
+    def __init__(self, pts, face, kind: str, *, centre=None, edge=None, width=0.0, light=None):
+        self.pts = np.asarray(pts, np.float64)  # (n, k, 3)
+        n = self.pts.shape[0]
+        self.face = np.broadcast_to(np.asarray(face, np.float64), (n, 4)).copy()
+        self.edge = (
+            self.face.copy()
+            if edge is None
+            else np.broadcast_to(np.asarray(edge, np.float64), (n, 4)).copy()
+        )
+        self.width = np.full(n, float(width))
+        self.kind = kind
+        self.centre = centre  # a closed surface's centre (3,): back faces culled
+        self.light = light  # (ambient, diffuse) or None: drawn unshaded
+
+
+def _reach(state: SceneState3D) -> float:
+    return 1.1 * shapes3d.scene_extent(state)
+
+
+def _eye_batches(state: SceneState3D, scene: Scene) -> list[_Batch]:
+    pair = state.pair
+    n = pair.nside
+    colors = to_rgba_array([f.color for f in scene.features]) if scene.features else None
+    out = []
+    for e, cx in enumerate((-pair.h, pair.h)):
+        c = np.array([cx, 0.0, 0.0])
+        own = shapes3d.facet_owner(state, "AB"[e])
+        if n <= shapes3d.FULL_MAX_NSIDE:  # every facet, coloured by its owner
+            pts = c + pair.l * healpix.boundaries(n, np.arange(pair.npix), shapes3d.edge_step(n))
+            face = np.tile(np.asarray(UNLIT_RGBA), (pts.shape[0], 1))
+            lit = own >= 0
+            if colors is not None and lit.any():
+                face[lit] = colors[own[lit]]
+            edged = n <= EDGES_MAX_NSIDE
+            out.append(
+                _Batch(pts, face, "eye", centre=c, edge=EDGE_RGBA if edged else None,
+                       width=0.25 if edged else 0.05, light=EYE_LIGHT)
+            )  # fmt: skip
+            continue
+        vn = shapes3d.view_nside(n)
+        pts = c + pair.l * healpix.boundaries(vn, np.arange(healpix.npix(vn)), 2)
+        out.append(_Batch(pts, UNLIT_RGBA, "eye", centre=c, width=0.05, light=EYE_LIGHT))
+        pix = np.flatnonzero(own >= 0)
+        if pix.size and colors is not None:
+            lp = c + pair.l * healpix.boundaries(n, pix, 1)
+            out.append(_Batch(lp, colors[own[pix]], "lit", centre=c, width=0.05, light=EYE_LIGHT))
+    return out
+
+
+def _ball_batches(scene: Scene) -> list[_Batch]:
+    unit = healpix.boundaries(BALL_NSIDE, np.arange(healpix.npix(BALL_NSIDE)), 2)
+    out = []
+    for f in scene.features:
+        c = np.array([f.x, f.y, f.z], np.float64)
+        out.append(
+            _Batch(c + f.g * unit, to_rgba(f.color), "ball", centre=c, width=0.05,
+                   light=BALL_LIGHT)
+        )  # fmt: skip
+    return out
+
+
+def _cone_batches(state: SceneState3D, scene: Scene, length: float | None) -> list[_Batch]:
+    """Each eye's tangent cone to each ball (:func:`eyeviz.model.shapes3d.tangent_cone`)
+    from the eye's surface to the circle where it touches the ball (to ``length`` from
+    the apex when given), cut in bands along its length, shortest at the eye."""
+    pair = state.pair
+    out = []
+    # band ends in geometric steps: the first pieces short, so they sort in front of the
+    # eye's facets they start from
+    s = (np.geomspace(1.0, 2.0**CONE_BANDS, CONE_BANDS + 1) - 1.0) / (2.0**CONE_BANDS - 1.0)
+    nxt = np.roll(np.arange(CONE_RES), -1)
+    for cx in (-pair.h, pair.h):
+        a = np.array([cx, 0.0, 0.0])
+        for f in scene.features:
+            cone = shapes3d.tangent_cone(a, (f.x, f.y, f.z), f.g, CONE_RES)
+            if length is not None:
+                cone = shapes3d.shorten_cones(cone, CONE_RES, length)
+            gen = cone[1:] - a  # generators, apex to circle
+            size = np.linalg.norm(gen, axis=-1)
+            if not np.all(size > pair.l):  # degenerate, or ending inside the eye
+                continue
+            t0 = pair.l / size  # the eye's surface along each generator
+            t = t0[None, :] + s[:, None] * (1.0 - t0[None, :])  # (bands + 1, res)
+            rings = a + t[..., None] * gen[None]
+            quads = np.stack(
+                [rings[:-1], rings[:-1][:, nxt], rings[1:][:, nxt], rings[1:]], axis=2
+            ).reshape(-1, 4, 3)
+            rgba = list(to_rgba(f.color))
+            rgba[3] = CONE_ALPHA
+            out.append(_Batch(quads, rgba, "cone", width=0.0))
+    return out
+
+
+def _bfv_batches(state: SceneState3D) -> list[_Batch]:
+    """The field's boundary (:func:`eyeviz.model.shapes3d.bfv_cones`), its triangles from
+    the origin cut in bands (finer near the eyes)."""
+    pair = state.pair
+    pts, faces = shapes3d.bfv_cones(pair.h, pair.l, _reach(state))
+    tri = faces.reshape(-1, 4)[:, 1:]
+    apex, p1, p2 = pts[tri[:, 0]], pts[tri[:, 1]], pts[tri[:, 2]]
+    s = np.concatenate([[0.0], np.geomspace(2.0 * pair.h / _reach(state), 1.0, 10)])
+    s = s[:, None, None]
+    r1, r2 = apex + s * (p1 - apex), apex + s * (p2 - apex)
+    quads = np.stack([r1[:-1], r2[:-1], r2[1:], r1[1:]], axis=2).reshape(-1, 4, 3)
+    return [_Batch(quads, BFV_RGBA, "bfv", width=0.0)]
+
+
+def _plane(state: SceneState3D) -> tuple[list[_Batch], np.ndarray]:
+    """The plane z = 0 as the VTK view draws it (:func:`eyeviz.model.shapes3d.plane_z0`
+    over [-0.8, 0.8] x [-0.2, 1] times the reach) in tiles (12 across, a quarter of an eye
+    radius about the eyes, so that the tiles inside an eye sort behind its face), and its
+    grid segments (k, 2, 3)."""
+    pair = state.pair
+    r = _reach(state)
+    x0, x1, y0, y1 = -0.8 * r, 0.8 * r, -0.2 * r, r
+    corners, segs = shapes3d.plane_z0(x0, x1, y0, y1)
+    fine_x = np.arange(-pair.h - 1.5 * pair.l, pair.h + 1.5 * pair.l, pair.l / 4)
+    fine_y = np.arange(-1.5 * pair.l, 1.5 * pair.l, pair.l / 4)
+    xs = np.unique(np.clip(np.concatenate([np.linspace(x0, x1, 13), fine_x]), x0, x1))
+    ys = np.unique(np.clip(np.concatenate([np.linspace(y0, y1, 13), fine_y]), y0, y1))
+    gx, gy = np.meshgrid(xs, ys, indexing="ij")
+    q = np.stack([gx, gy, np.zeros_like(gx)], axis=-1)
+    quads = np.stack([q[:-1, :-1], q[1:, :-1], q[1:, 1:], q[:-1, 1:]], axis=2).reshape(-1, 4, 3)
+    return [_Batch(quads, PLANE_RGBA, "plane", width=0.0)], segs
+
+
+def _equators(state: SceneState3D) -> np.ndarray:
+    """Each eye's equator just outside the eye (k, 2, 3 segments): the planar eye."""
+    pair = state.pair
+    t = np.linspace(0.0, 2.0 * math.pi, 121)
+    r = pair.l * 1.012
+    out = []
+    for cx in (-pair.h, pair.h):
+        ring = np.column_stack([cx + r * np.cos(t), r * np.sin(t), 0 * t])
+        out.append(np.stack([ring[:-1], ring[1:]], axis=1))
+    return np.concatenate(out)
+
+
+def scene_polygons(
+    state: SceneState3D,
+    scene: Scene,
+    cam: Camera3D,
+    aspect: float,
+    part: str = "scene",
+    layers=None,
+) -> Polygons:
+    """The polygons of one part of the view (``"scene"`` or the ``"eyes"`` close-up)
+    through ``cam`` for a viewport of ``aspect`` = width / height, culled, clipped to the
+    view and sorted far to near (see the module docstring). ``layers`` (default: the
+    scene's) picks the parts among :data:`VIEW_LAYERS`."""
+    shown = set(scene.layers if layers is None else layers)
+    batches: list[_Batch] = []
+    if "bfv" in shown:
+        batches += _bfv_batches(state)
+    if "plane" in shown and part == "scene":
+        batches += _plane(state)[0]
+    if "eyes" in shown and state.lit_a is not None:
+        batches += _eye_batches(state, scene)
+    if "features" in shown and part == "scene":
+        batches += _ball_batches(scene)
+    if "tangents" in shown:
+        batches += _cone_batches(state, scene, None if part == "scene" else EYE_CONE * state.pair.l)
+    return _project(batches, cam, aspect, state.pair.l)
+
+
+def _project(batches: list[_Batch], cam: Camera3D, aspect: float, l: float) -> Polygons:
+    cam_pos = np.asarray(cam.position, np.float64)
+    dist = float(np.linalg.norm(cam_pos - np.asarray(cam.focal_point, np.float64)))
+    near = 1e-3 * dist
+    verts: list[np.ndarray] = []
+    faces, edges, widths, depths, kinds = [], [], [], [], []
+    for b in batches:
+        if b.pts.shape[0] == 0:
+            continue
+        mid = b.pts.mean(axis=1)
+        to_cam = cam_pos - mid
+        to_cam /= np.linalg.norm(to_cam, axis=-1, keepdims=True)
+        if b.centre is not None:  # a closed surface: back faces culled
+            normal = mid - b.centre
+            normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+            keep = (to_cam * normal).sum(axis=-1) > 0
+        else:
+            normal = None
+            keep = np.ones(mid.shape[0], bool)
+        xy, depth = project(cam, b.pts, aspect)
+        keep &= depth.min(axis=1) > near
+        lo, hi = xy.min(axis=1), xy.max(axis=1)
+        keep &= np.all(hi > -1.0, axis=1) & np.all(lo < 1.0, axis=1)
+        idx = np.flatnonzero(keep)
+        if idx.size == 0:
+            continue
+        face, edge = b.face[idx], b.edge[idx]
+        if b.light is not None and normal is not None:  # headlight shading
+            cos = np.abs((normal[idx] * to_cam[idx]).sum(axis=-1))
+            k = np.minimum(b.light[0] + b.light[1] * cos, 1.0)[:, None]
+            same = np.all(edge == face, axis=-1)
+            face = face.copy()
+            face[:, :3] *= k
+            edge = edge.copy()
+            edge[same, :3] = face[same, :3]
+        d = np.linalg.norm(mid[idx] - cam_pos, axis=-1)
+        if b.kind == "lit":  # over the coarse unlit sphere they lie on
+            d = d - 0.1 * l
+        verts.extend(xy[idx])
+        faces.append(face)
+        edges.append(edge)
+        widths.append(b.width[idx])
+        depths.append(d)
+        kinds.append(np.full(idx.size, b.kind))
+    if not verts:
+        z4 = np.zeros((0, 4))
+        return Polygons([], z4, z4, np.zeros(0), np.zeros(0), np.zeros(0, "<U5"))
+    depth = np.concatenate(depths)
+    order = np.argsort(-depth, kind="stable")  # far first
+    return Polygons(
+        [verts[i] for i in order],
+        np.concatenate(faces)[order],
+        np.concatenate(edges)[order],
+        np.concatenate(widths)[order],
+        depth[order],
+        np.concatenate(kinds)[order],
+    )
+
+
+def _segments(ax: Axes, cam: Camera3D, aspect: float, segs: np.ndarray, rgba, lw: float):
+    """3D segments (k, 2, 3) drawn as lines (those wholly in front of the camera)."""
+    xy, depth = project(cam, segs, aspect)
+    keep = depth.min(axis=1) > 0
+    if keep.any():
+        ax.add_collection(LineCollection(list(xy[keep]), colors=[rgba], linewidths=lw))
+
+
+def draw_view(
+    ax: Axes,
+    state: SceneState3D,
+    scene: Scene,
+    cam: Camera3D,
+    aspect: float,
+    part: str = "scene",
+    layers=None,
+) -> PolyCollection:
+    """One part of the view through ``cam`` on ``ax``, whose box must have width /
+    height = ``aspect``: one collection of polygons, the plane's grid and the equators
+    (layer "plane"), the names (layer "labels"); limits [-1, 1] x [-1, 1], no axis."""
+    shown = set(scene.layers if layers is None else layers)
+    polys = scene_polygons(state, scene, cam, aspect, part, layers)
+    coll = PolyCollection(
+        polys.verts, facecolors=polys.face, edgecolors=polys.edge, linewidths=polys.width
+    )
+    coll.set_gid(f"view-{part}")
+    ax.add_collection(coll, autolim=False)
+    if "plane" in shown:
+        if part == "scene":
+            _segments(ax, cam, aspect, _plane(state)[1], GRID_RGBA, 0.4)
+        if "eyes" in shown:
+            _segments(ax, cam, aspect, _equators(state), INK_RGBA, 0.8)
+    if "labels" in shown:
+        _labels(ax, state, scene, cam, aspect, part, shown)
+    ax.set_xlim(-1.0, 1.0)
+    ax.set_ylim(-1.0, 1.0)
+    ax.set_axis_off()
+    return coll
+
+
+def _labels(ax, state, scene, cam, aspect, part, shown) -> None:
+    pair = state.pair
+    if part == "eyes" and "eyes" in shown:
+        pts = np.array([[-pair.h, 0.0, -1.55 * pair.l], [pair.h, 0.0, -1.55 * pair.l]])
+        xy, depth = project(cam, pts, aspect)
+        for (x, y), d, t in zip(xy, depth, ("eye A", "eye B"), strict=True):
+            if d > 0 and abs(x) < 1 and abs(y) < 1:
+                ax.text(x, y, t, fontsize=SMALL + 1, color=INK_RGBA, ha="center", va="center")
+    if part == "scene" and "features" in shown and scene.features:
+        pts = np.array([[f.x, f.y, f.z + f.g] for f in scene.features])
+        xy, depth = project(cam, pts, aspect)
+        for (x, y), d, f in zip(xy, depth, scene.features, strict=True):
+            if d > 0 and abs(x) < 1 and abs(y) < 1:
+                ax.text(x, y, " " + short(f.name, 16), fontsize=SMALL + 1, color=f.color,
+                        ha="left", va="bottom")  # fmt: skip
+
+
+def draw_panel(
+    fig: Figure,
+    box: tuple[float, float, float, float],
+    state: SceneState3D,
+    scene: Scene,
+    cam: Camera3D,
+    layers=None,
+) -> tuple[Axes, Axes]:
+    """The whole 3D view in ``box`` (figure fractions: left, bottom, width, height) as the
+    VTK view lays it out (:func:`split_viewports`): the eyes close up on the left, the
+    scene through ``cam`` on the right. Returns the (eyes, scene) axes."""
+    w_in, h_in = box[2] * fig.get_figwidth(), box[3] * fig.get_figheight()
+    axes = []
+    for part, (x0, y0, x1, y1) in zip(("eyes", "scene"), split_viewports(w_in, h_in), strict=True):
+        ax = fig.add_axes(
+            (box[0] + x0 * box[2], box[1] + y0 * box[3], (x1 - x0) * box[2], (y1 - y0) * box[3])
+        )
+        ax.set_gid(f"perspective-{part}")
+        aspect = (x1 - x0) * w_in / ((y1 - y0) * h_in)
+        if part == "eyes":
+            ax.add_patch(Rectangle((-1, -1), 2, 2, facecolor=INSET_RGBA, lw=0, zorder=-1))
+            pcam = eyes_camera(cam, state.pair.h, state.pair.l, aspect)
+        else:
+            pcam = cam
+        draw_view(ax, state, scene, pcam, aspect, part, layers)
+        axes.append(ax)
+    return axes[0], axes[1]
