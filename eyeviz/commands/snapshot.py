@@ -2,8 +2,11 @@
 
 No window, no Qt, no VTK: the figure is drawn by matplotlib (Agg) from the scene model
 (:mod:`eyeviz.render.mpl.vector`). torch is imported only when the scene shows predictions.
-A spherical scene (``[eyes] nside``) is drawn by :mod:`eyeviz.render.mpl.figure3d`: each
-eye's facets on a Mollweide map, a readout table and a perspective view of the eyes.
+A spherical scene (``[eyes] nside``) is drawn by :mod:`eyeviz.render.mpl.figure3d` for
+SVG and PDF (each eye's facets on a Mollweide map, a readout table and a perspective view of
+the eyes); its PNG is the app's 3D view rendered off-screen by VTK
+(:func:`eyeviz.render.vtk.scene3d.render_png3d`, EGL: no display), ``--width`` inches at
+300 dpi times ``--scale`` wide and ``--aspect`` (default 9/16) of that high.
 """
 
 from __future__ import annotations
@@ -76,6 +79,15 @@ def run(args: argparse.Namespace) -> int:
     aspect = resolve_aspect(args.aspect, width)
     min_font = None if args.min_font is None else check_min_font(args.min_font)
     sc = scene_mod.load(args.scene)
+    if sc.kind == "spherical" and format_of(args.output) == "png":  # the 3D view, by VTK
+        from eyeviz.render.mpl.figure3d import check_drawable3d
+        from eyeviz.render.mpl.style import BASE_DPI
+        from eyeviz.render.vtk.scene3d import png_size, render_png3d
+
+        check_drawable3d(sc)
+        px_w, px_h = png_size(width * BASE_DPI * args.scale, args.aspect)
+        print(render_png3d(sc, args.output, None, px_w, px_h, transparent=args.transparent))
+        return 0
     if sc.kind == "spherical":  # HEALPix eyes: maps, table and perspective (figure3d)
         from eyeviz import EyevizError
         from eyeviz.render.mpl.figure3d import check_drawable3d, export3d
@@ -83,18 +95,21 @@ def run(args: argparse.Namespace) -> int:
         if min_font is not None:
             raise EyevizError("min-font: spherical scenes do not take it yet (planar only)")
 
+        from eyeviz.render.mpl.glyphs import one_glyph_warning
+
         check_drawable3d(sc)
-        out = export3d(
-            sc,
-            args.output,
-            scale=args.scale,
-            transparent=args.transparent,
-            width=width,
-            title=not args.no_title,
-            table=not args.no_table,
-            bitmaps=not args.no_bitmaps,
-            aspect=None if args.aspect is None else aspect,
-        )
+        with one_glyph_warning():  # an emoji name: one line, not a warning pair per glyph
+            out = export3d(
+                sc,
+                args.output,
+                scale=args.scale,
+                transparent=args.transparent,
+                width=width,
+                title=not args.no_title,
+                table=not args.no_table,
+                bitmaps=not args.no_bitmaps,
+                aspect=None if args.aspect is None else aspect,
+            )
         print(out)
         return 0
     check_drawable(sc)  # too many features or undrawable coordinates: refused at once

@@ -85,3 +85,35 @@ def test_min_font_makes_a_taller_figure_and_bad_values_are_refused(tmp_path):
         assert run.returncode == 2, run.stderr
         assert run.stderr.count("\n") == 1 and "min-font" in run.stderr, run.stderr
     assert not (tmp_path / "bad.png").exists()
+
+
+def test_emoji_in_names_print_one_warning_line(tmp_path):
+    """Three emoji in a name printed three warning pairs (the warning and its source
+    line) per export; now one line naming each character once."""
+    text = (SCENES / "default.toml").read_text(encoding="utf-8")
+    scene = tmp_path / "emoji.toml"
+    scene.write_text(
+        text.replace('name = "target"', 'name = "bee \U0001f41d\U0001f98b\U0001f41e\U0001f41d"'),
+        encoding="utf-8",
+    )
+    for suffix in ("png", "svg"):
+        run = _snapshot(scene, "-o", tmp_path / f"e.{suffix}")
+        assert run.returncode == 0, run.stderr
+        lines = run.stderr.strip().splitlines()
+        assert len(lines) == 1, run.stderr
+        assert lines[0].startswith("eyeviz: warning: 3 characters not in the figure's font")
+        for ch in "\U0001f41d\U0001f98b\U0001f41e":
+            assert lines[0].count(ch) == 1
+
+
+def test_other_warnings_pass_through_the_glyph_collector(capsys):
+    import warnings
+
+    from eyeviz.render.mpl.glyphs import one_glyph_warning
+
+    with pytest.warns(RuntimeWarning, match="something else"), one_glyph_warning():
+        warnings.warn("Glyph 9731 (\\N{SNOWMAN}) missing from font(s) DejaVu Sans.", stacklevel=1)
+        warnings.warn("Glyph 9731 (\\N{SNOWMAN}) missing from font(s) DejaVu Sans.", stacklevel=1)
+        warnings.warn("something else", RuntimeWarning, stacklevel=1)
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "1 character not in" in err and "\u2603" in err

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from eyeviz import EyevizError
 from eyeviz.files.atomic import atomic_output
+from eyeviz.render.mpl.glyphs import one_glyph_warning
 from eyeviz.render.mpl.style import BASE_DPI, WIDTHS
 
 __all__ = ["FORMATS", "export", "format_of"]
@@ -92,8 +93,6 @@ def export(
     if not parent.is_dir():
         raise EyevizError(f"{target}: directory {parent} does not exist")
 
-    import matplotlib
-
     from eyeviz.render.mpl import vector
 
     if fmt == "png":
@@ -105,20 +104,33 @@ def export(
                 f"{MAX_PNG_PX} px: scale <= {MAX_PNG_PX / (w_in * BASE_DPI):.3g} at this width"
             )
     dpi = vector.BASE_DPI * scale if fmt == "png" else vector.VECTOR_DPI
-    fig = vector.figure(
-        scene,
-        state,
-        dpi=dpi,
-        merge=merge,
-        predictions=predictions,
-        width=width,
-        title=title,
-        table=table,
-        bitmaps=bitmaps,
-        predictor=predictor,
-        aspect=aspect,
-        min_font=min_font,
-    )
+    with one_glyph_warning():  # an emoji name: one line, not a warning pair per glyph
+        _draw(
+            scene,
+            target,
+            fmt,
+            dpi,
+            transparent,
+            state=state,
+            predictions=predictions,
+            merge=merge,
+            width=width,
+            title=title,
+            table=table,
+            bitmaps=bitmaps,
+            predictor=predictor,
+            aspect=aspect,
+            min_font=min_font,
+        )
+    return target
+
+
+def _draw(scene, target: Path, fmt: str, dpi: float, transparent: bool, **kw) -> None:
+    import matplotlib
+
+    from eyeviz.render.mpl import vector
+
+    fig = vector.figure(scene, dpi=dpi, **kw)
     with atomic_output(target) as tmp, matplotlib.rc_context(vector.RC):
         fig.savefig(
             tmp,
@@ -127,7 +139,6 @@ def export(
             transparent=transparent,
             metadata=_metadata(fmt, scene),
         )
-    return target
 
 
 def _metadata(fmt: str, scene) -> dict:
