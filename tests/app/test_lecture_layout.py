@@ -126,3 +126,29 @@ def test_no_tab_is_cut_with_every_panel_open(make_window, qtbot, size):
             need = bar.fontMetrics().horizontalAdvance(text)
             assert bar.tabRect(i).width() >= need, text
             assert bar.tabRect(i).right() <= bar.width(), text  # no scrolled-off tab
+
+
+def test_the_paper_estimators_message_names_the_folders_it_searched(
+    make_window, monkeypatch, tmp_path
+):
+    from eyeviz.estimators.paper.weights import weights_dirs
+
+    monkeypatch.delenv("EYEVIZ_PAPER_DIR", raising=False)
+    monkeypatch.setenv("HOME", str(tmp_path))  # no weights in the user's folders
+    monkeypatch.delenv("XDG_DATA_HOME", raising=False)
+    monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
+    monkeypatch.delenv("EYEVIZ_HOME", raising=False)
+    if any((d / "ad.pt").is_file() for d in weights_dirs()):
+        pytest.skip("the paper's weights are installed here: no message to read")
+    sc = load(scene_path("default"))
+    sc.layers.append("predictions")
+    sc.estimators = ["paper"]
+    win = make_window(sc)
+    win.jobs.wait()
+    win.picker.refresh()
+    note, row = win.picker.note.text(), win.readout.texts.get("pred:paper", "")
+    # the picker's note names all three; the readout's one line starts with them
+    assert "looked in eyeviz/assets/models/paper, ~/.local/share/eyeviz/models/paper, " in note
+    assert "~/.cache/eyeviz/models/paper)" in note
+    assert "looked in eyeviz/assets/models/paper, ~/.local/share/eyeviz/" in row
+    assert str(tmp_path) not in note + row  # no local path: the home folder is ~

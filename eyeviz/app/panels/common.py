@@ -8,7 +8,9 @@ import re
 from PyQt5 import QtCore, QtWidgets
 
 ERROR_STYLE = "color: #b00020; font-weight: bold;"
-_PATH = re.compile(r"(?:[A-Za-z]:)?(?:[\\/][^\s\\/:'\"()\[\],]+){2,}[\\/]?")
+# an absolute path (not one written ~/..., nor a relative one such as eyeviz/assets/...: those name
+# no local user and are kept whole, e.g. the folders an estimator searched)
+_PATH = re.compile(r"(?<![~\w.])(?:[A-Za-z]:)?(?:[\\/][^\s\\/:'\"()\[\],]+){2,}[\\/]?")
 _DEV = re.compile(
     r"\b(?:Traceback|\w*Error|\w*Exception)\b:?\s*|\[Errno \d+\]\s*|\b\w+\.py\b(?::\d+)?"
 )

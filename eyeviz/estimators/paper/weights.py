@@ -15,7 +15,7 @@ from torch import nn
 from eyeviz import EyevizError
 from eyeviz.estimators.paper.nets import SPECS, build
 from eyeviz.estimators.store import user_models_dir
-from eyeviz.resources import models_dir
+from eyeviz.resources import assets_dir, models_dir
 
 WEIGHTS_HINT = "eyeviz train paper --budget 600"
 
@@ -48,6 +48,21 @@ def default_out_dir() -> Path:
     return user_models_dir() / "paper"
 
 
+def shown_dir(d: Path) -> str:
+    """``d`` as a message names it, the same on every machine: the shipped assets as
+    ``eyeviz/assets/...`` (the installed package's folder), a folder under the home folder
+    as ``~/...``, else as given."""
+    package = assets_dir().parent
+    try:
+        return f"{package.name}/{d.relative_to(package).as_posix()}"
+    except ValueError:
+        pass
+    try:
+        return f"~/{d.relative_to(Path.home()).as_posix()}"
+    except ValueError:
+        return str(d)
+
+
 def find_weights(name: str, path: str | os.PathLike | None = None) -> Path:
     """The ``<name>.pt`` weights file; one-line error naming the command that makes it."""
     dirs = [Path(path)] if path is not None else weights_dirs()
@@ -55,7 +70,7 @@ def find_weights(name: str, path: str | os.PathLike | None = None) -> Path:
         f = d / f"{name}.pt"
         if f.is_file():
             return f
-    where = ", ".join(str(d) for d in dirs)
+    where = ", ".join(shown_dir(d) for d in dirs)
     raise EyevizError(
         f"paper network weights {name}.pt not found (looked in {where}); "
         f"make them with `{WEIGHTS_HINT}` (weights are not shipped: ~243 MB + ~133 MB)"
