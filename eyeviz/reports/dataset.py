@@ -1,8 +1,10 @@
 """``eyeviz report dataset DATA [DATA ...] -o DIR``: how the elements are distributed.
 
 For each data set, side by side: the histogram of r (the paper's Figures 8, 9) and the
-centres (x, y) in the BFV (Figures 10, 11). Writes ``dataset.png``, ``dataset.md`` and
-``dataset.csv`` (one row of summary figures per data set) into DIR, each atomically.
+centres (x, y) in the BFV (Figures 10, 11). Writes the figure as ``dataset.png`` (300
+dpi), ``dataset.svg`` and ``dataset.pdf`` (vectors, the scatter rasterised), and
+``dataset.md`` and ``dataset.csv`` (one row of summary figures per data set) into DIR,
+each atomically.
 Each file is streamed block by block (:func:`eyeviz.dataset.reader.iter_blocks`), so a
 10^7-row data set needs one block of memory plus 8 bytes per distinct bitmap pair (the
 pairs are counted by 64-bit hash: a collision among 10^7 pairs has odds about 3e-6).
@@ -11,6 +13,11 @@ The summary's ``area_density_ratio`` is the number of centres per unit BFV area 
 outer half of the r range divided by that in the inner half: about 1 for centres uniform
 over the area (multi-pass), (r_in + r_mid) / (r_mid + r_max) < 1 for a flat histogram
 of r (a single pass), where r_in .. r_max is the range split at r_mid.
+
+The generation mode is the one an NPZ records (``mode_source`` "recorded"); a CSV records
+none, so it is inferred from that ratio (``mode_source`` "inferred"): "single" when it is
+near the flat-histogram value, "multi" when near 1, else "unknown" (too few rows, or a
+distribution that is neither, such as ``--unique-bitmaps``).
 """
 
 from __future__ import annotations
@@ -26,6 +33,11 @@ import numpy as np
 
 #: Centres drawn per scatter plot, at most (each is kept in memory until the plot).
 MAX_POINTS = 10**6
+#: The figure's raster resolution (print quality) and its formats.
+DPI = 300
+FORMATS = ("png", "svg", "pdf")
+#: Fewer rows than this: the mode is not inferred (the ratio's noise is too large).
+MIN_ROWS_TO_INFER = 1000
 
 HELP = "distribution of a data set: r histogram and centres in the BFV (Figures 8-11)"
 
@@ -58,6 +70,7 @@ class Summary:
     n: int
     m: int
     mode: str
+    mode_source: str  # "recorded" (the file's metadata), "inferred" (from r) or "unknown"
     r_min: float
     r_max: float
     r_mean: float
@@ -74,6 +87,7 @@ class Summary:
         "n",
         "m",
         "mode",
+        "mode_source",
         "r_min",
         "r_max",
         "r_mean",
@@ -158,12 +172,19 @@ def summarise(path: Path, label: str) -> Summary:
     a_in, a_out = mid**2 - lo**2, hi**2 - mid**2  # annulus areas, up to the BFV angle
     ratio = (outer / a_out) / (inner / a_in) if inner and a_in > 0 and a_out > 0 else math.nan
     has_g = scan.g_lo <= scan.g_hi
+    recorded = reader.params.get("mode")
+    if recorded in ("single", "multi"):
+        mode, source = str(recorded), "recorded"
+    else:
+        mode = infer_mode(float(ratio), lo, hi, scan.n)
+        source = "unknown" if mode == "unknown" else "inferred"
     return Summary(
         label,
         str(path),
         scan.n,
         reader.eyes.m,
-        str(reader.params.get("mode", "unknown")),
+        mode,
+        source,
         lo,
         hi,
         scan.r_sum / scan.n,
@@ -174,6 +195,24 @@ def summarise(path: Path, label: str) -> Summary:
         int(scan.hashes.size),
         float(ratio),
     )
+
+
+def infer_mode(ratio: float, r_lo: float, r_hi: float, n: int) -> str:
+    """ "single", "multi" or "unknown" from the outer/inner density ratio per area: a
+    single pass (r flat) gives (r_lo + r_mid) / (r_mid + r_hi), a multi-pass set (uniform
+    over the area) 1. The nearer one (in log ratio) when within 30 % of the distance
+    between the two; "unknown" otherwise or for fewer than :data:`MIN_ROWS_TO_INFER` rows."""
+    mid = 0.5 * (r_lo + r_hi)
+    flat = (r_lo + mid) / (mid + r_hi) if mid + r_hi > 0 else math.nan
+    if n < MIN_ROWS_TO_INFER or not (ratio > 0 and math.isfinite(ratio)) or not flat > 0:
+        return "unknown"
+    gap = abs(math.log(flat))
+    if gap < 0.1:  # a range too narrow to tell the two apart
+        return "unknown"
+    d_single, d_multi = abs(math.log(ratio / flat)), abs(math.log(ratio))
+    if min(d_single, d_multi) > 0.3 * gap:
+        return "unknown"
+    return "single" if d_single < d_multi else "multi"
 
 
 def _histogram_and_sample(path: Path, edges: np.ndarray, step: int):
@@ -190,7 +229,8 @@ def _histogram_and_sample(path: Path, edges: np.ndarray, step: int):
     return counts, np.concatenate(xs), np.concatenate(ys), reader.eyes
 
 
-def _plot(paths, summaries, bins: int, max_points: int, path: Path) -> None:
+def _plot(paths, summaries, bins: int, max_points: int, path: Path) -> list[Path]:
+    """The figure at ``path`` (.png, 300 dpi) and beside it as .svg and .pdf; the paths."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -230,7 +270,8 @@ def _plot(paths, summaries, bins: int, max_points: int, path: Path) -> None:
         ax.set_ylim(0, max(hmax, 1) * 1.18)
         ax.set_xlabel("distance r of the centre")
         ax.set_ylabel("elements per bin" if j == 0 else "")
-        ax.set_title(f"{s.label}\nn = {s.n:,}, mode: {s.mode}", fontsize=10)
+        how = "" if s.mode_source != "inferred" else " (inferred from r)"
+        ax.set_title(f"{s.label}\nn = {s.n:,}, mode: {s.mode}{how}", fontsize=10)
         ax.legend(fontsize=8, loc="upper left", frameon=False)
         ax.grid(axis="y", alpha=0.3)
 
@@ -258,10 +299,21 @@ def _plot(paths, summaries, bins: int, max_points: int, path: Path) -> None:
         )
     fig.suptitle("Data set distribution (paper Figures 8-11)", fontsize=12)
     fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
+    written = []
+    with matplotlib.rc_context(
+        {"svg.fonttype": "none", "pdf.fonttype": 42, "svg.hashsalt": "eyeviz"}
+    ):
+        for fmt in FORMATS:
+            buf = io.BytesIO()
+            meta = (
+                {"Date": None} if fmt == "svg" else {"CreationDate": None} if fmt == "pdf" else {}
+            )
+            fig.savefig(buf, format=fmt, dpi=DPI, metadata=meta)  # vectors: dpi for the scatter
+            target = path.with_suffix(f".{fmt}")
+            _write_atomic(target, buf.getvalue())
+            written.append(target)
     plt.close(fig)
-    _write_atomic(path, buf.getvalue())
+    return written
 
 
 def _write_atomic(path: Path, data: bytes) -> None:
@@ -277,18 +329,23 @@ def _markdown(summaries: list[Summary]) -> str:
         "",
         "![r histograms and centres](dataset.png)",
         "",
+        "Also as vectors: [dataset.svg](dataset.svg), [dataset.pdf](dataset.pdf).",
+        "",
         "| data set | n | m | mode | r range | mean r | g range | phi range (deg) "
         "| distinct bitmap pairs | outer/inner density per area |",
         "|---|---:|---:|---|---|---:|---|---|---:|---:|",
     ]
     for s in summaries:
         lines.append(
-            f"| {s.label} | {s.n:,} | {s.m} | {s.mode} | {s.r_min:.1f} - {s.r_max:.1f} "
+            f"| {s.label} | {s.n:,} | {s.m} | {_mode_cell(s)} | {s.r_min:.1f} - {s.r_max:.1f} "
             f"| {s.r_mean:.1f} | {s.g_min:.2f} - {s.g_max:.2f} "
             f"| {s.phi_min_deg:.1f} - {s.phi_max_deg:.1f} | {s.distinct_pairs:,} "
             f"| {s.area_density_ratio:.2f} |"
         )
     lines += [
+        "",
+        "The mode is the one an NPZ records; a CSV records none, so it is inferred from the "
+        "last column (marked *inferred*), or left unknown when that is neither value.",
         "",
         "The last column is the number of centres per unit BFV area in the outer half of "
         "the r range over that in the inner half: about 1 when centres are uniform over the "
@@ -297,6 +354,10 @@ def _markdown(summaries: list[Summary]) -> str:
         "",
     ]
     return "\n".join(lines)
+
+
+def _mode_cell(s: Summary) -> str:
+    return f"{s.mode} (*inferred*)" if s.mode_source == "inferred" else s.mode
 
 
 def run(args: argparse.Namespace) -> int:
@@ -314,7 +375,7 @@ def run(args: argparse.Namespace) -> int:
     summaries = [summarise(p, lab) for p, lab in zip(args.data, labels, strict=True)]
     out = args.output
     out.mkdir(parents=True, exist_ok=True)
-    _plot(args.data, summaries, bins, max_points, out / "dataset.png")
+    figures = _plot(args.data, summaries, bins, max_points, out / "dataset.png")
     _write_atomic(out / "dataset.md", _markdown(summaries).encode())
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
@@ -322,5 +383,5 @@ def run(args: argparse.Namespace) -> int:
     for s in summaries:
         w.writerow([getattr(s, f) for f in Summary.FIELDS])
     _write_atomic(out / "dataset.csv", buf.getvalue().encode())
-    print(f"wrote {out / 'dataset.png'}, {out / 'dataset.md'}, {out / 'dataset.csv'}")
+    print("wrote " + ", ".join(str(p) for p in [*figures, out / "dataset.md", out / "dataset.csv"]))
     return 0

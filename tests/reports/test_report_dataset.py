@@ -44,18 +44,30 @@ def test_report_side_by_side(files, tmp_path):
     assert res.returncode == 0, res.stderr
     png = (out / "dataset.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 50_000
+    # 300 dpi (was 110): the pHYs chunk holds pixels per metre
+    phys = png.index(b"pHYs")
+    ppm = int.from_bytes(png[phys + 4 : phys + 8], "big")
+    assert round(ppm * 0.0254) == 300
+    # and as vectors, text kept as text
+    svg = (out / "dataset.svg").read_text()
+    assert svg.lstrip().startswith("<?xml") and "<text" in svg and "Data set distribution" in svg
+    assert (out / "dataset.pdf").read_bytes()[:5] == b"%PDF-"
+    assert "dataset.svg" in res.stdout and "dataset.pdf" in res.stdout
     with open(out / "dataset.csv") as f:
         rows = list(csv.DictReader(f))
     assert [r["label"] for r in rows] == ["one pass", "multi-pass"]
     single, multi = rows
     assert single["mode"] == "single" and int(single["n"]) == 20000
-    assert multi["mode"] == "unknown"  # a CSV does not record how it was made
+    assert single["mode_source"] == "recorded"
+    # a CSV does not record how it was made: inferred from r ("unknown" before)
+    assert (multi["mode"], multi["mode_source"]) == ("multi", "inferred")
     # one pass: flat in r, so the density per area halves from inner to outer half
     assert float(single["area_density_ratio"]) == pytest.approx(0.5, abs=0.05)
     # multi-pass: uniform over the BFV area
     assert float(multi["area_density_ratio"]) == pytest.approx(1.0, abs=0.05)
     md = (out / "dataset.md").read_text()
     assert "![r histograms and centres](dataset.png)" in md and "| multi-pass | 20,000 |" in md
+    assert "| multi (*inferred*) |" in md
     assert not [p for p in out.iterdir() if p.name.endswith(".part")]
 
 
@@ -124,3 +136,30 @@ def test_bins_and_points_are_bounded(files, tmp_path, flag, value, match):
     )
     assert res.returncode == 2 and match in res.stderr, res.stderr
     assert len(res.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("ratio", "n", "want"),
+    [
+        (0.5, 20000, "single"),  # 1000..5000: flat r gives (1000 + 3000) / (3000 + 5000)
+        (0.56, 20000, "single"),
+        (1.0, 20000, "multi"),
+        (0.93, 20000, "multi"),
+        (0.7, 20000, "unknown"),  # neither
+        (0.3, 20000, "unknown"),  # fewer far rows than a single pass (--unique-bitmaps)
+        (1.0, 500, "unknown"),  # too few rows
+        (float("nan"), 20000, "unknown"),
+    ],
+)
+def test_infer_mode(ratio, n, want):
+    from eyeviz.reports.dataset import infer_mode
+
+    assert infer_mode(ratio, 1000.0, 5000.0, n) == want
+
+
+def test_a_single_pass_csv_is_inferred_single(tmp_path):
+    from eyeviz.reports.dataset import summarise
+
+    D.write(tmp_path / "s.csv", 20000, seed=3)
+    s = summarise(tmp_path / "s.csv", "s")
+    assert (s.mode, s.mode_source) == ("single", "inferred")
