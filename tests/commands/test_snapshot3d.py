@@ -12,7 +12,7 @@ from pathlib import Path
 import matplotlib.image as mpimg
 import numpy as np
 import pytest
-from matplotlib.collections import PolyCollection
+from matplotlib.collections import PathCollection, PolyCollection
 
 from eyeviz.cli import main
 from eyeviz.core import healpix
@@ -45,12 +45,13 @@ def test_snapshot3d_written_and_opened(name, fmt, tmp_path, capsys):
     args = ["snapshot", str(SCENES / f"{name}.toml"), "-o", str(out)]
     assert main(args + (["--scale", "0.5"] if fmt == "png" else [])) == 0
     assert capsys.readouterr().out.strip() == str(out)
-    if fmt == "png":
+    if fmt == "png":  # the app's 3D view rendered off-screen (render_png3d)
         img = mpimg.imread(out)
-        assert img.shape[1] == 525 and img.shape[0] > img.shape[1]  # 3.5 in at 150 dpi
-        # not blank: the lit facets' colours are in it (the first ball's, #D55E00)
+        assert img.shape[:2] == (295, 525)  # 3.5 in at 150 dpi, 9/16 of that high
+        # not blank: the first ball's colour (#D55E00: the ball, its lit facets) is in it
         rgb = (img[..., :3] * 255).round().astype(int).reshape(-1, 3)
-        assert (np.abs(rgb - [0xD5, 0x5E, 0x00]).sum(axis=1) < 30).sum() > 20
+        assert (np.abs(rgb - [0xD5, 0x5E, 0x00]).sum(axis=1) < 60).sum() > 20
+        assert len(np.unique(rgb, axis=0)) > 100
     elif fmt == "svg":
         root = ET.parse(out).getroot()
         assert root.tag == f"{SVG}svg"
@@ -114,10 +115,19 @@ def test_snapshot3d_imports_no_vtk_qt_or_torch(tmp_path):
     )
     out = subprocess.run(
         [sys.executable, "-c", probe, "snapshot", str(SCENES / "sphere_teaching.toml"),
-         "-o", str(tmp_path / "t.png"), "--scale", "0.25"],
+         "-o", str(tmp_path / "t.svg")],
         capture_output=True, text=True, timeout=120, cwd=ROOT,
     )  # fmt: skip
     assert json.loads(out.stdout.strip().splitlines()[-1]) == {"rc": 0, "heavy": []}, out.stderr
+    # the PNG is VTK's off-screen render of the 3D view: still no Qt and no torch
+    out = subprocess.run(
+        [sys.executable, "-c", probe, "snapshot", str(SCENES / "sphere_teaching.toml"),
+         "-o", str(tmp_path / "t.png"), "--scale", "0.25"],
+        capture_output=True, text=True, timeout=120, cwd=ROOT,
+    )  # fmt: skip
+    res = json.loads(out.stdout.strip().splitlines()[-1])
+    assert res["rc"] == 0 and "PyQt5" not in res["heavy"] and "torch" not in res["heavy"]
+    assert "pyvista" in res["heavy"]
 
 
 def _maps(fig):
@@ -146,10 +156,18 @@ def test_maps_draw_the_lit_facets_in_their_colours():
     st = compute_state3d(sc)
     axes = _maps(figure3d(sc, table=False))
     for eye in "AB":
-        back, coll = [c for c in axes[f"map{eye}"].collections if isinstance(c, PolyCollection)]
+        back, coll = [
+            c
+            for c in axes[f"map{eye}"].collections
+            if isinstance(c, PolyCollection | PathCollection)
+        ]
         assert len(back.get_paths()) == 1  # the unlit sphere, one solid outline
         lit = np.unique(np.concatenate([st.lit(i, eye) for i in range(st.n)]))
-        assert len(coll.get_paths()) == lit.size  # no facet of these balls crosses the edge
+        # one compound path per ball colour, a closed polygon per lit facet (no facet of
+        # these balls crosses the map's edge)
+        assert len(coll.get_paths()) == len(sc.features)
+        subpaths = sum(int((p.codes == p.MOVETO).sum()) for p in coll.get_paths())
+        assert subpaths == lit.size
         assert lit.size < 2000 < healpix.npix(180)
     assert "readout" not in axes
 
@@ -203,9 +221,10 @@ def test_app_takes_a_spherical_scene_to_the_display_check(capsys, monkeypatch):
 def test_transparent_export_keeps_the_unlit_sphere(tmp_path, capsys):
     """At nside 180 the unlit sphere is an artist, not the axes' background (which a
     transparent export empties): the map's centre stays opaque grey, its corner clear."""
-    out = tmp_path / "t.png"
-    args = ["snapshot", str(SCENES / "sphere_paper.toml"), "-o", str(out), "--scale", "0.25"]
-    assert main(args + ["--transparent", "--no-table"]) == 0
+    from eyeviz.render.mpl.figure3d import export3d
+
+    out = tmp_path / "t.png"  # the figure's PNG (the snapshot command's PNG is the 3D view)
+    export3d(load(SCENES / "sphere_paper.toml"), out, scale=0.25, transparent=True, table=False)
     img = mpimg.imread(out)
     fig = figure3d(load(SCENES / "sphere_paper.toml"), table=False)
     box = _maps(fig)["mapA"].get_position()  # figure fractions, origin at the bottom

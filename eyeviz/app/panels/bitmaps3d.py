@@ -31,7 +31,6 @@ from matplotlib.collections import PathCollection, PolyCollection
 from matplotlib.colors import to_rgba_array
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
-from matplotlib.path import Path
 from PyQt5 import QtCore, QtWidgets
 
 from eyeviz.app.panels.common import wrap_label
@@ -40,6 +39,7 @@ from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.mpl.healpix_map import (
     MAX_ALL_FACETS,
+    compound_path,
     mollweide,
     pixel_at,
     view_lonlat,
@@ -119,17 +119,7 @@ def _by_ball(verts: np.ndarray, owner: np.ndarray, rgba: np.ndarray):
         return [], np.zeros((0, 4))
     order = np.argsort(owner, kind="stable")
     groups = np.split(order, np.flatnonzero(np.diff(owner[order])) + 1)
-    return [_compound(verts[g]) for g in groups], rgba[[int(owner[g[0]]) for g in groups]]
-
-
-def _compound(verts: np.ndarray) -> Path:
-    """One path of many closed polygons (k, n, 2): a single artist path to draw, not k."""
-    k, n = verts.shape[:2]
-    closed = np.concatenate([verts, verts[:, :1]], axis=1).reshape(-1, 2)
-    codes = np.full((k, n + 1), Path.LINETO, dtype=Path.code_type)
-    codes[:, 0] = Path.MOVETO
-    codes[:, -1] = Path.CLOSEPOLY
-    return Path(closed, codes.ravel())
+    return [compound_path(verts[g]) for g in groups], rgba[[int(owner[g[0]]) for g in groups]]
 
 
 def _ellipse(n: int = 181) -> np.ndarray:

@@ -9,8 +9,9 @@ where the VTK render puts them) into normalised device coordinates, [-1, 1] acro
 part. The geometry is :mod:`eyeviz.model.shapes3d`'s, the arrays the VTK painters draw:
 
 - the eyes' facets (layer "eyes"): up to nside ``FULL_MAX_NSIDE`` every facet, else the
-  unlit sphere at nside 16 and the lit facets at the scene's nside over it; lit facets in
-  their ball's colour (a later ball wins);
+  unlit sphere at nside 16 (at nside 4 where an eye is drawn a few pixels wide) and the
+  lit facets at the scene's nside over it; lit facets in their ball's colour (a later
+  ball wins);
 - the balls (layer "features"), spheres in their colours, named (layer "labels");
 - the tangent cones from each eye centre to each ball (layer "tangents"), translucent,
   from the eye's surface on (the VTK cone starts at the centre, hidden by the eye), in
@@ -78,6 +79,9 @@ BALL_LIGHT = (0.35, 0.7)
 BALL_NSIDE = 4
 CONE_RES = 32  # points around a tangent cone
 CONE_BANDS = 8  # pieces along it
+#: An eye whose radius is drawn below this fraction of the view's half height (a few
+#: pixels) has its unlit sphere drawn at nside 4: the file stays small, the picture alike.
+SMALL_EYE = 0.04
 #: Layers the view draws (the others are drawn elsewhere or not at all).
 VIEW_LAYERS = ("eyes", "features", "tangents", "plane", "bfv")
 
@@ -132,15 +136,21 @@ def _reach(state: SceneState3D) -> float:
     return 1.1 * shapes3d.scene_extent(state)
 
 
-def _eye_batches(state: SceneState3D, scene: Scene) -> list[_Batch]:
+def _eye_batches(state: SceneState3D, scene: Scene, cam: Camera3D) -> list[_Batch]:
+    """Each eye's facets (see the module docstring); an eye drawn smaller than
+    :data:`SMALL_EYE` (its radius, a fraction of the view's half height) has its unlit
+    sphere drawn at nside 4 under its lit facets, which keep the scene's nside."""
     pair = state.pair
     n = pair.nside
     colors = to_rgba_array([f.color for f in scene.features]) if scene.features else None
+    half = math.tan(math.radians(cam.view_angle) / 2.0)
     out = []
     for e, cx in enumerate((-pair.h, pair.h)):
         c = np.array([cx, 0.0, 0.0])
         own = shapes3d.facet_owner(state, "AB"[e])
-        if n <= shapes3d.FULL_MAX_NSIDE:  # every facet, coloured by its owner
+        dist = float(np.linalg.norm(np.asarray(cam.position) - c))
+        small = pair.l < SMALL_EYE * dist * half
+        if n <= shapes3d.FULL_MAX_NSIDE and not small:  # every facet, by its owner
             pts = c + pair.l * healpix.boundaries(n, np.arange(pair.npix), shapes3d.edge_step(n))
             face = np.tile(np.asarray(UNLIT_RGBA), (pts.shape[0], 1))
             lit = own >= 0
@@ -152,7 +162,7 @@ def _eye_batches(state: SceneState3D, scene: Scene) -> list[_Batch]:
                        width=0.25 if edged else 0.05, light=EYE_LIGHT)
             )  # fmt: skip
             continue
-        vn = shapes3d.view_nside(n)
+        vn = 4 if small else shapes3d.view_nside(n)
         pts = c + pair.l * healpix.boundaries(vn, np.arange(healpix.npix(vn)), 2)
         out.append(_Batch(pts, UNLIT_RGBA, "eye", centre=c, width=0.05, light=EYE_LIGHT))
         pix = np.flatnonzero(own >= 0)
@@ -270,7 +280,7 @@ def scene_polygons(
     if "plane" in shown and part == "scene":
         batches += _plane(state)[0]
     if "eyes" in shown and state.lit_a is not None:
-        batches += _eye_batches(state, scene)
+        batches += _eye_batches(state, scene, cam)
     if "features" in shown and part == "scene":
         batches += _ball_batches(scene)
     if "tangents" in shown:
