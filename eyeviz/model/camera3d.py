@@ -75,7 +75,16 @@ def _look(
     )
 
 
-def preset(name: str, h: float, l: float, extent: float, aspect: float = 1.0) -> Camera3D:
+def preset(
+    name: str,
+    h: float,
+    l: float,
+    extent: float,
+    aspect: float = 1.0,
+    *,
+    centre: Vec3 | None = None,
+    radius: float | None = None,
+) -> Camera3D:
     """A named view of a scene with eyes ``h``, ``l`` whose features reach ``extent``.
 
     ``extent`` is the size of the region to show ahead of the eyes: the whole-scene
@@ -90,7 +99,8 @@ def preset(name: str, h: float, l: float, extent: float, aspect: float = 1.0) ->
     - ``"eye_a"``, ``"eye_b"``: along the eye's forward axis (the line through its
       centre parallel to y), looking back at that eye from ahead.
 
-    ``aspect`` (the viewport's width / height) narrows the fit for a tall viewport.
+    ``aspect`` (the viewport's width / height) narrows the fit for a tall viewport;
+    ``centre`` and ``radius`` (a ball the scene lies in) replace the ball ``extent`` gives.
     """
     name = check_choice("view", name, PRESETS)
     h = check_real("h", h, gt=0.0)
@@ -98,7 +108,9 @@ def preset(name: str, h: float, l: float, extent: float, aspect: float = 1.0) ->
     extent = check_real("extent", extent, gt=0.0)
     aspect = check_real("aspect", aspect, gt=0.0)
     direction, up = _DIRS[name]
-    radius = max(0.6 * extent, h + l)
+    if radius is None:
+        radius = max(0.6 * extent, h + l)
+    radius = check_real("radius", radius, gt=0.0)
     half = math.radians(30.0) / 2.0
     half = min(half, math.atan(math.tan(half) * aspect))
     dist = radius / math.sin(half)
@@ -106,7 +118,7 @@ def preset(name: str, h: float, l: float, extent: float, aspect: float = 1.0) ->
         focal = np.array([-h if name == "eye_a" else h, 0.0, 0.0])
         dist += extent / 2.0
     else:
-        focal = np.array([0.0, extent / 2.0, 0.0])
+        focal = np.array([0.0, extent / 2.0, 0.0] if centre is None else centre, dtype=float)
     return _look(focal, direction, up, dist, 30.0)
 
 

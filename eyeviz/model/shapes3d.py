@@ -25,6 +25,7 @@ __all__ = [
     "facet_mesh",
     "facet_owner",
     "plane_z0",
+    "bounding_ball",
     "scene_extent",
     "shorten_cones",
     "tangent_cone",
@@ -183,6 +184,26 @@ def plane_z0(
     ys = np.linspace(y0, y1, lines + 1)
     seg = [((x, y0, 0.0), (x, y1, 0.0)) for x in xs] + [((x0, y, 0.0), (x1, y, 0.0)) for y in ys]
     return corners, np.asarray(seg, dtype=np.float64)
+
+
+def bounding_ball(state: SceneState3D) -> tuple[tuple[float, float, float], float]:
+    """(centre, radius) of a ball holding the eyes and every ball of the scene: the centre
+    of their bounding box and the largest distance from it (what the presets frame)."""
+    pair = state.pair
+    r = pair.h + pair.l
+    lo = np.array([-r, -pair.l, -pair.l])
+    hi = -lo
+    if state.n:
+        c = np.column_stack([state.x, state.y, state.z])
+        lo = np.minimum(lo, (c - state.g[:, None]).min(axis=0))
+        hi = np.maximum(hi, (c + state.g[:, None]).max(axis=0))
+    mid = (lo + hi) / 2.0
+    # the eyes' box's farthest corner from mid
+    rad = float(np.linalg.norm(np.abs(mid) + np.array([r, pair.l, pair.l])))
+    if state.n:
+        d = np.linalg.norm(c - mid, axis=1) + state.g
+        rad = max(rad, float(d.max()))
+    return (float(mid[0]), float(mid[1]), float(mid[2])), rad
 
 
 def scene_extent(state: SceneState3D) -> float:

@@ -50,10 +50,12 @@ from eyeviz.render.vtk.style import BACKGROUND, INK, INSET_BACKGROUND, UNLIT, he
 
 __all__ = [
     "EYES_FRACTION",
+    "PNG_ASPECT",
     "Scene3DActors",
     "apply_camera",
     "camera_of",
     "default_camera",
+    "png_size",
     "render_png3d",
     "split_viewports",
 ]
@@ -107,7 +109,9 @@ def default_camera(state: SceneState3D, name: str = "default", aspect: float = 1
     """The preset ``name`` framing the scene's balls (:func:`shapes3d.scene_extent`) in a
     viewport ``aspect`` (width / height) wide."""
     pair = state.pair
-    return preset(name, pair.h, pair.l, shapes3d.scene_extent(state), aspect)
+    centre, radius = shapes3d.bounding_ball(state)
+    ext = shapes3d.scene_extent(state)
+    return preset(name, pair.h, pair.l, ext, aspect, centre=centre, radius=radius)
 
 
 def _great_circles(r: float, n: int = 96) -> pv.PolyData:
@@ -234,7 +238,7 @@ class Scene3DActors:
         pts, faces = shapes3d.bfv_cones(pair.h, pair.l, reach)
         self.bfv_actor = actor(pv.PolyData(pts, faces), BFV_RGB)
         self.bfv_actor.GetProperty().SetOpacity(BFV_OPACITY)
-        self._add(self.eye_store, self.bfv_actor)
+        self._add(self.eye_store, self.bfv_actor, eyes=False)
         corners, segs = shapes3d.plane_z0(-reach * 0.8, reach * 0.8, -0.2 * reach, reach)
         quad = pv.PolyData(corners, np.array([4, 0, 1, 2, 3]))
         fill = actor(quad, PLANE_RGB)
@@ -431,6 +435,25 @@ def layout(scene_ren: vtkRenderer, eyes_ren: vtkRenderer, w: float, h: float) ->
     scene_ren.SetViewport(*right)
 
 
+#: A PNG's height / width when none is given (the app's window is about as wide).
+PNG_ASPECT = 9.0 / 16.0
+
+
+def png_size(width_px: float, aspect: float | None = None) -> tuple[int, int]:
+    """(width, height) pixels of a PNG ``width_px`` wide, ``aspect`` (height / width,
+    default :data:`PNG_ASPECT`) high; EyevizError (one line) beyond 64 ... 8192 pixels."""
+    from eyeviz import EyevizError
+
+    a = PNG_ASPECT if aspect is None else float(aspect)
+    w, h = int(round(width_px)), int(round(width_px * a))
+    if not (64 <= w <= 8192 and 64 <= h <= 8192):
+        raise EyevizError(
+            f"a 3D PNG must be 64 to 8192 pixels wide and high, got {w} x {h} "
+            "(change --scale, --width or --aspect)"
+        )
+    return w, h
+
+
 def render_png3d(
     scene: Scene,
     path: str | os.PathLike,
@@ -440,10 +463,11 @@ def render_png3d(
     *,
     state: SceneState3D | None = None,
     selected: int | None = None,
+    transparent: bool = False,
 ) -> Path:
     """Render a spherical scene off-screen (no display: EGL) to a PNG at ``camera`` (the
     default preset framing the balls when None), ``width`` x ``height`` pixels, written
-    atomically; the same picture as the app's 3D view."""
+    atomically; the same picture as the app's 3D view (``transparent``: no background)."""
     from eyeviz import EyevizError
     from eyeviz.core.validation import check_int
 
@@ -472,7 +496,7 @@ def render_png3d(
             camera = default_camera(st, aspect=(1.0 - left[2]) * width / height)
         actors.set_cameras(camera)
         main.camera.is_set = True  # else pyvista's first render resets it (an isometric fit)
-        img = pl.screenshot(return_img=True)
+        img = pl.screenshot(return_img=True, transparent_background=transparent)
     finally:
         pl.close()
     from PIL import Image
