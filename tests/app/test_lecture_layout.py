@@ -152,3 +152,29 @@ def test_the_paper_estimators_message_names_the_folders_it_searched(
     assert "~/.cache/eyeviz/models/paper)" in note
     assert "looked in eyeviz/assets/models/paper, ~/.local/share/eyeviz/" in row
     assert str(tmp_path) not in note + row  # no local path: the home folder is ~
+
+
+def test_three_estimators_fit_the_readout_uncut_at_1280x720(make_window, qtbot):
+    from eyeviz.model.scene import Eyes, Feature, Scene, View
+
+    # far from the training range: four-digit errors, the longest lines the readout shows
+    sc = Scene(
+        Eyes(40.0, 20.0, 720),
+        [Feature("target", 400.0, 700.0, 30.0)],
+        ["eyes", "bfv", "features", "readout", "predictions"],
+        estimators=["analytic", "limit", "compact"],
+        view=View((0.0, 2300.0), 7000.0),
+    )
+    win = make_window(sc)
+    win.resize(1280, 720)
+    qtbot.waitUntil(lambda: win.width() == 1280, timeout=3000)
+    win.jobs.wait()
+    win.model.select(0)
+    qtbot.wait(50)
+    rows = [v for k, v in win.readout._rows if v.isVisible()]
+    texts = [v.text() for v in rows]
+    assert any("Δr" in t for t in texts)
+    for v in rows:
+        fm = v.fontMetrics()
+        for line in v.text().split("\n"):
+            assert fm.horizontalAdvance(line) <= v.width(), line  # never elided

@@ -30,9 +30,12 @@ def range_note(model: AppModel, name: str, r: float, g: float) -> str | None:
     d = getattr(est, "domain", None)
     if d is None or isinstance(est, str):
         return None
-    if not d.r_min <= r <= d.r_max or g > d.g_max:
-        return f"outside its range: r in [{d.r_min:g}, {d.r_max:g}], g <= {d.g_max:g}"
-    return None
+    out = []  # short lines: each fits the narrowest readout (issue 24)
+    if not d.r_min <= r <= d.r_max:
+        out.append(f"r outside [{d.r_min:g}, {d.r_max:g}]")
+    if g > d.g_max:
+        out.append(f"g above its {d.g_max:g}")
+    return "\n".join(out) or None
 
 
 def design_skips(model: AppModel) -> set[str]:

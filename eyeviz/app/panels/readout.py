@@ -254,9 +254,12 @@ class ReadoutPanel(QtWidgets.QWidget):
                 rows.append((f"pred:{name}", key, "no answer for these bitmaps", GREY))
                 continue
             dr, pct, dphi = errors(float(r[i]), float(phi[i]), r_hat, phi_hat)
+            # compact: each line fits the narrowest side panel with a 4-digit error (issue 24)
+            rd = 1 if abs(r_hat) < 1000 else 0  # a decimal fewer from four digits on
+            dd = 1 if abs(dr) < 1000 else 0
             text = (
-                f"r {r_hat:.1f}   Δr {dr:+.1f} ({pct:+.2f} %)\n"
-                f"φ {math.degrees(phi_hat):.2f}°   Δφ {dphi:+.3f}°"
+                f"r {r_hat:.{rd}f}  Δr {dr:+.{dd}f} ({pct:+.1f} %)\n"
+                f"φ {math.degrees(phi_hat):.2f}°  Δφ {dphi:+.3f}°"
             )
             out = range_note(self.model, name, float(r[i]), float(f_g(sc, i)))
             if out is not None:
