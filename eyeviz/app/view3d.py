@@ -26,7 +26,7 @@ from __future__ import annotations
 import os
 from collections.abc import Generator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from PyQt5 import QtCore, QtWidgets
 
@@ -48,7 +48,6 @@ from eyeviz.render.vtk.scene3d import (
 
 if TYPE_CHECKING:
     from eyeviz.app.view import _Frames
-    from eyeviz.app.window import MainWindow
 
 __all__ = ["PRESET_KEYS", "Scene3DCommand", "Scene3DHost"]
 
@@ -94,9 +93,11 @@ class Scene3DHost(QtCore.QObject):
     """The window's 3D page: the view widget, its actors and model, the 3D docks, the
     View > 3D view menu. Built on the first spherical scene; ``active`` while shown."""
 
-    def __init__(self, win: MainWindow, split: QtWidgets.QSplitter) -> None:
+    def __init__(self, win: QtWidgets.QMainWindow, split: QtWidgets.QSplitter) -> None:
         super().__init__(win)
-        self.win = win
+        # the MainWindow (its plotter, bitmaps, undo_stack, jobs, show_error); typed
+        # loosely: this module is imported by the window (no import cycle)
+        self.win: Any = win
         self.split = split
         self.active = False
         self.model: m3.AppModel3D | None = None
@@ -474,8 +475,6 @@ class Scene3DHost(QtCore.QObject):
         """File > Export of a spherical scene: PNG from an off-screen VTK render at the
         view's camera (:func:`render_png3d`), SVG/PDF the vector figure
         (:func:`eyeviz.render.mpl.figure3d.export3d`), on a worker thread."""
-        import inspect
-
         from eyeviz import EyevizError
         from eyeviz.app.panels import user_message
         from eyeviz.render.mpl.figure3d import export3d
@@ -498,9 +497,6 @@ class Scene3DHost(QtCore.QObject):
                 return render_png3d(scene, path, cam, px_w, px_h)
 
         else:
-            kw = {}
-            if "camera" in inspect.signature(export3d).parameters:
-                kw["camera"] = cam
 
             def work():
                 return export3d(
@@ -512,7 +508,7 @@ class Scene3DHost(QtCore.QObject):
                     title=title,
                     table=table,
                     bitmaps=bitmaps,
-                    **kw,
+                    camera=cam,
                 )
 
         def done(out) -> None:

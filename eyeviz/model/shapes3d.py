@@ -15,6 +15,7 @@ from functools import lru_cache
 import numpy as np
 
 from eyeviz.core import healpix
+from eyeviz.model.camera3d import Camera3D, preset
 from eyeviz.model.state3d import SceneState3D
 
 __all__ = [
@@ -27,6 +28,7 @@ __all__ = [
     "plane_z0",
     "bounding_ball",
     "scene_extent",
+    "view_camera",
     "shorten_cones",
     "tangent_cone",
     "view_nside",
@@ -215,3 +217,12 @@ def scene_extent(state: SceneState3D) -> float:
         return lo
     reach = np.sqrt(state.x**2 + state.y**2 + state.z**2) + state.g
     return float(max(lo, reach.max()))
+
+
+def view_camera(state: SceneState3D, name: str = "default", aspect: float = 1.0) -> Camera3D:
+    """The preset ``name`` (:func:`eyeviz.model.camera3d.preset`) framing the eyes and the
+    balls (:func:`bounding_ball`) in a viewport ``aspect`` (width / height) wide: the 3D
+    view's camera when a scene opens, its PNG's and its vector figure's by default."""
+    pair = state.pair
+    centre, radius = bounding_ball(state)
+    return preset(name, pair.h, pair.l, scene_extent(state), aspect, centre=centre, radius=radius)

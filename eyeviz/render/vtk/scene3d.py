@@ -34,7 +34,7 @@ from vtkmodules.vtkRenderingCore import vtkActor, vtkRenderer
 
 from eyeviz.files.atomic import atomic_output
 from eyeviz.model import shapes3d
-from eyeviz.model.camera3d import Camera3D, eyes_camera, preset
+from eyeviz.model.camera3d import Camera3D, eyes_camera
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
 from eyeviz.render.vtk.primitives import (
@@ -108,10 +108,7 @@ def camera_of(ren: vtkRenderer) -> Camera3D:
 def default_camera(state: SceneState3D, name: str = "default", aspect: float = 1.0) -> Camera3D:
     """The preset ``name`` framing the scene's balls (:func:`shapes3d.scene_extent`) in a
     viewport ``aspect`` (width / height) wide."""
-    pair = state.pair
-    centre, radius = shapes3d.bounding_ball(state)
-    ext = shapes3d.scene_extent(state)
-    return preset(name, pair.h, pair.l, ext, aspect, centre=centre, radius=radius)
+    return shapes3d.view_camera(state, name, aspect)
 
 
 def _great_circles(r: float, n: int = 96) -> pv.PolyData:
