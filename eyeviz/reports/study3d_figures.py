@@ -84,8 +84,8 @@ def design_figure(designs: dict, l_of: dict, h_star: float, estimator: str):
     from matplotlib.ticker import FuncFormatter, NullFormatter
 
     ls_star = sorted({k[1] for k in designs if k[0] == h_star})
-    for col, ticks in enumerate((hs, ls_star, ns)):
-        for ax in axes[:, col]:
+    for j, ticks in enumerate((hs, ls_star, ns)):
+        for ax in axes[:, j]:
             ax.set_xticks(ticks)
             ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
             ax.xaxis.set_minor_formatter(NullFormatter())
