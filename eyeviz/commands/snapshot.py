@@ -60,6 +60,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "table rows and label lanes grow to match; default: the figure's own sizes (6 pt "
         "smallest)",
     )
+    parser.add_argument(
+        "--view",
+        default="default",
+        metavar="V",
+        help="spherical scenes: the 3D view's camera preset, one of default, front, top, side, "
+        "eye_a, eye_b, framing the balls; default: default",
+    )
     parser.add_argument("--no-title", action="store_true", help="leave the title out")
     parser.add_argument("--no-table", action="store_true", help="leave the readout table out")
     parser.add_argument("--no-bitmaps", action="store_true", help="leave the bitmap strips out")
@@ -79,14 +86,27 @@ def run(args: argparse.Namespace) -> int:
     aspect = resolve_aspect(args.aspect, width)
     min_font = None if args.min_font is None else check_min_font(args.min_font)
     sc = scene_mod.load(args.scene)
+    if sc.kind == "spherical":
+        from eyeviz.core.validation import check_choice
+        from eyeviz.model.camera3d import PRESETS
+
+        check_choice("view", args.view, PRESETS)
+    elif args.view != "default":
+        from eyeviz import EyevizError
+
+        raise EyevizError("view: a planar scene has one view (--view is for spherical scenes)")
     if sc.kind == "spherical" and format_of(args.output) == "png":  # the 3D view, by VTK
+        from eyeviz.model.state3d import compute_state3d
         from eyeviz.render.mpl.figure3d import check_drawable3d
         from eyeviz.render.mpl.style import BASE_DPI
-        from eyeviz.render.vtk.scene3d import png_size, render_png3d
+        from eyeviz.render.vtk.scene3d import default_camera, png_size, render_png3d
 
         check_drawable3d(sc)
         px_w, px_h = png_size(width * BASE_DPI * args.scale, args.aspect)
-        print(render_png3d(sc, args.output, None, px_w, px_h, transparent=args.transparent))
+        st = compute_state3d(sc)
+        cam = default_camera(st, args.view)
+        png = render_png3d(sc, args.output, cam, px_w, px_h, state=st, transparent=args.transparent)
+        print(png)
         return 0
     if sc.kind == "spherical":  # HEALPix eyes: maps, table and perspective (figure3d)
         from eyeviz import EyevizError
@@ -109,6 +129,7 @@ def run(args: argparse.Namespace) -> int:
                 table=not args.no_table,
                 bitmaps=not args.no_bitmaps,
                 aspect=None if args.aspect is None else aspect,
+                view=args.view,
             )
         print(out)
         return 0

@@ -233,3 +233,32 @@ def test_transparent_export_keeps_the_unlit_sphere(tmp_path, capsys):
     y = int((1 - (box.y0 + 0.55 * box.height)) * h)
     assert img[y, x, 3] == 1.0 and np.allclose(img[y, x, :3], 0xEE / 255, atol=0.02)
     assert img[int((1 - box.y1) * h) + 1, int(box.x0 * w) + 1, 3] == 0.0  # outside the map
+
+
+def test_snapshot3d_view_presets(tmp_path, capsys):
+    """--view picks the 3D view's camera preset (vector and PNG); a bad name or a planar
+    scene is refused in one line naming --view, before anything is written."""
+    teaching = str(SCENES / "sphere_teaching.toml")
+    paths = {}
+    for view in ("default", "top"):
+        out = tmp_path / f"{view}.svg"
+        assert main(["snapshot", teaching, "-o", str(out), "--view", view, "--no-table"]) == 0
+        paths[view] = out.read_text()
+    capsys.readouterr()
+    assert paths["default"] != paths["top"]
+    assert "seen from above" in paths["top"] and "seen from front, right, above" in paths["default"]
+    pngs = []
+    for view in ("front", "side"):
+        out = tmp_path / f"{view}.png"
+        assert main(["snapshot", teaching, "-o", str(out), "--view", view, "--scale", "0.3"]) == 0
+        pngs.append(mpimg.imread(out))
+    assert pngs[0].shape == pngs[1].shape and not np.array_equal(pngs[0], pngs[1])
+    capsys.readouterr()
+    for args in (
+        [teaching, "--view", "below"],
+        [str(SCENES / "default.toml"), "--view", "top"],
+    ):
+        out = tmp_path / "bad.svg"
+        assert main(["snapshot", args[0], "-o", str(out), *args[1:]]) == 2
+        assert "view" in _one_line_error(capsys)
+        assert not out.exists()

@@ -33,8 +33,9 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from eyeviz import EyevizError
+from eyeviz.core.validation import check_choice
 from eyeviz.files.atomic import atomic_output
-from eyeviz.model.camera3d import Camera3D
+from eyeviz.model.camera3d import PRESETS, Camera3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
 from eyeviz.render.mpl.healpix_map import MapAxes, draw_eye_view, view_lonlat
@@ -181,12 +182,13 @@ def figure3d(
     bitmaps: bool = True,
     aspect: float | None = None,
     camera: Camera3D | None = None,
+    view: str = "default",
 ) -> Figure:
     """The spherical scene as a Figure ``width`` inches wide (see the module docstring).
     ``title``, ``table`` and ``bitmaps`` (False) leave those parts out; ``aspect`` is the
     3D view's height / width (default 0.6; 0.38 from 6 inches wide, where the two maps
-    stand side by side); ``camera`` is the view's (default: the ``default`` preset framing
-    the balls)."""
+    stand side by side); ``camera`` is the view's (default: the preset ``view``, one of
+    :data:`eyeviz.model.camera3d.PRESETS`, framing the balls)."""
     import matplotlib
 
     if scene.kind != "spherical":
@@ -231,7 +233,7 @@ def figure3d(
                     va="center", fontsize=FONT + 1, color=INK, gid="title",
                 )  # fmt: skip
             elif name == "persp":
-                cam = default_camera(st) if camera is None else camera
+                cam = default_camera(st, view) if camera is None else camera
                 _draw_view(fig, rect(m, width - 2 * m, h), st, scene, cam)
             elif name in ("maps", "mapA", "mapB"):
                 eyes = "AB" if name == "maps" else name[-1]
@@ -301,8 +303,10 @@ def export3d(
     bitmaps: bool = True,
     aspect: float | None = None,
     camera: Camera3D | None = None,
+    view: str = "default",
 ) -> Path:
-    """Write the spherical scene's figure (:func:`figure3d`, through ``camera``) to
+    """Write the spherical scene's figure (:func:`figure3d`, through ``camera`` or the
+    preset ``view``) to
     ``path`` (.png, .svg or .pdf) atomically, as :func:`eyeviz.render.mpl.export.export`
     writes a planar one."""
     import matplotlib
@@ -311,6 +315,7 @@ def export3d(
 
     fmt = format_of(path)
     scale = _check_scale(scale)
+    check_choice("view", view, PRESETS)
     if fmt == "png" and width * BASE_DPI * scale > MAX_PNG_PX:
         raise EyevizError(
             f"scale {scale:g} at width {width:g} in makes a PNG "
@@ -323,7 +328,7 @@ def export3d(
         raise EyevizError(f"{target}: directory {parent} does not exist")
     fig = figure3d(
         scene, width=width, title=title, table=table, bitmaps=bitmaps, aspect=aspect,
-        camera=camera,
+        camera=camera, view=view,
     )  # fmt: skip
     dpi = BASE_DPI * scale if fmt == "png" else VECTOR_DPI
     with atomic_output(target) as tmp, matplotlib.rc_context(RC):

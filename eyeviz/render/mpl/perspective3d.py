@@ -108,10 +108,11 @@ class Polygons:
         return len(self.verts)
 
 
-def default_camera(state: SceneState3D) -> Camera3D:
-    """The view's default camera: the ``default`` preset framing the scene's balls."""
+def default_camera(state: SceneState3D, view: str = "default") -> Camera3D:
+    """The view's camera for a preset ``view`` (:data:`eyeviz.model.camera3d.PRESETS`)
+    framing the scene's balls, as the VTK view's ``default_camera``."""
     pair = state.pair
-    return preset("default", pair.h, pair.l, shapes3d.scene_extent(state))
+    return preset(view, pair.h, pair.l, shapes3d.scene_extent(state))
 
 
 class _Batch:
