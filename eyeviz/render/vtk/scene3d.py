@@ -279,6 +279,7 @@ class Scene3DActors:
         faces = shapes3d.cone_faces(res).reshape(res, 4)
         allf = np.concatenate(
             [faces + np.array([0, 1, 1, 1]) * k * (res + 1) for k in range(2 * n)]
+            or [np.zeros((0, 4), dtype=int)]
         )
         self.cones = pv.PolyData(
             np.zeros((max(2 * n, 1) * (res + 1), 3)), allf.ravel() if n else None
@@ -290,9 +291,10 @@ class Scene3DActors:
         self.cone_actor.GetProperty().SetOpacity(CONE_OPACITY)
         self._add(self.ball_store, self.cone_actor, eyes=False)
         # in the eyes' close-up, the cones' first EYE_CONE eye radii only
-        self.near_cones = pv.PolyData()
-        self.near_cones.ShallowCopy(self.cones)
-        self.near_cones.points = self.cones.points.copy()
+        # (a mesh of its own: a shallow copy would share the points written in place)
+        self.near_cones = pv.PolyData(np.array(self.cones.points), allf.ravel() if n else None)
+        if n:
+            set_rgb(self.near_cones.GetCellData(), np.concatenate([cols, cols]))
         self.near_cone_actor = actor(self.near_cones, rgb=bool(n))
         self.near_cone_actor.GetProperty().SetOpacity(CONE_OPACITY)
         self._add(self.ball_store, self.near_cone_actor, scene=False)
