@@ -36,7 +36,7 @@ from eyeviz.render.mpl.layout import interval_lanes, label_width  # noqa: E402
 LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout", "labels"]
 
 
-def scene(n: int, seed: int = 0) -> Scene:
+def scene(n: int, seed: int = 0, layers: list[str] | None = None) -> Scene:
     rng = np.random.default_rng(seed)
     feats = [
         Feature(
@@ -48,7 +48,9 @@ def scene(n: int, seed: int = 0) -> Scene:
         )
         for i in range(n)
     ]
-    return Scene(Eyes(), feats, list(LAYERS), [], View((0.0, 2500.0), 8000.0), f"{n} features")
+    return Scene(
+        Eyes(), feats, list(layers or LAYERS), [], View((0.0, 2500.0), 8000.0), f"{n} features"
+    )
 
 
 def old_lanes(L, R, m: int, strip_in: float) -> int:
@@ -81,17 +83,25 @@ def main() -> int:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--sizes", default="100,300,1000,3000,10000")
     ap.add_argument("--old-max", type=int, default=300, help="largest n for the old placement")
+    ap.add_argument(
+        "--layers",
+        default=",".join(LAYERS),
+        help="layers shown (default: %(default)s; the teaching layers tangents and sectors "
+        "draw lines per feature)",
+    )
     args = ap.parse_args()
     sizes = [int(s) for s in args.sizes.split(",")]
+    layers = [s.strip() for s in args.layers.split(",") if s.strip()]
     print(
-        f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs; median of {args.repeat}"
+        f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs; median of "
+        f"{args.repeat}; layers {', '.join(layers)}"
     )
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "s.png"
         export(scene(3), out)  # warm up: imports, fonts
         rows = []
         for n in sizes:
-            sc = scene(n)
+            sc = scene(n, layers=layers)
             t = median_time(lambda sc=sc: export(sc, out), args.repeat)
             w, h = struct.unpack(">II", out.read_bytes()[16:24])
             rng = np.random.default_rng(n)

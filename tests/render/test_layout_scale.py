@@ -229,3 +229,26 @@ def test_a_min_font_outside_its_range_is_refused(bad):
 
     with pytest.raises(EyevizError, match=r"min-font must be between 6 and 12 points"):
         vector.figure(_scene(2), min_font=bad)
+
+
+def test_teaching_layers_draw_at_most_max_taught_features_and_count_the_rest():
+    from eyeviz.render.mpl.layout import MAX_TAUGHT
+
+    n = MAX_TAUGHT + 25
+    fig = vector.figure(_scene(n, layers=["eyes", "features", "tangents", "sectors"]))
+    names = set()
+    for ax in fig.axes:
+        for ln in ax.lines:
+            gid = ln.get_gid() or ""
+            if gid.startswith("tangent-"):
+                names.add(gid.split("-", 2)[2])
+        for p in ax.patches:
+            gid = p.get_gid() or ""
+            if gid.startswith("sector-fan-"):
+                names.add(gid.split("-", 3)[3])
+    assert names and names <= {f"f{i}" for i in range(MAX_TAUGHT)}
+    note = _texts(fig, "label-more")["label-more"]
+    assert "more without tangents" in note and "more without sectors" in note
+    # a few features: every one drawn, no note
+    fig = vector.figure(_scene(5, layers=["eyes", "features", "tangents", "sectors"]))
+    assert "label-more" not in _texts(fig, "label-more")

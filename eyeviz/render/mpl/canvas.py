@@ -51,6 +51,7 @@ class Canvas:
     eye_units_per_in: float = 1.0
     label_boxes: list[tuple[float, float, float, float]] = field(default_factory=list)
     merged: bool | None = None
+    notes: list[str] = field(default_factory=list)  # "... and N more ..." lines (draw_notes)
 
     @property
     def layers(self) -> set[str]:
@@ -128,6 +129,32 @@ def make_canvas(scene: Scene, frame: Frame, lay: Layout, dpi: float, merge, titl
     if p.l / cv.units_per_in < 0.1 and ({"eyes", "tangents", "sectors", "bfv"} & cv.layers):
         _make_inset(cv)
     return cv
+
+
+def draw_notes(cv: Canvas) -> None:
+    """The notes of what was left out ("... and 960 more unlabelled"), one per line, in a
+    top corner of the main view the inset leaves free."""
+    if not cv.notes:
+        return
+    right = True
+    if cv.inset is not None:
+        b = cv.inset.get_position()
+        main = cv.lay.main
+        right = b.x0 + b.width / 2 < (main.x + main.w / 2) / cv.lay.width
+    cv.ax.text(
+        0.99 if right else 0.01,
+        0.99,
+        "\n".join(cv.notes),
+        transform=cv.ax.transAxes,
+        ha="right" if right else "left",
+        va="top",
+        fontsize=SMALL,
+        color=INK,
+        bbox=HALO,
+        zorder=10,
+        gid="label-more",
+        parse_math=False,
+    )
 
 
 def fit_text(text: str, size: float, width_pt: float) -> str:

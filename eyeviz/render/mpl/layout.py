@@ -27,6 +27,7 @@ __all__ = [
     "MAX_LABELS",
     "MAX_LANES",
     "MAX_TABLE_ROWS",
+    "MAX_TAUGHT",
     "default_aspect",
     "interval_lanes",
     "layout",
@@ -51,6 +52,8 @@ MAX_LANES = 3
 MAX_TABLE_ROWS = 24
 #: At most this many feature names beside their discs in the main view.
 MAX_LABELS = 40
+#: At most this many features drawn with the teaching layers' lines (tangents, sectors).
+MAX_TAUGHT = 40
 
 
 def default_aspect(width: float) -> float:

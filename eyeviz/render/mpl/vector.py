@@ -26,7 +26,7 @@ from eyeviz.model.predictor import Predictor
 from eyeviz.model.scene import Scene
 from eyeviz.model.state import SceneState
 from eyeviz.render.mpl.bounded import bound_figure
-from eyeviz.render.mpl.canvas import make_canvas
+from eyeviz.render.mpl.canvas import draw_notes, make_canvas
 from eyeviz.render.mpl.layout import ASPECT_RANGE, default_aspect, layout
 from eyeviz.render.mpl.style import (
     BASE_DPI,
@@ -227,6 +227,7 @@ def figure(
         cv = make_canvas(scene, fr, lay0, dpi, merge, title)
         for spec in ordered("mpl", lay_names):  # the layer table, in its matplotlib order
             resolve(spec.mpl)(cv)
+        draw_notes(cv)  # what the caps left out, counted
         raise_fonts(cv.fig, floor)
         bound_figure(cv.fig)  # nothing Agg/FreeType cannot raster in bounded time
         cv.fig._eyeviz_rc = dict(RC)  # savefig must run under the same rc (fonttype)

@@ -55,28 +55,7 @@ def paint(cv: Canvas) -> None:
     for col, (xs, ys) in dots.items():  # one line per colour, not one per feature
         ax.plot(xs, ys, ls="none", marker="o", ms=2.4, color=col, zorder=8, mew=0)
     if unlabelled:
-        _more_labels(cv, unlabelled)
-
-
-def _more_labels(cv: Canvas, n: int) -> None:
-    """ "... and N more unlabelled" in a top corner of the view the inset leaves free."""
-    right = True
-    if cv.inset is not None:
-        b = cv.inset.get_position()
-        right = b.x0 + b.width / 2 < cv.lay.main.x / cv.lay.width + cv.lay.main.w / cv.lay.width / 2
-    cv.ax.text(
-        0.99 if right else 0.01,
-        0.99,
-        more_text(n, "more unlabelled"),
-        transform=cv.ax.transAxes,
-        ha="right" if right else "left",
-        va="top",
-        fontsize=SMALL,
-        color=INK,
-        bbox=HALO,
-        zorder=10,
-        gid="label-more",
-    )
+        cv.notes.append(more_text(unlabelled, "more unlabelled"))
 
 
 def _feature_label(cv: Canvas, i: int, col: str) -> None:

@@ -8,6 +8,7 @@ import math
 from matplotlib.patches import Wedge
 
 from eyeviz.render.mpl.canvas import Canvas
+from eyeviz.render.mpl.layers.tangents import taught
 from eyeviz.render.mpl.style import GREY, HALO, SMALL, dark, slug
 
 
@@ -16,7 +17,10 @@ def paint(cv: Canvas) -> None:
     # one ray per eye and boundary k, as long as the longest sector that has it: features
     # sharing a boundary drew it once each (52 lines a feature, minutes for 10^3 features)
     rays: dict[tuple[str, int], tuple[tuple[float, float], float, int]] = {}
+    drawn = taught(cv, [s.feature for s in fr.sectors], "without sectors")
     for s in fr.sectors:
+        if s.feature not in drawn:
+            continue
         for k in s.rays:
             key = (s.eye, k % p.m)
             if key not in rays or rays[key][1] < s.reach:

@@ -8,15 +8,28 @@ from __future__ import annotations
 import math
 
 from eyeviz.render.mpl.canvas import Canvas
+from eyeviz.render.mpl.layout import MAX_TAUGHT, more_text
 from eyeviz.render.mpl.style import HALO, SMALL, arc, dark, slug, subscripted
+
+
+def taught(cv: Canvas, features: list[int], what: str) -> set[int]:
+    """The first :data:`MAX_TAUGHT` of ``features`` (scene order) that a teaching layer
+    draws; the rest are counted in a note ("... and N more without tangents")."""
+    unique = sorted(set(features))
+    if len(unique) > MAX_TAUGHT:
+        cv.notes.append(more_text(len(unique) - MAX_TAUGHT, f"more {what}"))
+    return set(unique[:MAX_TAUGHT])
 
 
 def paint(cv: Canvas) -> None:
     fr = cv.frame
     rA, rB = fr.rA, fr.rB
     assert rA is not None and rB is not None  # the tangents layer needs the readout
+    drawn = taught(cv, [t.feature for t in fr.tangents], "without tangents")
     for t in fr.tangents:
         i = t.feature
+        if i not in drawn:
+            continue
         col = dark(fr.colors[i])
         cx, cy = t.center
         name = slug(fr.names[i])
