@@ -93,3 +93,41 @@ def test_the_triangulation_finds_a_known_ball_and_errors_shrink_with_nside():
     fine = evaluate3d(DesignPoint3D(nside=64, n=600))[0]
     assert fine["dd_mape"] < coarse["dd_mape"] / 2
     assert fine["el_mae_deg"] < coarse["el_mae_deg"] / 2
+
+
+def test_the_estimator_is_a_parameter_loaded_from_the_registry():
+    """A registered 3D estimator is loaded with the point's Domain3D and measured like the
+    built-in triangulation (here one that answers the triangulation, as a record)."""
+    from types import SimpleNamespace
+
+    from eyeviz.estimators import registry
+
+    seen = {}
+
+    class Tri:
+        def __init__(self, domain):
+            seen["domain"] = domain
+            self.domain = domain
+
+        def predict(self, lit_a, lit_b):
+            r, az, el, fl = triangulate(self.domain, lit_a, lit_b)
+            return SimpleNamespace(r=r, azimuth=az, elevation=el, flagged=fl)
+
+    registry.register(
+        registry.Entry("tri_for_test", "test", load=lambda domain: Tri(domain), any_design=True)
+    )
+    try:
+        p = DesignPoint3D(h=40, l=20, nside=16, n=300, seed=2)
+        q = DesignPoint3D(h=40, l=20, nside=16, n=300, seed=2, estimator="tri_for_test")
+        a, b = evaluate3d(p), evaluate3d(q)
+        assert seen["domain"] == p.domain
+        assert [r["estimator"] for r in b] == ["tri_for_test"] * len(b)
+        drop = ("seconds", "estimator")
+        assert [{k: v for k, v in r.items() if k not in drop} for r in a] == [
+            {k: v for k, v in r.items() if k not in drop} for r in b
+        ]
+        assert p.key != q.key
+    finally:
+        registry.unregister("tri_for_test")
+    with pytest.raises(EyevizError, match="unknown estimator 'tri_for_test'"):
+        evaluate3d(q)
