@@ -11,6 +11,7 @@ import math
 from collections.abc import Generator
 from typing import TYPE_CHECKING
 
+import numpy as np
 from PyQt5 import QtCore, QtWidgets
 
 from eyeviz.model import camera, interactions
@@ -205,18 +206,29 @@ class CanvasMixin(_MainWindow):
         self._fitted_view = self.model.scene.view
 
     def _path_box(self) -> tuple[float, float, float, float] | None:
-        """The shown trajectory's path with its disc's radius (F frames it too)."""
+        """What F frames besides the eyes and the features: the shown trajectory's path
+        and the estimators' ghost discs (issue 24: none under the title or cut)."""
+        xs: list[float] = []
+        ys: list[float] = []
         panel = getattr(self, "trajectory_panel", None)
         p = panel.path if panel is not None else None
-        if p is None or not self.model.scene.shows("trajectory") or p.n == 0:
+        if p is not None and self.model.scene.shows("trajectory") and p.n > 0:
+            xs += [float(p.x.min()) - p.g, float(p.x.max()) + p.g]
+            ys += [float(p.y.min()) - p.g, float(p.y.max()) + p.g]
+        g = np.array([f.g for f in self.model.scene.features], dtype=float)
+        for res in self.model.predictions.values():
+            if isinstance(res, str):
+                continue
+            r, phi = np.asarray(res[0], float), np.asarray(res[1], float)
+            ok = np.isfinite(r) & np.isfinite(phi)
+            if r.shape != g.shape or not ok.any():
+                continue
+            x, y, gg = r[ok] * np.cos(phi[ok]), r[ok] * np.sin(phi[ok]), g[ok]
+            xs += [float((x - gg).min()), float((x + gg).max())]
+            ys += [float((y - gg).min()), float((y + gg).max())]
+        if not xs:
             return None
-        g = p.g
-        return (
-            float(p.x.min()) - g,
-            float(p.x.max()) + g,
-            float(p.y.min()) - g,
-            float(p.y.max()) + g,
-        )
+        return min(xs), max(xs), min(ys), max(ys)
 
     def fit_inset(self) -> None:
         interactions.fit_inset(self.model, self.viewport("inset"))

@@ -17,6 +17,7 @@ from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import TRAJECTORY_KINDS
 
 if TYPE_CHECKING:
+    from matplotlib.legend import Legend
     from matplotlib.lines import Line2D
 
     from eyeviz.model.frame_parts import TrajectoryPath
@@ -156,7 +157,7 @@ class TrajectoryPanel(QtWidgets.QWidget):
         )
         self.cursors: list[Line2D] = []
         self._key: tuple | None = None
-        self.legend = None  # the figure's legend, above the axes (never on the data)
+        self.legend: Legend | None = None  # the figure's, above the axes (never on the data)
 
     # --- model (the player's state lives in eyeviz.model.player) ---------------------
     @property

@@ -249,6 +249,7 @@ class Presenter(QtCore.QObject):
             fm.height() + 4,
         )
         self._scale_view_text()
+        self.win.fit_caption()
         if self.win.isVisible():
             self.win.render()
 
@@ -313,9 +314,7 @@ class Presenter(QtCore.QObject):
             self._hidden_docks = []
         self.apply()
         if self.presenting:
-            self.win.statusBar().showMessage(
-                "presentation mode: F5 to leave, F11 full screen, PageDown next step", 6000
-            )
+            self.win.statusBar().showMessage("F5: leave presentation mode", 6000)
 
 
 def install_presenting(win: MainWindow) -> Presenter:

@@ -25,9 +25,10 @@ if TYPE_CHECKING:
 else:
     _MainWindow = object  # MainWindow brings QMainWindow
 
-__all__ = ["CAPTION_PT", "StepsMixin"]
+__all__ = ["CAPTION_MARGIN", "CAPTION_PT", "StepsMixin"]
 
-CAPTION_PT = 18  # the caption bar's text at text scale 1
+CAPTION_PT = 16  # the caption bar's text at text scale 1
+CAPTION_MARGIN = 6
 
 
 class StepsMixin(_MainWindow):
@@ -59,7 +60,7 @@ class StepsMixin(_MainWindow):
             bar = QtWidgets.QLabel("")
             bar.setObjectName("step_caption")
             bar.setWordWrap(True)
-            bar.setMargin(8)
+            bar.setMargin(CAPTION_MARGIN)
             bar.setAlignment(QtCore.Qt.AlignmentFlag.AlignCenter)
             bar.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Maximum)
             presenter = getattr(self, "presenter", None)
@@ -109,8 +110,26 @@ class StepsMixin(_MainWindow):
         bar = self._caption_bar()
         bar.setText(f"{i + 1} / {len(steps)}   {steps[i].caption}")
         bar.show()
+        self.fit_caption()
         if self.leave_steps_action is not None:
             self.leave_steps_action.setEnabled(True)
+
+    def fit_caption(self) -> None:
+        """The caption bar as tall as its wrapped text at the window's width (a splitter
+        does not ask a word-wrapped label for its height)."""
+        bar = self.caption_bar
+        if bar is None or not bar.isVisible():
+            return
+        central = self.centralWidget()
+        width = central.width() if central is not None else self.width()
+        inner = max(width - 2 * CAPTION_MARGIN - 8, 50)
+        flags = int(QtCore.Qt.TextFlag.TextWordWrap) | int(QtCore.Qt.AlignmentFlag.AlignCenter)
+        text = bar.fontMetrics().boundingRect(QtCore.QRect(0, 0, inner, 0), flags, bar.text())
+        bar.setFixedHeight(text.height() + 2 * CAPTION_MARGIN + 4)
+
+    def resizeEvent(self, ev) -> None:  # noqa: N802 (Qt name)
+        super().resizeEvent(ev)
+        self.fit_caption()
 
     def _check_scene(self) -> None:
         """A scene with other steps in the model (a file opened while walking) ends the

@@ -10,7 +10,7 @@ import time
 from pathlib import Path
 
 import pytest
-from PyQt5 import QtGui, QtWidgets
+from PyQt5 import QtCore, QtGui, QtWidgets
 
 from eyeviz.app.launch import APP_FONT_PT
 from eyeviz.app.presenting import PRESENT_FACTOR, SCALE_KEY
@@ -265,3 +265,34 @@ def test_pagedown_on_a_scene_without_steps_says_so(make_window, qtbot):
     _focus(win, qtbot)
     _keys(qtbot, "Next", until=lambda: "no steps" in win.statusBar().currentMessage())
     assert win.step_index == -1 and win.model.scene.layers == _scene().layers
+
+
+def _caption_whole(bar) -> bool:
+    inner = bar.contentsRect().adjusted(bar.margin(), bar.margin(), -bar.margin(), -bar.margin())
+    need = bar.fontMetrics().boundingRect(
+        QtCore.QRect(0, 0, inner.width(), 0),
+        int(QtCore.Qt.TextFlag.TextWordWrap) | int(QtCore.Qt.AlignmentFlag.AlignCenter),
+        bar.text(),
+    )
+    return need.height() <= inner.height()
+
+
+def test_the_step_caption_shows_whole_and_grows_in_presentation_mode(make_window, qtbot):
+    from eyeviz.app.steps import CAPTION_PT
+
+    path = scene_path("lecture")
+    win = make_window(load(path), path)
+    win.resize(1280, 720)
+    qtbot.waitUntil(lambda: win.width() == 1280, timeout=3000)
+    _focus(win, qtbot)
+    longest = max(range(len(win.model.scene.steps)), key=lambda i: len(win._steps()[i].caption))
+    _keys(qtbot, *(["Next"] * (longest + 1)), until=lambda: win.step_index == longest)
+    bar = win.caption_bar
+    assert bar.font().pointSizeF() == CAPTION_PT
+    qtbot.waitUntil(lambda: _caption_whole(bar), timeout=3000)
+    _keys(qtbot, "F5", until=lambda: win.presenter.presenting)
+    assert bar.font().pointSizeF() == pytest.approx(CAPTION_PT * PRESENT_FACTOR)
+    qtbot.waitUntil(lambda: _caption_whole(bar), timeout=3000)
+    assert bar.isVisible() and win._steps()[longest].caption in bar.text()
+    _keys(qtbot, "F5", until=lambda: not win.presenter.presenting)
+    assert bar.font().pointSizeF() == CAPTION_PT
