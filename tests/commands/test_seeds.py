@@ -105,3 +105,13 @@ def test_train_without_a_seed_draws_one_and_records_it(tmp_path):
         meta = json.loads(str(z["meta"]))
     assert meta["seed"] == int(m.group(1)) != 12345
     assert meta["command"].endswith(f"--seed {m.group(1)}")
+
+
+def test_the_estimator_report_test_sets_share_no_seed_with_shipped_training():
+    """`report estimators` draws its single- and multi-pass test sets with TEST_SEED and
+    TEST_SEED + 1: neither may be a seed a shipped model was fitted on."""
+    from eyeviz.reports.estimators_measure import TEST_SEED, TEST_SETS
+
+    shipped = {s.seed for s in _seeds.shipped_seeds()}
+    assert shipped  # the metadata was found
+    assert not shipped & {TEST_SEED + i for i in range(len(TEST_SETS))}
