@@ -42,6 +42,7 @@ from eyeviz.app.steps import StepsMixin
 from eyeviz.app.view import VtkView, fast_renderer
 from eyeviz.app.view3d import Scene3DHost
 from eyeviz.model.app_model import AppModel
+from eyeviz.model.camera import eye_overlaps
 from eyeviz.model.scene import Eyes, Scene
 from eyeviz.model.state import SceneState
 from eyeviz.render.vtk.actors import SceneActors
@@ -87,7 +88,7 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self.unsaved_box: QtWidgets.QMessageBox | None = None
         self._force_close = False
         self.jobs = JobRunner(lambda text, ms: self.statusBar().showMessage(text, ms), self)
-        self._eyes_key = (scene.eyes.h, scene.eyes.l)
+        self._eyes_key: tuple = (scene.eyes.h, scene.eyes.l)
 
         self._dirty: set[int] = set()  # features changed live, not yet drawn
         self._table_index: int | None = None
@@ -248,7 +249,9 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         if self.last_error and what == "scene":  # a successful edit clears an old error
             self.last_error = ""
             self.statusBar().clearMessage()
-        eyes = (self.model.scene.eyes.h, self.model.scene.eyes.l)
+        sc_eyes = self.model.scene.eyes
+        # h, l, or which features overlap an eye (the inset shows them whole) changed
+        eyes = (sc_eyes.h, sc_eyes.l, tuple(eye_overlaps(sc_eyes, self.model.scene.features)))
         if eyes != self._eyes_key:
             self._eyes_key = eyes
             if self.model.inset_auto:  # h or l changed: the inset shows both eyes again

@@ -198,12 +198,34 @@ def fit_view(
     return min(views, key=lambda v: v.width)  # the larger picture
 
 
-def fit_inset(eyes: Eyes, vp: Viewport) -> View:
-    """The inset's view: both eyes with their A/B labels above the m/theta/psi text line."""
+def eye_overlaps(eyes: Eyes, features) -> list[tuple[int, str]]:
+    """(index, "A" or "B") of each feature disc that overlaps an eye's circle (centres at
+    (-h, 0) and (h, 0), radius l: the situation BFV Property 1 excludes)."""
+    out = []
+    for i, f in enumerate(features):
+        for eye, cx in (("A", -eyes.h), ("B", eyes.h)):
+            if math.hypot(f.x - cx, f.y) < f.g + eyes.l:
+                out.append((i, eye))
+    return out
+
+
+def fit_inset(eyes: Eyes, vp: Viewport, features=()) -> View:
+    """The inset's view: both eyes with their A/B labels above the m/theta/psi text line,
+    and whole any of ``features`` that overlaps an eye (:func:`eye_overlaps`)."""
     w, h = max(vp.width, 1.0), max(vp.height, 1.0)
     u = max(
         2 * (eyes.h + eyes.l) * 1.08 / w,
         3.1 * eyes.l / max(h - 1.6 * INSET_TEXT_PX, 1.0),
     )
+    cx, cy = 0.0, -0.25 * eyes.l
+    hit = sorted({i for i, _ in eye_overlaps(eyes, features)})
+    if hit:
+        fs = [features[i] for i in hit]
+        x0 = min([-(eyes.h + eyes.l)] + [f.x - f.g for f in fs])
+        x1 = max([eyes.h + eyes.l] + [f.x + f.g for f in fs])
+        y0 = min([-1.3 * eyes.l] + [f.y - f.g for f in fs])  # room for A and B below
+        y1 = max([eyes.l] + [f.y + f.g for f in fs])
+        u = max(u, (x1 - x0) * 1.08 / w, (y1 - y0) * 1.08 / max(h - 1.6 * INSET_TEXT_PX, 1.0))
+        cx, cy = (x0 + x1) / 2.0, (y0 + y1) / 2.0
     shift = 0.8 * INSET_TEXT_PX * u  # centre the content above the text line
-    return View((0.0, -0.25 * eyes.l - shift), u * w)
+    return View((cx, cy - shift), u * w)

@@ -162,7 +162,7 @@ def fit_view(
 
 def fit_inset(model: AppModel, vp: Viewport) -> None:
     """Shift+F (and after h or l change): the inset shows both eyes again."""
-    model.inset_view = camera.fit_inset(model.scene.eyes, vp)
+    model.inset_view = camera.fit_inset(model.scene.eyes, vp, model.scene.features)
     model.inset_auto = True
     model.notify_view("inset")
 

@@ -194,6 +194,8 @@ class ReadoutPanel(QtWidgets.QWidget):
         ink = "#1e1e1e"
         vis, vis_c = pair(st.vis_a[i], st.vis_b[i])
         ovl, ovl_c = pair(st.overlap_a[i], st.overlap_b[i], False)
+        if st.overlap_a[i] or st.overlap_b[i]:  # a warning, not a grey value (issue 24)
+            ovl, ovl_c = f"⚠ {ovl}: inside an eye", BAD
         bfv, bfv_c = yes(st.in_bfv[i])
         rows = [
             ("r", "r, φ", f"{st.r[i]:.1f}, {st.phi[i] * deg:.2f}°", ink),

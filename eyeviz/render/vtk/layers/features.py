@@ -47,6 +47,9 @@ class FeaturesLayer:
 
     def __init__(self, main, inset):
         self.main = main
+        # the inset shows the discs too: a feature overlapping an eye is drawn over it there
+        # (Z_FEAT above Z_EYES), not cut off at the eye (issue 24)
+        self.inset = inset
         self.store = Store()
         self._key: tuple | None = None
         self.fill_mesh: pv.PolyData | None = None
@@ -79,6 +82,9 @@ class FeaturesLayer:
             a.SetVisibility(False)
             main.AddActor(a)
         main.AddActor(self.sel_actor)
+        if inset is not None:
+            for a in (*self.live_actors, self.sel_actor):
+                inset.AddActor(a)
         main.AddActor(self.handle_actor)
         main.AddActor(self.sight_actors[0])
         inset.AddActor(self.sight_actors[1])  # the sight lines reach the eyes in the inset
@@ -120,8 +126,10 @@ class FeaturesLayer:
         fa = actor(self.fill_mesh, rgb=True)
         la = actor(self.line_mesh, rgb=True)
         la.GetProperty().SetLineWidth(3.0)
-        self.store.add(self.main, fa)
-        self.store.add(self.main, la)
+        for ren in (self.main, self.inset):
+            if ren is not None:
+                self.store.add(ren, fa)
+                self.store.add(ren, la)
         self.centers_mesh = pv.PolyData(np.zeros((n, 3)))
         self._centers_actor = points_actor(self.centers_mesh, 11, None)
         mapper = self._centers_actor.GetMapper()
