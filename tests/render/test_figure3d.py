@@ -35,7 +35,7 @@ def test_polygons_are_painted_far_to_near_and_back_faces_culled():
     polys = scene_polygons(st, sc, cam, 1.5)
     assert len(polys) > 1000
     assert np.all(np.diff(polys.depth) <= 0)  # far first
-    assert set(polys.kind) == {"eye", "ball", "cone", "plane", "bfv"}
+    assert set(polys.kind) == {"eye", "ball", "cone", "plane", "bfv", "line"}
     # every eye facet drawn faces the camera: n . (camera - facet) > 0
     pos = np.asarray(cam.position)
     eyes = polys.kind == "eye"

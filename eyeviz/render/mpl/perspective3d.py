@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.collections import LineCollection, PolyCollection
+from matplotlib.collections import PolyCollection
 from matplotlib.colors import to_rgba, to_rgba_array
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
@@ -75,6 +75,8 @@ INSET_RGBA = (0.965, 0.965, 0.955, 1.0)
 INK_RGBA = (0.15, 0.15, 0.15, 1.0)
 EYE_LIGHT = (0.45, 0.6)  # ambient, diffuse
 BALL_LIGHT = (0.35, 0.7)
+SEAM = 0.3  # pt: facets outlined in their own colour, so no seam shows between them
+LINE_PIECES = 24  # a grid line of the plane is cut in this many pieces to sort
 #: The balls are HEALPix spheres of this nside (192 facets, the front ~96 drawn).
 BALL_NSIDE = 4
 CONE_RES = 32  # points around a tangent cone
@@ -102,7 +104,7 @@ class Polygons:
     edge: np.ndarray  # (n, 4) rgba
     width: np.ndarray  # (n,) line widths, points
     depth: np.ndarray  # (n,) centroid distance from the camera
-    kind: np.ndarray  # (n,) "eye", "lit", "ball", "cone", "plane", "bfv"
+    kind: np.ndarray  # (n,) "eye", "lit", "ball", "cone", "plane", "bfv", "line"
 
     def __len__(self) -> int:
         return len(self.verts)
@@ -160,16 +162,18 @@ def _eye_batches(state: SceneState3D, scene: Scene, cam: Camera3D) -> list[_Batc
             edged = n <= EDGES_MAX_NSIDE
             out.append(
                 _Batch(pts, face, "eye", centre=c, edge=EDGE_RGBA if edged else None,
-                       width=0.25 if edged else 0.05, light=EYE_LIGHT)
+                       width=0.25 if edged else SEAM, light=EYE_LIGHT)
             )  # fmt: skip
             continue
         vn = 4 if small else shapes3d.view_nside(n)
         pts = c + pair.l * healpix.boundaries(vn, np.arange(healpix.npix(vn)), 2)
-        out.append(_Batch(pts, UNLIT_RGBA, "eye", centre=c, width=0.05, light=EYE_LIGHT))
+        out.append(_Batch(pts, UNLIT_RGBA, "eye", centre=c, width=SEAM, light=EYE_LIGHT))
         pix = np.flatnonzero(own >= 0)
         if pix.size and colors is not None:
             lp = c + pair.l * healpix.boundaries(n, pix, 1)
-            out.append(_Batch(lp, colors[own[pix]], "lit", centre=c, width=0.05, light=EYE_LIGHT))
+            out.append(
+                _Batch(lp, colors[own[pix]], "lit", centre=c, width=SEAM / 2, light=EYE_LIGHT)
+            )  # a thinner seam: a patch of facets under a pixel wide would grow
     return out
 
 
@@ -179,7 +183,7 @@ def _ball_batches(scene: Scene) -> list[_Batch]:
     for f in scene.features:
         c = np.array([f.x, f.y, f.z], np.float64)
         out.append(
-            _Batch(c + f.g * unit, to_rgba(f.color), "ball", centre=c, width=0.05,
+            _Batch(c + f.g * unit, to_rgba(f.color), "ball", centre=c, width=SEAM,
                    light=BALL_LIGHT)
         )  # fmt: skip
     return out
@@ -262,6 +266,15 @@ def _equators(state: SceneState3D) -> np.ndarray:
     return np.concatenate(out)
 
 
+def _lines(segs: np.ndarray, rgba, lw: float, pieces: int = 1) -> _Batch:
+    """Segments (k, 2, 3) as painted items (each cut in ``pieces``): an outline only, so a
+    line passes behind what is nearer, as in the VTK view."""
+    t = np.linspace(0.0, 1.0, pieces + 1)[None, :, None]
+    pts = segs[:, :1] + t * (segs[:, 1:] - segs[:, :1])  # (k, pieces + 1, 3)
+    cut = np.stack([pts[:, :-1], pts[:, 1:]], axis=2).reshape(-1, 2, 3)
+    return _Batch(cut, (0.0, 0.0, 0.0, 0.0), "line", edge=rgba, width=lw)
+
+
 def scene_polygons(
     state: SceneState3D,
     scene: Scene,
@@ -279,7 +292,10 @@ def scene_polygons(
     if "bfv" in shown:
         batches += _bfv_batches(state)
     if "plane" in shown and part == "scene":
-        batches += _plane(state)[0]
+        tiles, grid = _plane(state)
+        batches += [*tiles, _lines(grid, GRID_RGBA, 0.4, LINE_PIECES)]
+    if "plane" in shown and "eyes" in shown:
+        batches.append(_lines(_equators(state), INK_RGBA, 0.8))
     if "eyes" in shown and state.lit_a is not None:
         batches += _eye_batches(state, scene, cam)
     if "features" in shown and part == "scene":
@@ -325,8 +341,8 @@ def _project(batches: list[_Batch], cam: Camera3D, aspect: float, l: float) -> P
             edge = edge.copy()
             edge[same, :3] = face[same, :3]
         d = np.linalg.norm(mid[idx] - cam_pos, axis=-1)
-        if b.kind == "lit":  # over the coarse unlit sphere they lie on
-            d = d - 0.1 * l
+        if b.kind in ("lit", "line"):  # over the sphere they lie on (lit facets, equators)
+            d = d - 0.15 * l
         verts.extend(xy[idx])
         faces.append(face)
         edges.append(edge)
@@ -348,14 +364,6 @@ def _project(batches: list[_Batch], cam: Camera3D, aspect: float, l: float) -> P
     )
 
 
-def _segments(ax: Axes, cam: Camera3D, aspect: float, segs: np.ndarray, rgba, lw: float):
-    """3D segments (k, 2, 3) drawn as lines (those wholly in front of the camera)."""
-    xy, depth = project(cam, segs, aspect)
-    keep = depth.min(axis=1) > 0
-    if keep.any():
-        ax.add_collection(LineCollection(list(xy[keep]), colors=[rgba], linewidths=lw))
-
-
 def draw_view(
     ax: Axes,
     state: SceneState3D,
@@ -366,8 +374,9 @@ def draw_view(
     layers=None,
 ) -> PolyCollection:
     """One part of the view through ``cam`` on ``ax``, whose box must have width /
-    height = ``aspect``: one collection of polygons, the plane's grid and the equators
-    (layer "plane"), the names (layer "labels"); limits [-1, 1] x [-1, 1], no axis."""
+    height = ``aspect``: one collection of polygons and lines (the plane's grid and the
+    equators, layer "plane") in painting order, the names (layer "labels") over them;
+    limits [-1, 1] x [-1, 1], no axis."""
     shown = set(scene.layers if layers is None else layers)
     polys = scene_polygons(state, scene, cam, aspect, part, layers)
     coll = PolyCollection(
@@ -375,11 +384,6 @@ def draw_view(
     )
     coll.set_gid(f"view-{part}")
     ax.add_collection(coll, autolim=False)
-    if "plane" in shown:
-        if part == "scene":
-            _segments(ax, cam, aspect, _plane(state)[1], GRID_RGBA, 0.4)
-        if "eyes" in shown:
-            _segments(ax, cam, aspect, _equators(state), INK_RGBA, 0.8)
     if "labels" in shown:
         _labels(ax, state, scene, cam, aspect, part, shown)
     ax.set_xlim(-1.0, 1.0)
