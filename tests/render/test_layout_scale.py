@@ -85,7 +85,7 @@ def test_bounded_lanes_hold_at_most_max_lanes_and_count_the_rest(n):
     assert {ln for *_, ln in lanes} <= set(range(MAX_LANES))
     assert len(lanes.placed) + lanes.dropped == n
     assert not _overlaps(lanes, M, 3.0)
-    if n >= 1000:  # more labels than three lanes can hold
+    if n >= 1000:  # more labels than MAX_LANES lanes can hold
         assert lanes.dropped > 0 and lanes.height == MAX_LANES + 1
 
 

@@ -46,7 +46,7 @@ LANE = 7.0 / 72  # one interval-label lane above/below a bitmap strip, inches
 LABEL_PT = SMALL
 #: At most this many label lanes above (below) a bitmap strip; labels that fit in none
 #: are counted in one more lane ("... and N more").
-MAX_LANES = 3
+MAX_LANES = 6
 #: At most this many rows in the readout table, headers and the "... and N more" row
 #: included; features whose rows do not fit are counted, not listed.
 MAX_TABLE_ROWS = 24

@@ -30,6 +30,9 @@ def paint(cv: Canvas) -> None:
     yB = cv.lay.lanes[1] * lane_h + 0.01
     yA = yB + STRIP + AXIS_H * k
     fills = [None] + fr.palette
+    rear = "rear half: not a network input"  # shortened where --min-font makes it too wide
+    if len(rear) * 0.6 * cv.lay.pt(SMALL) / 72 > 0.95 * box.w * (m - half) / m:
+        rear = "rear half: not an input"
     for eye, y0 in zip(fr.eyes, (yA, yB), strict=True):
         name = eye.name
         ax.add_patch(
@@ -92,7 +95,7 @@ def paint(cv: Canvas) -> None:
         ax.text(
             0.75 * m,
             y0 + STRIP / 2,
-            "rear half: not a network input",
+            rear,
             ha="center",
             va="center",
             fontsize=SMALL,
