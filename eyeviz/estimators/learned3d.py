@@ -1,0 +1,345 @@
+"""The learned estimator of the spherical eyes: a small network on summaries of the lit sets.
+
+Each eye's lit set is summarised in one vectorised pass over its CSR row
+(:mod:`eyeviz.estimators.learned3d_features`): the solid-angle-weighted mean direction of
+the lit facets, the cap's angular radius from the facet count, the west and east edge
+longitudes and the z-extent. The two mean directions are triangulated (the closest
+approach of the rays from A and B, docs/spherical.md) and one multilayer perceptron
+(SiLU, two hidden layers) corrects the triangulation, as the planar compact networks do
+(:mod:`eyeviz.estimators.compact`):
+
+- log r = log r0 + f_0(x): trained on the relative error |r_hat / r - 1| (the MAPE of
+  Eq. 34), so it learns the 1/r-weighted posterior median;
+- azimuth = azimuth0 + 1e-4 f_1(x), trained on |az_hat / az - 1|;
+- elevation = elevation0 + 1e-4 f_2(x), trained on |el_hat - el| (an elevation crosses 0,
+  where a relative error is undefined).
+
+The last layer starts at zero, so training starts from the triangulation.
+
+Weights: ``assets/models/learned3d/learned3d.npz``, plain arrays read without unpickling
+by :class:`eyeviz.files.npz.NpzReader` (every shape checked against the declared widths
+before anything is built), with ``learned3d.json`` (the design the weights were trained
+for, the training and validation seeds, metrics, time, command). Inference is numpy
+(float32 matrix products), so loading and predicting need no torch; training does
+(:mod:`eyeviz.estimators.learned3d_training`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from eyeviz import EyevizError
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.estimators.learned3d_features import N_FEATURES, eye_summaries, features
+from eyeviz.files import limits
+from eyeviz.files.atomic import atomic_output
+from eyeviz.files.npz import NpzReader, one_line
+from eyeviz.resources import models_dir
+
+__all__ = [
+    "AZ_SCALE",
+    "EL_SCALE",
+    "FORMAT",
+    "META_FILE",
+    "WEIGHTS_FILE",
+    "Learned3DEstimator",
+    "Prediction3D",
+    "default_dir",
+    "load",
+    "read_weights",
+    "write_weights",
+]
+
+FORMAT = "eyeviz.learned3d"
+VERSION = 1
+WEIGHTS_FILE = "learned3d.npz"
+META_FILE = "learned3d.json"
+#: radians per unit of the network's azimuth and elevation outputs
+AZ_SCALE = 1e-4
+EL_SCALE = 1e-4
+N_OUT = 3
+#: rows per block through the network (keeps the temporaries in cache)
+_BLOCK = 1 << 14
+_LAYERS = ("0", "2", "4")  # Linear layers of nn.Sequential(Linear, SiLU, Linear, SiLU, Linear)
+
+
+def default_dir() -> Path:
+    return models_dir() / "learned3d"
+
+
+def expected_shapes(hidden: int) -> dict[str, tuple[int, ...]]:
+    """Member name -> shape of the weights of a network of width ``hidden``."""
+    return {
+        "x_mean": (N_FEATURES,),
+        "x_scale": (N_FEATURES,),
+        "net.0.weight": (hidden, N_FEATURES),
+        "net.0.bias": (hidden,),
+        "net.2.weight": (hidden, hidden),
+        "net.2.bias": (hidden,),
+        "net.4.weight": (N_OUT, hidden),
+        "net.4.bias": (N_OUT,),
+    }
+
+
+def write_weights(path: str | os.PathLike, hidden: int, arrays: dict[str, np.ndarray]) -> None:
+    """The weights as an uncompressed NPZ of float32 arrays plus ``hidden`` (int64),
+    written atomically. ``arrays`` must have exactly :func:`expected_shapes`."""
+    want = expected_shapes(hidden)
+    if set(arrays) != set(want):
+        raise ValueError(f"weights need {sorted(want)}, got {sorted(arrays)}")
+    out = {k: np.ascontiguousarray(arrays[k], np.float32) for k in want}
+    for k, shape in want.items():
+        if out[k].shape != shape:
+            raise ValueError(f"{k} has shape {out[k].shape}, expected {shape}")
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_output(p) as tmp, open(tmp, "wb") as f:
+        members: dict[str, np.ndarray] = {"hidden": np.array(hidden, np.int64), **out}
+        np.savez(f, allow_pickle=False, **members)
+
+
+def read_weights(path: str | os.PathLike) -> tuple[int, dict[str, np.ndarray]]:
+    """(hidden, arrays) from a weights file, every problem one EyevizError line naming the
+    file: a bounded regular file, an NPZ read without unpickling, ``hidden`` an integer in
+    [1, MAX_HIDDEN], exactly the members of :func:`expected_shapes` with those shapes,
+    float32 and finite."""
+    p = Path(path)
+    limits.check_file_size(p, limits.MAX_MODEL_FILE_BYTES, "learned3d weights file")
+    what = f"{str(p)!r}"
+    with NpzReader(p, what) as z:
+        h = z.read_member("hidden", 1, ("int64",), ndim=0)
+        hidden = limits.check_hidden(p.name, int(h))
+        want = expected_shapes(hidden)
+        extra = sorted(set(z.names) - set(want) - {"hidden"})
+        if extra:
+            raise EyevizError(f"{what}: unexpected members {extra[:8]}")
+        arrays: dict[str, np.ndarray] = {}
+        for k, shape in want.items():
+            a = z.read_member(k, math.prod(shape), ("float32",), ndim=len(shape))
+            if a.shape != shape:
+                raise EyevizError(
+                    f"{what}: {k} has shape {a.shape}, expected {shape} for hidden = {hidden}"
+                )
+            if not np.isfinite(a).all():
+                raise EyevizError(f"{what}: {k} holds NaN or infinite weights")
+            arrays[k] = a
+    if not (arrays["x_scale"] > 0).all():
+        raise EyevizError(f"{what}: x_scale must be > 0")
+    return hidden, arrays
+
+
+class Prediction3D(tuple):
+    """``(r, azimuth, elevation)`` (radians) with ``valid``, ``in_domain`` and ``flagged``
+    masks. ``valid`` is False (and the values NaN) where an eye lit no facet; ``flagged``
+    marks rows whose mean directions do not meet in front of both eyes (the answer is
+    then r_max along their mean, corrected by the network)."""
+
+    def __new__(cls, r, azimuth, elevation, valid, in_domain, flagged):
+        obj = super().__new__(cls, (r, azimuth, elevation))
+        obj.valid = valid
+        obj.in_domain = in_domain
+        obj.flagged = flagged
+        return obj
+
+    @property
+    def r(self):
+        return self[0]
+
+    @property
+    def azimuth(self):
+        return self[1]
+
+    @property
+    def elevation(self):
+        return self[2]
+
+    def __getnewargs__(self):
+        return (self[0], self[1], self[2], self.valid, self.in_domain, self.flagged)
+
+
+def _silu(x: np.ndarray) -> np.ndarray:
+    with np.errstate(over="ignore"):
+        return x / (1.0 + np.exp(-x))
+
+
+def _csr(name: str, lit: Any, npix: int) -> tuple[np.ndarray, np.ndarray, bool]:
+    """(indptr, indices, single) from CSR ``(indptr, indices)`` or dense bool bitmaps
+    (npix,) / (N, npix); one-line ValueError naming ``name`` otherwise."""
+    if isinstance(lit, tuple):
+        if len(lit) != 2:
+            raise ValueError(f"{name} must be (indptr, indices) or bitmaps, got a {len(lit)}-tuple")
+        ptr = np.asarray(lit[0])
+        ind = np.asarray(lit[1])
+        if ptr.ndim != 1 or ptr.size < 1 or ptr.dtype.kind not in "iu":
+            raise ValueError(f"{name}: indptr must be a 1-D integer array of length n + 1")
+        if ind.ndim != 1 or (ind.size and ind.dtype.kind not in "iu"):
+            raise ValueError(f"{name}: indices must be a 1-D integer array")
+        ptr = ptr.astype(np.int64, copy=False)
+        if ptr[0] != 0 or ptr[-1] != ind.size or np.any(np.diff(ptr) < 0):
+            raise ValueError(
+                f"{name}: indptr must start at 0, not decrease and end at len(indices) = {ind.size}"
+            )
+        # order and range of the indices are checked on the runs (eye_summaries)
+        return ptr, ind, False
+    a = np.asarray(lit)
+    if a.ndim not in (1, 2) or a.shape[-1] != npix:
+        raise ValueError(
+            f"{name} must be (indptr, indices) or bitmaps of shape (npix,) or (N, npix) with "
+            f"npix = {npix}, got shape {a.shape}"
+        )
+    if a.dtype != np.bool_:
+        if a.dtype.kind not in "biuf" or not np.isin(a, (0, 1)).all():
+            raise ValueError(f"{name} bitmaps must hold 0/1 values")
+        a = a != 0
+    single = a.ndim == 1
+    a = a.reshape(-1, npix)
+    rows, cols = np.nonzero(a)
+    ptr = np.zeros(a.shape[0] + 1, np.int64)
+    np.cumsum(np.bincount(rows, minlength=a.shape[0]), out=ptr[1:])
+    return ptr, cols.astype(np.int64), single
+
+
+class Learned3DEstimator:
+    """Corrects the triangulation of the two eyes' mean lit directions with an MLP."""
+
+    name = "learned3d"
+
+    def __init__(
+        self,
+        hidden: int,
+        arrays: dict[str, np.ndarray],
+        domain: Domain3D | None = None,
+        metadata: dict | None = None,
+    ) -> None:
+        self.domain = Domain3D() if domain is None else domain
+        self.hidden = hidden
+        self._w = {k: np.asarray(v, np.float32) for k, v in arrays.items()}
+        self.metadata: dict[str, Any] = dict(metadata or {})
+        n_w = sum(v.size for k, v in arrays.items() if k.startswith("net."))
+        self.metadata["n_weights"] = int(n_w)
+
+    @property
+    def n_weights(self) -> int:
+        return int(self.metadata["n_weights"])
+
+    def network(self, x: np.ndarray) -> np.ndarray:
+        """The network's raw outputs (n, 3) for feature rows x (n, N_FEATURES)."""
+        w = self._w
+        out = np.empty((x.shape[0], N_OUT), np.float32)
+        for s in range(0, x.shape[0], _BLOCK):
+            h = (x[s : s + _BLOCK] - w["x_mean"]) / w["x_scale"]
+            for i, layer in enumerate(_LAYERS):
+                h = h @ w[f"net.{layer}.weight"].T + w[f"net.{layer}.bias"]
+                if i < len(_LAYERS) - 1:
+                    h = _silu(h)
+            out[s : s + _BLOCK] = h
+        return out
+
+    def predict(self, lit_a, lit_b) -> Prediction3D:
+        """(r, azimuth, elevation) per row from each eye's lit facets: CSR rows
+        ``(indptr, indices)`` (sorted RING indices, as the 3D data set stores them) or
+        dense bool bitmaps (npix,) / (N, npix). ValueError for malformed input or a
+        row-count mismatch; NaN and ``valid = False`` where an eye lit nothing."""
+        d = self.domain
+        pa, ia, single_a = _csr("lit_a", lit_a, d.npix)
+        pb, ib, single_b = _csr("lit_b", lit_b, d.npix)
+        if pa.size != pb.size:
+            raise ValueError(
+                f"lit_a and lit_b have different row counts: {pa.size - 1} and {pb.size - 1}"
+            )
+        sa = eye_summaries(d.nside, pa, ia, "lit_a")
+        sb = eye_summaries(d.nside, pb, ib, "lit_b")
+        x, log_r0, az0, el0, ok, flagged = features(sa, sb, d.h, d.nside, d.r_min, d.r_max)
+        n = x.shape[0]
+        r = np.full(n, np.nan)
+        az = np.full(n, np.nan)
+        el = np.full(n, np.nan)
+        sel = np.flatnonzero(ok)
+        if sel.size:
+            out = self.network(x[sel]).astype(np.float64)
+            r[sel] = np.exp(log_r0[sel] + out[:, 0])
+            az[sel] = az0[sel] + AZ_SCALE * out[:, 1]
+            el[sel] = el0[sel] + EL_SCALE * out[:, 2]
+        in_dom = ok & (sa.count >= 2) & (sb.count >= 2)
+        flagged = flagged & ok
+        if single_a and single_b and n == 1:
+            return Prediction3D(r[0], az[0], el[0], ok[0], in_dom[0], flagged[0])
+        return Prediction3D(r, az, el, ok, in_dom, flagged)
+
+    def __repr__(self) -> str:
+        return f"<Learned3DEstimator hidden={self.hidden} nside={self.domain.nside}>"
+
+
+def _read_meta(d: Path) -> dict:
+    meta_f = d / META_FILE
+    if not meta_f.is_file():
+        raise EyevizError(
+            f"learned3d weights not found in {d} (no {META_FILE}); "
+            f"train them with `eyeviz train learned3d -o {d}`"
+        )
+    raw = limits.read_bounded(meta_f, limits.MAX_MODEL_META_BYTES, "model metadata")
+    try:
+        meta = json.loads(raw)
+    except (ValueError, RecursionError) as exc:
+        raise EyevizError(f"{str(meta_f)!r}: not valid JSON ({one_line(exc, 120)})") from None
+    if not isinstance(meta, dict):
+        raise EyevizError(f"{str(meta_f)!r}: expected a JSON object, got {type(meta).__name__}")
+    if meta.get("format") != FORMAT or meta.get("version") != VERSION:
+        raise EyevizError(
+            f"{str(meta_f)!r}: format {meta.get('format')!r} version {meta.get('version')!r}, "
+            f"expected {FORMAT!r} version {VERSION}"
+        )
+    return meta
+
+
+def load(
+    path: str | os.PathLike | None = None, domain: Domain3D | None = None
+) -> Learned3DEstimator:
+    """The weights in directory ``path`` (default the shipped ``assets/models/learned3d``).
+
+    The weights answer for the design they were trained for: ``domain`` (default: the
+    design in ``learned3d.json``) must have the same h, l and nside and lie inside the
+    trained ranges of r, g and elevation, else one EyevizError line says which differs.
+    Every problem with the files is one EyevizError line naming the file."""
+    d = Path(path) if path is not None else default_dir()
+    meta = _read_meta(d)
+    meta_f = d / META_FILE
+    data = meta.get("data")
+    if not isinstance(data, dict):
+        raise EyevizError(f"{str(meta_f)!r}: 'data' must be an object with the domain")
+    try:
+        trained = Domain3D.from_dict(data)
+    except (EyevizError, ValueError, TypeError, OverflowError) as exc:
+        raise EyevizError(f"{str(meta_f)!r}: bad data ({one_line(exc, 160)})") from None
+    hidden, arrays = read_weights(d / WEIGHTS_FILE)
+    if domain is None:
+        domain = trained
+    elif not isinstance(domain, Domain3D):
+        raise EyevizError(f"domain must be a Domain3D, got {type(domain).__name__}")
+    else:
+        check_design(domain, trained, str(d))
+    return Learned3DEstimator(hidden, arrays, domain, meta)
+
+
+def check_design(domain: Domain3D, trained: Domain3D, where: str) -> None:
+    """EyevizError unless ``domain`` has the trained eyes (h, l, nside) and ranges inside
+    the trained ones (the network was never shown anything else)."""
+    if domain.design != trained.design:
+        raise EyevizError(
+            f"learned3d weights in {where} are for h={trained.h:g}, l={trained.l:g}, "
+            f"nside={trained.nside}; the domain has h={domain.h:g}, l={domain.l:g}, "
+            f"nside={domain.nside} (train them for it with `eyeviz train learned3d`)"
+        )
+    for name, lo in (("r_min", True), ("r_max", False), ("g_max", False), ("el_max", False)):
+        have, was = getattr(domain, name), getattr(trained, name)
+        if (have < was * (1 - 1e-12)) if lo else (have > was * (1 + 1e-12)):
+            raise EyevizError(
+                f"learned3d weights in {where} were trained for {name}={was:g}; the domain's "
+                f"{name}={have:g} lies outside the trained range"
+            )
