@@ -109,7 +109,7 @@ class Presenter(QtCore.QObject):
         self._applied = 1.0  # the effective scale the widgets and labels have now
         self._hidden_docks: list[QtWidgets.QDockWidget] = []
         self._palette = _app().palette()
-        self._vtk_base: dict[Any, float] = {}
+        self._vtk_base: dict[Any, tuple[float, int]] = {}  # actor -> (size at 1, size set)
         self.shortcuts_dialog: ShortcutsDialog | None = None
         self.about_dialog: AboutModelDialog | None = None
         self._build_menus()
@@ -270,13 +270,15 @@ class Presenter(QtCore.QObject):
         eff = self._applied
         for actor in self._vtk_texts():
             tp = actor.GetTextProperty()
-            if actor not in self._vtk_base:
-                # made at scale 1 by the renderer (style_text); a label made after a scale
-                # change still has its own size
-                self._vtk_base[actor] = float(tp.GetFontSize())
-            size = max(1, round(self._vtk_base[actor] * eff))
+            base, last = self._vtk_base.get(actor, (0.0, -1))
+            if tp.GetFontSize() != last:
+                # new, or its layer chose another size since (a long inset line): that
+                # is its size at scale 1 (labels are made at scale 1 by style_text)
+                base = float(tp.GetFontSize())
+            size = max(1, round(base * eff))
             if tp.GetFontSize() != size:
                 tp.SetFontSize(size)
+            self._vtk_base[actor] = (base, size)
 
     def _on_model(self, what: str, _index: int | None) -> None:
         if what in ("feature", "view", "player", "selection"):

@@ -178,3 +178,26 @@ def test_three_estimators_fit_the_readout_uncut_at_1280x720(make_window, qtbot):
         fm = v.fontMetrics()
         for line in v.text().split("\n"):
             assert fm.horizontalAdvance(line) <= v.width(), line  # never elided
+
+
+@pytest.mark.parametrize("m", [720, 100000])
+def test_the_insets_m_theta_psi_line_stays_inside_the_inset(make_window, m):
+    from eyeviz.model.scene import Eyes, Feature, Scene, View
+
+    sc = Scene(
+        Eyes(40.0, 20.0, m),
+        [Feature("target", 0.0, 1500.0, 50.0)],
+        ["eyes", "bfv", "features", "labels"],
+        view=View((0.0, 2300.0), 7000.0),
+    )
+    win = make_window(sc)
+    win.resize(1280, 720)
+    win.fit_inset()
+    win.render()
+    assert win.inset_shown
+    foot = win.actors.labels.bfv_text["inset"]
+    assert f"m = {m}" in foot.GetInput() and "θ = 120°" in foot.GetInput()
+    box = [0.0] * 4
+    foot.GetBoundingBox(win.inset_ren, box)  # pixels about its anchor (centred)
+    width = win.inset_ren.GetSize()[0]
+    assert box[1] - box[0] <= 0.96 * width, (box, width)

@@ -12,7 +12,10 @@ from eyeviz.model.frame import Frame
 from eyeviz.render.vtk.primitives import Store, border_actor, screen_text, text3d
 from eyeviz.render.vtk.style import BFV_LINE, INK, LABEL_ALL_MAX, Z_POINT, rgbf, style_text
 
-__all__ = ["LabelsLayer", "bfv_line"]
+__all__ = ["INSET_LINE_CHARS", "INSET_LINE_PX", "LabelsLayer", "bfv_line"]
+
+INSET_LINE_PX = 14  # the inset's "m, θ, ψ" line
+INSET_LINE_CHARS = 26  # characters of it that fit the smallest inset at INSET_LINE_PX
 
 
 def bfv_line(frame: Frame) -> str:
@@ -36,7 +39,7 @@ class LabelsLayer:
         self.main_eye_labels: list[vtkBillboardTextActor3D] = []
         self.feature_labels: list[vtkBillboardTextActor3D] = []
         self.bfv_text = {
-            "inset": screen_text(14, BFV_LINE, (0.5, 0.03), center=True),
+            "inset": screen_text(INSET_LINE_PX, BFV_LINE, (0.5, 0.03), center=True),
             "main": screen_text(20, BFV_LINE, (0.985, 0.02), right=True),
         }
         inset.AddViewProp(self.bfv_text["inset"])
@@ -86,6 +89,9 @@ class LabelsLayer:
         self.inset_label.SetInput("")
         text = bfv_line(frame)
         self.bfv_text["inset"].SetInput(text)
+        # a long line (m = 100000) gets smaller text: it stays inside the inset
+        size = INSET_LINE_PX * min(1.0, INSET_LINE_CHARS / max(len(text), 1))
+        self.bfv_text["inset"].GetTextProperty().SetFontSize(max(9, int(size)))
         self.bfv_text["main"].SetInput(text if "θ" in text else "")
         self.place_bfv_text()
 
