@@ -60,7 +60,8 @@ PRESET_KEYS = (
     ("eye_a", "Along eye &A's axis", "4"),
     ("eye_b", "Along eye &B's axis", "5"),
 )
-PANEL_MS = 100  # the docks follow a drag at <= 10 Hz; its end refreshes them at once
+PANEL_MS = 200  # the docks follow a drag at <= 5 Hz (the Mollweide maps take ~75 ms at
+# nside 180); the drag's end refreshes them at once
 _MOD_DEPTH = QtCore.Qt.KeyboardModifier.ShiftModifier | QtCore.Qt.KeyboardModifier.ControlModifier
 
 

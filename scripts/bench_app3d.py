@@ -1,0 +1,238 @@
+"""Latency of the app's 3D view: a ball's drag frame against a bare render of the same
+window, window-up time, and memory at nside 180 (issue 22, item 7).
+
+Runs under Xvfb (re-executes itself with xvfb-run when $DISPLAY is unset), 1280x800,
+this machine's software OpenGL. For nside 16 and nside 180 (the paper's eyes: 388,800
+facets per eye) with 8 balls in the paper's regime (r 1000-5000, elevation within 30
+degrees) it presses on a ball in the 3D view, sends >= 200 mouse-move events along a
+path and times each from the event to the end of the first frame that reflects it (the
+view coalesces moves: the model moves the ball at once, the lit sets are recomputed and
+one pending frame draws them; the clock stops when that VTK render has finished and the
+Qt panels are painted; the Mollweide and readout docks follow at <= 5 Hz, inside the
+timed frames). Right after each drag frame it times a bare re-render of the same window
+(the baseline, same run, same state): drag p50 and p95 are reported as ratios to the
+bare render's p50 and p95 (targets: p50 <= 1.5x, p95 <= 1.6x), beside the absolute
+figures.
+
+One run (2026-11-25, the shared 2-core machine, load ~4, llvmpipe): nside 16 drag p50
+41.5 ms / p95 95.2 ms against bare 34.2 / 75.8 ms (1.21x, 1.26x); nside 180 drag 72.4 /
+181.3 ms against bare 54.8 / 139.1 ms (1.32x, 1.30x); window up 1.67 s; 409 MB resident
+at nside 180 (peak 423 MB). With the docks at 10 Hz the nside 180 ratios were 1.45x and
+1.51x (the Mollweide maps' update takes ~75 ms there).
+
+Window-up: a whole process, start to the first rendered frame of sphere_paper.toml
+(nside 180), median of 3, target <= 3 s; the same process reports its resident memory
+(VmRSS and the peak VmHWM) once the window is up and after 20 renders.
+
+    xvfb-run -a .venv/bin/python scripts/bench_app3d.py [--events 240]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = (16, 180)
+N_BALLS = 8
+P50_RATIO, P95_RATIO = 1.5, 1.6
+UP_TARGET_S = 3.0
+
+
+def _scene(nside: int):
+    import numpy as np
+
+    from eyeviz.model.scene import OKABE_ITO, Eyes, Feature, Scene
+
+    rng = np.random.default_rng(7)
+    fs = []
+    for i in range(N_BALLS - 1):
+        r = rng.uniform(1000, 5000)
+        az = rng.uniform(math.radians(40), math.radians(140))
+        el = rng.uniform(math.radians(-30), math.radians(30))
+        fs.append(
+            Feature(
+                f"b{i}",
+                r * math.cos(el) * math.cos(az),
+                r * math.cos(el) * math.sin(az),
+                float(rng.uniform(30, 300)),
+                OKABE_ITO[i % len(OKABE_ITO)],
+                r * math.sin(el),
+            )
+        )
+    fs.append(Feature("dragged", 0.0, 1500.0, 120.0, OKABE_ITO[0], 0.0))
+    layers = ["eyes", "features", "bfv", "bitmaps", "readout", "labels", "tangents", "plane"]
+    return Scene(Eyes(40.0, 20.0, nside=nside), fs, layers)
+
+
+def _pct(v, q):
+    s = sorted(v)
+    return s[min(len(s) - 1, int(round(q / 100 * (len(s) - 1))))]
+
+
+def bench_drag(nside: int, events: int, settings: str) -> dict:
+    from PyQt5 import QtCore
+    from PyQt5.QtTest import QTest
+
+    from eyeviz.app.window import MainWindow, make_app, make_settings
+
+    app = make_app()
+    win = MainWindow(_scene(nside), settings=make_settings(settings))
+    win.resize(1280, 800)
+    win.show()
+    for _ in range(5):
+        app.processEvents()
+    host = win.host3d
+    host.set_preset("default")
+    w = host.view
+    rw = w.ren_win
+    dragged = len(host.model.scene.features) - 1
+
+    def centre():
+        assert dragged is not None
+        f = host.model.scene.features[dragged]
+        return (f.x, f.y, f.z)
+
+    def frame(before: int, was) -> bool:
+        """Until the frame drawn after the event; False when the event changed nothing."""
+        idle = 0
+        while w.frames == before:
+            app.processEvents()
+            if not host._frame_timer.isActive() and not host._dirty and centre() == was:
+                idle += 1
+                if idle > 3:
+                    return False
+        rw.WaitForCompletion()
+        app.processEvents()  # the docks' paint events
+        return True
+
+    base = []
+
+    def bare() -> None:
+        t0 = time.perf_counter()
+        w.draw()
+        rw.WaitForCompletion()
+        base.append(1e3 * (time.perf_counter() - t0))
+
+    for _ in range(10):  # warm-up
+        w.draw()
+        rw.WaitForCompletion()
+    px, py = host.scene_pixel(centre())
+    start = QtCore.QPoint(round(px), round(py))
+    win_in = w.windowHandle()
+    QTest.mousePress(win_in, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
+    assert host._drag is not None, "the press did not grab a ball"
+    dragged = host.model.selected  # the nearest ball under the pointer
+    c0 = centre()
+    lat = []
+    p = start
+    for k in range(events + 10):
+        a = 2 * math.pi * k / 80
+        p = start + QtCore.QPoint(round(120 * math.sin(a)) + k % 3, round(-50 * (1 - math.cos(a))))
+        t0 = time.perf_counter()
+        before = w.frames
+        was = centre()
+        QTest.mouseMove(win_in, p)
+        drew = frame(before, was)
+        if k >= 10 and drew:  # the first moves cross the click/drag threshold
+            lat.append(1e3 * (time.perf_counter() - t0))
+            bare()
+    QTest.mouseRelease(win_in, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, p)
+    moved = centre() != c0
+    steps = win.undo_stack.count()
+    lit = int(host.model.state.facets_a[dragged]) + int(host.model.state.facets_b[dragged])
+    win.force_close()
+    app.processEvents()
+    return {"lat": lat, "base": base, "moved": moved, "undo_steps": steps, "lit": lit}
+
+
+def bench_up(settings: str) -> tuple[float, list[str]]:
+    code = (
+        "import time; t0 = time.perf_counter()\n"
+        "from eyeviz.app.window import MainWindow, make_app, make_settings\n"
+        "from eyeviz.model.scene import load\n"
+        "app = make_app()\n"
+        f"w = MainWindow(load({str(ROOT / 'assets/scenes/sphere_paper.toml')!r}), "
+        f"settings=make_settings({settings!r}))\n"
+        "w.show(); app.processEvents(); w.host3d.draw()\n"
+        "w.host3d.view.ren_win.WaitForCompletion()\n"
+        "print('up', flush=True)\n"
+        "def mem():\n"
+        "    d = dict(l.split(':', 1) for l in open('/proc/self/status') if ':' in l)\n"
+        "    return d['VmRSS'].strip(), d['VmHWM'].strip()\n"
+        "print('mem up', *mem(), flush=True)\n"
+        "for _ in range(20): w.host3d.draw(); app.processEvents()\n"
+        "print('mem 20 renders', *mem(), flush=True)\n"
+        "w.force_close()\n"
+    )
+    times = []
+    mem: list[str] = []
+    for _ in range(3):
+        t0 = time.perf_counter()
+        p = subprocess.Popen(
+            [sys.executable, "-c", code],
+            stdout=subprocess.PIPE,
+            text=True,
+            stderr=subprocess.DEVNULL,
+        )
+        assert p.stdout is not None
+        mem = []
+        for line in p.stdout:
+            if line.strip() == "up":
+                times.append(time.perf_counter() - t0)
+            elif line.startswith("mem"):
+                mem.append(line.strip())
+        p.wait()
+    return statistics.median(times), mem
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--events", type=int, default=240, help="mouse-move events per case (>= 200)")
+    args = ap.parse_args()
+    if not os.environ.get("DISPLAY"):
+        xvfb = shutil.which("xvfb-run")
+        if xvfb is None:
+            print("needs a display or xvfb-run", file=sys.stderr)
+            return 2
+        cmd = [xvfb, "-a", "-s", "-screen 0 1920x1080x24", sys.executable, *sys.argv]
+        return subprocess.call(cmd)
+    os.environ.setdefault("QT_API", "pyqt5")
+    settings = str(Path(tempfile.mkdtemp()) / "settings.json")
+    ok = True
+    print(f"3D view drag frame vs bare render of the same window ({N_BALLS} balls, 1280x800)")
+    for nside in CASES:
+        r = bench_drag(nside, args.events, settings)
+        lat, base = r["lat"], r["base"]
+        p50, p95 = _pct(lat, 50), _pct(lat, 95)
+        b50, b95 = _pct(base, 50), _pct(base, 95)
+        r50, r95 = p50 / b50, p95 / b95
+        good = r50 <= P50_RATIO and r95 <= P95_RATIO and r["moved"] and r["undo_steps"] == 1
+        ok &= good
+        print(
+            f"nside {nside:>3} ({12 * nside * nside:,} facets/eye): {len(lat)} frames; "
+            f"drag p50 {p50:.1f} ms p95 {p95:.1f} ms; bare p50 {b50:.1f} ms p95 {b95:.1f} ms; "
+            f"ratio p50 {r50:.2f}x (<= {P50_RATIO}) p95 {r95:.2f}x (<= {P95_RATIO}); "
+            f"moved {r['moved']}, undo steps {r['undo_steps']}, dragged ball lights {r['lit']:,} "
+            f"facets: {'OK' if good else 'MISSED'}"
+        )
+    up, mem = bench_up(settings)
+    ok &= up <= UP_TARGET_S
+    print(f"window up (sphere_paper.toml, nside 180): {up:.2f} s median of 3 (<= {UP_TARGET_S} s)")
+    for m in mem:
+        words = m.split()
+        when, rss, hwm = " ".join(words[1:-4]), " ".join(words[-4:-2]), " ".join(words[-2:])
+        print(f"memory at nside 180 ({when}): VmRSS {rss}, peak VmHWM {hwm}")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
