@@ -206,8 +206,8 @@ class CanvasMixin(_MainWindow):
         self._fitted_view = self.model.scene.view
 
     def _path_box(self) -> tuple[float, float, float, float] | None:
-        """What F frames besides the eyes and the features: the shown trajectory's path
-        and the estimators' ghost discs (issue 24: none under the title or cut)."""
+        """What F frames besides the eyes and the features: the shown trajectory's path,
+        the estimators' ghost discs and the sector rays (issue 24: none under the title)."""
         xs: list[float] = []
         ys: list[float] = []
         panel = getattr(self, "trajectory_panel", None)
@@ -226,6 +226,13 @@ class CanvasMixin(_MainWindow):
             x, y, gg = r[ok] * np.cos(phi[ok]), r[ok] * np.sin(phi[ok]), g[ok]
             xs += [float((x - gg).min()), float((x + gg).max())]
             ys += [float((y - gg).min()), float((y + gg).max())]
+        # the selected feature's sector rays (they reach past the disc: none under the title
+        # or its tangents' note)
+        sectors = self.actors.painters.get("sectors")
+        if self.model.scene.shows("sectors") and getattr(sectors, "shown", False):
+            pts = np.asarray(sectors.mesh.points)[:, :2]  # type: ignore[union-attr]
+            xs += [float(pts[:, 0].min()), float(pts[:, 0].max())]
+            ys += [float(pts[:, 1].min()), float(pts[:, 1].max())]
         if not xs:
             return None
         return min(xs), max(xs), min(ys), max(ys)

@@ -201,3 +201,23 @@ def test_the_insets_m_theta_psi_line_stays_inside_the_inset(make_window, m):
     foot.GetBoundingBox(win.inset_ren, box)  # pixels about its anchor (centred)
     width = win.inset_ren.GetSize()[0]
     assert box[1] - box[0] <= 0.96 * width, (box, width)
+
+
+def test_figure3b_opens_with_its_sector_rays_clear_of_the_title_and_the_tangents_note(
+    make_window, qtbot
+):
+    import numpy as np
+
+    path = scene_path("figure3b")
+    win = make_window(load(path), path)
+    win.resize(1280, 720)
+    qtbot.waitUntil(lambda: win.width() == 1280, timeout=3000)
+    win.frame_bundled()
+    win.render()
+    sectors = win.actors.painters["sectors"]
+    assert sectors.shown
+    band = win.title_band_px()
+    assert band > 48  # the title and the tangents' note under it
+    vp, view = win.viewport("main"), win.model.scene.view
+    for x, y in np.asarray(sectors.mesh.points)[:, :2]:
+        assert to_pixel(view, vp, x, y)[1] >= band, (x, y)
