@@ -62,8 +62,8 @@ __all__ = [
 
 #: The eyes' close-up takes this fraction of the view's width (left); the scene the rest.
 EYES_FRACTION = 0.4
-EDGE_RGB = (0.45, 0.45, 0.45)  # facet edges (nside <= EDGES_MAX_NSIDE)
-EDGES_MAX_NSIDE = 16
+EDGE_RGB = (0.55, 0.55, 0.55)  # facet edges (nside <= EDGES_MAX_NSIDE)
+EDGES_MAX_NSIDE = 8  # at 16 the edges of a ~100 px eye hide its facets
 BFV_RGB = (0.80, 0.72, 0.35)
 BFV_OPACITY = 0.16
 CONE_OPACITY = 0.28
