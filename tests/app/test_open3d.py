@@ -168,3 +168,47 @@ def test_export_png_and_svg(make_window, tmp_path):
     root = ET.parse(svg).getroot()
     assert len(root.findall(".//{http://www.w3.org/2000/svg}path")) > 100
     assert QtWidgets.QApplication.instance() is not None
+
+
+def test_a_drag_on_the_background_turns_the_camera_and_the_eyes_follow(make_window, qtbot):
+    """Standard VTK camera interaction (trackball) where no ball is under the pointer; the
+    eyes' close-up keeps looking from the scene camera's direction."""
+    if shutil.which("xdotool") is None:
+        pytest.fail("xdotool is needed for this test: apt-get install xdotool")
+    win = make_window(load(SCENES / "sphere_teaching.toml"))
+    win.activateWindow()
+    win.raise_()
+    host = win.host3d
+    host.set_preset("front")
+    qtbot.wait(50)
+    cam0 = host.camera()
+    # the scene viewport's top-right corner: background
+    p = host.view.mapToGlobal(QtCore.QPoint(host.view.width() - 40, 60))
+    _xdo(qtbot, "mousemove", p.x(), p.y())
+    _xdo(qtbot, "mousedown", 1)
+    for k in range(1, 9):
+        _xdo(qtbot, "mousemove", p.x() - 10 * k, p.y() + 4 * k)
+    _xdo(qtbot, "mouseup", 1)
+    qtbot.waitUntil(lambda: host.camera().position != cam0.position, timeout=3000)
+    assert win.undo_stack.count() == 0  # a camera move is no scene edit
+    host.draw()
+    from eyeviz.render.vtk.scene3d import camera_of
+
+    eyes = camera_of(host.actors.eyes_ren)
+    cam = host.camera()
+    d0 = np.subtract(cam.position, cam.focal_point)
+    d1 = np.subtract(eyes.position, eyes.focal_point)
+    np.testing.assert_allclose(d0 / np.linalg.norm(d0), d1 / np.linalg.norm(d1), atol=1e-9)
+
+
+def test_save_writes_the_spherical_scene(make_window, tmp_path):
+    win = make_window(load(SCENES / "sphere_teaching.toml"))
+    host = win.host3d
+    host.model.move(0, (10.0, 320.0, 25.0), "Nudge ahead")
+    out = tmp_path / "s.toml"
+    assert win.save_path(out)
+    back = load(out)
+    assert back.kind == "spherical" and back.eyes.nside == 8
+    f = back.features[0]
+    assert (f.x, f.y, f.z) == (10.0, 320.0, 25.0)
+    assert win.undo_stack.isClean()
