@@ -47,6 +47,24 @@ from eyeviz.model.camera3d import Camera3D, eyes_camera, preset, project
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.mpl.style import SMALL, short
+from eyeviz.render.style3d import (
+    BALL_LIGHT,
+    BFV_OPACITY,
+    BFV_RGB,
+    CONE_OPACITY,
+    EDGE_RGB,
+    EDGES_MAX_NSIDE,
+    EYE_CONE,
+    EYE_LIGHT,
+    EYES_FRACTION,
+    GRID_OPACITY,
+    INK_RGB,
+    INSET_RGB,
+    PLANE_OPACITY,
+    PLANE_RGB,
+    UNLIT_RGB,
+    split_viewports,
+)
 
 __all__ = [
     "EYES_FRACTION",
@@ -59,22 +77,17 @@ __all__ = [
     "split_viewports",
 ]
 
-# The VTK view's looks (eyeviz/render/vtk/scene3d.py and style.py), mirrored here: this
-# module must not import VTK (snapshot runs without it); tests/render/test_figure3d_vtk.py
-# compares the two pictures.
-EYES_FRACTION = 0.4
-UNLIT_RGBA = (225 / 255, 225 / 255, 225 / 255, 1.0)
-EDGE_RGBA = (0.45, 0.45, 0.45, 1.0)
-EDGES_MAX_NSIDE = 16
-BFV_RGBA = (0.80, 0.72, 0.35, 0.16)
-PLANE_RGBA = (0.55, 0.62, 0.75, 0.10)
-GRID_RGBA = (0.55, 0.62, 0.75, 0.6)
-CONE_ALPHA = 0.28
-EYE_CONE = 4.0  # the close-up draws the cones this many eye radii long
-INSET_RGBA = (0.965, 0.965, 0.955, 1.0)
-INK_RGBA = (0.15, 0.15, 0.15, 1.0)
-EYE_LIGHT = (0.45, 0.6)  # ambient, diffuse
-BALL_LIGHT = (0.35, 0.7)
+# The looks the VTK view shares (eyeviz/render/style3d.py: one place for both painters;
+# this module must not import VTK, snapshot runs without it);
+# tests/render/test_figure3d_vtk.py compares the two pictures.
+UNLIT_RGBA = (*UNLIT_RGB, 1.0)
+EDGE_RGBA = (*EDGE_RGB, 1.0)
+BFV_RGBA = (*BFV_RGB, BFV_OPACITY)
+PLANE_RGBA = (*PLANE_RGB, PLANE_OPACITY)
+GRID_RGBA = (*PLANE_RGB, GRID_OPACITY)
+CONE_ALPHA = CONE_OPACITY
+INSET_RGBA = (*INSET_RGB, 1.0)
+INK_RGBA = (*INK_RGB, 1.0)
 SEAM = 0.3  # pt: facets outlined in their own colour, so no seam shows between them
 LINE_PIECES = 24  # a grid line of the plane is cut in this many pieces to sort
 #: The balls are HEALPix spheres of this nside (192 facets, the front ~96 drawn).
@@ -86,13 +99,6 @@ CONE_BANDS = 8  # pieces along it
 SMALL_EYE = 0.04
 #: Layers the view draws (the others are drawn elsewhere or not at all).
 VIEW_LAYERS = ("eyes", "features", "tangents", "plane", "bfv")
-
-
-def split_viewports(w: float, h: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """(eyes, scene) viewports (xmin, ymin, xmax, ymax), fractions of a ``w`` x ``h`` view:
-    the VTK view's split (``eyeviz.render.vtk.scene3d.split_viewports``)."""
-    f = EYES_FRACTION if w >= 2.0 * h * EYES_FRACTION else 0.5
-    return (0.0, 0.0, f, 1.0), (f, 0.0, 1.0, 1.0)
 
 
 @dataclass

@@ -37,6 +37,16 @@ from eyeviz.model import shapes3d
 from eyeviz.model.camera3d import Camera3D, eyes_camera
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
+from eyeviz.render.style3d import (  # the looks the vector view shares (one place)
+    BFV_OPACITY,
+    BFV_RGB,
+    CONE_OPACITY,
+    EDGE_RGB,
+    EDGES_MAX_NSIDE,
+    EYE_CONE,
+    EYES_FRACTION,
+    PLANE_RGB,
+)
 from eyeviz.render.vtk.primitives import (
     Store,
     actor,
@@ -60,21 +70,12 @@ __all__ = [
     "split_viewports",
 ]
 
-#: The eyes' close-up takes this fraction of the view's width (left); the scene the rest.
-EYES_FRACTION = 0.4
-EDGE_RGB = (0.55, 0.55, 0.55)  # facet edges (nside <= EDGES_MAX_NSIDE)
-EDGES_MAX_NSIDE = 8  # at 16 the edges of a ~100 px eye hide its facets
-BFV_RGB = (0.80, 0.72, 0.35)
-BFV_OPACITY = 0.16
-CONE_OPACITY = 0.28
-PLANE_RGB = (0.55, 0.62, 0.75)
 SELECT_RGB = INK
 CONE_RES = 40
 #: the lit patch of ball i lies at radius l (1 + PATCH_LIFT (1 + i / n)): above the
 #: coarse sphere, a later ball's above an earlier one's (the last one's colour wins)
 PATCH_LIFT = 0.004
 LABEL_PX = 20
-EYE_CONE = 4.0  # the eyes' close-up draws the tangent cones this many eye radii long
 
 
 def split_viewports(w: float, h: float) -> tuple[tuple[float, ...], tuple[float, ...]]:
