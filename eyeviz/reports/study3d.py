@@ -65,9 +65,14 @@ class Design3D:
 
 
 def choose_estimator(rows: list[dict]) -> str:
-    """``limit`` when the table has it, else the only estimator, else the first by name."""
-    names = sorted({r["estimator"] for r in rows})
-    return "limit" if "limit" in names else names[0]
+    """``limit`` when the table has it, else the estimator measured on the most designs
+    (of those, the first by name)."""
+    designs: dict[str, set] = {}
+    for r in rows:
+        designs.setdefault(r["estimator"], set()).add((r["h"], r["l"], r["nside"]))
+    if "limit" in designs:
+        return "limit"
+    return min(designs, key=lambda e: (-len(designs[e]), e))
 
 
 def designs3d(rows: list[dict], estimator: str, prior: str) -> dict[tuple, Design3D]:
@@ -227,6 +232,19 @@ def write_report3d(
                 "el_mae_over_gamma": d.all["el_mae_deg"] / math.degrees(d.gamma),
             }
             for d in sorted(designs.values(), key=lambda d: d.key)
+        ],
+        "other_estimators": [  # the table's other estimators, overall, beside the drawn one
+            {
+                "estimator": r["estimator"],
+                "h": r["h"],
+                "l": r["l"],
+                "nside": r["nside"],
+                "n": r["n"],
+                "seed": r["seed"],
+                **{k: r[k] for k in ("dd_mape", "ad_mape", "el_mae_deg", "az_mae_deg")},
+            }
+            for r in rows
+            if r["bin"] == "all" and r["estimator"] != est and r["prior"] == prior
         ],
     }
     text = json.dumps(summary, indent=1, allow_nan=False) + "\n"
