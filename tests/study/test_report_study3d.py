@@ -73,3 +73,15 @@ def test_the_power_law_fit_recovers_known_exponents():
     # a parameter that does not vary is left out, not fitted
     same_l = [p for p in pts if p.l == 5.0]
     assert fit_power(same_l)["exp_l"] is None
+
+
+def test_the_report_draws_the_limit_else_the_estimator_of_the_most_designs():
+    from eyeviz.reports.study3d import choose_estimator
+
+    def rows(spec):
+        return [{"estimator": e, "h": 40.0, "l": 20.0, "nside": n} for e, ns in spec for n in ns]
+
+    tri = ("triangulation", (16, 32, 64))
+    assert choose_estimator(rows([tri, ("learned3d", (180,))])) == "triangulation"
+    assert choose_estimator(rows([tri, ("limit", (16,))])) == "limit"
+    assert choose_estimator(rows([("b", (16,)), ("a", (32,))])) == "a"
