@@ -181,6 +181,8 @@ class FilesMixin(_MainWindow):
         except SceneError as exc:
             self.show_error("Cannot open scene", str(exc))
             return False
+        if scene.kind == "spherical" and not self.host3d.check(scene):
+            return False  # lit sets the 3D view cannot hold: one line, the scene kept
         self.model.finish_gestures()
         self._set_path(path)
         self.undo_stack.clear()

@@ -194,6 +194,17 @@ class Scene3DHost(QtCore.QObject):
             self.model.set_layer(layer, bool(on))
 
     # --- swapping ------------------------------------------------------------------------
+    def check(self, scene: Scene) -> bool:
+        """Whether the view can hold ``scene`` (else a one-line dialog; nothing changes)."""
+        from eyeviz import EyevizError
+
+        try:
+            m3.checked_state(scene)
+        except EyevizError as exc:
+            self.win.show_error("Cannot open scene", str(exc))
+            return False
+        return True
+
     def open(self, scene: Scene) -> None:
         """Show ``scene`` (spherical) in the 3D page, swapping the planar page out."""
         if self.view is None:
@@ -410,6 +421,8 @@ class Scene3DHost(QtCore.QObject):
             self._drag.send(p)
         except StopIteration:
             self._drag = None
+        except ValueError as exc:  # a move the view cannot draw: the ball stays
+            self.win.statusBar().showMessage(str(exc), 8000)
 
     def _end_drag(self) -> None:
         if self._drag is not None:
@@ -439,7 +452,12 @@ class Scene3DHost(QtCore.QObject):
         if steps is None:
             return False
         vp = self.pointer("move", 0, 0)
-        m3.nudge(self.model, self.camera(), vp.h, *steps)
+        from eyeviz import EyevizError
+
+        try:
+            m3.nudge(self.model, self.camera(), vp.h, *steps)
+        except (EyevizError, ValueError) as exc:  # the ball stays
+            self.win.statusBar().showMessage(str(exc), 8000)
         return True
 
     # --- edits from the window's Edit menu -------------------------------------------------

@@ -171,7 +171,7 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
             self._add_recent(Path(path))  # the file named on the command line too
         self.fit_inset()
         self._on_model("scene", None)
-        if scene.kind == "spherical":
+        if scene.kind == "spherical" and self.host3d.check(scene):
             self.host3d.open(scene)
         self._update_title()
 

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from eyeviz import EyevizError
 from eyeviz.model.camera3d import Camera3D, basis
 from eyeviz.model.scene import OKABE_ITO, Feature, Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
@@ -36,7 +37,9 @@ __all__ = [
     "NUDGE_DEPTH",
     "NUDGE_PX",
     "PICK_PX",
+    "MAX_VIEW_LIT",
     "AppModel3D",
+    "checked_state",
     "Pointer",
     "drag_ball",
     "nudge",
@@ -49,6 +52,9 @@ PICK_PX = 8.0  # a ball is grabbed within this many pixels of its drawn outline
 DEPTH_PX = 200.0  # a depth drag of this many pixels changes the distance by a factor e
 NUDGE_PX = 10.0  # one arrow key
 NUDGE_DEPTH = 0.05  # one depth key: the distance times exp(+-0.05)
+#: The 3D view holds at most this many lit facets (both eyes, all balls; 128 MB of
+#: indices): a scene or an edit beyond it is refused in one line, the scene kept.
+MAX_VIEW_LIT = 1 << 24
 
 
 @dataclass(frozen=True)
@@ -98,6 +104,18 @@ def pick_ball(cam: Camera3D, p: Pointer, x, y, z, g) -> int | None:
     return int(np.argmin(front))
 
 
+def checked_state(scene: Scene) -> SceneState3D:
+    """:func:`compute_state3d`, refused (EyevizError, one line) beyond MAX_VIEW_LIT."""
+    st = compute_state3d(scene)
+    n = sum(int(c[1].size) for c in (st.lit_a, st.lit_b) if c is not None)
+    if n > MAX_VIEW_LIT:
+        raise EyevizError(
+            f"the balls light {n:,} facets at nside {st.pair.nside}; the 3D view draws at "
+            f"most {MAX_VIEW_LIT:,} (smaller balls, farther balls or a smaller nside)"
+        )
+    return st
+
+
 @dataclass
 class _Live:
     before: Scene
@@ -129,7 +147,7 @@ class AppModel3D:
     def state(self) -> SceneState3D:
         """The scene's state (:func:`compute_state3d`), recomputed after each change."""
         if self._state is None:
-            self._state = compute_state3d(self.scene)
+            self._state = checked_state(self.scene)
         return self._state
 
     def _notify(self, what: str, index: int | None = None) -> None:
@@ -152,10 +170,12 @@ class AppModel3D:
         self._notify("scene")
 
     def commit(self, after: Scene, text: str, merge_key=None) -> None:
-        """One undoable edit to ``after`` (edits with one ``merge_key`` merge)."""
+        """One undoable edit to ``after`` (edits with one ``merge_key`` merge); an edit
+        whose state the view cannot hold raises EyevizError and changes nothing."""
         self.end_live()
         before = self.scene.copy()
         if after != before:
+            checked_state(after)
             self.push(before, after.copy(), text, merge_key)
 
     @property
@@ -187,8 +207,17 @@ class AppModel3D:
             raise ValueError(f"live() changes x, y, z or g only, got {', '.join(sorted(bad))}")
         checked = {k: _finite(k, v) for k, v in values.items()}
         f = self.scene.features[index]
+        old = {k: getattr(f, k) for k in checked}
         for k, v in checked.items():
             setattr(f, k, v)
+        self._state = None
+        try:
+            self.state  # noqa: B018 (computed now: a refused move leaves the ball where it was)
+        except EyevizError as exc:
+            for k, v in old.items():
+                setattr(f, k, v)
+            self._state = None
+            raise ValueError(str(exc)) from None
         self._notify("feature", index)
 
     def select(self, index: int | None) -> None:

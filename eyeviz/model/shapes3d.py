@@ -25,6 +25,7 @@ __all__ = [
     "edge_step",
     "facet_mesh",
     "facet_owner",
+    "patch_facets",
     "plane_z0",
     "bounding_ball",
     "scene_extent",
@@ -83,6 +84,26 @@ def facet_mesh(
     faces[:, 0] = k
     faces[:, 1:] = np.arange(pix.size * k, dtype=np.int64).reshape(pix.size, k)
     return pts, faces.ravel()
+
+
+#: A ball's lit facets are drawn one cell each up to this many per eye; beyond (a large
+#: ball near the eye at a large nside) as the facets of nside PATCH_COARSE_NSIDE their
+#: centres fall in (a sample of at most this many), so a frame stays bounded.
+MAX_PATCH_FACETS = 200_000
+PATCH_COARSE_NSIDE = 64
+
+
+def patch_facets(nside: int, pix: np.ndarray) -> tuple[int, np.ndarray]:
+    """(nside, facets) to draw for the lit facets ``pix`` of one eye at ``nside``: the
+    facets themselves, or beyond :data:`MAX_PATCH_FACETS` the coarse facets holding a
+    sample of their centres."""
+    pix = np.asarray(pix, dtype=np.int64)
+    if pix.size <= MAX_PATCH_FACETS or nside <= PATCH_COARSE_NSIDE:
+        return int(nside), pix
+    step = -(-pix.size // MAX_PATCH_FACETS)
+    v = healpix.centers(nside, pix[::step])
+    coarse = healpix.vec2pix_ring(PATCH_COARSE_NSIDE, v[:, 0], v[:, 1], v[:, 2])
+    return PATCH_COARSE_NSIDE, np.unique(coarse)
 
 
 def facet_owner(state: SceneState3D, eye: str, out: np.ndarray | None = None) -> np.ndarray:

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from eyeviz import EyevizError
 from eyeviz.model import app_model3d as m3
 from eyeviz.model.camera3d import Camera3D, basis, preset, project, to_pixels
 from eyeviz.model.scene import Eyes, Feature, Scene
@@ -165,3 +166,19 @@ def test_edits_are_undo_steps():
     m.set_layer("tangents", True)
     assert [s[2] for s in steps] == ["Add ball", "Duplicate a", "Delete b", "Show tangents"]
     assert isinstance(preset("side", 40.0, 20.0, 1.0), Camera3D)
+
+
+def test_lit_sets_beyond_the_view_bound_are_refused_and_nothing_moves(monkeypatch):
+    m, steps = _model()
+    n0 = sum(int(c[1].size) for c in (m.state.lit_a, m.state.lit_b))
+    monkeypatch.setattr(m3, "MAX_VIEW_LIT", n0 + 10)
+    m.begin_live("Move a")
+    with pytest.raises(ValueError, match="3D view draws at most"):
+        m.live(0, y=60.0)  # next to the eyes: a large cap on each
+    assert m.scene.features[0].y == 300.0
+    m.end_live()
+    after = m.scene.copy()
+    after.features[0].y = 60.0
+    with pytest.raises(EyevizError, match="3D view draws at most"):
+        m.commit(after, "Move a")
+    assert not steps and m.scene.features[0].y == 300.0

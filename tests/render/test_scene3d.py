@@ -214,3 +214,20 @@ def test_shapes_bounding_ball_holds_everything():
         assert np.linalg.norm(np.subtract((f.x, f.y, f.z), c)) + f.g <= r + 1e-9
     for cx in (-40.0, 40.0):
         assert np.linalg.norm(np.subtract((cx, 0, 0), c)) + 20.0 <= r + 1e-9
+
+
+def test_a_huge_lit_set_is_drawn_on_coarse_facets(monkeypatch):
+    from eyeviz.core import healpix as hp
+
+    monkeypatch.setattr(shapes3d, "MAX_PATCH_FACETS", 500)
+    sc = _scene(180, [("t", 0.0, 120.0, 0.0, 60.0, "#D55E00")])
+    st = compute_state3d(sc)
+    pix = st.lit(0, "A")
+    assert pix.size > 500
+    dn, dpix = shapes3d.patch_facets(180, pix)
+    assert dn == shapes3d.PATCH_COARSE_NSIDE and 0 < dpix.size < pix.size
+    # every coarse facet drawn holds lit facets: the coarse facet of a lit centre
+    v = hp.centers(180, pix)
+    owners = set(hp.vec2pix_ring(dn, v[:, 0], v[:, 1], v[:, 2]).tolist())
+    assert set(dpix.tolist()) <= owners
+    assert shapes3d.patch_facets(180, pix[:400])[0] == 180  # small sets: themselves

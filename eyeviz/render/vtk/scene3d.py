@@ -347,7 +347,8 @@ class Scene3DActors:
                         continue
                     cx = (-pair.h, pair.h)[e]
                     lift = pair.l * (1.0 + PATCH_LIFT * (1.0 + i / max(n, 1)))
-                    pts, faces = shapes3d.facet_mesh(pair.nside, (cx, 0.0, 0.0), lift, pix, step=1)
+                    dn, dpix = shapes3d.patch_facets(pair.nside, pix)
+                    pts, faces = shapes3d.facet_mesh(dn, (cx, 0.0, 0.0), lift, dpix, step=1)
                     fresh = pv.PolyData(pts, faces) if pix.size else pv.PolyData()
                     mesh.ShallowCopy(fresh)
                     a.GetProperty().SetColor(*(pal[i] / 255.0))
