@@ -103,13 +103,13 @@ class _Rings:
         """Ring number (1 .. 4 nside - 1) of each pixel."""
         return np.searchsorted(self.first, pix, side="right") - 1
 
-    def partial(self, k: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """Sum of the centres of cells a..b (positions in ring k, a <= b), (n, 3)."""
+    def partial(self, k: np.ndarray, a: np.ndarray, b: np.ndarray) -> list[np.ndarray]:
+        """Sums of the centres of cells a..b (positions in ring k, a <= b): [x, y, z]."""
         d = self.step[k]
         n = (b - a + 1).astype(np.float64)
         amp = self.amp[k] * np.sin(0.5 * d * n)
         mid = self.phi0[k] + 0.5 * d * (a + b)
-        return np.stack([amp * np.cos(mid), amp * np.sin(mid), n * self.z[k]], axis=-1)
+        return [amp * np.cos(mid), amp * np.sin(mid), n * self.z[k]]
 
 
 def _runs(indptr: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -180,8 +180,9 @@ def eye_summaries(
         kc = ks[cross]
         kd = rings.ring(e[cross])
         bd = e[cross] - rings.first[kd]
-        tot[cross] += rings.partial(kd, np.zeros_like(kd), bd)
-        tot[cross, 2] += rings.zcum[kd] - rings.zcum[kc + 1]
+        for col, extra in zip(tot, rings.partial(kd, np.zeros_like(kd), bd), strict=True):
+            col[cross] += extra
+        tot[2][cross] += rings.zcum[kd] - rings.zcum[kc + 1]
         west[cross] = 0.0
         east[cross] = 2.0 * math.pi
         ke = ks.copy()
@@ -194,7 +195,7 @@ def eye_summaries(
     z_bottom = np.full(n, np.nan)
     if s.size:
         fr = first_run[full]
-        sum_xyz[full] = np.add.reduceat(tot, fr, axis=0)
+        sum_xyz[full] = np.stack([np.add.reduceat(col, fr) for col in tot], axis=1)
         lon_w[full] = np.minimum.reduceat(west, fr)
         lon_e[full] = np.maximum.reduceat(east, fr)
         z_top[full] = rings.z[ks[fr]]
@@ -276,16 +277,15 @@ def _bounds(
     base = west + w - lon0[row]
     top = east - w - lon0[row]
     band = np.searchsorted(BANDS, t / alpha[row]) - 1  # -1 / len(BANDS) - 1: outside
-    # lower bounds as they are, upper bounds negated: one maximum per band and column
-    v = np.stack([base, -(base + d), top - d, -top], axis=1)
-    sign = np.array([1.0, -1.0, 1.0, -1.0])
+    # lower bounds as they are, upper bounds negated: a maximum per band and column
+    cols = (base, -(base + d), top - d, -top)
     for b in range(len(BANDS) - 1):
         grp = use & (band == b)
-        red = np.maximum.reduceat(np.where(grp[:, None], v, -big), fr, axis=0)
-        ok = red > -big
-        red = np.clip(sign * red / gamma, -_NO_BOUND, _NO_BOUND)
-        blk = out[full, 4 * b : 4 * b + 4]
-        out[full, 4 * b : 4 * b + 4] = np.where(ok, red, blk)
+        for j, v in enumerate(cols):
+            red = np.maximum.reduceat(np.where(grp, v, -big), fr)
+            ok = red > -big
+            sign = 1.0 if j % 2 == 0 else -1.0
+            out[full[ok], 4 * b + j] = np.clip(sign * red[ok] / gamma, -_NO_BOUND, _NO_BOUND)
     return out
 
 
