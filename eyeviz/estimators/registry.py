@@ -13,6 +13,15 @@ weights were made for (``design``), whether it needs torch, how to load it, how 
 'the information limit: posterior median of r and phi per bitmap pair (a lookup table)'
 >>> est = registry.load("analytic", domain=Domain(m=360))
 
+Estimators of the spherical eyes (docs/spherical.md) are entries of ``kind="spherical"``,
+loaded with a :class:`~eyeviz.core.domain3d.Domain3D` and named with a ``3d`` suffix
+(``analytic3d``, ``limit3d``, ``learned3d``); :func:`entries` and :func:`available` list
+one kind at a time (planar by default, so every planar list is as it was):
+
+>>> registry.available("spherical")
+['analytic3d', 'learned3d']
+>>> est3 = registry.load("analytic3d", domain=Domain3D(nside=16))
+
 A plug-in registers its own entry (see ``examples/add_an_estimator.py``)::
 
     registry.register(Entry("nearest", "nearest sector centres", load=my_load, any_design=True))
@@ -33,8 +42,10 @@ from typing import Any
 
 from eyeviz import EyevizError
 from eyeviz.core.domain import DEFAULTS, FIELDS, PAPER_DOMAIN, Domain
+from eyeviz.core.domain3d import Domain3D
 
 __all__ = [
+    "KINDS",
     "Entry",
     "Option",
     "DOMAIN_OPTIONS",
@@ -95,6 +106,11 @@ def _resolve(target: str | Callable | None) -> Callable | None:
     return getattr(importlib.import_module(mod), attr)
 
 
+#: What an entry estimates from: the planar eyes' half bitmaps (``Domain``) or the
+#: spherical eyes' lit facets (``Domain3D``).
+KINDS = ("planar", "spherical")
+
+
 @dataclass(frozen=True)
 class Entry:
     """Everything the rest of eyeviz needs to know about one estimator."""
@@ -112,6 +128,7 @@ class Entry:
     weights_subdir: str = ""  # sub-folder of the models directory its files go in
     fit_takes_data: bool = True  # False: fit samples its own data (bayes)
     module: str = ""  # module to look for when deciding if the entry is installed
+    kind: str = "planar"  # "planar" (Domain, half bitmaps) or "spherical" (Domain3D, lit sets)
 
     @property
     def learns(self) -> bool:
@@ -128,7 +145,20 @@ class Entry:
             return False
 
     def load_estimator(self, **kw):
-        """The estimator (``load(**kw)`` of its module)."""
+        """The estimator (``load(**kw)`` of its module). EyevizError when ``domain`` is of
+        the other kind (a Domain for a spherical entry, a Domain3D for a planar one)."""
+        dom = kw.get("domain")
+        want = Domain3D if self.kind == "spherical" else Domain
+        if dom is not None and not isinstance(dom, want):
+            hint = (
+                f"; for the spherical eyes use {self.name}3d"
+                if isinstance(dom, Domain3D) and f"{self.name}3d" in _REGISTRY
+                else ""
+            )
+            raise EyevizError(
+                f"estimator {self.name!r} is {self.kind}: domain must be a {want.__name__}, "
+                f"got {type(dom).__name__}{hint}"
+            )
         loader = _resolve(self.load)
         assert loader is not None
         return loader(**kw)
@@ -150,6 +180,8 @@ def register(entry: Entry, *, replace: bool = False) -> Entry:
     """Add ``entry``; EyevizError if the name is taken (unless ``replace``)."""
     if not entry.name or not entry.name.replace("_", "").isalnum():
         raise EyevizError(f"estimator name must be a word, got {entry.name!r}")
+    if entry.kind not in KINDS:
+        raise EyevizError(f"estimator kind must be one of {KINDS}, got {entry.kind!r}")
     if entry.name in _REGISTRY and not replace:
         raise EyevizError(f"estimator {entry.name!r} is already registered")
     _REGISTRY[entry.name] = entry
@@ -164,18 +196,28 @@ def get(name: str) -> Entry:
     """The entry called ``name``; EyevizError naming the available ones otherwise."""
     e = _REGISTRY.get(name)
     if e is None or not e.installed:
-        raise EyevizError(f"unknown estimator {name!r}; available: {', '.join(available())}")
+        raise EyevizError(f"unknown estimator {name!r}; available: {', '.join(available(None))}")
     return e
 
 
-def entries() -> list[Entry]:
-    """Installed entries, sorted by name."""
-    return [_REGISTRY[k] for k in sorted(_REGISTRY) if _REGISTRY[k].installed]
+def _check_kind(kind: str | None) -> None:
+    if kind is not None and kind not in KINDS:
+        raise EyevizError(f"kind must be one of {KINDS} or None, got {kind!r}")
 
 
-def available() -> list[str]:
-    """Names accepted by :func:`load`, sorted."""
-    return [e.name for e in entries()]
+def entries(kind: str | None = "planar") -> list[Entry]:
+    """Installed entries of ``kind`` (None: every kind), sorted by name."""
+    _check_kind(kind)
+    return [
+        e
+        for e in (_REGISTRY[k] for k in sorted(_REGISTRY))
+        if e.installed and (kind is None or e.kind == kind)
+    ]
+
+
+def available(kind: str | None = "planar") -> list[str]:
+    """Names of ``kind`` (None: every kind) accepted by :func:`load`, sorted."""
+    return [e.name for e in entries(kind)]
 
 
 def load(name: str, **kw):
@@ -345,6 +387,26 @@ for _entry in (
             ),
         ),
         module="eyeviz.estimators.limit",
+    ),
+    Entry(
+        "analytic3d",
+        "spherical eyes: triangulation of the two lit caps' centres (no weights, any design)",
+        "eyeviz.estimators.analytic3d:load",
+        any_design=True,
+        design=None,
+        kind="spherical",
+    ),
+    Entry(
+        "learned3d",
+        "spherical eyes: a small network correcting the triangulation (weights for one design)",
+        "eyeviz.estimators.learned3d:load",
+        fit="eyeviz.estimators.learned3d_training:fit",
+        design=None,
+        needs_torch=False,
+        weights_hint="eyeviz train learned3d",
+        weights_subdir="learned3d",
+        module="eyeviz.estimators.learned3d",
+        kind="spherical",
     ),
 ):
     register(_entry)
