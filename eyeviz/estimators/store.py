@@ -30,6 +30,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from eyeviz import EyevizError
+from eyeviz.files.atomic import full_disk_error
 
 __all__ = ["user_models_dir", "staged", "resolve_out_dir"]
 
@@ -96,5 +97,10 @@ def staged(out_dir: str | os.PathLike) -> Iterator[Path]:
                 dest = out / f.relative_to(tmp)
                 dest.parent.mkdir(parents=True, exist_ok=True)
                 os.replace(f, dest)
+    except OSError as exc:  # a full disk while a fit writes its files: name the output
+        full = full_disk_error(out, exc)
+        if full is None:
+            raise
+        raise full from exc
     finally:
         shutil.rmtree(tmp, ignore_errors=True)

@@ -179,3 +179,21 @@ def test_a_real_write_past_the_limit_names_the_file(tmp_path, args, name):
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and str(out) in lines[0] and "cannot write" in lines[0], res.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_full_disk_while_a_fit_stages_its_files_names_the_output(tmp_path):
+    """A fit writes weights with torch/numpy into the staging folder (no atomic_output):
+    a full disk there names the model folder, and leaves it as it was."""
+    import errno
+
+    from eyeviz.estimators.store import staged
+
+    out = tmp_path / "models"
+    out.mkdir()
+    (out / "old.json").write_text("{}")
+    with pytest.raises(EyevizError, match=r"models: cannot write: no space left"):
+        with staged(out) as stage:
+            (stage / "w.pt").write_bytes(b"half")
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    assert [p.name for p in out.iterdir()] == ["old.json"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["models"]
