@@ -236,7 +236,8 @@ class Scene3DHost(QtCore.QObject):
         assert self.view is not None
         self.active = to3d
         if to3d:
-            self._hidden = [w for w in self._planar_widgets() if w.isVisible()]
+            # not explicitly hidden (a window not shown yet counts its docks as shown)
+            self._hidden = [w for w in self._planar_widgets() if not w.isHidden()]
             for w in self._planar_widgets():
                 w.hide()
             self.view.show()

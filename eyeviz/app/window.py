@@ -196,6 +196,7 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self.model.finish_gestures()
         if self.jobs.busy():
             self.jobs.pool.waitForDone(120000)  # an export in flight finishes its file
+        self.host3d.leave()  # the planar page's docks are the layout saved
         self.settings.setValue("window/geometry", bytes(self.saveGeometry()))
         self.settings.setValue("window/state", bytes(self.saveState()))
         self.settings.sync()

@@ -154,6 +154,27 @@ def test_open_swaps_between_planar_and_3d(make_window):
     assert not win.host3d.active and win.plotter.isVisible() and not win.host3d.view.isVisible()
     assert win.model.scene.kind == "planar"
     assert win.features_panel.isVisibleTo(win)
+    assert win.open_path(SCENES / "sphere_teaching.toml")  # and back again
+    assert win.host3d.active and win.host3d.view.isVisible()
+    assert win.host3d.model.scene.eyes.nside == 8
+
+
+def test_closing_in_3d_saves_the_planar_layout(make_window, tmp_path):
+    """The window state saved at close is the planar page's (its docks shown), so the
+    next planar scene does not open with its docks hidden."""
+    from eyeviz.app.window import MainWindow, make_settings
+
+    win = make_window(load(SCENES / "sphere_teaching.toml"))
+    assert not win.features_panel.isVisibleTo(win)
+    win.force_close()
+    settings = make_settings(tmp_path / "settings.json")
+    again = MainWindow(load(SCENES / "default.toml"), settings=settings)
+    again._force_close = True
+    again.show()
+    try:
+        assert again.features_panel.isVisibleTo(again)
+    finally:
+        again.force_close()
 
 
 def test_export_png_and_svg(make_window, tmp_path):
@@ -212,3 +233,11 @@ def test_save_writes_the_spherical_scene(make_window, tmp_path):
     f = back.features[0]
     assert (f.x, f.y, f.z) == (10.0, 320.0, 25.0)
     assert win.undo_stack.isClean()
+
+
+def test_a_window_started_in_3d_shows_the_planar_docks_for_a_planar_scene(make_window):
+    win = make_window(load(SCENES / "sphere_paper.toml"))
+    assert win.host3d.active and not win.features_panel.isVisibleTo(win)
+    assert win.open_path(SCENES / "default.toml")
+    assert win.features_panel.isVisibleTo(win) and win.bitmaps.isVisibleTo(win)
+    assert not win.host3d.docks["bitmaps3d"].isVisibleTo(win)
