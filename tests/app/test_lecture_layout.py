@@ -221,3 +221,31 @@ def test_figure3b_opens_with_its_sector_rays_clear_of_the_title_and_the_tangents
     vp, view = win.viewport("main"), win.model.scene.view
     for x, y in np.asarray(sectors.mesh.points)[:, :2]:
         assert to_pixel(view, vp, x, y)[1] >= band, (x, y)
+
+
+def test_zoomed_onto_the_eyes_the_m_theta_psi_line_steps_aside_for_a_name(make_window, qtbot):
+    from eyeviz.model.scene import Eyes, Feature, Scene, View
+
+    sc = Scene(
+        Eyes(40.0, 20.0, 72),
+        [Feature("a name", 0.0, 0.0, 4.0)],
+        ["eyes", "bfv", "features", "labels"],
+        view=View((0.0, 0.0), 200.0),
+    )
+    win = make_window(sc)
+    win.resize(1280, 720)
+    qtbot.waitUntil(lambda: win.width() == 1280, timeout=3000)
+    win.render()
+    assert not win.inset_shown  # the eyes are large: the main view carries the line
+    foot = win.actors.labels.bfv_text["main"]
+    vp, view = win.viewport("main"), win.model.scene.view
+    # the feature's name where the line is, then far from it
+    from eyeviz.model.camera import to_model
+
+    x, y = to_model(view, vp, vp.width - 200.0, vp.height - 8.0)
+    win.model.set_feature(0, x=x - 30.0, y=y)
+    win.render()
+    assert not foot.GetVisibility()
+    win.model.set_feature(0, x=0.0, y=60.0)
+    win.render()
+    assert foot.GetVisibility() and "θ = 120°" in foot.GetInput()

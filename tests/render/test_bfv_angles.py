@@ -37,7 +37,9 @@ def test_theta_spans_the_wedge_and_psi_the_x_axis_to_the_right_edge():
 
 def test_close_up_the_arcs_clear_the_eyes_and_far_away_they_are_not_drawn():
     m = angle_marks(PSI, 40.0, (-100.0, 100.0, -10.0, 90.0))
-    assert m is not None and np.hypot(*m["theta"][0]) == pytest.approx(60.0)  # 1.5 h
+    # both arcs outside the eyes (h + l = 60): theta at 1.5 (h + l), psi at 1.15 (h + l)
+    assert m is not None and np.hypot(*m["theta"][0]) == pytest.approx(90.0)
+    assert np.hypot(*m["psi"][0]) == pytest.approx(69.0)
     assert angle_marks(PSI, 40.0, (500.0, 900.0, 100.0, 400.0)) is None  # origin not in view
 
 

@@ -7,7 +7,7 @@ zoom or a pan: :meth:`eyeviz.render.vtk.actors.SceneActors.fit_bfv`).
 Where the origin is in view, the main view also draws the BFV's angles as the exported
 figure does (Definition 2, Figures 5-6): theta's arc between the two edges with its label
 above it, psi's arc between the x-axis and the right edge with its label beside it, at a
-fifth of the view's height (at least 1.5 h)."""
+fifth of the view's height, clear of the eyes where they are large."""
 
 from __future__ import annotations
 
@@ -34,8 +34,9 @@ def angle_marks(psi: float, h: float, rect: tuple[float, float, float, float]) -
     x0, x1, y0, y1 = rect
     if not (x0 <= 0.0 <= x1 and y0 <= 0.0 <= y1):
         return None
-    rad = max(0.2 * (y1 - y0), 1.5 * h)
-    rpsi = 0.72 * rad
+    reach = h * (1.0 + math.sin(psi))  # h + l (psi = arcsin(l / h)): the eyes' outer edge
+    rad = max(0.2 * (y1 - y0), 1.5 * reach)
+    rpsi = max(0.72 * rad, 1.15 * reach)  # both arcs clear the eyes where they are large
     t = np.linspace(psi, math.pi - psi, ARC_POINTS)
     u = np.linspace(0.0, psi, ARC_POINTS)
     return {

@@ -122,6 +122,7 @@ class LabelsLayer:
             if shown:  # a hidden label is placed when it is shown
                 label.SetInput(f" {lab.text}")  # no-op (no Modified) when unchanged
                 label.SetPosition(lab.x, lab.y, Z_POINT)
+        self.place_bfv_text()
 
     def set_inset_shown(self, shown: bool, main_eye_labels: bool | None = None) -> None:
         """The eye labels go to the inset when it is shown; the main view carries them
@@ -135,4 +136,31 @@ class LabelsLayer:
     def place_bfv_text(self) -> None:
         has = bool(self.bfv_text["main"].GetInput())
         self.bfv_text["inset"].SetVisibility(has and self.inset_shown)
-        self.bfv_text["main"].SetVisibility(has and not self.inset_shown)
+        main = has and not self.inset_shown
+        # the main view's line steps aside for a feature's name (zoomed onto the eyes it
+        # was drawn over one); the view's own theta and psi labels still say it
+        self.bfv_text["main"].SetVisibility(main and self._footer_free())
+
+    def _footer_free(self) -> bool:
+        """Whether no shown feature name meets the main view's "m, θ, ψ" line (pixels)."""
+        ren = self.main
+        w, h = ren.GetSize()
+        if w <= 0 or h <= 0:
+            return True
+        foot = self.bfv_text["main"]
+        box = [0.0] * 4
+        foot.GetBoundingBox(ren, box)  # about its anchor (right-justified)
+        x, y = foot.GetPosition()
+        fx1, fy0 = x * w, y * h
+        fx0, fy1 = fx1 - (box[1] - box[0]), fy0 + (box[3] - box[2])
+        for label in self.feature_labels:
+            if not label.GetVisibility():
+                continue
+            ren.SetWorldPoint(*label.GetPosition(), 1.0)
+            ren.WorldToDisplay()
+            lx, ly, _ = ren.GetDisplayPoint()
+            size = label.GetTextProperty().GetFontSize()
+            lw = 0.65 * size * len(label.GetInput() or "")  # left-justified, bottom anchor
+            if lx < fx1 and lx + lw > fx0 and ly < fy1 and ly + 1.3 * size > fy0:
+                return False
+        return True
