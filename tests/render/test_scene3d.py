@@ -97,6 +97,13 @@ def test_a_move_rewrites_the_colours_in_place(renderers):
     assert np.all(after[np.setdiff1d(st.lit(0, "A"), st.lit(1, "A"))] == hex_rgb("#D55E00"))
     # the ball's actor moved by its transform, its mesh untouched
     assert act.ball_actors[0].GetPosition() == pytest.approx((-120.0, 300.0, 0.0))
+    # far out: the field's cones and plane reach farther, the eyes and balls are kept
+    bfv, ball = act.bfv_actor, act.ball_actors[0]
+    sc.features[0].y = 3000.0
+    act.update(sc, compute_state3d(sc), 0)
+    assert act.eye_meshes[0] is mesh and act.ball_actors[0] is ball
+    assert act.bfv_actor is not bfv
+    assert act.bfv_actor.GetBounds()[3] > 3000.0
 
 
 def test_large_nside_draws_a_coarse_sphere_and_the_lit_patches(renderers):

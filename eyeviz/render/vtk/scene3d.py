@@ -156,6 +156,8 @@ class Scene3DActors:
         self._eyes_key: tuple | None = None
         self._balls_key: tuple | None = None
         self.eye_store = Store()
+        self.field_store = Store()
+        self._field_key: tuple | None = None
         self.ball_store = Store()
         self.eye_meshes: list[pv.PolyData] = []  # full LOD: one per eye, cell i = facet i
         self.patches: list[list[tuple[pv.PolyData, vtkActor, np.ndarray]]] = []
@@ -232,11 +234,20 @@ class Scene3DActors:
                 lab.SetPosition(cx, 0.0, -1.55 * pair.l)
                 self.eye_store.add(self.eyes_ren, lab)
                 self.eye_labels.append(lab)
-        reach = 1.1 * shapes3d.scene_extent(state)
+        self.eyes_caption.SetInput(
+            f"the eyes close up: nside {n}\n{pair.npix:,} facets each"
+            + ("" if self.full else ",\nthe lit ones drawn")
+        )
+
+    def _build_field(self, state: SceneState3D, reach: float) -> None:
+        """The BFV's cones and the plane z = 0, out to ``reach`` (rebuilt when the balls'
+        extent changes by about 40 %, not every frame)."""
+        self.field_store.clear()
+        pair = state.pair
         pts, faces = shapes3d.bfv_cones(pair.h, pair.l, reach)
         self.bfv_actor = actor(pv.PolyData(pts, faces), BFV_RGB)
         self.bfv_actor.GetProperty().SetOpacity(BFV_OPACITY)
-        self._add(self.eye_store, self.bfv_actor, eyes=False)
+        self._add(self.field_store, self.bfv_actor, eyes=False)
         corners, segs = shapes3d.plane_z0(-reach * 0.8, reach * 0.8, -0.2 * reach, reach)
         quad = pv.PolyData(corners, np.array([4, 0, 1, 2, 3]))
         fill = actor(quad, PLANE_RGB)
@@ -249,11 +260,7 @@ class Scene3DActors:
         lines.GetProperty().SetOpacity(0.6)
         self.plane_actors = [fill, lines]
         for a in self.plane_actors:
-            self._add(self.eye_store, a, eyes=False)
-        self.eyes_caption.SetInput(
-            f"the eyes close up: nside {n}\n{pair.npix:,} facets each"
-            + ("" if self.full else ",\nthe lit ones drawn")
-        )
+            self._add(self.field_store, a, eyes=False)
 
     def _build_balls(self, scene: Scene, state: SceneState3D) -> None:
         self.ball_store.clear()
@@ -311,7 +318,13 @@ class Scene3DActors:
     def update(self, scene: Scene, state: SceneState3D, selected: int | None) -> None:
         """Draw ``state`` (of ``scene``): structure rebuilt only when it changed."""
         pair = state.pair
-        eyes_key = (pair.h, pair.l, pair.nside, round(math.log(shapes3d.scene_extent(state)), 1))
+        eyes_key = (pair.h, pair.l, pair.nside)
+        # the field's reach in steps of 2^0.5 (a drag does not rebuild it every frame)
+        step = round(2.0 * math.log2(1.1 * shapes3d.scene_extent(state)))
+        field_key = (pair.h, pair.l, step)
+        if field_key != self._field_key:
+            self._build_field(state, 2.0 ** (step / 2.0 + 0.5))
+            self._field_key = field_key
         balls_key = (
             tuple((f.name, f.color) for f in scene.features),
             pair.nside,
