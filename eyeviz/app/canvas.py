@@ -190,7 +190,9 @@ class CanvasMixin(_MainWindow):
         sc = self.model.scene
         if not (sc.shows("labels") and sc.shows("features")) or not sc.features:
             return 0.0
-        return LABEL_CHAR_PX * (1 + max(len(f.name) for f in sc.features))
+        presenter = getattr(self, "presenter", None)
+        s = presenter.effective_scale if presenter is not None else 1.0  # Ctrl+= grows them
+        return LABEL_CHAR_PX * s * (1 + max(len(f.name) for f in sc.features))
 
     def fit_view(self) -> None:
         """F: every feature and the eyes in view, none under the inset or the title. The

@@ -66,3 +66,31 @@ def test_the_view_draws_the_labels_with_the_bfv_layer_only(actors):
     act.draw(view_frame(sc, compute_state(sc), 0, rect), 0)
     assert not pl.renderer.HasViewProp(bfv.theta_label)
     assert not pl.renderer.HasViewProp(bfv.arc_actor)
+
+
+def test_the_labels_step_aside_for_a_feature_and_its_name(actors):
+    pl, act = actors
+    rect = (-400.0, 400.0, -50.0, 550.0)
+    m = angle_marks(PSI, 40.0, rect)
+    px, py = m["psi_at"]
+    tx, ty = m["theta_at"]
+    # a small disc whose name covers psi's place, and a disc on theta's
+    feats = [
+        Feature("a long feature name", px - 40.0, py - 10.0, 3.0),
+        Feature("b", tx, ty + 10.0, 15.0),
+    ]
+    sc = Scene(Eyes(40.0, 20.0, 72), feats, ["eyes", "bfv", "features", "labels"])
+    pl.render()
+    act.draw(view_frame(sc, compute_state(sc), 0, rect), 0)
+    bfv = act.bfv
+    x, y, _ = bfv.psi_label.GetPosition()
+    assert x == pytest.approx(-px) and y == pytest.approx(py)  # mirrored to the left edge
+    arc = np.asarray(bfv.arcs.points)[49:98, :2]
+    assert np.all(arc[:, 0] <= 1e-9)  # psi's arc between the left edge and the -x axis
+    _, ty2, _ = bfv.theta_label.GetPosition()
+    assert ty2 != pytest.approx(ty)  # theta's label moved off the disc
+    # without the features both sit where the figure puts them
+    sc.features = []
+    act.draw(view_frame(sc, compute_state(sc), None, rect), None)
+    assert bfv.psi_label.GetPosition()[0] == pytest.approx(px)
+    assert bfv.theta_label.GetPosition()[1] == pytest.approx(ty)

@@ -53,7 +53,7 @@ class BFVLayer:
     the renderers only while the layer is shown."""
 
     def __init__(self, main, inset):
-        self.renderers = (main, inset)
+        self.renderers = (main, inset)  # main first: the angles' labels are placed in it
         self.z_fill, self.z_line = Z_BFV, Z_LINE
         k = np.arange(1, BFV_SLOTS - 1)
         faces = np.column_stack([np.full(k.size, 3), np.zeros(k.size, int), k, k + 1]).ravel()
@@ -85,6 +85,10 @@ class BFVLayer:
         self.shown = False
         self.polygon = np.zeros((0, 2))
         self._written: tuple | None = None
+        self._marks: dict | None = None
+        self._psi_side = 1.0
+        empty = np.zeros(0)
+        self._obstacles: tuple = (empty, empty, empty, [], False)  # the last Frame's features
 
     def draw(self, frame: Frame, selected: int | None) -> None:
         shown = "bfv" in frame.layers and frame.bfv is not None
@@ -97,6 +101,7 @@ class BFVLayer:
             self.shown = shown
         if shown:
             self.update(frame)
+            self.place_angle_labels(frame)
 
     def update(self, frame: Frame) -> None:
         """Write the wedge and its edges (nothing when they are what is drawn)."""
@@ -122,17 +127,78 @@ class BFVLayer:
                 ep[2 * j + 1] = (seg[2], seg[3], self.z_line)
         write_points(self.edges, ep)
         marks = None if bfv is None else angle_marks(bfv.psi, frame.pair.h, bfv.rect)
+        self._marks = marks
         for a in (self.arc_actor, self.theta_label, self.psi_label):
             a.SetVisibility(marks is not None)
         if marks is None or bfv is None:
             return
+        self.theta_label.SetInput(f"\u03b8 = {math.degrees(bfv.theta):.0f}\u00b0")
+        self.psi_label.SetInput(f"\u03c8 = {math.degrees(bfv.psi):.0f}\u00b0")
+        self._write_arcs(1.0)
+
+    def _write_arcs(self, side: float) -> None:
+        """theta's arc, and psi's on the right (side 1) or mirrored on the left (-1)."""
+        m = self._marks
+        assert m is not None  # written only where the origin is in view
         ap = np.zeros((2 * ARC_POINTS + 2, 3))
         ap[:, 2] = self.z_line
-        ap[:ARC_POINTS, :2] = marks["theta"]
-        ap[ARC_POINTS : 2 * ARC_POINTS, :2] = marks["psi"]
-        ap[2 * ARC_POINTS :, :2] = marks["axis"]
+        ap[:ARC_POINTS, :2] = m["theta"]
+        ap[ARC_POINTS : 2 * ARC_POINTS, :2] = m["psi"] * [side, 1.0]
+        ap[2 * ARC_POINTS :, :2] = m["axis"] * [side, 1.0]
         write_points(self.arcs, ap)
-        self.theta_label.SetInput(f"\u03b8 = {math.degrees(bfv.theta):.0f}\u00b0")
-        self.theta_label.SetPosition(*marks["theta_at"], self.z_line)
-        self.psi_label.SetInput(f"\u03c8 = {math.degrees(bfv.psi):.0f}\u00b0")
-        self.psi_label.SetPosition(*marks["psi_at"], self.z_line)
+        tp = self.psi_label.GetTextProperty()
+        if side > 0:
+            tp.SetJustificationToLeft()
+        else:
+            tp.SetJustificationToRight()
+        self._psi_side = side
+
+    def place_angle_labels(self, frame: Frame) -> None:
+        """theta's label at the first radius along the bisector where it covers no feature
+        disc or name, psi's beside the right edge or, mirrored, the left one (as the
+        exported figure places them). Cheap: run for every frame, a drag included."""
+        m, bfv = self._marks, frame.bfv
+        if m is None or bfv is None:
+            return
+        w, h = self.renderers[0].GetSize()
+        upp = (bfv.rect[3] - bfv.rect[2]) / max(h, 1)  # model units per pixel
+        if frame.n == 0 and set(frame.layers) == {"bfv"}:
+            # the eyes-only Frame of a refit after a zoom (SceneActors.fit_bfv): the
+            # features are the last full Frame's
+            xs, ys, gs, names, named = self._obstacles
+        else:
+            xs, ys, gs = np.asarray(frame.x), np.asarray(frame.y), np.asarray(frame.g)
+            names, named = list(frame.names), "labels" in frame.layers
+            self._obstacles = (xs, ys, gs, names, named)
+        # the features' names, right of each disc (22 px text, render.vtk.layers.labels)
+        lx0 = xs + gs
+        lx1 = lx0 + np.array([len(n) + 1 for n in names], dtype=float) * 14.0 * upp
+        ly0, ly1 = ys, ys + 28.0 * upp
+
+        def free(x0: float, x1: float, y0: float, y1: float) -> bool:
+            if not len(xs):
+                return True
+            dx = np.maximum(np.maximum(x0 - xs, 0.0), xs - x1)
+            dy = np.maximum(np.maximum(y0 - ys, 0.0), ys - y1)
+            if not np.all(np.hypot(dx, dy) >= gs):
+                return False
+            on_name = (lx0 < x1) & (lx1 > x0) & (ly0 < y1) & (ly1 > y0)
+            return not (named and bool(on_name.any()))
+
+        def size(label) -> tuple[float, float]:
+            px = label.GetTextProperty().GetFontSize()
+            return 0.62 * px * len(label.GetInput() or "") * upp, 1.3 * px * upp
+
+        tw, th = size(self.theta_label)
+        rad = float(m["theta_at"][1]) / 1.04
+        ys_try = [rad * f for f in (1.04, 0.7, 1.4, 0.45, 1.8)]
+        y = next((v for v in ys_try if free(-tw / 2, tw / 2, v, v + th)), ys_try[0])
+        self.theta_label.SetPosition(0.0, y, self.z_line)
+        pw, ph = size(self.psi_label)
+        px, py = m["psi_at"]
+        right = free(px, px + pw, py - ph / 2, py + ph / 2)
+        left = free(-px - pw, -px, py - ph / 2, py + ph / 2)
+        side = 1.0 if right or not left else -1.0
+        if side != self._psi_side:
+            self._write_arcs(side)
+        self.psi_label.SetPosition(side * px, py, self.z_line)
