@@ -58,8 +58,8 @@ def full_disk_error(path, exc: OSError) -> EyevizError | None:
         return None
     what = os.strerror(exc.errno) if exc.errno is not None else "disk full"
     return EyevizError(
-        f"{path}: cannot write: {what[:1].lower()}{what[1:]} (disk full?); nothing was "
-        "written and an existing file there is unchanged"
+        f"{path}: cannot write: {what} (a full disk, quota or file size limit); nothing "
+        "was written and an existing file there is unchanged"
     )
 
 
