@@ -30,12 +30,12 @@ import json
 import math
 import os
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from eyeviz import EyevizError
 from eyeviz.core.domain3d import Domain3D
+from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D
 from eyeviz.estimators.learned3d_features import N_FEATURES, eye_summaries, features
 from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
@@ -64,7 +64,8 @@ META_FILE = "learned3d.json"
 AZ_SCALE = 1e-4
 EL_SCALE = 1e-4
 N_OUT = 3
-#: rows per block through the network (keeps the temporaries in cache)
+#: rows per block through the network (keeps the temporaries in cache; predict hands
+#: the network blocks of at most 16,384 rows, base3d's)
 _BLOCK = 1 << 14
 _LAYERS = ("0", "2", "4")  # Linear layers of nn.Sequential(Linear, SiLU, Linear, SiLU, Linear)
 
@@ -134,79 +135,16 @@ def read_weights(path: str | os.PathLike) -> tuple[int, dict[str, np.ndarray]]:
     return hidden, arrays
 
 
-class Prediction3D(tuple):
-    """``(r, azimuth, elevation)`` (radians) with ``valid``, ``in_domain`` and ``flagged``
-    masks. ``valid`` is False (and the values NaN) where an eye lit no facet; ``flagged``
-    marks rows whose mean directions do not meet in front of both eyes (the answer is
-    then r_max along their mean, corrected by the network)."""
-
-    def __new__(cls, r, azimuth, elevation, valid, in_domain, flagged):
-        obj = super().__new__(cls, (r, azimuth, elevation))
-        obj.valid = valid
-        obj.in_domain = in_domain
-        obj.flagged = flagged
-        return obj
-
-    @property
-    def r(self):
-        return self[0]
-
-    @property
-    def azimuth(self):
-        return self[1]
-
-    @property
-    def elevation(self):
-        return self[2]
-
-    def __getnewargs__(self):
-        return (self[0], self[1], self[2], self.valid, self.in_domain, self.flagged)
-
-
 def _silu(x: np.ndarray) -> np.ndarray:
     with np.errstate(over="ignore"):
         return x / (1.0 + np.exp(-x))
 
 
-def _csr(name: str, lit: Any, npix: int) -> tuple[np.ndarray, np.ndarray, bool]:
-    """(indptr, indices, single) from CSR ``(indptr, indices)`` or dense bool bitmaps
-    (npix,) / (N, npix); one-line ValueError naming ``name`` otherwise."""
-    if isinstance(lit, tuple):
-        if len(lit) != 2:
-            raise ValueError(f"{name} must be (indptr, indices) or bitmaps, got a {len(lit)}-tuple")
-        ptr = np.asarray(lit[0])
-        ind = np.asarray(lit[1])
-        if ptr.ndim != 1 or ptr.size < 1 or ptr.dtype.kind not in "iu":
-            raise ValueError(f"{name}: indptr must be a 1-D integer array of length n + 1")
-        if ind.ndim != 1 or (ind.size and ind.dtype.kind not in "iu"):
-            raise ValueError(f"{name}: indices must be a 1-D integer array")
-        ptr = ptr.astype(np.int64, copy=False)
-        if ptr[0] != 0 or ptr[-1] != ind.size or np.any(np.diff(ptr) < 0):
-            raise ValueError(
-                f"{name}: indptr must start at 0, not decrease and end at len(indices) = {ind.size}"
-            )
-        # order and range of the indices are checked on the runs (eye_summaries)
-        return ptr, ind, False
-    a = np.asarray(lit)
-    if a.ndim not in (1, 2) or a.shape[-1] != npix:
-        raise ValueError(
-            f"{name} must be (indptr, indices) or bitmaps of shape (npix,) or (N, npix) with "
-            f"npix = {npix}, got shape {a.shape}"
-        )
-    if a.dtype != np.bool_:
-        if a.dtype.kind not in "biuf" or not np.isin(a, (0, 1)).all():
-            raise ValueError(f"{name} bitmaps must hold 0/1 values")
-        a = a != 0
-    single = a.ndim == 1
-    a = a.reshape(-1, npix)
-    rows, cols = np.nonzero(a)
-    ptr = np.zeros(a.shape[0] + 1, np.int64)
-    np.cumsum(np.bincount(rows, minlength=a.shape[0]), out=ptr[1:])
-    return ptr, cols.astype(np.int64), single
+class Learned3DEstimator(Estimator3D):
+    """Corrects the triangulation of the two eyes' mean lit directions with an MLP.
 
-
-class Learned3DEstimator:
-    """Corrects the triangulation of the two eyes' mean lit directions with an MLP."""
+    ``flagged`` marks rows whose mean directions do not meet in front of both eyes (the
+    triangulation is then r_max along their mean, which the network corrects)."""
 
     name = "learned3d"
 
@@ -217,16 +155,11 @@ class Learned3DEstimator:
         domain: Domain3D | None = None,
         metadata: dict | None = None,
     ) -> None:
-        self.domain = Domain3D() if domain is None else domain
+        meta = dict(metadata or {})
+        meta["n_weights"] = int(sum(v.size for k, v in arrays.items() if k.startswith("net.")))
+        super().__init__(Domain3D() if domain is None else domain, meta)
         self.hidden = hidden
         self._w = {k: np.asarray(v, np.float32) for k, v in arrays.items()}
-        self.metadata: dict[str, Any] = dict(metadata or {})
-        n_w = sum(v.size for k, v in arrays.items() if k.startswith("net."))
-        self.metadata["n_weights"] = int(n_w)
-
-    @property
-    def n_weights(self) -> int:
-        return int(self.metadata["n_weights"])
 
     def network(self, x: np.ndarray) -> np.ndarray:
         """The network's raw outputs (n, 3) for feature rows x (n, N_FEATURES)."""
@@ -241,20 +174,12 @@ class Learned3DEstimator:
             out[s : s + _BLOCK] = h
         return out
 
-    def predict(self, lit_a, lit_b) -> Prediction3D:
-        """(r, azimuth, elevation) per row from each eye's lit facets: CSR rows
-        ``(indptr, indices)`` (sorted RING indices, as the 3D data set stores them) or
-        dense bool bitmaps (npix,) / (N, npix). ValueError for malformed input or a
-        row-count mismatch; NaN and ``valid = False`` where an eye lit nothing."""
+    def _predict_csr(
+        self, lit_a: LitCSR, lit_b: LitCSR
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         d = self.domain
-        pa, ia, single_a = _csr("lit_a", lit_a, d.npix)
-        pb, ib, single_b = _csr("lit_b", lit_b, d.npix)
-        if pa.size != pb.size:
-            raise ValueError(
-                f"lit_a and lit_b have different row counts: {pa.size - 1} and {pb.size - 1}"
-            )
-        sa = eye_summaries(d.nside, pa, ia, "lit_a")
-        sb = eye_summaries(d.nside, pb, ib, "lit_b")
+        sa = eye_summaries(d.nside, lit_a[0], lit_a[1])
+        sb = eye_summaries(d.nside, lit_b[0], lit_b[1])
         x, log_r0, az0, el0, ok, flagged = features(sa, sb, d.h, d.nside, d.r_min, d.r_max)
         n = x.shape[0]
         r = np.full(n, np.nan)
@@ -266,11 +191,7 @@ class Learned3DEstimator:
             r[sel] = np.exp(log_r0[sel] + out[:, 0])
             az[sel] = az0[sel] + AZ_SCALE * out[:, 1]
             el[sel] = el0[sel] + EL_SCALE * out[:, 2]
-        in_dom = ok & (sa.count >= 2) & (sb.count >= 2)
-        flagged = flagged & ok
-        if single_a and single_b and n == 1:
-            return Prediction3D(r[0], az[0], el[0], ok[0], in_dom[0], flagged[0])
-        return Prediction3D(r, az, el, ok, in_dom, flagged)
+        return r, az, el, flagged
 
     def __repr__(self) -> str:
         return f"<Learned3DEstimator hidden={self.hidden} nside={self.domain.nside}>"

@@ -407,6 +407,24 @@ for _entry in (
         weights_subdir="learned3d",
         module="eyeviz.estimators.learned3d",
         kind="spherical",
+        fit_options=(
+            _opt(
+                "-n",
+                "--n-train",
+                dest="n",
+                type=int,
+                default=None,
+                help="training elements to generate (default 500,000)",
+            ),
+            _opt("--n-val", type=int, default=None, help="validation elements (50,000)"),
+            _opt("--epochs", type=int, default=None, help="at most this many (40)"),
+            _opt("--hidden", type=int, default=None, help="hidden width (128)"),
+            _opt("--patience", type=int, default=None, help="early stopping (5)"),
+            _opt("--nside", type=int, default=None, help="learned3d: HEALPix nside (m / 4)"),
+            _opt("--el-max", type=float, default=None, help="learned3d: degrees (30)"),
+            _SEED,
+            _THREADS,
+        ),
     ),
 ):
     register(_entry)

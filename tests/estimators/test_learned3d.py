@@ -310,3 +310,44 @@ def test_fit_on_a_given_data_set_and_from_a_planar_domain(tmp_path):
         fit(None, tmp_path / "p", domain=Domain(m=722), n=2048)
     with pytest.raises(EyevizError, match="hidden"):
         fit(None, tmp_path / "q", domain=SMALL, hidden=0)
+
+
+# --- the registry ---------------------------------------------------------------------
+
+
+def test_registry_loads_the_shipped_weights_and_refuses_a_planar_domain():
+    from eyeviz.estimators import registry
+
+    assert "learned3d" in registry.available("spherical")
+    assert "learned3d" not in registry.available()  # planar lists stay planar
+    est = registry.load("learned3d", domain=Domain3D())
+    assert isinstance(est, learned3d.Learned3DEstimator) and est.n_weights > 0
+    with pytest.raises(EyevizError, match="Domain3D"):
+        registry.load("learned3d", domain=Domain())
+
+
+def test_registry_fit_takes_what_eyeviz_train_passes(tmp_path):
+    """eyeviz train hands fit a planar Domain (--h ... --g-max) and the entry's options."""
+    from eyeviz.estimators import registry
+
+    entry = registry.get("learned3d")
+    dests = {o.dest for o in entry.fit_options}
+    assert {"n", "n_val", "epochs", "hidden", "patience", "seed", "nside", "el_max"} <= dests
+    out = registry.fit(
+        "learned3d",
+        None,
+        tmp_path / "m",
+        domain=Domain(g_max=400.0),
+        nside=16,
+        el_max=20.0,
+        n=2048,
+        n_val=256,
+        epochs=1,
+        hidden=4,
+        seed=11,
+        threads=1,
+        command="eyeviz train learned3d --nside 16",
+    )
+    est = registry.load("learned3d", path=out)
+    assert est.domain == Domain3D(nside=16, g_max=400.0, el_max=math.radians(20.0))
+    assert est.metadata["command"] == "eyeviz train learned3d --nside 16"
