@@ -21,7 +21,10 @@ from eyeviz.resources import models_dir
 __all__ = ["ShippedSeed", "fresh_seed", "same_sets", "shipped_seeds"]
 
 SEED_BITS = 32  # a drawn seed is < 2^32: short enough to type back
-_DOMAIN_KEYS = ("h", "l", "m", "r_min", "r_max", "g_max")
+_DOMAIN_KEYS = {
+    "planar": ("h", "l", "m", "r_min", "r_max", "g_max"),
+    "spherical": ("h", "l", "nside", "r_min", "r_max", "g_max", "el_max"),
+}
 _META_MAX = 1 << 20  # bytes of a shipped metadata file read here
 
 
@@ -30,14 +33,15 @@ class ShippedSeed:
     """One data set a shipped model was fitted on: its seed, parameters and where said."""
 
     seed: int
-    domain: tuple[float, ...]  # h, l, m, r_min, r_max, g_max
+    domain: tuple[float, ...]  # h, l, m, r_min, r_max, g_max (spherical: _DOMAIN_KEYS)
     mode: str
-    what: str  # "the compact weights' training set (eyeviz/assets/models/compact.json)"
+    what: str  # "the compact weights' training set (models/compact.json)"
+    kind: str = "planar"  # or "spherical" (a 3D data set)
 
 
-def _domain(d: dict) -> tuple[float, ...] | None:
+def _domain(d: dict, kind: str = "planar") -> tuple[float, ...] | None:
     try:
-        return tuple(float(d[k]) for k in _DOMAIN_KEYS)
+        return tuple(float(d[k]) for k in _DOMAIN_KEYS[kind])
     except (KeyError, TypeError, ValueError):
         return None
 
@@ -95,6 +99,20 @@ def shipped_seeds(root: Path | None = None) -> list[ShippedSeed]:
                 "the bayes table's samples (models/bayes.npz)",
             )
         )
+    doc = _json(root / "learned3d" / "learned3d.json").get("data", {})
+    dom = _domain(doc, "spherical") if isinstance(doc, dict) else None
+    if dom is not None:
+        for key, what in (("train_seed", "training"), ("val_seed", "validation")):
+            if isinstance(doc.get(key), int):
+                out.append(
+                    ShippedSeed(
+                        doc[key],
+                        dom,
+                        str(doc.get("mode", "single")),
+                        f"the learned3d weights' {what} set (models/learned3d/learned3d.json)",
+                        "spherical",
+                    )
+                )
     for path in sorted((root / "paper").glob("*.json")):
         data = _json(path).get("data", {})
         dom = _domain(data) if isinstance(data, dict) else None
@@ -120,16 +138,18 @@ def fresh_seed(avoid: set[int] | None = None) -> int:
             return seed
 
 
-def same_sets(seed: int, domain: dict, mode: str) -> list[str]:
+def same_sets(seed: int, domain: dict, mode: str, kind: str = "planar") -> list[str]:
     """What shipped models were fitted on the set that ``seed`` draws with these parameters
-    (``domain``: h, l, m, r_min, r_max, g_max) and ``mode``; empty when none."""
-    dom = _domain(domain)
+    (``domain``: h, l, m, r_min, r_max, g_max; spherical: h, l, nside, r_min, r_max, g_max,
+    el_max) and ``mode``; empty when none."""
+    dom = _domain(domain, kind)
     if dom is None:
         return []
     return [
         s.what
         for s in shipped_seeds()
         if s.seed == seed
+        and s.kind == kind
         and s.mode == mode
         and all(math.isclose(a, b, rel_tol=1e-12) for a, b in zip(s.domain, dom, strict=True))
     ]

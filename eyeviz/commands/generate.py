@@ -94,7 +94,7 @@ def _seed(args: argparse.Namespace) -> bool:
     return True
 
 
-def _say_seed(args: argparse.Namespace, drawn: bool, domain: dict | None) -> None:
+def _say_seed(args: argparse.Namespace, drawn: bool, domain: dict, kind: str = "planar") -> None:
     """The drawn seed on stdout, even with --quiet (a CSV has nowhere to keep it); on
     stderr a warning when the given seed draws a set a shipped model was fitted on."""
     if drawn:
@@ -103,11 +103,9 @@ def _say_seed(args: argparse.Namespace, drawn: bool, domain: dict | None) -> Non
             flush=True,
         )
         return
-    if domain is None:
-        return
     from eyeviz.commands._seeds import same_sets
 
-    for what in same_sets(args.seed, domain, args.mode):
+    for what in same_sets(args.seed, domain, args.mode, kind):
         print(
             f"generate: warning: seed {args.seed} with these parameters draws {what}; "
             "it is not a held-out test set for that model",
@@ -203,7 +201,9 @@ def _run3d(args: argparse.Namespace, drawn: bool = False) -> int:
     n = algorithm1_3d.check_n(args.n)
     algorithm1_3d.make_params3d(domain, args.mode, args.seed, args.segments)
     limits.check_free_space(args.output, sparse3d.estimated_bytes3d(n, domain))
-    _say_seed(args, drawn, None)  # no shipped model was fitted on a 3D set
+    d3 = {"h": domain.h, "l": domain.l, "nside": domain.nside, "el_max": domain.el_max}
+    d3.update(r_min=domain.r_min, r_max=domain.r_max, g_max=domain.g_max)
+    _say_seed(args, drawn, d3, "spherical")
     bar = _progress(args, n, _PROGRESS_MIN_3D)
     t0 = time.perf_counter()
     try:

@@ -115,3 +115,20 @@ def test_the_estimator_report_test_sets_share_no_seed_with_shipped_training():
     shipped = {s.seed for s in _seeds.shipped_seeds()}
     assert shipped  # the metadata was found
     assert not shipped & {TEST_SEED + i for i in range(len(TEST_SETS))}
+
+
+def test_a_shipped_3d_seed_is_warned_about_and_never_drawn(tmp_path, capsys):
+    """The learned3d weights were trained on 3D sets (learned3d.json: train_seed,
+    val_seed); a 3D generate with that seed and those parameters is warned about."""
+    found = [s for s in _seeds.shipped_seeds() if s.kind == "spherical"]
+    assert found, "learned3d.json's seeds not found"
+    s = found[0]
+    h, l, nside, r_min, r_max, g_max, el_max = s.domain
+    out = tmp_path / "t.npz"
+    args = ["generate", "-n", "3", "--quiet", "--nside", str(int(nside)), "--h", str(h)]
+    args += ["--l", str(l), "--r-min", str(r_min), "--r-max", str(r_max)]
+    args += ["--g-max", str(g_max), "--el-max", repr(el_max), "--seed", str(s.seed)]
+    assert cli.main([*args, "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert f"warning: seed {s.seed}" in err and "learned3d" in err
+    assert s.seed not in {_seeds.fresh_seed() for _ in range(50)}
