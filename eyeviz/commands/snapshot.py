@@ -2,11 +2,13 @@
 
 No window, no Qt, no VTK: the figure is drawn by matplotlib (Agg) from the scene model
 (:mod:`eyeviz.render.mpl.vector`). torch is imported only when the scene shows predictions.
-A spherical scene (``[eyes] nside``) is drawn by :mod:`eyeviz.render.mpl.figure3d` for
-SVG and PDF (each eye's facets on a Mollweide map, a readout table and a perspective view of
-the eyes); its PNG is the app's 3D view rendered off-screen by VTK
-(:func:`eyeviz.render.vtk.scene3d.render_png3d`, EGL: no display), ``--width`` inches at
-300 dpi times ``--scale`` wide and ``--aspect`` (default 9/16) of that high.
+A spherical scene (``[eyes] nside``) is drawn by :mod:`eyeviz.render.mpl.figure3d`: the 3D
+view (the eyes close up and the scene), each eye's facets on a Mollweide map and a readout
+table. SVG and PDF draw the view from the model as polygons; the PNG is the same figure
+with the view rendered off-screen by VTK, as the app's 3D view draws it
+(:func:`eyeviz.render.vtk.png3d.export_png3d`, EGL: no display), at the view box's pixel
+size: ``--width`` inches at 300 dpi times ``--scale``, the view ``--aspect`` of its width
+high (docs/spherical.md).
 """
 
 from __future__ import annotations
@@ -95,20 +97,7 @@ def run(args: argparse.Namespace) -> int:
         from eyeviz import EyevizError
 
         raise EyevizError("view: a planar scene has one view (--view is for spherical scenes)")
-    if sc.kind == "spherical" and format_of(args.output) == "png":  # the 3D view, by VTK
-        from eyeviz.model.state3d import compute_state3d
-        from eyeviz.render.mpl.figure3d import check_drawable3d
-        from eyeviz.render.mpl.style import BASE_DPI
-        from eyeviz.render.vtk.scene3d import default_camera, png_size, render_png3d
-
-        check_drawable3d(sc)
-        px_w, px_h = png_size(width * BASE_DPI * args.scale, args.aspect)
-        st = compute_state3d(sc)
-        cam = default_camera(st, args.view)
-        png = render_png3d(sc, args.output, cam, px_w, px_h, state=st, transparent=args.transparent)
-        print(png)
-        return 0
-    if sc.kind == "spherical":  # HEALPix eyes: maps, table and perspective (figure3d)
+    if sc.kind == "spherical":  # HEALPix eyes: the view, the maps and the table (figure3d)
         from eyeviz import EyevizError
         from eyeviz.render.mpl.figure3d import check_drawable3d, export3d
 
@@ -118,19 +107,23 @@ def run(args: argparse.Namespace) -> int:
         from eyeviz.render.mpl.glyphs import one_glyph_warning
 
         check_drawable3d(sc)
+        opts = dict(
+            scale=args.scale,
+            transparent=args.transparent,
+            width=width,
+            title=not args.no_title,
+            table=not args.no_table,
+            bitmaps=not args.no_bitmaps,
+            aspect=None if args.aspect is None else aspect,
+            view=args.view,
+        )
         with one_glyph_warning():  # an emoji name: one line, not a warning pair per glyph
-            out = export3d(
-                sc,
-                args.output,
-                scale=args.scale,
-                transparent=args.transparent,
-                width=width,
-                title=not args.no_title,
-                table=not args.no_table,
-                bitmaps=not args.no_bitmaps,
-                aspect=None if args.aspect is None else aspect,
-                view=args.view,
-            )
+            if format_of(args.output) == "png":  # the same figure, the view rendered by VTK
+                from eyeviz.render.vtk.png3d import export_png3d
+
+                out = export_png3d(sc, args.output, **opts)
+            else:
+                out = export3d(sc, args.output, **opts)
         print(out)
         return 0
     check_drawable(sc)  # too many features or undrawable coordinates: refused at once

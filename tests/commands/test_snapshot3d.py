@@ -45,9 +45,10 @@ def test_snapshot3d_written_and_opened(name, fmt, tmp_path, capsys):
     args = ["snapshot", str(SCENES / f"{name}.toml"), "-o", str(out)]
     assert main(args + (["--scale", "0.5"] if fmt == "png" else [])) == 0
     assert capsys.readouterr().out.strip() == str(out)
-    if fmt == "png":  # the app's 3D view rendered off-screen (render_png3d)
+    if fmt == "png":  # the whole figure, its 3D view rendered off-screen by VTK
         img = mpimg.imread(out)
-        assert img.shape[:2] == (295, 525)  # 3.5 in at 150 dpi, 9/16 of that high
+        fig = figure3d(load(SCENES / f"{name}.toml"))  # the SVG's figure, same layout
+        assert img.shape[:2] == (round(fig.get_figheight() * 150), 525)  # 3.5 in at 150 dpi
         # not blank: the first ball's colour (#D55E00: the ball, its lit facets) is in it
         rgb = (img[..., :3] * 255).round().astype(int).reshape(-1, 3)
         assert (np.abs(rgb - [0xD5, 0x5E, 0x00]).sum(axis=1) < 60).sum() > 20

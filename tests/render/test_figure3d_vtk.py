@@ -9,6 +9,12 @@ facets and balls, shaded differently by VTK's lights and the vector headlight, s
 by hue, not by value) must lie at the same place: centroids within 1 % of the width and
 intersection over union at least 0.6. The same check with the camera turned by 6 degrees
 must fail: the comparison can tell a wrong camera.
+
+The PNG that ``eyeviz snapshot`` writes is the whole figure (:func:`export_png3d`: the view
+rendered by VTK at the view box's pixel size, the maps and the readout drawn by matplotlib):
+it is compared with the SVG's figure rasterised through Agg at the same dpi; outside the
+view's box (title, maps, table) the pixels must be the same, inside it the per-colour check
+above holds and fails for a turned camera.
 """
 
 from __future__ import annotations
@@ -30,11 +36,13 @@ from matplotlib.figure import Figure  # noqa: E402
 from eyeviz.model.camera3d import Camera3D  # noqa: E402
 from eyeviz.model.scene import load  # noqa: E402
 from eyeviz.model.state3d import compute_state3d  # noqa: E402
+from eyeviz.render.mpl.figure3d import figure3d  # noqa: E402
 from eyeviz.render.mpl.perspective3d import (  # noqa: E402
     default_camera,
     draw_panel,
     split_viewports,
 )
+from eyeviz.render.vtk.png3d import export_png3d  # noqa: E402
 from eyeviz.render.vtk.scene3d import render_png3d  # noqa: E402
 
 SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
@@ -122,4 +130,71 @@ def test_the_png_and_the_vector_view_show_the_same_picture(name, size, tmp_path)
     assert not bad, bad
     # a wrong camera (turned 6 degrees) does not pass the same check
     wrong = _agreement(vtk_img, _vector(sc, st, _turned(cam, 6.0), size), colors)
+    assert [r for r in wrong if not (r[2] <= CENTROID and r[3] >= IOU)], wrong
+
+
+def _figure_rgb(fig, dpi: float, svg: Path | None = None) -> np.ndarray:
+    """``fig`` rasterised through Agg at ``dpi``, rgb uint8 (written as SVG first when
+    asked: the same figure)."""
+    if svg is not None:
+        fig.savefig(svg, format="svg")
+    fig.set_dpi(dpi)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    return np.asarray(canvas.buffer_rgba())[..., :3].copy()
+
+
+def _view_box(fig, shape) -> tuple[int, int, int, int]:
+    """(row0, row1, col0, col1) pixels of the 3D view's box (its two parts' axes)."""
+    exts = [a.get_window_extent() for a in fig.axes if a.get_gid() in PARTS]
+    assert len(exts) == 2
+    x0, x1 = min(e.x0 for e in exts), max(e.x1 for e in exts)
+    y0, y1 = min(e.y0 for e in exts), max(e.y1 for e in exts)
+    return shape[0] - round(y1), shape[0] - round(y0), round(x0), round(x1)
+
+
+PARTS = ("perspective-eyes", "perspective-scene")
+SAME = 8  # of 255: a pixel outside the view differs by less
+SAME_FRACTION = 1e-4  # ... but on this fraction of them
+
+
+# nside 180's lit patches in the close-up are compared at a double column (a view 2112 px
+# wide; at a single one, IoU 0.62-0.8 at scales 1.2-1.6: patches of a few pixels)
+@pytest.mark.parametrize(
+    ("name", "scale", "width"), [("sphere_teaching", 0.6, 3.5), ("sphere_paper", 1.0, 7.2)]
+)
+def test_the_png_is_the_whole_figure_with_the_vtk_view(name, scale, width, tmp_path):
+    sc = load(SCENES / f"{name}.toml")
+    sc.layers = ["eyes", "features", "labels", "bitmaps", "readout"]  # opaque view parts
+    st = compute_state3d(sc)
+    cam = default_camera(st, "default", 1.5)
+    dpi = 300.0 * scale
+    png = export_png3d(sc, tmp_path / "fig.png", scale, camera=cam, width=width)
+    got = (mpimg.imread(png)[..., :3] * 255.0).round().astype(np.int16)
+    svg = tmp_path / "fig.svg"
+    fig = figure3d(sc, camera=cam, dpi=dpi, width=width)  # the SVG's figure, the PNG's pixels
+    vec = _figure_rgb(fig, dpi, svg).astype(np.int16)
+    assert not ET.parse(svg).getroot().findall(f".//{SVG}image")  # true vector
+    assert got.shape == vec.shape and got.shape[1] == round(width * dpi)
+    r0, r1, c0, c1 = _view_box(fig, got.shape)
+    # the VTK view has the box's exact pixel size (VTK and mpl split its two parts alike)
+    outside = np.ones(got.shape[:2], bool)
+    outside[r0:r1, c0:c1] = False
+    diff = np.abs(got - vec).max(axis=-1)
+    assert (diff[outside] > SAME).mean() < SAME_FRACTION, (diff[outside] > SAME).mean()
+    inside = diff[~outside]
+    assert (inside > SAME).mean() > 0.005  # the view is VTK's, not the polygons again
+    colors = [f.color for f in sc.features]
+    rows = _agreement(got[r0:r1, c0:c1] / 255.0, vec[r0:r1, c0:c1] / 255.0, colors)
+    assert len(rows) >= 4 and {p for p, *_ in rows} == {"eyes", "scene"}, rows
+    bad = [r for r in rows if not (r[2] <= CENTROID and r[3] >= IOU)]
+    assert not bad, bad
+    # the maps are the same too: lit facets of every colour outside the view, identical
+    outside_rows = np.flatnonzero(outside.all(axis=1))
+    masks = _masks(got[outside_rows] / 255.0, colors)
+    assert all(m.sum() > 20 for m in masks)
+    # a turned camera in the vector figure fails the view's check
+    turned = figure3d(sc, camera=_turned(cam, 6.0), dpi=dpi, width=width)
+    wrong_img = _figure_rgb(turned, dpi)[r0:r1, c0:c1] / 255.0
+    wrong = _agreement(got[r0:r1, c0:c1] / 255.0, wrong_img, colors)
     assert [r for r in wrong if not (r[2] <= CENTROID and r[3] >= IOU)], wrong

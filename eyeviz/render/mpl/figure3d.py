@@ -27,6 +27,7 @@ matplotlib is imported when this module is; callers that must stay light import 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -39,7 +40,12 @@ from eyeviz.model.camera3d import PRESETS, Camera3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
 from eyeviz.render.mpl.healpix_map import MapAxes, draw_eye_view, view_lonlat
-from eyeviz.render.mpl.perspective3d import VIEW_LAYERS, default_camera, draw_panel
+from eyeviz.render.mpl.perspective3d import (
+    VIEW_LAYERS,
+    default_camera,
+    draw_panel,
+    scene_aspect,
+)
 from eyeviz.render.mpl.style import (
     BASE_DPI,
     FONT,
@@ -51,7 +57,18 @@ from eyeviz.render.mpl.style import (
     short,
 )
 
-__all__ = ["MAX_BALLS", "check_drawable3d", "export3d", "figure3d", "readout_rows"]
+__all__ = [
+    "MAX_BALLS",
+    "ViewImage",
+    "check_drawable3d",
+    "export3d",
+    "figure3d",
+    "readout_rows",
+]
+
+#: ``view_image(camera, width_px, height_px)`` -> the 3D view's picture, rows x columns x
+#: 3 or 4 (uint8 or floats in [0, 1]): the VTK render the PNG shows (:func:`figure3d`).
+ViewImage = Callable[[Camera3D, int, int], np.ndarray]
 
 #: A 3D figure shows at most this many balls (the table holds a row per ball).
 MAX_BALLS = 40
@@ -83,17 +100,19 @@ def _draw_view(
     st: SceneState3D,
     scene: Scene,
     cam: Camera3D,
+    image: np.ndarray | None = None,
 ) -> None:
     """The 3D view in ``box`` (figure fractions) as the VTK view lays it out: the eyes
-    close up on the left, the scene through ``cam`` on the right."""
-    eyes_ax, scene_ax = draw_panel(fig, box, st, scene, cam)
+    close up on the left, the scene through ``cam`` on the right (polygons, or ``image``:
+    the VTK render of the same view, :func:`eyeviz.render.mpl.perspective3d.draw_panel`)."""
+    eyes_ax, scene_ax = draw_panel(fig, box, st, scene, cam, image=image)
     scene_ax.text(
-        0.01, 0.99, _view_caption(cam), transform=scene_ax.transAxes, fontsize=SMALL,
+        0.02, 0.98, _view_caption(cam), transform=scene_ax.transAxes, fontsize=SMALL,
         color=GREY, ha="left", va="top",
     )  # fmt: skip
     pair = st.pair
     eyes_ax.text(
-        0.03, 0.98, f"the eyes, nside {pair.nside}: {pair.npix:,} facets each",
+        0.03, 0.98, f"the eyes close up\nnside {pair.nside}, {pair.npix:,} facets each",
         transform=eyes_ax.transAxes, fontsize=SMALL, color=GREY, ha="left", va="top",
     )  # fmt: skip
 
@@ -183,13 +202,25 @@ def figure3d(
     aspect: float | None = None,
     camera: Camera3D | None = None,
     view: str = "default",
+    dpi: float | None = None,
+    view_image: ViewImage | None = None,
 ) -> Figure:
     """The spherical scene as a Figure ``width`` inches wide (see the module docstring).
     ``title``, ``table`` and ``bitmaps`` (False) leave those parts out; ``aspect`` is the
     3D view's height / width (default 0.6; 0.38 from 6 inches wide, where the two maps
     stand side by side); ``camera`` is the view's (default: the preset ``view``, one of
-    :data:`eyeviz.model.camera3d.PRESETS`, framing the balls)."""
+    :data:`eyeviz.model.camera3d.PRESETS`, framing the eyes and the balls).
+
+    ``dpi`` (the PNG's pixels per inch) makes the figure a whole number of pixels wide
+    and high and puts the 3D view's box on whole pixels; ``view_image`` (needs ``dpi``)
+    is called as ``view_image(camera, width_px, height_px)`` for the view's picture at
+    that box's pixel size (the VTK off-screen render,
+    :func:`eyeviz.render.vtk.png3d.view_rgba`), shown pixel for pixel in place of the
+    polygons; the maps, the readout and the text are drawn as for the vector figure."""
     import matplotlib
+
+    if view_image is not None and dpi is None:
+        raise EyevizError("figure3d: view_image needs the PNG's dpi")
 
     if scene.kind != "spherical":
         raise EyevizError("figure3d draws a spherical scene ([eyes] nside)")
@@ -217,6 +248,8 @@ def figure3d(
     if not parts:
         parts.append(("empty", 0.3))
     height = sum(h for _, h in parts) + 2 * m
+    if dpi is not None:  # whole pixels (the rounding goes to the right and bottom margins)
+        width, height = round(width * dpi) / dpi, round(height * dpi) / dpi
     with matplotlib.rc_context(RC):
         fig = Figure(figsize=(width, height))
         top = height - m
@@ -233,8 +266,21 @@ def figure3d(
                     va="center", fontsize=FONT + 1, color=INK, gid="title",
                 )  # fmt: skip
             elif name == "persp":
-                cam = default_camera(st, view) if camera is None else camera
-                _draw_view(fig, rect(m, width - 2 * m, h), st, scene, cam)
+                box = rect(m, width - 2 * m, h)
+                image = None
+                if dpi is not None:
+                    box, (w_px, h_px) = _on_pixels(box, width * dpi, height * dpi)
+                cam = camera
+                if cam is None:
+                    cam = default_camera(st, view, scene_aspect(box[2] * width, box[3] * height))
+                if view_image is not None:
+                    image = view_image(cam, w_px, h_px)
+                    if image.shape[:2] != (h_px, w_px):
+                        raise EyevizError(
+                            f"figure3d: view_image gave {image.shape[1]} x {image.shape[0]} "
+                            f"px for a {w_px} x {h_px} px view"
+                        )
+                _draw_view(fig, box, st, scene, cam, image)
             elif name in ("maps", "mapA", "mapB"):
                 eyes = "AB" if name == "maps" else name[-1]
                 for k, eye in enumerate(eyes):
@@ -251,6 +297,16 @@ def figure3d(
             top -= h
         fig._eyeviz_rc = dict(RC)  # type: ignore[attr-defined]
     return fig
+
+
+def _on_pixels(
+    box: tuple[float, float, float, float], fig_w: float, fig_h: float
+) -> tuple[tuple[float, float, float, float], tuple[int, int]]:
+    """``box`` (figure fractions) moved to whole pixels of a ``fig_w`` x ``fig_h`` pixel
+    figure, and its (width, height) in pixels."""
+    x0, y0 = round(box[0] * fig_w), round(box[1] * fig_h)
+    x1, y1 = round((box[0] + box[2]) * fig_w), round((box[1] + box[3]) * fig_h)
+    return (x0 / fig_w, y0 / fig_h, (x1 - x0) / fig_w, (y1 - y0) / fig_h), (x1 - x0, y1 - y0)
 
 
 def _draw_map(ax, st: SceneState3D, scene: Scene, eye: str) -> None:
@@ -304,11 +360,14 @@ def export3d(
     aspect: float | None = None,
     camera: Camera3D | None = None,
     view: str = "default",
+    view_image: ViewImage | None = None,
 ) -> Path:
     """Write the spherical scene's figure (:func:`figure3d`, through ``camera`` or the
     preset ``view``) to
     ``path`` (.png, .svg or .pdf) atomically, as :func:`eyeviz.render.mpl.export.export`
-    writes a planar one."""
+    writes a planar one. A PNG is ``width`` inches at 300 dpi times ``scale``, on whole
+    pixels; ``view_image`` (PNG only, see :func:`figure3d`) gives its 3D view's picture
+    (:func:`eyeviz.render.vtk.png3d.export_png3d` passes the VTK render)."""
     import matplotlib
 
     from eyeviz.render.mpl.export import MAX_PNG_PX, _check_scale, _metadata, format_of
@@ -326,11 +385,12 @@ def export3d(
     parent = target.parent if str(target.parent) else Path(".")
     if not parent.is_dir():
         raise EyevizError(f"{target}: directory {parent} does not exist")
+    dpi = BASE_DPI * scale if fmt == "png" else VECTOR_DPI
     fig = figure3d(
         scene, width=width, title=title, table=table, bitmaps=bitmaps, aspect=aspect,
-        camera=camera, view=view,
+        camera=camera, view=view, dpi=dpi if fmt == "png" else None,
+        view_image=view_image if fmt == "png" else None,
     )  # fmt: skip
-    dpi = BASE_DPI * scale if fmt == "png" else VECTOR_DPI
     with atomic_output(target) as tmp, matplotlib.rc_context(RC):
         fig.savefig(
             tmp,

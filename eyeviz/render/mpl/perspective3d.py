@@ -43,7 +43,7 @@ from matplotlib.patches import Rectangle
 
 from eyeviz.core import healpix
 from eyeviz.model import shapes3d
-from eyeviz.model.camera3d import Camera3D, eyes_camera, preset, project
+from eyeviz.model.camera3d import Camera3D, eyes_camera, project
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.mpl.style import SMALL, short
@@ -73,6 +73,7 @@ __all__ = [
     "default_camera",
     "draw_panel",
     "draw_view",
+    "scene_aspect",
     "scene_polygons",
     "split_viewports",
 ]
@@ -116,11 +117,17 @@ class Polygons:
         return len(self.verts)
 
 
-def default_camera(state: SceneState3D, view: str = "default") -> Camera3D:
+def default_camera(state: SceneState3D, view: str = "default", aspect: float = 1.0) -> Camera3D:
     """The view's camera for a preset ``view`` (:data:`eyeviz.model.camera3d.PRESETS`)
-    framing the scene's balls, as the VTK view's ``default_camera``."""
-    pair = state.pair
-    return preset(view, pair.h, pair.l, shapes3d.scene_extent(state))
+    framing the eyes and the balls in a scene part ``aspect`` (width / height) wide: the
+    app's and the VTK PNG's (:func:`eyeviz.model.shapes3d.view_camera`)."""
+    return shapes3d.view_camera(state, view, aspect)
+
+
+def scene_aspect(w: float, h: float) -> float:
+    """The scene part's width / height in a ``w`` x ``h`` view (:func:`split_viewports`)."""
+    _, (x0, _y0, x1, _y1) = split_viewports(w, h)
+    return (x1 - x0) * w / h
 
 
 class _Batch:
@@ -295,7 +302,7 @@ def scene_polygons(
     scene's) picks the parts among :data:`VIEW_LAYERS`."""
     shown = set(scene.layers if layers is None else layers)
     batches: list[_Batch] = []
-    if "bfv" in shown:
+    if "bfv" in shown and part == "scene":  # as VTK: the field is not in the close-up
         batches += _bfv_batches(state)
     if "plane" in shown and part == "scene":
         tiles, grid = _plane(state)
@@ -378,18 +385,23 @@ def draw_view(
     aspect: float,
     part: str = "scene",
     layers=None,
-) -> PolyCollection:
+    *,
+    geometry: bool = True,
+) -> PolyCollection | None:
     """One part of the view through ``cam`` on ``ax``, whose box must have width /
     height = ``aspect``: one collection of polygons and lines (the plane's grid and the
     equators, layer "plane") in painting order, the names (layer "labels") over them;
-    limits [-1, 1] x [-1, 1], no axis."""
+    limits [-1, 1] x [-1, 1], no axis. ``geometry`` False draws the names only (over the
+    VTK render of the same view, :func:`draw_panel` ``image``)."""
     shown = set(scene.layers if layers is None else layers)
-    polys = scene_polygons(state, scene, cam, aspect, part, layers)
-    coll = PolyCollection(
-        polys.verts, facecolors=polys.face, edgecolors=polys.edge, linewidths=polys.width
-    )
-    coll.set_gid(f"view-{part}")
-    ax.add_collection(coll, autolim=False)
+    coll = None
+    if geometry:
+        polys = scene_polygons(state, scene, cam, aspect, part, layers)
+        coll = PolyCollection(
+            polys.verts, facecolors=polys.face, edgecolors=polys.edge, linewidths=polys.width
+        )
+        coll.set_gid(f"view-{part}")
+        ax.add_collection(coll, autolim=False)
     if "labels" in shown:
         _labels(ax, state, scene, cam, aspect, part, shown)
     ax.set_xlim(-1.0, 1.0)
@@ -411,8 +423,11 @@ def _labels(ax, state, scene, cam, aspect, part, shown) -> None:
         xy, depth = project(cam, pts, aspect)
         for (x, y), d, f in zip(xy, depth, scene.features, strict=True):
             if d > 0 and abs(x) < 1 and abs(y) < 1:
-                ax.text(x, y, " " + short(f.name, 16), fontsize=SMALL + 1, color=f.color,
-                        ha="left", va="bottom")  # fmt: skip
+                # right of the ball's top, or left of it near the right edge (stays inside)
+                right = x < 0.55
+                name = short(f.name, 16)
+                ax.text(x, y, f" {name}" if right else f"{name} ", fontsize=SMALL + 1,
+                        color=f.color, ha="left" if right else "right", va="bottom")  # fmt: skip
 
 
 def draw_panel(
@@ -422,11 +437,29 @@ def draw_panel(
     scene: Scene,
     cam: Camera3D,
     layers=None,
+    *,
+    image: np.ndarray | None = None,
 ) -> tuple[Axes, Axes]:
     """The whole 3D view in ``box`` (figure fractions: left, bottom, width, height) as the
     VTK view lays it out (:func:`split_viewports`): the eyes close up on the left, the
-    scene through ``cam`` on the right. Returns the (eyes, scene) axes."""
+    scene through ``cam`` on the right. Returns the (eyes, scene) axes.
+
+    ``image`` (rows x columns x 3 or 4, the VTK render of this view through ``cam``, as
+    many pixels as ``box`` holds at the figure's dpi) is shown in place of the polygons,
+    filling the box pixel for pixel (no resampling); the names are drawn over it as over
+    the polygons."""
     w_in, h_in = box[2] * fig.get_figwidth(), box[3] * fig.get_figheight()
+    if image is not None:
+        img_ax = fig.add_axes(box)
+        img_ax.set_gid("perspective-image")
+        rows, cols = image.shape[:2]
+        img_ax.imshow(
+            image, extent=(0.0, cols, 0.0, rows), origin="upper", interpolation="none",
+            aspect="auto", resample=False,
+        )  # fmt: skip
+        img_ax.set_xlim(0.0, cols)
+        img_ax.set_ylim(0.0, rows)
+        img_ax.set_axis_off()
     axes = []
     for part, (x0, y0, x1, y1) in zip(("eyes", "scene"), split_viewports(w_in, h_in), strict=True):
         ax = fig.add_axes(
@@ -435,10 +468,11 @@ def draw_panel(
         ax.set_gid(f"perspective-{part}")
         aspect = (x1 - x0) * w_in / ((y1 - y0) * h_in)
         if part == "eyes":
-            ax.add_patch(Rectangle((-1, -1), 2, 2, facecolor=INSET_RGBA, lw=0, zorder=-1))
+            if image is None:
+                ax.add_patch(Rectangle((-1, -1), 2, 2, facecolor=INSET_RGBA, lw=0, zorder=-1))
             pcam = eyes_camera(cam, state.pair.h, state.pair.l, aspect)
         else:
             pcam = cam
-        draw_view(ax, state, scene, pcam, aspect, part, layers)
+        draw_view(ax, state, scene, pcam, aspect, part, layers, geometry=image is None)
         axes.append(ax)
     return axes[0], axes[1]

@@ -1,0 +1,119 @@
+"""The PNG of a spherical scene (issue 22 item 6, docs/spherical.md): the whole figure of
+:func:`eyeviz.render.mpl.figure3d.figure3d` (the 3D view, the Mollweide maps, the readout),
+its 3D view the VTK off-screen render of the app's view through the same camera.
+
+:func:`view_rgba` renders the 3D view (the eyes close up and the scene, as
+:class:`eyeviz.render.vtk.scene3d.Scene3DActors` draws them in the app) off-screen (EGL,
+no display) to an array of exactly the view box's pixels; the text (names, captions,
+title) is left to matplotlib, so that it is the vector figure's, at the figure's sizes.
+:func:`export_png3d` writes the figure with that picture in the view's box, pixel for
+pixel; the SVG/PDF draw the same view from the model as polygons
+(:mod:`eyeviz.render.mpl.perspective3d`). ``tests/render/test_figure3d_vtk.py`` compares
+the two.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pyvista as pv
+
+from eyeviz import EyevizError
+from eyeviz.core.validation import check_int
+from eyeviz.model.camera3d import Camera3D
+from eyeviz.model.scene import Scene
+from eyeviz.model.state3d import SceneState3D, compute_state3d
+from eyeviz.render.mpl.figure3d import export3d
+from eyeviz.render.vtk.scene3d import Scene3DActors, layout, make_renderers
+
+__all__ = ["MAX_VIEW_PX", "export_png3d", "view_rgba"]
+
+#: VTK renders the 3D view at most this many pixels wide or high (an off-screen buffer).
+MAX_VIEW_PX = 8192
+
+
+def view_rgba(
+    scene: Scene,
+    camera: Camera3D,
+    width: int,
+    height: int,
+    *,
+    state: SceneState3D | None = None,
+    selected: int | None = None,
+    transparent: bool = False,
+) -> np.ndarray:
+    """The 3D view of ``scene`` through ``camera`` (the scene part's; the close-up's
+    follows it) rendered off-screen, ``height`` x ``width`` x 4 uint8 (alpha 0 where
+    ``transparent`` leaves the background out), without text: no title, no caption, no
+    names (layer "labels" is drawn by the figure)."""
+    width = check_int("width", width, ge=16, le=MAX_VIEW_PX)
+    height = check_int("height", height, ge=16, le=MAX_VIEW_PX)
+    sc = scene.copy()
+    sc.layers = [k for k in sc.layers if k != "labels"]
+    st = compute_state3d(sc) if state is None else state
+    pl = pv.Plotter(off_screen=True, window_size=[width, height], lighting="light kit")
+    try:
+        ren_win = pl.ren_win
+        assert ren_win is not None
+        ren_win.SetMultiSamples(0)
+        main = pl.renderer
+        main.SetUseOIT(False)
+        main.SetUseDepthPeeling(False)
+        eyes = make_renderers(ren_win, main)
+        layout(main, eyes, width, height)
+        actors = Scene3DActors(main, eyes)
+        actors.update(sc, st, selected)
+        actors.title.SetVisibility(False)
+        actors.eyes_caption.SetVisibility(False)
+        actors.set_cameras(camera)
+        main.camera.is_set = True  # else pyvista's first render resets it (an isometric fit)
+        img = np.asarray(pl.screenshot(return_img=True, transparent_background=transparent))
+    finally:
+        pl.close()
+    if img.shape[:2] != (height, width):
+        raise EyevizError(
+            f"VTK rendered {img.shape[1]} x {img.shape[0]} px, not {width} x {height}"
+        )
+    if img.shape[2] == 3:
+        img = np.concatenate([img, np.full((height, width, 1), 255, np.uint8)], axis=2)
+    return np.ascontiguousarray(img, dtype=np.uint8)
+
+
+def export_png3d(
+    scene: Scene,
+    path: str | os.PathLike,
+    scale: float = 1.0,
+    transparent: bool = False,
+    *,
+    width: float = 3.5,
+    title: bool = True,
+    table: bool = True,
+    bitmaps: bool = True,
+    aspect: float | None = None,
+    camera: Camera3D | None = None,
+    view: str = "default",
+    selected: int | None = None,
+) -> Path:
+    """Write the spherical scene's figure as a PNG (``width`` inches at 300 dpi times
+    ``scale``), atomically: :func:`eyeviz.render.mpl.figure3d.export3d` with the 3D view
+    rendered by VTK (:func:`view_rgba`) at the view box's pixel size. EyevizError (one
+    line) for a view beyond :data:`MAX_VIEW_PX` pixels."""
+    if Path(path).suffix.lower() != ".png":
+        raise EyevizError(f"export_png3d writes .png files, got {str(path)!r}")
+    st = compute_state3d(scene)
+
+    def vtk_view(cam: Camera3D, w: int, h: int) -> np.ndarray:
+        if max(w, h) > MAX_VIEW_PX:
+            most = float(scale) * MAX_VIEW_PX / max(w, h)
+            raise EyevizError(
+                f"scale {float(scale):g} makes the 3D view {w} x {h} px; VTK renders at most "
+                f"{MAX_VIEW_PX} px: scale <= {most:.3g} at this width"
+            )
+        return view_rgba(scene, cam, w, h, state=st, selected=selected, transparent=transparent)
+
+    return export3d(
+        scene, path, scale, transparent, width=width, title=title, table=table,
+        bitmaps=bitmaps, aspect=aspect, camera=camera, view=view, view_image=vtk_view,
+    )  # fmt: skip
