@@ -30,7 +30,10 @@ percentile 8e-3, max 9e-3) and phi by at most 3.4e-5 rad (99th percentile); the 
 of a 2*10^4-row test set moves by under 0.001 points between n = 12, K = 6 and
 n = 24, K = 10 (the limit's own MAPE is about 7 %). Node arithmetic is float32. A key
 whose polyhedron is a sliver the grid misses is retried on a 4n x 4n grid before it is
-called empty.
+called empty; the feasible stretch of every ray is found before any node, so a key no
+ray reaches (the prior cannot produce it) costs the rays of both grids, never their
+nodes. The grid stays n = 12, K = 6: coarser ones measured past the bound above
+(n = 10, K = 4: max 1.2e-2; n = 12, K = 4: 1.4e-2).
 Keys the prior cannot produce (empty posterior, e.g. g = 5
 beyond r = 1146, or a run touching the end of the half bitmap) are answered by analytic
 triangulation and flagged in :attr:`LimitEstimator.last_flagged` /
@@ -39,6 +42,7 @@ triangulation and flagged in :attr:`LimitEstimator.last_flagged` /
 
 from __future__ import annotations
 
+import functools
 import math
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -107,24 +111,48 @@ def _interval_quadratic(qa, qb, qc):
     return lo, hi
 
 
-def posterior_nodes(keys, domain: Domain, prior: str = "single", n: int = 12, k: int = 6) -> Nodes:
-    """Quadrature nodes and weights of the posterior over (x, y, g) for keys (N, 4).
+@dataclass(frozen=True)
+class _Rays:
+    """Eye A's rays for N keys, arrays (N, n*n): direction, sin/cos of the half angle
+    delta, and the feasible interval [lo, hi] of the distance rho (``ok``: non-empty)."""
 
-    Deterministic: n x n midpoints over eye A's tangent sectors, k Gauss-Legendre points
-    in the distance from A on each ray (module docstring). Weights are zero where the
-    prior gives no mass; an all-zero row is an empty posterior.
-    """
-    if prior not in PRIORS:
-        raise ValueError(f"prior must be one of {PRIORS}, got {prior!r}")
-    keys = np.asarray(keys, np.int64).reshape(-1, 4)
+    cu: np.ndarray
+    su: np.ndarray
+    sd: np.ndarray
+    cd: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    ok: np.ndarray
+
+
+@functools.lru_cache(maxsize=16)
+def _grid(n: int) -> tuple[np.ndarray, np.ndarray]:
+    u = (np.arange(n) + 0.5) / n
+    u1, u2 = (v.ravel() for v in np.meshgrid(u, u, indexing="ij"))
+    u1.flags.writeable = False
+    u2.flags.writeable = False
+    return u1, u2
+
+
+@functools.lru_cache(maxsize=16)
+def _gauss(k: int) -> tuple[np.ndarray, np.ndarray]:
+    gx, gw = np.polynomial.legendre.leggauss(k)
+    gx, gw = gx.astype(np.float32), gw.astype(np.float32)
+    gx.flags.writeable = False
+    gw.flags.writeable = False
+    return gx, gw
+
+
+def _rays(keys: np.ndarray, domain: Domain, n: int) -> _Rays:
+    """The feasible distance interval on each of the n x n rays of eye A (module docstring:
+    eye B's half-planes and the BFV lines are linear in rho, the r and g bounds
+    quadratic). Cheap next to the nodes: an empty key is found here without them."""
     LA, RA, LB, RB = keys.T
-    N = keys.shape[0]
     gam = 2.0 * math.pi / domain.m
     s = math.sin(gam / 2)
     psi = math.asin(domain.l / domain.h)
     h = domain.h
-    u = (np.arange(n) + 0.5) / n
-    u1, u2 = (v.ravel() for v in np.meshgrid(u, u, indexing="ij"))
+    u1, u2 = _grid(n)
     tm = (LA[:, None] + u1[None, :]) * gam  # (N, n*n)
     tp = (RA[:, None] + u2[None, :]) * gam
     phiA = 0.5 * (tm + tp)
@@ -178,39 +206,77 @@ def posterior_nodes(keys, domain: Domain, prior: str = "single", n: int = 12, k:
     ok &= np.isfinite(lo) & np.isfinite(hi) & (hi > lo)
     lo = np.where(ok, lo, 0.0)
     hi = np.where(ok, hi, 0.0)
-    gx, gw = np.polynomial.legendre.leggauss(k)
+    return _Rays(cu, su, sd, np.cos(delta), lo, hi, ok)
+
+
+def _nodes(rays: _Rays, domain: Domain, prior: str, k: int) -> Nodes:
+    """K Gauss-Legendre nodes in rho on each ray's feasible interval, with the posterior
+    density (module docstring) times the Jacobian rho^2 cos(delta) / 2 as weight."""
+    N = rays.cu.shape[0]
+    s = math.sin(math.pi / domain.m)
+    psi = math.asin(domain.l / domain.h)
+    gx, gw = _gauss(k)
     f32 = np.float32  # node-level arithmetic in float32: 2x faster, rounding ~1e-7
-    half = (0.5 * (hi - lo)).astype(f32)[..., None]
-    rho = (0.5 * (hi + lo)).astype(f32)[..., None] + half * gx.astype(f32)  # (N, n*n, k)
-    x = f32(-h) + rho * cu.astype(f32)[..., None]
-    y = rho * su.astype(f32)[..., None]
-    g = rho * sd.astype(f32)[..., None]
+    half = (0.5 * (rays.hi - rays.lo)).astype(f32)[..., None]
+    rho = (0.5 * (rays.hi + rays.lo)).astype(f32)[..., None] + half * gx  # (N, n*n, k)
+    x = f32(-domain.h) + rho * rays.cu.astype(f32)[..., None]
+    y = rho * rays.su.astype(f32)[..., None]
+    g = rho * rays.sd.astype(f32)[..., None]
     r = np.hypot(x, y)
     with np.errstate(divide="ignore", invalid="ignore"):
         width = f32(math.pi - 2 * psi) - f32(2) * np.arcsin(np.minimum(g / r, f32(1)))
         dens = (rho * rho) / (r * (f32(domain.g_max) - r * f32(s)) * width)
     if prior == "multi":
         dens *= r
-    w = dens * (np.cos(delta).astype(f32)[..., None] * half) * gw.astype(f32)
-    w = np.where(ok[..., None] & np.isfinite(w) & (w > 0), w, f32(0))
+    w = dens * (rays.cd.astype(f32)[..., None] * half) * gw
+    w = np.where(rays.ok[..., None] & np.isfinite(w) & (w > 0), w, f32(0))
     phi = np.arctan2(y, x)
     return Nodes(*(v.reshape(N, -1) for v in (x, y, g, w, r, phi)))
 
 
+def posterior_nodes(keys, domain: Domain, prior: str = "single", n: int = 12, k: int = 6) -> Nodes:
+    """Quadrature nodes and weights of the posterior over (x, y, g) for keys (N, 4).
+
+    Deterministic: n x n midpoints over eye A's tangent sectors, k Gauss-Legendre points
+    in the distance from A on each ray (module docstring). Weights are zero where the
+    prior gives no mass; an all-zero row is an empty posterior.
+    """
+    if prior not in PRIORS:
+        raise ValueError(f"prior must be one of {PRIORS}, got {prior!r}")
+    keys = np.asarray(keys, np.int64).reshape(-1, 4)
+    return _nodes(_rays(keys, domain, n), domain, prior, k)
+
+
+def _sortable(v: np.ndarray) -> np.ndarray:
+    """float32 values as int32 codes in the same order (an involution; no NaN)."""
+    b = np.ascontiguousarray(v, np.float32).view(np.int32)
+    return b ^ ((b >> 31) & np.int32(0x7FFFFFFF))
+
+
 def weighted_median(v: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Per row, the median of v under weights w (CDF interpolated at node midpoints)."""
-    order = np.argsort(v, axis=1)
-    vs = np.take_along_axis(v, order, 1)
-    ws = np.take_along_axis(w, order, 1)
+    """Per row, the median of v under weights w (CDF interpolated at node midpoints).
+
+    One value sort instead of an argsort and two gathers: each float32 value's order code
+    (:func:`_sortable`) and its column share one int64, so a plain (SIMD) sort orders the
+    values and carries the columns to fetch the weights with. Values are taken as
+    float32 (the nodes' precision); ties are ordered by column.
+    """
+    v = np.asarray(v)
+    P = v.shape[1]
+    packed = (_sortable(v).astype(np.int64) << 32) | np.arange(P, dtype=np.int64)
+    packed.sort(axis=1)
+    col = packed & 0xFFFFFFFF
+    vs = _sortable((packed >> 32).astype(np.int32).view(np.float32)).view(np.float32)
+    ws = np.take_along_axis(np.asarray(w), col, 1)
     cw = np.cumsum(ws, axis=1)
     tot = cw[:, -1:]
     mid = (cw - 0.5 * ws) / np.where(tot > 0, tot, 1.0)
     i = (mid < 0.5).sum(axis=1)
-    i1 = np.clip(i, 1, v.shape[1] - 1)
+    i1 = np.clip(i, 1, P - 1)
     i0 = i1 - 1
     rows = np.arange(v.shape[0])
     m0, m1 = mid[rows, i0], mid[rows, i1]
-    v0, v1 = vs[rows, i0], vs[rows, i1]
+    v0, v1 = vs[rows, i0].astype(np.float64), vs[rows, i1].astype(np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):
         t = np.clip((0.5 - m0) / (m1 - m0), 0.0, 1.0)
     t = np.where(np.isfinite(t), t, 0.0)
@@ -218,7 +284,14 @@ def weighted_median(v: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 
 def limit_estimates(keys, domain: Domain, prior: str = "single", n: int = 12, k: int = 6):
-    """(r, phi, empty) for keys (N, 4): MAPE-optimal estimates; NaN where ``empty``."""
+    """(r, phi, empty) for keys (N, 4): MAPE-optimal estimates; NaN where ``empty``.
+
+    A key none of whose rays has a feasible stretch is empty without computing nodes; a
+    key the n x n grid finds empty is retried on a 4n x 4n grid (a sliver polyhedron can
+    fall between the rays), again nodes only where a ray is feasible.
+    """
+    if prior not in PRIORS:
+        raise ValueError(f"prior must be one of {PRIORS}, got {prior!r}")
     keys = np.asarray(keys, np.int64).reshape(-1, 4)
     N = keys.shape[0]
     r_out = np.full(N, np.nan)
@@ -226,24 +299,98 @@ def limit_estimates(keys, domain: Domain, prior: str = "single", n: int = 12, k:
     empty = np.ones(N, bool)
     step = max(1, 200_000 // (n * n * k))
     for s0 in range(0, N, step):
-        sl = slice(s0, min(N, s0 + step))
-        nd = posterior_nodes(keys[sl], domain, prior, n, k)
-        tot = nd.w.sum(axis=1)
-        e = ~(tot > 0)
-        r = nd.r
-        phi = nd.phi
+        rays = _rays(keys[s0 : s0 + step], domain, n)
+        live = rays.ok.any(axis=1)
+        if not live.any():
+            continue
+        if not live.all():
+            rays = _Rays(*(a[live] for a in vars(rays).values()))
+        nd = _nodes(rays, domain, prior, k)
+        e = ~(nd.w.sum(axis=1) > 0)
         with np.errstate(divide="ignore", invalid="ignore"):
-            r_out[sl] = weighted_median(r, nd.w / np.where(r > 0, r, 1.0))
-            p_out[sl] = weighted_median(phi, nd.w / np.where(phi > 0, phi, 1.0))
-        r_out[sl] = np.where(e, np.nan, r_out[sl])
-        p_out[sl] = np.where(e, np.nan, p_out[sl])
-        empty[sl] = e
+            rr = weighted_median(nd.r, nd.w / np.where(nd.r > 0, nd.r, 1.0))
+            pp = weighted_median(nd.phi, nd.w / np.where(nd.phi > 0, nd.phi, 1.0))
+        idx = s0 + np.flatnonzero(live)
+        r_out[idx] = np.where(e, np.nan, rr)
+        p_out[idx] = np.where(e, np.nan, pp)
+        empty[idx] = e
     # a sliver polyhedron can fall between the grid's rays: retry those keys on a 4x grid
     again = np.flatnonzero(empty)
     if again.size and n < 48:
         r2, p2, e2 = limit_estimates(keys[again], domain, prior, 4 * n, k)
         r_out[again], p_out[again], empty[again] = r2, p2, e2
     return r_out, p_out, empty
+
+
+class _KeyCache:
+    """A bounded map from packed int64 key codes to (r, phi, empty), built for batches.
+
+    Most entries sit in sorted arrays, so a batch of rows is looked up with one
+    ``searchsorted`` (no Python loop, no ``np.unique`` of the rows: the cached path is as
+    cheap as the bayes table lookup). New entries go to a small dict first and are merged
+    in bulk (one key at a time stays cheap). Each entry carries the tick of its last use;
+    beyond ``size`` entries the least recently used are dropped, down to 7/8 of ``size``.
+    """
+
+    def __init__(self, size: int) -> None:
+        self.size = max(1, int(size))
+        self.codes = np.zeros(0, np.int64)
+        self.values = np.zeros((0, 3))  # r, phi, empty (0/1)
+        self.used = np.zeros(0, np.int64)
+        self.recent: dict[int, tuple[float, float, float, int]] = {}
+        self.tick = 0
+
+    def __len__(self) -> int:
+        return self.codes.size + len(self.recent)
+
+    def lookup(self, code: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+        """(values (N, 3), found (N,), distinct keys found) for the rows' codes."""
+        self.tick += 1
+        vals = np.empty((code.size, 3))
+        found = np.zeros(code.size, bool)
+        hits = 0
+        if self.codes.size:
+            i = np.minimum(np.searchsorted(self.codes, code), self.codes.size - 1)
+            found = self.codes[i] == code
+            vals = self.values[i]
+            slots = i[found]
+            self.used[slots] = self.tick
+            hits = int(np.count_nonzero(np.bincount(slots, minlength=self.codes.size)))
+        if self.recent and not found.all():
+            miss = np.flatnonzero(~found)
+            uniq, inv = np.unique(code[miss], return_inverse=True)
+            got = np.zeros(uniq.size, bool)
+            for j, c in enumerate(uniq.tolist()):
+                hit = self.recent.get(c)
+                if hit is not None:
+                    self.recent[c] = (*hit[:3], self.tick)
+                    vals[miss[inv == j]] = hit[:3]
+                    got[j] = True
+            found[miss] = got[inv]
+            hits += int(got.sum())
+        return vals, found, hits
+
+    def insert(self, codes: np.ndarray, values: np.ndarray) -> None:
+        """Distinct codes absent from the cache, with their (r, phi, empty) rows."""
+        for c, v in zip(codes.tolist(), values.tolist(), strict=True):
+            self.recent[c] = (v[0], v[1], v[2], self.tick)
+        if len(self.recent) > min(4096, self.size // 8) or len(self) > self.size:
+            self._merge()
+
+    def _merge(self) -> None:
+        rc = np.fromiter(self.recent.keys(), np.int64, len(self.recent))
+        rv = np.array([v[:3] for v in self.recent.values()]).reshape(-1, 3)
+        ru = np.fromiter((v[3] for v in self.recent.values()), np.int64, len(self.recent))
+        self.recent = {}
+        codes = np.concatenate([self.codes, rc])
+        values = np.concatenate([self.values, rv])
+        used = np.concatenate([self.used, ru])
+        if codes.size > self.size:  # drop the least recently used, down to 7/8 of size
+            keep = np.argpartition(-used, self.size - self.size // 8 - 1)
+            keep = keep[: max(1, self.size - self.size // 8)]
+            codes, values, used = codes[keep], values[keep], used[keep]
+        order = np.argsort(codes)
+        self.codes, self.values, self.used = codes[order], values[order], used[order]
 
 
 class LimitEstimator(Estimator):
@@ -271,65 +418,83 @@ class LimitEstimator(Estimator):
         self.n = int(n)
         self.k = int(k)
         self.cache_size = int(cache_size)
-        self._cache: OrderedDict[int | tuple, tuple[float, float, bool]] = OrderedDict()
+        w = self.domain.width
+        # keys packed into one int64 while (m/2)^4 fits; tuples beyond (m > about 110,000),
+        # where the packed code would overflow and make different keys share an answer
+        self._packed = w**4 < 2**63
+        self._cache: _KeyCache | OrderedDict[tuple, tuple[float, float, bool]] = (
+            _KeyCache(self.cache_size) if self._packed else OrderedDict()
+        )
         self.last_flagged = np.zeros(0, bool)
         self._parts: list[np.ndarray] = []
         self.hits = 0
         self.misses = 0
 
-    def _codes(self, LA, RA, LB, RB) -> tuple[list, np.ndarray]:
-        """The distinct keys of the rows (hashable: the cache's keys) and each row's index
-        into them. Each code is a function of its row alone: the four interval ends (each
-        in [0, m/2)) are packed into one int64 while (m/2)^4 fits, and kept as a tuple of
-        four beyond (m > about 110,000), where the packed code would overflow and make
-        different keys share an answer."""
+    def _solve(self, keys: np.ndarray):
+        """(r, phi, empty) for distinct keys (M, 4); empty keys triangulated."""
+        rr, pp, ee = limit_estimates(keys, self.domain, self.prior, self.n, self.k)
+        if ee.any():
+            e = keys[ee]
+            fr, fp = analytic.estimate(e[:, 0], e[:, 1], e[:, 2], e[:, 3], self.domain)
+            rr[ee], pp[ee] = fr, fp
+        return rr, pp, ee
+
+    def _predict_packed(self, LA, RA, LB, RB):
         w = self.domain.width
-        if w**4 < 2**63:
-            code = ((LA * w + RA) * w + LB) * w + RB
-            uniq, inv = np.unique(code, return_inverse=True)
-            return uniq.tolist(), inv
+        code = ((LA * w + RA) * w + LB) * w + RB
+        cache = self._cache
+        assert isinstance(cache, _KeyCache)
+        vals, found, hits = cache.lookup(code)
+        self.hits += hits
+        if not found.all():
+            miss = np.flatnonzero(~found)
+            uniq, first, inv = np.unique(code[miss], return_index=True, return_inverse=True)
+            f = miss[first]
+            rr, pp, ee = self._solve(np.stack([LA[f], RA[f], LB[f], RB[f]], axis=1))
+            new = np.stack([rr, pp, ee.astype(float)], axis=1)
+            vals[miss] = new[inv.reshape(-1)]
+            cache.insert(uniq, new)
+            self.misses += uniq.size
+        return vals[:, 0], vals[:, 1], vals[:, 2] > 0
+
+    def _predict_tuples(self, LA, RA, LB, RB):
         rows = np.stack([LA, RA, LB, RB], axis=1)
         uniq, inv = np.unique(rows, axis=0, return_inverse=True)
-        return [tuple(k) for k in uniq.tolist()], inv.reshape(-1)
-
-    def _predict_intervals(self, LA, RA, LB, RB):
-        LA, RA, LB, RB = (np.asarray(v, np.int64) for v in (LA, RA, LB, RB))
-        codes, inv = self._codes(LA, RA, LB, RB)
-        nu = len(codes)
-        first = np.zeros(nu, np.int64)
-        first[inv[::-1]] = np.arange(inv.size)[::-1]
-        r_u = np.empty(nu)
-        p_u = np.empty(nu)
-        e_u = np.empty(nu, bool)
-        todo = []
+        inv = inv.reshape(-1)
+        codes = [tuple(k) for k in uniq.tolist()]
         cache = self._cache
+        assert isinstance(cache, OrderedDict)
+        nu = len(codes)
+        out = np.empty((nu, 3))
+        todo = []
         for j, c in enumerate(codes):
             hit = cache.get(c)
             if hit is None:
                 todo.append(j)
             else:
                 cache.move_to_end(c)
-                r_u[j], p_u[j], e_u[j] = hit
+                out[j] = hit
         self.hits += nu - len(todo)
         self.misses += len(todo)
         if todo:
             t = np.asarray(todo)
-            f = first[t]
-            keys = np.stack([LA[f], RA[f], LB[f], RB[f]], axis=1)
-            rr, pp, ee = limit_estimates(keys, self.domain, self.prior, self.n, self.k)
-            if ee.any():
-                fr, fp = analytic.estimate(*keys[ee].T, self.domain)
-                rr[ee], pp[ee] = fr, fp
-            r_u[t], p_u[t], e_u[t] = rr, pp, ee
-            for c, a, b, e in zip(
-                [codes[j] for j in todo], rr.tolist(), pp.tolist(), ee.tolist(), strict=True
-            ):
-                cache[c] = (a, b, e)
+            rr, pp, ee = self._solve(uniq[t])
+            out[t] = np.stack([rr, pp, ee], axis=1)
+            for j, a, b, e in zip(todo, rr.tolist(), pp.tolist(), ee.tolist(), strict=True):
+                cache[codes[j]] = (a, b, e)
             while len(cache) > self.cache_size:
                 cache.popitem(last=False)
-        self.last_flagged = e_u[inv]
-        self._parts.append(self.last_flagged)
-        return r_u[inv], p_u[inv]
+        return out[inv, 0], out[inv, 1], out[inv, 2] > 0
+
+    def _predict_intervals(self, LA, RA, LB, RB):
+        LA, RA, LB, RB = (np.asarray(v, np.int64) for v in (LA, RA, LB, RB))
+        if self._packed:
+            r, phi, flagged = self._predict_packed(LA, RA, LB, RB)
+        else:
+            r, phi, flagged = self._predict_tuples(LA, RA, LB, RB)
+        self.last_flagged = flagged
+        self._parts.append(flagged)
+        return r, phi
 
     def _with_flags(self, call, *args):
         self._parts = []

@@ -144,7 +144,7 @@ def test_cache_and_determinism():
     a = LimitEstimator(cache_size=50)
     p1 = a.predict(ds.omega_a, ds.omega_b)
     misses = a.misses
-    assert len(a._cache) == 50 and misses > 250
+    assert 40 <= len(a._cache) <= 50 and misses > 250  # bounded: LRU down to 7/8
     b = LimitEstimator()
     p2 = b.predict(ds.omega_a, ds.omega_b)
     np.testing.assert_array_equal(p1.r, p2.r)
@@ -226,3 +226,85 @@ def test_each_rows_answer_is_its_own_at_the_largest_m():
     for i in range(2):
         assert both.r[i] == alone[i].r[0] and both.phi[i] == alone[i].phi[0]
     assert both.r[0] != both.r[1]
+
+
+def _argsort_median(v, w):
+    """The weighted median as computed before issue 25 (argsort, two gathers)."""
+    order = np.argsort(v, axis=1, kind="stable")
+    vs = np.take_along_axis(v, order, 1).astype(np.float64)
+    ws = np.take_along_axis(w, order, 1)
+    cw = np.cumsum(ws, axis=1)
+    mid = (cw - 0.5 * ws) / cw[:, -1:]
+    i1 = np.clip((mid < 0.5).sum(axis=1), 1, v.shape[1] - 1)
+    rows = np.arange(v.shape[0])
+    m0, m1 = mid[rows, i1 - 1], mid[rows, i1]
+    t = np.clip((0.5 - m0) / (m1 - m0), 0.0, 1.0)
+    return vs[rows, i1 - 1] + t * (vs[rows, i1] - vs[rows, i1 - 1])
+
+
+def test_sorted_code_median_equals_the_argsort_median():
+    from eyeviz.estimators.limit import weighted_median
+
+    ds = dataset.generate(400, seed=11)
+    from eyeviz.estimators.base import bitmaps_to_intervals
+
+    keys = np.unique(np.stack(bitmaps_to_intervals(ds.omega_a, ds.omega_b)[:4], 1), axis=0)
+    nd = posterior_nodes(keys, PAPER_DOMAIN)
+    live = nd.w.sum(axis=1) > 0
+    for v in (nd.r[live], nd.phi[live], -nd.phi[live]):
+        w = nd.w[live] / np.abs(v)
+        np.testing.assert_allclose(weighted_median(v, w), _argsort_median(v, w), rtol=1e-6)
+
+
+def test_answers_stay_within_the_stated_error_bound():
+    """Against the fine quadrature (n = 48, K = 16) the default stays within the module
+    docstring's bound: relative error of r at most 9e-3, phi within 1e-4 rad."""
+    from eyeviz.estimators.base import bitmaps_to_intervals
+    from eyeviz.estimators.limit import limit_estimates
+
+    ds = dataset.generate(600, seed=5)
+    keys = np.unique(np.stack(bitmaps_to_intervals(ds.omega_a, ds.omega_b)[:4], 1), axis=0)
+    keys = keys[:150]
+    r, p, e = limit_estimates(keys, PAPER_DOMAIN)
+    ref_r, ref_p, ref_e = limit_estimates(keys, PAPER_DOMAIN, "single", 48, 16)
+    assert not e.any() and not ref_e.any()
+    assert np.abs(r / ref_r - 1).max() <= 9e-3
+    assert np.abs(p - ref_p).max() <= 1e-4
+
+
+def test_impossible_keys_skip_the_nodes(monkeypatch):
+    """A key no ray of which is feasible (g = 5 at r = 3000) is empty from the rays alone,
+    on the default and on the 4x grid: no quadrature nodes are computed for it (before,
+    it paid the nodes of both grids: 13.5x a real key)."""
+    from eyeviz.estimators import limit
+
+    eyes = PAPER_DOMAIN.eyes
+    key = np.stack(eyes.intervals(np.array([0.0]), np.array([3000.0]), np.array([5.0])), 1)
+    calls = []
+    real_nodes = limit._nodes
+    monkeypatch.setattr(
+        limit, "_nodes", lambda rays, *a: calls.append(len(rays.cu)) or real_nodes(rays, *a)
+    )
+    r, p, e = limit.limit_estimates(key, PAPER_DOMAIN)
+    assert e.all() and calls == []
+    good = np.stack(eyes.intervals(np.array([0.0]), np.array([3000.0]), np.array([150.0])), 1)
+    limit.limit_estimates(np.vstack([good, key]), PAPER_DOMAIN)
+    assert calls == [1]  # the real key's nodes only
+
+
+def test_cached_rows_are_answered_without_solving(monkeypatch):
+    """A batch whose keys are all cached is one array lookup: nothing solved, same
+    answers; the cache stays within its size."""
+    from eyeviz.estimators import limit
+
+    ds = dataset.generate(3000, seed=8)
+    est = LimitEstimator(cache_size=1 << 12)
+    p1 = est.predict(ds.omega_a, ds.omega_b)
+    monkeypatch.setattr(limit, "limit_estimates", lambda *a, **k: pytest.fail("solved again"))
+    p2 = est.predict(ds.omega_a, ds.omega_b)
+    np.testing.assert_array_equal(p1.r, p2.r)
+    np.testing.assert_array_equal(p1.flagged, p2.flagged)
+    small = LimitEstimator(cache_size=64)
+    monkeypatch.undo()
+    small.predict(ds.omega_a, ds.omega_b)
+    assert len(small._cache) <= 64
