@@ -19,7 +19,7 @@ loaded with a :class:`~eyeviz.core.domain3d.Domain3D` and named with a ``3d`` su
 one kind at a time (planar by default, so every planar list is as it was):
 
 >>> registry.available("spherical")
-['analytic3d', 'learned3d']
+['analytic3d', 'learned3d', 'limit3d']
 >>> est3 = registry.load("analytic3d", domain=Domain3D(nside=16))
 
 A plug-in registers its own entry (see ``examples/add_an_estimator.py``)::
@@ -394,6 +394,24 @@ for _entry in (
         "eyeviz.estimators.analytic3d:load",
         any_design=True,
         design=None,
+        kind="spherical",
+    ),
+    Entry(
+        "limit3d",
+        "spherical eyes: the information limit (posterior under the 3D Algorithm 1 prior, "
+        "importance-sampled with the exact lit sets)",
+        "eyeviz.estimators.limit3d:load",
+        any_design=True,
+        design=None,
+        load_options=(
+            _opt(
+                "--prior",
+                choices=("single", "multi"),
+                default=None,
+                help="limit: prior over features, single or multi pass (default single)",
+            ),
+        ),
+        module="eyeviz.estimators.limit3d",
         kind="spherical",
     ),
     Entry(

@@ -1,0 +1,553 @@
+"""The information limit of the spherical eyes: the posterior under the 3D Algorithm 1 prior.
+
+The likelihood of a ball (x, y, z, g) given a key (the two eyes' lit sets) is 0/1: 1
+exactly when ``EyePair3D.lit_csr`` of the ball gives both lit sets (docs/spherical.md,
+3D Proposition 2). The posterior is the prior of :mod:`eyeviz.dataset.algorithm1_3d`
+restricted to those balls. In (r, g, el, az) the single-pass prior's density is
+
+    1 / (g_max - r sin(gamma/2)) * 1 / (pi - 2 az0(r, g, el))
+
+on r in [r_min, r_max], g in [r sin(gamma/2), g_max], |el| <= el_max, az in
+[az0, pi - az0] with cos(az0) = cos(psi + asin(g/r)) / cos(el) (steps 7-12; its
+rejections, the 3D field test and Definition 1, only restrict the support). The multi-pass
+prior has r^2 cos(el) / (g_max - r sin(gamma/2)) / (pi - 2 az0(r, g, el_max)) (its
+segment quotas are treated as the r^2 density they approximate). In (x, y, z, g) both
+gain the Jacobian 1 / (r^2 cos el).
+
+**Proposal (importance sampling).** The posterior's support is a sliver: at nside 180 a
+ball lighting 1,000 facets per eye is pinned to about a hundredth of a facet in
+direction. So the proposal is built from each eye's feasible caps, as the planar limit
+integrates over eye A's tangent sectors and then along the ray (:mod:`.limit`):
+
+1. Per eye, the cells where the cap's edge can lie: the key's lit cells that a cap
+   ``EDGE`` facet widths smaller than the lit set's cap (:func:`.analytic3d.cap_estimates`)
+   does not light, and the unlit cells a cap as much larger lights. For each, its
+   boundary point nearest the cap centre (``STEP`` points per edge) linearises its
+   distance to a cap centre c near the estimate: dist(c) ~ d - t . delta (delta: c in
+   gnomonic coordinates about the estimate). The cap (c, alpha) lights exactly the key's
+   cells only if alpha > dist for every lit edge cell and alpha <= dist for every unlit
+   one, so the feasible centres are where G(delta) = min_unlit - max_lit > 0 (concave),
+   and alpha lies in (max_lit, min_unlit] there.
+2. Eye A: G on a grid about the estimate, the centre moved to its best point and the
+   distances linearised again, G on a finer grid; the cells that may hold feasible
+   centres (G + its Lipschitz bound over the cell + ``slack`` > 0) are the proposal:
+   a uniform cell, a uniform point in it, alpha uniform in [max_lit - slack,
+   min_unlit + slack].
+3. Along the ray A + rho c_A (g = rho sin alpha_A) eye B's constraints are nearly linear
+   in rho: the interval where all hold (two secant passes) gives rho uniformly.
+4. Every proposed ball is checked exactly with ``EyePair3D.lit_csr`` (0/1 likelihood),
+   against the prior's support and the exact field test ``in_bfv``, and weighted by
+   prior x Jacobian (rho^3 cos(alpha_A) / (1 + |delta|^2)^(3/2)) / proposal density.
+
+The slacks make the proposal's support cover the posterior's (the tests compare with
+brute-force rejection sampling from the prior at nside 4 and 8), and the exact check
+makes the likelihood exact whatever the linearisation's error; the price of a loose
+proposal is fewer accepted samples, not bias. A key with no accepted sample is tried
+again with a wider grid and slack (``RETRY``); a key still empty is answered by the
+analytic triangulation and ``flagged``.
+
+**Estimates.** MAPE-optimal (Eq. 34): the 1/r-weighted posterior median of r and the
+1/az-weighted median of the azimuth; the elevation crosses 0, where a relative error is
+undefined, so its estimate is the posterior median (optimal for its mean absolute error).
+Monte-Carlo error per key: ``mc_error`` (relative standard error of r's estimate,
+1.2533 sd_w(r) / sqrt(ESS) / r, ESS = (sum w)^2 / sum w^2) and ``n_accepted`` travel with
+the prediction. Draws are a function of the key alone (a counter-based hash of its lit
+sets), so a row's answer never depends on the other rows.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from eyeviz.core import healpix
+from eyeviz.core.domain3d import PAPER_DOMAIN3D, Domain3D
+from eyeviz.estimators.analytic3d import cap_estimates, estimate, triangulate
+from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D, as_csr, take_rows
+from eyeviz.estimators.limit import weighted_median
+
+__all__ = ["PRIORS", "Limit3DEstimator", "load", "posterior_samples3d", "prior_density"]
+
+PRIORS = ("single", "multi")
+#: facet widths inside and outside the estimated cap where the cap's edge is looked for
+EDGE = 2.0
+#: boundary points per cell edge for the nearest point of a cell
+STEP = 8
+#: keys processed together
+_CHUNK = 16
+
+
+def prior_density(domain: Domain3D, prior: str, r, g, el, az) -> np.ndarray:
+    """The prior density of Algorithm 1 in 3D in (x, y, z, g), up to a constant, at balls
+    of centre (r, az, el) and radius g (0 outside its support; the field test and
+    Definition 1 are not applied here)."""
+    d = domain
+    s = math.sin(d.gamma / 2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        a = np.arcsin(np.minimum(g / r, 1.0))
+        cone = d.psi + a
+        ok = (r >= d.r_min) & (r <= d.r_max) & (g >= r * s) & (g <= d.g_max) & (g <= r)
+        ok &= (cone < math.pi / 2) & (np.abs(el) <= d.el_max)
+        cel = np.cos(el)
+        if prior == "multi":
+            az0 = np.arccos(np.minimum(np.cos(cone) / math.cos(d.el_max), 1.0))
+            dens = r * r * cel
+        else:
+            az0 = np.arccos(np.minimum(np.cos(cone) / cel, 1.0))
+            dens = np.ones_like(r)
+        ok &= (az >= az0) & (az <= math.pi - az0)
+        dens = dens / ((d.g_max - r * s) * (math.pi - 2 * az0) * r * r * cel)
+    return np.where(ok & np.isfinite(dens), dens, 0.0)
+
+
+# --- counter-based uniforms: a function of the key and the draw's number -----------------
+
+_M1 = np.uint64(0xBF58476D1CE4E5B9)
+_M2 = np.uint64(0x94D049BB133111EB)
+_GOLD = np.uint64(0x9E3779B97F4A7C15)
+
+
+def _mix(z: np.ndarray) -> np.ndarray:
+    with np.errstate(over="ignore"):
+        z = z + _GOLD
+        z = (z ^ (z >> np.uint64(30))) * _M1
+        z = (z ^ (z >> np.uint64(27))) * _M2
+    return z ^ (z >> np.uint64(31))
+
+
+def _key_hash(lit_a: LitCSR, lit_b: LitCSR) -> np.ndarray:
+    out = np.zeros(lit_a[0].size - 1, np.uint64)
+    for salt, (ptr, ind) in enumerate((lit_a, lit_b)):
+        hv = _mix(ind.astype(np.uint64) + np.uint64(salt << 40))
+        cnt = np.diff(ptr)
+        sums = np.zeros(cnt.size, np.uint64)
+        nz = cnt > 0
+        with np.errstate(over="ignore"):
+            sums[nz] = np.add.reduceat(hv, ptr[:-1][nz])
+            out = _mix(out ^ sums ^ (cnt.astype(np.uint64) << np.uint64(48)))
+    return out
+
+
+def _uniforms(keys: np.ndarray, m: int, k: int, stream: int) -> np.ndarray:
+    """(N, m, k) uniforms in (0, 1) from the key hashes."""
+    j = np.arange(m * k, dtype=np.uint64) + np.uint64(stream << 32)
+    with np.errstate(over="ignore"):
+        z = _mix(keys[:, None] * _M1 + j[None, :])
+    u = ((z >> np.uint64(11)).astype(np.float64) + 0.5) * 2.0**-53
+    return u.reshape(keys.size, m, k)
+
+
+# --- one eye's edge cells ------------------------------------------------------------------
+
+
+def _frame(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """East and north unit vectors (N, 3) at unit vectors c (N, 3)."""
+    e1 = np.stack([-c[:, 1], c[:, 0], np.zeros(len(c))], axis=1)
+    n1 = np.linalg.norm(e1, axis=1, keepdims=True)
+    e1 = np.where(n1 > 1e-12, e1 / np.maximum(n1, 1e-300), [1.0, 0.0, 0.0])
+    e2 = np.cross(c, e1)
+    return e1, e2
+
+
+def _codes(ptr: np.ndarray, ind: np.ndarray, npix: int) -> np.ndarray:
+    rows = np.repeat(np.arange(ptr.size - 1, dtype=np.int64), np.diff(ptr))
+    return rows * npix + ind
+
+
+class _Eye:
+    """The edge cells of one eye for a chunk of keys: their boundary points, padded to
+    (N, K, P, 3), with ``lit`` (N, K) (True: must stay lit), ``pad`` (N, K)."""
+
+    def __init__(self, domain: Domain3D, lit: LitCSR, centre: np.ndarray, eye: int):
+        self.nside = domain.nside
+        npix = domain.npix
+        u, alpha = cap_estimates(domain.nside, lit)
+        self.u0 = u
+        self.alpha0 = alpha
+        fw = math.sqrt(4 * math.pi / npix)
+        n = u.shape[0]
+        dist = 1000.0
+        a_in = np.maximum(alpha - EDGE * fw, 1e-9)
+        a_out = np.minimum(alpha + EDGE * fw, math.pi / 2 - 1e-6)
+        gs = dist * np.sin(np.concatenate([a_in, a_out]))
+        pos = np.asarray(centre) + dist * np.concatenate([u, u])
+        res = domain.eyes.lit_csr(pos[:, 0], pos[:, 1], pos[:, 2], gs)[eye]
+        ptr, ind = res
+        inner = (ptr[: n + 1], ind[: ptr[n]])
+        outer = (ptr[n:] - ptr[n], ind[ptr[n] :])
+        key = _codes(*lit, npix)
+        c_in = _codes(*inner, npix)
+        c_out = _codes(*outer, npix)
+        lit_edge = key[~np.isin(key, c_in, assume_unique=True)]
+        unlit = c_out[~np.isin(c_out, key, assume_unique=True)]
+        codes = np.concatenate([lit_edge, unlit])
+        is_lit = np.concatenate([np.ones(lit_edge.size, bool), np.zeros(unlit.size, bool)])
+        rows = codes // npix
+        order = np.argsort(rows, kind="stable")
+        codes, is_lit, rows = codes[order], is_lit[order], rows[order]
+        cnt = np.bincount(rows, minlength=n)
+        kmax = max(1, int(cnt.max()) if cnt.size else 1)
+        slot = np.arange(codes.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        pts = healpix.boundaries(self.nside, codes % npix, STEP)  # (T, P, 3)
+        self.pts = np.zeros((n, kmax, pts.shape[1], 3))
+        self.pts[rows, slot] = pts
+        self.lit = np.zeros((n, kmax), bool)
+        self.lit[rows, slot] = is_lit
+        self.pad = np.ones((n, kmax), bool)
+        self.pad[rows, slot] = False
+        self.n_lit_edge = np.bincount(rows[is_lit], minlength=n)
+        self.n_unlit = np.bincount(rows[~is_lit], minlength=n)
+        self.centre = np.asarray(centre, float)
+        self.linearise(u)
+
+    def linearise(self, c: np.ndarray) -> None:
+        """Distances d (N, K) and gradients t (N, K, 2) of every edge cell at centres c."""
+        self.c = c / np.linalg.norm(c, axis=1, keepdims=True)
+        self.e1, self.e2 = _frame(self.c)
+        dots = np.einsum("nkpj,nj->nkp", self.pts, self.c)
+        best = np.argmax(dots, axis=2)
+        p = np.take_along_axis(self.pts, best[:, :, None, None], 2)[:, :, 0]
+        cp = np.einsum("nkj,nj->nk", p, self.c)
+        tang = p - cp[..., None] * self.c[:, None, :]
+        tn = np.linalg.norm(tang, axis=2)
+        d = np.arctan2(tn, cp)
+        # the nearest boundary sample is farther than the cell by at most spacing^2 / (8 d)
+        # (edges <= 1.5 facet widths): lit cells' distances are lowered by that much, so
+        # the linearised region holds the true one; unlit cells' samples lie in the cell
+        spacing = 1.5 * math.sqrt(4 * math.pi / (12 * self.nside**2)) / STEP
+        corr = 1.5 * spacing**2 / (8.0 * np.maximum(d, 0.25 * spacing))
+        self.d = np.where(self.lit, d - corr, d)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t1 = np.einsum("nkj,nj->nk", tang, self.e1) / tn
+            t2 = np.einsum("nkj,nj->nk", tang, self.e2) / tn
+        self.t = np.stack([np.nan_to_num(t1), np.nan_to_num(t2)], axis=-1)
+
+    def bounds(self, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(max over lit edge cells, min over unlit) of the linearised distance at
+        gnomonic offsets delta (N, G, 2): arrays (N, G)."""
+        v = self.d[:, :, None] - np.einsum("nkj,ngj->nkg", self.t, delta)
+        lo = np.where((self.lit & ~self.pad)[:, :, None], v, -np.inf).max(axis=1)
+        hi = np.where((~self.lit & ~self.pad)[:, :, None], v, np.inf).min(axis=1)
+        return lo, hi
+
+    def direction(self, delta: np.ndarray) -> np.ndarray:
+        """Unit vectors (N, M, 3) at gnomonic offsets delta (N, M, 2)."""
+        v = (
+            self.c[:, None, :]
+            + delta[..., :1] * self.e1[:, None, :]
+            + delta[..., 1:] * self.e2[:, None, :]
+        )
+        return v / np.linalg.norm(v, axis=2, keepdims=True)
+
+    def gnomonic(self, v: np.ndarray) -> np.ndarray:
+        """Gnomonic offsets (N, M, 2) of unit vectors v (N, M, 3) about the centre."""
+        cc = np.einsum("nmj,nj->nm", v, self.c)
+        return np.stack(
+            [np.einsum("nmj,nj->nm", v, self.e1) / cc, np.einsum("nmj,nj->nm", v, self.e2) / cc],
+            axis=-1,
+        )
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def _grid(n: int) -> np.ndarray:
+    t = (np.arange(n) + 0.5) / n * 2 - 1
+    a, b = np.meshgrid(t, t, indexing="ij")
+    return np.stack([a.ravel(), b.ravel()], axis=1)  # (n*n, 2) in (-1, 1)
+
+
+_DIRS = np.stack([np.cos(np.arange(8) * math.pi / 4), np.sin(np.arange(8) * math.pi / 4)], axis=1)
+
+
+def _locate(eye: _Eye, half: float, n: int, levels: int) -> None:
+    """Move the eye's centre to the maximum of G (zooming grids of n x n about the best
+    point, each a third as wide) and linearise there."""
+    rows = np.arange(eye.c.shape[0])
+    g0 = _grid(n)
+    for _ in range(levels):
+        g = g0[None] * half
+        lo, hi = eye.bounds(np.broadcast_to(g, (rows.size, *g0.shape)))
+        best = np.argmax(hi - lo, axis=1)
+        eye.linearise(eye.direction(g[0][best][:, None, :])[:, 0])
+        half = half / 3.0
+
+
+def _extent(eye: _Eye, reach: float, slack: float, iters: int = 18) -> np.ndarray:
+    """Half-widths (N, 2) of a box about the centre holding every delta with
+    G(delta) >= -slack (bisection along 8 directions: G is concave)."""
+    n = eye.c.shape[0]
+    lo = np.zeros((n, 8))
+    hi = np.full((n, 8), reach)
+    for _ in range(iters):
+        mid = 0.5 * (lo + hi)
+        a, b = eye.bounds(mid[..., None] * _DIRS[None])
+        inside = (b - a) >= -slack
+        lo = np.where(inside, mid, lo)
+        hi = np.where(inside, hi, mid)
+    pts = hi[..., None] * _DIRS[None]  # (N, 8, 2): outside the region by < one step
+    # the box of the 8 boundary points, widened: a convex polygon between two of them
+    # bulges out by at most tan(pi/8) times their distance
+    ext = np.abs(pts).max(axis=1) * (1.0 + math.tan(math.pi / 8))
+    return np.maximum(ext, 1e-12)
+
+
+def _rho_interval(eye_b: _Eye, ca: np.ndarray, sin_a: np.ndarray, lo, hi, slack: float):
+    """Secant pass: the rho in [lo, hi] where every linearised constraint of eye B holds
+    within ``slack`` for balls A + rho ca, g = rho sin_a. Returns new (lo, hi)."""
+    out_lo = np.full(lo.shape, -np.inf)
+    out_hi = np.full(lo.shape, np.inf)
+    f = []
+    for rho in (lo, hi):
+        p = eye_b.a + rho[..., None] * ca  # relative to B
+        dist = np.linalg.norm(p, axis=2)
+        cb = p / dist[..., None]
+        ab = np.arcsin(np.clip(rho * sin_a / dist, -1.0, 1.0))
+        dl = eye_b.gnomonic(cb)
+        v = eye_b.d[:, :, None] - np.einsum("nkj,nmj->nkm", eye_b.t, dl)  # (N, K, M)
+        f.append(np.where(eye_b.lit[:, :, None], ab[:, None, :] - v, v - ab[:, None, :]))
+    f0, f1 = f
+    live = ~eye_b.pad[:, :, None]
+    span = (hi - lo)[:, None, :]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = (f1 - f0) / span
+        root = lo[:, None, :] + (-slack - f0) / k
+    up = live & (k > 0)
+    down = live & (k < 0)
+    flat_bad = live & (k == 0) & (f0 < -slack)
+    out_lo = np.maximum(lo, np.where(up, root, -np.inf).max(axis=1))
+    out_hi = np.minimum(hi, np.where(down, root, np.inf).min(axis=1))
+    out_hi = np.where(flat_bad.any(axis=1), -np.inf, out_hi)
+    return out_lo, out_hi
+
+
+class Limit3DEstimator(Estimator3D):
+    """The MAPE-optimal answers of the 3D posterior, by importance sampling with the exact
+    0/1 likelihood (module docstring); any design, no weights.
+
+    Predictions carry ``flagged`` (empty posterior: answered by analytic3d),
+    ``mc_error`` (relative standard error of r's estimate; NaN where flagged) and
+    ``n_accepted`` (samples that reproduce both lit sets)."""
+
+    name = "limit3d"
+
+    def __init__(
+        self,
+        domain: Domain3D = PAPER_DOMAIN3D,
+        prior: str = "single",
+        samples: int = 256,
+        grid: int = 12,
+        seed: int = 0,
+    ) -> None:
+        if prior not in PRIORS:
+            raise ValueError(f"prior must be one of {PRIORS}, got {prior!r}")
+        for name, v, lo in (("samples", samples, 4), ("grid", grid, 4)):
+            if not isinstance(v, int | np.integer) or isinstance(v, bool) or v < lo:
+                raise ValueError(f"{name} must be an integer >= {lo}, got {v!r}")
+        super().__init__(domain, {"n_weights": 0, "train_seconds": 0.0, "prior": prior})
+        self.prior = prior
+        self.samples = int(samples)
+        self.grid = int(grid)
+        self.seed = int(seed)
+        self.last_mc_error = np.zeros(0)
+        self.last_accepted = np.zeros(0, np.int64)
+
+    # --- the posterior of a chunk of keys ------------------------------------------------
+    def _draw(self, lit_a: LitCSR, lit_b: LitCSR, keys: np.ndarray, wide: float, stream: int):
+        """Weighted posterior samples of a chunk: dict of (N, M) arrays."""
+        d = self.domain
+        fw = math.sqrt(4 * math.pi / d.npix)
+        A = np.array([-d.h, 0.0, 0.0])
+        B = np.array([d.h, 0.0, 0.0])
+        ea = _Eye(d, lit_a, A, 0)
+        eb = _Eye(d, lit_b, B, 1)
+        n = ea.c.shape[0]
+        m = self.samples
+        ng = self.grid
+        slack = wide * 0.002 * fw
+        for e in (ea, eb):
+            _locate(e, 0.25 * wide * fw, ng, 4)
+        ext = _extent(ea, wide * 0.5 * fw, slack)
+        u = _uniforms(keys, m, 4, stream)
+        delta = (2.0 * u[..., 0:2] - 1.0) * ext[:, None, :]
+        q = np.broadcast_to(1.0 / (4.0 * ext[:, 0] * ext[:, 1])[:, None], (n, m))
+        lo_a, hi_a = ea.bounds(delta)
+        lo_a = np.maximum(lo_a - slack, 1e-12)
+        hi_a = np.minimum(hi_a + slack, math.pi / 2 - 1e-9)
+        alpha = lo_a + (hi_a - lo_a) * u[..., 2]
+        with np.errstate(over="ignore"):
+            q = q / np.maximum(hi_a - lo_a, 1e-300)
+        good = hi_a > lo_a
+        ca = ea.direction(delta)
+        # along the ray: the closest approach to B's ray gives the bracket's middle
+        cbv = np.broadcast_to(eb.c[:, None, :], ca.shape).reshape(-1, 3)
+        pm, okm = triangulate(ca.reshape(-1, 3), cbv, d.h)
+        rho0 = np.linalg.norm(pm - A, axis=1).reshape(n, m)
+        rho0 = np.where(okm.reshape(n, m), rho0, d.r_max)
+        eb.a = A - B
+        ext_b = _extent(eb, wide * 0.5 * fw, slack).max(axis=1)
+        # bracket: where B's view of the ray stays within 3 of B's extents of its centre
+        d0 = eb.gnomonic(_unit(eb.a + rho0[..., None] * ca))
+        d1 = eb.gnomonic(_unit(eb.a + (rho0 * 1.001)[..., None] * ca))
+        rate = np.linalg.norm(d1 - d0, axis=2) / (0.001 * rho0)
+        reach = (3.0 * ext_b[:, None] + np.linalg.norm(d0, axis=2)) / np.maximum(rate, 1e-300)
+        lo = np.maximum(rho0 - reach, d.r_min - d.h)
+        hi = np.minimum(rho0 + reach, d.r_max + d.h)
+        sin_a = np.sin(alpha)
+        for _ in range(2):
+            lo, hi = _rho_interval(eb, ca, sin_a, lo, hi, slack)
+            bad = ~(hi > lo)
+            lo = np.where(bad, rho0, lo)
+            hi = np.where(bad, rho0 * (1 + 1e-9), hi)
+            good &= ~bad
+        rho = lo + (hi - lo) * u[..., 3]
+        with np.errstate(over="ignore"):
+            q = q / np.maximum(hi - lo, 1e-300)
+        p = A + rho[..., None] * ca
+        gg = rho * sin_a
+        r = np.linalg.norm(p, axis=2)
+        el = np.arcsin(np.clip(p[..., 2] / r, -1, 1))
+        az = np.arctan2(p[..., 1], p[..., 0])
+        nd = np.einsum("nmj,nmj->nm", delta, delta)
+        jac = rho**3 * np.cos(alpha) / (1 + nd) ** 1.5
+        with np.errstate(over="ignore", invalid="ignore"):
+            w = prior_density(d, self.prior, r, gg, el, az) * jac / np.where(q > 0, q, 1)
+        w = np.where(good & np.isfinite(w), w, 0.0)
+        # the exact 0/1 likelihood on the draws with prior mass
+        cand = np.flatnonzero(w.ravel() > 0)
+        hit = np.zeros(n * m, bool)
+        if cand.size:
+            x, y, z = (p.reshape(-1, 3)[cand, i] for i in range(3))
+            gc = gg.ravel()[cand]
+            inb = d.eyes.in_bfv(x, y, z, gc)
+            (pa, ia), (pb, ib) = d.eyes.lit_csr(x, y, z, gc)
+            row = cand // m
+            match = inb & _same(pa, ia, lit_a, row) & _same(pb, ib, lit_b, row)
+            hit[cand] = match
+        w = np.where(hit.reshape(n, m), w, 0.0)
+        return {"r": r, "az": az, "el": el, "g": gg, "x": p[..., 0], "y": p[..., 1],
+                "z": p[..., 2], "w": w}  # fmt: skip
+
+    def _posterior(self, lit_a: LitCSR, lit_b: LitCSR):
+        keys = _key_hash(lit_a, lit_b) ^ np.uint64(self.seed)
+        s = self._draw(lit_a, lit_b, keys, 1.0, 0)
+        empty = ~(s["w"].sum(axis=1) > 0)
+        few = np.flatnonzero(empty)
+        if few.size:  # wider grid and slack for the keys with nothing accepted
+            sub_a, sub_b = take_rows(*lit_a, few), take_rows(*lit_b, few)
+            s2 = self._draw(sub_a, sub_b, keys[few], 4.0, 1)
+            for k in s:
+                s[k][few] = s2[k]
+        return s
+
+    def _predict_csr(self, lit_a: LitCSR, lit_b: LitCSR):
+        n = lit_a[0].size - 1
+        r = np.empty(n)
+        az = np.empty(n)
+        el = np.empty(n)
+        empty = np.zeros(n, bool)
+        mc = np.full(n, np.nan)
+        acc = np.zeros(n, np.int64)
+        for s0 in range(0, n, _CHUNK):
+            rows = np.arange(s0, min(n, s0 + _CHUNK))
+            la, lb = take_rows(*lit_a, rows), take_rows(*lit_b, rows)
+            sm = self._posterior(la, lb)
+            w = sm["w"]
+            tot = w.sum(axis=1)
+            e = ~(tot > 0)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                rr = weighted_median(sm["r"], w / sm["r"])
+                aa = weighted_median(sm["az"], w / sm["az"])
+                ee = weighted_median(sm["el"], w)
+                wn = w / np.where(tot > 0, tot, 1)[:, None]
+                mean = (wn * sm["r"]).sum(axis=1)
+                sd = np.sqrt(np.maximum((wn * (sm["r"] - mean[:, None]) ** 2).sum(axis=1), 0))
+                ess = tot**2 / (w**2).sum(axis=1)
+                mc[rows] = np.where(e, np.nan, 1.2533 * sd / np.sqrt(ess) / rr)
+            r[rows], az[rows], el[rows] = rr, aa, ee
+            empty[rows] = e
+            acc[rows] = (w > 0).sum(axis=1)
+        if empty.any():
+            idx = np.flatnonzero(empty)
+            fr, fa, fe, _ = estimate(self.domain, take_rows(*lit_a, idx), take_rows(*lit_b, idx))
+            r[idx], az[idx], el[idx] = fr, fa, fe
+        self._mc_parts.append(mc)
+        self._acc_parts.append(acc)
+        return r, az, el, empty
+
+    def predict(self, lit_a, lit_b) -> Prediction3D:
+        """As :meth:`Estimator3D.predict`, plus ``mc_error`` and ``n_accepted`` (also in
+        :attr:`last_mc_error`, :attr:`last_accepted`); NaN / 0 on invalid rows."""
+        self._mc_parts: list[np.ndarray] = []
+        self._acc_parts: list[np.ndarray] = []
+        p = super().predict(lit_a, lit_b)
+        valid = np.atleast_1d(p.valid)
+        mc = np.full(valid.shape, np.nan)
+        acc = np.zeros(valid.shape, np.int64)
+        if self._mc_parts:
+            mc[valid] = np.concatenate(self._mc_parts)
+            acc[valid] = np.concatenate(self._acc_parts)
+        scalar = np.ndim(p.valid) == 0
+        p.mc_error = mc[0] if scalar else mc
+        p.n_accepted = acc[0] if scalar else acc
+        self.last_mc_error, self.last_accepted = mc, acc
+        return p
+
+    def __repr__(self) -> str:
+        d = self.domain
+        return (
+            f"<Limit3DEstimator h={d.h:g} l={d.l:g} nside={d.nside} r=[{d.r_min:g}, "
+            f"{d.r_max:g}] g_max={d.g_max:g} el_max={d.el_max:g} prior={self.prior}>"
+        )
+
+
+def _same(ptr: np.ndarray, ind: np.ndarray, key: LitCSR, row: np.ndarray) -> np.ndarray:
+    """Whether each CSR row i of (ptr, ind) equals the key's row ``row[i]``."""
+    kp, ki = key
+    cnt = np.diff(ptr)
+    kc = np.diff(kp)[row]
+    same = cnt == kc
+    sel = np.flatnonzero(same & (cnt > 0))
+    if sel.size:
+        lens = cnt[sel]
+        starts = ptr[sel]
+        kstarts = kp[row[sel]]
+        off = np.arange(int(lens.sum())) - np.repeat(np.cumsum(lens) - lens, lens)
+        a = ind[np.repeat(starts, lens) + off]
+        b = ki[np.repeat(kstarts, lens) + off]
+        bad = np.add.reduceat((a != b).astype(np.int64), np.cumsum(lens) - lens)
+        same[sel] = bad == 0
+    return same
+
+
+def posterior_samples3d(est: Limit3DEstimator, lit_a, lit_b) -> dict[str, np.ndarray]:
+    """The weighted posterior samples of one key (lit sets as sorted index arrays):
+    ``x, y, z, g, r, azimuth, elevation, weight`` (weights sum to 1; empty arrays when no
+    sample reproduced the key), for the app's point cloud."""
+    a = np.asarray(lit_a, np.int64)
+    b = np.asarray(lit_b, np.int64)
+    ptr_a = np.array([0, a.size])
+    ptr_b = np.array([0, b.size])
+    la = as_csr("lit_a", (ptr_a, a), est.domain.npix)[:2]
+    lb = as_csr("lit_b", (ptr_b, b), est.domain.npix)[:2]
+    s = est._posterior(la, lb)
+    w = s["w"][0]
+    keep = w > 0
+    tot = w.sum()
+    return {
+        "x": s["x"][0][keep],
+        "y": s["y"][0][keep],
+        "z": s["z"][0][keep],
+        "g": s["g"][0][keep],
+        "r": s["r"][0][keep],
+        "azimuth": s["az"][0][keep],
+        "elevation": s["el"][0][keep],
+        "weight": w[keep] / tot if tot > 0 else w[keep],
+    }
+
+
+def load(domain: Domain3D | None = None, prior: str = "single", **kw) -> Limit3DEstimator:
+    """The limit for ``domain`` (default the paper's design at nside 180)."""
+    return Limit3DEstimator(PAPER_DOMAIN3D if domain is None else domain, prior, **kw)

@@ -1,0 +1,103 @@
+"""The information limit of the spherical eyes against brute-force rejection sampling."""
+
+from __future__ import annotations
+
+import collections
+
+import numpy as np
+import pytest
+
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.dataset.algorithm1_3d import generate3d
+from eyeviz.estimators import registry
+from eyeviz.estimators.analytic3d import Analytic3DEstimator
+from eyeviz.estimators.base3d import take_rows
+from eyeviz.estimators.limit import weighted_median
+from eyeviz.estimators.limit3d import Limit3DEstimator, posterior_samples3d, prior_density
+from eyeviz.estimators.metrics import mape
+
+D4 = Domain3D(nside=4)
+D16 = Domain3D(nside=16)
+
+
+@pytest.fixture(scope="module")
+def brute4():
+    """The keys drawn most often among 60,000 prior draws at nside 4: each group of rows
+    sharing a key is a sample of that key's exact posterior (rejection sampling)."""
+    ds = generate3d(60_000, D4, seed=3)
+    groups = collections.defaultdict(list)
+    for i in range(len(ds)):
+        a, b = ds.lit(i)
+        groups[(a.tobytes(), b.tobytes())].append(i)
+    top = sorted(groups.values(), key=len, reverse=True)[:6]
+    return ds, [np.array(g) for g in top]
+
+
+def test_matches_rejection_sampling(brute4):
+    ds, groups = brute4
+    rows = np.array([g[0] for g in groups])
+    est = Limit3DEstimator(D4, samples=2048)
+    p = est.predict(take_rows(ds.indptr_a, ds.indices_a, rows),
+                    take_rows(ds.indptr_b, ds.indices_b, rows))  # fmt: skip
+    assert not p.flagged.any() and (p.n_accepted >= 20).all()
+    z = []
+    for j, g in enumerate(groups):
+        r = ds.r[g]
+        want = weighted_median(r[None], 1.0 / r[None])[0]  # MAPE-optimal, as the limit's
+        se_bf = 1.2533 * r.std() / np.sqrt(g.size)
+        se = np.hypot(se_bf, p.mc_error[j] * p.r[j])
+        z.append((p.r[j] - want) / se)
+        el = ds.elevation[g]
+        assert abs(p.elevation[j] - np.median(el)) < 4 * 1.2533 * el.std() / np.sqrt(g.size) + 0.03
+    z = np.array(z)
+    assert np.all(np.abs(z) < 4.0), z
+    assert abs(z.mean()) < 2.5, z  # no bias shared by the keys
+
+
+def test_posterior_samples_reproduce_the_key(brute4):
+    ds, groups = brute4
+    i = int(groups[0][0])
+    est = Limit3DEstimator(D4, samples=512)
+    s = posterior_samples3d(est, *ds.lit(i))
+    assert s["x"].size > 0 and np.isclose(s["weight"].sum(), 1.0)
+    a, b = ds.lit(i)
+    for k in range(min(5, s["x"].size)):
+        la, lb = D4.eyes.lit(s["x"][k], s["y"][k], s["z"][k], s["g"][k])
+        assert np.array_equal(la, a) and np.array_equal(lb, b)
+
+
+def test_prior_density_support():
+    d = D16
+    r = np.array([2000.0, 2000.0, 900.0, 2000.0])
+    g = np.array([100.0, 100.0, 100.0, 600.0])
+    el = np.array([0.1, 0.6, 0.1, 0.1])
+    az = np.array([1.5, 1.5, 1.5, 1.5])
+    p = prior_density(d, "single", r, g, el, az)
+    assert p[0] > 0 and (p[1:] == 0).all()  # el beyond el_max, r < r_min, g > g_max
+    assert prior_density(d, "multi", r[:1], g[:1], el[:1], az[:1])[0] > 0
+
+
+def test_more_accurate_than_analytic_at_nside16():
+    ds = generate3d(80, D16, seed=21)
+    lim = registry.load("limit3d", domain=D16).predict_dataset(ds)
+    ana = Analytic3DEstimator(D16).predict_dataset(ds)
+    assert lim.valid.all() and lim.flagged.mean() < 0.3
+    assert np.nanmax(lim.mc_error) < 0.5
+    assert mape(ds.r, lim.r) < mape(ds.r, ana.r)
+    assert np.mean(np.abs(lim.elevation - ds.elevation)) < np.mean(
+        np.abs(ana.elevation - ds.elevation)
+    )
+
+
+def test_rows_independent_and_errors():
+    ds = generate3d(20, D16, seed=5)
+    est = Limit3DEstimator(D16, samples=64)
+    full = est.predict_dataset(ds)
+    rows = np.array([7, 3, 12])
+    sub = est.predict(take_rows(ds.indptr_a, ds.indices_a, rows),
+                      take_rows(ds.indptr_b, ds.indices_b, rows))  # fmt: skip
+    assert np.array_equal(sub.r, full.r[rows]) and np.array_equal(sub.flagged, full.flagged[rows])
+    with pytest.raises(ValueError, match="prior must be one of"):
+        Limit3DEstimator(D16, prior="flat")
+    with pytest.raises(ValueError, match="samples must be an integer >= 4"):
+        Limit3DEstimator(D16, samples=2)
