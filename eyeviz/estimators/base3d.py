@@ -48,7 +48,12 @@ _BLOCK = 1 << 14
 
 class Prediction3D(tuple):
     """``(r, azimuth, elevation)`` (radians) with ``valid``, ``in_domain`` and ``flagged``
-    masks; unpacks as a triple. For a single row every field is a numpy scalar."""
+    masks; unpacks as a triple. For a single row every field is a numpy scalar. An
+    estimator may add per-row fields of its own (limit3d: ``mc_error``, ``n_accepted``)."""
+
+    valid: Any
+    in_domain: Any
+    flagged: Any
 
     def __new__(cls, r, azimuth, elevation, valid, in_domain, flagged):
         obj = super().__new__(cls, (r, azimuth, elevation))

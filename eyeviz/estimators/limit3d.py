@@ -58,6 +58,7 @@ sets), so a row's answer never depends on the other rows.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -199,6 +200,7 @@ class _Eye:
         self.n_lit_edge = np.bincount(rows[is_lit], minlength=n)
         self.n_unlit = np.bincount(rows[~is_lit], minlength=n)
         self.centre = np.asarray(centre, float)
+        self.a = np.zeros(3)  # the other eye's centre relative to this one (set by the caller)
         self.linearise(u)
 
     def linearise(self, c: np.ndarray) -> None:
@@ -351,8 +353,8 @@ class Limit3DEstimator(Estimator3D):
         self.samples = int(samples)
         self.grid = int(grid)
         self.seed = int(seed)
-        self.last_mc_error = np.zeros(0)
-        self.last_accepted = np.zeros(0, np.int64)
+        self.last_mc_error: np.ndarray = np.zeros(0)
+        self.last_accepted: np.ndarray = np.zeros(0, np.int64)
 
     # --- the posterior of a chunk of keys ------------------------------------------------
     def _draw(self, lit_a: LitCSR, lit_b: LitCSR, keys: np.ndarray, wide: float, stream: int):
@@ -482,7 +484,7 @@ class Limit3DEstimator(Estimator3D):
         :attr:`last_mc_error`, :attr:`last_accepted`); NaN / 0 on invalid rows."""
         self._mc_parts: list[np.ndarray] = []
         self._acc_parts: list[np.ndarray] = []
-        p = super().predict(lit_a, lit_b)
+        p: Any = super().predict(lit_a, lit_b)
         valid = np.atleast_1d(p.valid)
         mc = np.full(valid.shape, np.nan)
         acc = np.zeros(valid.shape, np.int64)
