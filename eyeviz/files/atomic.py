@@ -131,8 +131,13 @@ def atomic_output(path) -> Iterator[Path]:
     The temporary name keeps ``path``'s suffix (numpy and matplotlib look at it). On any
     exception, KeyboardInterrupt (and so SIGTERM/SIGHUP under the CLI) included, the
     temporary file is removed and an existing ``path`` is left as it was.
+
+    A symlinked ``path`` is written through: its target is replaced (in the target's
+    folder) and the link stays a link (issue 25).
     """
     path = Path(path)
+    if path.is_symlink():
+        path = Path(os.path.realpath(path))
     d = path.parent if str(path.parent) else Path(".")
     if not d.is_dir():
         raise EyevizError(f"output directory does not exist: {str(d)!r}")

@@ -242,13 +242,17 @@ def dask_config(connect_timeout: float = CONNECT_TIMEOUT_S) -> dict:
 def _exclusive(path):
     """Hold ``.NAME.lock`` beside the table: a second study into the same file is refused
     at once (one line) instead of both rewriting the table and losing points. The lock is
-    the kernel's (``flock``): a crashed study leaves none held."""
+    the kernel's (``flock``): a crashed study leaves none held.
+
+    It acts on the resolved file (issue 25): a symlinked ``-o`` is locked beside its
+    target, and an existing table is also locked itself (its inode), so the same file
+    under another name (a hard link) is refused too."""
     try:
         import fcntl
     except ImportError:  # no flock (Windows): no protection, as before
         yield
         return
-    target = Path(path)
+    target = Path(os.path.realpath(path))
     lock = target.with_name(f".{target.name}.lock")
     while True:
         try:
@@ -271,11 +275,41 @@ def _exclusive(path):
             break
         os.close(fd)
     try:
+        held = _lock_inode(fcntl, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(lock)
+        os.close(fd)
+        raise
+    try:
         yield
     finally:
         with contextlib.suppress(OSError):
             os.unlink(lock)
         os.close(fd)
+        if held is not None:
+            os.close(held)
+
+
+def _lock_inode(fcntl, target: Path) -> int | None:
+    """flock the existing table itself (shared by all its hard links); its descriptor,
+    or None when there is no table yet (or it cannot be opened: the reader says why)."""
+    try:
+        fd = os.open(target, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError:
+        return None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        os.close(fd)
+        raise EyevizError(
+            f"another study is writing {str(target)!r} under another name (a hard link to "
+            "the same file); wait for it or write to another -o"
+        ) from None
+    except OSError:
+        os.close(fd)
+        return None
+    return fd
 
 
 def run_study(
