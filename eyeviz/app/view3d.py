@@ -42,7 +42,6 @@ from eyeviz.render.vtk.scene3d import (
     default_camera,
     layout,
     make_renderers,
-    render_png3d,
     split_viewports,
 )
 
@@ -492,13 +491,14 @@ class Scene3DHost(QtCore.QObject):
         table: bool = True,
         bitmaps: bool = True,
     ):
-        """File > Export of a spherical scene: PNG from an off-screen VTK render at the
-        view's camera (:func:`render_png3d`), SVG/PDF the vector figure
-        (:func:`eyeviz.render.mpl.figure3d.export3d`), on a worker thread."""
+        """File > Export of a spherical scene: the figure (the 3D view through the view's
+        camera, framed as on screen: its height / width, within [0.3, 1.6]; the maps; the
+        readout). SVG/PDF the vector figure (:func:`eyeviz.render.mpl.figure3d.export3d`)
+        on a worker thread; PNG the same figure with the view rendered off-screen by VTK
+        (:func:`eyeviz.render.vtk.png3d.export_png3d`), on this thread."""
         from eyeviz import EyevizError
         from eyeviz.app.panels import user_message
         from eyeviz.render.mpl.figure3d import export3d
-        from eyeviz.render.mpl.style import BASE_DPI
         from eyeviz.render.mpl.vector import resolve_width
 
         assert self.model is not None and self.view is not None
@@ -507,29 +507,22 @@ class Scene3DHost(QtCore.QObject):
         win = self.win
         fmt = Path(path).suffix.lower()
         result: list = []
+        vw, vh = max(self.view.width(), 1), max(self.view.height(), 1)
+        aspect = min(max(vh / vw, 0.3), 1.6)  # the view's height / width, as on screen
+        opts = dict(
+            width=resolve_width(width), title=title, table=table, bitmaps=bitmaps,
+            aspect=aspect, camera=cam,
+        )  # fmt: skip
         if fmt == ".png":
-            inches = resolve_width(width)
-            px_w = int(round(inches * BASE_DPI * scale))
-            vw, vh = max(self.view.width(), 1), max(self.view.height(), 1)
-            px_h = int(round(px_w * vh / vw))
+            from eyeviz.render.vtk.png3d import export_png3d
 
             def work():
-                return render_png3d(scene, path, cam, px_w, px_h)
+                return export_png3d(scene, path, scale, transparent, **opts)
 
         else:
 
             def work():
-                return export3d(
-                    scene,
-                    path,
-                    scale,
-                    transparent,
-                    width=resolve_width(width),
-                    title=title,
-                    table=table,
-                    bitmaps=bitmaps,
-                    camera=cam,
-                )
+                return export3d(scene, path, scale, transparent, **opts)
 
         def done(out) -> None:
             result.append(Path(out))

@@ -17,6 +17,7 @@ from PyQt5 import QtCore, QtWidgets
 from PyQt5.QtTest import QTest
 
 from eyeviz.model.scene import Eyes, Feature, Scene, load
+from eyeviz.render.mpl.figure3d import figure3d
 
 SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 
@@ -184,10 +185,21 @@ def test_export_png_and_svg(make_window, tmp_path):
     assert png == tmp_path / "v.png" and svg == tmp_path / "v.svg"
     img = mpimg.imread(png)
     assert img.shape[1] == 525  # 3.5 in at 300 dpi, scale 0.5
+    # the whole figure (view, maps, readout), its view framed as the window's: its height
+    # / width, which sets the figure's height (another aspect gives another height)
+    view = win.host3d.view
+    aspect = view.height() / view.width()
+    fig = figure3d(win.host3d.model.scene, aspect=aspect)
+    assert img.shape[0] == round(fig.get_figheight() * 150)
+    assert abs(figure3d(win.host3d.model.scene, aspect=aspect + 0.05).get_figheight() * 150
+               - img.shape[0]) > 5  # fmt: skip
     rgb = (img[..., :3] * 255).round().astype(int).reshape(-1, 3)
     assert len(np.unique(rgb, axis=0)) > 200  # not blank: shaded balls, eyes, facets
     root = ET.parse(svg).getroot()
     assert len(root.findall(".//{http://www.w3.org/2000/svg}path")) > 100
+    assert float(root.get("height").removesuffix("pt")) == pytest.approx(  # same layout
+        fig.get_figheight() * 72, abs=0.5
+    )
     assert QtWidgets.QApplication.instance() is not None
 
 
