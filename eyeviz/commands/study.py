@@ -71,8 +71,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--estimator",
         default=None,
         metavar="NAME",
-        help="3D only: the estimator measured, 'limit' (the accuracy limit) or another "
-        "registry name, or 'triangulation' (built in); default triangulation",
+        help="3D only: the estimator of the spherical eyes measured (the registry's: the "
+        "limit for the accuracy limit); default analytic3d",
     )
     parser.add_argument(
         "--n",
@@ -146,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
     if args.nside is not None:
         from eyeviz.core.domain3d import DEFAULT_EL_MAX
         from eyeviz.study.grid3d import DEFAULT_N3D, design_grid3d
-        from eyeviz.study.point3d import BUILTIN
+        from eyeviz.study.point3d import DEFAULT_ESTIMATOR
 
         if args.m is not None:
             raise EyevizError("--m is the planar study's, --nside the 3D study's: give one")
@@ -161,7 +161,7 @@ def run(args: argparse.Namespace) -> int:
             prior=args.prior,
             n=_int("n", args.n if args.n is not None else DEFAULT_N3D),
             seed=seed,
-            estimator=args.estimator or BUILTIN,
+            estimator=args.estimator or DEFAULT_ESTIMATOR,
         )
     else:
         if args.el_max is not None or args.estimator is not None:

@@ -22,7 +22,7 @@ Fitted: distance bins with at least :data:`~eyeviz.reports.study_design.MIN_COUN
 elements, no flagged answer, not the first or last bin of a design (the prior's bounds
 truncate there) and a relative error <= :data:`FIT_MAX` (where it saturates, the prior's
 range bounds it). The estimator is named in every figure's title: only ``limit`` is the
-accuracy limit; any other (``triangulation``) is an upper bound on it.
+accuracy limit (``limit3d``); any other (``analytic3d``) is an upper bound on its MAPE.
 """
 
 from __future__ import annotations
@@ -43,6 +43,8 @@ __all__ = ["FIT_MAX", "PAPER3D", "Design3D", "fit_power", "law_points3d", "write
 
 #: The paper's eyes in 3D: h = 40, l = 20 and nside 180 (m = 720 on the equator).
 PAPER3D = (40.0, 20.0, 180)
+#: Names of the accuracy limit (the posterior) in the estimator registry.
+LIMITS = ("limit3d", "limit")
 #: Largest relative DD error (a fraction) of a bin used in the fits.
 FIT_MAX = 0.10
 
@@ -65,14 +67,12 @@ class Design3D:
 
 
 def choose_estimator(rows: list[dict]) -> str:
-    """``limit`` when the table has it, else the estimator measured on the most designs
-    (of those, the first by name)."""
+    """The limit (:data:`LIMITS`) when the table has it, else the estimator measured on
+    the most designs (of those, the first by name)."""
     designs: dict[str, set] = {}
     for r in rows:
         designs.setdefault(r["estimator"], set()).add((r["h"], r["l"], r["nside"]))
-    if "limit" in designs:
-        return "limit"
-    return min(designs, key=lambda e: (-len(designs[e]), e))
+    return min(designs, key=lambda e: (e not in LIMITS, -len(designs[e]), e))
 
 
 def designs3d(rows: list[dict], estimator: str, prior: str) -> dict[tuple, Design3D]:
@@ -185,7 +185,8 @@ def write_report3d(
     hs = sorted({k[0] for k in designs})
     l_of = {h: _nearest([k[1] for k in designs if k[0] == h], l_wanted) for h in hs}
     h_star = _nearest(hs, PAPER3D[0])
-    label = est if est == "limit" else f"{est} (an upper bound on the limit, not the limit)"
+    is_limit = est in LIMITS
+    label = est if is_limit else f"{est} (an upper bound on the limit, not the limit)"
     outdir.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
     with matplotlib.rc_context(_rc()):
@@ -199,7 +200,7 @@ def write_report3d(
     summary = {
         "table": str(path),
         "estimator": est,
-        "is_the_limit": est == "limit",
+        "is_the_limit": is_limit,
         "prior": prior,
         "law_slope_1": {
             "C": fit.C,

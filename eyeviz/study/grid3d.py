@@ -24,7 +24,7 @@ from eyeviz.core.validation import check_choice, check_int, check_real
 from eyeviz.files.limits import MAX_ROWS
 from eyeviz.study.grid import DEFAULT_H, DEFAULT_L, MAX_GRID_POINTS, _unique, parse_list
 from eyeviz.study.point import BIN_WIDTH
-from eyeviz.study.point3d import BUILTIN, DesignPoint3D
+from eyeviz.study.point3d import DEFAULT_ESTIMATOR, DesignPoint3D
 
 __all__ = ["DEFAULT_NSIDE", "DEFAULT_N3D", "design_grid3d"]
 
@@ -52,14 +52,15 @@ def design_grid3d(
     prior: str = "single",
     n: int = DEFAULT_N3D,
     seed: int = 0,
-    estimator: str = BUILTIN,
+    estimator: str = DEFAULT_ESTIMATOR,
 ) -> list[DesignPoint3D]:
     """The 3D study's design points: every (h, l, nside) of the lists with l < h, in the
     order h, then l, then nside (duplicates dropped). Lists may be texts ("16,32,64").
 
     Raises a one-line :class:`EyevizError` for a non-number, an odd nside or one < 2, n < 1
     (or beyond :data:`~eyeviz.files.limits.MAX_ROWS`), a bad range, el_max outside
-    (0, pi/2), a bad prior or estimator name, a grid where no design has l < h, or a
+    (0, pi/2), a bad prior, an estimator the registry does not list for the spherical
+    eyes, a grid where no design has l < h, or a
     design where no ball can be visible in the binocular field.
     """
     hs = _unique(parse_list("h", h))
@@ -75,6 +76,14 @@ def design_grid3d(
     r_hi = check_real("r_max", r_max, gt=r_lo)
     check_real("g_max", g_max, gt=0)
     check_real("el_max", el_max, gt=0, lt=math.pi / 2)
+    from eyeviz.estimators import registry
+
+    have = registry.available("spherical")
+    if estimator not in have:
+        raise EyevizError(
+            f"estimator must be an estimator of the spherical eyes ({', '.join(have)}), "
+            f"got {estimator!r}"
+        )
     check_r_min(r_lo, max(hs))
     if (r_hi - r_lo) / BIN_WIDTH > MAX_BINS:
         raise EyevizError(

@@ -7,17 +7,14 @@ Its test set is drawn from the design's Algorithm 1 in 3D
 (:func:`eyeviz.dataset.algorithm1_3d.iter_chunks3d`, sparse lit sets, no bitmaps held)
 and every element is estimated from the two lit sets alone.
 
-The estimator is a parameter of the point (the ``estimator`` column of the table):
-
-``"triangulation"``  built in here, for any design: each eye's direction to the ball is
-    the normalised mean of its lit facets' centres (the centre of the lit cap, to within
-    the facet size), and the ball is the midpoint of the two rays' closest approach
-    (from A = (-h, 0, 0) and B = (h, 0, 0)). No prior is used: an upper bound on the
-    information limit, not the limit.
-any other name  loaded from the estimator registry,
-    ``registry.load(name, domain=Domain3D(...))``, whose ``predict(lit_a, lit_b)`` takes
-    the CSR lit sets ``(indptr, indices)`` per eye and answers (r, azimuth, elevation, ...)
-    (``"limit"``: the exact posterior, the accuracy limit the study is for).
+The estimator is a parameter of the point (the ``estimator`` column of the table), an
+estimator of the spherical eyes from the registry,
+``registry.load(name, domain=Domain3D(...))``, whose ``predict(lit_a, lit_b)`` takes the
+CSR lit sets ``(indptr, indices)`` per eye and answers (r, azimuth, elevation) with
+``valid`` and ``flagged`` masks: ``"limit3d"`` (the exact posterior, the
+accuracy limit the study is for), ``"analytic3d"`` (the default: the closest approach of
+the rays along the two lit caps' mean directions, an upper bound on the limit's MAPE) or
+``"learned3d"`` (for the design its weights were trained on).
 
 The errors per row: DD and AD MAPE (%) and R^2 (Eqs. 34-35, docs/conventions.md, as the
 planar study), the mean absolute elevation and azimuth error in degrees (MAPE is no
@@ -46,22 +43,22 @@ from eyeviz.estimators.metrics import mape, r2
 from eyeviz.study.point import BIN_WIDTH, distance_bins
 
 __all__ = [
-    "BUILTIN",
+    "DEFAULT_ESTIMATOR",
     "COLUMNS3D",
     "EL_BINS",
     "STUDY3D_VERSION",
     "DesignPoint3D",
     "elevation_bins",
     "evaluate3d",
-    "triangulate",
 ]
 
 #: Version of the 3D study table's columns; a file with another version is refused.
 STUDY3D_VERSION = 1
 #: Equal elevation bins over [-el_max, el_max] (10 degrees each at the default 30).
 EL_BINS = 6
-#: The estimator built into this module (every other name comes from the registry).
-BUILTIN = "triangulation"
+#: The default estimator: the closest-approach triangulation of the lit caps' mean
+#: directions (:mod:`eyeviz.estimators.analytic3d`), for any design.
+DEFAULT_ESTIMATOR = "analytic3d"
 #: The 3D study table's columns, in order: one row per design point and bin ("all" first,
 #: then the distance bins "r0", "r1", ..., then the elevation bins "e0" ... "e5").
 #: ``lo``/``hi``: the bin's range of r (rows "all" and "r*") or of the elevation in
@@ -113,7 +110,7 @@ class DesignPoint3D:
     prior: str = "single"
     n: int = 20_000
     seed: int = 0
-    estimator: str = BUILTIN
+    estimator: str = DEFAULT_ESTIMATOR
 
     def __post_init__(self) -> None:
         from eyeviz.dataset.algorithm1_3d import make_params3d
@@ -161,59 +158,9 @@ def elevation_bins(el_max: float, k: int = EL_BINS) -> np.ndarray:
     return np.linspace(-el_max, el_max, k + 1)
 
 
-def _cap_directions(nside: int, indptr: np.ndarray, indices: np.ndarray) -> np.ndarray:
-    """Per row, the normalised mean of its lit facets' centre vectors (rows, 3)."""
-    from eyeviz.core.healpix import centers
-
-    v = centers(nside, indices)
-    lens = np.diff(indptr)
-    if np.any(lens == 0):
-        raise EyevizError("a row lights no facet of an eye (not a visible ball)")
-    s = np.add.reduceat(v, indptr[:-1], axis=0)
-    return s / np.linalg.norm(s, axis=1, keepdims=True)
-
-
-def triangulate(
-    domain: Domain3D, lit_a: tuple[np.ndarray, np.ndarray], lit_b: tuple[np.ndarray, np.ndarray]
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(r, azimuth, elevation, flagged) from the CSR lit sets ``(indptr, indices)`` per eye.
-
-    Each eye's direction u (A) and v (B) is its lit cap's centre (mean of the facet
-    centres); the ball is the midpoint of the closest approach of A + s u and B + t v
-    (the 3D form of the planar triangulation of Eqs. 20-21). Rays that do not meet in
-    front of both eyes (s or t <= 0, or parallel) are ``flagged``: the answer is then
-    r_max along the mean of u and v. r is clipped to [r_min, r_max].
-    """
-    u = _cap_directions(domain.nside, *lit_a)
-    v = _cap_directions(domain.nside, *lit_b)
-    a = np.array([-domain.h, 0.0, 0.0])
-    w0 = a - (-a)  # A - B
-    b = np.einsum("ij,ij->i", u, v)
-    d = u @ w0
-    e = v @ w0
-    den = 1.0 - b * b
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = (b * e - d) / den
-        t = (e - b * d) / den
-    ok = (den > 1e-15) & (s > 0) & (t > 0) & np.isfinite(s) & np.isfinite(t)
-    s = np.where(ok, s, 1.0)
-    t = np.where(ok, t, 1.0)
-    p = 0.5 * ((a + s[:, None] * u) + (-a + t[:, None] * v))
-    mean_dir = u + v
-    mean_dir /= np.linalg.norm(mean_dir, axis=1, keepdims=True)
-    p = np.where(ok[:, None], p, domain.r_max * mean_dir)
-    rho = np.linalg.norm(p, axis=1)
-    r = np.clip(rho, domain.r_min, domain.r_max)
-    az = np.arctan2(p[:, 1], p[:, 0])
-    el = np.arcsin(np.clip(p[:, 2] / rho, -1.0, 1.0))
-    return r, az, el, ~ok
-
-
 def _load(point: DesignPoint3D):
     """A ``predict(lit_a, lit_b) -> (r, azimuth, elevation, flagged)`` for the point."""
     d = point.domain
-    if point.estimator == BUILTIN:
-        return lambda la, lb: triangulate(d, la, lb)
     from eyeviz.estimators import registry
 
     est = registry.load(point.estimator, domain=d)

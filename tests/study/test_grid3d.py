@@ -8,14 +8,9 @@ import pytest
 
 from eyeviz import EyevizError
 from eyeviz.core.domain3d import Domain3D
+from eyeviz.estimators import registry
 from eyeviz.study.grid3d import design_grid3d
-from eyeviz.study.point3d import (
-    COLUMNS3D,
-    EL_BINS,
-    DesignPoint3D,
-    evaluate3d,
-    triangulate,
-)
+from eyeviz.study.point3d import COLUMNS3D, EL_BINS, DesignPoint3D, evaluate3d
 
 
 @pytest.mark.parametrize(
@@ -31,7 +26,11 @@ from eyeviz.study.point3d import (
         ({"el_max": 2.0}, ["el_max", "2.0"]),
         ({"el_max": 0}, ["el_max"]),
         ({"prior": "uniform"}, ["prior must be one of", "'uniform'"]),
-        ({"estimator": "no such"}, ["estimator must be an estimator's name", "'no such'"]),
+        (
+            {"estimator": "no such"},
+            ["estimator must be an estimator of the spherical eyes", "'no such'"],
+        ),
+        ({"estimator": "limit"}, ["analytic3d", "got 'limit'"]),  # the planar one
         ({"r_min": 5000, "r_max": 100}, ["r_max"]),
         ({"g_max": -1}, ["g_max", "-1"]),
         # g_max below r_min sin(gamma/2): no ball can light two facets (named design)
@@ -48,11 +47,12 @@ def test_bad_grids_are_refused_in_one_line_naming_the_parameter(kwargs, words):
 
 
 def test_the_grid_keeps_l_below_h_in_order_without_duplicates():
-    pts = design_grid3d("20,40,20", "10,20", "16,8,16", n=10, seed=3, estimator="limit")
+    pts = design_grid3d("20,40,20", "10,20", "16,8,16", n=10, seed=3, estimator="analytic3d")
     got = [(p.h, p.l, p.nside) for p in pts]
     assert got == [(20, 10, 16), (20, 10, 8), (40, 10, 16), (40, 10, 8), (40, 20, 16), (40, 20, 8)]
-    assert {(p.n, p.seed, p.estimator, p.m) for p in pts} == {(10, 3, "limit", 64)} | {
-        (10, 3, "limit", 32)
+    assert {(p.n, p.seed, p.estimator, p.m) for p in pts} == {
+        (10, 3, "analytic3d", 64),
+        (10, 3, "analytic3d", 32),
     }
     assert len({p.key for p in pts}) == len(pts)
 
@@ -78,14 +78,15 @@ def test_a_points_rows_are_whole_and_deterministic():
     assert c[0]["dd_mape"] != a[0]["dd_mape"]
 
 
-def test_the_triangulation_finds_a_known_ball_and_errors_shrink_with_nside():
+def test_the_default_estimator_finds_a_known_ball_and_errors_shrink_with_nside():
     d = Domain3D(h=40, l=20, nside=64)
     eyes = d.eyes
     x, y, z, g = np.array([300.0]), np.array([1400.0]), np.array([200.0]), np.array([150.0])
     (pa, ia), (pb, ib) = eyes.lit_csr(x, y, z, g)
-    r, az, el, flagged = triangulate(d, (pa, ia), (pb, ib))
+    p = registry.load(DesignPoint3D().estimator, domain=d).predict((pa, ia), (pb, ib))
+    r, az, el = p.r, p.azimuth, p.elevation
     true_r = math.sqrt(300**2 + 1400**2 + 200**2)
-    assert not flagged[0]
+    assert not p.flagged[0]
     assert abs(r[0] - true_r) / true_r < 0.03
     assert az[0] == pytest.approx(math.atan2(1400, 300), abs=2e-3)
     assert el[0] == pytest.approx(math.asin(200 / true_r), abs=2e-3)
@@ -97,24 +98,30 @@ def test_the_triangulation_finds_a_known_ball_and_errors_shrink_with_nside():
 
 def test_the_estimator_is_a_parameter_loaded_from_the_registry():
     """A registered 3D estimator is loaded with the point's Domain3D and measured like the
-    built-in triangulation (here one that answers the triangulation, as a record)."""
+    default (here one that answers the default's triangulation, as a plain record)."""
     from types import SimpleNamespace
-
-    from eyeviz.estimators import registry
 
     seen = {}
 
     class Tri:
         def __init__(self, domain):
             seen["domain"] = domain
-            self.domain = domain
+            self.inner = registry.load("analytic3d", domain=domain)
 
         def predict(self, lit_a, lit_b):
-            r, az, el, fl = triangulate(self.domain, lit_a, lit_b)
-            return SimpleNamespace(r=r, azimuth=az, elevation=el, flagged=fl)
+            p = self.inner.predict(lit_a, lit_b)
+            return SimpleNamespace(
+                r=p.r, azimuth=p.azimuth, elevation=p.elevation, flagged=p.flagged
+            )
 
     registry.register(
-        registry.Entry("tri_for_test", "test", load=lambda domain: Tri(domain), any_design=True)
+        registry.Entry(
+            "tri_for_test",
+            "test",
+            load=lambda domain: Tri(domain),
+            any_design=True,
+            kind="spherical",
+        )
     )
     try:
         p = DesignPoint3D(h=40, l=20, nside=16, n=300, seed=2)

@@ -46,7 +46,7 @@ def test_report_study_draws_the_3d_figures_and_opens_them(tmp_path):
         assert (tmp_path / "f" / f"{stem}.pdf").read_bytes().startswith(b"%PDF")
         ET.parse(tmp_path / "f" / f"{stem}.svg")  # well-formed
     s = json.loads((tmp_path / "f" / "summary3d.json").read_text())
-    assert s["estimator"] == "triangulation" and s["is_the_limit"] is False
+    assert s["estimator"] == "analytic3d" and s["is_the_limit"] is False
     assert {(d["h"], d["l"], d["nside"]) for d in s["designs"]} == {
         (h, l_, n) for h in (20, 40) for l_ in (5, 10) for n in (16, 32)
     }
@@ -81,7 +81,7 @@ def test_the_report_draws_the_limit_else_the_estimator_of_the_most_designs():
     def rows(spec):
         return [{"estimator": e, "h": 40.0, "l": 20.0, "nside": n} for e, ns in spec for n in ns]
 
-    tri = ("triangulation", (16, 32, 64))
-    assert choose_estimator(rows([tri, ("learned3d", (180,))])) == "triangulation"
-    assert choose_estimator(rows([tri, ("limit", (16,))])) == "limit"
+    tri = ("analytic3d", (16, 32, 64))
+    assert choose_estimator(rows([tri, ("learned3d", (180,))])) == "analytic3d"
+    assert choose_estimator(rows([tri, ("limit3d", (16,))])) == "limit3d"
     assert choose_estimator(rows([("b", (16,)), ("a", (32,))])) == "a"

@@ -41,7 +41,7 @@ def test_a_tiny_3d_study_runs_and_resumes_skipping_finished_points(tmp_path):
     assert (s2.computed, s2.skipped, s2.points) == (2, 4, 6)
     assert path.read_text().splitlines()[: len(lines)] == lines  # finished rows untouched
     # another estimator is another point in the same table (the key holds it)
-    assert design_grid3d("20", "10", "8", n=150, seed=2, estimator="limit")[0].key not in (
+    assert design_grid3d("20", "10", "8", n=150, seed=2, estimator="learned3d")[0].key not in (
         StudyTable3D.open(path).finished
     )
 
