@@ -30,8 +30,6 @@ from typing import TYPE_CHECKING, Any
 
 from PyQt5 import QtCore, QtWidgets
 
-from eyeviz.app.panels.bitmaps3d import Bitmaps3DPanel
-from eyeviz.app.panels.readout3d import Readout3DPanel
 from eyeviz.app.view import make_view
 from eyeviz.model import app_model3d as m3
 from eyeviz.model.camera3d import PRESETS, Camera3D
@@ -46,6 +44,8 @@ from eyeviz.render.vtk.scene3d import (
 )
 
 if TYPE_CHECKING:
+    from eyeviz.app.panels.bitmaps3d import Bitmaps3DPanel
+    from eyeviz.app.panels.readout3d import Readout3DPanel
     from eyeviz.app.view import _Frames
 
 __all__ = ["PRESET_KEYS", "Scene3DCommand", "Scene3DHost"]
@@ -147,6 +147,10 @@ class Scene3DHost(QtCore.QObject):
         view.installEventFilter(self)
         self.split.addWidget(view)
         self.split.setStretchFactor(self.split.indexOf(view), 1)
+        # imported with the page: matplotlib's Qt canvas costs a planar window ~1 s
+        from eyeviz.app.panels.bitmaps3d import Bitmaps3DPanel
+        from eyeviz.app.panels.readout3d import Readout3DPanel
+
         self.bitmaps = Bitmaps3DPanel()
         self.readout = Readout3DPanel()
         self.docks["bitmaps3d"] = self._dock("Facets (Mollweide)", self.bitmaps, "bitmaps3d")
