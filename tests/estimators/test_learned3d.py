@@ -306,6 +306,13 @@ def test_fit_on_a_given_data_set_and_from_a_planar_domain(tmp_path):
     assert meta["data"]["train_seed"] == TEST_SEED + 2 and meta["data"]["n_train"] == 1350
     with pytest.raises(EyevizError, match="data design"):
         fit(ds, tmp_path / "n", domain=Domain3D(nside=18), epochs=1, hidden=4)
+    # a sparse 3D data set file (eyeviz generate --nside), read block by block
+    from eyeviz.dataset.sparse3d import write3d
+
+    f = tmp_path / "d.npz"
+    write3d(f, 1500, SMALL, seed=TEST_SEED + 3)
+    meta = learned3d.load(fit(str(f), tmp_path / "f", domain=SMALL, epochs=1, hidden=4)).metadata
+    assert meta["data"]["train_seed"] == TEST_SEED + 3 and meta["data"]["n_val"] == 150
     with pytest.raises(EyevizError, match="multiple of 4"):
         fit(None, tmp_path / "p", domain=Domain(m=722), n=2048)
     with pytest.raises(EyevizError, match="hidden"):
