@@ -3,7 +3,9 @@
 Each eye's lit set is summarised in one vectorised pass over its CSR row
 (:mod:`eyeviz.estimators.learned3d_features`): the solid-angle-weighted mean direction of
 the lit facets, the cap's angular radius from the facet count, the west and east edge
-longitudes and the z-extent. The two mean directions are triangulated (the closest
+longitudes, the z-extent and bounds on the cap centre's longitude from every ring's run
+ends (a set-membership cue: each ring pins the centre to a cell, many rings to a
+fraction of one). The two mean directions are triangulated (the closest
 approach of the rays from A and B, docs/spherical.md) and one multilayer perceptron
 (SiLU, two hidden layers) corrects the triangulation, as the planar compact networks do
 (:mod:`eyeviz.estimators.compact`):
@@ -15,6 +17,16 @@ approach of the rays from A and B, docs/spherical.md) and one multilayer percept
   where a relative error is undefined).
 
 The last layer starts at zero, so training starts from the triangulation.
+
+Why summaries and not a spherical convolution on the HEALPix grid (DeepSphere): one
+convolution layer over both eyes' 2 x 388,800 facets at nside 180 with 8 channels and
+9-cell neighbourhoods is about 5.6e7 multiply-adds per row, some 10^3 times this
+network's 2.1e4, which rules out 10^5 rows/s on a CPU; and the information is in the
+cap's boundary, which the summaries read exactly. Measured at nside 180 (single pass,
+the shipped weights, a fresh 10^5-row test set, seed 31337): DD MAPE 0.965 % against the
+triangulation's 1.49 % (a network on the summaries without the per-ring bounds:
+1.47 %), AD MAPE 0.0079 % (0.0132 %), elevation mean
+absolute error 0.0076 degrees (0.0108).
 
 Weights: ``assets/models/learned3d/learned3d.npz``, plain arrays read without unpickling
 by :class:`eyeviz.files.npz.NpzReader` (every shape checked against the declared widths
