@@ -32,6 +32,7 @@ __all__ = [
     "view_camera",
     "shorten_cones",
     "tangent_cone",
+    "tangent_cones",
     "view_nside",
 ]
 
@@ -153,6 +154,32 @@ def tangent_cone(apex, centre, g: float, res: int = 48) -> np.ndarray:
     t = np.linspace(0.0, 2.0 * math.pi, res, endpoint=False)
     out[1:] = c + rad * (np.cos(t)[:, None] * e1 + np.sin(t)[:, None] * e2)
     return out
+
+
+def tangent_cones(apices, centres, g, res: int = 48) -> np.ndarray:
+    """:func:`tangent_cone` for many cones at once: apices (k, 3), centres (k, 3), radii
+    (k,) -> points (k * (res + 1), 3), cone after cone (vectorised: a drag frame)."""
+    a = np.asarray(apices, dtype=np.float64).reshape(-1, 3)
+    d = np.asarray(centres, dtype=np.float64).reshape(-1, 3) - a
+    g = np.asarray(g, dtype=np.float64).reshape(-1)
+    dd = (d * d).sum(axis=1)
+    ok = dd > g * g
+    dn = np.sqrt(np.where(ok, dd, 1.0))
+    u = d / dn[:, None]
+    ref = np.where((np.abs(u[:, 2]) < 0.9)[:, None], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+    e1 = np.cross(u, ref)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    e2 = np.cross(u, e1)
+    c = a + d * np.where(ok, 1.0 - g * g / np.where(ok, dd, 1.0), 0.0)[:, None]
+    rad = np.where(ok, g * np.sqrt(np.maximum(dd - g * g, 0.0)) / dn, 0.0)
+    t = np.linspace(0.0, 2.0 * math.pi, res, endpoint=False)
+    ring = c[:, None, :] + rad[:, None, None] * (
+        np.cos(t)[None, :, None] * e1[:, None, :] + np.sin(t)[None, :, None] * e2[:, None, :]
+    )
+    out = np.empty((a.shape[0], res + 1, 3))
+    out[:, 0] = a
+    out[:, 1:] = np.where(ok[:, None, None], ring, a[:, None, :])
+    return out.reshape(-1, 3)
 
 
 def cone_faces(res: int = 48) -> np.ndarray:

@@ -238,3 +238,18 @@ def test_a_huge_lit_set_is_drawn_on_coarse_facets(monkeypatch):
     owners = set(hp.vec2pix_ring(dn, v[:, 0], v[:, 1], v[:, 2]).tolist())
     assert set(dpix.tolist()) <= owners
     assert shapes3d.patch_facets(180, pix[:400])[0] == 180  # small sets: themselves
+
+
+def test_tangent_cones_vectorised_equal_one_by_one():
+    rng = np.random.default_rng(3)
+    apex = rng.normal(size=(7, 3)) * 40
+    centre = rng.normal(size=(7, 3)) * 300
+    g = rng.uniform(10, 120, size=7)
+    centre[3] = apex[3] + [5.0, 0.0, 0.0]  # the apex inside the ball: degenerate
+    centre[4] = apex[4] + [0.0, 0.0, 500.0]  # along z (the other reference axis)
+    many = shapes3d.tangent_cones(apex, centre, g, 24).reshape(7, 25, 3)
+    for k in range(7):
+        np.testing.assert_allclose(
+            many[k], shapes3d.tangent_cone(apex[k], centre[k], g[k], 24), atol=1e-9
+        )
+    assert np.all(many[3] == apex[3])

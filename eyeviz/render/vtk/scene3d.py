@@ -393,17 +393,11 @@ class Scene3DActors:
             self.cone_actor.SetVisibility(on)
             self.near_cone_actor.SetVisibility(on)
             if on:
-                pts = np.concatenate(
-                    [
-                        shapes3d.tangent_cone(
-                            (cx, 0.0, 0.0),
-                            (state.x[i], state.y[i], state.z[i]),
-                            float(state.g[i]),
-                            CONE_RES,
-                        )
-                        for cx in (-pair.h, pair.h)
-                        for i in range(n)
-                    ]
+                apex = np.zeros((2 * n, 3))
+                apex[:n, 0], apex[n:, 0] = -pair.h, pair.h
+                c = np.column_stack([state.x, state.y, state.z])
+                pts = shapes3d.tangent_cones(
+                    apex, np.concatenate([c, c]), np.concatenate([state.g, state.g]), CONE_RES
                 )
                 write_points(self.cones, pts)
                 write_points(
