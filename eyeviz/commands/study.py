@@ -178,6 +178,12 @@ def run(args: argparse.Namespace) -> int:
             seed=seed,
         )
     workers = None if args.workers is None else _int("workers", args.workers)
+    if workers is not None and args.scheduler is None:
+        from eyeviz.study.cpus import workers_warning
+
+        advice = workers_warning(workers)
+        if advice:
+            print(f"eyeviz: warning: {advice}", file=sys.stderr)
     logging.getLogger("distributed").setLevel(logging.ERROR)  # a killed worker: no log spam
     try:
         summary = run_study(

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from eyeviz import EyevizError
+from eyeviz.study.cpus import usable_cpus
 from eyeviz.study.kinds import POINT_TYPES, Point, columns_of, evaluate3d, open_table
 from eyeviz.study.point import DesignPoint, evaluate
 
@@ -96,11 +97,49 @@ def _one_line(exc: BaseException) -> str:
 
 
 def _cores() -> int:
-    """Cores this process may run on (its CPU affinity where the OS tells)."""
+    """CPUs this process may use (affinity and cgroup quota, :mod:`eyeviz.study.cpus`)."""
+    return usable_cpus()
+
+
+def check_scheduler(scheduler: str) -> None:
+    """Refuse, in one line, an address no Dask client can reach: no scheme:host:port, an
+    unknown scheme, ``inproc://`` (inside one process only), an unclosed IPv6 bracket.
+    Dask's own parsers, before any Client exists (a failed Client's ``__del__`` printed
+    a 9-line traceback and held the exit for 10 s)."""
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.comm.registry import get_backend
+
+    example = "an address such as tcp://host:8786"
     try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except (AttributeError, OSError):
-        return os.cpu_count() or 1
+        scheme, loc = parse_address(scheduler)
+        if scheme == "inproc":
+            raise ValueError("inproc:// addresses exist only inside one process")
+        get_backend(scheme)
+        parse_host_port(loc)
+    except (ValueError, TypeError) as exc:
+        raise EyevizError(
+            f"scheduler must be {example}, got {scheduler!r} ({_one_line(exc)})"
+        ) from None
+
+
+def _probe(scheduler: str, timeout: float) -> None:
+    """Open and close one connection to the scheduler within ``timeout`` s (no Client:
+    nothing left to clean up when it fails)."""
+    import asyncio
+    import socket
+
+    from distributed.comm import connect
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    scheme, loc = parse_address(scheduler)
+    if scheme in ("tcp", "tls", "ws", "wss"):  # a refused port fails now, not after retries
+        socket.create_connection(parse_host_port(loc), timeout=timeout).close()
+
+    async def once() -> None:
+        comm = await asyncio.wait_for(connect(scheduler, timeout=timeout), timeout)
+        await comm.close()
+
+    asyncio.run(once())
 
 
 def _connect(scheduler: str | None, workers: int | None, timeout: float):
@@ -109,6 +148,7 @@ def _connect(scheduler: str | None, workers: int | None, timeout: float):
 
     if scheduler is not None:
         try:
+            _probe(scheduler, timeout)
             client = Client(scheduler, timeout=timeout, set_as_default=False)
         except Exception as exc:  # OSError, TimeoutError, ValueError (a bad address)...
             raise EyevizError(
@@ -361,6 +401,8 @@ def _run(path, points, workers, scheduler, progress, connect_timeout) -> StudySu
     if scheduler is not None and (not isinstance(scheduler, str) or not scheduler.strip()):
         msg = f"scheduler must be an address such as tcp://host:8786, got {scheduler!r}"
         raise EyevizError(msg)
+    if scheduler is not None:
+        check_scheduler(scheduler)
 
     def summary(
         computed: int, n_workers: int, failures: list[str], resubmitted: int = 0
