@@ -112,7 +112,7 @@ def _draw_view(
     )  # fmt: skip
     pair = st.pair
     eyes_ax.text(
-        0.03, 0.98, f"the eyes close up\nnside {pair.nside}, {pair.npix:,} facets each",
+        0.03, 0.98, f"eyes close up, nside {pair.nside}\n{pair.npix:,} facets each",
         transform=eyes_ax.transAxes, fontsize=SMALL, color=GREY, ha="left", va="top",
     )  # fmt: skip
 
