@@ -272,5 +272,27 @@ def view_camera(state: SceneState3D, name: str = "default", aspect: float = 1.0)
     balls (:func:`bounding_ball`) in a viewport ``aspect`` (width / height) wide: the 3D
     view's camera when a scene opens, its PNG's and its vector figure's by default."""
     pair = state.pair
+    if name in ("eye_a", "eye_b"):
+        return _along_eye(state, name, aspect)
     centre, radius = bounding_ball(state)
     return preset(name, pair.h, pair.l, scene_extent(state), aspect, centre=centre, radius=radius)
+
+
+def _along_eye(state: SceneState3D, name: str, aspect: float) -> Camera3D:
+    """Along the eye's forward axis, from ahead of every ball, far enough back that the
+    balls and the other eye are in view (each point's offset from the axis within the
+    view's half-angles at its distance from the camera, with a 10 % margin)."""
+    pair = state.pair
+    ex = -pair.h if name == "eye_a" else pair.h
+    base = preset(name, pair.h, pair.l, scene_extent(state), aspect)
+    half_v = math.radians(base.view_angle) / 2.0
+    tv = math.tan(half_v)
+    th = tv * aspect
+    pts = [(abs(-ex - ex) + pair.l, 0.0, pair.l)]  # the other eye
+    pts += [
+        (abs(x - ex) + g, y, abs(z) + g)
+        for x, y, z, g in zip(state.x, state.y, state.z, state.g, strict=True)
+    ]
+    need = max(y + 1.2 * max(dx / th, dz / tv) for dx, y, dz in pts)
+    need = max(need, base.position[1])
+    return Camera3D((ex, float(need), 0.0), (ex, 0.0, 0.0), base.view_up, base.view_angle)

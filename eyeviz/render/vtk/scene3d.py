@@ -16,7 +16,7 @@ and each eye's equator: that row of facets is the planar eye), ``labels`` (names
 
 Level of detail: up to :data:`eyeviz.model.shapes3d.FULL_MAX_NSIDE` each eye is one mesh
 with one cell per facet, and a frame rewrites its cell colours in place. Beyond (nside 180:
-388,800 facets per eye, each under a pixel) the unlit sphere is a coarse mesh drawn once,
+388,800 facets per eye, each under a pixel) the unlit sphere is a smooth mesh drawn once,
 and each ball's lit facets are a small mesh of their own (one cell per lit facet at the
 scene's nside) rebuilt only when that ball's lit set changes. Balls and their labels move
 by their actors' transforms; cones by writing their points in place.
@@ -73,7 +73,7 @@ __all__ = [
 SELECT_RGB = INK
 CONE_RES = 40
 #: the lit patch of ball i lies at radius l (1 + PATCH_LIFT (1 + i / n)): above the
-#: coarse sphere, a later ball's above an earlier one's (the last one's colour wins)
+#: unlit sphere, a later ball's above an earlier one's (the last one's colour wins)
 PATCH_LIFT = 0.004
 LABEL_PX = 20
 
@@ -215,11 +215,18 @@ class Scene3DActors:
                     p.SetLineWidth(1.0)
                 self.eye_meshes.append(mesh)
                 self._owner.append(np.full(pair.npix, -1, dtype=np.int32))
-            else:
-                cn = shapes3d.view_nside(n)
-                pts, faces = shapes3d.facet_mesh(cn, centre, pair.l * (1.0 - 1e-3), step=2)
-                a = _lit(actor(pv.PolyData(pts, faces), rgbf("#E1E1E1")))
-            self._add(self.eye_store, a)
+                self._add(self.eye_store, a)
+            # a smooth unlit sphere just inside the facets: the whole eye beyond
+            # FULL_MAX_NSIDE, and behind the facets' polygons (which share no points, so
+            # the rasteriser leaves pixel cracks between them) up to it
+            sphere = pv.Sphere(
+                # (inside the flat facets' centres: a facet's sagitta is < 1 - cos(1.2 / n))
+                radius=pair.l * (min(0.997, math.cos(1.2 / n)) if self.full else 0.999),
+                center=centre,
+                theta_resolution=96,
+                phi_resolution=48,
+            )
+            self._add(self.eye_store, _lit(actor(sphere, rgbf("#E1E1E1"))))
             # the equator (plane layer): that ring of facets is the planar eye
             t = np.linspace(0.0, 2.0 * math.pi, 241)
             r = pair.l * 1.012
