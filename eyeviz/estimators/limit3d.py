@@ -29,15 +29,16 @@ integrates over eye A's tangent sectors and then along the ray (:mod:`.limit`):
    one, so the feasible centres are where G(delta) = min_unlit - max_lit > 0 (concave),
    and alpha lies in (max_lit, min_unlit] there.
 2. Eye A: G on a grid about the estimate, the centre moved to its best point and the
-   distances linearised again, G on a finer grid; the cells that may hold feasible
-   centres (G + its Lipschitz bound over the cell + ``slack`` > 0) are the proposal:
-   a uniform cell, a uniform point in it, alpha uniform in [max_lit - slack,
-   min_unlit + slack].
+   distances modelled again there (zooming grids); the box holding every centre with
+   G >= -slack (bisection along 8 directions) is the proposal: a uniform point in it,
+   alpha uniform in [max_lit - slack, min_unlit + slack].
 3. Along the ray A + rho c_A (g = rho sin alpha_A) eye B's constraints are nearly linear
-   in rho: the interval where all hold (two secant passes) gives rho uniformly.
+   in u = 1 / rho (the direction from B is normalise(c_A + (A - B) u)): the interval of
+   u where all hold (two secant passes) gives u uniformly.
 4. Every proposed ball is checked exactly with ``EyePair3D.lit_csr`` (0/1 likelihood),
    against the prior's support and the exact field test ``in_bfv``, and weighted by
-   prior x Jacobian (rho^3 cos(alpha_A) / (1 + |delta|^2)^(3/2)) / proposal density.
+   prior x Jacobian (rho^3 cos(alpha_A) / (1 + |delta|^2)^(3/2)) / proposal density
+   (the density of rho is u^2 times that of u).
 
 The slacks make the proposal's support cover the posterior's (the tests compare with
 brute-force rejection sampling from the prior at nside 4 and 8), and the exact check
@@ -75,6 +76,8 @@ PRIORS = ("single", "multi")
 EDGE = 2.0
 #: boundary points per cell edge for the nearest point of a cell
 STEP = 8
+#: the widening factors of the windows and slacks of the retries of empty keys
+RETRY = (2.5, 6.0)
 #: keys processed together
 _CHUNK = 16
 
@@ -225,10 +228,24 @@ class _Eye:
             t2 = np.einsum("nkj,nj->nk", tang, self.e2) / tn
         self.t = np.stack([np.nan_to_num(t1), np.nan_to_num(t2)], axis=-1)
 
+    def model(self, delta: np.ndarray) -> np.ndarray:
+        """Each edge cell's modelled distance (N, K, G) at gnomonic offsets delta (N, G, 2).
+
+        Lit cells: d - t . delta, below the true distance (the distance to an edge is
+        linear to first order and to a vertex convex), so their constraint alpha > dist
+        is loosened. Unlit cells: the distance to their nearest sample point p,
+        sqrt((d - t . delta)^2 + |delta_perp|^2), above the true distance (p lies in the
+        cell), so alpha <= dist is loosened too: the modelled region holds the true one.
+        """
+        td = np.einsum("nkj,ngj->nkg", self.t, delta)
+        v = self.d[:, :, None] - td
+        perp2 = np.maximum(np.einsum("ngj,ngj->ng", delta, delta)[:, None, :] - td * td, 0.0)
+        return np.where(self.lit[:, :, None], v, np.sqrt(v * v + perp2))
+
     def bounds(self, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(max over lit edge cells, min over unlit) of the linearised distance at
-        gnomonic offsets delta (N, G, 2): arrays (N, G)."""
-        v = self.d[:, :, None] - np.einsum("nkj,ngj->nkg", self.t, delta)
+        """(max over lit edge cells, min over unlit) of :meth:`model` at gnomonic offsets
+        delta (N, G, 2): arrays (N, G)."""
+        v = self.model(delta)
         lo = np.where((self.lit & ~self.pad)[:, :, None], v, -np.inf).max(axis=1)
         hi = np.where((~self.lit & ~self.pad)[:, :, None], v, np.inf).min(axis=1)
         return lo, hi
@@ -296,19 +313,18 @@ def _extent(eye: _Eye, reach: float, slack: float, iters: int = 18) -> np.ndarra
     return np.maximum(ext, 1e-12)
 
 
-def _rho_interval(eye_b: _Eye, ca: np.ndarray, sin_a: np.ndarray, lo, hi, slack: float):
-    """Secant pass: the rho in [lo, hi] where every linearised constraint of eye B holds
-    within ``slack`` for balls A + rho ca, g = rho sin_a. Returns new (lo, hi)."""
-    out_lo = np.full(lo.shape, -np.inf)
-    out_hi = np.full(lo.shape, np.inf)
+def _inverse_interval(eye_b: _Eye, ca: np.ndarray, sin_a: np.ndarray, lo, hi, slack: float):
+    """Secant pass in u = 1 / rho: the u in [lo, hi] where every modelled constraint of
+    eye B holds within ``slack`` for balls A + c_A / u, g = sin(alpha_A) / u. (In u the
+    direction from B is normalise(c_A + (A - B) u), linear before normalising, so the
+    constraints are nearly linear in u.) Returns the new (lo, hi)."""
     f = []
-    for rho in (lo, hi):
-        p = eye_b.a + rho[..., None] * ca  # relative to B
+    for u in (lo, hi):
+        p = ca + u[..., None] * eye_b.a  # (P - B) u
         dist = np.linalg.norm(p, axis=2)
         cb = p / dist[..., None]
-        ab = np.arcsin(np.clip(rho * sin_a / dist, -1.0, 1.0))
-        dl = eye_b.gnomonic(cb)
-        v = eye_b.d[:, :, None] - np.einsum("nkj,nmj->nkm", eye_b.t, dl)  # (N, K, M)
+        ab = np.arcsin(np.clip(sin_a / dist, -1.0, 1.0))
+        v = eye_b.model(eye_b.gnomonic(cb))  # (N, K, M)
         f.append(np.where(eye_b.lit[:, :, None], ab[:, None, :] - v, v - ab[:, None, :]))
     f0, f1 = f
     live = ~eye_b.pad[:, :, None]
@@ -395,18 +411,20 @@ class Limit3DEstimator(Estimator3D):
         d1 = eb.gnomonic(_unit(eb.a + (rho0 * 1.001)[..., None] * ca))
         rate = np.linalg.norm(d1 - d0, axis=2) / (0.001 * rho0)
         reach = (3.0 * ext_b[:, None] + np.linalg.norm(d0, axis=2)) / np.maximum(rate, 1e-300)
-        lo = np.maximum(rho0 - reach, d.r_min - d.h)
-        hi = np.minimum(rho0 + reach, d.r_max + d.h)
+        # in u = 1 / rho
+        lo = 1.0 / np.minimum(rho0 + reach, d.r_max + d.h)
+        hi = 1.0 / np.maximum(rho0 - reach, d.r_min - d.h)
         sin_a = np.sin(alpha)
         for _ in range(2):
-            lo, hi = _rho_interval(eb, ca, sin_a, lo, hi, slack)
+            lo, hi = _inverse_interval(eb, ca, sin_a, lo, hi, slack)
             bad = ~(hi > lo)
-            lo = np.where(bad, rho0, lo)
-            hi = np.where(bad, rho0 * (1 + 1e-9), hi)
+            lo = np.where(bad, 1.0 / rho0, lo)
+            hi = np.where(bad, (1.0 + 1e-9) / rho0, hi)
             good &= ~bad
-        rho = lo + (hi - lo) * u[..., 3]
-        with np.errstate(over="ignore"):
-            q = q / np.maximum(hi - lo, 1e-300)
+        uu = lo + (hi - lo) * u[..., 3]
+        rho = 1.0 / uu
+        with np.errstate(over="ignore"):  # density of rho: that of u times u^2
+            q = q * uu * uu / np.maximum(hi - lo, 1e-300)
         p = A + rho[..., None] * ca
         gg = rho * sin_a
         r = np.linalg.norm(p, axis=2)
@@ -435,11 +453,13 @@ class Limit3DEstimator(Estimator3D):
     def _posterior(self, lit_a: LitCSR, lit_b: LitCSR):
         keys = _key_hash(lit_a, lit_b) ^ np.uint64(self.seed)
         s = self._draw(lit_a, lit_b, keys, 1.0, 0)
-        empty = ~(s["w"].sum(axis=1) > 0)
-        few = np.flatnonzero(empty)
-        if few.size:  # wider grid and slack for the keys with nothing accepted
+        for stream, wide in enumerate(RETRY, start=1):
+            few = np.flatnonzero(~(s["w"].sum(axis=1) > 0))
+            if not few.size:
+                break
+            # wider windows and slack for the keys with nothing accepted
             sub_a, sub_b = take_rows(*lit_a, few), take_rows(*lit_b, few)
-            s2 = self._draw(sub_a, sub_b, keys[few], 4.0, 1)
+            s2 = self._draw(sub_a, sub_b, keys[few], wide, stream)
             for k in s:
                 s[k][few] = s2[k]
         return s

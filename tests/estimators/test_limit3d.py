@@ -36,7 +36,7 @@ def brute4():
 def test_matches_rejection_sampling(brute4):
     ds, groups = brute4
     rows = np.array([g[0] for g in groups])
-    est = Limit3DEstimator(D4, samples=2048)
+    est = Limit3DEstimator(D4, samples=8192)
     p = est.predict(take_rows(ds.indptr_a, ds.indices_a, rows),
                     take_rows(ds.indptr_b, ds.indices_b, rows))  # fmt: skip
     assert not p.flagged.any() and (p.n_accepted >= 20).all()
@@ -51,7 +51,9 @@ def test_matches_rejection_sampling(brute4):
         assert abs(p.elevation[j] - np.median(el)) < 4 * 1.2533 * el.std() / np.sqrt(g.size) + 0.03
     z = np.array(z)
     assert np.all(np.abs(z) < 4.0), z
-    assert abs(z.mean()) < 2.5, z  # no bias shared by the keys
+    # no bias shared by the keys: the mean of 6 z-scores has sd 0.41 (a prior tilted by
+    # r^2 gives a mean of 2.5 here)
+    assert abs(z.mean()) < 1.5, z
 
 
 def test_posterior_samples_reproduce_the_key(brute4):
@@ -81,7 +83,7 @@ def test_more_accurate_than_analytic_at_nside16():
     ds = generate3d(80, D16, seed=21)
     lim = registry.load("limit3d", domain=D16).predict_dataset(ds)
     ana = Analytic3DEstimator(D16).predict_dataset(ds)
-    assert lim.valid.all() and lim.flagged.mean() < 0.3
+    assert lim.valid.all() and lim.flagged.mean() < 0.1
     assert np.nanmax(lim.mc_error) < 0.5
     assert mape(ds.r, lim.r) < mape(ds.r, ana.r)
     assert np.mean(np.abs(lim.elevation - ds.elevation)) < np.mean(
