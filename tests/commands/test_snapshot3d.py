@@ -263,3 +263,14 @@ def test_snapshot3d_view_presets(tmp_path, capsys):
         assert main(["snapshot", args[0], "-o", str(out), *args[1:]]) == 2
         assert "view" in _one_line_error(capsys)
         assert not out.exists()
+
+
+def test_snapshot3d_png_too_large_a_view_refused_in_one_line(tmp_path, capsys):
+    """The PNG's 3D view is rendered by VTK at the view box's pixels: beyond 8192 px the
+    scale is refused in one line naming it, and nothing is written."""
+    out = tmp_path / "big.png"
+    teaching = str(SCENES / "sphere_teaching.toml")
+    assert main(["snapshot", teaching, "-o", str(out), "--scale", "19"]) == 2
+    line = _one_line_error(capsys)
+    assert "scale 19" in line and "8192" in line and "scale <=" in line
+    assert not out.exists()
