@@ -37,9 +37,10 @@ __all__ = [
 ]
 
 #: Up to this nside every facet of an eye is a cell of the view's mesh (nside 32: 12,288
-#: per eye). Beyond, the unlit sphere is drawn at :data:`COARSE_NSIDE` and the lit facets
-#: at the scene's nside over it (nside 180: 388,800 facets per eye, each under a pixel in
-#: the view; measured in scripts/bench_app3d.py).
+#: per eye). Beyond, the unlit sphere is one smooth mesh (the vector figure's: the facets
+#: of :data:`COARSE_NSIDE`, :func:`view_nside`) and the lit facets are drawn at the scene's
+#: nside over it (nside 180: 388,800 facets per eye, each under a pixel in the view; a
+#: full mesh rendered in ~450 ms a frame here, scripts/bench_app3d.py measures the LOD).
 FULL_MAX_NSIDE = 32
 COARSE_NSIDE = 16
 
