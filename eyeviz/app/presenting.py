@@ -252,18 +252,33 @@ class Presenter(QtCore.QObject):
         self.win.fit_caption()
         if self.win.isVisible():
             self.win.render()
+            host = getattr(self.win, "host3d", None)
+            if host is not None and host.active:
+                host.draw()
 
     def _vtk_texts(self):
-        rens = self.win.ren_win.GetRenderers()
-        rens.InitTraversal()
-        for _ in range(rens.GetNumberOfItems()):
-            ren = rens.GetNextItem()
-            props = ren.GetViewProps()
-            props.InitTraversal()
-            for _ in range(props.GetNumberOfItems()):
-                p = props.GetNextProp()
-                if hasattr(p, "GetTextProperty"):
-                    yield p
+        """The text actors of the planar view and, once built, of the 3D view."""
+        wins = [self.win.ren_win]
+        host = getattr(self.win, "host3d", None)
+        if host is not None and host.view is not None:
+            wins.append(host.view.ren_win)
+        for ren_win in wins:
+            rens = ren_win.GetRenderers()
+            rens.InitTraversal()
+            for _ in range(rens.GetNumberOfItems()):
+                ren = rens.GetNextItem()
+                props = ren.GetViewProps()
+                props.InitTraversal()
+                for _ in range(props.GetNumberOfItems()):
+                    p = props.GetNextProp()
+                    if hasattr(p, "GetTextProperty"):
+                        yield p
+
+    def rescale_view(self) -> None:
+        """Labels made since the last scaling (a new scene or step in the 3D view) at the
+        effective scale; called by the 3D view before it draws a new scene."""
+        if self._applied != 1.0:
+            self._scale_view_text()
 
     def _scale_view_text(self) -> None:
         """The view's labels and captions at the effective scale (their own size x it)."""

@@ -5,6 +5,10 @@ same keys), Esc shows the whole scene again. Each step's caption is shown in a b
 the view. Walking never edits the scene: the whole scene is kept aside and comes back on
 leaving, and saving while walking leaves the steps first, so the file gets the whole scene.
 An edit made while a step is shown changes that step's picture only.
+
+A spherical scene's steps walk the same way in the 3D view (eyeviz.app.view3d): the
+model walked is the page shown (the 3D page's AppModel3D while it is active, else the
+planar AppModel), and the caption bar sits under that page's view.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ from eyeviz.model.steps import apply_step
 if TYPE_CHECKING:
     from eyeviz.app.presenting import Presenter
     from eyeviz.model.app_model import AppModel
+    from eyeviz.model.app_model3d import AppModel3D
     from eyeviz.model.scene import Scene
 
     _MainWindow = QtWidgets.QMainWindow
@@ -51,9 +56,29 @@ class StepsMixin(_MainWindow):
     def walking(self) -> bool:
         return self._steps_base is not None
 
+    def _step_model(self) -> AppModel | AppModel3D:
+        """The model of the page shown: the 3D view's while it is active, else the planar."""
+        host = getattr(self, "host3d", None)
+        if host is not None and host.active and host.model is not None:
+            return host.model
+        return self.model
+
     def _steps(self) -> list:
-        base = self._steps_base if self._steps_base is not None else self.model.scene
+        base = self._steps_base if self._steps_base is not None else self._step_model().scene
         return base.steps
+
+    def _place_caption(self, bar: QtWidgets.QLabel) -> None:
+        """The bar right under the view shown (the planar view or the 3D one)."""
+        split = self.centralWidget()
+        if not isinstance(split, QtWidgets.QSplitter) or split.indexOf(bar) < 0:
+            return
+        host = getattr(self, "host3d", None)
+        view = host.view if host is not None and host.active else None
+        at = split.indexOf(view) if view is not None else -1
+        at = at if at >= 0 else 0
+        if split.indexOf(bar) != at + 1:
+            split.insertWidget(at + 1 if split.indexOf(bar) > at else at, bar)
+            split.setStretchFactor(split.indexOf(bar), 0)
 
     def _caption_bar(self) -> QtWidgets.QLabel:
         if self.caption_bar is None:
@@ -93,21 +118,23 @@ class StepsMixin(_MainWindow):
             self._go(max(self.step_index - 1, 0))
 
     def _go(self, i: int) -> None:
-        if self.walking and self._steps_shown is not self.model.scene:
+        if self.walking and self._steps_shown is not self._step_model().scene:
             self._check_scene()  # another file opened meanwhile: its own steps
+        model = self._step_model()
         steps = self._steps()
         if not steps:
             self.statusBar().showMessage("this scene has no steps ([[steps]] in its file)", 6000)
             return
         i = min(i, len(steps) - 1)
         if self._steps_base is None:
-            self._steps_base = self.model.scene.copy()
+            self._steps_base = model.scene.copy()
         self.step_index = i
         shown = apply_step(self._steps_base, steps[i])
-        shown.view = self.model.scene.view  # where the presenter put it
-        self.model.set_scene(shown)
-        self._steps_shown = self.model.scene
+        shown.view = model.scene.view  # where the presenter put it
+        model.set_scene(shown)
+        self._steps_shown = model.scene
         bar = self._caption_bar()
+        self._place_caption(bar)
         bar.setText(f"{i + 1} / {len(steps)}   {steps[i].caption}")
         bar.show()
         self.fit_caption()
@@ -135,7 +162,7 @@ class StepsMixin(_MainWindow):
         """A scene with other steps in the model (a file opened while walking) ends the
         walk without bringing the old scene back."""
         base = self._steps_base
-        if base is not None and self.model.scene.steps != base.steps:
+        if base is not None and self._step_model().scene.steps != base.steps:
             self._end(restore=False)
 
     def leave_steps(self) -> None:
@@ -152,8 +179,9 @@ class StepsMixin(_MainWindow):
         if self.leave_steps_action is not None:
             self.leave_steps_action.setEnabled(False)
         if restore and base is not None:
-            base.view = self.model.scene.view
-            self.model.set_scene(base)
+            model = self._step_model()
+            base.view = model.scene.view
+            model.set_scene(base)
 
     def save_path(self, path: str | os.PathLike) -> bool:
         """Saving while walking writes the whole scene: the steps are left first."""

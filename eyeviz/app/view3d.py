@@ -273,6 +273,10 @@ class Scene3DHost(QtCore.QObject):
                 self._frame_timer.start()
             return
         self._dirty = True
+        presenter = getattr(self.win, "presenter", None)
+        if presenter is not None and self.active:  # new labels at the text scale (issue 24)
+            self.flush()
+            presenter.rescale_view()
         self.draw()
         self.refresh_panels()
         if what == "scene" and self.model is not None:

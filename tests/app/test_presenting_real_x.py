@@ -15,6 +15,7 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from eyeviz.app.launch import APP_FONT_PT
 from eyeviz.app.presenting import PRESENT_FACTOR, SCALE_KEY
 from eyeviz.model.scene import Eyes, Feature, Scene, View, load
+from eyeviz.render.vtk.scene3d import LABEL_PX
 from eyeviz.resources import scene_path
 
 
@@ -296,3 +297,105 @@ def test_the_step_caption_shows_whole_and_grows_in_presentation_mode(make_window
     assert bar.isVisible() and win._steps()[longest].caption in bar.text()
     _keys(qtbot, "F5", until=lambda: not win.presenter.presenting)
     assert bar.font().pointSizeF() == CAPTION_PT
+
+
+# --- the 3D view (a spherical scene's lecture) ---------------------------------------------
+
+
+def _focus3d(win, qtbot):
+    view = win.host3d.view
+    win.activateWindow()
+    win.raise_()
+    view.setFocus()
+    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
+    qtbot.waitUntil(view.hasFocus, timeout=3000)
+
+
+def _shown3d(win) -> dict[str, bool]:
+    """What the 3D view draws now, read from its VTK actors."""
+    a = win.host3d.actors
+    return {
+        "balls": any(b.GetVisibility() for b in a.ball_actors),
+        "cones": bool(a.cone_actor is not None and a.cone_actor.GetVisibility()),
+        "plane": any(p.GetVisibility() for p in a.plane_actors),
+        "bfv": bool(a.bfv_actor is not None and a.bfv_actor.GetVisibility()),
+    }
+
+
+def test_pagedown_walks_a_spherical_lecture_in_the_3d_view(make_window, qtbot):
+    path = scene_path("sphere_lecture")
+    whole = load(path)
+    win = make_window(load(path), path)
+    host, steps = win.host3d, whole.steps
+    assert host.active and not win.plotter.isVisible()
+    _focus3d(win, qtbot)
+    picture0 = win.grab_image()
+    _keys(qtbot, "Next", until=lambda: win.step_index == 0)
+    assert host.model.scene.layers == steps[0].layers and host.model.scene.features == []
+    assert _shown3d(win) == {"balls": False, "cones": False, "plane": False, "bfv": False}
+    bar = win.caption_bar
+    assert bar.isVisible() and f"1 / {len(steps)}   {steps[0].caption}" == bar.text()
+    # the caption sits under the 3D view (the planar view and strip are hidden)
+    split = win.centralWidget()
+    assert split.indexOf(bar) == split.indexOf(host.view) + 1
+    assert bar.geometry().top() >= host.view.geometry().bottom()
+    qtbot.waitUntil(lambda: win.grab_image() != picture0, timeout=3000)  # balls gone
+    _keys(qtbot, "Next", until=lambda: win.step_index == 1)
+    assert [f.name for f in host.model.scene.features] == ["target"]
+    assert _shown3d(win) == {"balls": True, "cones": False, "plane": False, "bfv": False}
+    assert sum(int(n) for n in host.model.state.facets_a) > 0  # its facets are lit
+    _keys(qtbot, "Next", until=lambda: win.step_index == 2)
+    assert _shown3d(win)["cones"] and steps[2].caption in bar.text()
+    plane = next(i for i, s in enumerate(steps) if "plane" in s.layers)
+    _keys(qtbot, *(["Next"] * (plane - 2)), until=lambda: win.step_index == plane)
+    assert _shown3d(win)["plane"] and not _shown3d(win)["cones"]
+    _keys(qtbot, "Prior", until=lambda: win.step_index == plane - 1)
+    assert not _shown3d(win)["plane"]
+    assert host.docks["bitmaps3d"].isVisible()
+    _keys(qtbot, *(["Next"] * len(steps)), until=lambda: win.step_index == len(steps) - 1)
+    assert _shown3d(win)["bfv"] and len(host.model.scene.features) == len(whole.features)
+    assert not win.is_modified()  # walking is not an edit
+    _keys(qtbot, "Escape", until=lambda: win.step_index == -1)
+    assert host.model.scene.layers == whole.layers
+    assert host.model.scene.features == whole.features
+    assert not bar.isVisible() and host.active
+
+
+def test_f5_f1_f11_and_ctrl_plus_work_in_the_3d_view(make_window, qtbot):
+    path = scene_path("sphere_teaching")
+    win = make_window(load(path), path)
+    host = win.host3d
+    docks = [host.docks["bitmaps3d"], host.docks["readout3d"]]
+    assert all(d.isVisible() for d in docks)
+    title0 = host.actors.title.GetTextProperty().GetFontSize()
+    _focus3d(win, qtbot)
+    _keys(qtbot, "F5", until=lambda: win.presenter.presenting)
+    qtbot.waitUntil(lambda: not any(d.isVisible() for d in docks), timeout=3000)
+    assert QtWidgets.QApplication.font().pointSizeF() == pytest.approx(APP_FONT_PT * PRESENT_FACTOR)
+    assert host.actors.title.GetTextProperty().GetFontSize() == round(title0 * PRESENT_FACTOR)
+    assert host.active and host.view.isVisible()
+    _focus3d(win, qtbot)
+    _keys(qtbot, "F5", until=lambda: not win.presenter.presenting)
+    qtbot.waitUntil(lambda: all(d.isVisible() for d in docks), timeout=3000)
+    assert host.actors.title.GetTextProperty().GetFontSize() == title0
+    _focus3d(win, qtbot)
+    _keys(qtbot, "ctrl+equal", until=lambda: win.presenter.scale == 1.15)
+    assert host.actors.title.GetTextProperty().GetFontSize() == round(title0 * 1.15)
+    # a label made after the scaling (a ball added) is at the text scale too
+    n = len(host.actors.ball_labels)
+    host.add_ball()
+    qtbot.waitUntil(lambda: len(host.actors.ball_labels) == n + 1, timeout=3000)
+    sizes = {lab.GetTextProperty().GetFontSize() for lab in host.actors.ball_labels}
+    assert sizes == {round(LABEL_PX * 1.15)}
+    _keys(qtbot, "ctrl+0", until=lambda: win.presenter.scale == 1.0)
+    assert host.actors.title.GetTextProperty().GetFontSize() == title0
+    _focus3d(win, qtbot)
+    _keys(qtbot, "F1", until=lambda: win.presenter.shortcuts_dialog is not None)
+    qtbot.waitUntil(win.presenter.shortcuts_dialog.isVisible, timeout=3000)
+    win.presenter.shortcuts_dialog.close()
+    _focus3d(win, qtbot)
+    full = _screen_size(win)
+    _keys(qtbot, "F11", until=lambda: win.isFullScreen() and win.size() == full)
+    assert host.view.isVisible()
+    _focus3d(win, qtbot)
+    _keys(qtbot, "F11", until=lambda: not win.isFullScreen())

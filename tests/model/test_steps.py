@@ -106,3 +106,35 @@ def test_the_lecture_scene_walks_from_the_eyes_to_the_predictions():
     firsts = [next(i for i, s in enumerate(sc.steps) if name in s.layers) for name in order]
     assert firsts == sorted(firsts)
     assert all(s.caption for s in sc.steps)
+
+
+SPHERE_HEAD = HEAD.replace("m = 36", "nside = 8").replace("g = 20.0\n", "z = 30.0\ng = 20.0\n", 1)
+
+
+def test_a_spherical_scene_s_steps_take_the_3d_layers_and_refuse_planar_only_ones():
+    text = (
+        SPHERE_HEAD + '\n[[steps]]\ncaption = "the plane"\nlayers = ["eyes", "plane", "tangents"]\n'
+    )
+    sc = loads(text, "<s>")
+    assert sc.kind == "spherical" and sc.steps[0].layers == ["eyes", "plane", "tangents"]
+    assert loads(dumps(sc)) == sc
+    shown = apply_step(sc, sc.steps[0])
+    assert shown.features == sc.features and shown.features[0].z == 30.0
+    bad = SPHERE_HEAD + '\n[[steps]]\ncaption = "x"\nlayers = ["eyes", "sectors"]\n'
+    with pytest.raises(SceneError, match=r"^<s>:\d+: steps\[0\]\.layers: unknown layer 'sectors'"):
+        loads(bad, "<s>")
+    planar = HEAD + '\n[[steps]]\ncaption = "x"\nlayers = ["plane"]\n'
+    with pytest.raises(SceneError, match=r"steps\[0\]\.layers: unknown layer 'plane'"):
+        loads(planar, "<s>")
+
+
+def test_the_sphere_lecture_walks_from_the_eyes_to_the_binocular_field():
+    sc = load(scene_path("sphere_lecture"))
+    assert sc.kind == "spherical" and len(sc.steps) >= 7
+    first = sc.steps[0]
+    assert first.features == [] and first.layers == ["eyes", "labels"]
+    order = ["eyes", "features", "tangents", "bitmaps", "plane", "bfv", "readout"]
+    firsts = [next(i for i, s in enumerate(sc.steps) if name in s.layers) for name in order]
+    assert firsts == sorted(firsts)
+    assert all(s.caption for s in sc.steps)
+    assert sc.steps[-1].features is None  # every ball at the end
