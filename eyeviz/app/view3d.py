@@ -59,6 +59,18 @@ PRESET_KEYS = (
     ("eye_a", "Along eye &A's axis", "4"),
     ("eye_b", "Along eye &B's axis", "5"),
 )
+HELP_TEXT = (
+    "Left-drag on the background: turn the view. Middle-drag (or Shift+left-drag on the "
+    "background): pan. Wheel or right-drag: zoom. The eyes' close-up (left) looks from "
+    "the same direction.\n\n"
+    "Left-drag a ball: move it in the plane through its centre facing you. "
+    "Shift+ or Ctrl+left-drag a ball: move it along the line of sight (up: farther). "
+    "A drag is one undo step (Ctrl+Z).\n\n"
+    "With the view focused: arrow keys nudge the selected ball across the screen, "
+    "Shift+Up / Shift+Down move it farther / nearer; Tab selects the next ball.\n\n"
+    "Camera presets: 0 default, 1 front, 2 top, 3 side, 4 along eye A's axis, "
+    "5 along eye B's axis."
+)
 PANEL_MS = 200  # the docks follow a drag at <= 5 Hz (the Mollweide maps take ~75 ms at
 # nside 180); the drag's end refreshes them at once
 _MOD_DEPTH = QtCore.Qt.KeyboardModifier.ShiftModifier | QtCore.Qt.KeyboardModifier.ControlModifier
@@ -117,6 +129,7 @@ class Scene3DHost(QtCore.QObject):
         self._panel_timer.setSingleShot(True)
         self._panel_timer.setInterval(PANEL_MS)
         self._panel_timer.timeout.connect(self.refresh_panels)
+        self.help_box: QtWidgets.QMessageBox | None = None  # 3D view > Mouse and keys
         self.preset: str | None = None  # the preset shown, until the user moves the camera
         self.preset_actions: dict[str, QtWidgets.QAction] = {}
         self.layer_actions: dict[str, QtWidgets.QAction] = {}
@@ -179,6 +192,10 @@ class Scene3DHost(QtCore.QObject):
             self.win.addAction(a)
             self.preset_actions[name] = a
         menu.addSeparator()
+        help_action = QtWidgets.QAction("Mouse and &keys…", self.win)
+        help_action.triggered.connect(self._show_help)
+        menu.addAction(help_action)
+        menu.addSeparator()
         for layer in SPHERICAL_LAYERS:
             a = QtWidgets.QAction(f"Show {layer}", self.win)
             a.setCheckable(True)
@@ -186,6 +203,19 @@ class Scene3DHost(QtCore.QObject):
             menu.addAction(a)
             self.layer_actions[layer] = a
         return menu
+
+    def _show_help(self) -> None:
+        self.show_help()
+
+    def show_help(self) -> QtWidgets.QMessageBox:
+        """3D view > Mouse and keys: how to turn the view and move the balls."""
+        box = QtWidgets.QMessageBox(
+            QtWidgets.QMessageBox.Information, "The 3D view", HELP_TEXT, parent=self.win
+        )
+        box.setObjectName("help3d")
+        box.open()
+        self.help_box = box
+        return box
 
     def _menu_action(self, shown: bool) -> None:
         a = self.menu.menuAction()

@@ -253,3 +253,13 @@ def test_a_window_started_in_3d_shows_the_planar_docks_for_a_planar_scene(make_w
     assert win.open_path(SCENES / "default.toml")
     assert win.features_panel.isVisibleTo(win) and win.bitmaps.isVisibleTo(win)
     assert not win.host3d.docks["bitmaps3d"].isVisibleTo(win)
+
+
+def test_the_3d_menu_explains_the_mouse_and_keys(make_window):
+    win = make_window(load(SCENES / "sphere_teaching.toml"))
+    box = win.host3d.show_help()
+    text = box.text()
+    assert "Shift+Up" in text and "line of sight" in text and "Ctrl+Z" in text
+    box.close()
+    titles = [a.text() for a in win.host3d.menu.actions()]
+    assert "Mouse and &keys…" in titles
