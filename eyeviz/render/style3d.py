@@ -11,6 +11,8 @@ VTK view shares (unlit facets, the close-up's background, ink) are also in
 
 from __future__ import annotations
 
+import math
+
 __all__ = [
     "BALL_LIGHT",
     "BFV_OPACITY",
@@ -27,6 +29,7 @@ __all__ = [
     "PLANE_OPACITY",
     "PLANE_RGB",
     "UNLIT_RGB",
+    "field_reach",
     "split_viewports",
 ]
 
@@ -61,3 +64,12 @@ def split_viewports(w: float, h: float) -> tuple[tuple[float, ...], tuple[float,
     the close-up takes :data:`EYES_FRACTION` of the width, half of a tall view."""
     f = EYES_FRACTION if w >= 2.0 * h * EYES_FRACTION else 0.5
     return (0.0, 0.0, f, 1.0), (f, 0.0, 1.0, 1.0)
+
+
+def field_reach(extent: float) -> float:
+    """How far from the origin the views draw the binocular field's cones and the plane
+    z = 0 for balls reaching ``extent`` (:func:`eyeviz.model.shapes3d.scene_extent`):
+    1.1 ``extent`` rounded up to a step of 2^0.5 (the VTK view rebuilds them only when the
+    step changes, not every frame of a drag; the vector view draws them as far)."""
+    step = round(2.0 * math.log2(1.1 * extent))
+    return 2.0 ** (step / 2.0 + 0.5)

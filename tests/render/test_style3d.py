@@ -39,3 +39,26 @@ def test_the_vtk_view_takes_the_shared_looks():
 def test_split_viewports(w, h, f):
     eyes, scene = style3d.split_viewports(w, h)
     assert eyes == (0.0, 0.0, f, 1.0) and scene == (f, 0.0, 1.0, 1.0)
+
+
+def test_both_views_draw_the_field_and_the_plane_as_far():
+    """The VTK view's plane reaches y = field_reach (its far edge); the vector view's too."""
+    pytest.importorskip("pyvista")
+    from vtkmodules.vtkRenderingCore import vtkRenderer
+
+    from eyeviz.model import shapes3d
+    from eyeviz.model.scene import Eyes, Feature, Scene
+    from eyeviz.model.state3d import compute_state3d
+    from eyeviz.render.vtk.scene3d import Scene3DActors
+
+    for r in (300.0, 1000.0, 4700.0):
+        sc = Scene(Eyes(40.0, 20.0, nside=8), [Feature("a", 0.0, r, 30.0, "#D55E00", 0.0)],
+                   ["eyes", "features", "bfv", "plane"])  # fmt: skip
+        st = compute_state3d(sc)
+        reach = style3d.field_reach(shapes3d.scene_extent(st))
+        assert 1.1 * shapes3d.scene_extent(st) <= reach * 2**0.25 + 1e-9
+        act = Scene3DActors(vtkRenderer(), vtkRenderer())
+        act.update(sc, st, None)
+        assert act.plane_actors[0].GetBounds()[3] == pytest.approx(reach)
+        quads = perspective3d._plane(st)[0][0].pts
+        assert quads[..., 1].max() == pytest.approx(reach)

@@ -63,6 +63,7 @@ from eyeviz.render.style3d import (
     PLANE_OPACITY,
     PLANE_RGB,
     UNLIT_RGB,
+    field_reach,
     split_viewports,
 )
 
@@ -149,7 +150,7 @@ class _Batch:
 
 
 def _reach(state: SceneState3D) -> float:
-    return 1.1 * shapes3d.scene_extent(state)
+    return field_reach(shapes3d.scene_extent(state))  # as far as the VTK view
 
 
 def _eye_batches(state: SceneState3D, scene: Scene, cam: Camera3D) -> list[_Batch]:
