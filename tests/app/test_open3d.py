@@ -263,3 +263,28 @@ def test_the_3d_menu_explains_the_mouse_and_keys(make_window):
     box.close()
     titles = [a.text() for a in win.host3d.menu.actions()]
     assert "Mouse and &keys…" in titles
+
+
+def test_cli_screenshot_of_a_spherical_scene(tmp_path):
+    """``eyeviz app SCENE3D --screenshot``: the window with its 3D view, the 3D docks."""
+    import os
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[2]
+    out = tmp_path / "s.png"
+    env = {**os.environ, "PYTHONPATH": str(root), "QT_API": "pyqt5", "MPLBACKEND": "Agg"}
+    args = ["app", str(SCENES / "sphere_equator.toml"), "--screenshot", str(out)]
+    args += ["--settings", str(tmp_path / "settings.json")]
+    r = subprocess.run(
+        [sys.executable, "-m", "eyeviz", *args], capture_output=True, text=True, env=env,
+        timeout=120,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    img = (mpimg.imread(out)[..., :3] * 255).round().astype(int)
+    # the balls' colours are in the view (left of the docks, which show them too): the 3D
+    # view was rendered into the screenshot
+    view = img[:, : int(0.6 * img.shape[1])].reshape(-1, 3)
+    for color in ("#D55E00", "#0072B2", "#009E73"):
+        rgb = np.array([int(color[k : k + 2], 16) for k in (1, 3, 5)])
+        assert (np.abs(view - rgb).sum(axis=1) < 60).sum() > 20, color
