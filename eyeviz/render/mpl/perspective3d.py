@@ -420,15 +420,44 @@ def _labels(ax, state, scene, cam, aspect, part, shown) -> None:
             if d > 0 and abs(x) < 1 and abs(y) < 1:
                 ax.text(x, y, t, fontsize=SMALL + 1, color=INK_RGBA, ha="center", va="center")
     if part == "scene" and "features" in shown and scene.features:
-        pts = np.array([[f.x, f.y, f.z + f.g] for f in scene.features])
-        xy, depth = project(cam, pts, aspect)
-        for (x, y), d, f in zip(xy, depth, scene.features, strict=True):
-            if d > 0 and abs(x) < 1 and abs(y) < 1:
-                # right of the ball's top, or left of it near the right edge (stays inside)
-                right = x < 0.55
-                name = short(f.name, 16)
-                ax.text(x, y, f" {name}" if right else f"{name} ", fontsize=SMALL + 1,
-                        color=f.color, ha="left" if right else "right", va="bottom")  # fmt: skip
+        _ball_labels(ax, scene, cam, aspect)
+
+
+def _ball_labels(ax, scene: Scene, cam: Camera3D, aspect: float) -> None:
+    """Each ball's name beside the top of the ball (to its left near the right edge), or
+    below the ball when that would overlap a name already placed (boxes estimated from
+    the text's length: the same in the PNG and the SVG, no renderer needed)."""
+    top, _ = project(cam, np.array([[f.x, f.y, f.z + f.g] for f in scene.features]), aspect)
+    low, _ = project(cam, np.array([[f.x, f.y, f.z - f.g] for f in scene.features]), aspect)
+    _, depth = project(cam, np.array([[f.x, f.y, f.z] for f in scene.features]), aspect)
+    pos = ax.get_position()
+    fig_w, fig_h = ax.figure.get_size_inches()
+    ax_w, ax_h = max(pos.width * fig_w, 1e-6), max(pos.height * fig_h, 1e-6)
+    size = SMALL + 1
+    line = 2.0 * size * 1.25 / 72.0 / ax_h  # a line's height, axes data units
+    placed: list[tuple[float, float, float, float]] = []
+    for i, f in enumerate(scene.features):
+        (x, y), (xl, yl), d = top[i], low[i], depth[i]
+        if not (d > 0 and abs(x) < 1 and abs(y) < 1):
+            continue
+        name = short(f.name, 16)
+        w = 2.0 * (len(name) + 1) * 0.6 * size / 72.0 / ax_w
+        right = x + w < 0.99
+        x0 = x if right else x - w
+        box = (x0, y, x0 + w, y + line)
+        va = "bottom"
+        if any(_overlap(box, b) for b in placed):  # below the ball instead
+            x, y, va = xl, yl, "top"
+            right = x + w < 0.99
+            x0 = x if right else x - w
+            box = (x0, y - line, x0 + w, y)
+        placed.append(box)
+        ax.text(x, y, f" {name}" if right else f"{name} ", fontsize=size, color=f.color,
+                ha="left" if right else "right", va=va)  # fmt: skip
+
+
+def _overlap(a: tuple[float, ...], b: tuple[float, ...]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 
 def draw_panel(
