@@ -13,6 +13,10 @@ limit (the best error any estimator can reach from the bitmaps).
 Estimators that cannot be loaded (the paper nets without weights, say) are listed with
 the reason, never crashed on. Output: ``estimators.md``, ``estimators.csv``,
 ``estimators.png`` (error against inference time, log axes).
+
+With ``--data FILE`` (a sparse 3D data set) or ``--nside N`` (a fresh 3D test set) the
+report is the spherical eyes' instead (:mod:`eyeviz.reports.estimators3d`): DD, AD and
+elevation error of the "spherical" estimators and their run time.
 """
 
 from __future__ import annotations
@@ -121,11 +125,88 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=TEST_SEED,
         help=f"test-set seed; multi-pass uses seed+1 (default {TEST_SEED})",
     )
+    parser.add_argument(
+        "--data",
+        type=Path,
+        default=None,
+        help="spherical eyes: score the 3D estimators on this sparse 3D data set "
+        "(eyeviz generate --nside)",
+    )
+    parser.add_argument(
+        "--nside",
+        type=int,
+        default=None,
+        help="spherical eyes: score the 3D estimators on a fresh 3D test set of --n-test "
+        "rows at this nside (the paper's h, l, ranges; seed --seed)",
+    )
+    parser.add_argument(
+        "--limit-rows",
+        type=int,
+        default=1000,
+        help="spherical eyes: the limit (ms per row) on at most this many evenly spaced "
+        "rows, where every estimator is also scored (default 1000)",
+    )
+
+
+def run3d(args: argparse.Namespace) -> int:
+    """The spherical eyes' report (``--data`` or ``--nside``)."""
+    from eyeviz import EyevizError
+    from eyeviz.estimators import registry
+    from eyeviz.reports.estimators3d import measure3d, write3d
+
+    if args.data is not None and args.nside is not None:
+        raise EyevizError("give --data or --nside, not both")
+    check_int("--limit-rows", args.limit_rows, ge=1, le=limits.MAX_ROWS)
+    if args.data is not None:
+        from eyeviz.dataset.sparse3d import load3d
+
+        ds = load3d(args.data)
+        what = (
+            f"Data set `{Path(args.data).name}`: {len(ds)} rows, h = {ds.domain.h:g}, "
+            f"l = {ds.domain.l:g}, nside = {ds.domain.nside}, params {ds.params}."
+        )
+    else:
+        from eyeviz.core.domain3d import Domain3D
+        from eyeviz.dataset.algorithm1_3d import generate3d
+
+        check_int("--n-test", args.n_test, ge=10, le=limits.MAX_ROWS)
+        ds = generate3d(args.n_test, Domain3D(nside=args.nside), "single", args.seed)
+        what = (
+            f"A fresh test set: {len(ds)} rows of the 3D Algorithm 1 (single pass, seed "
+            f"{args.seed}), the paper's design at nside = {args.nside}."
+        )
+    avail = registry.available("spherical")
+    if args.estimators is None:
+        names = avail
+    else:
+        names = [s for s in str(args.estimators).replace(",", " ").split() if s]
+        bad = [s for s in names if s not in avail]
+        if bad or not names:
+            raise EyevizError(
+                f"unknown 3D estimator(s) {', '.join(bad) or '(none given)'}; available: "
+                f"{', '.join(avail)}"
+            )
+    results = measure3d(ds, names, args.limit_rows)
+    paths = write3d(results, args.output, what)
+    for r in results:
+        if r.ok:
+            m = r.metrics["subset"]
+            print(
+                f"{r.name:11s} DD MAPE {m['dd']:.3f} %  AD MAPE {m['ad']:.4f} %  el MAE "
+                f"{m['el_mae_deg']:.5f} deg  {r.batched_us:.3g} µs/row (subset of "
+                f"{len(range(0, len(ds), max(1, -(-len(ds) // args.limit_rows))))} rows)"
+            )
+        else:
+            print(f"{r.name:11s} unavailable: {r.status}")
+    print("wrote " + ", ".join(str(p) for p in paths))
+    return 0
 
 
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
+    if getattr(args, "data", None) is not None or getattr(args, "nside", None) is not None:
+        return run3d(args)
     check_int("--n-test", args.n_test, ge=10, le=limits.MAX_ROWS)
     names = parse_names(args.estimators)
     bar = tqdm(total=len(names), desc="estimators", unit="est", leave=False)

@@ -1,0 +1,52 @@
+"""`eyeviz report estimators --nside/--data`: the spherical eyes' estimators report."""
+
+import csv
+
+import numpy as np
+
+from eyeviz.cli import main
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.dataset.algorithm1_3d import generate3d
+from eyeviz.dataset.sparse3d import write3d
+from eyeviz.estimators import registry
+from eyeviz.estimators.metrics import mape
+
+
+def test_report_on_a_3d_data_file(tmp_path, capsys):
+    d = Domain3D(nside=8)
+    data = tmp_path / "t3d.npz"
+    write3d(data, 60, d, "single", 97)
+    out = tmp_path / "rep"
+    args = ["report", "estimators", "-o", str(out), "--data", str(data), "--limit-rows", "20"]
+    assert main([*args, "--estimators", "analytic3d,limit3d"]) == 0
+    printed = capsys.readouterr().out
+    assert "analytic3d" in printed and "limit3d" in printed
+    for name in ("estimators3d.md", "estimators3d.csv", "estimators3d.png"):
+        assert (out / name).stat().st_size > 0
+    assert not (out / "estimators.md").exists()  # not the planar report
+    rows = {r["estimator"]: r for r in csv.DictReader(open(out / "estimators3d.csv"))}
+    assert set(rows) == {"analytic3d", "limit3d"}
+    # the analytic row's figures are recomputable from the estimator and the file
+    ds = generate3d(60, d, "single", 97)
+    p = registry.load("analytic3d", domain=d).predict_dataset(ds)
+    assert np.isclose(float(rows["analytic3d"]["all_dd_mape"]), mape(ds.r, p.r), rtol=1e-5)
+    sub = np.arange(0, 60, 3)
+    assert np.isclose(float(rows["analytic3d"]["subset_dd_mape"]), mape(ds.r[sub], p.r[sub]),
+                      rtol=1e-5)  # fmt: skip
+    assert rows["limit3d"]["all_dd_mape"] == ""  # the limit: the subset only
+    assert float(rows["limit3d"]["subset_dd_mape"]) > 0
+    md = (out / "estimators3d.md").read_text()
+    assert "| limit3d |" in md and "el MAE deg" in md
+
+
+def test_report_3d_fresh_set_and_errors(tmp_path, capsys):
+    out = tmp_path / "rep"
+    base = ["report", "estimators", "-o", str(out)]
+    assert main([*base, "--nside", "8", "--n-test", "30", "--estimators", "analytic3d"]) == 0
+    assert "nside = 8" in (out / "estimators3d.md").read_text()
+    capsys.readouterr()
+    assert main([*base, "--nside", "8", "--estimators", "analytic"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown 3D estimator" in err and err.count("\n") == 1
+    assert main([*base, "--nside", "8", "--data", str(tmp_path / "x.npz")]) == 2
+    assert "not both" in capsys.readouterr().err
