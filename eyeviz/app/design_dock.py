@@ -25,6 +25,7 @@ from typing import Any
 
 from PyQt5 import QtCore, QtWidgets
 
+from eyeviz.app.docks import follows_text_scale, text_scale
 from eyeviz.app.jobs import Job
 from eyeviz.app.panels import set_message, wrap_label
 from eyeviz.model.app_model import AppModel
@@ -235,12 +236,24 @@ class DesignPanel(QtWidgets.QWidget):
         self._plot()
 
     def _style_axes(self) -> None:
+        """Grid, labels and ticks at the window's text scale (Ctrl+= / Ctrl+- / Ctrl+0)."""
+        self._scale = scale = text_scale()
+        pt = PLOT_PT * scale
         for ax, name in ((self.ax_dd, "DD"), (self.ax_ad, "AD")):
             ax.grid(True, color="#dddddd", lw=0.6)
-            ax.set_ylabel(f"{name} MAPE (%)", fontsize=PLOT_PT)
-            ax.tick_params(labelsize=PLOT_PT)
+            ax.set_ylabel(f"{name} MAPE (%)", fontsize=pt)
+            ax.tick_params(labelsize=pt)
         self.ax_dd.tick_params(labelbottom=False)
-        self.ax_ad.set_xlabel("distance r", fontsize=PLOT_PT)
+        self.ax_ad.set_xlabel("distance r", fontsize=pt)
+        self.computing.set_fontsize((PLOT_PT + 1) * scale)
+
+    def changeEvent(self, ev) -> None:  # noqa: N802 (Qt name)
+        """The app font changed (the text scale): the plot's text follows."""
+        super().changeEvent(ev)
+        drawn = getattr(self, "_scale", None)  # None: still being built
+        if follows_text_scale(ev) and drawn is not None and text_scale() != drawn:
+            self._style_axes()
+            self.canvas.draw_idle()
 
     def _plot(self) -> None:
         for ln in self.lines["current"] + self.lines["paper"]:

@@ -22,9 +22,36 @@ if TYPE_CHECKING:
 
     from eyeviz.model.frame_parts import TrajectoryPath
 
-__all__ = ["EstimatorPicker", "ExportDialog", "TrajectoryPanel", "PLOT_PT", "estimator_help"]
+__all__ = [
+    "EstimatorPicker",
+    "ExportDialog",
+    "TrajectoryPanel",
+    "PLOT_PT",
+    "estimator_help",
+    "text_scale",
+]
 
-PLOT_PT = 10  # the smallest text of the accuracy plot (projector-readable)
+PLOT_PT = 10  # the smallest text of the accuracy plot (projector-readable), at text scale 1
+
+
+def text_scale() -> float:
+    """The window's text scale now (View > Larger text, presentation mode): the app font's
+    size over its size at scale 1 (eyeviz.app.presenting sets the app font)."""
+    from eyeviz.app.launch import APP_FONT_PT
+
+    app = QtWidgets.QApplication.instance()
+    pt = app.font().pointSizeF() if isinstance(app, QtWidgets.QApplication) else -1.0
+    return pt / APP_FONT_PT if pt > 0 else 1.0
+
+
+def follows_text_scale(ev: QtCore.QEvent | None) -> bool:
+    """Whether ``ev`` may change the text scale (the app's font changed)."""
+    return ev is not None and ev.type() in (
+        QtCore.QEvent.Type.FontChange,
+        QtCore.QEvent.Type.ApplicationFontChange,
+    )
+
+
 PLOT_LW = 1.3  # the accuracy curves' width (thin: the curves' detail shows)
 LINE_STYLES = ("-", (0, (5, 2)), (0, (1.5, 1.5)), (0, (6, 2, 1.5, 2)))
 
@@ -158,6 +185,14 @@ class TrajectoryPanel(QtWidgets.QWidget):
         self.cursors: list[Line2D] = []
         self._key: tuple | None = None
         self.legend: Legend | None = None  # the figure's, above the axes (never on the data)
+        self._scale = text_scale()  # the text scale the plot was drawn at
+
+    def changeEvent(self, ev) -> None:  # noqa: N802 (Qt name)
+        """Ctrl+= / Ctrl+- / Ctrl+0 (the app font changed): the plot's text follows."""
+        super().changeEvent(ev)
+        drawn = getattr(self, "_scale", None)  # None: still being built
+        if follows_text_scale(ev) and drawn is not None and text_scale() != drawn:
+            self._plot()
 
     # --- model (the player's state lives in eyeviz.model.player) ---------------------
     @property
@@ -216,6 +251,9 @@ class TrajectoryPanel(QtWidgets.QWidget):
         axes (empty 0-1 axes looked like a broken plot). Text at PLOT_PT points or more."""
         from eyeviz.model.palette import estimator_colors
 
+        self._scale = text_scale()
+        pt = PLOT_PT * self._scale
+        self.placeholder.set_fontsize(pt + self._scale)
         for ax in (self.ax_ad, self.ax_dd):
             ax.clear()
             ax.grid(True, color="#dddddd", lw=0.6)
@@ -257,7 +295,7 @@ class TrajectoryPanel(QtWidgets.QWidget):
             self.ax_dd.set_ylim(max(0.0, min(lo, 90.0)) - 2, 101)
             t = self.model.scene.trajectory
             assert t is not None  # p is its path (refresh)
-            self.ax_dd.set_xlabel(p.axis_label, fontsize=PLOT_PT)
+            self.ax_dd.set_xlabel(p.axis_label, fontsize=pt)
             notes.insert(
                 0, f"{t.kind} path, distance {t.distance:g}, g = {t.g:g}: {p.n} points in the BFV"
             )
@@ -269,15 +307,15 @@ class TrajectoryPanel(QtWidgets.QWidget):
                     labels,
                     loc="outside upper right",
                     ncol=max(len(labels), 1),
-                    fontsize=PLOT_PT,
+                    fontsize=pt,
                     frameon=False,
                     handlelength=2.2,
                     borderaxespad=0.1,
                 )
-            self.ax_ad.set_title("AD accuracy (%)", fontsize=PLOT_PT, loc="left")
-            self.ax_dd.set_title("DD accuracy (%)", fontsize=PLOT_PT, loc="left")
-            self.ax_ad.tick_params(labelsize=PLOT_PT, labelbottom=False)
-            self.ax_dd.tick_params(labelsize=PLOT_PT)
+            self.ax_ad.set_title("AD accuracy (%)", fontsize=pt, loc="left")
+            self.ax_dd.set_title("DD accuracy (%)", fontsize=pt, loc="left")
+            self.ax_ad.tick_params(labelsize=pt, labelbottom=False)
+            self.ax_dd.tick_params(labelsize=pt)
         set_message(self.info, "\n".join(notes))
         self.canvas.draw_idle()
 

@@ -399,3 +399,46 @@ def test_f5_f1_f11_and_ctrl_plus_work_in_the_3d_view(make_window, qtbot):
     assert host.view.isVisible()
     _focus3d(win, qtbot)
     _keys(qtbot, "F11", until=lambda: not win.isFullScreen())
+
+
+def _plot_fonts(ax) -> tuple[float, float, float]:
+    """(x label, the largest other text: y label or title, first tick label) sizes."""
+    side = [ax.yaxis.label] if ax.get_ylabel() else []
+    side += [t for t in ax.texts + [ax.title] if t.get_text()]
+    side += [ax._left_title] if ax.get_title(loc="left") else []  # the trajectory's titles
+    ticks = ax.get_yticklabels() or ax.get_xticklabels()
+    return (
+        ax.xaxis.label.get_fontsize(),
+        max(t.get_fontsize() for t in side),
+        ticks[0].get_fontsize(),
+    )
+
+
+def test_the_trajectory_and_design_plots_follow_the_text_scale(make_window, qtbot):
+    from eyeviz.app.docks import PLOT_PT
+
+    path = scene_path("trajectory")
+    win = make_window(load(path), path)
+    traj = win.trajectory_panel
+    assert traj is not None and traj.path is not None  # the scene's path is plotted
+    design = win.show_design()
+    design.wait()
+    qtbot.waitUntil(lambda: design.running is None, timeout=30000)
+    axes = {"trajectory": (traj, traj.ax_dd), "design": (design, design.ax_ad)}
+    before = {k: _plot_fonts(ax) for k, (_p, ax) in axes.items()}
+    for k, sizes in before.items():
+        assert sizes == (PLOT_PT, PLOT_PT, PLOT_PT), (k, sizes)
+    _focus(win, qtbot)
+    _keys(qtbot, "ctrl+equal", "ctrl+equal", until=lambda: win.presenter.scale == 1.3)
+    for k, (panel, ax) in axes.items():
+        qtbot.waitUntil(lambda ax=ax: _plot_fonts(ax)[0] > PLOT_PT, timeout=3000)
+        assert _plot_fonts(ax) == pytest.approx((PLOT_PT * 1.3,) * 3), k
+        panel.canvas.draw()  # the constrained layout still fits the bigger text
+    _focus(win, qtbot)
+    _keys(qtbot, "ctrl+0", until=lambda: win.presenter.scale == 1.0)
+    for _p, ax in axes.values():
+        qtbot.waitUntil(lambda ax=ax: _plot_fonts(ax) == (PLOT_PT,) * 3, timeout=3000)
+    # presentation mode scales them too
+    _keys(qtbot, "F5", until=lambda: win.presenter.presenting)
+    assert _plot_fonts(design.ax_ad)[0] == pytest.approx(PLOT_PT * PRESENT_FACTOR)
+    _keys(qtbot, "F5", until=lambda: not win.presenter.presenting)
