@@ -199,14 +199,31 @@ CHECKS: tuple[Callable, ...] = (
 )
 
 
+def _is_3d(est) -> bool:
+    from eyeviz.core.domain3d import Domain3D
+
+    return isinstance(getattr(est, "domain", None), Domain3D)
+
+
 def estimator_checks(est) -> Iterator[tuple[object, Callable]]:
-    """``(estimator, check)`` pairs, for ``pytest.mark.parametrize``."""
+    """``(estimator, check)`` pairs, for ``pytest.mark.parametrize`` (the 3D battery of
+    :mod:`eyeviz.estimators.checks3d` for an estimator of the spherical eyes)."""
+    if _is_3d(est):
+        from eyeviz.estimators.checks3d import estimator_checks3d
+
+        yield from estimator_checks3d(est)
+        return
     for check in CHECKS:
         yield est, check
 
 
 def check_estimator(est) -> list[str]:
-    """Run every check on ``est``; AssertionError naming the first failing check."""
+    """Run every check on ``est``; AssertionError naming the first failing check. An
+    estimator whose domain is a Domain3D gets the 3D battery (:mod:`.checks3d`)."""
+    if _is_3d(est):
+        from eyeviz.estimators.checks3d import check_estimator3d
+
+        return check_estimator3d(est)
     done = []
     for check in CHECKS:
         try:
