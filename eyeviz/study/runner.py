@@ -103,7 +103,8 @@ def _cores() -> int:
 
 def check_scheduler(scheduler: str) -> None:
     """Refuse, in one line, an address no Dask client can reach: no scheme:host:port, an
-    unknown scheme, ``inproc://`` (inside one process only), an unclosed IPv6 bracket.
+    unknown scheme, ``inproc://`` but for a scheduler in this process, an unclosed IPv6
+    bracket.
     Dask's own parsers, before any Client exists (a failed Client's ``__del__`` printed
     a 9-line traceback and held the exit for 10 s)."""
     from distributed.comm.addressing import parse_address, parse_host_port
@@ -112,8 +113,16 @@ def check_scheduler(scheduler: str) -> None:
     example = "an address such as tcp://host:8786"
     try:
         scheme, loc = parse_address(scheduler)
-        if scheme == "inproc":
-            raise ValueError("inproc:// addresses exist only inside one process")
+        if scheme == "inproc":  # valid only for a scheduler inside this very process
+            from distributed.comm.inproc import global_manager
+
+            try:
+                listener = global_manager.get_listener_for(loc)
+            except ValueError:  # not even inproc's ip/pid/n form
+                listener = None
+            if listener is None:
+                raise ValueError("no scheduler of this process; inproc:// stays in-process")
+            return
         get_backend(scheme)
         parse_host_port(loc)
     except (ValueError, TypeError) as exc:

@@ -27,7 +27,7 @@ def eyeviz(*args):
     [
         ("nonsense", "missing port number"),
         ("http://localhost:8786", "unknown address scheme 'http'"),
-        ("inproc://x", "inside one process"),
+        ("inproc://x", "inproc:// stays in-process"),
         ("tcp://[::1", "invalid address"),
     ],
 )

@@ -1,0 +1,132 @@
+"""Issue 25 items 4 and 7: the study table is appended in place (never rewritten, no
+lines held in memory), a point that would take it past the bound its reader accepts is
+refused before anything is written, and the runner and the report read it through one
+parser that refuses every edit the report used to choke on, naming file and line."""
+
+import csv
+import io
+import math
+import os
+
+import pytest
+
+from eyeviz import EyevizError
+from eyeviz.reports.study_table import read_study
+from eyeviz.study import table as table_mod
+from eyeviz.study.point import COLUMNS, DesignPoint, evaluate
+from eyeviz.study.table import StudyTable, format_row
+
+P1 = DesignPoint(h=40, l=20, m=180, n=200, seed=1)
+P2 = DesignPoint(h=20, l=10, m=360, n=200, seed=2)
+P3 = DesignPoint(h=30, l=10, m=360, n=200, seed=3)
+
+
+@pytest.fixture(scope="module")
+def rows():
+    return {p.key: evaluate(p) for p in (P1, P2, P3)}
+
+
+def test_appends_keep_the_file_and_write_only_the_new_point(tmp_path, rows, monkeypatch):
+    path = tmp_path / "s.csv"
+    t = StudyTable.open(path)
+    t.append(rows[P1.key])
+    ino, first = os.stat(path).st_ino, path.read_bytes()
+
+    def no_rewrite(*_a, **_k):
+        raise AssertionError("the table was rewritten")
+
+    monkeypatch.setattr(table_mod, "atomic_output", no_rewrite)
+    t.append(rows[P2.key])
+    t = StudyTable.open(path)
+    t.append(rows[P3.key])
+    data = path.read_bytes()
+    assert os.stat(path).st_ino == ino and data.startswith(first)
+    assert StudyTable.open(path).finished == {P1.key, P2.key, P3.key}
+    assert not hasattr(t, "lines")  # keys and a size: memory does not grow with the file
+    assert t.size == len(data)
+
+
+def test_a_point_past_the_readers_bound_is_refused_before_writing(tmp_path, rows):
+    path = tmp_path / "s.csv"
+    t = StudyTable.open(path)
+    t.append(rows[P1.key])
+    size = t.size
+    t = StudyTable.open(path, max_bytes=size + 100)  # room for less than one more point
+    before = path.read_bytes()
+    with pytest.raises(EyevizError) as err:
+        t.append(rows[P2.key])
+    msg = str(err.value)
+    assert "\n" not in msg and str(path) in msg and f"past {size + 100} bytes" in msg
+    assert "1 point(s) kept" in msg
+    assert path.read_bytes() == before
+    StudyTable.open(path, max_bytes=size + 100)  # still readable under that bound
+
+
+def _edit(path, line_no, column, value):
+    lines = path.read_text().splitlines()
+    fields = next(csv.reader([lines[line_no - 1]]))
+    fields[COLUMNS.index(column)] = value
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="").writerow(fields)
+    lines[line_no - 1] = buf.getvalue()
+    path.write_text("\n".join(lines) + "\n")
+
+
+@pytest.mark.parametrize(
+    ("line", "column", "value", "words"),
+    [
+        (3, "gamma", "0.5", "gamma = 0.5 is not 2 pi / m"),
+        (4, "count", "999999", "count 999999 exceeds n = 200"),
+        (5, "dd_mape", "-1.5", "column dd_mape: must be >= 0"),
+        (5, "ad_mape", "inf", "column ad_mape: must be >= 0 and finite"),
+        (6, "r_lo", "-1e308", "r_lo = -1e+308 is not bin"),
+        (6, "r_hi", "1e308", "r_hi = 1e+308 is not bin"),
+        (2, "r_lo", "0", "r_lo = 0 is not bin all"),
+        (2, "version", "\u0661", "version must be an integer"),
+        (3, "m", "1_80", "m must be an integer"),
+        (3, "h", "4\uff10", "h must be a number"),
+        (4, "flagged", "201", "flagged 201 exceeds count"),
+        (4, "dd_r2", "2.5", "dd_r2: must be finite and <= 1"),
+        (4, "seconds", "nan", "seconds: must be >= 0 and finite"),
+    ],
+)
+def test_runner_and_report_refuse_the_same_edit_naming_file_and_line(
+    tmp_path, rows, line, column, value, words
+):
+    path = tmp_path / "s.csv"
+    StudyTable.open(path).append(rows[P1.key])
+    _edit(path, line, column, value)
+    before = path.read_bytes()
+    msgs = []
+    for read in (StudyTable.open, read_study):
+        with pytest.raises(EyevizError) as err:
+            read(path)
+        msgs.append(str(err.value))
+    for msg in msgs:
+        assert "\n" not in msg and str(path) in msg and f"line {line}:" in msg, msg
+        assert words in msg, msg
+    assert msgs[0] == msgs[1]  # one parser
+    assert path.read_bytes() == before
+
+
+def test_a_point_the_reader_would_refuse_is_never_written(tmp_path, rows):
+    path = tmp_path / "s.csv"
+    t = StudyTable.open(path)
+    t.append(rows[P1.key])
+    before = path.read_bytes()
+    bad = [dict(r) for r in rows[P2.key]]
+    bad[0]["r_hi"] = 1e308
+    with pytest.raises(EyevizError, match="row for bin all: r_hi"):
+        t.append(bad)
+    bad = [dict(r) for r in rows[P2.key]]
+    bad[2]["gamma"] = math.pi
+    with pytest.raises(EyevizError, match="gamma"):
+        t.append(bad)
+    assert path.read_bytes() == before
+    t.append(rows[P2.key])
+    assert StudyTable.open(path).finished == {P1.key, P2.key}
+
+
+def test_formatted_rows_are_ascii(rows):
+    for r in rows[P1.key]:
+        assert format_row(r).isascii()
