@@ -184,8 +184,15 @@ def _line_of(name: str, i: int, raw: bytes) -> str:
     return line
 
 
+def _fields(where: str, line: str) -> list[str]:
+    try:
+        return next(csv.reader([line]), [])
+    except csv.Error as exc:  # e.g. a lone carriage return inside the line
+        raise EyevizError(f"{where}: not a CSV line ({exc})") from None
+
+
 def _check_header(name: str, line: str) -> None:
-    header = next(csv.reader([line]), [])
+    header = _fields(f"{name} line 1", line)
     if tuple(header) != COLUMNS:
         what = "another version of the study table" if "version" in header else "not a study table"
         raise EyevizError(
@@ -223,7 +230,7 @@ def iter_rows(path, max_bytes: int = MAX_STUDY_BYTES) -> Iterator[tuple[str, dic
                 continue
             line = _line_of(name, i, raw[:-1] if raw.endswith(b"\n") else raw)
             where = f"{name} line {i}"
-            values = next(csv.reader([line]), [])
+            values = _fields(where, line)
             if len(values) != len(COLUMNS):
                 raise EyevizError(f"{where}: {len(values)} fields, expected {len(COLUMNS)}")
             row = _parse(where, values)

@@ -130,3 +130,15 @@ def test_a_point_the_reader_would_refuse_is_never_written(tmp_path, rows):
 def test_formatted_rows_are_ascii(rows):
     for r in rows[P1.key]:
         assert format_row(r).isascii()
+
+
+def test_a_lone_carriage_return_is_one_line_naming_it(tmp_path, rows):
+    """Found by the second fuzz campaign: csv's own error escaped as a traceback."""
+    path = tmp_path / "s.csv"
+    StudyTable.open(path).append(rows[P1.key])
+    lines = path.read_bytes().split(b"\n")
+    lines[1] = b"\r" + lines[1][1:]
+    path.write_bytes(b"\n".join(lines))
+    for read in (StudyTable.open, read_study):
+        with pytest.raises(EyevizError, match=r"line 2: not a CSV line"):
+            read(path)
