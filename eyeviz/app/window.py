@@ -47,7 +47,7 @@ from eyeviz.model.scene import Eyes, Scene
 from eyeviz.model.state import SceneState
 from eyeviz.render.vtk.actors import SceneActors
 from eyeviz.render.vtk.overlays import OverlayActors
-from eyeviz.render.vtk.style import BACKGROUND, INSET_BACKGROUND, style_text
+from eyeviz.render.vtk.style import BACKGROUND, INSET_BACKGROUND, halo, style_text
 
 if TYPE_CHECKING:
     from eyeviz.app.docks import ExportChoice, ExportDialog
@@ -124,6 +124,7 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self.title_actor = vtkTextActor()
         style_text(self.title_actor.GetTextProperty(), 24, (0.1, 0.1, 0.1))
         self.title_actor.GetTextProperty().SetVerticalJustificationToTop()
+        halo(self.title_actor.GetTextProperty())  # geometry panned under it never crosses it
         self.title_actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
         self.main_ren.AddViewProp(self.title_actor)
         self.plotter.setMouseTracking(True)

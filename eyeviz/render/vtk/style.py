@@ -24,6 +24,7 @@ __all__ = [
     "Z_POINT",
     "FONT_FILE",
     "style_text",
+    "halo",
     "hex_rgb",
     "rgbf",
 ]
@@ -32,6 +33,8 @@ BACKGROUND = (1.0, 1.0, 1.0)
 INSET_BACKGROUND = (0.965, 0.965, 0.955)
 UNLIT = np.array([225, 225, 225], dtype=np.uint8)
 INK = (0.15, 0.15, 0.15)
+HALO_OPACITY = 0.92  # the title's and notes' background box (style.halo)
+HALO_FRAME = (0.82, 0.82, 0.82)
 BFV_FILL = (0.93, 0.91, 0.80)
 BFV_LINE = (0.45, 0.42, 0.30)
 FILL_ALPHA = 0.4
@@ -66,6 +69,16 @@ def style_text(tp, size: int, color) -> None:
     tp.SetFontSize(size)
     tp.BoldOn()
     tp.SetColor(*color)
+
+
+def halo(tp, opacity: float = HALO_OPACITY) -> None:
+    """A background box behind a screen text (the view's white, nearly opaque, a thin grey
+    frame): geometry panned under the title or a note never crosses the letters."""
+    tp.SetBackgroundColor(*BACKGROUND)
+    tp.SetBackgroundOpacity(opacity)
+    tp.SetFrame(True)
+    tp.SetFrameColor(*HALO_FRAME)
+    tp.SetFrameWidth(1)
 
 
 def hex_rgb(color: str) -> tuple[int, int, int]:

@@ -11,7 +11,7 @@ import pyvista as pv
 
 from eyeviz.model.frame import Frame
 from eyeviz.render.vtk.primitives import actor, screen_text, write_points
-from eyeviz.render.vtk.style import INK, Z_LINE
+from eyeviz.render.vtk.style import INK, Z_LINE, halo
 
 __all__ = ["TangentsLayer"]
 
@@ -32,6 +32,7 @@ class TangentsLayer:
             ren.AddActor(a)
             self.actors.append(a)
         self.text_actor = screen_text(20, INK, (0.015, 0.90), top=True)
+        halo(self.text_actor.GetTextProperty())  # rays panned under it never cross it
         main.AddViewProp(self.text_actor)
 
     def draw(self, frame: Frame, selected: int | None) -> None:
