@@ -2,7 +2,14 @@
 normal or presentation mode, optionally at one of its lecture steps.
 
     xvfb-run -a -s "-screen 0 1920x1080x24" .venv/bin/python scripts/presenting_screenshots.py \
-        --scene lecture --size 1280x720 --present --step 4 docs/img/app_present_1280.png
+        --scene lecture --size 1280x720 --present --step 6 docs/img/app_present_1280.png
+
+The README's pictures: ``--scene default|predictions|trajectory|figure3b`` at 1280x720
+(docs/img/app_<scene>.png), ``--scene default --size 1366x768 --design --m 2880``
+(app_design_dock.png), ``--scene lecture --step 6`` at 1280x720 / 1920x1080 with and
+without ``--present`` (app_lecture_*.png, app_present_*.png), ``--scene sphere_teaching``,
+``sphere_paper`` and ``sphere_lecture --step 3`` at 1280x720 (app3d_*.png); saved as
+256-colour PNGs.
 """
 
 from __future__ import annotations
@@ -21,6 +28,7 @@ def main() -> None:
     ap.add_argument("--step", type=int, default=0, help="show lecture step N (1-based)")
     ap.add_argument("--scale", type=float, default=1.0, help="text scale")
     ap.add_argument("--design", action="store_true", help="open View > Eye design too")
+    ap.add_argument("--m", type=int, default=0, help="set the eyes' m after opening")
     a = ap.parse_args()
     w, h = (int(v) for v in a.size.lower().split("x"))
 
@@ -45,6 +53,13 @@ def main() -> None:
         if a.design:
             win.show_design()
             win.design_panel.wait()
+            for _ in range(5):
+                app.processEvents()
+        if a.m:
+            e = win.model.scene.eyes
+            win.model.set_eyes(e.h, e.l, a.m)
+            if a.design:
+                win.design_panel.wait()
             for _ in range(5):
                 app.processEvents()
         if a.present:
