@@ -228,6 +228,29 @@ class _Eye:
             t2 = np.einsum("nkj,nj->nk", tang, self.e2) / tn
         self.t = np.stack([np.nan_to_num(t1), np.nan_to_num(t2)], axis=-1)
 
+    def prune(self, reach: np.ndarray) -> None:
+        """Drop the edge cells that cannot bind anywhere within ``reach`` (N,) of the
+        centre: a lit cell's modelled distance moves by at most |delta| and an unlit
+        one's by at most |delta| + |delta|^2 / (2 d), so a lit cell below max_lit - 2.2
+        reach or an unlit one above min_unlit + 2.2 reach never decides. (Dropping
+        constraints only loosens the model: the exact check decides.)"""
+        live = ~self.pad
+        lo0 = np.where(self.lit & live, self.d, -np.inf).max(axis=1)
+        hi0 = np.where(~self.lit & live, self.d, np.inf).min(axis=1)
+        m = 2.2 * reach[:, None]
+        keep = live & np.where(self.lit, self.d >= lo0[:, None] - m, self.d <= hi0[:, None] + m)
+        cnt = keep.sum(axis=1)
+        kmax = max(1, int(cnt.max()) if cnt.size else 1)
+        if kmax >= keep.shape[1]:
+            return
+        order = np.argsort(~keep, axis=1, kind="stable")[:, :kmax]
+        rows = np.arange(keep.shape[0])[:, None]
+        self.pts = self.pts[rows, order]
+        self.lit = self.lit[rows, order]
+        self.pad = ~keep[rows, order]
+        self.d = self.d[rows, order]
+        self.t = self.t[rows, order]
+
     def model(self, delta: np.ndarray) -> np.ndarray:
         """Each edge cell's modelled distance (N, K, G) at gnomonic offsets delta (N, G, 2).
 
@@ -356,7 +379,7 @@ class Limit3DEstimator(Estimator3D):
         domain: Domain3D = PAPER_DOMAIN3D,
         prior: str = "single",
         samples: int = 256,
-        grid: int = 12,
+        grid: int = 8,
         seed: int = 0,
     ) -> None:
         if prior not in PRIORS:
@@ -386,8 +409,10 @@ class Limit3DEstimator(Estimator3D):
         ng = self.grid
         slack = wide * 0.002 * fw
         for e in (ea, eb):
+            e.prune(np.full(n, 0.5 * wide * fw))
             _locate(e, 0.25 * wide * fw, ng, 4)
         ext = _extent(ea, wide * 0.5 * fw, slack)
+        ea.prune(1.2 * math.sqrt(2.0) * ext.max(axis=1))
         u = _uniforms(keys, m, 4, stream)
         delta = (2.0 * u[..., 0:2] - 1.0) * ext[:, None, :]
         q = np.broadcast_to(1.0 / (4.0 * ext[:, 0] * ext[:, 1])[:, None], (n, m))
@@ -406,6 +431,7 @@ class Limit3DEstimator(Estimator3D):
         rho0 = np.where(okm.reshape(n, m), rho0, d.r_max)
         eb.a = A - B
         ext_b = _extent(eb, wide * 0.5 * fw, slack).max(axis=1)
+        eb.prune(5.0 * math.sqrt(2.0) * ext_b)
         # bracket: where B's view of the ray stays within 3 of B's extents of its centre
         d0 = eb.gnomonic(_unit(eb.a + rho0[..., None] * ca))
         d1 = eb.gnomonic(_unit(eb.a + (rho0 * 1.001)[..., None] * ca))
