@@ -7,6 +7,7 @@ fields.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import TYPE_CHECKING
 
 from PyQt5 import QtCore, QtGui, QtWidgets
@@ -32,9 +33,9 @@ class SceneCommand(QtWidgets.QUndoCommand):
         self.model, self.before, self.after, self.merge_key = model, before, after, merge_key
 
     def _set(self, scene: Scene) -> None:
-        s = scene.copy()
-        s.view = View(self.model.scene.view.center, self.model.scene.view.width)
-        self.model.set_scene(s)
+        # a shallow replace: set_scene makes the one copy (issue 25: copies cost at 10^4)
+        view = View(self.model.scene.view.center, self.model.scene.view.width)
+        self.model.set_scene(dataclasses.replace(scene, view=view))
 
     def redo(self) -> None:
         self._set(self.after)

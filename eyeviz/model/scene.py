@@ -184,7 +184,24 @@ class Scene:
     steps: list[Step] = field(default_factory=list)  # a lecture's steps (eyeviz.model.steps)
 
     def copy(self) -> Scene:
-        return copy.deepcopy(self)
+        """A deep copy, field by field (issue 25: ``copy.deepcopy`` took ~139 ms at 10^4
+        features, this ~4 ms; every undo step holds two). Nothing is shared with ``self``:
+        the features, lists, view, trajectory and steps are new objects (their fields are
+        immutable values: str, float, int, tuple)."""
+        e = self.eyes
+        eyes = Eyes.__new__(Eyes)
+        eyes.h, eyes.l, eyes.m, eyes.nside = e.h, e.l, e.m, e.nside
+        t = self.trajectory
+        return Scene(
+            eyes,
+            [Feature(f.name, f.x, f.y, f.g, f.color, f.z) for f in self.features],
+            list(self.layers),
+            list(self.estimators),
+            View(copy.copy(self.view.center), self.view.width),
+            self.title,
+            None if t is None else Trajectory(t.kind, t.distance, t.g),
+            [copy.deepcopy(st) for st in self.steps],
+        )
 
     def shows(self, layer: str) -> bool:
         return layer in self.layers

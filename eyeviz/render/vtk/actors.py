@@ -161,6 +161,7 @@ class SceneActors:
         """Refit the wedge; the eyes' level of detail (:meth:`EyesLayer.set_zoom`)."""
         self.fit_bfv()
         self.eyes.set_zoom(main_px_per_unit, inset_px_per_unit, l, m)
+        self.features.refit()  # the discs' level of detail (issue 25)
         self.labels.place_bfv_text()  # the "m, θ, ψ" line steps aside for a name
 
     def set_inset_shown(self, shown: bool, main_eye_labels: bool | None = None) -> None:

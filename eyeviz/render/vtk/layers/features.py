@@ -4,6 +4,12 @@ domain: Frame ``out_of_domain``) and the selected feature's ring, handle and sig
 All discs but the selected one are ONE fill mesh (triangle fans) and ONE outline mesh with
 cell colours: few draw calls. The selected disc is drawn by template actors placed by
 transforms, so a drag uploads no geometry (a transform is a uniform, not a buffer).
+
+Level of detail (issue 25: 10^4 discs of CIRCLE_N vertices took seconds per frame in
+software GL): each merged disc gets the fewest vertices of :data:`LOD_LEVELS` whose inscribed
+polygon stays within :data:`LOD_ERROR_PX` of the circle on screen (:func:`disc_vertices`),
+at the largest zoom of a view it is in (main or inset). The levels follow the cameras
+(:meth:`FeaturesLayer.refit`, called on every zoom); the selected disc keeps CIRCLE_N.
 """
 
 from __future__ import annotations
@@ -17,10 +23,8 @@ from vtkmodules.vtkCommonMath import vtkMatrix4x4
 from eyeviz.model.frame import Frame
 from eyeviz.render.vtk.primitives import (
     CIRCLE_N,
-    UNIT,
     Store,
     actor,
-    fans,
     points_actor,
     set_input,
     set_rgb,
@@ -39,7 +43,22 @@ from eyeviz.render.vtk.style import (
     rgbf,
 )
 
-__all__ = ["FeaturesLayer"]
+__all__ = ["LOD_ERROR_PX", "LOD_LEVELS", "FeaturesLayer", "disc_vertices"]
+
+#: Vertex counts a merged disc may have (few levels: a zoom step seldom rebuilds).
+LOD_LEVELS = np.array([8, 12, 16, 24, 32, 48, 64, 96, 128, CIRCLE_N])
+#: Largest gap, in pixels, between a disc's circle and its inscribed polygon.
+LOD_ERROR_PX = 0.5
+
+
+def disc_vertices(r_px: np.ndarray) -> np.ndarray:
+    """Vertices per disc of on-screen radius ``r_px`` (pixels): the smallest level c of
+    LOD_LEVELS with r (1 - cos(pi / c)) <= LOD_ERROR_PX (the polygon's sagitta), CIRCLE_N
+    at most."""
+    r = np.maximum(np.asarray(r_px, dtype=np.float64), 0.0)
+    ok = r[:, None] * (1.0 - np.cos(np.pi / LOD_LEVELS[None, :])) <= LOD_ERROR_PX
+    first = np.where(ok.any(axis=1), ok.argmax(axis=1), len(LOD_LEVELS) - 1)
+    return LOD_LEVELS[first]
 
 
 class FeaturesLayer:
@@ -56,8 +75,10 @@ class FeaturesLayer:
         self.line_mesh: pv.PolyData | None = None
         self.centers_mesh: pv.PolyData | None = None
         self.grey = np.zeros(0, bool)
-        self.fan = CIRCLE_N - 2
+        self.fan = CIRCLE_N - 2  # fill triangles of the finest merged disc
+        self.verts = np.zeros(0, np.int64)  # vertices of each merged disc (level of detail)
         self._merged_key: tuple | None = None
+        self._last: tuple[Frame, int | None] | None = None
         self.handle_actor = points_actor(pv.PolyData(np.zeros((1, 3))), 13, (0.35, 0.35, 0.35))
         # sight lines (-h, 0) -> (x, y) -> (h, 0): the template (-1, 0) -> (0, 1) -> (1, 0)
         # under the linear map [[h, x], [0, y]]
@@ -106,23 +127,16 @@ class FeaturesLayer:
         self._merged_key = None
         if "features" not in frame.layers or not frame.n:
             return
-        n, c = frame.n, CIRCLE_N
+        n = frame.n
         cols = np.array([hex_rgb(col) for col in frame.colors], dtype=np.float64)
         # an opaque tint, not alpha: translucency costs whole extra passes in software GL
         tint = np.round(FILL_ALPHA * cols + (1 - FILL_ALPHA) * 255).astype(np.uint8)
         self._feat_rgb = (tint, cols.astype(np.uint8))
         self._rgb_now = self._feat_rgb
         self.grey = np.zeros(n, bool)
-        pts = vtkPoints()
-        pts.SetDataTypeToDouble()  # features lie far from the origin: keep float64
-        pts.SetNumberOfPoints(n * c)
-        self._idx = np.arange(n * c).reshape(n, c)
-        # triangle fans, not c-gons: VTK would re-triangulate every polygon at each upload
-        self._fan_cells = fans(self._idx)
+        self.verts = np.zeros(0, np.int64)
         self.fill_mesh = pv.PolyData()
-        self.fill_mesh.SetPoints(pts)
         self.line_mesh = pv.PolyData()
-        self.line_mesh.SetPoints(pts)
         fa = actor(self.fill_mesh, rgb=True)
         la = actor(self.line_mesh, rgb=True)
         la.GetProperty().SetLineWidth(3.0)
@@ -139,7 +153,38 @@ class FeaturesLayer:
         mapper.ScalarVisibilityOn()
         self.store.add(self.main, self._centers_actor)
 
+    def refit(self) -> None:
+        """The cameras changed (zoom): the discs' levels of detail follow."""
+        if self._last is not None:
+            self.update(*self._last)
+
+    def _levels(self, frame: Frame) -> np.ndarray:
+        """Vertices of each disc (:func:`disc_vertices`) at the largest pixels per unit of
+        the views (main, inset) whose visible rectangle it meets; CIRCLE_N for all while
+        no view has a size yet."""
+        scale = np.zeros(frame.n)
+        sized = False
+        for ren in (self.main, self.inset):
+            if ren is None or not ren.GetDraw():  # a hidden inset
+                continue
+            cam = ren.GetActiveCamera()
+            half_h = cam.GetParallelScale()
+            h_px = ren.GetSize()[1]
+            if not (half_h > 0 and h_px > 0):
+                continue
+            sized = True
+            half_w = half_h * max(ren.GetTiledAspectRatio(), 1e-3)
+            cx, cy, _ = cam.GetFocalPoint()
+            meets = (np.abs(frame.x - cx) <= half_w + frame.g) & (
+                np.abs(frame.y - cy) <= half_h + frame.g
+            )
+            scale = np.where(meets, np.maximum(scale, h_px / (2.0 * half_h)), scale)
+        if not sized:
+            return np.full(frame.n, CIRCLE_N)
+        return disc_vertices(frame.g * scale)
+
     def update(self, frame: Frame, selected: int | None) -> None:
+        self._last = (frame, selected)
         n = frame.n
         has_sel = selected is not None and 0 <= selected < n and "features" in frame.layers
         sel = selected if has_sel and self.fill_mesh is not None else None
@@ -150,10 +195,12 @@ class FeaturesLayer:
             if sel is not None:
                 others[sel] = False
             geo = np.column_stack([frame.x, frame.y, frame.g])[others]
-            key = (sel, geo.tobytes(), tint.tobytes(), cols.tobytes())
+            verts = self._levels(frame)
+            verts[~others] = LOD_LEVELS[0]  # the selected disc is the live actors'
+            key = (sel, geo.tobytes(), tint.tobytes(), cols.tobytes(), verts.tobytes())
             if key != self._merged_key:  # not while only the selected feature moves
                 self._merged_key = key
-                self._write_merged(frame, others, tint, cols)
+                self._write_merged(frame, others, tint, cols, verts)
         for a in self.live_actors:
             a.SetVisibility(sel is not None)
         self.handle_actor.SetVisibility(has_sel)
@@ -189,24 +236,49 @@ class FeaturesLayer:
         for a in self.sight_actors:
             a.GetProperty().SetColor(*col)
 
-    def _write_merged(self, frame: Frame, others: np.ndarray, tint, cols) -> None:
-        """The merged fill/outline/centre meshes of every feature but the selected one."""
+    def _write_merged(self, frame: Frame, others: np.ndarray, tint, cols, verts) -> None:
+        """The merged fill/outline/centre meshes of every feature but the selected one;
+        disc i a polygon of ``verts[i]`` vertices inscribed in its circle."""
         assert self.fill_mesh is not None and self.line_mesh is not None
         n = frame.n
         zf = Z_FEAT + 0.9 * np.arange(n) / n
-        ring = np.empty((n, CIRCLE_N, 3))
-        ring[..., 0] = frame.x[:, None] + frame.g[:, None] * UNIT[None, :, 0]
-        ring[..., 1] = frame.y[:, None] + frame.g[:, None] * UNIT[None, :, 1]
-        ring[..., 2] = zf[:, None]
+        start = np.concatenate([[0], np.cumsum(verts)])  # disc i's first point id
+        disc = np.repeat(np.arange(n), verts)  # the disc of each point
+        k = np.arange(start[-1]) - start[disc]  # its vertex number on the disc
+        t = 2.0 * np.pi * k / verts[disc]
+        ring = np.empty((start[-1], 3))
+        ring[:, 0] = frame.x[disc] + frame.g[disc] * np.cos(t)
+        ring[:, 1] = frame.y[disc] + frame.g[disc] * np.sin(t)
+        ring[:, 2] = zf[disc]
+        if self.fill_mesh.GetPoints() is None or self.fill_mesh.n_points != len(ring):
+            pts = vtkPoints()
+            pts.SetDataTypeToDouble()  # features lie far from the origin: keep float64
+            pts.SetNumberOfPoints(len(ring))
+            self.fill_mesh.SetPoints(pts)
+            self.line_mesh.SetPoints(pts)
         pts = self.fill_mesh.GetPoints()
-        vtk_to_numpy(pts.GetData())[:] = ring.reshape(-1, 3)
+        vtk_to_numpy(pts.GetData())[:] = ring
         pts.Modified()
-        idx = self._idx[others]
-        self.fill_mesh.faces = self._fan_cells[others].reshape(-1)
-        set_rgb(self.fill_mesh.GetCellData(), np.repeat(tint[others], self.fan, axis=0))
-        self.line_mesh.lines = np.column_stack(
-            [np.full(len(idx), CIRCLE_N + 1), idx, idx[:, :1]]
-        ).ravel()
+        shown = np.flatnonzero(others)
+        c, s0 = verts[shown], start[shown]
+        self.verts = c
+        self.fan = int(c.max()) - 2 if len(c) else CIRCLE_N - 2
+        # triangle fans, not c-gons: VTK would re-triangulate every polygon at each upload
+        tri_disc = np.repeat(np.arange(len(shown)), c - 2)
+        tri_start = np.concatenate([[0], np.cumsum(c - 2)])
+        j = np.arange(len(tri_disc)) - tri_start[tri_disc] + 1
+        o = s0[tri_disc]
+        self.fill_mesh.faces = np.column_stack([np.full(len(o), 3), o, o + j, o + j + 1]).ravel()
+        set_rgb(self.fill_mesh.GetCellData(), np.repeat(tint[others], c - 2, axis=0))
+        # outlines: [c + 1, first, ..., last, first] per disc
+        cell_start = np.concatenate([[0], np.cumsum(c + 2)])
+        lines = np.empty(cell_start[-1], np.int64)
+        lines[cell_start[:-1]] = c + 1
+        lines[cell_start[1:] - 1] = s0
+        v_disc = np.repeat(np.arange(len(shown)), c)
+        v_k = np.arange(len(v_disc)) - np.concatenate([[0], np.cumsum(c)])[v_disc]
+        lines[cell_start[v_disc] + 1 + v_k] = s0[v_disc] + v_k
+        self.line_mesh.lines = lines
         set_rgb(self.line_mesh.GetCellData(), cols[others])
         self.fill_mesh.Modified()
         self.line_mesh.Modified()
