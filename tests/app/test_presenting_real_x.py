@@ -322,7 +322,7 @@ def _shown3d(win) -> dict[str, bool]:
     }
 
 
-def test_pagedown_walks_a_spherical_lecture_in_the_3d_view(make_window, qtbot):
+def test_pagedown_walks_a_spherical_lecture_in_the_3d_view(make_window, qtbot, tmp_path):
     path = scene_path("sphere_lecture")
     whole = load(path)
     win = make_window(load(path), path)
@@ -359,6 +359,14 @@ def test_pagedown_walks_a_spherical_lecture_in_the_3d_view(make_window, qtbot):
     assert host.model.scene.layers == whole.layers
     assert host.model.scene.features == whole.features
     assert not bar.isVisible() and host.active
+    # saving while walking writes the whole spherical scene
+    _keys(qtbot, "Next", "Next", until=lambda: win.step_index == 1)
+    out = tmp_path / "mine.toml"
+    assert win.save_path(out)
+    saved = load(out)
+    assert saved.kind == "spherical" and saved.features == whole.features
+    assert saved.layers == whole.layers and saved.steps == whole.steps
+    assert win.step_index == -1 and host.model.scene.features == whole.features
 
 
 def test_f5_f1_f11_and_ctrl_plus_work_in_the_3d_view(make_window, qtbot):
