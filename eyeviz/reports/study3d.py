@@ -19,9 +19,10 @@ report answers the 3D study's questions:
    and against r, a curve per nside, at the paper's h and l (or the nearest).
 
 Fitted: distance bins with at least :data:`~eyeviz.reports.study_design.MIN_COUNT`
-elements, no flagged answer, not the first or last bin of a design (the prior's bounds
+elements, at most :data:`FLAG_MAX` of them flagged (the estimator fell back: diverging
+rays, an empty posterior), not the first or last bin of a design (the prior's bounds
 truncate there) and a relative error <= :data:`FIT_MAX` (where it saturates, the prior's
-range bounds it). The estimator is named in every figure's title: only ``limit`` is the
+range bounds it). The estimator is named in every figure's title: only the limit is the
 accuracy limit (``limit3d``); any other (``analytic3d``) is an upper bound on its MAPE.
 """
 
@@ -45,6 +46,8 @@ __all__ = ["FIT_MAX", "PAPER3D", "Design3D", "fit_power", "law_points3d", "write
 PAPER3D = (40.0, 20.0, 180)
 #: Names of the accuracy limit (the posterior) in the estimator registry.
 LIMITS = ("limit3d", "limit")
+#: Largest fraction of flagged answers in a fitted bin.
+FLAG_MAX = 0.05
 #: Largest relative DD error (a fraction) of a bin used in the fits.
 FIT_MAX = 0.10
 
@@ -111,7 +114,8 @@ def law_points3d(designs: dict[tuple, Design3D]) -> list[LawPoint]:
             r_mid = 0.5 * (b["lo"] + b["hi"])
             y = b["dd_mape"] / 100.0
             interior = n < 3 or 0 < i < n - 1
-            fitted = interior and b["flagged"] == 0 and y <= FIT_MAX
+            few_flags = b["flagged"] <= FLAG_MAX * b["count"]
+            fitted = interior and few_flags and y <= FIT_MAX
             paper = d.key == PAPER3D
             out.append(
                 LawPoint(
@@ -210,7 +214,8 @@ def write_report3d(
             "C_free": fit.C_free,
         },
         "power_law": power,
-        "fit_rule": f"interior distance bins, >= {MIN_COUNT} elements, no flagged answer, "
+        "fit_rule": f"interior distance bins, >= {MIN_COUNT} elements, <= {FLAG_MAX:.0%} "
+        "flagged, "
         f"relative DD error <= {FIT_MAX:g}",
         "designs": [
             {
