@@ -3,8 +3,9 @@
 1. cached path: the same 10^5 rows again (every key cached) against the bayes table
    lookup on those rows; target: limit / bayes time <= 1;
 2. a new key's CPU cost, batched (distinct keys, empty cache) and one key per call,
-   against the previous computation (every ray's nodes, an argsort weighted median; kept
-   here as the baseline); target: new / previous <= 0.5;
+   against the previous computation (every ray's nodes, an argsort weighted median: the
+   module as of commit PREVIOUS_COMMIT read from git, else a copy kept here); target:
+   new / previous <= 0.5;
 3. keys no feature can produce (g = 5 beyond r = 1146: empty posterior) against real
    keys, one key per call; target: impossible / real <= 2.
 
@@ -47,17 +48,53 @@ def _previous_median(v, w):
 
 
 def _previous(keys, domain, n=12, k=6):
-    """The previous limit_estimates: nodes on every ray, argsort medians, 4x retry."""
+    """The previous limit_estimates: nodes on every ray, argsort medians, 4x retry, in
+    blocks of 200,000 nodes as before."""
     from eyeviz.estimators.limit import posterior_nodes
 
-    nd = posterior_nodes(keys, domain, "single", n, k)
-    e = ~(nd.w.sum(axis=1) > 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = _previous_median(nd.r, nd.w / np.where(nd.r > 0, nd.r, 1.0))
-        p = _previous_median(nd.phi, nd.w / np.where(nd.phi > 0, nd.phi, 1.0))
-    if e.any() and n < 48:
-        _previous(keys[e], domain, 4 * n, k)
-    return r, p, e
+    step = max(1, 200_000 // (n * n * k))
+    empty = np.zeros(len(keys), bool)
+    for s0 in range(0, len(keys), step):
+        nd = posterior_nodes(keys[s0 : s0 + step], domain, "single", n, k)
+        empty[s0 : s0 + step] = ~(nd.w.sum(axis=1) > 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            _previous_median(nd.r, nd.w / np.where(nd.r > 0, nd.r, 1.0))
+            _previous_median(nd.phi, nd.w / np.where(nd.phi > 0, nd.phi, 1.0))
+    if empty.any() and n < 48:
+        _previous(keys[empty], domain, 4 * n, k)
+    return empty
+
+
+#: The last commit with the previous `limit` (sort-based median, nodes on every ray).
+PREVIOUS_COMMIT = "6d63657"
+
+
+def _previous_module():
+    """The previous eyeviz/estimators/limit.py from git, imported on its own; None
+    without git (then the in-file baseline :func:`_previous` is used)."""
+    import importlib.util
+    import subprocess
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    try:
+        src = subprocess.run(
+            ["git", "show", f"{PREVIOUS_COMMIT}:eyeviz/estimators/limit.py"],
+            cwd=root, capture_output=True, text=True, check=True, timeout=30,
+        ).stdout  # fmt: skip
+    except (OSError, subprocess.SubprocessError):
+        return None
+    path = Path(tempfile.mkdtemp()) / "limit_previous.py"
+    path.write_text(src)
+    spec = importlib.util.spec_from_file_location("limit_previous", path)
+    if spec is None or spec.loader is None:
+        return None
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules["limit_previous"] = mod
+    spec.loader.exec_module(mod)
+    return mod
 
 
 def main() -> int:
@@ -87,10 +124,13 @@ def main() -> int:
     keys = np.unique(iv, axis=0)[: args.keys]
     one = keys[:200]
     d = PAPER_DOMAIN
+    prev = _previous_module()
+    old = prev.limit_estimates if prev is not None else _previous
+    print(f"   previous: {'git ' + PREVIOUS_COMMIT if prev is not None else 'in-file copy'}")
     t_new = _cpu(lambda: limit_estimates(keys, d), args.repeat)
-    t_old = _cpu(lambda: _previous(keys, d), args.repeat)
+    t_old = _cpu(lambda: old(keys, d), args.repeat)
     s_new = _cpu(lambda: [limit_estimates(k[None], d) for k in one], args.repeat)
-    s_old = _cpu(lambda: [_previous(k[None], d) for k in one], args.repeat)
+    s_old = _cpu(lambda: [old(k[None], d) for k in one], args.repeat)
     print(
         f"2. new key, {len(keys)} distinct keys batched: {t_new / len(keys) * 1e6:.0f} us "
         f"(previous {t_old / len(keys) * 1e6:.0f} us), ratio {t_new / t_old:.2f}x; one key "
@@ -106,13 +146,27 @@ def main() -> int:
     imp = np.unique(imp, axis=0)
     imp = imp[limit_estimates(imp, d)[2]][: len(one)]
 
-    def per_call(kk):
-        est = estimators.load("limit")
+    def per_call(kk, make=lambda: estimators.load("limit")):
+        est = make()
         for k in kk:
             est.predict_intervals(*(np.array([v]) for v in k))
 
     t_imp = _cpu(lambda: per_call(imp), args.repeat) / len(imp)
     t_real = _cpu(lambda: per_call(one), args.repeat) / len(one)
+    b_imp = _cpu(lambda: limit_estimates(imp, d), args.repeat) / len(imp)
+    b_real = _cpu(lambda: limit_estimates(one, d), args.repeat) / len(one)
+    print(f"   batched: impossible {b_imp * 1e6:.0f} us/key, real {b_real * 1e6:.0f} us/key; "
+          f"ratio {b_imp / b_real:.2f}x")  # fmt: skip
+    if prev is not None:
+        q_imp = _cpu(lambda: prev.limit_estimates(imp, d), args.repeat) / len(imp)
+        q_real = _cpu(lambda: prev.limit_estimates(one, d), args.repeat) / len(one)
+        print(f"   previous batched: impossible {q_imp * 1e6:.0f} us/key, real "
+              f"{q_real * 1e6:.0f} us/key; ratio {q_imp / q_real:.2f}x")  # fmt: skip
+    if prev is not None:
+        p_imp = _cpu(lambda: per_call(imp, prev.LimitEstimator), args.repeat) / len(imp)
+        p_real = _cpu(lambda: per_call(one, prev.LimitEstimator), args.repeat) / len(one)
+        print(f"   previous: impossible {p_imp * 1e3:.3f} ms, real {p_real * 1e3:.3f} ms; "
+              f"ratio {p_imp / p_real:.2f}x")  # fmt: skip
     print(
         f"3. one new key per predict call: impossible {t_imp * 1e3:.3f} ms "
         f"({len(imp)} keys), real {t_real * 1e3:.3f} ms; ratio {t_imp / t_real:.2f}x "
