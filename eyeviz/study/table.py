@@ -275,11 +275,15 @@ class StudyTable:
     max_bytes: int = MAX_STUDY_BYTES
 
     @classmethod
-    def open(cls, path, max_bytes: int = MAX_STUDY_BYTES) -> StudyTable:
+    def open(cls, path, max_bytes: int | None = None) -> StudyTable:
         """Read ``path`` if it exists (checked, see :func:`iter_rows`), else start empty.
 
         The folder must exist; nothing is written until the first :meth:`append`.
+        ``max_bytes``: the bound for reading and for appending (default
+        :data:`MAX_STUDY_BYTES`, the reader's).
         """
+        if max_bytes is None:
+            max_bytes = MAX_STUDY_BYTES
         p = Path(path)
         d = p.parent if str(p.parent) else Path(".")
         if not d.is_dir():

@@ -142,3 +142,21 @@ def test_a_lone_carriage_return_is_one_line_naming_it(tmp_path, rows):
     for read in (StudyTable.open, read_study):
         with pytest.raises(EyevizError, match=r"line 2: not a CSV line"):
             read(path)
+
+
+def test_a_study_stops_before_its_table_passes_the_bound(tmp_path, monkeypatch):
+    """The runner appends through the same check: the study ends in one line, the table
+    keeps the points that fit and still reads back."""
+    from eyeviz.study import design_grid, run_study
+
+    path = tmp_path / "s.csv"
+    points = design_grid("20", "10", "8,16", n=100)
+    run_study(path, points[:1], workers=1, progress=False)
+    size = path.stat().st_size
+    monkeypatch.setattr(table_mod, "MAX_STUDY_BYTES", size + 200)
+    with pytest.raises(EyevizError) as err:
+        run_study(path, points, workers=1, progress=False)
+    msg = str(err.value)
+    assert "\n" not in msg and "the most its reader accepts" in msg and str(path) in msg
+    assert path.stat().st_size == size
+    assert StudyTable.open(path).finished == {points[0].key}
