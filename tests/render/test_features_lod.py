@@ -99,3 +99,28 @@ def test_levels_follow_the_zoom(rig):
     _look(pl, 5000.0, 0.0, 50.0)  # the disc off screen: the coarsest again
     act.set_zoom(50.0, 50.0, 20.0, 72)
     assert act.features.verts.tolist() == [LOD_LEVELS[0]]
+
+
+def test_the_inset_draws_only_the_discs_it_shows(rig):
+    pl, act = rig
+    inset = act.inset
+    inset.SetViewport(0.0, 0.0, 0.3, 0.3)
+    inset.SetDraw(True)
+    fs = [Feature("near", 0.0, 0.0, 10.0, "#0072B2"), Feature("far", 5000.0, 0.0, 10.0, "#D55E00")]
+    sc = Scene(Eyes(40.0, 20.0, 72), fs, ["features"])
+    _look(pl, 2500.0, 0.0, 0.05)  # the main view shows both
+    cam = inset.GetActiveCamera()
+    cam.ParallelProjectionOn()
+    cam.SetFocalPoint(0.0, 0.0, 0.0)
+    cam.SetPosition(0.0, 0.0, 1000.0)
+    cam.SetParallelScale(50.0)  # the inset shows "near" only
+    act.update(sc, compute_state(sc), None)
+    near = act.features.verts[0]
+    assert act.fill_mesh.n_cells == sum(act.features.verts - 2)  # both in the main view
+    assert act.features.inset_fill.n_cells == near - 2
+    assert act.features.inset_line.n_cells == 1
+    # the inset's cells index the near disc's points (the first ones)
+    assert np.asarray(act.features.inset_line.lines)[1 : near + 1].tolist() == list(range(near))
+    inset.SetDraw(False)  # hidden: it draws no disc
+    act.set_zoom(0.05, 0.05, 20.0, 72)
+    assert act.features.inset_fill.n_cells == 0 and act.features.inset_line.n_cells == 0

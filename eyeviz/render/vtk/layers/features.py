@@ -9,7 +9,10 @@ Level of detail (issue 25: 10^4 discs of CIRCLE_N vertices took seconds per fram
 software GL): each merged disc gets the fewest vertices of :data:`LOD_LEVELS` whose inscribed
 polygon stays within :data:`LOD_ERROR_PX` of the circle on screen (:func:`disc_vertices`),
 at the largest zoom of a view it is in (main or inset). The levels follow the cameras
-(:meth:`FeaturesLayer.refit`, called on every zoom); the selected disc keeps CIRCLE_N.
+(:meth:`FeaturesLayer.refit`, called on every zoom); the selected disc keeps CIRCLE_N. The
+inset draws its own cells over the same points: only the discs that meet its rectangle
+(none while it is hidden), as a disc far from the eyes cost the inset as much as the main
+view in software GL.
 """
 
 from __future__ import annotations
@@ -77,6 +80,8 @@ class FeaturesLayer:
         self.grey = np.zeros(0, bool)
         self.fan = CIRCLE_N - 2  # fill triangles of the finest merged disc
         self.verts = np.zeros(0, np.int64)  # vertices of each merged disc (level of detail)
+        self.inset_fill = pv.PolyData()
+        self.inset_line = pv.PolyData()
         self._merged_key: tuple | None = None
         self._last: tuple[Frame, int | None] | None = None
         self.handle_actor = points_actor(pv.PolyData(np.zeros((1, 3))), 13, (0.35, 0.35, 0.35))
@@ -137,11 +142,16 @@ class FeaturesLayer:
         self.verts = np.zeros(0, np.int64)
         self.fill_mesh = pv.PolyData()
         self.line_mesh = pv.PolyData()
-        fa = actor(self.fill_mesh, rgb=True)
-        la = actor(self.line_mesh, rgb=True)
-        la.GetProperty().SetLineWidth(3.0)
-        for ren in (self.main, self.inset):
+        self.inset_fill = pv.PolyData()  # the inset's cells: the discs it shows
+        self.inset_line = pv.PolyData()
+        for ren, fill, line in (
+            (self.main, self.fill_mesh, self.line_mesh),
+            (self.inset, self.inset_fill, self.inset_line),
+        ):
             if ren is not None:
+                fa = actor(fill, rgb=True)
+                la = actor(line, rgb=True)
+                la.GetProperty().SetLineWidth(3.0)
                 self.store.add(ren, fa)
                 self.store.add(ren, la)
         self.centers_mesh = pv.PolyData(np.zeros((n, 3)))
@@ -158,11 +168,12 @@ class FeaturesLayer:
         if self._last is not None:
             self.update(*self._last)
 
-    def _levels(self, frame: Frame) -> np.ndarray:
+    def _levels(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
         """Vertices of each disc (:func:`disc_vertices`) at the largest pixels per unit of
-        the views (main, inset) whose visible rectangle it meets; CIRCLE_N for all while
-        no view has a size yet."""
+        the views (main, inset) whose visible rectangle it meets, and which discs meet the
+        inset's; CIRCLE_N and every disc while no view has a size yet."""
         scale = np.zeros(frame.n)
+        in_inset = np.zeros(frame.n, bool)
         sized = False
         for ren in (self.main, self.inset):
             if ren is None or not ren.GetDraw():  # a hidden inset
@@ -179,9 +190,11 @@ class FeaturesLayer:
                 np.abs(frame.y - cy) <= half_h + frame.g
             )
             scale = np.where(meets, np.maximum(scale, h_px / (2.0 * half_h)), scale)
+            if ren is self.inset:
+                in_inset = meets
         if not sized:
-            return np.full(frame.n, CIRCLE_N)
-        return disc_vertices(frame.g * scale)
+            return np.full(frame.n, CIRCLE_N), np.ones(frame.n, bool)
+        return disc_vertices(frame.g * scale), in_inset
 
     def update(self, frame: Frame, selected: int | None) -> None:
         self._last = (frame, selected)
@@ -195,12 +208,16 @@ class FeaturesLayer:
             if sel is not None:
                 others[sel] = False
             geo = np.column_stack([frame.x, frame.y, frame.g])[others]
-            verts = self._levels(frame)
+            verts, in_inset = self._levels(frame)
             verts[~others] = LOD_LEVELS[0]  # the selected disc is the live actors'
             key = (sel, geo.tobytes(), tint.tobytes(), cols.tobytes(), verts.tobytes())
+            key += (in_inset.tobytes(),)
             if key != self._merged_key:  # not while only the selected feature moves
                 self._merged_key = key
                 self._write_merged(frame, others, tint, cols, verts)
+                self._write_cells(
+                    self.inset_fill, self.inset_line, others & in_inset, tint, cols, verts
+                )
         for a in self.live_actors:
             a.SetVisibility(sel is not None)
         self.handle_actor.SetVisibility(has_sel)
@@ -254,22 +271,33 @@ class FeaturesLayer:
             pts = vtkPoints()
             pts.SetDataTypeToDouble()  # features lie far from the origin: keep float64
             pts.SetNumberOfPoints(len(ring))
-            self.fill_mesh.SetPoints(pts)
-            self.line_mesh.SetPoints(pts)
+            for mesh in (self.fill_mesh, self.line_mesh, self.inset_fill, self.inset_line):
+                mesh.SetPoints(pts)
         pts = self.fill_mesh.GetPoints()
         vtk_to_numpy(pts.GetData())[:] = ring
         pts.Modified()
-        shown = np.flatnonzero(others)
-        c, s0 = verts[shown], start[shown]
+        c = self._write_cells(self.fill_mesh, self.line_mesh, others, tint, cols, verts)
         self.verts = c
         self.fan = int(c.max()) - 2 if len(c) else CIRCLE_N - 2
+        centers = pv.PolyData(np.column_stack([frame.x, frame.y, np.full(n, Z_POINT)])[others])
+        set_rgb(centers.GetPointData(), cols[others])
+        self.centers_mesh = centers
+        set_input(self._centers_actor, centers)
+
+    @staticmethod
+    def _write_cells(fill, line, shown_mask, tint, cols, verts) -> np.ndarray:
+        """The fill fans and outlines of the discs in ``shown_mask`` over the shared points
+        (disc i's ``verts[i]`` points from sum(verts[:i])); their vertex counts."""
+        start = np.concatenate([[0], np.cumsum(verts)])
+        shown = np.flatnonzero(shown_mask)
+        c, s0 = verts[shown], start[shown]
         # triangle fans, not c-gons: VTK would re-triangulate every polygon at each upload
         tri_disc = np.repeat(np.arange(len(shown)), c - 2)
         tri_start = np.concatenate([[0], np.cumsum(c - 2)])
         j = np.arange(len(tri_disc)) - tri_start[tri_disc] + 1
         o = s0[tri_disc]
-        self.fill_mesh.faces = np.column_stack([np.full(len(o), 3), o, o + j, o + j + 1]).ravel()
-        set_rgb(self.fill_mesh.GetCellData(), np.repeat(tint[others], c - 2, axis=0))
+        fill.faces = np.column_stack([np.full(len(o), 3), o, o + j, o + j + 1]).ravel()
+        set_rgb(fill.GetCellData(), np.repeat(tint[shown], c - 2, axis=0))
         # outlines: [c + 1, first, ..., last, first] per disc
         cell_start = np.concatenate([[0], np.cumsum(c + 2)])
         lines = np.empty(cell_start[-1], np.int64)
@@ -278,14 +306,11 @@ class FeaturesLayer:
         v_disc = np.repeat(np.arange(len(shown)), c)
         v_k = np.arange(len(v_disc)) - np.concatenate([[0], np.cumsum(c)])[v_disc]
         lines[cell_start[v_disc] + 1 + v_k] = s0[v_disc] + v_k
-        self.line_mesh.lines = lines
-        set_rgb(self.line_mesh.GetCellData(), cols[others])
-        self.fill_mesh.Modified()
-        self.line_mesh.Modified()
-        centers = pv.PolyData(np.column_stack([frame.x, frame.y, np.full(n, Z_POINT)])[others])
-        set_rgb(centers.GetPointData(), cols[others])
-        self.centers_mesh = centers
-        set_input(self._centers_actor, centers)
+        line.lines = lines
+        set_rgb(line.GetCellData(), cols[shown])
+        fill.Modified()
+        line.Modified()
+        return c
 
     def fill_rgb(self, i: int) -> np.ndarray:
         """The fill colour feature i is drawn in."""
