@@ -106,7 +106,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help=f"largest object size; default {DEFAULTS['g_max']:g}",
     )
     parser.add_argument(
-        "--workers", default=None, metavar="N", help="local worker processes; default one per core"
+        "--workers",
+        default=None,
+        metavar="N",
+        help="local worker processes; default one per usable CPU (affinity, cgroup quota)",
     )
     parser.add_argument(
         "--scheduler",

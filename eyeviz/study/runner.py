@@ -2,12 +2,13 @@
 
 The only module of :mod:`eyeviz.study` that imports dask, and only inside
 :func:`run_study` (``import eyeviz.study`` stays light). By default a LocalCluster with
-one worker *process* per core (``threads_per_worker=1``); ``scheduler="tcp://HOST:8786"``
-runs the same study on an existing cluster (``dask scheduler`` / ``dask worker``, or
-dask-jobqueue on an HPC machine). Workers receive the :class:`DesignPoint` (a few
-numbers), evaluate it (:func:`eyeviz.study.point.evaluate`) and return its rows; results
-stream back with ``as_completed`` and each finished point is appended to the table at
-once (atomically, :class:`~eyeviz.study.table.StudyTable`).
+one worker *process* per usable CPU (affinity and cgroup quota, ``threads_per_worker=1``);
+``scheduler="tcp://HOST:8786"`` runs the same study on an existing cluster
+(``dask scheduler`` / ``dask worker``, or dask-jobqueue on an HPC machine). Workers
+receive the :class:`DesignPoint` (a few numbers), evaluate it
+(:func:`eyeviz.study.point.evaluate`) and return its rows; results stream back with
+``as_completed`` and each finished point is appended to the table at once (whole points
+only, :class:`~eyeviz.study.table.StudyTable`).
 
 A worker that dies mid-study loses only the point it was computing: the scheduler
 reschedules it on another worker (``allowed-failures`` raised for the local cluster), and
@@ -372,7 +373,8 @@ def run_study(
 ) -> StudySummary:
     """Evaluate every design point not yet in the table at ``path``, on Dask.
 
-    ``workers``: local worker processes (default: one per core); ``scheduler``: the
+    ``workers``: local worker processes (default: one per usable CPU, affinity and cgroup
+    quota, :mod:`eyeviz.study.cpus`); ``scheduler``: the
     address of an existing Dask scheduler instead (then ``workers`` must be None).
     Points (planar or 3D, :mod:`eyeviz.study.kinds`) already in the table (same
     ``key``) are skipped; each finished point is appended atomically as it arrives.
