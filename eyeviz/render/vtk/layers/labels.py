@@ -96,7 +96,9 @@ class LabelsLayer:
         self.place_bfv_text()
 
     def build_features(self, frame: Frame) -> None:
-        """One name label per feature (the features' names or colours changed)."""
+        """One name label per feature (the features' names or colours changed); beyond
+        LABEL_ALL_MAX features only the selected one's is shown: ONE label, moved to it
+        (issue 25: 10^4 hidden text actors cost seconds to build and walk)."""
         self.feature_store.clear()
         self.feature_labels = []
         if "features" not in frame.layers:
@@ -104,6 +106,8 @@ class LabelsLayer:
         for lab in frame.labels:
             if lab.kind != "feature" or lab.feature is None:
                 continue
+            if self.feature_labels and frame.n > LABEL_ALL_MAX:
+                break
             label = vtkBillboardTextActor3D()
             tp = label.GetTextProperty()
             style_text(tp, 22, rgbf(frame.colors[lab.feature]))
@@ -116,6 +120,13 @@ class LabelsLayer:
         """Feature names at the Frame's anchors (all for a few features, else the selected)."""
         few = frame.n <= LABEL_ALL_MAX
         feats = [lab for lab in frame.labels if lab.kind == "feature"]
+        if not few:  # the one label: the selected feature's name, in its colour
+            feats = [lab for lab in feats if lab.feature == selected][:1]
+            for label in self.feature_labels[len(feats) :]:
+                label.SetVisibility(False)
+            if feats and self.feature_labels and selected is not None:
+                tp = self.feature_labels[0].GetTextProperty()
+                tp.SetColor(*rgbf(frame.colors[selected]))
         for label, lab in zip(self.feature_labels, feats, strict=False):
             shown = few or lab.feature == selected
             label.SetVisibility(shown)
