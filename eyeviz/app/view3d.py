@@ -24,6 +24,7 @@ Mouse and keys (also in Help > Keyboard shortcuts through the View menu):
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Generator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -71,6 +72,8 @@ HELP_TEXT = (
     "Camera presets: 0 default, 1 front, 2 top, 3 side, 4 along eye A's axis, "
     "5 along eye B's axis."
 )
+PANEL_SHARE = 0.25  # the docks take at most about this share of a drag's time
+PANEL_FRAMES = 3  # and follow it at most every third frame
 PANEL_MS = 200  # the docks follow a drag at <= 5 Hz (the Mollweide maps take ~75 ms at
 # nside 180); the drag's end refreshes them at once
 _MOD_DEPTH = QtCore.Qt.KeyboardModifier.ShiftModifier | QtCore.Qt.KeyboardModifier.ControlModifier
@@ -121,6 +124,7 @@ class Scene3DHost(QtCore.QObject):
         self._hidden: list[QtWidgets.QWidget] = []
         self._drag: Generator[None, m3.Pointer, None] | None = None
         self._dirty = False
+        self._panel_frames = 0  # drag frames drawn since the docks' last refresh
         self._frame_timer = QtCore.QTimer(self)
         self._frame_timer.setSingleShot(True)
         self._frame_timer.setInterval(0)
@@ -319,7 +323,10 @@ class Scene3DHost(QtCore.QObject):
             self._dirty = False
             self.actors.update(self.model.scene, self.model.state, self.model.selected)
             if not self._panel_timer.isActive():
-                self._panel_timer.start()
+                self._panel_frames += 1
+                if self._panel_frames >= PANEL_FRAMES:
+                    self._panel_frames = 0
+                    self._panel_timer.start()
 
     def draw(self) -> None:
         """Update and render now."""
@@ -333,12 +340,16 @@ class Scene3DHost(QtCore.QObject):
         m = self.model
         if m is None or not self.active:
             return
+        t0 = time.perf_counter()
         st = m.state
         if self.bitmaps is not None:
             self.bitmaps.set_state(st, m.scene)
         if self.readout is not None:
             self.readout.set_state(st, m.scene)
         self.win.statusBar().showMessage(self._status(), 0)
+        # the next refresh during a drag waits PANEL_MS, or longer after a slow one
+        took = 1e3 * (time.perf_counter() - t0)
+        self._panel_timer.setInterval(max(PANEL_MS, int(took * (1.0 - PANEL_SHARE) / PANEL_SHARE)))
 
     def _status(self) -> str:
         m = self.model

@@ -288,3 +288,27 @@ def test_cli_screenshot_of_a_spherical_scene(tmp_path):
     for color in ("#D55E00", "#0072B2", "#009E73"):
         rgb = np.array([int(color[k : k + 2], 16) for k in (1, 3, 5)])
         assert (np.abs(view - rgb).sum(axis=1) < 60).sum() > 20, color
+
+
+def test_the_docks_follow_a_drag_every_third_frame_at_most(make_window, qtbot, monkeypatch):
+    """The Mollweide maps cost ~75 ms at nside 180: during a drag they are refreshed at
+    most every third frame (and at the drag's end), however slow the frames."""
+    win = make_window(load(SCENES / "sphere_teaching.toml"))
+    host = win.host3d
+    host.set_preset("top")
+    calls = []
+    real = host.bitmaps.set_state
+    monkeypatch.setattr(host.bitmaps, "set_state", lambda *a: (calls.append(1), real(*a)))
+    p = host.view.mapFromGlobal(_pixel(win, 0))
+    w = host.view
+    frames0 = w.frames
+    QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, p)
+    for k in range(1, 13):
+        QTest.mouseMove(w, p + QtCore.QPoint(5 * k, 0))
+        qtbot.wait(250)  # longer than the docks' timer: only the frame count holds them
+    n_frames = w.frames - frames0
+    during = len(calls)
+    QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, p + QtCore.QPoint(60, 0))
+    assert n_frames >= 10
+    assert 1 <= during <= n_frames // 3 + 1
+    assert len(calls) > during  # the drag's end refreshes them at once
