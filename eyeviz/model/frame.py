@@ -43,6 +43,9 @@ Fields of :class:`Frame` (``None`` / empty when no layer needs them):
   None (the disc covers an eye centre)}.
 - ``posterior``: {feature index: :class:`eyeviz.model.posterior.Posterior` (the limit's
   posterior over centres, every g) or None (none: the prior cannot make the bitmaps)}.
+  Both cost ~6-9 ms a feature, so a Frame holds them for the first :data:`MAX_REGIONS`
+  features at most (the app asks for its selected feature only); ``regions_left_out``
+  counts the rest, which an exported figure notes ("… and N more without ...", issue 25).
 - ``trajectory``: :class:`TrajectoryPath` (points in the BFV and each estimator's accuracy)
   or None; ``trajectory_error``: why there is none.
 - ``labels``: :class:`LabelFrame` anchors (text, x, y, kind, feature) of the ``labels``
@@ -116,8 +119,13 @@ __all__ = [
     "view_rect",
     "EYE_LABEL_DROP",
     "FEATURE_LABEL_OFFSET",
+    "MAX_REGIONS",
     "WIDE_SECTOR",
 ]
+
+#: The most features whose ambiguity region and posterior one Frame computes (scene order;
+#: issue 25: a 10^4-feature scene would spend ~90 s on them; a figure draws 40 at most).
+MAX_REGIONS = 40
 
 # --- derived quantities (formerly eyeviz.model.derived) ----------------------------------
 
@@ -367,7 +375,9 @@ def build_ambiguity(fr: Frame, inp: FrameInputs) -> None:
     x0, x1, y0, y1 = inp.box
     w = x1 - x0
     box = (x0 - w, x1 + w, y0 - w, y1 + w)
-    for i, f in enumerate(inp.scene.features):
+    fs = inp.scene.features
+    fr.regions_left_out = max(fr.regions_left_out, len(fs) - MAX_REGIONS)
+    for i, f in enumerate(fs[:MAX_REGIONS]):
         fr.ambiguity[i] = ambiguity_of(inp.pair, f.x, f.y, f.g, box)
 
 
@@ -382,7 +392,8 @@ def build_posterior(fr: Frame, inp: FrameInputs) -> None:
     if st.LA is None or st.RA is None or st.LB is None or st.RB is None or not inp.teach:
         return
     dom = Domain.from_eyes(inp.pair)
-    for i in inp.teach:
+    fr.regions_left_out = max(fr.regions_left_out, len(inp.teach) - MAX_REGIONS)
+    for i in inp.teach[:MAX_REGIONS]:
         key = tuple(int(v[i]) for v in (st.LA, st.RA, st.LB, st.RB))
         try:
             p = posterior_for_key(key, dom)

@@ -299,6 +299,8 @@ class Frame:
     predictions: dict[str, PredictionFrame | str] = field(default_factory=dict)
     ambiguity: dict[int, dict | None] = field(default_factory=dict)
     posterior: dict[int, Posterior | None] = field(default_factory=dict)
+    #: features whose ambiguity region and posterior were left out (frame.MAX_REGIONS)
+    regions_left_out: int = 0
     trajectory: TrajectoryPath | None = None
     trajectory_error: str | None = None
     labels: list[LabelFrame] = field(default_factory=list)

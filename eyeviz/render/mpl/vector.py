@@ -27,7 +27,7 @@ from eyeviz.model.scene import Scene
 from eyeviz.model.state import SceneState
 from eyeviz.render.mpl.bounded import bound_figure
 from eyeviz.render.mpl.canvas import draw_notes, make_canvas
-from eyeviz.render.mpl.layout import ASPECT_RANGE, default_aspect, layout
+from eyeviz.render.mpl.layout import ASPECT_RANGE, default_aspect, layout, more_text
 from eyeviz.render.mpl.style import (
     BASE_DPI,
     MAX_WIDTH,
@@ -227,6 +227,9 @@ def figure(
         cv = make_canvas(scene, fr, lay0, dpi, merge, title)
         for spec in ordered("mpl", lay_names):  # the layer table, in its matplotlib order
             resolve(spec.mpl)(cv)
+        if fr.regions_left_out and {"ambiguity", "posterior"} & lay_names:
+            what = " or ".join(k for k in ("ambiguity", "posterior") if k in lay_names)
+            cv.notes.append(more_text(fr.regions_left_out, f"more without {what}"))
         draw_notes(cv)  # what the caps left out, counted
         raise_fonts(cv.fig, floor)
         bound_figure(cv.fig)  # nothing Agg/FreeType cannot raster in bounded time
