@@ -308,3 +308,31 @@ def test_cached_rows_are_answered_without_solving(monkeypatch):
     monkeypatch.undo()
     small.predict(ds.omega_a, ds.omega_b)
     assert len(small._cache) <= 64
+
+
+# keys of fresh paper-design rows (seed 31337) that no ray of the default 12 x 12 grid
+# reaches (slivers); the 4x grid finds each of them
+SLIVERS = [[63, 64, 63, 65], [63, 75, 63, 76], [64, 97, 66, 98], [157, 184, 161, 190],
+           [222, 226, 227, 229]]  # fmt: skip
+
+
+def test_slivers_are_found_and_impossible_keys_skip_the_4x_grid(monkeypatch):
+    """A key empty on the default grid goes to the 4x grid only when a ray of the 2x
+    grid reaches it: slivers keep their 4x-grid answer; an impossible key (g = 5 at
+    r = 3000) never pays the 4x grid's rays (before: the 12 and 48 grids, 14x a real
+    key batched; now the 12 and 24 grids)."""
+    from eyeviz.estimators import limit
+
+    keys = np.array(SLIVERS)
+    r, p, e = limit.limit_estimates(keys, PAPER_DOMAIN)
+    r48, p48, e48 = limit.limit_estimates(keys, PAPER_DOMAIN, "single", 48, 6)
+    assert not e.any() and not e48.any()
+    np.testing.assert_array_equal(r, r48)
+    np.testing.assert_array_equal(p, p48)
+    eyes = PAPER_DOMAIN.eyes
+    imp = np.stack(eyes.intervals(np.array([0.0]), np.array([3000.0]), np.array([5.0])), 1)
+    grids = []
+    real_rays = limit._rays
+    monkeypatch.setattr(limit, "_rays", lambda kk, d, n: grids.append(n) or real_rays(kk, d, n))
+    assert limit.limit_estimates(imp, PAPER_DOMAIN)[2].all()
+    assert grids == [12, 24]
