@@ -52,7 +52,7 @@ def test_matches_rejection_sampling(brute4):
     z = np.array(z)
     assert np.all(np.abs(z) < 4.0), z
     # no bias shared by the keys: the mean of 6 z-scores has sd 0.41 (a prior tilted by
-    # r^2 gives a mean of 2.5 here)
+    # r^2 gives a mean of 2.6 here)
     assert abs(z.mean()) < 1.5, z
 
 
