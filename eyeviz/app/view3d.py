@@ -73,8 +73,8 @@ HELP_TEXT = (
     "5 along eye B's axis."
 )
 PANEL_SHARE = 0.25  # the docks take at most about this share of a drag's time
-PANEL_FRAMES = 3  # and follow it at most every third frame
-PANEL_MS = 200  # the docks follow a drag at <= 5 Hz (the Mollweide maps take ~75 ms at
+PANEL_FRAMES = 4  # and follow it at most every fourth frame
+PANEL_MS = 250  # the docks follow a drag at <= 4 Hz (the Mollweide maps take 15-75 ms at
 # nside 180); the drag's end refreshes them at once
 _MOD_DEPTH = QtCore.Qt.KeyboardModifier.ShiftModifier | QtCore.Qt.KeyboardModifier.ControlModifier
 

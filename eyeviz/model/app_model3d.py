@@ -151,7 +151,8 @@ class AppModel3D:
         return self._state
 
     def _notify(self, what: str, index: int | None = None) -> None:
-        if what != "selection":
+        # a live move ("feature") has computed its state already (live())
+        if what not in ("selection", "feature"):
             self._state = None
         for fn in list(self.listeners):
             fn(what, index)

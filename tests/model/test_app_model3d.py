@@ -182,3 +182,15 @@ def test_lit_sets_beyond_the_view_bound_are_refused_and_nothing_moves(monkeypatc
     with pytest.raises(EyevizError, match="3D view draws at most"):
         m.commit(after, "Move a")
     assert not steps and m.scene.features[0].y == 300.0
+
+
+def test_a_live_move_computes_the_state_once(monkeypatch):
+    m, _ = _model()
+    calls = []
+    real = m3.compute_state3d
+    monkeypatch.setattr(m3, "compute_state3d", lambda sc: (calls.append(1), real(sc))[1])
+    m.begin_live("Move a")
+    m.live(0, x=-40.0)
+    st = m.state
+    assert len(calls) == 1 and st.x[0] == -40.0  # the listener's read is the live one's
+    m.end_live()
