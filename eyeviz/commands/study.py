@@ -86,7 +86,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         choices=("single", "multi"),
         help="Algorithm 1 prior of the test sets; default single",
     )
-    parser.add_argument("--seed", default="0", metavar="S", help="random seed; default 0")
+    parser.add_argument(
+        "--seed",
+        default=None,
+        metavar="S",
+        help="random seed; default: a resumed table's, else drawn afresh (and printed)",
+    )
     parser.add_argument(
         "--r-min",
         default=DEFAULTS["r_min"],
@@ -135,6 +140,37 @@ def _float(name: str, text) -> float:
     return check_real(name, text)
 
 
+def _seed(args: argparse.Namespace) -> int:
+    """``--seed`` as given; else the seed of the table being resumed (every row of a table
+    carries its point's seed, the key a resume matches); else a fresh one, printed (issue
+    25: a default of 0 gave every study the same test sets)."""
+    from eyeviz import EyevizError
+
+    if args.seed is not None:
+        return _int("seed", args.seed)
+    if args.nside is not None:
+        from eyeviz.study.table3d import StudyTable3D
+
+        keys, at = StudyTable3D.open(args.output).keys, -2  # (..., n, seed, estimator)
+    else:
+        from eyeviz.study.kinds import open_table
+
+        keys, at = open_table(args.output, []).keys, -1  # (..., n, seed); not a 3D table
+    seeds = sorted({int(k[at]) for k in keys})
+    if len(seeds) > 1:
+        raise EyevizError(
+            f"{args.output}: rows of seeds {', '.join(map(str, seeds[:5]))}: give --seed"
+        )
+    if seeds:
+        print(f"study: seed {seeds[0]} (the table's; resuming)", flush=True)
+        return seeds[0]
+    from eyeviz.commands._seeds import fresh_seed
+
+    seed = fresh_seed()
+    print(f"study: seed {seed} (drawn afresh; --seed {seed} repeats this study)", flush=True)
+    return seed
+
+
 def run(args: argparse.Namespace) -> int:
     import logging
 
@@ -144,7 +180,7 @@ def run(args: argparse.Namespace) -> int:
     from eyeviz.study.kinds import open_table
 
     r_min, r_max = _float("r_min", args.r_min), _float("r_max", args.r_max)
-    g_max, seed = _float("g_max", args.g_max), _int("seed", args.seed)
+    g_max, seed = _float("g_max", args.g_max), _seed(args)
     points: list = []
     if args.nside is not None:
         from eyeviz.core.domain3d import DEFAULT_EL_MAX
