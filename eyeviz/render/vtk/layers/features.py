@@ -210,8 +210,8 @@ class FeaturesLayer:
             geo = np.column_stack([frame.x, frame.y, frame.g])[others]
             verts, in_inset = self._levels(frame)
             verts[~others] = LOD_LEVELS[0]  # the selected disc is the live actors'
-            key = (sel, geo.tobytes(), tint.tobytes(), cols.tobytes(), verts.tobytes())
-            key += (in_inset.tobytes(),)
+            key: tuple = (sel, geo.tobytes(), tint.tobytes(), cols.tobytes())
+            key += (verts.tobytes(), in_inset.tobytes())
             if key != self._merged_key:  # not while only the selected feature moves
                 self._merged_key = key
                 self._write_merged(frame, others, tint, cols, verts)
