@@ -165,26 +165,26 @@ def _rays(keys: np.ndarray, domain: Domain, n: int) -> _Rays:
     cu, su = np.cos(phiA), np.sin(phiA)
     sd = np.sin(delta)
     # centre = (-h + rho cu, rho su), g = rho sd
-    lo = np.zeros_like(phiA)
-    hi = np.full_like(phiA, np.inf)
-
-    def lin(coef, rhs):  # coef * rho >= rhs
-        nonlocal lo, hi
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = rhs / coef
-        lo = np.where(coef > 0, np.maximum(lo, t), lo)
-        hi = np.where(coef < 0, np.minimum(hi, t), hi)
-        bad = (coef == 0) & (rhs > 0)
-        hi = np.where(bad, -np.inf, hi)
-
+    # the six linear constraints coef * rho >= rhs at once: eye B's four half-planes and
+    # the two BFV lines (Prop. 4: the disc lies left of the line at psi and right of the
+    # line at pi - psi)
     a, b, c = _b_halfplanes(domain, LB, RB)
+    sp, cp = math.sin(psi), math.cos(psi)
+    coef = np.empty((6, *phiA.shape))
+    rhs = np.empty((6, *phiA.shape))
     for i in range(4):
         ax, ay = a[:, i, 0:1], a[:, i, 1:2]
-        lin(ax * cu + ay * su + b[i] * sd, c[:, i : i + 1] + ax * h)
-    # BFV (Prop. 4): the disc lies left of the line at psi and right of the line at pi - psi
-    sp, cp = math.sin(psi), math.cos(psi)
-    lin(-sp * cu + cp * su - sd, -sp * h)
-    lin(sp * cu + cp * su - sd, sp * h)
+        coef[i] = ax * cu + ay * su + b[i] * sd
+        rhs[i] = c[:, i : i + 1] + ax * h
+    coef[4] = -sp * cu + cp * su - sd
+    rhs[4] = -sp * h
+    coef[5] = sp * cu + cp * su - sd
+    rhs[5] = sp * h
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = rhs / coef
+    lo = np.maximum(np.max(np.where(coef > 0, t, -np.inf), axis=0), 0.0)
+    hi = np.min(np.where(coef < 0, t, np.inf), axis=0)
+    hi = np.where(((coef == 0) & (rhs > 0)).any(axis=0), -np.inf, hi)
     hi = np.minimum(hi, np.where(sd > 0, domain.g_max / np.maximum(sd, 1e-300), np.inf))
     # r^2 = rho^2 + 2 rho (A.u) + h^2 with A.u = -h cu
     au = -h * cu
@@ -330,8 +330,13 @@ def limit_estimates(keys, domain: Domain, prior: str = "single", n: int = 12, k:
         nd = _nodes(rays, domain, prior, k)
         e = ~(nd.w.sum(axis=1) > 0)
         with np.errstate(divide="ignore", invalid="ignore"):
-            rr = weighted_median(nd.r, nd.w / np.where(nd.r > 0, nd.r, 1.0))
-            pp = weighted_median(nd.phi, nd.w / np.where(nd.phi > 0, nd.phi, 1.0))
+            wr = nd.w / np.where(nd.r > 0, nd.r, 1.0)
+            wp = nd.w / np.where(nd.phi > 0, nd.phi, 1.0)
+        if len(wr) <= 16:  # one call for both medians (rows are independent): less overhead
+            both = weighted_median(np.concatenate([nd.r, nd.phi]), np.concatenate([wr, wp]))
+            rr, pp = both[: len(wr)], both[len(wr) :]
+        else:
+            rr, pp = weighted_median(nd.r, wr), weighted_median(nd.phi, wp)
         idx = s0 + np.flatnonzero(live)
         r_out[idx] = np.where(e, np.nan, rr)
         p_out[idx] = np.where(e, np.nan, pp)
