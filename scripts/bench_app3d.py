@@ -8,17 +8,20 @@ degrees) it presses on a ball in the 3D view, sends >= 200 mouse-move events alo
 path and times each from the event to the end of the first frame that reflects it (the
 view coalesces moves: the model moves the ball at once, the lit sets are recomputed and
 one pending frame draws them; the clock stops when that VTK render has finished and the
-Qt panels are painted; the Mollweide and readout docks follow at <= 5 Hz, inside the
-timed frames). Right after each drag frame it times a bare re-render of the same window
+Qt panels are painted; the Mollweide and readout docks follow inside the timed
+frames). Right after each drag frame it times a bare re-render of the same window
 (the baseline, same run, same state): drag p50 and p95 are reported as ratios to the
 bare render's p50 and p95 (targets: p50 <= 1.5x, p95 <= 1.6x), beside the absolute
 figures.
 
-One run (2026-11-25, the shared 2-core machine, load ~4, llvmpipe): nside 16 drag p50
-41.5 ms / p95 95.2 ms against bare 34.2 / 75.8 ms (1.21x, 1.26x); nside 180 drag 72.4 /
-181.3 ms against bare 54.8 / 139.1 ms (1.32x, 1.30x); window up 1.67 s; 409 MB resident
-at nside 180 (peak 423 MB). With the docks at 10 Hz the nside 180 ratios were 1.45x and
-1.51x (the Mollweide maps' update takes ~75 ms there).
+Runs on 2026-11-25, the shared 2-core machine, llvmpipe (ratios from the same run):
+at load ~8, nside 16 drag p50 116.4 ms / p95 179.5 ms against bare 98.8 / 147.9 ms
+(1.18x, 1.21x), nside 180 124.1 / 209.1 ms against 97.6 / 164.6 ms (1.27x, 1.27x), window
+up 4.02 s; at load ~4, window up 1.56-1.67 s and frames of 30-45 ms (nside 16: 32.5 ms
+against 24.7 ms; nside 180: 42.4 against 31.5 ms); 404-413 MB resident at nside 180
+(peak 411-423 MB). The docks are refreshed at most every fourth drag frame and <= 4 Hz
+(the Mollweide maps' update takes 15-75 ms at nside 180; refreshed on every frame they
+made the nside 180 ratios 1.45-1.66x).
 
 Window-up: a whole process, start to the first rendered frame of sphere_paper.toml
 (nside 180), median of 3, target <= 3 s; the same process reports its resident memory
