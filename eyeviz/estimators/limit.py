@@ -355,7 +355,7 @@ def limit_estimates(keys, domain: Domain, prior: str = "single", n: int = 12, k:
 def _any_ray(keys: np.ndarray, domain: Domain, n: int) -> np.ndarray:
     """Per key: does any ray of the n x n grid have a feasible stretch (no nodes)."""
     out = np.zeros(len(keys), bool)
-    step = max(1, 200_000 // (n * n))
+    step = max(1, 40_000 // (n * n))  # ~40,000 rays a block: the six constraints in cache
     for s0 in range(0, len(keys), step):
         out[s0 : s0 + step] = _rays(keys[s0 : s0 + step], domain, n).ok.any(axis=1)
     return out
