@@ -78,27 +78,45 @@ class Prediction3D(tuple):
         return (self[0], self[1], self[2], self.valid, self.in_domain, self.flagged)
 
 
+#: indices per pass of the sortedness check (its temporaries stay in cache)
+_CHECK_BLOCK = 1 << 16
+
+
 def _check_indices(name: str, ptr: np.ndarray, ind: np.ndarray, npix: int) -> None:
+    """Range by min/max; sortedness by one difference pass in cache-sized blocks: every
+    step that does not rise must land on a row start (an ``indptr`` entry). No copy of
+    ``indices``."""
     if ind.size == 0:
         return
     lo, hi = int(ind.min()), int(ind.max())
     if lo < 0 or hi >= npix:
         bad = lo if lo < 0 else hi
         raise ValueError(f"{name}: indices must lie in [0, npix = {npix}), got {bad}")
-    step = np.diff(ind)
-    starts = ptr[1:-1]  # a new row may start lower
-    ok = step > 0
-    inner = starts[(starts > 0) & (starts < ind.size)] - 1
-    ok[inner] = True
-    if not ok.all():
-        raise ValueError(f"{name}: indices must increase strictly within a row")
+    m = ind.size - 1  # steps
+    if m == 0:
+        return
+    k = min(_CHECK_BLOCK, m)
+    step = np.empty(k, ind.dtype)  # in range, so no step overflows the dtype
+    down = np.empty(k, bool)
+    for s in range(0, m, _CHECK_BLOCK):
+        e = min(s + _CHECK_BLOCK, m)
+        np.subtract(ind[s + 1 : e + 1], ind[s:e], out=step[: e - s])
+        np.less_equal(step[: e - s], 0, out=down[: e - s])
+        at = np.flatnonzero(down[: e - s])
+        if at.size:
+            nxt = at + (s + 1)  # where the non-rising step lands
+            pos = np.searchsorted(ptr, nxt)
+            if not np.array_equal(ptr[np.minimum(pos, ptr.size - 1)], nxt):
+                raise ValueError(f"{name}: indices must increase strictly within a row")
 
 
 def as_csr(name: str, lit: Any, npix: int) -> tuple[np.ndarray, np.ndarray, bool]:
-    """(indptr int64, indices int64, single) from CSR rows ``(indptr, indices)`` or dense
+    """(indptr int64, indices, single) from CSR rows ``(indptr, indices)`` or dense
     bitmaps (npix,) / (N, npix); ``single`` is True for one 1-D bitmap. ValueError in one
     line naming ``name`` for anything else (wrong shape, non-binary values, indices out
-    of [0, npix) or not increasing within a row, an indptr that does not fit)."""
+    of [0, npix) or not increasing within a row, an indptr that does not fit). CSR
+    indices of int64, or of int32 when npix < 2^31, are returned as given (no copy); other
+    integer types, and dense bitmaps, as int64."""
     if isinstance(lit, tuple):
         if len(lit) != 2:
             raise ValueError(f"{name} must be (indptr, indices) or bitmaps, got a {len(lit)}-tuple")
@@ -113,7 +131,8 @@ def as_csr(name: str, lit: Any, npix: int) -> tuple[np.ndarray, np.ndarray, bool
             raise ValueError(
                 f"{name}: indptr must start at 0, not decrease and end at len(indices) = {ind.size}"
             )
-        ind = ind.astype(np.int64, copy=False)
+        if not (ind.dtype == np.int64 or (ind.dtype == np.int32 and npix < 2**31)):
+            ind = ind.astype(np.int64)
         _check_indices(name, ptr, ind, npix)
         return ptr, ind, False
     try:
