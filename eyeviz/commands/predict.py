@@ -14,6 +14,13 @@ not take (``--weights`` for analytic, ``--target`` for compact, ``--r-min`` for 
 fixed-design estimator) is refused, never ignored. ``-o`` may not be the input file
 (compared by device and inode, so links count).
 
+A sparse 3D data set (``eyeviz generate --nside``) takes an estimator of the spherical
+eyes (``analytic3d``, ``limit3d``, ``learned3d``; docs/spherical.md): it is read in blocks
+(:class:`eyeviz.dataset.sparse3d.Sparse3DReader`), its design comes from the file (no
+``--h --l --m --r-min --r-max --g-max``), and the CSV has ``r_hat,azimuth_hat,
+elevation_hat`` (radians). A planar estimator on 3D data, or a spherical one on planar
+data, is refused in one line.
+
 Exit status (also in ``--help``):
 
 - **0**: the output was written. Rows that are not a single feature (an eye with no lit
@@ -46,17 +53,22 @@ EXIT_UNANSWERED = 3
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from eyeviz.estimators import registry
 
-    names = registry.available()
+    names = registry.available(None)
     parser.epilog = EPILOG
     parser.add_argument("data", help="data set (.csv or .npz, as `eyeviz generate` writes)")
     parser.add_argument(
         "-e",
         "--estimator",
         default="compact",
-        help="; ".join(f"{e.name}: {e.help}" for e in registry.entries())
+        help="; ".join(f"{e.name}: {e.help}" for e in registry.entries(None))
         + f" (one of {', '.join(names)}; default compact)",
     )
-    parser.add_argument("-o", "--out", required=True, help="output CSV (r_hat,phi_hat)")
+    parser.add_argument(
+        "-o",
+        "--out",
+        required=True,
+        help="output CSV (r_hat,phi_hat; r_hat,azimuth_hat,elevation_hat for 3D data)",
+    )
     parser.add_argument(
         "--weights", default=None, help="weights directory/file instead of the shipped ones"
     )
@@ -65,7 +77,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     registry.add_options(g, registry.DOMAIN_OPTIONS)
     o = parser.add_argument_group("estimator options")
-    for e in registry.entries():
+    for e in registry.entries(None):
         registry.add_options(o, e.load_options)
 
 
@@ -123,7 +135,7 @@ def _refuse_foreign_options(entry, args, registry) -> None:
             f"(estimators with weights: {', '.join(_with_weights(registry))})"
         )
     own = {o.dest for o in entry.load_options}
-    for other in registry.entries():
+    for other in registry.entries(None):
         for opt in other.load_options:
             if opt.dest not in own and getattr(args, opt.dest, None) is not None:
                 flag = next((f for f in opt.flags if f.startswith("--")), opt.flags[0])
@@ -140,7 +152,7 @@ def _refuse_foreign_options(entry, args, registry) -> None:
 
 
 def _with_weights(registry) -> list[str]:
-    return [e.name for e in registry.entries() if e.weights_hint]
+    return [e.name for e in registry.entries(None) if e.weights_hint]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -161,6 +173,15 @@ def run(args: argparse.Namespace) -> int:
         raise EyevizError(f"output {args.out} is the input data file {args.data}; pick another -o")
     if not (out.parent if str(out.parent) else Path(".")).is_dir():
         raise EyevizError(f"output directory {out.parent} does not exist")
+    is3d = _is_3d(Path(args.data))
+    if is3d != (entry.kind == "spherical"):
+        which = "a sparse 3D" if is3d else "a planar"
+        raise EyevizError(
+            f"estimator {entry.name!r} is {entry.kind}, but {args.data} is {which} data set; "
+            f"use one of {', '.join(registry.available('spherical' if is3d else 'planar'))}"
+        )
+    if is3d:
+        return _run3d(args, entry, registry, out)
     reader, design = _reader(args, registry)
     kw = registry.options_from_args(entry.load_options, args)
     if args.weights is not None:
@@ -211,6 +232,90 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"eyeviz: warning: {out} written, but {args.estimator} gave no finite answer "
             f"for {unanswered} of {n - invalid} single-feature rows (nan there; exit "
+            f"{EXIT_UNANSWERED})",
+            file=sys.stderr,
+        )
+        return EXIT_UNANSWERED
+    return 0
+
+
+def _is_3d(path: Path) -> bool:
+    """Whether ``path`` is a sparse 3D data set (an NPZ with CSR lit sets); anything else
+    (a CSV, a planar NPZ, a file that is not a zip) is left to the planar reader."""
+    import zipfile
+
+    from eyeviz.dataset.io import format_of
+
+    try:
+        if format_of(path) != "npz":
+            return False
+        with zipfile.ZipFile(path) as zf:
+            return "indptr_a.npy" in zf.namelist()
+    except Exception:  # noqa: BLE001 - not a zip: the planar reader says what is wrong
+        return False
+
+
+def _run3d(args: argparse.Namespace, entry, registry, out: Path) -> int:
+    """``predict`` on a sparse 3D data set: r, azimuth, elevation per row, block by block."""
+    import numpy as np
+
+    from eyeviz import EyevizError
+    from eyeviz.dataset.sparse3d import Sparse3DReader
+    from eyeviz.estimators.metrics import RunningSummary
+    from eyeviz.files.atomic import atomic_output
+
+    if registry.domain_given(args):
+        raise EyevizError(
+            f"{args.data} is a 3D data set that carries its design (h, l, nside and ranges); "
+            "--h --l --m --r-min --r-max --g-max are for planar data"
+        )
+    reader = Sparse3DReader(args.data)
+    dom = reader.domain
+    kw = registry.options_from_args(entry.load_options, args)
+    if args.weights is not None:
+        kw["path"] = args.weights
+    if entry.any_design:
+        kw["domain"] = dom
+    est = entry.load_estimator(**kw)
+    if est.domain.design != dom.design:
+        raise EyevizError(
+            f"data set {args.data} has the eyes (h, l, nside) = {dom.design}, but estimator "
+            f"{entry.name!r} answers for {est.domain.design}"
+        )
+    n = invalid = unanswered = 0
+    sums = [RunningSummary() for _ in range(3)]
+    with atomic_output(out) as tmp, open(tmp, "w", encoding="ascii") as fh:
+        fh.write("r_hat,azimuth_hat,elevation_hat\n")
+        for b in reader:  # bounded memory: one block of rows at a time
+            pred = est.predict_dataset(b)
+            cols = [np.asarray(c, np.float64) for c in pred]
+            np.savetxt(fh, np.column_stack(cols), fmt="%.17g", delimiter=",")
+            valid = np.asarray(pred.valid)
+            answered = valid & np.isfinite(cols[0]) & np.isfinite(cols[1]) & np.isfinite(cols[2])
+            n += len(valid)
+            invalid += int((~valid).sum())
+            unanswered += int((valid & ~answered).sum())
+            for acc, true, got in zip(sums, (b.r, b.azimuth, b.elevation), cols, strict=True):
+                acc.update(true[answered], got[answered])
+    msg = f"{entry.name}: {n} rows -> {out}"
+    if invalid:
+        msg += f"; {invalid} with an eye that lit nothing (nan)"
+    print(msg, file=sys.stderr)
+    if sums[0].n >= 2:
+        try:
+            d, a, e = (acc.result() for acc in sums)
+        except ValueError:
+            pass
+        else:
+            print(
+                f"DD MAPE {d['mape']:.3f} %  MAE {d['mae']:.2f} | azimuth MAE "
+                f"{a['mae']:.3g} rad | elevation MAE {e['mae']:.3g} rad",
+                file=sys.stderr,
+            )
+    if unanswered:
+        print(
+            f"eyeviz: warning: {out} written, but {entry.name} gave no finite answer for "
+            f"{unanswered} of {n - invalid} rows where both eyes lit facets (nan there; exit "
             f"{EXIT_UNANSWERED})",
             file=sys.stderr,
         )

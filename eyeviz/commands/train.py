@@ -23,7 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from eyeviz.estimators import registry
 
     sub = parser.add_subparsers(dest="what", metavar="ESTIMATOR", required=True)
-    for e in registry.entries():
+    for e in registry.entries(None):  # planar and spherical (learned3d)
         if not e.learns:
             continue
         p = sub.add_parser(e.name, help=e.help, description=e.help)
@@ -32,7 +32,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                 "data",
                 nargs="?",
                 default=None,
-                help="training data (.csv or .npz from `eyeviz generate`); default: generate",
+                help=(
+                    "training data (a sparse 3D .npz from `eyeviz generate --nside`)"
+                    if e.kind == "spherical"
+                    else "training data (.csv or .npz from `eyeviz generate`)"
+                )
+                + "; default: generate",
             )
         out = p.add_mutually_exclusive_group()
         out.add_argument(

@@ -1,0 +1,113 @@
+"""``eyeviz train learned3d`` and ``eyeviz predict`` on the spherical eyes' sparse 3D data
+sets: training is reachable (a tiny run at nside 8), the CSV holds the estimator's own
+r, azimuth, elevation per row, and kind mismatches or bad options end in one line, exit
+2, nothing written."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from eyeviz import cli, dataset
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.dataset import sparse3d
+from eyeviz.estimators import learned3d, registry
+
+TINY = ["--nside", "8", "-n", "1100", "--n-val", "50", "--epochs", "1", "--hidden", "8"]
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory):
+    d = tmp_path_factory.mktemp("data3d")
+    sparse3d.write3d(d / "d8.npz", 120, Domain3D(nside=8), seed=11)
+    dataset.write(d / "planar.npz", 50, seed=2)
+    return d
+
+
+def _csv(path):
+    with open(path, encoding="ascii") as fh:
+        assert fh.readline() == "r_hat,azimuth_hat,elevation_hat\n"
+    return np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+
+
+def _one_line_refusal(capsys, rc, message):
+    err = capsys.readouterr().err
+    assert rc == 2, err
+    assert message in err and "Traceback" not in err, err
+    assert err.strip().splitlines()[-1].startswith("eyeviz: error:"), err
+
+
+@pytest.mark.parametrize("name", ["analytic3d", "limit3d"])
+def test_predict_writes_the_estimators_answers(tmp_path, capsys, data, name):
+    out = tmp_path / "p.csv"
+    rc = cli.main(["predict", "-e", name, str(data / "d8.npz"), "-o", str(out)])
+    assert rc == 0, capsys.readouterr().err
+    got = _csv(out)
+    ds = sparse3d.load3d(data / "d8.npz")
+    want = registry.load(name, domain=ds.domain).predict_dataset(ds)
+    assert got.shape == (len(ds), 3)
+    assert np.array_equal(got, np.column_stack(list(want)), equal_nan=True)
+
+
+def test_train_learned3d_then_predict_with_its_weights(tmp_path, capsys, data):
+    models = tmp_path / "m"
+    rc = cli.main(["train", "learned3d", *TINY, "--seed", "1", "-o", str(models)])
+    assert rc == 0, capsys.readouterr().err
+    est = learned3d.load(models)
+    assert est.domain.nside == 8 and est.hidden == 8
+    out = tmp_path / "p.csv"
+    argv = ["predict", "-e", "learned3d", "--weights", str(models), str(data / "d8.npz")]
+    rc = cli.main([*argv, "-o", str(out)])
+    assert rc == 0, capsys.readouterr().err
+    ds = sparse3d.load3d(data / "d8.npz")
+    want = np.column_stack(list(est.predict_dataset(ds)))
+    assert np.array_equal(_csv(out), want, equal_nan=True)
+
+
+def test_train_learned3d_takes_a_3d_data_file(tmp_path, capsys):
+    d8 = tmp_path / "train.npz"
+    sparse3d.write3d(d8, 1300, Domain3D(nside=8), seed=12)
+    models = tmp_path / "m"
+    argv = ["train", "learned3d", str(d8), "--nside", "8", "--epochs", "1", "--hidden", "4"]
+    rc = cli.main([*argv, "--seed", "2", "-o", str(models)])
+    assert rc == 0, capsys.readouterr().err
+    assert learned3d.load(models).hidden == 4
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--nside", "7"], "nside must be an even integer"),
+        (["--m", "30"], "--m must be a multiple of 4"),
+        (["--nside", "8", "--epochs", "0"], "epochs must be an integer >= 1"),
+    ],
+)
+def test_train_learned3d_refuses_bad_options(tmp_path, capsys, args, message):
+    rc = cli.main(["train", "learned3d", *args, "--seed", "1", "-o", str(tmp_path / "m")])
+    _one_line_refusal(capsys, rc, message)
+    assert not (tmp_path / "m").exists()
+
+
+@pytest.mark.parametrize(
+    "name, file, message",
+    [
+        ("compact", "d8.npz", "estimator 'compact' is planar, but"),
+        ("analytic", "d8.npz", "use one of analytic3d, learned3d, limit3d"),
+        ("analytic3d", "planar.npz", "estimator 'analytic3d' is spherical, but"),
+        ("learned3d", "d8.npz", "answers for (40.0, 20.0, 180)"),
+    ],
+)
+def test_predict_refuses_the_other_kind(tmp_path, capsys, data, name, file, message):
+    out = tmp_path / "p.csv"
+    rc = cli.main(["predict", "-e", name, str(data / file), "-o", str(out)])
+    _one_line_refusal(capsys, rc, message)
+    assert not out.exists()
+
+
+def test_predict_3d_refuses_design_flags(tmp_path, capsys, data):
+    out = tmp_path / "p.csv"
+    rc = cli.main(
+        ["predict", "-e", "analytic3d", "--h", "30", str(data / "d8.npz"), "-o", str(out)]
+    )
+    _one_line_refusal(capsys, rc, "carries its design")
+    assert not out.exists()
