@@ -1,0 +1,67 @@
+"""``base3d.as_csr`` on CSR rows: int32/int64 indices come back as given (no copy), other
+integer types as int64; the blocked sortedness check accepts a drop only at a row start
+(empty rows included) and refuses any other non-rising step, whatever block it falls in."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from eyeviz.estimators import base3d
+from eyeviz.estimators.base3d import as_csr
+
+NPIX = 768
+
+
+@pytest.mark.parametrize("dtype", [np.int32, np.int64])
+def test_indices_kept_without_a_copy(dtype):
+    ptr = np.array([0, 3, 3, 5])
+    ind = np.array([4, 9, 700, 1, 2], dtype)
+    p, i, single = as_csr("lit_a", (ptr, ind), NPIX)
+    assert i is ind and not single
+    assert p.dtype == np.int64 and np.array_equal(p, ptr)
+
+
+@pytest.mark.parametrize("dtype", [np.uint16, np.int16, np.uint32])
+def test_other_integer_types_become_int64(dtype):
+    ind = np.array([4, 9, 1], dtype)
+    _, i, _ = as_csr("lit_a", (np.array([0, 2, 3]), ind), NPIX)
+    assert i.dtype == np.int64 and np.array_equal(i, [4, 9, 1])
+
+
+@pytest.mark.parametrize(
+    "ptr, ind",
+    [
+        ([0, 2], [5, 5]),  # repeat within a row
+        ([0, 3], [5, 9, 6]),  # drop within a row
+        ([0, 1, 1, 3], [9, 7, 3]),  # drop inside the row after an empty one
+        ([0, 2, 2], [9, 3]),  # a drop at the end of a row (next row empty)
+    ],
+)
+def test_non_rising_step_inside_a_row_is_refused(ptr, ind):
+    for dtype in (np.int32, np.int64):
+        with pytest.raises(ValueError, match="lit_b: indices must increase strictly"):
+            as_csr("lit_b", (np.array(ptr), np.array(ind, dtype)), NPIX)
+
+
+def test_drops_across_blocks(monkeypatch):
+    monkeypatch.setattr(base3d, "_CHECK_BLOCK", 4)
+    rng = np.random.default_rng(3)
+    rows = [np.sort(rng.choice(NPIX, size=k, replace=False)) for k in (5, 0, 3, 7, 1, 0, 6)]
+    ptr = np.concatenate([[0], np.cumsum([r.size for r in rows])])
+    ind = np.concatenate(rows).astype(np.int32)
+    as_csr("lit_a", (ptr, ind), NPIX)  # every drop is at a row start
+    for j in range(1, ind.size):
+        if j in set(ptr.tolist()):
+            continue
+        bad = ind.copy()
+        bad[j] = bad[j - 1]
+        with pytest.raises(ValueError, match="increase strictly"):
+            as_csr("lit_a", (ptr, bad), NPIX)
+
+
+def test_range_checked_by_min_and_max():
+    with pytest.raises(ValueError, match=r"\[0, npix = 768\), got 768"):
+        as_csr("lit_a", (np.array([0, 2]), np.array([3, 768], np.int32)), NPIX)
+    with pytest.raises(ValueError, match="got -1"):
+        as_csr("lit_a", (np.array([0, 2]), np.array([-1, 3], np.int32)), NPIX)
