@@ -223,6 +223,12 @@ class StudyTable3D:
         if key in self.keys:
             raise EyevizError(f"design point {key} is already in {self.path} (a bug)")
         lines = self.lines + [format_row3d(r) for r in rows]
+        size = len(_HEADER) + 1 + sum(len(line.encode("utf-8")) + 1 for line in lines)
+        if size > MAX_STUDY_BYTES:  # never write a table the reader would refuse
+            raise EyevizError(
+                f"{self.path}: this point would make the 3D study table {size} bytes, more "
+                f"than the {MAX_STUDY_BYTES} its reader accepts; write the rest to another -o"
+            )
         with atomic_output(self.path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as f:
             f.write(_HEADER + "\n")
             for line in lines:

@@ -168,3 +168,20 @@ def test_the_3d_command_line_refuses_mixed_options_in_one_line(tmp_path):
         lines = out.stderr.strip().splitlines()
         assert len(lines) == 1 and words in lines[0], out.stderr
     assert os.listdir(tmp_path) == []
+
+
+def test_a_point_that_would_pass_the_readers_bound_is_refused_before_writing(tmp_path, monkeypatch):
+    from eyeviz.study import table3d
+    from eyeviz.study.point3d import evaluate3d
+
+    path = tmp_path / "s3.csv"
+    pts = design_grid3d("20", "10", "8,16", n=40)
+    t = StudyTable3D.open(path)
+    t.append(evaluate3d(pts[0]))
+    before = path.read_bytes()
+    monkeypatch.setattr(table3d, "MAX_STUDY_BYTES", len(before) + 100)
+    with pytest.raises(EyevizError, match="more than the .* its reader accepts") as err:
+        t.append(evaluate3d(pts[1]))
+    assert "\n" not in str(err.value)
+    assert path.read_bytes() == before
+    assert StudyTable3D.open(path).finished == {pts[0].key}
