@@ -17,7 +17,8 @@ import sys
 NAME = "study"
 HELP = (
     "the eye-design study: the information limit's distance and azimuth error over a "
-    "grid of (h, l, m), on Dask (local processes or an existing cluster); resumable"
+    "grid of (h, l, m), or with --nside the 3D study of the spherical eyes, on Dask (local "
+    "processes or an existing cluster); resumable"
 )
 
 
@@ -71,8 +72,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--estimator",
         default=None,
         metavar="NAME",
-        help="3D only: the estimator of the spherical eyes measured (the registry's: the "
-        "limit for the accuracy limit); default analytic3d",
+        help="3D only: the estimator of the spherical eyes measured (the registry's; "
+        "limit3d is the accuracy limit); default analytic3d",
     )
     parser.add_argument(
         "--n",
