@@ -51,6 +51,8 @@ def screenshot_on_xvfb(argv: list[str]) -> int | None:
         return None
     print("eyeviz: no display: rendering the window on a virtual one (xvfb-run)", file=sys.stderr)
     env = dict(os.environ, **{VIRTUAL_ENV_FLAG: "1"})
+    if env.get("VTK_DEFAULT_OPENGL_WINDOW") == "vtkEGLRenderWindow":
+        del env["VTK_DEFAULT_OPENGL_WINDOW"]  # set by eyeviz.render.vtk for no display
     if not env.get("XDG_RUNTIME_DIR"):  # else Qt warns on every start
         env["XDG_RUNTIME_DIR"] = tempfile.mkdtemp(prefix="eyeviz-xdg-")
     cmd = [xvfb, "-a", "-s", "-screen 0 1920x1080x24", sys.executable, "-m", "eyeviz", *argv]

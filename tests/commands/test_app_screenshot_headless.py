@@ -21,6 +21,7 @@ pytestmark = pytest.mark.slow
 
 def _headless_env(**extra: str) -> dict[str, str]:
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    env["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"  # as eyeviz.render.vtk sets it
     env.update(QT_API="pyqt5", **extra)
     return env
 
