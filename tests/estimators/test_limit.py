@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from eyeviz import dataset, estimators
-from eyeviz.estimators.base import PAPER_DOMAIN, Domain
+from eyeviz.estimators.base import PAPER_DOMAIN, Domain, bitmaps_to_intervals
 from eyeviz.estimators.limit import LimitEstimator, posterior_nodes, posterior_samples
 
 
@@ -308,6 +308,25 @@ def test_cached_rows_are_answered_without_solving(monkeypatch):
     monkeypatch.undo()
     small.predict(ds.omega_a, ds.omega_b)
     assert len(small._cache) <= 64
+
+
+def test_cached_lookup_of_shuffled_rows_matches_each_row():
+    """The cached path searches the rows' codes in sorted order and scatters the answers
+    back: a shuffled, duplicated batch gets each row's own answer, and ``hits`` counts
+    the distinct keys found."""
+    ds = dataset.generate(2000, seed=12)
+    est = LimitEstimator(cache_size=1 << 12)  # merged into the sorted arrays, none dropped
+    p1 = est.predict(ds.omega_a, ds.omega_b)
+    rng = np.random.default_rng(3)
+    idx = rng.integers(0, 2000, 5000)
+    hits = est.hits
+    p2 = est.predict(ds.omega_a[idx], ds.omega_b[idx])
+    np.testing.assert_array_equal(p2.r, p1.r[idx])
+    np.testing.assert_array_equal(p2.phi, p1.phi[idx])
+    np.testing.assert_array_equal(p2.flagged, p1.flagged[idx])
+    LA, RA, LB, RB, ok = bitmaps_to_intervals(ds.omega_a[idx], ds.omega_b[idx])
+    keys = np.stack([LA, RA, LB, RB], axis=1)[ok]
+    assert est.hits - hits == len(np.unique(keys, axis=0))  # each distinct key, once
 
 
 # keys of fresh paper-design rows (seed 31337) that no ray of the default 12 x 12 grid
