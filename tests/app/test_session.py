@@ -314,9 +314,11 @@ def test_estimators_load_off_the_gui_thread(make_window, monkeypatch):
     assert threads and all(t is not threading.main_thread() for t in threads)
 
 
-def test_a_feature_under_the_inset_is_drawn_and_the_inset_steps_aside(make_window):
+def test_a_feature_under_the_inset_is_drawn_and_the_inset_steps_aside(make_window, qtbot):
     """Issue 12 item 4: a feature dragged under the magnified inset was hidden by it."""
     win = make_window(load(ROOT / "assets" / "scenes" / "default.toml"))
+    qtbot.wait(200)  # deferred layout (docks, caption bar) settles before pixels are read
+    QtWidgets.QApplication.processEvents()
     assert win.inset_shown
     left, top, w, h = win._viewport_px("inset")
     start = pixel_of(win, *(lambda f: (f.x, f.y))(win.model.scene.features[0]))
