@@ -18,7 +18,6 @@ import os
 from pathlib import Path
 
 import numpy as np
-import pyvista as pv
 
 from eyeviz import EyevizError
 from eyeviz.core.validation import check_int
@@ -26,7 +25,7 @@ from eyeviz.model.camera3d import Camera3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
 from eyeviz.render.mpl.figure3d import export3d
-from eyeviz.render.vtk.scene3d import Scene3DActors, layout, make_renderers
+from eyeviz.render.vtk.scene3d import offscreen_view, shoot
 
 __all__ = ["MAX_VIEW_PX", "export_png3d", "view_rgba"]
 
@@ -87,23 +86,12 @@ def _render(
     sc = scene.copy()
     sc.layers = [k for k in sc.layers if k != "labels"]
     st = compute_state3d(sc) if state is None else state
-    pl = pv.Plotter(off_screen=True, window_size=[width, height], lighting="light kit")
+    pl, actors = offscreen_view(width, height)
     try:
-        ren_win = pl.ren_win
-        assert ren_win is not None
-        ren_win.SetMultiSamples(0)
-        main = pl.renderer
-        main.SetUseOIT(False)
-        main.SetUseDepthPeeling(False)
-        eyes = make_renderers(ren_win, main)
-        layout(main, eyes, width, height)
-        actors = Scene3DActors(main, eyes)
         actors.update(sc, st, selected)
         actors.title.SetVisibility(False)
         actors.eyes_caption.SetVisibility(False)
-        actors.set_cameras(camera)
-        main.camera.is_set = True  # else pyvista's first render resets it (an isometric fit)
-        img = np.asarray(pl.screenshot(return_img=True, transparent_background=transparent))
+        img = shoot(pl, actors, camera, transparent)
     finally:
         pl.close()
     if img.shape[:2] != (height, width):

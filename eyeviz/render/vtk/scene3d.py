@@ -469,6 +469,34 @@ def png_size(width_px: float, aspect: float | None = None) -> tuple[int, int]:
     return w, h
 
 
+def offscreen_view(width: int, height: int) -> tuple[pv.Plotter, Scene3DActors]:
+    """An off-screen plotter laid out as the app's 3D view (the scene, the eyes' close-up),
+    with no multisampling and no depth peeling, and its empty actors: what
+    :func:`render_png3d` and :mod:`eyeviz.render.vtk.png3d` render with. The caller
+    closes the plotter."""
+    pl = pv.Plotter(off_screen=True, window_size=[width, height], lighting="light kit")
+    try:
+        ren_win = pl.ren_win
+        assert ren_win is not None
+        ren_win.SetMultiSamples(0)
+        main = pl.renderer
+        main.SetUseOIT(False)
+        main.SetUseDepthPeeling(False)
+        eyes = make_renderers(ren_win, main)
+        layout(main, eyes, width, height)
+        return pl, Scene3DActors(main, eyes)
+    except BaseException:
+        pl.close()
+        raise
+
+
+def shoot(pl: pv.Plotter, actors: Scene3DActors, camera: Camera3D, transparent: bool) -> np.ndarray:
+    """Render ``pl`` (from :func:`offscreen_view`) through ``camera`` and return its pixels."""
+    actors.set_cameras(camera)
+    pl.renderer.camera.is_set = True  # else pyvista's first render resets it (an isometric fit)
+    return np.asarray(pl.screenshot(return_img=True, transparent_background=transparent))
+
+
 def render_png3d(
     scene: Scene,
     path: str | os.PathLike,
@@ -494,24 +522,13 @@ def render_png3d(
     if not (target.parent if str(target.parent) else Path(".")).is_dir():
         raise EyevizError(f"{target}: directory {target.parent} does not exist")
     st = compute_state3d(scene) if state is None else state
-    pl = pv.Plotter(off_screen=True, window_size=[width, height], lighting="light kit")
+    pl, actors = offscreen_view(width, height)
     try:
-        ren_win = pl.ren_win
-        assert ren_win is not None
-        ren_win.SetMultiSamples(0)
-        main = pl.renderer
-        main.SetUseOIT(False)
-        main.SetUseDepthPeeling(False)
-        eyes = make_renderers(ren_win, main)
-        layout(main, eyes, width, height)
-        actors = Scene3DActors(main, eyes)
         actors.update(scene, st, selected)
         if camera is None:
             left, _ = split_viewports(width, height)
             camera = default_camera(st, aspect=(1.0 - left[2]) * width / height)
-        actors.set_cameras(camera)
-        main.camera.is_set = True  # else pyvista's first render resets it (an isometric fit)
-        img = pl.screenshot(return_img=True, transparent_background=transparent)
+        img = shoot(pl, actors, camera, transparent)
     finally:
         pl.close()
     from PIL import Image
