@@ -17,6 +17,7 @@ from collections.abc import Callable, Generator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from eyeviz.model.edits import feature_value
 from eyeviz.model.player import TrajectoryPlayer
 from eyeviz.model.scene import OKABE_ITO, Feature, Scene, View
 from eyeviz.model.state import SceneState, compute_state, update_state
@@ -48,16 +49,6 @@ class MouseEvent:
     y: float
     px: float
     py: float
-
-
-def _number(key: str, value) -> float:
-    """A feature's x, y or g as a float; refused (not clamped) when not finite, g when <= 0."""
-    v = float(value)
-    if not math.isfinite(v):
-        raise ValueError(f"{key} must be finite, got {v!r}")
-    if key == "g" and v <= 0:
-        raise ValueError(f"g (feature radius) must be > 0, got {v!r}")
-    return v
 
 
 class AppModel:
@@ -217,7 +208,7 @@ class AppModel:
         bad = set(values) - {"x", "y", "g"}
         if bad:
             raise ValueError(f"live() changes x, y or g only, got {', '.join(sorted(bad))}")
-        checked = {k: _number(k, v) for k, v in values.items()}  # refused before any change
+        checked = {k: feature_value(k, v) for k, v in values.items()}  # refused before any change
         f = self.scene.features[index]
         for k, v in checked.items():
             setattr(f, k, v)
@@ -248,7 +239,7 @@ class AppModel:
                 if any(o.name == v for j, o in enumerate(after.features) if j != index):
                     raise ValueError(f"another feature is already named {v!r}")
             else:
-                v = _number(k, v)
+                v = feature_value(k, v)
             setattr(f, k, v)
         self.commit(after, f"Edit {f.name}")
 

@@ -29,6 +29,7 @@ import numpy as np
 
 from eyeviz import EyevizError
 from eyeviz.model.camera3d import Camera3D, basis
+from eyeviz.model.edits import feature_value
 from eyeviz.model.scene import OKABE_ITO, Feature, Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
 
@@ -122,15 +123,6 @@ class _Live:
     text: str
 
 
-def _finite(key: str, v: float) -> float:
-    v = float(v)
-    if not math.isfinite(v):
-        raise ValueError(f"{key} must be finite, got {v!r}")
-    if key == "g" and v <= 0:
-        raise ValueError(f"g (ball radius) must be > 0, got {v!r}")
-    return v
-
-
 class AppModel3D:
     """The open spherical scene plus the selection; notifies listeners ``fn(what, index)``
     ("scene", "feature" (a live move of ball ``index``), "selection")."""
@@ -206,7 +198,7 @@ class AppModel3D:
         bad = set(values) - {"x", "y", "z", "g"}
         if bad:
             raise ValueError(f"live() changes x, y, z or g only, got {', '.join(sorted(bad))}")
-        checked = {k: _finite(k, v) for k, v in values.items()}
+        checked = {k: feature_value(k, v, "ball radius") for k, v in values.items()}
         f = self.scene.features[index]
         old = {k: getattr(f, k) for k in checked}
         for k, v in checked.items():
@@ -238,7 +230,9 @@ class AppModel3D:
         """Put ball ``index`` at ``centre`` (x, y, z) as one undo step."""
         after = self.scene.copy()
         f = after.features[index]
-        f.x, f.y, f.z = (_finite(k, v) for k, v in zip("xyz", centre, strict=True))
+        f.x, f.y, f.z = (
+            feature_value(k, v, "ball radius") for k, v in zip("xyz", centre, strict=True)
+        )
         self.commit(after, text, merge_key)
 
     def _name(self, base: str) -> str:
