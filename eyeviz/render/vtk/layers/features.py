@@ -13,6 +13,13 @@ at the largest zoom of a view it is in (main or inset). The levels follow the ca
 inset draws its own cells over the same points: only the discs that meet its rectangle
 (none while it is hidden), as a disc far from the eyes cost the inset as much as the main
 view in software GL.
+
+Backdrop (issue 25): from :data:`BACKDROP_MIN_FEATURES` features on, the main view's
+merged discs are drawn by a :class:`eyeviz.render.vtk.backdrop.Backdrop` before the main
+renderer's other props, and kept (colour and depth) while the discs and the camera are
+unchanged: a drag frame, which moves only the selected feature (the live actors), then
+copies the kept buffers instead of filling 10^4 discs again. Smaller scenes keep the discs
+in the main renderer (the backdrop's copy costs more than it saves there).
 """
 
 from __future__ import annotations
@@ -24,6 +31,7 @@ from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonMath import vtkMatrix4x4
 
 from eyeviz.model.frame import Frame
+from eyeviz.render.vtk.backdrop import Backdrop
 from eyeviz.render.vtk.primitives import (
     CIRCLE_N,
     Store,
@@ -46,12 +54,21 @@ from eyeviz.render.vtk.style import (
     rgbf,
 )
 
-__all__ = ["LOD_ERROR_PX", "LOD_LEVELS", "FeaturesLayer", "disc_vertices"]
+__all__ = [
+    "BACKDROP_MIN_FEATURES",
+    "LOD_ERROR_PX",
+    "LOD_LEVELS",
+    "FeaturesLayer",
+    "disc_vertices",
+]
 
 #: Vertex counts a merged disc may have (few levels: a zoom step seldom rebuilds).
 LOD_LEVELS = np.array([8, 12, 16, 24, 32, 48, 64, 96, 128, CIRCLE_N])
 #: Largest gap, in pixels, between a disc's circle and its inscribed polygon.
 LOD_ERROR_PX = 0.5
+#: Features from which the main view's merged discs go to the backdrop (the crossover
+#: measured by scripts/bench_app_scale.py --crossover).
+BACKDROP_MIN_FEATURES = 1000
 
 
 def disc_vertices(r_px: np.ndarray) -> np.ndarray:
@@ -73,6 +90,8 @@ class FeaturesLayer:
         # (Z_FEAT above Z_EYES), not cut off at the eye (issue 24)
         self.inset = inset
         self.store = Store()
+        self.backdrop = Backdrop(main)
+        self.backdrop_min = BACKDROP_MIN_FEATURES  # features from which it holds the discs
         self._key: tuple | None = None
         self.fill_mesh: pv.PolyData | None = None
         self.line_mesh: pv.PolyData | None = None
@@ -144,8 +163,9 @@ class FeaturesLayer:
         self.line_mesh = pv.PolyData()
         self.inset_fill = pv.PolyData()  # the inset's cells: the discs it shows
         self.inset_line = pv.PolyData()
+        main = self.backdrop if n >= self.backdrop_min else self.main
         for ren, fill, line in (
-            (self.main, self.fill_mesh, self.line_mesh),
+            (main, self.fill_mesh, self.line_mesh),
             (self.inset, self.inset_fill, self.inset_line),
         ):
             if ren is not None:
@@ -161,7 +181,14 @@ class FeaturesLayer:
         mapper.SelectColorArray("rgb")
         mapper.SetColorModeToDirectScalars()
         mapper.ScalarVisibilityOn()
-        self.store.add(self.main, self._centers_actor)
+        self.store.add(main, self._centers_actor)
+
+    def set_backdrop_min(self, n: int) -> None:
+        """Features from which the merged discs go to the backdrop; the discs are rebuilt."""
+        self.backdrop_min = n
+        self._key = None
+        if self._last is not None:
+            self.draw(*self._last)
 
     def refit(self) -> None:
         """The cameras changed (zoom): the discs' levels of detail follow."""
