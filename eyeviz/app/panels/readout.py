@@ -1,5 +1,10 @@
 """The readout panel: the selected feature's values, each estimator's answer and the
-ambiguity range, in plain-text rows that repaint only themselves."""
+ambiguity range, in plain-text rows that repaint only themselves.
+
+Compact enough to show whole, unscrolled, in the side column of a 1280x720 window with the
+predictions and the ambiguity layers on (two estimators): the feature's radius g sits on
+the title line, "in BFV" shares the visibility row, and rows are 1 px apart.
+"""
 
 from __future__ import annotations
 
@@ -19,6 +24,8 @@ def f_g(scene: Scene, i: int) -> float:
 
 GOOD, BAD, GREY = "#1b7837", "#b00020", "#777777"
 READOUT_MIN_WIDTH = 420
+PRED_LINES = 2  # an estimator's answer: r and its error, phi and its error
+ROW_GAP_PX = 1  # between rows (3 px before: the last row did not fit at 1280x720)
 
 
 class ValueText(QtWidgets.QWidget):
@@ -33,13 +40,16 @@ class ValueText(QtWidgets.QWidget):
         super().__init__(parent)
         self._text = ""
         self._lines = 1
+        self.min_lines = 1  # the height kept however few lines the text has
         self._color = QtGui.QColor("#1e1e1e")
+        self._align = QtCore.Qt.AlignmentFlag.AlignLeft
         self.setAutoFillBackground(True)  # opaque: its repaint does not repaint the dock
         self.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Fixed)
         self.setFixedHeight(self._height(1))
 
     def _height(self, lines: int) -> int:
-        return self.fontMetrics().lineSpacing() * lines + 2
+        # the last line needs the font's height, a pixel more than its line spacing
+        return self.fontMetrics().lineSpacing() * lines + 1
 
     def text(self) -> str:
         return self._text
@@ -48,7 +58,7 @@ class ValueText(QtWidgets.QWidget):
         if text == self._text:
             return
         self._text = text
-        lines = text.count("\n") + 1
+        lines = max(text.count("\n") + 1, self.min_lines)
         if lines != self._lines:
             self._lines = lines
             self.setFixedHeight(self._height(lines))  # a layout only when the shape changes
@@ -64,13 +74,18 @@ class ValueText(QtWidgets.QWidget):
         self._color = QtGui.QColor(color)
         self.update()
 
+    def set_alignment(self, align: QtCore.Qt.AlignmentFlag) -> None:
+        """Left (the default) or right: where each line is painted."""
+        self._align = align
+        self.update()
+
     def sizeHint(self) -> QtCore.QSize:  # noqa: N802 (Qt name)
         return QtCore.QSize(120, self._height(self._lines))
 
     def paintEvent(self, event) -> None:  # noqa: N802 (Qt name)
         p = QtGui.QPainter(self)
         p.setPen(self._color)
-        flags = QtCore.Qt.AlignmentFlag.AlignLeft | QtCore.Qt.AlignmentFlag.AlignTop
+        flags = self._align | QtCore.Qt.AlignmentFlag.AlignTop
         fm = self.fontMetrics()
         y = 0
         for line in self._text.split("\n"):
@@ -84,9 +99,10 @@ class ValueText(QtWidgets.QWidget):
 
 
 class ReadoutPanel(QtWidgets.QWidget):
-    """The selected feature: r, phi, r_A, phi_A, r_B, phi_B, BFV, visibility, overlap; with
-    the predictions layer each estimator's answer and errors, with the ambiguity layer the
-    range of centres and radii giving the same bitmaps.
+    """The selected feature: its name and radius g on the title line, then r, phi, r_A,
+    phi_A, r_B, phi_B, visibility and BFV, overlap; with the predictions layer each
+    estimator's answer and errors, with the ambiguity layer the range of centres and radii
+    giving the same bitmaps.
 
     A grid of plain-text labels, each re-set only when its text changes: a rich-text
     QLabel re-laid out on every drag event cost ~5 ms a frame.
@@ -99,16 +115,25 @@ class ReadoutPanel(QtWidgets.QWidget):
         self.installEventFilter(self._unelide)
         self.texts: dict[str, str] = {}  # row key -> value text (what tests read)
         lay = QtWidgets.QVBoxLayout(self)
-        lay.setContentsMargins(8, 8, 8, 8)
+        lay.setContentsMargins(8, 4, 8, 4)
+        lay.setSpacing(ROW_GAP_PX + 1)
         self.title = QtWidgets.QLabel("")
         font = self.title.font()
         font.setPointSize(17)
         font.setBold(True)
         self.title.setFont(font)
-        lay.addWidget(self.title)
+        # the radius on the title line, right-aligned: a row fewer (a ValueText: a drag
+        # resizing the feature repaints it alone)
+        self.size_text = ValueText()
+        self.size_text.set_alignment(QtCore.Qt.AlignmentFlag.AlignRight)
+        head = QtWidgets.QHBoxLayout()
+        head.setSpacing(14)
+        head.addWidget(self.title, 3)
+        head.addWidget(self.size_text, 2, QtCore.Qt.AlignmentFlag.AlignBottom)
+        lay.addLayout(head)
         self.grid = QtWidgets.QGridLayout()
         self.grid.setHorizontalSpacing(14)
-        self.grid.setVerticalSpacing(3)
+        self.grid.setVerticalSpacing(ROW_GAP_PX)
         self.grid.setColumnStretch(0, 0)
         self.grid.setColumnStretch(1, 1)
         lay.addLayout(self.grid)
@@ -133,13 +158,20 @@ class ReadoutPanel(QtWidgets.QWidget):
             self._rows.append((key, val))
         return self._rows[k]
 
-    def _set(self, rows: list[tuple[str, str, str, str]]) -> None:
-        """rows of (id, key html, value text, value colour)."""
+    def _set(self, rows: list[tuple[str, str, str, str]], size: str = "") -> None:
+        """rows of (id, key html, value text, value colour); ``size`` the title line's
+        radius text (kept in ``texts`` as "g" when shown)."""
+        self.size_text.setText(size)
         self.texts = {rid: text for rid, _, text, _ in rows}
+        if size:
+            self.texts["g"] = size
         for k, row in enumerate(rows):
             if self._cache.get(k) == row:
                 continue
             key, val = self._row(k)
+            # an estimator's row keeps its two lines while it loads or fails: the height
+            # the dock was laid out for when the window opened (loading) is its final one
+            val.min_lines = PRED_LINES if row[0].startswith("pred:") else 1
             old = self._cache.get(k)
             _, key_html, text, color = row
             if old is None or old[1] != key_html:
@@ -196,13 +228,13 @@ class ReadoutPanel(QtWidgets.QWidget):
         ovl, ovl_c = pair(st.overlap_a[i], st.overlap_b[i], False)
         if st.overlap_a[i] or st.overlap_b[i]:  # a warning, not a grey value (issue 24)
             ovl, ovl_c = f"⚠ {ovl}: inside an eye", BAD
-        bfv, bfv_c = yes(st.in_bfv[i])
+        bfv = "in BFV" if st.in_bfv[i] else "not in BFV"
+        bfv_c = GOOD if st.in_bfv[i] else BAD
+        vis, vis_c = f"{vis}, {bfv}", (vis_c if vis_c == bfv_c else "#444444")
         rows = [
             ("r", "r, φ", f"{st.r[i]:.1f}, {st.phi[i] * deg:.2f}°", ink),
             ("rA", "r<sub>A</sub>, φ<sub>A</sub>", f"{st.rA[i]:.1f}, {st.phiA[i] * deg:.2f}°", ink),
             ("rB", "r<sub>B</sub>, φ<sub>B</sub>", f"{st.rB[i]:.1f}, {st.phiB[i] * deg:.2f}°", ink),
-            ("g", "g", f"{f.g:g}", ink),
-            ("bfv", "in BFV", bfv, bfv_c),
             ("visible", "visible A / B", vis, vis_c),
             ("overlap", "overlaps A / B", ovl, ovl_c),
         ]
@@ -215,7 +247,7 @@ class ReadoutPanel(QtWidgets.QWidget):
 
             text = readout(sc.eyes.pair(), f.x, f.y, f.g)
             rows.append(("posterior", "posterior", text, GREY if text[:5] == "none:" else ink))
-        self._set(rows)
+        self._set(rows, f"g = {f.g:g}")
 
     def _prediction_rows(self, i: int) -> list[tuple[str, str, str, str]]:
         from eyeviz.model.frame_parts import errors
