@@ -7,7 +7,8 @@ one (docs/architecture.md): Qt events -> :mod:`eyeviz.model.app_model3d` (a drag
 generator, one undo step on the window's stack) -> ``compute_state3d`` ->
 :class:`eyeviz.render.vtk.scene3d.Scene3DActors` and the docks.
 
-Mouse and keys (also in Help > Keyboard shortcuts through the View menu):
+Mouse and keys (3D view > Mouse and keys and Help > Keyboard shortcuts are both written
+from one list, eyeviz.app.help.VIEW3D_KEYS):
 
 - standard VTK camera interaction (trackball): left-drag on the background turns the
   view, middle-drag (or Shift+left on the background) pans, the wheel or right-drag
@@ -31,9 +32,19 @@ from typing import TYPE_CHECKING, Any
 
 from PyQt5 import QtCore, QtWidgets
 
+from eyeviz.app.help import view3d_help_text
 from eyeviz.app.view import make_view
 from eyeviz.model import app_model3d as m3
 from eyeviz.model.camera3d import PRESETS, Camera3D
+from eyeviz.model.predictions3d import (
+    LIMIT,
+    LatestOnly,
+    Predictions3D,
+    Predictor3D,
+    ball_key,
+    domain_of,
+    scene_predictions3d,
+)
 from eyeviz.model.scene import SPHERICAL_LAYERS, Scene
 from eyeviz.render.vtk.scene3d import (
     Scene3DActors,
@@ -46,6 +57,7 @@ from eyeviz.render.vtk.scene3d import (
 
 if TYPE_CHECKING:
     from eyeviz.app.panels.bitmaps3d import Bitmaps3DPanel
+    from eyeviz.app.panels.estimators3d import Estimators3DPanel
     from eyeviz.app.panels.readout3d import Readout3DPanel
     from eyeviz.app.view import _Frames
 
@@ -59,18 +71,6 @@ PRESET_KEYS = (
     ("side", "&Side", "3"),
     ("eye_a", "Along eye &A's axis", "4"),
     ("eye_b", "Along eye &B's axis", "5"),
-)
-HELP_TEXT = (
-    "Left-drag on the background: turn the view. Middle-drag (or Shift+left-drag on the "
-    "background): pan. Wheel or right-drag: zoom. The eyes' close-up (left) looks from "
-    "the same direction.\n\n"
-    "Left-drag a ball: move it in the plane through its centre facing you. "
-    "Shift+ or Ctrl+left-drag a ball: move it along the line of sight (up: farther). "
-    "A drag is one undo step (Ctrl+Z).\n\n"
-    "With the view focused: arrow keys nudge the selected ball across the screen, "
-    "Shift+Up / Shift+Down move it farther / nearer; Tab selects the next ball.\n\n"
-    "Camera presets: 0 default, 1 front, 2 top, 3 side, 4 along eye A's axis, "
-    "5 along eye B's axis."
 )
 PANEL_SHARE = 0.25  # the docks take at most about this share of a drag's time
 PANEL_FRAMES = 4  # and follow it at most every fourth frame
@@ -120,6 +120,13 @@ class Scene3DHost(QtCore.QObject):
         self.actors: Scene3DActors | None = None
         self.bitmaps: Bitmaps3DPanel | None = None
         self.readout: Readout3DPanel | None = None
+        self.estimators: Estimators3DPanel | None = None
+        # the predictions layer (eyeviz.model.predictions3d): the fast estimators answer
+        # on every frame; the limit on the window's job runner after a drag, latest only
+        self.predictor3d: Predictor3D | None = None
+        self.preds: Predictions3D | None = None
+        self.latest = LatestOnly()
+        self.limit_jobs = 0  # limit jobs started (tests)
         self.docks: dict[str, QtWidgets.QDockWidget] = {}
         self._hidden: list[QtWidgets.QWidget] = []
         self._drag: Generator[None, m3.Pointer, None] | None = None
@@ -166,12 +173,17 @@ class Scene3DHost(QtCore.QObject):
         self.split.setStretchFactor(self.split.indexOf(view), 1)
         # imported with the page: matplotlib's Qt canvas costs a planar window ~1 s
         from eyeviz.app.panels.bitmaps3d import Bitmaps3DPanel
+        from eyeviz.app.panels.estimators3d import Estimators3DPanel
         from eyeviz.app.panels.readout3d import Readout3DPanel
 
         self.bitmaps = Bitmaps3DPanel()
         self.readout = Readout3DPanel()
+        self.estimators = Estimators3DPanel(self._set_estimators)
         self.docks["bitmaps3d"] = self._dock("Facets (Mollweide)", self.bitmaps, "bitmaps3d")
         self.docks["readout3d"] = self._dock("Balls (3D readout)", self.readout, "readout3d")
+        # as the planar window's: a tab beside the readout, greyed until the layer is on
+        self.docks["estimators3d"] = self._dock("Estimators", self.estimators, "estimators3d")
+        self.win.tabifyDockWidget(self.docks["readout3d"], self.docks["estimators3d"])
 
     def _dock(self, title: str, widget: QtWidgets.QWidget, name: str) -> QtWidgets.QDockWidget:
         d = QtWidgets.QDockWidget(title, self.win)
@@ -214,7 +226,10 @@ class Scene3DHost(QtCore.QObject):
     def show_help(self) -> QtWidgets.QMessageBox:
         """3D view > Mouse and keys: how to turn the view and move the balls."""
         box = QtWidgets.QMessageBox(
-            QtWidgets.QMessageBox.Information, "The 3D view", HELP_TEXT, parent=self.win
+            QtWidgets.QMessageBox.Information,
+            "The 3D view",
+            view3d_help_text(PRESET_KEYS),
+            parent=self.win,
         )
         box.setObjectName("help3d")
         box.open()
@@ -229,6 +244,13 @@ class Scene3DHost(QtCore.QObject):
     def _set_layer(self, layer: str, on: bool) -> None:
         if self.model is not None:
             self.model.set_layer(layer, bool(on))
+
+    def _set_estimators(self, names: list[str]) -> None:
+        """The Estimators dock: the scene's ``[predictions] estimators`` (one undo step)."""
+        if self.model is not None and names != self.model.scene.estimators:
+            after = self.model.scene.copy()
+            after.estimators = list(names)
+            self.model.commit(after, "Choose estimators")
 
     # --- swapping ------------------------------------------------------------------------
     def check(self, scene: Scene) -> bool:
@@ -280,6 +302,7 @@ class Scene3DHost(QtCore.QObject):
             self.view.show()
             for d in self.docks.values():
                 d.show()
+            self.docks["readout3d"].raise_()
             self.view.setFocus()
         else:
             self.view.hide()
@@ -322,11 +345,77 @@ class Scene3DHost(QtCore.QObject):
         if self._dirty and self.model is not None and self.actors is not None:
             self._dirty = False
             self.actors.update(self.model.scene, self.model.state, self.model.selected)
+            self._predictions()
             if not self._panel_timer.isActive():
                 self._panel_frames += 1
                 if self._panel_frames >= PANEL_FRAMES:
                     self._panel_frames = 0
                     self._panel_timer.start()
+
+    # --- the predictions layer -----------------------------------------------------------
+    def _predictions(self) -> None:
+        """The layer's content for the selected ball: the fast estimators now, the limit
+        from the cache, or a job for it when no drag is open (latest key only)."""
+        m, actors = self.model, self.actors
+        assert m is not None and actors is not None
+        if not m.scene.shows("predictions"):
+            self.preds = None
+            self.latest.want(None)
+            actors.draw_predictions(None)
+            return
+        if self.predictor3d is None:
+            self.predictor3d = Predictor3D()
+        dragging = m.live_open
+        preds = scene_predictions3d(
+            m.scene, m.state, m.selected, self.predictor3d, limit="drag" if dragging else "cached"
+        )
+        self.preds = preds
+        actors.draw_predictions(preds)
+        wait = preds is not None and preds.answers.get(LIMIT) == "computing…"
+        key = ball_key(m.state, preds.ball) if wait and preds is not None else None
+        if self.latest.want(key):
+            self._start_limit(key)
+
+    def _start_limit(self, key: bytes | None) -> None:
+        """A worker computes the limit for the selected ball, whose key is ``key``."""
+        m = self.model
+        assert m is not None and self.predictor3d is not None
+        i = m.selected
+        if key is None or i is None or ball_key(m.state, i) != key:
+            self.latest.forget()  # the ball moved on: the next frame asks again
+            return
+        if self.predictor3d.cached(LIMIT, key) is not None:  # answered meanwhile
+            self.latest.forget()
+            self._dirty = True
+            self.draw()
+            return
+        work = self.predictor3d.limit_job(domain_of(m.scene), m.state, i)
+        if isinstance(work, str):
+            self.latest.forget()
+            return
+        self.limit_jobs += 1
+        predictor = self.predictor3d
+        self.win.jobs.start(
+            work,
+            "limit3d: the posterior of the selected ball…",
+            lambda res, k=key, p=predictor: self._limit_done(k, p, res),
+            lambda exc, k=key: self._limit_failed(k, exc),
+        )
+
+    def _limit_done(self, key: bytes, predictor: Predictor3D, res) -> None:
+        predictor.store_limit(key, res)
+        if self.latest.finish(key) and self.active:  # still the ball shown: draw it
+            self._dirty = True
+            self.draw()
+            self.refresh_panels()
+        nxt = self.latest.start_pending()
+        if nxt is not None and self.model is not None and self.active:
+            self._start_limit(nxt)
+
+    def _limit_failed(self, key: bytes, exc: BaseException) -> None:
+        self.latest.finish(key)
+        self.latest.forget()
+        self.win.statusBar().showMessage(f"limit3d: {exc}", 8000)
 
     def draw(self) -> None:
         """Update and render now."""
@@ -346,6 +435,9 @@ class Scene3DHost(QtCore.QObject):
             self.bitmaps.set_state(st, m.scene)
         if self.readout is not None:
             self.readout.set_state(st, m.scene)
+            self.readout.set_predictions(self.preds, m.scene)
+        if self.estimators is not None:
+            self.estimators.refresh(m.scene, self.preds)
         self.win.statusBar().showMessage(self._status(), 0)
         # the next refresh during a drag waits PANEL_MS, or longer after a slow one
         took = 1e3 * (time.perf_counter() - t0)

@@ -23,8 +23,9 @@ z != 0 is refused. nside is bounded by :func:`eyeviz.core.bounds.check_nside`, z
 y. A spherical scene may show only the layers in :data:`SPHERICAL_LAYERS` (eyes, features,
 bfv, bitmaps, readout, labels, and in the app's 3D view tangents: the tangent cones from
 each eye centre to each ball, and plane: the plane z = 0, a layer of spherical scenes only,
-:data:`SPHERICAL_ONLY`); the planar-only layers (sectors, ambiguity, posterior, trajectory,
-predictions, and any registered layer) and a ``[trajectory]`` table are refused in one line.
+:data:`SPHERICAL_ONLY`; and predictions: the spherical estimators' answers for one ball,
+:mod:`eyeviz.model.predictions3d`); the planar-only layers (sectors, ambiguity, posterior,
+trajectory, and any registered layer) and a ``[trajectory]`` table are refused in one line.
 
 This module imports the standard library and tomli_w only (no Qt, VTK or torch).
 
@@ -75,7 +76,9 @@ TRAJECTORY_KINDS = ("horizontal", "circular", "vertical")
 OKABE_ITO = ("#D55E00", "#0072B2", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#F0E442")
 DEFAULT_LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout"]
 #: The layers a spherical scene may show (see the module docstring).
-SPHERICAL_LAYERS = ("eyes", "features", "bfv", "bitmaps", "readout", "labels", "tangents", "plane")
+SPHERICAL_LAYERS = (
+    "eyes", "features", "bfv", "bitmaps", "readout", "labels", "tangents", "plane", "predictions"
+)  # fmt: skip
 #: Layers of spherical scenes only (not in the planar layer table, eyeviz.model.layers).
 SPHERICAL_ONLY = ("plane",)
 _COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")

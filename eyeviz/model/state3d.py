@@ -28,8 +28,8 @@ from eyeviz.model.scene import Scene
 
 __all__ = ["SceneState3D", "compute_state3d"]
 
-_LIT_LAYERS = frozenset({"eyes", "bitmaps", "readout"})
-_BFV_LAYERS = frozenset({"bfv", "readout"})
+_LIT_LAYERS = frozenset({"eyes", "bitmaps", "readout", "predictions"})
+_BFV_LAYERS = frozenset({"bfv", "readout", "predictions"})
 
 
 @dataclass

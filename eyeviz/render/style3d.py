@@ -17,15 +17,20 @@ __all__ = [
     "BALL_LIGHT",
     "BFV_OPACITY",
     "BFV_RGB",
+    "CLOUD_PX",
     "CONE_OPACITY",
     "EDGES_MAX_NSIDE",
     "EDGE_RGB",
     "EYES_FRACTION",
     "EYE_CONE",
     "EYE_LIGHT",
+    "GHOST_DOT_PX",
+    "GHOST_LINE_PX",
+    "GHOST_OPACITY",
     "GRID_OPACITY",
     "INK_RGB",
     "INSET_RGB",
+    "LINK_OPACITY",
     "PLANE_OPACITY",
     "PLANE_RGB",
     "UNLIT_RGB",
@@ -54,6 +59,14 @@ EYE_CONE = 4.0
 UNLIT_RGB = (225 / 255, 225 / 255, 225 / 255)
 INSET_RGB = (0.965, 0.965, 0.955)
 INK_RGB = (0.15, 0.15, 0.15)
+#: The predictions layer (issue 23 item 4; colours by estimator, eyeviz.model.palette): a
+#: ghost ball's fill opacity, its outline's and the link's width (points in the vector
+#: figure, pixels in VTK), its centre dot, the link's opacity, a posterior point's size.
+GHOST_OPACITY = 0.22
+GHOST_LINE_PX = 2.5
+GHOST_DOT_PX = 7.0
+LINK_OPACITY = 0.8
+CLOUD_PX = 4.0
 #: (ambient, diffuse) of the eyes' and the balls' surfaces.
 EYE_LIGHT = (0.45, 0.6)
 BALL_LIGHT = (0.35, 0.7)

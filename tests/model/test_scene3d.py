@@ -157,7 +157,7 @@ def test_refusals_one_line_naming_the_key():
         BASE3D.replace("nside = 8", "m = 720"), "features[0].z", "'a'", "planar", "z = 0"
     )
     assert msg.startswith("s.toml:11:")  # the line of z
-    for layer in ("sectors", "ambiguity", "posterior", "trajectory", "predictions"):
+    for layer in ("sectors", "ambiguity", "posterior", "trajectory"):
         _refused(
             BASE3D.replace('"bitmaps"]', f'"bitmaps", "{layer}"]'),
             "layers.show",
@@ -169,6 +169,16 @@ def test_refusals_one_line_naming_the_key():
         "trajectory",
         "spherical",
     )
+
+
+def test_predictions_is_a_spherical_layer_with_the_planar_key():
+    """The 3D view's predictions layer (issue 23 item 4) is shown from a scene file, its
+    estimators under the planar key ``[predictions] estimators``, saved and read back."""
+    text = BASE3D.replace('"bitmaps"]', '"bitmaps", "predictions"]')
+    s = loads(text + '\n[predictions]\nestimators = ["analytic3d", "limit3d"]\n', "s.toml")
+    assert s.shows("predictions") and s.estimators == ["analytic3d", "limit3d"]
+    assert loads(dumps(s), "t.toml") == s
+    _refused(text + "\n[predictions]\nestimators = []\n", "predictions.estimators", "at least")
 
 
 def test_cones_and_the_plane_are_spherical_layers():

@@ -6,17 +6,28 @@ visible per eye (Definition 1: at least two facets lit), overlaps per eye and fa
 per eye. The rows are :func:`eyeviz.render.mpl.figure3d.readout_rows`, the same strings
 the exported figure's table shows, so the app and the figure agree. A cell is re-set only
 when its text changes; the columns are re-fitted only when the rows change.
+
+With the predictions layer a second table holds one row per estimator for the layer's
+ball (:func:`eyeviz.model.predictions3d.prediction_rows`): r, azimuth and elevation and
+their errors against the true ball (r relative, in %; the angles absolute, in degrees),
+and a note: the limit's Monte-Carlo error of r, a flag when an answer is a fallback, or
+why there is no answer.
+
+Both tables fit the dock's width (no horizontal scroll bar, also at 1280x720): the
+columns take their contents' width and the first (the names) the rest, eliding a long
+name.
 """
 
 from __future__ import annotations
 
 from PyQt5 import QtCore, QtGui, QtWidgets
 
+from eyeviz.model.predictions3d import Predictions3D, estimator_color3d, prediction_rows
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.mpl.figure3d import readout_rows
 
-__all__ = ["COLUMNS", "Readout3DPanel"]
+__all__ = ["COLUMNS", "PRED_ROWS", "Readout3DPanel"]
 
 #: (header, tooltip) per column, in readout_rows' order.
 COLUMNS = (
@@ -30,6 +41,88 @@ COLUMNS = (
     ("ovl", "the ball overlaps eye A, B"),
     ("lit A/B", "facets lit on eye A / eye B"),
 )
+TABLE_FONT = 0.8  # the tables' font, times the panel's
+CELL_PAD_PX = 9  # a column's width beyond its widest text
+NAME_MIN_PX = 40  # the names' column at least (elided)
+#: The predictions table's rows (one column per estimator): each value with its error.
+PRED_ROWS = (
+    ("r", "the estimator's distance (in brackets: the relative error of r, %)"),
+    ("az°", "the estimator's azimuth (in brackets: its error, degrees)"),
+    ("el°", "the estimator's elevation (in brackets: its error, degrees)"),
+    ("note", "the limit's Monte-Carlo error of r, a flag (fallback answer), or why none"),
+)
+
+
+def _table(columns) -> QtWidgets.QTableWidget:
+    """A compact read-only table that fits its width (see the module docstring)."""
+    t = QtWidgets.QTableWidget(0, len(columns))
+    for j, (name, tip) in enumerate(columns):
+        item = QtWidgets.QTableWidgetItem(name)
+        item.setToolTip(tip)
+        t.setHorizontalHeaderItem(j, item)
+    head = t.horizontalHeader()
+    side = t.verticalHeader()
+    assert head is not None and side is not None  # a table has both
+    side.setVisible(False)
+    side.setSectionResizeMode(QtWidgets.QHeaderView.ResizeMode.Fixed)
+    side.setDefaultSectionSize(t.fontMetrics().height() + 4)
+    head.setHighlightSections(False)
+    head.setMinimumSectionSize(18)
+    head.setStretchLastSection(False)
+    t.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+    t.setTextElideMode(QtCore.Qt.TextElideMode.ElideRight)
+    t.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
+    t.setSelectionMode(QtWidgets.QAbstractItemView.SelectionMode.NoSelection)
+    t.setShowGrid(False)
+    t.setWordWrap(False)
+    font = t.font()
+    if font.pointSizeF() > 0:  # a notch smaller: nine columns fit a 1280x720 side column
+        font.setPointSizeF(font.pointSizeF() * TABLE_FONT)
+        t.setFont(font)
+    side.setDefaultSectionSize(t.fontMetrics().height() + 4)
+    head.setSectionResizeMode(QtWidgets.QHeaderView.ResizeMode.Fixed)
+    return t
+
+
+def fit_columns(t: QtWidgets.QTableWidget) -> None:
+    """Columns 1... as wide as their header and cells; column 0 (the names, elided) the
+    rest of the viewport, at least NAME_MIN_PX: no horizontal scroll bar."""
+    fm = QtGui.QFontMetrics(t.font())
+    head = t.horizontalHeader()
+    assert head is not None
+    hfm = QtGui.QFontMetrics(head.font())
+    widths = []
+    for j in range(t.columnCount()):
+        h_item = t.horizontalHeaderItem(j)
+        w = hfm.horizontalAdvance(h_item.text() if h_item is not None else "")
+        if h_item is not None and not h_item.icon().isNull():
+            w += 20  # the swatch
+        for i in range(t.rowCount()):
+            item = t.item(i, j)
+            if item is not None:
+                w = max(w, fm.horizontalAdvance(item.text()))
+        widths.append(w + CELL_PAD_PX)
+    style = t.style()
+    bar = style.pixelMetric(QtWidgets.QStyle.PixelMetric.PM_ScrollBarExtent) if style else 16
+    side = t.verticalHeader()
+    rows_h = t.rowCount() * (side.defaultSectionSize() if side is not None else 20)
+    tall = rows_h + head.height() + 2 * t.frameWidth() > t.height()
+    avail = t.width() - 2 * t.frameWidth() - (bar if tall else 0)  # a vertical bar's room
+    widths[0] = max(NAME_MIN_PX, avail - sum(widths[1:]))
+    for j, w in enumerate(widths):
+        head.resizeSection(j, int(w))
+
+
+def _cell(t: QtWidgets.QTableWidget, i: int, j: int) -> QtWidgets.QTableWidgetItem:
+    item = t.item(i, j)
+    if item is None:
+        item = QtWidgets.QTableWidgetItem()
+        align = QtCore.Qt.AlignmentFlag.AlignVCenter | (
+            QtCore.Qt.AlignmentFlag.AlignLeft if j == 0 else QtCore.Qt.AlignmentFlag.AlignRight
+        )
+        item.setTextAlignment(int(align))
+        t.setItem(i, j, item)
+    return item
 
 
 class Readout3DPanel(QtWidgets.QWidget):
@@ -39,32 +132,27 @@ class Readout3DPanel(QtWidgets.QWidget):
         super().__init__(parent)
         self.rows: list[tuple[str, ...]] = []
         self._colors: list[str] = []
-        self.table = QtWidgets.QTableWidget(0, len(COLUMNS))
+        self.table = _table(COLUMNS)
         self.table.setObjectName("readout3d")
-        for j, (name, tip) in enumerate(COLUMNS):
-            item = QtWidgets.QTableWidgetItem(name)
-            item.setToolTip(tip)
-            self.table.setHorizontalHeaderItem(j, item)
-        head = self.table.horizontalHeader()
-        side = self.table.verticalHeader()
-        assert head is not None and side is not None  # a table has both
-        side.setVisible(False)
-        side.setSectionResizeMode(QtWidgets.QHeaderView.ResizeMode.Fixed)
-        side.setDefaultSectionSize(self.fontMetrics().height() + 4)
-        head.setHighlightSections(False)
-        head.setMinimumSectionSize(24)
-        head.setStretchLastSection(True)
-        self.table.setEditTriggers(QtWidgets.QAbstractItemView.EditTrigger.NoEditTriggers)
-        self.table.setSelectionMode(QtWidgets.QAbstractItemView.SelectionMode.NoSelection)
-        self.table.setShowGrid(False)
-        self.table.setWordWrap(False)
-        self.table.setHorizontalScrollMode(QtWidgets.QAbstractItemView.ScrollMode.ScrollPerPixel)
         self.note = QtWidgets.QLabel("")
         self.note.setWordWrap(True)
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
         lay.addWidget(self.table, 1)
         lay.addWidget(self.note)
+        self.pred_title = QtWidgets.QLabel("")
+        self.pred_table = _table((("", ""),))
+        self.pred_table.setObjectName("predictions3d")
+        self.pred_note = QtWidgets.QLabel("")
+        self.pred_note.setWordWrap(True)
+        for w in (self.pred_title, self.pred_table, self.pred_note):
+            w.setVisible(False)
+        lay.addWidget(self.pred_title)
+        lay.addWidget(self.pred_table, 1)
+        lay.addWidget(self.pred_note)
+        self.pred_rows: list[tuple[str, ...]] = []
+        for t in (self.table, self.pred_table):
+            t.installEventFilter(self)  # re-fitted whenever a table is resized or shown
         self.setMinimumWidth(200)
 
     def set_state(self, state: SceneState3D, scene: Scene) -> None:
@@ -79,27 +167,86 @@ class Readout3DPanel(QtWidgets.QWidget):
             for j, text in enumerate(row):
                 if old is not None and old[j] == text and not (j == 0 and self._recolor(i, colors)):
                     continue
-                item = self.table.item(i, j)
-                if item is None:
-                    item = QtWidgets.QTableWidgetItem()
-                    align = QtCore.Qt.AlignmentFlag.AlignVCenter | (
-                        QtCore.Qt.AlignmentFlag.AlignLeft
-                        if j == 0
-                        else QtCore.Qt.AlignmentFlag.AlignRight
-                    )
-                    item.setTextAlignment(int(align))
-                    self.table.setItem(i, j, item)
+                item = _cell(self.table, i, j)
                 item.setText(text)
                 if j == 0:
                     item.setIcon(_swatch(colors[i]))
                     item.setToolTip(scene.features[i].name)
-        changed = reshaped or rows != self.rows
         self.rows, self._colors = rows, colors
-        if changed:
-            self.table.resizeColumnsToContents()
+        fit_columns(self.table)
         hidden = [k for k in ("readout",) if not scene.shows(k)]
         self.note.setText("readout layer hidden: overlaps not computed" if hidden else "")
         self.note.setVisible(bool(hidden))
+
+    def set_predictions(self, preds: Predictions3D | None, scene: Scene) -> None:
+        """The predictions table for ``preds`` (hidden without the layer or a ball)."""
+        on = scene.shows("predictions") and preds is not None
+        for w in (self.pred_title, self.pred_table):
+            w.setVisible(on)
+        if not on or preds is None:
+            self.pred_note.setVisible(False)
+            self.pred_rows = []
+            return
+        name = scene.features[preds.ball].name if preds.ball < len(scene.features) else ""
+        self.pred_title.setText(f"<b>Predictions</b> for {name} (errors against the truth)")
+        rows = prediction_rows(preds)  # per estimator: name, r, dr, az, daz, el, del, note
+        t = self.pred_table
+        if t.columnCount() != len(rows) + 1 or t.rowCount() != len(PRED_ROWS):
+            t.setColumnCount(len(rows) + 1)
+            t.setRowCount(len(PRED_ROWS))
+            for i, (label, tip) in enumerate(PRED_ROWS):
+                item = _cell(t, i, 0)
+                item.setText(label)
+                item.setToolTip(tip)
+        notes = []
+        for j, row in enumerate(rows, start=1):
+            head = t.horizontalHeaderItem(j)
+            if head is None or head.text() != row[0]:
+                head = QtWidgets.QTableWidgetItem(_swatch(estimator_color3d(row[0])), row[0])
+                t.setHorizontalHeaderItem(j, head)
+            name, r, dr, az, daz, el, de, note = row
+            texts = (
+                f"{r} ({dr} %)" if dr else r,
+                f"{az} ({daz})" if daz else az,
+                f"{el} ({de})" if de else el,
+                note if r else "—",
+            )
+            for i, text in enumerate(texts):
+                item = _cell(t, i, j)
+                if item.text() != text:
+                    item.setText(text)
+                    item.setToolTip(text)
+            if note and not r:  # no answer: the reason, in full, below
+                notes.append(f"{name}: {note}")
+        if preds.note:
+            notes.append(preds.note)
+        self.pred_rows = rows
+        fit_columns(t)
+        self.pred_note.setText("\n".join(notes))
+        self.pred_note.setVisible(bool(notes))
+        side = t.verticalHeader()
+        row_h = side.defaultSectionSize() if side is not None else 20
+        t.setFixedHeight(row_h * (len(PRED_ROWS) + 1) + 8)
+
+    def pred_text(self, name: str, row: str) -> str:
+        """The predictions table's text for estimator ``name`` in row ``row`` ("r", "az",
+        "el" or "note")."""
+        i = {"r": 0, "az": 1, "el": 2, "note": 3}[row]
+        t = self.pred_table
+        for j in range(1, t.columnCount()):
+            head = t.horizontalHeaderItem(j)
+            if head is not None and head.text() == name:
+                cell = t.item(i, j)
+                return cell.text() if cell is not None else ""
+        raise KeyError(name)
+
+    def eventFilter(self, obj, ev) -> bool:  # noqa: N802 (Qt name)
+        if ev.type() in (QtCore.QEvent.Type.Resize, QtCore.QEvent.Type.Show) and obj in (
+            self.table,
+            self.pred_table,
+        ):
+            fit_columns(obj)
+        return False
 
     def _recolor(self, i: int, colors: list[str]) -> bool:
         return i >= len(self._colors) or self._colors[i] != colors[i]

@@ -37,6 +37,13 @@ from eyeviz import EyevizError
 from eyeviz.core.validation import check_choice
 from eyeviz.files.atomic import atomic_output
 from eyeviz.model.camera3d import PRESETS, Camera3D
+from eyeviz.model.predictions3d import (
+    Predictions3D,
+    Predictor3D,
+    estimator_color3d,
+    prediction_rows,
+    scene_predictions3d,
+)
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
 from eyeviz.render.mpl.healpix_map import MapAxes, draw_eye_view, view_lonlat
@@ -101,11 +108,12 @@ def _draw_view(
     scene: Scene,
     cam: Camera3D,
     image: np.ndarray | None = None,
+    predictions: Predictions3D | None = None,
 ) -> None:
     """The 3D view in ``box`` (figure fractions) as the VTK view lays it out: the eyes
     close up on the left, the scene through ``cam`` on the right (polygons, or ``image``:
     the VTK render of the same view, :func:`eyeviz.render.mpl.perspective3d.draw_panel`)."""
-    eyes_ax, scene_ax = draw_panel(fig, box, st, scene, cam, image=image)
+    eyes_ax, scene_ax = draw_panel(fig, box, st, scene, cam, image=image, predictions=predictions)
     scene_ax.text(
         0.02, 0.98, _view_caption(cam), transform=scene_ax.transAxes, fontsize=SMALL,
         color=GREY, ha="left", va="top",
@@ -188,6 +196,27 @@ def _draw_table(ax, st: SceneState3D, scene: Scene) -> None:
             ax.text(x + (0.02 if j == 0 else 0.0), y, t, fontsize=SMALL, color=INK, va="center")
 
 
+def _draw_predictions_table(ax, preds: Predictions3D, scene: Scene) -> None:
+    """The predictions layer's rows (:func:`prediction_rows`, as the app's readout)."""
+    ax.set_axis_off()
+    ax.set_xlim(0, 1)
+    rows = prediction_rows(preds)
+    ax.set_ylim(-(len(rows) + 0.5), 1.0)
+    name = short(scene.features[preds.ball].name, 20) if preds.ball < len(scene.features) else ""
+    edges = [0.0, 0.2, 0.3, 0.4, 0.52, 0.63, 0.73, 0.84]
+    heads = ("estimator", "r", "\u0394r %", "az\u00b0", "\u0394az\u00b0", "el\u00b0",
+             "\u0394el\u00b0", f"({name})")  # fmt: skip
+    for x, t in zip(edges, heads, strict=True):
+        ax.text(x, 0.0, t, fontsize=SMALL, color=GREY, ha="left", va="center")
+    ax.plot([0, 1], [-0.5, -0.5], color=GREY, lw=0.4)
+    for i, row in enumerate(rows):
+        y = -(i + 1)
+        ax.plot([0.008], [y], marker="s", ms=3.5, mew=0, color=estimator_color3d(row[0]))
+        for j, (x, t) in enumerate(zip(edges, row, strict=True)):
+            ax.text(x + (0.02 if j == 0 else 0.0), y, short(t, 40), fontsize=SMALL, color=INK,
+                    va="center")  # fmt: skip
+
+
 # --- the figure --------------------------------------------------------------------------
 
 
@@ -204,6 +233,8 @@ def figure3d(
     view: str = "default",
     dpi: float | None = None,
     view_image: ViewImage | None = None,
+    predictions: Predictions3D | None = None,
+    ball: int = 0,
 ) -> Figure:
     """The spherical scene as a Figure ``width`` inches wide (see the module docstring).
     ``title``, ``table`` and ``bitmaps`` (False) leave those parts out; ``aspect`` is the
@@ -216,7 +247,12 @@ def figure3d(
     is called as ``view_image(camera, width_px, height_px)`` for the view's picture at
     that box's pixel size (the VTK off-screen render,
     :func:`eyeviz.render.vtk.png3d.view_rgba`), shown pixel for pixel in place of the
-    polygons; the maps, the readout and the text are drawn as for the vector figure."""
+    polygons; the maps, the readout and the text are drawn as for the vector figure.
+
+    With the predictions layer the view draws the estimators' ghosts and the limit's
+    cloud for ball ``ball`` (the app passes its selection) and the readout their rows:
+    ``predictions`` (:func:`eyeviz.model.predictions3d.scene_predictions3d`), computed
+    here (the limit included) when None."""
     import matplotlib
 
     if view_image is not None and dpi is None:
@@ -227,6 +263,11 @@ def figure3d(
     check_drawable3d(scene)
     st = compute_state3d(scene) if state is None else state
     shown = set(scene.layers)
+    preds = predictions
+    if "predictions" in shown and preds is None and scene.features:
+        preds = scene_predictions3d(scene, st, min(max(ball, 0), st.n - 1), Predictor3D())
+    if "predictions" not in shown:
+        preds = None
     persp = bool(shown & set(VIEW_LAYERS))
     maps = bitmaps and "bitmaps" in shown and st.lit_a is not None
     tab = table and "readout" in shown and bool(scene.features)
@@ -245,6 +286,8 @@ def figure3d(
         parts += [("maps", map_h)] if side else [("mapA", map_h), ("mapB", map_h)]
     if tab:
         parts.append(("table", ROW_IN * (len(scene.features) + 1.3)))
+    if table and preds is not None and preds.answers:
+        parts.append(("preds", ROW_IN * (len(preds.answers) + 1.3)))
     if not parts:
         parts.append(("empty", 0.3))
     height = sum(h for _, h in parts) + 2 * m
@@ -280,7 +323,7 @@ def figure3d(
                             f"figure3d: view_image gave {image.shape[1]} x {image.shape[0]} "
                             f"px for a {w_px} x {h_px} px view"
                         )
-                _draw_view(fig, box, st, scene, cam, image)
+                _draw_view(fig, box, st, scene, cam, image, preds)
             elif name in ("maps", "mapA", "mapB"):
                 eyes = "AB" if name == "maps" else name[-1]
                 for k, eye in enumerate(eyes):
@@ -292,6 +335,10 @@ def figure3d(
                 ax = fig.add_axes(rect(m, width - 2 * m, h))
                 ax.set_gid("readout")
                 _draw_table(ax, st, scene)
+            elif name == "preds" and preds is not None:
+                ax = fig.add_axes(rect(m, width - 2 * m, h))
+                ax.set_gid("predictions")
+                _draw_predictions_table(ax, preds, scene)
             elif name == "empty":
                 fig.text(0.5, 0.5, "(no layer to draw)", ha="center", fontsize=FONT, color=GREY)
             top -= h
@@ -361,6 +408,8 @@ def export3d(
     camera: Camera3D | None = None,
     view: str = "default",
     view_image: ViewImage | None = None,
+    predictions: Predictions3D | None = None,
+    ball: int = 0,
 ) -> Path:
     """Write the spherical scene's figure (:func:`figure3d`, through ``camera`` or the
     preset ``view``) to
@@ -389,7 +438,7 @@ def export3d(
     fig = figure3d(
         scene, width=width, title=title, table=table, bitmaps=bitmaps, aspect=aspect,
         camera=camera, view=view, dpi=dpi if fmt == "png" else None,
-        view_image=view_image if fmt == "png" else None,
+        view_image=view_image if fmt == "png" else None, predictions=predictions, ball=ball,
     )  # fmt: skip
     with atomic_output(target) as tmp, matplotlib.rc_context(RC):
         fig.savefig(

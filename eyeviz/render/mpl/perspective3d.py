@@ -43,7 +43,8 @@ from matplotlib.patches import Rectangle
 
 from eyeviz.core import healpix
 from eyeviz.model import shapes3d
-from eyeviz.model.camera3d import Camera3D, eyes_camera, project
+from eyeviz.model.camera3d import Camera3D, basis, eyes_camera, project
+from eyeviz.model.predictions3d import LIMIT, Predictions3D, estimator_color3d
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.mpl.style import SMALL, short
@@ -51,15 +52,20 @@ from eyeviz.render.style3d import (
     BALL_LIGHT,
     BFV_OPACITY,
     BFV_RGB,
+    CLOUD_PX,
     CONE_OPACITY,
     EDGE_RGB,
     EDGES_MAX_NSIDE,
     EYE_CONE,
     EYE_LIGHT,
     EYES_FRACTION,
+    GHOST_DOT_PX,
+    GHOST_LINE_PX,
+    GHOST_OPACITY,
     GRID_OPACITY,
     INK_RGB,
     INSET_RGB,
+    LINK_OPACITY,
     PLANE_OPACITY,
     PLANE_RGB,
     UNLIT_RGB,
@@ -456,6 +462,50 @@ def _ball_labels(ax, scene: Scene, cam: Camera3D, aspect: float) -> None:
                 ha="left" if right else "right", va=va)  # fmt: skip
 
 
+#: Points per ghost outline; the VTK layer's pixel sizes scaled to points of the figure.
+GHOST_RING_N = 96
+PX_TO_PT = 0.4
+
+
+def ghost_outline(cam: Camera3D, centre, g: float, n: int = GHOST_RING_N) -> np.ndarray:
+    """(n, 3) points of the circle of radius ``g`` about ``centre`` facing the camera (the
+    VTK layer's outline, a follower of the same circle)."""
+    right, up, _ = basis(cam)
+    t = np.linspace(0.0, 2.0 * math.pi, n, endpoint=False)
+    c = np.asarray(centre, np.float64)
+    return c + g * (np.cos(t)[:, None] * right + np.sin(t)[:, None] * up)
+
+
+def draw_ghosts(ax: Axes, preds: Predictions3D | None, cam: Camera3D, aspect: float) -> None:
+    """The predictions layer over the scene (as the VTK overlay: above everything): per
+    estimator a translucent disc with its outline (the ghost ball seen through ``cam``),
+    its centre and a line from the true centre; the limit's posterior as points."""
+    if preds is None:
+        return
+    near = 0.0
+    for a in preds.ghosts():
+        col = to_rgba(estimator_color3d(a.name))
+        ring, depth = project(cam, ghost_outline(cam, (a.x, a.y, a.z), preds.g), aspect)
+        if not np.all(depth > near):
+            continue
+        ax.fill(ring[:, 0], ring[:, 1], facecolor=(*col[:3], GHOST_OPACITY), edgecolor=col,
+                lw=GHOST_LINE_PX * PX_TO_PT, gid=f"ghost-{a.name}", zorder=5)  # fmt: skip
+        link, d = project(cam, np.array([preds.truth, (a.x, a.y, a.z)]), aspect)
+        if np.all(d > near):
+            ax.plot(link[:, 0], link[:, 1], color=col, alpha=LINK_OPACITY,
+                    lw=0.6 * GHOST_LINE_PX * PX_TO_PT, zorder=5)  # fmt: skip
+            ax.plot([link[1, 0]], [link[1, 1]], marker="o", ms=GHOST_DOT_PX * PX_TO_PT,
+                    mew=0, color=col, zorder=6)  # fmt: skip
+    cloud = preds.cloud
+    if cloud is not None and len(cloud.points):
+        xy, d = project(cam, cloud.points, aspect)
+        ok = d > near
+        rgba = np.tile(to_rgba(estimator_color3d(LIMIT)), (int(ok.sum()), 1))
+        rgba[:, 3] = cloud.alpha[ok]
+        ax.scatter(xy[ok, 0], xy[ok, 1], s=(CLOUD_PX * PX_TO_PT) ** 2, c=rgba, lw=0,
+                   zorder=6, gid="posterior-cloud")  # fmt: skip
+
+
 def _overlap(a: tuple[float, ...], b: tuple[float, ...]) -> bool:
     return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
@@ -469,6 +519,7 @@ def draw_panel(
     layers=None,
     *,
     image: np.ndarray | None = None,
+    predictions: Predictions3D | None = None,
 ) -> tuple[Axes, Axes]:
     """The whole 3D view in ``box`` (figure fractions: left, bottom, width, height) as the
     VTK view lays it out (:func:`split_viewports`): the eyes close up on the left, the
@@ -477,7 +528,9 @@ def draw_panel(
     ``image`` (rows x columns x 3 or 4, the VTK render of this view through ``cam``, as
     many pixels as ``box`` holds at the figure's dpi) is shown in place of the polygons,
     filling the box pixel for pixel (no resampling); the names are drawn over it as over
-    the polygons."""
+    the polygons. ``predictions`` (the predictions layer, drawn when the scene shows it)
+    are drawn over the polygons (:func:`draw_ghosts`); over an ``image`` they are in the
+    picture already (the VTK layer)."""
     w_in, h_in = box[2] * fig.get_figwidth(), box[3] * fig.get_figheight()
     if image is not None:
         img_ax = fig.add_axes(box)
@@ -504,5 +557,10 @@ def draw_panel(
         else:
             pcam = cam
         draw_view(ax, state, scene, pcam, aspect, part, layers, geometry=image is None)
+        shown = scene.layers if layers is None else layers
+        if part == "scene" and image is None and "predictions" in shown:
+            draw_ghosts(ax, predictions, pcam, aspect)
+            ax.set_xlim(-1.0, 1.0)
+            ax.set_ylim(-1.0, 1.0)
         axes.append(ax)
     return axes[0], axes[1]

@@ -22,6 +22,7 @@ import numpy as np
 from eyeviz import EyevizError
 from eyeviz.core.validation import check_int
 from eyeviz.model.camera3d import Camera3D
+from eyeviz.model.predictions3d import Predictions3D, Predictor3D, scene_predictions3d
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
 from eyeviz.render.mpl.figure3d import export3d
@@ -43,6 +44,7 @@ def view_rgba(
     selected: int | None = None,
     transparent: bool = False,
     supersample: int = 2,
+    predictions: Predictions3D | None = None,
 ) -> np.ndarray:
     """The 3D view of ``scene`` through ``camera`` (the scene part's; the close-up's
     follows it) rendered off-screen, ``height`` x ``width`` x 4 uint8 (alpha 0 where
@@ -57,7 +59,7 @@ def view_rgba(
     k = check_int("supersample", supersample, ge=1, le=4)
     while k > 1 and max(width, height) * k > MAX_VIEW_PX:
         k -= 1
-    img = _render(scene, camera, width * k, height * k, state, selected, transparent)
+    img = _render(scene, camera, width * k, height * k, state, selected, transparent, predictions)
     if k > 1:
         img = _downsample(img, k)
     return img
@@ -82,6 +84,7 @@ def _render(
     state: SceneState3D | None,
     selected: int | None,
     transparent: bool,
+    predictions: Predictions3D | None = None,
 ) -> np.ndarray:
     sc = scene.copy()
     sc.layers = [k for k in sc.layers if k != "labels"]
@@ -89,6 +92,7 @@ def _render(
     pl, actors = offscreen_view(width, height)
     try:
         actors.update(sc, st, selected)
+        actors.draw_predictions(predictions if sc.shows("predictions") else None)
         actors.title.SetVisibility(False)
         actors.eyes_caption.SetVisibility(False)
         img = shoot(pl, actors, camera, transparent)
@@ -117,14 +121,22 @@ def export_png3d(
     camera: Camera3D | None = None,
     view: str = "default",
     selected: int | None = None,
+    predictions: Predictions3D | None = None,
 ) -> Path:
     """Write the spherical scene's figure as a PNG (``width`` inches at 300 dpi times
     ``scale``), atomically: :func:`eyeviz.render.mpl.figure3d.export3d` with the 3D view
     rendered by VTK (:func:`view_rgba`) at the view box's pixel size. EyevizError (one
-    line) for a view beyond :data:`MAX_VIEW_PX` pixels."""
+    line) for a view beyond :data:`MAX_VIEW_PX` pixels. The predictions layer answers
+    for ball ``selected`` (the first when None); ``predictions`` is its content when
+    computed already (the app's), else it is computed once here for both the view and
+    the readout."""
     if Path(path).suffix.lower() != ".png":
         raise EyevizError(f"export_png3d writes .png files, got {str(path)!r}")
     st = compute_state3d(scene)
+    preds = predictions
+    if scene.shows("predictions") and preds is None and scene.features:
+        ball = 0 if selected is None else min(max(selected, 0), st.n - 1)
+        preds = scene_predictions3d(scene, st, ball, Predictor3D())
 
     def vtk_view(cam: Camera3D, w: int, h: int) -> np.ndarray:
         if max(w, h) > MAX_VIEW_PX:
@@ -133,9 +145,13 @@ def export_png3d(
                 f"scale {float(scale):g} makes the 3D view {w} x {h} px; VTK renders at most "
                 f"{MAX_VIEW_PX} px: scale <= {most:.3g} at this width"
             )
-        return view_rgba(scene, cam, w, h, state=st, selected=selected, transparent=transparent)
+        return view_rgba(
+            scene, cam, w, h, state=st, selected=selected, transparent=transparent,
+            predictions=preds,
+        )  # fmt: skip
 
     return export3d(
         scene, path, scale, transparent, width=width, title=title, table=table,
         bitmaps=bitmaps, aspect=aspect, camera=camera, view=view, view_image=vtk_view,
+        predictions=preds, ball=0 if selected is None else selected,
     )  # fmt: skip

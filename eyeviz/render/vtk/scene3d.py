@@ -35,6 +35,7 @@ from vtkmodules.vtkRenderingCore import vtkActor, vtkRenderer
 from eyeviz.files.atomic import atomic_output
 from eyeviz.model import shapes3d
 from eyeviz.model.camera3d import Camera3D, eyes_camera
+from eyeviz.model.predictions3d import Predictions3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
 from eyeviz.render.style3d import (  # the looks the vector view shares (one place)
@@ -47,6 +48,7 @@ from eyeviz.render.style3d import (  # the looks the vector view shares (one pla
     EYES_FRACTION,
     PLANE_RGB,
 )
+from eyeviz.render.vtk.ghosts3d import Ghosts3D, make_overlay
 from eyeviz.render.vtk.primitives import (
     Store,
     actor,
@@ -183,6 +185,9 @@ class Scene3DActors:
         self.unit_ring = _great_circles(1.3)
         self.nside = 0
         self.full = True
+        # the predictions layer: a renderer over the scene's, made on first use
+        self.overlay: vtkRenderer | None = None
+        self.ghosts: Ghosts3D | None = None
 
     # --- structure ---------------------------------------------------------------------
     def _add(self, store: Store, a, scene: bool = True, eyes: bool = True) -> None:
@@ -415,9 +420,28 @@ class Scene3DActors:
         for a in self.plane_actors:
             a.SetVisibility(shows("plane"))
 
+    def draw_predictions(self, preds: Predictions3D | None) -> None:
+        """The predictions layer (:mod:`eyeviz.render.vtk.ghosts3d`): ``preds``' ghosts
+        and cloud over the scene; None hides them."""
+        if preds is None and self.ghosts is None:
+            return
+        if self.ghosts is None:
+            self.overlay = make_overlay(self.scene_ren)
+            if self.overlay is None:
+                return
+            self.ghosts = Ghosts3D(self.overlay)
+        self.sync_overlay()
+        self.ghosts.draw(preds)
+
+    def sync_overlay(self) -> None:
+        """The predictions' renderer keeps the scene's viewport."""
+        if self.overlay is not None:
+            self.overlay.SetViewport(*self.scene_ren.GetViewport())
+
     def set_cameras(self, cam: Camera3D) -> None:
         """The scene through ``cam``; the eyes from the same direction, framed."""
         apply_camera(self.scene_ren, cam)
+        self.sync_overlay()
         if hasattr(self.scene_ren, "camera_set"):  # pyvista's: no reset at its first render
             self.scene_ren.camera_set = True
         if self.eyes_ren is not None and self._eyes_key is not None:
@@ -426,6 +450,7 @@ class Scene3DActors:
 
     def sync_eyes_camera(self, h: float, l: float) -> None:
         """The eyes' camera follows the scene camera's direction (after a rotation)."""
+        self.sync_overlay()
         if self.eyes_ren is not None:
             cam = eyes_camera(camera_of(self.scene_ren), h, l, _aspect(self.eyes_ren))
             apply_camera(self.eyes_ren, cam)
@@ -507,10 +532,12 @@ def render_png3d(
     state: SceneState3D | None = None,
     selected: int | None = None,
     transparent: bool = False,
+    predictions: Predictions3D | None = None,
 ) -> Path:
     """Render a spherical scene off-screen (no display: EGL) to a PNG at ``camera`` (the
     default preset framing the balls when None), ``width`` x ``height`` pixels, written
-    atomically; the same picture as the app's 3D view (``transparent``: no background)."""
+    atomically; the same picture as the app's 3D view (``transparent``: no background;
+    ``predictions``: the predictions layer's content, drawn when the scene shows it)."""
     from eyeviz import EyevizError
     from eyeviz.core.validation import check_int
 
@@ -525,6 +552,7 @@ def render_png3d(
     pl, actors = offscreen_view(width, height)
     try:
         actors.update(scene, st, selected)
+        actors.draw_predictions(predictions if scene.shows("predictions") else None)
         if camera is None:
             left, _ = split_viewports(width, height)
             camera = default_camera(st, aspect=(1.0 - left[2]) * width / height)
