@@ -110,13 +110,19 @@ def _check_indices(name: str, ptr: np.ndarray, ind: np.ndarray, npix: int) -> No
                 raise ValueError(f"{name}: indices must increase strictly within a row")
 
 
-def as_csr(name: str, lit: Any, npix: int) -> tuple[np.ndarray, np.ndarray, bool]:
+def as_csr(
+    name: str, lit: Any, npix: int, *, check_indices: bool = True
+) -> tuple[np.ndarray, np.ndarray, bool]:
     """(indptr int64, indices, single) from CSR rows ``(indptr, indices)`` or dense
     bitmaps (npix,) / (N, npix); ``single`` is True for one 1-D bitmap. ValueError in one
     line naming ``name`` for anything else (wrong shape, non-binary values, indices out
     of [0, npix) or not increasing within a row, an indptr that does not fit). CSR
     indices of int64, or of int32 when npix < 2^31, are returned as given (no copy); other
-    integer types, and dense bitmaps, as int64."""
+    integer types, and dense bitmaps, as int64.
+
+    ``check_indices=False`` leaves out the one pass over the CSR indices (range and
+    order) for a caller that makes it itself (:meth:`Estimator3D.predict` for an
+    estimator with ``checks_indices``); every other check is made."""
     if isinstance(lit, tuple):
         if len(lit) != 2:
             raise ValueError(f"{name} must be (indptr, indices) or bitmaps, got a {len(lit)}-tuple")
@@ -133,7 +139,8 @@ def as_csr(name: str, lit: Any, npix: int) -> tuple[np.ndarray, np.ndarray, bool
             )
         if not (ind.dtype == np.int64 or (ind.dtype == np.int32 and npix < 2**31)):
             ind = ind.astype(np.int64)
-        _check_indices(name, ptr, ind, npix)
+        if check_indices:
+            _check_indices(name, ptr, ind, npix)
         return ptr, ind, False
     try:
         a = np.asarray(lit)
@@ -175,6 +182,12 @@ class Estimator3D:
     """
 
     name: ClassVar[str] = "base3d"
+    #: True for an estimator whose :meth:`_predict_csr` reads every index anyway and
+    #: refuses indices out of range or not increasing within a row there, with
+    #: :func:`as_csr`'s ValueError naming ``lit_a`` or ``lit_b`` (one pass over the
+    #: indices instead of two); :meth:`predict` then checks only the rows it does not
+    #: hand over (those where an eye lit nothing).
+    checks_indices: ClassVar[bool] = False
 
     def __init__(self, domain: Domain3D = PAPER_DOMAIN3D, metadata: dict | None = None) -> None:
         if not isinstance(domain, Domain3D):
@@ -199,8 +212,9 @@ class Estimator3D:
         bitmaps, see the module docstring). ValueError naming the argument for malformed
         input or a row-count mismatch; NaN and ``valid = False`` where an eye lit nothing."""
         npix = self.domain.npix
-        pa, ia, single_a = as_csr("lit_a", lit_a, npix)
-        pb, ib, single_b = as_csr("lit_b", lit_b, npix)
+        check = not self.checks_indices
+        pa, ia, single_a = as_csr("lit_a", lit_a, npix, check_indices=check)
+        pb, ib, single_b = as_csr("lit_b", lit_b, npix, check_indices=check)
         if pa.size != pb.size:
             raise ValueError(
                 f"lit_a and lit_b have different row counts: {pa.size - 1} and {pb.size - 1}"
@@ -208,6 +222,10 @@ class Estimator3D:
         n = pa.size - 1
         ca, cb = np.diff(pa), np.diff(pb)
         valid = (ca > 0) & (cb > 0)
+        if not check and not valid.all():  # rows _predict_csr does not see
+            skip = np.flatnonzero(~valid)
+            _check_indices("lit_a", *take_rows(pa, ia, skip), npix)
+            _check_indices("lit_b", *take_rows(pb, ib, skip), npix)
         r = np.full(n, np.nan)
         az = np.full(n, np.nan)
         el = np.full(n, np.nan)

@@ -159,6 +159,7 @@ class Learned3DEstimator(Estimator3D):
     triangulation is then r_max along their mean, which the network corrects)."""
 
     name = "learned3d"
+    checks_indices = True  # on the runs of the summaries (learned3d_features._check_runs)
 
     def __init__(
         self,
@@ -190,8 +191,8 @@ class Learned3DEstimator(Estimator3D):
         self, lit_a: LitCSR, lit_b: LitCSR
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         d = self.domain
-        sa = eye_summaries(d.nside, lit_a[0], lit_a[1])
-        sb = eye_summaries(d.nside, lit_b[0], lit_b[1])
+        sa = eye_summaries(d.nside, lit_a[0], lit_a[1], name="lit_a")
+        sb = eye_summaries(d.nside, lit_b[0], lit_b[1], name="lit_b")
         x, log_r0, az0, el0, ok, flagged = features(sa, sb, d.h, d.nside, d.r_min, d.r_max)
         n = x.shape[0]
         r = np.full(n, np.nan)

@@ -44,8 +44,12 @@ __all__ = [
     "triangulate",
 ]
 
-# indices per pass of the run finder (temporaries stay in cache)
-_BLOCK = 1 << 18
+# indices per pass of the run finder (its temporaries stay in cache)
+_BLOCK = 1 << 16
+#: rows per pass of the per-run work (its temporaries stay in cache)
+_ROWS = 2048
+#: per-pixel tables (:class:`_PixelTables`) are kept for nside up to 256 (about 50 MB)
+_TABLE_NPIX = 12 * 256 * 256
 
 
 @dataclass(frozen=True)
@@ -67,6 +71,39 @@ class EyeSummary:
     bounds: np.ndarray
 
 
+@dataclass(frozen=True)
+class _PixelTables:
+    """Per-pixel tables of one nside, so that a run costs gathers instead of a ring
+    search and four sines and cosines: the ring of each pixel; the west and east edge
+    longitudes of each cell, phi0 + (j -+ 0.5) * step (j its position in the ring); at
+    first[k] + n - 1, the amplitude of the sum of n consecutive centres of ring k,
+    amp[k] * sin(step[k] n / 2); at 2 first[k] + j (j = 0 .. 2 num[k] - 2, the sum of a
+    run's first and last position), cos and sin of the run's middle longitude
+    phi0[k] + step[k] j / 2. Each entry is the expression :meth:`_Rings.partial` and
+    :func:`eye_summaries` evaluate per run, so both give the same floats."""
+
+    ring: np.ndarray
+    west: np.ndarray
+    east: np.ndarray
+    amp: np.ndarray
+    cos_mid: np.ndarray
+    sin_mid: np.ndarray
+
+    @classmethod
+    def build(cls, r: _Rings) -> _PixelTables:
+        kk = np.arange(1, 4 * r.nside, dtype=np.int64)
+        ring = np.repeat(kk, r.num[kk])
+        j = np.arange(ring.size, dtype=np.int64) - r.first[ring]
+        west = r.phi0[ring] + (j - 0.5) * r.step[ring]
+        east = r.phi0[ring] + (j + 0.5) * r.step[ring]
+        n = (j + 1).astype(np.float64)
+        amp = r.amp[ring] * np.sin(0.5 * r.step[ring] * n)
+        ring2 = np.repeat(kk, 2 * r.num[kk])
+        j2 = np.arange(ring2.size, dtype=np.int64) - 2 * r.first[ring2]
+        mid = r.phi0[ring2] + 0.5 * r.step[ring2] * j2
+        return cls(ring, west, east, amp, np.cos(mid), np.sin(mid))
+
+
 class _Rings:
     """Per-ring tables of one nside: first pixel, cells, longitude offset, z, sin(theta)
     and the prefix sums of n_k z_k (rings 0 .. 4 nside; 0 and 4 nside are empty)."""
@@ -81,6 +118,7 @@ class _Rings:
         self.nside = nside
         self.first = np.concatenate([[0], first, [12 * nside * nside]]).astype(np.int64)
         self.num = np.concatenate([[1], num, [1]]).astype(np.int64)
+        self.last = self.first + self.num - 1  # last pixel of each ring
         self.step = 2.0 * math.pi / self.num
         self.phi0 = np.where(np.concatenate([[False], shifted, [False]]), 0.5 * self.step, 0.0)
         self.z = np.concatenate([[1.0], z, [-1.0]])
@@ -89,6 +127,7 @@ class _Rings:
         self.zcum = np.concatenate([[0.0], np.cumsum(zsum)])  # zcum[k] = sum over rings < k
         self.amp = self.sth / np.sin(0.5 * self.step)
         self.theta = np.arctan2(self.sth, self.z)
+        self._pixels: _PixelTables | None = None
 
     @classmethod
     def of(cls, nside: int) -> _Rings:
@@ -98,6 +137,12 @@ class _Rings:
                 cls._cache.clear()
             r = cls._cache[nside] = cls(nside)
         return r
+
+    def pixels(self) -> _PixelTables | None:
+        """The per-pixel tables (built once), or None above :data:`_TABLE_NPIX` pixels."""
+        if self._pixels is None and 12 * self.nside * self.nside <= _TABLE_NPIX:
+            self._pixels = _PixelTables.build(self)
+        return self._pixels
 
     def ring(self, pix: np.ndarray) -> np.ndarray:
         """Ring number (1 .. 4 nside - 1) of each pixel."""
@@ -112,42 +157,66 @@ class _Rings:
         return [amp * np.cos(mid), amp * np.sin(mid), n * self.z[k]]
 
 
+def _run_starts(flat: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(positions, first values, last values) of the runs of consecutive values in
+    ``flat`` (non-empty): a run starts at j = 0 and at every j with flat[j] !=
+    flat[j - 1] + 1 (in the array's own integer arithmetic). One pass, in blocks whose
+    temporaries stay in cache; a run's first and last value are read while their block
+    is there."""
+    m = flat.size - 1  # steps
+    at_parts = [np.zeros(1, np.int64)]
+    s_parts = [flat[:1]]
+    e_parts = []
+    if m > 0:
+        k = min(_BLOCK, m)
+        dif = np.empty(k, flat.dtype)
+        brk = np.empty(k, bool)
+        for lo in range(0, m, _BLOCK):
+            hi = min(lo + _BLOCK, m)
+            blk = flat[lo : hi + 1]
+            np.subtract(blk[1:], blk[:-1], out=dif[: hi - lo])
+            np.not_equal(dif[: hi - lo], 1, out=brk[: hi - lo])
+            at = np.flatnonzero(brk[: hi - lo])
+            e_parts.append(blk[at])
+            at += 1
+            s_parts.append(blk[at])
+            at += lo
+            at_parts.append(at)
+    e_parts.append(flat[-1:])
+    return (
+        np.concatenate(at_parts),
+        np.concatenate(s_parts).astype(np.int64),
+        np.concatenate(e_parts).astype(np.int64),
+    )
+
+
 def _runs(indptr: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(first run of each row, first index, last index of every run): the runs of
     consecutive indices in row order (a run never spans two rows); a row with no index
     has no run, and its first run is the next row's.
 
-    One pass over the indices, in blocks whose temporaries stay in cache."""
+    One pass over the indices (:func:`_run_starts`); the row starts that do not already
+    break a run are inserted afterwards."""
     base = int(indptr[0])
     nnz = int(indptr[-1]) - base
     rel = indptr - base
     if nnz == 0:
         e = np.zeros(0, np.int64)
         return np.zeros(indptr.shape[0] - 1, np.int64), e, e
-    row_start = np.zeros(nnz + 1, bool)
-    row_start[rel[:-1]] = True  # an empty row marks the next row's start (or nnz)
-    brk = np.empty(min(_BLOCK, nnz), bool)
-    dif = np.empty(min(_BLOCK, nnz), indices.dtype)
-    starts: list[np.ndarray] = []
     flat = indices[base : base + nnz]
-    for lo in range(0, nnz, _BLOCK):
-        hi = min(lo + _BLOCK, nnz)
-        k = hi - lo
-        b = brk[:k]
-        if lo == 0:
-            b[0] = True
-        else:
-            b[0] = flat[lo] != flat[lo - 1] + 1
-        np.subtract(flat[lo + 1 : hi], flat[lo : hi - 1], out=dif[: k - 1])
-        np.not_equal(dif[: k - 1], 1, out=b[1:])
-        np.logical_or(b, row_start[lo:hi], out=b)
-        starts.append(np.flatnonzero(b) + lo)
-    s = np.concatenate(starts) if len(starts) > 1 else starts[0]
-    ends = np.empty_like(s)
-    ends[:-1] = s[1:] - 1
-    ends[-1] = nnz - 1
-    first_run = np.searchsorted(s, rel[:-1])
-    return first_run, flat[s].astype(np.int64), flat[ends].astype(np.int64)
+    st, s, e = _run_starts(flat)
+    rs = rel[:-1]
+    rs = rs[rs < nnz]  # rows with an index (an empty row's start is the next row's)
+    pos = np.searchsorted(st, rs)
+    miss = pos == st.size
+    miss |= st[np.minimum(pos, st.size - 1)] != rs
+    if miss.any():  # a row that goes on where the previous one ended: split its run
+        q, p = rs[miss], pos[miss]
+        st = np.insert(st, p, q)
+        s = np.insert(s, p, flat[q].astype(np.int64))
+        e = np.insert(e, p - 1, flat[q - 1].astype(np.int64))
+    first_run = np.searchsorted(st, rel[:-1])
+    return first_run, s, e
 
 
 def eye_summaries(
@@ -157,26 +226,76 @@ def eye_summaries(
 
     Rows with no lit facet get count 0, a zero sum and NaN longitudes and z. With a
     ``name``, the indices are checked (each row strictly increasing, every index in
-    [0, 12 nside^2)) on the runs, at no cost per index: ValueError naming ``name``."""
+    [0, 12 nside^2)) on the runs, at no cost per index: ValueError naming ``name``,
+    with the messages of :func:`eyeviz.estimators.base3d.as_csr`."""
     indptr = np.asarray(indptr, np.int64)
     indices = np.asarray(indices)
+    if name and not (
+        indices.dtype == np.int64 or (indices.dtype == np.int32 and indices.size < 2**31)
+    ):
+        indices = indices.astype(np.int64)  # so no run can wrap all the way round
     rings = _Rings.of(int(nside))
     n = indptr.shape[0] - 1
     count = np.diff(indptr)
     first_run, s, e = _runs(indptr, indices)
     if name:
-        _check_runs(name, rings, count, first_run, s, e)
-    ks = rings.ring(s)
-    a = s - rings.first[ks]
-    b = e - rings.first[ks]
-    last = rings.num[ks] - 1
-    same = b <= last
-    tot = rings.partial(ks, a, np.minimum(b, last))
-    west = rings.phi0[ks] + (a - 0.5) * rings.step[ks]
-    east = rings.phi0[ks] + (b + 0.5) * rings.step[ks]
+        _check_runs(name, rings, count, first_run, s, e, indices.dtype)
+    sum_xyz = np.zeros((n, 3))
+    lon_w = np.full(n, np.nan)
+    lon_e = np.full(n, np.nan)
+    z_top = np.full(n, np.nan)
+    z_bottom = np.full(n, np.nan)
+    bounds = np.empty((n, N_BOUNDS))
+    bounds[:, 0::2] = -_NO_BOUND
+    bounds[:, 1::2] = _NO_BOUND
+    # rows in groups whose per-run temporaries stay in cache (every value is per run or
+    # per row, so the grouping changes no float)
+    for lo in range(0, n, _ROWS):
+        hi = min(lo + _ROWS, n)
+        r0, r1 = int(first_run[lo]), (int(first_run[hi]) if hi < n else s.size)
+        if r1 == r0:
+            continue
+        fr = first_run[lo:hi] - r0
+        out = (sum_xyz[lo:hi], lon_w[lo:hi], lon_e[lo:hi], z_top[lo:hi], z_bottom[lo:hi])
+        runs = _summarise(rings, count[lo:hi], fr, s[r0:r1], e[r0:r1], out)
+        _bounds(rings, count[lo:hi], sum_xyz[lo:hi], fr, *runs, out=bounds[lo:hi])
+    return EyeSummary(count, sum_xyz, lon_w, lon_e, z_top, z_bottom, bounds)
+
+
+def _summarise(
+    rings: _Rings,
+    count: np.ndarray,
+    first_run: np.ndarray,
+    s: np.ndarray,
+    e: np.ndarray,
+    out: tuple[np.ndarray, ...],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Fill ``out`` = (sum_xyz, lon_w, lon_e, z_top, z_bottom) of rows whose runs are
+    (s, e) (the rows' first runs ``first_run``, relative to s); returns the per-run
+    (ring, west, east, within one ring) that :func:`_bounds` reads."""
+    sum_xyz, lon_w, lon_e, z_top, z_bottom = out
+    px = rings.pixels()
+    ks = px.ring[s] if px is not None else rings.ring(s)
+    lastp = rings.last[ks]
+    same = e <= lastp
+    cross = None if same.all() else np.flatnonzero(~same)
+    eb = e if cross is None else np.minimum(e, lastp)  # the run's end in its first ring
+    if px is not None:
+        span = eb - s
+        amp = px.amp[rings.first[ks] + span]
+        mid = s + eb
+        tot = [amp * px.cos_mid[mid], amp * px.sin_mid[mid], (span + 1).astype(np.float64)]
+        tot[2] *= rings.z[ks]
+        west = px.west[s]
+        east = px.east[e if cross is None else eb]
+    else:
+        a = s - rings.first[ks]
+        b = eb - rings.first[ks]
+        tot = rings.partial(ks, a, b)
+        west = rings.phi0[ks] + (a - 0.5) * rings.step[ks]
+        east = rings.phi0[ks] + (b + 0.5) * rings.step[ks]
     ke = ks
-    if not same.all():  # runs across ring boundaries: tail + whole rings + head
-        cross = np.flatnonzero(~same)
+    if cross is not None:  # runs across ring boundaries: tail + whole rings + head
         kc = ks[cross]
         kd = rings.ring(e[cross])
         bd = e[cross] - rings.first[kd]
@@ -188,21 +307,15 @@ def eye_summaries(
         ke = ks.copy()
         ke[cross] = kd
     full = count > 0
-    sum_xyz = np.zeros((n, 3))
-    lon_w = np.full(n, np.nan)
-    lon_e = np.full(n, np.nan)
-    z_top = np.full(n, np.nan)
-    z_bottom = np.full(n, np.nan)
-    if s.size:
-        fr = first_run[full]
-        sum_xyz[full] = np.stack([np.add.reduceat(col, fr) for col in tot], axis=1)
-        lon_w[full] = np.minimum.reduceat(west, fr)
-        lon_e[full] = np.maximum.reduceat(east, fr)
-        z_top[full] = rings.z[ks[fr]]
-        last_run = np.r_[fr[1:] - 1, s.size - 1]
-        z_bottom[full] = rings.z[ke[last_run]]
-    bounds = _bounds(rings, count, sum_xyz, first_run, ks, west, east, same)
-    return EyeSummary(count, sum_xyz, lon_w, lon_e, z_top, z_bottom, bounds)
+    fr = first_run[full]
+    for j, col in enumerate(tot):
+        sum_xyz[full, j] = np.add.reduceat(col, fr)
+    lon_w[full] = np.minimum.reduceat(west, fr)
+    lon_e[full] = np.maximum.reduceat(east, fr)
+    z_top[full] = rings.z[ks[fr]]
+    last_run = np.r_[fr[1:] - 1, s.size - 1]
+    z_bottom[full] = rings.z[ke[last_run]]
+    return ks, west, east, same
 
 
 #: The lit cap's radius from the count, 2 pi (1 - cos a) = count * 4 pi / npix, exceeds
@@ -229,8 +342,10 @@ def _bounds(
     west: np.ndarray,
     east: np.ndarray,
     same: np.ndarray,
-) -> np.ndarray:
-    """Bounds on the cap centre's longitude from each run's two ends (n, N_BOUNDS).
+    out: np.ndarray,
+) -> None:
+    """Bounds on the cap centre's longitude from each run's two ends, into ``out`` (n,
+    N_BOUNDS) (set beforehand to -1 and 1 in alternate columns).
 
     On a ring whose crossing with the cap's boundary is steeper than the cells' edges
     (the ring lies within _STEEP * alpha of the centre's colatitude), the west crossing
@@ -242,14 +357,15 @@ def _bounds(
     over the rings above and below the centre, for the west and east ends, relative to
     the mean direction's longitude in equatorial facet widths gamma, clipped to
     [-1, 1] (empty groups: -1 and 1): columns (west above lo, hi; west below lo, hi;
-    east above lo, hi; east below lo, hi)."""
+    east above lo, hi; east below lo, hi).
+
+    A row's runs come in ring order, so each band of rings is a contiguous range of its
+    runs, found per row on the ring table (:func:`_band_rings`): one reduction per
+    column and band, no mask per band."""
     n = count.shape[0]
-    out = np.empty((n, N_BOUNDS))
-    out[:, 0::2] = -_NO_BOUND
-    out[:, 1::2] = _NO_BOUND
     full = np.flatnonzero(count > 0)
     if ks.size == 0:
-        return out
+        return
     nside = rings.nside
     npix = 12 * nside * nside
     gamma = 2.0 * math.pi / (4 * nside)
@@ -263,30 +379,67 @@ def _bounds(
     alpha = np.maximum(np.arccos(cos_a) - OVERHANG * pix, 0.5 * pix)
     theta0 = np.arccos(z0)
     lens = np.diff(np.r_[first_run, ks.size])
-    row = np.repeat(np.arange(n), lens)
-    zk = rings.z[ks]
-    t = rings.theta[ks] - theta0[row]
     sth0 = np.sqrt(1.0 - z0 * z0)
-    d = rings.step[ks]
-    big = 1e300
-    fr = first_run[full]
     with np.errstate(invalid="ignore", divide="ignore"):
-        arg = (np.cos(alpha)[row] - zk * z0[row]) / (rings.sth[ks] * sth0[row])
-    use = same & (np.abs(arg) < 1.0)
-    w = np.arccos(np.clip(arg, -1.0, 1.0))
-    base = west + w - lon0[row]
-    top = east - w - lon0[row]
-    band = np.searchsorted(BANDS, t / alpha[row]) - 1  # -1 / len(BANDS) - 1: outside
-    # lower bounds as they are, upper bounds negated: a maximum per band and column
-    cols = (base, -(base + d), top - d, -top)
-    for b in range(len(BANDS) - 1):
-        grp = use & (band == b)
-        for j, v in enumerate(cols):
-            red = np.maximum.reduceat(np.where(grp, v, -big), fr)
-            ok = red > -big
-            sign = 1.0 if j % 2 == 0 else -1.0
-            out[full[ok], 4 * b + j] = np.clip(sign * red[ok] / gamma, -_NO_BOUND, _NO_BOUND)
-    return out
+        arg = np.repeat(np.cos(alpha), lens)
+        arg -= rings.z[ks] * np.repeat(z0, lens)
+        arg /= rings.sth[ks] * np.repeat(sth0, lens)
+    use = np.abs(arg) < 1.0
+    if not same.all():
+        use &= same
+    # w_k where the ring counts (|arg| < 1, the run within one ring), NaN elsewhere: the
+    # reductions below skip NaN (fmax, fmin)
+    w = np.full(arg.shape, np.nan)
+    np.arccos(arg, out=w, where=use)
+    d = rings.step[ks]
+    lon0_r = np.repeat(lon0, lens)
+    base = west + w
+    base -= lon0_r
+    top = east - w
+    top -= lon0_r
+    base_d = base + d
+    top_d = top - d
+    # per row, the first run of each band: ring keys (row, ring) rise along the runs
+    key = np.repeat(np.arange(n, dtype=np.int64) * (4 * nside + 1), lens)
+    key += ks
+    kb = _band_rings(rings, theta0[full], alpha[full])  # (len(full), len(BANDS))
+    at = np.searchsorted(key, (full * (4 * nside + 1))[:, None] + kb)
+    seg = at.ravel()
+    lo_b, hi_b = at[:, :-1], at[:, 1:]  # band b: runs [at[:, b], at[:, b + 1])
+    # columns: max of base, min of base + d, max of top - d, min of top (the upper
+    # bounds' maxima of the negated values are minus these minima)
+    cols = ((base, np.fmax), (base_d, np.fmin), (top_d, np.fmax), (top, np.fmin))
+    for j, (v, red_f) in enumerate(cols):
+        red = red_f.reduceat(np.r_[v, np.nan], seg).reshape(at.shape)[:, :-1]
+        ok = (hi_b > lo_b) & ~np.isnan(red)
+        for b in range(len(BANDS) - 1):
+            rows = full[ok[:, b]]
+            out[rows, 4 * b + j] = np.clip(red[ok[:, b], b] / gamma, -_NO_BOUND, _NO_BOUND)
+
+
+def _band_rings(rings: _Rings, theta0: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """(rows, len(BANDS)): per row, the first ring k whose (theta_k - theta0) / alpha,
+    evaluated as :func:`_bounds` would per run, exceeds each of :data:`BANDS` (4 nside + 1
+    if none does): a row's runs in band b are those on rings [k_b, k_(b+1)). A bisection
+    on the ring table with that very expression (monotone in theta_k), so a run's band is
+    the one its own comparison would give, ties included. NaN rows get 4 nside + 1."""
+    th = rings.theta
+    m = th.size
+    lo = np.zeros((theta0.size, BANDS.size), np.int64)
+    hi = np.full(lo.shape, m, np.int64)  # invariant: rings < lo fail, rings >= hi pass
+    t0 = theta0[:, None]
+    al = alpha[:, None]
+    with np.errstate(invalid="ignore"):
+        while True:
+            open_ = lo < hi
+            if not open_.any():
+                break
+            mid = (lo + hi) >> 1
+            v = (th[np.minimum(mid, m - 1)] - t0) / al
+            above = v > BANDS
+            hi = np.where(open_ & above, mid, hi)
+            lo = np.where(open_ & ~above, mid + 1, lo)
+    return lo
 
 
 def _check_runs(
@@ -296,16 +449,28 @@ def _check_runs(
     first_run: np.ndarray,
     s: np.ndarray,
     e: np.ndarray,
+    dtype: np.dtype,
 ) -> None:
-    """Within a run the indices rise by one; so a row is strictly increasing iff each run
-    starts above the previous run's end, and in range iff its runs are."""
+    """Within a run the indices rise by one (in the indices' own integer arithmetic); so
+    a row is strictly increasing iff each run starts above the previous run's end, and
+    in range iff its runs' ends are (a run whose end lies below its start wrapped past
+    the dtype's largest value, which it then holds). The messages are
+    :func:`eyeviz.estimators.base3d.as_csr`'s."""
     if s.size == 0:
         return
     npix = int(rings.first[-1])
-    if s.min() < 0 or e.max() >= npix or np.any(e < s):
-        raise ValueError(f"{name}: indices must lie in [0, npix = {npix})")
+    lo, hi = int(s.min()), int(e.max())
+    wrapped = bool(np.any(e < s))
+    if lo < 0 or hi >= npix or wrapped:
+        # the smallest index if negative, else the largest (as_csr's choice); a wrapped
+        # run holds both of the dtype's extremes
+        info = np.iinfo(dtype)
+        lo, hi = (int(info.min), int(info.max)) if wrapped else (lo, hi)
+        bad = lo if lo < 0 else hi
+        raise ValueError(f"{name}: indices must lie in [0, npix = {npix}), got {bad}")
     later = np.ones(s.size, bool)
     later[first_run[count > 0]] = False
+    later[0] = False
     j = np.flatnonzero(later)
     if np.any(s[j] <= e[j - 1]):
         raise ValueError(f"{name}: indices must increase strictly within a row")
