@@ -1,13 +1,18 @@
 """Help > Keyboard shortcuts (F1) and Help > About the model.
 
 The shortcut table is read from the window's own QActions each time it is shown (menu
-path, name, keys), so it cannot go stale when an action or its key changes. The model page
+path, name, keys), so it cannot go stale when an action or its key changes. The keys and
+mouse gestures the views handle themselves (no QAction carries them) follow:
+:data:`VIEW_KEYS` (the planar view) and :data:`VIEW3D_KEYS` (the 3D view,
+:mod:`eyeviz.app.view3d`), the one list that the 3D view's "Mouse and keys" box is also
+written from (:func:`view3d_help_text`; its camera presets are that menu's actions, listed
+here with the other actions). The model page
 is ``docs/model.md``, shipped with the package as ``assets/help/model.md``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from PyQt5 import QtCore, QtGui, QtWidgets
@@ -15,12 +20,15 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from eyeviz.resources import assets_dir
 
 __all__ = [
+    "VIEW3D_KEYS",
+    "VIEW3D_NOTES",
     "VIEW_KEYS",
     "AboutModelDialog",
     "ShortcutsDialog",
     "about_model_text",
     "model_page_path",
     "shortcut_rows",
+    "view3d_help_text",
 ]
 
 #: Keys the view handles itself (no QAction carries them): shown after the actions' rows.
@@ -29,6 +37,41 @@ VIEW_KEYS = (
     ("View", "Move a feature / pan the view", "drag"),
     ("View", "Zoom / resize a feature", "wheel / Shift+wheel"),
 )
+#: The 3D view's mouse and keys (eyeviz.app.view3d handles them: VTK's trackball camera on
+#: the background, Scene3DHost's event filter on the balls and keys), one (what, keys) row
+#: each: Help > Keyboard shortcuts lists them and 3D view > Mouse and keys is written from
+#: them, so the two cannot differ.
+VIEW3D_KEYS = (
+    ("Turn the view", "left-drag on the background"),
+    ("Pan", "middle-drag, or Shift+left-drag on the background"),
+    ("Zoom", "wheel, or right-drag"),
+    ("Move the ball in the plane through its centre facing you", "left-drag on a ball"),
+    ("Move the ball along the line of sight (up: farther)", "Shift+ or Ctrl+left-drag on a ball"),
+    ("Nudge the selected ball across the screen", "arrow keys (view focused)"),
+    ("Move the selected ball farther / nearer", "Shift+Up / Shift+Down (view focused)"),
+    ("Select the next ball", "Tab (view focused)"),
+)
+#: What the 3D view's box says besides the rows (no keys of their own).
+VIEW3D_NOTES = (
+    "The eyes' close-up (left) looks from the scene camera's direction.",
+    "A drag is one undo step (Ctrl+Z); consecutive nudges of one ball are one too.",
+)
+VIEW3D_MENU = "3D view"  # the menu column of VIEW3D_KEYS' rows in the shortcut table
+
+
+def _first_lower(text: str) -> str:
+    return text[:1].lower() + text[1:]
+
+
+def view3d_help_text(presets: Iterable[tuple[str, str, str]] = ()) -> str:
+    """3D view > Mouse and keys: one line per :data:`VIEW3D_KEYS` row ("keys: what"), the
+    camera presets (``(name, menu text, key)`` as eyeviz.app.view3d.PRESET_KEYS), then
+    :data:`VIEW3D_NOTES`."""
+    lines = [f"{keys[:1].upper()}{keys[1:]}: {_first_lower(what)}." for what, keys in VIEW3D_KEYS]
+    shown = [f"{key} {_first_lower(_plain(text))}" for _name, text, key in presets]
+    if shown:
+        lines.append(f"Camera presets (3D view menu): {', '.join(shown)}.")
+    return "\n".join(lines) + "\n\n" + " ".join(VIEW3D_NOTES)
 
 
 def _plain(text: str) -> str:
@@ -51,7 +94,8 @@ def _keys(a: QtWidgets.QAction) -> str:
 
 def shortcut_rows(win: QtWidgets.QMainWindow) -> list[tuple[str, str, str]]:
     """(menu, action, keys) for every action of the window's menus that has a key, then
-    the window's actions outside any menu, then :data:`VIEW_KEYS`."""
+    the window's actions outside any menu, then :data:`VIEW_KEYS` and
+    :data:`VIEW3D_KEYS`."""
     rows: list[tuple[str, str, str]] = []
     seen: set[int] = set()
     mb = win.menuBar()
@@ -69,6 +113,7 @@ def shortcut_rows(win: QtWidgets.QMainWindow) -> list[tuple[str, str, str]]:
         if id(a) not in seen and _keys(a):
             rows.append(("Window", _plain(a.text()), _keys(a)))
     rows.extend(VIEW_KEYS)
+    rows.extend((VIEW3D_MENU, what, keys) for what, keys in VIEW3D_KEYS)
     return rows
 
 
@@ -91,7 +136,7 @@ class ShortcutsDialog(QtWidgets.QDialog):
         assert hh is not None
         hh.setSectionResizeMode(0, QtWidgets.QHeaderView.ResizeToContents)
         hh.setSectionResizeMode(1, QtWidgets.QHeaderView.Stretch)
-        hh.setSectionResizeMode(2, QtWidgets.QHeaderView.ResizeToContents)
+        hh.setSectionResizeMode(2, QtWidgets.QHeaderView.Stretch)  # the 3D view's mouse rows
         lay.addWidget(self.table)
         close = QtWidgets.QDialogButtonBox(QtWidgets.QDialogButtonBox.Close)
         close.rejected.connect(self.reject)
@@ -107,7 +152,7 @@ class ShortcutsDialog(QtWidgets.QDialog):
         self.table.resizeRowsToContents()
         fm = self.fontMetrics()
         self.resize(
-            min(fm.averageCharWidth() * 90, 1400), min((len(rows) + 4) * (fm.height() + 10), 900)
+            min(fm.averageCharWidth() * 110, 1400), min((len(rows) + 4) * (fm.height() + 10), 900)
         )
 
     def rows(self) -> list[tuple[str, ...]]:
