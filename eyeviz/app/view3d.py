@@ -432,7 +432,7 @@ class Scene3DHost(QtCore.QObject):
         t0 = time.perf_counter()
         st = m.state
         if self.bitmaps is not None:
-            self.bitmaps.set_state(st, m.scene)
+            self.bitmaps.set_state(st, m.scene, m.selected)  # the selected ball outlined
         if self.readout is not None:
             self.readout.set_state(st, m.scene)
             self.readout.set_predictions(self.preds, m.scene)
@@ -654,16 +654,27 @@ class Scene3DHost(QtCore.QObject):
             width=resolve_width(width), title=title, table=table, bitmaps=bitmaps,
             aspect=aspect, camera=cam,
         )  # fmt: skip
+        # the predictions layer: the selected ball's, as shown (computed by the export,
+        # the limit included, while the view still waits for the limit)
+        ball = self.model.selected if self.model.selected is not None else 0
+        preds = self.preds
+        if preds is not None and any(a in ("computing…", "after the drag")
+                                     for a in preds.answers.values()):  # fmt: skip
+            preds = None
         if fmt == ".png":
             from eyeviz.render.vtk.png3d import export_png3d
 
             def work():
-                return export_png3d(scene, path, scale, transparent, **opts)
+                return export_png3d(
+                    scene, path, scale, transparent, ball=ball, predictions=preds, **opts
+                )
 
         else:
 
             def work():
-                return export3d(scene, path, scale, transparent, **opts)
+                return export3d(
+                    scene, path, scale, transparent, predictions=preds, ball=ball, **opts
+                )
 
         def done(out) -> None:
             result.append(Path(out))

@@ -122,12 +122,13 @@ def export_png3d(
     view: str = "default",
     selected: int | None = None,
     predictions: Predictions3D | None = None,
+    ball: int | None = None,
 ) -> Path:
     """Write the spherical scene's figure as a PNG (``width`` inches at 300 dpi times
     ``scale``), atomically: :func:`eyeviz.render.mpl.figure3d.export3d` with the 3D view
     rendered by VTK (:func:`view_rgba`) at the view box's pixel size. EyevizError (one
     line) for a view beyond :data:`MAX_VIEW_PX` pixels. The predictions layer answers
-    for ball ``selected`` (the first when None); ``predictions`` is its content when
+    for ball ``ball`` (default ``selected``, else the first); ``predictions`` is its content when
     computed already (the app's), else it is computed once here for both the view and
     the readout."""
     if Path(path).suffix.lower() != ".png":
@@ -135,8 +136,8 @@ def export_png3d(
     st = compute_state3d(scene)
     preds = predictions
     if scene.shows("predictions") and preds is None and scene.features:
-        ball = 0 if selected is None else min(max(selected, 0), st.n - 1)
-        preds = scene_predictions3d(scene, st, ball, Predictor3D())
+        one = ball if ball is not None else (0 if selected is None else selected)
+        preds = scene_predictions3d(scene, st, min(max(one, 0), st.n - 1), Predictor3D())
 
     def vtk_view(cam: Camera3D, w: int, h: int) -> np.ndarray:
         if max(w, h) > MAX_VIEW_PX:
@@ -153,5 +154,5 @@ def export_png3d(
     return export3d(
         scene, path, scale, transparent, width=width, title=title, table=table,
         bitmaps=bitmaps, aspect=aspect, camera=camera, view=view, view_image=vtk_view,
-        predictions=preds, ball=0 if selected is None else selected,
+        predictions=preds, ball=ball if ball is not None else (selected or 0),
     )  # fmt: skip
