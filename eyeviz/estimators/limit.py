@@ -53,8 +53,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from eyeviz.estimators import analytic
+from eyeviz.estimators import analytic, limit_solve
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
+from eyeviz.estimators.limit_solve import interval_quadratic
 
 __all__ = ["LimitEstimator", "load", "PRIORS", "posterior_nodes", "posterior_samples"]
 
@@ -87,32 +88,6 @@ def _b_halfplanes(domain: Domain, LB, RB):
     b = -flip * sign_g
     rhs = -flip[None, :] * cx * s
     return a, b, rhs
-
-
-def _interval_quadratic(qa, qb, qc):
-    """rho >= 0 with qa rho^2 + qb rho + qc >= 0 as [lo, hi] (lo > hi when empty).
-
-    qc < 0 always here (the point rho = 0 is the eye centre, never feasible).
-    """
-    disc = qb * qb - 4 * qa * qc
-    sq = np.sqrt(np.maximum(disc, 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r1 = (-qb - sq) / (2 * qa)
-        r2 = (-qb + sq) / (2 * qa)
-    pos = qa > 1e-15
-    neg = qa < -1e-15
-    lo = np.where(pos, np.maximum(r1, r2), np.inf)
-    hi = np.full_like(lo, np.inf)
-    # concave: between the roots, if real
-    lo = np.where(neg, np.minimum(r1, r2), lo)
-    hi = np.where(neg, np.maximum(r1, r2), hi)
-    lo = np.where(neg & (disc < 0), np.inf, lo)
-    # (nearly) linear: qb rho + qc >= 0
-    lin = ~(pos | neg)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        root = -qc / qb
-    lo = np.where(lin, np.where(qb > 0, root, np.inf), lo)
-    return lo, hi
 
 
 @dataclass(frozen=True)
@@ -202,7 +177,7 @@ def _rays(keys: np.ndarray, domain: Domain, n: int) -> _Rays:
             hi = np.where(disc >= 0, np.minimum(hi, -au + sq), -np.inf)
             lo = np.where(disc >= 0, np.maximum(lo, -au - sq), lo)
     # g >= r sin(gamma/2):  (sd^2 - s^2) rho^2 - 2 s^2 (A.u) rho - s^2 h^2 >= 0
-    qlo, qhi = _interval_quadratic(
+    qlo, qhi = interval_quadratic(
         sd * sd - s * s, -2 * s * s * au, np.full_like(au, -s * s * h * h)
     )
     lo = np.maximum(lo, qlo)
@@ -310,6 +285,23 @@ def limit_estimates(keys, domain: Domain, prior: str = "single", n: int = 12, k:
     A key none of whose rays has a feasible stretch is empty without computing nodes; a
     key the n x n grid finds empty is retried on a 4n x 4n grid (a sliver polyhedron can
     fall between the rays) when some ray of the 2n x 2n grid reaches it (module
+    docstring), again nodes only where a ray is feasible. Computed by
+    :func:`eyeviz.estimators.limit_solve.estimates` (the same nodes, organised for speed;
+    equal to :func:`_reference_estimates` up to float rounding).
+    """
+    if prior not in PRIORS:
+        raise ValueError(f"prior must be one of {PRIORS}, got {prior!r}")
+    return limit_solve.estimates(keys, domain, prior, int(n), int(k))
+
+
+def _reference_estimates(keys, domain: Domain, prior: str = "single", n: int = 12, k: int = 6):
+    """:func:`limit_estimates` as computed before its fast path (kept as the reference
+    the tests compare that path with): nodes through :func:`posterior_nodes`' own
+    functions, medians by :func:`weighted_median`.
+
+    A key none of whose rays has a feasible stretch is empty without computing nodes; a
+    key the n x n grid finds empty is retried on a 4n x 4n grid (a sliver polyhedron can
+    fall between the rays) when some ray of the 2n x 2n grid reaches it (module
     docstring), again nodes only where a ray is feasible.
     """
     if prior not in PRIORS:
@@ -347,7 +339,7 @@ def limit_estimates(keys, domain: Domain, prior: str = "single", n: int = 12, k:
     if again.size and n < 48:
         again = again[_any_ray(keys[again], domain, 2 * n)]
     if again.size and n < 48:
-        r2, p2, e2 = limit_estimates(keys[again], domain, prior, 4 * n, k)
+        r2, p2, e2 = _reference_estimates(keys[again], domain, prior, 4 * n, k)
         r_out[again], p_out[again], empty[again] = r2, p2, e2
     return r_out, p_out, empty
 

@@ -276,14 +276,14 @@ def test_impossible_keys_skip_the_nodes(monkeypatch):
     """A key no ray of which is feasible (g = 5 at r = 3000) is empty from the rays alone,
     on the default and on the 4x grid: no quadrature nodes are computed for it (before,
     it paid the nodes of both grids: 13.5x a real key)."""
-    from eyeviz.estimators import limit
+    from eyeviz.estimators import limit, limit_solve
 
     eyes = PAPER_DOMAIN.eyes
     key = np.stack(eyes.intervals(np.array([0.0]), np.array([3000.0]), np.array([5.0])), 1)
     calls = []
-    real_nodes = limit._nodes
+    real_nodes = limit_solve._nodes
     monkeypatch.setattr(
-        limit, "_nodes", lambda rays, *a: calls.append(len(rays.cu)) or real_nodes(rays, *a)
+        limit_solve, "_nodes", lambda cu, *a: calls.append(len(cu)) or real_nodes(cu, *a)
     )
     r, p, e = limit.limit_estimates(key, PAPER_DOMAIN)
     assert e.all() and calls == []
@@ -350,8 +350,10 @@ def test_slivers_are_found_and_impossible_keys_skip_the_4x_grid(monkeypatch):
     np.testing.assert_array_equal(p, p48)
     eyes = PAPER_DOMAIN.eyes
     imp = np.stack(eyes.intervals(np.array([0.0]), np.array([3000.0]), np.array([5.0])), 1)
+    from eyeviz.estimators import limit_solve
+
     grids = []
-    real_rays = limit._rays
-    monkeypatch.setattr(limit, "_rays", lambda kk, d, n: grids.append(n) or real_rays(kk, d, n))
+    real_rays = limit_solve.rays
+    monkeypatch.setattr(limit_solve, "rays", lambda kk, p: grids.append(p.n) or real_rays(kk, p))
     assert limit.limit_estimates(imp, PAPER_DOMAIN)[2].all()
     assert grids == [12, 24]
