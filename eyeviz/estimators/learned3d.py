@@ -148,8 +148,12 @@ def read_weights(path: str | os.PathLike) -> tuple[int, dict[str, np.ndarray]]:
 
 
 def _silu(x: np.ndarray) -> np.ndarray:
+    """x / (1 + exp(-x)), in place."""
+    t = np.negative(x)
     with np.errstate(over="ignore"):
-        return x / (1.0 + np.exp(-x))
+        np.exp(t, out=t)
+    t += 1.0
+    return np.divide(x, t, out=x)
 
 
 class Learned3DEstimator(Estimator3D):
@@ -181,9 +185,10 @@ class Learned3DEstimator(Estimator3D):
         for s in range(0, x.shape[0], _BLOCK):
             h = (x[s : s + _BLOCK] - w["x_mean"]) / w["x_scale"]
             for i, layer in enumerate(_LAYERS):
-                h = h @ w[f"net.{layer}.weight"].T + w[f"net.{layer}.bias"]
+                h = h @ w[f"net.{layer}.weight"].T
+                h += w[f"net.{layer}.bias"]
                 if i < len(_LAYERS) - 1:
-                    h = _silu(h)
+                    _silu(h)
             out[s : s + _BLOCK] = h
         return out
 

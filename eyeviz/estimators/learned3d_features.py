@@ -76,7 +76,7 @@ class _PixelTables:
     """Per-pixel tables of one nside, so that a run costs gathers instead of a ring
     search and four sines and cosines: the ring of each pixel; the west and east edge
     longitudes of each cell, phi0 + (j -+ 0.5) * step (j its position in the ring); at
-    first[k] + n - 1, the amplitude of the sum of n consecutive centres of ring k,
+    last[k] - (n - 1), the amplitude of the sum of n consecutive centres of ring k,
     amp[k] * sin(step[k] n / 2); at 2 first[k] + j (j = 0 .. 2 num[k] - 2, the sum of a
     run's first and last position), cos and sin of the run's middle longitude
     phi0[k] + step[k] j / 2. Each entry is the expression :meth:`_Rings.partial` and
@@ -96,7 +96,7 @@ class _PixelTables:
         j = np.arange(ring.size, dtype=np.int64) - r.first[ring]
         west = r.phi0[ring] + (j - 0.5) * r.step[ring]
         east = r.phi0[ring] + (j + 0.5) * r.step[ring]
-        n = (j + 1).astype(np.float64)
+        n = (r.last[ring] - np.arange(ring.size) + 1).astype(np.float64)  # at last - (n - 1)
         amp = r.amp[ring] * np.sin(0.5 * r.step[ring] * n)
         ring2 = np.repeat(kk, 2 * r.num[kk])
         j2 = np.arange(ring2.size, dtype=np.int64) - 2 * r.first[ring2]
@@ -282,7 +282,7 @@ def _summarise(
     eb = e if cross is None else np.minimum(e, lastp)  # the run's end in its first ring
     if px is not None:
         span = eb - s
-        amp = px.amp[rings.first[ks] + span]
+        amp = px.amp[lastp - span]
         mid = s + eb
         tot = [amp * px.cos_mid[mid], amp * px.sin_mid[mid], (span + 1).astype(np.float64)]
         tot[2] *= rings.z[ks]
@@ -306,7 +306,8 @@ def _summarise(
         east[cross] = 2.0 * math.pi
         ke = ks.copy()
         ke[cross] = kd
-    full = count > 0
+    has = count > 0
+    full: np.ndarray | slice = slice(None) if has.all() else has
     fr = first_run[full]
     for j, col in enumerate(tot):
         sum_xyz[full, j] = np.add.reduceat(col, fr)
@@ -393,53 +394,65 @@ def _bounds(
     np.arccos(arg, out=w, where=use)
     d = rings.step[ks]
     lon0_r = np.repeat(lon0, lens)
-    base = west + w
+    # the four columns, each with a NaN after the last run (a band that reaches the
+    # end starts there): max of base, min of base + d, max of top - d, min of top (the
+    # upper bounds' maxima of the negated values are minus these minima)
+    m = ks.size
+    cols = np.empty((4, m + 1))
+    cols[:, m] = np.nan
+    base, base_d, top_d, top = cols[0, :m], cols[1, :m], cols[2, :m], cols[3, :m]
+    np.add(west, w, out=base)
     base -= lon0_r
-    top = east - w
+    np.subtract(east, w, out=top)
     top -= lon0_r
-    base_d = base + d
-    top_d = top - d
+    np.add(base, d, out=base_d)
+    np.subtract(top, d, out=top_d)
     # per row, the first run of each band: ring keys (row, ring) rise along the runs
     key = np.repeat(np.arange(n, dtype=np.int64) * (4 * nside + 1), lens)
     key += ks
     kb = _band_rings(rings, theta0[full], alpha[full])  # (len(full), len(BANDS))
     at = np.searchsorted(key, (full * (4 * nside + 1))[:, None] + kb)
     seg = at.ravel()
-    lo_b, hi_b = at[:, :-1], at[:, 1:]  # band b: runs [at[:, b], at[:, b + 1])
-    # columns: max of base, min of base + d, max of top - d, min of top (the upper
-    # bounds' maxima of the negated values are minus these minima)
-    cols = ((base, np.fmax), (base_d, np.fmin), (top_d, np.fmax), (top, np.fmin))
-    for j, (v, red_f) in enumerate(cols):
-        red = red_f.reduceat(np.r_[v, np.nan], seg).reshape(at.shape)[:, :-1]
-        ok = (hi_b > lo_b) & ~np.isnan(red)
-        for b in range(len(BANDS) - 1):
-            rows = full[ok[:, b]]
-            out[rows, 4 * b + j] = np.clip(red[ok[:, b], b] / gamma, -_NO_BOUND, _NO_BOUND)
+    red = np.empty((full.size, len(BANDS), 4))
+    for j, red_f in enumerate((np.fmax, np.fmin, np.fmax, np.fmin)):
+        red[:, :, j] = red_f.reduceat(cols[j], seg).reshape(at.shape)
+    # band b: runs [at[:, b], at[:, b + 1]); columns 4 b + j
+    bands = red[:, :-1, :].reshape(full.size, N_BOUNDS)
+    ok = np.repeat(at[:, 1:] > at[:, :-1], 4, axis=1) & ~np.isnan(bands)
+    got = out[full]
+    np.copyto(got, np.clip(bands / gamma, -_NO_BOUND, _NO_BOUND), where=ok)
+    out[full] = got
 
 
 def _band_rings(rings: _Rings, theta0: np.ndarray, alpha: np.ndarray) -> np.ndarray:
     """(rows, len(BANDS)): per row, the first ring k whose (theta_k - theta0) / alpha,
     evaluated as :func:`_bounds` would per run, exceeds each of :data:`BANDS` (4 nside + 1
-    if none does): a row's runs in band b are those on rings [k_b, k_(b+1)). A bisection
-    on the ring table with that very expression (monotone in theta_k), so a run's band is
-    the one its own comparison would give, ties included. NaN rows get 4 nside + 1."""
+    if none does): a row's runs in band b are those on rings [k_b, k_(b+1)). A guess from
+    the ring table, then steps with that very expression (monotone in theta_k), so a
+    run's band is the one its own comparison would give, ties included. NaN rows get
+    4 nside + 1."""
     th = rings.theta
     m = th.size
-    lo = np.zeros((theta0.size, BANDS.size), np.int64)
-    hi = np.full(lo.shape, m, np.int64)  # invariant: rings < lo fail, rings >= hi pass
-    t0 = theta0[:, None]
-    al = alpha[:, None]
+
+    def passes(k: np.ndarray) -> np.ndarray:  # ring k's value exceeds the edge; k = m: yes
+        v = (th[np.minimum(k, m - 1)] - theta0[:, None]) / alpha[:, None]
+        return (v > BANDS) | (k >= m)
+
     with np.errstate(invalid="ignore"):
+        # a guess from the sorted table, then exact steps down and up (0 or 1 usually)
+        k = np.searchsorted(th, theta0[:, None] + BANDS * alpha[:, None], side="right")
+        k = np.minimum(k, m)
         while True:
-            open_ = lo < hi
-            if not open_.any():
+            down = (k > 0) & passes(k - 1)
+            if not down.any():
                 break
-            mid = (lo + hi) >> 1
-            v = (th[np.minimum(mid, m - 1)] - t0) / al
-            above = v > BANDS
-            hi = np.where(open_ & above, mid, hi)
-            lo = np.where(open_ & ~above, mid + 1, lo)
-    return lo
+            k -= down
+        while True:
+            up = ~passes(k)
+            if not up.any():
+                break
+            k += up
+    return k
 
 
 def _check_runs(
@@ -468,12 +481,13 @@ def _check_runs(
         lo, hi = (int(info.min), int(info.max)) if wrapped else (lo, hi)
         bad = lo if lo < 0 else hi
         raise ValueError(f"{name}: indices must lie in [0, npix = {npix}), got {bad}")
-    later = np.ones(s.size, bool)
-    later[first_run[count > 0]] = False
-    later[0] = False
-    j = np.flatnonzero(later)
-    if np.any(s[j] <= e[j - 1]):
-        raise ValueError(f"{name}: indices must increase strictly within a row")
+    # runs that do not start above the previous run's end must each start a row
+    j = np.flatnonzero(s[1:] <= e[:-1]) + 1
+    if j.size:
+        heads = first_run[count > 0]
+        at = np.minimum(np.searchsorted(heads, j), heads.size - 1)
+        if not np.array_equal(heads[at], j):
+            raise ValueError(f"{name}: indices must increase strictly within a row")
 
 
 def triangulate(

@@ -65,3 +65,49 @@ def test_range_checked_by_min_and_max():
         as_csr("lit_a", (np.array([0, 2]), np.array([3, 768], np.int32)), NPIX)
     with pytest.raises(ValueError, match="got -1"):
         as_csr("lit_a", (np.array([0, 2]), np.array([-1, 3], np.int32)), NPIX)
+
+
+def test_check_indices_false_leaves_out_only_the_pass_over_the_indices():
+    ptr, ind = np.array([0, 2]), np.array([9, 3], np.int32)  # falls within a row
+    p, i, _ = as_csr("lit_a", (ptr, ind), NPIX, check_indices=False)
+    assert i is ind and np.array_equal(p, ptr)
+    with pytest.raises(ValueError, match="increase strictly"):
+        as_csr("lit_a", (ptr, ind), NPIX)
+    with pytest.raises(ValueError, match="indptr must start at 0"):
+        as_csr("lit_a", (np.array([1, 2]), ind), NPIX, check_indices=False)
+    with pytest.raises(ValueError, match="1-D integer"):
+        as_csr("lit_a", (ptr, ind.astype(float)), NPIX, check_indices=False)
+
+
+class _Unchecking(base3d.Estimator3D):
+    """Claims to check the indices it is handed, and records them instead."""
+
+    checks_indices = True
+
+    def __init__(self):
+        from eyeviz.core.domain3d import Domain3D
+
+        super().__init__(Domain3D(nside=8))  # npix 768
+        self.seen = []
+
+    def _predict_csr(self, lit_a, lit_b):
+        self.seen.append((lit_a[1].copy(), lit_b[1].copy()))
+        n = lit_a[0].size - 1
+        return np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, bool)
+
+
+def test_an_estimator_that_checks_indices_gets_them_unchecked_but_skipped_rows_are_checked():
+    est = _Unchecking()
+    lit_a = (np.array([0, 2, 3]), np.array([9, 3, 5]))  # row 0 falls: handed over
+    lit_b = (np.array([0, 1, 2]), np.array([4, 6]))
+    est.predict(lit_a, lit_b)
+    assert np.array_equal(est.seen[0][0], [9, 3, 5])
+    # row 1 of lit_b is empty, so row 1 is not handed over: predict checks it itself
+    lit_a = (np.array([0, 1, 3]), np.array([4, 9, 3]))
+    lit_b = (np.array([0, 1, 1]), np.array([4]))
+    with pytest.raises(ValueError, match="lit_a: indices must increase strictly"):
+        est.predict(lit_a, lit_b)
+    lit_a = (np.array([0, 0, 1]), np.array([4]))  # row 0 empty
+    lit_b = (np.array([0, 1, 2]), np.array([NPIX, 5]))
+    with pytest.raises(ValueError, match=r"lit_b: indices must lie in \[0, npix = 768\), got 768"):
+        est.predict(lit_a, lit_b)
