@@ -17,7 +17,8 @@ the first one named is checked against the targets.
 Window-up: whole process, start to first rendered frame (median of 3), target <= 3 s.
 With ``--predictions`` the scenes also show the predictions layer (estimators analytic and
 compact: at m = 36,000 compact is its one-line "trained for" message): every drag frame
-then asks the Predictor and redraws the prediction ghosts.
+then asks the Predictor and redraws the prediction ghosts. The harness (scene, window,
+timed drag) is scripts/_bench_app_common.py, shared with scripts/bench_app_scale.py.
 
     xvfb-run -a .venv/bin/python scripts/bench_app.py [--events 240] [--predictions]
 """
@@ -25,15 +26,16 @@ then asks the Predictor and redraws the prediction ghosts.
 from __future__ import annotations
 
 import argparse
-import math
-import os
-import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _bench_app_common import drag, open_window, pct, release, scene, under_display  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = ((720, 10), (36_000, 50))
@@ -43,84 +45,9 @@ UP_TARGET_S = 3.0
 
 PREDICTIONS = False  # --predictions: the scenes show the predictions layer
 
-
-def _scene(m: int, n: int):
-    import numpy as np
-
-    from eyeviz.model.scene import OKABE_ITO, Eyes, Feature, Scene, View
-
-    rng = np.random.default_rng(7)
-    fs = []
-    for i in range(n):
-        r = rng.uniform(1000, 5000)
-        phi = rng.uniform(math.radians(40), math.radians(140))
-        fs.append(
-            Feature(
-                f"f{i}",
-                r * math.cos(phi),
-                r * math.sin(phi),
-                float(rng.uniform(20, 300)),
-                OKABE_ITO[i % len(OKABE_ITO)],
-            )
-        )
-    # the dragged feature goes last: the topmost disc, so the press grabs it even where
-    # a random disc overlaps it
-    fs[-1] = Feature("dragged", 0.0, 1500.0, 50.0, OKABE_ITO[0])
-    layers = ["eyes", "bfv", "features", "bitmaps", "readout", "labels"]
-    est = ["analytic", "compact"] if PREDICTIONS else []
-    if PREDICTIONS:
-        layers.append("predictions")
-    sc = Scene(Eyes(40.0, 20.0, m), fs, layers, view=View((0.0, 2600.0), 9000.0))
-    sc.estimators = est
-    return sc
-
-
-def _pct(v, q):
-    s = sorted(v)
-    return s[min(len(s) - 1, int(round(q / 100 * (len(s) - 1))))]
-
-
 def bench_drag(m: int, n: int, events: int, settings: str, backend: str = "vtk") -> dict:
-    from PyQt5 import QtCore
-    from PyQt5.QtTest import QTest
-
-    import eyeviz.app.view as view
-    from eyeviz.app.window import MainWindow, make_app, make_settings
-
-    view.BACKEND = backend
-    app = make_app()
-    win = MainWindow(_scene(m, n), settings=make_settings(settings))
-    win.resize(1280, 800)
-    win.show()
-    for _ in range(5):
-        app.processEvents()
-    win.fit_inset()
-    w = win.plotter
-    rw = win.ren_win
-
-    def frame(before: int, was) -> bool:
-        """Until the frame drawn after the event; False when the event changed nothing."""
-        idle = 0
-        while w.frames == before:
-            app.processEvents()
-            f = win.model.scene.features[-1]
-            if not win._frame_pending and (f.x, f.y) == was:
-                idle += 1
-                if idle > 3:  # Qt sent no event (same pixel) or the feature did not move
-                    return False
-        rw.WaitForCompletion()
-        app.processEvents()  # the panels' paint events
-        return True
-
-    assert w.backend == backend, (w.backend, backend)
-    base = []
-
-    def bare() -> None:
-        t0 = time.perf_counter()
-        win.render()
-        rw.WaitForCompletion()
-        base.append(1e3 * (time.perf_counter() - t0))
-
+    app, win, _up = open_window(scene(m, n, PREDICTIONS), settings, backend)
+    assert win.plotter.backend == backend, (win.plotter.backend, backend)
     if PREDICTIONS:  # the estimators load on a worker thread: wait for the ghosts
         t_end = time.perf_counter() + 60.0
         while win.model.loading and time.perf_counter() < t_end:
@@ -128,36 +55,13 @@ def bench_drag(m: int, n: int, events: int, settings: str, backend: str = "vtk")
             time.sleep(0.01)
         assert not win.model.loading, "the estimators did not load"
         assert win.overlays.ghosts, "no prediction ghost drawn"
-    for _ in range(10):  # warm-up
-        win.render()
-        rw.WaitForCompletion()
-    px, py = win.to_pixel(0.0, 1500.0)
-    start = QtCore.QPoint(round(px), round(py))
-    # mouse events through the view's native window (QWindow): Qt's input path into the
-    # widget's event filter, delivered at once. QTest on the QWidget warps the X pointer
-    # instead, and every other move then arrived one iteration late (it was counted as
-    # "idle" and the next move timed two frames): half the events were lost to the stats
-    win_in = w.windowHandle()
-    QTest.mousePress(win_in, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
-    lat = []
-    for k in range(events + 10):
-        a = 2 * math.pi * k / 80
-        p = start + QtCore.QPoint(round(150 * math.sin(a)) + k % 3, round(-60 * (1 - math.cos(a))))
-        t0 = time.perf_counter()
-        before = w.frames
-        f = win.model.scene.features[-1]
-        was = (f.x, f.y)
-        QTest.mouseMove(win_in, p)
-        drew = frame(before, was)
-        if k >= 10 and drew:  # the first moves cross the click/drag threshold
-            lat.append(1e3 * (time.perf_counter() - t0))
-            bare()
-    QTest.mouseRelease(win_in, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, p)
+    d = drag(app, win, events, skip=10, period=80, warmup=10)
+    release(win, d)
     moved = win.model.scene.features[-1].x != 0.0
     steps = win.undo_stack.count()
     win.force_close()  # the drag is an unsaved change: no prompt (it hung here)
     app.processEvents()
-    return {"lat": lat, "base": base, "moved": moved, "undo_steps": steps}
+    return {"lat": d.lat, "base": d.base, "moved": moved, "undo_steps": steps}
 
 
 def bench_up(settings: str) -> float:
@@ -206,13 +110,9 @@ def main() -> int:
     PREDICTIONS = args.predictions
     if args.events < 200:
         ap.error("--events must be >= 200")
-    if not os.environ.get("DISPLAY"):
-        if not shutil.which("xvfb-run"):
-            print("bench_app: no display and no xvfb-run", file=sys.stderr)
-            return 2
-        cmd = ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24", sys.executable, *sys.argv]
-        return subprocess.call(cmd)
-    os.environ.setdefault("QT_API", "pyqt5")
+    code = under_display("bench_app")
+    if code is not None:
+        return code
     with tempfile.TemporaryDirectory() as tmp:
         settings = str(Path(tmp) / "bench.ini")
         if PREDICTIONS:
@@ -241,7 +141,7 @@ def main() -> int:
                 pool["base"] += r["base"]
             for backend in args.views:
                 lat, base = pooled[backend]["lat"], pooled[backend]["base"]
-                p50, p95, b50, b95 = _pct(lat, 50), _pct(lat, 95), _pct(base, 50), _pct(base, 95)
+                p50, p95, b50, b95 = pct(lat, 50), pct(lat, 95), pct(base, 50), pct(base, 95)
                 q50, q95 = p50 / b50, p95 / b95
                 p50s[(m, backend)] = p50
                 if backend == args.views[0]:

@@ -1,33 +1,34 @@
-"""The app at scale (issue 25): a drag frame with 10^4 features against one with 10, and
-against a bare render of the same window (same run, same state).
+"""The app at scale (issue 25): a drag frame with 10^4 features against one with 10, with
+and without the backdrop of the merged discs (same run, same scenes).
 
 Runs under Xvfb (re-executes itself with xvfb-run when $DISPLAY is unset), 1280x800, this
 machine's software OpenGL, the app's default view widget. For m = 720 with 10 and with
-10,000 features (random discs in the view, as bench_app.py's scenes, the dragged one
-last) it presses on the last feature, sends mouse-move events along a path and times each
-from the event to the end of the first frame that reflects it (glFinish, then the panels'
-paint events); right after each drag frame it times a bare re-render of the window. It
-then releases the button (the gesture's one undo step), times the release and an undo,
-and counts the Scene copies an edit makes. Printed: p50 / p95 of the drag frames and of
-the bare renders, the ratios drag(10^4) / bare(10^4) (target <= 3x) and
-drag(10^4) / drag(10), the release and undo times, and Scene.copy at 10^4 features.
+10,000 features (random discs in the view, bench_app.py's scenes: the harness is
+scripts/_bench_app_common.py) it presses on the last feature, sends mouse-move events along
+a path and times each from the event to the end of the first frame that reflects it
+(glFinish, then the panels' paint events); right after each drag frame it times a bare
+re-render of the window, and after the drag a *full* render (the backdrop's kept discs
+dropped: every disc filled again, what a frame cost before the backdrop). It then releases
+the button (the gesture's one undo step), times the release and an undo, and counts the
+Scene copies an edit makes. The 10^4 case runs twice: with the backdrop
+(eyeviz/render/vtk/backdrop.py, the app's path from BACKDROP_MIN_FEATURES features) and
+with every disc in the main renderer (the path before it, and small scenes').
 
-What is left at 10^4 is the bare render itself (bare(10^4) / bare(10) is printed too): in
-software GL (llvmpipe) ~10^5 disc triangles and ~16 M overlapping fragments of the merged
-discs, drawn whether or not anything moved. Measured 2026-11-25 on the 2-core machine
-under load ~8: drag p50 618 ms, bare 556 ms at 10^4 (before the level of detail, the
-inset's culling and the single name label: 3674 ms and 3626 ms); window up 3.4 s (27.6 s).
+Printed: p50 / p95 of the drag frames, bare and full renders, the backdrop's captures and
+hits during the drag; the ratios drag(10^4) / drag(10) (target <= 3x), drag(10^4) /
+full render(10^4), and drag(10^4, backdrop) / drag(10^4, without). ``--crossover`` also
+measures drag p50 with and without the backdrop at 300, 1,000 and 3,000 features (where
+BACKDROP_MIN_FEATURES comes from).
 
-    xvfb-run -a .venv/bin/python scripts/bench_app_scale.py [--events 60]
+Measured 2026-11-26 on the quiet 2-core machine (load < 0.5): before the backdrop drag p50
+138 ms at 10^4 against 7.7 ms at 10 features (17.9x); see the README for this stop's run.
+
+    xvfb-run -a .venv/bin/python scripts/bench_app_scale.py [--events 60] [--crossover]
 """
 
 from __future__ import annotations
 
 import argparse
-import math
-import os
-import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -35,98 +36,53 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_app import _pct  # noqa: E402
+from _bench_app_common import (  # noqa: E402
+    bare_render,
+    drag,
+    open_window,
+    pct,
+    release,
+    scene,
+    under_display,
+)
 
-CASES = (10, 10_000)
+SMALL, BIG = 10, 10_000
+CROSSOVER = (300, 1_000, 3_000)
 M = 720
 RATIO_TARGET = 3.0
+NEVER = 10**9  # a backdrop threshold no scene reaches: every disc in the main renderer
 
 
-def _scene(n: int):
-    import numpy as np
-
-    from eyeviz.model.scene import OKABE_ITO, Eyes, Feature, Scene, View
-
-    rng = np.random.default_rng(7)
-    r = rng.uniform(1000, 5000, n)
-    phi = rng.uniform(math.radians(40), math.radians(140), n)
-    g = rng.uniform(20, 300, n)
-    fs = [
-        Feature(
-            f"f{i}",
-            float(r[i] * math.cos(phi[i])),
-            float(r[i] * math.sin(phi[i])),
-            float(g[i]),
-            OKABE_ITO[i % len(OKABE_ITO)],
-        )
-        for i in range(n)
-    ]
-    fs[-1] = Feature("dragged", 0.0, 1500.0, 50.0, OKABE_ITO[0])
-    layers = ["eyes", "bfv", "features", "bitmaps", "readout", "labels"]
-    return Scene(Eyes(40.0, 20.0, M), fs, layers, view=View((0.0, 2600.0), 9000.0))
-
-
-def bench_drag(n: int, events: int, settings: str) -> dict:
-    from PyQt5 import QtCore
-    from PyQt5.QtTest import QTest
-
+def bench_drag(n: int, events: int, settings: str, backdrop_min: int | None, undo=True) -> dict:
+    """One window of n features, the backdrop from ``backdrop_min`` features (None: the
+    app's BACKDROP_MIN_FEATURES)."""
     import eyeviz.model.scene as scene_mod
-    from eyeviz.app.window import MainWindow, make_app, make_settings
 
-    app = make_app()
-    t0 = time.perf_counter()
-    win = MainWindow(_scene(n), settings=make_settings(settings))
-    win.resize(1280, 800)
-    win.show()
+    app, win, up = open_window(scene(M, n), settings)
+    feats = win.actors.features
+    if backdrop_min is not None:
+        feats.set_backdrop_min(backdrop_min)
+    bd = feats.backdrop
+    d = drag(app, win, events, skip=5, period=40, warmup=3)
+    captures, hits = bd.captures, bd.hits  # during the drag (warm-up included)
+    full = []
     for _ in range(5):
+        bd.invalidate()
+        full.append(bare_render(win))
+    out = {
+        "lat": d.lat,
+        "base": d.base,
+        "full": full,
+        "up": up,
+        "captures": captures,
+        "hits": hits,
+        "backdrop": bd.active,
+    }
+    if not undo:
+        release(win, d)
+        win.force_close()
         app.processEvents()
-    win.fit_inset()
-    up = time.perf_counter() - t0
-    w = win.plotter
-    rw = win.ren_win
-
-    def frame(before: int, was) -> bool:
-        idle = 0
-        while w.frames == before:
-            app.processEvents()
-            f = win.model.scene.features[-1]
-            if not win._frame_pending and (f.x, f.y) == was:
-                idle += 1
-                if idle > 3:
-                    return False
-        rw.WaitForCompletion()
-        app.processEvents()
-        return True
-
-    base: list[float] = []
-
-    def bare() -> None:
-        t = time.perf_counter()
-        win.render()
-        rw.WaitForCompletion()
-        base.append(1e3 * (time.perf_counter() - t))
-
-    for _ in range(3):
-        win.render()
-        rw.WaitForCompletion()
-    px, py = win.to_pixel(0.0, 1500.0)
-    start = QtCore.QPoint(round(px), round(py))
-    win_in = w.windowHandle()
-    QTest.mousePress(win_in, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
-    lat = []
-    p = start
-    for k in range(events + 5):
-        a = 2 * math.pi * k / 40
-        p = start + QtCore.QPoint(round(150 * math.sin(a)) + k % 3, round(-60 * (1 - math.cos(a))))
-        t = time.perf_counter()
-        before = w.frames
-        f = win.model.scene.features[-1]
-        was = (f.x, f.y)
-        QTest.mouseMove(win_in, p)
-        drew = frame(before, was)
-        if k >= 5 and drew:
-            lat.append(1e3 * (time.perf_counter() - t))
-            bare()
+        return out
     copies = [0]
     real_copy = scene_mod.Scene.copy
 
@@ -137,18 +93,18 @@ def bench_drag(n: int, events: int, settings: str) -> dict:
     scene_mod.Scene.copy = counted  # type: ignore[method-assign]
     try:
         t = time.perf_counter()
-        QTest.mouseRelease(win_in, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, p)
+        release(win, d)
         app.processEvents()
-        release = 1e3 * (time.perf_counter() - t)
-        release_copies = copies[0]
+        out["release"] = 1e3 * (time.perf_counter() - t)
+        out["copies"] = copies[0]
         moved = win.model.scene.features[-1].x != 0.0
         steps = win.undo_stack.count()
         t = time.perf_counter()
         win.model.finish_gestures()
         win.undo_stack.undo()
         app.processEvents()
-        rw.WaitForCompletion()
-        undo = 1e3 * (time.perf_counter() - t)
+        win.ren_win.WaitForCompletion()
+        out["undo"] = 1e3 * (time.perf_counter() - t)
         restored = win.model.scene.features[-1].x == 0.0
     finally:
         scene_mod.Scene.copy = real_copy  # type: ignore[method-assign]
@@ -156,63 +112,83 @@ def bench_drag(n: int, events: int, settings: str) -> dict:
     t = time.perf_counter()
     for _ in range(5):
         sc.copy()
-    copy_ms = 1e3 * (time.perf_counter() - t) / 5
+    out["copy_ms"] = 1e3 * (time.perf_counter() - t) / 5
     win.force_close()
     app.processEvents()
-    ok = moved and restored and steps == 1
-    return {
-        "lat": lat,
-        "base": base,
-        "ok": ok,
-        "release": release,
-        "undo": undo,
-        "copies": release_copies,
-        "copy_ms": copy_ms,
-        "up": up,
-    }
+    out["ok"] = moved and restored and steps == 1
+    return out
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--events", type=int, default=60, help="mouse-move events per case (>= 20)")
+    ap.add_argument(
+        "--crossover",
+        action="store_true",
+        help="also drag at 300, 1,000 and 3,000 features with and without the backdrop",
+    )
     args = ap.parse_args()
     if args.events < 20:
         ap.error(f"--events must be >= 20, got {args.events}")
-    if not os.environ.get("DISPLAY"):
-        if not shutil.which("xvfb-run"):
-            print("bench_app_scale: no display and no xvfb-run", file=sys.stderr)
-            return 2
-        cmd = ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24", sys.executable, *sys.argv]
-        return subprocess.call(cmd)
-    os.environ.setdefault("QT_API", "pyqt5")
-    res = {}
+    code = under_display("bench_app_scale")
+    if code is not None:
+        return code
+    res: dict[str, dict] = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for n in CASES:
-            res[n] = bench_drag(n, args.events, str(Path(tmp) / "bench.ini"))
+        ini = str(Path(tmp) / "bench.ini")
+        # the big case without, then with the backdrop, then the small one: neither path
+        # of the big case has the run's first window
+        res["small"] = bench_drag(SMALL, args.events, ini, None)
+        res["big, no backdrop"] = bench_drag(BIG, args.events, ini, NEVER)
+        res["big"] = bench_drag(BIG, args.events, ini, None)
+        cross = {}
+        if args.crossover:
+            for n in CROSSOVER:
+                for on in (False, True):
+                    r = bench_drag(n, max(20, args.events // 2), ini, 0 if on else NEVER, False)
+                    cross[(n, on)] = r
+    names = {
+        "small": f"{SMALL}",
+        "big, no backdrop": f"{BIG:,} no backdrop",
+        "big": f"{BIG:,} backdrop",
+    }
     print(
-        f"{'features':>9}{'events':>7}{'drag50':>8}{'drag95':>8}{'bare50':>8}{'bare95':>8}"
-        f"{'d50/b50':>9}{'release':>9}{'undo':>8}{'copies':>7}{'copy ms':>8}{'up s':>6}"
+        f"{'features':<20}{'events':>7}{'drag50':>8}{'drag95':>8}{'bare50':>8}{'full50':>8}"
+        f"{'capt':>6}{'hits':>6}{'release':>9}{'undo':>8}{'copies':>7}{'copy ms':>8}{'up s':>6}"
     )
-    for n, r in res.items():
-        lat, base = r["lat"], r["base"]
+    for key, r in res.items():
+        lat = r["lat"]
         print(
-            f"{n:>9,}{len(lat):>7}{_pct(lat, 50):>8.1f}{_pct(lat, 95):>8.1f}{_pct(base, 50):>8.1f}"
-            f"{_pct(base, 95):>8.1f}{_pct(lat, 50) / _pct(base, 50):>8.2f}x{r['release']:>9.1f}"
-            f"{r['undo']:>8.1f}{r['copies']:>7}{r['copy_ms']:>8.2f}{r['up']:>6.1f}"
+            f"{names[key]:<20}{len(lat):>7}{pct(lat, 50):>8.1f}{pct(lat, 95):>8.1f}"
+            f"{pct(r['base'], 50):>8.1f}{pct(r['full'], 50):>8.1f}{r['captures']:>6}"
+            f"{r['hits']:>6}{r['release']:>9.1f}{r['undo']:>8.1f}{r['copies']:>7}"
+            f"{r['copy_ms']:>8.2f}{r['up']:>6.1f}"
         )
-    big, small = res[CASES[-1]], res[CASES[0]]
-    q_bare = _pct(big["lat"], 50) / _pct(big["base"], 50)
-    q_small = _pct(big["lat"], 50) / _pct(small["lat"], 50)
+    big, small, old = res["big"], res["small"], res["big, no backdrop"]
+    q_small = pct(big["lat"], 50) / pct(small["lat"], 50)
+    q95_small = pct(big["lat"], 95) / pct(small["lat"], 95)
     print(
-        f"drag p50 at {CASES[-1]:,} / bare render p50 at {CASES[-1]:,}: {q_bare:.2f}x "
+        f"drag at {BIG:,} / drag at {SMALL}: p50 {q_small:.2f}x, p95 {q95_small:.2f}x "
         f"(target <= {RATIO_TARGET:g}x)"
     )
-    print(f"drag p50 at {CASES[-1]:,} / drag p50 at {CASES[0]}: {q_small:.2f}x")
     print(
-        f"bare render p50 at {CASES[-1]:,} / at {CASES[0]}: "
-        f"{_pct(big['base'], 50) / _pct(small['base'], 50):.2f}x"
+        f"drag p50 at {BIG:,}, backdrop / without: {pct(big['lat'], 50) / pct(old['lat'], 50):.2f}x"
+        f" ({pct(big['lat'], 50):.1f} ms / {pct(old['lat'], 50):.1f} ms)"
     )
-    ok = all(r["ok"] for r in res.values()) and q_bare <= RATIO_TARGET
+    print(
+        f"drag p50 at {BIG:,} / full render p50 at {BIG:,}: "
+        f"{pct(big['lat'], 50) / pct(big['full'], 50):.2f}x"
+    )
+    print(
+        f"full render p50 at {BIG:,} / at {SMALL}: "
+        f"{pct(big['full'], 50) / pct(small['full'], 50):.2f}x"
+    )
+    if cross:
+        print(f"{'crossover':<12}{'no backdrop':>13}{'backdrop':>10}{'ratio':>8}   (drag p50, ms)")
+        for n in CROSSOVER:
+            off, on = pct(cross[(n, False)]["lat"], 50), pct(cross[(n, True)]["lat"], 50)
+            print(f"{n:>9,}   {off:>13.1f}{on:>10.1f}{on / off:>7.2f}x")
+    ok = all(r["ok"] for r in res.values()) and q_small <= RATIO_TARGET and big["backdrop"]
     print("all targets met" if ok else "SOME TARGETS MISSED")
     return 0
 
