@@ -234,6 +234,7 @@ class FrameInputs:
     predictions: dict | None = None
     ambiguity: dict[int, dict | None] | None = None
     trajectory: TrajectoryPath | None = None
+    named: list[int] | None = None  # the features the labels layer names (None: all)
 
 
 def _polar(st: SceneState) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -322,11 +323,15 @@ def build_labels(fr: Frame, inp: FrameInputs) -> None:
         LabelFrame("O", 0.0, y, "eye"),
     ]
     if "features" in fr.layers:
-        d = FEATURE_LABEL_OFFSET * st.g
-        xs, ys = (st.x + d).tolist(), (st.y + d).tolist()
+        fs = inp.scene.features
+        rows = np.arange(len(fs))
+        if inp.named is not None:
+            rows = np.array([i for i in inp.named if 0 <= i < len(fs)], dtype=np.intp)
+        d = FEATURE_LABEL_OFFSET * st.g[rows]
+        xs, ys = (st.x[rows] + d).tolist(), (st.y[rows] + d).tolist()
         fr.labels += [
-            LabelFrame(f.name, x, y_, "feature", i)
-            for i, (f, x, y_) in enumerate(zip(inp.scene.features, xs, ys, strict=True))
+            LabelFrame(fs[i].name, x, y_, "feature", i)
+            for i, x, y_ in zip(rows.tolist(), xs, ys, strict=True)
         ]
 
 
@@ -428,6 +433,7 @@ def build_frame(
     only: int | None = None,
     ambiguity: dict[int, dict | None] | None = None,
     trajectory: TrajectoryPath | None = None,
+    named: list[int] | None = None,
 ) -> Frame:
     """The :class:`Frame` of ``scene`` for its layers: the readout every layer shares,
     then the frame builder of each layer shown (the layer table,
@@ -440,7 +446,9 @@ def build_frame(
     ``only`` limits the per-feature teaching layers (tangents, sectors, posterior) to one
     feature (the app's selection). ``ambiguity`` ({feature: region or None}, e.g. the app
     model's cached region) and ``trajectory`` (a :class:`TrajectoryPath` already made) are
-    taken as given instead of being computed.
+    taken as given instead of being computed. ``named`` limits the features' name labels
+    to those features (the app's view, which names only its selection among many: no
+    10^4 label objects per drag frame).
     """
     st = state_for(scene, state)
     pair = st.pair
@@ -482,7 +490,9 @@ def build_frame(
         fr.in_domain = st.in_domain()
     fr.out_of_domain = np.zeros(n, bool)
     teach = list(range(n)) if only is None else [only] if 0 <= only < n else []
-    inp = FrameInputs(scene, st, pair, box, teach, predictor, predictions, ambiguity, trajectory)
+    inp = FrameInputs(
+        scene, st, pair, box, teach, predictor, predictions, ambiguity, trajectory, named
+    )
     for spec in ordered("frame", lay):
         resolve(spec.frame)(fr, inp)
     return fr

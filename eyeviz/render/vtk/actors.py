@@ -31,6 +31,7 @@ from eyeviz.render.vtk.layers.features import FeaturesLayer
 from eyeviz.render.vtk.layers.labels import LabelsLayer
 from eyeviz.render.vtk.layers.sectors import SectorsLayer
 from eyeviz.render.vtk.layers.tangents import TangentsLayer
+from eyeviz.render.vtk.style import LABEL_ALL_MAX
 
 __all__ = ["SceneActors", "eye_mesh", "inset_viewport", "view_frame"]
 
@@ -65,9 +66,17 @@ def view_frame(
     selected feature only, the BFV wedge clipped to ``rect`` (the view passes what its
     cameras show); no estimator, ambiguity region or trajectory (the overlay stage's, from
     the app model: :mod:`eyeviz.render.vtk.overlays`), so the predictions layer only greys
-    the features outside the estimators' domain here."""
+    the features outside the estimators' domain here. Beyond LABEL_ALL_MAX features the
+    labels layer names the selected feature alone (:mod:`eyeviz.render.vtk.layers.labels`),
+    so the Frame holds that one name label (issue 25: 10^4 label objects a drag frame,
+    and the garbage collections they caused, were a third of the frame)."""
     light = dataclasses.replace(scene, estimators=[], trajectory=None)
-    return build_frame(light, state, rect=rect, predictions={}, ambiguity={}, only=selected)
+    many = len(scene.features) > LABEL_ALL_MAX
+    # (feature 0's without a selection: the one label actor exists, hidden)
+    named = [0 if selected is None else selected] if many else None
+    return build_frame(
+        light, state, rect=rect, predictions={}, ambiguity={}, only=selected, named=named
+    )
 
 
 class SceneActors:

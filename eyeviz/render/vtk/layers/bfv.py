@@ -89,6 +89,7 @@ class BFVLayer:
         self._psi_side = 1.0
         empty = np.zeros(0)
         self._obstacles: tuple = (empty, empty, empty, [], False)  # the last Frame's features
+        self._name_chars: tuple[list[str], np.ndarray] = ([], empty)  # names, len + 1 each
 
     def draw(self, frame: Frame, selected: int | None) -> None:
         shown = "bfv" in frame.layers and frame.bfv is not None
@@ -172,7 +173,9 @@ class BFVLayer:
             self._obstacles = (xs, ys, gs, names, named)
         # the features' names, right of each disc (22 px text, render.vtk.layers.labels)
         lx0 = xs + gs
-        lx1 = lx0 + np.array([len(n) + 1 for n in names], dtype=float) * 14.0 * upp
+        if names != self._name_chars[0]:  # a drag keeps the names: no walk over 10^4 of them
+            self._name_chars = (names, np.array([len(n) + 1 for n in names], dtype=float))
+        lx1 = lx0 + self._name_chars[1] * 14.0 * upp
         ly0, ly1 = ys, ys + 28.0 * upp
 
         def free(x0: float, x1: float, y0: float, y1: float) -> bool:
