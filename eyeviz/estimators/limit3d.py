@@ -75,9 +75,14 @@ PRIORS = ("single", "multi")
 #: facet widths inside and outside the estimated cap where the cap's edge is looked for
 EDGE = 2.0
 #: boundary points per cell edge for the nearest point of a cell
-STEP = 8
+STEP = 6
 #: the widening factors of the windows and slacks of the retries of empty keys
 RETRY = (2.5, 6.0)
+#: facet widths the centre search may move: edge cells that cannot bind within them are
+#: dropped before it
+PRUNE = 0.25
+#: zoom levels of the search for the centre (each grid a third as wide)
+LEVELS = 4
 #: keys processed together
 _CHUNK = 16
 
@@ -154,6 +159,44 @@ def _frame(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return e1, e2
 
 
+def _sample_gap(nside: int, d: np.ndarray) -> np.ndarray:
+    """How much farther than a cell's closure its nearest boundary sample can be, given
+    that sample's distance d: samples are s = 1.5 fw / STEP apart along edges (edges are
+    at most 1.5 facet widths fw long), so the nearest sample to the closure's nearest
+    point q lies within s / 2 of q along the edge: d <= sqrt(D^2 + s^2 / 4) with D the
+    true distance, hence D >= D_lo = sqrt(d^2 - s^2 / 4) and d - D <= sqrt(D_lo^2 +
+    s^2 / 4) - D_lo. Times 1.5 for the edges' curvature."""
+    s = 1.5 * math.sqrt(4 * math.pi / (12 * nside**2)) / STEP
+    d_lo = np.sqrt(np.maximum(d * d - 0.25 * s * s, 0.0))
+    return 1.5 * (np.sqrt(d_lo * d_lo + 0.25 * s * s) - d_lo)
+
+
+def _prefilter(eye: _Eye, row: np.ndarray, c: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """A necessary condition for caps (c (D, 3) unit, alpha (D,)) of the keys ``row`` (D,)
+    to light exactly the key's cells, on the eye's (pruned) edge cells, from their
+    boundary samples' true distances: a lit cell needs alpha > dist(c, cell) >= d_s -
+    gap (d_s: the nearest sample's distance, gap: :func:`_sample_gap`), an unlit one
+    alpha <= dist(c, closure) <= d_s. Both with a 1e-9 rad margin for rounding. Draws
+    failing it would fail the exact check; the survivors get that check."""
+    ok = np.ones(row.size, bool)
+    pp = eye.pts.shape[2]
+    bounds = np.flatnonzero(np.diff(row)) + 1  # row is sorted: one product per key
+    for idx in np.split(np.arange(row.size), bounds):
+        if not idx.size:
+            continue
+        r = row[idx[0]]
+        live = ~eye.pad[r]
+        k = int(live.sum())
+        pts = eye.pts[r][live].reshape(k * pp, 3)
+        dots = (pts @ c[idx].T).reshape(k, pp, idx.size).max(axis=1)
+        ds = np.arccos(np.clip(dots, -1.0, 1.0))  # (K, Dk)
+        a = alpha[idx][None, :]
+        lit = eye.lit[r][live][:, None]
+        bad = np.where(lit, a + _sample_gap(eye.nside, ds) + 1e-9 <= ds, a > ds + 1e-9)
+        ok[idx] = ~bad.any(axis=0)
+    return ok
+
+
 def _codes(ptr: np.ndarray, ind: np.ndarray, npix: int) -> np.ndarray:
     rows = np.repeat(np.arange(ptr.size - 1, dtype=np.int64), np.diff(ptr))
     return rows * npix + ind
@@ -172,7 +215,7 @@ class _Eye:
         fw = math.sqrt(4 * math.pi / npix)
         n = u.shape[0]
         dist = 1000.0
-        a_in = np.maximum(alpha - EDGE * fw, 1e-9)
+        a_in = np.maximum(alpha - EDGE * fw, 0.5 * fw)
         a_out = np.minimum(alpha + EDGE * fw, math.pi / 2 - 1e-6)
         gs = dist * np.sin(np.concatenate([a_in, a_out]))
         pos = np.asarray(centre) + dist * np.concatenate([u, u])
@@ -182,6 +225,10 @@ class _Eye:
         outer = (ptr[n:] - ptr[n], ind[ptr[n] :])
         key = _codes(*lit, npix)
         c_in = _codes(*inner, npix)
+        # a key too small for an inner cap of half a facet: every lit cell is an edge cell
+        # (a cap of 1e-9 rad would send its cells to the exact fallback, ~10 ms each)
+        small = alpha - EDGE * fw < 0.5 * fw
+        c_in = c_in[~small[c_in // npix]]
         c_out = _codes(*outer, npix)
         lit_edge = key[~np.isin(key, c_in, assume_unique=True)]
         unlit = c_out[~np.isin(c_out, key, assume_unique=True)]
@@ -217,16 +264,15 @@ class _Eye:
         tang = p - cp[..., None] * self.c[:, None, :]
         tn = np.linalg.norm(tang, axis=2)
         d = np.arctan2(tn, cp)
-        # the nearest boundary sample is farther than the cell by at most spacing^2 / (8 d)
-        # (edges <= 1.5 facet widths): lit cells' distances are lowered by that much, so
-        # the linearised region holds the true one; unlit cells' samples lie in the cell
-        spacing = 1.5 * math.sqrt(4 * math.pi / (12 * self.nside**2)) / STEP
-        corr = 1.5 * spacing**2 / (8.0 * np.maximum(d, 0.25 * spacing))
-        self.d = np.where(self.lit, d - corr, d)
+        # the nearest boundary sample is farther than the cell by at most _sample_gap:
+        # lit cells' distances are lowered by that much, so the linearised region holds
+        # the true one; unlit cells' samples lie in the cell's closure
+        self.d = np.where(self.lit, d - _sample_gap(self.nside, d), d)
         with np.errstate(invalid="ignore", divide="ignore"):
             t1 = np.einsum("nkj,nj->nk", tang, self.e1) / tn
             t2 = np.einsum("nkj,nj->nk", tang, self.e2) / tn
         self.t = np.stack([np.nan_to_num(t1), np.nan_to_num(t2)], axis=-1)
+        self._affine()
 
     def prune(self, reach: np.ndarray) -> None:
         """Drop the edge cells that cannot bind anywhere within ``reach`` (N,) of the
@@ -250,6 +296,19 @@ class _Eye:
         self.pad = ~keep[rows, order]
         self.d = self.d[rows, order]
         self.t = self.t[rows, order]
+        self._affine()
+
+    def _affine(self) -> None:
+        """The model as affine forms in delta: a lit cell's distance is d - t . delta, an
+        unlit one's squared distance is d^2 - 2 d t . delta + |delta|^2 (the same value as
+        (d - t . delta)^2 + |delta_perp|^2, |t| = 1), so max_lit and min_unlit are one
+        matrix product and one reduction each (padding: -inf / +inf, zero slope)."""
+        lit = self.lit & ~self.pad
+        unl = ~self.lit & ~self.pad
+        self.a_lit = np.where(lit, self.d, -np.inf)
+        self.t_lit = np.where(lit[..., None], self.t, 0.0)
+        self.a_unl = np.where(unl, self.d * self.d, np.inf)
+        self.t_unl = np.where(unl[..., None], 2.0 * self.d[..., None] * self.t, 0.0)
 
     def model(self, delta: np.ndarray) -> np.ndarray:
         """Each edge cell's modelled distance (N, K, G) at gnomonic offsets delta (N, G, 2).
@@ -259,19 +318,28 @@ class _Eye:
         is loosened. Unlit cells: the distance to their nearest sample point p,
         sqrt((d - t . delta)^2 + |delta_perp|^2), above the true distance (p lies in the
         cell), so alpha <= dist is loosened too: the modelled region holds the true one.
+        (Padding cells: any value; callers mask them with ``pad``.)
         """
-        td = np.einsum("nkj,ngj->nkg", self.t, delta)
+        dt = np.swapaxes(delta, 1, 2)  # (N, 2, G)
+        td = np.matmul(self.t, dt)
         v = self.d[:, :, None] - td
-        perp2 = np.maximum(np.einsum("ngj,ngj->ng", delta, delta)[:, None, :] - td * td, 0.0)
-        return np.where(self.lit[:, :, None], v, np.sqrt(v * v + perp2))
+        sq = np.einsum("ngj,ngj->ng", delta, delta)[:, None, :]
+        w = self.d[:, :, None] * (self.d[:, :, None] - 2.0 * td) + sq
+        return np.where(self.lit[:, :, None], v, np.sqrt(np.maximum(w, 0.0)))
 
     def bounds(self, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(max over lit edge cells, min over unlit) of :meth:`model` at gnomonic offsets
         delta (N, G, 2): arrays (N, G)."""
-        v = self.model(delta)
-        lo = np.where((self.lit & ~self.pad)[:, :, None], v, -np.inf).max(axis=1)
-        hi = np.where((~self.lit & ~self.pad)[:, :, None], v, np.inf).min(axis=1)
-        return lo, hi
+        dx = delta[:, None, :, 0]
+        dy = delta[:, None, :, 1]
+        v = self.t_lit[..., 0, None] * dx
+        v += self.t_lit[..., 1, None] * dy
+        lo = (self.a_lit[..., None] - v).max(axis=1)
+        v = self.t_unl[..., 0, None] * dx
+        v += self.t_unl[..., 1, None] * dy
+        hi2 = (self.a_unl[..., None] - v).min(axis=1)
+        hi2 += np.einsum("ngj,ngj->ng", delta, delta)
+        return lo, np.sqrt(np.maximum(hi2, 0.0))
 
     def direction(self, delta: np.ndarray) -> np.ndarray:
         """Unit vectors (N, M, 3) at gnomonic offsets delta (N, M, 2)."""
@@ -317,7 +385,7 @@ def _locate(eye: _Eye, half: float, n: int, levels: int) -> None:
         half = half / 3.0
 
 
-def _extent(eye: _Eye, reach: float, slack: float, iters: int = 18) -> np.ndarray:
+def _extent(eye: _Eye, reach: float, slack: float, iters: int = 12) -> np.ndarray:
     """Half-widths (N, 2) of a box about the centre holding every delta with
     G(delta) >= -slack (bisection along 8 directions: G is concave)."""
     n = eye.c.shape[0]
@@ -336,25 +404,67 @@ def _extent(eye: _Eye, reach: float, slack: float, iters: int = 18) -> np.ndarra
     return np.maximum(ext, 1e-12)
 
 
-def _inverse_interval(eye_b: _Eye, ca: np.ndarray, sin_a: np.ndarray, lo, hi, slack: float):
+_BOX = np.array(
+    [(x, y) for x in (-1.0, -0.5, 0.0, 0.5, 1.0) for y in (-1.0, 1.0)]
+    + [(x, y) for x in (-1.0, 1.0) for y in (-0.5, 0.0, 0.5)]
+)  # 16 points on the boundary of [-1, 1]^2, at most 1/2 apart along each edge
+
+
+def _epipolar(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(theta, phi) of unit vectors v (..., 3): theta = atan2(v_z, v_y), the angle of the
+    plane through the baseline (the x-axis) and v, and phi the angle of v from +x. A ball's
+    centre and both eyes' cap centres share one theta (the eyes lie on the x-axis)."""
+    return np.arctan2(v[..., 2], v[..., 1]), np.arctan2(np.hypot(v[..., 1], v[..., 2]), v[..., 0])
+
+
+def _angle_box(eye: _Eye, ext: np.ndarray) -> np.ndarray:
+    """Bounds (N, 4) = (theta_lo, theta_hi, phi_lo, phi_hi) over the eye's box of centres
+    (half-widths ``ext`` (N, 2) about its centre, gnomonic). theta and phi have no
+    critical point off the x-axis, so their extremes lie on the box's boundary, whose
+    edges are great-circle arcs: sampled at most s = ext / 2 apart, each is off by at
+    most M s^2 / 8 with |theta''|, |phi''| <= M = 2 / sin(phi)^2 along a unit-speed arc;
+    the pad is four times that. NaN where the box reaches y <= 0 or the x-axis."""
+    pts = eye.direction(_BOX[None] * ext[:, None, :])  # (N, 16, 3)
+    th, ph = _epipolar(pts)
+    s = 0.5 * np.hypot(ext[:, 0], ext[:, 1])
+    sin_min = np.sin(ph).min(axis=1) - 2.0 * s
+    ok = (pts[..., 1].min(axis=1) > 0) & (sin_min > 1e-3)
+    pad = s * s / np.where(ok, sin_min, 1.0) ** 2 + 1e-12
+    out = np.stack(
+        [th.min(axis=1) - pad, th.max(axis=1) + pad, ph.min(axis=1) - pad, ph.max(axis=1) + pad],
+        axis=1,
+    )
+    return np.where(ok[:, None], out, np.nan)
+
+
+def _inverse_interval(eye_b: _Eye, row: np.ndarray, ca, sin_a, lo, hi, slack: float):
     """Secant pass in u = 1 / rho: the u in [lo, hi] where every modelled constraint of
     eye B holds within ``slack`` for balls A + c_A / u, g = sin(alpha_A) / u. (In u the
     direction from B is normalise(c_A + (A - B) u), linear before normalising, so the
-    constraints are nearly linear in u.) Returns the new (lo, hi)."""
+    constraints are nearly linear in u.) Draws are flat: ``row`` (D,) is each draw's key,
+    ca (D, 3), sin_a, lo, hi (D,). Returns the new (lo, hi)."""
+    t = eye_b.t[row]  # (D, K, 2)
+    dd = eye_b.d[row]
+    lit = eye_b.lit[row]
+    live = ~eye_b.pad[row]
+    c, e1, e2 = eye_b.c[row], eye_b.e1[row], eye_b.e2[row]
     f = []
     for u in (lo, hi):
-        p = ca + u[..., None] * eye_b.a  # (P - B) u
-        dist = np.linalg.norm(p, axis=2)
-        cb = p / dist[..., None]
+        p = ca + u[:, None] * eye_b.a  # (P - B) u
+        dist = np.linalg.norm(p, axis=1)
+        cc = np.einsum("dj,dj->d", p, c)
+        delta = np.stack([np.einsum("dj,dj->d", p, e1) / cc, np.einsum("dj,dj->d", p, e2) / cc], 1)
         ab = np.arcsin(np.clip(sin_a / dist, -1.0, 1.0))
-        v = eye_b.model(eye_b.gnomonic(cb))  # (N, K, M)
-        f.append(np.where(eye_b.lit[:, :, None], ab[:, None, :] - v, v - ab[:, None, :]))
+        td = np.einsum("dkj,dj->dk", t, delta)
+        v = dd - td
+        w = dd * (v - td) + np.einsum("dj,dj->d", delta, delta)[:, None]
+        v = np.where(lit, v, np.sqrt(np.maximum(w, 0.0)))
+        f.append(np.where(lit, ab[:, None] - v, v - ab[:, None]))
     f0, f1 = f
-    live = ~eye_b.pad[:, :, None]
-    span = (hi - lo)[:, None, :]
+    span = (hi - lo)[:, None]
     with np.errstate(invalid="ignore", divide="ignore"):
         k = (f1 - f0) / span
-        root = lo[:, None, :] + (-slack - f0) / k
+        root = lo[:, None] + (-slack - f0) / k
     up = live & (k > 0)
     down = live & (k < 0)
     flat_bad = live & (k == 0) & (f0 < -slack)
@@ -409,29 +519,45 @@ class Limit3DEstimator(Estimator3D):
         ng = self.grid
         slack = wide * 0.002 * fw
         for e in (ea, eb):
-            e.prune(np.full(n, 0.5 * wide * fw))
-            _locate(e, 0.25 * wide * fw, ng, 4)
+            e.prune(np.full(n, PRUNE * wide * fw))
+            _locate(e, 0.25 * wide * fw, ng, LEVELS)
         ext = _extent(ea, wide * 0.5 * fw, slack)
         ea.prune(1.2 * math.sqrt(2.0) * ext.max(axis=1))
+        eb.a = A - B
+        ext_b = _extent(eb, wide * 0.5 * fw, slack)
+        eb.prune(5.0 * math.sqrt(2.0) * ext_b.max(axis=1))
+        # A's centre: uniform in (theta, phi) over the bounds of A's box, theta cut to
+        # those of B's box (both caps' centres share the ball's theta: B's box bounds it)
+        box = _angle_box(ea, ext)
+        box_b = _angle_box(eb, ext_b)
+        th_lo = np.fmax(box[:, 0], box_b[:, 0])
+        th_hi = np.fmin(box[:, 1], box_b[:, 1])
         u = _uniforms(keys, m, 4, stream)
-        delta = (2.0 * u[..., 0:2] - 1.0) * ext[:, None, :]
-        q = np.broadcast_to(1.0 / (4.0 * ext[:, 0] * ext[:, 1])[:, None], (n, m))
+        th = th_lo[:, None] + (th_hi - th_lo)[:, None] * u[..., 0]
+        ph = box[:, 2:3] + (box[:, 3] - box[:, 2])[:, None] * u[..., 1]
+        sp = np.sin(ph)
+        ca = np.stack([np.cos(ph), sp * np.cos(th), sp * np.sin(th)], axis=-1)
+        good = np.broadcast_to(((th_hi > th_lo) & (box[:, 3] > box[:, 2]))[:, None], (n, m))
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            q = 1.0 / ((th_hi - th_lo) * (box[:, 3] - box[:, 2]))[:, None]
+            delta = ea.gnomonic(np.where(good[..., None], ca, ea.c[:, None, :]))
+        # outside A's box the model region is empty: drawn, then dropped
+        good = good & (np.abs(delta) <= ext[:, None, :]).all(axis=2)
+        delta = np.where(good[..., None], delta, 0.0)
+        ca = np.where(good[..., None], ca, ea.c[:, None, :])
         lo_a, hi_a = ea.bounds(delta)
         lo_a = np.maximum(lo_a - slack, 1e-12)
         hi_a = np.minimum(hi_a + slack, math.pi / 2 - 1e-9)
         alpha = lo_a + (hi_a - lo_a) * u[..., 2]
         with np.errstate(over="ignore"):
             q = q / np.maximum(hi_a - lo_a, 1e-300)
-        good = hi_a > lo_a
-        ca = ea.direction(delta)
+        good = good & (hi_a > lo_a)
         # along the ray: the closest approach to B's ray gives the bracket's middle
         cbv = np.broadcast_to(eb.c[:, None, :], ca.shape).reshape(-1, 3)
         pm, okm = triangulate(ca.reshape(-1, 3), cbv, d.h)
         rho0 = np.linalg.norm(pm - A, axis=1).reshape(n, m)
         rho0 = np.where(okm.reshape(n, m), rho0, d.r_max)
-        eb.a = A - B
-        ext_b = _extent(eb, wide * 0.5 * fw, slack).max(axis=1)
-        eb.prune(5.0 * math.sqrt(2.0) * ext_b)
+        ext_b = ext_b.max(axis=1)
         # bracket: where B's view of the ray stays within 3 of B's extents of its centre
         d0 = eb.gnomonic(_unit(eb.a + rho0[..., None] * ca))
         d1 = eb.gnomonic(_unit(eb.a + (rho0 * 1.001)[..., None] * ca))
@@ -441,12 +567,22 @@ class Limit3DEstimator(Estimator3D):
         lo = 1.0 / np.minimum(rho0 + reach, d.r_max + d.h)
         hi = 1.0 / np.maximum(rho0 - reach, d.r_min - d.h)
         sin_a = np.sin(alpha)
+        # B's interval only for the draws still alive (flat)
+        live = np.flatnonzero(good.ravel())
+        ll, hh = lo.ravel()[live], hi.ravel()[live]
         for _ in range(2):
-            lo, hi = _inverse_interval(eb, ca, sin_a, lo, hi, slack)
-            bad = ~(hi > lo)
-            lo = np.where(bad, 1.0 / rho0, lo)
-            hi = np.where(bad, (1.0 + 1e-9) / rho0, hi)
-            good &= ~bad
+            ll, hh = _inverse_interval(
+                eb, live // m, ca.reshape(-1, 3)[live], sin_a.ravel()[live], ll, hh, slack
+            )
+            keep = hh > ll
+            live, ll, hh = live[keep], ll[keep], hh[keep]
+        good = np.zeros(n * m, bool)
+        good[live] = True
+        good = good.reshape(n, m)
+        lo = np.full(n * m, 1.0)
+        hi = np.full(n * m, 2.0)
+        lo[live], hi[live] = ll, hh
+        lo, hi = lo.reshape(n, m), hi.reshape(n, m)
         uu = lo + (hi - lo) * u[..., 3]
         rho = 1.0 / uu
         with np.errstate(over="ignore"):  # density of rho: that of u times u^2
@@ -456,14 +592,23 @@ class Limit3DEstimator(Estimator3D):
         r = np.linalg.norm(p, axis=2)
         el = np.arcsin(np.clip(p[..., 2] / r, -1, 1))
         az = np.arctan2(p[..., 1], p[..., 0])
-        nd = np.einsum("nmj,nmj->nm", delta, delta)
-        jac = rho**3 * np.cos(alpha) / (1 + nd) ** 1.5
+        jac = rho**3 * np.cos(alpha) * sp  # d(x, y, z, g) / d(rho, theta, phi, alpha)
         with np.errstate(over="ignore", invalid="ignore"):
             w = prior_density(d, self.prior, r, gg, el, az) * jac / np.where(q > 0, q, 1)
         w = np.where(good & np.isfinite(w), w, 0.0)
         # the exact 0/1 likelihood on the draws with prior mass
         cand = np.flatnonzero(w.ravel() > 0)
         hit = np.zeros(n * m, bool)
+        if cand.size:  # a cheap necessary condition first
+            row = cand // m
+            pc = p.reshape(-1, 3)[cand]
+            pb_ = pc - B
+            rb = np.linalg.norm(pb_, axis=1)
+            keep = _prefilter(ea, row, ca.reshape(-1, 3)[cand], alpha.ravel()[cand])
+            cand, row, pb_, rb = cand[keep], row[keep], pb_[keep], rb[keep]
+            sin_b = np.minimum(gg.ravel()[cand] / rb, 1.0)
+            keep = _prefilter(eb, row, pb_ / rb[:, None], np.arcsin(sin_b))
+            cand = cand[keep]
         if cand.size:
             x, y, z = (p.reshape(-1, 3)[cand, i] for i in range(3))
             gc = gg.ravel()[cand]
