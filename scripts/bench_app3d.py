@@ -27,7 +27,11 @@ Window-up: a whole process, start to the first rendered frame of sphere_paper.to
 (nside 180), median of 3, target <= 3 s; the same process reports its resident memory
 (VmRSS and the peak VmHWM) once the window is up and after 20 renders.
 
-    xvfb-run -a .venv/bin/python scripts/bench_app3d.py [--events 240]
+    xvfb-run -a .venv/bin/python scripts/bench_app3d.py [--events 240] [--predictions]
+
+``--predictions`` also drags each case with the predictions layer on (issue 23 item 4:
+the fast estimators answer the dragged ball on every frame, the limit waits for the
+drag's end) and prints its frames against the same run's layer-off drag.
 """
 
 from __future__ import annotations
@@ -50,7 +54,7 @@ P50_RATIO, P95_RATIO = 1.5, 1.6
 UP_TARGET_S = 3.0
 
 
-def _scene(nside: int):
+def _scene(nside: int, predictions: bool = False):
     import numpy as np
 
     from eyeviz.model.scene import OKABE_ITO, Eyes, Feature, Scene
@@ -73,7 +77,11 @@ def _scene(nside: int):
         )
     fs.append(Feature("dragged", 0.0, 1500.0, 120.0, OKABE_ITO[0], 0.0))
     layers = ["eyes", "features", "bfv", "bitmaps", "readout", "labels", "tangents", "plane"]
-    return Scene(Eyes(40.0, 20.0, nside=nside), fs, layers)
+    if predictions:
+        layers.append("predictions")
+    sc = Scene(Eyes(40.0, 20.0, nside=nside), fs, layers)
+    sc.estimators = ["analytic3d", "learned3d", "limit3d"]
+    return sc
 
 
 def _pct(v, q):
@@ -81,14 +89,14 @@ def _pct(v, q):
     return s[min(len(s) - 1, int(round(q / 100 * (len(s) - 1))))]
 
 
-def bench_drag(nside: int, events: int, settings: str) -> dict:
+def bench_drag(nside: int, events: int, settings: str, predictions: bool = False) -> dict:
     from PyQt5 import QtCore
     from PyQt5.QtTest import QTest
 
     from eyeviz.app.window import MainWindow, make_app, make_settings
 
     app = make_app()
-    win = MainWindow(_scene(nside), settings=make_settings(settings))
+    win = MainWindow(_scene(nside, predictions), settings=make_settings(settings))
     win.resize(1280, 800)
     win.show()
     for _ in range(5):
@@ -125,6 +133,7 @@ def bench_drag(nside: int, events: int, settings: str) -> dict:
         rw.WaitForCompletion()
         base.append(1e3 * (time.perf_counter() - t0))
 
+    win.jobs.wait()  # the limit of the first selected ball
     for _ in range(10):  # warm-up
         w.draw()
         rw.WaitForCompletion()
@@ -148,13 +157,19 @@ def bench_drag(nside: int, events: int, settings: str) -> dict:
         if k >= 10 and drew:  # the first moves cross the click/drag threshold
             lat.append(1e3 * (time.perf_counter() - t0))
             bare()
+    jobs_in_drag = host.limit_jobs
     QTest.mouseRelease(win_in, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, p)
+    win.jobs.wait()
+    jobs_after = host.limit_jobs
     moved = centre() != c0
     steps = win.undo_stack.count()
     lit = int(host.model.state.facets_a[dragged]) + int(host.model.state.facets_b[dragged])
     win.force_close()
     app.processEvents()
-    return {"lat": lat, "base": base, "moved": moved, "undo_steps": steps, "lit": lit}
+    return {
+        "lat": lat, "base": base, "moved": moved, "undo_steps": steps, "lit": lit,
+        "jobs": (jobs_in_drag, jobs_after),
+    }  # fmt: skip
 
 
 def bench_up(settings: str) -> tuple[float, list[str]]:
@@ -200,6 +215,9 @@ def bench_up(settings: str) -> tuple[float, list[str]]:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--events", type=int, default=240, help="mouse-move events per case (>= 200)")
+    ap.add_argument(
+        "--predictions", action="store_true", help="also drag with the predictions layer on"
+    )
     args = ap.parse_args()
     if not os.environ.get("DISPLAY"):
         xvfb = shutil.which("xvfb-run")
@@ -227,6 +245,18 @@ def main() -> int:
             f"moved {r['moved']}, undo steps {r['undo_steps']}, dragged ball lights {r['lit']:,} "
             f"facets: {'OK' if good else 'MISSED'}"
         )
+        if args.predictions:
+            q = bench_drag(nside, args.events, settings, predictions=True)
+            q50, q95 = _pct(q["lat"], 50), _pct(q["lat"], 95)
+            c50, c95 = _pct(q["base"], 50), _pct(q["base"], 95)
+            print(
+                f"  predictions on: drag p50 {q50:.1f} ms p95 {q95:.1f} ms; bare p50 "
+                f"{c50:.1f} ms p95 {c95:.1f} ms; ratio p50 {q50 / c50:.2f}x p95 "
+                f"{q95 / c95:.2f}x; against the layer off p50 {q50 / p50:.2f}x p95 "
+                f"{q95 / p95:.2f}x; limit jobs started up to the release (the window's "
+                f"first ball, the press's selection) {q['jobs'][0]}, after it "
+                f"{q['jobs'][1] - q['jobs'][0]}"
+            )
     up, mem = bench_up(settings)
     ok &= up <= UP_TARGET_S
     print(f"window up (sphere_paper.toml, nside 180): {up:.2f} s median of 3 (<= {UP_TARGET_S} s)")
