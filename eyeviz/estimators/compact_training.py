@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import functools
 import json
-import math
 import os
 import time
 from collections.abc import Callable
@@ -30,6 +29,7 @@ from eyeviz.estimators.compact_net import (
     save_net,
     write_atomic,
 )
+from eyeviz.estimators.fit_loop import fit_one_cycle
 from eyeviz.estimators.store import staged, user_models_dir
 from eyeviz.files import limits
 
@@ -66,39 +66,24 @@ def _fit(
     progress: Callable[[str, int, int, float], None] | None,
     label: str,
 ) -> dict:
-    """Adam with a one-cycle schedule on the relative error; early stopping on validation."""
-    g = torch.Generator().manual_seed(seed)
-    n = x.shape[0]
-    steps = n // batch
-    opt = torch.optim.Adam(net.parameters(), lr=lr)
-    sched = torch.optim.lr_scheduler.OneCycleLR(opt, max_lr=lr, total_steps=epochs * steps)
-    best, best_state, bad, history = math.inf, None, 0, []
-    for ep in range(epochs):
-        net.train()
-        perm = torch.randperm(n, generator=g)
-        for i in range(steps):
-            idx = perm[i * batch : (i + 1) * batch]
-            opt.zero_grad(set_to_none=True)
-            loss = predict(net(x[idx]), y[idx])
-            loss.backward()
-            opt.step()
-            sched.step()
-        net.eval()
-        with torch.inference_mode():
-            val = float(predict(net(xv), yv))
-        history.append(val)
-        if progress is not None:
-            progress(label, ep + 1, epochs, val)
-        if val < best - 1e-7:
-            best, bad = val, 0
-            best_state = {k: v.detach().clone() for k, v in net.state_dict().items()}
-            ckpt(net)
-        else:
-            bad += 1
-            if bad >= patience:
-                break
-    if best_state is not None:
-        net.load_state_dict(best_state)
+    """Adam with a one-cycle schedule on the relative error; early stopping on validation
+    (the loop: :func:`eyeviz.estimators.fit_loop.fit_one_cycle`)."""
+    history, best = fit_one_cycle(
+        net,
+        x.shape[0],
+        x.shape[0] // batch,
+        batch,
+        lambda idx: predict(net(x[idx]), y[idx]),
+        lambda: float(predict(net(xv), yv)),
+        epochs=epochs,
+        lr=lr,
+        patience=patience,
+        min_delta=1e-7,
+        generator=torch.Generator().manual_seed(seed),
+        on_best=lambda: ckpt(net),
+        progress=progress,
+        label=label,
+    )
     return {"epochs": len(history), "val_history": [round(v, 7) for v in history], "best_val": best}
 
 

@@ -30,6 +30,7 @@ from eyeviz.core.domain3d import DEFAULT_EL_MAX, Domain3D
 from eyeviz.core.validation import check_int, check_real
 from eyeviz.dataset.records3d import Dataset3D
 from eyeviz.estimators import metrics
+from eyeviz.estimators.fit_loop import fit_one_cycle
 from eyeviz.estimators.learned3d import (
     AZ_SCALE,
     EL_SCALE,
@@ -164,40 +165,27 @@ def train_net(
     base = [float(e) for e in _errors(zero, t)]
     base = [b if b > 0 else 1.0 for b in base]
     n = t["x"].shape[0]
-    steps = max(1, n // batch)
-    opt = torch.optim.Adam(net.parameters(), lr=lr)
-    sched = torch.optim.lr_scheduler.OneCycleLR(opt, max_lr=lr, total_steps=epochs * steps)
 
     def loss_of(out: torch.Tensor, tt: dict[str, torch.Tensor]) -> torch.Tensor:
         dd, ad, el = _errors(out.double(), tt)
         return dd / base[0] + ad / base[1] + el / base[2]
 
-    best, best_state, bad, history = math.inf, None, 0, []
-    for ep in range(epochs):
-        net.train()
-        perm = torch.randperm(n, generator=g)
-        for i in range(steps):
-            idx = perm[i * batch : (i + 1) * batch]
-            opt.zero_grad(set_to_none=True)
-            loss = loss_of(net(t["x"][idx]), {k: w[idx] for k, w in t.items()})
-            loss.backward()
-            opt.step()
-            sched.step()
-        net.eval()
-        with torch.inference_mode():
-            val = float(loss_of(net(v["x"]), v))
-        history.append(round(val, 6))
-        if progress is not None:
-            progress("learned3d", ep + 1, epochs, val)
-        if val < best - 1e-6:
-            best, bad = val, 0
-            best_state = {k: w.detach().clone() for k, w in net.state_dict().items()}
-        else:
-            bad += 1
-            if bad >= patience:
-                break
-    if best_state is not None:
-        net.load_state_dict(best_state)
+    raw, best = fit_one_cycle(
+        net,
+        n,
+        max(1, n // batch),
+        batch,
+        lambda idx: loss_of(net(t["x"][idx]), {k: w[idx] for k, w in t.items()}),
+        lambda: float(loss_of(net(v["x"]), v)),
+        epochs=epochs,
+        lr=lr,
+        patience=patience,
+        min_delta=1e-6,
+        generator=g,
+        progress=progress,
+        label="learned3d",
+    )
+    history = [round(val, 6) for val in raw]
     info = {
         "epochs": len(history),
         "val_loss_history": history,
