@@ -38,9 +38,17 @@ import numpy as np
 from eyeviz import EyevizError
 from eyeviz.reports.study_design import MIN_COUNT
 from eyeviz.reports.study_law import LawFit, LawPoint, fit_law
-from eyeviz.study.table3d import read_rows3d
+from eyeviz.study.table3d import iter_rows3d
 
-__all__ = ["FIT_MAX", "PAPER3D", "Design3D", "fit_power", "law_points3d", "write_report3d"]
+__all__ = [
+    "FIT_MAX",
+    "PAPER3D",
+    "Design3D",
+    "fit_power",
+    "law_points3d",
+    "read_study3d",
+    "write_report3d",
+]
 
 #: The paper's eyes in 3D: h = 40, l = 20 and nside 180 (m = 720 on the equator).
 PAPER3D = (40.0, 20.0, 180)
@@ -76,6 +84,16 @@ def choose_estimator(rows: list[dict]) -> str:
     for r in rows:
         designs.setdefault(r["estimator"], set()).add((r["h"], r["l"], r["nside"]))
     return min(designs, key=lambda e: (e not in LIMITS, -len(designs[e]), e))
+
+
+def read_study3d(path) -> list[dict]:
+    """The rows of a 3D study table, read by the study tables' one parser (the runner's
+    checks and one-line errors naming the file and the first bad line,
+    :mod:`eyeviz.study.table`); the report adds only: at least one row."""
+    rows = [row for _, row in iter_rows3d(path)]
+    if not rows:
+        raise EyevizError(f"{path}: the 3D study table has no rows")
+    return rows
 
 
 def designs3d(rows: list[dict], estimator: str, prior: str) -> dict[tuple, Design3D]:
@@ -175,9 +193,7 @@ def write_report3d(
     from eyeviz.reports.study_figures import _rc, save
     from eyeviz.reports.study_summary import _write_text
 
-    rows, _ = read_rows3d(path)
-    if not rows:
-        raise EyevizError(f"{path}: the 3D study table has no rows")
+    rows = read_study3d(path)
     if prior is None:
         have = sorted({r["prior"] for r in rows})
         prior = have[0] if len(have) == 1 else "single"

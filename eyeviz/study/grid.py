@@ -12,7 +12,8 @@ Bad input ends in one :class:`eyeviz.EyevizError` naming it: ``parse_list("m", "
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
 
 from eyeviz import EyevizError
 from eyeviz.core.bounds import MAX_BINS, check_m, check_r_min
@@ -22,7 +23,17 @@ from eyeviz.estimators.limit import PRIORS
 from eyeviz.files.limits import MAX_ROWS
 from eyeviz.study.point import BIN_WIDTH, DesignPoint
 
-__all__ = ["MAX_GRID_POINTS", "design_grid", "parse_list", "DEFAULT_H", "DEFAULT_L", "DEFAULT_M"]
+__all__ = [
+    "DEFAULT_H",
+    "DEFAULT_L",
+    "DEFAULT_M",
+    "MAX_GRID_POINTS",
+    "GridAxes",
+    "design_grid",
+    "grid_axes",
+    "grid_pairs",
+    "parse_list",
+]
 
 #: The issue's default grid: the paper's design (h=40, l=20, m=720) by factors of 4 each way.
 DEFAULT_H = (10.0, 20.0, 40.0, 80.0, 160.0)
@@ -64,16 +75,81 @@ def parse_list(name: str, text: str | Iterable) -> list[float]:
     return out
 
 
-def _check_m(values: Sequence[float]) -> list[int]:
-    # the one bound of m (eyeviz.core.bounds.MAX_M); a list's 720.0 is shown as 720
-    return [check_m(int(v) if float(v).is_integer() else v) for v in values]
-
-
 def _unique(values: Iterable) -> list:
     seen: dict = {}
     for v in values:
         seen.setdefault(v, None)
     return list(seen)
+
+
+@dataclass(frozen=True)
+class GridAxes:
+    """A grid's checked lists (duplicates dropped) and the settings all its points share."""
+
+    h: list[float]
+    l: list[float]  # noqa: E741  (the paper's name)
+    resolution: list[int]  # m (planar) or nside (3D)
+    n: int
+    seed: int
+    r_min: float
+    r_max: float
+
+
+def grid_axes(
+    h: str | Iterable,
+    l: str | Iterable,  # noqa: E741  (the paper's name)
+    resolution: tuple[str, str | Iterable, Callable[..., int]],
+    *,
+    r_min: float,
+    r_max: float,
+    prior: str,
+    priors: Sequence[str],
+    n: int,
+    seed: int,
+) -> GridAxes:
+    """The lists of h, l and the resolution (``(name, list, checker of one value)``:
+    m and :func:`~eyeviz.core.bounds.check_m`, or nside and
+    :func:`~eyeviz.core.bounds.check_nside`) and what every point shares, each checked
+    with a one-line error naming it; for :func:`design_grid` and
+    :func:`eyeviz.study.grid3d.design_grid3d`."""
+    name, values, check = resolution
+    hs = _unique(parse_list("h", h))
+    ls = _unique(parse_list("l", l))
+    # the one bound of each (eyeviz.core.bounds); a list's 720.0 is shown as 720
+    rs = _unique(check(int(v) if v.is_integer() else v) for v in parse_list(name, values))
+    for what, vals in (("h", hs), ("l", ls)):
+        for v in vals:
+            check_real(what, v, gt=0)
+    n = check_int("n", n, ge=1, le=MAX_ROWS)
+    seed = check_int("seed", seed, ge=0)
+    check_choice("prior", prior, tuple(priors))
+    r_lo = check_real("r_min", r_min, gt=0)
+    r_hi = check_real("r_max", r_max, gt=r_lo)
+    return GridAxes(hs, ls, rs, int(n), seed, r_lo, r_hi)
+
+
+def grid_pairs(axes: GridAxes) -> list[tuple[float, float]]:
+    """The (h, l) of the grid with l < h, in order; refused in one line: r_min too near
+    the eyes, too many distance bins, no design with l < h, too many points."""
+    hs, ls = axes.h, axes.l
+    check_r_min(axes.r_min, max(hs))
+    if (axes.r_max - axes.r_min) / BIN_WIDTH > MAX_BINS:
+        raise EyevizError(
+            f"r_max - r_min = {axes.r_max - axes.r_min:g} gives more than {MAX_BINS} distance "
+            f"bins of {BIN_WIDTH:g}"
+        )
+    pairs = [(hv, lv) for hv in hs for lv in ls if lv < hv]
+    if not pairs:
+        raise EyevizError(
+            f"no design in the grid has l < h (h: {', '.join(f'{v:g}' for v in hs)}; "
+            f"l: {', '.join(f'{v:g}' for v in ls)})"
+        )
+    if len(pairs) * len(axes.resolution) > MAX_GRID_POINTS:
+        raise EyevizError(
+            f"the grid has {len(pairs) * len(axes.resolution)} design points, more than "
+            f"{MAX_GRID_POINTS}"
+        )
+    return pairs
 
 
 def design_grid(
@@ -95,35 +171,19 @@ def design_grid(
     beyond :data:`~eyeviz.files.limits.MAX_ROWS`), a bad range or prior, or a grid where
     no design has l < h.
     """
-    hs = _unique(parse_list("h", h))
-    ls = _unique(parse_list("l", l))
-    ms = _unique(_check_m(parse_list("m", m)))
-    for name, vals in (("h", hs), ("l", ls)):
-        for v in vals:
-            check_real(name, v, gt=0)
-    n = check_int("n", n, ge=1, le=MAX_ROWS)
-    seed = check_int("seed", seed, ge=0)
-    check_choice("prior", prior, PRIORS)
-    r_lo = check_real("r_min", r_min, gt=0)
-    r_hi = check_real("r_max", r_max, gt=r_lo)
-    check_r_min(r_lo, max(hs))
-    if (r_hi - r_lo) / BIN_WIDTH > MAX_BINS:
-        raise EyevizError(
-            f"r_max - r_min = {r_hi - r_lo:g} gives more than {MAX_BINS} distance bins "
-            f"of {BIN_WIDTH:g}"
-        )
-    pairs = [(hv, lv) for hv in hs for lv in ls if lv < hv]
-    if not pairs:
-        raise EyevizError(
-            f"no design in the grid has l < h (h: {', '.join(f'{v:g}' for v in hs)}; "
-            f"l: {', '.join(f'{v:g}' for v in ls)})"
-        )
-    if len(pairs) * len(ms) > MAX_GRID_POINTS:
-        raise EyevizError(
-            f"the grid has {len(pairs) * len(ms)} design points, more than {MAX_GRID_POINTS}"
-        )
+    axes = grid_axes(
+        h,
+        l,
+        ("m", m, check_m),
+        r_min=r_min,
+        r_max=r_max,
+        prior=prior,
+        priors=PRIORS,
+        n=n,
+        seed=seed,
+    )
     return [
-        DesignPoint(hv, lv, mv, r_min, r_max, g_max, prior, int(n), seed)
-        for hv, lv in pairs
-        for mv in ms
+        DesignPoint(hv, lv, mv, r_min, r_max, g_max, prior, axes.n, axes.seed)
+        for hv, lv in grid_pairs(axes)
+        for mv in axes.resolution
     ]

@@ -17,13 +17,11 @@ import math
 from collections.abc import Iterable
 
 from eyeviz import EyevizError
-from eyeviz.core.bounds import MAX_BINS, check_nside, check_r_min
+from eyeviz.core.bounds import check_nside
 from eyeviz.core.domain import DEFAULTS
 from eyeviz.core.domain3d import DEFAULT_EL_MAX
-from eyeviz.core.validation import check_choice, check_int, check_real
-from eyeviz.files.limits import MAX_ROWS
-from eyeviz.study.grid import DEFAULT_H, DEFAULT_L, MAX_GRID_POINTS, _unique, parse_list
-from eyeviz.study.point import BIN_WIDTH
+from eyeviz.core.validation import check_real
+from eyeviz.study.grid import DEFAULT_H, DEFAULT_L, grid_axes, grid_pairs
 from eyeviz.study.point3d import DEFAULT_ESTIMATOR, DesignPoint3D
 
 __all__ = ["DEFAULT_NSIDE", "DEFAULT_N3D", "design_grid3d"]
@@ -34,10 +32,6 @@ __all__ = ["DEFAULT_NSIDE", "DEFAULT_N3D", "design_grid3d"]
 DEFAULT_NSIDE = (16, 32, 64)
 #: Test elements per 3D design point by default.
 DEFAULT_N3D = 20_000
-
-
-def _check_nsides(values: list[float]) -> list[int]:
-    return [check_nside(int(v) if float(v).is_integer() else v) for v in values]
 
 
 def design_grid3d(
@@ -63,17 +57,17 @@ def design_grid3d(
     eyes, a grid where no design has l < h, or a
     design where no ball can be visible in the binocular field.
     """
-    hs = _unique(parse_list("h", h))
-    ls = _unique(parse_list("l", l))
-    ns = _unique(_check_nsides(parse_list("nside", nside)))
-    for name, vals in (("h", hs), ("l", ls)):
-        for v in vals:
-            check_real(name, v, gt=0)
-    n = check_int("n", n, ge=1, le=MAX_ROWS)
-    seed = check_int("seed", seed, ge=0)
-    check_choice("prior", prior, ("single", "multi"))
-    r_lo = check_real("r_min", r_min, gt=0)
-    r_hi = check_real("r_max", r_max, gt=r_lo)
+    axes = grid_axes(
+        h,
+        l,
+        ("nside", nside, check_nside),
+        r_min=r_min,
+        r_max=r_max,
+        prior=prior,
+        priors=("single", "multi"),
+        n=n,
+        seed=seed,
+    )
     check_real("g_max", g_max, gt=0)
     check_real("el_max", el_max, gt=0, lt=math.pi / 2)
     from eyeviz.estimators import registry
@@ -84,25 +78,11 @@ def design_grid3d(
             f"estimator must be an estimator of the spherical eyes ({', '.join(have)}), "
             f"got {estimator!r}"
         )
-    check_r_min(r_lo, max(hs))
-    if (r_hi - r_lo) / BIN_WIDTH > MAX_BINS:
-        raise EyevizError(
-            f"r_max - r_min = {r_hi - r_lo:g} gives more than {MAX_BINS} distance bins "
-            f"of {BIN_WIDTH:g}"
-        )
-    pairs = [(hv, lv) for hv in hs for lv in ls if lv < hv]
-    if not pairs:
-        raise EyevizError(
-            f"no design in the grid has l < h (h: {', '.join(f'{v:g}' for v in hs)}; "
-            f"l: {', '.join(f'{v:g}' for v in ls)})"
-        )
-    if len(pairs) * len(ns) > MAX_GRID_POINTS:
-        raise EyevizError(
-            f"the grid has {len(pairs) * len(ns)} design points, more than {MAX_GRID_POINTS}"
-        )
+    pairs = grid_pairs(axes)
     out = []
+    r_lo, r_hi, n, seed = axes.r_min, axes.r_max, axes.n, axes.seed
     for hv, lv in pairs:
-        for nv in ns:
+        for nv in axes.resolution:
             try:
                 p = DesignPoint3D(hv, lv, nv, r_lo, r_hi, g_max, el_max, prior, n, seed, estimator)
             except EyevizError as exc:

@@ -2,8 +2,9 @@
 
 :mod:`eyeviz.study.runner` is one resumable Dask runner for both; what differs per kind
 is here: the point type, its table (:class:`~eyeviz.study.table.StudyTable` or
-:class:`~eyeviz.study.table3d.StudyTable3D`, told apart by their headers), its columns
-and the function a worker evaluates. A study's points are all of one kind.
+:class:`~eyeviz.study.table3d.StudyTable3D`: one appender and one parser, with a format
+each, told apart by their headers), its columns and the function a worker evaluates. A
+study's points are all of one kind.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ def columns_of(point: Point) -> tuple[str, ...]:
     return COLUMNS3D if isinstance(point, DesignPoint3D) else COLUMNS
 
 
-def open_table(path, points: Sequence) -> StudyTable | StudyTable3D:
+def open_table(path, points: Sequence) -> StudyTable:
     """The table at ``path`` for ``points`` (all planar or all 3D; checked here)."""
     kinds = {type(p) for p in points}
     if len(kinds) > 1:

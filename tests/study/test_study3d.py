@@ -74,16 +74,16 @@ def _table(tmp_path):
 @pytest.mark.parametrize(
     ("edit", "words"),
     [
-        (lambda ls: ls[:-1], ["has 14 rows, expected 15", "incomplete"]),
+        (lambda ls: ls[:-1], ["has 14 of its 15 rows", "incomplete"]),
         (lambda ls: [ls[0].replace("version", "versio")] + ls[1:], ["not a 3D study table"]),
         (lambda ls: ls[:1] + ["2" + ls[1][1:]] + ls[2:], ["line 2", "3D study version 2"]),
         (lambda ls: ls[:2] + [ls[2].replace(",single,", ",sngle,")] + ls[3:], ["line 3", "prior"]),
         (lambda ls: ls[:2] + [ls[2] + ",1"] + ls[3:], ["line 3", "28 fields, expected 27"]),
         (
             lambda ls: ls[:2] + [ls[2].replace(",64,", ",65,", 1)] + ls[3:],
-            ["line 3", "m and gamma"],
+            ["line 3", "m = 65 is not 4 nside = 64"],
         ),
-        (lambda ls: ls + [ls[1]], ["bin 'all' of this design point appears twice"]),
+        (lambda ls: ls + [ls[1]], ["line 32", "bin all of this design point appears twice"]),
     ],
 )
 def test_a_bad_3d_table_is_refused_naming_the_line_and_left_as_it_is(tmp_path, edit, words):
@@ -171,16 +171,16 @@ def test_the_3d_command_line_refuses_mixed_options_in_one_line(tmp_path):
 
 
 def test_a_point_that_would_pass_the_readers_bound_is_refused_before_writing(tmp_path, monkeypatch):
-    from eyeviz.study import table3d
+    from eyeviz.study import table
     from eyeviz.study.point3d import evaluate3d
 
     path = tmp_path / "s3.csv"
     pts = design_grid3d("20", "10", "8,16", n=40)
-    t = StudyTable3D.open(path)
-    t.append(evaluate3d(pts[0]))
+    StudyTable3D.open(path).append(evaluate3d(pts[0]))
     before = path.read_bytes()
-    monkeypatch.setattr(table3d, "MAX_STUDY_BYTES", len(before) + 100)
-    with pytest.raises(EyevizError, match="more than the .* its reader accepts") as err:
+    monkeypatch.setattr(table, "MAX_STUDY_BYTES", len(before) + 100)  # the tables' one bound
+    t = StudyTable3D.open(path)
+    with pytest.raises(EyevizError, match="past .* bytes, the most its reader accepts") as err:
         t.append(evaluate3d(pts[1]))
     assert "\n" not in str(err.value)
     assert path.read_bytes() == before

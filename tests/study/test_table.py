@@ -220,11 +220,11 @@ def test_an_append_interrupted_at_any_moment_keeps_whole_points(tmp_path, rows, 
         real = table_mod.format_row
         calls = []
 
-        def format_then_boom(row):
+        def format_then_boom(row, *columns):
             calls.append(row)
             if len(calls) == 3:
                 raise KeyboardInterrupt
-            return real(row)
+            return real(row, *columns)
 
         monkeypatch.setattr(table_mod, "format_row", format_then_boom)
     with pytest.raises(KeyboardInterrupt):

@@ -1,10 +1,9 @@
 """Issue 25 items 4 and 7: the study table is appended in place (never rewritten, no
 lines held in memory), a point that would take it past the bound its reader accepts is
-refused before anything is written, and the runner and the report read it through one
-parser that refuses every edit the report used to choke on, naming file and line."""
+refused before anything is written (for both kinds of table:
+test_table3d_append.py), and the runner and the report read it through one parser that
+refuses every edit the report used to choke on, naming file and line."""
 
-import csv
-import io
 import math
 import os
 
@@ -46,32 +45,6 @@ def test_appends_keep_the_file_and_write_only_the_new_point(tmp_path, rows, monk
     assert t.size == len(data)
 
 
-def test_a_point_past_the_readers_bound_is_refused_before_writing(tmp_path, rows):
-    path = tmp_path / "s.csv"
-    t = StudyTable.open(path)
-    t.append(rows[P1.key])
-    size = t.size
-    t = StudyTable.open(path, max_bytes=size + 100)  # room for less than one more point
-    before = path.read_bytes()
-    with pytest.raises(EyevizError) as err:
-        t.append(rows[P2.key])
-    msg = str(err.value)
-    assert "\n" not in msg and str(path) in msg and f"past {size + 100} bytes" in msg
-    assert "1 point(s) kept" in msg
-    assert path.read_bytes() == before
-    StudyTable.open(path, max_bytes=size + 100)  # still readable under that bound
-
-
-def _edit(path, line_no, column, value):
-    lines = path.read_text().splitlines()
-    fields = next(csv.reader([lines[line_no - 1]]))
-    fields[COLUMNS.index(column)] = value
-    buf = io.StringIO()
-    csv.writer(buf, lineterminator="").writerow(fields)
-    lines[line_no - 1] = buf.getvalue()
-    path.write_text("\n".join(lines) + "\n")
-
-
 @pytest.mark.parametrize(
     ("line", "column", "value", "words"),
     [
@@ -91,11 +64,11 @@ def _edit(path, line_no, column, value):
     ],
 )
 def test_runner_and_report_refuse_the_same_edit_naming_file_and_line(
-    tmp_path, rows, line, column, value, words
+    tmp_path, rows, edit_field, line, column, value, words
 ):
     path = tmp_path / "s.csv"
     StudyTable.open(path).append(rows[P1.key])
-    _edit(path, line, column, value)
+    edit_field(path, line, COLUMNS, column, value)
     before = path.read_bytes()
     msgs = []
     for read in (StudyTable.open, read_study):
