@@ -4,7 +4,8 @@
 For nside 16 and 180 (the teaching and the paper scenes' balls) the first ball moves along
 a path of ``--frames`` steps; the states are computed first (the geometry is not what this
 measures: scripts/bench_geometry3d.py does). Each frame times ``set_state`` on the
-bitmaps panel (lit polygons set in place and blitted over the kept background) and on
+bitmaps panel (lit polygons set in place and blitted over the kept background, the moving
+ball selected: its outline is redrawn every frame too) and on
 the readout; right after it, in the same run and state, a full redraw of the bitmaps
 canvas (the baseline: what re-creating the figure's artists would at least cost) is timed.
 Printed: p50 and p95 in ms and the update / full-redraw ratios. No target is asserted.
@@ -65,7 +66,7 @@ def main() -> int:
         ro = Readout3DPanel()
         ro.resize(420, 240)
         ro.show()
-        bm.set_state(*states[0])
+        bm.set_state(*states[0], 0)
         ro.set_state(*states[0])
         for _ in range(10):
             app.processEvents()
@@ -73,7 +74,7 @@ def main() -> int:
         upd, full, rd = [], [], []
         for st, s in states[1:]:
             t0 = time.perf_counter()
-            bm.set_state(st, s)
+            bm.set_state(st, s, 0)
             upd.append(time.perf_counter() - t0)
             t0 = time.perf_counter()
             ro.set_state(st, s)

@@ -126,7 +126,7 @@ def test_bitmaps_at_nside_180_draw_only_the_lit_facets(qtbot):
     panel.set_state(st, sc)
     _settle(qtbot, panel)
     ax = panel.axes["A"]
-    (back,) = [c for c in ax.collections if c not in panel._lit["A"]]
+    (back,) = [c for c in ax.collections if c not in (*panel._lit["A"], panel._halo["A"])]
     assert len(back.get_paths()) == 1  # the unlit sphere: one solid ellipse
     inner, edge = panel._lit["A"]
     drawn = sum(int((p.codes == p.MOVETO).sum()) for c in (inner, edge) for p in c.get_paths())

@@ -4,14 +4,16 @@ Each eye's HEALPix facets on a Mollweide map seen from inside the eye (forward a
 centre, the eye's right on the right, as the 3D figure draws them:
 :func:`eyeviz.render.mpl.healpix_map.draw_eye_view`), lit facets in their features'
 colours (a later feature wins), the equator drawn and labelled: that row of facets is the
-planar eye's bitmap (m = 4 nside).
+planar eye's bitmap (m = 4 nside). The selected ball's lit facets (all of them, those a
+later ball colours too) are outlined in ink: a thick stroke drawn under the lit facets'
+fills, so only the patch's border shows; it follows the selection (Tab in the 3D view).
 
 Fast updates: what does not change with the balls (the unlit sphere, at nside <= 32 every
 facet with its outline, otherwise one solid ellipse; the graticule) is drawn once and kept
 as a pixel background; a new state sets the lit facets' polygons in place and repaints
-them and the equator over that background (blitting). Only the lit facets
-are polygons: a ball at the paper's distances lights a few hundred of nside 180's 388,800
-facets per eye. The maps are drawn in the exact Mollweide projection
+them, the selected ball's outline and the equator over that background (blitting). Only
+the lit facets are polygons: a ball at the paper's distances lights a few hundred of nside
+180's 388,800 facets per eye. The maps are drawn in the exact Mollweide projection
 (:func:`eyeviz.render.mpl.healpix_map.mollweide`) on plain axes, so the point under the
 mouse is inverted in closed form and mapped to its facet by
 :func:`eyeviz.core.healpix.ang2pix_ring` (:func:`~eyeviz.render.mpl.healpix_map.pixel_at`):
@@ -51,6 +53,7 @@ __all__ = ["Bitmaps3DPanel", "facet_text", "lit_owners"]
 
 EYES = ("A", "B")
 STEP = 2  # outline points per facet edge
+HALO_LW = 2.2  # the selected ball's outline (points; about half of it shows outside)
 R2 = math.sqrt(2.0)
 SQ_DEG = (180.0 / math.pi) ** 2
 
@@ -130,8 +133,9 @@ def _ellipse(n: int = 181) -> np.ndarray:
 class Bitmaps3DPanel(QtWidgets.QWidget):
     """Eye A over eye B, each a Mollweide map of its facets; see the module docstring.
 
-    ``set_state(state, scene)`` takes a computed :class:`SceneState3D`; ``update_ms``
-    holds the time of the last update (the lit polygons set and repainted)."""
+    ``set_state(state, scene, selected)`` takes a computed :class:`SceneState3D` and the
+    selected ball (outlined; None: none); ``update_ms`` holds the time of the last update
+    (the lit polygons set and repainted)."""
 
     def __init__(self, parent: QtWidgets.QWidget | None = None) -> None:
         super().__init__(parent)
@@ -143,6 +147,12 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self._keys: dict[str, bytes] = {}
         self._bg = None
         self._lit: dict[str, tuple[PathCollection, ...]] = {}
+        self.selected: int | None = None
+        self._halo: dict[str, PathCollection] = {}  # the selected ball's outline per eye
+        self._clips: dict[str, Polygon] = {}  # each map's outline (the halo's clip)
+        self._halo_keys: dict[str, bytes | None] = {}
+        # per eye: the lit facets and their outlines (base, across the edge, second copies)
+        self._geom: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
         self._outlines = {e: _Outlines(2) for e in EYES}
         self._over: list = []  # animated artists drawn over the lit facets, in order
         self._hover_coll: PolyCollection | None = None
@@ -174,10 +184,11 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
 
     # --- state ---------------------------------------------------------------------------
 
-    def set_state(self, state: SceneState3D, scene: Scene) -> None:
-        """Show the lit facets of ``state`` (computed from ``scene``): the polygons of the
-        eyes whose lit sets or colours changed are set in place and repainted over the
-        kept background; a new nside redraws the whole figure."""
+    def set_state(self, state: SceneState3D, scene: Scene, selected: int | None = None) -> None:
+        """Show the lit facets of ``state`` (computed from ``scene``) and outline ball
+        ``selected``'s: the polygons of the eyes whose lit sets, colours or outline changed
+        are set in place and repainted over the kept background; a new nside redraws the
+        whole figure."""
         t0 = time.perf_counter()
         if state.lit_a is None or state.lit_b is None or not scene.shows("bitmaps"):
             self.canvas.hide()
@@ -187,7 +198,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
                 "bitmaps layer hidden" if not scene.shows("bitmaps") else "no lit sets"
             )
             self.message.show()
-            self.owners, self._keys = {}, {}
+            self.owners, self._keys, self._halo_keys = {}, {}, {}
             return
         self.message.hide()
         self.canvas.show()
@@ -199,16 +210,20 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         rgba = to_rgba_array(colors) if colors else np.zeros((0, 4))
         changed = False
         counts: list[str] = []
+        n = len(scene.features)
+        self.selected = selected if selected is not None and 0 <= selected < n else None
         for eye, csr in zip(EYES, (state.lit_a, state.lit_b), strict=True):
             pix, ball = lit_owners(csr)
             key = b"".join((pix.tobytes(), ball.tobytes(), rgba.tobytes()))
             self.owners[eye] = (pix, ball)
+            if self._set_halo(eye, csr, pix, key):
+                changed = True
             if self._keys.get(eye) == key:
                 counts.append(f"{eye} {pix.size:,}")
                 continue
             self._keys[eye] = key
             changed = True
-            base, over, dup = self._outlines[eye].get(pix)
+            base, over, dup = self._geom[eye][1:]
             # facets inside the map's outline need no clipping (2 ms a frame at nside 180)
             inner, edge = self._lit[eye]
             paths, fc = _by_ball(base[~over], ball[~over], rgba)
@@ -220,12 +235,47 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             edge.set_paths(paths)
             edge.set_facecolor(fc)
             counts.append(f"{eye} {pix.size:,}")
+        sel = "" if self.selected is None else f"; {self.names[self.selected]!r} outlined"
         self.counts.setText(
-            f"nside {nside}, {healpix.npix(nside):,} facets per eye\nlit: " + ", ".join(counts)
+            f"nside {nside}, {healpix.npix(nside):,} facets per eye\nlit: "
+            + ", ".join(counts)
+            + sel
         )
         if changed:
             self._repaint()
         self.update_ms = (time.perf_counter() - t0) * 1e3
+
+    def _set_halo(self, eye: str, csr, pix: np.ndarray, key: bytes) -> bool:
+        """Outline the selected ball's lit facets on eye ``eye`` (``pix`` all lit facets,
+        ``key`` their drawing's key); True when the outline changed. Keeps the facets'
+        outlines of ``pix`` in ``_geom`` (computed once per lit set)."""
+        if self._keys.get(eye) != key or eye not in self._geom:
+            self._geom[eye] = (pix, *self._outlines[eye].get(pix))
+        i = self.selected
+        indptr, idx = csr
+        mine = idx[indptr[i] : indptr[i + 1]] if i is not None else idx[:0]
+        hkey = None if i is None else b"".join((key, np.int64(i).tobytes(), mine.tobytes()))
+        if self._halo_keys.get(eye, b"") == hkey:
+            return False
+        self._halo_keys[eye] = hkey
+        lit, base, over, dup = self._geom[eye]
+        k = np.searchsorted(lit, mine)
+        across = over[k]
+        verts = np.concatenate([base[k], dup[k[across]]])
+        halo = self._halo[eye]
+        halo.set_paths([compound_path(verts)] if len(verts) else [])
+        # clipped to the map only when the patch crosses its edge (a clip path costs a
+        # mask of the whole map at every repaint)
+        halo.set_clip_path(self._clips[eye] if across.any() else None)
+        return True
+
+    def outlined(self, eye: str) -> int:
+        """How many facet outlines the selected ball's outline on eye ``eye`` holds (its
+        lit facets, those across the map's edge twice; tests)."""
+        h = self._halo.get(eye)
+        if h is None:
+            return 0
+        return sum(int(np.count_nonzero(np.asarray(p.codes) == p.MOVETO)) for p in h.get_paths())
 
     def lit_facets(self, eye: str) -> np.ndarray:
         """The facets drawn lit on eye ``eye``'s map (sorted RING indices)."""
@@ -238,6 +288,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self.nside = nside
         self._outlines = {e: _Outlines(nside) for e in EYES}
         self._keys = {}
+        self._halo_keys = {}
+        self._geom = {}
         self._over = []
         self._bg = None
         n_pix = healpix.npix(nside)
@@ -278,9 +330,17 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
                 for _ in range(2)
             )
             lit[1].set_clip_path(clip)
-            for c in lit:
+            # the selected ball's outline: a thick stroke under the fills (only the border
+            # of its patch shows), clipped to the map
+            halo = PathCollection(
+                [], facecolors="none", edgecolors=INK, linewidths=HALO_LW, animated=True
+            )
+            halo.set_gid(f"selected{eye}")
+            self._clips[eye] = clip
+            for c in (halo, *lit):
                 ax.add_collection(c, autolim=False)
             self._lit[eye] = lit
+            self._halo[eye] = halo
             (eq,) = ax.plot([-2 * R2, 2 * R2], [0.0, 0.0], color=INK, lw=0.8, animated=True)
             ax.text(
                 -2 * R2 * 0.97, -0.04, f"equator: the planar eye, m = {4 * nside:,}",
@@ -290,7 +350,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
                 0.5, 1.0, f"eye {eye} ({'left' if eye == 'A' else 'right'}), seen from inside",
                 transform=ax.transAxes, fontsize=7.5, color=INK, ha="center", va="bottom",
             )  # fmt: skip
-            self._over += [(ax, lit[0]), (ax, lit[1]), (ax, eq)]
+            self._over += [(ax, halo), (ax, lit[0]), (ax, lit[1]), (ax, eq)]
         self._hover_coll = PolyCollection(
             [], facecolors="none", edgecolors="#000000", linewidths=1.2, animated=True
         )
@@ -299,6 +359,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
 
     def _draw_over(self) -> None:
         for _, artist in self._over:
+            if isinstance(artist, PathCollection) and not artist.get_paths():
+                continue  # nothing lit or selected on that map: not even a draw call
             self.fig.draw_artist(artist)
         if self.hover_pix is not None and self._hover_coll is not None:
             self.fig.draw_artist(self._hover_coll)
