@@ -4,7 +4,10 @@
   1e308, inf, nan, signs) are read the same by the runner (StudyTable.open) and the
   report (read_study): both accept, or both refuse with the same one line naming the
   file; an accepted table takes one more point and still reads back; the input file is
-  never changed by reading.
+  never changed by reading. The same for the 3D study table (StudyTable3D.open and the
+  3D report's read_study3d; nside, elevation bins and errors among the edits).
+- Appends of either table stopped after any byte (an interruption or a full disk) are
+  cut back: the file is byte for byte what it was, and the next append goes in.
 - Symlinks: chains of absolute or relative links (dangling or not) are written through
   by atomic_output (every link stays a link, the final target gets the bytes) and a
   study lock held on the file refuses every alias (symlink or hard link).
@@ -27,9 +30,12 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from eyeviz import EyevizError
+from eyeviz.reports.study3d import read_study3d
 from eyeviz.reports.study_table import read_study
 from eyeviz.study.point import COLUMNS, DesignPoint, evaluate
+from eyeviz.study.point3d import COLUMNS3D, DesignPoint3D, evaluate3d
 from eyeviz.study.table import StudyTable
+from eyeviz.study.table3d import StudyTable3D
 
 from .conftest import assert_one_line, count, digest, fuzz_settings
 
@@ -37,36 +43,50 @@ P1 = DesignPoint(h=40, l=20, m=180, n=120, seed=1)
 P2 = DesignPoint(h=20, l=10, m=360, n=120, seed=2)
 P3 = DesignPoint(h=30, l=10, m=90, n=120, seed=3)
 ROWS = {p.key: evaluate(p) for p in (P1, P2, P3)}
+Q1 = DesignPoint3D(h=20, l=10, nside=8, n=60, seed=1)
+Q2 = DesignPoint3D(h=40, l=10, nside=8, n=60, seed=2)
+Q3 = DesignPoint3D(h=20, l=10, nside=16, n=60, seed=3)
+ROWS3D = {q.key: evaluate3d(q) for q in (Q1, Q2, Q3)}
 
 
-def _table_bytes() -> bytes:
+def _table_bytes(table, rows) -> bytes:
     with tempfile.TemporaryDirectory() as d:
         p = Path(d) / "s.csv"
-        t = StudyTable.open(p)
-        t.append(ROWS[P1.key])
-        t.append(ROWS[P2.key])
+        t = table.open(p)
+        for r in rows:
+            t.append(r)
         return p.read_bytes()
 
 
-TABLE = _table_bytes()
+TABLE = _table_bytes(StudyTable, [ROWS[P1.key], ROWS[P2.key]])
 TABLE_LINES = TABLE.decode().splitlines()
+TABLE3D_LINES = _table_bytes(StudyTable3D, [ROWS3D[Q1.key], ROWS3D[Q2.key]]).decode().splitlines()
 NASTY = [
     "\u0661", "\u0663\u0660", "\uff11", "1_000", "1e308", "-1e308", "inf", "-inf", "nan",
     "-0", "+5", "0x10", " 7", "1e999", "", "9" * 25, "1.5", "-1", "all", "\u00b2", "0.0",
 ]  # fmt: skip
+#: And what a 3D table's nside, bins and estimator columns may be given.
+NASTY3D = [*NASTY, "7", "0", "8", "16", "e5", "e6", "r7", "r8", "r07", "e\u0661", "limit3d", "x"]
+#: Columns whose edit may leave a 3D table valid (the metrics, counts and time).
+FOCUS3D = ("dd_mape", "el_mae_deg", "az_mae_deg", "dd_r2", "el_r2", "flagged", "seconds")
 
 
 @st.composite
-def edited_table(draw) -> bytes:
-    lines = list(TABLE_LINES)
+def edited_table(draw, table_lines=TABLE_LINES, columns=COLUMNS, nasty=NASTY, focus=()) -> bytes:
+    """1-3 fields of the table set to nasty values (``focus``: column names drawn more
+    often, so that some edits keep the table valid), then perhaps a few bytes changed."""
+    pick = st.integers(0, len(columns) - 1)
+    if focus:
+        pick = pick | st.sampled_from([columns.index(c) for c in focus])
+    lines = list(table_lines)
     for _ in range(draw(st.integers(1, 3))):
         i = draw(st.integers(1, len(lines) - 1))
         try:
             fields = next(csv.reader([lines[i]]))
         except csv.Error:  # an earlier edit put a line break in this line
             continue
-        j = draw(st.integers(0, len(COLUMNS) - 1))
-        fields[j] = draw(st.sampled_from(NASTY) | st.text(max_size=6))
+        j = draw(pick)
+        fields[j] = draw(st.sampled_from(nasty) | st.text(max_size=6))
         buf = io.StringIO()
         csv.writer(buf, lineterminator="").writerow(fields)
         lines[i] = buf.getvalue()
@@ -116,6 +136,102 @@ def test_runner_and_report_read_an_edited_table_alike(data):
             assert P3.key in StudyTable.open(path).keys
             read_study(path)
         count("study table edits", "ok")
+
+
+def _read_both3d(path):
+    out = []
+    for read in (StudyTable3D.open, read_study3d):
+        try:
+            out.append(("ok", read(path)))
+        except EyevizError as exc:
+            out.append(("refused", str(exc)))
+    return out
+
+
+def _holds_3d(row: dict) -> None:
+    """What the 3D report draws from: the invariants of an accepted row."""
+    assert row["m"] == 4 * row["nside"] and row["nside"] % 2 == 0
+    assert math.isclose(row["gamma"], 2 * math.pi / row["m"], rel_tol=1e-9)
+    assert 0 <= row["count"] <= row["n"] and 0 <= row["flagged"] <= row["count"]
+    for k in ("dd_mape", "ad_mape", "el_mae_deg", "az_mae_deg"):
+        v = row[k]
+        assert (math.isnan(v) and not row["count"]) or 0 <= v < math.inf, (k, v)
+    for k in ("dd_r2", "ad_r2", "el_r2"):
+        assert math.isnan(row[k]) or row[k] <= 1
+    assert 0 <= row["seconds"] < math.inf
+    if row["bin"].startswith("e"):
+        assert -row["el_max"] <= row["lo"] < row["hi"] <= row["el_max"]
+    else:
+        assert row["bin"] == "all" or row["bin"].startswith("r")
+        assert row["r_min"] <= row["lo"] < row["hi"] <= row["r_max"]
+
+
+@fuzz_settings(60)
+@given(edited_table(TABLE3D_LINES, COLUMNS3D, NASTY3D, FOCUS3D))
+def test_runner_and_report_read_an_edited_3d_table_alike(data):
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "s3.csv"
+        path.write_bytes(data)
+        before = digest(path)
+        (a, ra), (b, rb) = _read_both3d(path)
+        assert digest(path) == before
+        assert a == b, (ra, rb)
+        if a == "refused":
+            assert ra == rb
+            assert_one_line(ra)
+            assert str(path) in ra
+            count("3D study table edits", "refused")
+            return
+        for row in rb:
+            _holds_3d(row)
+        if Q3.key not in ra.keys:  # one more point: the file still reads back
+            ra.append(ROWS3D[Q3.key])
+            assert Q3.key in StudyTable3D.open(path).keys
+            read_study3d(path)
+        count("3D study table edits", "ok")
+
+
+@fuzz_settings(40)
+@given(st.booleans(), st.integers(0, 10**6), st.sampled_from(["interrupt", "disk full"]))
+def test_an_append_stopped_after_any_byte_is_cut_back(three_d, cut, how):
+    import errno
+
+    if three_d:
+        table, rows, k1, k2 = StudyTable3D, ROWS3D, Q1.key, Q2.key
+    else:
+        table, rows, k1, k2 = StudyTable, ROWS, P1.key, P2.key
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "s.csv"
+        t = table.open(path)
+        t.append(rows[k1])
+        before = path.read_bytes()
+        real_write = os.write
+
+        def stop_after(fd, data):
+            keep = cut % (len(data) + 1)  # 0 ... all of the point's bytes
+            real_write(fd, bytes(data[:keep]))
+            if how == "disk full":
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+            raise KeyboardInterrupt
+
+        os.write = stop_after
+        try:
+            t.append(rows[k2])
+        except KeyboardInterrupt:
+            assert how == "interrupt"
+        except EyevizError as exc:
+            assert how == "disk full"
+            assert_one_line(str(exc))
+            assert str(path) in str(exc)
+        else:
+            raise AssertionError("the append was not stopped")
+        finally:
+            os.write = real_write
+        assert path.read_bytes() == before
+        assert sorted(p.name for p in Path(d).iterdir()) == ["s.csv"]
+        t.append(rows[k2])
+        assert table.open(path).finished == {k1, k2}
+        count("appends stopped after any byte", "ok")
 
 
 @st.composite
