@@ -43,10 +43,21 @@ __all__ = ["Plan", "plan", "rays", "any_ray", "estimates", "row_medians", "inter
 
 _LO, _HI = (0, 1) if np.little_endian else (1, 0)
 _fmin, _fmax = np.fmin.reduce, np.fmax.reduce  # NaN-skipping minimum / maximum
-#: eye B's sector edges LB, LB + 1, RB, RB + 1 as half-planes: side and sign of g
-_FLIP = np.array([1.0, -1.0, 1.0, -1.0])
-#: sign of sin(delta) in the six linear constraints (eye B's four, the two BFV lines)
-_BSIGN = (-1, 1, 1, -1, -1, -1)
+#: keys (LA, RA, LB, RB) -> LA + RA, RA - LA, LB, RB, LB (+1), RB (+1)
+_KEY_INTS = np.array(
+    [[1, -1, 0, 0, 0, 0], [1, 1, 0, 0, 0, 0], [0, 0, 1, 0, 1, 0], [0, 0, 0, 1, 0, 1]]
+)
+#: Rows of the (N, 10, 4) matrix of :func:`rays`, as columns of the angles' [sin (0-7),
+#: cos (8-15), -sin (16-23), -cos (24-31), 0 (32)], the angles being A, D, A - beta for
+#: LB, RB, LB + 1, RB + 1, A - psi, A + psi. cos phi_A = cos A cos b - sin A sin b, and
+#: so on; a constraint's row is [f sin(A - beta), f cos(A - beta), +-sin D, +-cos D]
+#: with f = +1 for LB, RB (and the BFV lines), -1 for LB + 1, RB + 1, and the sign of
+#: sin(delta) -1 for LB, RB + 1 and the BFV lines, +1 for RB, LB + 1.
+_ROWS = np.array(
+    [[8, 16, 32, 32], [0, 8, 32, 32], [32, 32, 1, 9], [32, 32, 9, 17],  # cu su sd cd
+     [2, 10, 17, 25], [3, 11, 1, 9], [6, 14, 17, 25],  # LB, RB, line at psi
+     [20, 28, 1, 9], [21, 29, 17, 25], [7, 15, 17, 25]]  # LB + 1, RB + 1, line at pi - psi
+)  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,6 +74,10 @@ class Plan:
     r_min: float
     r_max: float
     width: int  # m / 2
+    scale: np.ndarray  # (6,) gamma / 2, gamma / 2, then gamma four times
+    psis: np.ndarray  # (2,) -psi, psi
+    rhs_edges: np.ndarray  # (2, 1) -2 h, 2 h
+    rhs_bfv: np.ndarray  # (2,) -h sin psi, h sin psi
     tab: np.ndarray  # (4, R): cos b, sin b, cos e, sin e for the grid's offsets of phi_A,
     # b = (u1 + u2) gamma / 2, and of delta, e = (u2 - u1) gamma / 2
     du: np.ndarray  # (R,) u2 - u1
@@ -82,15 +97,19 @@ def plan(domain: Domain, n: int, k: int) -> Plan:
     e = 0.5 * (u2 - u1) * gam
     gx, gw = np.polynomial.legendre.leggauss(k)
     h, r_max = float(domain.h), float(domain.r_max)
+    psi = math.asin(domain.l / h)
     tab = np.stack([np.cos(b), np.sin(b), np.cos(e), np.sin(e)])
     du = u2 - u1
     gx32, gw32 = gx.astype(np.float32)[:, None], gw.astype(np.float32)[:, None]
     for t in (tab, du, gx32, gw32):
         t.flags.writeable = False
     return Plan(
-        n=n, k=k, gam=gam, h=h, s=math.sin(gam / 2), psi=math.asin(domain.l / h),
+        n=n, k=k, gam=gam, h=h, s=math.sin(gam / 2), psi=psi,
         g_max=float(domain.g_max), r_min=float(domain.r_min), r_max=r_max,
-        width=domain.width, tab=tab, du=du, gx=gx32, gw=gw32,
+        width=domain.width, scale=np.array([0.5 * gam] * 2 + [gam] * 4),
+        psis=np.array([-psi, psi]), rhs_edges=np.array([[-2 * h], [2 * h]]),
+        rhs_bfv=np.array([-h * math.sin(psi), h * math.sin(psi)]),
+        tab=tab, du=du, gx=gx32, gw=gw32,
         near=h <= domain.r_min and r_max * r_max > 2 * h * h,
         small=2 * (h + r_max) < 1e18,
     )  # fmt: skip
@@ -127,67 +146,52 @@ def rays(keys: np.ndarray, p: Plan):
     phi_A, sin/cos of the half angle delta, and the feasible stretch [lo, hi] of rho
     (``ok``: non-empty; lo = hi = 0 elsewhere) for int64 keys (N, 4)."""
     N = keys.shape[0]
-    LA, RA, LB, RB = (keys[:, i] for i in range(4))
-    gam = p.gam
     h = p.h
-    # angles per key: phi_A's and delta's centres, phi_A - beta for eye B's sector edges,
-    # phi_A -+ psi for the BFV lines
-    A = (LA + RA) * (0.5 * gam)
+    # per key, exactly in integers: LA + RA, RA - LA, then eye B's sector edges LB, RB,
+    # LB + 1, RB + 1; in angle: phi_A's and delta's centres A and D, the edges' beta
+    ints = keys @ _KEY_INTS
+    ints[:, 4:] += 1
+    x = ints * p.scale
+    # the angles whose sines and cosines build every ray quantity: A, D, A - beta for
+    # the four edges, A -+ psi for the BFV lines (Prop. 4)
     ang = np.empty((N, 8))
-    ang[:, 0] = A
-    ang[:, 1] = (RA - LA) * (0.5 * gam)
-    ang[:, 2] = A - LB * gam
-    ang[:, 3] = A - (LB + 1) * gam
-    ang[:, 4] = A - RB * gam
-    ang[:, 5] = A - (RB + 1) * gam
-    ang[:, 6] = A - p.psi
-    ang[:, 7] = A + p.psi
-    sn, cs = np.sin(ang), np.cos(ang)
-    # the six linear constraints coef * rho >= rhs with coef = f sin(phi_A - beta)
-    # +- sin(delta) (eye B's four sector edges, f = +-1, then the BFV lines at psi and
-    # pi - psi), by angle addition linear in the tables [cos b, sin b, cos e, sin e]
-    coef = np.empty((N, 6, 4))
-    coef[:, :4, 0] = sn[:, 2:6] * _FLIP
-    coef[:, :4, 1] = cs[:, 2:6] * _FLIP
-    coef[:, 4:, 0] = sn[:, 6:8]
-    coef[:, 4:, 1] = cs[:, 6:8]
-    coef[:, :, 2] = sn[:, 1:2] * _BSIGN
-    coef[:, :, 3] = cs[:, 1:2] * _BSIGN
-    rhs = np.empty((N, 6))
-    rhs[:, :4] = np.sin(np.stack([LB, LB + 1, RB, RB + 1], axis=1) * gam)
-    rhs[:, :4] *= (-2 * h) * _FLIP
-    sp = math.sin(p.psi)
-    rhs[:, 4] = -sp * h
-    rhs[:, 5] = sp * h
-    # every ray quantity at once: (N, 10, 4) rows over the (4, R) tables. Rows 0-3: cos
-    # and sin of phi_A and of delta; rows 4-9: coef / rhs. With 0 < beta < pi (eye B's
-    # run clear of both ends of the half bitmap) rhs has a fixed sign per constraint, so
-    # in v = 1 / rho each constraint is a bound of known side: v >= coef / rhs for
-    # rhs < 0 (constraints 0, 2, 4), v <= coef / rhs for rhs > 0 (1, 3, 5)
-    M = np.zeros((N, 10, 4))
-    M[:, 0, 0] = M[:, 1, 1] = cs[:, 0]
-    M[:, 0, 1] = -sn[:, 0]
-    M[:, 1, 0] = sn[:, 0]
-    M[:, 2, 2] = M[:, 3, 3] = sn[:, 1]
-    M[:, 2, 3] = M[:, 3, 2] = cs[:, 1]
-    M[:, 3, 3] *= -1
+    ang[:, :2] = x[:, :2]
+    np.subtract(x[:, :1], x[:, 2:], out=ang[:, 2:6])
+    np.add(x[:, :1], p.psis, out=ang[:, 6:])
+    vals = np.empty((N, 33))  # sin, cos, -sin, -cos of the angles, and 0
+    np.sin(ang, out=vals[:, :8])
+    np.cos(ang, out=vals[:, 8:16])
+    np.negative(vals[:, :16], out=vals[:, 16:32])
+    vals[:, 32] = 0.0
+    # the linear constraints coef * rho >= rhs, coef = f sin(phi_A - beta) +- sin(delta)
+    # (eye B's sector edges, f = +-1; the BFV lines), rhs = -2 h f sin(beta) (-+ h sin psi
+    # for the BFV lines); ordered: rhs < 0 (LB, RB, the line at psi), then rhs > 0
+    rhs = np.empty((N, 2, 3))
+    np.multiply(np.sin(x[:, 2:]).reshape(N, 2, 2), p.rhs_edges, out=rhs[:, :, :2])
+    rhs[:, :, 2] = p.rhs_bfv
+    rhs = rhs.reshape(N, 6)
+    # every ray quantity at once, by angle addition: rows (N, 10, 4) over the tables
+    # [cos b, sin b, cos e, sin e] (R,). Rows 0-3: cos and sin of phi_A and of delta;
+    # rows 4-9: coef / rhs. With 0 < beta < pi (eye B's run clear of both ends of the
+    # half bitmap) each rhs has the sign above, so in v = 1 / rho the constraint is a
+    # bound of known side: v >= coef / rhs (rows 4-6), v <= coef / rhs (rows 7-9)
+    M = vals[:, _ROWS]
     with np.errstate(divide="ignore", invalid="ignore"):
-        np.divide(coef, rhs[:, :, None], out=M[:, 4:])
+        M[:, 4:] /= rhs[:, :, None]
         Y = np.einsum("nij,jr->nir", M, p.tab)  # no BLAS: its threads cost more here
         cu, su, sd, cd = Y[:, 0], Y[:, 1], Y[:, 2], Y[:, 3]
-        v = np.maximum(Y[:, 4], Y[:, 6])
-        np.maximum(v, Y[:, 8], out=v)
+        v = np.max(Y[:, 4:7], axis=1)
         np.maximum(v, 0.0, out=v)
         v += 0.0  # -0 -> +0
         hi = np.divide(1.0, v, out=v)
-        v = np.minimum(Y[:, 5], Y[:, 7])
-        np.minimum(v, Y[:, 9], out=v)
+        v = np.min(Y[:, 7:10], axis=1)
         np.maximum(v, 0.0, out=v)  # v <= 0: no rho > 0, lo = inf
         v += 0.0
         lo = np.divide(1.0, v, out=v)
-        edge = np.flatnonzero((LB <= 0) | (RB >= p.width - 2))
-        if edge.size:  # beta = 0 or pi: rhs of either sign (or 0), bounds in rho
-            c = np.einsum("nij,jr->nir", coef[edge], p.tab)
+        if ints[:, 2].min() <= 0 or ints[:, 3].max() >= p.width - 2:
+            edge = np.flatnonzero((ints[:, 2] <= 0) | (ints[:, 3] >= p.width - 2))
+            # beta = 0 or pi: rhs of either sign (or 0), bounds in rho instead
+            c = np.einsum("nij,jr->nir", vals[edge][:, _ROWS[4:]], p.tab)
             r = rhs[edge][:, :, None]
             # coef > 0: rho >= rhs / coef, i.e. rhs / max(coef, 0) (for coef <= 0: +inf
             # when rhs > 0, infeasible; -inf otherwise, no bound); coef < 0 with rhs <= 0:
@@ -233,15 +237,15 @@ def rays(keys: np.ndarray, p: Plan):
         np.sqrt(root, out=root)
         root -= qb
         root /= 2 * qa
-    other = np.flatnonzero(qa.min(axis=1) <= 1e-15)
-    if other.size:  # keys with a ray at delta <= gamma/2: the general root-finding
-        ql, qh = interval_quadratic(qa[other], qb[other], np.full((other.size, 1), qc))
+    other = np.flatnonzero(qa.min(axis=1) <= 1e-15) if qa.min() <= 1e-15 else ()
+    if len(other):  # keys with a ray at delta <= gamma/2: the general root-finding
+        ql, qh = interval_quadratic(qa[other], qb[other], np.full((len(other), 1), qc))
         root[other] = ql
         hi[other] = np.minimum(hi[other], qh)
     np.maximum(lo, root, out=lo)
     ok = hi > lo  # a NaN or infinite lo fails; hi is never +inf past the r <= r_max bound
-    if (RA <= LA).any():  # keys with rays at delta <= 0
-        ok &= (RA - LA)[:, None] + p.du > 0
+    if ints[:, 1].min() <= 0:  # keys with rays at delta <= 0 (RA <= LA)
+        ok &= ints[:, 1:2] + p.du > 0
     # no stretch: lo = hi = 0 (the reference's nodes at the eye, with zero weight); both
     # made finite first, leaving the rays with a stretch as they are (hi > lo >= 0)
     np.maximum(hi, 0.0, out=hi)
@@ -262,10 +266,12 @@ def any_ray(keys: np.ndarray, domain: Domain, n: int) -> np.ndarray:
 
 
 def _nodes(cu, su, sd, cd, lo, hi, p: Plan, prior: str):
-    """(r, phi, w, r_span, phi_span): the nodes' distance, azimuth and posterior weight
-    (density times the Jacobian rho^2 cos(delta) / 2, as the reference), float32
-    (N, K * n^2), and per key the (lowest, highest) value of r and of phi over the rays
-    with a stretch (float32 (N,) each), for :func:`row_medians`."""
+    """(values, weights, span, empty) for the N keys' nodes: values (2N, K n^2) float32,
+    the nodes' distance r (rows 0..N-1) and azimuth phi (rows N..2N-1); weights the
+    posterior weight (density times the Jacobian rho^2 cos(delta) / 2, as the reference)
+    over r, then over phi (the MAPE medians' weights); span the (lowest, highest) value
+    per row over the rays with a stretch (float32 (2N,) each, for :func:`row_medians`);
+    empty (N,): no weight."""
     f32 = np.float32
     N, R = cu.shape
     half = (0.5 * (hi - lo)).astype(f32)[:, None, :]
@@ -274,12 +280,14 @@ def _nodes(cu, su, sd, cd, lo, hi, p: Plan, prior: str):
     x -= f32(p.h)
     y = rho * su.astype(f32)[:, None, :]
     g = rho * sd.astype(f32)[:, None, :]
+    vals = np.empty((2, *rho.shape), f32)
+    r, phi = vals[0], vals[1]
     if p.small:
-        r = x * x
+        np.multiply(x, x, out=r)
         r += y * y
         np.sqrt(r, out=r)
     else:
-        r = np.hypot(x, y)
+        np.hypot(x, y, out=r)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         g /= r
         np.minimum(g, f32(1), out=g)
@@ -299,19 +307,26 @@ def _nodes(cu, su, sd, cd, lo, hi, p: Plan, prior: str):
     # weight 0 for NaN, inf and <= 0 (rays with no stretch: half = 0), no np.where
     np.fmax(w, f32(0), out=w)
     w[w == np.inf] = 0
-    phi = np.arctan2(y, x)
+    np.arctan2(y, x, out=phi)
+    wts = np.maximum(vals, f32(1e-30))
+    np.divide(w, wts, out=wts)
+    empty = ~(w.reshape(N, -1).sum(axis=1) > 0)
     # each key's span of r and phi over the rays with a stretch (1 / 0 = inf and * 0 = 0
     # leave out the others). Along a ray from A, phi decreases (from pi at the eye) and
     # r increases where rho > h cu, which r >= r_min >= h ensures: the span is then that
     # of the first and last nodes (up to float32 rounding, which row_medians tolerates)
     on = (half[:, 0, :] > 0).astype(f32)
+    span = np.empty((2, 2, N), f32)  # (low, high), (r, phi), key
     with np.errstate(divide="ignore", invalid="ignore"):
         if p.near:
-            r_span = _fmin(r[:, 0, :] / on, 1), _fmax(r[:, -1, :] * on, 1)
+            np.fmin.reduce(r[:, 0, :] / on, axis=1, out=span[0, 0])
+            np.fmax.reduce(r[:, -1, :] * on, axis=1, out=span[1, 0])
         else:
-            r_span = _fmin(r / on[:, None], (1, 2)), _fmax(r * on[:, None], (1, 2))
-        p_span = _fmin(phi[:, -1, :] / on, 1), _fmax(phi[:, 0, :] * on, 1)
-    return r.reshape(N, -1), phi.reshape(N, -1), w.reshape(N, -1), r_span, p_span
+            np.fmin.reduce(r / on[:, None], axis=(1, 2), out=span[0, 0])
+            np.fmax.reduce(r * on[:, None], axis=(1, 2), out=span[1, 0])
+        np.fmin.reduce(phi[:, -1, :] / on, axis=1, out=span[0, 1])
+        np.fmax.reduce(phi[:, 0, :] * on, axis=1, out=span[1, 1])
+    return vals.reshape(2 * N, -1), wts.reshape(2 * N, -1), span.reshape(2, 2 * N), empty
 
 
 @functools.lru_cache(maxsize=8)
@@ -324,6 +339,13 @@ def _columns(P: int) -> np.ndarray:
 _BLOCK = 32  # weights summed in blocks of 32 to find the median's neighbourhood
 
 
+@functools.lru_cache(maxsize=1)
+def _window() -> np.ndarray:
+    c = np.arange(3 * _BLOCK, dtype=np.int32)
+    c.flags.writeable = False
+    return c
+
+
 def row_medians(v: np.ndarray, w: np.ndarray, span=None) -> np.ndarray:
     """Per row, the median of v >= 0 (float32, (N, P)) under weights w >= 0 (float32,
     (N, P)): the weighted CDF at node midpoints interpolated linearly, as
@@ -332,26 +354,28 @@ def row_medians(v: np.ndarray, w: np.ndarray, span=None) -> np.ndarray:
     Each value's float32 bits (order-preserving for v >= 0) sit above its column in one
     integer, so one plain sort per row orders the values and carries the columns to fetch
     the weights with (one flat ``take``). The integer is 32-bit (sorted ~2.5x faster than
-    64-bit) when the row's values span few enough codes: ``span`` (lowest, highest value
-    per row, float32 (N,) each) must hold every node of positive weight, default that
-    span computed here. Values outside it are clamped to its ends: a node before the
-    first weighted one has CDF 0 and one after the last has CDF 1, so neither is ever the
-    upper node of the interpolation, and the lower one only beside a lone weighted node,
-    whose value is then the answer whatever the lower one's. A span too wide for the
-    column bits drops its lowest bits (ties then ordered by column: an order error of at
-    most 2^b float32 ulps for b dropped bits, b <= 8); rows wider still, or more than 2^13
-    columns, use a 64-bit integer.
+    64-bit) for up to 2^13 columns: ``span`` (lowest, highest value per row, float32
+    (N,) each) must hold every node of positive weight, default that span computed here.
+    Values outside it are clamped to its ends: a node before the first weighted one has
+    CDF 0 and one after the last has CDF 1, so neither is ever the upper node of the
+    interpolation, and the lower one only beside a lone weighted node, whose value is
+    then the answer whatever the lower one's. A row whose span has more codes than the
+    bits left beside the column drops its lowest bits (ties then ordered by column: an
+    order error of at most 2^b float32 ulps for b dropped bits, b <= 8; on the paper's
+    design b <= 3 for r and 0 for phi); a row wider still, and every row past 2^13
+    columns, sorts full codes in a 64-bit integer. Each choice is the row's own: a row's
+    answer does not depend on the rows computed with it.
 
-    The CDF is found from sums of blocks of 32 sorted weights (float64) and one cumulative
-    sum over the three blocks around the median, not over the whole row.
+    The CDF is found from sums of blocks of 32 sorted weights and one cumulative sum
+    (float64) over the three blocks around the median, not over the whole row.
     """
     N, P = v.shape
     v = np.ascontiguousarray(v, np.float32)
     w = np.ascontiguousarray(w, np.float32)
     code = v.view(np.int32)
     cbits = max(1, (P - 1).bit_length())
-    drop = 99
-    if cbits <= 13 and N:
+    wide = np.arange(N)  # rows sorted by a 64-bit integer
+    if cbits <= 13:
         if span is None:
             pos = w > 0
             cmin = np.min(code, axis=1, where=pos, initial=np.iinfo(np.int32).max)
@@ -360,59 +384,71 @@ def row_medians(v: np.ndarray, w: np.ndarray, span=None) -> np.ndarray:
             cmin = np.ascontiguousarray(span[0], np.float32).view(np.int32)
             cmax = np.ascontiguousarray(span[1], np.float32).view(np.int32)
         width = np.maximum(cmax - cmin, 0)  # rows with no weight: cmin > cmax
-        drop = max(0, int(width.max()).bit_length() - (31 - cbits))
-    if drop <= 8:
         q = code - cmin[:, None]
         np.maximum(q, 0, out=q)
         np.minimum(q, width[:, None], out=q)
-        if drop:
-            q >>= drop
+        # bits dropped per row, from that row alone (a row's answer never depends on the
+        # rows batched with it): its span's bit length beyond the 31 - cbits available
+        narrow: slice | np.ndarray = slice(None)
+        if width.max() >> (31 - cbits):
+            drop = np.frexp(width.astype(np.float64))[1] - (31 - cbits)
+            np.maximum(drop, 0, out=drop)
+            wide = np.flatnonzero(drop > 8)
+            if wide.size:
+                narrow = np.flatnonzero(drop <= 8)
+                q = q[narrow]
+            q >>= drop[narrow].astype(np.int32)[:, None]
+        else:
+            wide = wide[:0]
         q <<= cbits
         q |= _columns(P)
         q.sort(axis=1)
-        col = q & ((1 << cbits) - 1)
+        q &= (1 << cbits) - 1
+        col = q if not wide.size else np.empty((N, P), np.int32)
+        if wide.size:
+            col[narrow] = q
     else:
-        packed = np.empty((N, P), np.int64)
-        halves = packed.view(np.int32).reshape(N, P, 2)
-        halves[..., _HI] = code
+        col = np.empty((N, P), np.int32)
+    if wide.size:  # each value's full code above its column
+        packed = np.empty((wide.size, P), np.int64)
+        halves = packed.view(np.int32).reshape(wide.size, P, 2)
+        halves[..., _HI] = code[wide]
         halves[..., _LO] = _columns(P)
         packed.sort(axis=1)
-        col = packed.view(np.int32).reshape(N, P, 2)[..., _LO]
+        col[wide] = packed.view(np.int32).reshape(wide.size, P, 2)[..., _LO]
     rows = np.arange(N)
-    flat = col + (rows * P).astype(np.int32 if N * P < 2**31 else np.int64)[:, None]
+    off = np.arange(0, N * P, P, dtype=np.int32 if N * P < 2**31 else np.int64)[:, None]
+    flat = col + off
     ws = np.take(w.reshape(-1), flat)
     nb = P // _BLOCK
+    cum = np.zeros((N, nb + 1))  # the CDF (times the total) at the ends of the blocks
     if P % _BLOCK or nb < 3:
-        cw = np.cumsum(ws, axis=1, dtype=np.float64)
-        tot = cw[:, -1].copy()
-        crit = cw - 0.5 * ws
         base = np.zeros(N, np.intp)
+        win = ws
+        cum[:, -1] = ws.sum(axis=1, dtype=np.float64)
     else:
         # (einsum sums the blocks ~4x faster than .sum(axis=2))
-        blocks = np.einsum("nbk->nb", ws.reshape(N, nb, _BLOCK))
-        blocks = np.cumsum(blocks, axis=1, dtype=np.float64)
-        tot = blocks[:, -1].copy()
+        np.cumsum(np.einsum("nbk->nb", ws.reshape(N, nb, _BLOCK)), axis=1, out=cum[:, 1:])
         # the crossing lies in the first block whose cumulative weight reaches half the
         # total, or the next; its lower neighbour may end the block before
-        jb = np.count_nonzero(blocks < (0.5 * tot)[:, None], axis=1)
-        sb = np.clip(jb - 1, 0, nb - 3)
-        prefix = np.where(sb > 0, blocks[rows, sb - 1], 0.0)
-        base = sb * _BLOCK
-        win = ws[rows[:, None], base[:, None] + np.arange(3 * _BLOCK)]
-        crit = np.cumsum(win, axis=1, dtype=np.float64)
-        crit += prefix[:, None]
-        crit -= 0.5 * win
-    i = np.count_nonzero(crit < (0.5 * tot)[:, None], axis=1)
-    i1 = np.clip(base + i, 1, P - 1) - base
-    i0 = i1 - 1
-    t_ = np.where(tot > 0, tot, 1.0)
-    m0, m1 = crit[rows, i0] / t_, crit[rows, i1] / t_
-    vf = v.reshape(-1)
-    v0 = vf[flat[rows, base + i0]].astype(np.float64)
-    v1 = vf[flat[rows, base + i1]].astype(np.float64)
+        jb = np.count_nonzero(cum[:, 1:] < 0.5 * cum[:, -1:], axis=1)
+        jb -= 1
+        np.maximum(jb, 0, out=jb)
+        np.minimum(jb, nb - 3, out=jb)
+        base = jb * _BLOCK
+        win = ws.reshape(-1)[(off + base[:, None]) + _window()]
+    half = 0.5 * cum[:, -1]
+    crit = np.cumsum(win, axis=1, dtype=np.float64)
+    crit += cum[rows, base // _BLOCK][:, None]
+    crit -= 0.5 * win  # the CDF at node midpoints, times the total
+    i = np.count_nonzero(crit < half[:, None], axis=1)
+    i1 = np.minimum(np.maximum(base + i, 1), P - 1) - base
+    both = np.stack([i1 - 1, i1], axis=1)
+    c0, c1 = crit[rows[:, None], both].T
+    v0, v1 = v.reshape(-1)[flat[rows[:, None], base[:, None] + both]].astype(np.float64).T
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.clip((0.5 - m0) / (m1 - m0), 0.0, 1.0)
-    t = np.where(np.isfinite(t), t, 0.0)
+        t = (half - c0) / (c1 - c0)
+    t = np.fmin(np.fmax(t, 0.0), 1.0)  # NaN (c1 = c0) -> 0
     return v0 + t * (v1 - v0)
 
 
@@ -434,17 +470,9 @@ def estimates(keys, domain: Domain, prior: str = "single", n: int = 12, k: int =
             continue
         if idx.size < live.size:
             cu, su, sd, cd, lo, hi = (a[idx] for a in (cu, su, sd, cd, lo, hi))
-        r, phi, w, r_span, p_span = _nodes(cu, su, sd, cd, lo, hi, p, prior)
-        e = ~(w.sum(axis=1) > 0)
-        wr = w / np.maximum(r, np.float32(1e-30))
-        wp = w / np.maximum(phi, np.float32(1e-30))
-        M = idx.size
-        if M <= 16:  # one call for both medians (rows are independent): less overhead
-            span = (np.concatenate([r_span[0], p_span[0]]), np.concatenate([r_span[1], p_span[1]]))
-            both = row_medians(np.concatenate([r, phi]), np.concatenate([wr, wp]), span)
-            rr, pp = both[:M], both[M:]
-        else:
-            rr, pp = row_medians(r, wr, r_span), row_medians(phi, wp, p_span)
+        vals, wts, span, e = _nodes(cu, su, sd, cd, lo, hi, p, prior)
+        both = row_medians(vals, wts, span)  # r's rows, then phi's
+        rr, pp = both[: idx.size], both[idx.size :]
         idx += s0
         r_out[idx] = np.where(e, np.nan, rr)
         p_out[idx] = np.where(e, np.nan, pp)
