@@ -166,10 +166,10 @@ def rays(keys: np.ndarray, p: Plan):
     # the linear constraints coef * rho >= rhs, coef = f sin(phi_A - beta) +- sin(delta)
     # (eye B's sector edges, f = +-1; the BFV lines), rhs = -2 h f sin(beta) (-+ h sin psi
     # for the BFV lines); ordered: rhs < 0 (LB, RB, the line at psi), then rhs > 0
-    rhs = np.empty((N, 2, 3))
-    np.multiply(np.sin(x[:, 2:]).reshape(N, 2, 2), p.rhs_edges, out=rhs[:, :, :2])
-    rhs[:, :, 2] = p.rhs_bfv
-    rhs = rhs.reshape(N, 6)
+    rhs3 = np.empty((N, 2, 3))
+    np.multiply(np.sin(x[:, 2:]).reshape(N, 2, 2), p.rhs_edges, out=rhs3[:, :, :2])
+    rhs3[:, :, 2] = p.rhs_bfv
+    rhs = rhs3.reshape(N, 6)
     # every ray quantity at once, by angle addition: rows (N, 10, 4) over the tables
     # [cos b, sin b, cos e, sin e] (R,). Rows 0-3: cos and sin of phi_A and of delta;
     # rows 4-9: coef / rhs. With 0 < beta < pi (eye B's run clear of both ends of the
