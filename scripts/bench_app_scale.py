@@ -10,15 +10,16 @@ a path and times each from the event to the end of the first frame that reflects
 re-render of the window, and after the drag a *full* render (the backdrop's kept discs
 dropped: every disc filled again, what a frame cost before the backdrop). It then releases
 the button (the gesture's one undo step), times the release and an undo, and counts the
-Scene copies an edit makes. The 10^4 case runs twice: with the backdrop
+Scene copies an edit makes (the first run's). The 10^4 case is measured twice: with the backdrop
 (eyeviz/render/vtk/backdrop.py, the app's path from BACKDROP_MIN_FEATURES features) and
 with every disc in the main renderer (the path before it, and small scenes').
 
 Printed: p50 / p95 of the drag frames, bare and full renders, the backdrop's captures and
 hits during the drag; the ratios drag(10^4) / drag(10) (target <= 3x), drag(10^4) /
 full render(10^4), and drag(10^4, backdrop) / drag(10^4, without). ``--crossover`` also
-measures drag p50 with and without the backdrop at 300, 1,000 and 3,000 features (where
-BACKDROP_MIN_FEATURES comes from).
+times renders of a drag's state at 10, 30, 100, 300 and 1,000 features with the discs in the
+main renderer and kept by the backdrop, alternating in one window (where
+BACKDROP_MIN_FEATURES comes from: a drag frame is that render plus the same updates).
 
 Measured 2026-11-26 on the quiet 2-core machine (load < 0.5): before the backdrop drag p50
 138 ms at 10^4 against 7.7 ms at 10 features (17.9x); see the README for this stop's run.
@@ -47,7 +48,7 @@ from _bench_app_common import (  # noqa: E402
 )
 
 SMALL, BIG = 10, 10_000
-CROSSOVER = (300, 1_000, 3_000)
+CROSSOVER = (10, 30, 100, 300, 1_000)
 M = 720
 RATIO_TARGET = 3.0
 NEVER = 10**9  # a backdrop threshold no scene reaches: every disc in the main renderer
@@ -63,8 +64,9 @@ def bench_drag(n: int, events: int, settings: str, backdrop_min: int | None, und
     if backdrop_min is not None:
         feats.set_backdrop_min(backdrop_min)
     bd = feats.backdrop
+    c0, h0 = bd.captures, bd.hits
     d = drag(app, win, events, skip=5, period=40, warmup=3)
-    captures, hits = bd.captures, bd.hits  # during the drag (warm-up included)
+    captures, hits = bd.captures - c0, bd.hits - h0  # during the drag (warm-up included)
     full = []
     for _ in range(5):
         bd.invalidate()
@@ -119,13 +121,39 @@ def bench_drag(n: int, events: int, settings: str, backdrop_min: int | None, und
     return out
 
 
+def crossover(n: int, settings: str, rounds: int) -> tuple[list[float], list[float]]:
+    """Renders of one window of n features (a drag's state: the dragged one selected and
+    moved), the discs in the main renderer and in the backdrop in turn, ``rounds`` times:
+    (renders without, renders with the backdrop kept) in ms. A drag frame is this render
+    plus the same model and actor updates either way."""
+    app, win, _up = open_window(scene(M, n), settings)
+    feats = win.actors.features
+    win.model.select(n - 1)
+    win.model.begin_live("bench")
+    win.model.live(n - 1, x=120.0, y=1600.0)
+    app.processEvents()
+    off: list[float] = []
+    on: list[float] = []
+    for _ in range(rounds):
+        feats.set_backdrop_min(NEVER)
+        bare_render(win)
+        off += [bare_render(win) for _ in range(3)]
+        feats.set_backdrop_min(0)
+        bare_render(win)  # the capture
+        on += [bare_render(win) for _ in range(3)]
+    win.model.end_live()
+    win.force_close()
+    app.processEvents()
+    return off, on
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--events", type=int, default=60, help="mouse-move events per case (>= 20)")
     ap.add_argument(
         "--crossover",
         action="store_true",
-        help="also drag at 300, 1,000 and 3,000 features with and without the backdrop",
+        help="also time renders at 10-1,000 features with the discs kept or not",
     )
     args = ap.parse_args()
     if args.events < 20:
@@ -136,21 +164,25 @@ def main() -> int:
     res: dict[str, dict] = {}
     with tempfile.TemporaryDirectory() as tmp:
         ini = str(Path(tmp) / "bench.ini")
-        # the big case without, then with the backdrop, then the small one: neither path
-        # of the big case has the run's first window
-        res["small"] = bench_drag(SMALL, args.events, ini, None)
-        res["big, no backdrop"] = bench_drag(BIG, args.events, ini, NEVER)
-        res["big"] = bench_drag(BIG, args.events, ini, None)
-        cross = {}
-        if args.crossover:
-            for n in CROSSOVER:
-                for on in (False, True):
-                    r = bench_drag(n, max(20, args.events // 2), ini, 0 if on else NEVER, False)
-                    cross[(n, on)] = r
+        # in the order a, b, c, c, b, a (the machine's load drifts; the first window of a
+        # run is the slowest): each case pools its two runs' frames
+        cases = {"small": (SMALL, None), "big": (BIG, None), "big, no backdrop": (BIG, NEVER)}
+        for key in [*cases, *reversed(cases)]:
+            n, backdrop_min = cases[key]
+            r = bench_drag(n, args.events, ini, backdrop_min)
+            if key not in res:
+                res[key] = r
+                continue
+            for k in ("lat", "base", "full"):
+                res[key][k] += r[k]
+            for k in ("captures", "hits"):
+                res[key][k] += r[k]
+            res[key]["ok"] &= r["ok"]
+        cross = {n: crossover(n, ini, 10) for n in CROSSOVER} if args.crossover else {}
     names = {
         "small": f"{SMALL}",
-        "big, no backdrop": f"{BIG:,} no backdrop",
         "big": f"{BIG:,} backdrop",
+        "big, no backdrop": f"{BIG:,} no backdrop",
     }
     print(
         f"{'features':<20}{'events':>7}{'drag50':>8}{'drag95':>8}{'bare50':>8}{'full50':>8}"
@@ -184,10 +216,11 @@ def main() -> int:
         f"{pct(big['full'], 50) / pct(small['full'], 50):.2f}x"
     )
     if cross:
-        print(f"{'crossover':<12}{'no backdrop':>13}{'backdrop':>10}{'ratio':>8}   (drag p50, ms)")
-        for n in CROSSOVER:
-            off, on = pct(cross[(n, False)]["lat"], 50), pct(cross[(n, True)]["lat"], 50)
-            print(f"{n:>9,}   {off:>13.1f}{on:>10.1f}{on / off:>7.2f}x")
+        print("crossover: render p50 (ms) of a drag's state, discs in the main renderer or kept")
+        print(f"{'features':>9}{'main':>9}{'kept':>9}{'kept/main':>11}{'saved ms':>10}")
+        for n, (off, on) in cross.items():
+            a, b = pct(off, 50), pct(on, 50)
+            print(f"{n:>9,}{a:>9.2f}{b:>9.2f}{b / a:>10.2f}x{a - b:>10.2f}")
     ok = all(r["ok"] for r in res.values()) and q_small <= RATIO_TARGET and big["backdrop"]
     print("all targets met" if ok else "SOME TARGETS MISSED")
     return 0

@@ -20,8 +20,8 @@ pixels equal those of drawing everything in one renderer (tests/app/test_backdro
 compares them). This holds for opaque props only, which is all a backdrop may hold; the
 one difference is a tie, a main-renderer prop at exactly a backdrop prop's depth, which
 the main renderer's prop now wins (it is drawn later). A window without a render
-framebuffer leaves the backdrop drawing its props at every frame: the same pixels, no
-saving.
+framebuffer, or with multisampling, leaves the backdrop drawing its props at every frame:
+the same pixels, no saving.
 """
 
 from __future__ import annotations
@@ -107,6 +107,8 @@ class Backdrop:
             tuple(rw.GetTileScale()),
             tuple(self.main.GetViewport()),
             tuple(self.main.GetBackground()),
+            tuple(self.main.GetBackground2()),
+            self.main.GetGradientBackground(),
             self.main.GetBackgroundAlpha(),
             id(cam),
             cam.GetParallelProjection(),
@@ -140,6 +142,8 @@ class Backdrop:
             ren.SetActiveCamera(main.GetActiveCamera())
         ren.SetViewport(*main.GetViewport())
         ren.SetBackground(*main.GetBackground())
+        ren.SetBackground2(*main.GetBackground2())
+        ren.SetGradientBackground(main.GetGradientBackground())
         ren.SetBackgroundAlpha(main.GetBackgroundAlpha())
         ren.Render()
 
@@ -184,7 +188,7 @@ class Backdrop:
         if rw is None:
             return
         rfb = rw.GetRenderFramebuffer() if hasattr(rw, "GetRenderFramebuffer") else None
-        if not self.keep or rfb is None:  # draw the props, keep nothing
+        if not self.keep or rfb is None or rw.GetMultiSamples():  # draw them, keep nothing
             self._draw_props(rw)
             self._key = None
             return

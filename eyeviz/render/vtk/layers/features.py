@@ -66,9 +66,11 @@ __all__ = [
 LOD_LEVELS = np.array([8, 12, 16, 24, 32, 48, 64, 96, 128, CIRCLE_N])
 #: Largest gap, in pixels, between a disc's circle and its inscribed polygon.
 LOD_ERROR_PX = 0.5
-#: Features from which the main view's merged discs go to the backdrop (the crossover
-#: measured by scripts/bench_app_scale.py --crossover).
-BACKDROP_MIN_FEATURES = 1000
+#: Features from which the main view's merged discs go to the backdrop: the crossover that
+#: scripts/bench_app_scale.py --crossover measures (2026-11-26, loaded 2-core machine: a
+#: render of a drag's state 1.07x with the backdrop at 50 features (its copy costs more
+#: than the fill it saves), 0.86x at 100, 0.37-0.49x at 150-300, 0.39x at 1,000).
+BACKDROP_MIN_FEATURES = 100
 
 
 def disc_vertices(r_px: np.ndarray) -> np.ndarray:
