@@ -411,6 +411,8 @@ class Scene3DHost(QtCore.QObject):
         nxt = self.latest.start_pending()
         if nxt is not None and self.model is not None and self.active:
             self._start_limit(nxt)
+        if self.active and not self.win.jobs.busy():  # the runner cleared the status line
+            self.win.statusBar().showMessage(self._status(), 0)
 
     def _limit_failed(self, key: bytes, exc: BaseException) -> None:
         self.latest.finish(key)
