@@ -16,7 +16,7 @@ import pytest
 from PyQt5 import QtCore
 
 from eyeviz.model import predictions3d as p3
-from eyeviz.model.scene import load
+from eyeviz.model.scene import Eyes, load
 from eyeviz.render.vtk.style import hex_rgb
 
 SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
@@ -207,3 +207,20 @@ def test_export_draws_the_ghosts(make_window, qtbot, tmp_path):
     png2 = win.export_to(tmp_path / "q.png", scale=0.5)
     img2 = (mpimg.imread(png2)[..., :3] * 255).round().astype(int)
     assert (np.abs(img2[:top] - want).sum(axis=-1) < 40).sum() < close.sum() / 5
+
+
+def test_an_estimator_for_other_eyes_is_greyed_with_its_line(make_window, qtbot):
+    sc = _scene(True)
+    sc.eyes = Eyes(sc.eyes.h, sc.eyes.l, nside=16)  # learned3d's weights: nside 180
+    win = make_window(sc)
+    host = win.host3d
+    qtbot.waitUntil(lambda: _limit_done(win), timeout=20000)
+    host.refresh_panels()
+    box = host.estimators.boxes["learned3d"]
+    assert box.isChecked() and "8a8a8a" in box.styleSheet()
+    assert "nside=180" in host.estimators.note.text() and host.estimators.note.isVisible()
+    assert "learned3d" not in host.actors.ghosts.centres  # no ghost for the wrong eyes
+    assert host.readout.pred_text("learned3d", "r") == ""
+    assert host.readout.pred_text("learned3d", "note") == "—"
+    assert "learned3d: unavailable" in host.readout.pred_note.text()
+    assert host.estimators.boxes["analytic3d"].styleSheet() == ""
