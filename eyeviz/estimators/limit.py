@@ -384,18 +384,26 @@ class _KeyCache:
             # the rows' codes searched in sorted order (a sort plus a monotone search is
             # ~3x cheaper than a binary search from scratch per row, measured on 10^5 rows)
             order = np.argsort(code)
+            at = np.searchsorted(self.codes, code[order])
+            np.minimum(at, self.codes.size - 1, out=at)
             i = np.empty(code.size, np.intp)
-            i[order] = np.searchsorted(self.codes, code[order])
-            np.minimum(i, self.codes.size - 1, out=i)
+            i[order] = at
             found = self.codes[i] == code
             vals = self.values[i]
             self.used[i[found]] = self.tick
-            # the tick is new to this call: the entries marked with it are the distinct
-            # keys found (no bincount over the whole cache)
-            hits = int(np.count_nonzero(self.used == self.tick))
+            # distinct keys found: for a few rows, the changes along their (sorted)
+            # entries; for many, the entries marked with this call's tick (no bincount)
+            if code.size < self.codes.size // 4:
+                at = at[found[order]]
+                hits = int(at.size and 1 + np.count_nonzero(at[1:] != at[:-1]))
+            else:
+                hits = int(np.count_nonzero(self.used == self.tick))
         if self.recent and not found.all():
             miss = np.flatnonzero(~found)
-            uniq, inv = np.unique(code[miss], return_inverse=True)
+            if miss.size == 1:  # one row (np.unique costs more than the rest here)
+                uniq, inv = code[miss], np.zeros(1, np.intp)
+            else:
+                uniq, inv = np.unique(code[miss], return_inverse=True)
             got = np.zeros(uniq.size, bool)
             for j, c in enumerate(uniq.tolist()):
                 hit = self.recent.get(c)
@@ -485,11 +493,18 @@ class LimitEstimator(Estimator):
         self.hits += hits
         if not found.all():
             miss = np.flatnonzero(~found)
-            uniq, first, inv = np.unique(code[miss], return_index=True, return_inverse=True)
-            f = miss[first]
-            rr, pp, ee = self._solve(np.stack([LA[f], RA[f], LB[f], RB[f]], axis=1))
-            new = np.stack([rr, pp, ee.astype(float)], axis=1)
-            vals[miss] = new[inv.reshape(-1)]
+            if miss.size == 1:  # one new row (np.unique costs more than the rest here)
+                uniq, f, inv = code[miss], miss, np.zeros(1, np.intp)
+            else:
+                uniq, first, inv = np.unique(code[miss], return_index=True, return_inverse=True)
+                f, inv = miss[first], inv.reshape(-1)
+            keys = np.empty((f.size, 4), np.int64)
+            for j, col in enumerate((LA, RA, LB, RB)):
+                keys[:, j] = col[f]
+            rr, pp, ee = self._solve(keys)
+            new = np.empty((f.size, 3))
+            new[:, 0], new[:, 1], new[:, 2] = rr, pp, ee
+            vals[miss] = new[inv]
             cache.insert(uniq, new)
             self.misses += uniq.size
         return vals[:, 0], vals[:, 1], vals[:, 2] > 0
