@@ -11,6 +11,7 @@ from PyQt5.QtTest import QTest
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
 
+from eyeviz.model import interactions
 from eyeviz.model.scene import OKABE_ITO, Eyes, Feature, Scene, View
 from eyeviz.render.vtk.layers.features import BACKDROP_MIN_FEATURES
 
@@ -123,10 +124,19 @@ def test_a_drag_frame_over_the_backdrop_equals_the_full_render(make_window):
     f = win.model.scene.features[K]
     assert abs(f.x - (X0 + 180.0)) <= 3 * u and abs(f.y - (Y0 + 60.0)) <= 3 * u
     assert win.model.scene.features[:K] == before.features[:K]
+    c = bd.captures
     win.undo_stack.undo()
     app.processEvents()
     assert win.model.scene.features == before.features
-    # after the undo the discs changed: the backdrop draws them again, then keeps them
-    restored = view_pixels(win)
+    # the undo changed the discs and a zoom moves the camera: the backdrop draws them
+    # again, keeps them, and its next frame still equals the full render
+    assert bd.captures > c
+    vp = win.viewport("main")
+    c, h = bd.captures, bd.hits
+    assert interactions.wheel(win.model, "main", vp, 300.0, 300.0, 1.0, False) == "zoom"
+    app.processEvents()
+    view_pixels(win)
+    zoomed = view_pixels(win)  # a hit
+    assert bd.captures == c + 1 and bd.hits >= h + 1
     feats.set_backdrop_min(10**9)
-    assert np.array_equal(restored, view_pixels(win))
+    assert np.array_equal(zoomed, view_pixels(win))
