@@ -4,9 +4,9 @@ The paper's open question (Section 8): how do azimuth (AD) and distance (DD) acc
 depend on the eye diameter l, the distance between the eyes h and the number of
 ommatidia m? :mod:`eyeviz.study.point` evaluates one design (pure numpy, no dask),
 :mod:`eyeviz.study.grid` builds the grid of designs, :mod:`eyeviz.study.table` keeps the
-results (CSV, appended atomically, resumable) and :mod:`eyeviz.study.runner` distributes
-design points as tasks on Dask. Importing this package does not import dask:
-:func:`run_study` imports the runner when called.
+results (CSV, whole points appended in place, resumable; the 3D study's too) and
+:mod:`eyeviz.study.runner` distributes design points as tasks on Dask. Importing this
+package does not import dask: :func:`run_study` imports the runner when called.
 """
 
 from __future__ import annotations

@@ -291,7 +291,7 @@ def dask_config(connect_timeout: float = CONNECT_TIMEOUT_S) -> dict:
 @contextlib.contextmanager
 def _exclusive(path):
     """Hold ``.NAME.lock`` beside the table: a second study into the same file is refused
-    at once (one line) instead of both rewriting the table and losing points. The lock is
+    at once (one line) instead of both appending to the table and losing points. The lock is
     the kernel's (``flock``): a crashed study leaves none held.
 
     It acts on the resolved file (issue 25): a symlinked ``-o`` is locked beside its
@@ -377,7 +377,8 @@ def run_study(
     quota, :mod:`eyeviz.study.cpus`); ``scheduler``: the
     address of an existing Dask scheduler instead (then ``workers`` must be None).
     Points (planar or 3D, :mod:`eyeviz.study.kinds`) already in the table (same
-    ``key``) are skipped; each finished point is appended atomically as it arrives.
+    ``key``) are skipped; each finished point is appended as it arrives (in place, whole
+    points only: :class:`~eyeviz.study.table.StudyTable`).
     Returns a
     :class:`StudySummary`; raises :class:`StudyFailed` when some points failed (the
     others are kept), :class:`EyevizError` for an unreadable table, a bad worker count
