@@ -47,6 +47,9 @@ _fmin, _fmax = np.fmin.reduce, np.fmax.reduce  # NaN-skipping minimum / maximum
 _KEY_INTS = np.array(
     [[1, -1, 0, 0, 0, 0], [1, 1, 0, 0, 0, 0], [0, 0, 1, 0, 1, 0], [0, 0, 0, 1, 0, 1]]
 )
+#: columns of that array holding rhs in the constraints' order: -2 h sin(beta) for LB,
+#: RB, then -h sin psi, 2 h sin(beta) for LB + 1, RB + 1, then h sin psi
+_RHS = np.array([35, 36, 33, 37, 38, 34])
 #: Rows of the (N, 10, 4) matrix of :func:`rays`, as columns of the angles' [sin (0-7),
 #: cos (8-15), -sin (16-23), -cos (24-31), 0 (32)], the angles being A, D, A - beta for
 #: LB, RB, LB + 1, RB + 1, A - psi, A + psi. cos phi_A = cos A cos b - sin A sin b, and
@@ -76,8 +79,9 @@ class Plan:
     width: int  # m / 2
     scale: np.ndarray  # (6,) gamma / 2, gamma / 2, then gamma four times
     psis: np.ndarray  # (2,) -psi, psi
-    rhs_edges: np.ndarray  # (2, 1) -2 h, 2 h
-    rhs_bfv: np.ndarray  # (2,) -h sin psi, h sin psi
+    rhs_edges: np.ndarray  # (4,) -2 h, -2 h, 2 h, 2 h (times sin beta: LB, RB, LB + 1, RB + 1)
+    consts: np.ndarray  # (3,) 0, -h sin psi, h sin psi (the BFV lines' rhs)
+    radii2: np.ndarray  # (2, 1, 1) r_min^2, r_max^2
     tab: np.ndarray  # (4, R): cos b, sin b, cos e, sin e for the grid's offsets of phi_A,
     # b = (u1 + u2) gamma / 2, and of delta, e = (u2 - u1) gamma / 2
     du: np.ndarray  # (R,) u2 - u1
@@ -107,8 +111,9 @@ def plan(domain: Domain, n: int, k: int) -> Plan:
         n=n, k=k, gam=gam, h=h, s=math.sin(gam / 2), psi=psi,
         g_max=float(domain.g_max), r_min=float(domain.r_min), r_max=r_max,
         width=domain.width, scale=np.array([0.5 * gam] * 2 + [gam] * 4),
-        psis=np.array([-psi, psi]), rhs_edges=np.array([[-2 * h], [2 * h]]),
-        rhs_bfv=np.array([-h * math.sin(psi), h * math.sin(psi)]),
+        psis=np.array([-psi, psi]), rhs_edges=np.array([-2 * h, -2 * h, 2 * h, 2 * h]),
+        consts=np.array([0.0, -h * math.sin(psi), h * math.sin(psi)]),
+        radii2=np.array([domain.r_min**2, r_max**2], float)[:, None, None],
         tab=tab, du=du, gx=gx32, gw=gw32,
         near=h <= domain.r_min and r_max * r_max > 2 * h * h,
         small=2 * (h + r_max) < 1e18,
@@ -141,6 +146,7 @@ def interval_quadratic(qa, qb, qc):
     return lo, hi
 
 
+@np.errstate(divide="ignore", invalid="ignore")
 def rays(keys: np.ndarray, p: Plan):
     """(cu, su, sd, cd, lo, hi, ok), arrays (N, n*n): eye A's ray directions cos/sin
     phi_A, sin/cos of the half angle delta, and the feasible stretch [lo, hi] of rho
@@ -158,62 +164,53 @@ def rays(keys: np.ndarray, p: Plan):
     ang[:, :2] = x[:, :2]
     np.subtract(x[:, :1], x[:, 2:], out=ang[:, 2:6])
     np.add(x[:, :1], p.psis, out=ang[:, 6:])
-    vals = np.empty((N, 33))  # sin, cos, -sin, -cos of the angles, and 0
+    # sin, cos, -sin, -cos of the angles, 0, then the constraints' right-hand sides
+    vals = np.empty((N, 39))
     np.sin(ang, out=vals[:, :8])
     np.cos(ang, out=vals[:, 8:16])
     np.negative(vals[:, :16], out=vals[:, 16:32])
-    vals[:, 32] = 0.0
+    vals[:, 32:35] = p.consts
     # the linear constraints coef * rho >= rhs, coef = f sin(phi_A - beta) +- sin(delta)
     # (eye B's sector edges, f = +-1; the BFV lines), rhs = -2 h f sin(beta) (-+ h sin psi
     # for the BFV lines); ordered: rhs < 0 (LB, RB, the line at psi), then rhs > 0
-    rhs3 = np.empty((N, 2, 3))
-    np.multiply(np.sin(x[:, 2:]).reshape(N, 2, 2), p.rhs_edges, out=rhs3[:, :, :2])
-    rhs3[:, :, 2] = p.rhs_bfv
-    rhs = rhs3.reshape(N, 6)
-    # every ray quantity at once, by angle addition: rows (N, 10, 4) over the tables
-    # [cos b, sin b, cos e, sin e] (R,). Rows 0-3: cos and sin of phi_A and of delta;
-    # rows 4-9: coef / rhs. With 0 < beta < pi (eye B's run clear of both ends of the
-    # half bitmap) each rhs has the sign above, so in v = 1 / rho the constraint is a
-    # bound of known side: v >= coef / rhs (rows 4-6), v <= coef / rhs (rows 7-9)
+    np.multiply(np.sin(x[:, 2:]), p.rhs_edges, out=vals[:, 35:])
+    rhs = vals[:, _RHS]
     M = vals[:, _ROWS]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        M[:, 4:] /= rhs[:, :, None]
-        Y = np.einsum("nij,jr->nir", M, p.tab)  # no BLAS: its threads cost more here
-        cu, su, sd, cd = Y[:, 0], Y[:, 1], Y[:, 2], Y[:, 3]
-        v = np.max(Y[:, 4:7], axis=1)
-        np.maximum(v, 0.0, out=v)
-        v += 0.0  # -0 -> +0
-        hi = np.divide(1.0, v, out=v)
-        v = np.min(Y[:, 7:10], axis=1)
-        np.maximum(v, 0.0, out=v)  # v <= 0: no rho > 0, lo = inf
-        v += 0.0
-        lo = np.divide(1.0, v, out=v)
-        if ints[:, 2].min() <= 0 or ints[:, 3].max() >= p.width - 2:
-            edge = np.flatnonzero((ints[:, 2] <= 0) | (ints[:, 3] >= p.width - 2))
-            # beta = 0 or pi: rhs of either sign (or 0), bounds in rho instead
-            c = np.einsum("nij,jr->nir", vals[edge][:, _ROWS[4:]], p.tab)
-            r = rhs[edge][:, :, None]
-            # coef > 0: rho >= rhs / coef, i.e. rhs / max(coef, 0) (for coef <= 0: +inf
-            # when rhs > 0, infeasible; -inf otherwise, no bound); coef < 0 with rhs <= 0:
-            # rho <= rhs / coef = -|rhs| / min(coef, -0) (+inf for coef > 0); NaN (rhs =
-            # 0 = coef) is no bound, skipped by fmax / fmin
-            lo[edge] = np.maximum(np.fmax.reduce(r / np.maximum(c, 0.0), axis=1), 0.0)
-            hi[edge] = np.fmin.reduce(-np.abs(r) / np.minimum(c, -0.0), axis=1)
-        np.minimum(hi, p.g_max / sd, out=hi)
+    M[:, 4:] /= rhs[:, :, None]
+    Y = np.einsum("nij,jr->nir", M, p.tab)  # no BLAS: its threads cost more here
+    cu, su, sd, cd = Y[:, 0], Y[:, 1], Y[:, 2], Y[:, 3]
+    v = np.maximum.reduce(Y[:, 4:7], axis=1)
+    np.maximum(v, 0.0, out=v)
+    v += 0.0  # -0 -> +0
+    hi = np.divide(1.0, v, out=v)
+    v = np.minimum.reduce(Y[:, 7:10], axis=1)
+    np.maximum(v, 0.0, out=v)  # v <= 0: no rho > 0, lo = inf
+    v += 0.0
+    lo = np.divide(1.0, v, out=v)
+    low = ints.min(axis=0)  # RA - LA, LB: the lowest in the batch
+    if low[2] <= 0 or ints[:, 3].max() >= p.width - 2:
+        edge = np.flatnonzero((ints[:, 2] <= 0) | (ints[:, 3] >= p.width - 2))
+        # beta = 0 or pi: rhs of either sign (or 0), bounds in rho instead
+        c = np.einsum("nij,jr->nir", vals[edge][:, _ROWS[4:]], p.tab)
+        r = rhs[edge][:, :, None]
+        # coef > 0: rho >= rhs / coef, i.e. rhs / max(coef, 0) (for coef <= 0: +inf
+        # when rhs > 0, infeasible; -inf otherwise, no bound); coef < 0 with rhs <= 0:
+        # rho <= rhs / coef = -|rhs| / min(coef, -0) (+inf for coef > 0); NaN (rhs =
+        # 0 = coef) is no bound, skipped by fmax / fmin
+        lo[edge] = np.maximum(np.fmax.reduce(r / np.maximum(c, 0.0), axis=1), 0.0)
+        hi[edge] = np.fmin.reduce(-np.abs(r) / np.minimum(c, -0.0), axis=1)
+    np.minimum(hi, p.g_max / sd, out=hi)
     # r^2 = rho^2 - 2 rho h cu + h^2: r >= r_min is rho >= h cu + sqrt(r_min^2 - h^2 su^2)
     # and r <= r_max is rho <= h cu + sqrt(r_max^2 - h^2 su^2) (see the reference)
     hcu = h * cu
-    if p.near:
+    if p.near:  # both circles at once: (2, N, R)
         hsu2 = su * su
         hsu2 *= h * h
-        q = p.r_min * p.r_min - hsu2
+        q = p.radii2 - hsu2
         np.sqrt(q, out=q)
         q += hcu
-        np.maximum(lo, q, out=lo)
-        q = p.r_max * p.r_max - hsu2
-        np.sqrt(q, out=q)
-        q += hcu
-        np.minimum(hi, q, out=hi)
+        np.maximum(lo, q[0], out=lo)
+        np.minimum(hi, q[1], out=hi)
     else:
         au = -hcu
         for rr, keep_above in ((p.r_min, True), (p.r_max, False)):
@@ -231,12 +228,11 @@ def rays(keys: np.ndarray, p: Plan):
     qa -= s2
     qb = (2 * s2) * hcu
     qc = -s2 * h * h
-    with np.errstate(divide="ignore", invalid="ignore"):
-        root = qb * qb
-        root += (-4 * qc) * qa
-        np.sqrt(root, out=root)
-        root -= qb
-        root /= 2 * qa
+    root = qb * qb
+    root += (-4 * qc) * qa
+    np.sqrt(root, out=root)
+    root -= qb
+    root /= 2 * qa
     other = np.flatnonzero(qa.min(axis=1) <= 1e-15) if qa.min() <= 1e-15 else ()
     if len(other):  # keys with a ray at delta <= gamma/2: the general root-finding
         ql, qh = interval_quadratic(qa[other], qb[other], np.full((len(other), 1), qc))
@@ -244,7 +240,7 @@ def rays(keys: np.ndarray, p: Plan):
         hi[other] = np.minimum(hi[other], qh)
     np.maximum(lo, root, out=lo)
     ok = hi > lo  # a NaN or infinite lo fails; hi is never +inf past the r <= r_max bound
-    if ints[:, 1].min() <= 0:  # keys with rays at delta <= 0 (RA <= LA)
+    if low[1] <= 0:  # keys with rays at delta <= 0 (RA <= LA)
         ok &= ints[:, 1:2] + p.du > 0
     # no stretch: lo = hi = 0 (the reference's nodes at the eye, with zero weight); both
     # made finite first, leaving the rays with a stretch as they are (hi > lo >= 0)
@@ -265,6 +261,7 @@ def any_ray(keys: np.ndarray, domain: Domain, n: int) -> np.ndarray:
     return out
 
 
+@np.errstate(divide="ignore", invalid="ignore", over="ignore")
 def _nodes(cu, su, sd, cd, lo, hi, p: Plan, prior: str):
     """(values, weights, span, empty) for the N keys' nodes: values (2N, K n^2) float32,
     the nodes' distance r (rows 0..N-1) and azimuth phi (rows N..2N-1); weights the
@@ -288,22 +285,21 @@ def _nodes(cu, su, sd, cd, lo, hi, p: Plan, prior: str):
         np.sqrt(r, out=r)
     else:
         np.hypot(x, y, out=r)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        g /= r
-        np.minimum(g, f32(1), out=g)
-        np.arcsin(g, out=g)
-        g *= f32(-2)
-        g += f32(math.pi - 2 * p.psi)  # the azimuth range left at this (r, g)
-        den = r * f32(-p.s)
-        den += f32(p.g_max)
-        den *= r
-        den *= g
-        w = rho * rho
-        w /= den
-        if prior == "multi":
-            w *= r
-        w *= cd.astype(f32)[:, None, :] * half
-        w *= p.gw
+    g /= r
+    np.minimum(g, f32(1), out=g)
+    np.arcsin(g, out=g)
+    g *= f32(-2)
+    g += f32(math.pi - 2 * p.psi)  # the azimuth range left at this (r, g)
+    den = r * f32(-p.s)
+    den += f32(p.g_max)
+    den *= r
+    den *= g
+    w = rho * rho
+    w /= den
+    if prior == "multi":
+        w *= r
+    w *= cd.astype(f32)[:, None, :] * half
+    w *= p.gw
     # weight 0 for NaN, inf and <= 0 (rays with no stretch: half = 0), no np.where
     np.fmax(w, f32(0), out=w)
     w[w == np.inf] = 0
@@ -317,13 +313,17 @@ def _nodes(cu, su, sd, cd, lo, hi, p: Plan, prior: str):
     # of the first and last nodes (up to float32 rounding, which row_medians tolerates)
     on = (half[:, 0, :] > 0).astype(f32)
     span = np.empty((2, 2, N), f32)  # (low, high), (r, phi), key
-    with np.errstate(divide="ignore", invalid="ignore"):
-        if p.near:
-            np.fmin.reduce(r[:, 0, :] / on, axis=1, out=span[0, 0])
-            np.fmax.reduce(r[:, -1, :] * on, axis=1, out=span[1, 0])
-        else:
-            np.fmin.reduce(r / on[:, None], axis=(1, 2), out=span[0, 0])
-            np.fmax.reduce(r * on[:, None], axis=(1, 2), out=span[1, 0])
+    if p.near:  # the first and last nodes of r and of phi: (2, N, 2, R)
+        ends = vals[:, :, :: p.k - 1 if p.k > 1 else 1, :]
+        low = np.minimum(ends[:, :, 0], ends[:, :, -1])
+        low /= on
+        np.fmin.reduce(low, axis=2, out=span[0])
+        np.maximum(ends[:, :, 0], ends[:, :, -1], out=low)
+        low *= on
+        np.fmax.reduce(low, axis=2, out=span[1])
+    else:
+        np.fmin.reduce(r / on[:, None], axis=(1, 2), out=span[0, 0])
+        np.fmax.reduce(r * on[:, None], axis=(1, 2), out=span[1, 0])
         np.fmin.reduce(phi[:, -1, :] / on, axis=1, out=span[0, 1])
         np.fmax.reduce(phi[:, 0, :] * on, axis=1, out=span[1, 1])
     return vals.reshape(2 * N, -1), wts.reshape(2 * N, -1), span.reshape(2, 2 * N), empty
@@ -337,6 +337,7 @@ def _columns(P: int) -> np.ndarray:
 
 
 _BLOCK = 32  # weights summed in blocks of 32 to find the median's neighbourhood
+_PAIR = np.array([-1, 0])
 
 
 @functools.lru_cache(maxsize=1)
@@ -426,24 +427,28 @@ def row_medians(v: np.ndarray, w: np.ndarray, span=None) -> np.ndarray:
         base = np.zeros(N, np.intp)
         win = ws
         cum[:, -1] = ws.sum(axis=1, dtype=np.float64)
+        half = 0.5 * cum[:, -1]
     else:
         # (einsum sums the blocks ~4x faster than .sum(axis=2))
-        np.cumsum(np.einsum("nbk->nb", ws.reshape(N, nb, _BLOCK)), axis=1, out=cum[:, 1:])
+        np.einsum("nbk->nb", ws.reshape(N, nb, _BLOCK)).cumsum(axis=1, out=cum[:, 1:])
+        half = 0.5 * cum[:, -1]
         # the crossing lies in the first block whose cumulative weight reaches half the
         # total, or the next; its lower neighbour may end the block before
-        jb = np.count_nonzero(cum[:, 1:] < 0.5 * cum[:, -1:], axis=1)
+        jb = (cum[:, 1:] < half[:, None]).sum(axis=1)
         jb -= 1
         np.maximum(jb, 0, out=jb)
         np.minimum(jb, nb - 3, out=jb)
         base = jb * _BLOCK
         win = ws.reshape(-1)[(off + base[:, None]) + _window()]
-    half = 0.5 * cum[:, -1]
-    crit = np.cumsum(win, axis=1, dtype=np.float64)
+    crit = win.cumsum(axis=1, dtype=np.float64)
     crit += cum[rows, base // _BLOCK][:, None]
     crit -= 0.5 * win  # the CDF at node midpoints, times the total
-    i = np.count_nonzero(crit < half[:, None], axis=1)
-    i1 = np.minimum(np.maximum(base + i, 1), P - 1) - base
-    both = np.stack([i1 - 1, i1], axis=1)
+    i = (crit < half[:, None]).sum(axis=1)
+    i += base
+    np.maximum(i, 1, out=i)
+    np.minimum(i, P - 1, out=i)
+    i -= base
+    both = i[:, None] + _PAIR  # the nodes below and above the median, in the window
     c0, c1 = crit[rows[:, None], both].T
     v0, v1 = v.reshape(-1)[flat[rows[:, None], base[:, None] + both]].astype(np.float64).T
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -458,31 +463,30 @@ def estimates(keys, domain: Domain, prior: str = "single", n: int = 12, k: int =
     keys = np.asarray(keys, np.int64).reshape(-1, 4)
     p = plan(domain, n, k)
     N = keys.shape[0]
-    r_out = np.full(N, np.nan)
-    p_out = np.full(N, np.nan)
+    out = np.full((2, N), np.nan)  # r, phi
     empty = np.ones(N, bool)
     step = max(1, 60_000 // (n * n * k))
     for s0 in range(0, N, step):
         cu, su, sd, cd, lo, hi, ok = rays(keys[s0 : s0 + step], p)
         live = ok.any(axis=1)
-        idx = np.flatnonzero(live)
+        idx = live.nonzero()[0]
         if not idx.size:
             continue
         if idx.size < live.size:
             cu, su, sd, cd, lo, hi = (a[idx] for a in (cu, su, sd, cd, lo, hi))
         vals, wts, span, e = _nodes(cu, su, sd, cd, lo, hi, p, prior)
         both = row_medians(vals, wts, span)  # r's rows, then phi's
-        rr, pp = both[: idx.size], both[idx.size :]
         idx += s0
-        r_out[idx] = np.where(e, np.nan, rr)
-        p_out[idx] = np.where(e, np.nan, pp)
+        both = both.reshape(2, -1)
+        both[:, e] = np.nan
+        out[:, idx] = both
         empty[idx] = e
     # a sliver polyhedron can fall between the grid's rays: retry those keys on a 4x grid,
     # once a 2x grid's rays (a quarter of the 4x grid's) show that some ray reaches it
-    again = np.flatnonzero(empty)
+    again = empty.nonzero()[0]
     if again.size and n < 48:
         again = again[any_ray(keys[again], domain, 2 * n)]
     if again.size and n < 48:
         r2, p2, e2 = estimates(keys[again], domain, prior, 4 * n, k)
-        r_out[again], p_out[again], empty[again] = r2, p2, e2
-    return r_out, p_out, empty
+        out[0, again], out[1, again], empty[again] = r2, p2, e2
+    return out[0], out[1], empty
