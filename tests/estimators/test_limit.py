@@ -357,3 +357,22 @@ def test_slivers_are_found_and_impossible_keys_skip_the_4x_grid(monkeypatch):
     monkeypatch.setattr(limit_solve, "rays", lambda kk, p: grids.append(p.n) or real_rays(kk, p))
     assert limit.limit_estimates(imp, PAPER_DOMAIN)[2].all()
     assert grids == [12, 24]
+
+
+def test_hits_of_a_few_rows_against_a_large_cache():
+    """A few rows against a cache of thousands count their distinct keys along their own
+    sorted entries (no pass over the whole cache): the same count and answers as a
+    fresh look-up."""
+    ds = dataset.generate(3000, seed=21)
+    est = LimitEstimator(cache_size=1 << 12)
+    p1 = est.predict(ds.omega_a, ds.omega_b)
+    cache = est._cache
+    assert cache.codes.size > 4 * 8  # merged into the sorted arrays
+    idx = np.array([5, 5, 17, 99, 5, 17])
+    hits, misses = est.hits, est.misses
+    p2 = est.predict(ds.omega_a[idx], ds.omega_b[idx])
+    np.testing.assert_array_equal(p2.r, p1.r[idx])
+    np.testing.assert_array_equal(p2.phi, p1.phi[idx])
+    LA, RA, LB, RB, ok = bitmaps_to_intervals(ds.omega_a[idx], ds.omega_b[idx])
+    keys = np.stack([LA, RA, LB, RB], axis=1)[ok]
+    assert est.hits - hits == len(np.unique(keys, axis=0)) and est.misses == misses
