@@ -74,6 +74,7 @@ PRESET_KEYS = (
 )
 PANEL_SHARE = 0.25  # the docks take at most about this share of a drag's time
 PANEL_FRAMES = 4  # and follow it at most every fourth frame
+DOCK_FRACTION = 0.4  # the 3D docks' column takes at most this share of the window's width
 PANEL_MS = 250  # the docks follow a drag at <= 4 Hz (the Mollweide maps take 15-75 ms at
 # nside 180); the drag's end refreshes them at once
 _MOD_DEPTH = QtCore.Qt.KeyboardModifier.ShiftModifier | QtCore.Qt.KeyboardModifier.ControlModifier
@@ -276,6 +277,7 @@ class Scene3DHost(QtCore.QObject):
             self._swap(True)
         self._on_model("scene", None)
         self.set_preset("default")
+        QtCore.QTimer.singleShot(0, self.fit_docks)
 
     def leave(self) -> None:
         """Back to the planar page (a planar scene was opened)."""
@@ -339,6 +341,7 @@ class Scene3DHost(QtCore.QObject):
         if what == "scene" and self.model is not None:
             for name, a in self.layer_actions.items():
                 a.setChecked(self.model.scene.shows(name))
+            QtCore.QTimer.singleShot(0, self.fit_docks)
 
     def flush(self) -> None:
         """Bring the actors up to the model (no render)."""
@@ -425,6 +428,17 @@ class Scene3DHost(QtCore.QObject):
             return
         self.flush()
         self.view.draw()
+
+    def fit_docks(self) -> None:
+        """Widen the readout's dock column to its tables' natural width (both whole: no
+        horizontal scroll bar, nothing elided but long names), at most DOCK_FRACTION of the
+        window; never narrowed (the user's width is kept when it is wider)."""
+        if self.readout is None or not self.active:
+            return
+        d = self.docks["readout3d"]
+        want = min(self.readout.natural_width() + 8, int(DOCK_FRACTION * self.win.width()))
+        if d.isVisible() and d.width() < want:
+            self.win.resizeDocks([d], [want], QtCore.Qt.Orientation.Horizontal)
 
     def refresh_panels(self) -> None:
         self._panel_timer.stop()

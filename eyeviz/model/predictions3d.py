@@ -447,7 +447,7 @@ def prediction_rows(preds: Predictions3D | None) -> list[tuple[str, ...]]:
         if math.isfinite(a.mc_error):
             notes.append(f"MC ±{100.0 * a.mc_error:.2g} %")
         if a.flagged:
-            notes.append("⚑ flagged (fallback)")
+            notes.append("⚑ flagged")  # answered by a fallback (analytic3d for the limit)
         rows.append(
             (
                 name,

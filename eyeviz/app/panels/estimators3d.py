@@ -14,6 +14,7 @@ from collections.abc import Callable
 
 from PyQt5 import QtGui, QtWidgets
 
+from eyeviz.app.panels.common import user_message, wrap_label
 from eyeviz.model.predictions3d import Predictions3D, estimator_color3d, estimators3d
 from eyeviz.model.scene import Scene
 
@@ -49,8 +50,7 @@ class Estimators3DPanel(QtWidgets.QWidget):
             b.toggled.connect(lambda on, n=name: self._toggled(n, on))
             lay.addWidget(b)
             self.boxes[name] = b
-        self.note = QtWidgets.QLabel("")
-        self.note.setWordWrap(True)
+        self.note = wrap_label(QtWidgets.QLabel(""))
         self.note.setStyleSheet("color: #b00020;")
         lay.addWidget(self.note)
         lay.addStretch(1)
@@ -78,7 +78,7 @@ class Estimators3DPanel(QtWidgets.QWidget):
             unavailable = isinstance(a, str) and a.startswith("unavailable")
             b.setStyleSheet("color: #8a8a8a;" if unavailable else "")
             if unavailable:
-                bad.append(f"{name}: {a}")
+                bad.append(user_message(f"{name}: {a}", 200))
         self.note.setText("\n".join(bad))
         self.note.setVisible(bool(bad))
 

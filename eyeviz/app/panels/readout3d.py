@@ -7,11 +7,11 @@ per eye. The rows are :func:`eyeviz.render.mpl.figure3d.readout_rows`, the same 
 the exported figure's table shows, so the app and the figure agree. A cell is re-set only
 when its text changes; the columns are re-fitted only when the rows change.
 
-With the predictions layer a second table holds one row per estimator for the layer's
-ball (:func:`eyeviz.model.predictions3d.prediction_rows`): r, azimuth and elevation and
-their errors against the true ball (r relative, in %; the angles absolute, in degrees),
-and a note: the limit's Monte-Carlo error of r, a flag when an answer is a fallback, or
-why there is no answer.
+With the predictions layer a second table holds a column per estimator for the layer's
+ball, named in its corner (:func:`eyeviz.model.predictions3d.prediction_rows`): r,
+azimuth and elevation and their errors against the true ball (r relative, in %; the
+angles absolute, in degrees), and a note: the limit's Monte-Carlo error of r, a flag when
+an answer is a fallback, or why there is no answer (in full in its tooltip).
 
 Both tables fit the dock's width (no horizontal scroll bar, also at 1280x720): the
 columns take their contents' width and the first (the names) the rest, eliding a long
@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from PyQt5 import QtCore, QtGui, QtWidgets
 
+from eyeviz.app.panels.common import user_message, wrap_label
 from eyeviz.model.predictions3d import Predictions3D, estimator_color3d, prediction_rows
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
@@ -44,6 +45,9 @@ COLUMNS = (
 TABLE_FONT = 0.8  # the tables' font, times the panel's
 CELL_PAD_PX = 9  # a column's width beyond its widest text
 NAME_MIN_PX = 40  # the names' column at least (elided)
+NAME_WANT_PX = 100  # ... and what the dock is widened for (eyeviz.app.view3d)
+NOTE_WANT_PX = 130  # an estimator's column with a long reason: what the dock widens for
+NOTE_CHARS = 110  # a note below the predictions table at most (the dock keeps its size)
 #: The predictions table's rows (one column per estimator): each value with its error.
 PRED_ROWS = (
     ("r", "the estimator's distance (in brackets: the relative error of r, %)"),
@@ -84,9 +88,8 @@ def _table(columns) -> QtWidgets.QTableWidget:
     return t
 
 
-def fit_columns(t: QtWidgets.QTableWidget) -> None:
-    """Columns 1... as wide as their header and cells; column 0 (the names, elided) the
-    rest of the viewport, at least NAME_MIN_PX: no horizontal scroll bar."""
+def _text_widths(t: QtWidgets.QTableWidget) -> list[int]:
+    """Each column's widest text (header and cells) plus CELL_PAD_PX."""
     fm = QtGui.QFontMetrics(t.font())
     head = t.horizontalHeader()
     assert head is not None
@@ -102,12 +105,47 @@ def fit_columns(t: QtWidgets.QTableWidget) -> None:
             if item is not None:
                 w = max(w, fm.horizontalAdvance(item.text()))
         widths.append(w + CELL_PAD_PX)
+    return widths
+
+
+def _bar_px(t: QtWidgets.QTableWidget) -> int:
     style = t.style()
-    bar = style.pixelMetric(QtWidgets.QStyle.PixelMetric.PM_ScrollBarExtent) if style else 16
+    return style.pixelMetric(QtWidgets.QStyle.PixelMetric.PM_ScrollBarExtent) if style else 16
+
+
+def natural_width(t: QtWidgets.QTableWidget) -> int:
+    """The width ``t`` wants: every number whole, names up to NAME_WANT_PX, a long reason
+    (an estimator's note) up to NOTE_WANT_PX, a vertical scroll bar's room."""
+    w = _text_widths(t)
+    if not w:
+        return 0
+    return (min(w[0], NAME_WANT_PX) + sum(min(v, NOTE_WANT_PX) for v in w[1:])
+            + 2 * t.frameWidth() + _bar_px(t))  # fmt: skip
+
+
+def fit_columns(t: QtWidgets.QTableWidget) -> None:
+    """Columns 1... as wide as their header and cells; column 0 (the names, elided) the
+    rest of the viewport, at least NAME_MIN_PX: no horizontal scroll bar."""
+    head = t.horizontalHeader()
+    assert head is not None
+    widths = _text_widths(t)
+    bar = _bar_px(t)
     side = t.verticalHeader()
     rows_h = t.rowCount() * (side.defaultSectionSize() if side is not None else 20)
     tall = rows_h + head.height() + 2 * t.frameWidth() > t.height()
     avail = t.width() - 2 * t.frameWidth() - (bar if tall else 0)  # a vertical bar's room
+    room = avail - NAME_MIN_PX
+    if len(widths) > 1 and sum(widths[1:]) > room:
+        # too wide (a long reason): the narrow columns keep their width, the widest share
+        # what is left, their text elided (water-filling)
+        rest = sorted(range(1, len(widths)), key=lambda j: widths[j])
+        while rest:
+            fair = max(room // len(rest), 24)
+            if widths[rest[0]] > fair:
+                for j in rest:
+                    widths[j] = fair
+                break
+            room -= widths[rest.pop(0)]
     widths[0] = max(NAME_MIN_PX, avail - sum(widths[1:]))
     for j, w in enumerate(widths):
         head.resizeSection(j, int(w))
@@ -134,20 +172,21 @@ class Readout3DPanel(QtWidgets.QWidget):
         self._colors: list[str] = []
         self.table = _table(COLUMNS)
         self.table.setObjectName("readout3d")
+        side = self.table.verticalHeader()
+        row_h = side.defaultSectionSize() if side is not None else 20
+        self.table.setMinimumHeight(3 * row_h + 4)  # the header and two balls at least
         self.note = QtWidgets.QLabel("")
         self.note.setWordWrap(True)
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(4, 4, 4, 4)
+        lay.setSpacing(3)  # with the predictions the dock still fits 1280x720
         lay.addWidget(self.table, 1)
         lay.addWidget(self.note)
-        self.pred_title = QtWidgets.QLabel("")
         self.pred_table = _table((("", ""),))
         self.pred_table.setObjectName("predictions3d")
-        self.pred_note = QtWidgets.QLabel("")
-        self.pred_note.setWordWrap(True)
-        for w in (self.pred_title, self.pred_table, self.pred_note):
+        self.pred_note = wrap_label(QtWidgets.QLabel(""))
+        for w in (self.pred_table, self.pred_note):
             w.setVisible(False)
-        lay.addWidget(self.pred_title)
         lay.addWidget(self.pred_table, 1)
         lay.addWidget(self.pred_note)
         self.pred_rows: list[tuple[str, ...]] = []
@@ -181,14 +220,12 @@ class Readout3DPanel(QtWidgets.QWidget):
     def set_predictions(self, preds: Predictions3D | None, scene: Scene) -> None:
         """The predictions table for ``preds`` (hidden without the layer or a ball)."""
         on = scene.shows("predictions") and preds is not None
-        for w in (self.pred_title, self.pred_table):
-            w.setVisible(on)
+        self.pred_table.setVisible(on)
         if not on or preds is None:
             self.pred_note.setVisible(False)
             self.pred_rows = []
             return
         name = scene.features[preds.ball].name if preds.ball < len(scene.features) else ""
-        self.pred_title.setText(f"<b>Predictions</b> for {name} (errors against the truth)")
         rows = prediction_rows(preds)  # per estimator: name, r, dr, az, daz, el, del, note
         t = self.pred_table
         if t.columnCount() != len(rows) + 1 or t.rowCount() != len(PRED_ROWS):
@@ -198,7 +235,13 @@ class Readout3DPanel(QtWidgets.QWidget):
                 item = _cell(t, i, 0)
                 item.setText(label)
                 item.setToolTip(tip)
-        notes = []
+        corner = t.horizontalHeaderItem(0)
+        if corner is None or corner.text() != name:  # the layer's ball, named above its rows
+            corner = QtWidgets.QTableWidgetItem(name)
+            t.setHorizontalHeaderItem(0, corner)
+        corner.setToolTip(f"the estimators' answers for {name}, errors against the truth")
+        notes: list[str] = []
+        reasons: set[str] = set()
         for j, row in enumerate(rows, start=1):
             head = t.horizontalHeaderItem(j)
             if head is None or head.text() != row[0]:
@@ -209,24 +252,37 @@ class Readout3DPanel(QtWidgets.QWidget):
                 f"{r} ({dr} %)" if dr else r,
                 f"{az} ({daz})" if daz else az,
                 f"{el} ({de})" if de else el,
-                note if r else "—",
+                note if r or not note else user_message(note, 60),
             )
             for i, text in enumerate(texts):
                 item = _cell(t, i, j)
                 if item.text() != text:
                     item.setText(text)
                     item.setToolTip(text)
-            if note and not r:  # no answer: the reason, in full, below
-                notes.append(f"{name}: {note}")
+            if note and not r:  # no answer: the reason in the cell's tooltip, in full
+                _cell(t, 3, j).setToolTip(user_message(f"{name}: {note}", 400))
+                reasons.add(note)
+        if len(reasons) == 1 and len(rows) > 1 and all(not row[1] for row in rows):
+            notes.append(user_message(reasons.pop(), NOTE_CHARS))  # one reason for all
         if preds.note:
-            notes.append(preds.note)
+            notes.append(user_message(preds.note, NOTE_CHARS))
         self.pred_rows = rows
         fit_columns(t)
         self.pred_note.setText("\n".join(notes))
+        self.pred_note.setToolTip("\n".join(notes))
         self.pred_note.setVisible(bool(notes))
-        side = t.verticalHeader()
+        side, top = t.verticalHeader(), t.horizontalHeader()
         row_h = side.defaultSectionSize() if side is not None else 20
-        t.setFixedHeight(row_h * (len(PRED_ROWS) + 1) + 8)
+        head_h = top.sizeHint().height() if top is not None else row_h
+        t.setFixedHeight(row_h * len(PRED_ROWS) + head_h + 2 * t.frameWidth() + 1)
+
+    def natural_width(self) -> int:
+        """The panel's width with both tables whole (names up to NAME_WANT_PX)."""
+        lay = self.layout()
+        m = lay.contentsMargins() if lay is not None else None
+        pad = m.left() + m.right() if m is not None else 8
+        tables = [self.table] + ([self.pred_table] if self.pred_table.isVisibleTo(self) else [])
+        return max(natural_width(t) for t in tables) + pad
 
     def pred_text(self, name: str, row: str) -> str:
         """The predictions table's text for estimator ``name`` in row ``row`` ("r", "az",
