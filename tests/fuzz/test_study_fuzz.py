@@ -99,57 +99,49 @@ def edited_table(draw, table_lines=TABLE_LINES, columns=COLUMNS, nasty=NASTY, fo
     return ("\n".join(lines) + "\n").encode("utf-8", "surrogatepass")
 
 
-def _read_both(path):
-    out = []
-    for read in (StudyTable.open, read_study):
-        try:
-            out.append(("ok", read(path)))
-        except EyevizError as exc:
-            out.append(("refused", str(exc)))
-    return out
-
-
-@fuzz_settings(60)
-@given(edited_table())
-def test_runner_and_report_read_an_edited_table_alike(data):
+def _read_alike(data: bytes, table, report, holds, more, category: str) -> None:
+    """The runner (``table.open``) and the report (``report``) read ``data`` alike: both
+    accept it, the report's rows hold ``holds``, and the table takes one more point
+    (``more``: its key and rows) and still reads back; or both refuse it with the same
+    one line naming the file. Reading never changes the file."""
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / "s.csv"
         path.write_bytes(data)
         before = digest(path)
-        (a, ra), (b, rb) = _read_both(path)
+        out = []
+        for read in (table.open, report):
+            try:
+                out.append(("ok", read(path)))
+            except EyevizError as exc:
+                out.append(("refused", str(exc)))
+        (a, ra), (b, rb) = out
         assert digest(path) == before
         assert a == b, (ra, rb)
         if a == "refused":
             assert ra == rb
             assert_one_line(ra)
             assert str(path) in ra
-            count("study table edits", "refused")
+            count(category, "refused")
             return
         for row in rb:  # what the report draws from holds its invariants
-            assert math.isclose(row.gamma, 2 * math.pi / row.m, rel_tol=1e-9)
-            assert 0 <= row.count <= row.n and row.flagged <= row.count
-            for v in (row.dd_mape, row.ad_mape, row.seconds):
-                assert math.isnan(v) or 0 <= v < math.inf
-            assert row.r_min <= row.r_lo < row.r_hi <= row.r_max
-        if P3.key not in ra.keys:  # one more point: the file still reads back
-            ra.append(ROWS[P3.key])
-            assert P3.key in StudyTable.open(path).keys
-            read_study(path)
-        count("study table edits", "ok")
+            holds(row)
+        key, rows = more
+        if key not in ra.keys:  # one more point: the file still reads back
+            ra.append(rows)
+            assert key in table.open(path).keys
+            report(path)
+        count(category, "ok")
 
 
-def _read_both3d(path):
-    out = []
-    for read in (StudyTable3D.open, read_study3d):
-        try:
-            out.append(("ok", read(path)))
-        except EyevizError as exc:
-            out.append(("refused", str(exc)))
-    return out
+def _holds_planar(row) -> None:
+    assert math.isclose(row.gamma, 2 * math.pi / row.m, rel_tol=1e-9)
+    assert 0 <= row.count <= row.n and row.flagged <= row.count
+    for v in (row.dd_mape, row.ad_mape, row.seconds):
+        assert math.isnan(v) or 0 <= v < math.inf
+    assert row.r_min <= row.r_lo < row.r_hi <= row.r_max
 
 
 def _holds_3d(row: dict) -> None:
-    """What the 3D report draws from: the invariants of an accepted row."""
     assert row["m"] == 4 * row["nside"] and row["nside"] % 2 == 0
     assert math.isclose(row["gamma"], 2 * math.pi / row["m"], rel_tol=1e-9)
     assert 0 <= row["count"] <= row["n"] and 0 <= row["flagged"] <= row["count"]
@@ -167,28 +159,17 @@ def _holds_3d(row: dict) -> None:
 
 
 @fuzz_settings(60)
+@given(edited_table())
+def test_runner_and_report_read_an_edited_table_alike(data):
+    more = (P3.key, ROWS[P3.key])
+    _read_alike(data, StudyTable, read_study, _holds_planar, more, "study table edits")
+
+
+@fuzz_settings(60)
 @given(edited_table(TABLE3D_LINES, COLUMNS3D, NASTY3D, FOCUS3D))
 def test_runner_and_report_read_an_edited_3d_table_alike(data):
-    with tempfile.TemporaryDirectory() as d:
-        path = Path(d) / "s3.csv"
-        path.write_bytes(data)
-        before = digest(path)
-        (a, ra), (b, rb) = _read_both3d(path)
-        assert digest(path) == before
-        assert a == b, (ra, rb)
-        if a == "refused":
-            assert ra == rb
-            assert_one_line(ra)
-            assert str(path) in ra
-            count("3D study table edits", "refused")
-            return
-        for row in rb:
-            _holds_3d(row)
-        if Q3.key not in ra.keys:  # one more point: the file still reads back
-            ra.append(ROWS3D[Q3.key])
-            assert Q3.key in StudyTable3D.open(path).keys
-            read_study3d(path)
-        count("3D study table edits", "ok")
+    more = (Q3.key, ROWS3D[Q3.key])
+    _read_alike(data, StudyTable3D, read_study3d, _holds_3d, more, "3D study table edits")
 
 
 @fuzz_settings(40)
