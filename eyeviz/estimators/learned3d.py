@@ -41,6 +41,7 @@ from __future__ import annotations
 import json
 import math
 import os
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -48,7 +49,12 @@ import numpy as np
 from eyeviz import EyevizError
 from eyeviz.core.domain3d import Domain3D
 from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D
-from eyeviz.estimators.learned3d_features import N_FEATURES, eye_summaries, features
+from eyeviz.estimators.learned3d_features import (
+    N_FEATURES,
+    EyeSummary,
+    eye_summaries,
+    features,
+)
 from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
 from eyeviz.files.npz import NpzReader, one_line
@@ -177,6 +183,8 @@ class Learned3DEstimator(Estimator3D):
         super().__init__(Domain3D() if domain is None else domain, meta)
         self.hidden = hidden
         self._w = {k: np.asarray(v, np.float32) for k, v in arrays.items()}
+        #: 2: summarise the two eyes in two threads (:meth:`_summaries`); 1: in turn
+        self.threads = 1
 
     def network(self, x: np.ndarray) -> np.ndarray:
         """The network's raw outputs (n, 3) for feature rows x (n, N_FEATURES)."""
@@ -196,8 +204,7 @@ class Learned3DEstimator(Estimator3D):
         self, lit_a: LitCSR, lit_b: LitCSR
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         d = self.domain
-        sa = eye_summaries(d.nside, lit_a[0], lit_a[1], name="lit_a")
-        sb = eye_summaries(d.nside, lit_b[0], lit_b[1], name="lit_b")
+        sa, sb = self._summaries(lit_a, lit_b)
         x, log_r0, az0, el0, ok, flagged = features(sa, sb, d.h, d.nside, d.r_min, d.r_max)
         n = x.shape[0]
         r = np.full(n, np.nan)
@@ -210,6 +217,24 @@ class Learned3DEstimator(Estimator3D):
             az[sel] = az0[sel] + AZ_SCALE * out[:, 1]
             el[sel] = el0[sel] + EL_SCALE * out[:, 2]
         return r, az, el, flagged
+
+    def _summaries(self, lit_a: LitCSR, lit_b: LitCSR) -> tuple[EyeSummary, EyeSummary]:
+        """Both eyes' summaries; with ``threads`` = 2 side by side (numpy releases the GIL
+        in its loops; the same floats either way). lit_a's error, if any, comes first."""
+        nside = self.domain.nside
+        if self.threads < 2:
+            return (
+                eye_summaries(nside, lit_a[0], lit_a[1], name="lit_a"),
+                eye_summaries(nside, lit_b[0], lit_b[1], name="lit_b"),
+            )
+        with ThreadPoolExecutor(1, thread_name_prefix="eyeviz-learned3d") as pool:
+            fut = pool.submit(eye_summaries, nside, lit_a[0], lit_a[1], name="lit_a")
+            try:
+                sb = eye_summaries(nside, lit_b[0], lit_b[1], name="lit_b")
+            except ValueError:
+                fut.result()  # lit_a's error first
+                raise
+            return fut.result(), sb
 
     def __repr__(self) -> str:
         return f"<Learned3DEstimator hidden={self.hidden} nside={self.domain.nside}>"

@@ -87,7 +87,7 @@ class _PixelTables:
     longitudes of each cell, phi0 + (j -+ 0.5) * step (j its position in the ring); at
     last[k] - (n - 1), the amplitude of the sum of n consecutive centres of ring k,
     amp[k] * sin(step[k] n / 2); at 2 first[k] + j (j = 0 .. 2 num[k] - 2, the sum of a
-    run's first and last position), cos and sin of the run's middle longitude
+    run's first and last position), cos + i sin of the run's middle longitude
     phi0[k] + step[k] j / 2. Each entry is the expression :meth:`_Rings.partial` and
     :func:`eye_summaries` evaluate per run, so both give the same floats."""
 
@@ -95,8 +95,7 @@ class _PixelTables:
     west: np.ndarray
     east: np.ndarray
     amp: np.ndarray
-    cos_mid: np.ndarray
-    sin_mid: np.ndarray
+    cis_mid: np.ndarray  # cos + i sin: one gather for both
 
     @classmethod
     def build(cls, r: _Rings) -> _PixelTables:
@@ -110,7 +109,10 @@ class _PixelTables:
         ring2 = np.repeat(kk, 2 * r.num[kk])
         j2 = np.arange(ring2.size, dtype=np.int64) - 2 * r.first[ring2]
         mid = r.phi0[ring2] + 0.5 * r.step[ring2] * j2
-        return cls(ring, west, east, amp, np.cos(mid), np.sin(mid))
+        cis = np.empty(mid.size, np.complex128)
+        cis.real = np.cos(mid)
+        cis.imag = np.sin(mid)
+        return cls(ring, west, east, amp, cis)
 
 
 class _Rings:
@@ -292,8 +294,8 @@ def _summarise(
     if px is not None:
         span = eb - s
         amp = px.amp[lastp - span]
-        mid = s + eb
-        tot = [amp * px.cos_mid[mid], amp * px.sin_mid[mid], (span + 1).astype(np.float64)]
+        cis = px.cis_mid[s + eb]
+        tot = [amp * cis.real, amp * cis.imag, (span + 1).astype(np.float64)]
         tot[2] *= rings.z[ks]
         west = px.west[s]
         east = px.east[e if cross is None else eb]

@@ -444,3 +444,19 @@ def test_rows_not_handed_to_the_network_are_still_checked(shipped):
     assert _message(shipped.predict, lit_a, lit_b) == (
         "lit_b: indices must lie in [0, npix = 388800), got 400000"
     )
+
+
+def test_two_threads_give_the_same_floats_and_lit_a_s_error_first(shipped, rows):
+    lit_a, lit_b = rows
+    one = shipped.predict(lit_a, lit_b)
+    two = learned3d.load()
+    two.threads = 2
+    got = two.predict(lit_a, lit_b)
+    for g, w in zip(got, one, strict=True):
+        assert np.array_equal(g, w)
+    pa, ia = lit_a
+    pb, ib = lit_b
+    bad_a = (pa, np.r_[ia[1], ia[1:]])  # the first row falls
+    bad_b = (pb, np.r_[ib[:-1], shipped.domain.npix])
+    assert "lit_a: indices must increase" in _message(two.predict, bad_a, bad_b)
+    assert "lit_b: indices must lie" in _message(two.predict, lit_a, bad_b)
