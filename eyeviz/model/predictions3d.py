@@ -151,7 +151,8 @@ class Answer3D:
     ``x, y, z`` come from (r, azimuth, elevation) by :func:`spherical_to_xyz`; ``dr_pct``
     is 100 (r_hat - r) / r, ``daz`` and ``del_`` are degrees (azimuth wrapped to
     (-180, 180]). ``mc_error`` is the limit's relative Monte-Carlo error of r (NaN for
-    the others); ``valid`` False when an eye lit nothing (NaN answers)."""
+    the others; undefined from fewer than two accepted draws, ``n_accepted``); ``valid``
+    False when an eye lit nothing (NaN answers)."""
 
     name: str
     r: float
@@ -163,6 +164,7 @@ class Answer3D:
     valid: bool
     flagged: bool
     mc_error: float = math.nan
+    n_accepted: int = -1  # the limit's accepted posterior draws (-1: not the limit)
     dr_pct: float = math.nan
     daz: float = math.nan
     del_: float = math.nan
@@ -193,13 +195,14 @@ def answer_from(name: str, p: Any, truth: tuple[float, float, float]) -> Answer3
     valid = bool(np.asarray(p.valid).reshape(-1)[0]) and math.isfinite(r)
     flagged = bool(np.asarray(p.flagged).reshape(-1)[0])
     mc = one(p.mc_error) if hasattr(p, "mc_error") else math.nan
+    acc = int(one(p.n_accepted)) if hasattr(p, "n_accepted") else -1
     if not valid:
         nan = math.nan
-        return Answer3D(name, nan, nan, nan, nan, nan, nan, False, flagged, mc)
+        return Answer3D(name, nan, nan, nan, nan, nan, nan, False, flagged, mc, acc)
     xyz = spherical_to_xyz(np.array([r]), np.array([az]), np.array([el]))
     x, y, z = (float(v[0]) for v in xyz)
     dr, daz, de = errors3d(truth, (r, az, el))
-    return Answer3D(name, r, az, el, x, y, z, True, flagged, mc, dr, daz, de)
+    return Answer3D(name, r, az, el, x, y, z, True, flagged, mc, acc, dr, daz, de)
 
 
 @dataclass(frozen=True)
@@ -444,7 +447,9 @@ def prediction_rows(preds: Predictions3D | None) -> list[tuple[str, ...]]:
             rows.append((name, "", "", "", "", "", "", "no answer: an eye lit nothing"))
             continue
         notes = []
-        if math.isfinite(a.mc_error):
+        if 0 <= a.n_accepted < 2 and not a.flagged:  # one draw: no error to estimate
+            notes.append(f"{a.n_accepted} draw: MC n/a")
+        elif math.isfinite(a.mc_error):
             notes.append(f"MC ±{100.0 * a.mc_error:.2g} %")
         if a.flagged:
             notes.append("⚑ flagged")  # answered by a fallback (analytic3d for the limit)

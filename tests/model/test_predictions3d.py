@@ -165,8 +165,11 @@ def test_cloud_is_capped_to_the_heaviest_with_alpha_by_weight():
 
 
 def test_rows_flag_and_monte_carlo_error():
-    a = p3.Answer3D("limit3d", 2010.0, 1.5, 0.1, 1.0, 2.0, 3.0, True, True, 0.0021, 0.5,
-                    0.01, -0.002)  # fmt: skip
+    a = p3.Answer3D("limit3d", 2010.0, 1.5, 0.1, 1.0, 2.0, 3.0, True, True, 0.0021, 14,
+                    0.5, 0.01, -0.002)  # fmt: skip
+    one = p3.Answer3D("limit3d", 2010.0, 1.5, 0.1, 1.0, 2.0, 3.0, True, False, 0.0, 1)
+    solo = p3.Predictions3D(0, 50.0, (0.0, 0.0, 0.0), {"limit3d": one})
+    assert p3.prediction_rows(solo)[0][-1] == "1 draw: MC n/a"  # not "MC ±0 %"
     b = p3.Answer3D("analytic3d", *([math.nan] * 6), False, False)
     pr = p3.Predictions3D(0, 50.0, (0.0, 0.0, 0.0), {"limit3d": a, "analytic3d": b})
     pr.answers["learned3d"] = "unavailable: weights for nside 180"
