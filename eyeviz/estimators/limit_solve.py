@@ -302,7 +302,8 @@ def _nodes(cu, su, sd, cd, lo, hi, p: Plan, prior: str):
     w *= p.gw
     # weight 0 for NaN, inf and <= 0 (rays with no stretch: half = 0), no np.where
     np.fmax(w, f32(0), out=w)
-    w[w == np.inf] = 0
+    if w.max(initial=0) == np.inf:  # (rare: a zero density denominator)
+        w[w == np.inf] = 0
     np.arctan2(y, x, out=phi)
     wts = np.maximum(vals, f32(1e-30))
     np.divide(w, wts, out=wts)
