@@ -65,7 +65,7 @@ import numpy as np
 
 from eyeviz.core import healpix
 from eyeviz.core.domain3d import PAPER_DOMAIN3D, Domain3D
-from eyeviz.estimators.analytic3d import cap_estimates, estimate, triangulate
+from eyeviz.estimators.analytic3d import cap_estimates, estimate
 from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D, as_csr, take_rows
 from eyeviz.estimators.limit import weighted_median
 
@@ -73,18 +73,24 @@ __all__ = ["PRIORS", "Limit3DEstimator", "load", "posterior_samples3d", "prior_d
 
 PRIORS = ("single", "multi")
 #: facet widths inside and outside the estimated cap where the cap's edge is looked for
-EDGE = 2.0
+EDGE = 1.25
 #: boundary points per cell edge for the nearest point of a cell
 STEP = 6
-#: the widening factors of the windows and slacks of the retries of empty keys
-RETRY = (2.5, 6.0)
+#: the retries of keys with no accepted draw: (window and slack factor, batches of draws)
+RETRY = ((1.0, 8), (2.5, 24))
 #: facet widths the centre search may move: edge cells that cannot bind within them are
 #: dropped before it
 PRUNE = 0.25
 #: zoom levels of the search for the centre (each grid a third as wide)
 LEVELS = 4
+#: grid points and rounds of the search along the ray for B's region
+RAY_GRID = 8
+RAY_ROUNDS = 2
+#: the Monte-Carlo error of r a key's draws are topped up to (at most TOPUP more batches)
+MC_TARGET = 0.01
+TOPUP = 1
 #: keys processed together
-_CHUNK = 16
+_CHUNK = 8
 
 
 def prior_density(domain: Domain3D, prior: str, r, g, el, az) -> np.ndarray:
@@ -437,41 +443,60 @@ def _angle_box(eye: _Eye, ext: np.ndarray) -> np.ndarray:
     return np.where(ok[:, None], out, np.nan)
 
 
-def _inverse_interval(eye_b: _Eye, row: np.ndarray, ca, sin_a, lo, hi, slack: float):
-    """Secant pass in u = 1 / rho: the u in [lo, hi] where every modelled constraint of
-    eye B holds within ``slack`` for balls A + c_A / u, g = sin(alpha_A) / u. (In u the
-    direction from B is normalise(c_A + (A - B) u), linear before normalising, so the
-    constraints are nearly linear in u.) Draws are flat: ``row`` (D,) is each draw's key,
-    ca (D, 3), sin_a, lo, hi (D,). Returns the new (lo, hi)."""
-    t = eye_b.t[row]  # (D, K, 2)
-    dd = eye_b.d[row]
-    lit = eye_b.lit[row]
-    live = ~eye_b.pad[row]
-    c, e1, e2 = eye_b.c[row], eye_b.e1[row], eye_b.e2[row]
-    f = []
-    for u in (lo, hi):
-        p = ca + u[:, None] * eye_b.a  # (P - B) u
-        dist = np.linalg.norm(p, axis=1)
-        cc = np.einsum("dj,dj->d", p, c)
-        delta = np.stack([np.einsum("dj,dj->d", p, e1) / cc, np.einsum("dj,dj->d", p, e2) / cc], 1)
-        ab = np.arcsin(np.clip(sin_a / dist, -1.0, 1.0))
-        td = np.einsum("dkj,dj->dk", t, delta)
-        v = dd - td
-        w = dd * (v - td) + np.einsum("dj,dj->d", delta, delta)[:, None]
-        v = np.where(lit, v, np.sqrt(np.maximum(w, 0.0)))
-        f.append(np.where(lit, ab[:, None] - v, v - ab[:, None]))
-    f0, f1 = f
-    span = (hi - lo)[:, None]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        k = (f1 - f0) / span
-        root = lo[:, None] + (-slack - f0) / k
-    up = live & (k > 0)
-    down = live & (k < 0)
-    flat_bad = live & (k == 0) & (f0 < -slack)
-    out_lo = np.maximum(lo, np.where(up, root, -np.inf).max(axis=1))
-    out_hi = np.minimum(hi, np.where(down, root, np.inf).min(axis=1))
-    out_hi = np.where(flat_bad.any(axis=1), -np.inf, out_hi)
-    return out_lo, out_hi
+def _ray_in_box(eye_b: _Eye, ca: np.ndarray, ext: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The interval (lo, hi) (N, M) of u = 1 / rho where the direction from B to
+    A + c_A / u, proportional to v(u) = c_A + u (A - B), has gnomonic coordinates about
+    B's centre inside the box |delta_i| <= ext_i (N, 2): with v . c_B > 0 each side is
+    |v . e_i| <= ext_i v . c_B, two inequalities linear in u (ca: (N, M, 3))."""
+    a = eye_b.a
+    shape = ca.shape[:2]
+    c = eye_b.c[:, None, :]
+    cc = (ca * c).sum(-1)
+    rows = [(-cc, np.broadcast_to(-(eye_b.c @ a)[:, None], shape))]  # v . c_B >= 0
+    for e, x in ((eye_b.e1, ext[:, 0]), (eye_b.e2, ext[:, 1])):
+        ce = (ca * e[:, None, :]).sum(-1)
+        for sgn in (1.0, -1.0):  # sgn v . e - ext v . c_B <= 0
+            k1 = sgn * (e @ a) - x * (eye_b.c @ a)
+            rows.append((sgn * ce - x[:, None] * cc, np.broadcast_to(k1[:, None], shape)))
+    lo = np.zeros(shape)
+    hi = np.full(shape, np.inf)
+    for k0, k1 in rows:  # k0 + u k1 <= 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            root = -k0 / k1
+        hi = np.where(k1 > 0, np.minimum(hi, root), hi)
+        lo = np.where(k1 < 0, np.maximum(lo, root), lo)
+        lo = np.where((k1 == 0) & (k0 > 0), np.inf, lo)
+    return lo, hi
+
+
+def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack: float, grid: int = 12, rounds: int = 2):
+    """Shrink each draw's u-interval [lo, hi] (N, M) to one holding every u whose view
+    from B lies in B's modelled region G = min_unlit - max_lit >= -slack. G is concave
+    and the view moves monotonically along a great circle, so those u form an interval:
+    G on ``grid`` points, the interval from the grid point before the first inside to the
+    one after the last (or the two neighbours of the best point when none is inside);
+    ``rounds`` times. Returns (lo, hi)."""
+    n, m = lo.shape
+    t = np.linspace(0.0, 1.0, grid)
+    for _ in range(rounds):
+        uu = lo[..., None] + (hi - lo)[..., None] * t  # (N, M, grid)
+        v = ca[:, :, None, :] + uu[..., None] * eye_b.a
+        v = v / np.linalg.norm(v, axis=-1, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dl = eye_b.gnomonic(v.reshape(n, m * grid, 3))
+            blo, bhi = eye_b.bounds(np.nan_to_num(dl, nan=1e3, posinf=1e3, neginf=-1e3))
+        g = (bhi - blo).reshape(n, m, grid)
+        inside = g >= -slack
+        anyin = inside.any(axis=2)
+        first = np.where(anyin, inside.argmax(axis=2), g.argmax(axis=2))
+        last = np.where(anyin, grid - 1 - inside[..., ::-1].argmax(axis=2), first)
+        i0 = np.maximum(first - 1, 0)
+        i1 = np.minimum(last + 1, grid - 1)
+        lo, hi = (
+            np.take_along_axis(uu, i0[..., None], 2)[..., 0],
+            np.take_along_axis(uu, i1[..., None], 2)[..., 0],
+        )
+    return lo, hi
 
 
 class Limit3DEstimator(Estimator3D):
@@ -506,8 +531,17 @@ class Limit3DEstimator(Estimator3D):
         self.last_accepted: np.ndarray = np.zeros(0, np.int64)
 
     # --- the posterior of a chunk of keys ------------------------------------------------
-    def _draw(self, lit_a: LitCSR, lit_b: LitCSR, keys: np.ndarray, wide: float, stream: int):
-        """Weighted posterior samples of a chunk: dict of (N, M) arrays."""
+    def _draw(
+        self,
+        lit_a: LitCSR,
+        lit_b: LitCSR,
+        keys: np.ndarray,
+        wide: float,
+        stream: int,
+        reps: int = 1,
+    ) -> dict[str, np.ndarray]:
+        """Weighted posterior samples of a chunk: dict of (N, reps * samples) arrays (the
+        proposal set up once, ``reps`` batches of draws)."""
         d = self.domain
         fw = math.sqrt(4 * math.pi / d.npix)
         A = np.array([-d.h, 0.0, 0.0])
@@ -525,13 +559,39 @@ class Limit3DEstimator(Estimator3D):
         ea.prune(1.2 * math.sqrt(2.0) * ext.max(axis=1))
         eb.a = A - B
         ext_b = _extent(eb, wide * 0.5 * fw, slack)
-        eb.prune(5.0 * math.sqrt(2.0) * ext_b.max(axis=1))
+        eb.prune(1.2 * math.sqrt(2.0) * ext_b.max(axis=1))
         # A's centre: uniform in (theta, phi) over the bounds of A's box, theta cut to
         # those of B's box (both caps' centres share the ball's theta: B's box bounds it)
         box = _angle_box(ea, ext)
         box_b = _angle_box(eb, ext_b)
         th_lo = np.fmax(box[:, 0], box_b[:, 0])
         th_hi = np.fmin(box[:, 1], box_b[:, 1])
+        st = dict(d=d, A=A, B=B, ea=ea, eb=eb, n=n, m=m, slack=slack, ext=ext, ext_b=ext_b,
+                  box=box, th_lo=th_lo, th_hi=th_hi, lit_a=lit_a, lit_b=lit_b)  # fmt: skip
+        parts = [self._sample(st, keys, stream + 8 * rep) for rep in range(reps)]
+        out = {k: np.concatenate([q[k] for q in parts], axis=1) for k in parts[0]}
+        if reps > 1:
+            return out
+        # top-ups: a key whose Monte-Carlo error of r exceeds MC_TARGET gets another batch
+        # (its own stream; the other keys' draws are left as they are)
+        for rep in range(1, 1 + TOPUP):
+            need = _mc_rel(out["r"], out["w"]) > MC_TARGET
+            if not need.any():
+                break
+            more = self._sample(st, keys, stream + 8 * rep)
+            more["w"] = np.where(need[:, None], more["w"], 0.0)
+            out = {k: np.concatenate([out[k], more[k]], axis=1) for k in out}
+        if out["w"].shape[1] > m:  # the accepted draws first, in draw order
+            order = np.argsort(~(out["w"] > 0), axis=1, kind="stable")[:, :m]
+            out = {k: np.take_along_axis(v, order, 1) for k, v in out.items()}
+        return out
+
+    def _sample(self, st: dict, keys: np.ndarray, stream: int) -> dict[str, np.ndarray]:
+        """``samples`` weighted draws per key of a chunk set up by :meth:`_draw`."""
+        d, A, B, ea, eb = st["d"], st["A"], st["B"], st["ea"], st["eb"]
+        n, m, slack, ext, ext_b = st["n"], st["m"], st["slack"], st["ext"], st["ext_b"]
+        box, th_lo, th_hi = st["box"], st["th_lo"], st["th_hi"]
+        lit_a, lit_b = st["lit_a"], st["lit_b"]
         u = _uniforms(keys, m, 4, stream)
         th = th_lo[:, None] + (th_hi - th_lo)[:, None] * u[..., 0]
         ph = box[:, 2:3] + (box[:, 3] - box[:, 2])[:, None] * u[..., 1]
@@ -539,62 +599,60 @@ class Limit3DEstimator(Estimator3D):
         ca = np.stack([np.cos(ph), sp * np.cos(th), sp * np.sin(th)], axis=-1)
         good = np.broadcast_to(((th_hi > th_lo) & (box[:, 3] > box[:, 2]))[:, None], (n, m))
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            q = 1.0 / ((th_hi - th_lo) * (box[:, 3] - box[:, 2]))[:, None]
             delta = ea.gnomonic(np.where(good[..., None], ca, ea.c[:, None, :]))
         # outside A's box the model region is empty: drawn, then dropped
         good = good & (np.abs(delta) <= ext[:, None, :]).all(axis=2)
         delta = np.where(good[..., None], delta, 0.0)
         ca = np.where(good[..., None], ca, ea.c[:, None, :])
         lo_a, hi_a = ea.bounds(delta)
-        lo_a = np.maximum(lo_a - slack, 1e-12)
-        hi_a = np.minimum(hi_a + slack, math.pi / 2 - 1e-9)
-        alpha = lo_a + (hi_a - lo_a) * u[..., 2]
-        with np.errstate(over="ignore"):
-            q = q / np.maximum(hi_a - lo_a, 1e-300)
-        good = good & (hi_a > lo_a)
-        # along the ray: the closest approach to B's ray gives the bracket's middle
-        cbv = np.broadcast_to(eb.c[:, None, :], ca.shape).reshape(-1, 3)
-        pm, okm = triangulate(ca.reshape(-1, 3), cbv, d.h)
-        rho0 = np.linalg.norm(pm - A, axis=1).reshape(n, m)
-        rho0 = np.where(okm.reshape(n, m), rho0, d.r_max)
-        ext_b = ext_b.max(axis=1)
-        # bracket: where B's view of the ray stays within 3 of B's extents of its centre
-        d0 = eb.gnomonic(_unit(eb.a + rho0[..., None] * ca))
-        d1 = eb.gnomonic(_unit(eb.a + (rho0 * 1.001)[..., None] * ca))
-        rate = np.linalg.norm(d1 - d0, axis=2) / (0.001 * rho0)
-        reach = (3.0 * ext_b[:, None] + np.linalg.norm(d0, axis=2)) / np.maximum(rate, 1e-300)
-        # in u = 1 / rho
-        lo = 1.0 / np.minimum(rho0 + reach, d.r_max + d.h)
-        hi = 1.0 / np.maximum(rho0 - reach, d.r_min - d.h)
-        sin_a = np.sin(alpha)
-        # B's interval only for the draws still alive (flat)
-        live = np.flatnonzero(good.ravel())
-        ll, hh = lo.ravel()[live], hi.ravel()[live]
-        for _ in range(2):
-            ll, hh = _inverse_interval(
-                eb, live // m, ca.reshape(-1, 3)[live], sin_a.ravel()[live], ll, hh, slack
-            )
-            keep = hh > ll
-            live, ll, hh = live[keep], ll[keep], hh[keep]
-        good = np.zeros(n * m, bool)
-        good[live] = True
-        good = good.reshape(n, m)
-        lo = np.full(n * m, 1.0)
-        hi = np.full(n * m, 2.0)
-        lo[live], hi[live] = ll, hh
-        lo, hi = lo.reshape(n, m), hi.reshape(n, m)
-        uu = lo + (hi - lo) * u[..., 3]
+        good = good & (hi_a - lo_a > -2.0 * slack)
+        # along the ray A + c_A / u: u where B's view of it lies in B's box (the
+        # directions from B, c_A + u (A - B), span a great circle: a line in B's
+        # gnomonic coordinates, and each side of the box is linear in u), then in B's
+        # modelled region; on the live draws only (moved to the front of each row)
+        u_lo, u_hi = _ray_in_box(eb, ca, ext_b)
+        u_lo = np.maximum(u_lo, 1.0 / (d.r_max + d.h))
+        if d.r_min > d.h:
+            u_hi = np.minimum(u_hi, 1.0 / (d.r_min - d.h))
+        good = good & (u_hi > u_lo)
+        order = np.argsort(~good, axis=1, kind="stable")[:, : max(1, int(good.sum(1).max()))]
+        sel = np.take_along_axis(good, order, 1)
+
+        def pick(x: np.ndarray) -> np.ndarray:
+            return np.take_along_axis(x, order if x.ndim == 2 else order[..., None], 1)
+
+        c_lo = np.where(sel, pick(u_lo), 1.0 / d.r_max)
+        c_hi = np.where(sel, pick(u_hi), 1.0 / d.r_max)
+        c_lo, c_hi = _ray_in_region(eb, pick(ca), c_lo, c_hi, slack, RAY_GRID, RAY_ROUNDS)
+        rows = np.arange(n)[:, None]
+        u_lo, u_hi = u_lo.copy(), u_hi.copy()
+        u_lo[rows, order] = c_lo
+        u_hi[rows, order] = c_hi
+        u_lo = np.where(good, u_lo, 1.0 / d.r_max)
+        u_hi = np.where(good, u_hi, 1.0 / d.r_max)
+        uu = u_lo + (u_hi - u_lo) * u[..., 2]
+        uu = np.where(good, uu, 1.0 / d.r_max)
         rho = 1.0 / uu
-        with np.errstate(over="ignore"):  # density of rho: that of u times u^2
-            q = q * uu * uu / np.maximum(hi - lo, 1e-300)
         p = A + rho[..., None] * ca
-        gg = rho * sin_a
         r = np.linalg.norm(p, axis=2)
+        vb = p - B
+        rho_b = np.linalg.norm(vb, axis=2)
+        # g: uniform where both eyes' modelled cap radii allow it (and the prior's g range)
+        lo_b, hi_b = eb.bounds(eb.gnomonic(vb / rho_b[..., None]))
+        g_lo, g_hi = r * math.sin(d.gamma / 2), np.full_like(r, d.g_max)
+        for lo_e, hi_e, rh in ((lo_a, hi_a, rho), (lo_b, hi_b, rho_b)):
+            g_lo = np.maximum(g_lo, rh * np.sin(np.clip(lo_e - slack, 0.0, math.pi / 2)))
+            g_hi = np.minimum(g_hi, rh * np.sin(np.clip(hi_e + slack, 0.0, math.pi / 2)))
+        good = good & (g_hi > g_lo)
+        gg = g_lo + (g_hi - g_lo) * u[..., 3]
         el = np.arcsin(np.clip(p[..., 2] / r, -1, 1))
         az = np.arctan2(p[..., 1], p[..., 0])
-        jac = rho**3 * np.cos(alpha) * sp  # d(x, y, z, g) / d(rho, theta, phi, alpha)
+        alpha = np.arcsin(np.clip(gg / rho, 0.0, 1.0))
+        # d(x, y, z, g) = rho^4 sin(phi) d(u, theta, phi, g); 1 / q = the boxes' volume
         with np.errstate(over="ignore", invalid="ignore"):
-            w = prior_density(d, self.prior, r, gg, el, az) * jac / np.where(q > 0, q, 1)
+            vol = (th_hi - th_lo)[:, None] * (box[:, 3] - box[:, 2])[:, None]
+            vol = vol * (u_hi - u_lo) * (g_hi - g_lo)
+            w = prior_density(d, self.prior, r, gg, el, az) * rho**4 * sp * vol
         w = np.where(good & np.isfinite(w), w, 0.0)
         # the exact 0/1 likelihood on the draws with prior mass
         cand = np.flatnonzero(w.ravel() > 0)
@@ -624,15 +682,20 @@ class Limit3DEstimator(Estimator3D):
     def _posterior(self, lit_a: LitCSR, lit_b: LitCSR):
         keys = _key_hash(lit_a, lit_b) ^ np.uint64(self.seed)
         s = self._draw(lit_a, lit_b, keys, 1.0, 0)
-        for stream, wide in enumerate(RETRY, start=1):
+        m = self.samples
+        for stream, (wide, reps) in enumerate(RETRY, start=1):
             few = np.flatnonzero(~(s["w"].sum(axis=1) > 0))
             if not few.size:
                 break
-            # wider windows and slack for the keys with nothing accepted
+            # keys with nothing accepted: their posterior is a small part of the proposal
+            # (the misses are found with more draws, not with wider windows): ``reps``
+            # times the draws, the window and slack ``wide`` times wider; the accepted
+            # draws kept, the first ``samples`` of them in draw order
             sub_a, sub_b = take_rows(*lit_a, few), take_rows(*lit_b, few)
-            s2 = self._draw(sub_a, sub_b, keys[few], wide, stream)
+            s2 = self._draw(sub_a, sub_b, keys[few], wide, stream, reps)
+            order = np.argsort(~(s2["w"] > 0), axis=1, kind="stable")[:, :m]
             for k in s:
-                s[k][few] = s2[k]
+                s[k][few] = np.take_along_axis(s2[k], order, 1)
         return s
 
     def _predict_csr(self, lit_a: LitCSR, lit_b: LitCSR):
@@ -694,6 +757,19 @@ class Limit3DEstimator(Estimator3D):
             f"<Limit3DEstimator h={d.h:g} l={d.l:g} nside={d.nside} r=[{d.r_min:g}, "
             f"{d.r_max:g}] g_max={d.g_max:g} el_max={d.el_max:g} prior={self.prior}>"
         )
+
+
+def _mc_rel(r: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Per row, the relative Monte-Carlo standard error of r's estimate,
+    1.2533 sd_w(r) / sqrt(ESS) / mean_w(r) (inf where nothing is accepted)."""
+    tot = w.sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        wn = w / tot[:, None]
+        mean = (wn * r).sum(axis=1)
+        sd = np.sqrt(np.maximum((wn * (r - mean[:, None]) ** 2).sum(axis=1), 0.0))
+        ess = tot**2 / (w**2).sum(axis=1)
+        out = 1.2533 * sd / np.sqrt(ess) / mean
+    return np.where(tot > 0, out, np.inf)
 
 
 def _same(ptr: np.ndarray, ind: np.ndarray, key: LitCSR, row: np.ndarray) -> np.ndarray:

@@ -103,3 +103,28 @@ def test_rows_independent_and_errors():
         Limit3DEstimator(D16, prior="flat")
     with pytest.raises(ValueError, match="samples must be an integer >= 4"):
         Limit3DEstimator(D16, samples=2)
+
+
+D8 = Domain3D(nside=8)
+
+
+@pytest.mark.parametrize("row", [29, 96])
+def test_a_key_the_first_pass_misses_is_accepted(row):
+    """Rows 29 and 96 of generate3d(200, nside 8, seed 2026112523): a ball of the prior lit
+    them (the posterior is not empty), yet 256 draws, then 256 with 2.5x and 6x wider
+    windows, accepted none (the previous code flagged them). Their posterior is a small
+    part of the proposal: more draws find it, wider windows do not. Now accepted, and
+    every accepted draw lights exactly the key's sets."""
+    ds = generate3d(200, D8, seed=2026112523)
+    a, b = ds.lit(row)
+    la, lb = D8.eyes.lit(ds.x[row], ds.y[row], ds.z[row], ds.g[row])
+    assert np.array_equal(la, a) and np.array_equal(lb, b)  # the truth reproduces the key
+    est = Limit3DEstimator(D8)
+    p = est.predict((np.array([0, a.size]), a), (np.array([0, b.size]), b))
+    assert not p.flagged[0] and p.n_accepted[0] >= 1
+    assert D8.r_min <= p.r[0] <= D8.r_max
+    s = posterior_samples3d(est, a, b)
+    assert s["x"].size >= 1
+    for k in range(s["x"].size):
+        sa, sb = D8.eyes.lit(s["x"][k], s["y"][k], s["z"][k], s["g"][k])
+        assert np.array_equal(sa, a) and np.array_equal(sb, b)
