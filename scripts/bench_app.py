@@ -45,6 +45,7 @@ UP_TARGET_S = 3.0
 
 PREDICTIONS = False  # --predictions: the scenes show the predictions layer
 
+
 def bench_drag(m: int, n: int, events: int, settings: str, backend: str = "vtk") -> dict:
     app, win, _up = open_window(scene(m, n, PREDICTIONS), settings, backend)
     assert win.plotter.backend == backend, (win.plotter.backend, backend)

@@ -138,5 +138,9 @@ def test_a_drag_frame_over_the_backdrop_equals_the_full_render(make_window):
     view_pixels(win)
     zoomed = view_pixels(win)  # a hit
     assert bd.captures == c + 1 and bd.hits >= h + 1
+    bd.invalidate()
+    captured = view_pixels(win)  # a frame that draws the discs and keeps them
+    assert bd.captures == c + 2
     feats.set_backdrop_min(10**9)
-    assert np.array_equal(zoomed, view_pixels(win))
+    full = view_pixels(win)
+    assert np.array_equal(zoomed, full) and np.array_equal(captured, full)

@@ -16,12 +16,14 @@ main renderer's camera, viewport and background. Before the main renderer draws 
 The main renderer keeps the buffers (``PreserveColorBuffer``, ``PreserveDepthBuffer``)
 and draws its own props over them with the depth test: what is drawn over or under a
 backdrop disc is resolved per pixel as if the disc were the main renderer's, so a hit's
-pixels equal those of drawing everything in one renderer (tests/app/test_backdrop.py
-compares them). This holds for opaque props only, which is all a backdrop may hold; the
-one difference is a tie, a main-renderer prop at exactly a backdrop prop's depth, which
-the main renderer's prop now wins (it is drawn later). A window without a render
-framebuffer, or with multisampling, leaves the backdrop drawing its props at every frame:
-the same pixels, no saving.
+pixels equal those of drawing everything in one renderer (tests/app/test_backdrop.py and
+tests/render/test_backdrop_unit.py compare them). This holds for opaque props, which is
+all a backdrop may hold, and a main renderer without passes of its own (a backdrop hands
+its props to one with order-independent translucency or depth peeling instead; the app's
+is plain, eyeviz.app.view.fast_renderer). The one difference is a tie, a main-renderer
+prop at exactly a backdrop prop's depth, which the main renderer's prop now wins (it is
+drawn later). A window without a render framebuffer, or with multisampling, leaves the
+backdrop drawing its props at every frame: the same pixels, no saving.
 """
 
 from __future__ import annotations
@@ -48,15 +50,17 @@ class Backdrop:
 
     def __init__(self, main: vtkRenderer):
         self.main = main
-        self.ren = vtkRenderer()  # never added to the window: only this class renders it
+        self.ren = vtkRenderer()  # in the window, never drawn by it: only by this class
         self.ren.SetUseOIT(False)
         self.ren.SetUseDepthPeeling(False)
         self.ren.InteractiveOff()
         self.props: list[vtkProp] = []
+        self.passed: list[vtkProp] = []  # props handed to a main renderer with passes
         self.keep = True  # False: draw the props every frame, keep nothing (tests compare)
         self.captures = 0
         self.hits = 0
         self._observer: int | None = None
+        self._attach_later: int | None = None  # the window's EndEvent observer, if any
         self._fbo: vtkOpenGLFramebufferObject | None = None
         self._fbo_size: tuple[int, int] = (0, 0)
         self._key: tuple | None = None  # what the kept buffers show
@@ -64,6 +68,13 @@ class Backdrop:
 
     # --- a renderer's interface for a Store ----------------------------------------------
     def AddActor(self, prop: vtkProp) -> None:  # noqa: N802 (vtkRenderer's name)
+        m = self.main
+        if m.GetUseOIT() or m.GetUseDepthPeeling() or m.GetPass() is not None:
+            # a main renderer with passes of its own does not draw over kept buffers: the
+            # prop is simply its (the app's is plain: eyeviz.app.view.fast_renderer)
+            m.AddActor(prop)
+            self.passed.append(prop)
+            return
         self.ren.AddActor(prop)
         self.props.append(prop)
         self._key = None
@@ -75,14 +86,36 @@ class Backdrop:
             self.main.PreserveColorBufferOn()
             self.main.PreserveDepthBufferOn()
             self._observer = self.main.AddObserver(vtkCommand.StartEvent, self._before_main)
+        self._attach(self.main.GetRenderWindow())
+
+    def _attach(self, rw) -> None:
+        """Put the renderer in the window, which then holds it (and lets go of it when it
+        goes: a renderer keeps a plain pointer to its window) but never draws it."""
+        if rw is not None and self.ren.GetRenderWindow() is not rw:
+            self.ren.SetDraw(False)
+            rw.AddRenderer(self.ren)
+
+    def _attach_now(self, rw, _event=None) -> None:
+        if self._attach_later is not None:
+            rw.RemoveObserver(self._attach_later)
+            self._attach_later = None
+        if self.props:
+            self._attach(rw)
 
     def RemoveActor(self, prop: vtkProp) -> None:  # noqa: N802 (vtkRenderer's name)
+        if any(p is prop for p in self.passed):
+            self.main.RemoveActor(prop)
+            self.passed = [p for p in self.passed if p is not prop]
+            return
         self.ren.RemoveActor(prop)
         self.props = [p for p in self.props if p is not prop]
         self._key = None
         if not self.props and self._observer is not None:
             self.main.RemoveObserver(self._observer)
             self._observer = None
+            rw = self.ren.GetRenderWindow()
+            if rw is not None:
+                rw.RemoveRenderer(self.ren)
             self.main.SetPreserveColorBuffer(self._preserve[0])
             self.main.SetPreserveDepthBuffer(self._preserve[1])
 
@@ -110,7 +143,7 @@ class Backdrop:
             tuple(self.main.GetBackground2()),
             self.main.GetGradientBackground(),
             self.main.GetBackgroundAlpha(),
-            id(cam),
+            cam.GetAddressAsString("vtkObject"),  # the camera itself (wrappers come and go)
             cam.GetParallelProjection(),
             cam.GetParallelScale(),
             cam.GetViewAngle(),
@@ -136,8 +169,14 @@ class Backdrop:
     def _draw_props(self, rw) -> None:
         """Clear the main viewport to the main background and draw the props into it."""
         ren, main = self.ren, self.main
-        if ren.GetRenderWindow() is not rw:
+        # not in the window yet (its main renderer had none when the props came): the
+        # window is mid-render and its renderer list must not change now, so for this
+        # frame only
+        borrowed = ren.GetRenderWindow() is not rw
+        if borrowed:
             ren.SetRenderWindow(rw)
+            if self._attach_later is None:  # once this render is over
+                self._attach_later = rw.AddObserver(vtkCommand.EndEvent, self._attach_now)
         if ren.GetActiveCamera() is not main.GetActiveCamera():
             ren.SetActiveCamera(main.GetActiveCamera())
         ren.SetViewport(*main.GetViewport())
@@ -145,7 +184,13 @@ class Backdrop:
         ren.SetBackground2(*main.GetBackground2())
         ren.SetGradientBackground(main.GetGradientBackground())
         ren.SetBackgroundAlpha(main.GetBackgroundAlpha())
-        ren.Render()
+        ren.SetDraw(True)
+        try:
+            ren.Render()
+        finally:
+            ren.SetDraw(False)  # the window's own pass, after the main renderer, skips it
+            if borrowed:
+                ren.SetRenderWindow(None)  # type: ignore[arg-type]  # (VTK accepts nullptr)
 
     def _framebuffer(self, rw, size: tuple[int, int]) -> vtkOpenGLFramebufferObject | None:
         """The backdrop's own framebuffer, with the render framebuffer's size and formats."""
@@ -156,9 +201,15 @@ class Backdrop:
         fbo = vtkOpenGLFramebufferObject()
         fbo.SetContext(rw)
         depth = rw.GetRenderBufferTargetDepthSize()
-        if not fbo.PopulateFramebuffer(
-            size[0], size[1], True, 1, VTK_UNSIGNED_CHAR, True, depth, 0, False
-        ):
+        st = rw.GetState()
+        st.PushFramebufferBindings()  # making it binds it: the main renderer's must stay
+        try:
+            made = fbo.PopulateFramebuffer(
+                size[0], size[1], True, 1, VTK_UNSIGNED_CHAR, True, depth, 0, False
+            )
+        finally:
+            st.PopFramebufferBindings()
+        if not made:
             self._fbo = None
             self._fbo_size = (0, 0)
             return None
