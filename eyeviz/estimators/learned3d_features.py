@@ -169,36 +169,37 @@ class _Rings:
 
 
 def _run_starts(flat: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(positions, first values, last values) of the runs of consecutive values in
+    """(positions, first values, last values, int64) of the runs of consecutive values in
     ``flat`` (non-empty): a run starts at j = 0 and at every j with flat[j] !=
     flat[j - 1] + 1 (in the array's own integer arithmetic). One pass, in blocks whose
     temporaries stay in cache; a run's first and last value are read while their block
-    is there."""
+    is there, into arrays that grow as needed."""
     m = flat.size - 1  # steps
-    at_parts = [np.zeros(1, np.int64)]
-    s_parts = [flat[:1]]
-    e_parts = []
+    cap = m // 16 + 1024
+    at_all = np.empty(cap, np.int64)
+    s_all = np.empty(cap, np.int64)
+    e_all = np.empty(cap, np.int64)
+    at_all[0], s_all[0], k = 0, flat[0], 1  # k runs so far; e_all[k - 1] still open
     if m > 0:
-        k = min(_BLOCK, m)
-        dif = np.empty(k, flat.dtype)
-        brk = np.empty(k, bool)
+        dif = np.empty(min(_BLOCK, m), flat.dtype)
+        brk = np.empty(min(_BLOCK, m), bool)
         for lo in range(0, m, _BLOCK):
             hi = min(lo + _BLOCK, m)
             blk = flat[lo : hi + 1]
             np.subtract(blk[1:], blk[:-1], out=dif[: hi - lo])
             np.not_equal(dif[: hi - lo], 1, out=brk[: hi - lo])
             at = np.flatnonzero(brk[: hi - lo])
-            e_parts.append(blk[at])
+            if k + at.size > cap:
+                cap = 2 * (k + at.size)
+                at_all, s_all, e_all = (np.resize(v, cap) for v in (at_all, s_all, e_all))
+            e_all[k - 1 : k - 1 + at.size] = blk[at]
             at += 1
-            s_parts.append(blk[at])
+            s_all[k : k + at.size] = blk[at]
             at += lo
-            at_parts.append(at)
-    e_parts.append(flat[-1:])
-    return (
-        np.concatenate(at_parts),
-        np.concatenate(s_parts).astype(np.int64),
-        np.concatenate(e_parts).astype(np.int64),
-    )
+            at_all[k : k + at.size] = at
+            k += at.size
+    e_all[k - 1] = flat[-1]
+    return at_all[:k], s_all[:k], e_all[:k]
 
 
 def _runs(indptr: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

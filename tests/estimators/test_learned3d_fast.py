@@ -330,6 +330,14 @@ def _sub(nside, ptr, ind):
         return ref_eye_summaries(nside, ptr, ind)
 
 
+def test_many_short_runs_grow_the_run_arrays():
+    """Every other pixel lit: a run per index, more than the run finder first allots."""
+    nside = 64
+    npix = 12 * nside * nside
+    ptr, ind = _csr([np.arange(0, npix, 2), [5], np.arange(1, npix, 3)])
+    _assert_same(eye_summaries(nside, ptr, ind, name="lit_a"), _sub(nside, ptr, ind))
+
+
 def test_band_rings_are_the_per_run_comparison():
     """_band_rings' first ring of each band is where (theta_k - theta0) / alpha, as the
     reference evaluates it per run, first exceeds the band's edge, ties included."""
