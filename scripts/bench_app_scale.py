@@ -17,7 +17,7 @@ with every disc in the main renderer (the path before it, and small scenes').
 Printed: p50 / p95 of the drag frames, bare and full renders, the backdrop's captures and
 hits during the drag; the ratios drag(10^4) / drag(10) (target <= 3x), drag(10^4) /
 full render(10^4), and drag(10^4, backdrop) / drag(10^4, without). ``--crossover`` also
-times renders of a drag's state at 10, 30, 100, 300 and 1,000 features with the discs in the
+times renders of a drag's state at 10, 30, 100, 150, 300 and 1,000 features with the discs in the
 main renderer and kept by the backdrop, alternating in one window (where
 BACKDROP_MIN_FEATURES comes from: a drag frame is that render plus the same updates).
 
@@ -48,7 +48,7 @@ from _bench_app_common import (  # noqa: E402
 )
 
 SMALL, BIG = 10, 10_000
-CROSSOVER = (10, 30, 100, 300, 1_000)
+CROSSOVER = (10, 30, 100, 150, 300, 1_000)
 M = 720
 RATIO_TARGET = 3.0
 NEVER = 10**9  # a backdrop threshold no scene reaches: every disc in the main renderer

@@ -66,11 +66,12 @@ __all__ = [
 LOD_LEVELS = np.array([8, 12, 16, 24, 32, 48, 64, 96, 128, CIRCLE_N])
 #: Largest gap, in pixels, between a disc's circle and its inscribed polygon.
 LOD_ERROR_PX = 0.5
-#: Features from which the main view's merged discs go to the backdrop: the crossover that
-#: scripts/bench_app_scale.py --crossover measures (2026-11-26, loaded 2-core machine: a
-#: render of a drag's state 1.07x with the backdrop at 50 features (its copy costs more
-#: than the fill it saves), 0.86x at 100, 0.37-0.49x at 150-300, 0.39x at 1,000).
-BACKDROP_MIN_FEATURES = 100
+#: Features from which the main view's merged discs go to the backdrop, past the crossover
+#: that scripts/bench_app_scale.py --crossover measures (2026-11-26, 2-core machine, a
+#: render of a drag's state with the discs kept / in the main renderer: 1.05x at 10
+#: features, 0.99x at 30 (the copy costs what the fill saves), 0.79-1.07x at 100, 0.77-0.80x
+#: at 150, 0.70-0.74x at 200, 0.56-0.64x at 300, 0.34x at 1,000).
+BACKDROP_MIN_FEATURES = 150
 
 
 def disc_vertices(r_px: np.ndarray) -> np.ndarray:
