@@ -4,25 +4,31 @@ and without the backdrop of the merged discs (same run, same scenes).
 Runs under Xvfb (re-executes itself with xvfb-run when $DISPLAY is unset), 1280x800, this
 machine's software OpenGL, the app's default view widget. For m = 720 with 10 and with
 10,000 features (random discs in the view, bench_app.py's scenes: the harness is
-scripts/_bench_app_common.py) it presses on the last feature, sends mouse-move events along
-a path and times each from the event to the end of the first frame that reflects it
+scripts/_bench_app_common.py) it presses on the last feature, sends mouse-move events
+along a path and times each from the event to the end of the first frame that reflects it
 (glFinish, then the panels' paint events); right after each drag frame it times a bare
 re-render of the window, and after the drag a *full* render (the backdrop's kept discs
 dropped: every disc filled again, what a frame cost before the backdrop). It then releases
 the button (the gesture's one undo step), times the release and an undo, and counts the
-Scene copies an edit makes (the first run's). The 10^4 case is measured twice: with the backdrop
-(eyeviz/render/vtk/backdrop.py, the app's path from BACKDROP_MIN_FEATURES features) and
-with every disc in the main renderer (the path before it, and small scenes').
+Scene copies an edit makes (the first run's). The 10^4 case is measured twice: with the
+backdrop (eyeviz/render/vtk/backdrop.py, the app's path from BACKDROP_MIN_FEATURES
+features) and with every disc in the main renderer (the path before it, and small
+scenes'). The cases run in the order a, b, c, c, b, a and pool their two runs.
 
 Printed: p50 / p95 of the drag frames, bare and full renders, the backdrop's captures and
 hits during the drag; the ratios drag(10^4) / drag(10) (target <= 3x), drag(10^4) /
 full render(10^4), and drag(10^4, backdrop) / drag(10^4, without). ``--crossover`` also
-times renders of a drag's state at 10, 30, 100, 150, 300 and 1,000 features with the discs in the
-main renderer and kept by the backdrop, alternating in one window (where
+times renders of a drag's state at 10, 30, 100, 150, 300 and 1,000 features with the
+discs in the main renderer and kept by the backdrop, alternating in one window (where
 BACKDROP_MIN_FEATURES comes from: a drag frame is that render plus the same updates).
 
-Measured 2026-11-26 on the quiet 2-core machine (load < 0.5): before the backdrop drag p50
-138 ms at 10^4 against 7.7 ms at 10 features (17.9x); see the README for this stop's run.
+Measured 2026-11-26 on the 2-core machine (load 1.2-3.5 during the run), 120 drag frames
+a case: drag p50 / p95 9.5 / 10.2 ms at 10 features; at 10^4 with the backdrop 18.7 /
+35.5 ms (p50 1.97x of 10 features'), without it 196.7 / 409.3 ms (before the backdrop, on
+a quiet machine, 138 ms: 17.9x); the full render at 10^4 172 ms. What is left at 10^4 is
+Python: update_state's owners (a loop over the features, ~6 ms when the dragged feature's
+lit facets change), the Frame and the actors' updates (~5 ms), and a full garbage
+collection (~60 ms) about one frame in 60.
 
     xvfb-run -a .venv/bin/python scripts/bench_app_scale.py [--events 60] [--crossover]
 """
