@@ -158,7 +158,7 @@ def main() -> int:
 
     from eyeviz import dataset, estimators
     from eyeviz.estimators.base import PAPER_DOMAIN, bitmaps_to_intervals
-    from eyeviz.estimators.limit import limit_estimates
+    from eyeviz.estimators.limit import LimitEstimator, limit_estimates
 
     ds = dataset.generate(args.rows, seed=2024)
     a, b = ds.omega_a, ds.omega_b
@@ -191,11 +191,11 @@ def main() -> int:
         f"before {s_new / s_old:.2f}x (target <= 0.5)"
     )
     cols = [np.ascontiguousarray(c) for c in keys.T]
-    e_new = _cpu(lambda: estimators.load("limit").predict_intervals(*cols), args.repeat)
+    e_new = _cpu(lambda: LimitEstimator().predict_intervals(*cols), args.repeat)
     if prev is not None:
         e_old = _cpu(lambda: prev.LimitEstimator().predict_intervals(*cols), args.repeat)
         p_old = _cpu(lambda: _per_call(one, prev.LimitEstimator), args.repeat)
-    p_new = _cpu(lambda: _per_call(one, lambda: estimators.load("limit")), args.repeat)
+    p_new = _cpu(lambda: _per_call(one, LimitEstimator), args.repeat)
     if prev is not None:
         print(
             f"   the estimator, cache cold: batched {e_new / nk * 1e6:.0f} us a key (before "

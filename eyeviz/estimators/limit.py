@@ -428,19 +428,23 @@ class _KeyCache:
 
     def insert(self, codes: np.ndarray, values: np.ndarray) -> None:
         """Distinct codes absent from the cache, with their (r, phi, empty) rows."""
+        if codes.size > 256:  # a batch: straight into the sorted arrays (no Python loop)
+            self._merge(codes, values)
+            return
         for c, v in zip(codes.tolist(), values.tolist(), strict=True):
             self.recent[c] = (v[0], v[1], v[2], self.tick)
         if len(self.recent) > min(4096, self.size // 8) or len(self) > self.size:
             self._merge()
 
-    def _merge(self) -> None:
+    def _merge(self, new_codes=None, new_values=None) -> None:
         rc = np.fromiter(self.recent.keys(), np.int64, len(self.recent))
         rv = np.array([v[:3] for v in self.recent.values()]).reshape(-1, 3)
         ru = np.fromiter((v[3] for v in self.recent.values()), np.int64, len(self.recent))
         self.recent = {}
-        codes = np.concatenate([self.codes, rc])
-        values = np.concatenate([self.values, rv])
-        used = np.concatenate([self.used, ru])
+        parts = [(self.codes, self.values, self.used), (rc, rv, ru)]
+        if new_codes is not None:
+            parts.append((new_codes, new_values, np.full(new_codes.size, self.tick)))
+        codes, values, used = (np.concatenate(a) for a in zip(*parts, strict=True))
         if codes.size > self.size:  # drop the least recently used, down to 7/8 of size
             keep = np.argpartition(-used, self.size - self.size // 8 - 1)
             keep = keep[: max(1, self.size - self.size // 8)]
