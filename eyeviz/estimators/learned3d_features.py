@@ -82,37 +82,60 @@ class EyeSummary:
 
 @dataclass(frozen=True)
 class _PixelTables:
-    """Per-pixel tables of one nside, so that a run costs gathers instead of a ring
-    search and four sines and cosines: the ring of each pixel; the west and east edge
-    longitudes of each cell, phi0 + (j -+ 0.5) * step (j its position in the ring); at
-    last[k] - (n - 1), the amplitude of the sum of n consecutive centres of ring k,
-    amp[k] * sin(step[k] n / 2); at 2 first[k] + j (j = 0 .. 2 num[k] - 2, the sum of a
-    run's first and last position), cos + i sin of the run's middle longitude
-    phi0[k] + step[k] j / 2. Each entry is the expression :meth:`_Rings.partial` and
-    :func:`eye_summaries` evaluate per run, so both give the same floats."""
+    """Tables of one nside, so that a run costs gathers instead of a ring search and four
+    sines and cosines: the ring of each pixel (``ring``), and tables per class of rings
+    with the same cell count and offset (so with the same step and phi0: the equatorial
+    rings form two classes, a polar ring and its mirror one), reached through per-ring
+    offsets. For a run of ring k from position a to b (pixels s and e):
+
+    - ``west[w0[k] + s]``, ``east[w0[k] + e]``: phi0 + (a - 0.5) step, phi0 + (b + 0.5)
+      step, the run's outer cell edges;
+    - ``sin_half[n0[k] + n - 1]``: sin(step n / 2) for n = b - a + 1 cells (times amp[k],
+      the amplitude of the sum of their centres);
+    - ``cis_mid[c0[k] + s + e]``: cos + i sin of the middle longitude phi0 + step (a + b) / 2.
+
+    Each entry is the expression :meth:`_Rings.partial` and :func:`eye_summaries` evaluate
+    per run, on the same floats (a class's rings have the same step and phi0), so both
+    give the same results. The class tables are small (in the paper's elevations every
+    ring is equatorial: two classes of 4 nside cells), so their gathers stay in cache."""
 
     ring: np.ndarray
+    w0: np.ndarray
+    n0: np.ndarray
+    c0: np.ndarray
     west: np.ndarray
     east: np.ndarray
-    amp: np.ndarray
-    cis_mid: np.ndarray  # cos + i sin: one gather for both
+    sin_half: np.ndarray
+    cis_mid: np.ndarray
 
     @classmethod
     def build(cls, r: _Rings) -> _PixelTables:
         kk = np.arange(1, 4 * r.nside, dtype=np.int64)
         ring = np.repeat(kk, r.num[kk])
-        j = np.arange(ring.size, dtype=np.int64) - r.first[ring]
-        west = r.phi0[ring] + (j - 0.5) * r.step[ring]
-        east = r.phi0[ring] + (j + 0.5) * r.step[ring]
-        n = (r.last[ring] - np.arange(ring.size) + 1).astype(np.float64)  # at last - (n - 1)
-        amp = r.amp[ring] * np.sin(0.5 * r.step[ring] * n)
-        ring2 = np.repeat(kk, 2 * r.num[kk])
-        j2 = np.arange(ring2.size, dtype=np.int64) - 2 * r.first[ring2]
-        mid = r.phi0[ring2] + 0.5 * r.step[ring2] * j2
+        key = 2 * r.num[kk] + (r.phi0[kk] != 0.0)
+        _, first_of, cls_of = np.unique(key, return_index=True, return_inverse=True)
+        rep = kk[first_of]  # a ring of each class
+        cnum = r.num[rep]
+        coff = np.r_[0, np.cumsum(cnum)[:-1]]
+        cring = np.repeat(rep, cnum)
+        j = np.arange(cring.size, dtype=np.int64) - np.repeat(coff, cnum)
+        west = r.phi0[cring] + (j - 0.5) * r.step[cring]
+        east = r.phi0[cring] + (j + 0.5) * r.step[cring]
+        sin_half = np.sin(0.5 * r.step[cring] * (j + 1).astype(np.float64))
+        cring2 = np.repeat(rep, 2 * cnum)
+        j2 = np.arange(cring2.size, dtype=np.int64) - np.repeat(2 * coff, 2 * cnum)
+        mid = r.phi0[cring2] + 0.5 * r.step[cring2] * j2
         cis = np.empty(mid.size, np.complex128)
         cis.real = np.cos(mid)
         cis.imag = np.sin(mid)
-        return cls(ring, west, east, amp, cis)
+        w0 = np.zeros(r.num.size, np.int64)
+        n0 = np.zeros(r.num.size, np.int64)
+        c0 = np.zeros(r.num.size, np.int64)
+        off = coff[cls_of.ravel()]
+        w0[kk] = off - r.first[kk]
+        n0[kk] = off
+        c0[kk] = 2 * off - 2 * r.first[kk]
+        return cls(ring, w0, n0, c0, west, east, sin_half, cis)
 
 
 class _Rings:
@@ -294,12 +317,18 @@ def _summarise(
     eb = e if cross is None else np.minimum(e, lastp)  # the run's end in its first ring
     if px is not None:
         span = eb - s
-        amp = px.amp[lastp - span]
-        cis = px.cis_mid[s + eb]
+        amp = rings.amp[ks]
+        amp *= px.sin_half[px.n0[ks] + span]
+        mid = px.c0[ks]
+        mid += s
+        mid += eb
+        cis = px.cis_mid[mid]
         tot = [amp * cis.real, amp * cis.imag, (span + 1).astype(np.float64)]
         tot[2] *= rings.z[ks]
-        west = px.west[s]
-        east = px.east[e if cross is None else eb]
+        w0 = px.w0[ks]
+        west = px.west[w0 + s]
+        w0 += eb
+        east = px.east[w0]
     else:
         a = s - rings.first[ks]
         b = eb - rings.first[ks]
@@ -375,7 +404,6 @@ def _bounds(
     A row's runs come in ring order, so each band of rings is a contiguous range of its
     runs, found per row on the ring table (:func:`_band_rings`): one reduction per
     column and band, no mask per band."""
-    n = count.shape[0]
     full = np.flatnonzero(count > 0)
     if ks.size == 0:
         return
@@ -419,11 +447,9 @@ def _bounds(
     top -= lon0_r
     np.add(base, d, out=base_d)
     np.subtract(top, d, out=top_d)
-    # per row, the first run of each band: ring keys (row, ring) rise along the runs
-    key = np.repeat(np.arange(n, dtype=np.int64) * (4 * nside + 1), lens)
-    key += ks
+    # per row, the first run of each band
     kb = _band_rings(rings, theta0[full], alpha[full])  # (len(full), len(BANDS))
-    at = np.searchsorted(key, (full * (4 * nside + 1))[:, None] + kb)
+    at = _first_run_on(ks, first_run[full], first_run[full] + lens[full], kb)
     seg = at.ravel()
     red = np.empty((full.size, len(BANDS), 4))
     for j, red_f in enumerate((np.fmax, np.fmin, np.fmax, np.fmin)):
@@ -434,6 +460,37 @@ def _bounds(
     got = out[full]
     np.copyto(got, np.clip(bands / gamma, -_NO_BOUND, _NO_BOUND), where=ok)
     out[full] = got
+
+
+def _first_run_on(ks: np.ndarray, lo: np.ndarray, hi: np.ndarray, k: np.ndarray) -> np.ndarray:
+    """(rows, j): per row, the first of its runs lo .. hi - 1 whose ring is >= k[:, j]
+    (hi if none): a row's rings rise along its runs. Guessed as one run per ring from the
+    row's first ring, which holds unless a ring has two runs (a cap across longitude 0)
+    or a run spans rings; those rows are bisected."""
+    lo, hi = lo[:, None], hi[:, None]
+    n = hi - lo
+    if ks.size == 0:
+        return np.broadcast_to(lo, k.shape).copy()
+    k0 = ks[np.minimum(lo, ks.size - 1)]
+    at = lo + np.clip(k - k0, 0, n)
+    before = ks[np.maximum(at - 1, 0)]
+    here = ks[np.minimum(at, ks.size - 1)]
+    bad = ((at > lo) & (before >= k)) | ((at < hi) & (here < k))
+    if bad.any():
+        r, c = np.nonzero(bad)
+        a = np.broadcast_to(lo, k.shape)[r, c].copy()
+        b = np.broadcast_to(hi, k.shape)[r, c].copy()
+        want = k[r, c]
+        while True:
+            go = a < b
+            if not go.any():
+                break
+            mid = (a + b) >> 1
+            low = go & (ks[np.minimum(mid, ks.size - 1)] < want)
+            a = np.where(low, mid + 1, a)
+            b = np.where(go & ~low, mid, b)
+        at[r, c] = a
+    return at
 
 
 def _band_rings(rings: _Rings, theta0: np.ndarray, alpha: np.ndarray) -> np.ndarray:

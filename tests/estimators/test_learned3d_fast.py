@@ -355,6 +355,27 @@ def test_band_rings_are_the_per_run_comparison():
         np.testing.assert_array_equal(got[:, j], want)
 
 
+def test_first_run_on_a_ring_is_a_search_within_each_row():
+    """Rows with one run per ring (the guess), two runs on a ring, rings skipped (a run
+    across rings) and empty rows, against a search row by row."""
+    rng = np.random.default_rng(4)
+    rows = []
+    for i in range(300):
+        k0 = int(rng.integers(1, 40))
+        if i % 3 == 0:
+            rings = np.arange(k0, k0 + rng.integers(0, 12))
+        else:
+            rings = np.sort(rng.integers(k0, k0 + 15, rng.integers(0, 12)))
+        rows.append(rings)
+    ks = np.concatenate(rows).astype(np.int64)
+    lo = np.r_[0, np.cumsum([r.size for r in rows])[:-1]]
+    hi = lo + [r.size for r in rows]
+    k = rng.integers(0, 60, (len(rows), 3))
+    got = lf._first_run_on(ks, lo, hi, k)
+    for i, r in enumerate(rows):
+        np.testing.assert_array_equal(got[i], lo[i] + np.searchsorted(r, k[i]))
+
+
 def _reference_predict(est, ds):
     d = est.domain
     sa = ref_eye_summaries(d.nside, ds.indptr_a, ds.indices_a)
