@@ -27,25 +27,37 @@ integrates over eye A's tangent sectors and then along the ray (:mod:`.limit`):
    gnomonic coordinates about the estimate). The cap (c, alpha) lights exactly the key's
    cells only if alpha > dist for every lit edge cell and alpha <= dist for every unlit
    one, so the feasible centres are where G(delta) = min_unlit - max_lit > 0 (concave),
-   and alpha lies in (max_lit, min_unlit] there.
-2. Eye A: G on a grid about the estimate, the centre moved to its best point and the
+   and alpha lies in (max_lit, min_unlit] there. Both are affine forms in delta (the
+   unlit distances squared), one product and one reduction per evaluation.
+2. Per eye: G on a grid about the estimate, the centre moved to its best point and the
    distances modelled again there (zooming grids); the box holding every centre with
-   G >= -slack (bisection along 8 directions) is the proposal: a uniform point in it,
-   alpha uniform in [max_lit - slack, min_unlit + slack].
-3. Along the ray A + rho c_A (g = rho sin alpha_A) eye B's constraints are nearly linear
-   in u = 1 / rho (the direction from B is normalise(c_A + (A - B) u)): the interval of
-   u where all hold (two secant passes) gives u uniformly.
-4. Every proposed ball is checked exactly with ``EyePair3D.lit_csr`` (0/1 likelihood),
-   against the prior's support and the exact field test ``in_bfv``, and weighted by
-   prior x Jacobian (rho^3 cos(alpha_A) / (1 + |delta|^2)^(3/2)) / proposal density
-   (the density of rho is u^2 times that of u).
+   G >= -slack (bisection along ``NDIR`` directions). The slack is the search window's
+   (0.002 facet widths) or, for a box far smaller than the window (a thin posterior),
+   ``SLACK_SAFETY`` times the model's second-order error in the box, R^2 (1/alpha + 1).
+3. Eye A's centre: uniform in (theta, phi) over the bounds of A's box, theta = atan2(z, y)
+   (the angle of the plane through the baseline) cut to the bounds of B's box: a ball's
+   centre and both caps' centres share one theta, so B bounds it too. Draws outside A's
+   box are dropped (the model region lies in it).
+4. Along the ray A + c_A / u the directions from B, c_A + (A - B) u, span a great circle,
+   a line in B's gnomonic coordinates: the u where it lies in B's box is exact (each side
+   linear in u), then narrowed to B's region G_B >= -slack (concave along the line: a
+   grid, kept from the point before the first inside to the one after the last). u is
+   uniform there; then g uniform where both eyes' modelled radii and the prior's g range
+   allow it: rho_A sin[max_lit_A - slack, min_unlit_A + slack] intersected with B's.
+5. A necessary condition on the edge cells' boundary samples (their true distances, the
+   sampling gap bounded: :func:`_prefilter`) drops most draws that cannot match; the rest
+   are checked exactly with ``EyePair3D.lit_csr`` (0/1 likelihood), against the prior's
+   support and the exact field test ``in_bfv``, and weighted by prior x rho^4 sin(phi)
+   (d(x, y, z, g) / d(u, theta, phi, g)) / the proposal's density (uniform in each box).
 
 The slacks make the proposal's support cover the posterior's (the tests compare with
-brute-force rejection sampling from the prior at nside 4 and 8), and the exact check
-makes the likelihood exact whatever the linearisation's error; the price of a loose
-proposal is fewer accepted samples, not bias. A key with no accepted sample is tried
-again with a wider grid and slack (``RETRY``); a key still empty is answered by the
-analytic triangulation and ``flagged``.
+brute-force rejection sampling from the prior at nside 4), and the exact check makes the
+likelihood exact whatever the linearisation's error; the price of a loose proposal is
+fewer accepted samples, not bias. A key whose Monte-Carlo error of r exceeds
+``MC_TARGET`` gets ``TOPUP`` more batches of draws. A key with no accepted sample is
+drawn again, more times (``RETRY``: its posterior is a small part of the proposal; more
+draws find it where wider windows did not); a key still empty is answered by the analytic
+triangulation and ``flagged``.
 
 **Estimates.** MAPE-optimal (Eq. 34): the 1/r-weighted posterior median of r and the
 1/az-weighted median of the azimuth; the elevation crosses 0, where a relative error is
@@ -89,6 +101,10 @@ RAY_ROUNDS = 2
 #: the Monte-Carlo error of r a key's draws are topped up to (at most TOPUP more batches)
 MC_TARGET = 0.01
 TOPUP = 1
+#: the per-key slack: this many times the model's second-order error in the box
+SLACK_SAFETY = 4.0
+#: directions of the bisection for the box of centres
+NDIR = 8
 #: keys processed together
 _CHUNK = 8
 
@@ -391,23 +407,29 @@ def _locate(eye: _Eye, half: float, n: int, levels: int) -> None:
         half = half / 3.0
 
 
-def _extent(eye: _Eye, reach: float, slack: float, iters: int = 12) -> np.ndarray:
+def _extent(eye: _Eye, reach: float, slack, iters: int = 12) -> np.ndarray:
     """Half-widths (N, 2) of a box about the centre holding every delta with
-    G(delta) >= -slack (bisection along 8 directions: G is concave)."""
+    G(delta) >= -slack (bisection along NDIR directions: G is concave)."""
     n = eye.c.shape[0]
-    lo = np.zeros((n, 8))
-    hi = np.full((n, 8), reach)
+    dirs = _dirs(NDIR)
+    lo = np.zeros((n, NDIR))
+    hi = np.full((n, NDIR), reach)
     for _ in range(iters):
         mid = 0.5 * (lo + hi)
-        a, b = eye.bounds(mid[..., None] * _DIRS[None])
+        a, b = eye.bounds(mid[..., None] * dirs[None])
         inside = (b - a) >= -slack
         lo = np.where(inside, mid, lo)
         hi = np.where(inside, hi, mid)
-    pts = hi[..., None] * _DIRS[None]  # (N, 8, 2): outside the region by < one step
-    # the box of the 8 boundary points, widened: a convex polygon between two of them
-    # bulges out by at most tan(pi/8) times their distance
-    ext = np.abs(pts).max(axis=1) * (1.0 + math.tan(math.pi / 8))
+    pts = hi[..., None] * dirs[None]  # (N, NDIR, 2): outside the region by < one step
+    # the box of the boundary points, widened: a convex polygon between two of them
+    # bulges out by at most tan(pi / NDIR) times their distance
+    ext = np.abs(pts).max(axis=1) * (1.0 + math.tan(math.pi / NDIR))
     return np.maximum(ext, 1e-12)
+
+
+def _dirs(k: int) -> np.ndarray:
+    t = np.arange(k) * 2 * math.pi / k
+    return np.stack([np.cos(t), np.sin(t)], axis=1)
 
 
 _BOX = np.array(
@@ -469,7 +491,7 @@ def _ray_in_box(eye_b: _Eye, ca: np.ndarray, ext: np.ndarray) -> tuple[np.ndarra
     return lo, hi
 
 
-def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack: float, grid: int = 12, rounds: int = 2):
+def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack, grid: int = 12, rounds: int = 2):
     """Shrink each draw's u-interval [lo, hi] (N, M) to one holding every u whose view
     from B lies in B's modelled region G = min_unlit - max_lit >= -slack. G is concave
     and the view moves monotonically along a great circle, so those u form an interval:
@@ -486,7 +508,7 @@ def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack: float, grid: int = 12, rounds
             dl = eye_b.gnomonic(v.reshape(n, m * grid, 3))
             blo, bhi = eye_b.bounds(np.nan_to_num(dl, nan=1e3, posinf=1e3, neginf=-1e3))
         g = (bhi - blo).reshape(n, m, grid)
-        inside = g >= -slack
+        inside = g >= -slack[..., None]
         anyin = inside.any(axis=2)
         first = np.where(anyin, inside.argmax(axis=2), g.argmax(axis=2))
         last = np.where(anyin, grid - 1 - inside[..., ::-1].argmax(axis=2), first)
@@ -551,14 +573,24 @@ class Limit3DEstimator(Estimator3D):
         n = ea.c.shape[0]
         m = self.samples
         ng = self.grid
-        slack = wide * 0.002 * fw
+        slack0 = wide * 0.002 * fw
         for e in (ea, eb):
             e.prune(np.full(n, PRUNE * wide * fw))
             _locate(e, 0.25 * wide * fw, ng, LEVELS)
-        ext = _extent(ea, wide * 0.5 * fw, slack)
-        ea.prune(1.2 * math.sqrt(2.0) * ext.max(axis=1))
+        ext = _extent(ea, wide * 0.5 * fw, slack0)
         eb.a = A - B
+        ext_b = _extent(eb, wide * 0.5 * fw, slack0)
+        # within a box of radius R the model's distances are off by second-order terms,
+        # below R^2 (1 / alpha + 1) / 2: a thin posterior (a box far smaller than the
+        # search window) needs a slack far below the window's, or the proposal is
+        # mostly slack (keys with a tiny posterior found nothing in 10^4 draws)
+        sec = np.zeros(n)
+        for e, x in ((ea, ext), (eb, ext_b)):
+            sec = np.maximum(sec, (x * x).sum(axis=1) * (1.0 / e.alpha0 + 1.0))
+        slack = np.minimum(slack0, wide * (SLACK_SAFETY * sec + 1e-7 * fw))[:, None]
+        ext = _extent(ea, wide * 0.5 * fw, slack)
         ext_b = _extent(eb, wide * 0.5 * fw, slack)
+        ea.prune(1.2 * math.sqrt(2.0) * ext.max(axis=1))
         eb.prune(1.2 * math.sqrt(2.0) * ext_b.max(axis=1))
         # A's centre: uniform in (theta, phi) over the bounds of A's box, theta cut to
         # those of B's box (both caps' centres share the ball's theta: B's box bounds it)
