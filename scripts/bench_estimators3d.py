@@ -103,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
             lea.predict(a, b)  # warm the per-nside tables
             load = os.getloadavg()[0]
             rate = n / best(lambda: lea.predict(a, b), args.repeat)
-            report("learned3d predict", rate, "rows", 1e5)
+            report(f"learned3d predict (threads {lea.threads})", rate, "rows", 1e5)
             met = "met" if rate >= 1e5 else "NOT met"
             print(f"{'':40s} target {met}; 1-min load average {load:.2f} on the shared cores")
     else:

@@ -6,7 +6,8 @@ design (nside 180, Algorithm 1 single pass, a seed none of its data sets used), 
 ``--repeat``:
 
 1. ``predict`` from the CSR lit sets (validation, summaries, network), rows/s, and its
-   ratio to the 10^5 rows/s target;
+   ratio to the 10^5 rows/s target: with the default ``threads`` (the two eyes'
+   summaries side by side on two cores) and with one thread;
 2. its parts: the run finder alone (the one pass over the indices, both eyes), the
    summaries (both eyes, the run finder and the indices' checks included), the features
    and the network, rows/s;
@@ -57,6 +58,10 @@ def main(argv: list[str] | None = None) -> int:
     load = os.getloadavg()[0]
 
     t_pred = best(lambda: est.predict(a, b), args.repeat)
+    threads = est.threads
+    est.threads = 1
+    t_pred1 = best(lambda: est.predict(a, b), args.repeat)
+    est.threads = threads
     t_runs = best(lambda: (_runs(*a), _runs(*b)), args.repeat)
 
     def summaries():
@@ -71,7 +76,8 @@ def main(argv: list[str] | None = None) -> int:
     nnz = (ds.indptr_a[-1] + ds.indptr_b[-1]) / n
     print(f"{n} rows at nside {d.nside}, {nnz:.0f} lit indices per row (both eyes), "
           f"best of {args.repeat}, 1-min load average {load:.2f}")  # fmt: skip
-    print(f"predict (CSR):            {n / t_pred:12,.0f} rows/s  ({n / t_pred / 1e5:.2f}x target)")
+    for k, t in ((threads, t_pred), (1, t_pred1)):
+        print(f"predict (CSR), threads {k}: {n / t:10,.0f} rows/s  ({n / t / 1e5:.2f}x target)")
     print(f"  run finder (both eyes): {n / t_runs:12,.0f} rows/s")
     print(f"  summaries (both eyes):  {n / t_sum:12,.0f} rows/s")
     print(f"  features:               {n / t_feat:12,.0f} rows/s")

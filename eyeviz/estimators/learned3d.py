@@ -85,6 +85,8 @@ N_OUT = 3
 #: rows per block through the network (keeps the temporaries in cache; predict hands
 #: the network blocks of at most 16,384 rows, base3d's)
 _BLOCK = 1 << 14
+#: blocks of at most this many rows are summarised in one thread
+_THREAD_ROWS = 1024
 _LAYERS = ("0", "2", "4")  # Linear layers of nn.Sequential(Linear, SiLU, Linear, SiLU, Linear)
 
 
@@ -183,8 +185,9 @@ class Learned3DEstimator(Estimator3D):
         super().__init__(Domain3D() if domain is None else domain, meta)
         self.hidden = hidden
         self._w = {k: np.asarray(v, np.float32) for k, v in arrays.items()}
-        #: 2: summarise the two eyes in two threads (:meth:`_summaries`); 1: in turn
-        self.threads = 1
+        #: 2 (the default where there are two cores or more): summarise the two eyes in
+        #: two threads (:meth:`_summaries`); 1: in turn. The same floats either way.
+        self.threads = min(2, os.cpu_count() or 1)
 
     def network(self, x: np.ndarray) -> np.ndarray:
         """The network's raw outputs (n, 3) for feature rows x (n, N_FEATURES)."""
@@ -219,10 +222,11 @@ class Learned3DEstimator(Estimator3D):
         return r, az, el, flagged
 
     def _summaries(self, lit_a: LitCSR, lit_b: LitCSR) -> tuple[EyeSummary, EyeSummary]:
-        """Both eyes' summaries; with ``threads`` = 2 side by side (numpy releases the GIL
-        in its loops; the same floats either way). lit_a's error, if any, comes first."""
+        """Both eyes' summaries; with ``threads`` >= 2 and more than ``_THREAD_ROWS`` rows
+        side by side (numpy releases the GIL in its loops; the same floats either way).
+        lit_a's error, if any, comes first."""
         nside = self.domain.nside
-        if self.threads < 2:
+        if self.threads < 2 or lit_a[0].size <= _THREAD_ROWS:
             return (
                 eye_summaries(nside, lit_a[0], lit_a[1], name="lit_a"),
                 eye_summaries(nside, lit_b[0], lit_b[1], name="lit_b"),

@@ -7,6 +7,7 @@ features). Also the checks of the indices that the run finder makes instead of
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 import pytest
@@ -475,12 +476,24 @@ def test_rows_not_handed_to_the_network_are_still_checked(shipped):
     )
 
 
-def test_two_threads_give_the_same_floats_and_lit_a_s_error_first(shipped, rows):
+def test_two_threads_give_the_same_floats_and_lit_a_s_error_first(monkeypatch, shipped, rows):
+    monkeypatch.setattr(learned3d, "_THREAD_ROWS", 0)  # threads even for these few rows
     lit_a, lit_b = rows
-    one = shipped.predict(lit_a, lit_b)
+    one = learned3d.load()
+    one.threads = 1
+    one = one.predict(lit_a, lit_b)
     two = learned3d.load()
     two.threads = 2
+    names = []
+    summaries = learned3d.eye_summaries
+
+    def recorded(*args, **kw):
+        names.append(threading.current_thread().name)
+        return summaries(*args, **kw)
+
+    monkeypatch.setattr(learned3d, "eye_summaries", recorded)
     got = two.predict(lit_a, lit_b)
+    assert len(names) == 2 and any(n.startswith("eyeviz-learned3d") for n in names)
     for g, w in zip(got, one, strict=True):
         assert np.array_equal(g, w)
     pa, ia = lit_a
