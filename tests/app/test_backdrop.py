@@ -98,6 +98,10 @@ def test_a_drag_frame_over_the_backdrop_equals_the_full_render(make_window):
     for k in range(1, steps + 1):
         p = px + (end - px) * (k / steps)
         frame_after(win, app, lambda p=p: QTest.mouseMove(w, p), k)
+        if k == 1:
+            c1, h1 = bd.captures, bd.hits
+    # every drag frame after the first copied the kept discs (none drew them again)
+    assert bd.captures == c1 and bd.hits >= h1 + steps - 1
     captures, hits = bd.captures, bd.hits
     # mid-drag (the button still down): the kept discs drawn under the live ones
     dragged = view_pixels(win)
