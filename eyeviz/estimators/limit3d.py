@@ -89,7 +89,7 @@ EDGE = 1.25
 #: boundary points per cell edge for the nearest point of a cell
 STEP = 6
 #: the retries of keys with no accepted draw: (window and slack factor, batches of draws)
-RETRY = ((1.0, 8), (2.5, 24))
+RETRY = ((1.0, 8), (2.5, 24), (1.0, 96))
 #: facet widths the centre search may move: edge cells that cannot bind within them are
 #: dropped before it
 PRUNE = 0.25
