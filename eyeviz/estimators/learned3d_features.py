@@ -423,8 +423,12 @@ def _bounds(
     sth0 = np.sqrt(1.0 - z0 * z0)
     with np.errstate(invalid="ignore", divide="ignore"):
         arg = np.repeat(np.cos(alpha), lens)
-        arg -= rings.z[ks] * np.repeat(z0, lens)
-        arg /= rings.sth[ks] * np.repeat(sth0, lens)
+        t = rings.z[ks]
+        t *= np.repeat(z0, lens)
+        arg -= t
+        np.take(rings.sth, ks, out=t)
+        t *= np.repeat(sth0, lens)
+        arg /= t
     use = np.abs(arg) < 1.0
     if not same.all():
         use &= same
@@ -502,15 +506,20 @@ def _band_rings(rings: _Rings, theta0: np.ndarray, alpha: np.ndarray) -> np.ndar
     4 nside + 1."""
     th = rings.theta
     m = th.size
+    nb = BANDS.size
+    t0 = np.repeat(theta0, nb)  # flat (row, band)
+    al = np.repeat(alpha, nb)
+    c = np.tile(BANDS, theta0.size)
 
     def passes(k: np.ndarray) -> np.ndarray:  # ring k's value exceeds the edge; k = m: yes
-        v = (th[np.minimum(k, m - 1)] - theta0[:, None]) / alpha[:, None]
-        return (v > BANDS) | (k >= m)
+        v = th[np.minimum(k, m - 1)]
+        v -= t0
+        v /= al
+        return (v > c) | (k >= m)
 
     with np.errstate(invalid="ignore"):
         # a guess from the sorted table, then exact steps down and up (0 or 1 usually)
-        k = np.searchsorted(th, theta0[:, None] + BANDS * alpha[:, None], side="right")
-        k = np.minimum(k, m)
+        k = np.searchsorted(th, t0 + c * al, side="right")
         while True:
             down = (k > 0) & passes(k - 1)
             if not down.any():
@@ -521,7 +530,7 @@ def _band_rings(rings: _Rings, theta0: np.ndarray, alpha: np.ndarray) -> np.ndar
             if not up.any():
                 break
             k += up
-    return k
+    return k.reshape(theta0.size, nb)
 
 
 def _check_runs(
