@@ -195,7 +195,7 @@ def in_domain(LA, RA, LB, RB, domain: Domain) -> np.ndarray:
     w = domain.width
     LA, RA, LB, RB = (np.asarray(v, np.int64) for v in (LA, RA, LB, RB))
     inside = (np.minimum(LA, LB) > 0) & (np.maximum(RA, RB) < w - 1)
-    inside &= np.minimum(RA - LA, RB - LB) > 0
+    inside &= (RA > LA) & (RB > LB)  # (compared, not subtracted: no int64 overflow)
     ca = 0.5 * (LA + RA + 1) * gam
     cb = 0.5 * (LB + RB + 1) * gam
     # each tangent lies in its edge sector, so the true centre direction is within half a
@@ -206,7 +206,7 @@ def in_domain(LA, RA, LB, RB, domain: Domain) -> np.ndarray:
         r_near, r_far = _triangulated_r(ca + hg, cb - hg, domain.h)
     far_ok = (cb - ca - gam <= 0) | (r_far >= domain.r_min * (1 - 1e-9))
     near_ok = r_near <= domain.r_max * (1 + 1e-9)
-    half = 0.5 * np.minimum(RA - LA - 1, RB - LB - 1).clip(0) * gam
+    half = 0.5 * np.maximum(np.minimum(RA - LA, RB - LB) - 1, 0) * gam
     size_ok = np.maximum(r_near, domain.r_min) * np.sin(half) <= domain.g_max * (1 + 1e-9)
     return inside & far_ok & near_ok & size_ok
 
@@ -302,9 +302,10 @@ class Estimator:
         valid = (np.minimum(LA, LB) >= 0) & (np.maximum(RA, RB) < w)
         valid &= (LA <= RA) & (LB <= RB)
         n = LA.shape[0]
-        r = np.full(n, np.nan)
-        phi = np.full(n, np.nan)
-        sel = slice(None) if valid.all() else np.flatnonzero(valid)
+        r = np.empty(n)
+        r.fill(np.nan)
+        phi = r.copy()
+        sel = slice(None) if valid.all() else valid.nonzero()[0]
         if n and valid.any():
             rr, pp = self._predict_intervals(LA[sel], RA[sel], LB[sel], RB[sel])
             r[sel] = rr

@@ -376,3 +376,19 @@ def test_hits_of_a_few_rows_against_a_large_cache():
     LA, RA, LB, RB, ok = bitmaps_to_intervals(ds.omega_a[idx], ds.omega_b[idx])
     keys = np.stack([LA, RA, LB, RB], axis=1)[ok]
     assert est.hits - hits == len(np.unique(keys, axis=0)) and est.misses == misses
+
+
+def test_in_domain_of_extreme_integers_is_false():
+    """The base validation issue 25 sped up compares interval ends, never subtracts them
+    for a decision: runs of int64 extremes (whose differences wrap) are not in the
+    domain (this row was once in it at m = 1440), and such rows are not valid."""
+    from eyeviz.estimators.base import in_domain
+
+    row = [8453531506701483716, -6970123064301365628, 6988049752160692281, -3371325149471528585]
+    dom = Domain(m=1440, h=80.0)
+    assert not in_domain(*row, dom)
+    LA, RA, LB, RB = (np.array([v, 5]) for v in (*row[:2], row[2], row[3]))
+    LA[1], RA[1], LB[1], RB[1] = 5, 9, 6, 10
+    p = LimitEstimator(dom).predict_intervals(LA, RA, LB, RB)
+    assert p.valid.tolist() == [False, True] and not p.in_domain[0]
+    assert p.in_domain[1] == in_domain(5, 9, 6, 10, dom)
