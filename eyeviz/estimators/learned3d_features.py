@@ -436,28 +436,45 @@ def _bounds(
     # reductions below skip NaN (fmax, fmin)
     w = np.full(arg.shape, np.nan)
     np.arccos(arg, out=w, where=use)
-    d = rings.step[ks]
-    lon0_r = np.repeat(lon0, lens)
-    # the four columns, each with a NaN after the last run (a band that reaches the
-    # end starts there): max of base, min of base + d, max of top - d, min of top (the
-    # upper bounds' maxima of the negated values are minus these minima)
-    m = ks.size
-    cols = np.empty((4, m + 1))
-    cols[:, m] = np.nan
-    base, base_d, top_d, top = cols[0, :m], cols[1, :m], cols[2, :m], cols[3, :m]
-    np.add(west, w, out=base)
-    base -= lon0_r
-    np.subtract(east, w, out=top)
-    top -= lon0_r
-    np.add(base, d, out=base_d)
-    np.subtract(top, d, out=top_d)
     # per row, the first run of each band
     kb = _band_rings(rings, theta0[full], alpha[full])  # (len(full), len(BANDS))
     at = _first_run_on(ks, first_run[full], first_run[full] + lens[full], kb)
     seg = at.ravel()
+    # the four columns: max of base, min of base + d, max of top - d, min of top (the
+    # upper bounds' maxima of the negated values are minus these minima), each with a
+    # NaN after the last run (a band that reaches the end starts there)
+    m = ks.size
     red = np.empty((full.size, len(BANDS), 4))
-    for j, red_f in enumerate((np.fmax, np.fmin, np.fmax, np.fmin)):
-        red[:, :, j] = red_f.reduceat(cols[j], seg).reshape(at.shape)
+    reducers = (np.fmax, np.fmin, np.fmax, np.fmin)
+    if ks.min() >= nside and ks.max() <= 3 * nside:
+        # equatorial rings only: d is one step, and base = (west + w) - lon0, base + d,
+        # top = (east - w) - lon0, top - d are non-decreasing functions of west + w and
+        # east - w within a row (rounding is monotone), so each extreme is the function
+        # of that extreme: two columns per run instead of four (the same floats)
+        cols = np.empty((2, m + 1))
+        cols[:, m] = np.nan
+        np.add(west, w, out=cols[0, :m])
+        np.subtract(east, w, out=cols[1, :m])
+        for j, red_f in enumerate(reducers):
+            red[:, :, j] = red_f.reduceat(cols[j // 2], seg).reshape(at.shape)
+        d1 = rings.step[nside]
+        red -= lon0[full][:, None, None]
+        red[:, :, 1] += d1
+        red[:, :, 2] -= d1
+    else:
+        d = rings.step[ks]
+        lon0_r = np.repeat(lon0, lens)
+        cols = np.empty((4, m + 1))
+        cols[:, m] = np.nan
+        base, base_d, top_d, top = cols[0, :m], cols[1, :m], cols[2, :m], cols[3, :m]
+        np.add(west, w, out=base)
+        base -= lon0_r
+        np.subtract(east, w, out=top)
+        top -= lon0_r
+        np.add(base, d, out=base_d)
+        np.subtract(top, d, out=top_d)
+        for j, red_f in enumerate(reducers):
+            red[:, :, j] = red_f.reduceat(cols[j], seg).reshape(at.shape)
     # band b: runs [at[:, b], at[:, b + 1]); columns 4 b + j
     bands = red[:, :-1, :].reshape(full.size, N_BOUNDS)
     ok = np.repeat(at[:, 1:] > at[:, :-1], 4, axis=1) & ~np.isnan(bands)
