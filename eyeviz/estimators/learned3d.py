@@ -33,7 +33,9 @@ by :class:`eyeviz.files.npz.NpzReader` (every shape checked against the declared
 before anything is built), with ``learned3d.json`` (the design the weights were trained
 for, the training and validation seeds, metrics, time, command). Inference is numpy
 (float32 matrix products), so loading and predicting need no torch; training does
-(:mod:`eyeviz.estimators.learned3d_training`).
+(:mod:`eyeviz.estimators.learned3d_training`). ``predict`` checks the indices on the runs
+the summaries find (one pass over them, not two) and, on two cores or more, summarises
+the two eyes in two threads (``threads``); ``scripts/bench_learned3d.py`` times it.
 """
 
 from __future__ import annotations
