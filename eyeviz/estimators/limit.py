@@ -426,6 +426,27 @@ class _KeyCache:
             hits += int(got.sum())
         return vals, found, hits
 
+    def get(self, code: int) -> tuple[float, float, float] | None:
+        """One key's (r, phi, empty), marked used, or None; the call's tick must be new
+        (as :meth:`lookup` makes it)."""
+        if self.codes.size:
+            i = int(np.searchsorted(self.codes, code))
+            if i < self.codes.size and self.codes[i] == code:
+                self.used[i] = self.tick
+                r, phi, empty = self.values[i].tolist()
+                return r, phi, empty
+        hit = self.recent.get(code)
+        if hit is None:
+            return None
+        self.recent[code] = (*hit[:3], self.tick)
+        return hit[:3]
+
+    def insert_one(self, code: int, value: tuple[float, float, float]) -> None:
+        """One key absent from the cache, with its (r, phi, empty)."""
+        self.recent[code] = (*value, self.tick)
+        if len(self.recent) > min(4096, self.size // 8) or len(self) > self.size:
+            self._merge()
+
     def insert(self, codes: np.ndarray, values: np.ndarray) -> None:
         """Distinct codes absent from the cache, with their (r, phi, empty) rows."""
         if codes.size > 256:  # a batch: straight into the sorted arrays (no Python loop)
@@ -504,6 +525,8 @@ class LimitEstimator(Estimator):
         code = ((LA * w + RA) * w + LB) * w + RB
         cache = self._cache
         assert isinstance(cache, _KeyCache)
+        if code.size == 1:  # one row (a drag, one feature): the same answers, fewer calls
+            return self._predict_one(cache, int(code[0]), LA, RA, LB, RB)
         vals, found, hits = cache.lookup(code)
         self.hits += hits
         if not found.all():
@@ -523,6 +546,18 @@ class LimitEstimator(Estimator):
             cache.insert(uniq, new)
             self.misses += uniq.size
         return vals[:, 0], vals[:, 1], vals[:, 2] > 0
+
+    def _predict_one(self, cache: _KeyCache, code: int, LA, RA, LB, RB):
+        cache.tick += 1
+        hit = cache.get(code)
+        if hit is None:
+            rr, pp, ee = self._solve(np.stack([LA, RA, LB, RB], axis=1))
+            hit = (float(rr[0]), float(pp[0]), float(ee[0]))
+            cache.insert_one(code, hit)
+            self.misses += 1
+        else:
+            self.hits += 1
+        return np.array(hit[:1]), np.array(hit[1:2]), np.array([hit[2] > 0])
 
     def _predict_tuples(self, LA, RA, LB, RB):
         rows = np.stack([LA, RA, LB, RB], axis=1)
@@ -569,7 +604,9 @@ class LimitEstimator(Estimator):
         valid = np.atleast_1d(p.valid)
         flagged = np.zeros(valid.shape, bool)
         if self._parts:
-            flagged[valid] = np.concatenate(self._parts)
+            flagged[valid] = (
+                self._parts[0] if len(self._parts) == 1 else np.concatenate(self._parts)
+            )
         p.flagged = flagged[0] if np.ndim(p.valid) == 0 else flagged
         self.last_flagged = p.flagged
         return p

@@ -392,3 +392,27 @@ def test_in_domain_of_extreme_integers_is_false():
     p = LimitEstimator(dom).predict_intervals(LA, RA, LB, RB)
     assert p.valid.tolist() == [False, True] and not p.in_domain[0]
     assert p.in_domain[1] == in_domain(5, 9, 6, 10, dom)
+
+
+@pytest.mark.parametrize("cache_size", [64, 1 << 12])  # entries merged and dropped; kept
+def test_one_row_calls_equal_the_batch(cache_size):
+    """One row a call (its own short path) gives each row's batch answer and flag, and
+    counts a miss per new key and a hit per known one, from the dict of recent keys and
+    from the sorted arrays alike."""
+    ds = dataset.generate(300, seed=9)
+    LA, RA, LB, RB, ok = bitmaps_to_intervals(ds.omega_a, ds.omega_b)
+    iv = np.stack([LA, RA, LB, RB], 1)[ok]
+    imp = PAPER_DOMAIN.eyes.intervals(np.array([0.0]), np.array([3000.0]), np.array([5.0]))
+    iv = np.vstack([iv, np.stack(imp, 1), iv[:40]])  # an impossible key; repeats
+    batch = LimitEstimator().predict_intervals(*iv.T)
+    est = LimitEstimator(cache_size=cache_size)
+    for _ in range(2):
+        got = [est.predict_intervals(*(np.array([v]) for v in k)) for k in iv]
+        np.testing.assert_array_equal([g.r[0] for g in got], batch.r)
+        np.testing.assert_array_equal([g.phi[0] for g in got], batch.phi)
+        np.testing.assert_array_equal([g.flagged[0] for g in got], batch.flagged)
+    assert batch.flagged.sum() == 1
+    n_keys = len(np.unique(iv, axis=0))
+    assert est.hits + est.misses == 2 * len(iv)
+    if cache_size > 2 * n_keys:  # nothing dropped: each key solved once
+        assert est.misses == n_keys
