@@ -11,11 +11,13 @@
 3. keys no feature can produce (g = 5 beyond r = 1146: empty posterior) against real
    keys, one key per call; target: impossible / real <= 2.
 
-``--stages`` adds where a new key's time goes (rays, nodes, medians; validation and
-cache bookkeeping as the estimator's time beyond ``limit_estimates``). The load average
-is printed before and after: other processes inflate every figure, less so the ratios.
+``--large-m`` repeats item 2 at m = 2^20; ``--stages`` adds where a new key's time goes
+(rays, nodes, medians; validation and cache bookkeeping as the estimator's time beyond
+``limit_estimates``). The load average is printed before and after: other processes
+inflate every figure, less so the ratios.
 
     PYTHONPATH=. .venv/bin/python scripts/bench_limit.py [--rows 100000] [--keys 2000]
+        [--stages] [--large-m]
 """
 
 from __future__ import annotations
@@ -147,12 +149,40 @@ def _stages(keys, one, domain, repeat: int, solve_one: float, est_one: float) ->
     )
 
 
+def _large_m(prev, repeat: int) -> None:
+    """Item 2 at m = 2^20 (MAX_M; keys beyond the int64 packing: the estimator's tuple
+    cache), on the distinct keys of 300 fresh rows."""
+    from eyeviz import dataset
+    from eyeviz.core.bounds import MAX_M
+    from eyeviz.core.domain import Domain
+    from eyeviz.estimators.base import bitmaps_to_intervals
+    from eyeviz.estimators.limit import LimitEstimator, limit_estimates
+
+    dom = Domain(m=MAX_M)
+    ds = dataset.generate(300, eyes=dom.eyes, seed=5)
+    keys = np.unique(np.stack(bitmaps_to_intervals(ds.omega_a, ds.omega_b)[:4], 1), axis=0)
+    one = keys[:100]
+    t = [
+        _cpu(lambda: limit_estimates(keys, dom), repeat),
+        _cpu(lambda: prev.limit_estimates(keys, dom), repeat),
+        _cpu(lambda: _per_call(one, lambda: LimitEstimator(dom)), repeat),
+        _cpu(lambda: _per_call(one, lambda: prev.LimitEstimator(dom)), repeat),
+    ]
+    print(
+        f"   m = 2^20, {len(keys)} keys: limit_estimates batched {t[0] / len(keys) * 1e6:.0f} us "
+        f"a key (before {t[1] / len(keys) * 1e6:.0f} us), now / before {t[0] / t[1]:.2f}x; "
+        f"the estimator one key per call {t[2] / len(one) * 1e3:.3f} ms (before "
+        f"{t[3] / len(one) * 1e3:.3f} ms), now / before {t[2] / t[3]:.2f}x (target <= 0.5)"
+    )
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rows", type=int, default=100_000)
     ap.add_argument("--keys", type=int, default=2000)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--stages", action="store_true", help="where a new key's time goes")
+    ap.add_argument("--large-m", action="store_true", help="item 2 at m = 2^20 as well")
     args = ap.parse_args()
     print(f"load average at start: {os.getloadavg()[0]:.2f} (2 cores)")
 
@@ -205,6 +235,8 @@ def main() -> int:
         )
     if args.stages:
         _stages(keys, one, d, args.repeat, s_new / n1, p_new / n1)
+    if args.large_m and prev is not None:
+        _large_m(prev, args.repeat)
 
     eyes = d.eyes
     rng = np.random.default_rng(1)

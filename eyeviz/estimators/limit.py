@@ -561,8 +561,11 @@ class LimitEstimator(Estimator):
 
     def _predict_tuples(self, LA, RA, LB, RB):
         rows = np.stack([LA, RA, LB, RB], axis=1)
-        uniq, inv = np.unique(rows, axis=0, return_inverse=True)
-        inv = inv.reshape(-1)
+        if len(rows) == 1:  # one row: np.unique(axis=0) costs more than the rest here
+            uniq, inv = rows, np.zeros(1, np.intp)
+        else:
+            uniq, inv = np.unique(rows, axis=0, return_inverse=True)
+            inv = inv.reshape(-1)
         codes = [tuple(k) for k in uniq.tolist()]
         cache = self._cache
         assert isinstance(cache, OrderedDict)
