@@ -34,8 +34,10 @@ reference; :func:`row_medians` shows why such nodes never move a median. The ans
 equal the reference (:func:`eyeviz.estimators.limit._reference_estimates`) up to float
 rounding (tested on ~11,000 keys from m = 8 to m = 2^20), and each key's answer is a
 function of that key alone (tested bit for bit, alone and in shuffled batches).
-Measured on a 2-core machine shared with other jobs (load 2): a new key batched 29 us
-against 60 us before (0.47x), one key per call 0.18 ms against 0.47 ms (0.39x).
+Measured on a 2-core machine shared with other jobs (load ~1.5, ``bench_limit.py``): a
+new key batched 29 us against 59 us before (0.48x), one key per call 0.18 against
+0.46 ms (0.39x); through the estimator (validation and cache included) 0.49x and 0.47x;
+at m = 2^20 0.46x batched, 0.43x one key per call through the estimator.
 Cutting each block to the rays with a stretch (a quarter of the nodes lie on rays with
 none) was tried and measured slower: the gathers cost more than the nodes saved.
 """

@@ -151,3 +151,20 @@ def test_paper_design_keys_drop_few_bits():
     pos = wts > 0
     assert (np.where(pos, vals, np.inf).min(axis=1) >= span[0]).all()
     assert (np.where(pos, vals, 0).max(axis=1) <= span[1]).all()
+
+
+@pytest.mark.parametrize("phi_deg", [32.9, 33.2, 180.0 - 32.9, 180.0 - 33.2])
+def test_keys_at_the_bfvs_edges_equal_the_reference(phi_deg):
+    """Features just inside either edge of the BFV (Prop. 4; psi = 30 deg on the paper's
+    design), where the BFV lines cut the rays: the fast path's constraints (in 1 / rho,
+    from per-key sines) give the reference's answers."""
+    t = np.radians(phi_deg)
+    r = np.array([1200.0, 2000.0, 3500.0])
+    g = np.array([60.0, 100.0, 200.0])
+    keys = np.stack(PAPER_DOMAIN.eyes.intervals(r * np.cos(t), r * np.sin(t), g), 1)
+    r0, p0, e0 = limit._reference_estimates(keys, PAPER_DOMAIN)
+    r1, p1, e1 = limit.limit_estimates(keys, PAPER_DOMAIN)
+    np.testing.assert_array_equal(e1, e0)
+    assert not e0.all()
+    np.testing.assert_allclose(r1[~e0], r0[~e0], rtol=R_TOL)
+    np.testing.assert_allclose(p1[~e0], p0[~e0], atol=PHI_TOL)
