@@ -188,6 +188,8 @@ class Estimator3D:
     #: indices instead of two); :meth:`predict` then checks only the rows it does not
     #: hand over (those where an eye lit nothing).
     checks_indices: ClassVar[bool] = False
+    #: rows per :meth:`_predict_csr` call
+    block_rows: ClassVar[int] = _BLOCK
 
     def __init__(self, domain: Domain3D = PAPER_DOMAIN3D, metadata: dict | None = None) -> None:
         if not isinstance(domain, Domain3D):
@@ -231,8 +233,9 @@ class Estimator3D:
         el = np.full(n, np.nan)
         flagged = np.zeros(n, bool)
         rows = np.flatnonzero(valid)
-        for s in range(0, rows.size, _BLOCK):
-            blk = rows[s : s + _BLOCK]
+        step = self.block_rows
+        for s in range(0, rows.size, step):
+            blk = rows[s : s + step]
             contiguous = blk.size and blk[-1] - blk[0] == blk.size - 1
             if contiguous:
                 lo, hi = int(blk[0]), int(blk[-1]) + 1

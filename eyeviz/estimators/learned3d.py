@@ -84,8 +84,8 @@ META_FILE = "learned3d.json"
 AZ_SCALE = 1e-4
 EL_SCALE = 1e-4
 N_OUT = 3
-#: rows per block through the network (keeps the temporaries in cache; predict hands
-#: the network blocks of at most 16,384 rows, base3d's)
+#: rows per batch through the network (keeps the temporaries in cache; the batches of
+#: predict are those of its former blocks of 16,384 rows)
 _BLOCK = 1 << 14
 #: blocks of at most this many rows are summarised in one thread
 _THREAD_ROWS = 1024
@@ -174,6 +174,9 @@ class Learned3DEstimator(Estimator3D):
 
     name = "learned3d"
     checks_indices = True  # on the runs of the summaries (learned3d_features._check_runs)
+    #: the summaries of 32,768 rows at a time (both eyes side by side with two threads),
+    #: the network still in the batches of 16,384 rows it always had (:meth:`_predict_csr`)
+    block_rows = 2 * _BLOCK
 
     def __init__(
         self,
@@ -215,12 +218,15 @@ class Learned3DEstimator(Estimator3D):
         r = np.full(n, np.nan)
         az = np.full(n, np.nan)
         el = np.full(n, np.nan)
-        sel = np.flatnonzero(ok)
-        if sel.size:
-            out = self.network(x[sel]).astype(np.float64)
-            r[sel] = np.exp(log_r0[sel] + out[:, 0])
-            az[sel] = az0[sel] + AZ_SCALE * out[:, 1]
-            el[sel] = el0[sel] + EL_SCALE * out[:, 2]
+        # the network's batches: each _BLOCK rows handed over, less those with non-finite
+        # features (float32 products may round differently in another batch)
+        for s in range(0, n, _BLOCK):
+            sel = np.flatnonzero(ok[s : s + _BLOCK]) + s
+            if sel.size:
+                out = self.network(x[sel]).astype(np.float64)
+                r[sel] = np.exp(log_r0[sel] + out[:, 0])
+                az[sel] = az0[sel] + AZ_SCALE * out[:, 1]
+                el[sel] = el0[sel] + EL_SCALE * out[:, 2]
         return r, az, el, flagged
 
     def _summaries(self, lit_a: LitCSR, lit_b: LitCSR) -> tuple[EyeSummary, EyeSummary]:

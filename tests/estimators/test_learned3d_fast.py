@@ -392,13 +392,29 @@ def _reference_predict(est, ds):
 
 
 def test_shipped_predictions_are_the_reference_floats():
+    """More rows than one batch of the network (16,384): predict's blocks of 32,768 rows
+    still feed it the batches it had (the reference's network chunks them the same way),
+    with one thread and with two."""
     est = learned3d.load()
-    ds = generate3d(400, est.domain, seed=SEED + 2)
-    got = est.predict_dataset(ds)
+    ds = generate3d(learned3d._BLOCK + 300, est.domain, seed=SEED + 2)
     want = _reference_predict(est, ds)
-    for g, w in zip(got, want, strict=True):
-        assert np.max(np.abs(g - w)) == 0.0
-    assert got.valid.all()
+    for threads in (1, 2):
+        est.threads = threads
+        got = est.predict_dataset(ds)
+        for g, w in zip(got, want, strict=True):
+            assert np.max(np.abs(g - w)) == 0.0
+        assert got.valid.all()
+
+
+def test_network_batches_do_not_depend_on_predict_s_blocks(monkeypatch, shipped, rows):
+    monkeypatch.setattr(learned3d, "_BLOCK", 2)
+    lit_a, lit_b = rows  # 6 rows: batches of 2 rows
+    est = learned3d.load()
+    est.block_rows = 2
+    one = est.predict(lit_a, lit_b)
+    est.block_rows = 6
+    for g, w in zip(est.predict(lit_a, lit_b), one, strict=True):
+        assert np.array_equal(g, w)
 
 
 # --- the indices' checks on the runs ---------------------------------------------------
