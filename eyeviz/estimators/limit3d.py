@@ -54,7 +54,8 @@ The slacks make the proposal's support cover the posterior's (the tests compare 
 brute-force rejection sampling from the prior at nside 4), and the exact check makes the
 likelihood exact whatever the linearisation's error; the price of a loose proposal is
 fewer accepted samples, not bias. A key whose Monte-Carlo error of r exceeds
-``MC_TARGET`` gets ``TOPUP`` more batches of draws. A key with no accepted sample is
+``MC_TARGET``, or whose effective sample size is below ``MIN_ESS``, gets ``TOPUP`` more
+batches of draws. A key with no accepted sample is
 drawn again, more times (``RETRY``: its posterior is a small part of the proposal; more
 draws find it where wider windows did not); a key still empty is answered by the analytic
 triangulation and ``flagged``.
@@ -101,6 +102,9 @@ RAY_ROUNDS = 2
 #: the Monte-Carlo error of r a key's draws are topped up to (at most TOPUP more batches)
 MC_TARGET = 0.01
 TOPUP = 1
+#: a key whose effective sample size is below this is topped up too (one or two accepted
+#: draws give a Monte-Carlo error of 0 or none at all, not a small one)
+MIN_ESS = 4.0
 #: the per-key slack: this many times the model's second-order error in the box
 SLACK_SAFETY = 4.0
 #: directions of the bisection for the box of centres
@@ -607,7 +611,7 @@ class Limit3DEstimator(Estimator3D):
         # top-ups: a key whose Monte-Carlo error of r exceeds MC_TARGET gets another batch
         # (its own stream; the other keys' draws are left as they are)
         for rep in range(1, 1 + TOPUP):
-            need = _mc_rel(out["r"], out["w"]) > MC_TARGET
+            need = (_mc_rel(out["r"], out["w"]) > MC_TARGET) | (_ess(out["w"]) < MIN_ESS)
             if not need.any():
                 break
             more = self._sample(st, keys, stream + 8 * rep)
@@ -789,6 +793,13 @@ class Limit3DEstimator(Estimator3D):
             f"<Limit3DEstimator h={d.h:g} l={d.l:g} nside={d.nside} r=[{d.r_min:g}, "
             f"{d.r_max:g}] g_max={d.g_max:g} el_max={d.el_max:g} prior={self.prior}>"
         )
+
+
+def _ess(w: np.ndarray) -> np.ndarray:
+    """Per row, the effective sample size (sum w)^2 / sum w^2 of the draws (0 if none)."""
+    w2 = (w * w).sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(w2 > 0, w.sum(axis=1) ** 2 / w2, 0.0)
 
 
 def _mc_rel(r: np.ndarray, w: np.ndarray) -> np.ndarray:

@@ -128,3 +128,30 @@ def test_a_key_the_first_pass_misses_is_accepted(row):
     for k in range(s["x"].size):
         sa, sb = D8.eyes.lit(s["x"][k], s["y"][k], s["z"][k], s["g"][k])
         assert np.array_equal(sa, a) and np.array_equal(sb, b)
+
+
+def test_a_key_with_too_few_accepted_draws_gets_more(monkeypatch):
+    """Rows 146, 153 and 166 of generate3d(1000, nside 180, seed 2026112523): the first
+    batch accepts a single draw each, whose Monte-Carlo error comes out as 0 (no spread),
+    so the error rule alone never tops them up. With the effective-sample-size rule
+    (MIN_ESS) they get another batch and accept more, every draw still reproducing the key."""
+    import eyeviz.estimators.limit3d as limit3d
+
+    d = Domain3D(nside=180)
+    ds = generate3d(1000, d, seed=2026112523)
+    rows = np.array([146, 153, 166])
+    a = take_rows(ds.indptr_a, ds.indices_a, rows)
+    b = take_rows(ds.indptr_b, ds.indices_b, rows)
+    est = Limit3DEstimator(d)
+    monkeypatch.setattr(limit3d, "MIN_ESS", 0.0)
+    assert np.array_equal(est.predict(a, b).n_accepted, [1, 1, 1])
+    monkeypatch.setattr(limit3d, "MIN_ESS", 4.0)
+    p = est.predict(a, b)
+    assert (p.n_accepted >= 2).all() and not p.flagged.any()
+    for k, row in enumerate(rows):
+        la, lb = ds.lit(row)
+        s = posterior_samples3d(est, la, lb)
+        assert s["x"].size == p.n_accepted[k]
+        for j in range(s["x"].size):
+            sa, sb = d.eyes.lit(s["x"][j], s["y"][j], s["z"][j], s["g"][j])
+            assert np.array_equal(sa, la) and np.array_equal(sb, lb)
