@@ -253,3 +253,49 @@ def test_tangent_cones_vectorised_equal_one_by_one():
             many[k], shapes3d.tangent_cone(apex[k], centre[k], g[k], 24), atol=1e-9
         )
     assert np.all(many[3] == apex[3])
+
+
+def test_fit_lines_breaks_a_long_title_at_spaces_and_elides_past_two_lines():
+    from vtkmodules.vtkRenderingCore import vtkTextProperty, vtkTextRenderer
+
+    from eyeviz.render.vtk.primitives import fit_lines
+
+    tp = vtkTextProperty()
+    tp.SetFontSize(22)
+    tr = vtkTextRenderer()
+
+    def width(s: str) -> int:
+        box = [0, 0, 0, 0]
+        assert tr.GetBoundingBox(tp, s, box, 72)
+        return box[1] - box[0]
+
+    title = "Spherical eyes, one facet at a time (nside 8)"
+    assert fit_lines(tp, title, width(title) + 1) == title  # fits: unchanged
+    two = fit_lines(tp, title, 0.7 * width(title))
+    assert two.replace("\n", " ") == title and two.count("\n") == 1
+    assert all(width(line) <= 0.7 * width(title) for line in two.split("\n"))
+    many = fit_lines(tp, title + " and a great deal more to say", 0.4 * width(title))
+    assert many.count("\n") == 1 and many.endswith("…")
+    assert all(width(line) <= 0.4 * width(title) for line in many.split("\n"))
+
+
+def test_the_title_fits_the_scene_view(tmp_path):
+    """A title wider than the scene's viewport is broken into lines before the render
+    (it was cut at the view's edge), and put back whole when the view is wide enough."""
+    from eyeviz.render.vtk.scene3d import offscreen_view, shoot
+
+    sc = _scene(8, BALLS)
+    sc.title = "Spherical eyes, one facet at a time: a title of some length (nside 8)"
+    st = compute_state3d(sc)
+    for w, broken in ((1000, True), (3000, False)):
+        pl, actors = offscreen_view(w, 360)
+        try:
+            actors.update(sc, st, None)
+            shoot(pl, actors, default_camera(st, aspect=1.5), False)
+            text = actors.title.GetInput()
+            assert ("\n" in text) is broken and text.replace("\n", " ") == sc.title
+            box = [0.0] * 4
+            actors.title.GetBoundingBox(actors.scene_ren, box)
+            assert box[1] - box[0] <= actors.scene_ren.GetSize()[0]
+        finally:
+            pl.close()

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pyvista as pv
+import vtkmodules.vtkRenderingFreeType  # noqa: F401  (vtkTextRenderer's FreeType override)
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
@@ -19,6 +20,8 @@ from vtkmodules.vtkRenderingCore import (
     vtkPolyDataMapper,
     vtkPolyDataMapper2D,
     vtkTextActor,
+    vtkTextProperty,
+    vtkTextRenderer,
 )
 
 from eyeviz.render.vtk.style import INK, style_text
@@ -27,6 +30,7 @@ __all__ = [
     "CIRCLE_N",
     "UNIT",
     "actor",
+    "fit_lines",
     "points_actor",
     "text3d",
     "screen_text",
@@ -97,6 +101,43 @@ def screen_text(size, color, pos, top=False, center=False, right=False) -> vtkTe
     t.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
     t.SetPosition(*pos)
     return t
+
+
+def fit_lines(
+    tp: vtkTextProperty, text: str, width_px: float, dpi: int = 72, max_lines: int = 2
+) -> str:
+    """``text`` broken at spaces into lines that fit ``width_px`` pixels when drawn with
+    ``tp`` at ``dpi`` (a title wider than its view would be cut at the view's edge); past
+    ``max_lines`` the last line ends in "…". A word wider than the width stays whole."""
+    if width_px <= 0 or not text:
+        return text
+    tr = vtkTextRenderer()
+    box = [0, 0, 0, 0]
+
+    def width(s: str) -> int:
+        if not tr.GetBoundingBox(tp, s, box, dpi):
+            return 0
+        return box[1] - box[0]
+
+    if width(text) <= width_px:
+        return text
+    lines: list[str] = []
+    for para in text.split("\n"):
+        line = ""
+        for word in para.split(" "):
+            cand = f"{line} {word}" if line else word
+            if line and width(cand) > width_px:
+                lines.append(line)
+                line = word
+            else:
+                line = cand
+        lines.append(line)
+    if len(lines) > max_lines:
+        last = " ".join(lines[max_lines - 1 :])
+        while last and width(last + "…") > width_px:
+            last = last[:-1]
+        lines = lines[: max_lines - 1] + [last.rstrip() + "…"]
+    return "\n".join(lines)
 
 
 def border_actor() -> vtkActor2D:

@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 import pyvista as pv
+from vtkmodules.vtkCommonCore import vtkCommand
 from vtkmodules.vtkRenderingCore import vtkActor, vtkRenderer
 
 from eyeviz.files.atomic import atomic_output
@@ -52,6 +53,7 @@ from eyeviz.render.vtk.ghosts3d import Ghosts3D, make_overlay
 from eyeviz.render.vtk.primitives import (
     Store,
     actor,
+    fit_lines,
     screen_text,
     set_rgb,
     text3d,
@@ -178,6 +180,11 @@ class Scene3DActors:
         self._last: tuple | None = None  # (x, y, z, g) drawn last, per ball
         self.title = screen_text(22, INK, (0.01, 0.985), top=True)
         scene_ren.AddViewProp(self.title)
+        # the title is broken into lines that fit the view, checked before each render
+        # (the view's width and the title's font size change with the window and F5/Ctrl+=)
+        self._title_text = ""
+        self._title_fit: tuple | None = None
+        scene_ren.AddObserver(vtkCommand.StartEvent, self._fit_title)
         self.eyes_caption = screen_text(16, (0.35, 0.35, 0.35), (0.03, 0.985), top=True)
         if eyes_ren is not None:
             eyes_ren.AddViewProp(self.eyes_caption)
@@ -327,6 +334,21 @@ class Scene3DActors:
                     self.patches[e].append((mesh, a, np.empty(0, np.int64)))
 
     # --- per frame ---------------------------------------------------------------------
+    def _fit_title(self, *_args) -> None:
+        """Break the title into lines that fit the scene's viewport (at most two, then
+        "…"); refitted only when the view's width, the font size or the title change."""
+        ren = self.scene_ren
+        win = ren.GetRenderWindow()
+        width = ren.GetSize()[0]
+        tp = self.title.GetTextProperty()
+        dpi = win.GetDPI() if win is not None else 72
+        key = (width, tp.GetFontSize(), dpi)
+        if key == self._title_fit or width <= 0:
+            return
+        self._title_fit = key
+        avail = width * (1.0 - 2.0 * self.title.GetPosition()[0]) - 4.0
+        self.title.SetInput(fit_lines(tp, self._title_text, avail, dpi))
+
     def update(self, scene: Scene, state: SceneState3D, selected: int | None) -> None:
         """Draw ``state`` (of ``scene``): structure rebuilt only when it changed."""
         pair = state.pair
@@ -348,7 +370,10 @@ class Scene3DActors:
         if balls_key != self._balls_key:
             self._build_balls(scene, state)
             self._balls_key = balls_key
-        self.title.SetInput(scene.title)
+        if scene.title != self._title_text:
+            self._title_text = scene.title
+            self._title_fit = None
+            self.title.SetInput(scene.title)
         shows = scene.shows
         n = state.n
         pal = _palette(scene)
