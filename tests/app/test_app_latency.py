@@ -2,12 +2,14 @@
 the widgets whose content changed (real window, real VTK, counted by an event filter)."""
 
 import collections
+import math
 import time
 
 from mouse import pixel_of
 from PyQt5 import QtCore, QtWidgets
 from PyQt5.QtTest import QTest
 
+from eyeviz.app.window import LIVE_PANEL_MS
 from eyeviz.model.scene import Eyes, Feature, Scene, View
 
 LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout", "labels"]
@@ -89,7 +91,52 @@ def test_bitmaps_panel_repaints_nothing_when_the_bitmaps_do_not_change(make_wind
         win.render()
         for _ in range(3):
             app.processEvents()
+        QTest.qWait(LIVE_PANEL_MS + 100)  # the panels' coalesced refresh ran too
         counter.on = False
     finally:
         app.removeEventFilter(counter)
     assert counter.counts[(int(QtCore.QEvent.Paint), "BitmapPanel")] == 0, counter.counts
+
+
+def _shown(win):
+    """What the readout's r row and the bitmaps panel's A interval should show now."""
+    st, i = win.model.state, win.model.selected
+    r_text = f"{st.r[i]:.1f}, {math.degrees(st.phi[i]):.2f}°"
+    return r_text, (int(st.LA[i]), int(st.RA[i]))
+
+
+def _panels(win):
+    return win.readout.texts["r"], win.bitmaps.intervals["A"]
+
+
+def test_panels_follow_a_live_change_coalesced_and_show_its_end(make_window, qtbot):
+    """During a drag the readout and bitmaps panels refresh at <= 20 Hz (a drag frame does
+    not wait for them); flush(), the coalesced refresh and the release show the last state."""
+    fs = [Feature("f0", -1500.0, 3000.0, 60.0), Feature("dragged", 0.0, 1500.0, 50.0)]
+    win = make_window(Scene(Eyes(40.0, 20.0, 720), fs, LAYERS, view=View((0.0, 2600.0), 9000.0)))
+    win.model.select(1)
+    assert _panels(win) == _shown(win)
+    before = _panels(win)
+    win.model.live(1, x=300.0, y=1200.0)  # a live change: drawn by the next frame
+    win.render()  # no event handled since: the panels' refresh is still pending
+    assert _panels(win) == before and win._panel_timer.isActive()
+    assert _shown(win) != before  # the move changed what they show
+    win.flush()  # at once
+    assert _panels(win) == _shown(win) and not win._panel_timer.isActive()
+    win.model.live(1, x=-400.0, y=1800.0)
+    win.render()
+    qtbot.waitUntil(lambda: not win._panel_timer.isActive(), timeout=2000)
+    assert _panels(win) == _shown(win)  # the coalesced refresh took the last change
+    # a real drag: the release (its undo step) refreshes the panels at once
+    before = _panels(win)
+    start = pixel_of(win, -400.0, 1800.0)
+    end = start + QtCore.QPoint(40, 25)
+    w = win.plotter
+    QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
+    for k in range(1, 9):
+        QTest.mouseMove(w, start + (end - start) * (k / 8))
+        win.render()
+    QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, end)
+    assert win.model.scene.features[1].x != -400.0 and win.undo_stack.count() == 1
+    assert _shown(win) != before  # the drag changed what the panels show
+    assert _panels(win) == _shown(win) and not win._panel_timer.isActive()
