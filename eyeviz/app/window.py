@@ -100,8 +100,9 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self._table_timer.setInterval(100)
         self._table_timer.timeout.connect(lambda: self.features_panel.refresh(self._table_index))
         # the readout and bitmaps panels follow a live change (drag, play) at <= 20 Hz: their
-        # refresh and repaint cost ~0.6-0.9 ms of a ~9 ms drag frame; an edit, a selection,
-        # the drag's release (its undo step) or flush() refreshes them at once
+        # refresh and repaint cost ~0.5-1 ms of a 7-9 ms drag frame (scripts/bench_app.py);
+        # an edit, a selection, the drag's release (its undo step) or flush() refresh them
+        # at once
         self._panel_timer = QtCore.QTimer(self)
         self._panel_timer.setSingleShot(True)
         self._panel_timer.setInterval(LIVE_PANEL_MS)
