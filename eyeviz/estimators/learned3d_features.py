@@ -241,7 +241,8 @@ def _runs(indptr: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarr
     flat = indices[base : base + nnz]
     st, s, e = _run_starts(flat)
     rs = rel[:-1]
-    rs = rs[rs < nnz]  # rows with an index (an empty row's start is the next row's)
+    # rows with an index (an empty row's start is the next row's, so keep each start once)
+    rs = rs[(rs < nnz) & np.r_[True, rs[1:] != rs[:-1]]]
     pos = np.searchsorted(st, rs)
     miss = pos == st.size
     miss |= st[np.minimum(pos, st.size - 1)] != rs

@@ -518,3 +518,20 @@ def test_two_threads_give_the_same_floats_and_lit_a_s_error_first(monkeypatch, s
     bad_b = (pb, np.r_[ib[:-1], shipped.domain.npix])
     assert "lit_a: indices must increase" in _message(two.predict, bad_a, bad_b)
     assert "lit_b: indices must lie" in _message(two.predict, lit_a, bad_b)
+
+
+@pytest.mark.parametrize("n_empty", [1, 2, 3])
+def test_empty_rows_between_consecutive_indices_are_not_refused(n_empty):
+    """A row that goes on where an earlier one ended, with empty rows between them (their
+    starts repeat): the check on the runs accepts it as as_csr does, and every row's
+    summaries are those of the row alone."""
+    nside = 4
+    ptr = np.r_[0, [1] * (n_empty + 1), 3].astype(np.int64)  # [84], empty..., [85, 86]
+    ind = np.array([84, 85, 86], np.int64)
+    base3d.as_csr("lit_a", (ptr, ind), 12 * nside * nside)  # valid
+    got = eye_summaries(nside, ptr, ind, name="lit_a")
+    for row, want_ind in ((0, [84]), (ptr.size - 2, [85, 86])):
+        want = eye_summaries(nside, np.array([0, len(want_ind)]), np.array(want_ind))
+        for f in ("count", "sum_xyz", "lon_w", "lon_e", "z_top", "z_bottom", "bounds"):
+            assert np.array_equal(getattr(got, f)[row], getattr(want, f)[0], equal_nan=True), f
+    assert np.all(got.count[1 : 1 + n_empty] == 0)
