@@ -72,6 +72,16 @@ LOD_ERROR_PX = 0.5
 #: features, 0.99x at 30 (the copy costs what the fill saves), 0.79-1.07x at 100, 0.77-0.80x
 #: at 150, 0.70-0.74x at 200, 0.56-0.64x at 300, 0.34x at 1,000).
 BACKDROP_MIN_FEATURES = 150
+#: The centre dots' depths span Z_POINT .. Z_POINT + CENTER_DZ by feature index (the handle
+#: is at Z_POINT + 0.5): the selected feature's live dot and the merged dots of two
+#: coincident features never tie, so their order is the features' with or without the
+#: backdrop (a tie went to the live dot over the backdrop and to the merged dots without).
+CENTER_DZ = 0.4
+
+
+def center_z(i, n: int):
+    """Depth of feature i's centre dot among n (later features on top)."""
+    return Z_POINT + CENTER_DZ * (np.asarray(i, dtype=np.float64) + 1.0) / (n + 1.0)
 
 
 def disc_vertices(r_px: np.ndarray) -> np.ndarray:
@@ -262,7 +272,7 @@ class FeaturesLayer:
             tint, cols = self._rgb_now
             self.live_fill.SetPosition(x, y, z)
             self.live_line.SetPosition(x, y, z)
-            self.live_center.SetPosition(x, y, Z_POINT)
+            self.live_center.SetPosition(x, y, float(center_z(sel, n)))
             for a in (self.live_fill, self.live_line):
                 a.SetScale(g, g, 1.0)
             self.live_fill.GetProperty().SetColor(*(tint[sel] / 255.0))
@@ -309,7 +319,9 @@ class FeaturesLayer:
         self._write_cells(self.fill_mesh, self.line_mesh, others, tint, cols, verts)
         c = self.verts = verts[others]
         self.fan = int(c.max()) - 2 if len(c) else CIRCLE_N - 2
-        centers = pv.PolyData(np.column_stack([frame.x, frame.y, np.full(n, Z_POINT)])[others])
+        centers = pv.PolyData(
+            np.column_stack([frame.x, frame.y, center_z(np.arange(n), n)])[others]
+        )
         set_rgb(centers.GetPointData(), cols[others])
         self.centers_mesh = centers
         set_input(self._centers_actor, centers)
