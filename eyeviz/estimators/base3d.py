@@ -30,6 +30,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from eyeviz.core.domain3d import PAPER_DOMAIN3D, Domain3D
+from eyeviz.core.validation import check_int
 
 __all__ = [
     "Estimator3D",
@@ -188,7 +189,7 @@ class Estimator3D:
     #: indices instead of two); :meth:`predict` then checks only the rows it does not
     #: hand over (those where an eye lit nothing).
     checks_indices: ClassVar[bool] = False
-    #: rows per :meth:`_predict_csr` call
+    #: rows per :meth:`_predict_csr` call (an integer >= 1, checked by :meth:`predict`)
     block_rows: ClassVar[int] = _BLOCK
 
     def __init__(self, domain: Domain3D = PAPER_DOMAIN3D, metadata: dict | None = None) -> None:
@@ -233,7 +234,7 @@ class Estimator3D:
         el = np.full(n, np.nan)
         flagged = np.zeros(n, bool)
         rows = np.flatnonzero(valid)
-        step = self.block_rows
+        step = check_int("block_rows", self.block_rows, ge=1)
         for s in range(0, rows.size, step):
             blk = rows[s : s + step]
             contiguous = blk.size and blk[-1] - blk[0] == blk.size - 1

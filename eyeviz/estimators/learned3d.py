@@ -50,6 +50,7 @@ import numpy as np
 
 from eyeviz import EyevizError
 from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.validation import check_int
 from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D
 from eyeviz.estimators.learned3d_features import (
     N_FEATURES,
@@ -192,7 +193,13 @@ class Learned3DEstimator(Estimator3D):
         self._w = {k: np.asarray(v, np.float32) for k, v in arrays.items()}
         #: 2 (the default where there are two cores or more): summarise the two eyes in
         #: two threads (:meth:`_summaries`); 1: in turn. The same floats either way.
+        #: An integer >= 1 (more than 2 is 2), checked by :meth:`predict`.
         self.threads = min(2, os.cpu_count() or 1)
+
+    def predict(self, lit_a, lit_b) -> Prediction3D:
+        """:meth:`Estimator3D.predict`; ``threads`` must be an integer >= 1."""
+        self.threads = check_int("threads", self.threads, ge=1)
+        return super().predict(lit_a, lit_b)
 
     def network(self, x: np.ndarray) -> np.ndarray:
         """The network's raw outputs (n, 3) for feature rows x (n, N_FEATURES)."""

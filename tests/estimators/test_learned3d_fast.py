@@ -535,3 +535,23 @@ def test_empty_rows_between_consecutive_indices_are_not_refused(n_empty):
         for f in ("count", "sum_xyz", "lon_w", "lon_e", "z_top", "z_bottom", "bounds"):
             assert np.array_equal(getattr(got, f)[row], getattr(want, f)[0], equal_nan=True), f
     assert np.all(got.count[1 : 1 + n_empty] == 0)
+
+
+@pytest.mark.parametrize("threads", [0, -1, 1.5, "2", None, True])
+def test_threads_must_be_a_positive_integer(shipped, rows, threads):
+    est = learned3d.load()
+    est.threads = threads
+    with pytest.raises(ValueError, match=r"^threads must be an integer >= 1, got ") as exc:
+        est.predict(*rows)
+    assert "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize("block_rows", [0, -5, 1.5, "3", None])
+def test_block_rows_must_be_a_positive_integer(shipped, rows, block_rows):
+    """-5 used to give NaN for every row (an empty range of blocks), 0 a range() error."""
+    est = learned3d.load()
+    est.block_rows = block_rows
+    with pytest.raises(ValueError, match=r"^block_rows must be an integer >= 1, got "):
+        est.predict(*rows)
+    est.block_rows = 1 << 62  # huge: one block
+    assert np.isfinite(est.predict(*rows).r).all()
