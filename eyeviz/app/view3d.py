@@ -42,6 +42,7 @@ from eyeviz.model.predictions3d import (
     Predictions3D,
     Predictor3D,
     ball_key,
+    check_estimators,
     domain_of,
     scene_predictions3d,
 )
@@ -259,6 +260,7 @@ class Scene3DHost(QtCore.QObject):
         from eyeviz import EyevizError
 
         try:
+            check_estimators(scene)  # a name no estimator has: one line, not the defaults
             m3.checked_state(scene)
         except EyevizError as exc:
             self.win.show_error("Cannot open scene", str(exc))

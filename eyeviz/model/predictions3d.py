@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import re
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -60,12 +61,14 @@ __all__ = [
     "Predictor3D",
     "answer_from",
     "ball_key",
+    "check_estimators",
     "cloud_of",
     "domain_of",
     "errors3d",
     "estimator_color3d",
     "estimators3d",
     "in_domain",
+    "outside_reason",
     "prediction_rows",
     "range_note",
     "scene_predictions3d",
@@ -100,8 +103,40 @@ def estimators3d(scene: Scene, known: list[str] | None = None) -> list[str]:
     estimators``, the key the planar layer uses); :data:`DEFAULT_ESTIMATORS3D` (those
     installed) when it names none of them. ``known``: the registry's spherical names."""
     names = _spherical_names() if known is None else list(known)
-    chosen = [n for n in scene.estimators if n in names]
+    chosen = list(dict.fromkeys(n for n in scene.estimators if n in names))  # once each
     return chosen if chosen else [n for n in DEFAULT_ESTIMATORS3D if n in names]
+
+
+def check_estimators(scene: Scene) -> None:
+    """EyevizError (one line) when ``scene`` shows predictions and its ``[predictions]
+    estimators`` names an estimator the registry does not know at all (a typo: drawing
+    the defaults instead would hide it). Planar names pass (the key is shared; a
+    spherical scene naming none of its own shows :data:`DEFAULT_ESTIMATORS3D`)."""
+    if not scene.shows("predictions"):
+        return
+    from eyeviz import EyevizError
+    from eyeviz.estimators import registry
+
+    known = set(registry.available(None))
+    for name in scene.estimators:
+        if name not in known:
+            shown = name if len(name) <= 40 else name[:39] + "\u2026"
+            raise EyevizError(
+                f"predictions.estimators: unknown estimator {shown!r}; available: "
+                f"{', '.join(registry.available(None))}"
+            )
+
+
+#: A local path in an estimator's reason (a weights folder under the user's home): the
+#: readout and the exported figure show its last component only.
+_PATH = re.compile(r"(?<![~\w.])(?:[A-Za-z]:)?(?:[\\/][^\s\\/:'\"()\[\],]+){2,}[\\/]?")
+
+
+def _no_paths(text: str) -> str:
+    """``text`` with each local path reduced to its file name (in quotes)."""
+    return _PATH.sub(
+        lambda m: "\u2018" + re.split(r"[\\/]", m.group(0).rstrip("\\/"))[-1] + "\u2019", text
+    )
 
 
 def domain_of(scene: Scene) -> Domain3D:
@@ -116,6 +151,20 @@ def in_domain(state: SceneState3D, i: int) -> bool:
     if state.in_bfv is None or state.vis_a is None or state.vis_b is None:
         raise ValueError("this state has no BFV or visibility (no layer needed them)")
     return bool(state.in_bfv[i] and state.vis_a[i] and state.vis_b[i])
+
+
+def outside_reason(state: SceneState3D, i: int) -> str:
+    """Why ball ``i`` is outside the domain, in one short line (the readout's cell, the
+    figure's table): not in the 3D binocular field, and each eye on which it lights
+    fewer facets than Definition 1's two."""
+    parts = []
+    if state.in_bfv is not None and not state.in_bfv[i]:
+        parts.append("not in the 3D binocular field")
+    for eye, n in (("A", state.facets_a), ("B", state.facets_b)):
+        k = int(n[i]) if n is not None else 2
+        if k < 2:
+            parts.append(f"eye {eye}: {'1 facet' if k == 1 else 'no facet'} lit (needs 2)")
+    return "; ".join(parts) if parts else "not seen by both eyes"
 
 
 def range_note(domain: Domain3D, state: SceneState3D, i: int) -> str | None:
@@ -272,7 +321,7 @@ class Predictor3D:
                 self._est[key] = registry.load(name, domain=domain)
             except Exception as exc:  # noqa: BLE001  (shown as a line, never raised)
                 text = str(exc).strip().splitlines()[0] if str(exc).strip() else repr(exc)
-                self._est[key] = f"unavailable: {text}"
+                self._est[key] = f"unavailable: {_no_paths(text)}"
         return self._est[key]
 
     def cached(self, name: str, key: bytes):
@@ -395,7 +444,9 @@ def scene_predictions3d(
     job), ``"drag"`` answers "after the drag" unless cached."""
     if ball is None or not 0 <= ball < state.n or state.lit_a is None:
         return None
-    names = estimators3d(scene) if names is None else names
+    if names is None:
+        check_estimators(scene)
+        names = estimators3d(scene)
     domain = domain_of(scene)
     i = ball
     truth_sph = (float(state.r[i]), float(state.azimuth[i]), float(state.elevation[i]))
@@ -406,7 +457,7 @@ def scene_predictions3d(
     )
     if not in_domain(state, i):
         for n in names:
-            out.answers[n] = "outside the domain (not in the BFV or not seen by both eyes)"
+            out.answers[n] = outside_reason(state, i)
         return out
     out.note = range_note(domain, state, i)
     key = ball_key(state, i)

@@ -234,3 +234,18 @@ def test_an_estimator_for_other_eyes_is_greyed_with_its_line(make_window, qtbot)
     head = t.horizontalHeader()
     assert sum(head.sectionSize(j) for j in range(t.columnCount())) <= t.viewport().width() + 1
     assert host.estimators.boxes["analytic3d"].styleSheet() == ""
+
+
+def test_opening_a_scene_naming_an_unknown_estimator_is_refused(make_window, qtbot, tmp_path):
+    win = make_window(_scene(False))
+    host = win.host3d
+    before = host.model.scene
+    text = (SCENES / "sphere_predictions.toml").read_text()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace('estimators = ["analytic3d", "learned3d", "limit3d"]',
+                                'estimators = ["nonsense"]'))  # fmt: skip
+    assert not win.open_path(bad)  # File > Open: one line, the open scene kept
+    assert win.last_error.startswith("predictions.estimators: unknown estimator 'nonsense'")
+    assert "\n" not in win.last_error
+    assert host.model.scene is before and win.path != bad
+    win.error_box.close()

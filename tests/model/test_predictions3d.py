@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from eyeviz import EyevizError
 from eyeviz.core.domain3d import Domain3D
 from eyeviz.estimators import registry
 from eyeviz.model import predictions3d as p3
@@ -85,7 +86,7 @@ def test_answers_for_one_ball_only_and_in_the_domain():
     pred = p3.Predictor3D()
     out = p3.scene_predictions3d(behind, st, 0, pred, names=["analytic3d"])
     assert out is not None and out.ghosts() == []
-    assert "outside the domain" in out.answers["analytic3d"]
+    assert out.answers["analytic3d"] == "not in the 3D binocular field"  # says which
     assert p3.scene_predictions3d(behind, st, None, pred) is None
     assert p3.scene_predictions3d(behind, st, 5, pred) is None
     # in the field but outside Table 4's ranges: answered, with the note
@@ -191,3 +192,46 @@ def test_the_scene_names_the_estimators_with_the_planar_key():
     assert p3.estimator_color3d("analytic3d") != p3.estimator_color3d("limit3d")
     shipped = load(SCENES / "sphere_predictions.toml")
     assert shipped.shows("predictions") and p3.estimators3d(shipped, known) == known
+
+
+def test_outside_the_domain_says_which_eye_and_a_40_char_cut_keeps_it():
+    # a small ball at nside 2: in the field, one facet lit per eye (Definition 1: two)
+    tiny = _scene(nside=2, balls=((0.0, 1500.0, 0.0, 0.5),))
+    st = compute_state3d(tiny)
+    assert st.in_bfv[0] and int(st.facets_a[0]) == 1
+    out = p3.scene_predictions3d(tiny, st, 0, p3.Predictor3D(), names=["analytic3d"])
+    assert out is not None and out.ghosts() == []
+    assert out.answers["analytic3d"] == "eye A: 1 facet lit (needs 2); eye B: 1 facet lit (needs 2)"
+    behind = _scene(balls=((0.0, -1500.0, 0.0, 80.0),))
+    why = p3.outside_reason(compute_state3d(behind), 0)
+    assert len(why) <= 40  # the exported figure's table cuts a cell at 40 characters
+
+
+def test_an_unavailable_reason_names_no_local_path():
+    # learned3d's weights are for nside 180: its reason names their folder, which the
+    # readout and the exported figure must not show (a path under the user's home)
+    why = p3.Predictor3D().estimator("learned3d", Domain3D(h=40.0, l=20.0, nside=16))
+    assert isinstance(why, str) and why.startswith("unavailable: ") and "nside=180" in why
+    assert "/" not in why and "\\" not in why
+    assert str(Path(registry.__file__).resolve().parents[1]) not in why
+
+
+def test_a_name_no_estimator_has_is_refused_in_one_line():
+    sc = _scene(estimators=["nonsense"])
+    st = compute_state3d(sc)
+    with pytest.raises(
+        EyevizError,
+        match=r"^predictions.estimators: unknown estimator 'nonsense'; available: .*limit3d",
+    ):
+        p3.scene_predictions3d(sc, st, 0, p3.Predictor3D())
+    # planar names pass (the key is shared): the spherical defaults are shown
+    sc.estimators = ["analytic"]
+    p3.check_estimators(sc)
+    sc.layers.remove("predictions")  # a scene not showing the layer is not checked
+    sc.estimators = ["nonsense"]
+    p3.check_estimators(sc)
+
+
+def test_a_name_given_twice_is_one_estimator():
+    sc = _scene(estimators=["limit3d", "analytic3d", "limit3d"])
+    assert p3.estimators3d(sc, ["analytic3d", "learned3d", "limit3d"]) == ["limit3d", "analytic3d"]
