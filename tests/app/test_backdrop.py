@@ -11,6 +11,7 @@ from PyQt5.QtTest import QTest
 from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
 
+from eyeviz.app.screenshot import qimage_to_array
 from eyeviz.model import interactions
 from eyeviz.model.scene import OKABE_ITO, Eyes, Feature, Scene, View
 from eyeviz.render.vtk.layers.features import BACKDROP_MIN_FEATURES
@@ -173,3 +174,23 @@ def test_coincident_features_look_the_same_with_and_without_the_backdrop(make_wi
     assert (diff > 0).sum() == 0, f"{(diff > 0).sum()} pixels differ, by up to {diff.max()}"
     # the selected (later) feature's dot is the one on top either way
     assert np.array_equal(patch_colour(win, full, 0.0, 2000.0), feats._rgb_now[1][-1])
+
+
+def test_a_screenshot_over_the_backdrop_equals_one_without_it(make_window, tmp_path):
+    """vtkWindowToImageFilter (every screenshot, ``eyeviz app --screenshot``) gives each
+    renderer a camera copy for its render and deletes each renderer's camera afterwards:
+    the backdrop's renderer held the main renderer's, freed twice (a segmentation fault)."""
+    fs = [
+        Feature(f"f{i}", -3000.0 + 40.0 * i, 4000.0 + 15.0 * (i % 9), 30.0, OKABE_ITO[i % 7])
+        for i in range(BACKDROP_MIN_FEATURES)
+    ]
+    sc = Scene(Eyes(40.0, 20.0, 72), fs, ["eyes", "features"], [], View((0.0, 2600.0), 6000.0))
+    win = make_window(sc)
+    win.resize(640, 480)
+    feats = win.actors.features
+    assert feats.backdrop.active
+    kept = qimage_to_array(win.save_screenshot(tmp_path / "kept.png") and win.grab_image())
+    again = qimage_to_array(win.grab_image())  # the main camera survived the first
+    feats.set_backdrop_min(10**9)
+    full = qimage_to_array(win.grab_image())
+    assert np.array_equal(kept, full) and np.array_equal(again, full)

@@ -3,7 +3,7 @@
 Issue 25: at 10^4 features, filling the merged discs (~16 M fragments in software GL) was
 nearly the whole of a drag frame, though a drag moves only the selected feature and never
 the camera. A :class:`Backdrop` holds such props (the features layer gives it its merged
-discs, :mod:`eyeviz.render.vtk.layers.features`) in a renderer of its own that shares the
+discs, :mod:`eyeviz.render.vtk.layers.features`) in a renderer of its own that follows the
 main renderer's camera, viewport and background. Before the main renderer draws (its
 ``StartEvent``), the backdrop either
 
@@ -177,8 +177,11 @@ class Backdrop:
             ren.SetRenderWindow(rw)
             if self._attach_later is None:  # once this render is over
                 self._attach_later = rw.AddObserver(vtkCommand.EndEvent, self._attach_now)
-        if ren.GetActiveCamera() is not main.GetActiveCamera():
-            ren.SetActiveCamera(main.GetActiveCamera())
+        # a copy of the main camera, not the camera itself: vtkWindowToImageFilter (every
+        # screenshot) gives each renderer a camera of its own for its render and Delete()s
+        # whatever camera each has afterwards, so a renderer that took the main renderer's
+        # camera then freed it twice (a segmentation fault from 150 features on)
+        ren.GetActiveCamera().DeepCopy(main.GetActiveCamera())
         ren.SetViewport(*main.GetViewport())
         ren.SetBackground(*main.GetBackground())
         ren.SetBackground2(*main.GetBackground2())
