@@ -64,6 +64,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from eyeviz.core.validation import check_int
 from eyeviz.estimators import analytic, limit_solve
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, Estimator
 from eyeviz.estimators.limit_solve import interval_quadratic
@@ -72,6 +73,9 @@ __all__ = ["LimitEstimator", "load", "PRIORS", "posterior_nodes", "posterior_sam
 
 PRIORS = ("single", "multi")
 _CACHE_SIZE = 1 << 18
+#: largest grid size n and Gauss-Legendre order K a LimitEstimator takes
+_MAX_N = 256
+_MAX_K = 64
 
 
 @dataclass(frozen=True)
@@ -496,9 +500,11 @@ class LimitEstimator(Estimator):
             raise ValueError(f"prior must be one of {PRIORS}, got {prior!r}")
         super().__init__(domain, {"n_weights": 0, "train_seconds": 0.0, "prior": prior})
         self.prior = prior
-        self.n = int(n)
-        self.k = int(k)
-        self.cache_size = int(cache_size)
+        # the grid's n x n rays (4n x 4n on a retry) and K nodes per ray, bounded so a
+        # key's nodes fit in memory; a cache of 0 keys keeps none
+        self.n = check_int("n", n, ge=1, le=_MAX_N)
+        self.k = check_int("k", k, ge=1, le=_MAX_K)
+        self.cache_size = check_int("cache_size", cache_size, ge=0)
         w = self.domain.width
         # keys packed into one int64 while (m/2)^4 fits; tuples beyond (m > about 110,000),
         # where the packed code would overflow and make different keys share an answer

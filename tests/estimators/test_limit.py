@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -416,3 +417,31 @@ def test_one_row_calls_equal_the_batch(cache_size):
     assert est.hits + est.misses == 2 * len(iv)
     if cache_size > 2 * n_keys:  # nothing dropped: each key solved once
         assert est.misses == n_keys
+
+
+@pytest.mark.parametrize(
+    ("kw", "want"),
+    [
+        ({"n": 0}, "n must be an integer >= 1 and <= 256, got 0"),  # was ZeroDivisionError
+        ({"n": -3}, "n must be an integer >= 1"),  # was a numpy reduction error
+        ({"n": 1.7}, "n must be an integer >= 1"),  # was truncated to 1
+        ({"n": 10**6}, "n must be an integer >= 1 and <= 256, got 1000000"),  # 7 TiB
+        ({"k": 0}, "k must be an integer >= 1 and <= 64, got 0"),
+        ({"cache_size": -1}, "cache_size must be an integer >= 0, got -1"),  # KeyError at m=2^20
+        ({"cache_size": "x"}, "cache_size must be an integer >= 0, got 'x'"),
+    ],
+)
+def test_grid_and_cache_parameters_are_refused_in_one_line(kw, want):
+    for m in (720, 1 << 20):
+        with pytest.raises(ValueError, match="^" + re.escape(want)) as exc:
+            estimators.load("limit", domain=Domain(m=m), **kw)
+        assert "\n" not in str(exc.value)
+
+
+def test_a_cache_of_no_keys_answers_as_the_default():
+    cols = [np.array(v) for v in ([100, 5, 100], [104, 9, 104], [110, 12, 110], [114, 16, 114])]
+    for m in (720, 1 << 20):
+        want = LimitEstimator(Domain(m=m)).predict_intervals(*cols)
+        got = LimitEstimator(Domain(m=m), cache_size=0).predict_intervals(*cols)
+        np.testing.assert_array_equal(got.r, want.r)
+        np.testing.assert_array_equal(got.flagged, want.flagged)
