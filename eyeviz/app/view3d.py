@@ -51,6 +51,7 @@ from eyeviz.render.vtk.scene3d import (
     Scene3DActors,
     camera_of,
     default_camera,
+    fit_labels,
     layout,
     make_renderers,
     split_viewports,
@@ -503,7 +504,10 @@ class Scene3DHost(QtCore.QObject):
         self.flush()
         self.preset = name
         vp = self.pointer("move", 0, 0)
-        self.set_camera(default_camera(self.model.state, name, vp.w / max(vp.h, 1.0)))
+        cam = default_camera(self.model.state, name, vp.w / max(vp.h, 1.0))
+        if self.actors is not None and vp.w > 1 and vp.h > 1:  # the balls' names not cut
+            cam = fit_labels(cam, self.actors.label_boxes(), (vp.w, vp.h))
+        self.set_camera(cam)
 
     # --- pixels ----------------------------------------------------------------------------
     def pointer(self, kind: str, x: float, y: float) -> m3.Pointer:

@@ -249,3 +249,28 @@ def test_opening_a_scene_naming_an_unknown_estimator_is_refused(make_window, qtb
     assert "\n" not in win.last_error
     assert host.model.scene is before and win.path != bad
     win.error_box.close()
+
+
+def test_the_default_framing_keeps_the_balls_names_inside_the_view(make_window, qtbot):
+    from eyeviz.render.vtk.scene3d import LABEL_MARGIN_PX, default_camera
+
+    win = make_window(_scene(True))
+    win.resize(1280, 720)
+    qtbot.wait(50)
+    host = win.host3d
+    host.set_preset("default")
+    vp = host.pointer("move", 0, 0)
+    x0 = host.view.width() - vp.w  # the scene viewport's left edge in the widget
+    boxes = host.actors.label_boxes()
+    assert len(boxes) == 3
+    for anchor, w, h in boxes:  # "high" was cut at the view's right edge
+        x, y = host.scene_pixel(anchor)
+        assert x - x0 >= LABEL_MARGIN_PX - 0.5 and x - x0 + w <= vp.w - LABEL_MARGIN_PX + 0.5
+        assert y - h >= LABEL_MARGIN_PX - 0.5 and y <= vp.h - LABEL_MARGIN_PX + 0.5
+    # the preset's direction and focal point are kept: only moved back along the sight
+    cam, pre = host.camera(), default_camera(host.model.state, "default", vp.w / vp.h)
+    d = np.subtract(cam.position, cam.focal_point)
+    d0 = np.subtract(pre.position, pre.focal_point)
+    assert np.allclose(cam.focal_point, pre.focal_point)
+    assert np.allclose(d / np.linalg.norm(d), d0 / np.linalg.norm(d0))
+    assert np.linalg.norm(d0) <= np.linalg.norm(d) <= 2.0 * np.linalg.norm(d0)

@@ -64,10 +64,12 @@ from eyeviz.render.vtk.style import BACKGROUND, INK, INSET_BACKGROUND, UNLIT, he
 
 __all__ = [
     "EYES_FRACTION",
+    "LABEL_MARGIN_PX",
     "PNG_ASPECT",
     "Scene3DActors",
     "apply_camera",
     "camera_of",
+    "fit_labels",
     "default_camera",
     "png_size",
     "render_png3d",
@@ -114,6 +116,50 @@ def default_camera(state: SceneState3D, name: str = "default", aspect: float = 1
     """The preset ``name`` framing the scene's balls (:func:`shapes3d.scene_extent`) in a
     viewport ``aspect`` (width / height) wide."""
     return shapes3d.view_camera(state, name, aspect)
+
+
+#: The ball labels' margin to the scene viewport's edges when a preset frames the scene.
+LABEL_MARGIN_PX = 6
+
+
+def fit_labels(
+    cam: Camera3D,
+    labels: list[tuple[tuple[float, float, float], float, float]],
+    size: tuple[float, float],
+    margin: float = LABEL_MARGIN_PX,
+    steps: int = 16,
+) -> Camera3D:
+    """``cam`` moved back along its line of sight (10 % of the distance a step, at most
+    ``steps``) until every label is inside the viewport of ``size`` (width, height px)
+    with ``margin`` pixels to spare. ``labels``: per label its anchor (the model point
+    its text's bottom-left corner is drawn at, as the balls' names) and its text's width
+    and height in pixels. The presets frame the balls; a name drawn beside a ball at the
+    view's edge was cut (sphere_predictions at its default framing)."""
+    from eyeviz.model.camera3d import project, to_pixels
+
+    if not labels:
+        return cam
+    w, h = size
+    anchors = np.array([a for a, _, _ in labels], dtype=float)
+    tw = np.array([t for _, t, _ in labels], dtype=float)
+    th = np.array([t for _, _, t in labels], dtype=float)
+    pos, focal = np.asarray(cam.position, float), np.asarray(cam.focal_point, float)
+    for _ in range(steps + 1):
+        xy, depth = project(cam, anchors, w / max(h, 1.0))
+        px = to_pixels(xy, int(round(w)), int(round(h)))
+        front = depth > 0
+        inside = (
+            (px[:, 0] >= margin)
+            & (px[:, 0] + tw <= w - margin)
+            & (px[:, 1] - th >= margin)
+            & (px[:, 1] <= h - margin)
+        )
+        if bool(np.all(inside | ~front)):
+            return cam
+        pos = focal + 1.1 * (pos - focal)
+        x, y, z = (float(v) for v in pos)
+        cam = Camera3D((x, y, z), cam.focal_point, cam.view_up, cam.view_angle)
+    return cam
 
 
 def _great_circles(r: float, n: int = 96) -> pv.PolyData:
@@ -332,6 +378,23 @@ class Scene3DActors:
                     a = _lit(actor(mesh, (0.5, 0.5, 0.5)))
                     self._add(self.ball_store, a)
                     self.patches[e].append((mesh, a, np.empty(0, np.int64)))
+
+    def label_boxes(self) -> list[tuple[tuple[float, float, float], float, float]]:
+        """Each shown ball label's anchor (model point) and text width and height in
+        pixels (VTK's own text renderer), for :func:`fit_labels`."""
+        from vtkmodules.vtkRenderingCore import vtkTextRenderer
+
+        win = self.scene_ren.GetRenderWindow()
+        dpi = win.GetDPI() if win is not None else 72
+        tr, box, out = vtkTextRenderer(), [0, 0, 0, 0], []
+        for lab in self.ball_labels:
+            if not lab.GetVisibility() or not lab.GetInput():
+                continue
+            if not tr.GetBoundingBox(lab.GetTextProperty(), lab.GetInput(), box, dpi):
+                continue
+            pos = tuple(float(v) for v in lab.GetPosition())
+            out.append((pos, float(box[1] - box[0]), float(box[3] - box[2])))
+        return out  # type: ignore[return-value]
 
     # --- per frame ---------------------------------------------------------------------
     def _fit_title(self, *_args) -> None:
