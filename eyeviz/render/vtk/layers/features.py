@@ -72,16 +72,6 @@ LOD_ERROR_PX = 0.5
 #: features, 0.99x at 30 (the copy costs what the fill saves), 0.79-1.07x at 100, 0.77-0.80x
 #: at 150, 0.70-0.74x at 200, 0.56-0.64x at 300, 0.34x at 1,000).
 BACKDROP_MIN_FEATURES = 150
-#: The centre dots' depths span Z_POINT .. Z_POINT + CENTER_DZ by feature index (the handle
-#: is at Z_POINT + 0.5): the selected feature's live dot and the merged dots of two
-#: coincident features never tie, so their order is the features' with or without the
-#: backdrop (a tie went to the live dot over the backdrop and to the merged dots without).
-CENTER_DZ = 0.4
-
-
-def center_z(i, n: int):
-    """Depth of feature i's centre dot among n (later features on top)."""
-    return Z_POINT + CENTER_DZ * (np.asarray(i, dtype=np.float64) + 1.0) / (n + 1.0)
 
 
 def disc_vertices(r_px: np.ndarray) -> np.ndarray:
@@ -195,6 +185,14 @@ class FeaturesLayer:
         mapper.SetColorModeToDirectScalars()
         mapper.ScalarVisibilityOn()
         self.store.add(main, self._centers_actor)
+        if main is self.main:
+            # the selected feature's live actors after the merged ones, as over a backdrop
+            # (drawn before all of the main renderer's props): a tie at one depth (the
+            # centre dots of two coincident features, both at Z_POINT) goes to the live
+            # actors on either path
+            for a in self.live_actors:
+                self.main.RemoveActor(a)
+                self.main.AddActor(a)
 
     def set_backdrop_min(self, n: int) -> None:
         """Features from which the merged discs go to the backdrop; the discs are rebuilt."""
@@ -272,7 +270,7 @@ class FeaturesLayer:
             tint, cols = self._rgb_now
             self.live_fill.SetPosition(x, y, z)
             self.live_line.SetPosition(x, y, z)
-            self.live_center.SetPosition(x, y, float(center_z(sel, n)))
+            self.live_center.SetPosition(x, y, Z_POINT)
             for a in (self.live_fill, self.live_line):
                 a.SetScale(g, g, 1.0)
             self.live_fill.GetProperty().SetColor(*(tint[sel] / 255.0))
@@ -319,9 +317,7 @@ class FeaturesLayer:
         self._write_cells(self.fill_mesh, self.line_mesh, others, tint, cols, verts)
         c = self.verts = verts[others]
         self.fan = int(c.max()) - 2 if len(c) else CIRCLE_N - 2
-        centers = pv.PolyData(
-            np.column_stack([frame.x, frame.y, center_z(np.arange(n), n)])[others]
-        )
+        centers = pv.PolyData(np.column_stack([frame.x, frame.y, np.full(n, Z_POINT)])[others])
         set_rgb(centers.GetPointData(), cols[others])
         self.centers_mesh = centers
         set_input(self._centers_actor, centers)
