@@ -220,6 +220,10 @@ class StudyTable:
         key, data = self._encoded(rows)
         fresh = self.size == 0
         head = self.fmt.header if fresh else b""
+        if not fresh and not self._ends_with_newline():
+            # a last line without its newline (an editor's save): the reader takes it, so
+            # the point's lines must not go on at its end
+            data = b"\n" + data
         if self.size + len(head) + len(data) > self.max_bytes:
             raise EyevizError(
                 f"{self.path}: the next point would take the table past {self.max_bytes} "
@@ -235,6 +239,15 @@ class StudyTable:
             self._append_bytes(data)
         self.size += len(head) + len(data)
         self.keys.add(key)
+
+    def _ends_with_newline(self) -> bool:
+        """Whether the file's last byte (at ``size - 1``, as read) is a newline."""
+        try:
+            with open(os.path.realpath(self.path), "rb") as f:
+                f.seek(self.size - 1)
+                return f.read(1) == b"\n"
+        except OSError:
+            return True  # _append_bytes names what is wrong with the file
 
     def _append_bytes(self, data: bytes) -> None:
         target = os.path.realpath(self.path)

@@ -217,3 +217,16 @@ def test_a_hard_link_to_a_3d_table_under_study_is_refused_and_names_one_file(tmp
     assert StudyTable3D.open(real).finished == {P1.key, P2.key}
     rows_back, _ = read_rows3d(real)
     assert len(rows_back) == 2 * 15
+
+
+def test_a_3d_table_without_its_final_newline_takes_the_next_point_on_a_line_of_its_own(
+    tmp_path, rows
+):
+    path = tmp_path / "s3.csv"
+    _one_point(path, rows)
+    path.write_bytes(path.read_bytes()[:-1])
+    before = path.read_bytes()
+    StudyTable3D.open(path).append(rows[P2.key])
+    data = path.read_bytes()
+    assert data.startswith(before) and data.endswith(b"\n")
+    assert StudyTable3D.open(path).finished == {P1.key, P2.key}

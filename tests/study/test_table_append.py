@@ -133,3 +133,25 @@ def test_a_study_stops_before_its_table_passes_the_bound(tmp_path, monkeypatch):
     assert "\n" not in msg and "the most its reader accepts" in msg and str(path) in msg
     assert path.stat().st_size == size
     assert StudyTable.open(path).finished == {points[0].key}
+
+
+@pytest.mark.parametrize("cut", ["last row", "header only"])
+def test_a_table_without_its_final_newline_takes_the_next_point_on_a_line_of_its_own(
+    tmp_path, rows, cut
+):
+    """An editor's save can drop the final newline; the reader takes such a table, so
+    the next point's lines must not go on at the end of its last line (they did: the
+    resumed table had a line of 41 fields, refused by its own reader)."""
+    path = tmp_path / "s.csv"
+    StudyTable.open(path).append(rows[P1.key])
+    if cut == "header only":
+        path.write_bytes(StudyTable.fmt.header)
+    path.write_bytes(path.read_bytes()[:-1])
+    before = path.read_bytes()
+    t = StudyTable.open(path)
+    t.append(rows[P2.key])
+    data = path.read_bytes()
+    assert data.startswith(before) and data.endswith(b"\n") and t.size == len(data)
+    want = {P2.key} if cut == "header only" else {P1.key, P2.key}
+    assert StudyTable.open(path).finished == want
+    assert len(read_study(path)) == len(want) * len(rows[P2.key])
