@@ -105,6 +105,9 @@ TOPUP = 1
 #: a key whose effective sample size is below this is topped up too (one or two accepted
 #: draws give a Monte-Carlo error of 0 or none at all, not a small one)
 MIN_ESS = 4.0
+#: the largest ``samples`` and ``grid`` a Limit3DEstimator takes
+MAX_SAMPLES = 1 << 14
+MAX_GRID = 64
 #: the per-key slack: this many times the model's second-order error in the box
 SLACK_SAFETY = 4.0
 #: directions of the bisection for the box of centres
@@ -545,9 +548,17 @@ class Limit3DEstimator(Estimator3D):
     ) -> None:
         if prior not in PRIORS:
             raise ValueError(f"prior must be one of {PRIORS}, got {prior!r}")
-        for name, v, lo in (("samples", samples, 4), ("grid", grid, 4)):
-            if not isinstance(v, int | np.integer) or isinstance(v, bool) or v < lo:
-                raise ValueError(f"{name} must be an integer >= {lo}, got {v!r}")
+        # bounded so that one chunk's draws and grid fit in memory
+        for name, v, lo, hi in (("samples", samples, 4, MAX_SAMPLES), ("grid", grid, 4, MAX_GRID)):
+            if not isinstance(v, int | np.integer) or isinstance(v, bool) or not lo <= v <= hi:
+                raise ValueError(f"{name} must be an integer >= {lo} and <= {hi}, got {v!r}")
+        # the seed is xor-ed into the keys' uint64 hashes
+        if (
+            not isinstance(seed, int | np.integer)
+            or isinstance(seed, bool)
+            or not 0 <= seed < 2**64
+        ):
+            raise ValueError(f"seed must be an integer >= 0 and < 2^64, got {seed!r}")
         super().__init__(domain, {"n_weights": 0, "train_seconds": 0.0, "prior": prior})
         self.prior = prior
         self.samples = int(samples)

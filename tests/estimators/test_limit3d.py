@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import collections
+import re
 
 import numpy as np
 import pytest
@@ -155,3 +156,26 @@ def test_a_key_with_too_few_accepted_draws_gets_more(monkeypatch):
         for j in range(s["x"].size):
             sa, sb = d.eyes.lit(s["x"][j], s["y"][j], s["z"][j], s["g"][j])
             assert np.array_equal(sa, la) and np.array_equal(sb, lb)
+
+
+@pytest.mark.parametrize(
+    ("kw", "want"),
+    [
+        ({"seed": -1}, "seed must be an integer >= 0 and < 2^64, got -1"),  # was OverflowError
+        ({"seed": "x"}, "seed must be an integer >= 0 and < 2^64, got 'x'"),
+        ({"seed": 1.5}, "seed must be an integer >= 0 and < 2^64, got 1.5"),  # was truncated
+        ({"seed": 2**70}, "seed must be an integer >= 0 and < 2^64"),
+        ({"samples": 2**40}, "samples must be an integer >= 4 and <= 16384"),  # 32 TiB
+        ({"grid": 10**6}, "grid must be an integer >= 4 and <= 64"),  # 7 TiB
+    ],
+)
+def test_seed_samples_and_grid_are_refused_in_one_line(kw, want):
+    with pytest.raises(ValueError, match="^" + re.escape(want)) as exc:
+        Limit3DEstimator(D16, **kw)
+    assert "\n" not in str(exc.value)
+
+
+def test_the_largest_seed_is_taken():
+    ds = generate3d(3, D16, seed=5)
+    p = Limit3DEstimator(D16, samples=64, seed=2**64 - 1).predict_dataset(ds)
+    assert np.isfinite(p.r).all()
