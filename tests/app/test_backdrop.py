@@ -194,3 +194,43 @@ def test_a_screenshot_over_the_backdrop_equals_one_without_it(make_window, tmp_p
     feats.set_backdrop_min(10**9)
     full = qimage_to_array(win.grab_image())
     assert np.array_equal(kept, full) and np.array_equal(again, full)
+
+
+def test_the_selected_name_label_is_not_hidden_by_other_centre_dots(make_window):
+    """Beyond six features only the selected feature is named; its label sat at the centre
+    dots' depth, and in a crowd (10^4 features) the other features' dots covered it whole:
+    the label must show over a field of dots as it does with the dots hidden."""
+    fs = [
+        Feature(f"c{i}_{j}", 0.0 + 70.0 * i, 2000.0 + 70.0 * j, 20.0, OKABE_ITO[(i + j) % 7])
+        for i in range(25)
+        for j in range(8)
+    ]
+    fs.append(Feature("the-selected-one", -100.0, 1900.0, 120.0, OKABE_ITO[5]))
+    assert len(fs) >= BACKDROP_MIN_FEATURES
+    sc = Scene(
+        Eyes(40.0, 20.0, 72), fs, ["eyes", "features", "labels"], [], View((0.0, 2600.0), 6000.0)
+    )
+    win = make_window(sc)
+    win.resize(900, 600)
+    win.model.select(len(fs) - 1)
+    feats, label = win.actors.features, win.actors.labels.feature_labels[0]
+
+    def label_pixels() -> int:
+        label.SetVisibility(True)
+        shown = view_pixels(win)
+        label.SetVisibility(False)
+        hidden = view_pixels(win)
+        label.SetVisibility(True)
+        return int((np.abs(shown.astype(int) - hidden.astype(int)).max(axis=2) > 0).sum())
+
+    assert label.GetInput().strip() == "the-selected-one"
+    for kept in (True, False):  # over the backdrop, then with the discs in the main renderer
+        feats.set_backdrop_min(BACKDROP_MIN_FEATURES if kept else 10**9)
+        assert feats.backdrop.active == kept
+        crowd = label_pixels()
+        feats._centers_actor.SetVisibility(False)
+        feats.backdrop.invalidate()
+        alone = label_pixels()
+        feats._centers_actor.SetVisibility(True)
+        feats.backdrop.invalidate()
+        assert alone > 200 and crowd >= 0.9 * alone, (kept, crowd, alone)

@@ -16,6 +16,11 @@ __all__ = ["INSET_LINE_CHARS", "INSET_LINE_PX", "LabelsLayer", "bfv_line"]
 
 INSET_LINE_PX = 14  # the inset's "m, θ, ψ" line
 INSET_LINE_CHARS = 26  # characters of it that fit the smallest inset at INSET_LINE_PX
+# a feature's name label's depth: over the centre dots, which are drawn as spheres whose
+# fragments come up to their radius in world units (~60-80 at a 6,000-9,000 wide view)
+# nearer the camera than Z_POINT, and so covered a label at Z_POINT (in a crowd of 10^4
+# features, wholly); the camera is at z = 1,000 (eyeviz/app/canvas.py), clipped at 1
+Z_NAME = 900.0
 
 
 def bfv_line(frame: Frame) -> str:
@@ -132,7 +137,7 @@ class LabelsLayer:
             label.SetVisibility(shown)
             if shown:  # a hidden label is placed when it is shown
                 label.SetInput(f" {lab.text}")  # no-op (no Modified) when unchanged
-                label.SetPosition(lab.x, lab.y, Z_POINT)
+                label.SetPosition(lab.x, lab.y, Z_NAME)
         self.place_bfv_text()
 
     def set_inset_shown(self, shown: bool, main_eye_labels: bool | None = None) -> None:
