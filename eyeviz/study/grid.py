@@ -12,6 +12,7 @@ Bad input ends in one :class:`eyeviz.EyevizError` naming it: ``parse_list("m", "
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
@@ -43,10 +44,14 @@ DEFAULT_M = (180, 360, 720, 1440, 2880)
 MAX_GRID_POINTS = 100_000
 #: Longest list text accepted by :func:`parse_list`.
 MAX_LIST_CHARS = 10_000
+#: Largest seed: the study tables hold integers of at most 19 digits (their one parser,
+#: :mod:`eyeviz.study.table_format`), so a larger one would be refused after its point.
+MAX_SEED = 10**19 - 1
 
 
 def parse_list(name: str, text: str | Iterable) -> list[float]:
-    """``"10,20,40"`` -> ``[10.0, 20.0, 40.0]``; a list or tuple passes through checked.
+    """``"10,20,40"`` -> ``[10.0, 20.0, 40.0]``; a list or tuple passes through checked,
+    one number is a list of one.
 
     Blanks around items are ignored; an empty list, an empty item or a non-number
     raises a one-line :class:`EyevizError` naming ``name`` and the item.
@@ -57,8 +62,16 @@ def parse_list(name: str, text: str | Iterable) -> list[float]:
         items: list = [s.strip() for s in text.split(",")]
         if items == [""]:
             raise EyevizError(f"{name}: empty list (give numbers separated by commas)")
+    elif isinstance(text, numbers.Real):  # one value, as a list of one
+        items = [text]
     else:
-        items = list(text)
+        try:
+            items = list(text)
+        except TypeError:
+            raise EyevizError(
+                f"{name} must be numbers separated by commas or a list of numbers, "
+                f"got {type(text).__name__}"
+            ) from None
         if not items:
             raise EyevizError(f"{name}: empty list")
     out = []
@@ -121,7 +134,7 @@ def grid_axes(
         for v in vals:
             check_real(what, v, gt=0)
     n = check_int("n", n, ge=1, le=MAX_ROWS)
-    seed = check_int("seed", seed, ge=0)
+    seed = check_int("seed", seed, ge=0, le=MAX_SEED)
     check_choice("prior", prior, tuple(priors))
     r_lo = check_real("r_min", r_min, gt=0)
     r_hi = check_real("r_max", r_max, gt=r_lo)

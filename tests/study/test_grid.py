@@ -79,3 +79,28 @@ def test_bad_grids_end_in_one_named_line(kwargs, words):
     assert "\n" not in msg
     for w in words:
         assert w in msg, msg
+
+
+def test_one_number_is_a_list_of_one_and_a_non_list_is_one_line():
+    """design_grid(m=720) was a TypeError ('int' object is not iterable)."""
+    assert design_grid(h=40, l=20.0, m=720, n=10) == design_grid("40", "20", "720", n=10)
+    for bad in (None, object()):
+        with pytest.raises(EyevizError, match="^m must be numbers separated by commas or a list"):
+            design_grid(m=bad)
+    with pytest.raises(EyevizError, match="^h: True is not a finite number"):
+        design_grid(h=True)
+
+
+@pytest.mark.parametrize("grid", ["planar", "3d"])
+def test_a_seed_the_table_cannot_hold_is_refused_before_any_point(grid):
+    """A 20-digit seed was taken, its first point computed, and then refused when its
+    row was checked before the append (the tables' integers have at most 19 digits)."""
+    from eyeviz.study.grid3d import design_grid3d
+
+    make = design_grid if grid == "planar" else design_grid3d
+    res = {"m": "16"} if grid == "planar" else {"nside": "4"}
+    assert make("40", "20", **res, n=10, seed=10**19 - 1)[0].seed == 10**19 - 1
+    with pytest.raises(
+        EyevizError, match=r"^seed must be an integer >= 0 and <= 9999999999999999999"
+    ):
+        make("40", "20", **res, n=10, seed=10**19)
