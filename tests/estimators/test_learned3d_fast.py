@@ -11,6 +11,8 @@ import threading
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from eyeviz.core import healpix
 from eyeviz.core.domain3d import Domain3D
@@ -555,3 +557,27 @@ def test_block_rows_must_be_a_positive_integer(shipped, rows, block_rows):
         est.predict(*rows)
     est.block_rows = 1 << 62  # huge: one block
     assert np.isfinite(est.predict(*rows).r).all()
+
+
+_DTYPES = [np.int64, np.int32, np.int16, np.int8, np.uint8, np.uint16, np.uint64, ">i4", ">i8"]
+
+
+@settings(max_examples=400, deadline=None, derandomize=True, database=None)
+@given(
+    st.lists(st.lists(st.integers(-3, 12 * 4 * 4 + 3), max_size=8), min_size=1, max_size=6),
+    st.sampled_from(_DTYPES),
+    st.booleans(),
+)
+def test_the_check_on_the_runs_is_as_csr_s_on_any_rows(rows, dtype, tidy):
+    """Random rows (empty ones among them; sorted and distinct, or as drawn) in any
+    integer dtype: eye_summaries(name=...) refuses exactly when as_csr's own pass does,
+    with its message."""
+    nside, npix = 4, 12 * 4 * 4
+    if tidy:
+        rows = [sorted(set(r)) for r in rows]
+    ptr = np.r_[0, np.cumsum([len(r) for r in rows])].astype(np.int64)
+    with np.errstate(all="ignore"):
+        ind = np.array([v for r in rows for v in r], np.int64).astype(dtype)
+    want = _message(base3d.as_csr, "lit_a", (ptr, ind), npix)
+    p, i, _ = base3d.as_csr("lit_a", (ptr, ind), npix, check_indices=False)
+    assert _message(eye_summaries, nside, p, i, "lit_a") == want
