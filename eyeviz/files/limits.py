@@ -21,8 +21,9 @@ from eyeviz.core.validation import check_int
 
 #: Rows of a generated data set (``eyeviz generate -n``).
 MAX_ROWS = 10**9
-#: Scene TOML files, and any other small text file a user hands in.
-MAX_SCENE_BYTES = 1 << 20
+#: Scene TOML files: room for MAX_FEATURES features with full-precision coordinates and
+#: names of MAX_NAME_CHARS (about 4 MB; a file Save writes must load back).
+MAX_SCENE_BYTES = 8 << 20
 #: A study table (``eyeviz study -o STUDY.csv``; one row per design point and distance bin).
 MAX_STUDY_BYTES = 1 << 28
 #: Features drawn in one scene / snapshot.

@@ -187,8 +187,8 @@ def test_too_many_features():
 
 def test_file_bounds(tmp_path):
     big = tmp_path / "big.toml"
-    big.write_text(BASE + "#" * (1 << 20))
-    with pytest.raises(SceneError, match="bytes, more than 1048576"):
+    big.write_text(BASE + "#" * (8 << 20))
+    with pytest.raises(SceneError, match="bytes, more than 8388608"):
         load(big)
     with pytest.raises(SceneError, match="is not a regular file"):
         load("/dev/zero")
@@ -238,3 +238,31 @@ def test_no_estimator_is_refused_only_when_the_predictions_layer_is_shown():
     assert sc.estimators == [] and not sc.shows("predictions")
     with pytest.raises(SceneError, match="needs at least one estimator"):
         loads(BASE.replace("m = 720", none + "['eyes', 'predictions']"), "<t>")
+
+
+def test_a_scene_of_the_most_features_saves_and_loads_back(tmp_path):
+    """A scene may hold MAX_FEATURES features; saved with full-precision coordinates and
+    long names it must stay under the reader's size limit (10^4 features made a 1.15 MB
+    file against a 1 MiB limit, so the app's Save refused a scene it had opened)."""
+    import math
+
+    from eyeviz.files import limits
+    from eyeviz.model.scene import Eyes, Feature, Scene, load, save
+
+    n = limits.MAX_FEATURES
+    feats = [
+        Feature(
+            f"feature number {i} with a rather long descriptive name, " + "é" * 40,
+            -1234.5678901234567 + math.pi * i,
+            2345.678901234567 + math.e * i,
+            12.345678901234567 + (i % 7) / 3,
+            "#0072b2",
+        )
+        for i in range(n)
+    ]
+    sc = Scene(Eyes(40.0, 20.0, 720), feats, ["eyes", "features"])
+    out = tmp_path / "big.toml"
+    save(sc, out)
+    back = load(out)
+    assert len(back.features) == n
+    assert back.features[-1] == feats[-1]  # full precision kept
