@@ -18,6 +18,8 @@ and >= 0, every R^2 <= 1, the bins "all", "r0" ... (distance) and "e0" ... "e5"
 
 from __future__ import annotations
 
+import os
+import stat
 from collections.abc import Iterator
 
 from eyeviz.files.limits import MAX_STUDY_BYTES
@@ -61,6 +63,8 @@ def is_table3d(path) -> bool:
     """Whether the file at ``path`` starts with the 3D study table's header (any version's
     first column names; the reader then checks the version)."""
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):  # a FIFO would block open() for good
+            return False  # (the reader then says what the file is)
         with open(path, "rb") as f:
             first = f.read(len(TABLE3D.header))
     except OSError:

@@ -230,3 +230,29 @@ def test_a_3d_table_without_its_final_newline_takes_the_next_point_on_a_line_of_
     data = path.read_bytes()
     assert data.startswith(before) and data.endswith(b"\n")
     assert StudyTable3D.open(path).finished == {P1.key, P2.key}
+
+
+def test_a_fifo_is_refused_without_opening_it(tmp_path):
+    """is_table3d opened the path to read its header: at a FIFO, open() blocked for
+    good, so `eyeviz report study` and the resume hung (the resume past SIGTERM)."""
+    import threading
+
+    from eyeviz.study.kinds import open_table
+    from eyeviz.study.table3d import is_table3d
+
+    fifo = tmp_path / "s.csv"
+    os.mkfifo(fifo)
+    out: list[bool] = []
+    t = threading.Thread(target=lambda: out.append(is_table3d(fifo)), daemon=True)
+    t.start()
+    t.join(10)
+    if t.is_alive():  # unblock it (a writer opens and goes), then fail
+        os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+        t.join(10)
+        pytest.fail("is_table3d blocked on a FIFO")
+    assert out == [False]
+    for table in (StudyTable, StudyTable3D):
+        with pytest.raises(EyevizError, match="is not a regular file"):
+            table.open(fifo)
+    with pytest.raises(EyevizError, match="is not a regular file"):
+        open_table(fifo, [P1])
