@@ -13,6 +13,7 @@ import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
 from eyeviz.app.panels import _Unelide, design_note, set_message, wrap_label
+from eyeviz.app.panels.common import estimator_help
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import TRAJECTORY_KINDS
 
@@ -54,18 +55,6 @@ def follows_text_scale(ev: QtCore.QEvent | None) -> bool:
 
 PLOT_LW = 1.3  # the accuracy curves' width (thin: the curves' detail shows)
 LINE_STYLES = ("-", (0, (5, 2)), (0, (1.5, 1.5)), (0, (6, 2, 1.5, 2)))
-
-
-def estimator_help(name: str) -> str:
-    """The registry's one-line help of estimator ``name`` (one place for names and help:
-    :mod:`eyeviz.estimators.registry`); "" for a name the registry does not know."""
-    from eyeviz import EyevizError
-    from eyeviz.estimators import registry
-
-    try:
-        return registry.get(name).help
-    except EyevizError:  # an uninstalled or unregistered name: no help, never a crash
-        return ""
 
 
 class EstimatorPicker(QtWidgets.QWidget):

@@ -61,3 +61,15 @@ def set_message(label: QtWidgets.QLabel, text: str) -> None:
     if label.text() != full:
         label.setText(full)
         label.setToolTip(full)
+
+
+def estimator_help(name: str) -> str:
+    """The registry's one-line help of estimator ``name`` (one place for names and help:
+    :mod:`eyeviz.estimators.registry`); "" for a name the registry does not know."""
+    from eyeviz import EyevizError
+    from eyeviz.estimators import registry
+
+    try:
+        return registry.get(name).help
+    except EyevizError:  # an uninstalled or unregistered name: no help, never a crash
+        return ""

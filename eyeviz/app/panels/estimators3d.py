@@ -14,21 +14,11 @@ from collections.abc import Callable
 
 from PyQt5 import QtGui, QtWidgets
 
-from eyeviz.app.panels.common import user_message, wrap_label
+from eyeviz.app.panels.common import estimator_help, user_message, wrap_label
 from eyeviz.model.predictions3d import Predictions3D, estimator_color3d, estimators3d
 from eyeviz.model.scene import Scene
 
 __all__ = ["Estimators3DPanel"]
-
-
-def _help(name: str) -> str:
-    from eyeviz import EyevizError
-    from eyeviz.estimators import registry
-
-    try:
-        return registry.get(name).help
-    except EyevizError:
-        return ""
 
 
 class Estimators3DPanel(QtWidgets.QWidget):
@@ -46,7 +36,7 @@ class Estimators3DPanel(QtWidgets.QWidget):
         self.boxes: dict[str, QtWidgets.QCheckBox] = {}
         for name in self.names:
             b = QtWidgets.QCheckBox(name)
-            b.setToolTip(_help(name))
+            b.setToolTip(estimator_help(name))
             b.toggled.connect(lambda on, n=name: self._toggled(n, on))
             lay.addWidget(b)
             self.boxes[name] = b
