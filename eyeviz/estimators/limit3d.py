@@ -619,10 +619,10 @@ class Limit3DEstimator(Estimator3D):
         out = {k: np.concatenate([q[k] for q in parts], axis=1) for k in parts[0]}
         if reps > 1:
             return out
-        # top-ups: a key whose Monte-Carlo error of r exceeds MC_TARGET gets another batch
+        # top-ups: a key with too few or too spread draws (_needs_more) gets another batch
         # (its own stream; the other keys' draws are left as they are)
         for rep in range(1, 1 + TOPUP):
-            need = (_mc_rel(out["r"], out["w"]) > MC_TARGET) | (_ess(out["w"]) < MIN_ESS)
+            need = _needs_more(out["r"], out["w"])
             if not need.any():
                 break
             more = self._sample(st, keys, stream + 8 * rep)
@@ -764,10 +764,7 @@ class Limit3DEstimator(Estimator3D):
                 rr = weighted_median(sm["r"], w / sm["r"])
                 aa = weighted_median(sm["az"], w / sm["az"])
                 ee = weighted_median(sm["el"], w)
-                wn = w / np.where(tot > 0, tot, 1)[:, None]
-                mean = (wn * sm["r"]).sum(axis=1)
-                sd = np.sqrt(np.maximum((wn * (sm["r"] - mean[:, None]) ** 2).sum(axis=1), 0))
-                ess = tot**2 / (w**2).sum(axis=1)
+                _, sd, ess = _spread(sm["r"], w)
                 mc[rows] = np.where(e, np.nan, 1.2533 * sd / np.sqrt(ess) / rr)
             r[rows], az[rows], el[rows] = rr, aa, ee
             empty[rows] = e
@@ -806,24 +803,26 @@ class Limit3DEstimator(Estimator3D):
         )
 
 
-def _ess(w: np.ndarray) -> np.ndarray:
-    """Per row, the effective sample size (sum w)^2 / sum w^2 of the draws (0 if none)."""
-    w2 = (w * w).sum(axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(w2 > 0, w.sum(axis=1) ** 2 / w2, 0.0)
-
-
-def _mc_rel(r: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Per row, the relative Monte-Carlo standard error of r's estimate,
-    1.2533 sd_w(r) / sqrt(ESS) / mean_w(r) (inf where nothing is accepted)."""
+def _spread(r: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per row of weighted draws: the weighted mean and standard deviation of r and the
+    effective sample size ESS = (sum w)^2 / sum w^2 (NaN where nothing is accepted)."""
     tot = w.sum(axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         wn = w / tot[:, None]
         mean = (wn * r).sum(axis=1)
         sd = np.sqrt(np.maximum((wn * (r - mean[:, None]) ** 2).sum(axis=1), 0.0))
         ess = tot**2 / (w**2).sum(axis=1)
-        out = 1.2533 * sd / np.sqrt(ess) / mean
-    return np.where(tot > 0, out, np.inf)
+    return mean, sd, ess
+
+
+def _needs_more(r: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """The keys to top up: the relative Monte-Carlo error of r, 1.2533 sd_w(r) / sqrt(ESS)
+    / mean_w(r), above ``MC_TARGET``, or an ESS below ``MIN_ESS`` (one or two accepted
+    draws give an error of 0 or none at all, not a small one), or nothing accepted."""
+    mean, sd, ess = _spread(r, w)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mc = 1.2533 * sd / np.sqrt(ess) / mean
+    return ~(ess >= MIN_ESS) | ~(mc <= MC_TARGET)
 
 
 def _same(ptr: np.ndarray, ind: np.ndarray, key: LitCSR, row: np.ndarray) -> np.ndarray:
