@@ -31,6 +31,7 @@ __all__ = [
     "UNIT",
     "actor",
     "fit_lines",
+    "text_size",
     "points_actor",
     "text3d",
     "screen_text",
@@ -103,6 +104,15 @@ def screen_text(size, color, pos, top=False, center=False, right=False) -> vtkTe
     return t
 
 
+def text_size(tp: vtkTextProperty, text: str, dpi: int = 72) -> tuple[int, int] | None:
+    """Width and height in pixels of ``text`` drawn with ``tp`` at ``dpi`` (VTK's own text
+    renderer, as a text actor draws it); None where it cannot say (an empty text)."""
+    box = [0, 0, 0, 0]
+    if not vtkTextRenderer().GetBoundingBox(tp, text, box, dpi):
+        return None
+    return box[1] - box[0], box[3] - box[2]
+
+
 def fit_lines(
     tp: vtkTextProperty, text: str, width_px: float, dpi: int = 72, max_lines: int = 2
 ) -> str:
@@ -111,13 +121,10 @@ def fit_lines(
     ``max_lines`` the last line ends in "…". A word wider than the width stays whole."""
     if width_px <= 0 or not text:
         return text
-    tr = vtkTextRenderer()
-    box = [0, 0, 0, 0]
 
     def width(s: str) -> int:
-        if not tr.GetBoundingBox(tp, s, box, dpi):
-            return 0
-        return box[1] - box[0]
+        size = text_size(tp, s, dpi)
+        return size[0] if size else 0
 
     if width(text) <= width_px:
         return text

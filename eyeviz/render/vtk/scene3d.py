@@ -57,6 +57,7 @@ from eyeviz.render.vtk.primitives import (
     screen_text,
     set_rgb,
     text3d,
+    text_size,
     write_points,
     write_rgb,
 )
@@ -382,29 +383,30 @@ class Scene3DActors:
     def label_boxes(self) -> list[tuple[tuple[float, float, float], float, float]]:
         """Each shown ball label's anchor (model point) and text width and height in
         pixels (VTK's own text renderer), for :func:`fit_labels`."""
-        from vtkmodules.vtkRenderingCore import vtkTextRenderer
-
-        win = self.scene_ren.GetRenderWindow()
-        dpi = win.GetDPI() if win is not None else 72
-        tr, box, out = vtkTextRenderer(), [0, 0, 0, 0], []
+        dpi = self._dpi()
+        out = []
         for lab in self.ball_labels:
             if not lab.GetVisibility() or not lab.GetInput():
                 continue
-            if not tr.GetBoundingBox(lab.GetTextProperty(), lab.GetInput(), box, dpi):
+            size = text_size(lab.GetTextProperty(), lab.GetInput(), dpi)
+            if size is None:
                 continue
             pos = tuple(float(v) for v in lab.GetPosition())
-            out.append((pos, float(box[1] - box[0]), float(box[3] - box[2])))
+            out.append((pos, float(size[0]), float(size[1])))
         return out  # type: ignore[return-value]
+
+    def _dpi(self) -> int:
+        win = self.scene_ren.GetRenderWindow()
+        return win.GetDPI() if win is not None else 72
 
     # --- per frame ---------------------------------------------------------------------
     def _fit_title(self, *_args) -> None:
         """Break the title into lines that fit the scene's viewport (at most two, then
         "…"); refitted only when the view's width, the font size or the title change."""
         ren = self.scene_ren
-        win = ren.GetRenderWindow()
         width = ren.GetSize()[0]
         tp = self.title.GetTextProperty()
-        dpi = win.GetDPI() if win is not None else 72
+        dpi = self._dpi()
         key = (width, tp.GetFontSize(), dpi)
         if key == self._title_fit or width <= 0:
             return
