@@ -1,0 +1,266 @@
+"""Measured compound eyes: a pair of eyes given as lists of ommatidia (docs/measured.md).
+
+Each ommatidium i of an eye has a lens position p_i (mm, eyeviz's frame: x towards eye B,
+y forward, z up), an optical axis a_i (any non-zero vector; only its direction counts) and
+a full acceptance angle dr_i in (0, pi). Facet i *sees* a ball (c, g) iff the closed ball
+meets the closed acceptance cone {p_i + t u : t >= 0, angle(u, a_i) <= dr_i / 2}, that is,
+iff the ball's distance from that cone is <= g (tangency counts as seen, as in the planar
+and HEALPix models). Cones may overlap, as in real eyes; the head does not occlude.
+
+This is the third eye model behind the seam of :mod:`eyeviz.core.eyes`; it answers the
+same calls as :class:`eyeviz.core.geometry3d.EyePair3D` (``lit``, ``lit_csr``,
+``bitmaps``, ``visible``, ``in_bfv``, ``overlaps_eye``).
+
+SKELETON: the decisions below are plain float64 on all facets; the certified fast path,
+the exact fallback and the spatial index replace them (issue: real eyes).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from eyeviz import EyevizError
+from eyeviz.core.geometry3d import validate_balls
+
+__all__ = ["MeasuredEye", "MeasuredEyePair", "MAX_FACETS"]
+
+#: Largest number of ommatidia one eye may have (a file controls it: bounded).
+MAX_FACETS = 1_000_000
+
+
+def _check_eye_arrays(name: str, positions, axes, acceptance):
+    pos = np.asarray(positions, dtype=np.float64)
+    ax = np.asarray(axes, dtype=np.float64)
+    acc = np.asarray(acceptance, dtype=np.float64)
+    if pos.ndim != 2 or pos.shape[1] != 3:
+        raise EyevizError(f"eye {name}: lens positions must have shape (n, 3), got {pos.shape}")
+    n = pos.shape[0]
+    if n < 1:
+        raise EyevizError(f"eye {name}: has no ommatidia")
+    if n > MAX_FACETS:
+        raise EyevizError(f"eye {name}: {n} ommatidia, more than the bound {MAX_FACETS}")
+    if ax.shape != (n, 3):
+        raise EyevizError(f"eye {name}: axes must have shape ({n}, 3), got {ax.shape}")
+    if acc.shape != (n,):
+        raise EyevizError(f"eye {name}: acceptance angles must have shape ({n},), got {acc.shape}")
+    for what, a in (("lens position", pos), ("axis", ax), ("acceptance angle", acc)):
+        bad = ~np.isfinite(a)
+        if bad.any():
+            i = int(np.flatnonzero(bad.reshape(n, -1).any(axis=1))[0])
+            raise EyevizError(f"eye {name}: ommatidium {i}: {what} is not finite")
+    zero = ~(ax != 0).any(axis=1)
+    if zero.any():
+        raise EyevizError(f"eye {name}: ommatidium {int(np.flatnonzero(zero)[0])}: axis is zero")
+    bad = ~((acc > 0) & (acc < math.pi))
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise EyevizError(
+            f"eye {name}: ommatidium {i}: acceptance angle must be in (0, pi) rad, "
+            f"got {acc[i]!r}"
+        )
+    return pos, ax, acc
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredEye:
+    """One eye: n ommatidia in eyeviz's frame, millimetres.
+
+    positions (n, 3) lens positions; axes (n, 3) optical axes (non-zero; not necessarily
+    unit: the model uses each float vector's exact direction); acceptance (n,) full
+    acceptance angles in radians, in (0, pi); focal_offset (n,) or None (kept for
+    round trips of the file formats, unused by the geometry).
+    """
+
+    positions: np.ndarray
+    axes: np.ndarray
+    acceptance: np.ndarray
+    focal_offset: np.ndarray | None = None
+    name: str = "eye"
+
+    def __post_init__(self) -> None:
+        pos, ax, acc = _check_eye_arrays(self.name, self.positions, self.axes, self.acceptance)
+        for k, v in (("positions", pos), ("axes", ax), ("acceptance", acc)):
+            v = np.ascontiguousarray(v)
+            v.setflags(write=False)
+            object.__setattr__(self, k, v)
+        if self.focal_offset is not None:
+            fo = np.ascontiguousarray(np.asarray(self.focal_offset, dtype=np.float64))
+            if fo.shape != acc.shape:
+                raise EyevizError(
+                    f"eye {self.name}: focal offsets must have shape {acc.shape}, got {fo.shape}"
+                )
+            fo.setflags(write=False)
+            object.__setattr__(self, "focal_offset", fo)
+
+    @property
+    def n(self) -> int:
+        """Number of ommatidia."""
+        return int(self.positions.shape[0])
+
+    @property
+    def centroid(self) -> np.ndarray:
+        """Mean lens position (mm)."""
+        return self.positions.mean(axis=0)
+
+    @property
+    def unit_axes(self) -> np.ndarray:
+        """The axes normalised (float64; for drawing and indexing, not for decisions)."""
+        return self.axes / np.linalg.norm(self.axes, axis=1)[:, None]
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredEyePair:
+    """Two measured eyes, A (left, at -x) and B (right, at +x), in eyeviz's frame (mm).
+
+    ``h`` is half the distance between the two eyes' lens centroids and ``l`` the largest
+    distance of a lens from its eye's centroid: the numbers the seam's callers that need a
+    scale (cameras, ranges) read. They are derived, not parameters.
+    """
+
+    eye_a: MeasuredEye
+    eye_b: MeasuredEye
+    name: str = "measured eyes"
+    source: str = ""
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    # --- what the seam (eyeviz.core.eyes.EyeModel) asks -------------------------------
+    @property
+    def kind(self) -> str:
+        """``"measured"``: eyes given as lists of ommatidia."""
+        return "measured"
+
+    @property
+    def dims(self) -> int:
+        return 3
+
+    @property
+    def facet_counts(self) -> tuple[int, int]:
+        """(n_A, n_B): ommatidia per eye (the two eyes may differ)."""
+        return (self.eye_a.n, self.eye_b.n)
+
+    @property
+    def h(self) -> float:
+        ca, cb = self.eye_a.centroid, self.eye_b.centroid
+        return float(np.linalg.norm(cb - ca) / 2)
+
+    @property
+    def l(self) -> float:  # noqa: E743  (the seam's name)
+        return float(
+            max(
+                np.linalg.norm(e.positions - e.centroid, axis=1).max()
+                for e in (self.eye_a, self.eye_b)
+            )
+        )
+
+    @property
+    def centers(self) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        """The two eyes' lens centroids."""
+        a, b = self.eye_a.centroid, self.eye_b.centroid
+        return (tuple(map(float, a)), tuple(map(float, b)))  # type: ignore[return-value]
+
+    @property
+    def fingerprint(self) -> str:
+        """sha256 of the two eyes' arrays (bit for bit): what a data set stores."""
+        if "fp" not in self._cache:
+            hsh = hashlib.sha256()
+            for e in (self.eye_a, self.eye_b):
+                hsh.update(np.int64(e.n).tobytes())
+                for a in (e.positions, e.axes, e.acceptance):
+                    hsh.update(np.ascontiguousarray(a, dtype="<f8").tobytes())
+            self._cache["fp"] = hsh.hexdigest()
+        return self._cache["fp"]
+
+    @property
+    def design(self) -> dict[str, float | int | str]:
+        """What a data set or an estimator must agree on: the eyes' fingerprint."""
+        return {"eye": self.fingerprint, "n_a": self.eye_a.n, "n_b": self.eye_b.n}
+
+    def eye(self, eye: str) -> MeasuredEye:
+        if eye == "A":
+            return self.eye_a
+        if eye == "B":
+            return self.eye_b
+        raise ValueError(f"eye must be 'A' or 'B', got {eye!r}")
+
+    def facets(self, eye: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(positions (n, 3) mm, axes (n, 3), full acceptance angles (n,) rad) of one eye."""
+        e = self.eye(eye)
+        return e.positions, e.axes, e.acceptance
+
+    # --- the geometry ------------------------------------------------------------------
+    def _lit_eye(self, e: MeasuredEye, xf, yf, zf, gf) -> tuple[np.ndarray, np.ndarray]:
+        """SKELETON: float64 over every facet; replaced by the certified path."""
+        rows = []
+        ax = e.unit_axes
+        half = e.acceptance / 2
+        for c in zip(xf, yf, zf, gf, strict=True):
+            v = np.array(c[:3]) - e.positions
+            nv = np.linalg.norm(v, axis=1)
+            cos_t = np.einsum("ij,ij->i", v, ax) / np.where(nv > 0, nv, 1)
+            th = np.arccos(np.clip(cos_t, -1, 1))
+            beyond = th - half
+            dist = np.where(
+                beyond <= 0, 0.0, np.where(beyond >= np.pi / 2, nv, nv * np.sin(beyond))
+            )
+            dist = np.where(nv == 0, 0.0, dist)
+            rows.append(np.flatnonzero(dist <= c[3]).astype(np.int64))
+        indptr = np.zeros(len(rows) + 1, np.int64)
+        indptr[1:] = np.cumsum([r.size for r in rows])
+        idx = np.concatenate(rows) if rows else np.zeros(0, np.int64)
+        return indptr, idx
+
+    def lit_csr(self, x, y, z, g) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+        """Per eye (A, B): (indptr, indices) of the facets that see each ball, CSR over
+        the flattened balls, indices sorted int64."""
+        xa, ya, za, ga = validate_balls(x, y, z, g)
+        xf, yf, zf, gf = (np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, za, ga))
+        return tuple(self._lit_eye(e, xf, yf, zf, gf) for e in (self.eye_a, self.eye_b))
+
+    def lit(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
+        """One ball: (lit_a, lit_b), sorted int64 facet indices."""
+        for name, v in zip("xyzg", (x, y, z, g), strict=True):
+            if np.ndim(v) != 0:
+                raise ValueError(f"{name} must be a scalar for lit(); use lit_csr for arrays")
+        (pa, ia), (pb, ib) = self.lit_csr(x, y, z, g)
+        return ia[pa[0] : pa[1]], ib[pb[0] : pb[1]]
+
+    def bitmaps(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
+        """(omega_a, omega_b) bool of shapes (..., n_A) and (..., n_B)."""
+        xa, _, _, _ = validate_balls(x, y, z, g)
+        shape = xa.shape
+        res = []
+        for (indptr, idx), n in zip(self.lit_csr(x, y, z, g), self.facet_counts, strict=True):
+            nb = indptr.size - 1
+            bm = np.zeros((nb, n), bool)
+            bm[np.repeat(np.arange(nb), np.diff(indptr)), idx] = True
+            res.append(bm.reshape(shape + (n,)))
+        return res[0], res[1]
+
+    def visible(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
+        """Definition 1 per eye: the ball lights at least two facets."""
+        xa, _, _, _ = validate_balls(x, y, z, g)
+        (pa, _), (pb, _) = self.lit_csr(x, y, z, g)
+        return (np.diff(pa) >= 2).reshape(xa.shape), (np.diff(pb) >= 2).reshape(xa.shape)
+
+    def overlaps_eye(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
+        """Per eye: the closed ball contains a lens of that eye."""
+        xa, ya, za, ga = validate_balls(x, y, z, g)
+        shape = xa.shape
+        c = np.stack([xa.ravel(), ya.ravel(), za.ravel()], axis=1)
+        gg = ga.ravel()
+        res = []
+        for e in (self.eye_a, self.eye_b):
+            d2 = ((c[:, None, :] - e.positions[None, :, :]) ** 2).sum(axis=2).min(axis=1)
+            res.append((d2 <= gg * gg).reshape(shape))
+        return res[0], res[1]
+
+    def in_bfv(self, x, y, z, g) -> np.ndarray:
+        """The binocular field of a measured pair: the ball lights at least two facets of
+        each eye and contains no lens of either eye (docs/measured.md)."""
+        va, vb = self.visible(x, y, z, g)
+        oa, ob = self.overlaps_eye(x, y, z, g)
+        return va & vb & ~oa & ~ob
