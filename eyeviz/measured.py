@@ -9,6 +9,15 @@
 from __future__ import annotations
 
 from eyeviz.core.measured import MeasuredEye, MeasuredEyePair
-from eyeviz.files.eye_io import load_eyes, save_eyes, shipped_eye
+from eyeviz.core.measured_from import as_measured
+from eyeviz.files.eye_io import EyeSizeWarning, load_eyes, save_eyes, shipped_eye
 
-__all__ = ["MeasuredEye", "MeasuredEyePair", "load_eyes", "save_eyes", "shipped_eye"]
+__all__ = [
+    "EyeSizeWarning",
+    "MeasuredEye",
+    "MeasuredEyePair",
+    "as_measured",
+    "load_eyes",
+    "save_eyes",
+    "shipped_eye",
+]

@@ -59,8 +59,7 @@ def _check_eye_arrays(name: str, positions, axes, acceptance):
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise EyevizError(
-            f"eye {name}: ommatidium {i}: acceptance angle must be in (0, pi) rad, "
-            f"got {acc[i]!r}"
+            f"eye {name}: ommatidium {i}: acceptance angle must be in (0, pi) rad, got {acc[i]!r}"
         )
     return pos, ax, acc
 

@@ -38,6 +38,16 @@ MAX_MODEL_META_BYTES = 1 << 20
 MAX_TABLE_KEYS = 50_000_000
 #: Length of a feature name in a scene.
 MAX_NAME_CHARS = 200
+#: Measured eye files (``.eye``, ``.gltf``, ``.glb`` and a glTF's external buffers): bytes
+#: of one file, and ommatidia (rows) in all; two eyes of the model's MAX_FACETS each
+#: (:mod:`eyeviz.core.measured`). A ``.eye`` row with full-precision numbers is about 160
+#: bytes.
+MAX_EYE_FILE_BYTES = 1 << 29
+MAX_EYE_ROWS = 2_000_000
+#: The JSON part of a glTF (nodes, accessors, a base64 buffer inside a ``data:`` URI).
+MAX_GLTF_JSON_BYTES = 1 << 29
+#: glTF objects of one kind (nodes, accessors, buffer views, buffers, OCES eyes).
+MAX_GLTF_OBJECTS = 10_000
 
 
 def check_rows(n, name: str = "n") -> int:
