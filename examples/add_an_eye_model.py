@@ -40,8 +40,8 @@ class DamagedEyes:
     dims = 2
 
     @property
-    def facets(self) -> int:
-        return self.m
+    def facet_counts(self) -> tuple[int, int]:
+        return (self.m, self.m)
 
     @property
     def design(self) -> dict[str, float | int]:

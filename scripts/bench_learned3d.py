@@ -46,7 +46,8 @@ def main(argv: list[str] | None = None) -> int:
 
     from eyeviz.dataset.algorithm1_3d import generate3d
     from eyeviz.estimators import learned3d
-    from eyeviz.estimators.learned3d_features import _runs, eye_summaries, features
+    from eyeviz.estimators.healpix_summaries import _runs, eye_summaries
+    from eyeviz.estimators.learned3d_features import features
 
     est = learned3d.load()
     d = est.domain

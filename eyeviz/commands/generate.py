@@ -1,4 +1,9 @@
-"""``eyeviz generate``: write a training data set of Algorithm 1 (CSV or NPZ)."""
+"""``eyeviz generate``: write a training data set of Algorithm 1 (CSV or NPZ).
+
+Planar eyes (default, ``--h --l --m``), HEALPix eyes (``--nside``) or a measured pair
+(``--eye FILE [--units mm]``): the last two write the sparse data set
+(:mod:`eyeviz.dataset.sparse3d`); a measured pair is embedded in it, and its ranges
+default to the animal's scale (:func:`eyeviz.core.domain3d.measured_ranges`)."""
 
 from __future__ import annotations
 
@@ -51,8 +56,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         parser.add_argument(
             f"--{flag.replace('_', '-')}",
             type=typ,
-            default=DEFAULTS[flag],
-            help=f"{what} (default: {DEFAULTS[flag]:g}, Table {table})",
+            default=None,  # filled by _fill_defaults: --eye has ranges of its own
+            help=f"{what} (default: {DEFAULTS[flag]:g}, Table {table}"
+            + ("; with --eye: at the animal's scale)" if table == 4 else ")"),
         )
     parser.add_argument(
         "--nside",
@@ -63,11 +69,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "eye; 180 matches m = 720); writes the sparse 3D data set (.npz only)",
     )
     parser.add_argument(
+        "--eye",
+        default=None,
+        metavar="FILE",
+        help="a measured eye pair (.eye): balls in its binocular field, the pair embedded "
+        "in the sparse data set (.npz only)",
+    )
+    parser.add_argument(
+        "--units",
+        choices=("mm", "m", "um"),
+        default="mm",
+        help="with --eye: the eye file's length unit (default mm, as .eye files)",
+    )
+    parser.add_argument(
         "--el-max",
         type=float,
         default=None,
         help="with --nside: largest |elevation| of a feature centre, in radians, in "
-        "(0, pi/2) (default: pi/6)",
+        "(0, pi/2) (default: pi/6); with --eye: in (0, pi/2] (default pi/2)",
     )
     parser.add_argument(
         "--segments",
@@ -113,8 +132,20 @@ def _say_seed(args: argparse.Namespace, drawn: bool, domain: dict, kind: str = "
         )
 
 
+def _fill_defaults(args: argparse.Namespace) -> None:
+    """The planar and HEALPix runs' defaults (Tables 3-4) for the options not given."""
+    from eyeviz.core.domain import DEFAULTS
+
+    for k in ("h", "l", "m", "r_min", "r_max", "g_max"):
+        if getattr(args, k) is None:
+            setattr(args, k, DEFAULTS[k])
+
+
 def run(args: argparse.Namespace) -> int:
     drawn = _seed(args)
+    if args.eye is not None:
+        return _run_eye(args, drawn)
+    _fill_defaults(args)
     if args.nside is not None or args.el_max is not None:
         return _run3d(args, drawn)
     from eyeviz import EyevizError, dataset
@@ -224,5 +255,57 @@ def _run3d(args: argparse.Namespace, drawn: bool = False) -> int:
         print(
             f"wrote {n:,} 3D elements (nside {domain.nside}, {args.mode} pass, seed "
             f"{args.seed}) to {args.output} ({size:.1f} MB) in {time.perf_counter() - t0:.2f} s"
+        )
+    return 0
+
+
+def _run_eye(args: argparse.Namespace, drawn: bool) -> int:
+    """``--eye FILE``: Algorithm 1 on a measured pair, written as the sparse data set with
+    the pair embedded."""
+    from eyeviz import EyevizError
+    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.dataset import algorithm1_3d, sparse3d
+    from eyeviz.files import limits
+    from eyeviz.files.eye_io import load_eyes
+
+    for flag in ("nside", "h", "l", "m"):
+        if getattr(args, flag) is not None:
+            raise EyevizError(f"--{flag} describes model eyes; with --eye the file gives the eyes")
+    if args.unique_bitmaps:
+        raise EyevizError("--unique-bitmaps is for the planar data set only, not with --eye")
+    sparse3d.check_output_path(args.output)
+    n = algorithm1_3d.check_n(args.n)
+    if not os.path.isfile(args.eye):
+        raise EyevizError(f"eye file {args.eye} not found")
+    pair = load_eyes(args.eye, units=args.units)
+    ranges = {k: getattr(args, k) for k in ("r_min", "r_max", "g_max", "el_max")}
+    domain = Domain3D.for_eyes(pair, **ranges)
+    algorithm1_3d.make_params3d(domain, args.mode, args.seed, args.segments)
+    limits.check_free_space(args.output, sparse3d.estimated_bytes3d(n, domain))
+    if drawn:
+        _say_seed(args, drawn, {}, "measured")
+    bar = _progress(args, n, _PROGRESS_MIN_3D)
+    t0 = time.perf_counter()
+    try:
+        sparse3d.write3d(
+            args.output,
+            n,
+            domain,
+            mode=args.mode,
+            seed=args.seed,
+            segments=args.segments,
+            progress=bar.update if bar else None,
+        )
+    finally:
+        if bar is not None:
+            bar.close()
+    if not args.quiet:
+        size = os.path.getsize(args.output) / 1e6
+        na, nb = domain.facet_counts
+        print(
+            f"wrote {n:,} elements of measured eyes {pair.name} ({na} + {nb} facets; r in "
+            f"[{domain.r_min:.4g}, {domain.r_max:.4g}], g <= {domain.g_max:.4g}; {args.mode} "
+            f"pass, seed {args.seed}) to {args.output} ({size:.1f} MB) in "
+            f"{time.perf_counter() - t0:.2f} s"
         )
     return 0

@@ -14,12 +14,14 @@ not take (``--weights`` for analytic, ``--target`` for compact, ``--r-min`` for 
 fixed-design estimator) is refused, never ignored. ``-o`` may not be the input file
 (compared by device and inode, so links count).
 
-A sparse 3D data set (``eyeviz generate --nside``) takes an estimator of the spherical
-eyes (``analytic3d``, ``limit3d``, ``learned3d``; docs/spherical.md): it is read in blocks
-(:class:`eyeviz.dataset.sparse3d.Sparse3DReader`), its design comes from the file (no
-``--h --l --m --r-min --r-max --g-max``), and the CSV has ``r_hat,azimuth_hat,
-elevation_hat`` (radians). A planar estimator on 3D data, or a spherical one on planar
-data, is refused in one line.
+The file's eye design picks its reader (:func:`eyeviz.dataset.kinds.kind_of`, read
+from its meta). A sparse data set (``eyeviz generate --nside`` or ``--eye``) takes an
+estimator of the spherical side that answers for its eyes (``analytic3d``, ``limit3d``,
+``learned3d`` for HEALPix eyes; ``analytic3d`` for a measured pair; docs/spherical.md,
+docs/measured.md): it is read in blocks (:class:`eyeviz.dataset.sparse3d.Sparse3DReader`),
+its design comes from the file (no ``--h --l --m --r-min --r-max --g-max``), and the CSV
+has ``r_hat,azimuth_hat,elevation_hat`` (radians). An estimator that does not answer for
+the file's eyes is refused in one line naming those that do.
 
 Exit status (also in ``--help``):
 
@@ -173,15 +175,18 @@ def run(args: argparse.Namespace) -> int:
         raise EyevizError(f"output {args.out} is the input data file {args.data}; pick another -o")
     if not (out.parent if str(out.parent) else Path(".")).is_dir():
         raise EyevizError(f"output directory {out.parent} does not exist")
-    is3d = _is_3d(Path(args.data))
-    if is3d != (entry.kind == "spherical"):
-        which = "a sparse 3D" if is3d else "a planar"
+    from eyeviz.dataset.kinds import kind_of
+
+    kind = kind_of(args.data)
+    if kind not in entry.eye_models:
+        which = {"planar": "a planar", "spherical": "a sparse 3D"}.get(kind, f"a {kind}-eye")
         raise EyevizError(
-            f"estimator {entry.name!r} is {entry.kind}, but {args.data} is {which} data set; "
-            f"use one of {', '.join(registry.available('spherical' if is3d else 'planar'))}"
+            f"estimator {entry.name!r} answers for {' and '.join(entry.eye_models)} eyes, but "
+            f"{args.data} is {which} data set; use one of "
+            f"{', '.join(registry.available_for(kind)) or '(none registered)'}"
         )
-    if is3d:
-        return _run3d(args, entry, registry, out)
+    if kind != "planar":
+        return _run3d(args, entry, registry, out, kind)
     reader, design = _reader(args, registry)
     kw = registry.options_from_args(entry.load_options, args)
     if args.weights is not None:
@@ -239,37 +244,22 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _is_3d(path: Path) -> bool:
-    """Whether ``path`` is a sparse 3D data set (an NPZ with CSR lit sets); anything else
-    (a CSV, a planar NPZ, a file that is not a zip) is left to the planar reader."""
-    import zipfile
-
-    from eyeviz.dataset.io import format_of
-
-    try:
-        if format_of(path) != "npz":
-            return False
-        with zipfile.ZipFile(path) as zf:
-            return "indptr_a.npy" in zf.namelist()
-    except Exception:  # noqa: BLE001 - not a zip: the planar reader says what is wrong
-        return False
-
-
-def _run3d(args: argparse.Namespace, entry, registry, out: Path) -> int:
-    """``predict`` on a sparse 3D data set: r, azimuth, elevation per row, block by block."""
+def _run3d(args: argparse.Namespace, entry, registry, out: Path, kind: str) -> int:
+    """``predict`` on a sparse data set (HEALPix or measured eyes): r, azimuth, elevation
+    per row, block by block."""
     import numpy as np
 
     from eyeviz import EyevizError
-    from eyeviz.dataset.sparse3d import Sparse3DReader
+    from eyeviz.dataset.kinds import open_reader
     from eyeviz.estimators.metrics import RunningSummary
     from eyeviz.files.atomic import atomic_output
 
     if registry.domain_given(args):
         raise EyevizError(
-            f"{args.data} is a 3D data set that carries its design (h, l, nside and ranges); "
+            f"{args.data} is a 3D data set that carries its design (its eyes and ranges); "
             "--h --l --m --r-min --r-max --g-max are for planar data"
         )
-    reader = Sparse3DReader(args.data)
+    reader = open_reader(args.data, kind)
     dom = reader.domain
     kw = registry.options_from_args(entry.load_options, args)
     if args.weights is not None:
@@ -278,8 +268,9 @@ def _run3d(args: argparse.Namespace, entry, registry, out: Path) -> int:
         kw["domain"] = dom
     est = entry.load_estimator(**kw)
     if est.domain.design != dom.design:
+        what = "(h, l, nside)" if kind == "spherical" else "(h, l, fingerprint)"
         raise EyevizError(
-            f"data set {args.data} has the eyes (h, l, nside) = {dom.design}, but estimator "
+            f"data set {args.data} has the eyes {what} = {dom.design}, but estimator "
             f"{entry.name!r} answers for {est.domain.design}"
         )
     n = invalid = unanswered = 0

@@ -1,14 +1,18 @@
 """The eye-model seam: what the layers above the core need from "a pair of eyes".
 
-Two models implement it: the paper's planar :class:`eyeviz.core.geometry.EyePair` (rings of
-m ommatidia, features are discs (x, y, g)) and the spherical
+Three models implement it: the paper's planar :class:`eyeviz.core.geometry.EyePair`
+(rings of m ommatidia, features are discs (x, y, g)), the spherical
 :class:`eyeviz.core.geometry3d.EyePair3D` (HEALPix facets, features are balls
-(x, y, z, g)). Both put eye A at (-h, 0[, 0]) and eye B at (h, 0[, 0]); the plane z = 0 of
-the spherical model is the planar one (docs/spherical.md).
+(x, y, z, g)) and the measured :class:`eyeviz.core.measured.MeasuredEyePair` (lists of
+real ommatidia, balls; docs/measured.md). The first two put eye A at (-h, 0[, 0]) and eye
+B at (h, 0[, 0]); the plane z = 0 of the spherical model is the planar one
+(docs/spherical.md). A measured pair has eye A on the left (-x) too, h and l derived from
+its lenses.
 
 What a data set, an estimator's domain, a scene or a report may rely on without knowing
 which model it holds is :class:`EyeModel`: the design (the numbers a file must match), the
-number of facets per eye, and the four per-feature predicates of the paper (the bitmaps,
+number of facets of each eye (``facet_counts``: the two eyes of a measured pair may
+differ), and the four per-feature predicates of the paper (the bitmaps,
 Definition 1, Proposition 4 and overlap with an eye), each taking a feature's centre
 coordinates followed by its radius g. Anything model-specific (the planar intervals of
 Prop. 2, the spherical lit lists) is reached through the concrete class. See
@@ -16,8 +20,8 @@ docs/architecture.md, "The eye-model seam".
 
 >>> from eyeviz.core.eyes import eyes_from_design
 >>> eyes = eyes_from_design({"h": 40.0, "l": 20.0, "m": 720})
->>> eyes.kind, eyes.dims, eyes.facets
-('planar', 2, 720)
+>>> eyes.kind, eyes.dims, eyes.facet_counts
+('planar', 2, (720, 720))
 >>> [int(v.sum()) for v in eyes.bitmaps(0.0, 1500.0, 50.0)]
 [8, 8]
 """
@@ -34,8 +38,9 @@ from eyeviz import EyevizError
 __all__ = ["EyeModel", "KINDS", "design_kind", "eyes_from_design"]
 
 #: The eye models and the key of the design that names each: a design with ``m`` is
-#: planar, one with ``nside`` spherical.
-KINDS: dict[str, str] = {"m": "planar", "nside": "spherical"}
+#: planar, one with ``nside`` spherical, one with ``eye`` (the sha256 fingerprint of the
+#: ommatidia's arrays) measured.
+KINDS: dict[str, str] = {"m": "planar", "nside": "spherical", "eye": "measured"}
 
 
 @runtime_checkable
@@ -50,7 +55,7 @@ class EyeModel(Protocol):
 
     @property
     def kind(self) -> str:
-        """``"planar"`` or ``"spherical"``."""
+        """``"planar"``, ``"spherical"`` or ``"measured"``."""
         ...
 
     @property
@@ -59,17 +64,19 @@ class EyeModel(Protocol):
         ...
 
     @property
-    def facets(self) -> int:
-        """Facets (ommatidia) per eye: m, or 12 nside^2."""
+    def facet_counts(self) -> tuple[int, int]:
+        """Facets (ommatidia) of eye A and of eye B: (m, m), (12 nside^2, 12 nside^2), or
+        a measured pair's (n_A, n_B)."""
         ...
 
     @property
-    def design(self) -> dict[str, float | int]:
-        """h, l and the facet parameter (m or nside): what files and estimators match."""
+    def design(self) -> Mapping[str, Any]:
+        """What files and estimators match: h, l and m or nside; a measured pair's
+        fingerprint (``eye``) and facet counts."""
         ...
 
     def bitmaps(self, *centre_and_g: Any) -> tuple[np.ndarray, np.ndarray]:
-        """(omega_a, omega_b): bool, shape (..., facets)."""
+        """(omega_a, omega_b): bool, shapes (..., n_A) and (..., n_B)."""
         ...
 
     def visible(self, *centre_and_g: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -86,21 +93,29 @@ class EyeModel(Protocol):
 
 
 def design_kind(design: Mapping[str, Any]) -> str:
-    """``"planar"`` for a design with m, ``"spherical"`` for one with nside; EyevizError
-    (one line) for both or neither."""
+    """``"planar"`` for a design with m, ``"spherical"`` for one with nside,
+    ``"measured"`` for one with eye (a fingerprint); EyevizError (one line) for more than
+    one or none."""
     keys = [k for k in KINDS if k in design]
     if len(keys) != 1:
         raise EyevizError(
-            "an eye design gives exactly one of m (planar eyes) or nside (spherical eyes), "
-            f"got {', '.join(keys) if keys else 'neither'}"
+            "an eye design gives exactly one of m (planar eyes), nside (spherical eyes) or "
+            f"eye (a measured pair's fingerprint), got {' and '.join(keys) if keys else 'none'}"
         )
     return KINDS[keys[0]]
 
 
 def eyes_from_design(design: Mapping[str, Any]) -> EyeModel:
     """The eye pair a design names: ``{"h", "l", "m"}`` -> EyePair, ``{"h", "l", "nside"}``
-    -> EyePair3D. The model's own checks apply (ValueError naming the parameter)."""
+    -> EyePair3D. The model's own checks apply (ValueError naming the parameter). A
+    measured design names its eyes by fingerprint only: EyevizError (the arrays come from
+    an eye file, :func:`eyeviz.measured.load_eyes`, or a data set that embeds them)."""
     kind = design_kind(design)
+    if kind == "measured":
+        raise EyevizError(
+            "a measured design names its eyes by fingerprint only: load the pair from its "
+            "eye file (eyeviz.measured.load_eyes) or from a data set that embeds it"
+        )
     h, l = design.get("h", 40.0), design.get("l", 20.0)
     if kind == "planar":
         from eyeviz.core.geometry import EyePair

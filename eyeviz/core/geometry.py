@@ -186,9 +186,9 @@ class EyePair:
         return 2
 
     @property
-    def facets(self) -> int:
-        """Ommatidia per eye, m."""
-        return self.m
+    def facet_counts(self) -> tuple[int, int]:
+        """Ommatidia of eye A and of eye B: (m, m)."""
+        return (self.m, self.m)
 
     @property
     def design(self) -> dict[str, float | int]:

@@ -628,9 +628,9 @@ class EyePair3D:
         return 3
 
     @property
-    def facets(self) -> int:
-        """Facets per eye, 12 nside^2."""
-        return self.npix
+    def facet_counts(self) -> tuple[int, int]:
+        """Facets of eye A and of eye B: (12 nside^2, 12 nside^2)."""
+        return (self.npix, self.npix)
 
     @property
     def design(self) -> dict[str, float | int]:

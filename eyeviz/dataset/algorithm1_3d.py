@@ -29,6 +29,14 @@ r and g, a centre is uniform over the solid angle of the field in the band; reje
 elements are redrawn in their own segment, which keeps the r histogram proportional to
 r^2. Segments are interleaved in a random order, as in the planar generator.
 
+**Measured eyes** (a :class:`Domain3D` of kind "measured", docs/measured.md) follow the
+same steps with the pair's own geometry: gamma is the interommatidial angle
+(:attr:`Domain3D.gamma`), and r, azimuth and elevation are about the midpoint of the two
+lens centroids (:attr:`Domain3D.origin`; x = o_x + r cos(el) cos(az), ...), measured in
+eyeviz's frame as for the HEALPix eyes. No cone bounds the azimuth (a real pair's field
+has no closed form): the azimuth is uniform on [0, pi] (in front) and the exact field
+test ``in_bfv`` (lights >= 2 facets of each eye, contains no lens) rejects the rest.
+
 Chunks of :func:`chunk_rows` elements (fewer at large balls and fine facets, so that a
 chunk's lit lists stay within :data:`LIT_BUDGET` indices per eye) are generated one after
 another from one seeded ``numpy.random.Generator``: the same parameters and seed give the
@@ -112,7 +120,9 @@ def make_params3d(
             f"no feature can be visible: g_max={domain.g_max:g} <= r_min*sin(gamma/2)="
             f"{domain.r_min * s:.6g} (Algorithm 1 step 9 rejects every r >= r_min)"
         )
-    if domain.gamma / 2 + domain.psi >= math.pi / 2:
+    if domain.kind == "measured":
+        pass  # no cones: the exact field test decides (module docstring)
+    elif domain.gamma / 2 + domain.psi >= math.pi / 2:
         raise EyevizError(
             f"no visible feature fits in the binocular field: gamma/2 + psi >= pi/2 "
             f"(nside={domain.nside} too small for h={domain.h:g}, l={domain.l:g})"
@@ -138,6 +148,8 @@ def max_lit(d: Domain3D) -> int:
     a = asin(g_max / (r_min - h)); its cap covers the fraction (1 - cos a)/2 of the
     sphere, plus a rim of cells along its border (each about sqrt(4 pi / npix) wide).
     """
+    if d.kind == "measured":  # every facet, at worst
+        return max(d.facet_counts)
     npix = d.npix
     near = d.r_min - d.h
     if near <= d.g_max:
@@ -199,9 +211,11 @@ class _Sampler3D:
         self.eyes = d.eyes
         self.rng = rng
         self.sin_half = math.sin(d.gamma / 2)
-        self.psi = d.psi
+        self.measured = d.kind == "measured"
+        self.psi = 0.0 if self.measured else d.psi
+        self.origin = np.asarray(d.origin) if self.measured else None
         self.multi = p.mode == "multi"
-        self.dtype = index_dtype(d.npix)
+        self.dtype = index_dtype(max(d.facet_counts))
 
     def _candidates(self, k: int, lo, hi):
         """k candidates (r, az, el, g) and the mask of those steps 7-12 keep."""
@@ -216,9 +230,12 @@ class _Sampler3D:
         ok = g_min <= d.g_max  # step 9
         g = g_min + (d.g_max - g_min) * u[1]  # step 10
         ok &= g <= r  # step 11
-        a = np.arcsin(np.minimum(g / r, 1.0))
-        cone = self.psi + a  # the ball's centre must be >= cone from the x-axis
-        ok &= cone < math.pi / 2
+        if self.measured:  # no cones: azimuth uniform in front, the field test decides
+            cone = np.zeros_like(r)
+        else:
+            a = np.arcsin(np.minimum(g / r, 1.0))
+            cone = self.psi + a  # the ball's centre must be >= cone from the x-axis
+            ok &= cone < math.pi / 2
         if self.multi:  # density proportional to cos(el): uniform in solid angle
             el = np.arcsin(math.sin(d.el_max) * (2 * u[2] - 1))
             c_el = math.cos(d.el_max)
@@ -248,6 +265,8 @@ class _Sampler3D:
             good = idx[:0]
             if idx.size:
                 x, y, z = spherical_to_xyz(r[idx], az[idx], el[idx])
+                if self.origin is not None:
+                    x, y, z = x + self.origin[0], y + self.origin[1], z + self.origin[2]
                 inb = np.flatnonzero(self.eyes.in_bfv(x, y, z, g[idx]))
                 idx, x, y, z = idx[inb], x[inb], y[inb], z[inb]
             if idx.size:

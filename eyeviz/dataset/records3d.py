@@ -70,12 +70,14 @@ class Dataset3D:
         return a, b
 
     def bitmaps(self, start: int = 0, stop: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Dense bool (k, npix) bitmaps of rows start..stop-1 (npix bytes per row and eye:
-        take few rows at a time at large nside)."""
+        """Dense bool (k, n_A) and (k, n_B) bitmaps of rows start..stop-1 (npix bytes per
+        row and eye: take few rows at a time at large nside)."""
         stop = len(self) if stop is None else stop
-        npix = self.domain.npix
         out = []
-        for indptr, indices in ((self.indptr_a, self.indices_a), (self.indptr_b, self.indices_b)):
+        for indptr, indices, npix in (
+            (self.indptr_a, self.indices_a, self.domain.facet_counts[0]),
+            (self.indptr_b, self.indices_b, self.domain.facet_counts[1]),
+        ):
             k = stop - start
             bm = np.zeros((k, npix), bool)
             lo, hi = int(indptr[start]), int(indptr[stop])

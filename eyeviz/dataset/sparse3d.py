@@ -15,6 +15,13 @@ of ``.npy`` members (numpy's NPZ, readable by ``numpy.load`` without pickles):
 - ``r``, ``azimuth``, ``elevation``, ``g`` (radians for the angles) and ``x``, ``y``,
   ``z`` (the centre the lit sets were computed at): float64 (n,).
 
+A data set of measured eyes (``eyeviz generate --eye``) is the same format: its domain
+names the pair by fingerprint (``eye``, ``n_a``, ``n_b`` in place of ``nside``), each
+eye's indices are facet numbers in [0, n_A) and [0, n_B), r, azimuth and elevation are
+about the midpoint of the two lens centroids (:attr:`Domain3D.origin`), and the pair
+itself is embedded (:mod:`eyeviz.dataset.embedded_eyes`): the reader rebuilds it, checks
+its fingerprint and re-computes a few rows' lit sets.
+
 Writing streams chunk by chunk in bounded memory: each chunk's arrays are appended to
 one spool file per member next to the output, and the zip is assembled at the end by
 copying the spools into members whose headers now know their lengths. Spools and the
@@ -41,8 +48,9 @@ from typing import Any, BinaryIO
 import numpy as np
 
 from eyeviz import EyevizError
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain3d import FIELDS3D, Domain3D
 from eyeviz.core.validation import check_int
+from eyeviz.dataset import embedded_eyes
 from eyeviz.dataset.algorithm1_3d import check_n, iter_chunks3d, make_params3d
 from eyeviz.dataset.records3d import Dataset3D, index_dtype
 from eyeviz.files import limits
@@ -91,8 +99,13 @@ def estimated_bytes3d(n: int, domain: Domain3D) -> int:
     r_max), plus a rim of about 8 pi (g/r) / (cell width) facets.
     """
     d = domain
-    npix = d.npix
     mean_a = d.g_max / 2 / math.sqrt(d.r_min * d.r_max)
+    if d.kind == "measured":  # facets over about a hemisphere, seen through the acceptance
+        npix = max(d.facet_counts)
+        lit = min(npix, npix * (mean_a + d.gamma) ** 2 / 2 + 2)
+        per_row = 2 * lit * index_dtype(npix).itemsize + 8 * (2 + len(FLOATS))
+        return int(2 * n * per_row) + 2 * 56 * sum(d.facet_counts)
+    npix = d.npix
     rim = 8 * math.pi * mean_a / math.sqrt(4 * math.pi / npix)
     lit = min(npix, npix * d.g_max**2 / (12 * d.r_min * d.r_max) + rim + 2)
     per_row = 2 * lit * index_dtype(npix).itemsize + 8 * (2 + len(FLOATS))
@@ -158,7 +171,7 @@ def write_chunks3d(
 ) -> None:
     """Stream generated chunks (:class:`Dataset3D`) into ``path``, atomically."""
     target = check_output_path(path)
-    idt = index_dtype(domain.npix)
+    idt = index_dtype(max(domain.facet_counts))
     with atomic_output(target) as tmp:
         spools = _Spools(target)
         try:
@@ -197,6 +210,10 @@ def write_chunks3d(
                     np.lib.format.write_array(f, np.array(json.dumps(meta)), allow_pickle=False)
                 for name in MEMBERS:
                     spools.copy_into(zf, name)
+                if domain.kind == "measured":  # the pair itself: the file is self-contained
+                    for name, arr in embedded_eyes.eye_arrays(domain.eyes).items():
+                        with zf.open(name + ".npy", "w", force_zip64=True) as f:
+                            np.lib.format.write_array(f, arr, allow_pickle=False)
         finally:
             spools.close()
 
@@ -270,6 +287,11 @@ class Sparse3DReader:
                 )
             with open(self.path, "rb") as f:
                 self.members = {name: self._member(f, infos, name) for name in MEMBERS}
+                self._eye_members = {
+                    name: self._member(f, infos, name)
+                    for name in embedded_eyes.EYE_MEMBERS
+                    if name + ".npy" in infos
+                }
         except EyevizError:
             raise
         except Exception as exc:  # noqa: BLE001 - BadZipFile, numpy's header TokenError, ...
@@ -333,10 +355,12 @@ class Sparse3DReader:
             dom = meta["domain"]
             if not isinstance(dom, dict):
                 raise TypeError("domain is not an object")
-            missing = [k for k in Domain3D.__dataclass_fields__ if k not in dom]
+            keys = FIELDS3D if "eye" not in dom else _MEASURED_KEYS
+            missing = [k for k in keys if k not in dom]
             if missing:
                 raise KeyError(missing[0])
-            self.domain = Domain3D.from_dict(dom)
+            self.pair = self._embedded_pair(dom) if "eye" in dom else None
+            self.domain = Domain3D.from_dict(dom, eyes=self.pair)
             self.n = check_int("n", meta["n"], ge=0, le=limits.MAX_ROWS)
             self.nnz_a = check_int("nnz_a", meta["nnz_a"], ge=0, le=1 << 62)
             self.nnz_b = check_int("nnz_b", meta["nnz_b"], ge=0, le=1 << 62)
@@ -348,7 +372,8 @@ class Sparse3DReader:
             raise self.fail(f"bad meta: {exc}") from None
         except (ValueError, KeyError, TypeError, OverflowError, IndexError) as exc:
             raise self.fail(f"bad meta: {_one_line(exc)}") from None
-        self.npix = self.domain.npix
+        self.counts = dict(zip(EYES, self.domain.facet_counts, strict=True))
+        self.npix = max(self.domain.facet_counts)  # the index dtype's bound
         want: dict[str, tuple[np.dtype, int]] = {
             f"indptr_{e}": (np.dtype("<i8"), self.n + 1) for e in EYES
         }
@@ -364,6 +389,26 @@ class Sparse3DReader:
                     f"member {name!r} has dtype {m.dtype} length {m.length}, "
                     f"expected {dt} length {length}"
                 )
+
+    def _embedded_pair(self, dom: dict):
+        """The measured pair embedded in the file, its sizes and fingerprint checked."""
+        n_a, n_b = embedded_eyes.check_counts(dom["n_a"], dom["n_b"])
+        arrays = {}
+        with open(self.path, "rb") as f:
+            self._crcs = {}
+            for name, length in embedded_eyes.expected_lengths(n_a, n_b).items():
+                m = self._eye_members.get(name)
+                if m is None:
+                    raise EyevizError(f"member {name!r} is missing (the embedded eyes)")
+                if m.dtype != np.dtype("<f8") or m.length != length:
+                    raise EyevizError(
+                        f"member {name!r} has dtype {m.dtype} length {m.length}, "
+                        f"expected float64 length {length}"
+                    )
+                self.members[name] = m  # read and CRC-checked as every member
+                self._crcs[name] = _Crc(m)
+                arrays[name] = self._read(f, name, 0, length)
+        return embedded_eyes.pair_from_arrays(arrays, str(dom["eye"]))
 
     # -- rows --
 
@@ -401,16 +446,17 @@ class Sparse3DReader:
         """indptr_e[start .. start + k] checked: starts where the last block ended (0 at
         row 0), non-decreasing, at most nnz, and each row at most npix long."""
         nnz = self.nnz_a if e == "a" else self.nnz_b
+        npix = self.counts[e]
         ptr = self._read(f, f"indptr_{e}", start, k + 1)
         if ptr[0] != prev:
             raise self.fail(f"indptr_{e}: row {start + 1} starts at {int(ptr[0])}, not {prev}")
         d = np.diff(ptr)
-        bad = (d < 0) | (d > self.npix)
+        bad = (d < 0) | (d > npix)
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
             raise self.fail(
                 f"indptr_{e}: row {start + i + 1} has {int(d[i])} indices "
-                f"(need 0..{self.npix}: indptr must not decrease)"
+                f"(need 0..{npix}: indptr must not decrease)"
             )
         if ptr[-1] > nnz or (start + k == self.n and ptr[-1] != nnz):
             raise self.fail(f"indptr_{e} ends at {int(ptr[-1])}, but nnz_{e} is {nnz}")
@@ -418,7 +464,8 @@ class Sparse3DReader:
 
     def _check_indices(self, e: str, start: int, ptr: np.ndarray, ind: np.ndarray) -> None:
         """Every index in [0, npix), strictly increasing within each row."""
-        bad = (ind < 0) | (ind >= self.npix)
+        npix = self.counts[e]
+        bad = (ind < 0) | (ind >= npix)
         if ind.size > 1:
             step_bad = np.diff(ind) <= 0
             first = ptr[1:-1] - ptr[0]  # where rows 2.. begin: no order across rows
@@ -429,30 +476,33 @@ class Sparse3DReader:
             j = int(np.flatnonzero(bad)[0])
             row = int(np.searchsorted(ptr - ptr[0], j, side="right")) - 1
             v = int(ind[j])
-            why = f"outside [0, {self.npix})" if not 0 <= v < self.npix else "not increasing"
+            why = f"outside [0, {npix})" if not 0 <= v < npix else "not increasing"
             raise self.fail(f"indices_{e}: row {start + row + 1}: index {v} {why}")
 
     def _check_floats(self, start: int, cols: dict[str, np.ndarray]) -> None:
         d = self.domain
         r, az, el, g = cols["r"], cols["azimuth"], cols["elevation"], cols["g"]
+        o = d.origin if d.kind == "measured" else (0.0, 0.0, 0.0)
+        tol = 1e-9 * (r + max(abs(v) for v in o))
         with np.errstate(invalid="ignore", over="ignore"):
             ok = (r >= d.r_min) & (r <= d.r_max)
             ok &= (az >= 0) & (az <= math.pi)
             ok &= (np.abs(el) <= d.el_max) & (g > 0) & (g <= d.g_max)
             c = np.cos(el)
-            for name, want in (
-                ("x", r * c * np.cos(az)),
-                ("y", r * c * np.sin(az)),
-                ("z", r * np.sin(el)),
+            for name, want, at in (
+                ("x", r * c * np.cos(az), o[0]),
+                ("y", r * c * np.sin(az), o[1]),
+                ("z", r * np.sin(el), o[2]),
             ):
-                ok &= np.abs(cols[name] - want) <= 1e-9 * r
+                ok &= np.abs(cols[name] - at - want) <= tol
         if not ok.all():
             i = int(np.flatnonzero(~ok)[0])
             vals = ", ".join(f"{k}={float(v[i])!r}" for k, v in cols.items())
             raise self.fail(
                 f"row {start + i + 1}: {vals} (need r in [{d.r_min:g}, {d.r_max:g}], "
                 f"0 <= azimuth <= pi, |elevation| <= el_max={d.el_max:.6g}, "
-                f"0 < g <= {d.g_max:g}, x, y, z the centre of r, azimuth, elevation)"
+                f"0 < g <= {d.g_max:g}, x, y, z the centre of r, azimuth, elevation"
+                f"{' about the origin ' + str(o) if d.kind == 'measured' else ''})"
             )
 
     def __iter__(self) -> Iterator[Dataset3D]:
@@ -488,7 +538,12 @@ class Sparse3DReader:
             self._check_floats(start, cols)
             if start + k == self.n:  # before the last block is handed out
                 self._check_crcs(f)
-            yield Dataset3D(**out, **cols, domain=self.domain, params=dict(self.params))
+            block = Dataset3D(**out, **cols, domain=self.domain, params=dict(self.params))
+            if self.pair is not None:
+                bad = embedded_eyes.check_lit_rows(self.pair, block, start, self.n)
+                if bad:
+                    raise self.fail(f"the lit sets do not match the embedded eyes: {bad}")
+            yield block
             start += k
 
     def read_all(self) -> Dataset3D:
@@ -501,6 +556,10 @@ class Sparse3DReader:
         empty = np.zeros(0)
         floats = dict.fromkeys(FLOATS, empty)
         return Dataset3D(ptr, idx, ptr, idx, **floats, domain=self.domain, params=self.params)
+
+
+#: The domain keys of a measured data set (the pair by fingerprint, no nside).
+_MEASURED_KEYS = ("h", "l", "eye", "n_a", "n_b", "r_min", "r_max", "g_max", "el_max")
 
 
 def load3d(path) -> Dataset3D:

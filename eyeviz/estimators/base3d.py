@@ -29,6 +29,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from eyeviz import EyevizError
 from eyeviz.core.domain3d import PAPER_DOMAIN3D, Domain3D
 from eyeviz.core.validation import check_int
 
@@ -183,6 +184,9 @@ class Estimator3D:
     """
 
     name: ClassVar[str] = "base3d"
+    #: the eye models (:attr:`Domain3D.kind`) the estimator answers for; a domain of
+    #: another kind is refused in one line naming these
+    kinds: ClassVar[tuple[str, ...]] = ("spherical",)
     #: True for an estimator whose :meth:`_predict_csr` reads every index anyway and
     #: refuses indices out of range or not increasing within a row there, with
     #: :func:`as_csr`'s ValueError naming ``lit_a`` or ``lit_b`` (one pass over the
@@ -195,6 +199,11 @@ class Estimator3D:
     def __init__(self, domain: Domain3D = PAPER_DOMAIN3D, metadata: dict | None = None) -> None:
         if not isinstance(domain, Domain3D):
             raise ValueError(f"domain must be a Domain3D, got {type(domain).__name__}")
+        if domain.kind not in self.kinds:
+            raise EyevizError(
+                f"estimator {self.name!r} answers for {' and '.join(self.kinds)} eyes, not "
+                f"{domain.kind} ones"
+            )
         self.domain = domain
         self.metadata: dict[str, Any] = dict(metadata or {})
 
@@ -214,10 +223,10 @@ class Estimator3D:
         """(r, azimuth, elevation) per row from each eye's lit facets (CSR rows or dense
         bitmaps, see the module docstring). ValueError naming the argument for malformed
         input or a row-count mismatch; NaN and ``valid = False`` where an eye lit nothing."""
-        npix = self.domain.npix
+        na, nb = self.domain.facet_counts
         check = not self.checks_indices
-        pa, ia, single_a = as_csr("lit_a", lit_a, npix, check_indices=check)
-        pb, ib, single_b = as_csr("lit_b", lit_b, npix, check_indices=check)
+        pa, ia, single_a = as_csr("lit_a", lit_a, na, check_indices=check)
+        pb, ib, single_b = as_csr("lit_b", lit_b, nb, check_indices=check)
         if pa.size != pb.size:
             raise ValueError(
                 f"lit_a and lit_b have different row counts: {pa.size - 1} and {pb.size - 1}"
@@ -227,8 +236,8 @@ class Estimator3D:
         valid = (ca > 0) & (cb > 0)
         if not check and not valid.all():  # rows _predict_csr does not see
             skip = np.flatnonzero(~valid)
-            _check_indices("lit_a", *take_rows(pa, ia, skip), npix)
-            _check_indices("lit_b", *take_rows(pb, ib, skip), npix)
+            _check_indices("lit_a", *take_rows(pa, ia, skip), na)
+            _check_indices("lit_b", *take_rows(pb, ib, skip), nb)
         r = np.full(n, np.nan)
         az = np.full(n, np.nan)
         el = np.full(n, np.nan)
@@ -259,11 +268,17 @@ class Estimator3D:
                 raise ValueError(f"ds must be a Dataset3D (no {k}), got {type(ds).__name__}")
         if ds.domain.design != self.domain.design:
             raise ValueError(
-                f"ds has the eyes (h, l, nside) = {ds.domain.design}, the estimator "
-                f"{self.domain.design}"
+                f"ds has the eyes {_design_text(ds.domain)}, the estimator "
+                f"{_design_text(self.domain)}"
             )
         return self.predict((ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b))
 
     def __repr__(self) -> str:
-        d = self.domain
-        return f"<{type(self).__name__} {self.name!r} h={d.h:g} l={d.l:g} nside={d.nside}>"
+        return f"<{type(self).__name__} {self.name!r} {_design_text(self.domain)}>"
+
+
+def _design_text(d: Domain3D) -> str:
+    """The eyes of a domain in words: h, l, nside, or the measured pair's fingerprint."""
+    if d.kind == "measured":
+        return f"h={d.h:g} l={d.l:g} measured pair {str(d.eyes.fingerprint)[:12]}"
+    return f"(h, l, nside) = {d.design}"

@@ -174,7 +174,7 @@ class Learned3DEstimator(Estimator3D):
     triangulation is then r_max along their mean, which the network corrects)."""
 
     name = "learned3d"
-    checks_indices = True  # on the runs of the summaries (learned3d_features._check_runs)
+    checks_indices = True  # on the runs of the summaries (healpix_summaries._check_runs)
     #: the summaries of 32,768 rows at a time (both eyes side by side with two threads),
     #: the network still in the batches of 16,384 rows it always had (:meth:`_predict_csr`)
     block_rows = 2 * _BLOCK

@@ -13,7 +13,9 @@ weights were made for (``design``), whether it needs torch, how to load it, how 
 'the information limit: posterior median of r and phi per bitmap pair (a lookup table)'
 >>> est = registry.load("analytic", domain=Domain(m=360))
 
-Estimators of the spherical eyes (docs/spherical.md) are entries of ``kind="spherical"``,
+Estimators of the spherical side (docs/spherical.md) are entries of ``kind="spherical"``,
+answering for the HEALPix eyes and, where ``models`` says so, for measured ones
+(docs/measured.md; :func:`available_for`),
 loaded with a :class:`~eyeviz.core.domain3d.Domain3D` and named with a ``3d`` suffix
 (``analytic3d``, ``limit3d``, ``learned3d``); :func:`entries` and :func:`available` list
 one kind at a time (planar by default, so every planar list is as it was):
@@ -54,6 +56,7 @@ __all__ = [
     "get",
     "entries",
     "available",
+    "available_for",
     "load",
     "fit",
     "add_options",
@@ -129,6 +132,14 @@ class Entry:
     fit_takes_data: bool = True  # False: fit samples its own data (bayes)
     module: str = ""  # module to look for when deciding if the entry is installed
     kind: str = "planar"  # "planar" (Domain, half bitmaps) or "spherical" (Domain3D, lit sets)
+    #: the eye models a spherical entry answers for (Domain3D.kind: "spherical" for
+    #: HEALPix, "measured"); empty: its kind's own model only
+    models: tuple[str, ...] = ()
+
+    @property
+    def eye_models(self) -> tuple[str, ...]:
+        """The eye models (:attr:`eyeviz.core.eyes.EyeModel.kind`) it answers for."""
+        return self.models or (self.kind,)
 
     @property
     def learns(self) -> bool:
@@ -158,6 +169,12 @@ class Entry:
             raise EyevizError(
                 f"estimator {self.name!r} is {self.kind}: domain must be a {want.__name__}, "
                 f"got {type(dom).__name__}{hint}"
+            )
+        if isinstance(dom, Domain3D) and dom.kind not in self.eye_models:
+            others = available_for(dom.kind)
+            raise EyevizError(
+                f"estimator {self.name!r} answers for {' and '.join(self.eye_models)} eyes only, "
+                f"not {dom.kind} ones; for those use {', '.join(others) or 'no estimator yet'}"
             )
         loader = _resolve(self.load)
         assert loader is not None
@@ -218,6 +235,12 @@ def entries(kind: str | None = "planar") -> list[Entry]:
 def available(kind: str | None = "planar") -> list[str]:
     """Names of ``kind`` (None: every kind) accepted by :func:`load`, sorted."""
     return [e.name for e in entries(kind)]
+
+
+def available_for(model: str) -> list[str]:
+    """Names of the installed entries that answer for eyes of ``model`` (an
+    :attr:`eyeviz.core.eyes.EyeModel.kind`: "planar", "spherical", "measured"), sorted."""
+    return [e.name for e in entries(None) if model in e.eye_models]
 
 
 def load(name: str, **kw):
@@ -390,11 +413,13 @@ for _entry in (
     ),
     Entry(
         "analytic3d",
-        "spherical eyes: triangulation of the two lit caps' centres (no weights, any design)",
+        "spherical and measured eyes: triangulation of the two lit caps' centres, or of the "
+        "lit facets' mean rays (no weights, any design)",
         "eyeviz.estimators.analytic3d:load",
         any_design=True,
         design=None,
         kind="spherical",
+        models=("spherical", "measured"),
     ),
     Entry(
         "limit3d",

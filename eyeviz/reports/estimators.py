@@ -161,9 +161,17 @@ def run3d(args: argparse.Namespace) -> int:
         from eyeviz.dataset.sparse3d import load3d
 
         ds = load3d(args.data)
+        d = ds.domain
+        eyes = (
+            f"nside = {d.nside}"
+            if d.kind == "spherical"
+            else f"a measured pair of {d.facet_counts[0]} + {d.facet_counts[1]} facets "
+            f"(fingerprint {str(d.eyes.fingerprint)[:12]}), r in [{d.r_min:.4g}, "
+            f"{d.r_max:.4g}], g <= {d.g_max:.4g}, about the lens centroids' midpoint"
+        )
         what = (
-            f"Data set `{Path(args.data).name}`: {len(ds)} rows, h = {ds.domain.h:g}, "
-            f"l = {ds.domain.l:g}, nside = {ds.domain.nside}, params {ds.params}."
+            f"Data set `{Path(args.data).name}`: {len(ds)} rows, h = {d.h:g}, "
+            f"l = {d.l:g}, {eyes}, params {ds.params}."
         )
     else:
         from eyeviz.core.domain3d import Domain3D
@@ -177,7 +185,7 @@ def run3d(args: argparse.Namespace) -> int:
         )
     avail = registry.available("spherical")
     if args.estimators is None:
-        names = avail
+        names = registry.available_for(ds.domain.kind)
     else:
         names = [s for s in str(args.estimators).replace(",", " ").split() if s]
         bad = [s for s in names if s not in avail]

@@ -18,15 +18,15 @@ from eyeviz.core import healpix
 from eyeviz.core.domain3d import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import base3d, learned3d
-from eyeviz.estimators import learned3d_features as lf
-from eyeviz.estimators.learned3d_features import (
+from eyeviz.estimators import healpix_summaries as lf
+from eyeviz.estimators.healpix_summaries import (
     BANDS,
     N_BOUNDS,
     OVERHANG,
     EyeSummary,
     eye_summaries,
-    features,
 )
+from eyeviz.estimators.learned3d_features import features
 
 SEED = 9_023_555  # neither the shipped training nor its validation seed
 _NO_BOUND = 1.0

@@ -1,0 +1,109 @@
+"""A measured eye through the spherical side's doors, end to end on the command line:
+``eyeviz generate --eye`` (the shipped honeybee) -> ``eyeviz predict --estimator
+analytic3d`` -> ``eyeviz report estimators --data``; and the one-line refusals on the way."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+
+from eyeviz import cli
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.dataset import algorithm1_3d, sparse3d
+from eyeviz.measured import shipped_eye
+
+BEE = str(shipped_eye("AM_60185-real.eye"))
+
+
+@pytest.fixture(scope="module")
+def bee_npz(tmp_path_factory):
+    out = tmp_path_factory.mktemp("bee") / "bee.npz"
+    assert cli.main(["generate", "--eye", BEE, "-n", "12", "--seed", "4", "-o", str(out)]) == 0
+    return out
+
+
+def test_generate_eye_writes_what_the_api_generates(bee_npz, honeybee, capsys):
+    ds = sparse3d.load3d(bee_npz)
+    dom = Domain3D.for_eyes(honeybee)
+    assert ds.domain == dom and ds.domain.design == (honeybee.h, honeybee.l, honeybee.fingerprint)
+    want = algorithm1_3d.generate3d(12, dom, seed=4)
+    for k in ("indptr_a", "indices_a", "indptr_b", "indices_b", "r", "azimuth", "g", "x"):
+        assert np.array_equal(getattr(ds, k), getattr(want, k)), k
+    assert ds.params["seed"] == 4
+
+
+def test_predict_analytic_then_report_estimators(bee_npz, tmp_path, capsys):
+    pred = tmp_path / "p.csv"
+    rc = cli.main(["predict", "--estimator", "analytic3d", str(bee_npz), "-o", str(pred)])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    assert "analytic3d: 12 rows" in err and "DD MAPE" in err
+    with open(pred, newline="") as f:
+        rows = list(csv.reader(f))
+    assert rows[0] == ["r_hat", "azimuth_hat", "elevation_hat"] and len(rows) == 13
+    vals = np.array(rows[1:], float)
+    ds = sparse3d.load3d(bee_npz)
+    dom = ds.domain
+    assert np.isfinite(vals).all() and (vals[:, 0] >= dom.r_min).all()
+    assert (vals[:, 0] <= dom.r_max).all()
+    # the direction of the ball from the bee is found to a few degrees (the distance is
+    # what a 3 mm baseline with 1 degree facets cannot give)
+    d_true = np.c_[ds.x, ds.y, ds.z] - np.asarray(dom.origin)
+    az, el = vals[:, 1], vals[:, 2]
+    d_hat = np.c_[np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)]
+    cos = np.einsum("ij,ij->i", d_hat, d_true / np.linalg.norm(d_true, axis=1)[:, None])
+    assert np.median(np.degrees(np.arccos(np.clip(cos, -1, 1)))) < 10
+
+    out = tmp_path / "rep"
+    rc = cli.main(["report", "estimators", "--data", str(bee_npz), "-o", str(out)])
+    text = capsys.readouterr().out
+    assert rc == 0 and "analytic3d" in text, text
+    md = (out / "estimators3d.md").read_text()
+    assert "a measured pair of 3187 + 3187 facets" in md and "| analytic3d |" in md
+    with open(out / "estimators3d.csv", newline="") as f:
+        table = {r["estimator"]: r for r in csv.DictReader(f)}
+    assert set(table) == {"analytic3d"} and table["analytic3d"]["status"] == "ok"
+    assert table["analytic3d"]["rows"] == "12"
+    assert (out / "estimators3d.png").stat().st_size > 1000
+
+
+@pytest.mark.parametrize("name", ["limit3d", "learned3d", "analytic"])
+def test_predict_refuses_an_estimator_that_does_not_answer_for_measured_eyes(
+    bee_npz, tmp_path, capsys, name
+):
+    rc = cli.main(["predict", "--estimator", name, str(bee_npz), "-o", str(tmp_path / "p.csv")])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert "is a measured-eye data set; use one of analytic3d" in err
+    assert not (tmp_path / "p.csv").exists()
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--nside", "8"], "--nside describes model eyes; with --eye the file gives the eyes"),
+        (["--h", "3"], "--h describes model eyes"),
+        (["--m", "64"], "--m describes model eyes"),
+        (["--unique-bitmaps"], "--unique-bitmaps is for the planar data set only"),
+        (["--el-max", "2"], "el_max must be a finite number > 0 and <= 1.5708"),
+        (["--r-min", "50", "--r-max", "20"], "r_min must be < r_max"),
+        (["--g-max", "0.0001"], "no feature can be visible"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2(tmp_path, capsys, args, message):
+    rc = cli.main(["generate", "-n", "5", "--eye", BEE, *args, "-o", str(tmp_path / "x.npz")])
+    err = capsys.readouterr().err
+    assert rc == 2 and message in err and err.count("\n") == 1, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_missing_eye_file_and_csv_output_are_refused(tmp_path, capsys):
+    rc = cli.main(["generate", "-n", "5", "--eye", str(tmp_path / "no.eye"), "-o", "x.npz"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "eye file" in err and "not found" in err and err.count("\n") == 1, err
+    rc = cli.main(["generate", "-n", "5", "--eye", BEE, "-o", str(tmp_path / "x.csv")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "written as .npz" in err, err
+    assert list(tmp_path.iterdir()) == []
