@@ -482,7 +482,7 @@ class Sparse3DReader:
     def _check_floats(self, start: int, cols: dict[str, np.ndarray]) -> None:
         d = self.domain
         r, az, el, g = cols["r"], cols["azimuth"], cols["elevation"], cols["g"]
-        o = d.origin if d.kind == "measured" else (0.0, 0.0, 0.0)
+        o = d.origin  # (0, 0, 0) for HEALPix eyes
         tol = 1e-9 * (r + max(abs(v) for v in o))
         with np.errstate(invalid="ignore", over="ignore"):
             ok = (r >= d.r_min) & (r <= d.r_max)

@@ -141,7 +141,9 @@ def test_reader_refuses_lit_sets_that_the_embedded_eyes_do_not_light(toy_file, t
     n_b = int(json.loads(str(_load_member(members["meta.npy"])[()]))["domain"]["n_b"])
     last = slice(int(ptr[-2]), int(ptr[-1]))  # the last row: always among the checked
     unlit = np.setdiff1d(np.arange(n_b), ind[last])
-    ind[int(ptr[-1]) - 1] = unlit[-1] if unlit[-1] > ind[int(ptr[-1]) - 2] else ind[int(ptr[-1]) - 1]
+    ind[int(ptr[-1]) - 1] = (
+        unlit[-1] if unlit[-1] > ind[int(ptr[-1]) - 2] else ind[int(ptr[-1]) - 1]
+    )
     assert not np.array_equal(ind, _load_member(members["indices_b.npy"]))
     bad = _rewrite(path, tmp_path / "lit.npz", indices_b=ind)
     with pytest.raises(EyevizError) as info:
