@@ -91,9 +91,9 @@ def test_train_learned3d_refuses_bad_options(tmp_path, capsys, args, message):
 @pytest.mark.parametrize(
     "name, file, message",
     [
-        ("compact", "d8.npz", "estimator 'compact' is planar, but"),
+        ("compact", "d8.npz", "estimator 'compact' answers for planar eyes, but"),
         ("analytic", "d8.npz", "use one of analytic3d, learned3d, limit3d"),
-        ("analytic3d", "planar.npz", "estimator 'analytic3d' is spherical, but"),
+        ("analytic3d", "planar.npz", "'analytic3d' answers for spherical and measured eyes, but"),
         ("learned3d", "d8.npz", "answers for (40.0, 20.0, 180)"),
     ],
 )
