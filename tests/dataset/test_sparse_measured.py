@@ -196,3 +196,36 @@ def test_embedded_eye_members_are_the_documented_ones(toy_pair):
     assert {k: v.size for k, v in arrays.items()} == embedded_eyes.expected_lengths(n_a, n_b)
     back = embedded_eyes.pair_from_arrays(arrays, toy_pair.fingerprint)
     assert back.fingerprint == toy_pair.fingerprint
+
+
+def test_each_eyes_indices_range_over_its_own_facet_count(tmp_path, toy_pair):
+    """Eyes of different sizes: eye B's indices stop at n_B, eye A's at n_A, in the
+    sampler, the file, the reader's bounds and the estimator's."""
+    from eyeviz.core.measured import MeasuredEye, MeasuredEyePair
+    from eyeviz.estimators import registry
+
+    b = toy_pair.eye_b
+    keep = slice(0, b.n - 40)
+    small_b = MeasuredEye(b.positions[keep], b.axes[keep], b.acceptance[keep], name="B")
+    pair = MeasuredEyePair(toy_pair.eye_a, small_b)
+    n_a, n_b = pair.facet_counts
+    assert n_b == n_a - 40
+    dom = Domain3D.for_eyes(pair)
+    path = tmp_path / "uneven.npz"
+    sparse3d.write3d(path, 30, dom, seed=3)
+    ds = sparse3d.load3d(path)
+    assert ds.domain.facet_counts == (n_a, n_b) and ds.indices_b.max() < n_b
+    wa, wb = ds.bitmaps(0, 2)
+    assert wa.shape == (2, n_a) and wb.shape == (2, n_b)
+    est = registry.load("analytic3d", domain=ds.domain)
+    assert est.predict_dataset(ds).valid.all()
+    with pytest.raises(ValueError, match=f"lit_b: indices must lie in \\[0, npix = {n_b}\\)"):
+        est.predict((np.array([0, 1]), np.array([n_b])), (np.array([0, 1]), np.array([n_b])))
+    # an index valid in eye A but past eye B's last facet: refused in the file, naming it
+    members = _members(path)
+    ind = _load_member(members["indices_b.npy"]).copy()
+    ptr = _load_member(members["indptr_b.npy"])
+    ind[int(ptr[1]) - 1] = n_b  # row 1's last index
+    bad = _rewrite(path, tmp_path / "past.npz", indices_b=ind)
+    with pytest.raises(EyevizError, match=f"indices_b: row 1: index {n_b} outside \\[0, {n_b}\\)"):
+        sparse3d.load3d(bad)
