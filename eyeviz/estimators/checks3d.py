@@ -82,7 +82,7 @@ def check_csr_equals_bitmaps(est) -> None:
 def check_rejects_bad_input3d(est) -> None:
     """Wrong npix, non-binary values, mismatched rows, bad CSR: one-line ValueErrors."""
     a, b, ds = _data(est)
-    npix = est.domain.npix
+    npix = est.domain.facet_counts[0]  # eye A's (a measured pair's eyes may differ)
     ba, bb = ds.bitmaps(0, 3)
     two = ba.astype(np.int64)
     two[1, 0] = 2

@@ -54,3 +54,11 @@ class _ElevationSlip(Analytic3DEstimator):
 def test_broken_estimators_fail(bad, which):
     with pytest.raises(AssertionError, match=which):
         check_estimator(bad(D16))
+
+
+def test_the_analytic_estimator_on_a_measured_pair_passes_the_battery(toy_pair):
+    """One battery for every model on the spherical side: the measured pair's analytic
+    estimator passes the checks the HEALPix estimators pass."""
+    est = registry.load("analytic3d", domain=Domain3D.for_eyes(toy_pair))
+    done = check_estimator(est)
+    assert "check_rejects_bad_input3d" in done and "check_sensible_answers3d" in done
