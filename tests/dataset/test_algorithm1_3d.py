@@ -151,3 +151,24 @@ def test_the_free_space_estimate_covers_the_spools_and_the_file(tmp_path, dom):
     sparse3d.write3d(out, 300, dom, seed=1)
     need = 2 * out.stat().st_size  # spools and zip side by side
     assert need <= sparse3d.estimated_bytes3d(300, dom) <= 4 * need
+
+
+@pytest.mark.parametrize("mode", ["single", "multi"])
+def test_r_and_g_are_drawn_from_independent_uniforms(mode):
+    """Joint statistics, not marginals (issue 37): each row's r, as the uniform it was drawn
+    from (its position in its segment: linear in single pass, by volume in multi), and its
+    g, as the uniform of step 10 (its position in [r sin(gamma/2), g_max]), are
+    uncorrelated. Drawn from one uniform they correlate fully."""
+    p = A.make_params3d(DOM, mode, seed=5)
+    ds = A.generate3d(1500, DOM, mode=mode, seed=5)
+    if mode == "single":
+        u_r = (ds.r - DOM.r_min) / (DOM.r_max - DOM.r_min)
+    else:
+        edges, _ = A.segment_plan3d(1500, p)
+        k = np.clip(np.searchsorted(edges, ds.r, side="right") - 1, 0, len(edges) - 2)
+        lo, hi = edges[k], edges[k + 1]
+        u_r = (ds.r**3 - lo**3) / (hi**3 - lo**3)
+    g_min = ds.r * math.sin(DOM.gamma / 2)
+    u_g = (ds.g - g_min) / (DOM.g_max - g_min)
+    assert abs(np.corrcoef(u_r, u_g)[0, 1]) < 0.15
+    assert abs(np.corrcoef(u_r, np.cos(ds.azimuth))[0, 1]) < 0.15
