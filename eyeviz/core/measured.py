@@ -25,11 +25,17 @@ import numpy as np
 
 from eyeviz import EyevizError
 from eyeviz.core.geometry3d import validate_balls
+from eyeviz.core.measured_exact import lens_in_ball_exact
+from eyeviz.core.measured_fast import EyeTables, decide_pairs, eye_tables, lens_bound
+from eyeviz.core.measured_index import AxisIndex
 
 __all__ = ["MeasuredEye", "MeasuredEyePair", "MAX_FACETS"]
 
 #: Largest number of ommatidia one eye may have (a file controls it: bounded).
 MAX_FACETS = 1_000_000
+_CHUNK = 1 << 15  # candidate (ball, facet) pairs per block of the decision
+_U = 2.0**-53
+_LO, _HI = 2.0**-480, 2.0**480  # the range of |c - p| and g where the float bound holds
 
 
 def _check_eye_arrays(name: str, positions, axes, acceptance):
@@ -107,8 +113,10 @@ class MeasuredEye:
 
     @property
     def unit_axes(self) -> np.ndarray:
-        """The axes normalised (float64; for drawing and indexing, not for decisions)."""
-        return self.axes / np.linalg.norm(self.axes, axis=1)[:, None]
+        """The axes normalised (float64; for drawing and indexing, not for decisions).
+        Each axis is first scaled by its largest component: no overflow or underflow."""
+        a = self.axes / np.abs(self.axes).max(axis=1)[:, None]
+        return a / np.linalg.norm(a, axis=1)[:, None]
 
 
 @dataclass(frozen=True, eq=False)
@@ -191,33 +199,57 @@ class MeasuredEyePair:
         return e.positions, e.axes, e.acceptance
 
     # --- the geometry ------------------------------------------------------------------
-    def _lit_eye(self, e: MeasuredEye, xf, yf, zf, gf) -> tuple[np.ndarray, np.ndarray]:
-        """SKELETON: float64 over every facet; replaced by the certified path."""
-        rows = []
-        ax = e.unit_axes
-        half = e.acceptance / 2
-        for c in zip(xf, yf, zf, gf, strict=True):
-            v = np.array(c[:3]) - e.positions
-            nv = np.linalg.norm(v, axis=1)
-            cos_t = np.einsum("ij,ij->i", v, ax) / np.where(nv > 0, nv, 1)
-            th = np.arccos(np.clip(cos_t, -1, 1))
-            beyond = th - half
-            dist = np.where(
-                beyond <= 0, 0.0, np.where(beyond >= np.pi / 2, nv, nv * np.sin(beyond))
+    def _prepared(self, which: str) -> tuple[EyeTables, AxisIndex]:
+        """The fast path's tables and the axis index of one eye, built once per pair."""
+        key = ("prepared", which)
+        if key not in self._cache:
+            e = self.eye(which)
+            centre = e.centroid
+            tables = eye_tables(e.positions, e.axes, e.acceptance)
+            index = AxisIndex(
+                e.unit_axes,
+                centre,
+                lens_bound(e.positions, centre),
+                float(e.acceptance.max()) / 2,
             )
-            dist = np.where(nv == 0, 0.0, dist)
-            rows.append(np.flatnonzero(dist <= c[3]).astype(np.int64))
-        indptr = np.zeros(len(rows) + 1, np.int64)
-        indptr[1:] = np.cumsum([r.size for r in rows])
-        idx = np.concatenate(rows) if rows else np.zeros(0, np.int64)
-        return indptr, idx
+            self._cache[key] = (tables, index)
+        return self._cache[key]
+
+    def _lit_eye(self, which: str, balls, *, index: bool = True) -> tuple[np.ndarray, ...]:
+        """CSR (indptr, indices) of the facets of one eye that see each ball: candidates
+        from the axis index (or every facet: ``index=False``, the brute-force pass), then
+        the certified decision with its exact fallback (docs/measured.md)."""
+        tables, ix = self._prepared(which)
+        nb, n = balls[0].size, ix.n
+        if index:
+            unit, dirs, thr, rho = ix.query(*balls)
+            ball, start, count = ix.cells(unit, rho)
+        else:
+            ball, start, count = ix.every(nb)
+        lit = []
+        ends = np.cumsum(count)
+        cuts = np.searchsorted(ends, np.arange(_CHUNK, int(ends[-1]) if ends.size else 0, _CHUNK))
+        for sl in np.split(np.arange(ball.size), np.unique(cuts)):
+            bi, pos = ix.expand(ball[sl], start[sl], count[sl])
+            if index:
+                keep = ix.chord_ok(bi, pos, dirs, thr)
+                bi, pos = bi[keep], pos[keep]
+            fi = ix.perm.take(pos)
+            seen = decide_pairs(tables, balls, bi, fi)
+            lit.append(bi[seen] * n + fi[seen])
+        keys = np.sort(np.concatenate(lit)) if lit else np.zeros(0, np.int64)
+        indptr = np.searchsorted(keys, np.arange(nb + 1, dtype=np.int64) * n)
+        return indptr.astype(np.int64), (keys % n).astype(np.int64)
+
+    def _flat_balls(self, x, y, z, g) -> tuple[tuple[int, ...], tuple[np.ndarray, ...]]:
+        xa, ya, za, ga = validate_balls(x, y, z, g)
+        return xa.shape, tuple(np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, za, ga))
 
     def lit_csr(self, x, y, z, g) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
         """Per eye (A, B): (indptr, indices) of the facets that see each ball, CSR over
         the flattened balls, indices sorted int64."""
-        xa, ya, za, ga = validate_balls(x, y, z, g)
-        xf, yf, zf, gf = (np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, za, ga))
-        return tuple(self._lit_eye(e, xf, yf, zf, gf) for e in (self.eye_a, self.eye_b))
+        _, balls = self._flat_balls(x, y, z, g)
+        return self._lit_eye("A", balls), self._lit_eye("B", balls)
 
     def lit(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
         """One ball: (lit_a, lit_b), sorted int64 facet indices."""
@@ -245,17 +277,45 @@ class MeasuredEyePair:
         (pa, _), (pb, _) = self.lit_csr(x, y, z, g)
         return (np.diff(pa) >= 2).reshape(xa.shape), (np.diff(pb) >= 2).reshape(xa.shape)
 
+    def _lens_in_ball(self, which: str, balls) -> np.ndarray:
+        """Per ball: the closed ball contains a lens of the eye, exactly. Only balls whose
+        centre is within L + g of the eye's centre can (the index's ``every`` case); their
+        |c - p|^2 - g^2 is decided in float64 with the bound 16 u (|c - p|^2 + g^2) of
+        :mod:`eyeviz.core.measured_fast`, the rest in rationals."""
+        tables, ix = self._prepared(which)
+        cx, cy, cz, g = balls
+        out = np.zeros(cx.size, bool)
+        near = np.flatnonzero(~np.isfinite(ix.search(*balls)[1]))
+        n = ix.n
+        step = max(1, _CHUNK // n)
+        for k in range(0, near.size, step):
+            b = near[k : k + step]
+            with np.errstate(all="ignore"):
+                v = [
+                    c[b][:, None] - p[None, :]
+                    for c, p in zip(balls[:3], tables.columns(), strict=True)
+                ]
+                v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+                g2 = (g[b] * g[b])[:, None]
+                da, bound = v2 - g2, 16 * _U * (v2 + g2)
+                mag = np.maximum(np.maximum(np.abs(v[0]), np.abs(v[1])), np.abs(v[2]))
+                ok = (mag >= _LO) & (mag <= _HI) & (g[b] <= _HI)[:, None]
+            inside = (ok & (da <= -bound)) | (mag == 0)
+            unsure = ~inside & ~(ok & (da > bound))
+            hit = inside.any(axis=1)
+            for r in np.flatnonzero(~hit & unsure.any(axis=1)).tolist():
+                c = (float(cx[b[r]]), float(cy[b[r]]), float(cz[b[r]]))
+                hit[r] = any(
+                    lens_in_ball_exact(c, float(g[b[r]]), tables.positions[i].tolist())
+                    for i in np.flatnonzero(unsure[r]).tolist()
+                )
+            out[b] = hit
+        return out
+
     def overlaps_eye(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
-        """Per eye: the closed ball contains a lens of that eye."""
-        xa, ya, za, ga = validate_balls(x, y, z, g)
-        shape = xa.shape
-        c = np.stack([xa.ravel(), ya.ravel(), za.ravel()], axis=1)
-        gg = ga.ravel()
-        res = []
-        for e in (self.eye_a, self.eye_b):
-            d2 = ((c[:, None, :] - e.positions[None, :, :]) ** 2).sum(axis=2).min(axis=1)
-            res.append((d2 <= gg * gg).reshape(shape))
-        return res[0], res[1]
+        """Per eye: the closed ball contains a lens of that eye (exact)."""
+        shape, balls = self._flat_balls(x, y, z, g)
+        return tuple(self._lens_in_ball(w, balls).reshape(shape) for w in "AB")  # type: ignore[return-value]
 
     def in_bfv(self, x, y, z, g) -> np.ndarray:
         """The binocular field of a measured pair: the ball lights at least two facets of
