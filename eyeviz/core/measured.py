@@ -215,7 +215,7 @@ class MeasuredEyePair:
             self._cache[key] = (tables, index)
         return self._cache[key]
 
-    def _lit_eye(self, which: str, balls, *, index: bool = True) -> tuple[np.ndarray, ...]:
+    def _lit_eye(self, which: str, balls, *, index: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """CSR (indptr, indices) of the facets of one eye that see each ball: candidates
         from the axis index (or every facet: ``index=False``, the brute-force pass), then
         the certified decision with its exact fallback (docs/measured.md)."""

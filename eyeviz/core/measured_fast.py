@@ -94,8 +94,8 @@ def eye_tables(positions: np.ndarray, axes: np.ndarray, acceptance: np.ndarray) 
     exact_only = ~(np.ldexp(scaled, (ex - 1)[:, None]) == axes).all(axis=1)
     nrm = np.sqrt((scaled * scaled).sum(axis=1)) * (1 + 8 * _U)
     c, s = _cos_sin(acceptance)
-    cols = [np.ascontiguousarray(a) for a in (*positions.T, *scaled.T)]
-    return EyeTables(*cols, nrm, c, s, exact_only, positions, axes, acceptance)
+    px, py, pz, ax, ay, az = (np.ascontiguousarray(a) for a in (*positions.T, *scaled.T))
+    return EyeTables(px, py, pz, ax, ay, az, nrm, c, s, exact_only, positions, axes, acceptance)
 
 
 def _certified(t: EyeTables, cx, cy, cz, g, fi) -> tuple[np.ndarray, np.ndarray]:

@@ -11,8 +11,9 @@ every facet of the eye, the textbook distance from a point to a closed circular 
 and "seen" iff dist <= g. A float64 screen decides the pairs whose |dist - g| exceeds
 1e-7 (|v| + g) (more than 10^8 times its rounding error) when the components of v and a
 lie in [1e-140, 1e140] and g <= 1e140; every other pair is evaluated in mpmath at 60 and
-then 300 digits, and a pair still within 10^-280 (|v| + g) of a tie raises instead of guessing. |v| <= g (the lens
-in the ball) is decided first, in rationals: it is the only tie that occurs exactly.
+then 300 digits, and a pair still within 10^-280 (|v| + g) of a tie raises instead of
+guessing. |v| <= g (the lens in the ball) is decided first, in rationals: it is the only
+tie that occurs exactly.
 """
 
 from __future__ import annotations
