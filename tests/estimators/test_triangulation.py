@@ -90,6 +90,8 @@ def test_analytic3d_healpix_answers_are_those_of_the_frozen_pipeline():
     rho = np.linalg.norm(p, axis=1)
     assert np.array_equal(flagged, ~ok)
     assert np.array_equal(r, np.clip(rho, d.r_min, d.r_max))
+    # flagged rows answer r_max, as the docstring says (issue 37: not r_min)
+    assert flagged.any() and np.allclose(r[flagged], d.r_max, rtol=1e-12)
     assert np.array_equal(az, np.arctan2(p[:, 1], p[:, 0]))
     assert np.array_equal(el, np.arcsin(np.clip(p[:, 2] / rho, -1.0, 1.0)))
 
@@ -143,8 +145,16 @@ def test_analytic3d_on_a_measured_pair_is_the_closest_approach_of_the_lens_rays(
         assert np.isclose(pred.azimuth[i], np.arctan2(q[1], q[0]), atol=1e-9)
         assert np.isclose(pred.elevation[i], np.arcsin(q[2] / rho), atol=1e-9)
     # flagged rows answer r_max along the mean of the two axes
-    f = np.flatnonzero(~ok)
-    assert np.all(pred.r[f] == d.r_max)
+    # rays that diverge (eye A's outermost facets look left, eye B's right) are flagged
+    # and answer r_max along the mean of the two axes
+    la = np.argsort(toy_pair.eye_a.axes[:, 0])[:3]
+    lb = np.argsort(-toy_pair.eye_b.axes[:, 0])[:3]
+    far = est.predict((np.array([0, 3]), np.sort(la)), (np.array([0, 3]), np.sort(lb)))
+    assert far.flagged[0] and np.isclose(far.r[0], d.r_max, rtol=1e-12)
+    _, u1, _ = lens_rays(toy_pair.eye_a.positions, toy_pair.eye_a.axes, (np.array([0, 3]), la))
+    _, v1, _ = lens_rays(toy_pair.eye_b.positions, toy_pair.eye_b.axes, (np.array([0, 3]), lb))
+    mean = (u1 + v1)[0] / np.linalg.norm((u1 + v1)[0])
+    assert np.isclose(far.azimuth[0], np.arctan2(mean[1], mean[0]))
     # the toy's field is wide and its facets coarse: the triangulation still finds the
     # ball's direction to a few degrees where the rays meet
     assert np.median(np.abs(pred.azimuth[ok] - ds.azimuth[ok])) < 0.1
