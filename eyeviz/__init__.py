@@ -1,7 +1,9 @@
-"""eyeviz: visualiser and toolkit for the planar binocular compound-eye model.
+"""eyeviz: visualiser and toolkit for binocular compound-eye vision.
 
-The model is the paper's (``shared/paper.md``): two circular eyes of m ommatidia each,
-centred at A = (-h, 0) and B = (h, 0), looking at circular features in the plane.
+The model is the paper's, "Building 2D Model of Compound Eye Vision for Machine Learning"
+(``docs/model.md`` summarises it): two circular eyes of m ommatidia each, centred at
+A = (-h, 0) and B = (h, 0), looking at circular features in the plane; and its spherical
+generalisation (``docs/spherical.md``).
 """
 
 __version__ = "0.1.0"
