@@ -4,9 +4,10 @@ Qt's ``QSettings`` INI reader unpickles every ``@Variant(... PyQt_PyObject ...)`
 meets, whatever its key, so a planted settings file could run code when the app starts.
 eyeviz never lets QSettings read a file: settings are a JSON object of strings, numbers and
 lists of strings; byte values (the window geometry) are stored as base64 text. A file that
-is not such an object, contains ``@Variant(`` or a pickle, or is larger than MAX_BYTES is
-refused with a one-line message and ignored: the app starts with defaults and never writes
-over the refused file.
+is not such an object, contains ``@Variant(`` or a pickle, is larger than MAX_BYTES or is
+not a regular file (a FIFO blocked the app forever, /dev/zero read until MemoryError:
+issue 35) is refused with a one-line message and ignored: the app starts with defaults
+and never writes over the refused file.
 
 Path: ``--settings`` > ``$EYEVIZ_SETTINGS`` > ``$XDG_CONFIG_HOME/eyeviz/settings.json``
 (default ``~/.config/eyeviz/settings.json``).
@@ -17,10 +18,12 @@ from __future__ import annotations
 import base64
 import json
 import os
+import stat
 import sys
 from pathlib import Path
 from typing import Any
 
+from eyeviz import EyevizError
 from eyeviz.files.atomic import atomic_output
 
 __all__ = ["MAX_BYTES", "Settings", "default_path", "make_settings"]
@@ -56,16 +59,16 @@ class Settings:
         print(self.refused, file=sys.stderr)
 
     def _read(self) -> None:
-        try:
-            size = self.path.stat().st_size
-        except OSError:
+        if not self.path.exists() and not self.path.is_symlink():
             return  # no file yet: defaults
-        if size > MAX_BYTES:
-            return self._refuse(f"larger than {MAX_BYTES} bytes")
         try:
-            raw = self.path.read_bytes()
+            raw = _read_regular(self.path, MAX_BYTES)
+        except _NotRegular:
+            return self._refuse("not a regular file")
         except OSError as exc:
             return self._refuse(f"cannot read it ({exc.strerror})")
+        if raw is None:
+            return self._refuse(f"larger than {MAX_BYTES} bytes")
         if any(tok in raw for tok in _HOSTILE):
             return self._refuse("it holds a Qt @Variant / pickled value, which could run code")
         try:
@@ -111,8 +114,35 @@ class Settings:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             with atomic_output(self.path) as tmp:
                 Path(tmp).write_text(json.dumps(self.data, indent=1), encoding="utf-8")
-        except OSError as exc:
+        except (OSError, EyevizError) as exc:
             print(f"eyeviz: cannot write settings {self.path}: {exc}", file=sys.stderr)
+
+
+class _NotRegular(Exception):
+    pass
+
+
+def _read_regular(path: Path, max_bytes: int) -> bytes | None:
+    """The bytes of the regular file at ``path`` (None when larger than ``max_bytes``).
+
+    Opened without blocking (a FIFO with no writer would block ``open`` forever) and
+    checked on the open descriptor, so nothing can be swapped in between; at most
+    ``max_bytes + 1`` bytes are read whatever the file claims."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise _NotRegular
+        if st.st_size > max_bytes:
+            return None
+        os.set_blocking(fd, True)
+        chunks, got = [], 0
+        while got <= max_bytes and (chunk := os.read(fd, max_bytes + 1 - got)):
+            chunks.append(chunk)
+            got += len(chunk)
+    finally:
+        os.close(fd)
+    return None if got > max_bytes else b"".join(chunks)
 
 
 def make_settings(path: str | os.PathLike | None = None) -> Settings:

@@ -3,12 +3,21 @@
 Each kind is a module with ``HELP``, ``add_arguments`` and ``run(args) -> int``: the
 package's own live in ``eyeviz.reports.<kind>``; :func:`register` adds another (a plug-in
 module of any name, docs/extending.md). Kinds whose module is absent are not offered.
+
+Every report is written into a staging folder beside ``-o DIR`` and moved in only when it
+is complete (:func:`eyeviz.files.atomic.atomic_folder`): an interrupted report leaves DIR
+as it was, never old and new files side by side (issue 35). What the report prints comes
+out once its files are in place, naming DIR.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import io
+import sys
+from pathlib import Path
 
 NAME = "report"
 HELP = "write a report (Markdown, CSV and plots) into a directory"
@@ -42,4 +51,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    return args._report(args)
+    from eyeviz.files.atomic import atomic_folder
+
+    # the package's reports take -o/--output; a plug-in may call it --out
+    dest = next((d for d in ("output", "out") if isinstance(getattr(args, d, None), Path)), None)
+    if dest is None:
+        return args._report(args)
+    out = getattr(args, dest)
+    printed = io.StringIO()
+    with atomic_folder(out) as stage:
+        setattr(args, dest, stage)
+        try:
+            with contextlib.redirect_stdout(printed):
+                code = args._report(args)
+        finally:
+            setattr(args, dest, out)
+    sys.stdout.write(printed.getvalue().replace(str(stage), str(out)))
+    return code

@@ -173,7 +173,7 @@ def write_chunks3d(
     target = check_output_path(path)
     idt = index_dtype(max(domain.facet_counts))
     with atomic_output(target) as tmp:
-        spools = _Spools(target)
+        spools = _Spools(tmp.parent / target.name)  # beside the temporary: not in /dev
         try:
             base = dict.fromkeys(EYES, 0)
             for e in EYES:

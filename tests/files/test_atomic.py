@@ -31,7 +31,8 @@ def _plant(folder, name, age_s):
 def test_temp_name_carries_pid_and_is_removed_on_error(tmp_path):
     target = tmp_path / "x.csv"
     with pytest.raises(RuntimeError), atomic_output(target) as tmp:
-        assert tmp.name.startswith(f".x.csv.{os.getpid()}.") and tmp.name.endswith(".part.csv")
+        assert tmp.name.startswith(f".x.csv.eyeviz-{os.getpid()}-")
+        assert tmp.name.endswith(".part.csv")
         assert atomic._PART.match(tmp.name)
         tmp.write_text("half")
         raise RuntimeError
@@ -48,25 +49,30 @@ def test_sweep_removes_only_stale_files_of_dead_writers(tmp_path):
     stale_npz = _plant(tmp_path, part_name(tmp_path / "y.npz", dead), old)
     young = _plant(tmp_path, part_name(tmp_path / "x.csv", dead), 5)
     alive = _plant(tmp_path, part_name(tmp_path / "x.csv", os.getppid()), old)
-    legacy_old = _plant(tmp_path, ".x.csv.ab_cd123.part.csv", atomic.SWEEP_AGE_LEGACY_S + 60)
-    legacy_young = _plant(tmp_path, ".x.csv.zz_cd123.part.csv", old)
+    # eyeviz's temporaries of earlier versions had no marker: like a user's, never touched
+    unmarked = _plant(tmp_path, f".x.csv.{dead}.0123456789abcdef.part.csv", 10 * old)
     user = [
-        _plant(tmp_path, name, 10 * atomic.SWEEP_AGE_LEGACY_S)
-        for name in ("x.csv", ".x.csv.part", "notes.part.csv", ".hidden", ".a.123.zz.part.csv")
+        _plant(tmp_path, name, 100 * old)
+        for name in (
+            "x.csv",
+            ".x.csv.part",
+            "notes.part.csv",
+            ".hidden",
+            ".a.123.zz.part.csv",
+            ".x.csv.ab_cd123.part.csv",
+        )
     ]
-    folder = tmp_path / f".d.csv.{dead}.0123456789abcdef.part.csv"
+    folder = tmp_path / f".x.csv.eyeviz-{dead}-0123456789abcdef.part.csv"
     os.mkdir(folder)
-    with atomic_output(tmp_path / "z.csv") as tmp:
+    with atomic_output(tmp_path / "x.csv") as tmp:
         tmp.write_text("1")
     left = set(tmp_path.iterdir())
-    for p in (stale, stale_npz, legacy_old):
-        assert p not in left
-    for p in (young, alive, legacy_young, *user):
+    assert stale not in left
+    for p in (stale_npz, young, alive, unmarked, *user):  # y.npz's: not this output's
         assert p in left
-    assert (tmp_path / "z.csv").exists() and (
-        tmp_path / f".d.csv.{dead}.0123456789abcdef.part.csv"
-    ).is_dir()
-    assert sweep_stale(tmp_path) == []
+    assert (tmp_path / "x.csv").read_text() == "1" and folder.is_dir()
+    assert sweep_stale(tmp_path, "x.csv") == []
+    assert sweep_stale(tmp_path) == [stale_npz]
 
 
 def test_sweep_after_sigkill(tmp_path):
@@ -83,7 +89,7 @@ def test_sweep_after_sigkill(tmp_path):
     proc.kill()
     proc.wait()
     (part,) = tmp_path.glob(".x.csv.*.part.csv")
-    assert f".{proc.pid}." in part.name
+    assert f".eyeviz-{proc.pid}-" in part.name
     assert sweep_stale(tmp_path) == []  # young: kept
     assert sweep_stale(tmp_path, now=time.time() + atomic.SWEEP_AGE_S + 1) == [part]
     assert list(tmp_path.iterdir()) == []

@@ -52,7 +52,7 @@ def test_signal_leaves_no_file(tmp_path, sig, code, word, fmt):
         text=True,
     )
     part = _wait_for_part(tmp_path, proc)
-    assert str(os.getpid()) not in part.name and f".{proc.pid}." in part.name  # writer's PID
+    assert str(os.getpid()) not in part.name and f".eyeviz-{proc.pid}-" in part.name  # writer's PID
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == code, err

@@ -9,11 +9,15 @@ from __future__ import annotations
 import csv
 import json
 import math
+import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
+import time
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -355,3 +359,50 @@ def test_the_largest_run_of_a_design_is_drawn(tmp_path):
     path = write_table(tmp_path / "s.csv", rows + more)
     d = study.designs_of(read_study(path), "single")[(40.0, 20.0, 720)]
     assert d.all.n == 16000 and d.all.line > 9
+
+
+# --- an interrupted report (issue 35, item 3) -------------------------------------------
+
+
+def _report_written(tmp_path, out, before: dict) -> bool:
+    """Whether the run has written a figure yet (in its staging folder, or in ``out``)."""
+    for p in tmp_path.rglob("*"):
+        if p.is_file() and p.suffix in (".pdf", ".png", ".svg") and ".part" not in p.name:
+            if p.parent != out or p.stat().st_mtime_ns != before.get(p.name):
+                return True
+    return False
+
+
+@pytest.mark.slow
+def test_sigint_leaves_the_old_report_folder_unmixed(tmp_path):
+    table = write_table(tmp_path / "s.csv", synthetic_rows())
+    out = tmp_path / "DIR"
+    out.mkdir()
+    for name in ("study_dd.pdf", "study_dd.png", "study.md", "summary.json"):
+        (out / name).write_text(f"old run: {name}")
+    os.utime(out / "study.md", (1e9, 1e9))
+    before = {p.name: p.stat().st_mtime_ns for p in out.iterdir()}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "eyeviz", "report", "study", str(table), "-o", str(out)],
+        cwd=tmp_path,
+        env={
+            **os.environ,
+            "PYTHONPATH": str(Path(__file__).resolve().parents[2]),
+            "MPLBACKEND": "Agg",
+        },
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    t = time.monotonic()
+    while not _report_written(tmp_path, out, before):
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() - t < 300, "no figure written in 300 s"
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert {p.name: p.read_text() for p in out.iterdir()} == {
+        name: f"old run: {name}" for name in before
+    }
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["DIR", "s.csv"]  # no staging left
