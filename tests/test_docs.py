@@ -54,7 +54,9 @@ def test_no_code_cites_a_missing_file():
 #: A citation of the guidance or the paper's text kept outside the repository (issue 35.12:
 #: the package's docstring cited ``shared/paper.md``); the docs stand alone.
 ALL_MD = [ROOT / "README.md"] + [
-    p for top in ("docs", "eyeviz", "examples", "scripts") for p in sorted((ROOT / top).rglob("*.md"))
+    p
+    for top in ("docs", "eyeviz", "examples", "scripts")
+    for p in sorted((ROOT / top).rglob("*.md"))
 ]
 OUTSIDE = re.compile(r"DESIGN\.md|\bshared/|paper\.md")
 
