@@ -100,9 +100,14 @@ def estimated_bytes3d(n: int, domain: Domain3D) -> int:
     """
     d = domain
     mean_a = d.g_max / 2 / math.sqrt(d.r_min * d.r_max)
-    if d.kind == "measured":  # facets over about a hemisphere, seen through the acceptance
+    if d.kind == "measured":
+        # facets spread over about a hemisphere (solid angle 2 pi): a ball lights those
+        # within its angular radius (rms g/r over the draws) plus the widest half
+        # acceptance plus a facet spacing; twice that, as a real eye's facets crowd
         npix = max(d.facet_counts)
-        lit = min(npix, npix * (mean_a + d.gamma) ** 2 / 2 + 2)
+        rms_a = d.g_max / math.sqrt(3 * d.r_min * d.r_max)
+        half = max(float(e.acceptance.max()) for e in (d.eyes.eye_a, d.eyes.eye_b)) / 2
+        lit = min(npix, npix * (rms_a + half + d.gamma) ** 2 + 2)
         per_row = 2 * lit * index_dtype(npix).itemsize + 8 * (2 + len(FLOATS))
         return int(2 * n * per_row) + 2 * 56 * sum(d.facet_counts)
     npix = d.npix

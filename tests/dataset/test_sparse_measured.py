@@ -229,3 +229,18 @@ def test_each_eyes_indices_range_over_its_own_facet_count(tmp_path, toy_pair):
     bad = _rewrite(path, tmp_path / "past.npz", indices_b=ind)
     with pytest.raises(EyevizError, match=f"indices_b: row 1: index {n_b} outside \\[0, {n_b}\\)"):
         sparse3d.load3d(bad)
+
+
+def test_interrupted_writing_leaves_nothing_and_the_space_estimate_covers_it(tmp_path, toy_pair):
+    dom = Domain3D.for_eyes(toy_pair)
+
+    def stop(k):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        sparse3d.write3d(tmp_path / "d.npz", 20, dom, progress=stop)
+    assert list(tmp_path.iterdir()) == []
+    out = tmp_path / "e.npz"
+    sparse3d.write3d(out, 200, dom, seed=1)
+    need = 2 * out.stat().st_size  # spools and zip side by side
+    assert need <= sparse3d.estimated_bytes3d(200, dom) <= 6 * need
