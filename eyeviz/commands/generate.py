@@ -11,6 +11,7 @@ import argparse
 import os
 import sys
 import time
+import warnings
 
 NAME = "generate"
 HELP = "generate a training data set with the paper's Algorithm 1 (CSV or NPZ)"
@@ -277,7 +278,11 @@ def _run_eye(args: argparse.Namespace, drawn: bool) -> int:
     n = algorithm1_3d.check_n(args.n)
     if not os.path.isfile(args.eye):
         raise EyevizError(f"eye file {args.eye} not found")
-    pair = load_eyes(args.eye, units=args.units)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        pair = load_eyes(args.eye, units=args.units)
+    for w in caught:  # e.g. a size that looks like the wrong unit: one line, no source
+        print(f"generate: warning: {w.message}", file=sys.stderr)
     ranges = {k: getattr(args, k) for k in ("r_min", "r_max", "g_max", "el_max")}
     domain = Domain3D.for_eyes(pair, **ranges)
     algorithm1_3d.make_params3d(domain, args.mode, args.seed, args.segments)

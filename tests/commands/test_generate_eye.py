@@ -107,3 +107,16 @@ def test_missing_eye_file_and_csv_output_are_refused(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "written as .npz" in err, err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_implausible_size_is_one_warning_line(tmp_path, capsys):
+    out = tmp_path / "m.npz"
+    rc = cli.main(
+        ["generate", "-n", "2", "--eye", BEE, "--units", "m", "--seed", "1", "-o", str(out)]
+    )
+    err = capsys.readouterr().err
+    assert rc == 0 and out.exists(), err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("generate: warning: ") and "units" in lines[0]
+    d = sparse3d.load3d(out).domain
+    assert 1000 < d.h < 2000  # metres read as such: the bee is 1000 times larger
