@@ -18,13 +18,9 @@ from eyeviz.app.panels.readout3d import Readout3DPanel
 from eyeviz.core import healpix
 from eyeviz.model.scene import load
 from eyeviz.model.state3d import compute_state3d
+from eyeviz.render.mpl.facet_map import mollweide, mollweide_inverse, view_lonlat
 from eyeviz.render.mpl.figure3d import readout_rows
-from eyeviz.render.mpl.healpix_map import (
-    mollweide,
-    mollweide_inverse,
-    pixel_at,
-    view_lonlat,
-)
+from eyeviz.render.mpl.healpix_map import pixel_at
 from eyeviz.render.mpl.style import UNLIT
 
 SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"

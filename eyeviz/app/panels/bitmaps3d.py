@@ -1,25 +1,30 @@
-"""The spherical eyes' bitmaps beside the 3D view (issue 22 item 4, docs/spherical.md).
+"""The eyes' facets beside the 3D view, for any eye model with facets on a sphere of
+directions (docs/spherical.md, docs/measured.md).
 
-Each eye's HEALPix facets on a Mollweide map seen from inside the eye (forward at the
-centre, the eye's right on the right, as the 3D figure draws them:
-:func:`eyeviz.render.mpl.healpix_map.draw_eye_view`), lit facets in their features'
-colours (a later feature wins), the equator drawn and labelled: that row of facets is the
-planar eye's bitmap (m = 4 nside). The selected ball's lit facets (all of them, those a
-later ball colours too) are outlined in ink: a thick stroke drawn under the lit facets'
-fills, so only the patch's border shows; it follows the selection (Tab in the 3D view).
+Each eye's facets on a Mollweide map seen from inside the eye (forward at the centre, the
+eye's right on the right, as the 3D figure draws them:
+:func:`eyeviz.render.mpl.facet_map.draw_eye_view`), lit facets in their features'
+colours (a later feature wins), the equator drawn. The facets' outlines come from the eye
+model's outline provider (:func:`eyeviz.model.facet_patches.facet_patches`): HEALPix
+cells for the spherical eyes (the equator is labelled: that row of facets is the planar
+eye's bitmap, m = 4 nside), the Voronoi patches of the axes for a measured eye. The
+selected ball's lit facets (all of them, those a later ball colours too) are outlined in
+ink: a thick stroke drawn under the lit facets' fills, so only the patch's border shows;
+it follows the selection (Tab in the 3D view).
 
-Fast updates: what does not change with the balls (the unlit sphere, at nside <= 32 every
-facet with its outline, otherwise one solid ellipse; the graticule) is drawn once and kept
-as a pixel background; a new state sets the lit facets' polygons in place and repaints
-them, the selected ball's outline and the equator over that background (blitting). Only
-the lit facets are polygons: a ball at the paper's distances lights a few hundred of nside
-180's 388,800 facets per eye. The maps are drawn in the exact Mollweide projection
-(:func:`eyeviz.render.mpl.healpix_map.mollweide`) on plain axes, so the point under the
-mouse is inverted in closed form and mapped to its facet by
-:func:`eyeviz.core.healpix.ang2pix_ring` (:func:`~eyeviz.render.mpl.healpix_map.pixel_at`):
-hovering shows the facet's RING index, its direction (azimuth from +x counter-clockwise
-seen from above, forward = 90 deg, and elevation, docs/conventions.md) and its solid angle
-4 pi / npix.
+Fast updates: what does not change with the balls (the unlit sphere: at most
+:data:`~eyeviz.render.mpl.facet_map.MAX_ALL_FACETS` facets per eye every facet with its
+outline, otherwise one solid ellipse; the graticule) is drawn once and kept as a pixel
+background; a new state sets the lit facets' polygons in place and repaints them, the
+selected ball's outline and the equator over that background (blitting). Only the lit
+facets are polygons: a ball at the paper's distances lights a few hundred of nside 180's
+388,800 facets per eye. The maps are drawn in the exact Mollweide projection
+(:func:`eyeviz.render.mpl.facet_map.mollweide`) on plain axes, so the point under the
+mouse is inverted in closed form and handed to the provider
+(:func:`~eyeviz.render.mpl.facet_map.facet_at`): hovering shows the facet's index, its
+direction (azimuth from +x counter-clockwise seen from above, forward = 90 deg, and
+elevation, docs/conventions.md) and its size (a HEALPix facet's solid angle 4 pi / npix, a
+measured facet's acceptance angle).
 """
 
 from __future__ import annotations
@@ -36,20 +41,21 @@ from matplotlib.patches import Polygon
 from PyQt5 import QtCore, QtWidgets
 
 from eyeviz.app.panels.common import wrap_label
-from eyeviz.core import healpix
+from eyeviz.model.facet_patches import FacetPatches, facet_patches, patches_caption
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
-from eyeviz.render.mpl.healpix_map import (
+from eyeviz.render.mpl.facet_map import (
     MAX_ALL_FACETS,
     compound_path,
+    facet_at,
+    map_width,
     mollweide,
-    pixel_at,
     view_lonlat,
     view_polys,
 )
 from eyeviz.render.mpl.style import EDGE, GREY, INK, UNLIT
 
-__all__ = ["Bitmaps3DPanel", "facet_text", "lit_owners"]
+__all__ = ["Bitmaps3DPanel", "lit_owners"]
 
 EYES = ("A", "B")
 STEP = 2  # outline points per facet edge
@@ -67,62 +73,59 @@ def lit_owners(csr: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarr
     return pix, ball[::-1][first]
 
 
-def facet_text(nside: int, pix: int) -> str:
-    """One line: a facet's RING index, direction (azimuth, elevation in degrees) and solid
-    angle (4 pi / npix: every HEALPix facet has the same)."""
-    c = healpix.centers(nside, np.array([pix]))[0]
-    az = math.degrees(math.atan2(c[1], c[0])) % 360.0
-    el = math.degrees(math.asin(max(-1.0, min(1.0, c[2]))))
-    sr = 4.0 * math.pi / healpix.npix(nside)
-    return (
-        f"facet {pix:,}: azimuth {az:.2f}\N{DEGREE SIGN}, elevation {el:.2f}\N{DEGREE SIGN}, "
-        f"{sr:.3g} sr = {sr * SQ_DEG:.3g} deg\N{SUPERSCRIPT TWO}"
-    )
-
-
-def _map_polys(nside: int, pix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Facet outlines in the Mollweide plane, those across the map's edge twice."""
-    verts, over = view_polys(nside, pix, STEP)
+def _map_polys(patches: FacetPatches, pix: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Facet outlines in the Mollweide plane, those across the map's edge twice, and the
+    points that count per outline."""
+    verts, over, counts = view_polys(patches, pix)
     x, y = mollweide(verts[..., 0], verts[..., 1])
-    return np.stack([x, y], axis=-1), over
+    return np.stack([x, y], axis=-1), over, counts
 
 
 class _Outlines:
-    """Facet outlines in the Mollweide plane at one nside, the last call's kept: a drag
+    """Facet outlines in the Mollweide plane of one eye, the last call's kept: a drag
     lights mostly the facets lit a frame before, and only the others are computed."""
 
-    def __init__(self, nside: int) -> None:
-        self.nside = nside
+    def __init__(self, patches: FacetPatches) -> None:
+        self.patches = patches
+        w = map_width(patches)
         self.pix = np.zeros(0, np.int64)
-        self.base = np.zeros((0, 4 * STEP, 2))
-        self.dup = np.zeros((0, 4 * STEP, 2))  # the second copy (where ``over``)
+        self.base = np.zeros((0, w, 2))
+        self.dup = np.zeros((0, w, 2))  # the second copy (where ``over``)
         self.over = np.zeros(0, bool)
+        self.counts = np.zeros(0, np.int64)
 
-    def get(self, pix: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(outlines, across the edge, second copies) of the sorted facets ``pix``."""
+    def get(self, pix: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(outlines, across the edge, second copies, points per outline) of the sorted
+        facets ``pix``."""
         k = pix.size
+        w = self.base.shape[1]
         at = np.minimum(np.searchsorted(self.pix, pix), max(self.pix.size - 1, 0))
         hit = self.pix[at] == pix if self.pix.size else np.zeros(k, bool)
-        base = np.empty((k, 4 * STEP, 2))
-        dup = np.empty((k, 4 * STEP, 2))
+        base = np.empty((k, w, 2))
+        dup = np.empty((k, w, 2))
         over = np.zeros(k, bool)
-        base[hit], dup[hit], over[hit] = self.base[at[hit]], self.dup[at[hit]], self.over[at[hit]]
+        counts = np.zeros(k, np.int64)
+        h = at[hit]
+        base[hit], dup[hit], over[hit], counts[hit] = (
+            self.base[h], self.dup[h], self.over[h], self.counts[h]
+        )  # fmt: skip
         new = np.flatnonzero(~hit)
         if new.size:
-            verts, o = _map_polys(self.nside, pix[new])
-            base[new], over[new] = verts[: new.size], o
+            verts, o, c = _map_polys(self.patches, pix[new])
+            base[new], over[new], counts[new] = verts[: new.size], o, c[: new.size]
             dup[new[o]] = verts[new.size :]
-        self.pix, self.base, self.dup, self.over = pix, base, dup, over
-        return base, over, dup
+        self.pix, self.base, self.dup, self.over, self.counts = pix, base, dup, over, counts
+        return base, over, dup, counts
 
 
-def _by_ball(verts: np.ndarray, owner: np.ndarray, rgba: np.ndarray):
+def _by_ball(verts: np.ndarray, owner: np.ndarray, rgba: np.ndarray, counts: np.ndarray):
     """One compound path per ball (its facets' outlines) and the balls' colours."""
     if owner.size == 0:
         return [], np.zeros((0, 4))
     order = np.argsort(owner, kind="stable")
     groups = np.split(order, np.flatnonzero(np.diff(owner[order])) + 1)
-    return [compound_path(verts[g]) for g in groups], rgba[[int(owner[g[0]]) for g in groups]]
+    paths = [compound_path(verts[g], counts[g]) for g in groups]
+    return paths, rgba[[int(owner[g[0]]) for g in groups]]
 
 
 def _ellipse(n: int = 181) -> np.ndarray:
@@ -139,7 +142,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
 
     def __init__(self, parent: QtWidgets.QWidget | None = None) -> None:
         super().__init__(parent)
-        self.nside: int | None = None
+        self.nside: int | None = None  # the spherical eyes' (None for other models)
+        self.patches: dict[str, FacetPatches] = {}  # per eye: the facets' outline provider
         self.owners: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self.names: list[str] = []
         self.update_ms = 0.0
@@ -152,8 +156,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self._clips: dict[str, Polygon] = {}  # each map's outline (the halo's clip)
         self._halo_keys: dict[str, bytes | None] = {}
         # per eye: the lit facets and their outlines (base, across the edge, second copies)
-        self._geom: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
-        self._outlines = {e: _Outlines(2) for e in EYES}
+        self._geom: dict[str, tuple[np.ndarray, ...]] = {}
+        self._outlines: dict[str, _Outlines] = {}
         self._over: list = []  # animated artists drawn over the lit facets, in order
         self._hover_coll: PolyCollection | None = None
         self.fig = Figure(figsize=(3.6, 4.2), facecolor="white")
@@ -187,8 +191,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
     def set_state(self, state: SceneState3D, scene: Scene, selected: int | None = None) -> None:
         """Show the lit facets of ``state`` (computed from ``scene``) and outline ball
         ``selected``'s: the polygons of the eyes whose lit sets, colours or outline changed
-        are set in place and repainted over the kept background; a new nside redraws the
-        whole figure."""
+        are set in place and repainted over the kept background; new eyes (another nside,
+        another measured pair) redraw the whole figure."""
         t0 = time.perf_counter()
         if state.lit_a is None or state.lit_b is None or not scene.shows("bitmaps"):
             self.canvas.hide()
@@ -202,9 +206,10 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             return
         self.message.hide()
         self.canvas.show()
-        nside = state.pair.nside
-        if nside != self.nside:
-            self._build(nside)
+        pair = state.pair
+        patches = {e: facet_patches(pair, e, STEP) for e in EYES}
+        if any(patches[e] is not self.patches.get(e) for e in EYES):
+            self._build(patches, getattr(pair, "nside", None))
         self.names = [f.name for f in scene.features]
         colors = [f.color for f in scene.features]
         rgba = to_rgba_array(colors) if colors else np.zeros((0, 4))
@@ -223,24 +228,23 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
                 continue
             self._keys[eye] = key
             changed = True
-            base, over, dup = self._geom[eye][1:]
+            base, over, dup, cnt = self._geom[eye][1:]
             # facets inside the map's outline need no clipping (2 ms a frame at nside 180)
             inner, edge = self._lit[eye]
-            paths, fc = _by_ball(base[~over], ball[~over], rgba)
+            paths, fc = _by_ball(base[~over], ball[~over], rgba, cnt[~over])
             inner.set_paths(paths)
             inner.set_facecolor(fc)
             paths, fc = _by_ball(
-                np.concatenate([base[over], dup[over]]), np.tile(ball[over], 2), rgba
+                np.concatenate([base[over], dup[over]]),
+                np.tile(ball[over], 2),
+                rgba,
+                np.tile(cnt[over], 2),
             )
             edge.set_paths(paths)
             edge.set_facecolor(fc)
             counts.append(f"{eye} {pix.size:,}")
         sel = "" if self.selected is None else f"; {self.names[self.selected]!r} outlined"
-        self.counts.setText(
-            f"nside {nside}, {healpix.npix(nside):,} facets per eye\nlit: "
-            + ", ".join(counts)
-            + sel
-        )
+        self.counts.setText(f"{patches_caption(pair)}\nlit: " + ", ".join(counts) + sel)
         if changed:
             self._repaint()
         self.update_ms = (time.perf_counter() - t0) * 1e3
@@ -258,12 +262,13 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         if self._halo_keys.get(eye, b"") == hkey:
             return False
         self._halo_keys[eye] = hkey
-        lit, base, over, dup = self._geom[eye]
+        lit, base, over, dup, cnt = self._geom[eye]
         k = np.searchsorted(lit, mine)
         across = over[k]
         verts = np.concatenate([base[k], dup[k[across]]])
+        counts = np.concatenate([cnt[k], cnt[k[across]]])
         halo = self._halo[eye]
-        halo.set_paths([compound_path(verts)] if len(verts) else [])
+        halo.set_paths([compound_path(verts, counts)] if len(verts) else [])
         # clipped to the map only when the patch crosses its edge (a clip path costs a
         # mask of the whole map at every repaint)
         halo.set_clip_path(self._clips[eye] if across.any() else None)
@@ -283,18 +288,19 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
 
     # --- drawing -------------------------------------------------------------------------
 
-    def _build(self, nside: int) -> None:
-        """The static parts for ``nside`` and empty lit collections."""
+    def _build(self, patches: dict[str, FacetPatches], nside: int | None) -> None:
+        """The static parts for the eyes' facets ``patches`` and empty lit collections."""
         self.nside = nside
-        self._outlines = {e: _Outlines(nside) for e in EYES}
+        self.patches = patches
+        self._outlines = {e: _Outlines(p) for e, p in patches.items()}
         self._keys = {}
         self._halo_keys = {}
         self._geom = {}
         self._over = []
         self._bg = None
-        n_pix = healpix.npix(nside)
         ell = _ellipse()
         for eye, ax in self.axes.items():
+            n_pix = patches[eye].n
             ax.clear()
             ax.set_axis_off()
             ax.set_xlim(-2 * R2 * 1.01, 2 * R2 * 1.01)
@@ -302,10 +308,11 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             ax.set_aspect("equal", adjustable="box", anchor="C")
             clip = Polygon(ell, closed=True, transform=ax.transData)
             if n_pix <= MAX_ALL_FACETS:  # every facet, outlined
-                verts, _ = _map_polys(nside, np.arange(n_pix))
+                verts, _, cnt = _map_polys(patches[eye], np.arange(n_pix))
                 back = PolyCollection(
-                    list(verts), facecolors=UNLIT, edgecolors=EDGE, linewidths=0.3
-                )
+                    [v[:c] for v, c in zip(verts, cnt, strict=True)], facecolors=UNLIT,
+                    edgecolors=EDGE, linewidths=0.3,
+                )  # fmt: skip
             else:  # the unlit sphere as one solid ellipse
                 back = PolyCollection([ell], facecolors=UNLIT, edgecolors="none")
             back.set_clip_path(clip)
@@ -320,13 +327,12 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             ax.plot(ell[:, 0], ell[:, 1], color=GREY, lw=0.6)
             for tx, t in ((-R2, "left"), (0.0, "forward"), (R2, "right")):
                 ax.text(tx, -R2 * 1.01, t, fontsize=6.5, color=GREY, ha="center", va="top")
-            # the lit facets: outlined at nside <= 32 (as the unlit ones), plain above (a
-            # stroke of every facet cost 7 ms a frame at nside 180); those across the
+            # the lit facets: outlined when all facets are (as the unlit ones), plain above
+            # (a stroke of every facet cost 7 ms a frame at nside 180); those across the
             # map's edge in a collection of their own, clipped to the outline
+            edged = n_pix <= MAX_ALL_FACETS
             lit = tuple(
-                PathCollection(
-                    [], edgecolors=EDGE, linewidths=0.3 if nside <= 32 else 0.0, animated=True
-                )
+                PathCollection([], edgecolors=EDGE, linewidths=0.3 if edged else 0.0, animated=True)
                 for _ in range(2)
             )
             lit[1].set_clip_path(clip)
@@ -343,7 +349,9 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             self._halo[eye] = halo
             (eq,) = ax.plot([-2 * R2, 2 * R2], [0.0, 0.0], color=INK, lw=0.8, animated=True)
             ax.text(
-                -2 * R2 * 0.97, -0.04, f"equator: the planar eye, m = {4 * nside:,}",
+                -2 * R2 * 0.97, -0.04,
+                "equator: the plane z = 0" if nside is None
+                else f"equator: the planar eye, m = {4 * nside:,}",
                 fontsize=6.5, color=INK, ha="left", va="top",
             )  # fmt: skip
             ax.text(
@@ -384,13 +392,13 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
     def facet_at(self, eye: str, x: float, y: float) -> int:
         """The facet of eye ``eye`` drawn at (x, y) of its map (Mollweide plane), -1 off
         the map."""
-        if self.nside is None:
+        if eye not in self.patches:
             return -1
-        return int(pixel_at(self.nside, x, y))
+        return int(facet_at(self.patches[eye], x, y))
 
     def _on_move(self, event) -> None:
         eye = next((e for e, ax in self.axes.items() if event.inaxes is ax), None)
-        if eye is None or event.xdata is None or self.nside is None:
+        if eye is None or event.xdata is None or not self.patches:
             self._set_hover(None)
             return
         pix = self.facet_at(eye, event.xdata, event.ydata)
@@ -403,13 +411,14 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         if hit == self.hover_pix:
             return
         self.hover_pix = hit
-        if hit is None or self.nside is None:
+        if hit is None or not self.patches:
             self.hover.setText("")
             self.canvas.setToolTip("")
             self._repaint()
             return
         eye, pix = hit
-        text = f"eye {eye}, " + facet_text(self.nside, pix)
+        patches = self.patches[eye]
+        text = f"eye {eye}, " + patches.describe(pix)
         lit, ball = self.owners.get(eye, (np.zeros(0, np.int64), np.zeros(0, np.int64)))
         k = int(np.searchsorted(lit, pix))
         if k < lit.size and lit[k] == pix:
@@ -417,8 +426,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self.hover.setText(text)
         self.canvas.setToolTip(text)
         assert self._hover_coll is not None
-        verts, _ = _map_polys(self.nside, np.array([pix]))
-        self._hover_coll.set_verts(list(verts))
+        verts, _, cnt = _map_polys(patches, np.array([pix]))
+        self._hover_coll.set_verts([v[:c] for v, c in zip(verts, cnt, strict=True)])
         ax = self.axes[eye]
         if self._hover_coll.axes is not ax:
             if self._hover_coll.axes is not None:
@@ -429,8 +438,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
 
     def map_point(self, eye: str, pix: int) -> tuple[float, float]:
         """The Mollweide-plane point of facet ``pix``'s centre on eye ``eye``'s map."""
-        assert self.nside is not None
-        c = healpix.centers(self.nside, np.array([pix]))[0]
+        c = self.patches[eye].centers(np.array([pix]))[0]
         mx, my = view_lonlat(math.atan2(c[1], c[0]), math.asin(max(-1.0, min(1.0, c[2]))))
         x, y = mollweide(mx, my)
         return float(x), float(y)

@@ -37,6 +37,7 @@ from eyeviz import EyevizError
 from eyeviz.core.validation import check_choice
 from eyeviz.files.atomic import atomic_output
 from eyeviz.model.camera3d import PRESETS, Camera3D
+from eyeviz.model.facet_patches import facet_patches
 from eyeviz.model.predictions3d import (
     Predictions3D,
     Predictor3D,
@@ -46,7 +47,7 @@ from eyeviz.model.predictions3d import (
 )
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
-from eyeviz.render.mpl.healpix_map import MapAxes, draw_eye_view, view_lonlat
+from eyeviz.render.mpl.facet_map import MapAxes, draw_eye_view, view_lonlat
 from eyeviz.render.mpl.perspective3d import (
     VIEW_LAYERS,
     default_camera,
@@ -119,8 +120,13 @@ def _draw_view(
         color=GREY, ha="left", va="top",
     )  # fmt: skip
     pair = st.pair
+    if pair.kind == "spherical":
+        facets = f"nside {pair.nside}\n{pair.npix:,} facets each"
+    else:
+        na, nb = getattr(pair, "facet_counts", (0, 0))
+        facets = f"{na:,} + {nb:,} facets"
     eyes_ax.text(
-        0.03, 0.98, f"eyes close up, nside {pair.nside}\n{pair.npix:,} facets each",
+        0.03, 0.98, f"eyes close up, {facets}",
         transform=eyes_ax.transAxes, fontsize=SMALL, color=GREY, ha="left", va="top",
     )  # fmt: skip
 
@@ -357,13 +363,17 @@ def _on_pixels(
 
 
 def _draw_map(ax, st: SceneState3D, scene: Scene, eye: str) -> None:
+    """Eye ``eye``'s facets on ``ax`` (the outlines its model gives:
+    :func:`eyeviz.model.facet_patches.facet_patches`), lit ones in their balls' colours."""
     pair = st.pair
+    patches = facet_patches(pair, eye)
     lits = [st.lit(i, eye) for i in range(st.n)]
-    draw_eye_view(ax, pair.nside, lits, [f.color for f in scene.features])
+    draw_eye_view(ax, patches, lits, [f.color for f in scene.features])
     count = np.unique(np.concatenate(lits)).size if lits else 0
     side = "left" if eye == "A" else "right"
+    nside = f", nside {pair.nside}" if pair.kind == "spherical" else ""
     ax.set_title(
-        f"eye {eye} ({side}), nside {pair.nside}: {count:,} of {pair.npix:,} facets lit",
+        f"eye {eye} ({side}){nside}: {count:,} of {patches.n:,} facets lit",
         fontsize=SMALL, color=INK, pad=3,
     )  # fmt: skip
     for deg in (-60, -30, 30, 60):  # a faint graticule: elevation seen from the eye
@@ -376,10 +386,10 @@ def _draw_map(ax, st: SceneState3D, scene: Scene, eye: str) -> None:
         ax.text(x, -0.01, t, transform=ax.transAxes, fontsize=SMALL, color=GREY, ha="center",
                 va="top")  # fmt: skip
     if "labels" in scene.layers:
-        cx = pair.centers[0 if eye == "A" else 1][0]
+        cx, cy, cz = pair.centers[0 if eye == "A" else 1]
         for f in scene.features:
-            lon = math.atan2(f.y, f.x - cx)
-            lat = math.atan2(f.z, math.hypot(f.x - cx, f.y))
+            lon = math.atan2(f.y - cy, f.x - cx)
+            lat = math.atan2(f.z - cz, math.hypot(f.x - cx, f.y - cy))
             mx, my = view_lonlat(lon, lat)
             # a label on the side away from the map's centre (balls ahead of the eyes
             # crowd there), and inwards near the map's edge
