@@ -157,6 +157,12 @@ def _pair(a, b) -> str:
     return ("A" if a else "") + ("B" if b else "") or "no"
 
 
+def _dist(r: float) -> str:
+    """A distance: whole units from 100 on (the HEALPix scenes'), else three significant
+    digits (a bee's balls are a few millimetres away)."""
+    return f"{r:.0f}" if r >= 100 else f"{r:.3g}"
+
+
 def readout_rows(st: SceneState3D, scene: Scene) -> list[tuple[str, ...]]:
     """The table's rows (strings), one per ball: name, r, azimuth and elevation (degrees),
     g, in the BFV, visible per eye, overlaps per eye, facets lit per eye."""
@@ -165,7 +171,7 @@ def readout_rows(st: SceneState3D, scene: Scene) -> list[tuple[str, ...]]:
         rows.append(
             (
                 short(f.name, 14),
-                f"{st.r[i]:.0f}",
+                _dist(float(st.r[i])),
                 f"{math.degrees(st.azimuth[i]):.1f}",
                 f"{math.degrees(st.elevation[i]):.1f}",
                 f"{f.g:g}",
