@@ -1,5 +1,5 @@
 """Each facet of an eye as a patch of the sphere of directions: what a map of the facets
-draws, for any eye model (docs/spherical.md, docs/measured.md).
+draws, for any eye model (docs/facet_maps.md).
 
 A *facet outline provider* answers, for one eye:
 

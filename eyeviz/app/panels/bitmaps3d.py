@@ -1,5 +1,5 @@
 """The eyes' facets beside the 3D view, for any eye model with facets on a sphere of
-directions (docs/spherical.md, docs/measured.md).
+directions (docs/spherical.md, docs/measured.md, docs/facet_maps.md).
 
 Each eye's facets on a Mollweide map seen from inside the eye (forward at the centre, the
 eye's right on the right, as the 3D figure draws them:

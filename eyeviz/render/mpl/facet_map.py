@@ -1,6 +1,6 @@
 """An eye's facets on a Mollweide map, for any eye model: one painter, fed by a facet
 outline provider (:mod:`eyeviz.model.facet_patches`: HEALPix cells of the spherical
-eyes, Voronoi patches of a measured eye's axes).
+eyes, Voronoi patches of a measured eye's axes; docs/facet_maps.md).
 
 Each facet is one polygon, its outline from the provider. Longitude is the model's (0 =
 +x, counter-clockwise seen from above, docs/conventions.md). :func:`draw_eye_view` shows an
