@@ -131,6 +131,17 @@ def _eye_arrays(
     return out["POSITION"], out["ORIENTATION"], out["DIAMETER"][:, 0], fo[:, 0]
 
 
+def _indices(g: Gltf, v, what: str) -> list[int]:
+    """A list of mirror plane indices (None: none)."""
+    if v is None:
+        return []
+    if not isinstance(v, list) or not all(
+        isinstance(i, int) and not isinstance(i, bool) for i in v
+    ):
+        raise g.fail(f"{what}: mirrorPlanes must be a list of indices")
+    return v
+
+
 def _plane(g: Gltf, root: dict, i, what: str) -> tuple[np.ndarray, np.ndarray]:
     planes = root.get("mirrorPlanes", [])
     if isinstance(i, bool) or not isinstance(i, int) or not isinstance(planes, list):
@@ -204,8 +215,8 @@ def _instances(g: Gltf, root: dict) -> list[tuple[np.ndarray, ...]]:
         m = g.world_matrix(ni, parent) if ni is not None else np.eye(4)
         arrays = _place(*_eye_arrays(g, root, k), m, _similarity(g, m, what))
         placed.append(arrays)
-        planes = list(eye.get("mirrorPlanes", []) or []) + list(
-            (_ext(node) or {}).get("mirrorPlanes", []) or []
+        planes = _indices(g, eye.get("mirrorPlanes"), what) + _indices(
+            g, (_ext(node) or {}).get("mirrorPlanes"), what
         )
         head = ni
         while head is not None and not (_ext(g.obj("nodes", head, "node")) or {}).get("head"):

@@ -22,7 +22,7 @@ import numpy as np
 
 from eyeviz import EyevizError
 from eyeviz.files import limits
-from eyeviz.files.untrusted import read_regular, resolve_inside
+from eyeviz.files.untrusted import open_regular, read_regular, resolve_inside
 
 __all__ = ["Gltf", "encode_gltf", "load_gltf"]
 
@@ -103,7 +103,8 @@ class Gltf:
                 raise EyevizError(f"{what}: the data: uri is not valid base64") from None
         else:
             path = resolve_inside(self.folder, uri, what)
-            data = read_regular(path, limits.MAX_EYE_FILE_BYTES, f"{what} file")
+            with open_regular(path, limits.MAX_EYE_FILE_BYTES, f"{what} file") as (f, _):
+                data = f.read(n)  # only the bytes the buffer declares
         if len(data) < n:
             raise EyevizError(f"{what}: byteLength says {n} bytes, the data holds {len(data)}")
         self._buffers[i] = data[:n]
