@@ -333,6 +333,15 @@ def test_damaged_members_are_named(tmp_path, how, words):
     _refused(_mutated(tmp_path, how), *words)
 
 
+@pytest.mark.parametrize("name", ["x", "y", "z"])
+def test_a_centre_a_millionth_off_its_r_azimuth_elevation_is_refused(tmp_path, name):
+    # far inside any plotting tolerance, far outside float64 rounding (1e-9 r)
+    def nudge(m):
+        m[name][3] += 1e-6 * m["r"][3]
+
+    _refused(_mutated(tmp_path, nudge), "row 4", f"{name}=")
+
+
 @pytest.mark.parametrize(
     "meta, words",
     [
