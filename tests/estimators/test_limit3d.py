@@ -57,6 +57,57 @@ def test_matches_rejection_sampling(brute4):
     assert abs(z.mean()) < 1.5, z
 
 
+def test_azimuth_matches_rejection_sampling(brute4):
+    ds, groups = brute4
+    rows = np.array([g[0] for g in groups])
+    est = Limit3DEstimator(D4, samples=8192)
+    p = est.predict(take_rows(ds.indptr_a, ds.indices_a, rows),
+                    take_rows(ds.indptr_b, ds.indices_b, rows))  # fmt: skip
+    for j, g in enumerate(groups):
+        az = ds.azimuth[g]
+        want = weighted_median(az[None], 1.0 / az[None])[0]  # MAPE-optimal, as the limit's
+        se = 1.2533 * az.std() / np.sqrt(g.size)
+        # a weight that multiplies by the azimuth instead of dividing moves it ~1-3 mrad
+        assert abs(p.azimuth[j] - want) < 4 * se + 2e-4, (j, p.azimuth[j], want, se)
+
+
+def test_answers_are_the_mape_optimal_medians_of_the_posterior_draws(brute4):
+    """r and azimuth: medians weighted by 1/value (MAPE-optimal, the brute force's
+    ``want`` above); elevation: the plain weighted median (MAE). The same seed draws the
+    same posterior in predict and posterior_samples3d, so r and azimuth agree to
+    rounding: a weight of w * az instead of w / az moves the azimuth by ~1e-3."""
+    ds, groups = brute4
+    for g in groups[:3]:
+        a, b = ds.lit(int(g[0]))
+        lit = (np.array([0, a.size]), a), (np.array([0, b.size]), b)
+        p = Limit3DEstimator(D4, samples=2048, seed=5).predict(*lit)
+        s = posterior_samples3d(Limit3DEstimator(D4, samples=2048, seed=5), a, b)
+        w = s["weight"][None]
+        r, az, el = s["r"][None], s["azimuth"][None], s["elevation"][None]
+        assert p.r[0] == pytest.approx(weighted_median(r, w / r)[0], rel=1e-12)
+        assert p.azimuth[0] == pytest.approx(weighted_median(az, w / az)[0], rel=1e-12)
+        # elevation's plain median interpolates between nodes that include the rejected
+        # (zero-weight) draws predict keeps: equal to within the posterior's spread
+        assert abs(p.elevation[0] - weighted_median(el, w)[0]) < 0.1 * el.std() + 1e-9
+
+
+def test_the_stated_monte_carlo_error_is_calibrated(brute4):
+    """Two seeds' answers for one key differ by about sqrt(2) times the stated error:
+    z-scores of the differences have an rms near 1 (an error stated 10x too small gives
+    an rms near 10, 10x too large near 0.1)."""
+    ds, groups = brute4
+    rows = np.array([g[0] for g in groups])
+    lit = (take_rows(ds.indptr_a, ds.indices_a, rows), take_rows(ds.indptr_b, ds.indices_b, rows))
+    z = []
+    for seed in (11, 12, 13, 14):
+        p = Limit3DEstimator(D4, samples=1024, seed=seed).predict(*lit)
+        q = Limit3DEstimator(D4, samples=1024, seed=seed + 100).predict(*lit)
+        err = np.hypot(p.mc_error * p.r, q.mc_error * q.r)
+        z.extend((p.r - q.r) / err)
+    rms = float(np.sqrt(np.mean(np.square(z))))
+    assert 0.3 < rms < 3.0, (rms, z)
+
+
 def test_posterior_samples_reproduce_the_key(brute4):
     ds, groups = brute4
     i = int(groups[0][0])
