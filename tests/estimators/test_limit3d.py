@@ -72,23 +72,20 @@ def test_azimuth_matches_rejection_sampling(brute4):
 
 
 def test_answers_are_the_mape_optimal_medians_of_the_posterior_draws(brute4):
-    """r and azimuth: medians weighted by 1/value (MAPE-optimal, the brute force's
+    """r and azimuth: medians weighted by 1/value (MAPE-optimal, as the brute force's
     ``want`` above); elevation: the plain weighted median (MAE). The same seed draws the
-    same posterior in predict and posterior_samples3d, so r and azimuth agree to
-    rounding: a weight of w * az instead of w / az moves the azimuth by ~1e-3."""
+    same posterior (accepted and rejected draws) in predict and in _posterior, so the
+    answers agree to rounding: a weight of w * az instead of w / az moves the azimuth by
+    ~1e-3."""
     ds, groups = brute4
-    for g in groups[:3]:
-        a, b = ds.lit(int(g[0]))
-        lit = (np.array([0, a.size]), a), (np.array([0, b.size]), b)
-        p = Limit3DEstimator(D4, samples=2048, seed=5).predict(*lit)
-        s = posterior_samples3d(Limit3DEstimator(D4, samples=2048, seed=5), a, b)
-        w = s["weight"][None]
-        r, az, el = s["r"][None], s["azimuth"][None], s["elevation"][None]
-        assert p.r[0] == pytest.approx(weighted_median(r, w / r)[0], rel=1e-12)
-        assert p.azimuth[0] == pytest.approx(weighted_median(az, w / az)[0], rel=1e-12)
-        # elevation's plain median interpolates between nodes that include the rejected
-        # (zero-weight) draws predict keeps: equal to within the posterior's spread
-        assert abs(p.elevation[0] - weighted_median(el, w)[0]) < 0.1 * el.std() + 1e-9
+    rows = np.array([g[0] for g in groups])
+    lit = (take_rows(ds.indptr_a, ds.indices_a, rows), take_rows(ds.indptr_b, ds.indices_b, rows))
+    p = Limit3DEstimator(D4, samples=2048, seed=5).predict(*lit)
+    s = Limit3DEstimator(D4, samples=2048, seed=5)._posterior(*lit)
+    w = s["w"]
+    assert np.allclose(p.r, weighted_median(s["r"], w / s["r"]), rtol=1e-12)
+    assert np.allclose(p.azimuth, weighted_median(s["az"], w / s["az"]), rtol=1e-12)
+    assert np.allclose(p.elevation, weighted_median(s["el"], w), rtol=0, atol=1e-12)
 
 
 def test_the_stated_monte_carlo_error_is_calibrated(brute4):
