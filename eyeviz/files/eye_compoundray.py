@@ -65,27 +65,31 @@ def _token_counts(data: bytes) -> tuple[np.ndarray, np.ndarray]:
     return counts[lines], lines + 1
 
 
-def _parse_numbers(data: bytes, name: str) -> np.ndarray:
-    """Every number in the file, in order (chunks cut at line ends, to bound memory)."""
-    out = []
-    pos = 0
+def _chunks(data: bytes):
+    """(start, end, lines before start) of pieces of about _CHUNK bytes cut after a line
+    end: the file is tokenised piece by piece, to bound the memory a big file takes."""
+    pos, line0 = 0, 0
     while pos < len(data):
         end = data.find(b"\n", min(pos + _CHUNK, len(data)))
         end = len(data) if end < 0 else end + 1
-        toks = data[pos:end].replace(b",", b" ").split()
-        try:
-            out.append(np.array(toks, dtype=np.float64) if toks else np.zeros(0))
-        except ValueError:
-            first = _line_of(data, pos)
-            for i, text in enumerate(data[pos:end].split(b"\n")):
-                for tok in text.replace(b",", b" ").split():
-                    try:
-                        float(tok)
-                    except ValueError:
-                        raise _bad_token(data, first + i, name) from None
-            raise
+        yield pos, end, line0
+        line0 += data.count(b"\n", pos, end)
         pos = end
-    return np.concatenate(out) if out else np.zeros(0)
+
+
+def _numbers(chunk: bytes, data: bytes, line0: int, name: str) -> np.ndarray:
+    """The numbers of one piece, in order; a bad token names its line."""
+    toks = chunk.replace(b",", b" ").split()
+    try:
+        return np.array(toks, dtype=np.float64) if toks else np.zeros(0)
+    except ValueError:
+        for i, text in enumerate(chunk.split(b"\n")):
+            for tok in text.replace(b",", b" ").split():
+                try:
+                    float(tok)
+                except ValueError:
+                    raise _bad_token(data, line0 + i + 1, name) from None
+        raise
 
 
 def _check_rows(rows: np.ndarray, lines: np.ndarray, name: str) -> None:
@@ -123,19 +127,27 @@ def read_eye_rows(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
     if rest:
         pos = data.find(rest[:1])
         raise _bad_token(data, _line_of(data, pos), name)
-    counts, lines = _token_counts(data)
-    if counts.size == 0:
+    k, first, rows_, lines_ = 0, 0, [], []
+    for start, end, line0 in _chunks(data):
+        counts, lines = _token_counts(data[start:end])
+        if counts.size == 0:
+            continue
+        lines += line0
+        if not k:
+            k, first = int(counts[0]), int(lines[0])
+            if k not in (7, 8):
+                raise EyevizError(f"{name}: line {first}: {k} numbers, expected 8 (or 7)")
+        off = np.flatnonzero(counts != k)
+        if off.size:
+            i = int(off[0])
+            raise EyevizError(
+                f"{name}: line {lines[i]}: {counts[i]} numbers, expected {k} as on line {first}"
+            )
+        rows_.append(_numbers(data[start:end], data, line0, name).reshape(-1, k))
+        lines_.append(lines)
+    if not k:
         raise EyevizError(f"{name}: no ommatidia (the file has no numbers)")
-    k = int(counts[0])
-    if k not in (7, 8):
-        raise EyevizError(f"{name}: line {lines[0]}: {k} numbers, expected 8 (or 7)")
-    off = np.flatnonzero(counts != k)
-    if off.size:
-        i = int(off[0])
-        raise EyevizError(
-            f"{name}: line {lines[i]}: {counts[i]} numbers, expected {k} as on line {lines[0]}"
-        )
-    rows = _parse_numbers(data, name).reshape(-1, k)
+    rows, lines = np.concatenate(rows_), np.concatenate(lines_)
     _check_rows(rows, lines, name)
     return rows, lines
 

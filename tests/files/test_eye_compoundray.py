@@ -158,3 +158,23 @@ def test_explicit_frame_changes_the_split(tmp_path):
 def test_unknown_shipped_name_lists_the_shipped():
     with pytest.raises(EyevizError, match="AM_60185-real.eye"):
         shipped_eye("../eyes/x.eye")
+
+
+def test_pieces_keep_rows_and_line_numbers(tmp_path, monkeypatch):
+    from eyeviz.files import eye_compoundray
+
+    pair = load_eyes(shipped_eye("1000-horizontallyAcute-variableDegree.eye"))
+    save_eyes(pair, tmp_path / "p.eye")
+    monkeypatch.setattr(eye_compoundray, "_CHUNK", 300)  # a few lines a piece
+    assert _bits(load_eyes(tmp_path / "p.eye")) == _bits(pair)
+    lines = (tmp_path / "p.eye").read_text().splitlines()
+    good = lines[736]
+    lines[736] = "1-2 " + good.split(" ", 1)[1]  # passes the character check, not float()
+    lines[900] = " ".join(lines[900].split()[:7])
+    (tmp_path / "p.eye").write_text("\n\n" + "\n".join(lines))
+    with pytest.raises(EyevizError, match=r"line 739: '1-2' is not a number"):
+        load_eyes(tmp_path / "p.eye")
+    lines[736] = good
+    (tmp_path / "p.eye").write_text("\n\n" + "\n".join(lines))
+    with pytest.raises(EyevizError, match=r"line 903: 7 numbers, expected 8 as on line 3"):
+        load_eyes(tmp_path / "p.eye")
