@@ -137,8 +137,39 @@ def build_parser():
     for mod in _command_modules():
         p = sub.add_parser(mod.NAME, help=mod.HELP, description=mod.HELP)
         mod.add_arguments(p)
-        p.set_defaults(_run=mod.run)
+        p.set_defaults(_run=mod.run, _outputs=getattr(mod, "OUTPUTS", None))
+    _whole_floats_count(parser)
     return parser
+
+
+def _int_option(text: str) -> int:
+    """A count on the command line, by the package's one integer rule
+    (:mod:`eyeviz.core.validation`, docs/contract.md): ``8`` or a float holding a whole
+    number (``8.0``, ``1e6``), as a scene's ``nside = 8.0`` is; ``8.5`` is refused."""
+    try:
+        return int(text)
+    except ValueError:
+        v = float(text)  # ValueError: argparse says "invalid int value: '...'"
+        if not v.is_integer():
+            raise ValueError(text) from None
+        return int(v)
+
+
+_int_option.__name__ = "int"  # argparse names the type in its message
+
+
+def _whole_floats_count(parser) -> None:
+    """Every ``type=int`` option of ``parser`` and its sub-parsers takes
+    :func:`_int_option` instead (issue 36: ``--nside 8.0`` was refused while a scene's
+    ``nside = 8.0`` and ``study --nside 8.0`` were accepted)."""
+    import argparse
+
+    for action in parser._actions:
+        if action.type is int:
+            action.type = _int_option
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in set(action.choices.values()):
+                _whole_floats_count(sub)
 
 
 def _command_modules() -> list:
@@ -193,6 +224,9 @@ def _run(args) -> int:
     from eyeviz import EyevizError
 
     try:
+        from eyeviz.files.outputs import check_outputs
+
+        check_outputs(args)  # -o a directory: refused before any work (issue 36)
         return int(args._run(args) or 0)
     except EyevizError as exc:
         _error(str(exc))

@@ -10,6 +10,8 @@ import tempfile
 
 NAME = "app"
 HELP = "open the desktop app on a scene (default: assets/scenes/default.toml)"
+#: What the command writes, checked before any work (eyeviz.files.outputs).
+OUTPUTS = {"screenshot": "file"}
 
 
 def add_arguments(parser) -> None:

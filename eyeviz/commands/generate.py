@@ -15,6 +15,8 @@ import warnings
 
 NAME = "generate"
 HELP = "generate a training data set with the paper's Algorithm 1 (CSV or NPZ)"
+#: What the command writes, checked before any work (eyeviz.files.outputs).
+OUTPUTS = {"output": "file"}
 _PROGRESS_MIN = 200_000  # elements; below this a run takes well under a second
 
 
@@ -142,7 +144,21 @@ def _fill_defaults(args: argparse.Namespace) -> None:
             setattr(args, k, DEFAULTS[k])
 
 
+def _refuse_ignored(args: argparse.Namespace) -> None:
+    """An option the run would ignore is refused (issue 36): ``--segments`` cuts r only
+    in multi mode; ``--m`` (even the default 720) is not the HEALPix eyes'."""
+    from eyeviz import EyevizError
+
+    if args.segments is not None and args.mode != "multi":
+        raise EyevizError(
+            f"--segments {args.segments} is for --mode multi; a single pass has no segments"
+        )
+    if args.m is not None and args.nside is not None:
+        raise EyevizError("--m is the planar eye's; with --nside the equator has 4*nside facets")
+
+
 def run(args: argparse.Namespace) -> int:
+    _refuse_ignored(args)
     drawn = _seed(args)
     if args.eye is not None:
         return _run_eye(args, drawn)

@@ -43,6 +43,8 @@ from pathlib import Path
 
 NAME = "predict"
 HELP = "predict distance and azimuth for every row of a data set"
+#: What the command writes, checked before any work (eyeviz.files.outputs).
+OUTPUTS = {"out": "file"}
 EPILOG = (
     "exit status: 0 written (rows that are not a single feature are nan, counted on "
     "stderr); 2 refused, nothing written; 3 written, but the estimator left some "
@@ -93,7 +95,9 @@ def same_file(a, b) -> bool:
 
 
 def _design_text(h: float, l: float, m: int) -> str:  # noqa: E741
-    return f"h={h:g}, l={l:g}, m={m}"
+    from eyeviz.core.validation import num
+
+    return f"h={num(h)}, l={num(l)}, m={m}"
 
 
 def _reader(args, registry):

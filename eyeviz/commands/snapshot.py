@@ -17,6 +17,8 @@ import argparse
 
 NAME = "snapshot"
 HELP = "export a scene as a figure (PNG, or true-vector SVG/PDF) without opening a window"
+#: What the command writes, checked before any work (eyeviz.files.outputs).
+OUTPUTS = {"output": "file"}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -20,6 +20,8 @@ HELP = (
     "grid of (h, l, m), or with --nside the 3D study of the spherical eyes, on Dask (local "
     "processes or an existing cluster); resumable"
 )
+#: What the command writes, checked before any work (eyeviz.files.outputs).
+OUTPUTS = {"output": "file"}
 
 
 def _csv(values) -> str:

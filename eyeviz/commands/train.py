@@ -17,6 +17,8 @@ import sys
 
 NAME = "train"
 HELP = "train an estimator that learns (compact networks, bayes table, the paper's networks)"
+#: What the command writes, checked before any work (eyeviz.files.outputs).
+OUTPUTS = {"out": "path"}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

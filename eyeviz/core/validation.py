@@ -30,10 +30,20 @@ from numbers import Integral, Real
 
 from eyeviz import EyevizError
 
-__all__ = ["check_real", "check_positive", "check_int", "check_choice", "shown"]
+__all__ = ["check_real", "check_positive", "check_int", "check_choice", "num", "shown"]
 
 
-def _num(v: float) -> str:
+def num(v: float) -> str:
+    """``v`` as short as it reads back exactly: ``40`` for 40.0, ``39.999999`` (never
+    ``40``, which ``:g`` printed for it: issue 36), ``1e+300`` for 1e300."""
+    if isinstance(v, Integral):
+        return str(int(v))
+    v = float(v)
+    short = f"{v:g}"
+    return short if float(short) == v or not math.isfinite(v) else repr(v)
+
+
+def _num(v: float) -> str:  # a rule's bound, short: "< 1.5708" for pi/2
     return str(v) if isinstance(v, int) else f"{v:g}"
 
 

@@ -42,7 +42,7 @@ from eyeviz import EyevizError
 from eyeviz.core.bounds import check_r_min, check_segments
 from eyeviz.core.domain import DEFAULTS, Domain
 from eyeviz.core.geometry import EyePair
-from eyeviz.core.validation import check_choice, check_int, check_real
+from eyeviz.core.validation import check_choice, check_int, check_real, num
 from eyeviz.dataset import io as dataset_io
 from eyeviz.dataset.records import CHUNK, PAPER_EYES, Chunk, Dataset
 from eyeviz.files import limits
@@ -150,13 +150,13 @@ def make_params(
     c = math.cos(eyes.psi)
     if g_max <= r_min * s:
         raise EyevizError(
-            f"no feature can be visible: g_max={g_max:g} <= r_min*sin(gamma/2)="
+            f"no feature can be visible: g_max={num(g_max)} <= r_min*sin(gamma/2)="
             f"{r_min * s:.6g} (Algorithm 1 step 9 rejects every r >= r_min)"
         )
     if s >= c:
         raise EyevizError(
             f"no visible feature fits in the BFV: sin(gamma/2)={s:.6g} >= cos(psi)={c:.6g} "
-            f"(m={eyes.m} too small for h={eyes.h:g}, l={eyes.l:g})"
+            f"(m={eyes.m} too small for h={num(eyes.h)}, l={num(eyes.l)})"
         )
     if segments is not None:
         segments = check_segments(segments)

@@ -54,7 +54,7 @@ import numpy as np
 from eyeviz import EyevizError
 from eyeviz.core.bounds import check_r_min, check_segments
 from eyeviz.core.domain3d import Domain3D
-from eyeviz.core.validation import check_choice, check_int
+from eyeviz.core.validation import check_choice, check_int, num
 from eyeviz.dataset.algorithm1 import SEGMENT_WIDTH, segment_labels
 from eyeviz.dataset.records3d import Dataset3D, index_dtype, spherical_to_xyz
 from eyeviz.files import limits
@@ -117,7 +117,7 @@ def make_params3d(
     s = math.sin(domain.gamma / 2)
     if domain.g_max <= domain.r_min * s:
         raise EyevizError(
-            f"no feature can be visible: g_max={domain.g_max:g} <= r_min*sin(gamma/2)="
+            f"no feature can be visible: g_max={num(domain.g_max)} <= r_min*sin(gamma/2)="
             f"{domain.r_min * s:.6g} (Algorithm 1 step 9 rejects every r >= r_min)"
         )
     if domain.kind == "measured":
@@ -125,7 +125,7 @@ def make_params3d(
     elif domain.gamma / 2 + domain.psi >= math.pi / 2:
         raise EyevizError(
             f"no visible feature fits in the binocular field: gamma/2 + psi >= pi/2 "
-            f"(nside={domain.nside} too small for h={domain.h:g}, l={domain.l:g})"
+            f"(nside={domain.nside} too small for h={num(domain.h)}, l={num(domain.l)})"
         )
     if segments is not None:
         segments = check_segments(segments)

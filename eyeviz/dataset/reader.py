@@ -26,7 +26,7 @@ import numpy as np
 from eyeviz import EyevizError
 from eyeviz.core.bounds import MAX_M, check_m
 from eyeviz.core.geometry import EyePair
-from eyeviz.core.validation import check_int
+from eyeviz.core.validation import check_int, num
 from eyeviz.dataset.formats import (
     COMMA,
     ONE,
@@ -173,8 +173,8 @@ class BlockReader:
             )
         if has_design and (eyes.h != file_eyes.h or eyes.l != file_eyes.l):
             raise EyevizError(
-                f"{self.path}: data set was made with h={file_eyes.h:g}, l={file_eyes.l:g}, "
-                f"but eyes have h={eyes.h:g}, l={eyes.l:g}"
+                f"{self.path}: data set was made with h={num(file_eyes.h)}, l={num(file_eyes.l)}, "
+                f"but eyes have h={num(eyes.h)}, l={num(eyes.l)}"
             )
         return eyes
 

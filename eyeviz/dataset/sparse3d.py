@@ -99,20 +99,23 @@ def estimated_bytes3d(n: int, domain: Domain3D) -> int:
     r_max), plus a rim of about 8 pi (g/r) / (cell width) facets.
     """
     d = domain
-    mean_a = d.g_max / 2 / math.sqrt(d.r_min * d.r_max)
+    # ratios, not g_max**2 (which raised OverflowError for g_max = 1e300): a ball wider
+    # than its distance lights the whole eye at most
+    mean_a = min(1.0, d.g_max / math.sqrt(d.r_min) / math.sqrt(d.r_max)) / 2
     if d.kind == "measured":
         # facets spread over about a hemisphere (solid angle 2 pi): a ball lights those
         # within its angular radius (rms g/r over the draws) plus the widest half
         # acceptance plus a facet spacing; twice that, as a real eye's facets crowd
         npix = max(d.facet_counts)
-        rms_a = d.g_max / math.sqrt(3 * d.r_min * d.r_max)
+        rms_a = min(1.0, d.g_max / math.sqrt(3 * d.r_min) / math.sqrt(d.r_max))
         half = max(float(e.acceptance.max()) for e in (d.eyes.eye_a, d.eyes.eye_b)) / 2
         lit = min(npix, npix * (rms_a + half + d.gamma) ** 2 + 2)
         per_row = 2 * lit * index_dtype(npix).itemsize + 8 * (2 + len(FLOATS))
         return int(2 * n * per_row) + 2 * 56 * sum(d.facet_counts)
     npix = d.npix
     rim = 8 * math.pi * mean_a / math.sqrt(4 * math.pi / npix)
-    lit = min(npix, npix * d.g_max**2 / (12 * d.r_min * d.r_max) + rim + 2)
+    share = min(1.0, d.g_max / d.r_min) * min(1.0, d.g_max / d.r_max) / 12
+    lit = min(npix, npix * share + rim + 2)
     per_row = 2 * lit * index_dtype(npix).itemsize + 8 * (2 + len(FLOATS))
     return int(2 * n * per_row)
 

@@ -17,7 +17,7 @@ import torch
 
 from eyeviz import EyevizError
 from eyeviz.core.bounds import MAX_THREADS
-from eyeviz.core.validation import check_int, check_real
+from eyeviz.core.validation import check_int, check_real, num
 from eyeviz.estimators import metrics
 from eyeviz.estimators.base import PAPER_DOMAIN, Domain, bitmaps_to_intervals
 from eyeviz.estimators.compact_net import (
@@ -165,8 +165,8 @@ def _split(data: Dataset, seed: int, domain: Domain) -> tuple[dict, dict]:
     """Single-feature rows of a data set as interval columns, split 90/10 (seeded)."""
     if (data.eyes.h, data.eyes.l, data.eyes.m) != domain.design:
         raise EyevizError(
-            f"data design h={data.eyes.h:g}, l={data.eyes.l:g}, m={data.eyes.m} differs from "
-            f"the domain's h={domain.h:g}, l={domain.l:g}, m={domain.m}"
+            f"data design h={num(data.eyes.h)}, l={num(data.eyes.l)}, m={data.eyes.m} differs from "
+            f"the domain's h={num(domain.h)}, l={num(domain.l)}, m={domain.m}"
         )
     la, ra, lb, rb, ok = bitmaps_to_intervals(data.omega_a, data.omega_b, domain.width)
     cols = {"r": data.r, "phi": data.phi, "la": la, "ra": ra, "lb": lb, "rb": rb}

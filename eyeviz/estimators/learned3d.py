@@ -50,7 +50,7 @@ import numpy as np
 
 from eyeviz import EyevizError
 from eyeviz.core.domain3d import Domain3D
-from eyeviz.core.validation import check_int
+from eyeviz.core.validation import check_int, num
 from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D
 from eyeviz.estimators.learned3d_features import (
     N_FEATURES,
@@ -315,14 +315,14 @@ def check_design(domain: Domain3D, trained: Domain3D, where: str) -> None:
     the trained ones (the network was never shown anything else)."""
     if domain.design != trained.design:
         raise EyevizError(
-            f"learned3d weights in {where} are for h={trained.h:g}, l={trained.l:g}, "
-            f"nside={trained.nside}; the domain has h={domain.h:g}, l={domain.l:g}, "
+            f"learned3d weights in {where} are for h={num(trained.h)}, l={num(trained.l)}, "
+            f"nside={trained.nside}; the domain has h={num(domain.h)}, l={num(domain.l)}, "
             f"nside={domain.nside} (train them for it with `eyeviz train learned3d`)"
         )
     for name, lo in (("r_min", True), ("r_max", False), ("g_max", False), ("el_max", False)):
         have, was = getattr(domain, name), getattr(trained, name)
         if (have < was * (1 - 1e-12)) if lo else (have > was * (1 + 1e-12)):
             raise EyevizError(
-                f"learned3d weights in {where} were trained for {name}={was:g}; the domain's "
-                f"{name}={have:g} lies outside the trained range"
+                f"learned3d weights in {where} were trained for {name}={num(was)}; the domain's "
+                f"{name}={num(have)} lies outside the trained range"
             )

@@ -27,7 +27,7 @@ from eyeviz import EyevizError
 from eyeviz.core.bounds import MAX_THREADS
 from eyeviz.core.domain import Domain
 from eyeviz.core.domain3d import DEFAULT_EL_MAX, Domain3D
-from eyeviz.core.validation import check_int, check_real
+from eyeviz.core.validation import check_int, check_real, num
 from eyeviz.dataset.records3d import Dataset3D
 from eyeviz.estimators import metrics
 from eyeviz.estimators.fit_loop import fit_one_cycle
@@ -87,8 +87,8 @@ def featurise(chunks: Iterable[Dataset3D], domain: Domain3D) -> dict[str, np.nda
     for c in chunks:
         if c.domain.design != domain.design:
             raise EyevizError(
-                f"data design h={c.domain.h:g}, l={c.domain.l:g}, nside={c.domain.nside} "
-                f"differs from the domain's h={domain.h:g}, l={domain.l:g}, "
+                f"data design h={num(c.domain.h)}, l={num(c.domain.l)}, nside={c.domain.nside} "
+                f"differs from the domain's h={num(domain.h)}, l={num(domain.l)}, "
                 f"nside={domain.nside}"
             )
         sa = eye_summaries(domain.nside, c.indptr_a, c.indices_a)

@@ -46,7 +46,7 @@ import numpy as np
 from eyeviz.core.domain3d import Domain3D
 from eyeviz.dataset.records3d import spherical_to_xyz
 from eyeviz.model.palette import estimator_color
-from eyeviz.model.scene import Scene
+from eyeviz.model.scene import SPHERICAL_ESTIMATORS, Scene
 from eyeviz.model.state3d import SceneState3D
 
 __all__ = [
@@ -76,7 +76,7 @@ __all__ = [
 
 #: The estimators a spherical scene shows when its file names none of the spherical ones
 #: (a scene's ``[predictions] estimators`` defaults to the planar ``compact``).
-DEFAULT_ESTIMATORS3D = ("analytic3d", "learned3d", "limit3d")
+DEFAULT_ESTIMATORS3D = SPHERICAL_ESTIMATORS
 LIMIT = "limit3d"
 #: Estimators too slow for a drag frame: answered off the GUI thread, after a drag.
 SLOW = frozenset({LIMIT})
@@ -110,20 +110,27 @@ def estimators3d(scene: Scene, known: list[str] | None = None) -> list[str]:
 def check_estimators(scene: Scene) -> None:
     """EyevizError (one line) when ``scene`` shows predictions and its ``[predictions]
     estimators`` names an estimator the registry does not know at all (a typo: drawing
-    the defaults instead would hide it). Planar names pass (the key is shared; a
-    spherical scene naming none of its own shows :data:`DEFAULT_ESTIMATORS3D`)."""
+    the defaults instead would hide it), or one of the planar eyes (issue 36: ``compact``
+    silently drew the three spherical ones). A scene file naming none gets
+    :data:`~eyeviz.model.scene.SPHERICAL_ESTIMATORS` when it is read."""
     if not scene.shows("predictions"):
         return
     from eyeviz import EyevizError
     from eyeviz.estimators import registry
 
     known = set(registry.available(None))
+    spherical = registry.available("spherical")
     for name in scene.estimators:
+        shown = name if len(name) <= 40 else name[:39] + "\u2026"
         if name not in known:
-            shown = name if len(name) <= 40 else name[:39] + "\u2026"
             raise EyevizError(
                 f"predictions.estimators: unknown estimator {shown!r}; available: "
                 f"{', '.join(registry.available(None))}"
+            )
+        if name not in spherical:
+            raise EyevizError(
+                f"predictions.estimators: {shown!r} is an estimator of the planar eyes; a "
+                f"spherical scene's are {', '.join(spherical)}"
             )
 
 

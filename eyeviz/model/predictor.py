@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from eyeviz.core.geometry import intervals_to_bitmap
+from eyeviz.core.validation import num
 from eyeviz.model.scene import Scene
 from eyeviz.model.state import SceneState, compute_state
 
@@ -48,7 +49,7 @@ def design_of(obj: Any) -> Design | None:
 def trained_for(est: Any) -> str:
     """The short line for an estimator made for other eyes ("trained for h = 40, ...")."""
     d = est.domain
-    return f"trained for h = {d.h:g}, l = {d.l:g}, m = {int(d.m)}"
+    return f"trained for h = {num(d.h)}, l = {num(d.l)}, m = {int(d.m)}"
 
 
 def _any_design(name: str) -> bool:

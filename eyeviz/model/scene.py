@@ -79,6 +79,10 @@ DEFAULT_LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout"]
 SPHERICAL_LAYERS = (
     "eyes", "features", "bfv", "bitmaps", "readout", "labels", "tangents", "plane", "predictions"
 )  # fmt: skip
+#: The estimators of a spherical scene's predictions layer when its file names none (the
+#: planar scenes' default is compact; a spherical scene naming a planar one is refused by
+#: eyeviz.model.predictions3d.check_estimators).
+SPHERICAL_ESTIMATORS = ("analytic3d", "learned3d", "limit3d")
 #: Layers of spherical scenes only (not in the planar layer table, eyeviz.model.layers).
 SPHERICAL_ONLY = ("plane",)
 _COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
@@ -422,7 +426,8 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
 
     pred_t = c.table(doc, "predictions")
     c.keys(pred_t, "predictions.", ("estimators",))
-    estimators = c.strings(pred_t, "estimators", "predictions.", ["compact"])
+    default = list(SPHERICAL_ESTIMATORS) if kind == "spherical" else ["compact"]
+    estimators = c.strings(pred_t, "estimators", "predictions.", default)
     if not estimators and "predictions" in layers:
         raise c.fail("predictions.estimators", "needs at least one estimator name")
 

@@ -20,7 +20,7 @@ from eyeviz import EyevizError
 from eyeviz.core.bounds import check_nside
 from eyeviz.core.domain import DEFAULTS
 from eyeviz.core.domain3d import DEFAULT_EL_MAX
-from eyeviz.core.validation import check_real
+from eyeviz.core.validation import check_real, num
 from eyeviz.study.grid import DEFAULT_H, DEFAULT_L, grid_axes, grid_pairs
 from eyeviz.study.point3d import DEFAULT_ESTIMATOR, DesignPoint3D
 
@@ -86,6 +86,6 @@ def design_grid3d(
             try:
                 p = DesignPoint3D(hv, lv, nv, r_lo, r_hi, g_max, el_max, prior, n, seed, estimator)
             except EyevizError as exc:
-                raise EyevizError(f"design h={hv:g}, l={lv:g}, nside={nv}: {exc}") from None
+                raise EyevizError(f"design h={num(hv)}, l={num(lv)}, nside={nv}: {exc}") from None
             out.append(p)
     return out

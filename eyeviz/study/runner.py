@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from eyeviz import EyevizError
+from eyeviz.core.validation import num
 from eyeviz.study.cpus import usable_cpus
 from eyeviz.study.kinds import POINT_TYPES, Point, columns_of, evaluate3d, open_table
 from eyeviz.study.point import DesignPoint, evaluate
@@ -89,7 +90,7 @@ class StudyFailed(EyevizError):
 
 def _describe(p: Point) -> str:
     res = f"nside={p.nside}" if hasattr(p, "nside") else f"m={p.m}"
-    return f"h={p.h:g}, l={p.l:g}, {res}, n={p.n}, seed={p.seed}, prior={p.prior}"
+    return f"h={num(p.h)}, l={num(p.l)}, {res}, n={p.n}, seed={p.seed}, prior={p.prior}"
 
 
 def _one_line(exc: BaseException) -> str:

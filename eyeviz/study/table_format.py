@@ -24,6 +24,7 @@ from typing import Any
 
 from eyeviz import EyevizError
 from eyeviz.core.bounds import MAX_BINS
+from eyeviz.core.validation import num
 from eyeviz.study.point import BIN_WIDTH, COLUMNS, STUDY_VERSION, DesignPoint
 
 __all__ = [
@@ -97,7 +98,8 @@ class TableFormat:
 
     def describe(self, point) -> str:
         """A point as messages name it: "h=40, l=20, m=180" or "..., nside=180"."""
-        return f"h={point.h:g}, l={point.l:g}, {self.resolution}={getattr(point, self.resolution)}"
+        res = getattr(point, self.resolution)
+        return f"h={num(point.h)}, l={num(point.l)}, {self.resolution}={res}"
 
     def rows_per_point(self, point) -> int:
         """How many rows a point has: "all", its distance bins and elevation bins."""

@@ -14,6 +14,7 @@ from eyeviz import EyevizError
 from eyeviz.core.domain3d import Domain3D
 from eyeviz.estimators import registry
 from eyeviz.model import predictions3d as p3
+from eyeviz.model import scene as scene_mod
 from eyeviz.model.scene import Eyes, Feature, Scene, load
 from eyeviz.model.state3d import compute_state3d
 
@@ -224,9 +225,15 @@ def test_a_name_no_estimator_has_is_refused_in_one_line():
         match=r"^predictions.estimators: unknown estimator 'nonsense'; available: .*limit3d",
     ):
         p3.scene_predictions3d(sc, st, 0, p3.Predictor3D())
-    # planar names pass (the key is shared): the spherical defaults are shown
-    sc.estimators = ["analytic"]
-    p3.check_estimators(sc)
+    # a planar name is refused too (issue 36: "compact" silently drew the spherical three)
+    for planar in ("compact", "analytic"):
+        sc.estimators = ["limit3d", planar]
+        with pytest.raises(
+            EyevizError,
+            match=rf"^predictions.estimators: '{planar}' is an estimator of the planar eyes; "
+            r"a spherical scene's are analytic3d, learned3d, limit3d$",
+        ):
+            p3.check_estimators(sc)
     sc.layers.remove("predictions")  # a scene not showing the layer is not checked
     sc.estimators = ["nonsense"]
     p3.check_estimators(sc)
@@ -235,3 +242,15 @@ def test_a_name_no_estimator_has_is_refused_in_one_line():
 def test_a_name_given_twice_is_one_estimator():
     sc = _scene(estimators=["limit3d", "analytic3d", "limit3d"])
     assert p3.estimators3d(sc, ["analytic3d", "learned3d", "limit3d"]) == ["limit3d", "analytic3d"]
+
+
+def test_a_spherical_scene_file_naming_no_estimator_shows_the_spherical_three():
+    text = (
+        '[eyes]\nh = 40.0\nl = 20.0\nnside = 8\n[layers]\nshow = ["eyes", "predictions"]\n'
+    )
+    sc = scene_mod.loads(text)
+    assert sc.estimators == ["analytic3d", "learned3d", "limit3d"]
+    p3.check_estimators(sc)
+    planar = scene_mod.loads(text.replace("nside = 8", "m = 720"))
+    assert planar.estimators == ["compact"]  # the planar default is unchanged
+

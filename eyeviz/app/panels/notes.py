@@ -3,6 +3,7 @@ than the scene's, or a feature outside its declared r and g range."""
 
 from __future__ import annotations
 
+from eyeviz.core.validation import num
 from eyeviz.model.app_model import AppModel
 
 ANY_DESIGN = frozenset({"analytic", "limit"})  # answer for any h, l, m (no training)
@@ -21,7 +22,7 @@ def design_note(model: AppModel, name: str) -> str | None:
     e = model.scene.eyes
     if (float(d.h), float(d.l), int(d.m)) == (float(e.h), float(e.l), int(e.m)):
         return None
-    return f"trained for h = {d.h:g}, l = {d.l:g}, m = {d.m}"
+    return f"trained for h = {num(d.h)}, l = {num(d.l)}, m = {d.m}"
 
 
 def range_note(model: AppModel, name: str, r: float, g: float) -> str | None:
@@ -32,9 +33,9 @@ def range_note(model: AppModel, name: str, r: float, g: float) -> str | None:
         return None
     out = []  # short lines: each fits the narrowest readout (issue 24)
     if not d.r_min <= r <= d.r_max:
-        out.append(f"r outside [{d.r_min:g}, {d.r_max:g}]")
+        out.append(f"r outside [{num(d.r_min)}, {num(d.r_max)}]")
     if g > d.g_max:
-        out.append(f"g above its {d.g_max:g}")
+        out.append(f"g above its {num(d.g_max)}")
     return "\n".join(out) or None
 
 

@@ -1,0 +1,136 @@
+"""The third adversarial pass, second part (issue 36): messages that name the problem,
+options that would be ignored, and one integer rule for counts. Each case runs the real
+command line (``cli.main``) and reads its one line on stderr."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from eyeviz import cli
+from eyeviz.model import scene as scene_mod
+from eyeviz.resources import scenes_dir
+
+
+def _run(argv: list[str], capsys) -> tuple[int, str, str]:
+    rc = cli.main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def _one_line(rc: int, err: str) -> str:
+    assert rc == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("eyeviz: error: "), err
+    return lines[0]
+
+
+# --- item 6: huge ranges name the problem, not "(34, 'Numerical result out of range')"
+
+
+@pytest.mark.parametrize("extra", [["--g-max", "1e300"], ["--h", "1e300"]])
+def test_huge_ranges_of_a_3d_data_set_are_named(tmp_path, capsys, extra):
+    out = tmp_path / "a.npz"
+    rc, _, err = _run(["generate", "--nside", "8", "-n", "3", "-o", out, "--quiet", *extra], capsys)
+    line = _one_line(rc, err)
+    assert "Numerical result out of range" not in line
+    assert ("h =" in line or "h=" in line) if extra[0] == "--h" else "visible" in line
+    assert not out.exists()
+
+
+# --- item 7: the output path is checked before any work, in every command
+
+
+def _a_dir(tmp_path: Path, name: str) -> Path:
+    d = tmp_path / name
+    d.mkdir()
+    (d / "keep.txt").write_text("mine")
+    return d
+
+
+def test_an_output_that_is_a_directory_is_refused_before_any_work(tmp_path, capsys):
+    scene = scenes_dir() / "default.toml"
+    data = tmp_path / "d.csv"
+    assert _run(["generate", "-n", "20", "-o", data, "--quiet", "--seed", "7"], capsys)[0] == 0
+    cases = [
+        ["generate", "-n", str(10**12), "-o", "{d}"],  # -n is refused later: the path first
+        ["generate", "--nside", "8", "-n", "5", "-o", "{d}", "--seed", "7"],
+        ["predict", "-e", "analytic", data, "-o", "{d}"],
+        ["snapshot", scene, "-o", "{d}"],
+        ["study", "-o", "{d}", "--h", "40", "--l", "20", "--m", "720", "--n", "10"],
+    ]
+    for i, argv in enumerate(cases):
+        d = _a_dir(tmp_path, f"out{i}.{'npz' if 'nside' in argv else 'png'}")
+        argv = [str(d) if a == "{d}" else a for a in argv]
+        rc, out, err = _run(argv, capsys)
+        line = _one_line(rc, err)
+        assert line == f"eyeviz: error: output {str(d)!r} is a directory; give a file name"
+        assert out == ""  # no seed line, no progress: nothing was started
+        assert sorted(p.name for p in d.iterdir()) == ["keep.txt"]
+
+
+def test_a_report_folder_that_is_a_file_is_refused_before_any_work(tmp_path, capsys):
+    data = tmp_path / "d.csv"
+    assert _run(["generate", "-n", "20", "-o", data, "--quiet", "--seed", "7"], capsys)[0] == 0
+    f = tmp_path / "f"
+    f.write_text("mine")
+    rc, _, err = _run(["report", "dataset", data, "-o", f], capsys)
+    assert _one_line(rc, err).endswith(
+        f"output {str(f)!r} is not a folder (a report writes a folder)"
+    )
+    rc, _, err = _run(["report", "dataset", data, "-o", f / "sub"], capsys)
+    assert _one_line(rc, err).endswith(f"its folder {str(f)!r} is not a folder")
+    rc, _, err = _run(["train", "bayes", "-o", f / "x.npz"], capsys)
+    assert _one_line(rc, err).endswith(f"its folder {str(f)!r} is not a folder")
+    assert f.read_text() == "mine"
+
+
+# --- item 14: enough digits, and options that would be ignored are refused
+
+
+def test_a_design_is_printed_with_the_digits_it_has(tmp_path, capsys):
+    rc, _, err = _run(
+        ["generate", "-n", "3", "--l", "39.999999", "-o", tmp_path / "x.csv", "--seed", "7"],
+        capsys,
+    )
+    line = _one_line(rc, err)
+    assert "l=39.999999" in line and "l=40" not in line
+
+
+def test_segments_in_single_mode_and_m_with_nside_are_refused(tmp_path, capsys):
+    rc, _, err = _run(["generate", "-n", "3", "--segments", "4", "-o", tmp_path / "x.csv"], capsys)
+    assert _one_line(rc, err).endswith(
+        "--segments 4 is for --mode multi; a single pass has no segments"
+    )
+    argv = ["generate", "-n", "3", "--nside", "8", "--segments", "4", "-o", tmp_path / "x.npz"]
+    assert "--mode multi" in _one_line(*_run(argv, capsys)[::2])
+    # --m 720 is the planar default: it used to pass unnoticed beside --nside
+    argv = ["generate", "-n", "3", "--nside", "8", "--m", "720", "-o", tmp_path / "x.npz"]
+    assert "--m is the planar eye's" in _one_line(*_run(argv, capsys)[::2])
+    assert not list(tmp_path.iterdir())
+    # multi mode takes it
+    argv = ["generate", "-n", "30", "--mode", "multi", "--segments", "4", "--seed", "7"]
+    assert _run([*argv, "-o", tmp_path / "x.csv", "--quiet"], capsys)[0] == 0
+
+
+# --- item 15: a count is an integer or a float holding a whole number, everywhere
+
+
+def test_a_whole_float_is_a_count_in_scenes_and_on_the_command_line(tmp_path, capsys):
+    base = "[eyes]\nh = 40.0\nl = 20.0\nnside = {}\n"
+    for text in ("8", "8.0", "0x8"):  # TOML's hex literal is the integer 8
+        assert scene_mod.loads(base.format(text)).eyes.nside == 8
+    with pytest.raises(scene_mod.SceneError, match=r"nside must be an even integer"):
+        scene_mod.loads(base.format("8.5"))
+    rows = []
+    for nside in ("8", "8.0"):
+        out = tmp_path / f"a{nside}.npz"
+        argv = ["generate", "--nside", nside, "-n", "4.0", "-o", out, "--seed", "7", "--quiet"]
+        assert _run(argv, capsys)[0] == 0
+        rows.append(out.read_bytes())
+    assert rows[0] == rows[1]  # --nside 8.0 is --nside 8, -n 4.0 is -n 4
+    with pytest.raises(SystemExit) as info:  # argparse's own refusal, exit 2
+        cli.main(["generate", "--nside", "8.5", "-n", "4", "-o", str(tmp_path / "b.npz")])
+    assert info.value.code == 2
+    assert "argument --nside: invalid int value: '8.5'" in capsys.readouterr().err
