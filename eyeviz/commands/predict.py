@@ -173,8 +173,9 @@ def run(args: argparse.Namespace) -> int:
     entry = registry.get(args.estimator)
     _refuse_foreign_options(entry, args, registry)
     out = Path(args.out)
-    if not Path(args.data).is_file():
-        raise EyevizError(f"data file {args.data} not found")
+    from eyeviz.files.limits import check_regular_file
+
+    check_regular_file(args.data, "data file")  # names a folder, FIFO, device, link loop
     if same_file(args.data, out):
         raise EyevizError(f"output {args.out} is the input data file {args.data}; pick another -o")
     if not (out.parent if str(out.parent) else Path(".")).is_dir():
@@ -183,6 +184,8 @@ def run(args: argparse.Namespace) -> int:
 
     kind = kind_of(args.data)
     if kind not in entry.eye_models:
+        if kind == "planar":  # or unreadable: an empty, garbage or truncated NPZ is
+            _reader(args, registry)  # named by the planar reader (issue 36)
         which = {"planar": "a planar", "spherical": "a sparse 3D"}.get(kind, f"a {kind}-eye")
         raise EyevizError(
             f"estimator {entry.name!r} answers for {' and '.join(entry.eye_models)} eyes, but "

@@ -51,13 +51,16 @@ def estimate(
     u, _ = cap_estimates(domain.nside, lit_a)
     v, _ = cap_estimates(domain.nside, lit_b)
     p, ok = triangulate(u, v, domain.h)
-    mean_dir = u + v
-    mean_dir /= np.linalg.norm(mean_dir, axis=1, keepdims=True)
-    p = np.where(ok[:, None], p, domain.r_max * mean_dir)
-    rho = np.linalg.norm(p, axis=1)
-    r = np.clip(rho, domain.r_min, domain.r_max)
-    az = np.arctan2(p[:, 1], p[:, 0])
-    el = np.arcsin(np.clip(p[:, 2] / rho, -1.0, 1.0))
+    # overflow and 0/0 (opposite caps, a design near the float range) give inf/NaN rows,
+    # which are flagged; numpy's RuntimeWarnings on stderr said nothing more (issue 36)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        mean_dir = u + v
+        mean_dir /= np.linalg.norm(mean_dir, axis=1, keepdims=True)
+        p = np.where(ok[:, None], p, domain.r_max * mean_dir)
+        rho = np.linalg.norm(p, axis=1)
+        r = np.clip(rho, domain.r_min, domain.r_max)
+        az = np.arctan2(p[:, 1], p[:, 0])
+        el = np.arcsin(np.clip(p[:, 2] / rho, -1.0, 1.0))
     return r, az, el, ~ok
 
 

@@ -382,10 +382,9 @@ class _Eye:
     def gnomonic(self, v: np.ndarray) -> np.ndarray:
         """Gnomonic offsets (N, M, 2) of unit vectors v (N, M, 3) about the centre."""
         cc = np.einsum("nmj,nj->nm", v, self.c)
-        return np.stack(
-            [np.einsum("nmj,nj->nm", v, self.e1) / cc, np.einsum("nmj,nj->nm", v, self.e2) / cc],
-            axis=-1,
-        )
+        x, y = np.einsum("nmj,nj->nm", v, self.e1), np.einsum("nmj,nj->nm", v, self.e2)
+        with np.errstate(divide="ignore", invalid="ignore"):  # v at 90 deg: inf, no warning
+            return np.stack([x / cc, y / cc], axis=-1)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

@@ -44,9 +44,10 @@ def closest_approach(
     """(s, t, ok) of the closest approach of A + s u and B + t v (unit directions (n, 3)),
     given d = u . (A - B) and e = v . (A - B); ``ok`` is False where the rays do not meet
     in front of both origins (s or t <= 0, parallel, or not finite)."""
-    b = np.einsum("ij,ij->i", u, v)
-    den = 1.0 - b * b
-    with np.errstate(divide="ignore", invalid="ignore"):
+    # eyes near the float range overflow to inf (flagged), not a RuntimeWarning (issue 36)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        b = np.einsum("ij,ij->i", u, v)
+        den = 1.0 - b * b
         s = (b * e - d) / den
         t = (e - b * d) / den
     ok = (den > 1e-15) & (s > 0) & (t > 0) & np.isfinite(s) & np.isfinite(t)
@@ -57,11 +58,13 @@ def triangulate(u: np.ndarray, v: np.ndarray, h: float) -> tuple[np.ndarray, np.
     """(p (n, 3), ok): the midpoint of the closest approach of A + s u and B + t v
     (A = (-h, 0, 0), B = (h, 0, 0), unit directions (n, 3)); ``ok`` False where they do
     not meet in front of both eyes (s or t <= 0, or parallel); p is NaN there."""
-    s, t, ok = closest_approach(u, v, -2.0 * h * u[:, 0], -2.0 * h * v[:, 0])
-    s = np.where(ok, s, np.nan)
-    t = np.where(ok, t, np.nan)
-    p = 0.5 * (s[:, None] * u + t[:, None] * v)
-    return p, ok
+    with np.errstate(over="ignore", invalid="ignore"):
+        s, t, ok = closest_approach(u, v, -2.0 * h * u[:, 0], -2.0 * h * v[:, 0])
+        s = np.where(ok, s, np.nan)
+        t = np.where(ok, t, np.nan)
+        p = 0.5 * (s[:, None] * u + t[:, None] * v)
+    ok &= np.isfinite(p).all(axis=1)
+    return np.where(ok[:, None], p, np.nan), ok
 
 
 def triangulate_xyz(

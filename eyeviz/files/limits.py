@@ -11,6 +11,8 @@ these *before* allocating anything the file declares.
 
 from __future__ import annotations
 
+import errno
+import os
 import shutil
 import stat
 from pathlib import Path
@@ -81,15 +83,40 @@ def check_hidden(name: str, hidden) -> int:
     return check_int(f"model {name}: hidden width", hidden, ge=1, le=MAX_HIDDEN)
 
 
-def check_file_size(path, max_bytes: int, what: str = "file") -> int:
-    """A regular file no larger than ``max_bytes`` (refuses /dev/zero, FIFOs, folders)."""
+#: What a path that is not a regular file is, by its stat mode (for one-line refusals).
+_KINDS = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def check_regular_file(path, what: str = "file") -> os.stat_result:
+    """The stat of ``path`` when it is a regular file (or a link to one); else one line
+    saying what it is instead (issue 36: ``predict`` said "not found" for a directory, a
+    FIFO, /dev/zero and a symlink loop alike)."""
     p = Path(path)
     try:
         st = p.stat()
     except OSError as exc:
+        if exc.errno == errno.ENOENT:
+            why = "not found" if not p.is_symlink() else "a symbolic link to nothing"
+            raise EyevizError(f"{what} {str(p)!r}: {why}") from None
+        if exc.errno == errno.ELOOP:
+            raise EyevizError(f"{what} {str(p)!r}: a loop of symbolic links") from None
         raise EyevizError(f"cannot read {what} {str(p)!r}: {exc.strerror}") from None
     if not stat.S_ISREG(st.st_mode):
-        raise EyevizError(f"{what} {str(p)!r} is not a regular file")
+        kind = next((k for test, k in _KINDS if test(st.st_mode)), "of another kind")
+        raise EyevizError(f"{what} {str(p)!r} is not a regular file: it is {kind}")
+    return st
+
+
+def check_file_size(path, max_bytes: int, what: str = "file") -> int:
+    """A regular file no larger than ``max_bytes`` (refuses /dev/zero, FIFOs, folders)."""
+    p = Path(path)
+    st = check_regular_file(p, what)
     if st.st_size > max_bytes:
         raise EyevizError(f"{what} {str(p)!r} is {st.st_size} bytes, more than {max_bytes}")
     return st.st_size

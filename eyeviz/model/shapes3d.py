@@ -166,7 +166,9 @@ def tangent_cones(apices, centres, g, res: int = 48) -> np.ndarray:
     dd = (d * d).sum(axis=1)
     ok = dd > g * g
     dn = np.sqrt(np.where(ok, dd, 1.0))
-    u = d / dn[:, None]
+    # a ball holding its apex (at an eye centre: d = 0) has no cone; any unit u keeps the
+    # frame below free of 0/0 (a RuntimeWarning on stderr, issue 36)
+    u = np.where(ok[:, None], d / dn[:, None], [0.0, 1.0, 0.0])
     ref = np.where((np.abs(u[:, 2]) < 0.9)[:, None], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
     e1 = np.cross(u, ref)
     e1 /= np.linalg.norm(e1, axis=1, keepdims=True)

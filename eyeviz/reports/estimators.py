@@ -161,6 +161,8 @@ def run3d(args: argparse.Namespace) -> int:
         from eyeviz.dataset.sparse3d import load3d
 
         ds = load3d(args.data)
+        if len(ds) == 0:  # "metrics need at least one value" named no file (issue 36)
+            raise EyevizError(f"data set {args.data} has no rows: there is nothing to measure")
         d = ds.domain
         eyes = (
             f"nside = {d.nside}"

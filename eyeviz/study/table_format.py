@@ -40,6 +40,13 @@ __all__ = [
 
 #: Longest line of a study table (a planar row is about 250 characters, a 3D one 300).
 MAX_LINE_CHARS = 4096
+#: The largest error a study row may report (percent, or degrees): a distance answered
+#: 10^10 times too far. ``dd_mape = 1e308`` passed and broke the report's axes ("arange:
+#: cannot compute length", issue 36); an error above this is no measurement.
+MAX_ERROR = 1e12
+#: The most negative R^2 a row may report (R^2 = 1 - SS_res / SS_tot; below this the
+#: answers are as far off as MAX_ERROR).
+MIN_R2 = -1e30
 
 
 @dataclass(frozen=True)
@@ -207,10 +214,16 @@ def _check_values(fmt: TableFormat, where: str, row: dict, point) -> None:
         v = row[col]
         if not (math.isnan(v) or 0 <= v < math.inf) or (col == "seconds" and math.isnan(v)):
             raise EyevizError(f"{where}: column {col}: must be >= 0 and finite, got {v:g}")
+        if col != "seconds" and v > MAX_ERROR:
+            raise EyevizError(
+                f"{where}: column {col}: {v:g} is no error a study measures (at most {MAX_ERROR:g})"
+            )
     for col in fmt.r2:
         v = row[col]
-        if not (math.isnan(v) or -math.inf < v <= 1):
-            raise EyevizError(f"{where}: column {col}: must be finite and <= 1, got {v:g}")
+        if not (math.isnan(v) or MIN_R2 <= v <= 1):
+            raise EyevizError(
+                f"{where}: column {col}: must be within [{MIN_R2:g}, 1] (an R^2), got {v:g}"
+            )
     if count and any(math.isnan(row[col]) for col in fmt.errors):
         raise EyevizError(f"{where}: a bin with count > 0 needs {', '.join(fmt.errors)}")
     lo, hi = _bin_range(fmt, where, point, row["bin"])

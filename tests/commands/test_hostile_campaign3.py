@@ -4,6 +4,7 @@ command line (``cli.main``) and reads its one line on stderr."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -134,3 +135,76 @@ def test_a_whole_float_is_a_count_in_scenes_and_on_the_command_line(tmp_path, ca
         cli.main(["generate", "--nside", "8.5", "-n", "4", "-o", str(tmp_path / "b.npz")])
     assert info.value.code == 2
     assert "argument --nside: invalid int value: '8.5'" in capsys.readouterr().err
+
+
+# --- item 11: predict names what its data path is, and what an NPZ that is none is
+
+
+def test_predict_names_a_data_path_that_is_no_regular_file(tmp_path, capsys):
+    d = tmp_path / "dir.npz"
+    d.mkdir()
+    fifo = tmp_path / "pipe.npz"
+    os.mkfifo(fifo)
+    loop = tmp_path / "loop.npz"
+    os.symlink(tmp_path / "loop2.npz", loop)
+    os.symlink(loop, tmp_path / "loop2.npz")
+    out = tmp_path / "o.csv"
+    for path, words in (
+        (d, "is not a regular file: it is a directory"),
+        (fifo, "is not a regular file: it is a FIFO (named pipe)"),
+        (Path("/dev/zero"), "is not a regular file: it is a character device"),
+        (loop, ": a loop of symbolic links"),
+        (tmp_path / "absent.npz", ": not found"),
+    ):
+        rc, _, err = _run(["predict", "-e", "analytic3d", path, "-o", out], capsys)
+        line = _one_line(rc, err)
+        assert (
+            line == f"eyeviz: error: data file {str(path)!r}{'' if words[0] == ':' else ' '}{words}"
+        )
+    assert not out.exists()
+
+
+def test_predict_says_an_npz_is_none_rather_than_the_other_kind(tmp_path, capsys):
+    good = tmp_path / "good.npz"
+    argv = ["generate", "--nside", "8", "-n", "20", "-o", good, "--seed", "7", "--quiet"]
+    assert _run(argv, capsys)[0] == 0
+    data = good.read_bytes()
+    cases = {
+        "empty.npz": (b"", "is not an NPZ data set: an empty file"),
+        "garbage.npz": (os.urandom(300), "is not an NPZ data set: not a zip archive"),
+        "truncated.npz": (data[: len(data) // 2], "is not an NPZ data set: not a zip archive"),
+    }
+    for name, (body, words) in cases.items():
+        p = tmp_path / name
+        p.write_bytes(body)
+        for est in ("analytic3d", "analytic"):  # neither kind is named
+            rc, _, err = _run(["predict", "-e", est, p, "-o", tmp_path / "o.csv"], capsys)
+            line = _one_line(rc, err)
+            assert f"data file {p} {words}" in line and "data set; use one of" not in line
+
+
+# --- item 12: a data set without rows is named
+
+
+def test_report_estimators_names_a_data_set_without_rows(tmp_path, capsys):
+    import dataclasses
+
+    import numpy as np
+
+    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.dataset import sparse3d
+    from eyeviz.dataset.algorithm1_3d import generate3d, make_params3d
+
+    p = make_params3d(Domain3D(nside=8), "single", 1, None)
+    ds = generate3d(2, p.domain, "single", 1)
+    empty = {
+        f.name: np.zeros(1, np.int64) if f.name.startswith("indptr") else getattr(ds, f.name)[:0]
+        for f in dataclasses.fields(ds)
+        if isinstance(getattr(ds, f.name), np.ndarray)
+    }
+    path = tmp_path / "zero.npz"
+    sparse3d.write_chunks3d(path, 0, p.domain, p.as_dict(), [dataclasses.replace(ds, **empty)])
+    rc, _, err = _run(["report", "estimators", "--data", path, "-o", tmp_path / "rep"], capsys)
+    line = _one_line(rc, err)
+    assert str(path) in line and "metrics need at least one value" not in line
+    assert not (tmp_path / "rep").exists()

@@ -59,7 +59,9 @@ def test_appends_keep_the_file_and_write_only_the_new_point(tmp_path, rows, monk
         (3, "m", "1_80", "m must be an integer"),
         (3, "h", "4\uff10", "h must be a number"),
         (4, "flagged", "201", "flagged 201 exceeds count"),
-        (4, "dd_r2", "2.5", "dd_r2: must be finite and <= 1"),
+        (4, "dd_mape", "1e308", "column dd_mape: 1e+308 is no error a study measures"),
+        (4, "ad_r2", "-1e308", "ad_r2: must be within [-1e+30, 1]"),
+        (4, "dd_r2", "2.5", "dd_r2: must be within [-1e+30, 1]"),
         (4, "seconds", "nan", "seconds: must be >= 0 and finite"),
     ],
 )

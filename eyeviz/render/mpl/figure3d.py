@@ -205,7 +205,8 @@ def _draw_table(ax, st: SceneState3D, scene: Scene) -> None:
         y = -(i + 1)
         ax.plot([0.008], [y], marker="s", ms=3.5, mew=0, color=scene.features[i].color)
         for j, (x, t) in enumerate(zip(edges, row, strict=True)):
-            ax.text(x + (0.02 if j == 0 else 0.0), y, t, fontsize=SMALL, color=INK, va="center")
+            ax.text(x + (0.02 if j == 0 else 0.0), y, t, fontsize=SMALL, color=INK, va="center",
+                    parse_math=False)  # fmt: skip
 
 
 def _draw_predictions_table(ax, preds: Predictions3D, scene: Scene) -> None:
@@ -219,14 +220,14 @@ def _draw_predictions_table(ax, preds: Predictions3D, scene: Scene) -> None:
     heads = ("estimator", "r", "\u0394r %", "az\u00b0", "\u0394az\u00b0", "el\u00b0",
              "\u0394el\u00b0", f"({name})")  # fmt: skip
     for x, t in zip(edges, heads, strict=True):
-        ax.text(x, 0.0, t, fontsize=SMALL, color=GREY, ha="left", va="center")
+        ax.text(x, 0.0, t, fontsize=SMALL, color=GREY, ha="left", va="center", parse_math=False)
     ax.plot([0, 1], [-0.5, -0.5], color=GREY, lw=0.4)
     for i, row in enumerate(rows):
         y = -(i + 1)
         ax.plot([0.008], [y], marker="s", ms=3.5, mew=0, color=estimator_color3d(row[0]))
         for j, (x, t) in enumerate(zip(edges, row, strict=True)):
             ax.text(x + (0.02 if j == 0 else 0.0), y, short(t, 40), fontsize=SMALL, color=INK,
-                    va="center")  # fmt: skip
+                    va="center", parse_math=False)  # fmt: skip
 
 
 # --- the figure --------------------------------------------------------------------------
@@ -318,7 +319,7 @@ def figure3d(
             if name == "title":
                 fig.text(
                     0.5, (top - h / 2) / height, short(scene.title, 90), ha="center",
-                    va="center", fontsize=FONT + 1, color=INK, gid="title",
+                    va="center", fontsize=FONT + 1, color=INK, gid="title", parse_math=False,
                 )  # fmt: skip
             elif name == "persp":
                 box = rect(m, width - 2 * m, h)
@@ -403,7 +404,7 @@ def _draw_map(ax, st: SceneState3D, scene: Scene, eye: str) -> None:
             ax.annotate(
                 short(f.name, 16), (float(mx), float(my)), xytext=(-4 if west else 4, 3),
                 textcoords="offset points", fontsize=SMALL, color=INK,
-                ha="right" if west else "left",
+                ha="right" if west else "left", parse_math=False,
             )  # fmt: skip
 
 

@@ -255,6 +255,20 @@ def _bfv_batches(state: SceneState3D) -> list[_Batch]:
     return [_Batch(quads, BFV_RGBA, "bfv", width=0.0)]
 
 
+#: At most this many fine tile lines across the eyes (h / l = 1e300 made np.arange ask
+#: for 1e301 of them: "Maximum allowed size exceeded", issue 36); beyond it, 13 about
+#: each eye only.
+MAX_FINE_LINES = 256
+
+
+def _fine_lines(h: float, l: float) -> tuple[np.ndarray, np.ndarray]:  # noqa: E741
+    """x and y of the fine tile lines, a quarter of an eye radius apart, about the eyes."""
+    if (2 * h + 3 * l) / (l / 4) <= MAX_FINE_LINES:
+        return np.arange(-h - 1.5 * l, h + 1.5 * l, l / 4), np.arange(-1.5 * l, 1.5 * l, l / 4)
+    about = np.linspace(-1.5 * l, 1.5 * l, 13)
+    return np.concatenate([-h + about, h + about]), about
+
+
 def _plane(state: SceneState3D) -> tuple[list[_Batch], np.ndarray]:
     """The plane z = 0 as the VTK view draws it (:func:`eyeviz.model.shapes3d.plane_z0`
     over [-0.8, 0.8] x [-0.2, 1] times the reach) in tiles (12 across, a quarter of an eye
@@ -264,8 +278,7 @@ def _plane(state: SceneState3D) -> tuple[list[_Batch], np.ndarray]:
     r = _reach(state)
     x0, x1, y0, y1 = -0.8 * r, 0.8 * r, -0.2 * r, r
     corners, segs = shapes3d.plane_z0(x0, x1, y0, y1)
-    fine_x = np.arange(-pair.h - 1.5 * pair.l, pair.h + 1.5 * pair.l, pair.l / 4)
-    fine_y = np.arange(-1.5 * pair.l, 1.5 * pair.l, pair.l / 4)
+    fine_x, fine_y = _fine_lines(pair.h, pair.l)
     xs = np.unique(np.clip(np.concatenate([np.linspace(x0, x1, 13), fine_x]), x0, x1))
     ys = np.unique(np.clip(np.concatenate([np.linspace(y0, y1, 13), fine_y]), y0, y1))
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
@@ -339,7 +352,8 @@ def _project(batches: list[_Batch], cam: Camera3D, aspect: float, l: float) -> P
         to_cam /= np.linalg.norm(to_cam, axis=-1, keepdims=True)
         if b.centre is not None:  # a closed surface: back faces culled
             normal = mid - b.centre
-            normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+            with np.errstate(divide="ignore", invalid="ignore"):  # an eye of l = 1e-300:
+                normal /= np.linalg.norm(normal, axis=-1, keepdims=True)  # NaN, culled
             keep = (to_cam * normal).sum(axis=-1) > 0
         else:
             normal = None
@@ -459,7 +473,7 @@ def _ball_labels(ax, scene: Scene, cam: Camera3D, aspect: float) -> None:
             box = (x0, y - line, x0 + w, y)
         placed.append(box)
         ax.text(x, y, f" {name}" if right else f"{name} ", fontsize=size, color=f.color,
-                ha="left" if right else "right", va=va)  # fmt: skip
+                ha="left" if right else "right", va=va, parse_math=False)  # fmt: skip
 
 
 #: Points per ghost outline; the VTK layer's pixel sizes scaled to points of the figure.

@@ -26,6 +26,12 @@ from vtkmodules.vtkRenderingCore import (
 
 from eyeviz.render.vtk.style import INK, style_text
 
+# Text from a scene is drawn as written, as the figures draw it (parse_math=False): VTK's
+# text renderer (one instance for the process) sent a string with two "$" to its MathText
+# backend, matplotlib's parser, so "cost $5 and $6" lost its dollars and a name "$x^$"
+# printed 36 warning lines and no text (issues 35, 36). FreeType draws every string.
+vtkTextRenderer().SetDefaultBackend(vtkTextRenderer.FreeType)
+
 __all__ = [
     "CIRCLE_N",
     "UNIT",
