@@ -38,7 +38,8 @@ def _eyeviz(*args, cwd):
         (["-n", "10", "--r-min", "1e-300", "--r-max", "1e-299"], "r_min = 1e-300 is below"),
         (["-n", "10", "--r-min", "1e-300"], "r_min = 1e-300 is below"),
         (["-n", "1", "--m", "2000000000"], "m must be an even integer >= 4 and <= 1048576"),
-        (["-n", "1e23"], "invalid int value"),
+        # a whole float is a count (docs/contract.md), and 1e23 is beyond the bound
+        (["-n", "1e23"], "n must be an integer >= 1 and <= 1000000000"),
         (["-n", "inf"], "invalid int value"),
     ],
 )
