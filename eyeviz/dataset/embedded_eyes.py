@@ -76,23 +76,39 @@ def pair_from_arrays(arrays: dict[str, np.ndarray], fingerprint: str) -> Measure
     return pair
 
 
-def check_lit_rows(pair: MeasuredEyePair, block, start: int, n: int) -> str | None:
+def check_lit_rows(pair, block, start: int, n: int) -> str | None:
     """Re-compute the lit sets of the rows of ``block`` (a Dataset3D of rows ``start ..``
-    of ``n``) that fall on :data:`LIT_CHECK_ROWS` evenly spaced rows of the file; the
-    first mismatch as ``"row k: eye A lights ..."`` (1-based), or None."""
+    of ``n``) that fall on :data:`LIT_CHECK_ROWS` evenly spaced rows of the file, with
+    ``pair.lit_csr`` (any eye model of the seam: the embedded measured pair, or the
+    HEALPix eyes of the file's design); the first mismatch as ``"row k: eye A lights
+    ..."`` (1-based), saying so when the file's eye A and B lists are swapped; or None."""
     want = np.unique(np.linspace(0, max(n - 1, 0), min(n, LIT_CHECK_ROWS)).astype(np.int64))
     rows = want[(want >= start) & (want < start + len(block))] - start
     if rows.size == 0:
         return None
     got = pair.lit_csr(block.x[rows], block.y[rows], block.z[rows], block.g[rows])
-    for (ptr, idx), e in zip(got, ("a", "b"), strict=True):
+
+    def stored(e: str, i: int) -> np.ndarray:
         sptr, sidx = getattr(block, f"indptr_{e}"), getattr(block, f"indices_{e}")
-        for j, i in enumerate(rows):
-            stored = sidx[sptr[i] : sptr[i + 1]]
-            fresh = idx[ptr[j] : ptr[j + 1]]
-            if not np.array_equal(stored.astype(np.int64), fresh):
-                return (
-                    f"row {start + int(i) + 1}: eye {e.upper()} lights {fresh.size} facets of "
-                    f"the embedded eyes, the file lists {stored.size} (or other ones)"
-                )
+        return sidx[sptr[i] : sptr[i + 1]].astype(np.int64)
+
+    def fresh(k: int, j: int) -> np.ndarray:
+        ptr, idx = got[k]
+        return idx[ptr[j] : ptr[j + 1]]
+
+    for j, i in enumerate(rows):
+        same = [np.array_equal(stored(e, i), fresh(k, j)) for k, e in enumerate(("a", "b"))]
+        if all(same):
+            continue
+        row = start + int(i) + 1
+        if np.array_equal(stored("a", i), fresh(1, j)) and np.array_equal(
+            stored("b", i), fresh(0, j)
+        ):
+            return f"row {row}: the file's eye A and eye B lit sets are swapped"
+        k = same.index(False)
+        e = "AB"[k]
+        return (
+            f"row {row}: eye {e} lights {fresh(k, j).size} facets, the file lists "
+            f"{stored(e.lower(), i).size} (or other ones)"
+        )
     return None

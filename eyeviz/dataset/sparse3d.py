@@ -382,6 +382,14 @@ class Sparse3DReader:
             raise self.fail(f"bad meta: {_one_line(exc)}") from None
         self.counts = dict(zip(EYES, self.domain.facet_counts, strict=True))
         self.npix = max(self.domain.facet_counts)  # the index dtype's bound
+        d = self.domain
+        self._eyes = self.pair if self.pair is not None else d.eyes
+        self._eyes_text = (
+            "the embedded eyes"
+            if self.pair is not None
+            else f"the file's design h={d.h:g}, l={d.l:g}, nside={d.nside} (re-computed "
+            "from the stored balls)"
+        )
         want: dict[str, tuple[np.dtype, int]] = {
             f"indptr_{e}": (np.dtype("<i8"), self.n + 1) for e in EYES
         }
@@ -547,10 +555,11 @@ class Sparse3DReader:
             if start + k == self.n:  # before the last block is handed out
                 self._check_crcs(f)
             block = Dataset3D(**out, **cols, domain=self.domain, params=dict(self.params))
-            if self.pair is not None:
-                bad = embedded_eyes.check_lit_rows(self.pair, block, start, self.n)
-                if bad:
-                    raise self.fail(f"the lit sets do not match the embedded eyes: {bad}")
+            # a few rows' lit sets re-computed from their stored balls: an edited design or
+            # swapped eye members (a valid CRC either way) are refused, not answered
+            bad = embedded_eyes.check_lit_rows(self._eyes, block, start, self.n)
+            if bad:
+                raise self.fail(f"the lit sets do not match {self._eyes_text}: {bad}")
             yield block
             start += k
 
