@@ -14,9 +14,10 @@ Estimators that cannot be loaded (the paper nets without weights, say) are liste
 the reason, never crashed on. Output: ``estimators.md``, ``estimators.csv``,
 ``estimators.png`` (error against inference time, log axes).
 
-With ``--data FILE`` (a sparse 3D data set) or ``--nside N`` (a fresh 3D test set) the
-report is the spherical eyes' instead (:mod:`eyeviz.reports.estimators3d`): DD, AD and
-elevation error of the "spherical" estimators and their run time.
+With ``--data FILE`` (a sparse data set of HEALPix or measured eyes), ``--nside N`` (a
+fresh HEALPix test set) or ``--eye FILE`` (a fresh test set of a measured pair) the report
+is the spherical side's instead (:mod:`eyeviz.reports.estimators3d`): DD, AD and
+elevation error of the estimators that answer for those eyes, and their run time.
 """
 
 from __future__ import annotations
@@ -140,6 +141,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "rows at this nside (the paper's h, l, ranges; seed --seed)",
     )
     parser.add_argument(
+        "--eye",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="measured eyes: score the estimators that answer for them on a fresh test "
+        "set of --n-test rows of this eye file (.eye, millimetres; ranges at the "
+        "animal's scale; seed --seed)",
+    )
+    parser.add_argument(
         "--limit-rows",
         type=int,
         default=1000,
@@ -149,13 +159,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run3d(args: argparse.Namespace) -> int:
-    """The spherical eyes' report (``--data`` or ``--nside``)."""
+    """The spherical side's report (``--data``, ``--nside`` or ``--eye``)."""
     from eyeviz import EyevizError
     from eyeviz.estimators import registry
     from eyeviz.reports.estimators3d import measure3d, write3d
 
-    if args.data is not None and args.nside is not None:
-        raise EyevizError("give --data or --nside, not both")
+    given = [f for f in ("data", "nside", "eye") if getattr(args, f, None) is not None]
+    if len(given) > 1:
+        both = "both " if len(given) == 2 else "all of "
+        raise EyevizError(
+            f"give one of --data, --nside, --eye, not {both}--{' and --'.join(given)}"
+        )
     check_int("--limit-rows", args.limit_rows, ge=1, le=limits.MAX_ROWS)
     if args.data is not None:
         from eyeviz.dataset.sparse3d import load3d
@@ -174,6 +188,23 @@ def run3d(args: argparse.Namespace) -> int:
         what = (
             f"Data set `{Path(args.data).name}`: {len(ds)} rows, h = {d.h:g}, "
             f"l = {d.l:g}, {eyes}, params {ds.params}."
+        )
+    elif getattr(args, "eye", None) is not None:
+        from eyeviz.core.domain3d import Domain3D
+        from eyeviz.dataset.algorithm1_3d import generate3d
+        from eyeviz.files.eye_io import load_eyes
+
+        check_int("--n-test", args.n_test, ge=10, le=limits.MAX_ROWS)
+        if not args.eye.is_file():
+            raise EyevizError(f"eye file {args.eye} not found")
+        pair = load_eyes(args.eye)
+        ds = generate3d(args.n_test, Domain3D.for_eyes(pair), "single", args.seed)
+        d = ds.domain
+        what = (
+            f"A fresh test set: {len(ds)} rows of Algorithm 1 (single pass, seed {args.seed}) "
+            f"on the measured eyes `{args.eye.name}` ({d.facet_counts[0]} + "
+            f"{d.facet_counts[1]} facets), r in [{d.r_min:.4g}, {d.r_max:.4g}] mm, g <= "
+            f"{d.g_max:.4g} mm, about the lens centroids' midpoint."
         )
     else:
         from eyeviz.core.domain3d import Domain3D
@@ -215,7 +246,7 @@ def run3d(args: argparse.Namespace) -> int:
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    if getattr(args, "data", None) is not None or getattr(args, "nside", None) is not None:
+    if any(getattr(args, f, None) is not None for f in ("data", "nside", "eye")):
         return run3d(args)
     check_int("--n-test", args.n_test, ge=10, le=limits.MAX_ROWS)
     names = parse_names(args.estimators)

@@ -120,3 +120,16 @@ def test_an_implausible_size_is_one_warning_line(tmp_path, capsys):
     assert len(lines) == 1 and lines[0].startswith("generate: warning: ") and "units" in lines[0]
     d = sparse3d.load3d(out).domain
     assert 1000 < d.h < 2000  # metres read as such: the bee is 1000 times larger
+
+
+def test_report_estimators_on_a_fresh_set_of_an_eye_file(tmp_path, capsys):
+    out = tmp_path / "rep"
+    argv = ["report", "estimators", "--eye", BEE, "--n-test", "10", "--seed", "3", "-o", str(out)]
+    rc = cli.main(argv)
+    text = capsys.readouterr().out
+    assert rc == 0 and "analytic3d" in text, text
+    md = (out / "estimators3d.md").read_text()
+    assert "10 rows of Algorithm 1 (single pass, seed 3) on the measured eyes" in md
+    rc = cli.main([*argv, "--nside", "8"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "give one of --data, --nside, --eye, not both --nside and --eye" in err, err

@@ -113,6 +113,10 @@ def test_reader_refuses_embedded_eyes_that_are_not_the_fingerprints(toy_file, tm
         sparse3d.Sparse3DReader(bad)
     text = str(info.value)
     assert "\n" not in text and "fingerprint" in text and "do not belong together" in text
+    pos[0] = np.nan  # the model's own checks run before the fingerprint
+    bad = _rewrite(path, tmp_path / "nan.npz", eye_a_positions=pos)
+    with pytest.raises(EyevizError, match="eye A: ommatidium 0: lens position is not finite"):
+        sparse3d.Sparse3DReader(bad)
 
 
 def test_reader_refuses_embedded_eyes_of_the_wrong_size_or_missing(toy_file, tmp_path):
