@@ -47,8 +47,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     src.add_argument("--nside", type=int, metavar="N", help="a HEALPix pair of nside N")
     src.add_argument("--m", type=int, metavar="M", help="a planar pair of M ommatidia a ring")
     src.add_argument("file", nargs="?", metavar="FILE", help="an eye file (.eye, .gltf, .glb)")
-    ex.add_argument("--h", type=float, default=40.0, help="half the eye distance, mm; default 40")
-    ex.add_argument("--l", type=float, default=20.0, help="eye radius, mm; default 20")
+    ex.add_argument("--h", type=float, default=None, help="half the eye distance, mm; default 40")
+    ex.add_argument("--l", type=float, default=None, help="eye radius, mm; default 20")
     ex.add_argument("-o", "--output", required=True, metavar="OUT", help="OUT.eye|.gltf|.glb")
     _file_options(ex, "the input FILE")
     ex.add_argument("--to-units", choices=("mm", "m", "um"), default=None, help="output units")
@@ -74,7 +74,7 @@ def _export(args) -> int:
     from eyeviz.files.eye_io import save_eyes
 
     if args.file is not None:
-        if args.h != 40.0 or args.l != 20.0:
+        if args.h is not None or args.l is not None:
             raise EyevizError("--h and --l are for --nside and --m, not for an eye FILE")
         pair = _load(args)
     else:
@@ -84,10 +84,12 @@ def _export(args) -> int:
         from eyeviz.core.geometry3d import EyePair3D
         from eyeviz.core.measured_from import as_measured
 
+        h = 40.0 if args.h is None else args.h
+        l = 20.0 if args.l is None else args.l  # noqa: E741  (the model's name)
         if args.nside is not None:
-            pair = as_measured(EyePair3D(args.h, args.l, args.nside))
+            pair = as_measured(EyePair3D(h, l, args.nside))
         else:
-            pair = as_measured(EyePair(args.h, args.l, args.m))
+            pair = as_measured(EyePair(h, l, args.m))
     out = save_eyes(pair, args.output, units=args.to_units, frame=args.to_frame)
     na, nb = pair.facet_counts
     print(f"wrote {out}: {na} + {nb} ommatidia")

@@ -76,6 +76,7 @@ def test_info_warns_one_line_for_metres(tmp_path, capsys):
         (["eye", "export", "{d}/bad.eye", "-o", "{d}/x.eye"], "line 1"),
         (["eye", "export", "--m", "8", "--frame", "x,z,y", "-o", "{d}/x.eye"], "input FILE"),
         (["eye", "info", "--frame", "x,z,y", "{d}/bad.eye"], "reflection"),
+        (["eye", "export", "{d}/bad.eye", "--h", "40", "-o", "{d}/x.eye"], "not for an eye FILE"),
         (["eye", "info", "{d}/missing.eye"], "cannot read"),
     ],
 )
