@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 from PyQt5 import QtCore, QtGui, QtWidgets
 
 from eyeviz.model.app_model import AppModel
+from eyeviz.model.app_model3d import AppModel3D
 from eyeviz.model.scene import Scene, View
 
 if TYPE_CHECKING:
@@ -24,15 +25,27 @@ PLAY_SHORTCUT = "P"
 
 
 class SceneCommand(QtWidgets.QUndoCommand):
-    """One undo step: the scene before and after (the view is left where the user put it)."""
+    """One undo step of either page: the scene before and after. The planar page's view
+    is left where the user put it (``keep_view``); the 3D page's camera is not in its
+    scene (its model is an :class:`eyeviz.model.app_model3d.AppModel3D`)."""
 
     def __init__(
-        self, model: AppModel, before: Scene, after: Scene, text: str, merge_key: object = None
+        self,
+        model: AppModel | AppModel3D,
+        before: Scene,
+        after: Scene,
+        text: str,
+        merge_key: object = None,
+        keep_view: bool = True,
     ) -> None:
         super().__init__(text)
         self.model, self.before, self.after, self.merge_key = model, before, after, merge_key
+        self.keep_view = keep_view
 
     def _set(self, scene: Scene) -> None:
+        if not self.keep_view:
+            self.model.set_scene(scene)
+            return
         # a shallow replace: set_scene makes the one copy (issue 25: copies cost at 10^4)
         view = View(self.model.scene.view.center, self.model.scene.view.width)
         self.model.set_scene(dataclasses.replace(scene, view=view))
@@ -47,7 +60,7 @@ class SceneCommand(QtWidgets.QUndoCommand):
         return 1 if self.merge_key is not None else -1
 
     def mergeWith(self, other) -> bool:  # noqa: N802 (Qt name)
-        if other.merge_key != self.merge_key:
+        if getattr(other, "model", None) is not self.model or other.merge_key != self.merge_key:
             return False
         self.after = other.after
         return True

@@ -1,6 +1,7 @@
 """The 3D view of the main window: a spherical scene in pyvistaqt, in the same window.
 
-Opening a spherical scene (``[eyes] nside``) swaps the planar view and its strip for this
+Opening a spherical-side scene (HEALPix eyes, ``[eyes] nside``, or measured eyes,
+``[eyes] file``: docs/measured.md) swaps the planar view and its strip for this
 view (:class:`Scene3DHost`), hides the planar docks and shows the 3D ones (the facets on
 Mollweide maps, the readout); opening a planar scene swaps back. The flow is the planar
 one (docs/architecture.md): Qt events -> :mod:`eyeviz.model.app_model3d` (a drag is one
@@ -27,26 +28,23 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Generator
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from PyQt5 import QtCore, QtWidgets
 
+from eyeviz.app.actions import SceneCommand
 from eyeviz.app.help import view3d_help_text
+from eyeviz.app.predictions_layer3d import Predictions3DLayer
 from eyeviz.app.view import make_view
 from eyeviz.model import app_model3d as m3
 from eyeviz.model.camera3d import PRESETS, Camera3D
 from eyeviz.model.predictions3d import (
-    LIMIT,
     LatestOnly,
     Predictions3D,
     Predictor3D,
-    ball_key,
     check_estimators,
-    domain_of,
-    scene_predictions3d,
 )
-from eyeviz.model.scene import SPHERICAL_LAYERS, Scene
+from eyeviz.model.scene import SPHERICAL_LAYERS, Scene, layer_applies
 from eyeviz.render.vtk.scene3d import (
     Scene3DActors,
     camera_of,
@@ -63,7 +61,7 @@ if TYPE_CHECKING:
     from eyeviz.app.panels.readout3d import Readout3DPanel
     from eyeviz.app.view import _Frames
 
-__all__ = ["PRESET_KEYS", "Scene3DCommand", "Scene3DHost"]
+__all__ = ["PRESET_KEYS", "Scene3DHost"]
 
 #: View > 3D view presets: (name, menu text, shortcut)
 PRESET_KEYS = (
@@ -82,32 +80,7 @@ PANEL_MS = 250  # the docks follow a drag at <= 4 Hz (the Mollweide maps take 15
 _MOD_DEPTH = QtCore.Qt.KeyboardModifier.ShiftModifier | QtCore.Qt.KeyboardModifier.ControlModifier
 
 
-class Scene3DCommand(QtWidgets.QUndoCommand):
-    """One undo step of the 3D view: the scene before and after."""
-
-    def __init__(
-        self, model: m3.AppModel3D, before: Scene, after: Scene, text: str, merge_key=None
-    ) -> None:
-        super().__init__(text)
-        self.model, self.before, self.after, self.merge_key = model, before, after, merge_key
-
-    def redo(self) -> None:
-        self.model.set_scene(self.after)
-
-    def undo(self) -> None:
-        self.model.set_scene(self.before)
-
-    def id(self) -> int:  # noqa: A003 (Qt name)
-        return 3 if self.merge_key is not None else -1
-
-    def mergeWith(self, other) -> bool:  # noqa: N802 (Qt name)
-        if getattr(other, "merge_key", None) != self.merge_key:
-            return False
-        self.after = other.after
-        return True
-
-
-class Scene3DHost(QtCore.QObject):
+class Scene3DHost(Predictions3DLayer, QtCore.QObject):
     """The window's 3D page: the view widget, its actors and model, the 3D docks, the
     View > 3D view menu. Built on the first spherical scene; ``active`` while shown."""
 
@@ -326,7 +299,9 @@ class Scene3DHost(QtCore.QObject):
     # --- model -> view -------------------------------------------------------------------
     def _push(self, before: Scene, after: Scene, text: str, merge_key=None) -> None:
         assert self.model is not None
-        self.win.undo_stack.push(Scene3DCommand(self.model, before, after, text, merge_key))
+        self.win.undo_stack.push(
+            SceneCommand(self.model, before, after, text, merge_key, keep_view=False)
+        )
 
     def _on_model(self, what: str, index: int | None) -> None:
         if what == "feature":  # a live move: one frame pending at most
@@ -342,8 +317,10 @@ class Scene3DHost(QtCore.QObject):
         self.draw()
         self.refresh_panels()
         if what == "scene" and self.model is not None:
+            kind = self.model.scene.eyes.kind
             for name, a in self.layer_actions.items():
                 a.setChecked(self.model.scene.shows(name))
+                a.setVisible(layer_applies(name, kind))  # cones: measured eyes only
             QtCore.QTimer.singleShot(0, self.fit_docks)
 
     def flush(self) -> None:
@@ -357,73 +334,6 @@ class Scene3DHost(QtCore.QObject):
                 if self._panel_frames >= PANEL_FRAMES:
                     self._panel_frames = 0
                     self._panel_timer.start()
-
-    # --- the predictions layer -----------------------------------------------------------
-    def _predictions(self) -> None:
-        """The layer's content for the selected ball: the fast estimators now, the limit
-        from the cache, or a job for it when no drag is open (latest key only)."""
-        m, actors = self.model, self.actors
-        assert m is not None and actors is not None
-        if not m.scene.shows("predictions"):
-            self.preds = None
-            self.latest.want(None)
-            actors.draw_predictions(None)
-            return
-        if self.predictor3d is None:
-            self.predictor3d = Predictor3D()
-        dragging = m.live_open
-        preds = scene_predictions3d(
-            m.scene, m.state, m.selected, self.predictor3d, limit="drag" if dragging else "cached"
-        )
-        self.preds = preds
-        actors.draw_predictions(preds)
-        wait = preds is not None and preds.answers.get(LIMIT) == "computing…"
-        key = ball_key(m.state, preds.ball) if wait and preds is not None else None
-        if self.latest.want(key):
-            self._start_limit(key)
-
-    def _start_limit(self, key: bytes | None) -> None:
-        """A worker computes the limit for the selected ball, whose key is ``key``."""
-        m = self.model
-        assert m is not None and self.predictor3d is not None
-        i = m.selected
-        if key is None or i is None or ball_key(m.state, i) != key:
-            self.latest.forget()  # the ball moved on: the next frame asks again
-            return
-        if self.predictor3d.cached(LIMIT, key) is not None:  # answered meanwhile
-            self.latest.forget()
-            self._dirty = True
-            self.draw()
-            return
-        work = self.predictor3d.limit_job(domain_of(m.scene), m.state, i)
-        if isinstance(work, str):
-            self.latest.forget()
-            return
-        self.limit_jobs += 1
-        predictor = self.predictor3d
-        self.win.jobs.start(
-            work,
-            "limit3d: the posterior of the selected ball…",
-            lambda res, k=key, p=predictor: self._limit_done(k, p, res),
-            lambda exc, k=key: self._limit_failed(k, exc),
-        )
-
-    def _limit_done(self, key: bytes, predictor: Predictor3D, res) -> None:
-        predictor.store_limit(key, res)
-        if self.latest.finish(key) and self.active:  # still the ball shown: draw it
-            self._dirty = True
-            self.draw()
-            self.refresh_panels()
-        nxt = self.latest.start_pending()
-        if nxt is not None and self.model is not None and self.active:
-            self._start_limit(nxt)
-        if self.active and not self.win.jobs.busy():  # the runner cleared the status line
-            self.win.statusBar().showMessage(self._status(), 0)
-
-    def _limit_failed(self, key: bytes, exc: BaseException) -> None:
-        self.latest.finish(key)
-        self.latest.forget()
-        self.win.statusBar().showMessage(f"limit3d: {exc}", 8000)
 
     def draw(self) -> None:
         """Update and render now."""
@@ -475,8 +385,7 @@ class Scene3DHost(QtCore.QObject):
 
     def _sync_eyes(self) -> None:
         if self.actors is not None and self.model is not None:
-            e = self.model.scene.eyes
-            self.actors.sync_eyes_camera(e.h, e.l)
+            self.actors.sync_eyes_camera()
 
     # --- camera --------------------------------------------------------------------------
     def _layout(self) -> None:
@@ -648,77 +557,12 @@ class Scene3DHost(QtCore.QObject):
         scale: float = 1.0,
         transparent: bool = False,
         wait: bool = True,
-        *,
-        width: float | str = "single",
-        title: bool = True,
-        table: bool = True,
-        bitmaps: bool = True,
+        **opts,
     ):
-        """File > Export of a spherical scene: the figure (the 3D view through the view's
-        camera, framed as on screen: its height / width, within [0.3, 1.6]; the maps; the
-        readout). SVG/PDF the vector figure (:func:`eyeviz.render.mpl.figure3d.export3d`)
-        on a worker thread; PNG the same figure with the view rendered off-screen by VTK
-        (:func:`eyeviz.render.vtk.png3d.export_png3d`), on this thread."""
-        from eyeviz import EyevizError
-        from eyeviz.app.panels import user_message
-        from eyeviz.render.mpl.figure3d import export3d
-        from eyeviz.render.mpl.vector import resolve_width
+        """File > Export of a spherical scene (:func:`eyeviz.app.export3d.export_view3d`)."""
+        from eyeviz.app.export3d import export_view3d
 
-        assert self.model is not None and self.view is not None
-        scene = self.model.scene.copy()
-        cam = self.camera()
-        win = self.win
-        fmt = Path(path).suffix.lower()
-        result: list = []
-        vw, vh = max(self.view.width(), 1), max(self.view.height(), 1)
-        aspect = min(max(vh / vw, 0.3), 1.6)  # the view's height / width, as on screen
-        opts = dict(
-            width=resolve_width(width), title=title, table=table, bitmaps=bitmaps,
-            aspect=aspect, camera=cam,
-        )  # fmt: skip
-        # the predictions layer: the selected ball's, as shown (computed by the export,
-        # the limit included, while the view still waits for the limit)
-        ball = self.model.selected if self.model.selected is not None else 0
-        preds = self.preds
-        if preds is not None and any(a in ("computing…", "after the drag")
-                                     for a in preds.answers.values()):  # fmt: skip
-            preds = None
-        if fmt == ".png":
-            from eyeviz.render.vtk.png3d import export_png3d
-
-            def work():
-                return export_png3d(
-                    scene, path, scale, transparent, ball=ball, predictions=preds, **opts
-                )
-
-        else:
-
-            def work():
-                return export3d(
-                    scene, path, scale, transparent, predictions=preds, ball=ball, **opts
-                )
-
-        def done(out) -> None:
-            result.append(Path(out))
-            win.statusBar().showMessage(f"exported {out}", 8000)
-
-        def failed(exc) -> None:
-            if isinstance(exc, (EyevizError, OSError, ValueError)):
-                win.show_error("Cannot export", user_message(str(exc), 300))
-            else:
-                win.show_error("Cannot export", f"unexpected error: {user_message(str(exc))}")
-
-        if fmt == ".png":  # VTK renders on this thread (its OpenGL context is per thread)
-            try:
-                done(work())
-            except Exception as exc:  # noqa: BLE001 (shown in a dialog, as the job's)
-                failed(exc)
-            return result[0] if result else None
-        job = win.jobs.start(work, f"exporting {Path(path).name}…", done, failed)
-        if not wait:
-            return job
-        win.jobs.wait()
-        return result[0] if result else None
+        return export_view3d(self, path, scale, transparent, wait, **opts)
 
     def scene_or(self, planar: Scene) -> Scene:
         """The scene the window shows: the 3D page's when active, else ``planar``."""

@@ -1,5 +1,5 @@
-"""The 3D view's model: the open spherical scene, the selection, picking, and a ball's drag
-as one generator (no Qt, no VTK).
+"""The 3D view's model: the open spherical-side scene (HEALPix or measured eyes), the
+selection, picking, and a ball's drag as one generator (no Qt, no VTK).
 
 As the planar :class:`eyeviz.model.app_model.AppModel` (docs/architecture.md): every edit
 goes through :meth:`AppModel3D.commit` (one undo step; the window installs a
@@ -31,7 +31,7 @@ from eyeviz import EyevizError
 from eyeviz.model.camera3d import Camera3D, basis
 from eyeviz.model.edits import feature_value
 from eyeviz.model.scene import OKABE_ITO, Feature, Scene
-from eyeviz.model.state3d import SceneState3D, compute_state3d
+from eyeviz.model.state3d import SceneState3D, compute_state3d, eyes_name
 
 __all__ = [
     "DEPTH_PX",
@@ -111,7 +111,7 @@ def checked_state(scene: Scene) -> SceneState3D:
     n = sum(int(c[1].size) for c in (st.lit_a, st.lit_b) if c is not None)
     if n > MAX_VIEW_LIT:
         raise EyevizError(
-            f"the balls light {n:,} facets at nside {st.pair.nside}; the 3D view draws at "
+            f"the balls light {n:,} facets ({eyes_name(st.pair)}); the 3D view draws at "
             f"most {MAX_VIEW_LIT:,} (smaller balls, farther balls or a smaller nside)"
         )
     return st

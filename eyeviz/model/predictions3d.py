@@ -190,7 +190,7 @@ def range_note(domain: Domain3D, state: SceneState3D, i: int) -> str | None:
 def ball_key(state: SceneState3D, i: int) -> bytes:
     """What an estimator's answer for ball ``i`` depends on: the design and the ball's
     two lit sets (a digest)."""
-    pair = state.pair
+    pair = state.healpix
     h = hashlib.blake2b(digest_size=16)
     h.update(np.array([pair.h, pair.l, pair.nside], np.float64).tobytes())
     for eye in "AB":

@@ -27,6 +27,12 @@ each eye centre to each ball, and plane: the plane z = 0, a layer of spherical s
 :mod:`eyeviz.model.predictions3d`); the planar-only layers (sectors, ambiguity, posterior,
 trajectory, and any registered layer) and a ``[trajectory]`` table are refused in one line.
 
+Measured eyes (docs/measured.md): ``[eyes] file = "..."`` (and ``units``) names an eye file,
+resolved against the scene file's folder and written back relative to the folder a scene
+is saved to (:mod:`eyeviz.model.scene_eyes`); such a scene is on the spherical side too
+(balls in millimetres) and may show the ``cones`` layer (the selected ball's lit
+acceptance cones), not ``predictions`` (:data:`LAYER_KINDS`).
+
 This module imports the standard library and tomli_w only (no Qt, VTK or torch).
 
 It is over 400 lines because every rule of the scene contract is checked in one place
@@ -38,6 +44,7 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 import re
 import tomllib
 import unicodedata
@@ -47,12 +54,10 @@ from pathlib import Path
 import tomli_w
 
 from eyeviz import EyevizError
-from eyeviz.core.bounds import check_m, check_nside
-from eyeviz.core.eyes import EyeModel, design_kind, eyes_from_design
-from eyeviz.core.geometry import EyePair
 from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
 from eyeviz.model.layers import layer_names
+from eyeviz.model.scene_eyes import Eyes, eyes_doc, eyes_from_table
 from eyeviz.model.steps import Step, check_steps, step_doc
 
 __all__ = [
@@ -77,14 +82,26 @@ OKABE_ITO = ("#D55E00", "#0072B2", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "
 DEFAULT_LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout"]
 #: The layers a spherical scene may show (see the module docstring).
 SPHERICAL_LAYERS = (
-    "eyes", "features", "bfv", "bitmaps", "readout", "labels", "tangents", "plane", "predictions"
+    "eyes", "features", "bfv", "bitmaps", "readout", "labels", "tangents", "plane", "predictions",
+    "cones",
 )  # fmt: skip
 #: The estimators of a spherical scene's predictions layer when its file names none (the
 #: planar scenes' default is compact; a spherical scene naming a planar one is refused by
 #: eyeviz.model.predictions3d.check_estimators).
 SPHERICAL_ESTIMATORS = ("analytic3d", "learned3d", "limit3d")
 #: Layers of spherical scenes only (not in the planar layer table, eyeviz.model.layers).
-SPHERICAL_ONLY = ("plane",)
+SPHERICAL_ONLY = ("plane", "cones")
+#: The spherical side's layers that apply to some eye models only (the others: to both):
+#: the estimators' answers to HEALPix eyes (no estimator of measured eyes in the app yet),
+#: the lit acceptance cones to measured eyes (a HEALPix facet has no lens).
+LAYER_KINDS: dict[str, tuple[str, ...]] = {"predictions": ("spherical",), "cones": ("measured",)}
+
+
+def layer_applies(layer: str, kind: str) -> bool:
+    """Whether a spherical-side ``layer`` applies to eyes of model ``kind``."""
+    return kind in LAYER_KINDS.get(layer, (kind,))
+
+
 _COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
 #: Bounds of what a scene may ask the app to draw (see the module docstring).
 MAX_SCENE_COORD = 1e12
@@ -124,45 +141,6 @@ class Feature:
 
 
 @dataclass
-class Eyes:
-    """EyePair parameters: h origin-to-centre, l eye radius, m ommatidia (Table 3); or,
-    with ``nside`` set, the spherical pair EyePair3D(h, l, nside) (docs/spherical.md)."""
-
-    h: float = 40.0
-    l: float = 20.0
-    m: int = 720
-    nside: int | None = None  # set: spherical eyes, and m is the equator's 4 nside
-
-    def __post_init__(self) -> None:
-        if self.nside is not None:
-            self.m = 4 * self.nside
-
-    @property
-    def kind(self) -> str:
-        """``"planar"`` or ``"spherical"`` (:data:`eyeviz.core.eyes.KINDS`)."""
-        return "planar" if self.nside is None else "spherical"
-
-    @property
-    def design(self) -> dict[str, float | int]:
-        """{"h", "l", "m"} or {"h", "l", "nside"}: the design of :mod:`eyeviz.core.eyes`."""
-        if self.nside is None:
-            return {"h": self.h, "l": self.l, "m": self.m}
-        return {"h": self.h, "l": self.l, "nside": self.nside}
-
-    def pair(self) -> EyePair:
-        """The planar EyePair; a spherical scene's eyes are :meth:`model`'s EyePair3D."""
-        if self.nside is not None:
-            raise EyevizError(
-                f"the scene's eyes are spherical (nside = {self.nside}): use Eyes.model()"
-            )
-        return EyePair(self.h, self.l, self.m)
-
-    def model(self) -> EyeModel:
-        """EyePair (planar) or EyePair3D (spherical), through ``eyes_from_design``."""
-        return eyes_from_design(self.design)
-
-
-@dataclass
 class View:
     """The visible region: centre (x, y) and width in model units."""
 
@@ -195,12 +173,9 @@ class Scene:
         features, this ~4 ms; every undo step holds two). Nothing is shared with ``self``:
         the features, lists, view, trajectory and steps are new objects (their fields are
         immutable values: str, float, int, tuple)."""
-        e = self.eyes
-        eyes = Eyes.__new__(Eyes)
-        eyes.h, eyes.l, eyes.m, eyes.nside = e.h, e.l, e.m, e.nside
         t = self.trajectory
         return Scene(
-            eyes,
+            self.eyes.copy(),
             [Feature(f.name, f.x, f.y, f.g, f.color, f.z) for f in self.features],
             list(self.layers),
             list(self.estimators),
@@ -215,8 +190,9 @@ class Scene:
 
     @property
     def kind(self) -> str:
-        """``"planar"`` or ``"spherical"``: the kind of the scene's eyes."""
-        return self.eyes.kind
+        """``"planar"`` or ``"spherical"``: the side of the scene's eyes (HEALPix and
+        measured eyes are both spherical: balls in space; ``eyes.kind`` names the model)."""
+        return self.eyes.side
 
 
 # --- validation ------------------------------------------------------------------------
@@ -326,7 +302,7 @@ def _line_of(text: str, key: str) -> int | None:
     return None
 
 
-def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
+def _scene_from_doc(doc: dict, text: str, source: str, base: Path | None) -> Scene:
     c = _Checker(text, source)
     c.keys(
         doc,
@@ -335,41 +311,8 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
     )
     title = c.string(doc, "title", "", default="")
 
-    eyes_t = c.table(doc, "eyes")
-    c.keys(eyes_t, "eyes.", ("h", "l", "m", "nside"))
-    h = c.number(eyes_t, "h", "eyes.", default=40.0)
-    l = c.number(eyes_t, "l", "eyes.", default=20.0)
-    # no m and no nside: the planar default (m = 720), as before spherical scenes
-    kind = "planar"
-    if "m" in eyes_t or "nside" in eyes_t:
-        try:
-            kind = design_kind(eyes_t)
-        except EyevizError as exc:
-            raise c.fail("eyes.nside", str(exc)) from None
-    if kind == "spherical":
-        try:
-            nside = check_nside(eyes_t["nside"])
-        except EyevizError as exc:
-            raise c.fail("eyes.nside", str(exc)) from None
-        try:
-            eyes_from_design({"h": h, "l": l, "nside": nside})
-        except ValueError as exc:
-            first = str(exc).split(" ")[0]
-            raise c.fail(f"eyes.{first if first in ('h', 'l') else 'h'}", str(exc)) from None
-        eyes = Eyes(h, l, nside=nside)
-    else:
-        try:
-            m = check_m(eyes_t.get("m", 720))
-        except EyevizError as exc:
-            raise c.fail("eyes.m", str(exc)) from None
-        try:
-            EyePair(h, l, m)
-        except ValueError as exc:
-            first = str(exc).split(" ")[0]
-            where = first if first in ("h", "l", "m") else "h"
-            raise c.fail(f"eyes.{where}", str(exc)) from None
-        eyes = Eyes(h, l, m)
-
+    eyes = eyes_from_table(c, c.table(doc, "eyes"), base)
+    kind = eyes.side
     raw_features = doc.get("features", [])
     if not isinstance(raw_features, list):
         raise c.fail("features", "must be an array of tables ([[features]])")
@@ -394,7 +337,7 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
             raise c.fail(
                 f"{p}z",
                 f"feature {name!r} has z = {z!r}, but a planar scene's features lie on "
-                "z = 0 (give [eyes] nside for spherical eyes)",
+                "z = 0 (give [eyes] nside or file for eyes in space)",
             )
         g = c.number(ft, "g", p, rule="radius g > 0")
         if g <= 0:
@@ -422,6 +365,12 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
                     "layers.show",
                     f"layer {name!r} is planar-only; a spherical scene shows "
                     f"{', '.join(SPHERICAL_LAYERS)}",
+                )
+            if not layer_applies(name, eyes.kind):
+                raise c.fail(
+                    "layers.show",
+                    f"layer {name!r} applies to {' and '.join(LAYER_KINDS[name])} eyes, "
+                    f"not to the scene's {eyes.kind} eyes",
                 )
 
     pred_t = c.table(doc, "predictions")
@@ -469,7 +418,11 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
 
     steps = []
     if "steps" in doc:
-        step_layers = SPHERICAL_LAYERS if eyes.kind == "spherical" else known
+        step_layers = (
+            tuple(n for n in SPHERICAL_LAYERS if layer_applies(n, eyes.kind))
+            if eyes.side == "spherical"
+            else known
+        )
         steps = check_steps(doc["steps"], c.fail, step_layers, sorted(names), _bad_text)
         if not estimators and any("predictions" in st.layers for st in steps):
             raise c.fail("predictions.estimators", "a step shows predictions: name an estimator")
@@ -480,8 +433,9 @@ def _scene_from_doc(doc: dict, text: str, source: str) -> Scene:
 # --- public I/O ------------------------------------------------------------------------
 
 
-def loads(text: str, source: str = "<string>") -> Scene:
-    """Parse and validate a scene from TOML text; ``source`` names it in errors."""
+def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = None) -> Scene:
+    """Parse and validate a scene from TOML text; ``source`` names it in errors, ``base``
+    is the folder a relative ``[eyes] file`` is resolved in (the working folder if None)."""
     if len(text) > limits.MAX_SCENE_BYTES:
         raise SceneError(f"{source}: more than {limits.MAX_SCENE_BYTES} characters")
     try:
@@ -493,7 +447,7 @@ def loads(text: str, source: str = "<string>") -> Scene:
     except (ValueError, OverflowError) as exc:  # e.g. an integer of 5000 digits
         raise SceneError(f"{source}: not valid TOML: {_short(str(exc), 120)}") from None
     try:
-        return _scene_from_doc(doc, text, source)
+        return _scene_from_doc(doc, text, source, None if base is None else Path(base))
     except RecursionError:
         raise SceneError(f"{source}: nested too deeply") from None
 
@@ -513,23 +467,21 @@ def load(path) -> Scene:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
         raise SceneError(f"{p}: not a text (UTF-8) file") from None
-    return loads(text, str(p))
+    return loads(text, str(p), p.absolute().parent)
 
 
-def _doc(scene: Scene) -> dict:
-    """The TOML document of ``scene`` as plain data, keys in the order written."""
+def _doc(scene: Scene, base: Path | None = None) -> dict:
+    """The TOML document of ``scene`` as plain data, keys in the order written (an eye
+    file's path relative to ``base``, the folder written to, when given)."""
     doc: dict = {}
     if scene.title:
         doc["title"] = scene.title
     e = scene.eyes
-    if e.nside is None:
-        doc["eyes"] = {"h": float(e.h), "l": float(e.l), "m": int(e.m)}
-    else:
-        doc["eyes"] = {"h": float(e.h), "l": float(e.l), "nside": int(e.nside)}
+    doc["eyes"] = eyes_doc(e, base)
     if scene.features:
         doc["features"] = [
             {"name": f.name, "x": float(f.x), "y": float(f.y), "g": float(f.g), "color": f.color}
-            if e.nside is None  # a planar scene's file never gains a z key
+            if e.kind == "planar"  # a planar scene's file never gains a z key
             else {
                 "name": f.name,
                 "x": float(f.x),
@@ -564,11 +516,13 @@ def _table(name: str | None, tab: dict, aot: bool = False) -> list[str]:
     return head + [f"{k} = {_value(v)}" for k, v in tab.items()] + [""]
 
 
-def dumps(scene: Scene) -> str:
-    """TOML text of ``scene``; ``loads(dumps(s)) == s``. Values are formatted by tomli_w
-    (strings escaped, floats as repr); the layout is one ``key = value`` per line, one
-    ``[[features]]`` table per feature, as the shipped scenes are written."""
-    doc = _doc(scene)
+def dumps(scene: Scene, base: str | os.PathLike | None = None) -> str:
+    """TOML text of ``scene``; ``loads(dumps(s)) == s`` (with ``base``: an eye file's
+    path relative to that folder, and ``loads(dumps(s, base), base=base) == s``). Values
+    are formatted by tomli_w (strings escaped, floats as repr); the layout is one
+    ``key = value`` per line, one ``[[features]]`` table per feature, as the shipped
+    scenes are written."""
+    doc = _doc(scene, None if base is None else Path(base))
     out: list[str] = []
     if "title" in doc:
         out += _table(None, {"title": doc["title"]})
@@ -587,8 +541,9 @@ def dumps(scene: Scene) -> str:
 
 def save(scene: Scene, path) -> None:
     """Write ``scene`` atomically (temp file in the same directory, then os.replace)."""
-    text = dumps(scene)
-    loads(text, str(path))  # refuse to write a scene that would not load back
     p = Path(path)
+    base = p.absolute().parent
+    text = dumps(scene, base)
+    loads(text, str(path), base)  # refuse to write a scene that would not load back
     with atomic_output(p) as tmp:
         tmp.write_text(text, encoding="utf-8")

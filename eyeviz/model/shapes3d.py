@@ -4,7 +4,9 @@ cones, the plane z = 0 and the colour of every facet (no VTK, no matplotlib).
 The VTK painters (:mod:`eyeviz.render.vtk.scene3d`) and a vector figure draw these
 arrays only; the geometry is here, beside the model (docs/architecture.md: renderers never
 compute geometry). The eyes and the balls are those of docs/spherical.md: eye A at
-(-h, 0, 0), eye B at (h, 0, 0), facets the HEALPix cells in RING order.
+(-h, 0, 0), eye B at (h, 0, 0), facets the HEALPix cells in RING order; a measured pair's
+(docs/measured.md) are drawn through :mod:`eyeviz.model.facets3d`, and its h and l (half
+its eyes' distance, its largest lens distance from an eye's centroid) frame the cameras.
 """
 
 from __future__ import annotations
@@ -20,6 +22,8 @@ from eyeviz.model.state3d import SceneState3D
 
 __all__ = [
     "FULL_MAX_NSIDE",
+    "MAX_ACCEPTANCE_CONES",
+    "acceptance_cones",
     "bfv_cones",
     "cone_faces",
     "edge_step",
@@ -115,7 +119,7 @@ def facet_owner(state: SceneState3D, eye: str, out: np.ndarray | None = None) ->
     planar owner of an ommatidium and the 3D figure). ``out`` (int32, npix) is filled in
     place when given.
     """
-    npix = state.pair.npix
+    npix = state.facet_counts[0 if eye == "A" else 1]
     own = np.full(npix, -1, dtype=np.int32) if out is None else out
     if out is not None:
         own.fill(-1)
@@ -189,6 +193,43 @@ def cone_faces(res: int = 48) -> np.ndarray:
     """VTK faces of :func:`tangent_cone`'s points: ``res`` triangles apex, i, i + 1."""
     i = np.arange(res)
     return np.column_stack([np.full(res, 3), np.zeros(res, int), 1 + i, 1 + (i + 1) % res]).ravel()
+
+
+#: The cones layer draws at most this many acceptance cones per eye (a sample beyond).
+MAX_ACCEPTANCE_CONES = 1000
+
+
+def acceptance_cones(
+    positions, axes, acceptance, centre, res: int = 12
+) -> tuple[np.ndarray, np.ndarray]:
+    """Measured facets' acceptance cones (docs/measured.md): per facet the apex at its lens
+    ``positions[i]``, along its unit axis ``axes[i]``, of half-angle ``acceptance[i] / 2``,
+    truncated at the ball ``centre``'s distance from the lens (points: the apex, then
+    ``res`` points of the rim, facet after facet; at most :data:`MAX_ACCEPTANCE_CONES`,
+    an even sample beyond). Returns (points (k (res + 1), 3), the facets drawn)."""
+    pos = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    k = pos.shape[0]
+    take = np.arange(k)
+    if k > MAX_ACCEPTANCE_CONES:
+        take = take[:: -(-k // MAX_ACCEPTANCE_CONES)]
+    pos = pos[take]
+    u = np.asarray(axes, dtype=np.float64).reshape(-1, 3)[take]
+    u = u / np.linalg.norm(u, axis=1, keepdims=True)
+    half = np.asarray(acceptance, dtype=np.float64).reshape(-1)[take] / 2.0
+    length = np.linalg.norm(np.asarray(centre, dtype=np.float64) - pos, axis=1)
+    ref = np.where((np.abs(u[:, 2]) < 0.9)[:, None], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+    e1 = np.cross(u, ref)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    e2 = np.cross(u, e1)
+    t = np.linspace(0.0, 2.0 * math.pi, res, endpoint=False)
+    rad = length * np.tan(half)
+    rim = (pos + u * length[:, None])[:, None, :] + rad[:, None, None] * (
+        np.cos(t)[None, :, None] * e1[:, None, :] + np.sin(t)[None, :, None] * e2[:, None, :]
+    )
+    out = np.empty((pos.shape[0], res + 1, 3))
+    out[:, 0] = pos
+    out[:, 1:] = rim
+    return out.reshape(-1, 3), take
 
 
 def shorten_cones(pts: np.ndarray, res: int, length: float) -> np.ndarray:

@@ -315,10 +315,10 @@ def _shown3d(win) -> dict[str, bool]:
     """What the 3D view draws now, read from its VTK actors."""
     a = win.host3d.actors
     return {
-        "balls": any(b.GetVisibility() for b in a.ball_actors),
-        "cones": bool(a.cone_actor is not None and a.cone_actor.GetVisibility()),
-        "plane": any(p.GetVisibility() for p in a.plane_actors),
-        "bfv": bool(a.bfv_actor is not None and a.bfv_actor.GetVisibility()),
+        "balls": any(b.GetVisibility() for b in a.balls.ball_actors),
+        "cones": bool(a.balls.cone_actor is not None and a.balls.cone_actor.GetVisibility()),
+        "plane": any(p.GetVisibility() for p in a.field.plane_actors),
+        "bfv": bool(a.field.bfv_actor is not None and a.field.bfv_actor.GetVisibility()),
     }
 
 
@@ -390,10 +390,10 @@ def test_f5_f1_f11_and_ctrl_plus_work_in_the_3d_view(make_window, qtbot):
     _keys(qtbot, "ctrl+equal", until=lambda: win.presenter.scale == 1.15)
     assert host.actors.title.GetTextProperty().GetFontSize() == round(title0 * 1.15)
     # a label made after the scaling (a ball added) is at the text scale too
-    n = len(host.actors.ball_labels)
+    n = len(host.actors.balls.ball_labels)
     host.add_ball()
-    qtbot.waitUntil(lambda: len(host.actors.ball_labels) == n + 1, timeout=3000)
-    sizes = {lab.GetTextProperty().GetFontSize() for lab in host.actors.ball_labels}
+    qtbot.waitUntil(lambda: len(host.actors.balls.ball_labels) == n + 1, timeout=3000)
+    sizes = {lab.GetTextProperty().GetFontSize() for lab in host.actors.balls.ball_labels}
     assert sizes == {round(LABEL_PX * 1.15)}
     _keys(qtbot, "ctrl+0", until=lambda: win.presenter.scale == 1.0)
     assert host.actors.title.GetTextProperty().GetFontSize() == title0

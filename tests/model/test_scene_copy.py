@@ -35,7 +35,7 @@ def test_copy_knows_every_field():
             "steps",
         ],
         Feature: ["name", "x", "y", "g", "color", "z"],
-        Eyes: ["h", "l", "m", "nside"],
+        Eyes: ["h", "l", "m", "nside", "file", "units"],
         View: ["center", "width"],
     }
 

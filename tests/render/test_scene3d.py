@@ -61,8 +61,8 @@ def test_one_cell_per_facet_coloured_by_the_lit_sets(renderers):
     st = compute_state3d(sc)
     act = Scene3DActors(*renderers)
     act.update(sc, st, 0)
-    assert act.full and len(act.eye_meshes) == 2
-    for e, mesh in enumerate(act.eye_meshes):
+    assert act.eyes.full and len(act.eyes.meshes) == 2
+    for e, mesh in enumerate(act.eyes.meshes):
         assert mesh.n_cells == healpix.npix(8)
         rgb = _cell_rgb(mesh)
         lit_a, lit_b = st.lit(0, "AB"[e]), st.lit(1, "AB"[e])
@@ -83,27 +83,27 @@ def test_a_move_rewrites_the_colours_in_place(renderers):
     sc = _scene(8, BALLS)
     act = Scene3DActors(*renderers)
     act.update(sc, compute_state3d(sc), 0)
-    mesh = act.eye_meshes[0]
+    mesh = act.eyes.meshes[0]
     arr = mesh.GetCellData().GetAbstractArray("rgb")
     before = _cell_rgb(mesh).copy()
     mtime = arr.GetMTime()
     sc.features[0].x = -120.0  # a live move
     st = compute_state3d(sc)
     act.update(sc, st, 0)
-    assert act.eye_meshes[0] is mesh and mesh.GetCellData().GetAbstractArray("rgb") is arr
+    assert act.eyes.meshes[0] is mesh and mesh.GetCellData().GetAbstractArray("rgb") is arr
     assert arr.GetMTime() > mtime
     after = _cell_rgb(mesh)
     assert not np.array_equal(before, after)
     assert np.all(after[np.setdiff1d(st.lit(0, "A"), st.lit(1, "A"))] == hex_rgb("#D55E00"))
     # the ball's actor moved by its transform, its mesh untouched
-    assert act.ball_actors[0].GetPosition() == pytest.approx((-120.0, 300.0, 0.0))
+    assert act.balls.ball_actors[0].GetPosition() == pytest.approx((-120.0, 300.0, 0.0))
     # far out: the field's cones and plane reach farther, the eyes and balls are kept
-    bfv, ball = act.bfv_actor, act.ball_actors[0]
+    bfv, ball = act.field.bfv_actor, act.balls.ball_actors[0]
     sc.features[0].y = 3000.0
     act.update(sc, compute_state3d(sc), 0)
-    assert act.eye_meshes[0] is mesh and act.ball_actors[0] is ball
-    assert act.bfv_actor is not bfv
-    assert act.plane_actors[1].GetBounds()[3] > 3060.0  # the plane reaches past the ball
+    assert act.eyes.meshes[0] is mesh and act.balls.ball_actors[0] is ball
+    assert act.field.bfv_actor is not bfv
+    assert act.field.plane_actors[1].GetBounds()[3] > 3060.0  # the plane reaches past the ball
 
 
 def test_large_nside_draws_a_coarse_sphere_and_the_lit_patches(renderers):
@@ -111,30 +111,30 @@ def test_large_nside_draws_a_coarse_sphere_and_the_lit_patches(renderers):
     st = compute_state3d(sc)
     act = Scene3DActors(*renderers)
     act.update(sc, st, None)
-    assert not act.full and not act.eye_meshes
+    assert not act.eyes.full and not act.eyes.meshes
     for e in range(2):
-        mesh, a, pix = act.patches[e][0]
+        mesh, a, pix = act.eyes.patches[e][0]
         assert np.array_equal(pix, st.lit(0, "AB"[e]))
         assert mesh.n_cells == pix.size > 100
         assert a.GetProperty().GetColor() == pytest.approx(np.array(hex_rgb("#D55E00")) / 255)
     # an unchanged lit set is not rebuilt
-    mesh0 = act.patches[0][0][0]
+    mesh0 = act.eyes.patches[0][0][0]
     mt = mesh0.GetMTime()
     act.update(sc, st, None)
-    assert act.patches[0][0][0].GetMTime() == mt
+    assert act.eyes.patches[0][0][0].GetMTime() == mt
 
 
 def test_layers_hide_their_actors(renderers):
     sc = _scene(8, BALLS)
     act = Scene3DActors(*renderers)
     act.update(sc, compute_state3d(sc), 0)
-    assert act.cone_actor.GetVisibility() and act.bfv_actor.GetVisibility()
-    assert all(a.GetVisibility() for a in act.plane_actors)
+    assert act.balls.cone_actor.GetVisibility() and act.field.bfv_actor.GetVisibility()
+    assert all(a.GetVisibility() for a in act.field.plane_actors)
     sc.layers = ["eyes"]
     act.update(sc, compute_state3d(sc), 0)
-    assert not act.cone_actor.GetVisibility() and not act.bfv_actor.GetVisibility()
-    assert not any(a.GetVisibility() for a in act.plane_actors + act.ball_actors)
-    assert not any(lab.GetVisibility() for lab in act.ball_labels)
+    assert not act.balls.cone_actor.GetVisibility() and not act.field.bfv_actor.GetVisibility()
+    assert not any(a.GetVisibility() for a in act.field.plane_actors + act.balls.ball_actors)
+    assert not any(lab.GetVisibility() for lab in act.balls.ball_labels)
 
 
 def test_cones_touch_their_balls(renderers):
@@ -142,7 +142,7 @@ def test_cones_touch_their_balls(renderers):
     st = compute_state3d(sc)
     act = Scene3DActors(*renderers)
     act.update(sc, st, 0)
-    pts = np.asarray(act.cones.points).reshape(4, -1, 3)  # A: a, b; then B: a, b
+    pts = np.asarray(act.balls.cones.points).reshape(4, -1, 3)  # A: a, b; then B: a, b
     for k, (cx, i) in enumerate([(-40.0, 0), (-40.0, 1), (40.0, 0), (40.0, 1)]):
         apex, rim = pts[k, 0], pts[k, 1:]
         assert apex == pytest.approx((cx, 0.0, 0.0))
@@ -196,7 +196,9 @@ def test_a_scene_without_balls(renderers, tmp_path):
         sc = _scene(nside, [])
         act = Scene3DActors(*renderers)
         act.update(sc, compute_state3d(sc), None)
-        assert not act.cone_actor.GetVisibility() and not act.select_actor.GetVisibility()
+        assert (
+            not act.balls.cone_actor.GetVisibility() and not act.balls.select_actor.GetVisibility()
+        )
     assert render_png3d(_scene(8, []), tmp_path / "e.png", None, 200, 120).exists()
 
 

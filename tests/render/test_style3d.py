@@ -59,6 +59,6 @@ def test_both_views_draw_the_field_and_the_plane_as_far():
         assert 1.1 * shapes3d.scene_extent(st) <= reach * 2**0.25 + 1e-9
         act = Scene3DActors(vtkRenderer(), vtkRenderer())
         act.update(sc, st, None)
-        assert act.plane_actors[0].GetBounds()[3] == pytest.approx(reach)
+        assert act.field.plane_actors[0].GetBounds()[3] == pytest.approx(reach)
         quads = perspective3d._plane(st)[0][0].pts
         assert quads[..., 1].max() == pytest.approx(reach)

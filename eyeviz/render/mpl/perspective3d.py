@@ -163,7 +163,7 @@ def _eye_batches(state: SceneState3D, scene: Scene, cam: Camera3D) -> list[_Batc
     """Each eye's facets (see the module docstring); an eye drawn smaller than
     :data:`SMALL_EYE` (its radius, a fraction of the view's half height) has its unlit
     sphere drawn at nside 4 under its lit facets, which keep the scene's nside."""
-    pair = state.pair
+    pair = state.healpix
     n = pair.nside
     colors = to_rgba_array([f.color for f in scene.features]) if scene.features else None
     half = math.tan(math.radians(cam.view_angle) / 2.0)
