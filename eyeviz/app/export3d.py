@@ -5,16 +5,13 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from eyeviz.app.view3d import Scene3DHost
+from typing import Any
 
 __all__ = ["export_view3d"]
 
 
 def export_view3d(
-    host: Scene3DHost,
+    host: Any,  # the 3D page (eyeviz.app.view3d.Scene3DHost: no import cycle)
     path: str | os.PathLike,
     scale: float = 1.0,
     transparent: bool = False,

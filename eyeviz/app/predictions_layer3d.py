@@ -5,6 +5,7 @@ for the latest ball only. A part of :class:`eyeviz.app.view3d.Scene3DHost` (its 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from eyeviz.model.predictions3d import (
@@ -31,11 +32,10 @@ class Predictions3DLayer:
     active: bool
     _dirty: bool
 
-    def draw(self) -> None: ...  # the page's (Scene3DHost.draw)
-
-    def refresh_panels(self) -> None: ...
-
-    def _status(self) -> str: ...
+    # the page's own (Scene3DHost)
+    draw: Callable[[], None]
+    refresh_panels: Callable[[], None]
+    _status: Callable[[], str]
 
     def _predictions(self) -> None:
         """The layer's content for the selected ball: the fast estimators now, the limit

@@ -62,7 +62,7 @@ class EyeSurface(Protocol):
 
     @property
     def nside(self) -> int | None:
-        """The HEALPix nside (edges drawn up to a bound), None for measured eyes (drawn)."""
+        """The HEALPix nside (edges drawn up to a bound), None for measured eyes."""
         ...
 
     @property

@@ -5,11 +5,13 @@ Three eye models behind one table (:mod:`eyeviz.core.eyes`, the seam):
 - ``h, l, m``: the paper's planar pair (:class:`eyeviz.core.geometry.EyePair`);
 - ``h, l, nside``: the HEALPix pair (:class:`eyeviz.core.geometry3d.EyePair3D`,
   docs/spherical.md);
-- ``file`` (and optionally ``units``, ``"mm"`` by default): a measured pair
-  (:class:`eyeviz.core.measured.MeasuredEyePair`, docs/measured.md) read from an eye file
-  by :func:`eyeviz.measured.load_eyes`. A relative path is resolved against the scene
-  file's folder (a shipped scene names a shipped eye file: ``"../eyes/AM_60185-real.eye"``);
-  a scene written elsewhere writes the path back relative to its own folder.
+- ``file`` (and optionally ``units`` and ``frame``, by default the format's: millimetres
+  and CompoundRay's axes for ``.eye``, metres and glTF's for OCES ``.gltf``/``.glb``): a
+  measured pair (:class:`eyeviz.core.measured.MeasuredEyePair`, docs/measured.md) read
+  from an eye file by :func:`eyeviz.measured.load_eyes`. A relative path is resolved
+  against the scene file's folder (a shipped scene names a shipped eye file:
+  ``"../eyes/AM_60185-real.eye"``); a scene written elsewhere writes the path back
+  relative to its own folder.
 
 The HEALPix and the measured pairs are the spherical side (:attr:`Eyes.side`): their
 features are balls (x, y, z, g) and the app shows them in the 3D view; the measured
@@ -41,9 +43,11 @@ _CACHE: OrderedDict[tuple, MeasuredEyePair] = OrderedDict()
 _CACHE_SIZE = 4
 
 
-def load_measured(path: Path, units: str = "mm") -> MeasuredEyePair:
+def load_measured(
+    path: Path, units: str | None = None, frame: str | None = None
+) -> MeasuredEyePair:
     """The measured pair in ``path`` (:func:`eyeviz.measured.load_eyes`), loaded once per
-    (path, units, size, modification time). EyevizError (one line) for a file that cannot
+    (path, units, frame, size, modification time). EyevizError (one line) for a file that cannot
     be read or is not an eye file."""
     from eyeviz.measured import load_eyes
 
@@ -52,7 +56,7 @@ def load_measured(path: Path, units: str = "mm") -> MeasuredEyePair:
         st = p.stat()
     except OSError as exc:
         raise EyevizError(f"{p}: cannot read the eye file: {exc.strerror or exc}") from None
-    key = (str(p), units, st.st_size, st.st_mtime_ns)
+    key = (str(p), units, frame, st.st_size, st.st_mtime_ns)
     hit = _CACHE.get(key)
     if hit is not None:
         _CACHE.move_to_end(key)
@@ -60,7 +64,7 @@ def load_measured(path: Path, units: str = "mm") -> MeasuredEyePair:
     if not p.is_file():
         raise EyevizError(f"{p}: not a regular file")
     try:
-        pair = load_eyes(p, units=units)
+        pair = load_eyes(p, units=units, frame=frame)
     except EyevizError:
         raise
     except (OSError, ValueError, IndexError, KeyError) as exc:  # the reader's own
@@ -76,15 +80,17 @@ def load_measured(path: Path, units: str = "mm") -> MeasuredEyePair:
 class Eyes:
     """The scene's eye pair: h origin-to-centre, l eye radius, m ommatidia (Table 3); with
     ``nside`` the HEALPix pair EyePair3D(h, l, nside); with ``file`` a measured pair read
-    from that eye file (absolute path) in ``units`` (h and l then the pair's own: half the
-    distance of its eyes' centroids, the largest lens distance from its centroid)."""
+    from that eye file (absolute path) in ``units`` and ``frame`` (None: the format's;
+    h and l then the pair's own: half the distance of its eyes' centroids, the largest
+    lens distance from its centroid)."""
 
     h: float = 40.0
     l: float = 20.0
     m: int = 720
     nside: int | None = None  # set: spherical eyes, and m is the equator's 4 nside
     file: Path | None = None  # set: measured eyes from this eye file
-    units: str = "mm"
+    units: str | None = None
+    frame: str | None = None
 
     def __post_init__(self) -> None:
         if self.nside is not None:
@@ -124,28 +130,30 @@ class Eyes:
     def model(self) -> EyeModel:
         """EyePair, EyePair3D or MeasuredEyePair (the seam, :mod:`eyeviz.core.eyes`)."""
         if self.file is not None:
-            return load_measured(self.file, self.units)  # type: ignore[return-value]
+            return load_measured(self.file, self.units, self.frame)  # type: ignore[return-value]
         return eyes_from_design(self.design)
 
     def copy(self) -> Eyes:
         e = Eyes.__new__(Eyes)
-        e.h, e.l, e.m, e.nside, e.file, e.units = (
-            self.h, self.l, self.m, self.nside, self.file, self.units
+        e.h, e.l, e.m, e.nside, e.file, e.units, e.frame = (
+            self.h, self.l, self.m, self.nside, self.file, self.units, self.frame
         )  # fmt: skip
         return e
 
 
 def _measured(c, eyes_t: dict, base: Path | None) -> Eyes:
-    """``[eyes] file, units``: the eye file, resolved against ``base`` (the scene's folder)."""
+    """``[eyes] file, units, frame``: the eye file, resolved against ``base`` (the scene's
+    folder)."""
     for k in eyes_t:
-        if k not in ("file", "units"):
-            raise c.fail(f"eyes.{k}", "a scene naming an eye file gives file and units only")
+        if k not in ("file", "units", "frame"):
+            raise c.fail(f"eyes.{k}", "a scene naming an eye file gives file, units and frame")
     name = c.string(eyes_t, "file", "eyes.")
     if not name.strip():
         raise c.fail("eyes.file", "must not be empty")
-    units = c.string(eyes_t, "units", "eyes.", default="mm")
-    if units not in EYE_UNITS:
+    units = c.string(eyes_t, "units", "eyes.") if "units" in eyes_t else None
+    if units is not None and units not in EYE_UNITS:
         raise c.fail("eyes.units", f"must be one of {', '.join(EYE_UNITS)}, got {units!r}")
+    frame = c.string(eyes_t, "frame", "eyes.") if "frame" in eyes_t else None
     p = Path(name).expanduser()
     if not p.is_absolute():
         p = (base if base is not None else Path.cwd()) / p
@@ -153,10 +161,11 @@ def _measured(c, eyes_t: dict, base: Path | None) -> Eyes:
     if not p.exists():
         raise c.fail("eyes.file", f"no such eye file: {p}")
     try:
-        pair = load_measured(p, units)
+        pair = load_measured(p, units, frame)
     except EyevizError as exc:
-        raise c.fail("eyes.file", str(exc)) from None
-    return Eyes(pair.h, pair.l, 0, None, p, units)
+        key = "eyes.frame" if frame is not None and "frame" in str(exc) else "eyes.file"
+        raise c.fail(key, str(exc)) from None
+    return Eyes(pair.h, pair.l, 0, None, p, units, frame)
 
 
 def eyes_from_table(c, eyes_t: dict, base: Path | None) -> Eyes:
@@ -210,8 +219,10 @@ def eyes_doc(e: Eyes, base: Path | None) -> dict:
             except ValueError:  # another drive (Windows): keep it absolute
                 pass
         doc: dict = {"file": name}
-        if e.units != "mm":
+        if e.units is not None:
             doc["units"] = e.units
+        if e.frame is not None:
+            doc["frame"] = e.frame
         return doc
     if e.nside is None:
         return {"h": float(e.h), "l": float(e.l), "m": int(e.m)}

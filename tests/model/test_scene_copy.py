@@ -35,7 +35,7 @@ def test_copy_knows_every_field():
             "steps",
         ],
         Feature: ["name", "x", "y", "g", "color", "z"],
-        Eyes: ["h", "l", "m", "nside", "file", "units"],
+        Eyes: ["h", "l", "m", "nside", "file", "units", "frame"],
         View: ["center", "width"],
     }
 

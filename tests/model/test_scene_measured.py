@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from eyeviz.measured import load_eyes, shipped_eye
+from eyeviz.measured import EyeSizeWarning, load_eyes, shipped_eye
 from eyeviz.model import shapes3d
 from eyeviz.model.app_model3d import AppModel3D
 from eyeviz.model.facets3d import MeasuredSurface, hexagon_mesh, surface_of
@@ -105,6 +105,9 @@ def test_missing_file_units_and_mixed_keys_are_refused(tmp_path):
     p.write_text('[eyes]\nfile = "bee.eye"\nunits = "furlong"\n', encoding="utf-8")
     with pytest.raises(SceneError, match="eyes.units: must be one of mm, m, um"):
         load(p)
+    p.write_text('[eyes]\nfile = "bee.eye"\nframe = "x,y"\n', encoding="utf-8")
+    with pytest.raises(SceneError, match="eyes.frame"):
+        load(p)
     p.write_text('[eyes]\nfile = "bee.eye"\nnside = 8\n', encoding="utf-8")
     with pytest.raises(SceneError, match="eyes.nside: a scene naming an eye file"):
         load(p)
@@ -117,7 +120,8 @@ def test_missing_file_units_and_mixed_keys_are_refused(tmp_path):
 def test_units_scale_the_eyes(tmp_path):
     p = _measured("", tmp_path)
     p.write_text('[eyes]\nfile = "bee.eye"\nunits = "um"\n', encoding="utf-8")
-    sc = load(p)
+    with pytest.warns(EyeSizeWarning):  # 3 um apart: implausible, and said so
+        sc = load(p)
     assert sc.eyes.units == "um" and sc.eyes.h == pytest.approx(load(BEE).eyes.h / 1000.0)
     assert 'units = "um"' in dumps(sc)
 

@@ -22,11 +22,17 @@ def test_the_vector_view_takes_the_shared_looks():
 
 def test_the_vtk_view_takes_the_shared_looks():
     pytest.importorskip("pyvista")
-    from eyeviz.render.vtk import scene3d, style
+    from eyeviz.render.vtk import balls3d, eyes3d, field3d, scene3d, style
 
-    for name in ("EYES_FRACTION", "EDGE_RGB", "EDGES_MAX_NSIDE", "BFV_RGB", "BFV_OPACITY",
-                 "CONE_OPACITY", "PLANE_RGB", "EYE_CONE"):  # fmt: skip
-        assert getattr(scene3d, name) is getattr(style3d, name), name
+    # each painter takes its looks from style3d (the painters of eyeviz.render.vtk.scene3d)
+    for mod, names in (
+        (scene3d, ("EYES_FRACTION",)),
+        (eyes3d, ("EDGE_RGB", "EDGES_MAX_NSIDE")),
+        (field3d, ("BFV_RGB", "BFV_OPACITY", "PLANE_RGB")),
+        (balls3d, ("CONE_OPACITY", "EYE_CONE")),
+    ):
+        for name in names:
+            assert getattr(mod, name) is getattr(style3d, name), name
     # the colours the planar VTK view shares are the same values
     assert np.allclose(np.asarray(style.UNLIT) / 255.0, style3d.UNLIT_RGB)
     assert np.allclose(style.INSET_BACKGROUND, style3d.INSET_RGB)

@@ -57,7 +57,9 @@ class EyesPainter(Painter3D):
         self.store.clear()
         self.full = surface.full
         self.meshes, self._owner, self.equators, self.labels = [], [], [], []
-        edges = surface.nside is None or surface.nside <= EDGES_MAX_NSIDE
+        # edges up to a small nside; a measured eye's facets are a few pixels across in
+        # the close-up (a 1 px edge would hide their colour): none
+        edges = surface.nside is not None and surface.nside <= EDGES_MAX_NSIDE
         for e, centre in enumerate(surface.centres):
             if self.full:
                 pts, faces = surface.mesh(e)
