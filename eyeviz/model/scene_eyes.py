@@ -130,7 +130,7 @@ class Eyes:
     def model(self) -> EyeModel:
         """EyePair, EyePair3D or MeasuredEyePair (the seam, :mod:`eyeviz.core.eyes`)."""
         if self.file is not None:
-            return load_measured(self.file, self.units, self.frame)  # type: ignore[return-value]
+            return load_measured(self.file, self.units, self.frame)
         return eyes_from_design(self.design)
 
     def copy(self) -> Eyes:

@@ -34,6 +34,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from eyeviz import EyevizError
+from eyeviz.core.geometry3d import EyePair3D
 from eyeviz.core.validation import check_choice
 from eyeviz.files.atomic import atomic_output
 from eyeviz.model.camera3d import PRESETS, Camera3D
@@ -120,7 +121,7 @@ def _draw_view(
         color=GREY, ha="left", va="top",
     )  # fmt: skip
     pair = st.pair
-    if pair.kind == "spherical":
+    if isinstance(pair, EyePair3D):
         facets = f"nside {pair.nside}\n{pair.npix:,} facets each"
     else:
         na, nb = getattr(pair, "facet_counts", (0, 0))
@@ -378,7 +379,7 @@ def _draw_map(ax, st: SceneState3D, scene: Scene, eye: str) -> None:
     draw_eye_view(ax, patches, lits, [f.color for f in scene.features])
     count = np.unique(np.concatenate(lits)).size if lits else 0
     side = "left" if eye == "A" else "right"
-    nside = f", nside {pair.nside}" if pair.kind == "spherical" else ""
+    nside = f", nside {pair.nside}" if isinstance(pair, EyePair3D) else ""
     ax.set_title(
         f"eye {eye} ({side}){nside}: {count:,} of {patches.n:,} facets lit",
         fontsize=SMALL, color=INK, pad=3,
