@@ -144,7 +144,7 @@ def _refused(text: str, key: str, *words: str) -> str:
 
 
 def test_refusals_one_line_naming_the_key():
-    _refused(BASE3D.replace("nside = 8", "nside = 8\nm = 720"), "eyes.nside", "m, nside")
+    _refused(BASE3D.replace("nside = 8", "nside = 8\nm = 720"), "eyes.nside", "m and nside")
     _refused(BASE3D.replace("nside = 8", "nside = 7"), "eyes.nside", "nside", "even")
     _refused(BASE3D.replace("nside = 8", "nside = 0"), "eyes.nside", "nside")
     _refused(BASE3D.replace("nside = 8", f"nside = {2**21}"), "eyes.nside", "nside")
