@@ -15,6 +15,7 @@ import sys
 
 NAME = "eye"
 HELP = "export eyeviz's eyes as measured eye files (.eye, OCES .gltf/.glb), or describe one"
+OUTPUTS = {"output": "file"}
 
 
 def _file_options(p: argparse.ArgumentParser, what: str) -> None:

@@ -73,6 +73,7 @@ def test_info_warns_one_line_for_metres(tmp_path, capsys):
         (["eye", "export", "--nside", "3", "-o", "{d}/x.eye"], "nside"),
         (["eye", "export", "--nside", "2", "-o", "{d}/x.obj"], "unknown eye file type"),
         (["eye", "export", "--nside", "2", "-o", "{d}/no/x.eye"], "does not exist"),
+        (["eye", "export", "--nside", "2", "-o", "{d}/adir.eye"], "directory"),
         (["eye", "export", "{d}/bad.eye", "-o", "{d}/x.eye"], "line 1"),
         (["eye", "export", "--m", "8", "--frame", "x,z,y", "-o", "{d}/x.eye"], "input FILE"),
         (["eye", "info", "--frame", "x,z,y", "{d}/bad.eye"], "reflection"),
@@ -82,6 +83,7 @@ def test_info_warns_one_line_for_metres(tmp_path, capsys):
 )
 def test_errors_are_one_line_exit_2(tmp_path, capsys, argv, frag):
     (tmp_path / "bad.eye").write_text("1 2 three\n")
+    (tmp_path / "adir.eye").mkdir()
     code, _, err = _run(capsys, *[a.format(d=tmp_path) for a in argv])
     assert code == 2
     assert len(err.strip().splitlines()) == 1 and err.startswith("eyeviz: error:")

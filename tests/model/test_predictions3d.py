@@ -245,12 +245,9 @@ def test_a_name_given_twice_is_one_estimator():
 
 
 def test_a_spherical_scene_file_naming_no_estimator_shows_the_spherical_three():
-    text = (
-        '[eyes]\nh = 40.0\nl = 20.0\nnside = 8\n[layers]\nshow = ["eyes", "predictions"]\n'
-    )
+    text = '[eyes]\nh = 40.0\nl = 20.0\nnside = 8\n[layers]\nshow = ["eyes", "predictions"]\n'
     sc = scene_mod.loads(text)
     assert sc.estimators == ["analytic3d", "learned3d", "limit3d"]
     p3.check_estimators(sc)
     planar = scene_mod.loads(text.replace("nside = 8", "m = 720"))
     assert planar.estimators == ["compact"]  # the planar default is unchanged
-
