@@ -20,7 +20,10 @@ estimator of the spherical side that answers for its eyes (``analytic3d``, ``lim
 ``learned3d`` for HEALPix eyes; ``analytic3d`` for a measured pair; docs/spherical.md,
 docs/measured.md): it is read in blocks (:class:`eyeviz.dataset.sparse3d.Sparse3DReader`),
 its design comes from the file (no ``--h --l --m --r-min --r-max --g-max``), and the CSV
-has ``r_hat,azimuth_hat,elevation_hat`` (radians). An estimator that does not answer for
+has ``r_hat,azimuth_hat,elevation_hat,flagged`` (radians; ``flagged`` is 1 where the
+estimator answered by its fallback or the row lies outside its domain, e.g. learned3d past
+its training ranges, and the count is on stderr: no such answer is written unmarked,
+issue 36). An estimator that does not answer for
 the file's eyes is refused in one line naming those that do.
 
 Exit status (also in ``--help``):
@@ -71,7 +74,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "-o",
         "--out",
         required=True,
-        help="output CSV (r_hat,phi_hat; r_hat,azimuth_hat,elevation_hat for 3D data)",
+        help="output CSV (r_hat,phi_hat; r_hat,azimuth_hat,elevation_hat,flagged for 3D data)",
     )
     parser.add_argument(
         "--weights", default=None, help="weights directory/file instead of the shipped ones"
@@ -280,24 +283,32 @@ def _run3d(args: argparse.Namespace, entry, registry, out: Path, kind: str) -> i
             f"data set {args.data} has the eyes {what} = {dom.design}, but estimator "
             f"{entry.name!r} answers for {est.domain.design}"
         )
-    n = invalid = unanswered = 0
+    n = invalid = unanswered = flagged = 0
     sums = [RunningSummary() for _ in range(3)]
     with atomic_output(out) as tmp, open(tmp, "w", encoding="ascii") as fh:
-        fh.write("r_hat,azimuth_hat,elevation_hat\n")
+        fh.write("r_hat,azimuth_hat,elevation_hat,flagged\n")
         for b in reader:  # bounded memory: one block of rows at a time
             pred = est.predict_dataset(b)
             cols = [np.asarray(c, np.float64) for c in pred]
-            np.savetxt(fh, np.column_stack(cols), fmt="%.17g", delimiter=",")
+            flag = np.asarray(pred.flagged, bool)
+            table = np.column_stack([*cols, flag])
+            np.savetxt(fh, table, fmt=["%.17g"] * 3 + ["%d"], delimiter=",")
             valid = np.asarray(pred.valid)
             answered = valid & np.isfinite(cols[0]) & np.isfinite(cols[1]) & np.isfinite(cols[2])
             n += len(valid)
             invalid += int((~valid).sum())
             unanswered += int((valid & ~answered).sum())
+            flagged += int(flag.sum())
             for acc, true, got in zip(sums, (b.r, b.azimuth, b.elevation), cols, strict=True):
                 acc.update(true[answered], got[answered])
     msg = f"{entry.name}: {n} rows -> {out}"
     if invalid:
         msg += f"; {invalid} with an eye that lit nothing (nan)"
+    if flagged:
+        msg += (
+            f"; {flagged} flagged (column 'flagged' = 1: answered by {entry.name}'s fallback "
+            "or outside its domain; not its own answer)"
+        )
     print(msg, file=sys.stderr)
     if sums[0].n >= 2:
         try:

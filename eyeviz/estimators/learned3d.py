@@ -91,6 +91,13 @@ _BLOCK = 1 << 14
 #: blocks of at most this many rows are summarised in one thread
 _THREAD_ROWS = 1024
 _LAYERS = ("0", "2", "4")  # Linear layers of nn.Sequential(Linear, SiLU, Linear, SiLU, Linear)
+#: How far past the trained ranges an answer may lie and still be the trained network's
+#: (a fraction of r_min, r_max, el_max and pi): on 2,000 test rows at nside 180 the shipped
+#: weights answer within 1.1 % past r_max and 0.07 % below r_min, |el| <= el_max. A row
+#: answered beyond it is outside the training domain (balls over the poles: r = 1.97e38,
+#: el = 2.74 rad, issue 35): flagged, and answered by the triangulation where that lies
+#: inside, else NaN (:func:`inside_domain`).
+DOMAIN_SLACK = 0.1
 
 
 def default_dir() -> Path:
@@ -171,7 +178,9 @@ class Learned3DEstimator(Estimator3D):
     """Corrects the triangulation of the two eyes' mean lit directions with an MLP.
 
     ``flagged`` marks rows whose mean directions do not meet in front of both eyes (the
-    triangulation is then r_max along their mean, which the network corrects)."""
+    triangulation is then r_max along their mean, which the network corrects), and rows
+    whose answer lies outside the training domain (:func:`inside_domain`): those are
+    answered by the triangulation where it lies inside, else NaN (issue 35)."""
 
     name = "learned3d"
     checks_indices = True  # on the runs of the summaries (healpix_summaries._check_runs)
@@ -234,7 +243,14 @@ class Learned3DEstimator(Estimator3D):
                 r[sel] = np.exp(log_r0[sel] + out[:, 0])
                 az[sel] = az0[sel] + AZ_SCALE * out[:, 1]
                 el[sel] = el0[sel] + EL_SCALE * out[:, 2]
-        return r, az, el, flagged
+        # outside the training domain: the triangulation where it lies inside, else NaN
+        out_ = ~inside_domain(d, r, az, el)
+        if out_.any():
+            r0 = np.exp(log_r0)
+            back = out_ & inside_domain(d, r0, az0, el0)
+            r, az, el = (np.where(back, f, np.where(out_, np.nan, v))
+                         for v, f in ((r, r0), (az, az0), (el, el0)))  # fmt: skip
+        return r, az, el, flagged | out_
 
     def _summaries(self, lit_a: LitCSR, lit_b: LitCSR) -> tuple[EyeSummary, EyeSummary]:
         """Both eyes' summaries; with ``threads`` >= 2 and more than ``_THREAD_ROWS`` rows
@@ -257,6 +273,18 @@ class Learned3DEstimator(Estimator3D):
 
     def __repr__(self) -> str:
         return f"<Learned3DEstimator hidden={self.hidden} nside={self.domain.nside}>"
+
+
+def inside_domain(d: Domain3D, r, az, el) -> np.ndarray:
+    """Whether each answer lies in the ranges the network was trained on, widened by
+    :data:`DOMAIN_SLACK`: r in [r_min, r_max], azimuth in [0, pi], |elevation| <= el_max
+    (finite; the data set's convention, :mod:`eyeviz.estimators.base3d`)."""
+    s = DOMAIN_SLACK
+    with np.errstate(invalid="ignore"):
+        ok = (r >= d.r_min * (1 - s)) & (r <= d.r_max * (1 + s))
+        ok &= (az >= -s * math.pi) & (az <= (1 + s) * math.pi)
+        ok &= np.abs(el) <= d.el_max * (1 + s)
+    return ok
 
 
 def _read_meta(d: Path) -> dict:

@@ -42,7 +42,7 @@ def test_predict_analytic_then_report_estimators(bee_npz, tmp_path, capsys):
     assert "analytic3d: 12 rows" in err and "DD MAPE" in err
     with open(pred, newline="") as f:
         rows = list(csv.reader(f))
-    assert rows[0] == ["r_hat", "azimuth_hat", "elevation_hat"] and len(rows) == 13
+    assert rows[0] == ["r_hat", "azimuth_hat", "elevation_hat", "flagged"] and len(rows) == 13
     vals = np.array(rows[1:], float)
     ds = sparse3d.load3d(bee_npz)
     dom = ds.domain

@@ -26,7 +26,7 @@ def data(tmp_path_factory):
 
 def _csv(path):
     with open(path, encoding="ascii") as fh:
-        assert fh.readline() == "r_hat,azimuth_hat,elevation_hat\n"
+        assert fh.readline() == "r_hat,azimuth_hat,elevation_hat,flagged\n"
     return np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
 
 
@@ -45,8 +45,9 @@ def test_predict_writes_the_estimators_answers(tmp_path, capsys, data, name):
     got = _csv(out)
     ds = sparse3d.load3d(data / "d8.npz")
     want = registry.load(name, domain=ds.domain).predict_dataset(ds)
-    assert got.shape == (len(ds), 3)
-    assert np.array_equal(got, np.column_stack(list(want)), equal_nan=True)
+    assert got.shape == (len(ds), 4)
+    assert np.array_equal(got[:, :3], np.column_stack(list(want)), equal_nan=True)
+    assert np.array_equal(got[:, 3], want.flagged)
 
 
 def test_train_learned3d_then_predict_with_its_weights(tmp_path, capsys, data):
@@ -60,7 +61,8 @@ def test_train_learned3d_then_predict_with_its_weights(tmp_path, capsys, data):
     rc = cli.main([*argv, "-o", str(out)])
     assert rc == 0, capsys.readouterr().err
     ds = sparse3d.load3d(data / "d8.npz")
-    want = np.column_stack(list(est.predict_dataset(ds)))
+    pred = est.predict_dataset(ds)
+    want = np.column_stack([*pred, pred.flagged])
     assert np.array_equal(_csv(out), want, equal_nan=True)
 
 
@@ -111,3 +113,47 @@ def test_predict_3d_refuses_design_flags(tmp_path, capsys, data):
     )
     _one_line_refusal(capsys, rc, "carries its design")
     assert not out.exists()
+
+
+def test_learned3d_over_the_poles_is_flagged_never_written_unmarked(tmp_path, capsys, monkeypatch):
+    """Balls over the eye's poles (lit sets {0, npix - 1} in each eye, issues 35.8 and
+    36.1): the shipped weights answered r = 1.97e38 and elevation 2.74 rad, exit 0, no
+    word. Now the row is flagged (the CSV's column and a count on stderr) and its answer
+    is the triangulation's inside the training domain, or nan."""
+    est = learned3d.load()
+    d = est.domain
+    npix = d.npix
+    ptr = np.array([0, 2])
+    ind = np.array([0, npix - 1])
+    p = est.predict((ptr, ind), (ptr, ind))
+    assert bool(p.flagged[0])
+    assert not np.isfinite(p.r[0]) or learned3d.inside_domain(d, p.r, p.azimuth, p.elevation)[0]
+    # the CLI on a file holding such a row beside ordinary ones
+    from eyeviz.dataset.records3d import Dataset3D
+
+    good = sparse3d.load3d(_shipped_like(tmp_path, d))
+    rows = []
+    for e in ("a", "b"):
+        gp, gi = getattr(good, f"indptr_{e}"), getattr(good, f"indices_{e}")
+        rows += [np.concatenate([gp, [gp[-1] + 2]]), np.concatenate([gi, [0, npix - 1]])]
+    floats = {k: np.concatenate([getattr(good, k), getattr(good, k)[:1]]) for k in sparse3d.FLOATS}
+    poles = Dataset3D(*rows, **floats, domain=d, params=dict(good.params))
+    path = tmp_path / "poles.npz"
+    sparse3d.write_chunks3d(path, len(poles), d, dict(good.params), [poles])
+    out = tmp_path / "p.csv"
+    # the pole row is hand-made, not its ball's lit sets: the reader's re-computation off
+    monkeypatch.setattr(sparse3d.embedded_eyes, "LIT_CHECK_ROWS", 0)
+    rc = cli.main(["predict", "-e", "learned3d", str(path), "-o", str(out)])
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    got = _csv(out)
+    assert got[-1, 3] == 1 and "1 flagged" in err
+    r, az, el = got[-1, :3]
+    assert not np.isfinite(r) or learned3d.inside_domain(d, r, az, el)
+    assert np.all(learned3d.inside_domain(d, got[:-1, 0], got[:-1, 1], got[:-1, 2]))
+
+
+def _shipped_like(tmp_path, d):
+    path = tmp_path / "ok.npz"
+    sparse3d.write3d(path, 6, d, seed=4)
+    return path

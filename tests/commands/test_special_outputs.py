@@ -83,7 +83,7 @@ def test_a_fifo_is_written_through_whole(tmp_path, capsys, sky, command):
     head = {".csv": b"", ".npz": b"PK\x03\x04", ".svg": b"<?xml"}[SUFFIX[command]]
     assert reader.data.startswith(head) and len(reader.data) > 20
     if command == "predict":
-        assert reader.data.startswith(b"r_hat,azimuth_hat,elevation_hat\n")
+        assert reader.data.startswith(b"r_hat,azimuth_hat,elevation_hat,flagged\n")
         assert reader.data.count(b"\n") == 9  # the header and the 8 rows: whole
     assert sorted(p.name for p in tmp_path.iterdir()) == [fifo.name]
 
