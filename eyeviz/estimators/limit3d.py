@@ -114,6 +114,28 @@ SLACK_SAFETY = 4.0
 NDIR = 8
 #: keys processed together
 _CHUNK = 8
+#: The most facets per eye a key may light and still be sampled: each exact check of a
+#: draw costs about its lit count, and a draw is checked up to (1 + TOPUP + sum of
+#: RETRY's batches) x samples times. A key beyond it, or beyond what any ball of the
+#: domain can light (:func:`max_lit`), gets no draws: its posterior is empty (or too
+#: costly to find) and it is answered by analytic3d and flagged (issue 35: a row lighting
+#: the whole eye took 33 s).
+MAX_KEY_LIT = 1 << 20
+
+
+def max_lit(domain: Domain3D) -> int:
+    """An upper bound on the facets one eye of ``domain`` sees lit by any ball of its
+    prior: the cap's half-angle is at most asin(g_max / (r_min - h)) (the ball's centre
+    lies r_min or more from the origin, so r_min - h or more from an eye; pi/2 when that
+    is not positive), its area a fraction (1 - cos alpha) / 2 of the sphere, and the cells
+    on its rim at most 8 per facet width of its perimeter (generous: HEALPix cells are
+    within a factor ~2 of square), plus 16."""
+    d = domain
+    near = d.r_min - d.h
+    alpha = math.pi / 2 if near <= d.g_max else math.asin(d.g_max / near)
+    fw = math.sqrt(4 * math.pi / d.npix)
+    bound = d.npix * (1 - math.cos(alpha)) / 2 + 8 * 2 * math.pi * math.sin(alpha) / fw + 16
+    return int(min(d.npix, math.ceil(bound)))
 
 
 def prior_density(domain: Domain3D, prior: str, r, g, el, az) -> np.ndarray:
@@ -752,8 +774,13 @@ class Limit3DEstimator(Estimator3D):
         empty = np.zeros(n, bool)
         mc = np.full(n, np.nan)
         acc = np.zeros(n, np.int64)
-        for s0 in range(0, n, _CHUNK):
-            rows = np.arange(s0, min(n, s0 + _CHUNK))
+        # keys no ball of the domain lights, or too costly to sample: no draws (flagged)
+        most = min(MAX_KEY_LIT, max_lit(self.domain))
+        over = (np.diff(lit_a[0]) > most) | (np.diff(lit_b[0]) > most)
+        empty |= over
+        live = np.flatnonzero(~over)
+        for s0 in range(0, live.size, _CHUNK):
+            rows = live[s0 : s0 + _CHUNK]
             la, lb = take_rows(*lit_a, rows), take_rows(*lit_b, rows)
             sm = self._posterior(la, lb)
             w = sm["w"]
