@@ -43,3 +43,7 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
     } >"$log" 2>&1 || { tail -n 30 "$log" >&2; echo "eyeviz setup: pip failed (log: $log)" >&2; exit 1; }
     touch "$stamp"
 fi
+# Compile the numba kernels once into their cache (eyeviz/core/kernels/__pycache__), so
+# neither a first run nor a test worker compiles them (a few seconds when already warm).
+.venv/bin/python -c "from eyeviz.core import kernels; kernels.warm()" ||
+    echo "eyeviz setup: warming the compiled kernels failed (they compile on first use)" >&2

@@ -9,6 +9,7 @@ import os
 from PyQt5 import QtCore, QtWidgets
 
 from eyeviz import EyevizError
+from eyeviz.core import kernels
 
 __all__ = ["APP_FONT_PT", "check_display", "make_app"]
 
@@ -59,4 +60,7 @@ def make_app() -> QtWidgets.QApplication:
     font = app.font()
     font.setPointSize(APP_FONT_PT)
     app.setFont(font)
+    # the compiled kernels load (or compile) on a background thread; until they are
+    # ready the core answers with its numpy reference, so no drag waits for numba
+    kernels.warm_in_background()
     return app

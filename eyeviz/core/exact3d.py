@@ -33,6 +33,8 @@ _JRLL = [int(v) for v in healpix.JRLL]
 _JPLL = [int(v) for v in healpix.JPLL]
 _SAMPLES = 16
 _PRECS = (96, 256)
+#: A cap of chord below 2^-(_TINY_BITS + the inputs' bits) is decided as one of that size
+_TINY_BITS = 96
 
 
 def whole_eye(X: Fraction, Y: Fraction, Z: Fraction, G: Fraction) -> bool:
@@ -248,6 +250,14 @@ def cell_lit(
     # enough bits for the inputs' spread of exponents and for a cap of chord^2 ~ q^2
     bits = max(max(abs(v.numerator).bit_length(), v.denominator.bit_length()) for v in (X, Y, Z))
     ratio = G * G / (X * X + Y * Y + Z * Z)
+    floor = _TINY_BITS + bits
+    lr = ratio.numerator.bit_length() - ratio.denominator.bit_length()  # log2(ratio) +- 1
+    if lr < -2 * floor - 2:
+        # a cap far below a facet lights the cells whose closure holds its centre: any
+        # smaller cap lights the same as one of chord ~ 2^-floor (docs/spherical.md)
+        shift = (-2 * floor - 1 - lr) // 2
+        G = G * 2**shift
+        ratio = ratio * 4**shift
     scale = max(0, ratio.denominator.bit_length() - ratio.numerator.bit_length())
     extra = max(0, 2 * bits - 128) + 3 * scale
     for base in _PRECS:

@@ -29,7 +29,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from eyeviz.core import exact3d, healpix
+from eyeviz.core import exact3d, healpix, kernels, tiny_caps
 from eyeviz.core.bounds import MAX_NSIDE, check_nside
 from eyeviz.core.geometry import _first_index, check_h_l, eye_x
 
@@ -167,7 +167,64 @@ def _runs_to_pieces(first, nr, lo, hi):
 
 def _lit_runs(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The lit facets of one eye for flat float64 arrays of balls, as runs: (lit facets
-    per ball, run starts, run lengths), the runs sorted by ball, then start."""
+    per ball, run starts, run lengths), the runs sorted by ball, then start. The compiled
+    kernel (:mod:`eyeviz.core.kernels.healpix_lit`) where it is in use, else the numpy
+    reference :func:`_lit_runs_ref`."""
+    if kernels.use(x.shape[0]):
+        return _lit_runs_jit(n, x, y, z, g, cx)
+    return _lit_runs_ref(n, x, y, z, g, cx)
+
+
+def _lit_runs_jit(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The kernel's runs; the balls it leaves to the exact branches go through
+    :func:`_lit_runs_ref` and are merged in."""
+    from eyeviz.core.kernels.healpix_lit import lit_runs_kernel
+
+    sth, zr, unit = _ring_tables(n)
+    first, nr, shifted, delta, o = _ring_info_tables(n)
+    x, y, z, g = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, y, z, g))
+    status, per, st, ln, bl = lit_runs_kernel(
+        n, x, y, z, g, float(cx), sth, zr, unit, first, nr, shifted, delta, o
+    )
+    kernels.mark_ready()
+    ref = np.flatnonzero(status)
+    if ref.size == 0:
+        return per, st, ln
+    FALLBACK_COUNTS["kernel -> reference balls"] += ref.size
+    p2, s2, l2 = _lit_runs_ref(n, x[ref], y[ref], z[ref], g[ref], cx)
+    per[ref] = p2
+    bl = np.concatenate([bl, ref[tiny_caps.run_balls(p2, l2)]])
+    st = np.concatenate([st, s2])
+    ln = np.concatenate([ln, l2])
+    order = np.lexsort((st, bl))
+    return per, st[order], ln[order]
+
+
+def _lit_runs_ref(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_lit_runs` in numpy (the reference). Caps far below their direction's
+    rounding error go through :mod:`eyeviz.core.tiny_caps`."""
+    tiny = tiny_caps.tiny_mask(x, y, z, g, cx)
+    if not tiny.any():
+        return _lit_runs_fast(n, x, y, z, g, cx)
+    parts = []
+    for sel, fn in ((~tiny, _lit_runs_fast), (tiny, _lit_runs_tiny)):
+        idx = np.flatnonzero(sel)
+        per, st, ln = fn(n, x[idx], y[idx], z[idx], g[idx], cx)
+        parts.append((idx[tiny_caps.run_balls(per, ln)], st, ln, idx, per))
+    bl, st, ln = (np.concatenate([p[k] for p in parts]) for k in range(3))
+    order = np.lexsort((st, bl))
+    per_ball = np.zeros(x.shape[0], np.int64)
+    for p in parts:
+        per_ball[p[3]] = p[4]
+    return per_ball, st[order], ln[order]
+
+
+def _lit_runs_tiny(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return tiny_caps.tiny_lit_runs(n, x, y, z, g, cx, _lit_runs_fast)
+
+
+def _lit_runs_fast(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_lit_runs` for caps the float64 path places (and any other, more slowly)."""
     nb = x.shape[0]
     npix = 12 * n * n
     with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):

@@ -1,0 +1,70 @@
+"""Compiled (numba) kernels of the core's hot paths (docs/kernels.md).
+
+Each kernel has a numpy reference it must agree with element by element; ``EYEVIZ_JIT=0``
+runs the reference everywhere. :func:`enabled` says whether the kernels may be used.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+
+__all__ = ["enabled", "use", "warm", "warm_in_background", "defer_until_warm", "mark_ready"]
+
+_STATE = {"ready": False, "defer": False}
+#: Calls of fewer items than this do not load cold kernels (see :func:`use`)
+COLD_WORK = 64
+
+
+def enabled() -> bool:
+    """The compiled kernels are in use: numba imports and EYEVIZ_JIT is not 0."""
+    if os.environ.get("EYEVIZ_JIT", "1").strip() in ("0", "false", "no", "off"):
+        return False
+    # found, not imported: importing numba takes a second, which a caller on a GUI
+    # thread must not pay (the kernel modules import it when first used)
+    return importlib.util.find_spec("numba") is not None
+
+
+def use(work: int = 1 << 30) -> bool:
+    """Call the kernels now for ``work`` items (balls). Yes once they are warm. Before: no
+    in an app that defers them to a background warm-up; else yes for calls of at least
+    ``COLD_WORK`` items (the caller loads them from numba's cache, about a second, or
+    compiles them once), and no for smaller ones, which the reference answers sooner
+    (``eyeviz snapshot`` of one scene stays within its time)."""
+    if not enabled():
+        return False
+    if _STATE["ready"]:
+        return True
+    return not _STATE["defer"] and work >= COLD_WORK
+
+
+def warm() -> None:
+    """Compile (or load from numba's cache) every kernel by running it on small inputs."""
+    if not enabled():
+        return
+    from eyeviz.core.kernels import healpix_lit
+
+    healpix_lit.warm()
+    _STATE["ready"] = True
+
+
+def defer_until_warm() -> None:
+    """Use the numpy reference until the kernels are warm (see :func:`warm_in_background`)."""
+    _STATE["defer"] = True
+
+
+def warm_in_background():
+    """Start warming the kernels on a daemon thread; returns the thread (or None)."""
+    if not enabled() or _STATE["ready"]:
+        return None
+    import threading
+
+    defer_until_warm()
+    t = threading.Thread(target=warm, name="eyeviz-kernels-warm", daemon=True)
+    t.start()
+    return t
+
+
+def mark_ready() -> None:
+    """A kernel ran: it is loaded, later calls of any size use it."""
+    _STATE["ready"] = True

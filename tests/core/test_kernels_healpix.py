@@ -1,0 +1,112 @@
+"""The compiled lit-set kernel against the numpy reference, element by element (issue 31).
+
+Every ball the kernel decides itself (status 0) must give the reference's lit set; the
+balls it hands back (status 1) are few and go through the reference in geometry3d.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import eyeviz.core.geometry3d as g3
+from eyeviz.core import kernels
+from eyeviz.core.kernels.healpix_lit import lit_runs_kernel
+from eyeviz.reference import stability_cases3d as sc3
+
+NSIDES = [2, 4, 6, 8, 10, 12, 16, 18, 64, 180]  # nside / 2 odd and even, small and large
+
+
+def _kernel(n, x, y, z, g, cx):
+    sth, zr, unit = g3._ring_tables(n)
+    first, nr, shifted, delta, o = g3._ring_info_tables(n)
+    return lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first, nr, shifted, delta, o)
+
+
+def _sets(per, st, ln):
+    indptr, idx = g3._runs_to_csr(per, st, ln)
+    return [idx[indptr[i] : indptr[i + 1]].tolist() for i in range(per.size)]
+
+
+def _compare(n, x, y, z, g):
+    """(balls the kernel decided, balls compared); asserts equality on every one."""
+    decided = 0
+    for cx in (-40.0, 40.0):
+        status, per, st_, ln, bl = _kernel(n, x, y, z, g, cx)
+        want = _sets(*g3._lit_runs_ref(n, x, y, z, g, cx))
+        got = _sets(per, st_, ln)
+        assert np.all(np.diff(bl) >= 0), "runs not sorted by ball"
+        for i in np.flatnonzero(status == 0):
+            assert got[i] == want[i], (n, cx, x[i], y[i], z[i], g[i])
+        decided += int((status == 0).sum())
+        both = _sets(*g3._lit_runs_jit(n, x, y, z, g, cx))
+        assert both == want
+    return decided
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    name=st.sampled_from(sorted(sc3.CLASSES)),
+    seed=st.integers(0, 2**20),
+    nside=st.sampled_from([None] + NSIDES),
+)
+def test_kernel_equals_the_reference_on_every_tie_class(name, seed, nside):
+    cs = sc3.make(name, 12, seed)
+    n = cs.eyes.nside if nside is None else nside
+    x, y, z, g = (np.ascontiguousarray(v, dtype=np.float64) for v in (cs.x, cs.y, cs.z, cs.g))
+    _compare(n, x, y, z, g)
+
+
+@pytest.mark.parametrize("n", [16, 64, 180])
+def test_kernel_decides_the_paper_regime_itself(n):
+    """Nearly every paper-regime ball is decided in the kernel (not handed back), so the
+    comparison above is a comparison of the kernel, not of the reference with itself."""
+    cs = sc3.make("paper", 60, n)
+    x, y, z, g = (np.ascontiguousarray(v, dtype=np.float64) for v in (cs.x, cs.y, cs.z, cs.g))
+    assert _compare(n, x, y, z, g) >= 2 * 60 - 2
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    nside=st.sampled_from(NSIDES),
+    p=st.tuples(*[st.floats(-3000, 3000)] * 3),
+    q=st.floats(1e-3, 1.5),
+)
+def test_kernel_equals_the_reference_on_random_balls(nside, p, q):
+    r = float(np.linalg.norm(np.subtract(p, (40.0, 0.0, 0.0)))) + 1e-9
+    x, y, z, g = (np.array([v], np.float64) for v in (*p, q * r))
+    _compare(nside, x, y, z, g)
+
+
+def test_eyeviz_jit_0_runs_the_reference(monkeypatch):
+    """EYEVIZ_JIT=0: geometry3d never calls the kernel."""
+    import eyeviz.core.kernels.healpix_lit as hl
+
+    monkeypatch.setitem(kernels._STATE, "ready", True)
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    assert not kernels.use()
+
+    def boom(*a):
+        raise AssertionError("kernel called with EYEVIZ_JIT=0")
+
+    monkeypatch.setattr(hl, "lit_runs_kernel", boom)
+    la, lb = g3.EyePair3D(40.0, 20.0, 16).lit(10.0, 500.0, 20.0, 60.0)
+    assert la.size > 10 and lb.size > 10
+    monkeypatch.setenv("EYEVIZ_JIT", "1")
+    with pytest.raises(AssertionError, match="kernel called"):
+        g3.EyePair3D(40.0, 20.0, 16).lit(10.0, 500.0, 20.0, 60.0)
+
+
+def test_deferred_kernels_wait_for_the_warm_up(monkeypatch):
+    """An app defers the kernels until warm: the reference answers meanwhile; a warm-up
+    on a background thread makes them ready."""
+    monkeypatch.setitem(kernels._STATE, "ready", False)
+    monkeypatch.setitem(kernels._STATE, "defer", False)
+    assert kernels.use(kernels.COLD_WORK) and not kernels.use(1)  # small calls wait
+    thread = kernels.warm_in_background()
+    assert thread is not None
+    assert not kernels.use(10**6) or kernels._STATE["ready"]  # deferred until warm
+    thread.join(120)
+    assert kernels.use(1)
