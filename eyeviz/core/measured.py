@@ -222,21 +222,14 @@ class MeasuredEyePair:
         tables, ix = self._prepared(which)
         nb, n = balls[0].size, ix.n
         if index:
-            unit, dirs, thr, rho = ix.query(*balls)
-            ball, start, count = ix.cells(unit, rho)
+            bi, fi = ix.candidates(*balls)
         else:
-            ball, start, count = ix.every(nb)
+            bi, fi = np.repeat(np.arange(nb), n), np.tile(np.arange(n), nb)
         lit = []
-        ends = np.cumsum(count)
-        cuts = np.searchsorted(ends, np.arange(_CHUNK, int(ends[-1]) if ends.size else 0, _CHUNK))
-        for sl in np.split(np.arange(ball.size), np.unique(cuts)):
-            bi, pos = ix.expand(ball[sl], start[sl], count[sl])
-            if index:
-                keep = ix.chord_ok(bi, pos, dirs, thr)
-                bi, pos = bi[keep], pos[keep]
-            fi = ix.perm.take(pos)
-            seen = decide_pairs(tables, balls, bi, fi)
-            lit.append(bi[seen] * n + fi[seen])
+        for k in range(0, bi.size, _CHUNK):
+            b, f = bi[k : k + _CHUNK], fi[k : k + _CHUNK]
+            seen = decide_pairs(tables, balls, b, f)
+            lit.append(b[seen] * n + f[seen])
         keys = np.sort(np.concatenate(lit)) if lit else np.zeros(0, np.int64)
         indptr = np.searchsorted(keys, np.arange(nb + 1, dtype=np.int64) * n)
         return indptr.astype(np.int64), (keys % n).astype(np.int64)

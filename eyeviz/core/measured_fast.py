@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import mpmath
 import numpy as np
 
+from eyeviz.core import measured_kernel
 from eyeviz.core.measured_exact import seen_exact
 
 __all__ = ["EyeTables", "eye_tables", "decide_pairs", "FALLBACK_COUNTS"]
@@ -130,18 +131,26 @@ def _certified(t: EyeTables, cx, cy, cz, g, fi) -> tuple[np.ndarray, np.ndarray]
 
 
 def decide_pairs(t: EyeTables, balls: tuple[np.ndarray, ...], bi, fi) -> np.ndarray:
-    """Whether facet fi[k] sees ball bi[k] (balls: flat float64 cx, cy, cz, g), exactly."""
-    cx, cy, cz, g = (b[bi] for b in balls)
-    with np.errstate(all="ignore"):
-        seen, sure = _certified(t, cx, cy, cz, g, fi)
+    """Whether facet fi[k] sees ball bi[k] (balls: flat float64 cx, cy, cz, g), exactly:
+    the certified float64 test (compiled, or numpy with ``EYEVIZ_JIT=0``), then the exact
+    path for the pairs it leaves."""
+    if measured_kernel.enabled():
+        seen, sure = measured_kernel.certified(t, balls, bi, fi)
+        cx, cy, cz, g = balls[0], balls[1], balls[2], balls[3]
+        bk = bi
+    else:
+        cx, cy, cz, g = (b[bi] for b in balls)
+        bk = np.arange(bi.size)
+        with np.errstate(all="ignore"):
+            seen, sure = _certified(t, cx, cy, cz, g, fi)
     todo = np.flatnonzero(~sure)
     FALLBACK_COUNTS["fast"] += int(bi.size - todo.size)
     FALLBACK_COUNTS["exact"] += int(todo.size)
     for k in todo.tolist():
-        i = int(fi[k])
+        i, j = int(fi[k]), int(bk[k])
         seen[k] = seen_exact(
-            (float(cx[k]), float(cy[k]), float(cz[k])),
-            float(g[k]),
+            (float(cx[j]), float(cy[j]), float(cz[j])),
+            float(g[j]),
             t.positions[i].tolist(),
             t.axes[i].tolist(),
             float(t.acceptance[i]),

@@ -15,24 +15,27 @@ enclosing lenses), or R >= pi, takes every facet. Candidates are the facets whos
 axis u_i has chord |u_i - d / |d|| <= 2 sin(R / 2): a superset of the seen ones, which
 the exact decision then sorts out.
 
-The axes are binned in nested cubic grids over [-1, 1]^3 of cell side 2^(1-k),
-k = 0 .. LEVELS-1 (numpy only: a search of sorted cell keys). A ball's query uses the
-finest level whose cell side is at least twice the chord radius: at most 2 x 2 x 2 cells.
+The chord search is scipy's cKDTree over the unit axes, built once per eye (the pair
+caches it); its own rounding (1e-16) is far below the slack. With numba the same search
+runs compiled over nested grids (:mod:`eyeviz.core.measured_grid`); ``EYEVIZ_JIT=0``
+keeps the tree.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-__all__ = ["AxisIndex", "LEVELS"]
+from eyeviz.core import measured_kernel
+from eyeviz.core.measured_grid import AxisGrid
 
-LEVELS = 12
-FINER = 1
+__all__ = ["AxisIndex"]
+
 _SLACK = 1e-9
-_DOT_SLACK = 1e-5  # the float32 chord test: its rounding is below 1e-6
-_SHIFT = (56, 36, 18)  # level, x, y (z in the low bits)
+_EVERY = 3.0  # a chord radius above 2: every unit axis
 
 
 class AxisIndex:
@@ -40,35 +43,13 @@ class AxisIndex:
 
     def __init__(self, unit_axes: np.ndarray, centre: np.ndarray, lens_bound: float,
                  alpha_max: float) -> None:  # fmt: skip
-        n = unit_axes.shape[0]
-        self.n = n
-        self.ux, self.uy, self.uz = (np.ascontiguousarray(c) for c in unit_axes.T)
+        self.n = int(unit_axes.shape[0])
+        self.tree = cKDTree(unit_axes)
+        self._unit = unit_axes
+        self._grid: AxisGrid | None = None
         self.centre = np.asarray(centre, dtype=np.float64)
         self.lens = float(lens_bound)
         self.alpha = float(alpha_max)
-        keys, perms = [], []
-        for k in range(LEVELS):
-            cells = self._cells(unit_axes, k)
-            key = self._key(k, cells[:, 0], cells[:, 1], cells[:, 2])
-            order = np.argsort(key, kind="stable")
-            keys.append(key[order])
-            perms.append(order)
-        keys.append(np.full(n, np.int64(LEVELS) << _SHIFT[0]))  # the pseudo-cell "every facet"
-        perms.append(np.arange(n))
-        allkeys = np.concatenate(keys)
-        self.keys, first, self.counts = np.unique(allkeys, return_index=True, return_counts=True)
-        self.starts = first
-        self.perm = np.concatenate(perms)
-        self.pu = [np.ascontiguousarray(c[self.perm], dtype=np.float32) for c in unit_axes.T]
-
-    @staticmethod
-    def _cells(p: np.ndarray, k: int) -> np.ndarray:
-        side = 2.0 ** (1 - k)
-        return np.clip(np.floor((p + 1.0) / side), 0, (1 << k) - 1).astype(np.int64)
-
-    @staticmethod
-    def _key(k, ix, iy, iz):
-        return (np.int64(k) << _SHIFT[0]) | (ix << _SHIFT[1]) | (iy << _SHIFT[2]) | iz
 
     def search(self, cx, cy, cz, g) -> tuple[np.ndarray, np.ndarray]:
         """(direction (B, 3) unit, chord radius (B,)) per ball; radius inf: every facet."""
@@ -90,59 +71,19 @@ class AxisIndex:
         unit[every] = 0.0
         return unit, rho
 
-    def cells(self, unit: np.ndarray, rho: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Per ball the cells to read: (ball, start, count) of the non-empty ones."""
-        nb = unit.shape[0]
-        every = ~np.isfinite(rho)
-        r = np.where(every, 1.0, rho)
-        lev = np.clip(np.floor(FINER - np.log2(r)), 0, LEVELS - 1).astype(np.int64)
-        side = np.ldexp(2.0, -lev)[:, None]
-        top = (np.int64(1) << lev)[:, None] - 1
-        lo = np.clip(np.floor((unit - r[:, None] + 1.0) / side), 0, top).astype(np.int64)
-        hi = np.clip(np.floor((unit + r[:, None] + 1.0) / side), 0, top).astype(np.int64)
-        span = hi - lo + 1
-        ncell = np.where(every, 1, span.prod(axis=1))
-        ball = np.repeat(np.arange(nb), ncell)
-        local = np.arange(ball.size) - np.repeat(np.cumsum(ncell) - ncell, ncell)
-        nyz = (span[:, 1] * span[:, 2])[ball]
-        ix = lo[ball, 0] + local // nyz
-        rem = local % nyz
-        nz = span[ball, 2]
-        iy = lo[ball, 1] + rem // nz
-        iz = lo[ball, 2] + rem % nz
-        key = self._key(lev[ball], ix, iy, iz)
-        key[every[ball]] = np.int64(LEVELS) << _SHIFT[0]
-        pos = np.minimum(np.searchsorted(self.keys, key), self.keys.size - 1)
-        hit = self.keys[pos] == key
-        return ball[hit], self.starts[pos[hit]], self.counts[pos[hit]]
-
-    def every(self, nb: int) -> tuple[np.ndarray, ...]:
-        """(ball, start, count) of the pseudo-cell "every facet" for balls 0 .. nb-1: the
-        brute-force pass."""
-        return np.arange(nb), np.full(nb, self.starts[-1]), np.full(nb, self.n)
-
-    def expand(self, ball, start, count) -> tuple[np.ndarray, np.ndarray]:
-        """(ball, position in the index's order) of every facet in the given cells; the
-        facet is ``perm[position]``."""
-        tot = int(count.sum())
-        off = np.repeat(start - (np.cumsum(count) - count), count)
-        return np.repeat(ball, count), off + np.arange(tot)
-
-    def chord_ok(self, bi, pos, dirs, thr) -> np.ndarray:
-        """The candidates within the chord radius of their ball's direction: u . d >= thr,
-        thr = 1 - rho^2 / 2 - 1e-5 (:meth:`query`), in float32."""
-        dot = self.pu[0].take(pos) * dirs[0].take(bi)
-        dot += self.pu[1].take(pos) * dirs[1].take(bi)
-        dot += self.pu[2].take(pos) * dirs[2].take(bi)
-        return dot >= thr.take(bi)
-
-    def query(
-        self, cx, cy, cz, g
-    ) -> tuple[np.ndarray, tuple[np.ndarray, ...], np.ndarray, np.ndarray]:
-        """(unit directions (B, 3), their columns in float32, dot thresholds, chord radii)
-        of the balls: what :meth:`cells` and :meth:`chord_ok` read."""
+    def candidates(self, cx, cy, cz, g) -> tuple[np.ndarray, np.ndarray]:
+        """(ball, facet) pairs: every facet within the search radius of each ball, grouped
+        by ball (facets unsorted)."""
+        if measured_kernel.enabled():
+            if self._grid is None:
+                self._grid = AxisGrid(self._unit)
+            return self._grid.candidates((cx, cy, cz, g), self.centre, self.lens, self.alpha)
         unit, rho = self.search(cx, cy, cz, g)
-        with np.errstate(invalid="ignore"):
-            thr = np.where(np.isfinite(rho), 1 - rho * rho / 2 - _DOT_SLACK, -np.inf)
-        dirs = tuple(np.ascontiguousarray(c, dtype=np.float32) for c in unit.T)
-        return unit, dirs, thr, rho
+        rr = np.where(np.isfinite(rho), rho, _EVERY)
+        if unit.shape[0] == 1:
+            fi = np.asarray(self.tree.query_ball_point(unit[0], rr[0]), dtype=np.int64)
+            return np.zeros(fi.size, np.int64), fi
+        res = self.tree.query_ball_point(unit, rr, return_sorted=False)
+        cnt = np.fromiter(map(len, res), np.int64, len(res))
+        fi = np.fromiter(itertools.chain.from_iterable(res), np.int64, int(cnt.sum()))
+        return np.repeat(np.arange(len(res)), cnt), fi
