@@ -28,6 +28,7 @@ Window-up: a whole process, start to the first rendered frame of sphere_paper.to
 (VmRSS and the peak VmHWM) once the window is up and after 20 renders.
 
     xvfb-run -a .venv/bin/python scripts/bench_app3d.py [--events 240] [--predictions]
+    xvfb-run -a .venv/bin/python scripts/bench_app3d.py --bee   # measured eyes only
 
 ``--predictions`` also drags each case with the predictions layer on (issue 23 item 4:
 the fast estimators answer the dragged ball on every frame, the limit waits for the
@@ -89,14 +90,24 @@ def _pct(v, q):
     return s[min(len(s) - 1, int(round(q / 100 * (len(s) - 1))))]
 
 
-def bench_drag(nside: int, events: int, settings: str, predictions: bool = False) -> dict:
+def _bee():
+    """The shipped honeybee (measured eyes, 2 x 3,187 facets; docs/app_measured.md)."""
+    from eyeviz.model.scene import load
+    from eyeviz.resources import scene_path
+
+    return load(scene_path("bee"))
+
+
+def bench_drag(nside, events: int, settings: str, predictions: bool = False) -> dict:
+    """One case: ``nside`` (HEALPix eyes, the balls of :func:`_scene`) or ``"bee"``."""
     from PyQt5 import QtCore
     from PyQt5.QtTest import QTest
 
     from eyeviz.app.window import MainWindow, make_app, make_settings
 
     app = make_app()
-    win = MainWindow(_scene(nside, predictions), settings=make_settings(settings))
+    scene = _bee() if nside == "bee" else _scene(nside, predictions)
+    win = MainWindow(scene, settings=make_settings(settings))
     win.resize(1280, 800)
     win.show()
     for _ in range(5):
@@ -218,6 +229,9 @@ def main() -> int:
     ap.add_argument(
         "--predictions", action="store_true", help="also drag with the predictions layer on"
     )
+    ap.add_argument(
+        "--bee", action="store_true", help="the shipped honeybee only (measured eyes, bee.toml)"
+    )
     args = ap.parse_args()
     if not os.environ.get("DISPLAY"):
         xvfb = shutil.which("xvfb-run")
@@ -229,8 +243,9 @@ def main() -> int:
     os.environ.setdefault("QT_API", "pyqt5")
     settings = str(Path(tempfile.mkdtemp()) / "settings.json")
     ok = True
-    print(f"3D view drag frame vs bare render of the same window ({N_BALLS} balls, 1280x800)")
-    for nside in CASES:
+    balls = "bee.toml's 3 balls" if args.bee else f"{N_BALLS} balls"
+    print(f"3D view drag frame vs bare render of the same window ({balls}, 1280x800)")
+    for nside in ["bee"] if args.bee else CASES:
         r = bench_drag(nside, args.events, settings)
         lat, base = r["lat"], r["base"]
         p50, p95 = _pct(lat, 50), _pct(lat, 95)
@@ -239,13 +254,18 @@ def main() -> int:
         good = r50 <= P50_RATIO and r95 <= P95_RATIO and r["moved"] and r["undo_steps"] == 1
         ok &= good
         print(
-            f"nside {nside:>3} ({12 * nside * nside:,} facets/eye): {len(lat)} frames; "
+            (
+                "honeybee (bee.toml, 3,187 facets/eye)"
+                if nside == "bee"
+                else f"nside {nside:>3} ({12 * nside * nside:,} facets/eye)"
+            )
+            + f": {len(lat)} frames; "
             f"drag p50 {p50:.1f} ms p95 {p95:.1f} ms; bare p50 {b50:.1f} ms p95 {b95:.1f} ms; "
             f"ratio p50 {r50:.2f}x (<= {P50_RATIO}) p95 {r95:.2f}x (<= {P95_RATIO}); "
             f"moved {r['moved']}, undo steps {r['undo_steps']}, dragged ball lights {r['lit']:,} "
             f"facets: {'OK' if good else 'MISSED'}"
         )
-        if args.predictions:
+        if args.predictions and nside != "bee":
             q = bench_drag(nside, args.events, settings, predictions=True)
             q50, q95 = _pct(q["lat"], 50), _pct(q["lat"], 95)
             c50, c95 = _pct(q["base"], 50), _pct(q["base"], 95)
@@ -257,6 +277,8 @@ def main() -> int:
                 f"first ball, the press's selection) {q['jobs'][0]}, after it "
                 f"{q['jobs'][1] - q['jobs'][0]}"
             )
+    if args.bee:
+        return 0 if ok else 1
     up, mem = bench_up(settings)
     ok &= up <= UP_TARGET_S
     print(f"window up (sphere_paper.toml, nside 180): {up:.2f} s median of 3 (<= {UP_TARGET_S} s)")

@@ -314,12 +314,21 @@ def scene_extent(state: SceneState3D) -> float:
 def view_camera(state: SceneState3D, name: str = "default", aspect: float = 1.0) -> Camera3D:
     """The preset ``name`` (:func:`eyeviz.model.camera3d.preset`) framing the eyes and the
     balls (:func:`bounding_ball`) in a viewport ``aspect`` (width / height) wide: the 3D
-    view's camera when a scene opens, its PNG's and its vector figure's by default."""
+    view's camera when a scene opens, its PNG's and its vector figure's by default. The
+    default 3/4 view looks from above, or from below when the balls' mean height is
+    negative."""
     pair = state.pair
     if name in ("eye_a", "eye_b"):
         return _along_eye(state, name, aspect)
     centre, radius = bounding_ball(state)
-    return preset(name, pair.h, pair.l, scene_extent(state), aspect, centre=centre, radius=radius)
+    cam = preset(name, pair.h, pair.l, scene_extent(state), aspect, centre=centre, radius=radius)
+    if name == "default" and state.n and float(np.mean(state.z)) < 0.0:
+        # the 3/4 view from the balls' side: from below when they are mostly below the
+        # eyes' plane (a bee's binocular field), so the facets they light face the camera
+        x, y, z = cam.position
+        cam = Camera3D((x, y, 2.0 * cam.focal_point[2] - z), cam.focal_point, cam.view_up,
+                       cam.view_angle)  # fmt: skip
+    return cam
 
 
 def _along_eye(state: SceneState3D, name: str, aspect: float) -> Camera3D:

@@ -161,3 +161,12 @@ def test_hexagons_sit_at_the_lenses_facing_the_axes():
     s = surface_of(pair)
     assert isinstance(s, MeasuredSurface) and s is surface_of(pair) and s.full
     assert s.counts() == (3187, 3187) and s.centres == pair.centers
+
+
+def test_the_default_view_looks_from_the_balls_side():
+    # a bee's balls lie below its eyes: the 3/4 view looks up at the facets they light;
+    # HEALPix scenes with balls above keep the view from above
+    bee = shapes3d.view_camera(compute_state3d(load(BEE)), "default", 1.5)
+    assert bee.position[2] < bee.focal_point[2]
+    sphere = shapes3d.view_camera(compute_state3d(load(SCENES / "sphere_teaching.toml")))
+    assert sphere.position[2] > sphere.focal_point[2]
