@@ -122,12 +122,11 @@ def _draw_view(
     )  # fmt: skip
     pair = st.pair
     if isinstance(pair, EyePair3D):
-        facets = f"nside {pair.nside}\n{pair.npix:,} facets each"
+        caption = f"eyes close up, nside {pair.nside}\n{pair.npix:,} facets each"
     else:
-        na, nb = getattr(pair, "facet_counts", (0, 0))
-        facets = f"{na:,} + {nb:,} facets"
+        caption = "eyes close up\n{:,} + {:,} facets".format(*pair.facet_counts)
     eyes_ax.text(
-        0.03, 0.98, f"eyes close up, {facets}",
+        0.03, 0.98, caption,
         transform=eyes_ax.transAxes, fontsize=SMALL, color=GREY, ha="left", va="top",
     )  # fmt: skip
 

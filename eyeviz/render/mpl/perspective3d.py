@@ -44,6 +44,7 @@ from matplotlib.patches import Rectangle
 from eyeviz.core import healpix
 from eyeviz.model import shapes3d
 from eyeviz.model.camera3d import Camera3D, basis, eyes_camera, project
+from eyeviz.model.facets3d import surface_of
 from eyeviz.model.predictions3d import LIMIT, Predictions3D, estimator_color3d
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
@@ -162,7 +163,10 @@ def _reach(state: SceneState3D) -> float:
 def _eye_batches(state: SceneState3D, scene: Scene, cam: Camera3D) -> list[_Batch]:
     """Each eye's facets (see the module docstring); an eye drawn smaller than
     :data:`SMALL_EYE` (its radius, a fraction of the view's half height) has its unlit
-    sphere drawn at nside 4 under its lit facets, which keep the scene's nside."""
+    sphere drawn at nside 4 under its lit facets, which keep the scene's nside. A
+    measured pair's: :func:`_measured_eye_batches`."""
+    if state.pair.kind == "measured":
+        return _measured_eye_batches(state, scene)
     pair = state.healpix
     n = pair.nside
     colors = to_rgba_array([f.color for f in scene.features]) if scene.features else None
@@ -197,6 +201,36 @@ def _eye_batches(state: SceneState3D, scene: Scene, cam: Camera3D) -> list[_Batc
     return out
 
 
+def _measured_eye_batches(state: SceneState3D, scene: Scene) -> list[_Batch]:
+    """A measured pair's facets as the VTK view draws them
+    (:class:`eyeviz.model.facets3d.MeasuredSurface`): each ommatidium a hexagon at its
+    lens, lit ones in their ball's colour (a later ball wins), no edges (a facet is a few
+    pixels across); back faces culled about the eye's lens centroid."""
+    surf = surface_of(state.pair)
+    colors = to_rgba_array([f.color for f in scene.features]) if scene.features else None
+    out = []
+    for e, eye in enumerate("AB"):
+        pts, faces = surf.mesh(e)
+        k = int(faces[0])  # every cell a hexagon: [6, i0 .. i5] per facet
+        poly = pts[faces.reshape(-1, k + 1)[:, 1:]]
+        face = np.tile(np.asarray(UNLIT_RGBA), (poly.shape[0], 1))
+        own = shapes3d.facet_owner(state, eye)
+        lit = own >= 0
+        if colors is not None and lit.any():
+            face[lit] = colors[own[lit]]
+        out.append(
+            _Batch(poly, face, "eye", centre=np.asarray(surf.centres[e], np.float64),
+                   width=SEAM, light=EYE_LIGHT)
+        )  # fmt: skip
+    return out
+
+
+def _centres(state: SceneState3D) -> list[np.ndarray]:
+    """The eyes' centres (the tangent cones' apexes, the labels' places): (-+h, 0, 0),
+    or a measured pair's lens centroids."""
+    return [np.asarray(c, np.float64) for c in surface_of(state.pair).centres]
+
+
 def _ball_batches(scene: Scene) -> list[_Batch]:
     unit = healpix.boundaries(BALL_NSIDE, np.arange(healpix.npix(BALL_NSIDE)), 2)
     out = []
@@ -219,8 +253,7 @@ def _cone_batches(state: SceneState3D, scene: Scene, length: float | None) -> li
     # eye's facets they start from
     s = (np.geomspace(1.0, 2.0**CONE_BANDS, CONE_BANDS + 1) - 1.0) / (2.0**CONE_BANDS - 1.0)
     nxt = np.roll(np.arange(CONE_RES), -1)
-    for cx in (-pair.h, pair.h):
-        a = np.array([cx, 0.0, 0.0])
+    for a in _centres(state):
         for f in scene.features:
             cone = shapes3d.tangent_cone(a, (f.x, f.y, f.z), f.g, CONE_RES)
             if length is not None:
@@ -322,12 +355,13 @@ def scene_polygons(
     scene's) picks the parts among :data:`VIEW_LAYERS`."""
     shown = set(scene.layers if layers is None else layers)
     batches: list[_Batch] = []
-    if "bfv" in shown and part == "scene":  # as VTK: the field is not in the close-up
+    healpix_eyes = state.pair.kind == "spherical"  # the cones of its BFV, its equators
+    if "bfv" in shown and part == "scene" and healpix_eyes:  # as VTK: not in the close-up
         batches += _bfv_batches(state)
     if "plane" in shown and part == "scene":
         tiles, grid = _plane(state)
         batches += [*tiles, _lines(grid, GRID_RGBA, 0.4, LINE_PIECES)]
-    if "plane" in shown and "eyes" in shown:
+    if "plane" in shown and "eyes" in shown and healpix_eyes:
         batches.append(_lines(_equators(state), INK_RGBA, 0.8))
     if "eyes" in shown and state.lit_a is not None:
         batches += _eye_batches(state, scene, cam)
@@ -434,7 +468,7 @@ def draw_view(
 def _labels(ax, state, scene, cam, aspect, part, shown) -> None:
     pair = state.pair
     if part == "eyes" and "eyes" in shown:
-        pts = np.array([[-pair.h, 0.0, -1.55 * pair.l], [pair.h, 0.0, -1.55 * pair.l]])
+        pts = np.array([c + (0.0, 0.0, -1.55 * pair.l) for c in _centres(state)])
         xy, depth = project(cam, pts, aspect)
         for (x, y), d, t in zip(xy, depth, ("eye A", "eye B"), strict=True):
             if d > 0 and abs(x) < 1 and abs(y) < 1:
@@ -567,7 +601,8 @@ def draw_panel(
         if part == "eyes":
             if image is None:
                 ax.add_patch(Rectangle((-1, -1), 2, 2, facecolor=INSET_RGBA, lw=0, zorder=-1))
-            pcam = eyes_camera(cam, state.pair.h, state.pair.l, aspect)
+            ca, cb = _centres(state)  # as the VTK close-up: half the eyes' x distance
+            pcam = eyes_camera(cam, abs(cb[0] - ca[0]) / 2.0, state.pair.l, aspect)
         else:
             pcam = cam
         draw_view(ax, state, scene, pcam, aspect, part, layers, geometry=image is None)
