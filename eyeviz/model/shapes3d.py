@@ -16,12 +16,16 @@ from functools import lru_cache
 
 import numpy as np
 
+from eyeviz import EyevizError
 from eyeviz.core import healpix
 from eyeviz.model.camera3d import Camera3D, preset
 from eyeviz.model.state3d import SceneState3D
 
 __all__ = [
     "FULL_MAX_NSIDE",
+    "MAX_DRAWN_FACETS",
+    "check_drawn_facets",
+    "lit_owner",
     "MAX_ACCEPTANCE_CONES",
     "acceptance_cones",
     "bfv_cones",
@@ -110,6 +114,43 @@ def patch_facets(nside: int, pix: np.ndarray) -> tuple[int, np.ndarray]:
     v = healpix.centers(nside, pix[::step])
     coarse = healpix.vec2pix_ring(PATCH_COARSE_NSIDE, v[:, 0], v[:, 1], v[:, 2])
     return PATCH_COARSE_NSIDE, np.unique(coarse)
+
+
+#: The most lit facets per eye a figure draws, one polygon each (issue 35: a whole-eye
+#: ball at nside 1024, 12.6 million facets, took a snapshot to 11.6 GB and "out of
+#: memory"); a scene beyond is refused in one line by :func:`check_drawn_facets` before
+#: anything is drawn.
+MAX_DRAWN_FACETS = 1 << 20
+
+
+def lit_owner(state: SceneState3D, eye: str) -> tuple[np.ndarray, np.ndarray]:
+    """(facets, owners): the lit facets of ``eye`` (sorted RING indices) and the ball each
+    is coloured for, the last one lighting it (as :func:`facet_owner`). Memory in the lit
+    count, not in the eye's facets (facet_owner at nside 16384 made 12 GiB)."""
+    csr = state.lit_a if eye == "A" else state.lit_b
+    if csr is None or int(csr[0][-1]) == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int32)
+    ip, ix = csr
+    ball = np.repeat(np.arange(state.n, dtype=np.int32), np.diff(ip))
+    # the last ball per facet: unique over the reversed list keeps each facet's first hit
+    rev = np.asarray(ix, np.int64)[::-1]
+    pix, first = np.unique(rev, return_index=True)
+    return pix, ball[::-1][first]
+
+
+def check_drawn_facets(state: SceneState3D, bound: int | None = None) -> None:
+    """EyevizError (one line, the bound named) when an eye has more lit facets than a
+    figure draws (:data:`MAX_DRAWN_FACETS`); counted from the lit lists, before drawing."""
+    bound = MAX_DRAWN_FACETS if bound is None else bound
+    for eye, csr in (("A", state.lit_a), ("B", state.lit_b)):
+        if csr is None or int(csr[0][-1]) <= bound:
+            continue
+        count = lit_owner(state, eye)[0].size
+        if count > bound:
+            raise EyevizError(
+                f"eye {eye} has {count:,} lit facets; a figure draws at most {bound:,} per "
+                "eye (MAX_DRAWN_FACETS): a smaller nside or smaller balls"
+            )
 
 
 def facet_owner(state: SceneState3D, eye: str, out: np.ndarray | None = None) -> np.ndarray:

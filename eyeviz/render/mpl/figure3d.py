@@ -37,6 +37,7 @@ from eyeviz import EyevizError
 from eyeviz.core.geometry3d import EyePair3D
 from eyeviz.core.validation import check_choice
 from eyeviz.files.atomic import atomic_output
+from eyeviz.model import shapes3d
 from eyeviz.model.camera3d import PRESETS, Camera3D
 from eyeviz.model.facet_patches import facet_patches
 from eyeviz.model.predictions3d import (
@@ -275,6 +276,7 @@ def figure3d(
         raise EyevizError("figure3d draws a spherical scene ([eyes] nside)")
     check_drawable3d(scene)
     st = compute_state3d(scene) if state is None else state
+    shapes3d.check_drawn_facets(st)  # before anything is drawn (issue 35)
     shown = set(scene.layers)
     preds = predictions
     if "predictions" in shown and preds is None and scene.features:

@@ -174,10 +174,10 @@ def _eye_batches(state: SceneState3D, scene: Scene, cam: Camera3D) -> list[_Batc
     out = []
     for e, cx in enumerate((-pair.h, pair.h)):
         c = np.array([cx, 0.0, 0.0])
-        own = shapes3d.facet_owner(state, "AB"[e])
         dist = float(np.linalg.norm(np.asarray(cam.position) - c))
         small = pair.l < SMALL_EYE * dist * half
         if n <= shapes3d.FULL_MAX_NSIDE and not small:  # every facet, by its owner
+            own = shapes3d.facet_owner(state, "AB"[e])
             pts = c + pair.l * healpix.boundaries(n, np.arange(pair.npix), shapes3d.edge_step(n))
             face = np.tile(np.asarray(UNLIT_RGBA), (pts.shape[0], 1))
             lit = own >= 0
@@ -192,11 +192,11 @@ def _eye_batches(state: SceneState3D, scene: Scene, cam: Camera3D) -> list[_Batc
         vn = 4 if small else shapes3d.view_nside(n)
         pts = c + pair.l * healpix.boundaries(vn, np.arange(healpix.npix(vn)), 2)
         out.append(_Batch(pts, UNLIT_RGBA, "eye", centre=c, width=SEAM, light=EYE_LIGHT))
-        pix = np.flatnonzero(own >= 0)
+        pix, owner = shapes3d.lit_owner(state, "AB"[e])  # memory in the lit count only
         if pix.size and colors is not None:
             lp = c + pair.l * healpix.boundaries(n, pix, 1)
             out.append(
-                _Batch(lp, colors[own[pix]], "lit", centre=c, width=SEAM / 2, light=EYE_LIGHT)
+                _Batch(lp, colors[owner], "lit", centre=c, width=SEAM / 2, light=EYE_LIGHT)
             )  # a thinner seam: a patch of facets under a pixel wide would grow
     return out
 
