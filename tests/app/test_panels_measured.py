@@ -160,3 +160,33 @@ def test_readout_shows_the_measured_scenes_balls(qtbot, bee):
         assert panel.text(i, "lit A/B") == f"{st.facets_a[i]}/{st.facets_b[i]}"
         assert st.facets_a[i] >= 2 and st.facets_b[i] >= 2
         assert panel.text(i, "BFV") == "yes"
+
+
+def test_the_honeybee_scene_in_the_window_maps_its_lit_facets(make_window, qtbot):
+    """bee.toml in the real window: the Facets dock's maps are the measured pair's, each
+    ball's lit patches in its colour, and a real mouse move names a lit patch's facet."""
+    from pathlib import Path
+
+    from eyeviz.model.scene import load
+
+    path = Path(__file__).resolve().parents[2] / "assets" / "scenes" / "bee.toml"
+    win = make_window(load(path), path)
+    host = win.host3d
+    host.docks["bitmaps3d"].show()
+    host.docks["bitmaps3d"].raise_()
+    panel = host.bitmaps
+    st = host.model.state
+    qtbot.waitUntil(lambda: panel.canvas.isVisible() and panel._bg is not None, timeout=8000)
+    assert panel.patches["A"] is facet_patches(st.pair, "A")
+    for e, csr in zip("AB", (st.lit_a, st.lit_b), strict=True):
+        np.testing.assert_array_equal(panel.lit_facets(e), lit_owners(csr)[0])
+    owner = dict(zip(*lit_owners(st.lit_a), strict=True))
+    i = 2  # "far": the largest patch
+    mine = np.array([k for k, b in owner.items() if b == i])
+    f = _middle(st.pair, "A", mine)
+    pt = _canvas_px(panel, "A", f)
+    assert _near(_color_at(panel, pt), host.model.scene.features[i].color)
+    QTest.mouseMove(panel.canvas, pt)
+    want = f"eye A, facet {f:,}: axis "
+    qtbot.waitUntil(lambda: panel.hover.text().startswith(want), timeout=3000)
+    assert panel.hover.text().endswith(f"lit by {host.model.scene.features[i].name!r}")
