@@ -170,3 +170,26 @@ def test_the_default_view_looks_from_the_balls_side():
     assert bee.position[2] < bee.focal_point[2]
     sphere = shapes3d.view_camera(compute_state3d(load(SCENES / "sphere_teaching.toml")))
     assert sphere.position[2] > sphere.focal_point[2]
+
+
+def test_acceptance_cones_open_at_half_the_acceptance_and_reach_the_ball():
+    pair = load_eyes(shipped_eye("AM_60185-real.eye"))
+    pos, ax, acc = pair.facets("A")
+    idx = np.arange(0, 3187, 97)
+    centre = np.array([0.0, 11.3, -16.4])
+    pts, take = shapes3d.acceptance_cones(pos[idx], ax[idx], acc[idx], centre, res=12)
+    assert np.array_equal(take, np.arange(idx.size))
+    cones = pts.reshape(idx.size, 13, 3)
+    np.testing.assert_array_equal(cones[:, 0], pos[idx])  # the apex is the lens
+    u = ax[idx] / np.linalg.norm(ax[idx], axis=1, keepdims=True)
+    rim = cones[:, 1:] - cones[:, :1]
+    cos = (rim * u[:, None, :]).sum(axis=-1) / np.linalg.norm(rim, axis=-1)
+    half = np.broadcast_to(acc[idx, None] / 2, cos.shape)
+    np.testing.assert_allclose(np.arccos(np.clip(cos, -1, 1)), half, atol=1e-7)
+    along = (rim * u[:, None, :]).sum(axis=-1)  # cut at the ball's distance from the lens
+    dist = np.linalg.norm(centre - pos[idx], axis=1)[:, None]
+    np.testing.assert_allclose(along, np.broadcast_to(dist, along.shape))
+    many = np.repeat(pos[:1], 2500, axis=0)
+    _, kept = shapes3d.acceptance_cones(many, np.repeat(ax[:1], 2500, 0), np.full(2500, 0.05),
+                                        centre)  # fmt: skip
+    assert kept.size <= shapes3d.MAX_ACCEPTANCE_CONES  # a sample beyond the bound
