@@ -26,7 +26,7 @@ import numpy as np
 from eyeviz import EyevizError
 from eyeviz.core.geometry3d import validate_balls
 from eyeviz.core.measured_exact import lens_in_ball_exact
-from eyeviz.core.measured_fast import EyeTables, decide_pairs, eye_tables, lens_bound
+from eyeviz.core.measured_fast import EyeTables, decide_pairs, eye_tables, lens_bound, use_jit
 from eyeviz.core.measured_index import AxisIndex
 
 __all__ = ["MeasuredEye", "MeasuredEyePair", "MAX_FACETS"]
@@ -221,14 +221,15 @@ class MeasuredEyePair:
         the certified decision with its exact fallback (docs/measured.md)."""
         tables, ix = self._prepared(which)
         nb, n = balls[0].size, ix.n
+        jit = use_jit(nb)
         if index:
-            bi, fi = ix.candidates(*balls)
+            bi, fi = ix.candidates(*balls, jit=jit)
         else:
             bi, fi = np.repeat(np.arange(nb), n), np.tile(np.arange(n), nb)
         lit = []
         for k in range(0, bi.size, _CHUNK):
             b, f = bi[k : k + _CHUNK], fi[k : k + _CHUNK]
-            seen = decide_pairs(tables, balls, b, f)
+            seen = decide_pairs(tables, balls, b, f, jit=jit)
             lit.append(b[seen] * n + f[seen])
         keys = np.sort(np.concatenate(lit)) if lit else np.zeros(0, np.int64)
         indptr = np.searchsorted(keys, np.arange(nb + 1, dtype=np.int64) * n)

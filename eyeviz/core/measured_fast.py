@@ -40,10 +40,10 @@ from dataclasses import dataclass
 import mpmath
 import numpy as np
 
-from eyeviz.core import measured_kernel
+from eyeviz.core import kernels
 from eyeviz.core.measured_exact import seen_exact
 
-__all__ = ["EyeTables", "eye_tables", "decide_pairs", "FALLBACK_COUNTS"]
+__all__ = ["EyeTables", "eye_tables", "decide_pairs", "use_jit", "FALLBACK_COUNTS"]
 
 _U = 2.0**-53
 _LO, _HI = 2.0**-480, 2.0**480
@@ -130,12 +130,42 @@ def _certified(t: EyeTables, cx, cy, cz, g, fi) -> tuple[np.ndarray, np.ndarray]
     return seen | zero, sure
 
 
-def decide_pairs(t: EyeTables, balls: tuple[np.ndarray, ...], bi, fi) -> np.ndarray:
+_RAN: list[bool] = []
+
+
+def use_jit(work: int) -> bool:
+    """Run the compiled path for a call of ``work`` balls: the core's policy
+    (:func:`eyeviz.core.kernels.use`: EYEVIZ_JIT, numba, cold kernels only for large calls
+    or once warm), and always once the measured kernels have run in this process."""
+    if not kernels.enabled():
+        return False
+    return bool(_RAN) or kernels.use(work)
+
+
+def _certified_jit(t: EyeTables, balls, bi, fi) -> tuple[np.ndarray, np.ndarray]:
+    """(seen, sure) of the pairs from the compiled twin of :func:`_certified`."""
+    from eyeviz.core.kernels.measured_lit import certified_kernel
+
+    seen = np.empty(bi.size, np.bool_)
+    sure = np.empty(bi.size, np.bool_)
+    cx, cy, cz, g = balls
+    certified_kernel(
+        cx, cy, cz, g, bi, fi, t.px, t.py, t.pz, t.ax, t.ay, t.az, t.nrm, t.cos, t.sin,
+        t.exact_only, seen, sure,
+    )  # fmt: skip
+    if not _RAN:
+        _RAN.append(True)
+    return seen, sure
+
+
+def decide_pairs(
+    t: EyeTables, balls: tuple[np.ndarray, ...], bi, fi, *, jit: bool = False
+) -> np.ndarray:
     """Whether facet fi[k] sees ball bi[k] (balls: flat float64 cx, cy, cz, g), exactly:
-    the certified float64 test (compiled, or numpy with ``EYEVIZ_JIT=0``), then the exact
+    the certified float64 test (compiled with ``jit``, else numpy), then the exact
     path for the pairs it leaves."""
-    if measured_kernel.enabled():
-        seen, sure = measured_kernel.certified(t, balls, bi, fi)
+    if jit:
+        seen, sure = _certified_jit(t, balls, bi, fi)
         cx, cy, cz, g = balls[0], balls[1], balls[2], balls[3]
         bk = bi
     else:

@@ -29,7 +29,6 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from eyeviz.core import measured_kernel
 from eyeviz.core.measured_grid import AxisGrid
 
 __all__ = ["AxisIndex"]
@@ -71,10 +70,10 @@ class AxisIndex:
         unit[every] = 0.0
         return unit, rho
 
-    def candidates(self, cx, cy, cz, g) -> tuple[np.ndarray, np.ndarray]:
+    def candidates(self, cx, cy, cz, g, *, jit: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """(ball, facet) pairs: every facet within the search radius of each ball, grouped
-        by ball (facets unsorted)."""
-        if measured_kernel.enabled():
+        by ball (facets unsorted); ``jit``: the compiled grid instead of the tree."""
+        if jit:
             if self._grid is None:
                 self._grid = AxisGrid(self._unit)
             return self._grid.candidates((cx, cy, cz, g), self.centre, self.lens, self.alpha)

@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from eyeviz import EyevizError
-from eyeviz.core import measured_fast, measured_kernel
+from eyeviz.core import kernels, measured_fast
 from eyeviz.core.measured import MeasuredEye, MeasuredEyePair
 from eyeviz.core.measured_exact import seen_exact
 from eyeviz.files.eye_io import load_eyes, shipped_eye
@@ -75,7 +75,9 @@ def path(request, monkeypatch):
     """Both implementations of the fast path and the index: the compiled one (numba) and
     the numpy reference (cKDTree, EYEVIZ_JIT=0)."""
     monkeypatch.setenv("EYEVIZ_JIT", "1" if request.param == "jit" else "0")
-    assert measured_kernel.enabled() == (request.param == "jit")
+    if request.param == "jit":
+        kernels.warm()  # compiles or loads them: used for calls of any size
+    assert measured_fast.use_jit(1) == (request.param == "jit")
     return request.param
 
 
@@ -317,7 +319,7 @@ def test_compiled_and_numpy_decisions_agree(monkeypatch):
     balls = (x, y, z, g)
     bi = np.repeat(np.arange(x.size), pos.shape[0])
     fi = np.tile(np.arange(pos.shape[0]), x.size)
-    seen_k, sure_k = measured_kernel.certified(tables, balls, bi, fi)
+    seen_k, sure_k = measured_fast._certified_jit(tables, balls, bi, fi)
     with np.errstate(all="ignore"):
         seen_n, sure_n = measured_fast._certified(tables, x[bi], y[bi], z[bi], g[bi], fi)
     assert np.array_equal(sure_k, sure_n)

@@ -42,9 +42,10 @@ def warm() -> None:
     """Compile (or load from numba's cache) every kernel by running it on small inputs."""
     if not enabled():
         return
-    from eyeviz.core.kernels import healpix_lit
+    from eyeviz.core.kernels import healpix_lit, measured_lit
 
     healpix_lit.warm()
+    measured_lit.warm()
     _STATE["ready"] = True
 
 
