@@ -128,6 +128,16 @@ def _by_ball(verts: np.ndarray, owner: np.ndarray, rgba: np.ndarray, counts: np.
     return paths, rgba[[int(owner[g[0]]) for g in groups]]
 
 
+#: Above this many facets an eye (HEALPix nside 16) the outlines are drawn lighter: a
+#: measured eye's 3,000 facets are a few pixels each in the dock, and EDGE turned the map grey
+DENSE = 3072
+EDGE_DENSE = "#cdcdcd"
+
+
+def _edge(n: int) -> str:
+    return EDGE if n <= DENSE else EDGE_DENSE
+
+
 def _label_side(patches: FacetPatches) -> int:
     """-1 (left) or 1 (right): where the equator's label goes. The right only where the
     outer 65 % of the left half map holds more than twice as many facets near the
@@ -323,7 +333,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
                 verts, _, cnt = _map_polys(patches[eye], np.arange(n_pix))
                 back = PolyCollection(
                     [v[:c] for v, c in zip(verts, cnt, strict=True)], facecolors=UNLIT,
-                    edgecolors=EDGE, linewidths=0.3,
+                    edgecolors=_edge(n_pix), linewidths=0.3,
                 )  # fmt: skip
             else:  # the unlit sphere as one solid ellipse
                 back = PolyCollection([ell], facecolors=UNLIT, edgecolors="none")
@@ -344,7 +354,9 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             # map's edge in a collection of their own, clipped to the outline
             edged = n_pix <= MAX_ALL_FACETS
             lit = tuple(
-                PathCollection([], edgecolors=EDGE, linewidths=0.3 if edged else 0.0, animated=True)
+                PathCollection(
+                    [], edgecolors=_edge(n_pix), linewidths=0.3 if edged else 0.0, animated=True
+                )
                 for _ in range(2)
             )
             lit[1].set_clip_path(clip)
