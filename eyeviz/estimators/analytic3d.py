@@ -12,8 +12,8 @@ in the facets) are ``flagged``; the answer is then r_max along the mean of u and
 r is clipped to [r_min, r_max]. Any design, no weights.
 
 A measured pair (docs/measured.md) is triangulated the same way from its own rays: per
-eye, from the lit facets' mean lens position along their normalised mean axis
-(:func:`estimate_measured`); the rays and the closest approach are
+eye, from the lit facets' mean lens position along the centre of the cap fitted to the
+lit set's inner boundary (:func:`estimate_measured`); the rays and the closest approach are
 :mod:`eyeviz.estimators.triangulation`'s, which the limit and learned estimators read too.
 """
 
@@ -24,8 +24,9 @@ import numpy as np
 from eyeviz.core.domain3d import PAPER_DOMAIN3D, Domain3D
 from eyeviz.estimators.base3d import Estimator3D, LitCSR
 from eyeviz.estimators.triangulation import (
+    boundary_rays,
     cap_estimates,
-    lens_rays,
+    facet_neighbours,
     triangulate,
     triangulate_rays,
 )
@@ -68,15 +69,16 @@ def estimate_measured(
     domain: Domain3D, lit_a: LitCSR, lit_b: LitCSR
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The same for a measured pair: per eye the ray from the lit facets' mean lens
-    position along their normalised mean axis (:func:`.triangulation.lens_rays`), the
+    position along the centre of the cap fitted to the lit set's inner boundary
+    (:func:`.triangulation.boundary_rays`; the mean axis where none fits), the
     midpoint of the two rays' closest approach, and (r, azimuth, elevation) of it about
     the domain's origin (the midpoint of the two lens centroids). Rays that do not meet in
     front of both eyes are flagged and answered at r_max along the mean of the two axes."""
     eyes = domain.eyes
     pos_a, axes_a, _ = eyes.facets("A")
     pos_b, axes_b, _ = eyes.facets("B")
-    oa, u, _ = lens_rays(pos_a, axes_a, lit_a)
-    ob, v, _ = lens_rays(pos_b, axes_b, lit_b)
+    oa, u, _ = boundary_rays(pos_a, axes_a, lit_a, _neighbours(eyes, "A"))
+    ob, v, _ = boundary_rays(pos_b, axes_b, lit_b, _neighbours(eyes, "B"))
     p, ok = triangulate_rays(oa, u, ob, v)
     o = np.asarray(domain.origin)
     mean_dir = u + v
@@ -89,9 +91,22 @@ def estimate_measured(
     return r, az, el, ~ok
 
 
+_NEIGHBOURS: dict[tuple[str, str], np.ndarray] = {}
+
+
+def _neighbours(eyes, which: str) -> np.ndarray:
+    """:func:`.triangulation.facet_neighbours` of one eye, cached by the pair's fingerprint."""
+    key = (eyes.fingerprint, which)
+    if key not in _NEIGHBOURS:
+        if len(_NEIGHBOURS) > 8:
+            _NEIGHBOURS.clear()
+        _NEIGHBOURS[key] = facet_neighbours(eyes.facets(which)[1])
+    return _NEIGHBOURS[key]
+
+
 class Analytic3DEstimator(Estimator3D):
     """Closest-approach triangulation of the two lit caps' centres (HEALPix) or of the lit
-    facets' mean rays (measured eyes); 0 weights."""
+    sets' boundary-fitted rays (measured eyes); 0 weights."""
 
     name = "analytic3d"
     kinds = ("spherical", "measured")

@@ -10,7 +10,9 @@ through the facets' geometry:
   (:func:`cap_estimates`, from :func:`eyeviz.estimators.healpix_summaries.eye_summaries`:
   equal solid angles, so the plain mean is the solid-angle-weighted one);
 - **measured eyes** (docs/measured.md): the origin is the mean lens position of the lit
-  facets and the direction their normalised mean unit axis (:func:`lens_rays`).
+  facets (:func:`lens_rays`) and the direction the centre of the cap fitted to the lit
+  set's inner boundary (:func:`boundary_rays`); the lit facets' mean unit axis where no
+  cap fits.
 
 The midpoint of the shortest segment between
 A + s u and B + t v is the estimate; rays that do not meet in front of both eyes (s or
@@ -26,6 +28,7 @@ import numpy as np
 from eyeviz.estimators.healpix_summaries import eye_summaries
 
 __all__ = [
+    "boundary_rays",
     "cap_estimates",
     "closest_approach",
     "lens_rays",
@@ -131,3 +134,66 @@ def lens_rays(
         origin = pos_sum / count[:, None]
         direction = ax_sum / np.linalg.norm(ax_sum, axis=1, keepdims=True)
     return origin, direction, count
+
+
+#: Neighbours per facet that define the lit set's boundary (a hexagonal lattice has 6).
+BOUNDARY_NEIGHBOURS = 6
+#: A fitted cap centre further than this from the lit facets' mean axis is not trusted.
+BOUNDARY_MAX_TURN = math.radians(20.0)
+
+
+def facet_neighbours(axes: np.ndarray, k: int = BOUNDARY_NEIGHBOURS) -> np.ndarray:
+    """(n, k) int: each facet's k nearest facets by the angle between their unit axes."""
+    from scipy.spatial import cKDTree
+
+    unit = axes / np.linalg.norm(axes, axis=1, keepdims=True)
+    k = min(k, unit.shape[0] - 1)
+    return np.asarray(cKDTree(unit).query(unit, k=k + 1)[1][:, 1:], np.int64).reshape(-1, k)
+
+
+def boundary_rays(
+    positions: np.ndarray, axes: np.ndarray, lit: LitCSR, neighbours: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Measured eye: (origin (n, 3), direction (n, 3), fitted (n,)) per CSR row.
+
+    A ball lights the facets whose axes lie within a cap about its direction (to the lens
+    offsets), but an eye's field ends: a ball in the binocular field sits at the rim of
+    each eye's field, its lit set is the cap cut off on the midline side, and the lit
+    axes' mean leans away from the ball (docs/measured.md). The cap's edge where it lies
+    inside the eye's field is still seen: the midpoints x_j of (lit facet, unlit
+    neighbour) axis pairs lie on it, x_j . d = cos R. The direction is the normalised
+    least-squares w of x_j . w = 1 (w = d / cos R), which the rim does not bias. The
+    origin is :func:`lens_rays`' mean lens position. A row keeps the mean axis
+    (``fitted`` False) where fewer than 3 boundary points exist, the 3x3 system is
+    ill-conditioned (eigenvalue ratio below 1e-6), or the fit turns more than 20 degrees
+    from the mean axis."""
+    origin, mean_dir, count = lens_rays(positions, axes, lit)
+    nb = facet_neighbours(axes) if neighbours is None else neighbours
+    ptr = np.asarray(lit[0], np.int64)
+    idx = np.asarray(lit[1], np.int64)
+    n, nfac, k = ptr.size - 1, axes.shape[0], nb.shape[1]
+    unit = axes / np.linalg.norm(axes, axis=1, keepdims=True)
+    row = np.repeat(np.arange(n), count)
+    keys = row * nfac + idx  # sorted: CSR rows in order, each row's indices sorted
+    rr = np.repeat(row, k)
+    ii = np.repeat(idx, k)
+    jj = nb[idx].ravel()
+    want = rr * nfac + jj
+    at = np.minimum(np.searchsorted(keys, want), max(keys.size - 1, 0))
+    unlit = keys[at] != want if keys.size else np.ones(want.shape, bool)
+    rr, ii, jj = rr[unlit], ii[unlit], jj[unlit]
+    x = unit[ii] + unit[jj]
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    m = np.empty((n, 3, 3))
+    b = np.empty((n, 3))
+    for i in range(3):
+        b[:, i] = np.bincount(rr, x[:, i], minlength=n)
+        for j in range(3):
+            m[:, i, j] = np.bincount(rr, x[:, i] * x[:, j], minlength=n)
+    ev = np.linalg.eigvalsh(m)
+    fitted = (np.bincount(rr, minlength=n) >= 3) & (ev[:, 0] > 1e-6 * ev[:, 2])
+    w = np.linalg.solve(np.where(fitted[:, None, None], m, np.eye(3)), b[..., None])[..., 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = w / np.linalg.norm(w, axis=1, keepdims=True)
+        fitted &= np.einsum("ij,ij->i", d, mean_dir) > math.cos(BOUNDARY_MAX_TURN)
+    return origin, np.where(fitted[:, None], d, mean_dir), fitted

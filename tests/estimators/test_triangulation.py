@@ -13,6 +13,7 @@ from eyeviz.core.domain3d import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import analytic3d, learned3d_features, registry
 from eyeviz.estimators.triangulation import (
+    boundary_rays,
     cap_estimates,
     lens_rays,
     triangulate,
@@ -123,15 +124,15 @@ def test_lens_rays_are_the_lit_facets_mean_lens_and_mean_unit_axis():
     assert np.isnan(origin[1]).all() and np.isnan(direction[1]).all()
 
 
-def test_analytic3d_on_a_measured_pair_is_the_closest_approach_of_the_lens_rays(toy_pair):
+def test_analytic3d_on_a_measured_pair_is_the_closest_approach_of_the_boundary_rays(toy_pair):
     d = Domain3D.for_eyes(toy_pair)
     ds = generate3d(30, d, seed=7)
     est = registry.load("analytic3d", domain=d)
     pred = est.predict_dataset(ds)
     assert pred.valid.all() and pred.in_domain.all()
     la, lb = (ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b)
-    oa, u, _ = lens_rays(toy_pair.eye_a.positions, toy_pair.eye_a.axes, la)
-    ob, v, _ = lens_rays(toy_pair.eye_b.positions, toy_pair.eye_b.axes, lb)
+    oa, u, _ = boundary_rays(toy_pair.eye_a.positions, toy_pair.eye_a.axes, la)
+    ob, v, _ = boundary_rays(toy_pair.eye_b.positions, toy_pair.eye_b.axes, lb)
     ok = ~np.asarray(pred.flagged)
     assert ok.sum() >= 10
     # where the rays meet: the midpoint of the closest approach, solved independently
@@ -151,8 +152,9 @@ def test_analytic3d_on_a_measured_pair_is_the_closest_approach_of_the_lens_rays(
     lb = np.argsort(-toy_pair.eye_b.axes[:, 0])[:3]
     far = est.predict((np.array([0, 3]), np.sort(la)), (np.array([0, 3]), np.sort(lb)))
     assert far.flagged[0] and np.isclose(far.r[0], d.r_max, rtol=1e-12)
-    _, u1, _ = lens_rays(toy_pair.eye_a.positions, toy_pair.eye_a.axes, (np.array([0, 3]), la))
-    _, v1, _ = lens_rays(toy_pair.eye_b.positions, toy_pair.eye_b.axes, (np.array([0, 3]), lb))
+    ra, rb = (np.array([0, 3]), np.sort(la)), (np.array([0, 3]), np.sort(lb))
+    _, u1, _ = boundary_rays(toy_pair.eye_a.positions, toy_pair.eye_a.axes, ra)
+    _, v1, _ = boundary_rays(toy_pair.eye_b.positions, toy_pair.eye_b.axes, rb)
     mean = (u1 + v1)[0] / np.linalg.norm((u1 + v1)[0])
     assert np.isclose(far.azimuth[0], np.arctan2(mean[1], mean[0]))
     # the toy's field is wide and its facets coarse: the triangulation still finds the
