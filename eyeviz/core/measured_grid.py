@@ -56,12 +56,5 @@ class AxisGrid:
         nb = cx.size
         ux, uy, uz = self.pu
         keys, starts, counts, perm = self.keys, self.starts, self.counts, self.perm
-        cnt = np.zeros(nb, np.int64)
-        none = np.zeros(0, np.int64)
-        scan(cx, cy, cz, g, centre, lens, alpha, keys, starts, counts, ux, uy, uz, perm, cnt,
-             none, False)  # fmt: skip
-        offs = np.cumsum(cnt) - cnt
-        out = np.empty(int(cnt[-1] + offs[-1]) if nb else 0, np.int64)
-        scan(cx, cy, cz, g, centre, lens, alpha, keys, starts, counts, ux, uy, uz, perm, offs,
-             out, True)  # fmt: skip
+        cnt, out = scan(cx, cy, cz, g, centre, lens, alpha, keys, starts, counts, ux, uy, uz, perm)
         return np.repeat(np.arange(nb), cnt), out

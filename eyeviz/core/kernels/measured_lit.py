@@ -63,7 +63,7 @@ def certified_kernel(
 
 
 @_jit
-def scan_kernel(cx, cy, cz, g, centre, lens, alpha, keys, starts, counts, pux, puy, puz, perm,
+def _scan_pass(cx, cy, cz, g, centre, lens, alpha, keys, starts, counts, pux, puy, puz, perm,
           offs, out, fill):  # fmt: skip
     nfacet = pux.size // LEVELS
     for b in range(cx.size):
@@ -115,6 +115,21 @@ def scan_kernel(cx, cy, cz, g, centre, lens, alpha, keys, starts, counts, pux, p
             offs[b] = n
 
 
+@_jit
+def scan_kernel(cx, cy, cz, g, centre, lens, alpha, keys, starts, counts, pux, puy, puz, perm):
+    """(count per ball, facets) within each ball's search radius: a counting pass, then a
+    filling pass into one array (one call from Python)."""
+    cnt = np.zeros(cx.size, np.int64)
+    none = np.zeros(0, np.int64)
+    _scan_pass(cx, cy, cz, g, centre, lens, alpha, keys, starts, counts, pux, puy, puz, perm,
+               cnt, none, False)  # fmt: skip
+    offs = np.cumsum(cnt) - cnt
+    out = np.empty(cnt.sum(), np.int64)
+    _scan_pass(cx, cy, cz, g, centre, lens, alpha, keys, starts, counts, pux, puy, puz, perm,
+               offs, out, True)  # fmt: skip
+    return cnt, out
+
+
 def warm() -> None:
     """Compile (or load from the cache) both kernels for their one signature."""
     f = np.zeros(1)
@@ -125,5 +140,4 @@ def warm() -> None:
     keys = np.zeros(1, np.int64)
     pu = np.zeros(LEVELS)
     perm = np.zeros(LEVELS, np.int64)
-    scan_kernel(f, f, f, f + 1, np.zeros(3), 0.5, 0.1, keys, i, i + 1, pu, pu, pu, perm,
-                np.zeros(1, np.int64), np.zeros(0, np.int64), False)  # fmt: skip
+    scan_kernel(f, f, f, f + 1, np.zeros(3), 0.5, 0.1, keys, i, i + 1, pu, pu, pu, perm)
