@@ -12,6 +12,7 @@ from eyeviz.app.launch import check_display, make_app
 from eyeviz.app.screenshot import screenshot_format
 from eyeviz.app.settings import make_settings
 from eyeviz.app.window import MainWindow
+from eyeviz.model.draw_bounds import check_drawable_eyes
 from eyeviz.model.scene import load
 from eyeviz.resources import scene_path as scene_path_of
 
@@ -25,10 +26,11 @@ def run_app(
 ) -> int:
     if screenshot is not None:
         screenshot_format(screenshot)  # refuse a wrong suffix before any window opens
-    check_display()
     if scene_path is None:
         scene_path = scene_path_of("default")
     scene = load(scene_path)
+    check_drawable_eyes(scene, "app")  # one line before any window (issue 36)
+    check_display()
     settings = make_settings(settings_path)
     # a screenshot reads the saved window state but never changes it (nor recent files)
     settings.read_only = screenshot is not None

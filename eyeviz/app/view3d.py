@@ -38,6 +38,7 @@ from eyeviz.app.predictions_layer3d import Predictions3DLayer
 from eyeviz.app.view import make_view
 from eyeviz.model import app_model3d as m3
 from eyeviz.model.camera3d import PRESETS, Camera3D
+from eyeviz.model.draw_bounds import check_drawable_eyes
 from eyeviz.model.predictions3d import (
     LatestOnly,
     Predictions3D,
@@ -235,6 +236,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
 
         try:
             check_estimators(scene)  # a name no estimator has: one line, not the defaults
+            check_drawable_eyes(scene, "app")  # nside, balls, lit facets: before allocating
             m3.checked_state(scene)
         except EyevizError as exc:
             self.win.show_error("Cannot open scene", str(exc))

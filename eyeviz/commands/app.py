@@ -73,4 +73,10 @@ def run(args) -> int:
             return rc
     from eyeviz.app.main import run_app
 
-    return run_app(args.scene, args.screenshot, args.settings)
+    try:
+        return run_app(args.scene, args.screenshot, args.settings)
+    except MemoryError:
+        # fatal: exit now. Returning left the process alive until killed (issue 36: "out
+        # of memory" printed, then Qt's thread pool waited on a job that never ended)
+        print("eyeviz: error: out of memory", file=sys.stderr, flush=True)
+        os._exit(2)

@@ -109,6 +109,9 @@ def run(args: argparse.Namespace) -> int:
         from eyeviz.render.mpl.glyphs import one_glyph_warning
 
         check_drawable3d(sc)
+        from eyeviz.model.draw_bounds import check_drawable_eyes
+
+        check_drawable_eyes(sc, "png" if format_of(args.output) == "png" else "vector")
         opts = dict(
             scale=args.scale,
             transparent=args.transparent,

@@ -205,3 +205,97 @@ def test_report_estimators_names_a_data_set_without_rows(tmp_path, capsys):
     line = _one_line(rc, err)
     assert str(path) in line and "metrics need at least one value" not in line
     assert not (tmp_path / "rep").exists()
+
+
+# --- item 4: a fatal error in the app ends the process
+
+
+def test_out_of_memory_in_the_app_exits_even_with_a_job_running(tmp_path):
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, threading, time\n"
+        "import eyeviz.app.main as m\n"
+        "def run_app(*a, **k):\n"
+        "    threading.Thread(target=time.sleep, args=(600,)).start()  # a job never ending\n"
+        "    raise MemoryError\n"
+        "m.run_app = run_app\n"
+        "from eyeviz import cli\n"
+        f"sys.exit(cli.main(['app', '--screenshot', {str(tmp_path / 'x.png')!r}]))\n"
+    )
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "PYTHONPATH": str(root), "DISPLAY": ":987", "QT_QPA_PLATFORM": "offscreen"}
+    p = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120
+    )  # before: "out of memory", then alive until killed (here: the 120 s timeout)
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.strip().splitlines() == ["eyeviz: error: out of memory"]
+
+
+# --- item 5 (and 4): the largest nside, lit facets and balls each path draws, held
+
+
+def _ball_scene(path: Path, nside: int, balls: list[tuple[float, float, float, float]]) -> Path:
+    fs = [
+        scene_mod.Feature(f"b{i}", x, y, g, scene_mod.OKABE_ITO[i % 7], z)
+        for i, (x, y, z, g) in enumerate(balls)
+    ]
+    layers = ["eyes", "features", "bitmaps", "readout"]
+    scene_mod.save(scene_mod.Scene(scene_mod.Eyes(40.0, 20.0, nside=nside), fs, layers), path)
+    return path
+
+
+@pytest.fixture
+def no_lit_sets(monkeypatch):
+    """Any lit set computed fails the test: a refusal must come before allocating."""
+    from eyeviz.core.geometry3d import EyePair3D
+
+    def boom(*_a, **_k):
+        raise AssertionError("lit sets were computed")
+
+    monkeypatch.setattr(EyePair3D, "lit_csr", boom)
+
+
+def test_each_path_refuses_beyond_its_nside_and_lit_facets_before_allocating(
+    tmp_path, capsys, no_lit_sets, monkeypatch
+):
+    from eyeviz.model import draw_bounds as db
+
+    monkeypatch.setenv("DISPLAY", ":987")  # no xvfb-run copy: the refusal comes first
+
+    big = _ball_scene(tmp_path / "big.toml", 2048, [(0.0, 150.0, 0.0, 120.0)])
+    for out, path in (("f.png", "a PNG snapshot"), ("f.svg", "an SVG/PDF figure")):
+        rc, _, err = _run(["snapshot", big, "-o", tmp_path / out], capsys)
+        line = _one_line(rc, err)
+        assert "facets of an eye at nside 2048" in line and path in line
+        assert f"draws at most {db.MAX_DRAWN_LIT['vector']:,}" in line
+    huge = _ball_scene(tmp_path / "huge.toml", 2 * db.MAX_DRAW_NSIDE["vector"], [(0, 900, 0, 1)])
+    rc, _, err = _run(["snapshot", huge, "-o", tmp_path / "f.pdf"], capsys)
+    assert _one_line(rc, err).endswith(
+        f"nside = {2 * db.MAX_DRAW_NSIDE['vector']}: an SVG/PDF figure draws spherical eyes up "
+        f"to nside {db.MAX_DRAW_NSIDE['vector']} (a larger nside is for data sets and estimators)"
+    )
+    app = _ball_scene(tmp_path / "app.toml", 2 * db.MAX_DRAW_NSIDE["app"], [(0, 900, 0, 1)])
+    rc, _, err = _run(["app", app, "--screenshot", tmp_path / "s.png"], capsys)
+    assert "the app's 3D view draws spherical eyes up to nside" in _one_line(rc, err)
+    many = [(float(x), 2000.0, 0.0, 5.0) for x in range(db.MAX_APP_BALLS + 1)]
+    crowd = _ball_scene(tmp_path / "crowd.toml", 16, many)
+    rc, _, err = _run(["app", crowd, "--screenshot", tmp_path / "s.png"], capsys)
+    assert f"the app's 3D view draws at most {db.MAX_APP_BALLS}" in _one_line(rc, err)
+    assert sorted(p.suffix for p in tmp_path.iterdir()) == [".toml"] * 4
+
+
+def test_the_lit_estimate_brackets_the_exact_count():
+    from eyeviz.model import draw_bounds as db
+    from eyeviz.model.state3d import compute_state3d
+
+    for nside, ball in ((64, (0.0, 150.0, 0.0, 120.0)), (128, (30.0, 900.0, 50.0, 60.0))):
+        sc = scene_mod.Scene(
+            scene_mod.Eyes(40.0, 20.0, nside=nside),
+            [scene_mod.Feature("b", ball[0], ball[1], ball[3], "#D55E00", ball[2])],
+            ["eyes"],
+        )
+        st = compute_state3d(sc)
+        exact = max(int(st.facets_a[0]), int(st.facets_b[0]))
+        assert exact <= db.lit_estimate(sc) <= 2 * exact + 100, (nside, exact)
