@@ -252,3 +252,22 @@ def test_teaching_layers_draw_at_most_max_taught_features_and_count_the_rest():
     # a few features: every one drawn, no note
     fig = vector.figure(_scene(5, layers=["eyes", "features", "tangents", "sectors"]))
     assert "label-more" not in _texts(fig, "label-more")
+
+
+@pytest.mark.parametrize("width", ["single", "double", 5.0])
+def test_a_crowded_figure_keeps_within_a_pages_aspect(width):
+    """A 2,000-feature snapshot was 1050 x 2343 px (aspect 2.23, issue 35 item 11): the
+    lanes and the table's rows give way until the figure fits a page's aspect; what they
+    leave out is counted."""
+    from eyeviz.render.mpl.layout import MAX_FIGURE_ASPECT
+
+    fig = vector.figure(_scene(2000), width=width)
+    w, h = fig.get_size_inches()
+    assert h <= MAX_FIGURE_ASPECT * w + 0.01, (w, h)
+    texts = _texts(fig, "")
+    listed = {g.split("-")[2] for g in texts if g.startswith("readout-0-")}
+    more = int(texts["readout-more"].split()[2].replace(",", ""))
+    assert listed and len(listed) + more == 2000
+    assert "bitmap-interval-A-more" in texts and "bitmap-interval-B-more" in texts
+    few = vector.figure(_scene(4), width=width)  # a small scene is laid out as before
+    assert few.get_size_inches()[1] < h + 1e-9

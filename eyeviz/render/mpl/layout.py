@@ -24,6 +24,7 @@ __all__ = [
     "Box",
     "Lanes",
     "Layout",
+    "MAX_FIGURE_ASPECT",
     "MAX_LABELS",
     "MAX_LANES",
     "MAX_TABLE_ROWS",
@@ -50,6 +51,14 @@ MAX_LANES = 6
 #: At most this many rows in the readout table, headers and the "... and N more" row
 #: included; features whose rows do not fit are counted, not listed.
 MAX_TABLE_ROWS = 24
+#: A figure is at most this many times as tall as it is wide: a journal page's text block
+#: (7.1 x 9.7 in, 6.5 x 9 in) or an A4 sheet (1.41). A 2,000-feature snapshot was 2.23
+#: (issue 35): the lanes and table rows a figure lists shrink until it fits, the rest
+#: counted in their "... and N more" lines.
+MAX_FIGURE_ASPECT = 1.4
+#: The fewest lanes per strip and table rows the figure keeps, even past that aspect.
+MIN_LANES = 1
+MIN_TABLE_ROWS = 4
 #: At most this many feature names beside their discs in the main view.
 MAX_LABELS = 40
 #: At most this many features drawn with the teaching layers' lines (tangents, sectors).
@@ -95,6 +104,7 @@ class Layout:
     lanes: tuple[int, int] = (2, 2)
     table_features: int = 0  # features listed in the readout table (the rest are counted)
     min_font: float = 0.0  # no text smaller than this, points (0: the style's sizes)
+    max_lanes: int = MAX_LANES  # label lanes per bitmap strip (fewer in a crowded figure)
 
     def pt(self, size: float) -> float:
         """A font size raised to the figure's minimum."""
@@ -117,23 +127,24 @@ def _rows_per_feature(layers, n_estimators: int) -> int:
     return rows
 
 
-def table_features(layers, n_features: int, n_estimators: int) -> int:
+def table_features(
+    layers, n_features: int, n_estimators: int, max_rows: int = MAX_TABLE_ROWS
+) -> int:
     """How many features the readout table lists: all of them while the table fits in
-    :data:`MAX_TABLE_ROWS` rows, else as many as fit beside a "... and N more" row (at
-    least one)."""
+    ``max_rows`` rows, else as many as fit beside a "... and N more" row (at least one)."""
     if "readout" not in layers or not n_features:
         return 0
     per = _rows_per_feature(layers, n_estimators)
-    if 2 + n_features * per <= MAX_TABLE_ROWS:
+    if 2 + n_features * per <= max_rows:
         return n_features
-    return max(1, (MAX_TABLE_ROWS - 3) // per)
+    return max(1, (max_rows - 3) // per)
 
 
-def readout_rows(layers, n_features: int, n_estimators: int) -> int:
+def readout_rows(layers, n_features: int, n_estimators: int, max_rows: int = MAX_TABLE_ROWS) -> int:
     """Rows of the readout table: two header rows, each listed feature's rows and one
-    "... and N more" row when some are left out; at most :data:`MAX_TABLE_ROWS` (more
-    only when one feature's rows alone exceed it)."""
-    shown = table_features(layers, n_features, n_estimators)
+    "... and N more" row when some are left out; at most ``max_rows`` (more only when one
+    feature's rows alone exceed it)."""
+    shown = table_features(layers, n_features, n_estimators, max_rows)
     if not shown:
         return 0
     return 2 + shown * _rows_per_feature(layers, n_estimators) + (shown < n_features)
@@ -253,19 +264,29 @@ def layout(
     right = max(0.1, tick_chars(*xlim) * 0.6 * SMALL * k / 72 / 2 + 0.03)  # half a tick
     main_w = width - left - right
     shows_bitmaps = "bitmaps" in layers and n_features and intervals is not None
-    lanes = (0, 0)
-    if shows_bitmaps:
-        (LA, RA), (LB, RB) = intervals
-        pt = max(LABEL_PT, min_font)
-        a = interval_lanes(LA, RA, m, main_w, pt=pt)
-        b = interval_lanes(LB, RB, m, main_w, pt=pt)
-        lanes = (max(1, a.height), max(1, b.height))
     main_h = round(main_w * aspect, 3)
-    rows = readout_rows(layers, n_features, n_estimators)
-    shown = table_features(layers, n_features, n_estimators)
-    readout_h = rows * TEXT_ROW * k + (0.06 if rows else 0.0)
-    bitmaps_h = sum(lanes) * LANE * k + 0.02 + 0.12 * 2 + 0.15 * k if shows_bitmaps else 0.0
     title_h = 0.22 * k if title else 0.06
+    fixed = (
+        0.06 + 0.3 * k + main_h + title_h + (0.05 + 0.02 + 0.24 + 0.15 * k) * bool(shows_bitmaps)
+    )
+    # the most lanes and table rows that keep the figure within MAX_FIGURE_ASPECT: the
+    # lanes give way first (down to MIN_LANES), then the table's rows (to MIN_TABLE_ROWS)
+    caps = [(c, MAX_TABLE_ROWS) for c in range(MAX_LANES, MIN_LANES - 1, -1)]
+    caps += [(MIN_LANES, r) for r in range(MAX_TABLE_ROWS - 1, MIN_TABLE_ROWS - 1, -1)]
+    for max_lanes, max_rows in caps:
+        lanes = (0, 0)
+        if shows_bitmaps:
+            (LA, RA), (LB, RB) = intervals
+            pt = max(LABEL_PT, min_font)
+            a = interval_lanes(LA, RA, m, main_w, pt=pt, max_lanes=max_lanes)
+            b = interval_lanes(LB, RB, m, main_w, pt=pt, max_lanes=max_lanes)
+            lanes = (max(1, a.height), max(1, b.height))
+        rows = readout_rows(layers, n_features, n_estimators, max_rows)
+        readout_h = rows * TEXT_ROW * k + (0.06 if rows else 0.0)
+        if fixed + readout_h + sum(lanes) * LANE * k <= MAX_FIGURE_ASPECT * width:
+            break
+    shown = table_features(layers, n_features, n_estimators, max_rows)
+    bitmaps_h = sum(lanes) * LANE * k + 0.02 + 0.12 * 2 + 0.15 * k if shows_bitmaps else 0.0
     y = 0.06
     readout = Box(0.1, y, width - 0.2, readout_h) if rows else None
     y += readout_h
@@ -277,5 +298,15 @@ def layout(
     # whole hundredths of an inch: the PNG's pixel size then scales exactly with --scale
     height = math.ceil((y + title_h) * 100 - 1e-9) / 100
     return Layout(
-        width, height, main, bitmaps, readout, rows, title_y, lanes, shown, float(min_font)
+        width,
+        height,
+        main,
+        bitmaps,
+        readout,
+        rows,
+        title_y,
+        lanes,
+        shown,
+        float(min_font),
+        max_lanes,
     )

@@ -104,7 +104,7 @@ def paint(cv: Canvas) -> None:
         )
         L, R = fr.intervals[name]
         above = name == "A"
-        lanes = interval_lanes(L, R, m, box.w, pt=label_pt)
+        lanes = interval_lanes(L, R, m, box.w, pt=label_pt, max_lanes=cv.lay.max_lanes)
         for i, text, centre, lane in lanes:
             dy = 0.008 + lane * lane_h
             ax.text(
