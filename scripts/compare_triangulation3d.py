@@ -81,6 +81,8 @@ def mean_rays(domain, lit_a, lit_b):
 
 def scores(ds, est, rows) -> str:
     r, az, el, flagged = est
+    if not rows.any():
+        return f"no rows  flagged {flagged.mean():.1%}"
     dd = 100 * np.mean(np.abs(r[rows] - ds.r[rows]) / ds.r[rows])
     dz = np.angle(np.exp(1j * (az[rows] - ds.azimuth[rows])))
     ad = np.degrees(np.median(np.abs(dz)))

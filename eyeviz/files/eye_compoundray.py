@@ -43,6 +43,9 @@ def _bad_token(data: bytes, line: int, name: str) -> EyevizError:
     text = data.split(b"\n", line)[line - 1] if line > 0 else b""
     for tok in text.replace(b",", b" ").split():
         try:
+            # 'nan', 'inf' and '1_0' are Python floats, not the format's numbers
+            if tok.strip(_ALLOWED):
+                raise ValueError
             float(tok)
         except ValueError:
             shown = tok[:40].decode("ascii", "replace")
@@ -107,7 +110,7 @@ def _check_rows(rows: np.ndarray, lines: np.ndarray, name: str) -> None:
     if out.any():
         i = int(np.flatnonzero(out)[0])
         raise EyevizError(
-            f"{name}: line {lines[i]}: acceptance angle {acc[i]!r} rad is not in (0, pi)"
+            f"{name}: line {lines[i]}: acceptance angle {float(acc[i])!r} rad is not in (0, pi)"
         )
 
 
