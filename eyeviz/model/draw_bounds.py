@@ -31,8 +31,10 @@ PATHS = ("vector", "png", "app")
 #: until a per-eye array of 12 nside^2 entries is made: 200 MB at 4096).
 MAX_DRAW_NSIDE = {"vector": 4096, "png": 4096, "app": 2048}
 #: The most lit facets per eye (summed over balls) each path draws: each is a polygon of
-#: the Mollweide maps (vector, PNG) and of the view's lit patches (app).
-MAX_DRAWN_LIT = {"vector": 400_000, "png": 400_000, "app": 400_000}
+#: the Mollweide maps (vector, PNG; a ball lighting 25,700 facets per eye at nside 128 took
+#: 131 s and 0.30 GB under a load of 7-8, one lighting 101,500 at nside 256 did not end in
+#: 300 s) and of the view's lit patches (app; coarsened past 200,000 a ball).
+MAX_DRAWN_LIT = {"vector": 25_000, "png": 25_000, "app": 400_000}
 #: The most balls a spherical scene may have in the app (the 3D view): 10^4 at nside 180
 #: gave no first frame in 500 s (issue 36 item 4); at nside 180 under a load of 8-11, 100
 #: balls took 110 s to a first frame and 300 balls 251 s (docs/spherical.md).
