@@ -192,6 +192,28 @@ def test_lens_enclosing_balls(name):
     assert not pair.in_bfv(x, y, z, g)[oa | ob].any()
 
 
+def test_balls_enclosing_lenses_of_inward_looking_facets(path):
+    """Facets looking into the head (axes towards the eye's centre) whose lens a ball holds:
+    seen through |c - p| <= g alone, whatever the axis; the index must not drop them."""
+    hand = hand_eye(9)
+    eyes = [
+        MeasuredEye(e.positions, -e.axes, e.acceptance, name=e.name)
+        for e in (hand.eye_a, hand.eye_b)
+    ]
+    pair = MeasuredEyePair(*eyes)
+    pos = pair.facets("B")[0]
+    out = (pos - np.array([1.0, 0.0, 0.0])) / 0.5  # outward unit normals of eye B
+    x, y, z, g = [], [], [], []
+    for k in range(0, pos.shape[0], 3):
+        for off, gg in ((0.3, 0.35), (0.6, 0.7), (1.0, 1.2)):
+            c = pos[k] + off * out[k]
+            x.append(c[0])
+            y.append(c[1])
+            z.append(c[2])
+            g.append(gg)
+    check_against_reference(pair, x, y, z, g)
+
+
 @pytest.mark.parametrize("name", ["AM_60185-real.eye", "1000-horizontallyAcute-variableDegree.eye"])
 def test_tiny_balls(name):
     pair = shipped(name)
