@@ -233,6 +233,7 @@ def test_tiny_balls(name):
     assert 0 in pair.lit(*pos[0], 5e-324)[1]
 
 
+@pytest.mark.slow
 def test_huge_and_tiny_scales(path):
     """Magnitudes where float64 squares overflow or underflow: the exact path decides."""
     hand = hand_eye(4)
