@@ -20,9 +20,11 @@ from __future__ import annotations
 import os
 import signal
 import sys
+import warnings
 
 DEFAULT_COMMAND = "app"
 _SIGNALS = {"SIGINT": 130, "SIGTERM": 143, "SIGHUP": 129}
+_SHOW_WARNING = warnings.showwarning
 
 
 class Interrupted(KeyboardInterrupt):
@@ -220,6 +222,16 @@ def main(argv: list[str] | None = None) -> int:
                 setattr(sys, name, old)
 
 
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """An eye file's size warning as one line (not Python's two, with the source line)."""
+    from eyeviz.files.eye_io import EyeSizeWarning
+
+    if issubclass(category, EyeSizeWarning):
+        print(f"eyeviz: warning: {message}", file=sys.stderr if file is None else file)
+    else:
+        _SHOW_WARNING(message, category, filename, lineno, file, line)
+
+
 def _run(args) -> int:
     from eyeviz import EyevizError
 
@@ -227,7 +239,9 @@ def _run(args) -> int:
         from eyeviz.files.outputs import check_outputs
 
         check_outputs(args)  # -o a directory: refused before any work (issue 36)
-        return int(args._run(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning
+            return int(args._run(args) or 0)
     except EyevizError as exc:
         _error(str(exc))
     except (ZeroDivisionError, FloatingPointError) as exc:  # never names a problem: a bug
