@@ -43,30 +43,26 @@ from matplotlib.patches import Rectangle
 
 from eyeviz.core import healpix
 from eyeviz.model import shapes3d
-from eyeviz.model.camera3d import Camera3D, basis, eyes_camera, project
+from eyeviz.model.camera3d import Camera3D, eyes_camera, project
 from eyeviz.model.facets3d import surface_of
-from eyeviz.model.predictions3d import LIMIT, Predictions3D, estimator_color3d
+from eyeviz.model.predictions3d import Predictions3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
+from eyeviz.render.mpl.ghosts3d import draw_ghosts
 from eyeviz.render.mpl.style import SMALL, short
 from eyeviz.render.style3d import (
     BALL_LIGHT,
     BFV_OPACITY,
     BFV_RGB,
-    CLOUD_PX,
     CONE_OPACITY,
     EDGE_RGB,
     EDGES_MAX_NSIDE,
     EYE_CONE,
     EYE_LIGHT,
     EYES_FRACTION,
-    GHOST_DOT_PX,
-    GHOST_LINE_PX,
-    GHOST_OPACITY,
     GRID_OPACITY,
     INK_RGB,
     INSET_RGB,
-    LINK_OPACITY,
     PLANE_OPACITY,
     PLANE_RGB,
     UNLIT_RGB,
@@ -508,50 +504,6 @@ def _ball_labels(ax, scene: Scene, cam: Camera3D, aspect: float) -> None:
         placed.append(box)
         ax.text(x, y, f" {name}" if right else f"{name} ", fontsize=size, color=f.color,
                 ha="left" if right else "right", va=va, parse_math=False)  # fmt: skip
-
-
-#: Points per ghost outline; the VTK layer's pixel sizes scaled to points of the figure.
-GHOST_RING_N = 96
-PX_TO_PT = 0.4
-
-
-def ghost_outline(cam: Camera3D, centre, g: float, n: int = GHOST_RING_N) -> np.ndarray:
-    """(n, 3) points of the circle of radius ``g`` about ``centre`` facing the camera (the
-    VTK layer's outline, a follower of the same circle)."""
-    right, up, _ = basis(cam)
-    t = np.linspace(0.0, 2.0 * math.pi, n, endpoint=False)
-    c = np.asarray(centre, np.float64)
-    return c + g * (np.cos(t)[:, None] * right + np.sin(t)[:, None] * up)
-
-
-def draw_ghosts(ax: Axes, preds: Predictions3D | None, cam: Camera3D, aspect: float) -> None:
-    """The predictions layer over the scene (as the VTK overlay: above everything): per
-    estimator a translucent disc with its outline (the ghost ball seen through ``cam``),
-    its centre and a line from the true centre; the limit's posterior as points."""
-    if preds is None:
-        return
-    near = 0.0
-    for a in preds.ghosts():
-        col = to_rgba(estimator_color3d(a.name))
-        ring, depth = project(cam, ghost_outline(cam, (a.x, a.y, a.z), preds.g), aspect)
-        if not np.all(depth > near):
-            continue
-        ax.fill(ring[:, 0], ring[:, 1], facecolor=(*col[:3], GHOST_OPACITY), edgecolor=col,
-                lw=GHOST_LINE_PX * PX_TO_PT, gid=f"ghost-{a.name}", zorder=5)  # fmt: skip
-        link, d = project(cam, np.array([preds.truth, (a.x, a.y, a.z)]), aspect)
-        if np.all(d > near):
-            ax.plot(link[:, 0], link[:, 1], color=col, alpha=LINK_OPACITY,
-                    lw=0.6 * GHOST_LINE_PX * PX_TO_PT, zorder=5)  # fmt: skip
-            ax.plot([link[1, 0]], [link[1, 1]], marker="o", ms=GHOST_DOT_PX * PX_TO_PT,
-                    mew=0, color=col, zorder=6)  # fmt: skip
-    cloud = preds.cloud
-    if cloud is not None and len(cloud.points):
-        xy, d = project(cam, cloud.points, aspect)
-        ok = d > near
-        rgba = np.tile(to_rgba(estimator_color3d(LIMIT)), (int(ok.sum()), 1))
-        rgba[:, 3] = cloud.alpha[ok]
-        ax.scatter(xy[ok, 0], xy[ok, 1], s=(CLOUD_PX * PX_TO_PT) ** 2, c=rgba, lw=0,
-                   zorder=6, gid="posterior-cloud")  # fmt: skip
 
 
 def _overlap(a: tuple[float, ...], b: tuple[float, ...]) -> bool:
