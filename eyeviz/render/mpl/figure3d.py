@@ -160,7 +160,10 @@ def _pair(a, b) -> str:
 
 def _dist(r: float) -> str:
     """A distance: whole units from 100 on (the HEALPix scenes'), else three significant
-    digits (a bee's balls are a few millimetres away)."""
+    digits (a bee's balls are a few millimetres away); from 10^5 on in one-digit exponent
+    form, so the table's narrow column holds it."""
+    if r >= 1e5:
+        return f"{r:.0e}"
     return f"{r:.0f}" if r >= 100 else f"{r:.3g}"
 
 
@@ -175,7 +178,7 @@ def readout_rows(st: SceneState3D, scene: Scene) -> list[tuple[str, ...]]:
                 _dist(float(st.r[i])),
                 f"{math.degrees(st.azimuth[i]):.1f}",
                 f"{math.degrees(st.elevation[i]):.1f}",
-                f"{f.g:g}",
+                f"{f.g:g}" if f.g < 1e5 else f"{f.g:.0e}",
                 _yes(st.in_bfv[i]) if st.in_bfv is not None else "",
                 _pair(st.vis_a[i], st.vis_b[i])
                 if st.vis_a is not None and st.vis_b is not None
