@@ -172,7 +172,6 @@ def boundary_rays(
     ptr = np.asarray(lit[0], np.int64)
     idx = np.asarray(lit[1], np.int64)
     n, nfac, k = ptr.size - 1, axes.shape[0], nb.shape[1]
-    unit = axes / np.linalg.norm(axes, axis=1, keepdims=True)
     row = np.repeat(np.arange(n), count)
     keys = row * nfac + idx  # sorted: CSR rows in order, each row's indices sorted
     rr = np.repeat(row, k)
@@ -182,7 +181,8 @@ def boundary_rays(
     at = np.minimum(np.searchsorted(keys, want), max(keys.size - 1, 0))
     unlit = keys[at] != want if keys.size else np.ones(want.shape, bool)
     rr, ii, jj = rr[unlit], ii[unlit], jj[unlit]
-    x = unit[ii] + unit[jj]
+    ai, aj = axes[ii], axes[jj]  # only the boundary pairs' axes are normalised
+    x = ai / np.linalg.norm(ai, axis=1, keepdims=True) + aj / np.linalg.norm(aj, axis=1)[:, None]
     x /= np.linalg.norm(x, axis=1, keepdims=True)
     m = np.empty((n, 3, 3))
     b = np.empty((n, 3))
