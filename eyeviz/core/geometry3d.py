@@ -58,15 +58,6 @@ FALLBACK_COUNTS: Counter[str] = Counter()
 
 def validate_balls(x, y, z, g) -> tuple[np.ndarray, ...]:
     """Broadcast x, y, z, g to float64; refuse non-finite values and g <= 0."""
-    v4 = (x, y, z, g)
-    if all(type(v) is float or type(v) is int for v in v4):
-        # one ball of Python numbers (a drag frame, a draw): no broadcasting needed
-        try:
-            f4 = tuple(float(v) for v in v4)
-        except OverflowError:
-            f4 = (math.nan,)
-        if len(f4) == 4 and all(math.isfinite(v) for v in f4) and f4[3] > 0:
-            return tuple(np.array(v) for v in f4)
     try:
         arrs = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (x, y, z, g)))
     except (TypeError, ValueError) as exc:
@@ -207,18 +198,6 @@ def _lit_runs_jit(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray
     ln = np.concatenate([ln, l2])
     order = np.lexsort((st, bl))
     return per, st[order], ln[order]
-
-
-def _lit_csr_jit(n: int, x, y, z, g, h: float) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
-    """:meth:`EyePair3D.lit_csr` through the kernel: the whole call at once (the kernel
-    keeps no temporaries per ball), the indices written from the runs in compiled code."""
-    from eyeviz.core.kernels.healpix_lit import runs_to_indices
-
-    out = []
-    for cx in (-h, h):
-        per, st, ln = _lit_runs_jit(n, x, y, z, g, cx)
-        out.append(runs_to_indices(per, st, ln))
-    return out[0], out[1]
 
 
 def _lit_runs_ref(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -777,8 +756,6 @@ class EyePair3D:
                 f"the lit sets would hold about {est:.3g} facets (more than {MAX_LIT}): "
                 "use fewer or smaller balls per call, or a smaller nside"
             )
-        if kernels.use(nb):
-            return _lit_csr_jit(n, xf, yf, zf, gf, self.h)
         out = []
         block = _block(n)
         for cx in (-self.h, self.h):

@@ -108,31 +108,5 @@ def test_deferred_kernels_wait_for_the_warm_up(monkeypatch):
     thread = kernels.warm_in_background()
     assert thread is not None
     assert not kernels.use(10**6) or kernels._STATE["ready"]  # deferred until warm
-    thread.join()  # pytest-timeout bounds it (a cold compile: 10-60 s on a loaded machine)
+    thread.join(120)
     assert kernels.use(1)
-
-
-def test_lit_csr_through_the_kernel_equals_the_reference(monkeypatch):
-    """EyePair3D.lit_csr and lit, kernel (indices written in compiled code) against
-    EYEVIZ_JIT=0, on a batch mixing ordinary, tiny, grazing and whole-eye balls."""
-    rng = np.random.default_rng(4)
-    p = rng.uniform(-500, 500, (40, 3))
-    g = rng.uniform(1, 300, 40)
-    g[::7] = 1e-200  # tiny
-    p[3] = (40.0, 0.0, 0.0)  # whole eye B
-    g[5] = float(np.linalg.norm(p[5] - (40.0, 0.0, 0.0))) * (1 - 2.0**-30)  # grazing
-    eyes = g3.EyePair3D(40.0, 20.0, 18)
-    monkeypatch.setitem(kernels._STATE, "ready", True)
-    got = eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
-    one = eyes.lit(float(p[9, 0]), float(p[9, 1]), float(p[9, 2]), float(g[9]))
-    monkeypatch.setenv("EYEVIZ_JIT", "0")
-    want = eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
-    for (a, b), (c, d) in zip(got, want, strict=True):
-        np.testing.assert_array_equal(a, c)
-        np.testing.assert_array_equal(b, d)
-    for o, (ptr, idx) in zip(one, want, strict=True):
-        np.testing.assert_array_equal(o, idx[ptr[9] : ptr[10]])
-    with pytest.raises(ValueError, match="x has 1 non-finite"):
-        eyes.lit(float("nan"), 1.0, 2.0, 3.0)
-    with pytest.raises(ValueError, match="g .feature radius. must be > 0"):
-        eyes.lit(0.0, 1.0, 2.0, 0)

@@ -11,7 +11,7 @@ import os
 
 __all__ = ["enabled", "use", "warm", "warm_in_background", "defer_until_warm", "mark_ready"]
 
-_STATE: dict[str, bool | None] = {"ready": False, "defer": False, "found": None}
+_STATE = {"ready": False, "defer": False}
 #: Calls of fewer items than this do not load cold kernels (see :func:`use`)
 COLD_WORK = 64
 
@@ -22,10 +22,7 @@ def enabled() -> bool:
         return False
     # found, not imported: importing numba takes a second, which a caller on a GUI
     # thread must not pay (the kernel modules import it when first used)
-    found = _STATE.get("found")
-    if found is None:
-        found = _STATE["found"] = importlib.util.find_spec("numba") is not None
-    return bool(found)
+    return importlib.util.find_spec("numba") is not None
 
 
 def use(work: int = 1 << 30) -> bool:

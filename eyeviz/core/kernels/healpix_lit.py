@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["lit_runs_kernel", "runs_to_indices", "warm"]
+__all__ = ["lit_runs_kernel", "warm"]
 
 _EPS = 2.0**-52
 _DP = 64 * _EPS
@@ -517,26 +517,6 @@ def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2
     return 1, lo, hi
 
 
-@_jit
-def _expand(st, ln, total):
-    out = np.empty(total, np.int64)
-    k = 0
-    for r in range(st.shape[0]):
-        s = st[r]
-        for j in range(ln[r]):
-            out[k] = s + j
-            k += 1
-    return out
-
-
-def runs_to_indices(per, st, ln) -> tuple[np.ndarray, np.ndarray]:
-    """(indptr, indices) of the CSR lit sets from runs (start, length) sorted by ball,
-    then start, and the facets per ball (geometry3d._runs_to_csr, compiled)."""
-    indptr = np.zeros(per.size + 1, np.int64)
-    np.cumsum(per, out=indptr[1:])
-    return indptr, _expand(st, ln, int(indptr[-1]))
-
-
 def warm() -> None:
     """Compile (or load from the cache) :func:`lit_runs_kernel` for its one signature, on
     the ring tables of nside 4 (geometry3d's, built here from eyeviz.core.healpix)."""
@@ -550,7 +530,4 @@ def warm() -> None:
     first, nr, shifted = healpix.ring_info(n, np.clip(k, 1, 4 * n - 1))
     delta, o = 2 * math.pi / nr, np.where(shifted, 0.0, -0.5)
     x, y, z, g = (np.array(v, np.float64) for v in ([0.0], [100.0], [5.0], [30.0]))
-    _, per, st, ln, _ = lit_runs_kernel(
-        n, x, y, z, g, 40.0, sth, zr, unit, first, nr, shifted, delta, o
-    )
-    runs_to_indices(per, st, ln)
+    lit_runs_kernel(n, x, y, z, g, 40.0, sth, zr, unit, first, nr, shifted, delta, o)
