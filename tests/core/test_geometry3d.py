@@ -299,7 +299,7 @@ def test_vertex_lon_gives_every_cells_boundary_vertices(n):
 def test_edge_lower_bounds_every_function_of_bounded_curvature():
     """_edge_lower(fa, fb, M) <= min f on [0, 1] for f with |f''| <= M (the worst case is
     the parabola of curvature -M through the end values), and it is >= min - M / 8."""
-    from eyeviz.core.geometry3d import _edge_lower
+    from eyeviz.core.healpix_fast import _edge_lower
 
     rng = np.random.default_rng(5)
     fa, fb = rng.uniform(0, 1, 4000), rng.uniform(0, 1, 4000)

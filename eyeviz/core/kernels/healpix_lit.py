@@ -1,7 +1,7 @@
 """The float64 fast path of the spherical lit sets, compiled (numba), ball by ball.
 
-A scalar transcription of :func:`eyeviz.core.geometry3d._lit_runs_fast` and
-:func:`eyeviz.core.geometry3d._decide_cells` (docs/spherical.md, steps 1-5): the same
+A scalar transcription of :func:`eyeviz.core.healpix_fast._lit_runs_fast` and
+:func:`eyeviz.core.healpix_fast._decide_cells` (docs/spherical.md, steps 1-5): the same
 bounds, the same candidate and surely-lit ranges per ring, the same vertex, edge and
 edge-sample tests with the same rounding bounds, and one more sample stage (4096 samples
 per edge, the same bound) before a cell is left open. What the numpy path hands to mpmath or
@@ -127,7 +127,7 @@ def _xyf2vec(n, px, py, face):
 
 @_jit
 def _edge_bound(n, face, fixed_is_y, fixed, lo):
-    """geometry3d._edge_bounds for one edge."""
+    """healpix_fast._edge_bounds for one edge."""
     out = 2.0 / (n * n)
     if face < 4 or face >= 8:
         fx = fixed / n
@@ -160,7 +160,7 @@ def _tol(f, s2, ed, ds2):
 
 @_jit
 def _decide_cell(n, i, j, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit):
-    """geometry3d._decide_cells for one cell (the ball's centre pixel is lit before):
+    """healpix_fast._decide_cells for one cell (the ball's centre pixel is lit before):
     1 lit, 0 not lit, 2 left open (mpmath decides it in the reference)."""
     cxv, cyv, czv = c
     lw = 2 * j - (0 if shifted else 1)
@@ -244,7 +244,7 @@ def _vdist(sv, zv, ph, c):
 
 @_jit
 def _edge_m(n, pol, face, fixed_is_y, fixed, lo):
-    """2.5 times the curvature bound of an edge (geometry3d._decide_cells)."""
+    """2.5 times the curvature bound of an edge (healpix_fast._decide_cells)."""
     if pol:
         return 2.5 * _edge_bound(n, face, fixed_is_y, float(fixed), float(lo))
     return 2.5 * 2.0 / (n * n)
@@ -435,7 +435,7 @@ def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, 
 @_jit
 def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2, ed,
           cpix, sth, zr, unit, first, nr, shifted, delta, o):  # fmt: skip
-    """One (ball, ring) pair of geometry3d._lit_runs_fast: (0, 0, 0) nothing lit,
+    """One (ball, ring) pair of healpix_fast._lit_runs_fast: (0, 0, 0) nothing lit,
     (1, lo, hi) the lit cells lo .. hi (unwrapped), (2, 0, 0) the reference decides."""
     zb_lo, zb_hi, z_i = zr[i + 1], zr[i - 1], zr[i]
     za = max(zb_lo, zc_lo)
