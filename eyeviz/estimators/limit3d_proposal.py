@@ -1,0 +1,415 @@
+"""The proposal of the spherical limit (:mod:`eyeviz.estimators.limit3d`), HEALPix only:
+per key, each eye's feasible region of ball centres (the lit set's edge cells, the centre
+search, the affine bounds and the box of centres), B's region along A's rays, the
+necessary-condition prefilter before the exact check, and the key-hashed uniforms that
+make a key's draws the same alone and in any batch. Module docstring of limit3d, steps
+1-4, describes the construction."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from eyeviz.core import healpix
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.estimators.analytic3d import cap_estimates
+from eyeviz.estimators.base3d import LitCSR
+
+#: facet widths inside and outside the estimated cap where the cap's edge is looked for
+EDGE = 1.25
+
+
+#: boundary points per cell edge for the nearest point of a cell
+STEP = 6
+
+
+#: directions of the bisection for the box of centres
+NDIR = 8
+
+
+_M1 = np.uint64(0xBF58476D1CE4E5B9)
+
+
+_M2 = np.uint64(0x94D049BB133111EB)
+
+
+_GOLD = np.uint64(0x9E3779B97F4A7C15)
+
+
+def _mix(z: np.ndarray) -> np.ndarray:
+    with np.errstate(over="ignore"):
+        z = z + _GOLD
+        z = (z ^ (z >> np.uint64(30))) * _M1
+        z = (z ^ (z >> np.uint64(27))) * _M2
+    return z ^ (z >> np.uint64(31))
+
+
+def _key_hash(lit_a: LitCSR, lit_b: LitCSR) -> np.ndarray:
+    out = np.zeros(lit_a[0].size - 1, np.uint64)
+    for salt, (ptr, ind) in enumerate((lit_a, lit_b)):
+        hv = _mix(ind.astype(np.uint64) + np.uint64(salt << 40))
+        cnt = np.diff(ptr)
+        sums = np.zeros(cnt.size, np.uint64)
+        nz = cnt > 0
+        with np.errstate(over="ignore"):
+            sums[nz] = np.add.reduceat(hv, ptr[:-1][nz])
+            out = _mix(out ^ sums ^ (cnt.astype(np.uint64) << np.uint64(48)))
+    return out
+
+
+def _uniforms(keys: np.ndarray, m: int, k: int, stream: int) -> np.ndarray:
+    """(N, m, k) uniforms in (0, 1) from the key hashes."""
+    j = np.arange(m * k, dtype=np.uint64) + np.uint64(stream << 32)
+    with np.errstate(over="ignore"):
+        z = _mix(keys[:, None] * _M1 + j[None, :])
+    u = ((z >> np.uint64(11)).astype(np.float64) + 0.5) * 2.0**-53
+    return u.reshape(keys.size, m, k)
+
+
+def _frame(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """East and north unit vectors (N, 3) at unit vectors c (N, 3)."""
+    e1 = np.stack([-c[:, 1], c[:, 0], np.zeros(len(c))], axis=1)
+    n1 = np.linalg.norm(e1, axis=1, keepdims=True)
+    e1 = np.where(n1 > 1e-12, e1 / np.maximum(n1, 1e-300), [1.0, 0.0, 0.0])
+    e2 = np.cross(c, e1)
+    return e1, e2
+
+
+def _sample_gap(nside: int, d: np.ndarray) -> np.ndarray:
+    """How much farther than a cell's closure its nearest boundary sample can be, given
+    that sample's distance d: samples are s = 1.5 fw / STEP apart along edges (edges are
+    at most 1.5 facet widths fw long), so the nearest sample to the closure's nearest
+    point q lies within s / 2 of q along the edge: d <= sqrt(D^2 + s^2 / 4) with D the
+    true distance, hence D >= D_lo = sqrt(d^2 - s^2 / 4) and d - D <= sqrt(D_lo^2 +
+    s^2 / 4) - D_lo. Times 1.5 for the edges' curvature."""
+    s = 1.5 * math.sqrt(4 * math.pi / (12 * nside**2)) / STEP
+    d_lo = np.sqrt(np.maximum(d * d - 0.25 * s * s, 0.0))
+    return 1.5 * (np.sqrt(d_lo * d_lo + 0.25 * s * s) - d_lo)
+
+
+def _prefilter(eye: _Eye, row: np.ndarray, c: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """A necessary condition for caps (c (D, 3) unit, alpha (D,)) of the keys ``row`` (D,)
+    to light exactly the key's cells, on the eye's (pruned) edge cells, from their
+    boundary samples' true distances: a lit cell needs alpha > dist(c, cell) >= d_s -
+    gap (d_s: the nearest sample's distance, gap: :func:`_sample_gap`), an unlit one
+    alpha <= dist(c, closure) <= d_s. Both with a 1e-9 rad margin for rounding. Draws
+    failing it would fail the exact check; the survivors get that check."""
+    ok = np.ones(row.size, bool)
+    pp = eye.pts.shape[2]
+    bounds = np.flatnonzero(np.diff(row)) + 1  # row is sorted: one product per key
+    for idx in np.split(np.arange(row.size), bounds):
+        if not idx.size:
+            continue
+        r = row[idx[0]]
+        live = ~eye.pad[r]
+        k = int(live.sum())
+        pts = eye.pts[r][live].reshape(k * pp, 3)
+        dots = (pts @ c[idx].T).reshape(k, pp, idx.size).max(axis=1)
+        ds = np.arccos(np.clip(dots, -1.0, 1.0))  # (K, Dk)
+        a = alpha[idx][None, :]
+        lit = eye.lit[r][live][:, None]
+        bad = np.where(lit, a + _sample_gap(eye.nside, ds) + 1e-9 <= ds, a > ds + 1e-9)
+        ok[idx] = ~bad.any(axis=0)
+    return ok
+
+
+def _codes(ptr: np.ndarray, ind: np.ndarray, npix: int) -> np.ndarray:
+    rows = np.repeat(np.arange(ptr.size - 1, dtype=np.int64), np.diff(ptr))
+    return rows * npix + ind
+
+
+class _Eye:
+    """The edge cells of one eye for a chunk of keys: their boundary points, padded to
+    (N, K, P, 3), with ``lit`` (N, K) (True: must stay lit), ``pad`` (N, K)."""
+
+    def __init__(self, domain: Domain3D, lit: LitCSR, centre: np.ndarray, eye: int):
+        self.nside = domain.nside
+        npix = domain.npix
+        u, alpha = cap_estimates(domain.nside, lit)
+        self.u0 = u
+        self.alpha0 = alpha
+        fw = math.sqrt(4 * math.pi / npix)
+        n = u.shape[0]
+        dist = 1000.0
+        a_in = np.maximum(alpha - EDGE * fw, 0.5 * fw)
+        a_out = np.minimum(alpha + EDGE * fw, math.pi / 2 - 1e-6)
+        gs = dist * np.sin(np.concatenate([a_in, a_out]))
+        pos = np.asarray(centre) + dist * np.concatenate([u, u])
+        res = domain.eyes.lit_csr(pos[:, 0], pos[:, 1], pos[:, 2], gs)[eye]
+        ptr, ind = res
+        inner = (ptr[: n + 1], ind[: ptr[n]])
+        outer = (ptr[n:] - ptr[n], ind[ptr[n] :])
+        key = _codes(*lit, npix)
+        c_in = _codes(*inner, npix)
+        # a key too small for an inner cap of half a facet: every lit cell is an edge cell
+        # (a cap of 1e-9 rad would send its cells to the exact fallback, ~10 ms each)
+        small = alpha - EDGE * fw < 0.5 * fw
+        c_in = c_in[~small[c_in // npix]]
+        c_out = _codes(*outer, npix)
+        lit_edge = key[~np.isin(key, c_in, assume_unique=True)]
+        unlit = c_out[~np.isin(c_out, key, assume_unique=True)]
+        codes = np.concatenate([lit_edge, unlit])
+        is_lit = np.concatenate([np.ones(lit_edge.size, bool), np.zeros(unlit.size, bool)])
+        rows = codes // npix
+        order = np.argsort(rows, kind="stable")
+        codes, is_lit, rows = codes[order], is_lit[order], rows[order]
+        cnt = np.bincount(rows, minlength=n)
+        kmax = max(1, int(cnt.max()) if cnt.size else 1)
+        slot = np.arange(codes.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        pts = healpix.boundaries(self.nside, codes % npix, STEP)  # (T, P, 3)
+        self.pts = np.zeros((n, kmax, pts.shape[1], 3))
+        self.pts[rows, slot] = pts
+        self.lit = np.zeros((n, kmax), bool)
+        self.lit[rows, slot] = is_lit
+        self.pad = np.ones((n, kmax), bool)
+        self.pad[rows, slot] = False
+        self.n_lit_edge = np.bincount(rows[is_lit], minlength=n)
+        self.n_unlit = np.bincount(rows[~is_lit], minlength=n)
+        self.centre = np.asarray(centre, float)
+        self.a = np.zeros(3)  # the other eye's centre relative to this one (set by the caller)
+        self.linearise(u)
+
+    def linearise(self, c: np.ndarray) -> None:
+        """Distances d (N, K) and gradients t (N, K, 2) of every edge cell at centres c."""
+        self.c = c / np.linalg.norm(c, axis=1, keepdims=True)
+        self.e1, self.e2 = _frame(self.c)
+        dots = np.einsum("nkpj,nj->nkp", self.pts, self.c)
+        best = np.argmax(dots, axis=2)
+        p = np.take_along_axis(self.pts, best[:, :, None, None], 2)[:, :, 0]
+        cp = np.einsum("nkj,nj->nk", p, self.c)
+        tang = p - cp[..., None] * self.c[:, None, :]
+        tn = np.linalg.norm(tang, axis=2)
+        d = np.arctan2(tn, cp)
+        # the nearest boundary sample is farther than the cell by at most _sample_gap:
+        # lit cells' distances are lowered by that much, so the linearised region holds
+        # the true one; unlit cells' samples lie in the cell's closure
+        self.d = np.where(self.lit, d - _sample_gap(self.nside, d), d)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t1 = np.einsum("nkj,nj->nk", tang, self.e1) / tn
+            t2 = np.einsum("nkj,nj->nk", tang, self.e2) / tn
+        self.t = np.stack([np.nan_to_num(t1), np.nan_to_num(t2)], axis=-1)
+        self._affine()
+
+    def prune(self, reach: np.ndarray) -> None:
+        """Drop the edge cells that cannot bind anywhere within ``reach`` (N,) of the
+        centre: a lit cell's modelled distance moves by at most |delta| and an unlit
+        one's by at most |delta| + |delta|^2 / (2 d), so a lit cell below max_lit - 2.2
+        reach or an unlit one above min_unlit + 2.2 reach never decides. (Dropping
+        constraints only loosens the model: the exact check decides.)"""
+        live = ~self.pad
+        lo0 = np.where(self.lit & live, self.d, -np.inf).max(axis=1)
+        hi0 = np.where(~self.lit & live, self.d, np.inf).min(axis=1)
+        m = 2.2 * reach[:, None]
+        keep = live & np.where(self.lit, self.d >= lo0[:, None] - m, self.d <= hi0[:, None] + m)
+        cnt = keep.sum(axis=1)
+        kmax = max(1, int(cnt.max()) if cnt.size else 1)
+        if kmax >= keep.shape[1]:
+            return
+        order = np.argsort(~keep, axis=1, kind="stable")[:, :kmax]
+        rows = np.arange(keep.shape[0])[:, None]
+        self.pts = self.pts[rows, order]
+        self.lit = self.lit[rows, order]
+        self.pad = ~keep[rows, order]
+        self.d = self.d[rows, order]
+        self.t = self.t[rows, order]
+        self._affine()
+
+    def _affine(self) -> None:
+        """The model as affine forms in delta: a lit cell's distance is d - t . delta, an
+        unlit one's squared distance is d^2 - 2 d t . delta + |delta|^2 (the same value as
+        (d - t . delta)^2 + |delta_perp|^2, |t| = 1), so max_lit and min_unlit are one
+        matrix product and one reduction each (padding: -inf / +inf, zero slope)."""
+        lit = self.lit & ~self.pad
+        unl = ~self.lit & ~self.pad
+        self.a_lit = np.where(lit, self.d, -np.inf)
+        self.t_lit = np.where(lit[..., None], self.t, 0.0)
+        self.a_unl = np.where(unl, self.d * self.d, np.inf)
+        self.t_unl = np.where(unl[..., None], 2.0 * self.d[..., None] * self.t, 0.0)
+
+    def model(self, delta: np.ndarray) -> np.ndarray:
+        """Each edge cell's modelled distance (N, K, G) at gnomonic offsets delta (N, G, 2).
+
+        Lit cells: d - t . delta, below the true distance (the distance to an edge is
+        linear to first order and to a vertex convex), so their constraint alpha > dist
+        is loosened. Unlit cells: the distance to their nearest sample point p,
+        sqrt((d - t . delta)^2 + |delta_perp|^2), above the true distance (p lies in the
+        cell), so alpha <= dist is loosened too: the modelled region holds the true one.
+        (Padding cells: any value; callers mask them with ``pad``.)
+        """
+        dt = np.swapaxes(delta, 1, 2)  # (N, 2, G)
+        td = np.matmul(self.t, dt)
+        v = self.d[:, :, None] - td
+        sq = np.einsum("ngj,ngj->ng", delta, delta)[:, None, :]
+        w = self.d[:, :, None] * (self.d[:, :, None] - 2.0 * td) + sq
+        return np.where(self.lit[:, :, None], v, np.sqrt(np.maximum(w, 0.0)))
+
+    def bounds(self, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(max over lit edge cells, min over unlit) of :meth:`model` at gnomonic offsets
+        delta (N, G, 2): arrays (N, G)."""
+        dx = delta[:, None, :, 0]
+        dy = delta[:, None, :, 1]
+        v = self.t_lit[..., 0, None] * dx
+        v += self.t_lit[..., 1, None] * dy
+        lo = (self.a_lit[..., None] - v).max(axis=1)
+        v = self.t_unl[..., 0, None] * dx
+        v += self.t_unl[..., 1, None] * dy
+        hi2 = (self.a_unl[..., None] - v).min(axis=1)
+        hi2 += np.einsum("ngj,ngj->ng", delta, delta)
+        return lo, np.sqrt(np.maximum(hi2, 0.0))
+
+    def direction(self, delta: np.ndarray) -> np.ndarray:
+        """Unit vectors (N, M, 3) at gnomonic offsets delta (N, M, 2)."""
+        v = (
+            self.c[:, None, :]
+            + delta[..., :1] * self.e1[:, None, :]
+            + delta[..., 1:] * self.e2[:, None, :]
+        )
+        return v / np.linalg.norm(v, axis=2, keepdims=True)
+
+    def gnomonic(self, v: np.ndarray) -> np.ndarray:
+        """Gnomonic offsets (N, M, 2) of unit vectors v (N, M, 3) about the centre."""
+        cc = np.einsum("nmj,nj->nm", v, self.c)
+        x, y = np.einsum("nmj,nj->nm", v, self.e1), np.einsum("nmj,nj->nm", v, self.e2)
+        with np.errstate(divide="ignore", invalid="ignore"):  # v at 90 deg: inf, no warning
+            return np.stack([x / cc, y / cc], axis=-1)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def _grid(n: int) -> np.ndarray:
+    t = (np.arange(n) + 0.5) / n * 2 - 1
+    a, b = np.meshgrid(t, t, indexing="ij")
+    return np.stack([a.ravel(), b.ravel()], axis=1)  # (n*n, 2) in (-1, 1)
+
+
+_DIRS = np.stack([np.cos(np.arange(8) * math.pi / 4), np.sin(np.arange(8) * math.pi / 4)], axis=1)
+
+
+def _locate(eye: _Eye, half: float, n: int, levels: int) -> None:
+    """Move the eye's centre to the maximum of G (zooming grids of n x n about the best
+    point, each a third as wide) and linearise there."""
+    rows = np.arange(eye.c.shape[0])
+    g0 = _grid(n)
+    for _ in range(levels):
+        g = g0[None] * half
+        lo, hi = eye.bounds(np.broadcast_to(g, (rows.size, *g0.shape)))
+        best = np.argmax(hi - lo, axis=1)
+        eye.linearise(eye.direction(g[0][best][:, None, :])[:, 0])
+        half = half / 3.0
+
+
+def _extent(eye: _Eye, reach: float, slack, iters: int = 12) -> np.ndarray:
+    """Half-widths (N, 2) of a box about the centre holding every delta with
+    G(delta) >= -slack (bisection along NDIR directions: G is concave)."""
+    n = eye.c.shape[0]
+    dirs = _dirs(NDIR)
+    lo = np.zeros((n, NDIR))
+    hi = np.full((n, NDIR), reach)
+    for _ in range(iters):
+        mid = 0.5 * (lo + hi)
+        a, b = eye.bounds(mid[..., None] * dirs[None])
+        inside = (b - a) >= -slack
+        lo = np.where(inside, mid, lo)
+        hi = np.where(inside, hi, mid)
+    pts = hi[..., None] * dirs[None]  # (N, NDIR, 2): outside the region by < one step
+    # the box of the boundary points, widened: a convex polygon between two of them
+    # bulges out by at most tan(pi / NDIR) times their distance
+    ext = np.abs(pts).max(axis=1) * (1.0 + math.tan(math.pi / NDIR))
+    return np.maximum(ext, 1e-12)
+
+
+def _dirs(k: int) -> np.ndarray:
+    t = np.arange(k) * 2 * math.pi / k
+    return np.stack([np.cos(t), np.sin(t)], axis=1)
+
+
+_BOX = np.array(
+    [(x, y) for x in (-1.0, -0.5, 0.0, 0.5, 1.0) for y in (-1.0, 1.0)]
+    + [(x, y) for x in (-1.0, 1.0) for y in (-0.5, 0.0, 0.5)]
+)  # 16 points on the boundary of [-1, 1]^2, at most 1/2 apart along each edge
+
+
+def _epipolar(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(theta, phi) of unit vectors v (..., 3): theta = atan2(v_z, v_y), the angle of the
+    plane through the baseline (the x-axis) and v, and phi the angle of v from +x. A ball's
+    centre and both eyes' cap centres share one theta (the eyes lie on the x-axis)."""
+    return np.arctan2(v[..., 2], v[..., 1]), np.arctan2(np.hypot(v[..., 1], v[..., 2]), v[..., 0])
+
+
+def _angle_box(eye: _Eye, ext: np.ndarray) -> np.ndarray:
+    """Bounds (N, 4) = (theta_lo, theta_hi, phi_lo, phi_hi) over the eye's box of centres
+    (half-widths ``ext`` (N, 2) about its centre, gnomonic). theta and phi have no
+    critical point off the x-axis, so their extremes lie on the box's boundary, whose
+    edges are great-circle arcs: sampled at most s = ext / 2 apart, each is off by at
+    most M s^2 / 8 with |theta''|, |phi''| <= M = 2 / sin(phi)^2 along a unit-speed arc;
+    the pad is four times that. NaN where the box reaches y <= 0 or the x-axis."""
+    pts = eye.direction(_BOX[None] * ext[:, None, :])  # (N, 16, 3)
+    th, ph = _epipolar(pts)
+    s = 0.5 * np.hypot(ext[:, 0], ext[:, 1])
+    sin_min = np.sin(ph).min(axis=1) - 2.0 * s
+    ok = (pts[..., 1].min(axis=1) > 0) & (sin_min > 1e-3)
+    pad = s * s / np.where(ok, sin_min, 1.0) ** 2 + 1e-12
+    out = np.stack(
+        [th.min(axis=1) - pad, th.max(axis=1) + pad, ph.min(axis=1) - pad, ph.max(axis=1) + pad],
+        axis=1,
+    )
+    return np.where(ok[:, None], out, np.nan)
+
+
+def _ray_in_box(eye_b: _Eye, ca: np.ndarray, ext: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The interval (lo, hi) (N, M) of u = 1 / rho where the direction from B to
+    A + c_A / u, proportional to v(u) = c_A + u (A - B), has gnomonic coordinates about
+    B's centre inside the box |delta_i| <= ext_i (N, 2): with v . c_B > 0 each side is
+    |v . e_i| <= ext_i v . c_B, two inequalities linear in u (ca: (N, M, 3))."""
+    a = eye_b.a
+    shape = ca.shape[:2]
+    c = eye_b.c[:, None, :]
+    cc = (ca * c).sum(-1)
+    rows = [(-cc, np.broadcast_to(-(eye_b.c @ a)[:, None], shape))]  # v . c_B >= 0
+    for e, x in ((eye_b.e1, ext[:, 0]), (eye_b.e2, ext[:, 1])):
+        ce = (ca * e[:, None, :]).sum(-1)
+        for sgn in (1.0, -1.0):  # sgn v . e - ext v . c_B <= 0
+            k1 = sgn * (e @ a) - x * (eye_b.c @ a)
+            rows.append((sgn * ce - x[:, None] * cc, np.broadcast_to(k1[:, None], shape)))
+    lo = np.zeros(shape)
+    hi = np.full(shape, np.inf)
+    for k0, k1 in rows:  # k0 + u k1 <= 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            root = -k0 / k1
+        hi = np.where(k1 > 0, np.minimum(hi, root), hi)
+        lo = np.where(k1 < 0, np.maximum(lo, root), lo)
+        lo = np.where((k1 == 0) & (k0 > 0), np.inf, lo)
+    return lo, hi
+
+
+def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack, grid: int = 12, rounds: int = 2):
+    """Shrink each draw's u-interval [lo, hi] (N, M) to one holding every u whose view
+    from B lies in B's modelled region G = min_unlit - max_lit >= -slack. G is concave
+    and the view moves monotonically along a great circle, so those u form an interval:
+    G on ``grid`` points, the interval from the grid point before the first inside to the
+    one after the last (or the two neighbours of the best point when none is inside);
+    ``rounds`` times. Returns (lo, hi)."""
+    n, m = lo.shape
+    t = np.linspace(0.0, 1.0, grid)
+    for _ in range(rounds):
+        uu = lo[..., None] + (hi - lo)[..., None] * t  # (N, M, grid)
+        v = ca[:, :, None, :] + uu[..., None] * eye_b.a
+        v = v / np.linalg.norm(v, axis=-1, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dl = eye_b.gnomonic(v.reshape(n, m * grid, 3))
+            blo, bhi = eye_b.bounds(np.nan_to_num(dl, nan=1e3, posinf=1e3, neginf=-1e3))
+        g = (bhi - blo).reshape(n, m, grid)
+        inside = g >= -slack[..., None]
+        anyin = inside.any(axis=2)
+        first = np.where(anyin, inside.argmax(axis=2), g.argmax(axis=2))
+        last = np.where(anyin, grid - 1 - inside[..., ::-1].argmax(axis=2), first)
+        i0 = np.maximum(first - 1, 0)
+        i1 = np.minimum(last + 1, grid - 1)
+        lo, hi = (
+            np.take_along_axis(uu, i0[..., None], 2)[..., 0],
+            np.take_along_axis(uu, i1[..., None], 2)[..., 0],
+        )
+    return lo, hi
