@@ -20,7 +20,8 @@ direction. So the proposal is built from each eye's feasible caps, as the planar
 integrates over eye A's tangent sectors and then along the ray (:mod:`.limit`):
 
 1. Per eye, the cells where the cap's edge can lie: the key's lit cells that a cap
-   ``EDGE`` (:mod:`.limit3d_proposal`) facet widths smaller than the lit set's cap (:func:`.analytic3d.cap_estimates`)
+   ``EDGE`` facet widths (:mod:`.limit3d_proposal`) smaller than the lit set's cap
+   (:func:`.analytic3d.cap_estimates`)
    does not light, and the unlit cells a cap as much larger lights. For each, its
    boundary point nearest the cap centre (``STEP`` points per edge) linearises its
    distance to a cap centre c near the estimate: dist(c) ~ d - t . delta (delta: c in
@@ -79,7 +80,6 @@ import numpy as np
 from eyeviz.core.domain3d import PAPER_DOMAIN3D, Domain3D
 from eyeviz.estimators.analytic3d import estimate
 from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D, as_csr, take_rows
-from eyeviz.estimators.limit import weighted_median
 from eyeviz.estimators.limit3d_proposal import (
     _angle_box,
     _extent,
@@ -91,6 +91,7 @@ from eyeviz.estimators.limit3d_proposal import (
     _ray_in_region,
     _uniforms,
 )
+from eyeviz.estimators.weighted import weighted_median
 
 __all__ = ["PRIORS", "Limit3DEstimator", "load", "posterior_samples3d", "prior_density"]
 
