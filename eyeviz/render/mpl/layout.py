@@ -59,6 +59,9 @@ MAX_FIGURE_ASPECT = 1.4
 #: The fewest lanes per strip and table rows the figure keeps, even past that aspect.
 MIN_LANES = 1
 MIN_TABLE_ROWS = 4
+#: A scene of up to this many features keeps its whole table, even past that aspect: it
+#: lists every feature (a taller figure rather than "... and 1 more" under four rows).
+MIN_TABLE_FEATURES = 8
 #: At most this many feature names beside their discs in the main view.
 MAX_LABELS = 40
 #: At most this many features drawn with the teaching layers' lines (tangents, sectors).
@@ -272,7 +275,10 @@ def layout(
     # the most lanes and table rows that keep the figure within MAX_FIGURE_ASPECT: the
     # lanes give way first (down to MIN_LANES), then the table's rows (to MIN_TABLE_ROWS)
     caps = [(c, MAX_TABLE_ROWS) for c in range(MAX_LANES, MIN_LANES - 1, -1)]
-    caps += [(MIN_LANES, r) for r in range(MAX_TABLE_ROWS - 1, MIN_TABLE_ROWS - 1, -1)]
+    floor = MIN_TABLE_ROWS
+    if n_features <= MIN_TABLE_FEATURES:
+        floor = max(floor, readout_rows(layers, n_features, n_estimators))
+    caps += [(MIN_LANES, r) for r in range(MAX_TABLE_ROWS - 1, floor - 1, -1)]
     for max_lanes, max_rows in caps:
         lanes = (0, 0)
         if shows_bitmaps:
