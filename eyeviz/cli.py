@@ -255,6 +255,12 @@ def _run(args) -> int:
     except KeyboardInterrupt as exc:
         return _interrupted(exc)
     except Exception as exc:  # the last resort: a bug, but never a traceback for a user
+        from eyeviz.files.atomic import pending_interruption
+
+        # a signal inside compiled code surfaces as another exception (numba: SystemError)
+        sig = pending_interruption()
+        if sig is not None:
+            return _interrupted(sig)
         _unexpected(exc)
     return 2
 

@@ -46,6 +46,12 @@ def note_interruption(exc: BaseException) -> None:
     _interruptions.append(exc)
 
 
+def pending_interruption() -> BaseException | None:
+    """The first signal's exception since the command began, if one arrived (a library,
+    or numba's compiled code, may have turned it into another exception or swallowed it)."""
+    return _interruptions[0] if _interruptions else None
+
+
 def clear_interruptions() -> None:
     """Forget earlier interruptions (a new command begins)."""
     _interruptions.clear()
