@@ -252,8 +252,23 @@ def _run3d(args: argparse.Namespace, drawn: bool = False) -> int:
     d3 = {"h": domain.h, "l": domain.l, "nside": domain.nside, "el_max": domain.el_max}
     d3.update(r_min=domain.r_min, r_max=domain.r_max, g_max=domain.g_max)
     _say_seed(args, drawn, d3, "spherical")
-    bar = _progress(args, n, _PROGRESS_MIN_3D)
     t0 = time.perf_counter()
+    _write_sparse(args, n, domain)
+    if not args.quiet:
+        size = os.path.getsize(args.output) / 1e6
+        print(
+            f"wrote {n:,} 3D elements (nside {domain.nside}, {args.mode} pass, seed "
+            f"{args.seed}) to {args.output} ({size:.1f} MB) in {time.perf_counter() - t0:.2f} s"
+        )
+    return 0
+
+
+def _write_sparse(args: argparse.Namespace, n: int, domain) -> None:
+    """The sparse 3D data set of ``domain`` (HEALPix or measured eyes) to ``args.output``,
+    with a progress bar past _PROGRESS_MIN_3D rows."""
+    from eyeviz.dataset import sparse3d
+
+    bar = _progress(args, n, _PROGRESS_MIN_3D)
     try:
         sparse3d.write3d(
             args.output,
@@ -267,13 +282,6 @@ def _run3d(args: argparse.Namespace, drawn: bool = False) -> int:
     finally:
         if bar is not None:
             bar.close()
-    if not args.quiet:
-        size = os.path.getsize(args.output) / 1e6
-        print(
-            f"wrote {n:,} 3D elements (nside {domain.nside}, {args.mode} pass, seed "
-            f"{args.seed}) to {args.output} ({size:.1f} MB) in {time.perf_counter() - t0:.2f} s"
-        )
-    return 0
 
 
 def _run_eye(args: argparse.Namespace, drawn: bool) -> int:
@@ -305,21 +313,8 @@ def _run_eye(args: argparse.Namespace, drawn: bool) -> int:
     limits.check_free_space(args.output, sparse3d.estimated_bytes3d(n, domain))
     if drawn:
         _say_seed(args, drawn, {}, "measured")
-    bar = _progress(args, n, _PROGRESS_MIN_3D)
     t0 = time.perf_counter()
-    try:
-        sparse3d.write3d(
-            args.output,
-            n,
-            domain,
-            mode=args.mode,
-            seed=args.seed,
-            segments=args.segments,
-            progress=bar.update if bar else None,
-        )
-    finally:
-        if bar is not None:
-            bar.close()
+    _write_sparse(args, n, domain)
     if not args.quiet:
         size = os.path.getsize(args.output) / 1e6
         na, nb = domain.facet_counts
