@@ -40,6 +40,7 @@ from eyeviz.core.healpix_fast import (
     _ring_info_tables,
     _ring_tables,
 )
+from eyeviz.core.lit_views import LitSetViews
 
 __all__ = ["EyePair3D", "validate_balls", "MAX_NSIDE", "MAX_LIT", "FALLBACK_COUNTS"]
 
@@ -157,7 +158,7 @@ def _lit_eye(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 @dataclass(frozen=True)
-class EyePair3D:
+class EyePair3D(LitSetViews):
     """Two spherical HEALPix eyes (docs/spherical.md; the paper's Section 8 goal).
 
     Parameters
@@ -297,33 +298,6 @@ class EyePair3D:
             else:
                 out.append((np.zeros(1, np.int64), np.zeros(0, np.int64)))
         return out[0], out[1]
-
-    def lit(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
-        """One ball: (lit_a, lit_b), sorted int64 RING indices of the lit facets."""
-        for name, v in zip("xyzg", (x, y, z, g), strict=True):
-            if np.ndim(v) != 0:
-                raise ValueError(f"{name} must be a scalar for lit(); use lit_csr for arrays")
-        (pa, ia), (pb, ib) = self.lit_csr(x, y, z, g)
-        return ia[pa[0] : pa[1]], ib[pb[0] : pb[1]]
-
-    def bitmaps(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
-        """(omega_a, omega_b) bool of shape (..., npix)."""
-        xa, _, _, _ = validate_balls(x, y, z, g)
-        shape = xa.shape
-        res = []
-        for indptr, idx in self.lit_csr(x, y, z, g):
-            nb = indptr.size - 1
-            bm = np.zeros((nb, self.npix), bool)
-            rows = np.repeat(np.arange(nb), np.diff(indptr))
-            bm[rows, idx] = True
-            res.append(bm.reshape(shape + (self.npix,)))
-        return res[0], res[1]
-
-    def visible(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
-        """Definition 1 per eye: the ball lights at least two facets (vis_a, vis_b)."""
-        xa, _, _, _ = validate_balls(x, y, z, g)
-        (pa, _), (pb, _) = self.lit_csr(x, y, z, g)
-        return (np.diff(pa) >= 2).reshape(xa.shape), (np.diff(pb) >= 2).reshape(xa.shape)
 
     def in_bfv(self, x, y, z, g) -> np.ndarray:
         """The closed ball lies in the 3D binocular field of view (Prop. 4 generalised).

@@ -25,6 +25,7 @@ import numpy as np
 
 from eyeviz import EyevizError
 from eyeviz.core.geometry3d import validate_balls
+from eyeviz.core.lit_views import LitSetViews
 from eyeviz.core.measured_exact import lens_in_ball_exact
 from eyeviz.core.measured_fast import EyeTables, decide_pairs, eye_tables, lens_bound, use_jit
 from eyeviz.core.measured_index import AxisIndex
@@ -120,7 +121,7 @@ class MeasuredEye:
 
 
 @dataclass(frozen=True, eq=False)
-class MeasuredEyePair:
+class MeasuredEyePair(LitSetViews):
     """Two measured eyes, A (left, at -x) and B (right, at +x), in eyeviz's frame (mm).
 
     ``h`` is half the distance between the two eyes' lens centroids and ``l`` the largest
@@ -244,32 +245,6 @@ class MeasuredEyePair:
         the flattened balls, indices sorted int64."""
         _, balls = self._flat_balls(x, y, z, g)
         return self._lit_eye("A", balls), self._lit_eye("B", balls)
-
-    def lit(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
-        """One ball: (lit_a, lit_b), sorted int64 facet indices."""
-        for name, v in zip("xyzg", (x, y, z, g), strict=True):
-            if np.ndim(v) != 0:
-                raise ValueError(f"{name} must be a scalar for lit(); use lit_csr for arrays")
-        (pa, ia), (pb, ib) = self.lit_csr(x, y, z, g)
-        return ia[pa[0] : pa[1]], ib[pb[0] : pb[1]]
-
-    def bitmaps(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
-        """(omega_a, omega_b) bool of shapes (..., n_A) and (..., n_B)."""
-        xa, _, _, _ = validate_balls(x, y, z, g)
-        shape = xa.shape
-        res = []
-        for (indptr, idx), n in zip(self.lit_csr(x, y, z, g), self.facet_counts, strict=True):
-            nb = indptr.size - 1
-            bm = np.zeros((nb, n), bool)
-            bm[np.repeat(np.arange(nb), np.diff(indptr)), idx] = True
-            res.append(bm.reshape(shape + (n,)))
-        return res[0], res[1]
-
-    def visible(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
-        """Definition 1 per eye: the ball lights at least two facets."""
-        xa, _, _, _ = validate_balls(x, y, z, g)
-        (pa, _), (pb, _) = self.lit_csr(x, y, z, g)
-        return (np.diff(pa) >= 2).reshape(xa.shape), (np.diff(pb) >= 2).reshape(xa.shape)
 
     def _lens_in_ball(self, which: str, balls) -> np.ndarray:
         """Per ball: the closed ball contains a lens of the eye, exactly. Only balls whose
