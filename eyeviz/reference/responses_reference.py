@@ -21,6 +21,10 @@ that only touches the kernel's support (tangency) gives 0. The kernels:
   convention, as CompoundRay's shader: dr / 2.35482...). Normalised over the whole sphere:
   the denominator is 2 pi times the integral of K(theta) sin(theta) over [0, pi], so a
   wide kernel's tail beyond theta = pi / 2 counts, and R = 1 only for a ball holding the lens.
+  This is the acceptance function renderers sample (``support="sphere"``, the default).
+  With ``support="cone"`` K is cut at the acceptance cone's edge (theta <= dr / 2) and
+  normalised over the cone instead: the response is then > 0 exactly where the ball
+  meets the cone, as the binary model's lit set (the eye models' ``gaussian`` kind).
 
 A ball holding the lens strictly inside (|v| < g) covers every direction: R = 1. A ball
 whose surface passes through the lens (|v| = g) covers the open half-space of directions
@@ -38,9 +42,10 @@ response is the 1-D integral
     R = integral of K(theta) sin(theta) w(theta) d theta / (2 pi integral of K sin),
 
 by tanh-sinh quadrature split at the kinks of w (theta = |delta - beta|, delta + beta,
-2 pi - delta - beta) and of K (theta = dr / 2 for ``flat``). Done at ``dps`` digits and
-again at ``dps + 15``; the two must agree within 10^-(dps - 8) or a ValueError is raised,
-so a returned value carries an error far below 1e-9 (the core's tolerance).
+2 pi - delta - beta) and of K (theta = dr / 2 for ``flat`` and the cut Gaussian). Done at
+``dps`` digits and again at ``dps + 15``; the two must agree within 10^-(dps - 8) or a
+ValueError is raised, so a returned value carries an error far below 1e-9 (the core's
+tolerance).
 """
 
 from __future__ import annotations
@@ -106,12 +111,13 @@ def _extent(theta: mpmath.mpf, delta: mpmath.mpf, beta: mpmath.mpf) -> mpmath.mp
     return 2 * mpmath.acos(cc)
 
 
-def _kernel(kind: str, dr: mpmath.mpf):
+def _kernel(kind: str, dr: mpmath.mpf, support: str = "sphere"):
     if kind == "flat":
         return lambda t: mpmath.mpf(1), dr / 2
     if kind == "gaussian":
         two_s2 = 2 * (dr / (2 * mpmath.sqrt(2 * mpmath.log(2)))) ** 2
-        return lambda t: mpmath.exp(-(t * t) / two_s2), mpmath.pi
+        top = mpmath.pi if support == "sphere" else dr / 2
+        return lambda t: mpmath.exp(-(t * t) / two_s2), top
     raise ValueError(f"unknown response kind {kind!r}; known: {', '.join(KINDS)}")
 
 
@@ -121,21 +127,22 @@ def _points(lo: mpmath.mpf, hi: mpmath.mpf, kinks: Sequence[mpmath.mpf]) -> list
 
 
 @functools.lru_cache(maxsize=64)
-def _normaliser(kind: str, dr_text: str, dps: int) -> mpmath.mpf:
-    """The integral of K over the whole sphere (cached per kernel and precision)."""
+def _normaliser(kind: str, dr_text: str, dps: int, support: str) -> mpmath.mpf:
+    """The integral of K over its support (cached per kernel and precision)."""
     dr = mpmath.mpf(dr_text)
     if kind == "flat":
         return 2 * mpmath.pi * (1 - mpmath.cos(dr / 2))
-    kern, _ = _kernel(kind, dr)
-    return 2 * mpmath.pi * mpmath.quad(lambda t: kern(t) * mpmath.sin(t), [0, dr, mpmath.pi])
+    kern, top = _kernel(kind, dr, support)
+    pts = [0, dr / 2] if support == "cone" else [0, dr, mpmath.pi]
+    return 2 * mpmath.pi * mpmath.quad(lambda t: kern(t) * mpmath.sin(t), pts)
 
 
-def _response_at(delta, beta, dr, kind: str) -> mpmath.mpf:
+def _response_at(delta, beta, dr, kind: str, support: str) -> mpmath.mpf:
     delta, beta, dr = _mpf(delta), _mpf(beta), _mpf(dr)
-    kern, top = _kernel(kind, dr)
+    kern, top = _kernel(kind, dr, support)
     pi = mpmath.pi
     kinks = [abs(delta - beta), delta + beta, 2 * pi - delta - beta]
-    den = _normaliser(kind, str(dr), mpmath.mp.dps)
+    den = _normaliser(kind, str(dr), mpmath.mp.dps, support)
     # rings below delta - beta and beyond delta + beta (unless the cap wraps the antipode)
     # miss the cap
     lo = max(mpmath.mpf(0), delta - beta)
@@ -154,9 +161,11 @@ def cap_response(
     dr: float | mpmath.mpf,
     kind: str = "gaussian",
     dps: int = 30,
+    support: str = "sphere",
 ) -> float:
     """The response of a facet of acceptance angle ``dr`` to a cap of angular radius ``beta``
-    whose centre is ``delta`` from the axis (radians; beta = pi covers every direction).
+    whose centre is ``delta`` from the axis (radians; beta = pi covers every direction);
+    ``support`` ("sphere" or "cone") is the Gaussian kernel's (module docstring).
 
     Evaluated at ``dps`` and ``dps + 15`` digits; ValueError if they differ by more than
     10^-(dps - 8) or a parameter is out of range. Returns the value rounded to float64.
@@ -170,10 +179,12 @@ def cap_response(
         raise ValueError(f"delta and beta must be in [0, pi], got {delta!r}, {beta!r}")
     if kind not in KINDS:
         raise ValueError(f"unknown response kind {kind!r}; known: {', '.join(KINDS)}")
+    if support not in ("sphere", "cone"):
+        raise ValueError(f"support must be 'sphere' or 'cone', got {support!r}")
     with mpmath.workdps(dps):
-        r1 = _response_at(delta, beta, dr, kind)
+        r1 = _response_at(delta, beta, dr, kind, support)
     with mpmath.workdps(dps + 15):
-        r2 = _response_at(delta, beta, dr, kind)
+        r2 = _response_at(delta, beta, dr, kind, support)
         if abs(r1 - r2) > mpmath.mpf(10) ** (8 - dps):
             raise ValueError(f"quadrature did not settle: {r1} against {r2}")
         return float(r2)
@@ -187,6 +198,7 @@ def reference_response(
     g: float,
     kind: str = "gaussian",
     dps: int = 30,
+    support: str = "sphere",
 ) -> float:
     """The response of the facet (lens ``p``, axis ``a``, acceptance angle ``dr``) to the
     ball (``c``, ``g``), from the float inputs as given (the module's definition)."""
@@ -197,7 +209,7 @@ def reference_response(
         if cap is None:
             return 1.0
         delta, beta = cap
-        return cap_response(delta, beta, dr, kind, dps)
+        return cap_response(delta, beta, dr, kind, dps, support)
 
 
 def two_caps_area(r1: float, r2: float, d: float) -> float:

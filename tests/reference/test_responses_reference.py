@@ -128,3 +128,16 @@ def test_bad_parameters(args: tuple[float, float, float], word: str) -> None:
         cap_response(0.1, 0.1, 0.5, kind="box")
     with pytest.raises(ValueError, match="radius"):
         reference_response((0, 0, 0), (0, 0, 1), 0.5, (0, 0, 1), 0.0)
+
+
+def test_gaussian_cut_at_the_cone() -> None:
+    # support="cone": K cut at dr/2 and normalised there; concentric: F(beta) / F(dr/2)
+    dr, beta = D(2.6), D(1)
+    want = _gauss_disc(beta, dr) / _gauss_disc(dr / 2, dr)
+    assert cap_response(0, beta, dr, "gaussian", support="cone") == pytest.approx(want, rel=1e-13)
+    assert cap_response(0, dr, dr, "gaussian", support="cone") == 1.0
+    # zero past the cone, where the sphere-wide kernel still has weight
+    assert cap_response(dr / 2 + D(1.01), D(1), dr, "gaussian", support="cone") == 0.0
+    assert cap_response(dr / 2 + D(1.01), D(1), dr, "gaussian") > 1e-3
+    with pytest.raises(ValueError, match="support"):
+        cap_response(0.1, 0.1, 0.5, "gaussian", support="disc")
