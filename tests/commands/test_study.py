@@ -131,6 +131,23 @@ def wait_for_points(proc, path, k, timeout=240):
     raise AssertionError("the study never wrote its points")
 
 
+def wait_until_eyeviz_handles_signals(proc, timeout=120) -> None:
+    """Wait until the command has installed its own signal handlers (it catches SIGTERM,
+    which Python alone does not). A Ctrl-C before then meets Python's start-up and the
+    import of the package, where no program can answer it (on a loaded machine that took
+    over 0.5 s, and a fixed delay made the test flaky: exit -2 from runpy)."""
+    bit = 1 << (signal.SIGTERM - 1)
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        with open(f"/proc/{proc.pid}/status") as f:
+            caught = next(int(ln.split()[1], 16) for ln in f if ln.startswith("SigCgt:"))
+        if caught & bit:
+            return
+        assert proc.poll() is None, proc.communicate()
+        time.sleep(0.005)
+    raise AssertionError("the command never installed its signal handlers")
+
+
 def group_gone(pgid, timeout=60) -> bool:
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
@@ -184,6 +201,7 @@ def test_ctrl_c_while_the_cluster_starts_leaves_no_process_behind(tmp_path, dela
     path = tmp_path / "s.csv"
     proc, _ = start_study(path)
     try:
+        wait_until_eyeviz_handles_signals(proc)
         time.sleep(delay)
         os.killpg(proc.pid, signal.SIGINT)
         _, err = proc.communicate(timeout=120)
