@@ -223,6 +223,7 @@ def _decide(n, X, Y, Z, G, face, ix, iy, pix, prec):
                 return True
     if best > s2 + eps:
         return False
+    assert best_pt is not None  # set at the first sample of the first edge
     edge, t = best_pt
     if t <= tol_snap:
         t = mp(0)

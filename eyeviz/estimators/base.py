@@ -49,6 +49,9 @@ class Prediction(tuple):
     row all four are numpy scalars.
     """
 
+    valid: Any
+    in_domain: Any
+
     def __new__(cls, r, phi, valid, in_domain):
         obj = super().__new__(cls, (r, phi))
         obj.valid = valid

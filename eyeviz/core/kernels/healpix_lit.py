@@ -367,8 +367,8 @@ def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, 
         th_hi = min(max(theta_c + alpha + pad_t, 0.0), math.pi)
         i_min = np.int64(math.floor(n * _jr_of_theta(th_lo) * (1 - 1e-12))) - 1
         i_max = np.int64(math.ceil(n * _jr_of_theta(th_hi) * (1 + 1e-12))) + 1
-        i_min = min(max(i_min, 1), 4 * n - 1)
-        i_max = min(max(i_max, 1), 4 * n - 1)
+        i_min = min(max(i_min, np.int64(1)), 4 * n - 1)
+        i_max = min(max(i_max, np.int64(1)), 4 * n - 1)
         zc_hi = math.cos(th_lo)
         zc_lo = math.cos(th_hi)
         c = (dx / d, dy / d, dz / d)
@@ -473,7 +473,7 @@ def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2
         has_s = js_hi >= js_lo
     full_s = full_s or (has_s and js_hi - js_lo + 1 >= nr)
     if full_s:
-        js_lo, js_hi = 0, nr - 1
+        js_lo, js_hi = np.int64(0), np.int64(nr - 1)
     if has_s and not full_c and not no_cand:
         js_lo = max(js_lo, jc_lo)
         js_hi = min(js_hi, jc_hi)
@@ -484,13 +484,13 @@ def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2
         return 0, 0, 0
     # the undecided cells: blocks [u1_lo, u1_hi] and [u2_lo, u2_hi] (unwrapped j)
     if full_c:
-        u1_lo = js_hi + 1 if has_s else 0
-        u1_hi = js_lo + nr - 1 if has_s else nr - 1
-        u2_lo, u2_hi = 1, 0
+        u1_lo = js_hi + 1 if has_s else np.int64(0)
+        u1_hi = js_lo + nr - 1 if has_s else np.int64(nr - 1)
+        u2_lo, u2_hi = np.int64(1), np.int64(0)
     elif has_s:
         u1_lo, u1_hi, u2_lo, u2_hi = jc_lo, js_lo - 1, js_hi + 1, jc_hi
     else:
-        u1_lo, u1_hi, u2_lo, u2_hi = jc_lo, jc_hi, 1, 0
+        u1_lo, u1_hi, u2_lo, u2_hi = jc_lo, jc_hi, np.int64(1), np.int64(0)
     big = np.int64(1) << 62
     lo = js_lo if has_s else big
     hi = js_hi if has_s else -big
@@ -507,8 +507,8 @@ def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2
             if r == 2:
                 return 2, 0, 0
             if r == 1:
-                lo = min(lo, uj)
-                hi = max(hi, uj)
+                lo = min(lo, np.int64(uj))
+                hi = max(hi, np.int64(uj))
                 num += 1
     if num == 0:
         return 0, 0, 0

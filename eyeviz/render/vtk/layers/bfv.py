@@ -59,7 +59,7 @@ class BFVLayer:
         faces = np.column_stack([np.full(k.size, 3), np.zeros(k.size, int), k, k + 1]).ravel()
         self.mesh = pv.PolyData(np.zeros((BFV_SLOTS, 3)), faces=faces)
         self.edges = pv.PolyData(np.zeros((4, 3)), lines=[2, 0, 1, 2, 2, 3])
-        self.actors = []
+        self.actors: list[tuple] = []  # (renderer, an actor or a 3D text)
         for ren in self.renderers:
             a = actor(self.mesh, BFV_FILL)
             b = actor(self.edges, BFV_LINE)
@@ -80,8 +80,8 @@ class BFVLayer:
             tp.SetBackgroundOpacity(0.75)  # a halo: the label reads over a disc
         self.theta_label.GetTextProperty().SetJustificationToCentered()
         self.psi_label.GetTextProperty().SetVerticalJustificationToCentered()
-        for a in (self.arc_actor, self.theta_label, self.psi_label):
-            self.actors.append((main, a))
+        for part in (self.arc_actor, self.theta_label, self.psi_label):
+            self.actors.append((main, part))
         self.shown = False
         self.polygon = np.zeros((0, 2))
         self._written: tuple | None = None
