@@ -232,6 +232,10 @@ def main() -> int:
     ap.add_argument(
         "--bee", action="store_true", help="the shipped honeybee only (measured eyes, bee.toml)"
     )
+    ap.add_argument(
+        "--nside", type=int, action="append", help="only these nsides (repeatable), no window-up"
+    )
+    ap.add_argument("--profile", help="write a cProfile of the drags to this file")
     args = ap.parse_args()
     if not os.environ.get("DISPLAY"):
         xvfb = shutil.which("xvfb-run")
@@ -245,8 +249,17 @@ def main() -> int:
     ok = True
     balls = "bee.toml's 3 balls" if args.bee else f"{N_BALLS} balls"
     print(f"3D view drag frame vs bare render of the same window ({balls}, 1280x800)")
-    for nside in ["bee"] if args.bee else CASES:
+    prof = None
+    if args.profile:
+        import cProfile
+
+        prof = cProfile.Profile()
+    for nside in ["bee"] if args.bee else (args.nside or CASES):
+        if prof is not None:
+            prof.enable()
         r = bench_drag(nside, args.events, settings)
+        if prof is not None:
+            prof.disable()
         lat, base = r["lat"], r["base"]
         p50, p95 = _pct(lat, 50), _pct(lat, 95)
         b50, b95 = _pct(base, 50), _pct(base, 95)
@@ -277,7 +290,9 @@ def main() -> int:
                 f"first ball, the press's selection) {q['jobs'][0]}, after it "
                 f"{q['jobs'][1] - q['jobs'][0]}"
             )
-    if args.bee:
+    if prof is not None:
+        prof.dump_stats(args.profile)
+    if args.bee or args.nside:
         return 0 if ok else 1
     up, mem = bench_up(settings)
     ok &= up <= UP_TARGET_S

@@ -99,6 +99,11 @@ def _lit_runs_jit(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray
         n, x, y, z, g, float(cx), sth, zr, unit, first, nr, shifted, delta, o
     )
     kernels.mark_ready()
+    return _merge_ref(n, x, y, z, g, cx, status, per, st, ln, bl)
+
+
+def _merge_ref(n: int, x, y, z, g, cx: float, status, per, st, ln, bl):
+    """The kernel's runs with the reference's for the balls it handed back (status 1)."""
     ref = np.flatnonzero(status)
     if ref.size == 0:
         return per, st, ln
@@ -110,6 +115,50 @@ def _lit_runs_jit(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray
     ln = np.concatenate([ln, l2])
     order = np.lexsort((st, bl))
     return per, st[order], ln[order]
+
+
+def _lit_csr_jit(n: int, x, y, z, g, h: float) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+    """:meth:`EyePair3D.lit_csr` through the kernel: both eyes in one compiled call that
+    writes the indices from the runs (no temporaries per ball, no Python per block)."""
+    from eyeviz.core.kernels.healpix_lit import lit_csr_kernel
+
+    sth, zr, unit = _ring_tables(n)
+    first, nr, shifted, delta, o = _ring_info_tables(n)
+    res = lit_csr_kernel(n, x, y, z, g, h, sth, zr, unit, first, nr, shifted, delta, o)
+    kernels.mark_ready()
+    out = []
+    for cx, (status, indptr, idx, st, ln, bl) in zip((-h, h), res, strict=True):
+        if status.any():
+            per = np.diff(indptr)
+            indptr, idx = _runs_to_csr(*_merge_ref(n, x, y, z, g, cx, status, per, st, ln, bl))
+        out.append((indptr, idx))
+    return out[0], out[1]
+
+
+def _one_ball(x, y, z, g) -> tuple[float, float, float, float] | None:
+    """The four numbers of a call on one ball of Python or numpy float64 (or Python int)
+    scalars, finite with g > 0 (a drag frame, a draw); None for anything else, which
+    :func:`validate_balls` broadcasts, checks and names."""
+    v4 = (x, y, z, g)
+    if not all(isinstance(v, (float, int)) for v in v4):
+        return None
+    try:
+        f = (float(x), float(y), float(z), float(g))
+    except OverflowError:
+        return None
+    if math.isfinite(f[0] + f[1] + f[2] + f[3]) and f[3] > 0:
+        return f
+    return None
+
+
+def _estimate_one(x: float, y: float, z: float, g: float, h: float, npix: int) -> float:
+    """:meth:`EyePair3D.lit_csr`'s size estimate for one ball, in Python floats."""
+    est = 0.0
+    for cx in (-h, h):
+        d = math.hypot(math.hypot(x - cx, y), z)
+        q = g / d if d > 0 else math.inf
+        est += (1.0 if q >= 1 else 0.5 * q * q) * npix
+    return est
 
 
 def _lit_runs_ref(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -270,6 +319,13 @@ class EyePair3D(LitSetViews):
     def lit_csr(self, x, y, z, g) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
         """Per eye (A, B): (indptr, indices) of the lit facets, CSR over the flattened
         balls; indices sorted int64 RING indices per row (the 3D Proposition 2)."""
+        one = _one_ball(x, y, z, g)
+        if one is not None and kernels.use(1):
+            # one ball: no broadcasting, estimate in Python floats, straight to the kernel
+            est = _estimate_one(*one, self.h, self.npix)
+            if est <= MAX_LIT:
+                xf, yf, zf, gf = (np.array((v,)) for v in one)
+                return _lit_csr_jit(self.nside, xf, yf, zf, gf, self.h)
         xa, ya, za, ga = validate_balls(x, y, z, g)
         xf, yf, zf, gf = (np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, za, ga))
         nb, n = xf.shape[0], self.nside
@@ -283,6 +339,8 @@ class EyePair3D(LitSetViews):
                 f"the lit sets would hold about {est:.3g} facets (more than {MAX_LIT}): "
                 "use fewer or smaller balls per call, or a smaller nside"
             )
+        if kernels.use(nb):
+            return _lit_csr_jit(n, xf, yf, zf, gf, self.h)
         out = []
         block = _block(n)
         for cx in (-self.h, self.h):

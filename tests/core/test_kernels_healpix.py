@@ -92,6 +92,7 @@ def test_eyeviz_jit_0_runs_the_reference(monkeypatch):
         raise AssertionError("kernel called with EYEVIZ_JIT=0")
 
     monkeypatch.setattr(hl, "lit_runs_kernel", boom)
+    monkeypatch.setattr(hl, "lit_csr_kernel", boom)
     la, lb = g3.EyePair3D(40.0, 20.0, 16).lit(10.0, 500.0, 20.0, 60.0)
     assert la.size > 10 and lb.size > 10
     monkeypatch.setenv("EYEVIZ_JIT", "1")
@@ -110,3 +111,47 @@ def test_deferred_kernels_wait_for_the_warm_up(monkeypatch):
     assert not kernels.use(10**6) or kernels._STATE["ready"]  # deferred until warm
     thread.join(120)
     assert kernels.use(1)
+
+
+def test_lit_csr_through_the_kernel_equals_the_reference(monkeypatch):
+    """EyePair3D.lit_csr and lit, kernel (both eyes and the indices in compiled code)
+    against EYEVIZ_JIT=0, on a batch mixing ordinary, tiny, grazing and whole-eye balls
+    (the last three handed back to the reference and merged), and one-ball calls of
+    Python and numpy scalars."""
+    rng = np.random.default_rng(4)
+    p = rng.uniform(-500, 500, (40, 3))
+    g = rng.uniform(1, 300, 40)
+    g[::7] = 1e-200  # tiny
+    p[3] = (40.0, 0.0, 0.0)  # whole eye B
+    g[5] = float(np.linalg.norm(p[5] - (40.0, 0.0, 0.0))) * (1 - 2.0**-30)  # grazing
+    eyes = g3.EyePair3D(40.0, 20.0, 18)
+    monkeypatch.setitem(kernels._STATE, "ready", True)
+    got = eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
+    ones = [eyes.lit(float(p[i, 0]), p[i, 1], p[i, 2], g[i]) for i in range(40)]
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want = eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
+    for (a, b), (c, d) in zip(got, want, strict=True):
+        np.testing.assert_array_equal(a, c)
+        np.testing.assert_array_equal(b, d)
+    for i, one in enumerate(ones):
+        for o, (ptr, idx) in zip(one, want, strict=True):
+            np.testing.assert_array_equal(o, idx[ptr[i] : ptr[i + 1]])
+    monkeypatch.setenv("EYEVIZ_JIT", "1")
+    with pytest.raises(ValueError, match="x has 1 non-finite"):
+        eyes.lit(float("nan"), 1.0, 2.0, 3.0)
+    with pytest.raises(ValueError, match="g .feature radius. must be > 0"):
+        eyes.lit(0.0, 1.0, 2.0, 0)
+    with pytest.raises(ValueError, match="would hold about"):
+        g3.EyePair3D(40.0, 20.0, 1 << 20).lit(0.0, 100.0, 0.0, 50.0)
+
+
+def test_one_ball_estimate_equals_the_arrays():
+    """The one-ball path's size estimate (Python floats) is lit_csr's on arrays."""
+    for x, y, z, g in [(0.0, 100.0, 5.0, 30.0), (40.0, 0.0, 0.0, 1.0), (1e308, 1e308, 0, 1.0)]:
+        est = g3._estimate_one(x, y, z, g, 40.0, 12)
+        want = 0.0
+        with np.errstate(all="ignore"):
+            for cx in (-40.0, 40.0):
+                q = np.float64(g) / np.hypot(np.hypot(x - cx, y), z)
+                want += (1.0 if q >= 1 else 0.5 * q * q) * 12
+        assert est == want

@@ -11,7 +11,7 @@ import os
 
 __all__ = ["enabled", "use", "warm", "warm_in_background", "defer_until_warm", "mark_ready"]
 
-_STATE = {"ready": False, "defer": False}
+_STATE: dict[str, bool | None] = {"ready": False, "defer": False, "found": None}
 #: Calls of fewer items than this do not load cold kernels (see :func:`use`)
 COLD_WORK = 64
 
@@ -22,7 +22,10 @@ def enabled() -> bool:
         return False
     # found, not imported: importing numba takes a second, which a caller on a GUI
     # thread must not pay (the kernel modules import it when first used)
-    return importlib.util.find_spec("numba") is not None
+    found = _STATE["found"]
+    if found is None:  # looked up once: find_spec costs more than a one-ball call's kernel
+        found = _STATE["found"] = importlib.util.find_spec("numba") is not None
+    return bool(found)
 
 
 def use(work: int = 1 << 30) -> bool:
