@@ -432,6 +432,18 @@ class EyePair:
         la, ra, lb, rb = (o.reshape(shape) for o in outs)
         return la, ra, lb, rb
 
+    def responses(self, x, y, g, kind: str | None = None):
+        """Graded responses per eye (A, B): (indptr, indices, values) over the flattened
+        features, indices the lit ommatidia of :meth:`intervals` (sorted), values the
+        share of each sector's angle the disc covers (kind ``"cell"``, the only one;
+        docs/responses.md)."""
+        from eyeviz.core.responses import check_kind, planar_responses
+
+        check_kind("planar", kind)
+        xa, ya, ga = validate_features(x, y, g)
+        flat = (np.ascontiguousarray(v).reshape(-1) for v in (xa, ya, ga))
+        return planar_responses(self, *flat)
+
     def bitmaps(self, x, y, g) -> tuple[np.ndarray, np.ndarray]:
         """Whole-eye bitmaps (omega_a, omega_b), bool of shape (..., m)."""
         LA, RA, LB, RB = self.intervals(x, y, g)

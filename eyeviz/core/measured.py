@@ -281,6 +281,24 @@ class MeasuredEyePair(LitSetViews):
             out[b] = hit
         return out
 
+    def responses(self, x, y, z, g, kind: str | None = None):
+        """Graded responses per eye (A, B): (indptr, indices, values), the lit sets of
+        :meth:`lit_csr` with each lit facet's response in [0, 1]; ``kind`` ``"flat"``
+        (the default) or ``"gaussian"`` (docs/responses.md)."""
+        from eyeviz.core.responses import check_kind, measured_values
+
+        k = check_kind("measured", kind)
+        _, balls = self._flat_balls(x, y, z, g)
+        out = []
+        for w in "AB":
+            indptr, indices = self._lit_eye(w, balls)
+            e = self.eye(w)
+            vals = measured_values(
+                e.positions, e.unit_axes, e.acceptance, balls, indptr, indices, k
+            )
+            out.append((indptr, indices, vals))
+        return out[0], out[1]
+
     def overlaps_eye(self, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
         """Per eye: the closed ball contains a lens of that eye (exact)."""
         shape, balls = self._flat_balls(x, y, z, g)
