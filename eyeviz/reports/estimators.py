@@ -162,6 +162,7 @@ def run3d(args: argparse.Namespace) -> int:
     """The spherical side's report (``--data``, ``--nside`` or ``--eye``)."""
     from eyeviz import EyevizError
     from eyeviz.estimators import registry
+    from eyeviz.reports.errors import with_error
     from eyeviz.reports.estimators3d import measure3d, write3d
 
     given = [f for f in ("data", "nside", "eye") if getattr(args, f, None) is not None]
@@ -231,10 +232,11 @@ def run3d(args: argparse.Namespace) -> int:
     paths = write3d(results, args.output, what)
     for r in results:
         if r.ok:
-            m = r.metrics["subset"]
+            m, e = r.metrics["subset"], r.errors["subset"]
+            dd, ad, el = (with_error(m[k], e[k]) for k in ("dd", "ad", "el_mae_deg"))
             print(
-                f"{r.name:11s} DD MAPE {m['dd']:.3f} %  AD MAPE {m['ad']:.4f} %  el MAE "
-                f"{m['el_mae_deg']:.5f} deg  {r.batched_us:.3g} µs/row (subset of "
+                f"{r.name:11s} DD MAPE {dd} %  AD MAPE {ad} %  el MAE {el} deg  "
+                f"{r.batched_us:.3g} µs/row (subset of "
                 f"{len(range(0, len(ds), max(1, -(-len(ds) // args.limit_rows))))} rows)"
             )
         else:

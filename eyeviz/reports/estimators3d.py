@@ -25,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from eyeviz.estimators.metrics import mape
 from eyeviz.reports.common import save_figure, write_atomic
+from eyeviz.reports.errors import bootstrap_se, with_error
 
 __all__ = ["Result3D", "SLOW", "measure3d", "plot3d", "to_csv3d", "to_markdown3d", "write3d"]
 
@@ -41,6 +41,7 @@ class Result3D:
     status: str = ""  # "" when measured, else why not
     rows: int = 0
     metrics: dict[str, dict[str, float]] = field(default_factory=dict)  # "all"/"subset"
+    errors: dict[str, dict[str, float]] = field(default_factory=dict)  # their bootstrap SEs
     flagged: dict[str, int] = field(default_factory=dict)
     batched_us: float = math.nan
     single_ms: float = math.nan
@@ -51,13 +52,23 @@ class Result3D:
         return not self.status
 
 
-def _metrics(ds, rows: np.ndarray, r, az, el) -> dict[str, float]:
+def _terms(ds, rows: np.ndarray, r, az, el) -> dict[str, np.ndarray]:
+    """Each figure's per-row terms: its value is their mean (MAPE, Eq. 34; MAE)."""
+    if np.any(ds.r[rows] == 0) or np.any(ds.azimuth[rows] == 0) or np.any(ds.elevation[rows] == 0):
+        raise ValueError("MAPE is undefined where the true value is 0")
     return {
-        "dd": mape(ds.r[rows], r),
-        "ad": mape(ds.azimuth[rows], az),
-        "el_mape": mape(ds.elevation[rows], el),
-        "el_mae_deg": float(np.degrees(np.mean(np.abs(el - ds.elevation[rows])))),
+        "dd": 100.0 * np.abs((r - ds.r[rows]) / ds.r[rows]),
+        "ad": 100.0 * np.abs((az - ds.azimuth[rows]) / ds.azimuth[rows]),
+        "el_mape": 100.0 * np.abs((el - ds.elevation[rows]) / ds.elevation[rows]),
+        "el_mae_deg": np.degrees(np.abs(el - ds.elevation[rows])),
     }
+
+
+def _metrics(ds, rows: np.ndarray, r, az, el) -> tuple[dict[str, float], dict[str, float]]:
+    """The figures on ``rows`` and their bootstrap standard errors (eyeviz.reports.errors)."""
+    terms = _terms(ds, rows, r, az, el)
+    values = {k: float(np.mean(t)) for k, t in terms.items()}
+    return values, {k: bootstrap_se(t) for k, t in terms.items()}
 
 
 def measure3d(ds, names: list[str], limit_rows: int = 1000, progress=None) -> list[Result3D]:
@@ -94,10 +105,10 @@ def measure3d(ds, names: list[str], limit_rows: int = 1000, progress=None) -> li
         flagged = np.asarray(getattr(p, "flagged", np.zeros(rows.size, bool)), bool)
         at = np.searchsorted(rows, subset)
         r, az, el = (np.asarray(v, float) for v in (p[0], p[1], p[2]))
-        res.metrics["subset"] = _metrics(ds, subset, r[at], az[at], el[at])
+        res.metrics["subset"], res.errors["subset"] = _metrics(ds, subset, r[at], az[at], el[at])
         res.flagged["subset"] = int(flagged[at].sum())
         if name not in SLOW:
-            res.metrics["all"] = _metrics(ds, rows, r, az, el)
+            res.metrics["all"], res.errors["all"] = _metrics(ds, rows, r, az, el)
             res.flagged["all"] = int(flagged.sum())
         one_a = take_rows(ds.indptr_a, ds.indices_a, subset[:1])
         one_b = take_rows(ds.indptr_b, ds.indices_b, subset[:1])
@@ -152,6 +163,8 @@ CSV_FIELDS3D = (
     "estimator", "status", "rows", "subset_dd_mape", "subset_ad_mape", "subset_el_mape",
     "subset_el_mae_deg", "subset_flagged", "all_dd_mape", "all_ad_mape", "all_el_mape",
     "all_el_mae_deg", "all_flagged", "batched_us_per_row", "single_ms", "n_weights",
+    "subset_dd_se", "subset_ad_se", "subset_el_mape_se", "subset_el_mae_deg_se",
+    "all_dd_se", "all_ad_se", "all_el_mape_se", "all_el_mae_deg_se",
 )  # fmt: skip
 
 
@@ -166,14 +179,18 @@ def to_csv3d(results: list[Result3D]) -> str:
             row += [f"{m[k]:.6g}" if k in m else "" for k in _KEYS]
             row.append(r.flagged.get(part, ""))
         row += [f"{r.batched_us:.6g}", f"{r.single_ms:.6g}", r.n_weights]
+        for part in ("subset", "all"):
+            e = r.errors.get(part, {})
+            row += [f"{e[k]:.6g}" if k in e else "" for k in _KEYS]
         w.writerow(row)
     return buf.getvalue()
 
 
-def _cell(m: dict[str, float], k: str, best: float | None) -> str:
+def _cell(m: dict[str, float], e: dict[str, float], k: str, best: float | None) -> str:
+    """``value ± se`` to the precision the bootstrap error allows; bold for the best."""
     if k not in m:
         return "—"
-    s = f"{m[k]:.4f}" if k.startswith(("ad", "el_mae")) else f"{m[k]:.3f}"
+    s = with_error(m[k], e.get(k, math.nan))
     return f"**{s}**" if best is not None and m[k] == best else s
 
 
@@ -186,7 +203,9 @@ def to_markdown3d(results: list[Result3D], what: str, png: str) -> str:
         "",
         "DD, AD: MAPE (%) of r and of the azimuth (Eq. 34). Elevation: MAPE (%) and mean "
         "absolute error (degrees); the elevation crosses 0, where a relative error blows "
-        "up, so read the MAE. Bold: the best on the subset.",
+        "up, so read the MAE. Each figure is followed by its standard error (bootstrap "
+        "over the test rows) and printed to the precision that error allows. Bold: the "
+        "best on the subset.",
         "",
     ]
     for part, head in (("subset", "Every estimator on the same rows (the subset)"),
@@ -203,11 +222,10 @@ def to_markdown3d(results: list[Result3D], what: str, png: str) -> str:
             "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
         ]
         for r in have:
-            m = r.metrics[part]
+            m, e = r.metrics[part], r.errors.get(part, {})
+            cells = " | ".join(_cell(m, e, k, best.get(k)) for k in _KEYS)
             lines.append(
-                f"| {r.name} | {_cell(m, 'dd', best.get('dd'))} | "
-                f"{_cell(m, 'ad', best.get('ad'))} | {_cell(m, 'el_mape', best.get('el_mape'))} | "
-                f"{_cell(m, 'el_mae_deg', best.get('el_mae_deg'))} | {r.flagged.get(part, 0)} | "
+                f"| {r.name} | {cells} | {r.flagged.get(part, 0)} | "
                 f"{r.batched_us:.3g} | {r.single_ms:.3g} | {r.n_weights} |"
             )
         lines.append("")

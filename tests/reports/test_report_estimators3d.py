@@ -10,6 +10,7 @@ from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.dataset.sparse3d import write3d
 from eyeviz.estimators import registry
 from eyeviz.estimators.metrics import mape
+from eyeviz.reports.errors import bootstrap_se, with_error
 
 
 def test_report_on_a_3d_data_file(tmp_path, capsys):
@@ -37,6 +38,14 @@ def test_report_on_a_3d_data_file(tmp_path, capsys):
     assert float(rows["limit3d"]["subset_dd_mape"]) > 0
     md = (out / "estimators3d.md").read_text()
     assert "| limit3d |" in md and "el MAE deg" in md
+    # each figure carries its bootstrap standard error: about sd / sqrt(n) of the rows' terms
+    terms = 100 * np.abs(p.r - ds.r) / ds.r
+    se = float(rows["analytic3d"]["all_dd_se"])
+    assert 0.8 < se / (terms.std(ddof=1) / np.sqrt(60)) < 1.2
+    assert with_error(float(rows["analytic3d"]["all_dd_mape"]), se) in md
+    line = next(ln for ln in printed.splitlines() if ln.startswith("analytic3d"))
+    sub_se = float(rows["analytic3d"]["subset_dd_se"])
+    assert with_error(float(rows["analytic3d"]["subset_dd_mape"]), sub_se) in line
 
 
 def test_report_3d_fresh_set_and_errors(tmp_path, capsys):
@@ -50,3 +59,20 @@ def test_report_3d_fresh_set_and_errors(tmp_path, capsys):
     assert "unknown 3D estimator" in err and err.count("\n") == 1
     assert main([*base, "--nside", "8", "--data", str(tmp_path / "x.npz")]) == 2
     assert "not both" in capsys.readouterr().err
+
+
+def test_bootstrap_se_is_the_standard_error_of_a_mean():
+    rng = np.random.default_rng(5)
+    t = rng.exponential(size=2000)
+    assert abs(bootstrap_se(t) / (t.std(ddof=1) / np.sqrt(t.size)) - 1) < 0.1
+    assert bootstrap_se(t) == bootstrap_se(t)  # a fixed seed: reports are reproducible
+    assert np.isnan(bootstrap_se([1.0]))  # one row says nothing about its spread
+    assert bootstrap_se(np.full(50, 3.0)) == 0.0
+
+
+def test_with_error_prints_to_the_precision_the_error_allows():
+    assert with_error(0.77512, 0.02634) == "0.775 ± 0.026"
+    assert with_error(1.01834, 0.0291) == "1.018 ± 0.029"
+    assert with_error(0.0038123, 0.000104) == "0.00381 ± 0.00010"
+    assert with_error(1580.4, 37.2) == "1580 ± 37"
+    assert with_error(2.0, float("nan")) == "2"
