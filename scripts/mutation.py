@@ -55,6 +55,64 @@ EXTRA_TESTS = {
 }
 SKIP_MARK = "pragma: no mutate"
 
+#: The spherical side (``--spherical``): each module with the test files that test it,
+#: run with ``-m "not slow"`` (their whole directories take 10-25 min a mutant on two
+#: shared cores). The compiled kernels are left out: numba's on-disk cache is keyed on
+#: the file's time stamp and size, so a same-size mutant written within the second could
+#: run the unmutated kernel. Ordered by the time their tests take, the slowest last.
+_G3 = (
+    "tests/core/test_geometry3d_high_ties.py",
+    "tests/core/test_healpix_conventions.py",
+    "tests/core/test_geometry3d.py",
+)
+_MEASURED = ("tests/core/test_measured.py", "tests/core/test_measured_from.py")
+_APP3D = (
+    "tests/model/test_app_model3d.py",
+    "tests/model/test_app_model3d_paths.py",
+    "tests/model/test_camera3d.py",
+)
+SPHERICAL: dict[str, tuple[str, ...]] = {
+    "eyeviz/core/healpix.py": (
+        "tests/core/test_healpix.py",
+        "tests/core/test_healpix_conventions.py",
+    ),
+    "eyeviz/core/measured.py": _MEASURED,
+    "eyeviz/core/measured_exact.py": _MEASURED,
+    "eyeviz/core/measured_fast.py": _MEASURED,
+    "eyeviz/core/measured_from.py": _MEASURED,
+    "eyeviz/core/measured_grid.py": _MEASURED,
+    "eyeviz/core/measured_index.py": _MEASURED,
+    "eyeviz/dataset/algorithm1_3d.py": (
+        "tests/dataset/test_algorithm1_3d.py",
+        "tests/dataset/test_algorithm1_3d_joint.py",
+    ),
+    "eyeviz/dataset/sparse3d.py": (
+        "tests/dataset/test_sparse3d.py",
+        "tests/dataset/test_sparse3d_design_check.py",
+        "tests/dataset/test_sparse_measured.py",
+    ),
+    "eyeviz/estimators/analytic3d.py": (
+        "tests/estimators/test_analytic3d.py",
+        "tests/estimators/test_analytic3d_flagged.py",
+        "tests/estimators/test_boundary_rays.py",
+    ),
+    "eyeviz/estimators/triangulation.py": (
+        "tests/estimators/test_triangulation.py",
+        "tests/estimators/test_analytic3d.py",
+        "tests/estimators/test_boundary_rays.py",
+    ),
+    "eyeviz/core/healpix_fast.py": _G3,
+    "eyeviz/core/geometry3d.py": _G3,
+    "eyeviz/core/exact3d.py": _G3,
+    "eyeviz/model/app_model3d.py": _APP3D,
+    "eyeviz/model/camera3d.py": _APP3D,
+    "eyeviz/model/interactions.py": ("tests/model/test_app_model.py",),
+    "eyeviz/estimators/limit3d.py": (
+        "tests/estimators/test_limit3d.py",
+        "tests/estimators/test_limit3d_hostile.py",
+    ),
+}
+
 _OPS = {
     "<": ["<="],
     "<=": ["<"],
@@ -212,8 +270,11 @@ def _drop_pyc(path: Path) -> None:
             p.unlink(missing_ok=True)
 
 
-def run_tests(root: Path, tests: list[str], python: str, timeout: float) -> tuple[str, float]:
+def run_tests(
+    root: Path, tests: list[str], python: str, timeout: float, marks: str = ""
+) -> tuple[str, float]:
     cmd = [python, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-p", "no:randomly"]
+    cmd += ["-m", marks] if marks else []
     cmd += ["-o", "addopts=--import-mode=importlib", "--hypothesis-seed=0", *tests]
     t0 = time.monotonic()
     proc = subprocess.Popen(
@@ -261,12 +322,19 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--python", default=sys.executable)
     ap.add_argument("--json", type=Path, default=None, help="write every result here")
     ap.add_argument("--list", action="store_true", help="count the mutants, run nothing")
+    ap.add_argument(
+        "--spherical",
+        action="store_true",
+        help="the spherical modules (SPHERICAL), each against its own test files",
+    )
     a = ap.parse_args(argv)
     if a.per_module < 1:
         ap.error(f"--per-module must be an integer >= 1, got {a.per_module}")
     root = a.root.resolve()
     # a SIGTERM ends the run through the finally below, which restores the mutated file
     signal.signal(signal.SIGTERM, lambda *_: sys.exit("mutation run stopped (SIGTERM)"))
+    if a.spherical:
+        return run_spherical(a, root)
     tests = a.tests or ["tests/" + Path(p).name for p in a.packages]
     if len(tests) != len(a.packages):
         ap.error("--tests needs one directory per package")
@@ -341,6 +409,76 @@ def main(argv: list[str] | None = None) -> int:
             print(f"SURVIVED {r['path']}:{r['line']}: {r['old']!r} -> {r['new']!r}")
     if a.json:
         a.json.write_text(json.dumps({"totals": totals, "results": results}, indent=1))
+    return 0
+
+
+def _summary(results: list[dict], totals: dict[str, int], out: Path | None) -> None:
+    counts: dict[str, int] = {}
+    for r in results:
+        counts[r["status"]] = counts.get(r["status"], 0) + 1
+    n = len(results)
+    killed = counts.get("killed", 0) + counts.get("timeout", 0)
+    print("  ".join(f"{k}: {v}" for k, v in sorted(counts.items())))
+    if n:
+        print(f"kill rate {killed}/{n} = {100 * killed / n:.1f} % (timeouts count as killed)")
+    for r in results:
+        if r["status"] == "survived":
+            print(f"SURVIVED {r['path']}:{r['line']}: {r['old']!r} -> {r['new']!r}")
+    if out:
+        out.write_text(json.dumps({"totals": totals, "results": results}, indent=1))
+
+
+def run_spherical(a: argparse.Namespace, root: Path) -> int:
+    """The modules of :data:`SPHERICAL` (``--modules`` picks by stem), each mutant against
+    its module's own test files with ``-m "not slow"``; unmutated runs set the timeouts."""
+    if not a.list:
+        check_root(root, "eyeviz", a.python)
+    rng = random.Random(a.seed)
+    totals = {"sites": 0, "sampled": 0}
+    plan: list[tuple[Path, list[Mutant], tuple[str, ...]]] = []
+    for rel, tests in SPHERICAL.items():
+        mod = root / rel
+        if a.modules and mod.stem not in a.modules:
+            continue
+        every = mutants_of(rel, mod.read_text())
+        pick = sorted(
+            rng.sample(every, min(a.per_module, len(every))), key=lambda m: (m.line, m.col)
+        )
+        plan.append((mod, pick, tests))
+        totals["sites"] += len(every)
+        totals["sampled"] += len(pick)
+        print(f"{rel}: {len(pick)} of {len(every)} mutants", flush=True)
+    if a.list:
+        print(f"{totals['sampled']} mutants of {totals['sites']} would run")
+        return 0
+    base: dict[tuple[str, ...], float] = {}
+    results: list[dict] = []
+    for mod, pick, tests in plan:
+        if tests not in base:
+            status, base[tests] = run_tests(root, list(tests), a.python, 3600.0, "not slow")
+            if status != "survived":
+                raise SystemExit(f"{tests} fail without any mutant ({status}): fix that first")
+            print(f"{' '.join(tests)}: {base[tests]:.1f} s unmutated", flush=True)
+        t_out = a.timeout_factor * base[tests] + 20.0
+        original = mod.read_bytes()
+        src = original.decode()
+        try:
+            for m in pick:
+                mod.write_text(m.apply(src))
+                _drop_pyc(mod)
+                st, dt = run_tests(root, list(tests), a.python, t_out, "not slow")
+                mod.write_bytes(original)
+                _drop_pyc(mod)
+                results.append({**asdict(m), "status": st, "seconds": round(dt, 1)})
+                print(f"  {st:9s} {dt:6.1f} s  {m.label()}", flush=True)
+                if a.json:
+                    a.json.write_text(json.dumps({"totals": totals, "results": results}))
+        finally:
+            mod.write_bytes(original)
+            _drop_pyc(mod)
+        assert mod.read_bytes() == original
+    print(f"{totals['sampled']} mutants of {totals['sites']} run", flush=True)
+    _summary(results, totals, a.json)
     return 0
 
 
