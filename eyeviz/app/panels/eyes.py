@@ -5,8 +5,8 @@ from __future__ import annotations
 from PyQt5 import QtWidgets
 
 from eyeviz.app.panels.common import ERROR_STYLE, _Unelide, set_message, wrap_label
-from eyeviz.core.bounds import check_m
 from eyeviz.model.app_model import AppModel
+from eyeviz.model.scene_eyes import check_m  # the scene's own bound on m
 
 
 def _num(v: float) -> str:

@@ -3,8 +3,8 @@ than the scene's, or a feature outside its declared r and g range."""
 
 from __future__ import annotations
 
-from eyeviz.core.validation import num
 from eyeviz.model.app_model import AppModel
+from eyeviz.model.predictor import num, trained_for  # the model words its numbers
 
 ANY_DESIGN = frozenset({"analytic", "limit"})  # answer for any h, l, m (no training)
 
@@ -22,7 +22,7 @@ def design_note(model: AppModel, name: str) -> str | None:
     e = model.scene.eyes
     if (float(d.h), float(d.l), int(d.m)) == (float(e.h), float(e.l), int(e.m)):
         return None
-    return f"trained for h = {num(d.h)}, l = {num(d.l)}, m = {d.m}"
+    return trained_for(est)
 
 
 def range_note(model: AppModel, name: str, r: float, g: float) -> str | None:
