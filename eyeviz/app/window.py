@@ -72,6 +72,7 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
     redo_action: QtWidgets.QAction
     play_action: QtWidgets.QAction
 
+    # long: builds the docks, menus and views in the order Qt wires them; each step is one call
     def __init__(
         self, scene: Scene, path: str | os.PathLike | None = None, settings: Settings | None = None
     ) -> None:

@@ -20,6 +20,7 @@ OUTPUTS = {"output": "file"}
 _PROGRESS_MIN = 200_000  # elements; below this a run takes well under a second
 
 
+# long: one argparse option after another: the command's interface, no logic
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "-n", type=int, required=True, metavar="N", help="number of elements (rows)"

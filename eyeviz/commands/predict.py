@@ -164,6 +164,8 @@ def _with_weights(registry) -> list[str]:
     return [e.name for e in registry.entries(None) if e.weights_hint]
 
 
+# long: the command's one sequence (read, check, predict, write), each step with its own one-line
+# error
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 

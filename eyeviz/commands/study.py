@@ -28,6 +28,7 @@ def _csv(values) -> str:
     return ",".join(f"{v:g}" for v in values)
 
 
+# long: one argparse option after another: the command's interface, no logic
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from eyeviz.core.domain import DEFAULTS
     from eyeviz.study.grid import DEFAULT_H, DEFAULT_L, DEFAULT_M

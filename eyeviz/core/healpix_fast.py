@@ -119,6 +119,9 @@ def _runs_to_pieces(first, nr, lo, hi):
     return start1, len1, start2, len2
 
 
+# long: the float64 path of the 3D Proposition 2 as one vectorised pass over (ball, ring) pairs,
+# step for step as the compiled kernel (core/kernels/healpix_lit.py) reads; split, some twenty
+# arrays would pass between the pieces
 def _lit_runs_fast(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`_lit_runs` for caps the float64 path places (and any other, more slowly)."""
     nb = x.shape[0]
@@ -348,6 +351,8 @@ def _lit_runs_fast(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarra
     return per_ball, st, ln
 
 
+# long: vertices, then edges, then exact3d over the same undecided cells and ring tables; split,
+# the tables would pass between three functions
 def _decide_cells(
     n, upix, ub, uring, uj, ushift, dx, dy, dz, d, s2, ds2, errdir, alpha, x, y, z, g, cx
 ):

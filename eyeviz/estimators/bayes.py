@@ -168,6 +168,8 @@ def _keys_digest(key: np.ndarray) -> str:
     return hashlib.sha256(np.ascontiguousarray(key, np.int64).tobytes()).hexdigest()
 
 
+# long: every member of an untrusted file checked in turn before use, each with its own one-line
+# error
 def load_table(path) -> dict:
     """The table of ``path``, every member bounded and checked before use: one
     EyevizError line naming the file and the problem for anything else (never unpickles).

@@ -179,6 +179,7 @@ def _split(data: Dataset, seed: int, domain: Domain) -> tuple[dict, dict]:
     )
 
 
+# long: one training run in order (data, networks, loop, files), sharing the run's locals
 def _train_into(
     out: Path,
     tr: dict[str, np.ndarray],

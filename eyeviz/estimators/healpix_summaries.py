@@ -370,6 +370,8 @@ N_BOUNDS = 4 * (len(BANDS) - 1)
 _NO_BOUND = 1.0
 
 
+# long: each run's two ends bound the longitude in one vectorised pass, the wrap and the poles
+# included; split, the per-run arrays would pass between pieces
 def _bounds(
     rings: _Rings,
     count: np.ndarray,

@@ -215,6 +215,7 @@ def _metrics(est: Learned3DEstimator, va: dict[str, np.ndarray]) -> dict[str, An
     }
 
 
+# long: one training run in order (data, features, network, loop, files), sharing the run's locals
 def train(
     out_dir: str | os.PathLike | None = None,
     n_train: int = 500_000,

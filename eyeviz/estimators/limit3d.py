@@ -277,6 +277,8 @@ class Limit3DEstimator(Estimator3D):
             out = {k: np.take_along_axis(v, order, 1) for k, v in out.items()}
         return out
 
+    # long: the weighted draws of one chunk (propose, test the key, weigh) in one pass over shared
+    # arrays
     def _sample(self, st: dict, keys: np.ndarray, stream: int) -> dict[str, np.ndarray]:
         """``samples`` weighted draws per key of a chunk set up by :meth:`_draw`."""
         d, A, B, ea, eb = st["d"], st["A"], st["B"], st["ea"], st["eb"]

@@ -159,6 +159,8 @@ def interval_quadratic(qa, qb, qc):
     return lo, hi
 
 
+# long: eye A's ray directions and their feasible ranges in one vectorised pass over every key's
+# quadrature nodes
 @np.errstate(divide="ignore", invalid="ignore")
 def rays(keys: np.ndarray, p: Plan):
     """(cu, su, sd, cd, lo, hi, ok), arrays (N, n*n): eye A's ray directions cos/sin
@@ -361,6 +363,7 @@ def _window() -> np.ndarray:
     return c
 
 
+# long: a weighted median per row in one vectorised pass over float32 buffers reused in place
 def row_medians(v: np.ndarray, w: np.ndarray, span=None) -> np.ndarray:
     """Per row, the median of v >= 0 (float32, (N, P)) under weights w >= 0 (float32,
     (N, P)): the weighted CDF at node midpoints interpolated linearly, as

@@ -302,6 +302,8 @@ def _line_of(text: str, key: str) -> int | None:
     return None
 
 
+# long: every table of a scene file read in order, each key checked at the boundary with its own
+# one-line error
 def _scene_from_doc(doc: dict, text: str, source: str, base: Path | None) -> Scene:
     c = _Checker(text, source)
     c.keys(

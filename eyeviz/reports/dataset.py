@@ -229,6 +229,7 @@ def _histogram_and_sample(path: Path, edges: np.ndarray, step: int):
     return counts, np.concatenate(xs), np.concatenate(ys), reader.eyes
 
 
+# long: a figure's layout, panel after panel: matplotlib calls, not logic
 def _plot(paths, summaries, bins: int, max_points: int, path: Path) -> list[Path]:
     """The figure at ``path`` (.png, 300 dpi) and beside it as .svg and .pdf; the paths."""
     import matplotlib

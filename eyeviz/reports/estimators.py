@@ -158,6 +158,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+# long: the report's one sequence (read or generate, predict each estimator, write), each step
+# with its own one-line error
 def run3d(args: argparse.Namespace) -> int:
     """The spherical side's report (``--data``, ``--nside`` or ``--eye``)."""
     from eyeviz import EyevizError

@@ -12,6 +12,7 @@ from eyeviz.reports.estimators_measure import PAPER_TABLE5, Result, _limit
 _COLORS = ESTIMATOR_COLORS
 
 
+# long: a figure's layout, panel after panel: matplotlib calls, not logic
 def plot(results: list[Result]):
     """Figure: AD and DD MAPE against inference time per sample (log-log).
 

@@ -174,6 +174,7 @@ def _nearest(values, want: float) -> float:
     return min(values, key=lambda v: (abs(math.log(v / want)), v))
 
 
+# long: the report's sections written in order from one table
 def write_report3d(
     path: Path,
     outdir: Path,

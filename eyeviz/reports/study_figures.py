@@ -201,6 +201,7 @@ def heatmap_figure(table: list[dict], l_of: dict, at: float, wanted: float = PAP
     return fig
 
 
+# long: a figure's layout, panel after panel: matplotlib calls, not logic
 def law_figure(points: Sequence[LawPoint], fit: LawFit):
     """Measured relative DD error per bin against gamma r / (2h), log-log, with C x."""
     from matplotlib.figure import Figure

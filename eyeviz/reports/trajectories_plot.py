@@ -14,6 +14,7 @@ from eyeviz.reports.trajectories_measure import (
 )
 
 
+# long: a figure's layout, panel after panel: matplotlib calls, not logic
 def plot(points: list[Point], kind: str, names: list[str]):
     """Figures 15-17 style: accuracy against distance, one panel per (target, g)."""
     import matplotlib

@@ -390,6 +390,8 @@ def run_study(
         return _run(path, points, workers, scheduler, progress, connect_timeout)
 
 
+# long: the study's run loop inside one try/finally that owns the cluster, the signals and the
+# partial table
 def _run(path, points, workers, scheduler, progress, connect_timeout) -> StudySummary:
     t0 = time.perf_counter()
     unique: dict[tuple, Point] = {}

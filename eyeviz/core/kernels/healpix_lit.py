@@ -304,6 +304,8 @@ def _grow(buf, k):
     return new
 
 
+# long: the steps of healpix_fast._lit_runs_fast for each ball in compiled code, in the same
+# order, so the two read side by side
 @_jit
 def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, delta_t, o_t):
     """(status, facets per ball, run starts, run lengths, run balls) for one eye.
@@ -432,6 +434,8 @@ def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, 
     return status, per, st[:w], ln[:w], bl[:w]
 
 
+# long: one (ball, ring) pair of healpix_fast._lit_runs_fast in compiled code, in the same
+# order, so the two read side by side
 @_jit
 def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2, ed,
           cpix, sth, zr, unit, first, nr, shifted, delta, o):  # fmt: skip

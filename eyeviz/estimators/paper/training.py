@@ -33,6 +33,7 @@ from eyeviz.estimators.paper.weights import _atomic_write, _save_json, _sha256, 
 from eyeviz.estimators.store import staged
 
 
+# long: one training loop with its budget, early stop and logging, sharing the run's locals
 def train_net(
     spec: NetSpec,
     x: np.ndarray,
@@ -209,6 +210,7 @@ def train(
         )
 
 
+# long: one training run in order (data, networks, loop, files), sharing the run's locals
 def _train_into(
     out: Path,
     x,

@@ -237,6 +237,7 @@ def _draw_predictions_table(ax, preds: Predictions3D, scene: Scene) -> None:
 # --- the figure --------------------------------------------------------------------------
 
 
+# long: a figure's layout, panel after panel in drawing order: matplotlib calls, not logic
 def figure3d(
     scene: Scene,
     state: SceneState3D | None = None,

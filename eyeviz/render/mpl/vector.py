@@ -154,6 +154,7 @@ def resolve_aspect(aspect: float | None, width: float = WIDTH_IN) -> float:
     return a
 
 
+# long: a figure's layout, part after part in drawing order: matplotlib calls, not logic
 def figure(
     scene: Scene,
     state: SceneState | None = None,

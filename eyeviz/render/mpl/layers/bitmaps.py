@@ -13,6 +13,7 @@ STRIP = 0.12
 AXIS_H = 0.15
 
 
+# long: a figure's layout, strip after strip in drawing order: matplotlib calls, not logic
 def paint(cv: Canvas) -> None:
     box = cv.lay.bitmaps
     fr = cv.frame

@@ -117,6 +117,7 @@ def ambiguity_line(fr, i: int) -> str:
     )
 
 
+# long: the readout table's layout, column after column: matplotlib calls, not logic
 def paint(cv: Canvas) -> None:
     box = cv.lay.readout
     if box is None:
