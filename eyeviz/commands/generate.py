@@ -53,16 +53,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         ("h", float, "origin to eye centre distance", 3),
         ("l", float, "eye radius", 3),
         ("m", int, "ommatidia per eye, even", 3),
-        ("r_min", float, "minimum distance of a feature centre", 4),
-        ("r_max", float, "maximum distance of a feature centre", 4),
-        ("g_max", float, "maximum feature radius", 4),
+        ("r_min", _length, "minimum distance of a feature centre", 4),
+        ("r_max", _length, "maximum distance of a feature centre", 4),
+        ("g_max", _length, "maximum feature radius", 4),
     ):
         parser.add_argument(
             f"--{flag.replace('_', '-')}",
             type=typ,
             default=None,  # filled by _fill_defaults: --eye has ranges of its own
             help=f"{what} (default: {DEFAULTS[flag]:g}, Table {table}"
-            + ("; with --eye: at the animal's scale)" if table == 4 else ")"),
+            + (
+                "; with --eye: at the animal's scale, in mm, or in baselines b (the "
+                "distance between the eyes' lens centroids) as e.g. 12b)"
+                if table == 4
+                else ")"
+            ),
         )
     parser.add_argument(
         "--nside",
@@ -107,6 +112,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
+def _length(text: str):
+    """A range's value: a number (float), or with a unit (``30mm``, ``12b``) a
+    :class:`eyeviz.core.animal_scale.Length`, which only ``--eye`` takes."""
+    try:
+        return float(text)
+    except ValueError:
+        from eyeviz.core.animal_scale import parse_length
+
+        try:
+            return parse_length(text, "the value")
+        except ValueError as exc:  # argparse turns this into a one-line usage error
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def _seed(args: argparse.Namespace) -> bool:
     """Set ``args.seed`` to a fresh seed when none was given; whether it was drawn."""
     if args.seed is not None:
@@ -149,7 +168,16 @@ def _refuse_ignored(args: argparse.Namespace) -> None:
     """An option the run would ignore is refused (issue 36): ``--segments`` cuts r only
     in multi mode; ``--m`` (even the default 720) is not the HEALPix eyes'."""
     from eyeviz import EyevizError
+    from eyeviz.core.animal_scale import Length
 
+    if args.eye is None:
+        for k in ("r_min", "r_max", "g_max"):
+            if isinstance(getattr(args, k), Length):
+                flag = "--" + k.replace("_", "-")
+                raise EyevizError(
+                    f"{flag} {getattr(args, k)}: lengths in baselines or with a unit are "
+                    "for --eye (measured eyes); model eyes take plain numbers"
+                )
     if args.segments is not None and args.mode != "multi":
         raise EyevizError(
             f"--segments {args.segments} is for --mode multi; a single pass has no segments"
@@ -308,7 +336,11 @@ def _run_eye(args: argparse.Namespace, drawn: bool) -> int:
         pair = load_eyes(args.eye, units=args.units)
     for w in caught:  # e.g. a size that looks like the wrong unit: one line, no source
         print(f"generate: warning: {w.message}", file=sys.stderr)
-    ranges = {k: getattr(args, k) for k in ("r_min", "r_max", "g_max", "el_max")}
+    from eyeviz.core.animal_scale import prior_ranges
+
+    ranges = prior_ranges(
+        pair, **{k: getattr(args, k) for k in ("r_min", "r_max", "g_max", "el_max")}
+    )
     domain = Domain3D.for_eyes(pair, **ranges)
     algorithm1_3d.make_params3d(domain, args.mode, args.seed, args.segments)
     limits.check_free_space(args.output, sparse3d.estimated_bytes3d(n, domain))
@@ -319,9 +351,11 @@ def _run_eye(args: argparse.Namespace, drawn: bool) -> int:
     if not args.quiet:
         size = os.path.getsize(args.output) / 1e6
         na, nb = domain.facet_counts
+        b = 2 * domain.h
         print(
             f"wrote {n:,} elements of measured eyes {pair.name} ({na} + {nb} facets; r in "
-            f"[{domain.r_min:.4g}, {domain.r_max:.4g}], g <= {domain.g_max:.4g}; {args.mode} "
+            f"[{domain.r_min:.4g}, {domain.r_max:.4g}] mm = [{domain.r_min / b:.3g}, "
+            f"{domain.r_max / b:.3g}] b, g <= {domain.g_max:.4g} mm; {args.mode} "
             f"pass, seed {args.seed}) to {args.output} ({size:.1f} MB) in "
             f"{time.perf_counter() - t0:.2f} s"
         )
