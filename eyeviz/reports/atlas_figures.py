@@ -112,6 +112,8 @@ def _map_panel(ax, a, near: dict, far: dict) -> None:
 
 def _zoom_panel(fig, ax, near: dict, far: dict, key: str, eye: str, cmap: str, box) -> None:
     """The binocular field at r_max close up, coloured by the facets of one eye."""
+    from matplotlib.ticker import MaxNLocator
+
     if far["both"].any():
         val = np.where(far["both"], far[key], np.nan).astype(float)
         im = ax.imshow(
@@ -124,7 +126,8 @@ def _zoom_panel(fig, ax, near: dict, far: dict, key: str, eye: str, cmap: str, b
             vmin=2,
             vmax=max(3, np.nanmax(val)),
         )
-        fig.colorbar(im, ax=ax, shrink=0.85, pad=0.02, label="facets lit")
+        cb = fig.colorbar(im, ax=ax, shrink=0.85, pad=0.02, label="facets lit")
+        cb.ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     else:
         ax.text(0.5, 0.5, "no binocular direction", ha="center", transform=ax.transAxes)
     _outline(ax, near)
@@ -235,6 +238,7 @@ def _distance_figure(atlases):
 
 def _rule_figure(atlases):
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter, ScalarFormatter
 
     k = len(atlases)
     fig, axes = plt.subplots(1, k, figsize=(4.8 * k, 4.4), squeeze=False)
@@ -251,6 +255,9 @@ def _rule_figure(atlases):
             ax.plot(t, t, color="#555", ls="--", lw=1, label="DD = Z dphi / b")
         ax.set_xscale("log")
         ax.set_yscale("log")
+        for axis in (ax.xaxis, ax.yaxis):  # plain numbers: 30, 40, 60 rather than 3 x 10^1
+            axis.set_major_formatter(ScalarFormatter())
+            axis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("rule of thumb: Z dphi_loc / b (%)")
         ax.set_ylabel("DD (%)")
         ax.set_title(a.label, fontsize=10)
