@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 from PyQt5 import QtCore, QtGui, QtWidgets
 
+from eyeviz.app.help import HELP_NAME
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.app_model3d import AppModel3D
 from eyeviz.model.scene import Scene, View
@@ -19,7 +20,7 @@ from eyeviz.model.scene import Scene, View
 if TYPE_CHECKING:
     from eyeviz.app.window import MainWindow
 
-__all__ = ["PLAY_SHORTCUT", "SceneCommand", "build_menus"]
+__all__ = ["PLANAR_ONLY", "PLAY_SHORTCUT", "SceneCommand", "build_menus"]
 
 PLAY_SHORTCUT = "P"
 
@@ -91,6 +92,8 @@ def _undo_actions(win: MainWindow, menu: QtWidgets.QMenu) -> None:
 
     u = _action(win, menu, "&Undo", undo, QtGui.QKeySequence.Undo)
     r = _action(win, menu, "&Redo", redo, QtGui.QKeySequence.Redo)
+    u.setProperty(HELP_NAME, "Undo")  # F1 lists the action, not the live "Undo Nudge ..."
+    r.setProperty(HELP_NAME, "Redo")
     u.setEnabled(stack.canUndo())
     r.setEnabled(stack.canRedo())
     stack.canUndoChanged.connect(u.setEnabled)
@@ -136,3 +139,14 @@ def build_menus(win: MainWindow) -> None:
         win, v, "&Play / pause trajectory (Space in the view)", win.toggle_play, PLAY_SHORTCUT
     )
     win._refresh_recent()
+
+
+#: the window's actions that act on the planar scene only (disabled in the 3D view)
+PLANAR_ONLY = frozenset(
+    {
+        "Fit view",
+        "Fit inset to the eyes",
+        "Eye design: limit against distance",
+        "Play / pause trajectory (Space in the view)",
+    }
+)

@@ -13,7 +13,7 @@ import numpy as np
 from PyQt5 import QtCore, QtGui, QtWidgets
 
 from eyeviz.app.panels import _Unelide, design_note, set_message, wrap_label
-from eyeviz.app.panels.common import estimator_help
+from eyeviz.app.panels.common import estimator_help, follows_text_scale, text_scale
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.scene import TRAJECTORY_KINDS
 
@@ -33,24 +33,6 @@ __all__ = [
 ]
 
 PLOT_PT = 10  # the smallest text of the accuracy plot (projector-readable), at text scale 1
-
-
-def text_scale() -> float:
-    """The window's text scale now (View > Larger text, presentation mode): the app font's
-    size over its size at scale 1 (eyeviz.app.presenting sets the app font)."""
-    from eyeviz.app.launch import APP_FONT_PT
-
-    app = QtWidgets.QApplication.instance()
-    pt = app.font().pointSizeF() if isinstance(app, QtWidgets.QApplication) else -1.0
-    return pt / APP_FONT_PT if pt > 0 else 1.0
-
-
-def follows_text_scale(ev: QtCore.QEvent | None) -> bool:
-    """Whether ``ev`` may change the text scale (the app's font changed)."""
-    return ev is not None and ev.type() in (
-        QtCore.QEvent.Type.FontChange,
-        QtCore.QEvent.Type.ApplicationFontChange,
-    )
 
 
 PLOT_LW = 1.3  # the accuracy curves' width (thin: the curves' detail shows)

@@ -20,6 +20,9 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from eyeviz.resources import assets_dir
 
 __all__ = [
+    "HELP_NAME",
+    "LAYER3D_TEXT",
+    "SPHERICAL_SECTION",
     "VIEW3D_KEYS",
     "VIEW3D_NOTES",
     "VIEW_KEYS",
@@ -32,6 +35,22 @@ __all__ = [
 ]
 
 #: Keys the view handles itself (no QAction carries them): shown after the actions' rows.
+#: 3D view > Show ...: each spherical layer in words (not its file name: "bfv" is jargon)
+LAYER3D_TEXT = {
+    "eyes": "the eyes",
+    "features": "the balls",
+    "bfv": "the binocular field",
+    "bitmaps": "the facet maps (Mollweide)",
+    "readout": "the readout table",
+    "labels": "the names",
+    "tangents": "the tangent cones",
+    "plane": "the plane z = 0",
+    "predictions": "the estimators' answers",
+    "cones": "the lit facets' acceptance cones",
+}
+SPHERICAL_SECTION = "The spherical model (3D scenes)"  # docs/model.md's heading
+HELP_NAME = "eyeviz_help_name"  # a QAction property: its name in F1 (when its text changes)
+
 VIEW_KEYS = (
     ("View (with the focus)", "Play / pause the trajectory", "Space"),
     ("View", "Move a feature / pan the view", "drag"),
@@ -87,6 +106,13 @@ def _walk(menu: QtWidgets.QMenu, path: str) -> Iterator[tuple[str, QtWidgets.QAc
             yield path, a
 
 
+def _name(a: QtWidgets.QAction) -> str:
+    """The action's name for F1: its HELP_NAME property (an action whose text changes,
+    Undo's), else its text."""
+    name = a.property(HELP_NAME)
+    return name if isinstance(name, str) and name else _plain(a.text())
+
+
 def _keys(a: QtWidgets.QAction) -> str:
     seqs = [s.toString(QtGui.QKeySequence.NativeText) for s in a.shortcuts()]
     return ", ".join(s for s in seqs if s)
@@ -108,10 +134,10 @@ def shortcut_rows(win: QtWidgets.QMainWindow) -> list[tuple[str, str, str]]:
             seen.add(id(a))
             keys = _keys(a)
             if keys:
-                rows.append((path, _plain(a.text()), keys))
+                rows.append((path, _name(a), keys))
     for a in win.actions():
         if id(a) not in seen and _keys(a):
-            rows.append(("Window", _plain(a.text()), _keys(a)))
+            rows.append(("Window", _name(a), _keys(a)))
     rows.extend(VIEW_KEYS)
     rows.extend((VIEW3D_MENU, what, keys) for what, keys in VIEW3D_KEYS)
     return rows
@@ -194,3 +220,20 @@ class AboutModelDialog(QtWidgets.QDialog):
         fm = self.fontMetrics()
         self.resize(min(fm.averageCharWidth() * 95, 1400), min(fm.height() * 40, 900))
         self.setWindowModality(QtCore.Qt.WindowModality.NonModal)
+
+    def show_section(self, heading: str | None) -> None:
+        """Scroll to the section ``heading`` (its title's text) at the top; None: the page's
+        top (Help > About the model opens at the spherical model in a 3D scene)."""
+        bar = self.browser.verticalScrollBar()
+        assert bar is not None
+        self.browser.moveCursor(QtGui.QTextCursor.MoveOperation.Start)
+        bar.setValue(0)
+        if heading is None:
+            return
+        doc = self.browser.document()
+        layout = doc.documentLayout() if doc is not None else None
+        cur = doc.find(heading) if doc is not None else None
+        if cur is not None and layout is not None and not cur.isNull():
+            block = layout.blockBoundingRect(cur.block())
+            self.browser.setTextCursor(cur)
+            bar.setValue(int(block.top()))

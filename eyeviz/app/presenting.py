@@ -20,7 +20,7 @@ from typing import Any
 
 from PyQt5 import QtCore, QtGui, QtWidgets
 
-from eyeviz.app.help import AboutModelDialog, ShortcutsDialog
+from eyeviz.app.help import SPHERICAL_SECTION, AboutModelDialog, ShortcutsDialog
 from eyeviz.app.launch import APP_FONT_PT
 
 #: the main window (eyeviz.app.window.MainWindow; not imported: the window imports this)
@@ -77,6 +77,9 @@ def high_contrast_palette() -> QtGui.QPalette:
         (QtGui.QPalette.HighlightedText, white),
     ):
         pal.setColor(role, color)
+    grey = QtGui.QColor("#8a8a8a")  # a disabled entry must look disabled (issue 32)
+    for role in (QtGui.QPalette.WindowText, QtGui.QPalette.Text, QtGui.QPalette.ButtonText):
+        pal.setColor(QtGui.QPalette.Disabled, role, grey)
     return pal
 
 
@@ -108,6 +111,8 @@ class Presenter(QtCore.QObject):
         self.presenting = False
         self._applied = 1.0  # the effective scale the widgets and labels have now
         self._hidden_docks: list[QtWidgets.QDockWidget] = []
+        self._raised: list[QtWidgets.QDockWidget] = []  # tabs on top before F5
+        self._step_shown: list[QtWidgets.QDockWidget] = []  # shown in F5 for a step
         self._palette = _app().palette()
         self._vtk_base: dict[Any, tuple[float, int]] = {}  # actor -> (size at 1, size set)
         self.shortcuts_dialog: ShortcutsDialog | None = None
@@ -162,11 +167,19 @@ class Presenter(QtCore.QObject):
         menu = self.panels_menu
         assert menu is not None
         menu.clear()
-        docks = self.win.findChildren(QtWidgets.QDockWidget)
-        for d in sorted(docks, key=lambda d: d.windowTitle()):
+        for d in sorted(self.page_docks(), key=lambda d: d.windowTitle()):
             a = d.toggleViewAction()
             assert a is not None  # every dock has one
             menu.addAction(a)
+
+    def page_docks(self) -> list[QtWidgets.QDockWidget]:
+        """The docks of the page shown: the 3D view's in a spherical scene, else the
+        planar window's (each page's docks are hidden while the other page is shown)."""
+        host = getattr(self.win, "host3d", None)
+        own = list(host.docks.values()) if host is not None else []
+        if host is not None and host.active:
+            return own
+        return [d for d in self.win.findChildren(QtWidgets.QDockWidget) if d not in own]
 
     # --- help ----------------------------------------------------------------------------
     def show_shortcuts(self) -> ShortcutsDialog:
@@ -181,7 +194,13 @@ class Presenter(QtCore.QObject):
     def show_about(self) -> AboutModelDialog:
         if self.about_dialog is None:
             self.about_dialog = AboutModelDialog(self.win)
+        host = getattr(self.win, "host3d", None)
+        spherical = host is not None and host.active
+        section = SPHERICAL_SECTION if spherical else None
         self.about_dialog.show()
+        self.about_dialog.show_section(section)
+        dlg = self.about_dialog  # again once laid out (its first layout moves the text)
+        QtCore.QTimer.singleShot(0, lambda: dlg.show_section(section))
         self.about_dialog.raise_()
         self.about_dialog.activateWindow()
         return self.about_dialog
@@ -255,6 +274,7 @@ class Presenter(QtCore.QObject):
             host = getattr(self.win, "host3d", None)
             if host is not None and host.active:
                 host.draw()
+                QtCore.QTimer.singleShot(0, host.fit_docks)  # the readout's wider text
 
     def _vtk_texts(self):
         """The text actors of the planar view and, once built, of the 3D view."""
@@ -313,22 +333,47 @@ class Presenter(QtCore.QObject):
 
     # --- presentation mode ---------------------------------------------------------------
     def _hide_docks(self) -> None:
+        """Hide the side panels but those the lecture step shown needs (its ``panels``)."""
+        keep = self.win.step_docks()
         for d in self.win.findChildren(QtWidgets.QDockWidget):
-            if d.isVisible():
-                self._hidden_docks.append(d)
+            if d.isVisible() and d.objectName() not in keep:
+                if d not in self._hidden_docks:
+                    self._hidden_docks.append(d)
+                    if not d.visibleRegion().isEmpty():  # the tab on top of its group
+                        self._raised.append(d)
                 d.hide()
 
+    def step_panels(self) -> None:
+        """A lecture step was shown (or left): in presentation mode, its panels shown and
+        the others hidden."""
+        if not self.presenting:
+            return
+        keep = self.win.step_docks()
+        for d in self.page_docks():
+            if d.objectName() in keep and not d.isVisible():
+                d.show()
+                d.raise_()
+                self._step_shown.append(d)
+        self._hide_docks()
+
     def toggle_presentation(self) -> None:
-        """F5: large text, side panels hidden, high contrast; F5 again restores."""
+        """F5: large text, side panels hidden (but those the lecture step shown names),
+        high contrast; F5 again restores them, each tab group with the tab it had on top."""
         self.presenting = not self.presenting
         self.present_action.setChecked(self.presenting)
         if self.presenting:
-            self._hidden_docks = []
+            self._hidden_docks, self._raised, self._step_shown = [], [], []
             self._hide_docks()
+            self.step_panels()
         else:
+            for d in self._step_shown:
+                if d not in self._hidden_docks:
+                    d.hide()  # shown for a step only
             for d in self._hidden_docks:
                 d.show()
-            self._hidden_docks = []
+            for d in self._raised:
+                d.raise_()
+            self._hidden_docks, self._raised, self._step_shown = [], [], []
         self.apply()
         if self.presenting:
             self.win.statusBar().showMessage("F5: leave presentation mode", 6000)

@@ -9,6 +9,10 @@ An edit made while a step is shown changes that step's picture only.
 A spherical scene's steps walk the same way in the 3D view (eyeviz.app.view3d): the
 model walked is the page shown (the 3D page's AppModel3D while it is active, else the
 planar AppModel), and the caption bar sits under that page's view.
+
+Each step frames what it shows (issue 32): its ``camera`` (a preset or an explicit view),
+else the view fitted to the eyes and the step's features; and presentation mode (F5)
+keeps the side panels the step names (``panels``) while it hides the others.
 """
 
 from __future__ import annotations
@@ -18,7 +22,7 @@ from typing import TYPE_CHECKING
 
 from PyQt5 import QtCore, QtWidgets
 
-from eyeviz.model.steps import apply_step
+from eyeviz.model.steps import Step, apply_step
 
 if TYPE_CHECKING:
     from eyeviz.app.presenting import Presenter
@@ -30,10 +34,42 @@ if TYPE_CHECKING:
 else:
     _MainWindow = object  # MainWindow brings QMainWindow
 
-__all__ = ["CAPTION_MARGIN", "CAPTION_PT", "StepsMixin"]
+__all__ = ["CAPTION_MARGIN", "CAPTION_PT", "PANEL_DOCKS", "StepsMixin"]
 
 CAPTION_PT = 16  # the caption bar's text at text scale 1
 CAPTION_MARGIN = 6
+#: a step's panel names (eyeviz.model.steps.PANELS) -> the docks' object names, by side
+PANEL_DOCKS: dict[str, dict[str, str]] = {
+    "planar": {
+        "readout": "dock_readout",
+        "features": "dock_features",
+        "eyes": "dock_eyes",
+        "layers": "dock_layers",
+        "estimators": "dock_predictions",
+        "trajectory": "dock_trajectory",
+        "design": "dock_design",
+    },
+    "spherical": {
+        "maps": "dock_bitmaps3d",
+        "readout": "dock_readout3d",
+        "estimators": "dock_estimators3d",
+    },
+}
+
+
+class _WidthWatch(QtCore.QObject):
+    """Refits the caption bar when its width changes (a side panel shown or hidden by a
+    step or by F5 narrows the view: the wrapped caption needs more lines)."""
+
+    def __init__(self, bar: QtWidgets.QLabel, fit) -> None:
+        super().__init__(bar)
+        self._fit = fit
+        bar.installEventFilter(self)
+
+    def eventFilter(self, obj, ev) -> bool:  # noqa: N802 (Qt name)
+        if ev.type() == QtCore.QEvent.Type.Resize and ev.size().width() != ev.oldSize().width():
+            QtCore.QTimer.singleShot(0, self._fit)
+        return False
 
 
 class StepsMixin(_MainWindow):
@@ -62,6 +98,50 @@ class StepsMixin(_MainWindow):
         if host is not None and host.active and host.model is not None:
             return host.model
         return self.model
+
+    def _host3d_shown(self):  # the 3D page when it is shown, else None
+        host = getattr(self, "host3d", None)
+        return host if host is not None and host.active and host.model is not None else None
+
+    def step_docks(self) -> set[str]:
+        """The object names of the docks the step shown needs (empty when not walking)."""
+        if not self.walking or self.step_index < 0:
+            return set()
+        steps = self._steps()
+        if self.step_index >= len(steps):
+            return set()
+        names = steps[self.step_index].panels or []
+        table = PANEL_DOCKS["spherical" if self._host3d_shown() else "planar"]
+        return {table[n] for n in names if n in table}
+
+    def _frame_step(self, step: Step | None) -> None:
+        """The view framing what ``step`` shows (None: the whole scene)."""
+        cam = step.camera if step is not None else None
+        host = self._host3d_shown()
+        if host is not None:
+            if isinstance(cam, dict):
+                from eyeviz.model.camera3d import Camera3D
+
+                host.preset = None  # kept as given across resizes
+                host.set_camera(
+                    Camera3D(
+                        tuple(cam["position"]),
+                        tuple(cam["focal_point"]),
+                        tuple(cam["view_up"]),
+                        cam.get("view_angle", 30.0),
+                    )
+                )
+            else:
+                host.set_preset("default" if cam in (None, "fit") else cam)
+        elif isinstance(cam, dict):
+            from eyeviz.model import interactions
+            from eyeviz.model.scene import View
+
+            cx, cy = cam["center"]
+            interactions.set_view(self.model, "main", View((cx, cy), cam["width"]))
+            self._fitted_view = None  # CanvasMixin's: not fitted, kept as given
+        else:
+            self.fit_view()  # CanvasMixin's
 
     def _steps(self) -> list:
         base = self._steps_base if self._steps_base is not None else self._step_model().scene
@@ -96,6 +176,7 @@ class StepsMixin(_MainWindow):
             bar.setFont(f)
             bar.setProperty("eyeviz_base_pt", float(CAPTION_PT))  # the text scale's base
             bar.setStyleSheet("background: #1a1a1a; color: #ffffff;")
+            _WidthWatch(bar, self.fit_caption)
             split = self.centralWidget()
             if isinstance(split, QtWidgets.QSplitter):
                 split.insertWidget(1, bar)  # under the view, above the bitmaps
@@ -140,6 +221,14 @@ class StepsMixin(_MainWindow):
         self.fit_caption()
         if self.leave_steps_action is not None:
             self.leave_steps_action.setEnabled(True)
+        self._panels_changed()
+        # a resize after this (the caption bar's, the panels') keeps the framing
+        self._frame_step(steps[i])
+
+    def _panels_changed(self) -> None:
+        presenter = getattr(self, "presenter", None)
+        if presenter is not None:
+            presenter.step_panels()
 
     def fit_caption(self) -> None:
         """The caption bar as tall as its wrapped text at the window's width (a splitter
@@ -147,8 +236,7 @@ class StepsMixin(_MainWindow):
         bar = self.caption_bar
         if bar is None or not bar.isVisible():
             return
-        central = self.centralWidget()
-        width = central.width() if central is not None else self.width()
+        width = bar.width()
         inner = max(width - 2 * CAPTION_MARGIN - 8, 50)
         flags = int(QtCore.Qt.TextFlag.TextWordWrap) | int(QtCore.Qt.AlignmentFlag.AlignCenter)
         text = bar.fontMetrics().boundingRect(QtCore.QRect(0, 0, inner, 0), flags, bar.text())
@@ -182,6 +270,9 @@ class StepsMixin(_MainWindow):
             model = self._step_model()
             base.view = model.scene.view
             model.set_scene(base)
+        self._panels_changed()
+        if restore and base is not None:
+            self._frame_step(None)
 
     def save_path(self, path: str | os.PathLike) -> bool:
         """Saving while walking writes the whole scene: the steps are left first."""

@@ -25,6 +25,7 @@ from one list, eyeviz.app.help.VIEW3D_KEYS):
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from collections.abc import Generator
@@ -32,12 +33,12 @@ from typing import TYPE_CHECKING, Any
 
 from PyQt5 import QtCore, QtWidgets
 
-from eyeviz.app.actions import SceneCommand
-from eyeviz.app.help import view3d_help_text
+from eyeviz.app.actions import PLANAR_ONLY, SceneCommand
+from eyeviz.app.help import LAYER3D_TEXT, view3d_help_text
 from eyeviz.app.predictions_layer3d import Predictions3DLayer
 from eyeviz.app.view import make_view
 from eyeviz.model import app_model3d as m3
-from eyeviz.model.camera3d import PRESETS, Camera3D
+from eyeviz.model.camera3d import PRESETS, Camera3D, dolly
 from eyeviz.model.draw_bounds import check_drawable_eyes
 from eyeviz.model.predictions3d import (
     LatestOnly,
@@ -55,6 +56,7 @@ from eyeviz.render.vtk.scene3d import (
     make_renderers,
     split_viewports,
 )
+from eyeviz.render.vtk.side3d import SideNote
 
 if TYPE_CHECKING:
     from eyeviz.app.panels.bitmaps3d import Bitmaps3DPanel
@@ -119,6 +121,8 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self._panel_timer.timeout.connect(self.refresh_panels)
         self.help_box: QtWidgets.QMessageBox | None = None  # 3D view > Mouse and keys
         self.preset: str | None = None  # the preset shown, until the user moves the camera
+        self._framed: m3.SceneState3D | None = None  # the state the preset framed
+        self._back: float | None = None  # and how far fit_labels moved back from it
         self.preset_actions: dict[str, QtWidgets.QAction] = {}
         self.layer_actions: dict[str, QtWidgets.QAction] = {}
         self.menu = self._build_menu()
@@ -143,6 +147,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         eyes_ren = make_renderers(view.ren_win, scene_ren)
         self.view = view
         self.actors = Scene3DActors(scene_ren, eyes_ren)
+        self.side = SideNote(scene_ren)  # "seen from front, ...; eye A on the right"
         # the eyes' camera follows the scene's before every render (VTK's own too)
         view.ren_win.AddObserver(vtkCommand.StartEvent, lambda *_: self._sync_eyes())
         view.installEventFilter(self)
@@ -190,7 +195,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         menu.addAction(help_action)
         menu.addSeparator()
         for layer in SPHERICAL_LAYERS:
-            a = QtWidgets.QAction(f"Show {layer}", self.win)
+            a = QtWidgets.QAction(f"Show {LAYER3D_TEXT.get(layer, layer)}", self.win)
             a.setCheckable(True)
             a.triggered.connect(lambda on, n=layer: self._set_layer(n, on))
             menu.addAction(a)
@@ -292,10 +297,11 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
                 w.show()
             self._hidden = []
         self._menu_action(to3d)
+        self.win.cursor_label.setVisible(not to3d)  # the planar view's x, y: room for the status
         for a in self.preset_actions.values():
             a.setEnabled(to3d)
         for a in self.win.findChildren(QtWidgets.QAction):
-            if a.text().replace("&", "") in _PLANAR_ONLY:
+            if a.text().replace("&", "") in PLANAR_ONLY:
                 a.setEnabled(not to3d)
 
     # --- model -> view -------------------------------------------------------------------
@@ -388,6 +394,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
     def _sync_eyes(self) -> None:
         if self.actors is not None and self.model is not None:
             self.actors.sync_eyes_camera()
+            self.side.update(self.camera())
 
     # --- camera --------------------------------------------------------------------------
     def _layout(self) -> None:
@@ -408,16 +415,24 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self.actors.set_cameras(cam)
         self.draw()
 
-    def set_preset(self, name: str) -> None:
-        """View > 3D view: a camera preset (eyeviz.model.camera3d.preset)."""
+    def set_preset(self, name: str, keep: bool = False) -> None:
+        """View > 3D view: a camera preset (eyeviz.model.camera3d.preset) framing the balls
+        shown now, or (``keep``: a resize) those it framed last (an edit never re-frames)."""
         if self.model is None or name not in PRESETS:
             return
         self.flush()
         self.preset = name
+        if not keep or self._framed is None:
+            self._framed = self.model.state
         vp = self.pointer("move", 0, 0)
-        cam = default_camera(self.model.state, name, vp.w / max(vp.h, 1.0))
-        if self.actors is not None and vp.w > 1 and vp.h > 1:  # the balls' names not cut
+        base = default_camera(self._framed, name, vp.w / max(vp.h, 1.0))
+        cam = base
+        if keep and self._back is not None:  # a resize: as far back as the names needed
+            cam = dolly(base, self._back)
+        elif self.actors is not None and vp.w > 1 and vp.h > 1:  # the balls' names not cut
             cam = fit_labels(cam, self.actors.label_boxes(), (vp.w, vp.h))
+            d0 = math.dist(base.position, base.focal_point)
+            self._back = math.dist(cam.position, cam.focal_point) / d0
         self.set_camera(cam)
 
     # --- pixels ----------------------------------------------------------------------------
@@ -458,6 +473,8 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
             return True
         if t == E.KeyPress:
             return self._key(ev)
+        if t == E.Wheel and self.pointer("move", ev.x(), ev.y()).px < 0:
+            return True  # over the eyes' close-up: it follows the scene camera, not zoomed
         if t == E.Resize:
             QtCore.QTimer.singleShot(0, self._resized)
         return False
@@ -467,7 +484,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
 
     def _resized(self) -> None:
         if self.active and self.preset is not None:
-            self.set_preset(self.preset)
+            self.set_preset(self.preset, keep=True)
         elif self.active and self.actors is not None:
             self._layout()
             self._sync_eyes()
@@ -539,8 +556,6 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         """Edit > Add: a ball at the camera's focal point, 1/40 of its distance wide."""
         assert self.model is not None
         cam = self.camera()
-        import math
-
         d = math.dist(cam.position, cam.focal_point)
         self.model.add_ball(*cam.focal_point, g=max(d / 40.0, 1e-6))
 
@@ -576,14 +591,3 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self._panel_timer.stop()
         if self.view is not None:
             self.view.close()
-
-
-#: the window's actions that act on the planar scene only (disabled in the 3D view)
-_PLANAR_ONLY = frozenset(
-    {
-        "Fit view",
-        "Fit inset to the eyes",
-        "Eye design: limit against distance",
-        "Play / pause trajectory (Space in the view)",
-    }
-)

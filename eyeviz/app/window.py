@@ -197,6 +197,29 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         if isinstance(st, bytes):
             self.restoreState(QtCore.QByteArray(st))
 
+    def showEvent(self, ev) -> None:  # noqa: N802 (Qt name)
+        super().showEvent(ev)
+        if not ev.spontaneous():
+            QtCore.QTimer.singleShot(0, self.fit_screen)
+
+    def fit_screen(self) -> None:
+        """The whole window, its frame too, on the screen's free area: a 1280x720 window on
+        a 1280x720 screen had its status bar below the screen's edge (issue 32)."""
+        if self.isFullScreen() or self.isMaximized():
+            return
+        screen = self.screen() or QtWidgets.QApplication.primaryScreen()
+        if screen is None:
+            return
+        free, frame = screen.availableGeometry(), self.frameGeometry()
+        dw, dh = frame.width() - self.width(), frame.height() - self.height()
+        w, h = min(self.width(), free.width() - dw), min(self.height(), free.height() - dh)
+        if (w, h) != (self.width(), self.height()):
+            self.resize(max(w, 320), max(h, 240))
+        x = min(max(frame.left(), free.left()), free.right() + 1 - (w + dw))
+        y = min(max(frame.top(), free.top()), free.bottom() + 1 - (h + dh))
+        if (x, y) != (frame.left(), frame.top()):
+            self.move(x, y)
+
     def force_close(self) -> None:
         """Close without asking about unsaved changes (--screenshot, tests)."""
         self._force_close = True

@@ -27,6 +27,8 @@ __all__ = [
     "preset",
     "project",
     "to_pixels",
+    "dolly",
+    "view_side",
 ]
 
 Vec3 = tuple[float, float, float]
@@ -203,3 +205,34 @@ def to_pixels(xy_ndc: np.ndarray, width: int, height: int) -> np.ndarray:
     col = (xy[..., 0] + 1.0) * width / 2.0
     row = height - (xy[..., 1] + 1.0) * height / 2.0
     return np.stack([col, row], axis=-1)
+
+
+def view_side(cam: Camera3D) -> str:
+    """Where ``cam`` looks from, in words (the model's axes), and which way round it
+    draws the eyes: "seen from front, right, above; eye A on the right". The facet maps
+    show each eye from inside (eye A's left on the left), so a view from ahead is their
+    mirror image; the 3D view and its figure say so in a corner (issue 32)."""
+    d = np.asarray(cam.position, np.float64) - np.asarray(cam.focal_point, np.float64)
+    d /= np.linalg.norm(d)
+    words = []
+    for v, pos, neg in (
+        (d[1], "front", "behind"),
+        (d[0], "right", "left"),
+        (d[2], "above", "below"),
+    ):
+        if abs(v) > 0.25:
+            words.append(pos if v > 0 else neg)
+    text = "seen from " + (", ".join(words) if words else "the focal point")
+    right, _up, _back = basis(cam)
+    a_right = float(right[0]) < -0.25  # eye A (at -x) drawn right of eye B
+    if a_right or float(right[0]) > 0.25:
+        text += f"; eye A on the {'right' if a_right else 'left'}"
+    return text
+
+
+def dolly(cam: Camera3D, factor: float) -> Camera3D:
+    """``cam`` moved along its line of sight to ``factor`` times its distance from the
+    focal point (same direction, view-up and angle)."""
+    foc = np.asarray(cam.focal_point, np.float64)
+    pos = foc + (np.asarray(cam.position, np.float64) - foc) * check_real("factor", factor, gt=0.0)
+    return Camera3D(tuple(float(c) for c in pos), cam.focal_point, cam.view_up, cam.view_angle)  # type: ignore[arg-type]

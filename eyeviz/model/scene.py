@@ -425,7 +425,8 @@ def _scene_from_doc(doc: dict, text: str, source: str, base: Path | None) -> Sce
             if eyes.side == "spherical"
             else known
         )
-        steps = check_steps(doc["steps"], c.fail, step_layers, sorted(names), _bad_text)
+        side = "spherical" if eyes.side == "spherical" else "planar"
+        steps = check_steps(doc["steps"], c.fail, step_layers, sorted(names), _bad_text, side)
         if not estimators and any("predictions" in st.layers for st in steps):
             raise c.fail("predictions.estimators", "a step shows predictions: name an estimator")
 
@@ -510,6 +511,8 @@ def _value(v) -> str:
     """One TOML value: scalars by tomli_w (its quoting and float repr), arrays on one line."""
     if isinstance(v, list):
         return "[" + ", ".join(_value(x) for x in v) + "]"
+    if isinstance(v, dict):  # an inline table (a step's explicit camera)
+        return "{ " + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + " }"
     return tomli_w.dumps({"v": v})[4:].rstrip("\n")
 
 

@@ -9,6 +9,18 @@ the full scene is what is saved::
     caption = "Two eyes of m ommatidia each (Figure 2)"
     layers = ["eyes", "labels"]
     features = []          # no feature yet (omitted: every feature)
+    camera = "top"         # optional: how the view frames this step (below)
+    panels = ["readout"]   # optional: the side panels the step needs (kept in F5)
+
+A step frames what it shows: without ``camera`` the view is fitted to the eyes and the
+step's features (planar: the Fit view of the app; spherical: the default 3/4 preset
+framing the step's balls). ``camera`` names a spherical preset (``"default"``,
+``"front"``, ``"top"``, ``"side"``, ``"eye_a"``, ``"eye_b"``; ``"fit"`` in both models),
+or gives an explicit view: planar ``{center = [x, y], width = w}``, spherical
+``{position = [..], focal_point = [..], view_up = [..], view_angle = 30}`` (VTK's
+camera, eyeviz.model.camera3d.Camera3D). ``panels`` names the side panels the caption
+talks about (:data:`PANELS`); presentation mode (F5), which hides the side panels, keeps
+these.
 
 Pure functions on the scene's dataclasses; no Qt.
 """
@@ -28,10 +40,34 @@ class _Staged(Protocol):  # eyeviz.model.scene.Scene (not imported: it imports t
 
 S = TypeVar("S", bound=_Staged)
 
-__all__ = ["MAX_STEPS", "STEP_KEYS", "Step", "apply_step", "check_steps", "step_doc"]
+__all__ = [
+    "MAX_STEPS",
+    "PANELS",
+    "STEP_KEYS",
+    "Step",
+    "apply_step",
+    "check_camera",
+    "check_steps",
+    "step_doc",
+]
 
 MAX_STEPS = 100
-STEP_KEYS = ("caption", "layers", "features")
+STEP_KEYS = ("caption", "layers", "features", "camera", "panels")
+#: The side panels a step may name, by the scene's side (the app maps them to its docks).
+PANELS: dict[str, tuple[str, ...]] = {
+    "planar": ("readout", "features", "eyes", "layers", "estimators", "trajectory", "design"),
+    "spherical": ("maps", "readout", "estimators"),
+}
+#: The camera names a step may give, by side (``fit``: the view fitted to the step).
+CAMERA_NAMES: dict[str, tuple[str, ...]] = {
+    "planar": ("fit",),
+    "spherical": ("fit", "default", "front", "top", "side", "eye_a", "eye_b"),
+}
+_CAMERA_TABLE: dict[str, dict[str, int]] = {  # key -> number of values (0: one number)
+    "planar": {"center": 2, "width": 0},
+    "spherical": {"position": 3, "focal_point": 3, "view_up": 3, "view_angle": 0},
+}
+_MAX_COORD = 1e9  # an explicit camera's coordinates are bounded (untrusted files)
 
 
 @dataclass
@@ -41,6 +77,8 @@ class Step:
     caption: str
     layers: list[str] = field(default_factory=list)
     features: list[str] | None = None
+    camera: str | dict[str, Any] | None = None  # None: fitted to what the step shows
+    panels: list[str] | None = None  # the side panels kept in presentation mode
 
 
 def check_steps(
@@ -49,9 +87,11 @@ def check_steps(
     known_layers: Sequence[str],
     feature_names: Sequence[str],
     bad_text: Callable[[str], str | None],
+    side: str = "planar",
 ) -> list[Step]:
-    """The steps of a parsed ``[[steps]]`` array; ``fail(key, rule)`` makes the one-line
-    error (naming the file, line and key, e.g. ``steps[2].layers``) that is raised."""
+    """The steps of a parsed ``[[steps]]`` array of a scene of ``side`` (planar or
+    spherical); ``fail(key, rule)`` makes the one-line error (naming the file, line and
+    key, e.g. ``steps[2].layers``) that is raised."""
     if not isinstance(raw, list):
         raise fail("steps", "must be an array of tables ([[steps]])")
     if len(raw) > MAX_STEPS:
@@ -81,8 +121,51 @@ def check_steps(
             if name not in feature_names:
                 known = ", ".join(repr(n) for n in feature_names) or "none"
                 raise fail(f"{p}.features", f"no feature named {name!r} (features: {known})")
-        steps.append(Step(cap, layers, feats))
+        camera = check_camera(st["camera"], f"{p}.camera", fail, side) if "camera" in st else None
+        panels = _names(st, "panels", p, fail) if "panels" in st else None
+        for name in panels or []:
+            if name not in PANELS[side]:
+                known = ", ".join(PANELS[side])
+                raise fail(f"{p}.panels", f"unknown panel {name!r} (a {side} scene's: {known})")
+        steps.append(Step(cap, layers, feats, camera, panels))
     return steps
+
+
+def check_camera(
+    raw: Any, key: str, fail: Callable[[str, str], Exception], side: str
+) -> str | dict[str, Any]:
+    """A step's ``camera``: a name of :data:`CAMERA_NAMES` or an explicit view table."""
+    if isinstance(raw, str):
+        if raw not in CAMERA_NAMES[side]:
+            raise fail(key, f"unknown camera {raw!r} (known: {', '.join(CAMERA_NAMES[side])})")
+        return raw
+    if not isinstance(raw, dict):
+        raise fail(key, f"must be a name or a table, got {type(raw).__name__}")
+    spec = _CAMERA_TABLE[side]
+    out: dict[str, Any] = {}
+    for k, v in raw.items():
+        if k not in spec:
+            raise fail(f"{key}.{k}", f"unknown key (allowed: {', '.join(spec)})")
+        vals = v if spec[k] else [v]
+        if (
+            not isinstance(vals, list)
+            or len(vals) != max(spec[k], 1)
+            or not all(isinstance(x, int | float) and not isinstance(x, bool) for x in vals)
+            or not all(abs(float(x)) <= _MAX_COORD for x in vals)  # NaN fails too
+        ):
+            n = f"{spec[k]} numbers" if spec[k] else "a number"
+            raise fail(f"{key}.{k}", f"must be {n} of magnitude <= {_MAX_COORD:g}")
+        out[k] = [float(x) for x in vals] if spec[k] else float(v)
+    need = [k for k in spec if k not in ("view_angle",) and k not in out]
+    if need:
+        raise fail(key, f"missing {', '.join(need)}")
+    if "width" in out and out["width"] <= 0:
+        raise fail(f"{key}.width", f"must be > 0, got {out['width']!r}")
+    if "view_angle" in out and not 1.0 <= out["view_angle"] <= 170.0:
+        raise fail(f"{key}.view_angle", f"must be in [1, 170] degrees, got {out['view_angle']!r}")
+    if side == "spherical" and out["position"] == out["focal_point"]:
+        raise fail(key, "position must differ from focal_point")
+    return out
 
 
 def _names(st: dict, key: str, p: str, fail: Callable[[str, str], Exception]) -> list[str]:
@@ -99,6 +182,10 @@ def step_doc(step: Step) -> dict:
     doc: dict = {"caption": step.caption, "layers": list(step.layers)}
     if step.features is not None:
         doc["features"] = list(step.features)
+    if step.camera is not None:
+        doc["camera"] = step.camera if isinstance(step.camera, str) else dict(step.camera)
+    if step.panels is not None:
+        doc["panels"] = list(step.panels)
     return doc
 
 

@@ -40,7 +40,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 from PyQt5 import QtCore, QtWidgets
 
-from eyeviz.app.panels.common import wrap_label
+from eyeviz.app.panels.common import follows_text_scale, text_scale, wrap_label
 from eyeviz.model.facet_patches import FacetPatches, facet_patches, patches_caption
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
@@ -60,6 +60,8 @@ __all__ = ["Bitmaps3DPanel", "lit_owners"]
 EYES = ("A", "B")
 STEP = 2  # outline points per facet edge
 HALO_LW = 2.2  # the selected ball's outline (points; about half of it shows outside)
+MAP_PT = 8.0  # the maps' words (left / forward / right, the equator) at text scale 1
+MAP_TITLE_PT = 9.0  # each map's title at text scale 1
 R2 = math.sqrt(2.0)
 SQ_DEG = (180.0 / math.pi) ** 2
 
@@ -182,6 +184,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self._outlines: dict[str, _Outlines] = {}
         self._over: list = []  # animated artists drawn over the lit facets, in order
         self._hover_coll: PolyCollection | None = None
+        self._texts: list[tuple] = []  # the maps' words (matplotlib Text, size at scale 1)
         self.fig = Figure(figsize=(3.6, 4.2), facecolor="white")
         self.canvas = FigureCanvasQTAgg(self.fig)
         self.canvas.setSizePolicy(QtWidgets.QSizePolicy.Expanding, QtWidgets.QSizePolicy.Expanding)
@@ -207,6 +210,55 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self.canvas.mpl_connect("draw_event", self._on_draw)
         self.canvas.mpl_connect("motion_notify_event", self._on_move)
         self.canvas.mpl_connect("figure_leave_event", self._on_leave)
+        self.canvas.mpl_connect("resize_event", self._place_axes)
+        self._fit_text()
+
+    def _place_axes(self, _event=None) -> None:
+        """Each map below its title and above its words (left / forward / right) at their
+        size now: larger text gives the maps less room, never overlapping words."""
+        # the canvas widget's size now (the figure's own lags behind a resize)
+        px_per_in = self.fig.dpi / max(self.canvas.devicePixelRatioF(), 1.0)
+        h_in = self.canvas.height() / px_per_in
+        if h_in <= 0:
+            return
+        s = text_scale()
+        title = 1.35 * MAP_TITLE_PT * s / 72.0 / h_in  # figure fractions
+        words = 1.35 * MAP_PT * s / 72.0 / h_in
+        pad = 0.01
+        room = max((1.0 - 2.0 * (title + words + 2 * pad)) / 2.0, 0.05)
+        top_b = 1.0 - pad - title - room
+        self.axes["A"].set_position((0.01, top_b, 0.98, room))
+        self.axes["B"].set_position((0.01, top_b - words - 2 * pad - title - room, 0.98, room))
+        # left / forward / right need about 22 characters' width: on a map narrower than
+        # that (large text in a small panel) only "forward" is kept
+        w_in = self.canvas.width() / px_per_in
+        map_in = min(0.98 * w_in, 2.0 * room * h_in)
+        wide = map_in >= 22 * 0.62 * MAP_PT * s / 72.0
+        char_in = 0.62 * MAP_PT * s / 72.0
+        for t, _pt in self._texts:
+            if t.get_text() in ("left", "right"):
+                t.set_visible(wide)
+            elif t.get_text().startswith("equator"):  # only where it fits inside the map
+                fits = len(t.get_text()) * char_in <= 0.95 * map_in
+                t.set_visible(fits and 1.35 * MAP_PT * s / 72.0 <= 0.2 * map_in)
+
+    def changeEvent(self, ev) -> None:  # noqa: N802 (Qt name)
+        """Ctrl+= / Ctrl+- / F5 (the app font changed): the maps' words follow."""
+        super().changeEvent(ev)
+        if follows_text_scale(ev) and hasattr(self, "hover"):
+            self._fit_text()
+
+    def _fit_text(self) -> None:
+        """The maps' words at the text scale; the hover line's two lines kept free, so that
+        the first hover does not push the panels below it down (issue 32)."""
+        s = text_scale()
+        for t, pt in self._texts:
+            t.set_fontsize(pt * s)
+        self._place_axes()
+        fm = self.hover.fontMetrics()
+        self.hover.setMinimumHeight(2 * fm.lineSpacing() + 2 * self.hover.margin() + 4)
+        self._bg = None
+        self.canvas.draw_idle()
 
     # --- state ---------------------------------------------------------------------------
 
@@ -319,6 +371,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self._halo_keys = {}
         self._geom = {}
         self._over = []
+        self._texts = []
         self._bg = None
         ell = _ellipse()
         for eye, ax in self.axes.items():
@@ -347,8 +400,11 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
                 x, y = mollweide(np.full_like(lat, math.radians(deg)), lat)
                 ax.plot(x, y, color="#c8c8c8", lw=0.4)
             ax.plot(ell[:, 0], ell[:, 1], color=GREY, lw=0.6)
-            for tx, t in ((-R2, "left"), (0.0, "forward"), (R2, "right")):
-                ax.text(tx, -R2 * 1.01, t, fontsize=6.5, color=GREY, ha="center", va="top")
+            # left and right flush with the map's ends: apart from "forward" at any text size
+            for tx, t, ha in ((-2 * R2, "left", "left"), (0.0, "forward", "center"),
+                              (2 * R2, "right", "right")):  # fmt: skip
+                word = ax.text(tx, -R2 * 1.01, t, color=GREY, ha=ha, va="top")
+                self._texts.append((word, MAP_PT))
             # the lit facets: outlined when all facets are (as the unlit ones), plain above
             # (a stroke of every facet cost 7 ms a frame at nside 180); those across the
             # map's edge in a collection of their own, clipped to the outline
@@ -373,22 +429,23 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             self._halo[eye] = halo
             (eq,) = ax.plot([-2 * R2, 2 * R2], [0.0, 0.0], color=INK, lw=0.8, animated=True)
             side = _label_side(patches[eye])
-            ax.text(
+            eq_word = ax.text(
                 side * 2 * R2 * 0.97, -0.04,
                 "equator: the plane z = 0" if nside is None
                 else f"equator: the planar eye, m = {4 * nside:,}",
-                fontsize=6.5, color=INK, ha="left" if side < 0 else "right", va="top",
+                color=INK, ha="left" if side < 0 else "right", va="top",
             )  # fmt: skip
-            ax.text(
+            title = ax.text(
                 0.5, 1.0, f"eye {eye} ({'left' if eye == 'A' else 'right'}), seen from inside",
-                transform=ax.transAxes, fontsize=7.5, color=INK, ha="center", va="bottom",
+                transform=ax.transAxes, color=INK, ha="center", va="bottom",
             )  # fmt: skip
+            self._texts += [(eq_word, MAP_PT), (title, MAP_TITLE_PT)]
             self._over += [(ax, halo), (ax, lit[0]), (ax, lit[1]), (ax, eq)]
         self._hover_coll = PolyCollection(
             [], facecolors="none", edgecolors="#000000", linewidths=1.2, animated=True
         )
         self._hover_ax = None
-        self.canvas.draw_idle()
+        self._fit_text()
 
     def _draw_over(self) -> None:
         for _, artist in self._over:

@@ -73,3 +73,21 @@ def estimator_help(name: str) -> str:
         return registry.get(name).help
     except EyevizError:  # an uninstalled or unregistered name: no help, never a crash
         return ""
+
+
+def text_scale() -> float:
+    """The window's text scale now (View > Larger text, presentation mode): the app font's
+    size over its size at scale 1 (eyeviz.app.presenting sets the app font)."""
+    from eyeviz.app.launch import APP_FONT_PT
+
+    app = QtWidgets.QApplication.instance()
+    pt = app.font().pointSizeF() if isinstance(app, QtWidgets.QApplication) else -1.0
+    return pt / APP_FONT_PT if pt > 0 else 1.0
+
+
+def follows_text_scale(ev: QtCore.QEvent | None) -> bool:
+    """Whether ``ev`` may change the text scale (the app's font changed)."""
+    return ev is not None and ev.type() in (
+        QtCore.QEvent.Type.FontChange,
+        QtCore.QEvent.Type.ApplicationFontChange,
+    )

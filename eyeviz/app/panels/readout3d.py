@@ -297,10 +297,12 @@ class Readout3DPanel(QtWidgets.QWidget):
         raise KeyError(name)
 
     def eventFilter(self, obj, ev) -> bool:  # noqa: N802 (Qt name)
-        if ev.type() in (QtCore.QEvent.Type.Resize, QtCore.QEvent.Type.Show) and obj in (
-            self.table,
-            self.pred_table,
-        ):
+        E = QtCore.QEvent.Type
+        if ev.type() in (E.Resize, E.Show, E.FontChange) and obj in (self.table, self.pred_table):
+            if ev.type() == E.FontChange:  # Ctrl+= / F5: rows as tall as the new text
+                side = obj.verticalHeader()
+                if side is not None:
+                    side.setDefaultSectionSize(obj.fontMetrics().height() + 4)
             fit_columns(obj)
         return False
 
