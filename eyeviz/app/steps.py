@@ -28,7 +28,7 @@ if TYPE_CHECKING:
     from eyeviz.app.presenting import Presenter
     from eyeviz.model.app_model import AppModel
     from eyeviz.model.app_model3d import AppModel3D
-    from eyeviz.model.scene import Scene
+    from eyeviz.model.scene import Scene, View
 
     _MainWindow = QtWidgets.QMainWindow
 else:
@@ -79,6 +79,7 @@ class StepsMixin(_MainWindow):
     _steps_base: Scene | None = None  # the whole scene while walking
     _steps_shown: Scene | None = None  # the scene a step put in the model
     step_index = -1
+    _fitted_view: View | None = None  # CanvasMixin's (the main view as the last fit left it)
     caption_bar: QtWidgets.QLabel | None = None
     leave_steps_action: QtWidgets.QAction | None = None  # View > Steps (eyeviz.app.presenting)
     presenter: Presenter  # set by install_presenting
@@ -135,11 +136,11 @@ class StepsMixin(_MainWindow):
                 host.set_preset("default" if cam in (None, "fit") else cam)
         elif isinstance(cam, dict):
             from eyeviz.model import interactions
-            from eyeviz.model.scene import View
+            from eyeviz.model.scene import View as PlanarView
 
             cx, cy = cam["center"]
-            interactions.set_view(self.model, "main", View((cx, cy), cam["width"]))
-            self._fitted_view = None  # CanvasMixin's: not fitted, kept as given
+            interactions.set_view(self.model, "main", PlanarView((cx, cy), cam["width"]))
+            self._fitted_view = None  # not fitted: kept as given across resizes
         else:
             self.fit_view()  # CanvasMixin's
 
