@@ -7,7 +7,7 @@ import subprocess
 import numpy as np
 import pytest
 from PyQt5 import QtCore, QtGui, QtWidgets
-from test_presenting_real_x import _focus, _keys, window_manager  # noqa: F401 (fixture)
+from test_presenting_real_x import _focus, _keys, _scene, window_manager  # noqa: F401
 
 from eyeviz.app.help import SPHERICAL_SECTION
 from eyeviz.app.panels.bitmaps3d import MAP_TITLE_PT
@@ -216,7 +216,7 @@ def test_planar_lecture_steps_frame_the_eyes_and_their_feature(make_window, qtbo
 
 
 def test_a_window_the_screen_size_keeps_its_status_bar_on_screen(make_window, qtbot):
-    win = make_window(load(scene_path("sphere_lecture")), None)
+    win = make_window(_scene(), None)
     screen = win.screen().availableGeometry()
     win.resize(screen.width(), screen.height())
     qtbot.wait(200)
