@@ -104,6 +104,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="multi mode: number of r segments (default: segments of length 5, as the paper)",
     )
     parser.add_argument(
+        "--field",
+        choices=("wedge", "both-eyes"),
+        default=None,
+        help="with --nside: the binocular field a ball lies in: 'wedge' (default; the "
+        "paper's wedge rotated about the baseline, outside both tangent cones) or "
+        "'both-eyes' (in front, touching neither eye, >= 2 facets lit in each); with "
+        "--eye the field is always 'both-eyes'",
+    )
+    parser.add_argument(
         "--unique-bitmaps",
         action="store_true",
         help="keep one element per distinct (Omega_A, Omega_B) pair, as the "
@@ -184,6 +193,10 @@ def _refuse_ignored(args: argparse.Namespace) -> None:
         )
     if args.m is not None and args.nside is not None:
         raise EyevizError("--m is the planar eye's; with --nside the equator has 4*nside facets")
+    if args.field is not None and args.nside is None and args.eye is None:
+        raise EyevizError(
+            f"--field {args.field} needs --nside or --eye (the planar field is the paper's wedge)"
+        )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -276,7 +289,7 @@ def _run3d(args: argparse.Namespace, drawn: bool = False) -> int:
     el_max = DEFAULTS3D["el_max"] if args.el_max is None else args.el_max
     domain = Domain3D(args.h, args.l, args.nside, args.r_min, args.r_max, args.g_max, el_max)
     n = algorithm1_3d.check_n(args.n)
-    algorithm1_3d.make_params3d(domain, args.mode, args.seed, args.segments)
+    algorithm1_3d.make_params3d(domain, args.mode, args.seed, args.segments, args.field)
     limits.check_free_space(args.output, sparse3d.estimated_bytes3d(n, domain))
     d3 = {"h": domain.h, "l": domain.l, "nside": domain.nside, "el_max": domain.el_max}
     d3.update(r_min=domain.r_min, r_max=domain.r_max, g_max=domain.g_max)
@@ -285,8 +298,9 @@ def _run3d(args: argparse.Namespace, drawn: bool = False) -> int:
     _write_sparse(args, n, domain)
     if not args.quiet:
         size = os.path.getsize(args.output) / 1e6
+        field = "" if args.field in (None, "wedge") else f", field {args.field}"
         print(
-            f"wrote {n:,} 3D elements (nside {domain.nside}, {args.mode} pass, seed "
+            f"wrote {n:,} 3D elements (nside {domain.nside}{field}, {args.mode} pass, seed "
             f"{args.seed}) to {args.output} ({size:.1f} MB) in {time.perf_counter() - t0:.2f} s"
         )
     return 0
@@ -307,6 +321,7 @@ def _write_sparse(args: argparse.Namespace, n: int, domain) -> None:
             seed=args.seed,
             segments=args.segments,
             progress=bar.update if bar else None,
+            field=args.field,
         )
     finally:
         if bar is not None:
@@ -342,7 +357,7 @@ def _run_eye(args: argparse.Namespace, drawn: bool) -> int:
         pair, **{k: getattr(args, k) for k in ("r_min", "r_max", "g_max", "el_max")}
     )
     domain = Domain3D.for_eyes(pair, **ranges)
-    algorithm1_3d.make_params3d(domain, args.mode, args.seed, args.segments)
+    algorithm1_3d.make_params3d(domain, args.mode, args.seed, args.segments, args.field)
     limits.check_free_space(args.output, sparse3d.estimated_bytes3d(n, domain))
     if drawn:
         _say_seed(args, drawn, {}, "measured")

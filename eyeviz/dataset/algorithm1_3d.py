@@ -19,6 +19,13 @@ is the cones' part, y >= g only cuts near az = 0 and pi at the top of the band) 
 visible to both eyes (Definition 1 in 3D: at least two facets lit per eye, counted on the
 lit lists written out); rejected elements are drawn again until every slot is filled.
 
+``field="both-eyes"`` (:data:`FIELDS`; HEALPix eyes) replaces the wedge by what both eyes
+see: the azimuth is uniform in front, [0, pi], and a ball is kept when it touches neither
+eye, neither eye hides its centre from the other (the lit sets do not model occlusion),
+and it lights at least two facets of each eye. The wedge stays the default: it reduces to
+the paper's field at z = 0. It is not "seen by both eyes": balls above and below the
+plane can light facets of both eyes outside it (docs/spherical.md, "Which field").
+
 ``mode="multi"``: uniform density over the field's volume. The range of r is cut into
 segments (of length :data:`SEGMENT_WIDTH`, as the planar multi-pass) whose counts are
 proportional to their volume, b^3 - a^3, apportioned exactly to n; within a segment r has
@@ -61,6 +68,7 @@ from eyeviz.files import limits
 
 __all__ = [
     "CHUNK3D",
+    "FIELDS",
     "LIT_BUDGET",
     "MODES",
     "Gen3DParams",
@@ -72,6 +80,12 @@ __all__ = [
 ]
 
 MODES = ("single", "multi")
+#: The binocular field a ball must lie in (docs/spherical.md, "Which field"): ``wedge``,
+#: the paper's wedge rotated about the baseline (outside both tangent cones from the
+#: origin, in front: ``EyePair3D.in_bfv``; the HEALPix default, the paper at z = 0), or
+#: ``both-eyes``: in front, touching neither eye, at least two facets lit in each (the
+#: only field of a measured pair, whose eyes have no cones).
+FIELDS = ("wedge", "both-eyes")
 #: Most elements in one generated chunk.
 CHUNK3D = 4096
 #: Most lit indices per eye a chunk may hold (at the largest ball the domain allows).
@@ -89,10 +103,20 @@ class Gen3DParams:
     mode: str = "single"
     seed: int = 0
     segments: int | None = None  # multi only; default: segments of length SEGMENT_WIDTH
+    field: str = "wedge"  # FIELDS; a measured pair's is always "both-eyes"
 
     def as_dict(self) -> dict:
-        return {**self.domain.to_dict(), "mode": self.mode, "seed": self.seed,
-                "segments": self.segments}  # fmt: skip
+        """The parameters a data set records (``field`` only where it is not the default
+        of its eyes: files of the default field keep their bytes)."""
+        d = {**self.domain.to_dict(), "mode": self.mode, "seed": self.seed,
+             "segments": self.segments}  # fmt: skip
+        if self.field != _default_field(self.domain):
+            d["field"] = self.field
+        return d
+
+
+def _default_field(domain: Domain3D) -> str:
+    return "both-eyes" if domain.kind == "measured" else "wedge"
 
 
 def make_params3d(
@@ -100,8 +124,12 @@ def make_params3d(
     mode: str = "single",
     seed: int = 0,
     segments: int | None = None,
+    field: str | None = None,
 ) -> Gen3DParams:
     """Check every parameter at the boundary (one-line :class:`EyevizError` naming it).
+
+    ``field`` (:data:`FIELDS`; None: the eyes' default, ``wedge`` for HEALPix eyes and
+    ``both-eyes`` for a measured pair, which has no wedge).
 
     Besides the domain's own checks, refuse ranges where no ball can be both in the field
     and visible: steps 8-9 need r sin(gamma/2) <= g_max for some r >= r_min, and a ball
@@ -112,6 +140,13 @@ def make_params3d(
     if not isinstance(domain, Domain3D):
         raise EyevizError(f"domain must be a Domain3D, got {type(domain).__name__}")
     check_choice("mode", mode, MODES)
+    field = _default_field(domain) if field is None else field
+    check_choice("field", field, FIELDS)
+    if domain.kind == "measured" and field != "both-eyes":
+        raise EyevizError(
+            "field 'wedge' is the HEALPix eyes' (their tangent cones); a measured pair's "
+            "binocular field is 'both-eyes'"
+        )
     seed = check_int("seed", seed, ge=0)
     check_r_min(domain.r_min, domain.h)
     s = math.sin(domain.gamma / 2)
@@ -120,7 +155,7 @@ def make_params3d(
             f"no feature can be visible: g_max={num(domain.g_max)} <= r_min*sin(gamma/2)="
             f"{domain.r_min * s:.6g} (Algorithm 1 step 9 rejects every r >= r_min)"
         )
-    if domain.kind == "measured":
+    if domain.kind == "measured" or field == "both-eyes":
         pass  # no cones: the exact field test decides (module docstring)
     elif domain.gamma / 2 + domain.psi >= math.pi / 2:
         raise EyevizError(
@@ -129,7 +164,7 @@ def make_params3d(
         )
     if segments is not None:
         segments = check_segments(segments)
-    return Gen3DParams(domain, mode, int(seed), segments)
+    return Gen3DParams(domain, mode, int(seed), segments, field)
 
 
 def check_n(n) -> int:
@@ -212,7 +247,8 @@ class _Sampler3D:
         self.rng = rng
         self.sin_half = math.sin(d.gamma / 2)
         self.measured = d.kind == "measured"
-        self.psi = 0.0 if self.measured else d.psi
+        self.free = p.field == "both-eyes"  # no cones bound the azimuth
+        self.psi = 0.0 if self.free else d.psi
         self.origin = np.asarray(d.origin) if self.measured else None
         self.multi = p.mode == "multi"
         self.dtype = index_dtype(max(d.facet_counts))
@@ -230,7 +266,7 @@ class _Sampler3D:
         ok = g_min <= d.g_max  # step 9
         g = g_min + (d.g_max - g_min) * u[1]  # step 10
         ok &= g <= r  # step 11
-        if self.measured:  # no cones: azimuth uniform in front, the field test decides
+        if self.free:  # no cones: azimuth uniform in front, the field test decides
             cone = np.zeros_like(r)
         else:
             a = np.arcsin(np.minimum(g / r, 1.0))
@@ -246,6 +282,17 @@ class _Sampler3D:
             az0 = np.arccos(np.minimum(np.cos(cone) / c_el, 1.0))  # step 12's range
         az = az0 + (math.pi - 2 * az0) * u[3]
         return r, az, el, g, ok
+
+    def _in_field(self, x, y, z, g) -> np.ndarray:
+        """The field test before the facet counts: the wedge (``in_bfv``), a measured
+        pair's own ``in_bfv``, or for HEALPix eyes' ``both-eyes`` touching neither eye
+        (the >= 2 facets per eye are counted on the lit lists, as for every field)."""
+        if self.measured or not self.free:
+            return np.asarray(self.eyes.in_bfv(x, y, z, g), bool)
+        touch_a, touch_b = self.eyes.overlaps_eye(x, y, z, g)
+        ok = ~(np.asarray(touch_a, bool) | np.asarray(touch_b, bool))
+        h, l_ = float(self.d.h), float(self.d.l)
+        return ok & _sight_clear(x, y, z, -h, h, l_) & _sight_clear(x, y, z, h, -h, l_)
 
     def fill(self, n: int, lo, hi) -> Dataset3D:
         """n accepted elements; slot i draws r in [lo_i, hi_i] (scalars: every slot)."""
@@ -267,7 +314,7 @@ class _Sampler3D:
                 x, y, z = spherical_to_xyz(r[idx], az[idx], el[idx])
                 if self.origin is not None:
                     x, y, z = x + self.origin[0], y + self.origin[1], z + self.origin[2]
-                inb = np.flatnonzero(self.eyes.in_bfv(x, y, z, g[idx]))
+                inb = np.flatnonzero(self._in_field(x, y, z, g[idx]))
                 idx, x, y, z = idx[inb], x[inb], y[inb], z[inb]
             if idx.size:
                 (pa, ia), (pb, ib) = self.eyes.lit_csr(x, y, z, g[idx])
@@ -305,6 +352,18 @@ class _Sampler3D:
         return Dataset3D(pa, ia, pb, ib, r, az, el, g, x, y, z, self.d, self.p.as_dict())
 
 
+def _sight_clear(x, y, z, from_x: float, other_x: float, l_: float) -> np.ndarray:
+    """The segment from the eye centre (from_x, 0, 0) to the ball centre (x, y, z) passes
+    farther than l from the other eye's centre (other_x, 0, 0): the other eye does not
+    hide the ball's centre (the lit sets do not model occlusion; the field does)."""
+    dx = np.asarray(x, float) - from_x
+    y_, z_ = np.asarray(y, float), np.asarray(z, float)
+    n2 = dx * dx + y_ * y_ + z_ * z_
+    t = np.clip((other_x - from_x) * dx / n2, 0.0, 1.0)
+    ex = from_x + t * dx - other_x
+    return ex * ex + (t * y_) ** 2 + (t * z_) ** 2 > l_ * l_
+
+
 def _concat_csr(parts: list) -> tuple[np.ndarray, np.ndarray]:
     if len(parts) == 1:
         return parts[0]
@@ -336,9 +395,10 @@ def generate3d(
     mode: str = "single",
     seed: int = 0,
     segments: int | None = None,
+    field: str | None = None,
 ) -> Dataset3D:
     """n elements of Algorithm 1 in 3D, in memory (:func:`eyeviz.dataset.sparse3d.write3d`
     streams them to a file instead)."""
     n = check_n(n)
-    p = make_params3d(domain, mode, seed, segments)
+    p = make_params3d(domain, mode, seed, segments, field)
     return Dataset3D.concat(list(iter_chunks3d(n, p)))

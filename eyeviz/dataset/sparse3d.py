@@ -234,13 +234,14 @@ def write3d(
     seed: int = 0,
     segments: int | None = None,
     progress: Callable[[int], None] | None = None,
+    field: str | None = None,
 ) -> None:
     """Generate n elements of Algorithm 1 in 3D straight into ``path`` (.npz), streamed
     and atomic. Every parameter is checked before the file is touched; ``progress(k)`` is
-    called after each chunk of k elements."""
+    called after each chunk of k elements; ``field``: see :func:`make_params3d`."""
     check_output_path(path)
     n = check_n(n)
-    p = make_params3d(domain, mode, seed, segments)
+    p = make_params3d(domain, mode, seed, segments, field)
     write_chunks3d(path, n, p.domain, p.as_dict(), iter_chunks3d(n, p), progress)
 
 
