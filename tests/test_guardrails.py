@@ -82,3 +82,63 @@ def test_the_check_finds_a_long_function_and_reads_its_reason(tmp_path):
         "explained": (86, "one table of cases, read top to bottom"),
         "empty_reason": (86, None),
     }
+
+
+#: Files where 720 (or the pair 40, 20) is another quantity than the paper's design.
+PAPER_NUMBER_ELSEWHERE = {
+    "eyeviz/app/window.py": "the window's first size, 1280 x 720 pixels",
+    "eyeviz/estimators/paper/nets.py": "the first dense layer's 720 units (Appendix A/B)",
+    "eyeviz/reference/legacy_fastpath.py": "a frozen copy of the old fast path, kept verbatim",
+}
+
+
+def paper_numbers(root: Path = PACKAGE) -> list[str]:
+    """``path:line`` of every 720 and every ``40, 20`` pair in code (not in strings or
+    comments) outside ``core/paper.py``."""
+    import io
+    import tokenize
+
+    skip = {tokenize.NL, tokenize.COMMENT, tokenize.NEWLINE, tokenize.INDENT, tokenize.DEDENT}
+    out = []
+    for path in sorted(root.rglob("*.py")):
+        rel = str(path.relative_to(root.parent))
+        if rel == "eyeviz/core/paper.py":
+            continue
+        toks = [
+            t
+            for t in tokenize.generate_tokens(io.StringIO(path.read_text()).readline)
+            if t.type not in skip
+        ]
+        nums = {
+            k: float(t.string.replace("_", ""))
+            for k, t in enumerate(toks)
+            if t.type == tokenize.NUMBER
+            and t.string[:2].lower() not in ("0x", "0o", "0b")
+            and not t.string.endswith(("j", "J"))
+        }
+        for k, v in nums.items():
+            pair = v == 40 and toks[k + 1].string == "," and nums.get(k + 2) == 20
+            if v == 720 or pair:
+                out.append(f"{rel}:{toks[k].start[0]}")
+    return out
+
+
+def test_the_papers_numbers_are_written_in_core_paper_only():
+    found = paper_numbers()
+    stray = [w for w in found if w.split(":")[0] not in PAPER_NUMBER_ELSEWHERE]
+    assert not stray, "the paper's numbers written outside eyeviz/core/paper.py: " + str(stray)
+    # the check sees them: each allowed file still holds its other 720
+    assert {w.split(":")[0] for w in found} == set(PAPER_NUMBER_ELSEWHERE)
+
+
+def test_the_paper_number_check_finds_the_design_in_code_only(tmp_path):
+    pkg = tmp_path / "eyeviz"
+    (pkg / "core").mkdir(parents=True)
+    (pkg / "core" / "paper.py").write_text("H, L, M = 40.0, 20.0, 720\n")
+    (pkg / "a.py").write_text(
+        '"""m = 720, h = 40, l = 20"""\n'  # prose: fine
+        "x = 720  # a stray m\n"
+        "y = f(40.0, 20.0, 8)\n"
+        "z = (40, 21)  # another pair\n"
+    )
+    assert paper_numbers(pkg) == ["eyeviz/a.py:2", "eyeviz/a.py:3"]

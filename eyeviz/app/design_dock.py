@@ -28,6 +28,7 @@ from PyQt5 import QtCore, QtWidgets
 from eyeviz.app.docks import follows_text_scale, text_scale
 from eyeviz.app.jobs import Job
 from eyeviz.app.panels import set_message, wrap_label
+from eyeviz.core import paper
 from eyeviz.model.app_model import AppModel
 
 __all__ = ["DesignPanel", "compute_curve", "N_CURVE", "PAPER_EYES"]
@@ -37,7 +38,7 @@ DEBOUNCE_MS = 250  # quiet time after the last change of h, l or m before comput
 MARKER_MS = 40  # the feature's marker is redrawn at most this often during a drag
 CACHE = 16  # curves kept (undo / redo of an eye change shows them at once)
 PLOT_PT = 10  # the smallest text of the plot (as the trajectory dock)
-PAPER_EYES = (40.0, 20.0, 720)
+PAPER_EYES = (paper.H, paper.L, paper.M)
 CURRENT = "#0072B2"  # Okabe-Ito blue
 PAPER = "#262626"
 STALE = "#B8B8B8"

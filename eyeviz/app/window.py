@@ -41,6 +41,7 @@ from eyeviz.app.side_docks import SideDocksMixin
 from eyeviz.app.steps import StepsMixin
 from eyeviz.app.view import VtkView, fast_renderer
 from eyeviz.app.view3d import Scene3DHost
+from eyeviz.core import paper
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.camera import eye_overlaps
 from eyeviz.model.scene import Eyes, Scene
@@ -83,7 +84,9 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self.settings = settings if settings is not None else make_settings()
         self._set_path(path)
         # a spherical scene opens in the 3D page; the planar page keeps a planar scene
-        planar = scene if scene.kind == "planar" else Scene(Eyes(scene.eyes.h, scene.eyes.l, 720))
+        planar = (
+            scene if scene.kind == "planar" else Scene(Eyes(scene.eyes.h, scene.eyes.l, paper.M))
+        )
         self.model = AppModel(planar)
         self.undo_stack = QtWidgets.QUndoStack(self)
         self.model.push = self._push

@@ -81,12 +81,13 @@ def _export(args) -> int:
     else:
         if args.units is not None or args.frame is not None:
             raise EyevizError("--units and --frame describe an input FILE; use --to-units")
+        from eyeviz.core import paper
         from eyeviz.core.geometry import EyePair
         from eyeviz.core.geometry3d import EyePair3D
         from eyeviz.core.measured_from import as_measured
 
-        h = 40.0 if args.h is None else args.h
-        l = 20.0 if args.l is None else args.l  # noqa: E741  (the model's name)
+        h = paper.H if args.h is None else args.h
+        l = paper.L if args.l is None else args.l  # noqa: E741  (the model's name)
         if args.nside is not None:
             pair = as_measured(EyePair3D(h, l, args.nside))
         else:

@@ -1,7 +1,7 @@
 """The one parameter record: the eye design (Table 3) and the object ranges (Table 4).
 
-The paper's defaults are written here and nowhere else: h = 40, l = 20, m = 720
-(Table 3), r in [1000, 5000], g up to g_max = 500 (Table 4, Algorithm 1). The estimators
+The paper's defaults (h = 40, l = 20, m = 720 of Table 3; r in [1000, 5000], g up to
+g_max = 500 of Table 4 and Algorithm 1) come from :mod:`eyeviz.core.paper`. The estimators
 (:attr:`Estimator.domain`), the data set generator (:class:`eyeviz.dataset.GenParams`) and
 the CLI flags (``--h --l --m --r-min --r-max --g-max``) all read :data:`DEFAULTS`.
 """
@@ -12,19 +12,20 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from eyeviz import EyevizError
+from eyeviz.core import paper
 from eyeviz.core.geometry import EyePair
 from eyeviz.core.validation import check_real
 
 __all__ = ["DEFAULTS", "Domain", "PAPER_DOMAIN", "FIELDS"]
 
-#: Tables 3 and 4 of the paper; the only place these numbers are written.
+#: Tables 3 and 4 of the paper (eyeviz.core.paper).
 DEFAULTS: dict[str, float | int] = {
-    "h": 40.0,
-    "l": 20.0,
-    "m": 720,
-    "r_min": 1000.0,
-    "r_max": 5000.0,
-    "g_max": 500.0,
+    "h": paper.H,
+    "l": paper.L,
+    "m": paper.M,
+    "r_min": paper.R_MIN,
+    "r_max": paper.R_MAX,
+    "g_max": paper.G_MAX,
 }
 FIELDS = tuple(DEFAULTS)
 

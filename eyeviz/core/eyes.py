@@ -34,6 +34,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from eyeviz import EyevizError
+from eyeviz.core import paper
 
 __all__ = ["EyeModel", "KINDS", "design_kind", "eyes_from_design"]
 
@@ -116,7 +117,7 @@ def eyes_from_design(design: Mapping[str, Any]) -> EyeModel:
             "a measured design names its eyes by fingerprint only: load the pair from its "
             "eye file (eyeviz.measured.load_eyes) or from a data set that embeds it"
         )
-    h, l = design.get("h", 40.0), design.get("l", 20.0)
+    h, l = design.get("h", paper.H), design.get("l", paper.L)
     if kind == "planar":
         from eyeviz.core.geometry import EyePair
 

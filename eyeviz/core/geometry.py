@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from eyeviz.core import bits, exact
+from eyeviz.core import bits, exact, paper
 from eyeviz.core.bounds import check_m
 
 __all__ = ["EyePair", "intervals_to_bitmap", "validate_features", "validate_points"]
@@ -140,9 +140,9 @@ class EyePair:
     m : ommatidia per eye, an even integer in [4, MAX_M] (Eq. 6, 7; eyeviz.core.bounds).
     """
 
-    h: float = 40.0
-    l: float = 20.0
-    m: int = 720
+    h: float = paper.H
+    l: float = paper.L
+    m: int = paper.M
     _k: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:

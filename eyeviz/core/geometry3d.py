@@ -29,7 +29,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from eyeviz.core import exact3d, healpix, kernels, tiny_caps
+from eyeviz.core import exact3d, healpix, kernels, paper, tiny_caps
 from eyeviz.core.bounds import MAX_NSIDE, check_nside
 from eyeviz.core.geometry import _first_index, check_h_l, eye_x
 from eyeviz.core.healpix_fast import (
@@ -218,9 +218,9 @@ class EyePair3D(LitSetViews):
         eye, m = 4 nside of them on the equator (the planar eye EyePair(h, l, 4 nside)).
     """
 
-    h: float = 40.0
-    l: float = 20.0
-    nside: int = 180
+    h: float = paper.H
+    l: float = paper.L
+    nside: int = paper.NSIDE
 
     def __post_init__(self) -> None:
         h, l = check_h_l(self.h, self.l)

@@ -24,6 +24,7 @@ from typing import NamedTuple
 import numpy as np
 
 from eyeviz import EyevizError
+from eyeviz.core import paper
 from eyeviz.core.bounds import MAX_M, check_m
 from eyeviz.core.geometry import EyePair
 from eyeviz.core.validation import check_int, num
@@ -142,8 +143,8 @@ class BlockReader:
             params = meta.get("params", {})
             if not isinstance(params, dict):
                 raise TypeError("params is not an object")
-            h = float(params.get("h", 40.0))
-            l_ = float(params.get("l", 20.0))
+            h = float(params.get("h", paper.H))
+            l_ = float(params.get("l", paper.L))
             file_eyes = EyePair(h, l_, m)
         except EyevizError as exc:
             raise self._npz_fail(str(exc)) from None
@@ -246,7 +247,7 @@ class BlockReader:
         m = ncols - (3 if self.with_g else 2)
         if m < 4:
             raise _csv_error(self.path, 1, ncols, f"too few columns ({ncols}) for a data set row")
-        file_eyes = EyePair(40.0, 20.0, m)
+        file_eyes = EyePair(paper.H, paper.L, m)
         if eyes is not None and eyes.m != m:
             raise _csv_error(
                 self.path, 1, ncols, f"{ncols} columns mean m={m}, but eyes have m={eyes.m}"

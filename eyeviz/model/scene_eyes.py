@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from eyeviz import EyevizError
+from eyeviz.core import paper
 from eyeviz.core.bounds import check_m, check_nside
 from eyeviz.core.eyes import EyeModel, design_kind, eyes_from_design
 from eyeviz.core.geometry import EyePair
@@ -84,9 +85,9 @@ class Eyes:
     h and l then the pair's own: half the distance of its eyes' centroids, the largest
     lens distance from its centroid)."""
 
-    h: float = 40.0
-    l: float = 20.0
-    m: int = 720
+    h: float = paper.H
+    l: float = paper.L
+    m: int = paper.M
     nside: int | None = None  # set: spherical eyes, and m is the equator's 4 nside
     file: Path | None = None  # set: measured eyes from this eye file
     units: str | None = None
@@ -176,8 +177,8 @@ def eyes_from_table(c, eyes_t: dict, base: Path | None) -> Eyes:
     c.keys(eyes_t, "eyes.", ("h", "l", "m", "nside", "file", "units"))
     if "units" in eyes_t:
         raise c.fail("eyes.units", "units are those of an eye file (give [eyes] file)")
-    h = c.number(eyes_t, "h", "eyes.", default=40.0)
-    l = c.number(eyes_t, "l", "eyes.", default=20.0)
+    h = c.number(eyes_t, "h", "eyes.", default=paper.H)
+    l = c.number(eyes_t, "l", "eyes.", default=paper.L)
     # no m and no nside: the planar default (m = 720), as before spherical scenes
     kind = "planar"
     if "m" in eyes_t or "nside" in eyes_t:
@@ -197,7 +198,7 @@ def eyes_from_table(c, eyes_t: dict, base: Path | None) -> Eyes:
             raise c.fail(f"eyes.{first if first in ('h', 'l') else 'h'}", str(exc)) from None
         return Eyes(h, l, nside=nside)
     try:
-        m = check_m(eyes_t.get("m", 720))
+        m = check_m(eyes_t.get("m", paper.M))
     except EyevizError as exc:
         raise c.fail("eyes.m", str(exc)) from None
     try:

@@ -13,9 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from eyeviz.core import paper
 from eyeviz.core.geometry import EyePair
 
-PAPER = EyePair(40.0, 20.0, 720)
+PAPER = EyePair(paper.H, paper.L, paper.M)
 
 
 def _decimal(v: np.ndarray, rng: np.random.Generator, most: int) -> np.ndarray:
@@ -130,7 +131,7 @@ def extreme_scales(n: int, rng: np.random.Generator, eyes: EyePair = PAPER) -> C
 
 def huge_m(n: int, rng: np.random.Generator) -> CaseSet:
     """m = 2^20 ommatidia: paper-regime features and discs resting on y = 0."""
-    eyes = EyePair(40.0, 20.0, 2**20)
+    eyes = EyePair(paper.H, paper.L, 2**20)
     a = paper_regime(n - n // 2, rng, eyes)
     b = resting_on_ground(n // 2, rng, eyes)
     return CaseSet(
@@ -146,7 +147,7 @@ def huge_m(n: int, rng: np.random.Generator) -> CaseSet:
 def nearly_closed_bfv(n: int, rng: np.random.Generator) -> CaseSet:
     """l -> h: l = h (1 - 2^-k), features inside the thin BFV."""
     k = int(rng.integers(10, 40))
-    eyes = EyePair(40.0, 40.0 * (1 - 2.0**-k), 720)
+    eyes = EyePair(paper.H, paper.H * (1 - 2.0**-k), paper.M)
     r = rng.uniform(1000, 5000, n)
     half = eyes.theta / 2
     g = r * np.sin(half) * rng.uniform(0.05, 0.95, n)

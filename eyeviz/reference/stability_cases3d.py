@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from eyeviz.core import paper
 from eyeviz.core.geometry import EyePair
 from eyeviz.core.geometry3d import EyePair3D
 from eyeviz.reference import stability_cases as planar
@@ -38,7 +39,7 @@ class CaseSet3D:
 def paper_regime(n: int, rng: np.random.Generator) -> CaseSet3D:
     """Algorithm 1 in 3D (r in [1000, 5000], g in [r sin(gamma/2), 500], elevation within
     +-30 degrees), at nside 16 (m = 64)."""
-    eyes = EyePair3D(40.0, 20.0, 16)
+    eyes = EyePair3D(paper.H, paper.L, 16)
     r = rng.uniform(1000, 5000, n)
     g = rng.uniform(r * math.sin(math.pi / (4 * 16)), 500.0)
     el = rng.uniform(-math.pi / 6, math.pi / 6, n)
@@ -50,7 +51,7 @@ def paper_regime(n: int, rng: np.random.Generator) -> CaseSet3D:
 def resting_on_plane(n: int, rng: np.random.Generator) -> CaseSet3D:
     """Centres on z = 0: caps symmetric about the equator, so every equatorial facet's
     N-S diagonal is cut at its middle (nside 8)."""
-    eyes = EyePair3D(40.0, 20.0, 8)
+    eyes = EyePair3D(paper.H, paper.L, 8)
     r = 10 ** rng.uniform(1.8, 3.5, n)
     az = rng.uniform(0, 2 * math.pi, n)
     g = r * rng.uniform(0.02, 0.6, n)
@@ -62,8 +63,8 @@ def equator_ties(n: int, rng: np.random.Generator) -> CaseSet3D:
     """The planar tie classes lifted to z = 0: discs resting on y = 0 and touching an eye's
     vertical line, whose tangents fall exactly on longitude k gamma: the cap's rim passes
     exactly through an equatorial vertex of the HEALPix grid (nside 8, m = 32)."""
-    eyes = EyePair3D(40.0, 20.0, 8)
-    flat = EyePair(40.0, 20.0, 32)
+    eyes = EyePair3D(paper.H, paper.L, 8)
+    flat = EyePair(paper.H, paper.L, 32)
     a = planar.resting_on_ground(n - n // 2, rng, flat)
     b = planar.touching_vertical(n // 2, rng, flat)
     x, y, g = (np.concatenate([getattr(a, k), getattr(b, k)]) for k in "xyg")
@@ -81,8 +82,8 @@ def equator_ties(n: int, rng: np.random.Generator) -> CaseSet3D:
 def poles(n: int, rng: np.random.Generator) -> CaseSet3D:
     """Centres straight above or below an eye centre (the cap centred on a pole, where
     longitude is undefined), and a hair beside it (nside 8)."""
-    eyes = EyePair3D(40.0, 20.0, 8)
-    cx = np.where(rng.random(n) < 0.5, -40.0, 40.0)
+    eyes = EyePair3D(paper.H, paper.L, 8)
+    cx = np.where(rng.random(n) < 0.5, -paper.H, paper.H)
     off = np.where(rng.random(n) < 0.5, 0.0, 2.0 ** -rng.integers(20, 60, n).astype(float))
     z = np.where(rng.random(n) < 0.5, 1.0, -1.0) * 10 ** rng.uniform(1.5, 3.5, n)
     g = np.abs(z) * rng.uniform(0.01, 0.9, n)
@@ -101,8 +102,8 @@ def base_vertices(n: int, rng: np.random.Generator) -> CaseSet3D:
     """Caps centred exactly on a vertex of the 12 base cells on the equator (longitude
     pi/4 + k pi/2, where four base cells meet), nside 4 and 8."""
     nside = int(rng.choice([4, 8]))
-    eyes = EyePair3D(40.0, 20.0, nside)
-    cx = np.where(rng.random(n) < 0.5, -40.0, 40.0)
+    eyes = EyePair3D(paper.H, paper.L, nside)
+    cx = np.where(rng.random(n) < 0.5, -paper.H, paper.H)
     t = np.round(10 ** rng.uniform(1, 3, n), 2)
     sx = np.where(rng.random(n) < 0.5, -1.0, 1.0)
     sy = np.where(rng.random(n) < 0.5, -1.0, 1.0)
@@ -121,8 +122,8 @@ def base_vertices(n: int, rng: np.random.Generator) -> CaseSet3D:
 def grazing(n: int, rng: np.random.Generator) -> CaseSet3D:
     """g / |d| = 1 - 2^-k, k = 1..50: the eye centre almost on the ball's surface (the cap
     almost a hemisphere), nside 8."""
-    eyes = EyePair3D(40.0, 20.0, 8)
-    cx = np.where(rng.random(n) < 0.5, -40.0, 40.0)
+    eyes = EyePair3D(paper.H, paper.L, 8)
+    cx = np.where(rng.random(n) < 0.5, -paper.H, paper.H)
     d = 10 ** rng.uniform(-1, 3, n)
     v = rng.normal(size=(3, n))
     v /= np.linalg.norm(v, axis=0)
@@ -134,7 +135,7 @@ def grazing(n: int, rng: np.random.Generator) -> CaseSet3D:
 
 def extreme_scales(n: int, rng: np.random.Generator) -> CaseSet3D:
     """Distances up to 1e15 and radii down to 1e-6 (nside 8)."""
-    eyes = EyePair3D(40.0, 20.0, 8)
+    eyes = EyePair3D(paper.H, paper.L, 8)
     r = 10 ** rng.uniform(2, 15, n)
     v = rng.normal(size=(3, n))
     v /= np.linalg.norm(v, axis=0)

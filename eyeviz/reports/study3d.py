@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from eyeviz import EyevizError
+from eyeviz.core import paper
 from eyeviz.reports.study_design import MIN_COUNT
 from eyeviz.reports.study_law import LawFit, LawPoint, fit_law
 from eyeviz.study.table3d import iter_rows3d
@@ -51,7 +52,7 @@ __all__ = [
 ]
 
 #: The paper's eyes in 3D: h = 40, l = 20 and nside 180 (m = 720 on the equator).
-PAPER3D = (40.0, 20.0, 180)
+PAPER3D = (paper.H, paper.L, paper.NSIDE)
 #: Names of the accuracy limit (the posterior) in the estimator registry.
 LIMITS = ("limit3d", "limit")
 #: Largest fraction of flagged answers in a fitted bin.

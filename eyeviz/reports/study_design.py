@@ -10,9 +10,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from eyeviz import EyevizError
+from eyeviz.core import paper
 from eyeviz.reports.study_table import Row
 
-PAPER = (40.0, 20.0, 720)  # the paper's eyes (Table 3)
+PAPER = (paper.H, paper.L, paper.M)  # the paper's eyes (Table 3)
 MIN_COUNT = 30  # fewest test elements in a bin for it to be drawn / fitted
 
 

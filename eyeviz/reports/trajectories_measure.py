@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from eyeviz.core import paper
 from eyeviz.reports.common import try_load
 
 G_VALUES = (5.0, 50.0, 500.0)
@@ -96,7 +97,7 @@ def measure(
     """Accuracy per (kind, g, r, estimator); also {name: reason} of unavailable estimators."""
     from eyeviz.core.geometry import EyePair, intervals_to_bitmap
 
-    eyes = EyePair(40.0, 20.0, 720)
+    eyes = EyePair(paper.H, paper.L, paper.M)
     loaded, missing = {}, {}
     for name in names:
         if name == "limit":
@@ -115,8 +116,8 @@ def measure(
         for g in g_values:
             for r, x, y in trajectory_points(kind, g, lo, hi):
                 LA, RA, LB, RB = eyes.intervals(x, y, g)
-                oa = intervals_to_bitmap(LA, RA, 720, 360)
-                ob = intervals_to_bitmap(LB, RB, 720, 360)
+                oa = intervals_to_bitmap(LA, RA, paper.M, paper.M // 2)
+                ob = intervals_to_bitmap(LB, RB, paper.M, paper.M // 2)
                 r_true, phi_true = np.hypot(x, y), np.arctan2(y, x)
                 for name, est in loaded.items():
                     pred = est.predict(oa, ob)

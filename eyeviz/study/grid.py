@@ -17,6 +17,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 from eyeviz import EyevizError
+from eyeviz.core import paper
 from eyeviz.core.bounds import MAX_BINS, check_m, check_r_min
 from eyeviz.core.domain import DEFAULTS
 from eyeviz.core.validation import check_choice, check_int, check_real
@@ -36,10 +37,11 @@ __all__ = [
     "parse_list",
 ]
 
-#: The issue's default grid: the paper's design (h=40, l=20, m=720) by factors of 4 each way.
-DEFAULT_H = (10.0, 20.0, 40.0, 80.0, 160.0)
-DEFAULT_L = (5.0, 10.0, 20.0)
-DEFAULT_M = (180, 360, 720, 1440, 2880)
+#: The issue's default grid: the paper's design (h=40, l=20, m=720) by factors of 4 each way:
+#: h 10 ... 160, l 5 ... 20, m 180 ... 2880.
+DEFAULT_H = tuple(paper.H * f for f in (0.25, 0.5, 1, 2, 4))
+DEFAULT_L = tuple(paper.L * f for f in (0.25, 0.5, 1))
+DEFAULT_M = tuple(int(paper.M * f) for f in (0.25, 0.5, 1, 2, 4))
 #: Most design points in one study (a typo such as "--m 1,2,...,99999" is refused).
 MAX_GRID_POINTS = 100_000
 #: Longest list text accepted by :func:`parse_list`.

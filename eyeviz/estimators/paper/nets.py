@@ -9,7 +9,9 @@ from dataclasses import asdict, dataclass, field
 import torch
 from torch import nn
 
-N_INPUTS = 720  # 360 ommatidia per eye, m = 720 (Table 3)
+from eyeviz.core import paper
+
+N_INPUTS = paper.M  # m / 2 = 360 ommatidia per eye, both eyes (Table 3)
 
 
 @dataclass(frozen=True)
