@@ -362,6 +362,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
 
     # --- drawing -------------------------------------------------------------------------
 
+    # long: both eyes' maps set up in drawing order (axes, outlines, labels, empty lit
+    # collections): matplotlib calls, not logic
     def _build(self, patches: dict[str, FacetPatches], nside: int | None) -> None:
         """The static parts for the eyes' facets ``patches`` and empty lit collections."""
         self.nside = nside
