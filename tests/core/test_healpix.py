@@ -100,3 +100,23 @@ def test_ring_bookkeeping():
 def test_boundaries_refuses_bad_step():
     with pytest.raises(ValueError, match="step must be an integer >= 1"):
         hp.boundaries(4, [0], 0)
+
+
+@pytest.mark.parametrize("nside", [1, 2, 4, 8])
+def test_xyf2loc_gives_astropys_centres_and_corners(nside):
+    """(z, phi) of each pixel's centre and of its four corners, as astropy-healpix's
+    healpix_to_lonlat and boundaries_lonlat give them (astropy's nside: powers of two)."""
+    pix = np.arange(hp.npix(nside))
+    ix, iy, f = hp.pix2xyf(nside, pix)
+    z, phi = hp.xyf2loc(nside, ix + 0.5, iy + 0.5, f)
+    lon, lat = _astropy(nside).healpix_to_lonlat(pix)
+    assert np.abs(z - np.sin(lat.value)).max() < 1e-14
+    assert np.abs(np.angle(np.exp(1j * (phi - lon.value)))).max() < 1e-13
+    # corners N (1, 1), W (0, 1), S (0, 0), E (1, 0); a pole's longitude is arbitrary
+    blon, blat = _astropy(nside).boundaries_lonlat(pix, 1)
+    for k, (dx, dy) in enumerate([(1, 1), (0, 1), (0, 0), (1, 0)]):
+        zc, pc = hp.xyf2loc(nside, ix + dx, iy + dy, f)
+        assert np.abs(zc - np.sin(blat.value[:, k])).max() < 1e-14
+        off_pole = np.abs(zc) < 1 - 1e-12
+        dphi = np.angle(np.exp(1j * (pc - blon.value[:, k])))
+        assert np.abs(dphi[off_pole]).max() < 1e-12
