@@ -23,7 +23,16 @@ NAME = "report"
 HELP = "write a report (Markdown, CSV and plots) into a directory"
 #: What the command writes, checked before any work (eyeviz.files.outputs).
 OUTPUTS = {"output": "dir"}
-KINDS = ("stability", "dataset", "estimators", "trajectories", "study", "atlas", "renderers")
+KINDS = (
+    "stability",
+    "dataset",
+    "estimators",
+    "trajectories",
+    "study",
+    "atlas",
+    "renderers",
+    "information",
+)
 #: kind -> module path: the package's reports, then any registered with :func:`register`.
 MODULES: dict[str, str] = {kind: f"eyeviz.reports.{kind}" for kind in KINDS}
 

@@ -1,0 +1,223 @@
+"""``eyeviz report information -o DIR``: what graded responses are worth against bitmaps.
+
+With photon noise (Poisson, N photons a facet at full coverage) the graded responses
+bound how well a ball's distance can be known (a Cramer-Rao bound from the exact
+responses' derivatives, :mod:`eyeviz.reports.information_measure`); the binary bitmaps'
+best estimate sets the other side. At the paper's planar design, at a HEALPix pair
+(nside 180) and at the honeybee: the photons a facet from which grades beat the bitmaps,
+and by how much at N (issue 34.5; docs/renderers.md).
+
+Writes ``information.md``, ``information.csv`` (one row per model), ``balls.csv`` (per
+ball: r, the bound at N = 1, the binary error) and the figure ``information.png`` (also
+``.svg`` and ``.pdf``) into DIR (atomically, through ``eyeviz report``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+
+from eyeviz.core.validation import check_int
+
+HELP = "graded responses under photon noise against the bitmaps: a Cramer-Rao bound on distance"
+
+MAX_BALLS = 100_000
+MAX_PHOTONS = 1e12
+FORMATS = ("png", "svg", "pdf")
+COLORS = ("#4c72b0", "#c44e52", "#55a868", "#8172b3")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from eyeviz.reports.information_measure import DEFAULT_PHOTONS
+
+    parser.add_argument("-o", "--output", required=True, type=Path, help="output directory")
+    parser.add_argument(
+        "--photons",
+        type=float,
+        default=DEFAULT_PHOTONS,
+        help=f"photons a facet catches at full coverage (default {DEFAULT_PHOTONS})",
+    )
+    parser.add_argument(
+        "--planar-balls", type=int, default=400, help="features of the planar design (400)"
+    )
+    parser.add_argument(
+        "--bee-balls", type=int, default=120, help="balls at the honeybee (default 120)"
+    )
+    parser.add_argument(
+        "--healpix-balls",
+        type=int,
+        default=8,
+        help="balls at the HEALPix pair (default 8, 0 leaves it out: about 5 s a ball)",
+    )
+    parser.add_argument("--nside", type=int, default=180, help="the HEALPix pair's nside (180)")
+    parser.add_argument(
+        "--kind",
+        choices=("gaussian", "flat"),
+        default="gaussian",
+        help="the honeybee's response kernel (default gaussian)",
+    )
+    parser.add_argument("--seed", type=int, default=0)
+
+
+def _check(args: argparse.Namespace) -> None:
+    check_int("--planar-balls", args.planar_balls, ge=0, le=MAX_BALLS)
+    check_int("--bee-balls", args.bee_balls, ge=0, le=MAX_BALLS)
+    check_int("--healpix-balls", args.healpix_balls, ge=0, le=MAX_BALLS)
+    check_int("--nside", args.nside, ge=2, le=1024, even=True)
+    if not (math.isfinite(args.photons) and 0 < args.photons <= MAX_PHOTONS):
+        raise ValueError(f"--photons must be > 0 and <= 1e12, got {args.photons}")
+    if args.planar_balls + args.bee_balls + args.healpix_balls == 0:
+        raise ValueError("every model has 0 balls: nothing to measure")
+
+
+def measure(args: argparse.Namespace) -> list:
+    """One :class:`ModelResult` per model with balls."""
+    from eyeviz.files.eye_io import load_eyes, shipped_eye
+    from eyeviz.reports import information_measure as M
+
+    out = []
+    if args.planar_balls:
+        out.append(M.measure_planar(args.planar_balls, args.seed))
+    if args.healpix_balls:
+        out.append(M.measure_healpix(args.nside, args.healpix_balls, args.seed + 1))
+    if args.bee_balls:
+        pair = load_eyes(shipped_eye("AM_60185-real.eye"))
+        out.append(M.measure_measured("honeybee", pair, args.bee_balls, args.seed + 2, args.kind))
+    return out
+
+
+def _markdown(results, photons: float) -> str:
+    o = io.StringIO()
+    o.write("# What grades are worth: graded responses under photon noise against bitmaps\n\n")
+    o.write("![relative error of distance against photons](information.png)\n\n")
+    o.write(
+        "Also as vectors: [information.svg](information.svg), "
+        "[information.pdf](information.pdf).\n\n"
+    )
+    o.write(
+        "Graded: the Cramer-Rao bound on the distance r of a ball from Poisson photon counts "
+        "of every lit facet (mean N x the exact response), relative RMS over the balls; it "
+        "falls as 1/sqrt(N). Binary: the relative RMS error of r of the best estimate the "
+        "project has from the bitmaps, on the same balls. N*: the photons a facet (at full "
+        "coverage) from which the graded bound is below the binary error (RMS; and in "
+        "medians of |relative error|, the graded one at the bound's Gaussian median).\n\n"
+    )
+    o.write(
+        f"| model | kind | balls | binary estimate | binary RMS | graded RMS at N = {photons:g} "
+        "| binary / graded at N | N* (RMS) | N* (medians) | finite-difference check "
+        "(h vs h/2: median, max) | balls without a bound | not settled |\n"
+    )
+    o.write("|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+    for m in results:
+        g = m.graded_rms(photons)
+        o.write(
+            f"| {m.description} | {m.kind} | {m.n_balls} | {m.binary_name} | "
+            f"{m.binary_rms:.2%} | {g:.3%} | {m.binary_rms / g:.1f}x | {m.crossover:.3g} | "
+            f"{m.crossover_median:.3g} | {m.fd_change:.1e}, {m.fd_change_max:.1e} | "
+            f"{m.dropped} | {m.unresolved} |\n"
+        )
+    notes = [n for m in results for n in m.notes]
+    if notes:
+        o.write("\n" + "\n".join(f"- {m.name}: {n}" for m in results for n in m.notes) + "\n")
+    return o.getvalue()
+
+
+def _csv(results, photons: float) -> tuple[str, str]:
+    a, b = io.StringIO(), io.StringIO()
+    w = csv.writer(a, lineterminator="\n")
+    w.writerow(
+        ["model", "kind", "balls", "binary_estimate", "binary_rms", "graded_rms_at_n",
+         "photons", "crossover_rms", "crossover_median", "fd_change_median", "fd_change_max",
+         "balls_without_bound", "balls_not_settled"]
+    )  # fmt: skip
+    for m in results:
+        w.writerow(
+            [m.name, m.kind, m.n_balls, m.binary_name, f"{m.binary_rms:.6g}",
+             f"{m.graded_rms(photons):.6g}", photons, f"{m.crossover:.6g}",
+             f"{m.crossover_median:.6g}", f"{m.fd_change:.3g}", f"{m.fd_change_max:.3g}",
+             m.dropped, m.unresolved]
+        )  # fmt: skip
+    w2 = csv.writer(b, lineterminator="\n")
+    w2.writerow(["model", "r", "crb_var_r_at_1_photon", "binary_relative_error"])
+    for m in results:
+        for r, c, e in zip(m.r, m.crb1, m.binary_rel, strict=True):
+            w2.writerow([m.name, f"{r:.9g}", f"{c:.6g}", f"{e:.6g}"])
+    return a.getvalue(), b.getvalue()
+
+
+def _plot(results, photons: float, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from eyeviz.reports.common import write_atomic
+
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12.5, 4.8), constrained_layout=True)
+    ns = np.logspace(0, 6, 61)
+    for m, c in zip(results, COLORS, strict=False):
+        ax.plot(ns, [m.graded_rms(n) for n in ns], color=c, lw=2, label=f"{m.name}: graded")
+        ax.axhline(m.binary_rms, color=c, ls="--", lw=1.3, label=f"{m.name}: bitmaps")
+        if 1 <= m.crossover <= 1e6:
+            ax.plot([m.crossover], [m.binary_rms], "o", color=c, ms=7)
+            ax.annotate(f"N* = {m.crossover:.3g}", (m.crossover, m.binary_rms),
+                        textcoords="offset points", xytext=(6, 6), fontsize=8, color=c)  # fmt: skip
+        ok = m.ok
+        scale = float(np.max(m.r))
+        bx.scatter(m.r[ok] / scale, np.abs(m.binary_rel[ok]), s=9, color=c, marker="x",
+                   alpha=0.6, linewidths=0.8, label=f"{m.name}: bitmaps |error|")  # fmt: skip
+        bx.scatter(m.r[ok] / scale, np.sqrt(m.crb1[ok] / photons) / m.r[ok], s=9, color=c,
+                   alpha=0.6, label=f"{m.name}: graded bound")  # fmt: skip
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("photons a facet at full coverage, N")
+    ax.set_ylabel("relative RMS error of the distance r")
+    ax.set_title("graded (Cramer-Rao) against bitmaps (best estimate)", fontsize=10)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7.5, frameon=False, loc="lower left")
+    bx.set_yscale("log")
+    bx.set_xlabel("r / largest r of the model's balls")
+    bx.set_ylabel("relative error of r (per ball)")
+    bx.set_title(f"per ball, graded at N = {photons:g}", fontsize=10)
+    bx.grid(alpha=0.3, which="both")
+    bx.legend(fontsize=7, frameon=False, loc="lower right", ncol=2)
+    fig.suptitle("What grades are worth (issue 34.5)", fontsize=11)
+    fig.canvas.draw()
+    fig.set_layout_engine("none")
+    with matplotlib.rc_context(
+        {"svg.fonttype": "none", "pdf.fonttype": 42, "svg.hashsalt": "eyeviz"}
+    ):
+        for fmt in FORMATS:
+            buf = io.BytesIO()
+            meta = (
+                {"Date": None} if fmt == "svg" else {"CreationDate": None} if fmt == "pdf" else {}
+            )
+            fig.savefig(buf, format=fmt, dpi=170, metadata=meta)
+            write_atomic(path.with_suffix(f".{fmt}"), buf.getvalue())
+    plt.close(fig)
+
+
+def run(args: argparse.Namespace) -> int:
+    from eyeviz.reports.common import write_atomic
+
+    _check(args)
+    results = measure(args)
+    out: Path = args.output
+    out.mkdir(parents=True, exist_ok=True)
+    _plot(results, args.photons, out / "information.png")
+    write_atomic(out / "information.md", _markdown(results, args.photons))
+    table, balls = _csv(results, args.photons)
+    write_atomic(out / "information.csv", table)
+    write_atomic(out / "balls.csv", balls)
+    for m in results:
+        print(
+            f"{m.name}: bitmaps {m.binary_rms:.2%} RMS, graded {m.graded_rms(args.photons):.3%} "
+            f"at N = {args.photons:g}; grades win from N* = {m.crossover:.3g} photons"
+        )
+    print(f"wrote {out / 'information.md'}")
+    return 0
