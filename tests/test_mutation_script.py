@@ -101,3 +101,19 @@ def test_the_frames_modules_also_run_the_render_tests(tmp_path):
         "tests/model/test_frame.py",
         "tests/model",
     ]
+
+
+def test_the_spherical_set_names_modules_and_tests_that_exist(capsys):
+    """--spherical: every module and test file of SPHERICAL is in this checkout (a rename
+    would silently drop it from the run), and --list counts the draws without running."""
+    mut = _load()
+    root = SCRIPT.parents[1]
+    for module, tests in mut.SPHERICAL.items():
+        assert (root / module).is_file(), module
+        assert tests and all((root / t).is_file() for t in tests), (module, tests)
+    args = ["--root", str(root), "--spherical", "--list", "--per-module", "2"]
+    assert mut.main([*args, "--modules", "measured_grid", "measured_from"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("eyeviz/core/measured_from.py: 2 of ")
+    assert out[1].startswith("eyeviz/core/measured_grid.py: 2 of ")
+    assert out[-1].startswith("4 mutants of ") and out[-1].endswith(" would run")
