@@ -104,11 +104,15 @@ def test_exact_path_gives_the_real_points_pixel_at_the_zone_boundary(n):
         want = _astropy(n, inward, phi)
         got = [_exact(n, z, p) for p in phi]
         assert got == want.tolist(), (n, z)
-    # on the boundary itself (2/3 exactly, snapped) the exact path takes the float rule
-    with mpmath.workprec(300):
-        zz = mpmath.mpf(2) / 3
-        v = (mpmath.sqrt(1 - zz * zz), mpmath.mpf(0), zz)
-        assert exact3d.ang2pix_snap(n, v, mpmath.ldexp(1, -150)) == hp.ang2pix_ring(n, Z23, 0.0)
+    # on the boundary itself (2/3 exactly) and within the snap tolerance of it, on either
+    # side and at either pole's zone, the exact path takes the float rule at the corner
+    for sign in (1, -1):
+        want = int(_astropy(n, sign * Z23, 0.0))
+        for dz in (0, 1, -1):
+            with mpmath.workprec(300):
+                zz = sign * (mpmath.mpf(2) / 3 + dz * mpmath.ldexp(1, -200))
+                v = (mpmath.sqrt(1 - zz * zz), mpmath.mpf(0), zz)
+                assert exact3d.ang2pix_snap(n, v, mpmath.ldexp(1, -150)) == want, (sign, dz)
 
 
 @pytest.mark.parametrize("n", range(1, 10))
