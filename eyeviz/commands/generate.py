@@ -118,6 +118,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="keep one element per distinct (Omega_A, Omega_B) pair, as the "
         "authors' published data set",
     )
+    parser.add_argument(
+        "--responses",
+        choices=("flat", "gaussian"),
+        default=None,
+        help="with --eye: store each lit facet's graded response beside the lit sets "
+        "(flat: the covered share of the acceptance cone; gaussian: FWHM = the acceptance "
+        "angle; docs/responses.md)",
+    )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -196,6 +204,11 @@ def _refuse_ignored(args: argparse.Namespace) -> None:
     if args.field is not None and args.nside is None and args.eye is None:
         raise EyevizError(
             f"--field {args.field} needs --nside or --eye (the planar field is the paper's wedge)"
+        )
+    if args.responses is not None and args.eye is None:
+        raise EyevizError(
+            f"--responses {args.responses} needs --eye (flat and gaussian responses are the "
+            "measured eyes' acceptance cones)"
         )
 
 
@@ -322,6 +335,7 @@ def _write_sparse(args: argparse.Namespace, n: int, domain) -> None:
             segments=args.segments,
             progress=bar.update if bar else None,
             field=args.field,
+            responses=args.responses,
         )
     finally:
         if bar is not None:

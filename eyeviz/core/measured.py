@@ -281,20 +281,26 @@ class MeasuredEyePair(LitSetViews):
             out[b] = hit
         return out
 
-    def responses(self, x, y, z, g, kind: str | None = None):
+    def responses(self, x, y, z, g, kind: str | None = None, support: str = "cone"):
         """Graded responses per eye (A, B): (indptr, indices, values), the lit sets of
         :meth:`lit_csr` with each lit facet's response in [0, 1]; ``kind`` ``"flat"``
-        (the default) or ``"gaussian"`` (docs/responses.md)."""
+        (the default) or ``"gaussian"``; ``support="sphere"`` gives the gaussian kernel
+        untruncated, normalised over the sphere, on the same lit facets
+        (docs/responses.md)."""
         from eyeviz.core.responses import check_kind, measured_values
 
         k = check_kind("measured", kind)
+        if support not in ("cone", "sphere") or (support == "sphere" and k != "gaussian"):
+            raise EyevizError(
+                f"support {support!r}: 'cone', or 'sphere' for the gaussian kernel only"
+            )
         _, balls = self._flat_balls(x, y, z, g)
         out = []
         for w in "AB":
             indptr, indices = self._lit_eye(w, balls)
             e = self.eye(w)
             vals = measured_values(
-                e.positions, e.unit_axes, e.acceptance, balls, indptr, indices, k
+                e.positions, e.unit_axes, e.acceptance, balls, indptr, indices, k, support
             )
             out.append((indptr, indices, vals))
         return out[0], out[1]

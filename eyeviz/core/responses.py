@@ -28,7 +28,7 @@ __all__ = ["KINDS_BY_MODEL", "check_kind", "measured_values", "planar_responses"
 #: The kinds each model answers, its default first.
 KINDS_BY_MODEL: dict[str, tuple[str, ...]] = {
     "planar": ("cell",),
-    "spherical": ("cell",),
+    "spherical": (),  # HEALPix cells: to come
     "measured": ("flat", "gaussian"),
 }
 
@@ -39,7 +39,7 @@ def check_kind(model: str, kind: str | None) -> str:
     """The kind to use (the model's default for None); EyevizError naming the kinds the
     model answers otherwise."""
     kinds = KINDS_BY_MODEL[model]
-    if kind is None:
+    if kind is None and kinds:
         return kinds[0]
     if kind not in kinds:
         raise EyevizError(
@@ -61,6 +61,7 @@ def measured_values(
     indptr: np.ndarray,
     indices: np.ndarray,
     kind: str,
+    support: str = "cone",
 ) -> np.ndarray:
     """The responses of one measured eye's lit (ball, facet) pairs: the ball's cap seen
     from the lens (:func:`ball_cap`), its angle theta from the axis (atan2 of |v x a| and
@@ -83,7 +84,7 @@ def measured_values(
     a = acceptance[fi] / 2
     if kind == "flat":
         return flat_response(a, b, theta)
-    return gaussian_response(a, b, theta)
+    return gaussian_response(a, b, theta, support)
 
 
 def planar_responses(eyes, xf: np.ndarray, yf: np.ndarray, gf: np.ndarray) -> tuple[CSR3, CSR3]:

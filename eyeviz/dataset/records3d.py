@@ -43,7 +43,10 @@ class Dataset3D:
     the centre the lit sets were computed at, :func:`spherical_to_xyz` of (r, azimuth,
     elevation) as evaluated when generated (kept, so a lit set can be checked exactly
     whatever a platform's sin and cos round to).
-    ``params``: the generation parameters (mode, seed).
+    ``params``: the generation parameters (mode, seed; ``responses``, the kind, when the
+    rows carry graded responses). ``values_a``/``values_b``: None, or float64 in [0, 1]
+    aligned with ``indices_a``/``indices_b``, each lit facet's response
+    (docs/responses.md).
     """
 
     indptr_a: np.ndarray
@@ -59,6 +62,8 @@ class Dataset3D:
     z: np.ndarray
     domain: Domain3D = field(default_factory=Domain3D)
     params: dict = field(default_factory=dict)
+    values_a: np.ndarray | None = None
+    values_b: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.r.shape[0])
@@ -104,6 +109,9 @@ class Dataset3D:
         def cat(name: str) -> np.ndarray:
             return np.concatenate([getattr(p, name) for p in parts])
 
+        def values(name: str) -> np.ndarray | None:
+            return None if getattr(first, name) is None else cat(name)
+
         return Dataset3D(
             ptr("indptr_a"),
             cat("indices_a"),
@@ -118,4 +126,6 @@ class Dataset3D:
             cat("z"),
             first.domain,
             dict(first.params),
+            values("values_a"),
+            values("values_b"),
         )

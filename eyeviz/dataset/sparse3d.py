@@ -33,11 +33,9 @@ file declares against the file before allocating, and checks every row.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
 import os
-import shutil
 import struct
 import zipfile
 import zlib
@@ -50,11 +48,12 @@ import numpy as np
 from eyeviz import EyevizError
 from eyeviz.core.domain3d import FIELDS3D, Domain3D
 from eyeviz.core.validation import check_int
-from eyeviz.dataset import embedded_eyes
+from eyeviz.dataset import embedded_eyes, responses3d
 from eyeviz.dataset.algorithm1_3d import check_n, iter_chunks3d, make_params3d
 from eyeviz.dataset.records3d import Dataset3D, index_dtype
+from eyeviz.dataset.spools import Spools
 from eyeviz.files import limits
-from eyeviz.files.atomic import atomic_output, part_name
+from eyeviz.files.atomic import atomic_output
 from eyeviz.files.npz import NpzReader
 
 __all__ = [
@@ -123,52 +122,6 @@ def estimated_bytes3d(n: int, domain: Domain3D) -> int:
 # --- writing -------------------------------------------------------------------------
 
 
-class _Spools:
-    """One append-only raw file per member, next to the output (removed by :meth:`close`)."""
-
-    def __init__(self, target: Path):
-        d = target.parent if str(target.parent) else Path(".")
-        self.paths: dict[str, Path] = {}
-        self.files: dict[str, BinaryIO] = {}
-        self.counts = dict.fromkeys(MEMBERS, 0)
-        self.dtypes: dict[str, np.dtype] = {}
-        try:
-            for name in MEMBERS:
-                p = d / part_name(target)
-                self.files[name] = open(p, "xb")  # noqa: SIM115 - closed in close()
-                self.paths[name] = p
-        except BaseException:
-            self.close()
-            raise
-
-    def append(self, name: str, a: np.ndarray) -> None:
-        a = np.ascontiguousarray(a)
-        self.dtypes.setdefault(name, a.dtype)
-        self.files[name].write(a.data)
-        self.counts[name] += a.shape[0]
-
-    def close(self) -> None:
-        for f in self.files.values():
-            with contextlib.suppress(OSError):
-                f.close()
-        for p in self.paths.values():
-            with contextlib.suppress(OSError):
-                p.unlink()
-
-    def copy_into(self, zf: zipfile.ZipFile, name: str) -> None:
-        """Member ``name.npy`` from the spool (header from its dtype and count)."""
-        self.files[name].flush()
-        header = {
-            "descr": np.lib.format.dtype_to_descr(self.dtypes[name]),
-            "fortran_order": False,
-            "shape": (self.counts[name],),
-        }
-        with zf.open(name + ".npy", "w", force_zip64=True) as out:
-            np.lib.format.write_array_header_1_0(out, header)
-            with open(self.paths[name], "rb") as src:
-                shutil.copyfileobj(src, out, _COPY)
-
-
 def write_chunks3d(
     path: str | os.PathLike,
     n: int,
@@ -176,12 +129,15 @@ def write_chunks3d(
     params: dict,
     chunks: Iterable[Dataset3D],
     progress: Callable[[int], None] | None = None,
+    responses: str | None = None,
 ) -> None:
-    """Stream generated chunks (:class:`Dataset3D`) into ``path``, atomically."""
+    """Stream generated chunks (:class:`Dataset3D`) into ``path``, atomically; with
+    ``responses`` (a kind) each chunk's values too (:mod:`eyeviz.dataset.responses3d`)."""
     target = check_output_path(path)
     idt = index_dtype(max(domain.facet_counts))
+    members = MEMBERS + (responses3d.VALUE_MEMBERS if responses else ())
     with atomic_output(target) as tmp:
-        spools = _Spools(tmp.parent / target.name)  # beside the temporary: not in /dev
+        spools = Spools(tmp.parent / target.name, members)  # beside the temporary
         try:
             base = dict.fromkeys(EYES, 0)
             for e in EYES:
@@ -196,6 +152,8 @@ def write_chunks3d(
                         f"indices_{e}", getattr(c, f"indices_{e}").astype(idt, copy=False)
                     )
                     base[e] += int(ptr[-1])
+                    if responses:
+                        spools.append(f"values_{e}", getattr(c, f"values_{e}").astype("<f8"))
                 for name in FLOATS:
                     spools.append(name, getattr(c, name).astype(np.float64))
                 rows += len(c)
@@ -213,10 +171,12 @@ def write_chunks3d(
                 "domain": domain.to_dict(),
                 "params": {k: v for k, v in params.items() if k not in domain.to_dict()},
             }
+            if responses:
+                meta["responses"] = responses
             with zipfile.ZipFile(tmp, "w", zipfile.ZIP_STORED, allowZip64=True) as zf:
                 with zf.open("meta.npy", "w") as f:
                     np.lib.format.write_array(f, np.array(json.dumps(meta)), allow_pickle=False)
-                for name in MEMBERS:
+                for name in members:
                     spools.copy_into(zf, name)
                 if domain.kind == "measured":  # the pair itself: the file is self-contained
                     for name, arr in embedded_eyes.eye_arrays(domain.eyes).items():
@@ -235,14 +195,20 @@ def write3d(
     segments: int | None = None,
     progress: Callable[[int], None] | None = None,
     field: str | None = None,
+    responses: str | None = None,
 ) -> None:
     """Generate n elements of Algorithm 1 in 3D straight into ``path`` (.npz), streamed
     and atomic. Every parameter is checked before the file is touched; ``progress(k)`` is
-    called after each chunk of k elements; ``field``: see :func:`make_params3d`."""
+    called after each chunk of k elements; ``field``: see :func:`make_params3d`;
+    ``responses`` (a kind the eyes answer) adds each lit facet's graded response."""
     check_output_path(path)
     n = check_n(n)
     p = make_params3d(domain, mode, seed, segments, field)
-    write_chunks3d(path, n, p.domain, p.as_dict(), iter_chunks3d(n, p), progress)
+    chunks: Iterable[Dataset3D] = iter_chunks3d(n, p)
+    if responses is not None:
+        responses = responses3d.check_kind(p.domain.kind, responses)
+        chunks = responses3d.with_values(chunks, p.domain.eyes, responses)
+    write_chunks3d(path, n, p.domain, p.as_dict(), chunks, progress, responses)
 
 
 # --- reading -------------------------------------------------------------------------
@@ -295,7 +261,8 @@ class Sparse3DReader:
                     "meta", 1, dtypes=("U",), ndim=0, max_bytes=_META_MAX_BYTES
                 )
             with open(self.path, "rb") as f:
-                self.members = {name: self._member(f, infos, name) for name in MEMBERS}
+                names = MEMBERS + tuple(v for v in responses3d.VALUE_MEMBERS if v + ".npy" in infos)
+                self.members = {name: self._member(f, infos, name) for name in names}
                 self._eye_members = {
                     name: self._member(f, infos, name)
                     for name in embedded_eyes.EYE_MEMBERS
@@ -377,6 +344,10 @@ class Sparse3DReader:
             if not isinstance(params, dict):
                 raise TypeError("params is not an object")
             self.params = params
+            kind = meta.get("responses")
+            self.responses = None if kind is None else responses3d.check_kind(d_kind(dom), kind)
+            if self.responses:
+                self.params = {**params, "responses": self.responses}
         except EyevizError as exc:
             raise self.fail(f"bad meta: {exc}") from None
         except (ValueError, KeyError, TypeError, OverflowError, IndexError) as exc:
@@ -399,7 +370,12 @@ class Sparse3DReader:
             want[f"indices_{e}"] = (index_dtype(self.npix).newbyteorder("<"), nnz)
         for name in FLOATS:
             want[name] = (np.dtype("<f8"), self.n)
+        if self.responses:
+            for e in EYES:
+                want[f"values_{e}"] = (np.dtype("<f8"), self.nnz_a if e == "a" else self.nnz_b)
         for name, (dt, length) in want.items():
+            if name not in self.members:
+                raise self.fail(f"member {name!r} is missing (the meta names responses)")
             m = self.members[name]
             if m.dtype != dt or m.length != length:
                 raise self.fail(
@@ -550,6 +526,8 @@ class Sparse3DReader:
                 ind = self._read(f, f"indices_{e}", int(p[0]), int(p[-1] - p[0]))
                 self._check_indices(e, start, p, ind)
                 out[f"indptr_{e}"], out[f"indices_{e}"] = p - p[0], ind
+                if self.responses:
+                    out[f"values_{e}"] = self._read(f, f"values_{e}", int(p[0]), ind.size)
                 prev[e] = int(p[-1])
             cols = {name: self._read(f, name, start, k) for name in FLOATS}
             self._check_floats(start, cols)
@@ -561,6 +539,12 @@ class Sparse3DReader:
             bad = embedded_eyes.check_lit_rows(self._eyes, block, start, self.n)
             if bad:
                 raise self.fail(f"the lit sets do not match {self._eyes_text}: {bad}")
+            if self.responses:
+                bad = responses3d.check_values(block, start) or responses3d.check_value_rows(
+                    self._eyes, block, start, self.n, self.responses
+                )
+                if bad:
+                    raise self.fail(bad)
             yield block
             start += k
 
@@ -573,7 +557,16 @@ class Sparse3DReader:
         idx = np.zeros(0, index_dtype(self.npix))
         empty = np.zeros(0)
         floats = dict.fromkeys(FLOATS, empty)
-        return Dataset3D(ptr, idx, ptr, idx, **floats, domain=self.domain, params=self.params)
+        vals = empty if self.responses else None
+        d, p = self.domain, self.params
+        return Dataset3D(
+            ptr, idx, ptr, idx, **floats, domain=d, params=p, values_a=vals, values_b=vals
+        )
+
+
+def d_kind(dom: dict) -> str:
+    """The eye model a stored domain names."""
+    return "measured" if "eye" in dom else "spherical"
 
 
 #: The domain keys of a measured data set (the pair by fingerprint, no nside).

@@ -153,3 +153,19 @@ def test_planar_sum_is_the_disc_angle():
     r = np.hypot(x + 40, y)
     want = np.where(r < g, 2 * math.pi, 2 * np.arcsin(np.minimum(g / r, 1)))
     np.testing.assert_allclose(sums, want, rtol=0, atol=1e-9)
+
+
+def test_measured_gaussian_on_the_sphere(toy_pair):
+    """support="sphere": the untruncated kernel, on the same lit facets; refused for flat."""
+    x, y, z, g = 0.3, 4.0, 0.2, 0.4
+    cone = toy_pair.responses(x, y, z, g, kind="gaussian")
+    sphere = toy_pair.responses(x, y, z, g, kind="gaussian", support="sphere")
+    (p, i, v), _ = sphere
+    np.testing.assert_array_equal(i, cone[0][1])
+    e = toy_pair.eye_a
+    for j in range(min(5, i.size)):
+        th, b = ball_angles((x, y, z), e.positions[i[j]], e.axes[i[j]], g)
+        want = cap_response(e.acceptance[i[j]] / 2, b, th, "gaussian", "sphere")
+        assert abs(v[j] - want) <= TOL
+    with pytest.raises(EyevizError, match="support 'sphere'"):
+        toy_pair.responses(x, y, z, g, kind="flat", support="sphere")
