@@ -80,32 +80,17 @@ import numpy as np
 from eyeviz.core.domain3d import PAPER_DOMAIN3D, Domain3D
 from eyeviz.estimators.analytic3d import estimate
 from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D, as_csr, take_rows
-from eyeviz.estimators.limit3d_proposal import (
-    _angle_box,
-    _extent,
-    _Eye,
-    _key_hash,
-    _locate,
-    _prefilter,
-    _ray_in_box,
-    _ray_in_region,
-    _uniforms,
-)
+from eyeviz.estimators.limit3d_exact import prior_density, same_rows
+from eyeviz.estimators.limit3d_proposal import _Eye, _key_hash  # noqa: F401  (_Eye: read by tests)
 from eyeviz.estimators.weighted import weighted_median
 
 __all__ = ["PRIORS", "Limit3DEstimator", "load", "posterior_samples3d", "prior_density"]
 
+_same = same_rows  # the exact check's row comparison (kept under its old name)
+
 PRIORS = ("single", "multi")
 #: the retries of keys with no accepted draw: (window and slack factor, batches of draws)
 RETRY = ((1.0, 8), (2.5, 24), (1.0, 96))
-#: facet widths the centre search may move: edge cells that cannot bind within them are
-#: dropped before it
-PRUNE = 0.25
-#: zoom levels of the search for the centre (each grid a third as wide)
-LEVELS = 4
-#: grid points and rounds of the search along the ray for B's region
-RAY_GRID = 8
-RAY_ROUNDS = 2
 #: the Monte-Carlo error of r a key's draws are topped up to (at most TOPUP more batches)
 MC_TARGET = 0.01
 TOPUP = 1
@@ -115,8 +100,6 @@ MIN_ESS = 4.0
 #: the largest ``samples`` and ``grid`` a Limit3DEstimator takes
 MAX_SAMPLES = 1 << 14
 MAX_GRID = 64
-#: the per-key slack: this many times the model's second-order error in the box
-SLACK_SAFETY = 4.0
 #: keys processed together
 _CHUNK = 8
 #: The most facets per eye a key may light and still be sampled: each exact check of a
@@ -136,40 +119,13 @@ def max_lit(domain: Domain3D) -> int:
     on its rim at most 8 per facet width of its perimeter (generous: HEALPix cells are
     within a factor ~2 of square), plus 16."""
     d = domain
+    if d.kind == "measured":  # no closed form: every facet of the larger eye
+        return int(max(d.facet_counts))
     near = d.r_min - d.h
     alpha = math.pi / 2 if near <= d.g_max else math.asin(d.g_max / near)
     fw = math.sqrt(4 * math.pi / d.npix)
     bound = d.npix * (1 - math.cos(alpha)) / 2 + 8 * 2 * math.pi * math.sin(alpha) / fw + 16
     return int(min(d.npix, math.ceil(bound)))
-
-
-def prior_density(domain: Domain3D, prior: str, r, g, el, az) -> np.ndarray:
-    """The prior density of Algorithm 1 in 3D in (x, y, z, g), up to a constant, at balls
-    of centre (r, az, el) and radius g (0 outside its support; the field test and
-    Definition 1 are not applied here)."""
-    d = domain
-    s = math.sin(d.gamma / 2)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        a = np.arcsin(np.minimum(g / r, 1.0))
-        cone = d.psi + a
-        ok = (r >= d.r_min) & (r <= d.r_max) & (g >= r * s) & (g <= d.g_max) & (g <= r)
-        ok &= (cone < math.pi / 2) & (np.abs(el) <= d.el_max)
-        cel = np.cos(el)
-        if prior == "multi":
-            az0 = np.arccos(np.minimum(np.cos(cone) / math.cos(d.el_max), 1.0))
-            dens = r * r * cel
-        else:
-            az0 = np.arccos(np.minimum(np.cos(cone) / cel, 1.0))
-            dens = np.ones_like(r)
-        ok &= (az >= az0) & (az <= math.pi - az0)
-        dens = dens / ((d.g_max - r * s) * (math.pi - 2 * az0) * r * r * cel)
-    return np.where(ok & np.isfinite(dens), dens, 0.0)
-
-
-# --- counter-based uniforms: a function of the key and the draw's number -----------------
-
-
-# --- one eye's edge cells ------------------------------------------------------------------
 
 
 class Limit3DEstimator(Estimator3D):
@@ -181,6 +137,7 @@ class Limit3DEstimator(Estimator3D):
     ``n_accepted`` (samples that reproduce both lit sets)."""
 
     name = "limit3d"
+    kinds = ("spherical", "measured")
 
     def __init__(
         self,
@@ -208,6 +165,7 @@ class Limit3DEstimator(Estimator3D):
         self.samples = int(samples)
         self.grid = int(grid)
         self.seed = int(seed)
+        self._proposal = _proposal(domain, prior, self.samples, self.grid)
         self.last_mc_error: np.ndarray = np.zeros(0)
         self.last_accepted: np.ndarray = np.zeros(0, np.int64)
 
@@ -222,44 +180,11 @@ class Limit3DEstimator(Estimator3D):
         reps: int = 1,
     ) -> dict[str, np.ndarray]:
         """Weighted posterior samples of a chunk: dict of (N, reps * samples) arrays (the
-        proposal set up once, ``reps`` batches of draws)."""
-        d = self.domain
-        fw = math.sqrt(4 * math.pi / d.npix)
-        A = np.array([-d.h, 0.0, 0.0])
-        B = np.array([d.h, 0.0, 0.0])
-        ea = _Eye(d, lit_a, A, 0)
-        eb = _Eye(d, lit_b, B, 1)
-        n = ea.c.shape[0]
+        eye model's proposal set up once, ``reps`` batches of draws)."""
+        prop = self._proposal
+        st = prop.setup(lit_a, lit_b, keys, wide)
         m = self.samples
-        ng = self.grid
-        slack0 = wide * 0.002 * fw
-        for e in (ea, eb):
-            e.prune(np.full(n, PRUNE * wide * fw))
-            _locate(e, 0.25 * wide * fw, ng, LEVELS)
-        ext = _extent(ea, wide * 0.5 * fw, slack0)
-        eb.a = A - B
-        ext_b = _extent(eb, wide * 0.5 * fw, slack0)
-        # within a box of radius R the model's distances are off by second-order terms,
-        # below R^2 (1 / alpha + 1) / 2: a thin posterior (a box far smaller than the
-        # search window) needs a slack far below the window's, or the proposal is
-        # mostly slack (keys with a tiny posterior found nothing in 10^4 draws)
-        sec = np.zeros(n)
-        for e, x in ((ea, ext), (eb, ext_b)):
-            sec = np.maximum(sec, (x * x).sum(axis=1) * (1.0 / e.alpha0 + 1.0))
-        slack = np.minimum(slack0, wide * (SLACK_SAFETY * sec + 1e-7 * fw))[:, None]
-        ext = _extent(ea, wide * 0.5 * fw, slack)
-        ext_b = _extent(eb, wide * 0.5 * fw, slack)
-        ea.prune(1.2 * math.sqrt(2.0) * ext.max(axis=1))
-        eb.prune(1.2 * math.sqrt(2.0) * ext_b.max(axis=1))
-        # A's centre: uniform in (theta, phi) over the bounds of A's box, theta cut to
-        # those of B's box (both caps' centres share the ball's theta: B's box bounds it)
-        box = _angle_box(ea, ext)
-        box_b = _angle_box(eb, ext_b)
-        th_lo = np.fmax(box[:, 0], box_b[:, 0])
-        th_hi = np.fmin(box[:, 1], box_b[:, 1])
-        st = dict(d=d, A=A, B=B, ea=ea, eb=eb, n=n, m=m, slack=slack, ext=ext, ext_b=ext_b,
-                  box=box, th_lo=th_lo, th_hi=th_hi, lit_a=lit_a, lit_b=lit_b)  # fmt: skip
-        parts = [self._sample(st, keys, stream + 8 * rep) for rep in range(reps)]
+        parts = [prop.sample(st, keys, stream + 8 * rep) for rep in range(reps)]
         out = {k: np.concatenate([q[k] for q in parts], axis=1) for k in parts[0]}
         if reps > 1:
             return out
@@ -269,108 +194,13 @@ class Limit3DEstimator(Estimator3D):
             need = _needs_more(out["r"], out["w"])
             if not need.any():
                 break
-            more = self._sample(st, keys, stream + 8 * rep)
+            more = prop.sample(st, keys, stream + 8 * rep)
             more["w"] = np.where(need[:, None], more["w"], 0.0)
             out = {k: np.concatenate([out[k], more[k]], axis=1) for k in out}
         if out["w"].shape[1] > m:  # the accepted draws first, in draw order
             order = np.argsort(~(out["w"] > 0), axis=1, kind="stable")[:, :m]
             out = {k: np.take_along_axis(v, order, 1) for k, v in out.items()}
         return out
-
-    # long: the weighted draws of one chunk (propose, test the key, weigh) in one pass over shared
-    # arrays
-    def _sample(self, st: dict, keys: np.ndarray, stream: int) -> dict[str, np.ndarray]:
-        """``samples`` weighted draws per key of a chunk set up by :meth:`_draw`."""
-        d, A, B, ea, eb = st["d"], st["A"], st["B"], st["ea"], st["eb"]
-        n, m, slack, ext, ext_b = st["n"], st["m"], st["slack"], st["ext"], st["ext_b"]
-        box, th_lo, th_hi = st["box"], st["th_lo"], st["th_hi"]
-        lit_a, lit_b = st["lit_a"], st["lit_b"]
-        u = _uniforms(keys, m, 4, stream)
-        th = th_lo[:, None] + (th_hi - th_lo)[:, None] * u[..., 0]
-        ph = box[:, 2:3] + (box[:, 3] - box[:, 2])[:, None] * u[..., 1]
-        sp = np.sin(ph)
-        ca = np.stack([np.cos(ph), sp * np.cos(th), sp * np.sin(th)], axis=-1)
-        good = np.broadcast_to(((th_hi > th_lo) & (box[:, 3] > box[:, 2]))[:, None], (n, m))
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-            delta = ea.gnomonic(np.where(good[..., None], ca, ea.c[:, None, :]))
-        # outside A's box the model region is empty: drawn, then dropped
-        good = good & (np.abs(delta) <= ext[:, None, :]).all(axis=2)
-        delta = np.where(good[..., None], delta, 0.0)
-        ca = np.where(good[..., None], ca, ea.c[:, None, :])
-        lo_a, hi_a = ea.bounds(delta)
-        good = good & (hi_a - lo_a > -2.0 * slack)
-        # along the ray A + c_A / u: u where B's view of it lies in B's box (the
-        # directions from B, c_A + u (A - B), span a great circle: a line in B's
-        # gnomonic coordinates, and each side of the box is linear in u), then in B's
-        # modelled region; on the live draws only (moved to the front of each row)
-        u_lo, u_hi = _ray_in_box(eb, ca, ext_b)
-        u_lo = np.maximum(u_lo, 1.0 / (d.r_max + d.h))
-        if d.r_min > d.h:
-            u_hi = np.minimum(u_hi, 1.0 / (d.r_min - d.h))
-        good = good & (u_hi > u_lo)
-        order = np.argsort(~good, axis=1, kind="stable")[:, : max(1, int(good.sum(1).max()))]
-        sel = np.take_along_axis(good, order, 1)
-
-        def pick(x: np.ndarray) -> np.ndarray:
-            return np.take_along_axis(x, order if x.ndim == 2 else order[..., None], 1)
-
-        c_lo = np.where(sel, pick(u_lo), 1.0 / d.r_max)
-        c_hi = np.where(sel, pick(u_hi), 1.0 / d.r_max)
-        c_lo, c_hi = _ray_in_region(eb, pick(ca), c_lo, c_hi, slack, RAY_GRID, RAY_ROUNDS)
-        rows = np.arange(n)[:, None]
-        u_lo, u_hi = u_lo.copy(), u_hi.copy()
-        u_lo[rows, order] = c_lo
-        u_hi[rows, order] = c_hi
-        u_lo = np.where(good, u_lo, 1.0 / d.r_max)
-        u_hi = np.where(good, u_hi, 1.0 / d.r_max)
-        uu = u_lo + (u_hi - u_lo) * u[..., 2]
-        uu = np.where(good, uu, 1.0 / d.r_max)
-        rho = 1.0 / uu
-        p = A + rho[..., None] * ca
-        r = np.linalg.norm(p, axis=2)
-        vb = p - B
-        rho_b = np.linalg.norm(vb, axis=2)
-        # g: uniform where both eyes' modelled cap radii allow it (and the prior's g range)
-        lo_b, hi_b = eb.bounds(eb.gnomonic(vb / rho_b[..., None]))
-        g_lo, g_hi = r * math.sin(d.gamma / 2), np.full_like(r, d.g_max)
-        for lo_e, hi_e, rh in ((lo_a, hi_a, rho), (lo_b, hi_b, rho_b)):
-            g_lo = np.maximum(g_lo, rh * np.sin(np.clip(lo_e - slack, 0.0, math.pi / 2)))
-            g_hi = np.minimum(g_hi, rh * np.sin(np.clip(hi_e + slack, 0.0, math.pi / 2)))
-        good = good & (g_hi > g_lo)
-        gg = g_lo + (g_hi - g_lo) * u[..., 3]
-        el = np.arcsin(np.clip(p[..., 2] / r, -1, 1))
-        az = np.arctan2(p[..., 1], p[..., 0])
-        alpha = np.arcsin(np.clip(gg / rho, 0.0, 1.0))
-        # d(x, y, z, g) = rho^4 sin(phi) d(u, theta, phi, g); 1 / q = the boxes' volume
-        with np.errstate(over="ignore", invalid="ignore"):
-            vol = (th_hi - th_lo)[:, None] * (box[:, 3] - box[:, 2])[:, None]
-            vol = vol * (u_hi - u_lo) * (g_hi - g_lo)
-            w = prior_density(d, self.prior, r, gg, el, az) * rho**4 * sp * vol
-        w = np.where(good & np.isfinite(w), w, 0.0)
-        # the exact 0/1 likelihood on the draws with prior mass
-        cand = np.flatnonzero(w.ravel() > 0)
-        hit = np.zeros(n * m, bool)
-        if cand.size:  # a cheap necessary condition first
-            row = cand // m
-            pc = p.reshape(-1, 3)[cand]
-            pb_ = pc - B
-            rb = np.linalg.norm(pb_, axis=1)
-            keep = _prefilter(ea, row, ca.reshape(-1, 3)[cand], alpha.ravel()[cand])
-            cand, row, pb_, rb = cand[keep], row[keep], pb_[keep], rb[keep]
-            sin_b = np.minimum(gg.ravel()[cand] / rb, 1.0)
-            keep = _prefilter(eb, row, pb_ / rb[:, None], np.arcsin(sin_b))
-            cand = cand[keep]
-        if cand.size:
-            x, y, z = (p.reshape(-1, 3)[cand, i] for i in range(3))
-            gc = gg.ravel()[cand]
-            inb = d.eyes.in_bfv(x, y, z, gc)
-            (pa, ia), (pb, ib) = d.eyes.lit_csr(x, y, z, gc)
-            row = cand // m
-            match = inb & _same(pa, ia, lit_a, row) & _same(pb, ib, lit_b, row)
-            hit[cand] = match
-        w = np.where(hit.reshape(n, m), w, 0.0)
-        return {"r": r, "az": az, "el": el, "g": gg, "x": p[..., 0], "y": p[..., 1],
-                "z": p[..., 2], "w": w}  # fmt: skip
 
     def _posterior(self, lit_a: LitCSR, lit_b: LitCSR):
         keys = _key_hash(lit_a, lit_b) ^ np.uint64(self.seed)
@@ -454,6 +284,18 @@ class Limit3DEstimator(Estimator3D):
         )
 
 
+def _proposal(domain: Domain3D, prior: str, samples: int, grid: int) -> Any:
+    """The eye model's proposal (``setup(lit_a, lit_b, keys, wide)`` then
+    ``sample(state, keys, stream)``): HEALPix cells or measured facets' cones."""
+    if domain.kind == "measured":
+        from eyeviz.estimators.limit3d_measured import MeasuredProposal
+
+        return MeasuredProposal(domain, prior, samples, grid)
+    from eyeviz.estimators.limit3d_healpix import HealpixProposal
+
+    return HealpixProposal(domain, prior, samples, grid)
+
+
 def _spread(r: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per row of weighted draws: the weighted mean and standard deviation of r and the
     effective sample size ESS = (sum w)^2 / sum w^2 (NaN where nothing is accepted)."""
@@ -474,25 +316,6 @@ def _needs_more(r: np.ndarray, w: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore", divide="ignore"):
         mc = 1.2533 * sd / np.sqrt(ess) / mean
     return ~(ess >= MIN_ESS) | ~(mc <= MC_TARGET)
-
-
-def _same(ptr: np.ndarray, ind: np.ndarray, key: LitCSR, row: np.ndarray) -> np.ndarray:
-    """Whether each CSR row i of (ptr, ind) equals the key's row ``row[i]``."""
-    kp, ki = key
-    cnt = np.diff(ptr)
-    kc = np.diff(kp)[row]
-    same = cnt == kc
-    sel = np.flatnonzero(same & (cnt > 0))
-    if sel.size:
-        lens = cnt[sel]
-        starts = ptr[sel]
-        kstarts = kp[row[sel]]
-        off = np.arange(int(lens.sum())) - np.repeat(np.cumsum(lens) - lens, lens)
-        a = ind[np.repeat(starts, lens) + off]
-        b = ki[np.repeat(kstarts, lens) + off]
-        bad = np.add.reduceat((a != b).astype(np.int64), np.cumsum(lens) - lens)
-        same[sel] = bad == 0
-    return same
 
 
 def posterior_samples3d(est: Limit3DEstimator, lit_a, lit_b) -> dict[str, np.ndarray]:

@@ -1,0 +1,87 @@
+"""The two exact parts of the spherical limit (:mod:`eyeviz.estimators.limit3d`) that
+every eye model's proposal shares: the prior density of Algorithm 1 in 3D
+(:mod:`eyeviz.dataset.algorithm1_3d`) and the 0/1 likelihood, a draw being kept only when
+the pair's own exact ``lit_csr`` gives both of the key's lit sets and ``in_bfv`` holds."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.estimators.base3d import LitCSR
+
+__all__ = ["exact_hits", "prior_density", "same_rows"]
+
+
+def prior_density(domain: Domain3D, prior: str, r, g, el, az) -> np.ndarray:
+    """The prior density of Algorithm 1 in 3D in (x, y, z, g), up to a constant, at balls
+    of centre (r, az, el) (about :attr:`Domain3D.origin`) and radius g (0 outside its
+    support; the field test and Definition 1 are not applied here).
+
+    HEALPix eyes: in (r, g, el, az) the single-pass density is 1 / (g_max - r sin(gamma /
+    2)) / (pi - 2 az0(r, g, el)) with cos(az0) = cos(psi + asin(g / r)) / cos(el); the
+    multi-pass one r^2 cos(el) / (g_max - r sin(gamma / 2)) / (pi - 2 az0(r, g, el_max)).
+    Measured eyes have no cones (az0 = 0, the azimuth uniform on [0, pi]). Both gain the
+    Jacobian 1 / (r^2 cos el) in (x, y, z, g)."""
+    d = domain
+    s = math.sin(d.gamma / 2)
+    measured = d.kind == "measured"
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ok = (r >= d.r_min) & (r <= d.r_max) & (g >= r * s) & (g <= d.g_max) & (g <= r)
+        ok &= np.abs(el) <= d.el_max
+        cel = np.cos(el)
+        if measured:
+            cone = np.zeros_like(r)
+        else:
+            cone = d.psi + np.arcsin(np.minimum(g / r, 1.0))
+            ok &= cone < math.pi / 2
+        if prior == "multi":
+            az0 = np.arccos(np.minimum(np.cos(cone) / math.cos(d.el_max), 1.0))
+            dens = r * r * cel
+        else:
+            az0 = np.arccos(np.minimum(np.cos(cone) / cel, 1.0))
+            dens = np.ones_like(r)
+        if measured:
+            az0 = np.zeros_like(r)
+        ok &= (az >= az0) & (az <= math.pi - az0)
+        dens = dens / ((d.g_max - r * s) * (math.pi - 2 * az0) * r * r * cel)
+    return np.where(ok & np.isfinite(dens), dens, 0.0)
+
+
+def same_rows(ptr: np.ndarray, ind: np.ndarray, key: LitCSR, row: np.ndarray) -> np.ndarray:
+    """Whether each CSR row i of (ptr, ind) equals the key's row ``row[i]``."""
+    kp, ki = key
+    cnt = np.diff(ptr)
+    kc = np.diff(kp)[row]
+    same = cnt == kc
+    sel = np.flatnonzero(same & (cnt > 0))
+    if sel.size:
+        lens = cnt[sel]
+        starts = ptr[sel]
+        kstarts = kp[row[sel]]
+        off = np.arange(int(lens.sum())) - np.repeat(np.cumsum(lens) - lens, lens)
+        a = ind[np.repeat(starts, lens) + off]
+        b = ki[np.repeat(kstarts, lens) + off]
+        bad = np.add.reduceat((a != b).astype(np.int64), np.cumsum(lens) - lens)
+        same[sel] = bad == 0
+    return same
+
+
+def exact_hits(
+    domain: Domain3D, p: np.ndarray, g: np.ndarray, row: np.ndarray, lit_a: LitCSR, lit_b: LitCSR
+) -> np.ndarray:
+    """The 0/1 likelihood of draws (centres p (D, 3), radii g (D,)) of the keys ``row``
+    (D,): the pair's exact ``lit_csr`` gives both of the key's lit sets and the ball is in
+    the binocular field (``in_bfv``, decided only on the draws that match)."""
+    hit = np.zeros(row.size, bool)
+    if not row.size:
+        return hit
+    x, y, z = p[:, 0], p[:, 1], p[:, 2]
+    (pa, ia), (pb, ib) = domain.eyes.lit_csr(x, y, z, g)
+    match = same_rows(pa, ia, lit_a, row) & same_rows(pb, ib, lit_b, row)
+    at = np.flatnonzero(match)
+    if at.size:
+        hit[at] = domain.eyes.in_bfv(x[at], y[at], z[at], g[at])
+    return hit

@@ -1,0 +1,172 @@
+"""The HEALPix proposal of the spherical limit (:mod:`eyeviz.estimators.limit3d`, module
+docstring steps 1-5): per chunk of keys, each eye's feasible caps from its edge cells
+(:mod:`.limit3d_proposal`), A's box of centres, B's region along A's rays, g where both
+eyes' modelled radii allow it, the prefilter, then the exact check. Only HEALPix eyes
+come here; a measured pair has its own proposal (:mod:`.limit3d_measured`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.estimators.base3d import LitCSR
+from eyeviz.estimators.limit3d_exact import exact_hits, prior_density
+from eyeviz.estimators.limit3d_proposal import (
+    _angle_box,
+    _extent,
+    _Eye,
+    _locate,
+    _prefilter,
+    _ray_in_box,
+    _ray_in_region,
+    _uniforms,
+)
+
+__all__ = ["HealpixProposal"]
+
+#: facet widths the centre search may move: edge cells that cannot bind within them are
+#: dropped before it
+PRUNE = 0.25
+#: zoom levels of the search for the centre (each grid a third as wide)
+LEVELS = 4
+#: grid points and rounds of the search along the ray for B's region
+RAY_GRID = 8
+RAY_ROUNDS = 2
+#: the per-key slack: this many times the model's second-order error in the box
+SLACK_SAFETY = 4.0
+
+
+class HealpixProposal:
+    """Importance draws for keys of a HEALPix pair: :meth:`setup` once per chunk (and
+    window factor ``wide``), then :meth:`sample` per batch of ``samples`` draws."""
+
+    def __init__(self, domain: Domain3D, prior: str, samples: int, grid: int) -> None:
+        self.domain, self.prior, self.samples, self.grid = domain, prior, samples, grid
+
+    def setup(self, lit_a: LitCSR, lit_b: LitCSR, keys: np.ndarray, wide: float) -> dict:
+        """Each eye's edge cells, centre and box of centres for a chunk of keys."""
+        d = self.domain
+        fw = math.sqrt(4 * math.pi / d.npix)
+        A = np.array([-d.h, 0.0, 0.0])
+        B = np.array([d.h, 0.0, 0.0])
+        ea = _Eye(d, lit_a, A, 0)
+        eb = _Eye(d, lit_b, B, 1)
+        n = ea.c.shape[0]
+        slack0 = wide * 0.002 * fw
+        for e in (ea, eb):
+            e.prune(np.full(n, PRUNE * wide * fw))
+            _locate(e, 0.25 * wide * fw, self.grid, LEVELS)
+        ext = _extent(ea, wide * 0.5 * fw, slack0)
+        eb.a = A - B
+        ext_b = _extent(eb, wide * 0.5 * fw, slack0)
+        # within a box of radius R the model's distances are off by second-order terms,
+        # below R^2 (1 / alpha + 1) / 2: a thin posterior (a box far smaller than the
+        # search window) needs a slack far below the window's, or the proposal is
+        # mostly slack (keys with a tiny posterior found nothing in 10^4 draws)
+        sec = np.zeros(n)
+        for e, x in ((ea, ext), (eb, ext_b)):
+            sec = np.maximum(sec, (x * x).sum(axis=1) * (1.0 / e.alpha0 + 1.0))
+        slack = np.minimum(slack0, wide * (SLACK_SAFETY * sec + 1e-7 * fw))[:, None]
+        ext = _extent(ea, wide * 0.5 * fw, slack)
+        ext_b = _extent(eb, wide * 0.5 * fw, slack)
+        ea.prune(1.2 * math.sqrt(2.0) * ext.max(axis=1))
+        eb.prune(1.2 * math.sqrt(2.0) * ext_b.max(axis=1))
+        # A's centre: uniform in (theta, phi) over the bounds of A's box, theta cut to
+        # those of B's box (both caps' centres share the ball's theta: B's box bounds it)
+        box = _angle_box(ea, ext)
+        box_b = _angle_box(eb, ext_b)
+        th_lo = np.fmax(box[:, 0], box_b[:, 0])
+        th_hi = np.fmin(box[:, 1], box_b[:, 1])
+        return dict(A=A, B=B, ea=ea, eb=eb, n=n, slack=slack, ext=ext, ext_b=ext_b,
+                    box=box, th_lo=th_lo, th_hi=th_hi, lit_a=lit_a, lit_b=lit_b)  # fmt: skip
+
+    # long: the weighted draws of one chunk (propose, test the key, weigh) in one pass over shared
+    # arrays
+    def sample(self, st: dict, keys: np.ndarray, stream: int) -> dict[str, np.ndarray]:
+        """``samples`` weighted draws per key of a chunk set up by :meth:`setup`."""
+        d, A, B, ea, eb = self.domain, st["A"], st["B"], st["ea"], st["eb"]
+        n, m, slack, ext, ext_b = st["n"], self.samples, st["slack"], st["ext"], st["ext_b"]
+        box, th_lo, th_hi = st["box"], st["th_lo"], st["th_hi"]
+        u = _uniforms(keys, m, 4, stream)
+        th = th_lo[:, None] + (th_hi - th_lo)[:, None] * u[..., 0]
+        ph = box[:, 2:3] + (box[:, 3] - box[:, 2])[:, None] * u[..., 1]
+        sp = np.sin(ph)
+        ca = np.stack([np.cos(ph), sp * np.cos(th), sp * np.sin(th)], axis=-1)
+        good = np.broadcast_to(((th_hi > th_lo) & (box[:, 3] > box[:, 2]))[:, None], (n, m))
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            delta = ea.gnomonic(np.where(good[..., None], ca, ea.c[:, None, :]))
+        # outside A's box the model region is empty: drawn, then dropped
+        good = good & (np.abs(delta) <= ext[:, None, :]).all(axis=2)
+        delta = np.where(good[..., None], delta, 0.0)
+        ca = np.where(good[..., None], ca, ea.c[:, None, :])
+        lo_a, hi_a = ea.bounds(delta)
+        good = good & (hi_a - lo_a > -2.0 * slack)
+        # along the ray A + c_A / u: u where B's view of it lies in B's box (the
+        # directions from B, c_A + u (A - B), span a great circle: a line in B's
+        # gnomonic coordinates, and each side of the box is linear in u), then in B's
+        # modelled region; on the live draws only (moved to the front of each row)
+        u_lo, u_hi = _ray_in_box(eb, ca, ext_b)
+        u_lo = np.maximum(u_lo, 1.0 / (d.r_max + d.h))
+        if d.r_min > d.h:
+            u_hi = np.minimum(u_hi, 1.0 / (d.r_min - d.h))
+        good = good & (u_hi > u_lo)
+        order = np.argsort(~good, axis=1, kind="stable")[:, : max(1, int(good.sum(1).max()))]
+        sel = np.take_along_axis(good, order, 1)
+
+        def pick(x: np.ndarray) -> np.ndarray:
+            return np.take_along_axis(x, order if x.ndim == 2 else order[..., None], 1)
+
+        c_lo = np.where(sel, pick(u_lo), 1.0 / d.r_max)
+        c_hi = np.where(sel, pick(u_hi), 1.0 / d.r_max)
+        c_lo, c_hi = _ray_in_region(eb, pick(ca), c_lo, c_hi, slack, RAY_GRID, RAY_ROUNDS)
+        rows = np.arange(n)[:, None]
+        u_lo, u_hi = u_lo.copy(), u_hi.copy()
+        u_lo[rows, order] = c_lo
+        u_hi[rows, order] = c_hi
+        u_lo = np.where(good, u_lo, 1.0 / d.r_max)
+        u_hi = np.where(good, u_hi, 1.0 / d.r_max)
+        uu = u_lo + (u_hi - u_lo) * u[..., 2]
+        uu = np.where(good, uu, 1.0 / d.r_max)
+        rho = 1.0 / uu
+        p = A + rho[..., None] * ca
+        r = np.linalg.norm(p, axis=2)
+        vb = p - B
+        rho_b = np.linalg.norm(vb, axis=2)
+        # g: uniform where both eyes' modelled cap radii allow it (and the prior's g range)
+        lo_b, hi_b = eb.bounds(eb.gnomonic(vb / rho_b[..., None]))
+        g_lo, g_hi = r * math.sin(d.gamma / 2), np.full_like(r, d.g_max)
+        for lo_e, hi_e, rh in ((lo_a, hi_a, rho), (lo_b, hi_b, rho_b)):
+            g_lo = np.maximum(g_lo, rh * np.sin(np.clip(lo_e - slack, 0.0, math.pi / 2)))
+            g_hi = np.minimum(g_hi, rh * np.sin(np.clip(hi_e + slack, 0.0, math.pi / 2)))
+        good = good & (g_hi > g_lo)
+        gg = g_lo + (g_hi - g_lo) * u[..., 3]
+        el = np.arcsin(np.clip(p[..., 2] / r, -1, 1))
+        az = np.arctan2(p[..., 1], p[..., 0])
+        alpha = np.arcsin(np.clip(gg / rho, 0.0, 1.0))
+        # d(x, y, z, g) = rho^4 sin(phi) d(u, theta, phi, g); 1 / q = the boxes' volume
+        with np.errstate(over="ignore", invalid="ignore"):
+            vol = (th_hi - th_lo)[:, None] * (box[:, 3] - box[:, 2])[:, None]
+            vol = vol * (u_hi - u_lo) * (g_hi - g_lo)
+            w = prior_density(d, self.prior, r, gg, el, az) * rho**4 * sp * vol
+        w = np.where(good & np.isfinite(w), w, 0.0)
+        # the exact 0/1 likelihood on the draws with prior mass
+        cand = np.flatnonzero(w.ravel() > 0)
+        hit = np.zeros(n * m, bool)
+        if cand.size:  # a cheap necessary condition first
+            row = cand // m
+            pc = p.reshape(-1, 3)[cand]
+            pb_ = pc - B
+            rb = np.linalg.norm(pb_, axis=1)
+            keep = _prefilter(ea, row, ca.reshape(-1, 3)[cand], alpha.ravel()[cand])
+            cand, row, pb_, rb = cand[keep], row[keep], pb_[keep], rb[keep]
+            sin_b = np.minimum(gg.ravel()[cand] / rb, 1.0)
+            keep = _prefilter(eb, row, pb_ / rb[:, None], np.arcsin(sin_b))
+            cand = cand[keep]
+        hit[cand] = exact_hits(
+            d, p.reshape(-1, 3)[cand], gg.ravel()[cand], cand // m, st["lit_a"], st["lit_b"]
+        )
+        w = np.where(hit.reshape(n, m), w, 0.0)
+        return {"r": r, "az": az, "el": el, "g": gg, "x": p[..., 0], "y": p[..., 1],
+                "z": p[..., 2], "w": w}  # fmt: skip
