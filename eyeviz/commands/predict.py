@@ -17,13 +17,14 @@ fixed-design estimator) is refused, never ignored. ``-o`` may not be the input f
 The file's eye design picks its reader (:func:`eyeviz.dataset.kinds.kind_of`, read
 from its meta). A sparse data set (``eyeviz generate --nside`` or ``--eye``) takes an
 estimator of the spherical side that answers for its eyes (``analytic3d``, ``limit3d``,
-``learned3d`` for HEALPix eyes; ``analytic3d`` for a measured pair; docs/spherical.md,
-docs/measured.md): it is read in blocks (:class:`eyeviz.dataset.sparse3d.Sparse3DReader`),
-its design comes from the file (no ``--h --l --m --r-min --r-max --g-max``), and the CSV
-has ``r_hat,azimuth_hat,elevation_hat,flagged`` (radians; ``flagged`` is 1 where the
-estimator answered by its fallback or the row lies outside its domain, e.g. learned3d past
-its training ranges, and the count is on stderr: no such answer is written unmarked,
-issue 36). An estimator that does not answer for
+``learned3d`` for HEALPix eyes; ``analytic3d`` and ``limit3d`` for a measured pair;
+docs/spherical.md, docs/measured.md): it is read in blocks
+(:class:`eyeviz.dataset.sparse3d.Sparse3DReader`), its design comes from the file (no
+``--h --l --m --r-min --r-max --g-max``), and the CSV has
+``r_hat,azimuth_hat,elevation_hat,flagged`` (radians; ``flagged`` is 1 where the
+estimator answered by its fallback or the row lies outside its domain, e.g. learned3d
+past its training ranges, and the count is on stderr: no such answer is written
+unmarked, issue 36). An estimator that does not answer for
 the file's eyes is refused in one line naming those that do.
 
 Exit status (also in ``--help``):

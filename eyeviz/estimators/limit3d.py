@@ -1,5 +1,11 @@
 """The information limit of the spherical eyes: the posterior under the 3D Algorithm 1 prior.
 
+One estimator for every eye model of the spherical side: the prior, the retries and
+top-ups, the estimates and their Monte-Carlo errors are here; the proposal is the
+model's own (HEALPix cells: :mod:`.limit3d_healpix`, the construction below; measured
+facets' acceptance cones: :mod:`.limit3d_measured`); both check every draw exactly with
+the pair's ``lit_csr`` and ``in_bfv`` (:mod:`.limit3d_exact`).
+
 The likelihood of a ball (x, y, z, g) given a key (the two eyes' lit sets) is 0/1: 1
 exactly when ``EyePair3D.lit_csr`` of the ball gives both lit sets (docs/spherical.md,
 3D Proposition 2). The posterior is the prior of :mod:`eyeviz.dataset.algorithm1_3d`
@@ -326,8 +332,9 @@ def posterior_samples3d(est: Limit3DEstimator, lit_a, lit_b) -> dict[str, np.nda
     b = np.asarray(lit_b, np.int64)
     ptr_a = np.array([0, a.size])
     ptr_b = np.array([0, b.size])
-    la = as_csr("lit_a", (ptr_a, a), est.domain.npix)[:2]
-    lb = as_csr("lit_b", (ptr_b, b), est.domain.npix)[:2]
+    na, nb = est.domain.facet_counts
+    la = as_csr("lit_a", (ptr_a, a), na)[:2]
+    lb = as_csr("lit_b", (ptr_b, b), nb)[:2]
     s = est._posterior(la, lb)
     w = s["w"][0]
     keep = w > 0

@@ -423,8 +423,8 @@ for _entry in (
     ),
     Entry(
         "limit3d",
-        "spherical eyes: the information limit (posterior under the 3D Algorithm 1 prior, "
-        "importance-sampled with the exact lit sets)",
+        "spherical and measured eyes: the information limit (posterior under the 3D "
+        "Algorithm 1 prior, importance-sampled with the exact lit sets)",
         "eyeviz.estimators.limit3d:load",
         any_design=True,
         design=None,
@@ -438,6 +438,7 @@ for _entry in (
         ),
         module="eyeviz.estimators.limit3d",
         kind="spherical",
+        models=("spherical", "measured"),
     ),
     Entry(
         "learned3d",

@@ -1,0 +1,398 @@
+"""The measured-eye proposal of the spherical limit (:mod:`eyeviz.estimators.limit3d`).
+
+A measured eye (docs/measured.md) is a list of facets, each a lens p_i, a unit axis a_i
+and a half acceptance angle alpha_i; facet i sees the ball (c, g) iff the ball meets its
+acceptance cone K_i, i.e. iff g >= dist(c, K_i), where with v = c - p_i and theta the angle
+between v and a_i
+
+    dist(c, K_i) = 0 (theta <= alpha_i), |v| sin(theta - alpha_i) (theta - alpha_i < pi/2),
+                   |v| otherwise.
+
+So for a fixed centre c the radii g whose ball lights exactly the key's set of an eye form
+one interval, [max over its lit facets of dist(c, K_i), min over its unlit facets of
+dist(c, K_j)), and the ball must contain no lens (g < |c - p_i|). The proposal reads this
+**feasible region** of each eye from the facets' cones, as the HEALPix proposal reads it
+from the cells (:mod:`.limit3d_healpix`), here without a linearisation:
+
+1. Per eye, the constraining facets of a key: its lit facets and the unlit facets within
+   two rings of axis neighbours of them (:func:`eyeviz.estimators.triangulation.
+   facet_neighbours`). Dropping the other unlit facets only enlarges the region; the exact
+   check decides.
+2. H(c) = min(hi_A, hi_B, g_max, r) - max(lo_A, lo_B, r sin(gamma / 2)) (lo, hi the two
+   ends of each eye's interval; r about the domain's origin): the centre c is feasible
+   iff H(c) > 0.
+3. A reference centre: each eye's best direction at infinity (the maximum of min over
+   unlit facets of (angle(a_j, u) - alpha_j) - max over lit ones of (angle(a_i, u) -
+   alpha_i), zooming grids), the two rays triangulated, then moved to the maximum of H / |c
+   - o_A| on zooming grids (o_A: eye A's lens centroid); facets far from binding there
+   are dropped.
+4. Coordinates that make the region close to a box: delta, A's direction in gnomonic
+   coordinates about the reference, and beta, the angle at o_B between the baseline and
+   the ball (the triangle o_A, o_B, c gives |c - o_A| = |b| sin(beta) / sin(a + beta), a
+   the angle at o_A): A's lit set bounds delta and B's bounds beta. The box: bisection
+   along 26 directions of H >= -slack, the boundary points' box widened ``WIDEN`` times,
+   then widened by half again on each face near which a pilot's feasible draws fall.
+5. A draw: (delta, beta) uniform in the box, g uniform on the feasible interval at that
+   centre. Weight: prior x rho^2 (1 + |delta|^2)^(-3/2) |b| sin(a) / sin(a + beta)^2
+   (d(x, y, z) / d(delta, beta)) x the box's volume x the interval's length. Every draw
+   with a weight is checked exactly (:func:`.limit3d_exact.exact_hits`: the pair's own
+   ``lit_csr``, then ``in_bfv``).
+
+The proposal covers the posterior when the region is close to convex about the reference
+(the widening and the pilot are the margin); the tests compare the answers with
+brute-force rejection sampling from the prior on a small measured eye."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.estimators.analytic3d import estimate
+from eyeviz.estimators.base3d import LitCSR
+from eyeviz.estimators.limit3d_exact import exact_hits, prior_density
+from eyeviz.estimators.limit3d_proposal import _frame, _uniforms
+from eyeviz.estimators.triangulation import facet_neighbours, triangulate_rays
+
+__all__ = ["MeasuredProposal"]
+
+#: bisection steps
+ITERS = 12
+#: widening of the bisection's box, and the pilot draws and rounds that widen it further
+WIDEN = 2.0
+PILOT = 128
+PILOT_ROUNDS = 4
+#: zoom levels of the centre search (each grid 1 / 2.5 as wide) and its points per axis
+LEVELS = 6
+LOCATE = 5
+#: the centre search's first half-width in directions, in facet spacings (about each eye's
+#: best direction at infinity, triangulated), and the reach of the box's bisection
+SEARCH = 1.5
+REACH = 6.0
+#: rings of axis neighbours of the lit facets whose unlit facets constrain
+RINGS = 2
+
+
+_DIRS3 = np.array(
+    [
+        (i, j, k)
+        for i in (-1, 0, 1)
+        for j in (-1, 0, 1)
+        for k in (-1, 0, 1)
+        if (i, j, k) != (0, 0, 0)
+    ],
+    float,
+)
+_DIRS3 /= np.linalg.norm(_DIRS3, axis=1, keepdims=True)
+
+
+class _Facets:
+    """One eye's facets as the proposal reads them: lens positions, unit axes, half
+    acceptance angles and each facet's axis neighbours."""
+
+    def __init__(self, eyes, which: str) -> None:
+        pos, axes, acc = eyes.facets(which)
+        self.pos = np.asarray(pos, np.float64)
+        self.ax = np.asarray(eyes.eye(which).unit_axes, np.float64)
+        self.half = np.asarray(acc, np.float64) / 2
+        self.nb = facet_neighbours(np.asarray(axes, np.float64))
+        self.centre = np.asarray(eyes.eye(which).centroid, np.float64)
+
+
+_FACETS: dict[tuple[str, str], _Facets] = {}
+
+
+def _facets(eyes, which: str) -> _Facets:
+    key = (str(eyes.fingerprint), which)
+    if key not in _FACETS:
+        if len(_FACETS) > 8:
+            _FACETS.clear()
+        _FACETS[key] = _Facets(eyes, which)
+    return _FACETS[key]
+
+
+class _Edges:
+    """The constraining facets of one eye for a chunk of keys, padded to (N, K):
+    positions, axes, half-angles, ``lit`` (must be seen) and ``pad``."""
+
+    def __init__(self, f: _Facets, lit: LitCSR) -> None:
+        ptr, ind = lit
+        n, nf = ptr.size - 1, f.pos.shape[0]
+        rows = np.repeat(np.arange(n), np.diff(ptr))
+        lit_codes = rows * nf + ind
+        ring = lit_codes
+        near = [lit_codes]
+        for _ in range(RINGS):
+            r_, i_ = np.divmod(ring, nf)
+            ring = np.repeat(r_, f.nb.shape[1]) * nf + f.nb[i_].ravel()
+            near.append(ring)
+        allc = np.unique(np.concatenate(near))
+        unlit = allc[~np.isin(allc, lit_codes, assume_unique=True)]
+        codes = np.concatenate([lit_codes, unlit])
+        is_lit = np.concatenate([np.ones(lit_codes.size, bool), np.zeros(unlit.size, bool)])
+        r_all, i_all = np.divmod(codes, nf)
+        order = np.argsort(r_all, kind="stable")
+        r_all, i_all, is_lit = r_all[order], i_all[order], is_lit[order]
+        cnt = np.bincount(r_all, minlength=n)
+        k = max(1, int(cnt.max()) if cnt.size else 1)
+        slot = np.arange(r_all.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        self.pos = np.zeros((n, k, 3))
+        self.ax = np.zeros((n, k, 3))
+        self.ax[..., 0] = 1.0
+        self.half = np.zeros((n, k))
+        self.lit = np.zeros((n, k), bool)
+        self.pad = np.ones((n, k), bool)
+        self.pos[r_all, slot] = f.pos[i_all]
+        self.ax[r_all, slot] = f.ax[i_all]
+        self.half[r_all, slot] = f.half[i_all]
+        self.lit[r_all, slot] = is_lit
+        self.pad[r_all, slot] = False
+        self.pa = np.einsum("nkj,nkj->nk", self.pos, self.ax)[..., None]
+        self.pp = np.einsum("nkj,nkj->nk", self.pos, self.pos)[..., None]
+
+    def prune(self, c: np.ndarray, keep_lit: float = 0.5, keep_unlit: float = 2.0) -> None:
+        """Keep the facets that may bind near the centres c (N, 3): lit ones whose cone
+        lies at least ``keep_lit`` times lo from c, unlit ones within ``keep_unlit`` times
+        hi. (Dropping a constraint only enlarges the region: the exact check decides.)"""
+        dist, _ = self._dist(c[:, None, :])
+        dist = dist[..., 0]
+        live = ~self.pad
+        lo = np.where(self.lit & live, dist, -np.inf).max(axis=1, keepdims=True)
+        hi = np.where(~self.lit & live, dist, np.inf).min(axis=1, keepdims=True)
+        keep = live & np.where(self.lit, dist >= keep_lit * lo, dist <= keep_unlit * hi)
+        k = max(1, int(keep.sum(axis=1).max()))
+        order = np.argsort(~keep, axis=1, kind="stable")[:, :k]
+        for name in ("pos", "ax", "half", "lit", "pa", "pp"):
+            v = getattr(self, name)
+            setattr(
+                self, name, np.take_along_axis(v, order if v.ndim == 2 else order[..., None], 1)
+            )
+        self.pad = ~np.take_along_axis(keep, order, 1)
+
+    def _dist(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(dist(c, K_i), |c - p_i|) (N, K, G) at centres c (N, G, 3)."""
+        ct = np.swapaxes(c, 1, 2)  # (N, 3, G)
+        s = np.matmul(self.ax, ct) - self.pa  # v . a
+        v2 = np.matmul(self.pos, ct) * -2.0 + self.pp + np.einsum("ngj,ngj->ng", c, c)[:, None]
+        v2 = np.maximum(v2, 0.0)
+        q = np.sqrt(np.maximum(v2 - s * s, 0.0))
+        vn = np.sqrt(v2)
+        ex = np.arctan2(q, s) - self.half[..., None]
+        dist = np.where(ex <= 0.0, 0.0, np.where(ex < math.pi / 2, vn * np.sin(ex), vn))
+        return dist, vn
+
+    def bounds(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi) (N, G) at centres c (N, G, 3): the largest distance of a lit cone and
+        the smallest of an unlit cone or of a lit lens (module docstring)."""
+        dist, vn = self._dist(c)
+        lit = (self.lit & ~self.pad)[..., None]
+        unl = (~self.lit & ~self.pad)[..., None]
+        lo = np.where(lit, dist, -np.inf).max(axis=1)
+        hi = np.minimum(
+            np.where(unl, dist, np.inf).min(axis=1), np.where(lit, vn, np.inf).min(axis=1)
+        )
+        return lo, hi
+
+
+def _direction(e: _Edges, grid: int, levels: int = 6) -> np.ndarray:
+    """Per key (N, 3): the direction u maximising G(u) = min over unlit facets of
+    (angle(a_j, u) - alpha_j) - max over lit ones of (angle(a_i, u) - alpha_i), the eye's
+    feasible region at infinity (lens offsets ignored), on zooming grids about the lit
+    facets' mean axis, first as wide as the lit axes' spread and the widest cone."""
+    n = e.pos.shape[0]
+    lit = e.lit & ~e.pad
+    unl = ~e.lit & ~e.pad
+    c = np.where(lit[..., None], e.ax, 0.0).sum(axis=1)
+    c = c / np.linalg.norm(c, axis=1, keepdims=True)
+    spread = np.where(lit, np.arccos(np.clip(np.einsum("nkj,nj->nk", e.ax, c), -1, 1)), 0.0)
+    half = np.tan(np.minimum(spread.max(axis=1) + e.half.max(axis=1), 1.2))
+    t = (np.arange(grid) + 0.5) / grid * 2 - 1
+    g2 = np.stack(np.meshgrid(t, t, indexing="ij"), axis=-1).reshape(-1, 2)
+    for _ in range(levels):
+        e1, e2 = _frame(c)
+        dd = g2[None] * half[:, None, None]
+        v = c[:, None] + dd[..., :1] * e1[:, None] + dd[..., 1:] * e2[:, None]
+        v = v / np.linalg.norm(v, axis=2, keepdims=True)
+        ang = np.arccos(np.clip(np.matmul(e.ax, np.swapaxes(v, 1, 2)), -1, 1)) - e.half[..., None]
+        gv = np.where(unl[..., None], ang, np.inf).min(axis=1)
+        gv = gv - np.where(lit[..., None], ang, -np.inf).max(axis=1)
+        c = v[np.arange(n), np.argmax(gv, axis=1)]
+        half = half / 2.5
+    return c
+
+
+class MeasuredProposal:
+    """Importance draws for keys of a measured pair (module docstring): :meth:`setup`
+    once per chunk, then :meth:`sample` per batch of ``samples`` draws."""
+
+    def __init__(self, domain: Domain3D, prior: str, samples: int, grid: int) -> None:
+        self.domain, self.prior, self.samples, self.grid = domain, prior, samples, grid
+        self.fa = _facets(domain.eyes, "A")
+        self.fb = _facets(domain.eyes, "B")
+        self.origin = np.asarray(domain.origin, np.float64)
+        off = float(np.linalg.norm(self.fa.centre - self.origin))
+        self.w_min = 1.0 / (domain.r_max + off)
+        self.w_max = 1.0 / max(domain.r_min - off, 1e-3 * domain.r_min)
+        self.s_half = math.sin(domain.gamma / 2)
+        b = self.fb.centre - self.fa.centre
+        self.blen = float(np.linalg.norm(b))
+        self.bhat = b / self.blen
+
+    # --- the region ----------------------------------------------------------------------
+    def _h(self, st: dict, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(g_lo, g_hi) (N, G) of centres c (N, G, 3): the radii whose ball lights exactly
+        the key's sets of the constraining facets, within the prior's g range."""
+        d = self.domain
+        lo_a, hi_a = st["ea"].bounds(c)
+        lo_b, hi_b = st["eb"].bounds(c)
+        r = np.linalg.norm(c - self.origin, axis=2)
+        g_lo = np.maximum(np.maximum(lo_a, lo_b), r * self.s_half)
+        g_hi = np.minimum(np.minimum(hi_a, hi_b), np.minimum(r, d.g_max))
+        return g_lo, g_hi
+
+    def _centres(self, st: dict, delta: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """Centres (N, G, 3) at gnomonic offsets delta (N, G, 2) about the reference and
+        w = 1 / distance from o_A (N, G)."""
+        v = st["u0"][:, None, :] + delta[..., :1] * st["e1"][:, None, :]
+        v = v + delta[..., 1:] * st["e2"][:, None, :]
+        v = v / np.linalg.norm(v, axis=2, keepdims=True)
+        return self.fa.centre + v / w[..., None]
+
+    def _bcentres(self, st: dict, delta: np.ndarray, beta: np.ndarray):
+        """(centres (N, G, 3), distance from o_A, d distance / d beta) at gnomonic offsets
+        delta (N, G, 2) of A's direction and angles beta (N, G) at o_B between the
+        baseline and the ball (the triangle o_A, o_B, c: rho = |b| sin(beta) / sin(a +
+        beta), a the angle at o_A). NaN where the rays do not meet in front."""
+        v = st["u0"][:, None, :] + delta[..., :1] * st["e1"][:, None, :]
+        v = v + delta[..., 1:] * st["e2"][:, None, :]
+        v = v / np.linalg.norm(v, axis=2, keepdims=True)
+        a = np.arccos(np.clip(v @ self.bhat, -1.0, 1.0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s_ab = np.sin(a + beta)
+            ok = (beta > 0) & (a + beta < math.pi)
+            rho = np.where(ok, self.blen * np.sin(beta) / s_ab, np.nan)
+            drho = np.where(ok, self.blen * np.sin(a) / (s_ab * s_ab), np.nan)
+        return self.fa.centre + v * rho[..., None], rho, drho
+
+    def _hb(self, st: dict, x: np.ndarray) -> np.ndarray:
+        """H at points x (N, G, 3) = (delta_1, delta_2, beta) (-inf where undefined)."""
+        c, _, _ = self._bcentres(st, x[..., :2], x[..., 2])
+        with np.errstate(invalid="ignore"):
+            g_lo, g_hi = self._h(st, np.nan_to_num(c, nan=1e300))
+        hv = g_hi - g_lo
+        return np.where(np.isfinite(hv), hv, -np.inf)
+
+    # --- the proposal ----------------------------------------------------------------------
+    def setup(self, lit_a: LitCSR, lit_b: LitCSR, keys: np.ndarray, wide: float) -> dict:
+        """Each eye's constraining facets, the reference direction and the box of
+        directions for a chunk of keys (module docstring steps 1-4)."""
+        d = self.domain
+        st: dict = {"ea": _Edges(self.fa, lit_a), "eb": _Edges(self.fb, lit_b)}
+        st["lit_a"], st["lit_b"] = lit_a, lit_b
+        n = lit_a[0].size - 1
+        # a first centre: each eye's best direction at infinity, triangulated (or the
+        # triangulation estimate where those rays do not meet in front)
+        r0, az0, el0, _ = estimate(d, lit_a, lit_b)
+        p0 = self.origin + r0[:, None] * np.stack(
+            [np.cos(el0) * np.cos(az0), np.cos(el0) * np.sin(az0), np.sin(el0)], axis=1
+        )
+        ua, ub = _direction(st["ea"], self.grid), _direction(st["eb"], self.grid)
+        p1, ok = triangulate_rays(self.fa.centre, ua, self.fb.centre, ub)
+        p0 = np.where(ok[:, None], p1, p0)
+        u0 = p0 - self.fa.centre
+        st["u0"] = u0 / np.linalg.norm(u0, axis=1, keepdims=True)
+        st["e1"], st["e2"] = _frame(st["u0"])
+        slack = 1e-7 * d.g_max
+        st["slack"] = slack
+        # the reference: zooming grids over (delta, w) to the maximum of H
+        half = wide * SEARCH * d.gamma
+        wc = np.clip(1.0 / np.linalg.norm(u0, axis=1), self.w_min, self.w_max)
+        wc = np.where(np.isfinite(wc), wc, 0.5 * (self.w_min + self.w_max))
+        wh = np.full(n, 0.5 * (self.w_max - self.w_min))
+        t = (np.arange(LOCATE) + 0.5) / LOCATE * 2 - 1
+        g3 = np.stack(np.meshgrid(t, t, t, indexing="ij"), axis=-1).reshape(-1, 3)
+        dc = np.zeros((n, 2))
+        for _ in range(LEVELS):
+            dd = dc[:, None, :] + g3[None, :, :2] * half
+            ww = np.clip(wc[:, None] + g3[None, :, 2] * wh[:, None], self.w_min, self.w_max)
+            g_lo, g_hi = self._h(st, self._centres(st, dd, ww))
+            b = np.argmax((g_hi - g_lo) * ww, axis=1)  # H / distance: an angle
+            dc = dd[np.arange(n), b]
+            wc = ww[np.arange(n), b]
+            half, wh = half / 2.5, wh / 2.5
+        ref = self._centres(st, dc[:, None, :], wc[:, None])[:, 0]
+        st["ea"].prune(ref)
+        st["eb"].prune(ref)
+        v = ref - self.fa.centre
+        st["u0"] = v / np.linalg.norm(v, axis=1, keepdims=True)
+        st["e1"], st["e2"] = _frame(st["u0"])
+        # the box in (delta, beta): bisection along 26 directions of H >= -slack, the
+        # boundary points' box widened, then widened again where a pilot's feasible
+        # draws come near a face
+        cs = st["u0"] / wc[:, None] - (self.fb.centre - self.fa.centre)
+        cb = np.einsum("nj,j->n", cs, -self.bhat) / np.linalg.norm(cs, axis=1)
+        st["beta0"] = np.arccos(np.clip(cb, -1.0, 1.0))
+        centre = np.stack([np.zeros(n), np.zeros(n), st["beta0"]], axis=1)
+        lo = np.zeros((n, _DIRS3.shape[0]))
+        hi = np.full((n, _DIRS3.shape[0]), wide * REACH * d.gamma)
+        for _ in range(ITERS):
+            mid = 0.5 * (lo + hi)
+            x = centre[:, None, :] + mid[..., None] * _DIRS3[None]
+            inside = self._hb(st, x) >= -slack
+            lo = np.where(inside, mid, lo)
+            hi = np.where(inside, hi, mid)
+        pts = hi[..., None] * _DIRS3[None]  # (N, 26, 3) about the centre
+        box_lo = centre + np.minimum(pts.min(axis=1), 0.0) * WIDEN
+        box_hi = centre + np.maximum(pts.max(axis=1), 0.0) * WIDEN
+        floor = 1e-9 * d.gamma
+        box_lo, box_hi = np.minimum(box_lo, centre - floor), np.maximum(box_hi, centre + floor)
+        up = _uniforms(keys, PILOT, 3, 7)
+        for _ in range(PILOT_ROUNDS):
+            x = box_lo[:, None] + (box_hi - box_lo)[:, None] * up
+            inside = (self._hb(st, x) >= -slack)[..., None]
+            band = 0.1 * (box_hi - box_lo)[:, None]
+            near_lo = (inside & (x < box_lo[:, None] + band)).any(axis=1)
+            near_hi = (inside & (x > box_hi[:, None] - band)).any(axis=1)
+            if not (near_lo.any() or near_hi.any()):
+                break
+            span = box_hi - box_lo
+            box_lo = np.where(near_lo, box_lo - 0.5 * span, box_lo)
+            box_hi = np.where(near_hi, box_hi + 0.5 * span, box_hi)
+        st["box_lo"], st["box_hi"] = box_lo, box_hi
+        return st
+
+    def sample(self, st: dict, keys: np.ndarray, stream: int) -> dict[str, np.ndarray]:
+        """``samples`` weighted draws per key of a chunk set up by :meth:`setup`."""
+        d, m = self.domain, self.samples
+        n = st["u0"].shape[0]
+        u = _uniforms(keys, m, 4, stream)
+        lo, hi = st["box_lo"], st["box_hi"]
+        x = lo[:, None] + (hi - lo)[:, None] * u[..., :3]
+        delta = x[..., :2]
+        c, rho, drho = self._bcentres(st, delta, x[..., 2])
+        good = np.isfinite(rho)
+        c = np.where(good[..., None], c, self.fa.centre + st["u0"][:, None, :] / self.w_min)
+        g_lo, g_hi = self._h(st, c)
+        pad = 1e-9 * g_hi
+        g_lo, g_hi = np.maximum(g_lo - pad, 0.0), g_hi + pad
+        good &= g_hi > g_lo
+        gg = g_lo + (g_hi - g_lo) * u[..., 3]
+        q = c - self.origin
+        r = np.linalg.norm(q, axis=2)
+        el = np.arcsin(np.clip(q[..., 2] / r, -1.0, 1.0))
+        az = np.arctan2(q[..., 1], q[..., 0])
+        with np.errstate(over="ignore", invalid="ignore"):
+            # d(x, y, z) = rho^2 (1 + |delta|^2)^(-3/2) d(delta) d(rho), d(rho) = drho d(beta)
+            jac = rho * rho * (1.0 + (delta * delta).sum(axis=2)) ** -1.5 * drho
+            vol = np.prod(hi - lo, axis=1)[:, None] * (g_hi - g_lo)
+            wt = prior_density(d, self.prior, r, gg, el, az) * jac * vol
+        wt = np.where(good & np.isfinite(wt), wt, 0.0)
+        cand = np.flatnonzero(wt.ravel() > 0)
+        hit = np.zeros(n * m, bool)
+        hit[cand] = exact_hits(
+            d, c.reshape(-1, 3)[cand], gg.ravel()[cand], cand // m, st["lit_a"], st["lit_b"]
+        )
+        wt = np.where(hit.reshape(n, m), wt, 0.0)
+        return {"r": r, "az": az, "el": el, "g": gg, "x": c[..., 0], "y": c[..., 1],
+                "z": c[..., 2], "w": wt}  # fmt: skip

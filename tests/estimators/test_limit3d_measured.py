@@ -1,0 +1,114 @@
+"""The information limit for a measured eye pair (limit3d's measured proposal) against
+brute-force rejection sampling from the prior on a small eye with per-facet acceptance."""
+
+from __future__ import annotations
+
+import collections
+
+import numpy as np
+import pytest
+
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.measured import MeasuredEye, MeasuredEyePair
+from eyeviz.dataset.algorithm1_3d import generate3d
+from eyeviz.estimators import registry
+from eyeviz.estimators.analytic3d import estimate
+from eyeviz.estimators.base3d import take_rows
+from eyeviz.estimators.limit3d import Limit3DEstimator, posterior_samples3d, prior_density
+from eyeviz.estimators.weighted import weighted_median
+
+
+def small_pair(n_dirs: int = 90, seed: int = 0) -> MeasuredEyePair:
+    """40 facets per eye: lenses on spheres of radius 0.5 about (-/+2, 0, 0) looking
+    outwards (the front of a Fibonacci sphere), acceptance angles 0.3-0.5 rad per facet."""
+    rng = np.random.default_rng(seed)
+    k = np.arange(n_dirs) + 0.5
+    z = 1 - 2 * k / n_dirs
+    phi = np.pi * (1 + 5**0.5) * k
+    d = np.stack([np.sqrt(1 - z * z) * np.cos(phi), np.sqrt(1 - z * z) * np.sin(phi), z], 1)
+    d = d[d[:, 1] > 0.1]
+    eyes = [
+        MeasuredEye(np.array([sx, 0.0, 0.0]) + 0.5 * d, d, rng.uniform(0.3, 0.5, len(d)), name=nm)
+        for sx, nm in ((-2.0, "A"), (2.0, "B"))
+    ]
+    return MeasuredEyePair(eyes[0], eyes[1], name="small")
+
+
+@pytest.fixture(scope="module")
+def small():
+    """The keys drawn most often among 12,000 prior draws of the small pair: each group
+    of rows sharing a key is a sample of that key's exact posterior (rejection sampling)."""
+    dom = Domain3D.for_eyes(small_pair(), r_min=4.0, r_max=12.0, g_max=1.5, el_max=0.6)
+    ds = generate3d(12_000, dom, seed=3)
+    groups = collections.defaultdict(list)
+    for i in range(len(ds)):
+        a, b = ds.lit(i)
+        groups[(a.tobytes(), b.tobytes())].append(i)
+    top = sorted(groups.values(), key=len, reverse=True)[:6]
+    rows = np.array([g[0] for g in top])
+    lit = (take_rows(ds.indptr_a, ds.indices_a, rows), take_rows(ds.indptr_b, ds.indices_b, rows))
+    return dom, ds, [np.array(g) for g in top], lit
+
+
+def test_the_small_pair_has_per_facet_acceptance(small):
+    dom = small[0]
+    acc = dom.eyes.eye_a.acceptance
+    assert dom.facet_counts == (40, 40) and np.unique(acc).size == 40
+
+
+def test_matches_rejection_sampling_on_a_small_measured_eye(small):
+    dom, ds, groups, lit = small
+    p = Limit3DEstimator(dom, samples=1024).predict(*lit)
+    assert not p.flagged.any() and (p.n_accepted >= 20).all()
+    z = []
+    for j, g in enumerate(groups):
+        r = ds.r[g]
+        want = weighted_median(r[None], 1.0 / r[None])[0]  # MAPE-optimal, as the limit's
+        se = np.hypot(1.2533 * r.std() / np.sqrt(g.size), p.mc_error[j] * p.r[j])
+        z.append((p.r[j] - want) / se)
+        el = ds.elevation[g]
+        assert abs(p.elevation[j] - np.median(el)) < 4 * 1.2533 * el.std() / np.sqrt(g.size) + 0.02
+    z = np.array(z)
+    assert np.all(np.abs(z) < 4.0), z
+    assert abs(z.mean()) < 1.5, z  # no bias shared by the keys (the mean of 6 has sd 0.41)
+
+
+def test_posterior_samples_reproduce_the_key(small):
+    dom, ds, groups, _ = small
+    a, b = ds.lit(int(groups[0][0]))
+    s = posterior_samples3d(Limit3DEstimator(dom, samples=256), a, b)
+    assert s["x"].size > 0 and np.isclose(s["weight"].sum(), 1.0)
+    for k in range(min(5, s["x"].size)):
+        la, lb = dom.eyes.lit(s["x"][k], s["y"][k], s["z"][k], s["g"][k])
+        assert np.array_equal(la, a) and np.array_equal(lb, b)
+    o = np.asarray(dom.origin)
+    r = np.linalg.norm(np.c_[s["x"], s["y"], s["z"]] - o, axis=1)
+    assert np.allclose(r, s["r"])  # r about the domain's origin, as the data set's
+
+
+def test_an_empty_posterior_is_flagged_and_answered_by_triangulation(small):
+    """A key no ball makes (eye A's two outermost facets on opposite sides): no draw is
+    accepted; the row is flagged and gets the triangulation's answer."""
+    dom = small[0]
+    ax = dom.eyes.eye_a.unit_axes
+    i, j = int(np.argmin(ax[:, 0])), int(np.argmax(ax[:, 0]))
+    la = (np.array([0, 2]), np.sort(np.array([i, j])))
+    lb = (np.array([0, 2]), np.array([0, 1]))
+    p = Limit3DEstimator(dom, samples=64).predict(la, lb)
+    assert p.flagged[0] and p.n_accepted[0] == 0 and np.isnan(p.mc_error[0])
+    r, az, el, _ = estimate(dom, la, lb)
+    assert (p.r[0], p.azimuth[0], p.elevation[0]) == (r[0], az[0], el[0])
+
+
+def test_the_measured_prior_has_no_cones():
+    dom = Domain3D.for_eyes(small_pair(), r_min=4.0, r_max=12.0, g_max=1.5, el_max=0.6)
+    r, g = np.full(3, 6.0), np.full(3, 1.2)
+    el, az = np.array([0.1, 0.1, 0.7]), np.array([0.01, 1.5, 1.5])  # near the baseline
+    p = prior_density(dom, "single", r, g, el, az)
+    assert p[0] > 0 and p[0] == p[1] and p[2] == 0  # uniform in azimuth; el beyond el_max
+
+
+def test_the_registry_loads_limit3d_for_measured_eyes(small):
+    assert "limit3d" in registry.available_for("measured")
+    est = registry.load("limit3d", domain=small[0])
+    assert isinstance(est, Limit3DEstimator) and est.domain.kind == "measured"
