@@ -386,3 +386,15 @@ def test_set_trajectory_without_a_valid_selection_uses_the_defaults():
         assert (t.kind, t.distance, t.g) == ("vertical", 2000.0, 50.0) and m.scene.shows(
             "trajectory"
         )
+
+
+def test_set_trajectory_of_the_present_kind_shows_a_hidden_layer_and_keeps_the_path():
+    m, _ = make()
+    interactions.set_trajectory(m, "circular")
+    path = m.scene.trajectory
+    m.set_layer("trajectory", False)
+    assert not m.scene.shows("trajectory")
+    interactions.set_trajectory(m)  # the present kind: the layer comes back, same path
+    assert m.scene.shows("trajectory") and m.scene.trajectory == path
+    interactions.set_trajectory(m, "circular")
+    assert m.scene.shows("trajectory") and m.scene.trajectory == path
