@@ -46,7 +46,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--planar-balls", type=int, default=400, help="features of the planar design (400)"
     )
     parser.add_argument(
-        "--bee-balls", type=int, default=120, help="balls at the honeybee (default 120)"
+        "--bee-balls", type=int, default=60, help="balls at the honeybee (default 60)"
     )
     parser.add_argument(
         "--healpix-balls",

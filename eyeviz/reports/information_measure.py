@@ -25,8 +25,9 @@ h of the ball) is dropped, which can only raise the bound.
 **The binary limit** beside it: the relative RMS error of r of the best estimate from the
 bitmaps the project has for that model, on the same balls: the planar information limit
 (:mod:`eyeviz.estimators.limit`, the posterior's MAPE-optimal answer), limit3d for the
-HEALPix eyes, and for a measured pair (no limit there yet) the analytic triangulation
-(:func:`eyeviz.estimators.analytic3d.estimate_measured`, an upper bound of the limit).
+HEALPix eyes and for a measured pair (where limit3d refuses a measured pair, the
+analytic triangulation, :func:`eyeviz.estimators.analytic3d.estimate_measured`, an upper
+bound of the limit).
 
 Grades beat the bitmaps, in RMS relative error over the balls, from
 N* = mean(C / r^2) / (binary RMS)^2 photons a facet.
@@ -246,20 +247,26 @@ def measure_measured(
     name: str, pair, n: int, seed: int, kind: str = "gaussian", rel_step: float = STEP
 ) -> ModelResult:
     """A measured pair at its own scale (Domain3D.for_eyes), Algorithm 1 in 3D; the
-    binary side is the analytic triangulation (no limit for measured eyes yet)."""
+    binary side is limit3d (the analytic triangulation where limit3d refuses the pair)."""
+    from eyeviz import EyevizError
     from eyeviz.core.domain3d import Domain3D
     from eyeviz.dataset.algorithm1_3d import generate3d
+    from eyeviz.estimators import limit3d
     from eyeviz.estimators.analytic3d import estimate_measured
 
     dom = Domain3D.for_eyes(pair)
     ds = generate3d(n, dom, seed=seed)
     theta = np.stack([ds.x, ds.y, ds.z, ds.g], axis=1)
-    r_hat = estimate_measured(dom, (ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b))[0]
+    lit_a, lit_b = (ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b)
+    try:
+        r_hat, binary = limit3d.load(dom).predict(lit_a, lit_b)[0], "information limit (limit3d)"
+    except EyevizError:
+        r_hat, binary = estimate_measured(dom, lit_a, lit_b)[0], "analytic triangulation"
     return _result(
         name,
         f"{name} ({pair.facet_counts[0] + pair.facet_counts[1]:,} facets), {kind} kernel",
         kind,
-        "analytic triangulation (analytic3d)",
+        binary,
         theta,
         np.asarray(dom.origin),
         measured_fn(pair, kind),
