@@ -116,6 +116,9 @@ def test_bitmaps_follow_the_state(qtbot):
 
 
 def test_bitmaps_at_nside_180_draw_only_the_lit_facets(qtbot):
+    """Facets under a pixel wide: no polygons; the lit facets are painted as pixels (each
+    pixel the facet under its centre, and each lit facet's centre pixel) in their balls'
+    colours, and nothing else of the map changes colour."""
     sc = load(SCENES / "sphere_paper.toml")
     st = compute_state3d(sc)
     panel = _panel(qtbot, Bitmaps3DPanel)
@@ -125,12 +128,32 @@ def test_bitmaps_at_nside_180_draw_only_the_lit_facets(qtbot):
     (back,) = [c for c in ax.collections if c not in (*panel._lit["A"], panel._halo["A"])]
     assert len(back.get_paths()) == 1  # the unlit sphere: one solid ellipse
     inner, edge = panel._lit["A"]
-    drawn = sum(int((p.codes == p.MOVETO).sum()) for c in (inner, edge) for p in c.get_paths())
-    assert drawn == _union(st, "A").size < 2000
-    assert len(inner.get_paths()) == sc.features.__len__()  # one compound path per ball
+    assert not inner.get_paths() and not edge.get_paths()  # painted as pixels instead
+    ras = panel._raster["A"]
+    union = _union(st, "A")
+    np.testing.assert_array_equal(ras.pix, union)
     far = [f.name for f in sc.features].index("far")  # the largest patch, off the equator
     target = _interior_facet(panel, "A", st.lit(far, "A"), 180)
     assert _near(_color_at(panel, _canvas_px(panel, "A", target)), _rgb(sc.features[far].color))
+    # every lit facet shows: its centre's pixel has its ball's colour (the last ball
+    # lighting the facet; another lit facet sharing the pixel may be painted after it)
+    r, c = ras._centres(union)
+    buf = np.asarray(panel.canvas.buffer_rgba())
+    colors = {_rgb(f.color) for f in sc.features}
+    eq = buf.shape[0] - 1 - int(ax.transData.transform((0.0, 0.0))[1])  # drawn over
+    shown = [tuple(int(v) for v in buf[i, j, :3]) for i, j in zip(r, c, strict=True)]
+    assert (
+        all(
+            any(_near(rgb, k, 4) for k in colors)
+            for rgb, i in zip(shown, r, strict=True)
+            if abs(i - eq) > 2
+        )
+        and (np.abs(r - eq) > 2).sum() > 100
+    )
+    # the map's unlit pixels keep the background: one painted pixel per lit facet at most,
+    # plus the pixels whose centres lie in lit facets
+    painted = ras.paint(buf.copy(), np.zeros(4, np.uint8))
+    assert union.size <= painted <= 2 * union.size + 2000
 
 
 def test_hidden_bitmaps_layer_hides_the_maps(qtbot):

@@ -41,6 +41,7 @@ from matplotlib.patches import Polygon
 from PyQt5 import QtCore, QtWidgets
 
 from eyeviz.app.panels.common import follows_text_scale, text_scale, wrap_label
+from eyeviz.app.panels.lit_raster import LitRaster
 from eyeviz.model.facet_patches import FacetPatches, facet_patches, patches_caption
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
@@ -182,6 +183,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         # per eye: the lit facets and their outlines (base, across the edge, second copies)
         self._geom: dict[str, tuple[np.ndarray, ...]] = {}
         self._outlines: dict[str, _Outlines] = {}
+        # eyes of sub-pixel facets (above MAX_ALL_FACETS): lit facets painted as pixels
+        self._raster: dict[str, LitRaster] = {}
         self._over: list = []  # animated artists drawn over the lit facets, in order
         self._hover_coll: PolyCollection | None = None
         self._texts: list[tuple] = []  # the maps' words (matplotlib Text, size at scale 1)
@@ -295,6 +298,10 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             pix, ball = lit_owners(csr)
             key = b"".join((pix.tobytes(), ball.tobytes(), rgba.tobytes()))
             self.owners[eye] = (pix, ball)
+            if eye in self._raster:
+                changed |= self._set_raster(eye, csr, pix, ball, rgba, key)
+                counts.append(f"{eye} {pix.size:,}")
+                continue
             if self._set_halo(eye, csr, pix, key):
                 changed = True
             if self._keys.get(eye) == key:
@@ -322,6 +329,19 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         if changed:
             self._repaint()
         self.update_ms = (time.perf_counter() - t0) * 1e3
+
+    def _set_raster(self, eye: str, csr, pix, ball, rgba, key: bytes) -> bool:
+        """Eye ``eye``'s lit facets and the selected ball's, painted as pixels
+        (:class:`LitRaster`); True when they changed."""
+        i = self.selected
+        indptr, idx = csr
+        mine = idx[indptr[i] : indptr[i + 1]] if i is not None else idx[:0]
+        key = b"".join((key, b"" if i is None else np.int64(i).tobytes(), mine.tobytes()))
+        if self._keys.get(eye) == key:
+            return False
+        self._keys[eye] = key
+        self._raster[eye].set(pix, ball, rgba, mine)
+        return True
 
     def _set_halo(self, eye: str, csr, pix: np.ndarray, key: bytes) -> bool:
         """Outline the selected ball's lit facets on eye ``eye`` (``pix`` all lit facets,
@@ -351,6 +371,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
     def outlined(self, eye: str) -> int:
         """How many facet outlines the selected ball's outline on eye ``eye`` holds (its
         lit facets, those across the map's edge twice; tests)."""
+        if eye in self._raster:
+            return int(self._raster[eye].sel.size)
         h = self._halo.get(eye)
         if h is None:
             return 0
@@ -369,6 +391,10 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self.nside = nside
         self.patches = patches
         self._outlines = {e: _Outlines(p) for e, p in patches.items()}
+        halo_px = round(HALO_LW / 2 * self.fig.dpi / 72)
+        self._raster = {
+            e: LitRaster(p, halo_px) for e, p in patches.items() if p.n > MAX_ALL_FACETS
+        }
         self._keys = {}
         self._halo_keys = {}
         self._geom = {}
@@ -450,6 +476,11 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self._fit_text()
 
     def _draw_over(self) -> None:
+        if self._raster:  # sub-pixel facets: straight into the canvas's pixels
+            buf = np.asarray(self.canvas.buffer_rgba())
+            ink = np.round(to_rgba_array([INK])[0] * 255).astype(np.uint8)
+            for r in self._raster.values():
+                r.paint(buf, ink)
         for _, artist in self._over:
             if isinstance(artist, PathCollection) and not artist.get_paths():
                 continue  # nothing lit or selected on that map: not even a draw call
@@ -460,6 +491,10 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
     def _on_draw(self, _event) -> None:
         """After a full draw: keep the background, then paint the animated parts."""
         self._bg = self.canvas.copy_from_bbox(self.fig.bbox)
+        if self._raster:  # the figure's pixels may have moved (a resize)
+            height = np.asarray(self.canvas.buffer_rgba()).shape[0]
+            for eye, r in self._raster.items():
+                r.layout(self.axes[eye], height)
         self._draw_over()
 
     def _repaint(self) -> None:
