@@ -17,8 +17,8 @@ Fast updates: what does not change with the balls (the unlit sphere: at most
 outline, otherwise one solid ellipse; the graticule) is drawn once and kept as a pixel
 background; a new state sets the lit facets' polygons in place and repaints them, the
 selected ball's outline and the equator over that background (blitting). Only the lit
-facets are polygons: a ball at the paper's distances lights a few hundred of nside 180's
-388,800 facets per eye. The maps are drawn in the exact Mollweide projection
+facets are polygons; above MAX_ALL_FACETS facets an eye (facets under a pixel wide) they
+are painted as pixels instead (:mod:`eyeviz.app.panels.lit_raster`). The maps are drawn in the exact Mollweide projection
 (:func:`eyeviz.render.mpl.facet_map.mollweide`) on plain axes, so the point under the
 mouse is inverted in closed form and handed to the provider
 (:func:`~eyeviz.render.mpl.facet_map.facet_at`): hovering shows the facet's index, its
