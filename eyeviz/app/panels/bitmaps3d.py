@@ -18,7 +18,8 @@ outline, otherwise one solid ellipse; the graticule) is drawn once and kept as a
 background; a new state sets the lit facets' polygons in place and repaints them, the
 selected ball's outline and the equator over that background (blitting). Only the lit
 facets are polygons; above MAX_ALL_FACETS facets an eye (facets under a pixel wide) they
-are painted as pixels instead (:mod:`eyeviz.app.panels.lit_raster`). The maps are drawn in the exact Mollweide projection
+are painted as pixels instead (:mod:`eyeviz.app.panels.lit_raster`). The maps are drawn
+in the exact Mollweide projection
 (:func:`eyeviz.render.mpl.facet_map.mollweide`) on plain axes, so the point under the
 mouse is inverted in closed form and handed to the provider
 (:func:`~eyeviz.render.mpl.facet_map.facet_at`): hovering shows the facet's index, its
