@@ -1,7 +1,9 @@
 """``eyeviz study -o STUDY.csv``: the eye-design study (issue 11) on Dask.
 
 With ``--nside LIST`` the 3D design study of the spherical eyes instead (issue 23;
-:mod:`eyeviz.study.point3d`): the same resumable runner, a table of its own.
+:mod:`eyeviz.study.point3d`): the same resumable runner, a table of its own. With
+``--eye NAME`` the study over a shipped measured pair reshaped, fewer facets
+(``--facets``) or a wider head (``--widen``) (:mod:`eyeviz.study.point_measured`).
 
 For every design (h, l, m) of the grid with l < h, the information limit's DD and AD
 error (MAPE, Eq. 34; R^2, Eq. 35) overall and per distance bin, one row per design and
@@ -66,6 +68,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "docs/spherical.md), e.g. 16,32,64; a table of its own",
     )
     parser.add_argument(
+        "--eye",
+        default=None,
+        metavar="NAME",
+        help="the study over a measured pair instead: a shipped eye (e.g. AM_60185-real.eye) "
+        "with fewer facets (--facets) or a wider head (--widen); a table of its own",
+    )
+    parser.add_argument(
+        "--facets",
+        default=None,
+        metavar="LIST",
+        help="with --eye: fractions of each eye's facets kept (in (0, 1]); default 1,0.5,0.25",
+    )
+    parser.add_argument(
+        "--widen",
+        default=None,
+        metavar="LIST",
+        help="with --eye: baseline factors (the eyes moved apart); default 1,2",
+    )
+    parser.add_argument(
         "--el-max",
         default=None,
         metavar="RAD",
@@ -98,21 +119,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--r-min",
-        default=DEFAULTS["r_min"],
+        default=None,
         metavar="R",
-        help=f"nearest object distance; default {DEFAULTS['r_min']:g}",
+        help=f"nearest object distance; default {DEFAULTS['r_min']:g} (--eye: the pair's)",
     )
     parser.add_argument(
         "--r-max",
-        default=DEFAULTS["r_max"],
+        default=None,
         metavar="R",
-        help=f"farthest object distance; default {DEFAULTS['r_max']:g}",
+        help=f"farthest object distance; default {DEFAULTS['r_max']:g} (--eye: the pair's)",
     )
     parser.add_argument(
         "--g-max",
-        default=DEFAULTS["g_max"],
+        default=None,
         metavar="G",
-        help=f"largest object size; default {DEFAULTS['g_max']:g}",
+        help=f"largest object size; default {DEFAULTS['g_max']:g} (--eye: the pair's)",
     )
     parser.add_argument(
         "--workers",
@@ -152,7 +173,11 @@ def _seed(args: argparse.Namespace) -> int:
 
     if args.seed is not None:
         return _int("seed", args.seed)
-    if args.nside is not None:
+    if args.eye is not None:
+        from eyeviz.study.point_measured import StudyTableMeasured
+
+        keys, at = StudyTableMeasured.open(args.output).keys, -2  # (..., n, seed, estimator)
+    elif args.nside is not None:
         from eyeviz.study.table3d import StudyTable3D
 
         keys, at = StudyTable3D.open(args.output).keys, -2  # (..., n, seed, estimator)
@@ -175,18 +200,47 @@ def _seed(args: argparse.Namespace) -> int:
     return seed
 
 
+def _measured_points(args: argparse.Namespace, given: dict, seed: int) -> list:
+    """``--eye``: the measured study's points (eyeviz.study.point_measured)."""
+    from eyeviz import EyevizError
+    from eyeviz.study.point_measured import measured_grid
+
+    if args.nside is not None or args.m is not None:
+        raise EyevizError("--eye is the measured study; --m and --nside are the model eyes'")
+    common = {k: None if v is None else _float(k, v) for k, v in given.items()}
+    if args.el_max is not None:
+        common["el_max"] = _float("el_max", args.el_max)
+    return measured_grid(
+        args.eye,
+        "1,0.5,0.25" if args.facets is None else args.facets,
+        "1,2" if args.widen is None else args.widen,
+        **common,
+        prior=args.prior,
+        n=_int("n", args.n if args.n is not None else 300),
+        seed=seed,
+        estimator=args.estimator or "analytic3d",
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     import logging
 
     from eyeviz import EyevizError
+    from eyeviz.core.domain import DEFAULTS
     from eyeviz.study import design_grid, run_study
     from eyeviz.study.grid import DEFAULT_M
     from eyeviz.study.kinds import open_table
 
-    r_min, r_max = _float("r_min", args.r_min), _float("r_max", args.r_max)
-    g_max, seed = _float("g_max", args.g_max), _seed(args)
+    given = {k: getattr(args, k) for k in ("r_min", "r_max", "g_max")}
+    ranges = {k: _float(k, DEFAULTS[k] if v is None else v) for k, v in given.items()}
+    r_min, r_max, g_max = ranges["r_min"], ranges["r_max"], ranges["g_max"]
+    if args.eye is None and (args.facets is not None or args.widen is not None):
+        raise EyevizError("--facets and --widen reshape a measured pair: they need --eye")
+    seed = _seed(args)
     points: list = []
-    if args.nside is not None:
+    if args.eye is not None:
+        points = _measured_points(args, given, seed)
+    elif args.nside is not None:
         from eyeviz.core.domain3d import DEFAULT_EL_MAX
         from eyeviz.study.grid3d import DEFAULT_N3D, design_grid3d
         from eyeviz.study.point3d import DEFAULT_ESTIMATOR

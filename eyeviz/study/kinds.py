@@ -14,18 +14,26 @@ from collections.abc import Sequence
 from eyeviz import EyevizError
 from eyeviz.study.point import COLUMNS, DesignPoint
 from eyeviz.study.point3d import COLUMNS3D, DesignPoint3D, evaluate3d
+from eyeviz.study.point_measured import (
+    COLUMNS_MEASURED,
+    DesignPointMeasured,
+    StudyTableMeasured,
+    is_table_measured,
+)
 from eyeviz.study.table import StudyTable
 from eyeviz.study.table3d import StudyTable3D, is_table3d
 
 __all__ = ["POINT_TYPES", "Point", "columns_of", "evaluate3d", "open_table"]
 
-POINT_TYPES = (DesignPoint, DesignPoint3D)
+POINT_TYPES = (DesignPoint, DesignPoint3D, DesignPointMeasured)
 #: A point of either kind.
-Point = DesignPoint | DesignPoint3D
+Point = DesignPoint | DesignPoint3D | DesignPointMeasured
 
 
 def columns_of(point: Point) -> tuple[str, ...]:
     """The table columns of ``point``'s kind."""
+    if isinstance(point, DesignPointMeasured):
+        return COLUMNS_MEASURED
     return COLUMNS3D if isinstance(point, DesignPoint3D) else COLUMNS
 
 
@@ -36,6 +44,10 @@ def open_table(path, points: Sequence) -> StudyTable:
         raise EyevizError("a study's points must be all planar (m) or all 3D (nside), not both")
     if kinds == {DesignPoint3D}:
         return StudyTable3D.open(path)
+    if kinds == {DesignPointMeasured}:
+        return StudyTableMeasured.open(path)
+    if is_table_measured(path):
+        raise EyevizError(f"{path}: a measured study table (eyeviz study --eye); give another -o")
     if is_table3d(path):
         raise EyevizError(
             f"{path}: a 3D study table (eyeviz study --nside); the planar study (--m) "

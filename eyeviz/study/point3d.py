@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 
@@ -158,7 +159,7 @@ def elevation_bins(el_max: float, k: int = EL_BINS) -> np.ndarray:
     return np.linspace(-el_max, el_max, k + 1)
 
 
-def _load(point: DesignPoint3D):
+def _load(point: Any):
     """A ``predict(lit_a, lit_b) -> (r, azimuth, elevation, flagged)`` for the point."""
     d = point.domain
     from eyeviz.estimators import registry
@@ -197,7 +198,7 @@ def _errors(r, az, el, rh, ah, eh) -> dict[str, float]:
 _METRICS = ("dd_mape", "ad_mape", "el_mae_deg", "az_mae_deg", "dd_r2", "ad_r2", "el_r2")
 
 
-def evaluate3d(point: DesignPoint3D, bin_width: float = BIN_WIDTH) -> list[dict]:
+def evaluate3d(point: Any, bin_width: float = BIN_WIDTH) -> list[dict]:
     """Rows of the 3D study table for one point: ``"all"``, the distance bins ``"r<i>"``,
     the elevation bins ``"e<j>"`` (see this module's docstring for the columns)."""
     from eyeviz.dataset.algorithm1_3d import iter_chunks3d, make_params3d
@@ -214,8 +215,11 @@ def evaluate3d(point: DesignPoint3D, bin_width: float = BIN_WIDTH) -> list[dict]
             parts[k].append(np.asarray(v))
     r, az, el, rh, ah, eh, fl = (np.concatenate(v) for v in parts.values())
     seconds = time.perf_counter() - t0
-    base = {"version": STUDY3D_VERSION, **point.to_dict(), "m": point.m,
-            "gamma": 2 * math.pi / point.m}  # fmt: skip
+    # a measured eyes' point (eyeviz.study.point_measured) has its own version, columns,
+    # h and l (of the reshaped pair) and gamma (its interommatidial angle)
+    base = {"version": getattr(point, "VERSION", STUDY3D_VERSION), "h": point.h, "l": point.l,
+            **point.to_dict(), "m": point.m,
+            "gamma": getattr(point, "gamma", 2 * math.pi / point.m)}  # fmt: skip
     bins: list[tuple[str, float, float, np.ndarray]] = [
         ("all", point.r_min, point.r_max, np.ones(r.size, bool))
     ]
@@ -237,5 +241,5 @@ def evaluate3d(point: DesignPoint3D, bin_width: float = BIN_WIDTH) -> list[dict]
             row.update(dict.fromkeys(_METRICS, math.nan))
         row["flagged"] = int(fl[sel].sum())
         row["seconds"] = seconds
-        rows.append({k: row[k] for k in COLUMNS3D})
+        rows.append({k: row[k] for k in getattr(point, "COLUMNS", COLUMNS3D)})
     return rows

@@ -203,7 +203,11 @@ def _check_values(fmt: TableFormat, where: str, row: dict, point) -> None:
     """What the report's figures rely on, for the runner and the report alike."""
     if row["m"] != point.m:  # a 3D row's m is 4 nside; a planar one's is the design's
         raise EyevizError(f"{where}: m = {row['m']} is not 4 nside = {point.m}")
-    if not math.isclose(row["gamma"], 2 * math.pi / row["m"], rel_tol=1e-9):
+    gamma = getattr(point, "gamma", None)  # a measured pair's: its interommatidial angle
+    if gamma is not None:
+        if not math.isclose(row["gamma"], gamma, rel_tol=1e-9):
+            raise EyevizError(f"{where}: gamma = {row['gamma']:g} is not the eyes' {gamma:g}")
+    elif not math.isclose(row["gamma"], 2 * math.pi / row["m"], rel_tol=1e-9):
         raise EyevizError(f"{where}: gamma = {row['gamma']:g} is not 2 pi / m for m = {row['m']}")
     count = row["count"]
     if count > row["n"]:
