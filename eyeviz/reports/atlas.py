@@ -21,7 +21,7 @@ mm or baselines, ``--el-max``, ``--mode``):
 Output (written into a staging folder, moved in whole): ``atlas.md``, ``atlas_summary.csv``,
 ``atlas_bins.csv``, ``atlas_field.csv``, ``atlas_times.csv`` and the figures
 ``atlas_field``, ``atlas_distance``, ``atlas_rule``, ``atlas_scaling``, ``atlas_angles``,
-each as PNG and SVG. Defaults (300 rows, 150 limit rows, 1-degree grid) keep the whole
+each as PNG and SVG. Defaults (300 rows, 40 limit rows, 1-degree grid) keep the whole
 atlas of the three shipped pairs to a few minutes on one core.
 """
 
@@ -90,7 +90,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--rows", type=int, default=300, help="test balls per pair (default 300)")
     parser.add_argument(
-        "--limit-rows", type=int, default=150, help="rows the limit is run on (default 150)"
+        "--limit-rows", type=int, default=40, help="rows the limit is run on (default 40)"
     )
     parser.add_argument("--bins", type=int, default=5, help="distance bins (default 5)")
     parser.add_argument(
