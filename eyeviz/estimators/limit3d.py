@@ -61,8 +61,9 @@ The slacks make the proposal's support cover the posterior's (the tests compare 
 brute-force rejection sampling from the prior at nside 4), and the exact check makes the
 likelihood exact whatever the linearisation's error; the price of a loose proposal is
 fewer accepted samples, not bias. A key whose Monte-Carlo error of r exceeds
-``MC_TARGET``, or whose effective sample size is below ``MIN_ESS``, gets ``TOPUP`` more
-batches of draws. A key with no accepted sample is
+``accuracy`` (default ``MC_TARGET``), or whose effective sample size is below ``MIN_ESS``,
+gets more batches of draws until it is not, at most ``max_batches`` batches in all (a key
+still above its target then is marked ``mc_capped``). A key with no accepted sample is
 drawn again, more times (``RETRY``: its posterior is a small part of the proposal; more
 draws find it where wider windows did not); a key still empty is answered by the analytic
 triangulation and ``flagged``.
@@ -97,9 +98,12 @@ _same = same_rows  # the exact check's row comparison (kept under its old name)
 PRIORS = ("single", "multi")
 #: the retries of keys with no accepted draw: (window and slack factor, batches of draws)
 RETRY = ((1.0, 8), (2.5, 24), (1.0, 96))
-#: the Monte-Carlo error of r a key's draws are topped up to (at most TOPUP more batches)
+#: the default accuracy: the relative Monte-Carlo error of r a key's draws are topped up
+#: to, batch by batch, at most MAX_BATCHES batches in all (docs/limit3d_accuracy.md)
 MC_TARGET = 0.01
-TOPUP = 1
+MAX_BATCHES = 16
+#: the largest ``max_batches`` a Limit3DEstimator takes
+MAX_BATCHES_BOUND = 256
 #: a key whose effective sample size is below this is topped up too (one or two accepted
 #: draws give a Monte-Carlo error of 0 or none at all, not a small one)
 MIN_ESS = 4.0
@@ -109,7 +113,7 @@ MAX_GRID = 64
 #: keys processed together
 _CHUNK = 8
 #: The most facets per eye a key may light and still be sampled: each exact check of a
-#: draw costs about its lit count, and a draw is checked up to (1 + TOPUP + sum of
+#: draw costs about its lit count, and a draw is checked up to (max_batches + sum of
 #: RETRY's batches) x samples times. A key beyond it, or beyond what any ball of the
 #: domain can light (:func:`max_lit`), gets no draws: its posterior is empty (or too
 #: costly to find) and it is answered by analytic3d and flagged (issue 35: a row lighting
@@ -152,11 +156,15 @@ class Limit3DEstimator(Estimator3D):
         samples: int = 256,
         grid: int = 8,
         seed: int = 0,
+        accuracy: float = MC_TARGET,
+        max_batches: int = MAX_BATCHES,
     ) -> None:
         if prior not in PRIORS:
             raise ValueError(f"prior must be one of {PRIORS}, got {prior!r}")
         # bounded so that one chunk's draws and grid fit in memory
-        for name, v, lo, hi in (("samples", samples, 4, MAX_SAMPLES), ("grid", grid, 4, MAX_GRID)):
+        ints = (("samples", samples, 4, MAX_SAMPLES), ("grid", grid, 4, MAX_GRID),
+                ("max_batches", max_batches, 1, MAX_BATCHES_BOUND))  # fmt: skip
+        for name, v, lo, hi in ints:
             if not isinstance(v, int | np.integer) or isinstance(v, bool) or not lo <= v <= hi:
                 raise ValueError(f"{name} must be an integer >= {lo} and <= {hi}, got {v!r}")
         # the seed is xor-ed into the keys' uint64 hashes
@@ -171,9 +179,15 @@ class Limit3DEstimator(Estimator3D):
         self.samples = int(samples)
         self.grid = int(grid)
         self.seed = int(seed)
+        ok = isinstance(accuracy, float | int | np.floating) and not isinstance(accuracy, bool)
+        if not (ok and 0.0 < float(accuracy) <= 1.0):
+            raise ValueError(f"accuracy must be a number > 0 and <= 1, got {accuracy!r}")
+        self.accuracy = float(accuracy)
+        self.max_batches = int(max_batches)
         self._proposal = _proposal(domain, prior, self.samples, self.grid)
         self.last_mc_error: np.ndarray = np.zeros(0)
         self.last_accepted: np.ndarray = np.zeros(0, np.int64)
+        self.last_capped: np.ndarray = np.zeros(0, bool)
 
     # --- the posterior of a chunk of keys ------------------------------------------------
     def _draw(
@@ -189,23 +203,19 @@ class Limit3DEstimator(Estimator3D):
         eye model's proposal set up once, ``reps`` batches of draws)."""
         prop = self._proposal
         st = prop.setup(lit_a, lit_b, keys, wide)
-        m = self.samples
         parts = [prop.sample(st, keys, stream + 8 * rep) for rep in range(reps)]
         out = {k: np.concatenate([q[k] for q in parts], axis=1) for k in parts[0]}
         if reps > 1:
             return out
         # top-ups: a key with too few or too spread draws (_needs_more) gets another batch
-        # (its own stream; the other keys' draws are left as they are)
-        for rep in range(1, 1 + TOPUP):
-            need = _needs_more(out["r"], out["w"])
+        # (its own stream; the other keys' draws are left as they are), up to max_batches
+        for rep in range(1, self.max_batches):
+            need = _needs_more(out["r"], out["w"], self.accuracy)
             if not need.any():
                 break
             more = prop.sample(st, keys, stream + 8 * rep)
             more["w"] = np.where(need[:, None], more["w"], 0.0)
             out = {k: np.concatenate([out[k], more[k]], axis=1) for k in out}
-        if out["w"].shape[1] > m:  # the accepted draws first, in draw order
-            order = np.argsort(~(out["w"] > 0), axis=1, kind="stable")[:, :m]
-            out = {k: np.take_along_axis(v, order, 1) for k, v in out.items()}
         return out
 
     def _posterior(self, lit_a: LitCSR, lit_b: LitCSR):
@@ -223,8 +233,7 @@ class Limit3DEstimator(Estimator3D):
             sub_a, sub_b = take_rows(*lit_a, few), take_rows(*lit_b, few)
             s2 = self._draw(sub_a, sub_b, keys[few], wide, stream, reps)
             order = np.argsort(~(s2["w"] > 0), axis=1, kind="stable")[:, :m]
-            for k in s:
-                s[k][few] = np.take_along_axis(s2[k], order, 1)
+            s = _put_rows(s, few, {k: np.take_along_axis(v, order, 1) for k, v in s2.items()})
         return s
 
     def _predict_csr(self, lit_a: LitCSR, lit_b: LitCSR):
@@ -235,6 +244,7 @@ class Limit3DEstimator(Estimator3D):
         empty = np.zeros(n, bool)
         mc = np.full(n, np.nan)
         acc = np.zeros(n, np.int64)
+        cap = np.zeros(n, bool)
         # keys no ball of the domain lights, or too costly to sample: no draws (flagged)
         most = min(MAX_KEY_LIT, max_lit(self.domain))
         over = (np.diff(lit_a[0]) > most) | (np.diff(lit_b[0]) > most)
@@ -256,30 +266,38 @@ class Limit3DEstimator(Estimator3D):
             r[rows], az[rows], el[rows] = rr, aa, ee
             empty[rows] = e
             acc[rows] = (w > 0).sum(axis=1)
+            cap[rows] = ~e & _needs_more(sm["r"], w, self.accuracy)
         if empty.any():
             idx = np.flatnonzero(empty)
             fr, fa, fe, _ = estimate(self.domain, take_rows(*lit_a, idx), take_rows(*lit_b, idx))
             r[idx], az[idx], el[idx] = fr, fa, fe
         self._mc_parts.append(mc)
         self._acc_parts.append(acc)
+        self._cap_parts.append(cap)
         return r, az, el, empty
 
     def predict(self, lit_a, lit_b) -> Prediction3D:
-        """As :meth:`Estimator3D.predict`, plus ``mc_error`` and ``n_accepted`` (also in
-        :attr:`last_mc_error`, :attr:`last_accepted`); NaN / 0 on invalid rows."""
+        """As :meth:`Estimator3D.predict`, plus ``mc_error``, ``n_accepted`` and
+        ``mc_capped`` (the key's error is still above ``accuracy`` after ``max_batches``
+        batches; also in :attr:`last_mc_error`, :attr:`last_accepted`,
+        :attr:`last_capped`); NaN / 0 / False on invalid rows."""
         self._mc_parts: list[np.ndarray] = []
         self._acc_parts: list[np.ndarray] = []
+        self._cap_parts: list[np.ndarray] = []
         p: Any = super().predict(lit_a, lit_b)
         valid = np.atleast_1d(p.valid)
         mc = np.full(valid.shape, np.nan)
         acc = np.zeros(valid.shape, np.int64)
+        cap = np.zeros(valid.shape, bool)
         if self._mc_parts:
             mc[valid] = np.concatenate(self._mc_parts)
             acc[valid] = np.concatenate(self._acc_parts)
+            cap[valid] = np.concatenate(self._cap_parts)
         scalar = np.ndim(p.valid) == 0
         p.mc_error = mc[0] if scalar else mc
         p.n_accepted = acc[0] if scalar else acc
-        self.last_mc_error, self.last_accepted = mc, acc
+        p.mc_capped = cap[0] if scalar else cap
+        self.last_mc_error, self.last_accepted, self.last_capped = mc, acc, cap
         return p
 
     def __repr__(self) -> str:
@@ -314,14 +332,29 @@ def _spread(r: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
     return mean, sd, ess
 
 
-def _needs_more(r: np.ndarray, w: np.ndarray) -> np.ndarray:
+def _put_rows(s: dict, rows: np.ndarray, new: dict) -> dict:
+    """``s`` with its rows ``rows`` replaced by ``new``'s (the narrower padded with
+    zero-weight draws)."""
+    ws, wn = s["w"].shape[1], new["w"].shape[1]
+    if wn < ws:
+        new = {k: np.pad(v, ((0, 0), (0, ws - wn)), mode="edge") for k, v in new.items()}
+        new["w"][:, wn:] = 0.0
+    elif wn > ws:
+        s = {k: np.pad(v, ((0, 0), (0, wn - ws)), mode="edge") for k, v in s.items()}
+        s["w"][:, ws:] = 0.0
+    for k in s:
+        s[k][rows] = new[k]
+    return s
+
+
+def _needs_more(r: np.ndarray, w: np.ndarray, target: float = MC_TARGET) -> np.ndarray:
     """The keys to top up: the relative Monte-Carlo error of r, 1.2533 sd_w(r) / sqrt(ESS)
-    / mean_w(r), above ``MC_TARGET``, or an ESS below ``MIN_ESS`` (one or two accepted
+    / mean_w(r), above ``target``, or an ESS below ``MIN_ESS`` (one or two accepted
     draws give an error of 0 or none at all, not a small one), or nothing accepted."""
     mean, sd, ess = _spread(r, w)
     with np.errstate(invalid="ignore", divide="ignore"):
         mc = 1.2533 * sd / np.sqrt(ess) / mean
-    return ~(ess >= MIN_ESS) | ~(mc <= MC_TARGET)
+    return ~(ess >= MIN_ESS) | ~(mc <= target)
 
 
 def posterior_samples3d(est: Limit3DEstimator, lit_a, lit_b) -> dict[str, np.ndarray]:

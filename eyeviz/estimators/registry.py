@@ -435,6 +435,19 @@ for _entry in (
                 default=None,
                 help="limit: prior over features, single or multi pass (default single)",
             ),
+            _opt(
+                "--accuracy",
+                type=float,
+                default=None,
+                help="limit3d: target Monte-Carlo error of r per key, relative; draws are "
+                "added until it is met, at most --max-batches batches (default 0.01)",
+            ),
+            _opt(
+                "--max-batches",
+                type=int,
+                default=None,
+                help="limit3d: the most batches of draws per key (default 16)",
+            ),
         ),
         module="eyeviz.estimators.limit3d",
         kind="spherical",

@@ -227,3 +227,31 @@ def test_the_largest_seed_is_taken():
     ds = generate3d(3, D16, seed=5)
     p = Limit3DEstimator(D16, samples=64, seed=2**64 - 1).predict_dataset(ds)
     assert np.isfinite(p.r).all()
+
+
+def test_the_accuracy_setting_adds_draws_until_the_error_is_met():
+    """A tighter target gives more accepted draws and a smaller stated error on every key
+    that is not capped; one batch with a target no key meets marks the keys capped."""
+    ds = generate3d(6, D16, seed=9)
+    loose = Limit3DEstimator(D16, samples=64, accuracy=0.5).predict_dataset(ds)
+    tight = Limit3DEstimator(D16, samples=64, accuracy=0.02).predict_dataset(ds)
+    ok = ~tight.mc_capped & ~tight.flagged
+    assert ok.any() and (tight.mc_error[ok] <= 0.02).all()
+    assert (tight.n_accepted >= loose.n_accepted).all()
+    assert tight.n_accepted.sum() > loose.n_accepted.sum()
+    capped = Limit3DEstimator(D16, samples=64, accuracy=1e-6, max_batches=1).predict_dataset(ds)
+    assert capped.mc_capped[~capped.flagged].all()
+
+
+@pytest.mark.parametrize(
+    ("kw", "want"),
+    [
+        ({"accuracy": 0.0}, "accuracy must be a number > 0 and <= 1, got 0.0"),
+        ({"accuracy": float("nan")}, "accuracy must be a number > 0 and <= 1, got nan"),
+        ({"accuracy": "x"}, "accuracy must be a number > 0 and <= 1, got 'x'"),
+        ({"max_batches": 0}, "max_batches must be an integer >= 1 and <= 256, got 0"),
+    ],
+)
+def test_a_bad_accuracy_is_refused_in_one_line(kw, want):
+    with pytest.raises(ValueError, match="^" + re.escape(want)):
+        Limit3DEstimator(D16, **kw)
