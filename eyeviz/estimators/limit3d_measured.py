@@ -278,7 +278,7 @@ class MeasuredProposal:
     def _hb(self, st: dict, x: np.ndarray) -> np.ndarray:
         """H at points x (N, G, 3) = (delta_1, delta_2, beta) (-inf where undefined)."""
         c, _, _ = self._bcentres(st, x[..., :2], x[..., 2])
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore", over="ignore"):
             g_lo, g_hi = self._h(st, np.nan_to_num(c, nan=1e300))
         hv = g_hi - g_lo
         return np.where(np.isfinite(hv), hv, -np.inf)
