@@ -357,6 +357,22 @@ class EyePair3D(LitSetViews):
                 out.append((np.zeros(1, np.int64), np.zeros(0, np.int64)))
         return out[0], out[1]
 
+    def responses(self, x, y, z, g, kind: str | None = None):
+        """Graded responses per eye (A, B): (indptr, indices, values), the lit sets of
+        :meth:`lit_csr` with each lit cell's share of its area inside the ball's cap of
+        directions from the eye centre (kind ``"cell"``, the only one; docs/responses.md)."""
+        from eyeviz.core.responses import check_kind, healpix_values
+
+        check_kind("spherical", kind)
+        csr = self.lit_csr(x, y, z, g)  # validates the balls
+        xa, ya, za, ga = validate_balls(x, y, z, g)
+        balls = tuple(np.ascontiguousarray(a).reshape(-1) for a in (xa, ya, za, ga))
+        out = []
+        for (indptr, indices), cx in zip(csr, (-self.h, self.h), strict=True):
+            vals = healpix_values(self.nside, cx, balls, indptr, indices)
+            out.append((indptr, indices, vals))
+        return out[0], out[1]
+
     def in_bfv(self, x, y, z, g) -> np.ndarray:
         """The closed ball lies in the 3D binocular field of view (Prop. 4 generalised).
 

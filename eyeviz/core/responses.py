@@ -23,12 +23,18 @@ from eyeviz import EyevizError
 from eyeviz.core.responses_balls import ball_cap
 from eyeviz.core.responses_caps import flat_response, gaussian_response
 
-__all__ = ["KINDS_BY_MODEL", "check_kind", "measured_values", "planar_responses"]
+__all__ = [
+    "KINDS_BY_MODEL",
+    "check_kind",
+    "healpix_values",
+    "measured_values",
+    "planar_responses",
+]
 
 #: The kinds each model answers, its default first.
 KINDS_BY_MODEL: dict[str, tuple[str, ...]] = {
     "planar": ("cell",),
-    "spherical": (),  # HEALPix cells: to come
+    "spherical": ("cell",),
     "measured": ("flat", "gaussian"),
 }
 
@@ -85,6 +91,26 @@ def measured_values(
     if kind == "flat":
         return flat_response(a, b, theta)
     return gaussian_response(a, b, theta, support)
+
+
+def healpix_values(
+    nside: int,
+    cx: float,
+    balls: tuple[np.ndarray, ...],
+    indptr: np.ndarray,
+    indices: np.ndarray,
+) -> np.ndarray:
+    """The ``cell`` responses of one HEALPix eye (centre (cx, 0, 0)): each lit cell's
+    share of its area inside the ball's cap of directions from the centre
+    (:func:`eyeviz.core.responses_cells.cell_fraction`)."""
+    from eyeviz.core.responses_cells import cell_fraction
+
+    bi = _rows(indptr)
+    x, y, z, g = (v[bi] for v in balls)
+    v, b = ball_cap((x, y, z), (np.full(x.size, cx), np.zeros(x.size), np.zeros(x.size)), g)
+    theta_c = np.arctan2(np.hypot(v[0], v[1]), v[2])
+    phi_c = np.mod(np.arctan2(v[1], v[0]), 2 * math.pi)
+    return cell_fraction(nside, indices, theta_c, phi_c, b)
 
 
 def planar_responses(eyes, xf: np.ndarray, yf: np.ndarray, gf: np.ndarray) -> tuple[CSR3, CSR3]:

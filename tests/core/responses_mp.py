@@ -80,3 +80,38 @@ def ball_angles(c, p, axis, g):
         dot = sum(x * y for x, y in zip(v, ax, strict=True))
         th = mp.atan2(mp.sqrt(sum(x * x for x in cr)), dot)
         return th, b
+
+
+def healpix_cell_share(nside: int, pix: int, w, b: float) -> float:
+    """Share of HEALPix cell ``pix`` inside the cap of radius b about the unit vector w,
+    in the face chart (x, y), where HEALPix is equal-area with a constant Jacobian: the
+    outer integral over x by QUADPACK, the inner length in y from the sign changes of
+    cos(angle to w) - cos b on 257 points, each refined by brentq."""
+    import numpy as np
+    from scipy import optimize
+
+    from eyeviz.core import healpix
+
+    ix, iy, face = (int(v[0]) for v in healpix.pix2xyf(nside, np.array([pix])))
+    cb = math.cos(b)
+    vs = np.linspace(0.0, 1.0, 257)
+
+    def f(u: float, v) -> np.ndarray:
+        p = healpix.xyf2vec(nside, ix + u, iy + np.asarray(v, float), face)
+        return p @ np.asarray(w, float) - cb
+
+    def inner(u: float) -> float:
+        vals = f(u, vs)
+        inside = 0.0
+        edges = [0.0]
+        for j in np.flatnonzero(np.signbit(vals[:-1]) != np.signbit(vals[1:])):
+            edges.append(optimize.brentq(lambda v: float(f(u, v)), vs[j], vs[j + 1], xtol=1e-15))
+        edges.append(1.0)
+        for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+            if float(f(u, (lo + hi) / 2)) >= 0:
+                inside += hi - lo
+        return inside
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", integrate.IntegrationWarning)
+        return integrate.quad(inner, 0.0, 1.0, epsabs=1e-12, epsrel=1e-12, limit=400)[0]
