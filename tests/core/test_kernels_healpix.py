@@ -92,7 +92,7 @@ def test_eyeviz_jit_0_runs_the_reference(monkeypatch):
         raise AssertionError("kernel called with EYEVIZ_JIT=0")
 
     monkeypatch.setattr(hl, "lit_runs_kernel", boom)
-    monkeypatch.setattr(hl, "lit_csr_kernel", boom)
+    monkeypatch.setattr(hl, "csr_kernel", boom)
     la, lb = g3.EyePair3D(40.0, 20.0, 16).lit(10.0, 500.0, 20.0, 60.0)
     assert la.size > 10 and lb.size > 10
     monkeypatch.setenv("EYEVIZ_JIT", "1")

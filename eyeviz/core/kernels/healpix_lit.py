@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["lit_runs_kernel", "lit_csr_kernel", "warm"]
+__all__ = ["lit_runs_kernel", "csr_kernel", "warm"]
 
 _EPS = 2.0**-52
 _DP = 64 * _EPS
@@ -522,7 +522,7 @@ def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2
 
 
 @_jit
-def _csr(status, per, st, ln):
+def csr_kernel(status, per, st, ln):
     """(indptr, indices) from the runs (geometry3d._runs_to_csr, compiled); no indices
     when a ball was handed back (geometry3d merges the reference's runs first)."""
     indptr = np.zeros(per.shape[0] + 1, np.int64)
@@ -540,24 +540,8 @@ def _csr(status, per, st, ln):
     return indptr, out
 
 
-@_jit
-def lit_csr_kernel(n, x, y, z, g, h, sth, zr, unit, first_t, nr_t, shifted_t, delta_t, o_t):
-    """Both eyes (A at x = -h, then B at h) in one call: per eye (status, indptr, indices,
-    run starts, run lengths, run balls) as :func:`lit_runs_kernel`, with the CSR written
-    from the runs (indices empty when some ball has status 1)."""
-    sa, pa, sta, lna, bla = lit_runs_kernel(
-        n, x, y, z, g, -h, sth, zr, unit, first_t, nr_t, shifted_t, delta_t, o_t
-    )
-    sb, pb, stb, lnb, blb = lit_runs_kernel(
-        n, x, y, z, g, h, sth, zr, unit, first_t, nr_t, shifted_t, delta_t, o_t
-    )
-    ia, xa = _csr(sa, pa, sta, lna)
-    ib, xb = _csr(sb, pb, stb, lnb)
-    return (sa, ia, xa, sta, lna, bla), (sb, ib, xb, stb, lnb, blb)
-
-
 def warm() -> None:
-    """Compile (or load from the cache) :func:`lit_runs_kernel` and :func:`lit_csr_kernel`
+    """Compile (or load from the cache) :func:`lit_runs_kernel` and :func:`csr_kernel`
     for their one signature, on the ring tables of nside 4 (geometry3d's, built here from
     eyeviz.core.healpix)."""
     from eyeviz.core import healpix
@@ -570,5 +554,7 @@ def warm() -> None:
     first, nr, shifted = healpix.ring_info(n, np.clip(k, 1, 4 * n - 1))
     delta, o = 2 * math.pi / nr, np.where(shifted, 0.0, -0.5)
     x, y, z, g = (np.array(v, np.float64) for v in ([0.0], [100.0], [5.0], [30.0]))
-    lit_runs_kernel(n, x, y, z, g, 40.0, sth, zr, unit, first, nr, shifted, delta, o)
-    lit_csr_kernel(n, x, y, z, g, 40.0, sth, zr, unit, first, nr, shifted, delta, o)
+    status, per, st, ln, _ = lit_runs_kernel(
+        n, x, y, z, g, 40.0, sth, zr, unit, first, nr, shifted, delta, o
+    )
+    csr_kernel(status, per, st, ln)
