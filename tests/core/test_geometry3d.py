@@ -52,6 +52,8 @@ def test_attributes_and_shapes():
     assert np.array_equal(wa[0, 0], np.isin(np.arange(432), ia[pa[0] : pa[1]]))
     with pytest.raises(ValueError, match=r"g \(feature radius\) must be > 0"):
         e.lit_csr([1.0, 2.0], 0.0, 0.0, [1.0, -1.0])
+    with pytest.raises(ValueError, match=r"g \(feature radius\) must be > 0: 1 value"):
+        e.lit_csr([1.0, 2.0], 500.0, 0.0, [1.0, 0.0])  # a point is not a ball
     with pytest.raises(ValueError, match=r"z has 1 non-finite"):
         e.bitmaps(0.0, 1.0, np.nan, 1.0)
     with pytest.raises(ValueError, match="eye must be 'A' or 'B'"):
