@@ -222,6 +222,8 @@ def _measured_points(args: argparse.Namespace, given: dict, seed: int) -> list:
     )
 
 
+# long: the command's one sequence (options checked, grid built, the study run, the table
+# written), each step with its own one-line error
 def run(args: argparse.Namespace) -> int:
     import logging
 
