@@ -45,6 +45,7 @@ from eyeviz.core import healpix
 from eyeviz.model import shapes3d
 from eyeviz.model.camera3d import Camera3D, eyes_camera, project
 from eyeviz.model.facets3d import surface_of
+from eyeviz.model.labels3d import Named3D, place_named
 from eyeviz.model.predictions3d import Predictions3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
@@ -438,6 +439,7 @@ def draw_view(
     layers=None,
     *,
     geometry: bool = True,
+    predictions: Predictions3D | None = None,
 ) -> PolyCollection | None:
     """One part of the view through ``cam`` on ``ax``, whose box must have width /
     height = ``aspect``: one collection of polygons and lines (the plane's grid and the
@@ -454,60 +456,52 @@ def draw_view(
         coll.set_gid(f"view-{part}")
         ax.add_collection(coll, autolim=False)
     if "labels" in shown:
-        _labels(ax, state, scene, cam, aspect, part, shown)
+        _labels(ax, state, scene, cam, aspect, part, shown, predictions)
     ax.set_xlim(-1.0, 1.0)
     ax.set_ylim(-1.0, 1.0)
     ax.set_axis_off()
     return coll
 
 
-def _labels(ax, state, scene, cam, aspect, part, shown) -> None:
-    pair = state.pair
-    if part == "eyes" and "eyes" in shown:
-        pts = np.array([c + (0.0, 0.0, -1.55 * pair.l) for c in _centres(state)])
-        xy, depth = project(cam, pts, aspect)
-        for (x, y), d, t in zip(xy, depth, ("eye A", "eye B"), strict=True):
-            if d > 0 and abs(x) < 1 and abs(y) < 1:
-                ax.text(x, y, t, fontsize=SMALL + 1, color=INK_RGBA, ha="center", va="center")
-    if part == "scene" and "features" in shown and scene.features:
-        _ball_labels(ax, scene, cam, aspect)
-
-
-def _ball_labels(ax, scene: Scene, cam: Camera3D, aspect: float) -> None:
-    """Each ball's name beside the top of the ball (to its left near the right edge), or
-    below the ball when that would overlap a name already placed (boxes estimated from
-    the text's length: the same in the PNG and the SVG, no renderer needed)."""
-    top, _ = project(cam, np.array([[f.x, f.y, f.z + f.g] for f in scene.features]), aspect)
-    low, _ = project(cam, np.array([[f.x, f.y, f.z - f.g] for f in scene.features]), aspect)
-    _, depth = project(cam, np.array([[f.x, f.y, f.z] for f in scene.features]), aspect)
+def _labels(ax, state, scene, cam, aspect, part, shown, predictions=None) -> None:
+    """The eyes' names (close-up) and the balls' names (scene), each beside what it names
+    and over nothing else: :func:`eyeviz.model.labels3d.place_named`, as the app places
+    them (text boxes estimated from the text's length: the same in the PNG and the SVG)."""
     pos = ax.get_position()
     fig_w, fig_h = ax.figure.get_size_inches()
-    ax_w, ax_h = max(pos.width * fig_w, 1e-6), max(pos.height * fig_h, 1e-6)
+    w_pt, h_pt = max(pos.width * fig_w * 72.0, 1e-6), max(pos.height * fig_h * 72.0, 1e-6)
     size = SMALL + 1
-    line = 2.0 * size * 1.25 / 72.0 / ax_h  # a line's height, axes data units
-    placed: list[tuple[float, float, float, float]] = []
-    for i, f in enumerate(scene.features):
-        (x, y), (xl, yl), d = top[i], low[i], depth[i]
-        if not (d > 0 and abs(x) < 1 and abs(y) < 1):
+    eyes = np.array([(*c, state.pair.l) for c in _centres(state)], float)
+    feats = scene.features if "features" in shown else []
+    balls = np.array([(f.x, f.y, f.z, f.g) for f in feats], float).reshape(-1, 4)
+    if part == "eyes" and "eyes" in shown:
+        texts, cols = ["eye A", "eye B"], [INK_RGBA, INK_RGBA]
+        named = Named3D(eyes[:, :3], eyes[:, 3], _text_sizes(texts, size), eyes[:0], below=True)
+    elif part == "scene" and feats:
+        texts = [short(f.name, 16) for f in feats]
+        cols = [f.color for f in feats]
+        others = [eyes]
+        if predictions is not None and "predictions" in shown:
+            gh = [(a.x, a.y, a.z, predictions.g) for a in predictions.ghosts()]
+            others.append(np.array(gh, float).reshape(-1, 4))
+        named = Named3D(
+            balls[:, :3], balls[:, 3], _text_sizes(texts, size), np.concatenate(others)
+        )
+    else:
+        return
+    boxes = place_named(named, cam, w_pt, h_pt)
+    for box, t, col in zip(boxes, texts, cols, strict=True):
+        if not np.isfinite(box).all():
             continue
-        name = short(f.name, 16)
-        w = 2.0 * (len(name) + 1) * 0.6 * size / 72.0 / ax_w
-        right = x + w < 0.99
-        x0 = x if right else x - w
-        box = (x0, y, x0 + w, y + line)
-        va = "bottom"
-        if any(_overlap(box, b) for b in placed):  # below the ball instead
-            x, y, va = xl, yl, "top"
-            right = x + w < 0.99
-            x0 = x if right else x - w
-            box = (x0, y - line, x0 + w, y)
-        placed.append(box)
-        ax.text(x, y, f" {name}" if right else f"{name} ", fontsize=size, color=f.color,
-                ha="left" if right else "right", va=va, parse_math=False)  # fmt: skip
+        x, y = 2.0 * box[0] / w_pt - 1.0, 2.0 * box[1] / h_pt - 1.0
+        if abs(x) < 1 and abs(y) < 1:
+            ax.text(x, y, t, fontsize=size, color=col, ha="left", va="bottom",
+                    parse_math=False, gid="name3d")  # fmt: skip
 
 
-def _overlap(a: tuple[float, ...], b: tuple[float, ...]) -> bool:
-    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+def _text_sizes(texts: list[str], size: float) -> np.ndarray:
+    """Each text's width and height in points at ``size`` (estimated from its length)."""
+    return np.array([(len(t) * 0.6 * size, 1.2 * size) for t in texts], float).reshape(-1, 2)
 
 
 def draw_panel(
@@ -557,7 +551,8 @@ def draw_panel(
             pcam = eyes_camera(cam, abs(cb[0] - ca[0]) / 2.0, state.pair.l, aspect)
         else:
             pcam = cam
-        draw_view(ax, state, scene, pcam, aspect, part, layers, geometry=image is None)
+        draw_view(ax, state, scene, pcam, aspect, part, layers, geometry=image is None,
+                  predictions=predictions)  # fmt: skip
         shown = scene.layers if layers is None else layers
         if part == "scene" and image is None and "predictions" in shown:
             draw_ghosts(ax, predictions, pcam, aspect)

@@ -18,14 +18,17 @@ from eyeviz.model.facets3d import EyeSurface
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.style3d import CONE_OPACITY, EYE_CONE
+from eyeviz.model.labels3d import Named3D
 from eyeviz.render.vtk.eyes3d import LABEL_PX
+from eyeviz.render.vtk.names3d import named_of
 from eyeviz.render.vtk.painter3d import Painter3D, lit, palette
-from eyeviz.render.vtk.primitives import actor, set_rgb, text3d, text_size, write_points
+from eyeviz.render.vtk.primitives import actor, set_rgb, text3d, write_points
 from eyeviz.render.vtk.style import INK, rgbf
 
 __all__ = ["CONE_RES", "BallsPainter"]
 
 SELECT_RGB = INK
+RING = 1.3  # the selection's great circles' radius, in ball radii
 CONE_RES = 40
 
 
@@ -48,7 +51,7 @@ class BallsPainter(Painter3D):
     def __init__(self, scene_ren, eyes_ren) -> None:
         super().__init__(scene_ren, eyes_ren)
         self.unit_ball = pv.Sphere(radius=1.0, theta_resolution=40, phi_resolution=24)
-        self.unit_ring = _great_circles(1.3)
+        self.unit_ring = _great_circles(RING)
         self.ball_actors: list[vtkActor] = []
         self.ball_labels: list = []
         self.select_actor: vtkActor | None = None
@@ -67,7 +70,7 @@ class BallsPainter(Painter3D):
             lab = text3d(LABEL_PX, rgbf(f.color))
             lab.GetTextProperty().SetJustificationToLeft()
             lab.GetTextProperty().SetVerticalJustificationToBottom()
-            lab.SetInput(f" {f.name}")
+            lab.SetInput(f.name)
             self.add(lab, eyes=False)
             self.ball_labels.append(lab)
         n = len(scene.features)
@@ -100,19 +103,17 @@ class BallsPainter(Painter3D):
         self.near_cone_actor.GetProperty().SetOpacity(CONE_OPACITY)
         self.add(self.near_cone_actor, scene=False)
 
-    def label_boxes(self, dpi: int) -> list[tuple[tuple[float, float, float], float, float]]:
-        """Each shown ball label's anchor (model point) and text width and height in
-        pixels (VTK's own text renderer), for :func:`eyeviz.render.vtk.scene3d.fit_labels`."""
-        out = []
-        for lab in self.ball_labels:
-            if not lab.GetVisibility() or not lab.GetInput():
-                continue
-            size = text_size(lab.GetTextProperty(), lab.GetInput(), dpi)
-            if size is None:
-                continue
-            pos = tuple(float(v) for v in lab.GetPosition())
-            out.append((pos, float(size[0]), float(size[1])))
-        return out  # type: ignore[return-value]
+    def named(
+        self, state: SceneState3D, others: np.ndarray, dpi: int, selected: int | None
+    ) -> tuple[list[int], Named3D]:
+        """The shown ball names and what they must not cover (every ball, ``others``: the
+        eyes, the ghosts), for :mod:`eyeviz.render.vtk.names3d`; the selected ball's first."""
+        c = np.column_stack([state.x, state.y, state.z]) if state.n else np.zeros((0, 3))
+        labs = self.ball_labels[: state.n]
+        g = np.array(state.g[: len(labs)], float)
+        if selected is not None and 0 <= selected < len(g):
+            g[selected] *= RING  # the selection's great circles are wider than the ball
+        return named_of(labs, c[: len(labs)], g, others, dpi, first=selected)
 
     def update(
         self, scene: Scene, state: SceneState3D, selected: int | None, surface: EyeSurface
@@ -129,7 +130,7 @@ class BallsPainter(Painter3D):
             a.SetScale(state.g[i])
             lab = self.ball_labels[i]
             lab.SetVisibility(show_f and scene.shows("labels"))
-            lab.SetPosition(state.x[i], state.y[i], state.z[i] + state.g[i])
+            lab.SetPosition(state.x[i], state.y[i], state.z[i])  # moved aside: names3d
         sel = self.select_actor
         if sel is not None:
             on = show_f and selected is not None and 0 <= selected < n

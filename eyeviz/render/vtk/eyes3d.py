@@ -93,9 +93,11 @@ class EyesPainter(Painter3D):
                 self.add(eq)
                 self.equators.append(eq)
             if self.eyes_ren is not None:
-                lab = text3d(LABEL_PX, INK, center=True)
+                lab = text3d(LABEL_PX, INK)  # moved below its eye: names3d
+                lab.GetTextProperty().SetJustificationToLeft()
+                lab.GetTextProperty().SetVerticalJustificationToBottom()
                 lab.SetInput(f"eye {'AB'[e]}")
-                lab.SetPosition(centre[0], centre[1], centre[2] - 1.55 * surface.radius)
+                lab.SetPosition(*centre)
                 self.store.add(self.eyes_ren, lab)
                 self.labels.append(lab)
         if self.caption is not None:

@@ -133,6 +133,13 @@ class Ghosts3D:
         self._cloud_of: Cloud | None = None
         self.centres: dict[str, tuple[float, float, float]] = {}
         self.cloud_n = 0
+        self.g = 0.0
+
+    def discs(self) -> np.ndarray:
+        """The ghosts shown, (k, 4: x, y, z, radius): what a ball's name must not cover."""
+        if not self.centres:
+            return np.zeros((0, 4))
+        return np.array([(*c, self.g) for c in self.centres.values()], float)
 
     def draw(self, preds: Predictions3D | None) -> None:
         shown: dict[str, tuple[float, float, float]] = {}
@@ -146,6 +153,7 @@ class Ghosts3D:
         for name, gh in self.ghosts.items():
             gh.show(name in shown)
         self.centres = shown
+        self.g = preds.g if preds is not None else 0.0
         cloud = preds.cloud if preds is not None else None
         if cloud is None or len(cloud.points) == 0:
             self.cloud.SetVisibility(False)

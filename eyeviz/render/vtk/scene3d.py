@@ -33,6 +33,7 @@ from eyeviz.files.atomic import atomic_output
 from eyeviz.model import shapes3d
 from eyeviz.model.camera3d import Camera3D, eyes_camera
 from eyeviz.model.facets3d import EyeSurface, surface_of
+from eyeviz.model.labels3d import Named3D, place_named
 from eyeviz.model.predictions3d import Predictions3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
@@ -43,6 +44,7 @@ from eyeviz.render.vtk.eyes3d import LABEL_PX as EYES_LABEL_PX
 from eyeviz.render.vtk.eyes3d import EyesPainter
 from eyeviz.render.vtk.field3d import FieldPainter
 from eyeviz.render.vtk.ghosts3d import Ghosts3D, make_overlay
+from eyeviz.render.vtk.names3d import named_of, place_texts
 from eyeviz.render.vtk.painter3d import Painter3D
 from eyeviz.render.vtk.primitives import fit_lines, screen_text
 from eyeviz.render.vtk.style import BACKGROUND, INK, INSET_BACKGROUND
@@ -104,37 +106,29 @@ LABEL_MARGIN_PX = 6
 
 def fit_labels(
     cam: Camera3D,
-    labels: list[tuple[tuple[float, float, float], float, float]],
+    named: Named3D,
     size: tuple[float, float],
     margin: float = LABEL_MARGIN_PX,
     steps: int = 16,
 ) -> Camera3D:
     """``cam`` moved back along its line of sight (10 % of the distance a step, at most
-    ``steps``) until every label is inside the viewport of ``size`` (width, height px)
-    with ``margin`` pixels to spare. ``labels``: per label its anchor (the model point
-    its text's bottom-left corner is drawn at, as the balls' names) and its text's width
-    and height in pixels. The presets frame the balls; a name drawn beside a ball at the
-    view's edge was cut (sphere_predictions at its default framing)."""
-    from eyeviz.model.camera3d import project, to_pixels
-
-    if not labels:
+    ``steps``) until every name, placed by :func:`eyeviz.model.labels3d.place_named`, is
+    inside the viewport of ``size`` (width, height px) with ``margin`` pixels to spare.
+    The presets frame the balls; a name beside a ball at the view's edge was cut
+    (sphere_predictions at its default framing)."""
+    if len(named.centres) == 0:
         return cam
     w, h = size
-    anchors = np.array([a for a, _, _ in labels], dtype=float)
-    tw = np.array([t for _, t, _ in labels], dtype=float)
-    th = np.array([t for _, _, t in labels], dtype=float)
     pos, focal = np.asarray(cam.position, float), np.asarray(cam.focal_point, float)
     for _ in range(steps + 1):
-        xy, depth = project(cam, anchors, w / max(h, 1.0))
-        px = to_pixels(xy, int(round(w)), int(round(h)))
-        front = depth > 0
-        inside = (
-            (px[:, 0] >= margin)
-            & (px[:, 0] + tw <= w - margin)
-            & (px[:, 1] - th >= margin)
-            & (px[:, 1] <= h - margin)
+        boxes = place_named(named, cam, w, h)
+        ok = ~np.isfinite(boxes).all(axis=1) | (
+            (boxes[:, 0] >= margin - 0.5)
+            & (boxes[:, 2] <= w - margin + 0.5)
+            & (boxes[:, 1] >= margin - 0.5)
+            & (boxes[:, 3] <= h - margin + 0.5)
         )
-        if bool(np.all(inside | ~front)):
+        if bool(np.all(ok)):
             return cam
         pos = focal + 1.1 * (pos - focal)
         x, y, z = (float(v) for v in pos)
@@ -166,6 +160,13 @@ class Scene3DActors:
         self._title_text = ""
         self._title_fit: tuple | None = None
         scene_ren.AddObserver(vtkCommand.StartEvent, self._fit_title)
+        scene_ren.AddObserver(vtkCommand.StartEvent, self._place_names)
+        if eyes_ren is not None:
+            eyes_ren.AddObserver(vtkCommand.StartEvent, self._place_eye_names)
+        self.state: SceneState3D | None = None
+        self.selected: int | None = None
+        self.scene_shows_predictions = False
+        self.name_boxes = np.zeros((0, 4))
         self.eyes_caption = screen_text(16, (0.35, 0.35, 0.35), (0.03, 0.985), top=True)
         if eyes_ren is not None:
             eyes_ren.AddViewProp(self.eyes_caption)
@@ -179,9 +180,43 @@ class Scene3DActors:
         self.overlay: vtkRenderer | None = None
         self.ghosts: Ghosts3D | None = None
 
-    def label_boxes(self) -> list[tuple[tuple[float, float, float], float, float]]:
-        """Each shown ball label's anchor and text size in pixels, for :func:`fit_labels`."""
-        return self.balls.label_boxes(self._dpi())
+    def named(self) -> Named3D:
+        """The ball names shown and what they must not cover, for :func:`fit_labels`."""
+        return self._ball_names()[1]
+
+    def _eye_spheres(self) -> np.ndarray:
+        s = self.surface
+        if s is None:
+            return np.zeros((0, 4))
+        return np.array([(*c, s.radius) for c in s.centres], float)
+
+    def _ball_names(self) -> tuple[list[int], Named3D]:
+        others = [self._eye_spheres()]
+        if self.ghosts is not None and self.scene_shows_predictions:
+            others.append(self.ghosts.discs())
+        st = self.state
+        if st is None:
+            return [], Named3D(np.zeros((0, 3)), np.zeros(0), np.zeros((0, 2)), np.zeros((0, 4)))
+        return self.balls.named(st, np.concatenate(others), self._dpi(), self.selected)
+
+    def _place_names(self, *_args) -> None:
+        """Before the scene renders: each ball's name beside it, over nothing (issue 32.4)."""
+        order, named = self._ball_names()
+        self.name_boxes = place_texts(
+            self.scene_ren, camera_of(self.scene_ren), self.balls.ball_labels, named, order
+        )
+
+    def _place_eye_names(self, *_args) -> None:
+        """Before the close-up renders: each eye's name under it, over nothing."""
+        if self.eyes_ren is None or self.state is None:
+            return
+        eyes = self._eye_spheres()  # the close-up draws no ball: the eyes are all there is
+        labs = self.eyes.labels
+        if len(labs) != len(eyes):
+            return
+        none = np.zeros((0, 4))
+        order, named = named_of(labs, eyes[:, :3], eyes[:, 3], none, self._dpi(), below=True)
+        place_texts(self.eyes_ren, camera_of(self.eyes_ren), labs, named, order)
 
     def _dpi(self) -> int:
         win = self.scene_ren.GetRenderWindow()
@@ -212,6 +247,8 @@ class Scene3DActors:
             self.title.SetInput(scene.title)
         for p in self.painters:
             p.update(scene, state, selected, self.surface)
+        self.state, self.selected = state, selected
+        self.scene_shows_predictions = scene.shows("predictions")
 
     def draw_predictions(self, preds: Predictions3D | None) -> None:
         """The predictions layer (:mod:`eyeviz.render.vtk.ghosts3d`): ``preds``' ghosts

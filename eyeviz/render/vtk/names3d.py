@@ -1,0 +1,80 @@
+"""The 3D view's names (balls', eyes') moved beside what they name before each render.
+
+Each name is a billboard text anchored at its sphere's centre; before the renderer draws,
+:func:`place_texts` asks :func:`eyeviz.model.labels3d.place_named` (the one placement the
+exported figures use too) where each name's box goes through the renderer's camera, and
+sets the text's display offset there (pixels, so no actor is rebuilt: a drag or a turn
+of the camera only moves them). Text sizes come from VTK's own text renderer.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from vtkmodules.vtkRenderingCore import vtkBillboardTextActor3D, vtkRenderer
+
+from eyeviz.model.camera3d import Camera3D
+from eyeviz.model.labels3d import Named3D, discs, place_named
+from eyeviz.render.vtk.primitives import text_size
+
+__all__ = ["named_of", "place_texts"]
+
+
+def named_of(
+    labels: Sequence[vtkBillboardTextActor3D],
+    centres: np.ndarray,
+    radii: np.ndarray,
+    others: np.ndarray,
+    dpi: int,
+    *,
+    below: bool = False,
+    first: int | None = None,
+) -> tuple[list[int], Named3D]:
+    """The shown names among ``labels`` (sphere i named by ``labels[i]``) as a
+    :class:`Named3D`, ``first`` (the selected ball) placed first; the spheres whose names
+    are hidden join ``others``. Returns (the shown labels' indices in placing order, it)."""
+    shown = [i for i, t in enumerate(labels) if t.GetVisibility() and t.GetInput()]
+    if first in shown:
+        shown.remove(first)
+        shown.insert(0, first)
+    sizes = []
+    for i in shown:
+        s = text_size(labels[i].GetTextProperty(), labels[i].GetInput(), dpi)
+        sizes.append(s if s is not None else (0, 0))
+    c = np.asarray(centres, float).reshape(-1, 3)
+    r = np.asarray(radii, float).reshape(-1)
+    hidden = [i for i in range(len(labels)) if i not in shown]
+    oth = np.concatenate(
+        [np.asarray(others, float).reshape(-1, 4), np.column_stack([c[hidden], r[hidden]])]
+    )
+    named = Named3D(
+        c[shown], r[shown], np.asarray(sizes, float).reshape(-1, 2), oth, below=below
+    )
+    return shown, named
+
+
+def place_texts(
+    ren: vtkRenderer,
+    cam: Camera3D,
+    labels: Sequence[vtkBillboardTextActor3D],
+    named: Named3D,
+    order: list[int],
+) -> np.ndarray:
+    """Set each shown label's display offset so its box lands where
+    :func:`place_named` puts it in ``ren``'s viewport (a name whose sphere is out of the
+    viewport or behind the camera made transparent); returns the boxes (pixels of the
+    viewport, y up), one per ``order`` entry."""
+    w, h = ren.GetSize()
+    if w <= 0 or h <= 0 or not order:
+        return np.zeros((0, 4))
+    boxes = place_named(named, cam, float(w), float(h))
+    at, _ = discs(cam, named.centres, named.radii, float(w), float(h))
+    for k, i in enumerate(order):
+        x0, y0 = boxes[k, 0], boxes[k, 1]
+        drawn = bool(np.isfinite(x0) and np.isfinite(at[k, 0]))
+        labels[i].GetTextProperty().SetOpacity(1.0 if drawn else 0.0)
+        if not drawn:
+            continue
+        labels[i].SetDisplayOffset(int(round(x0 - at[k, 0])), int(round(y0 - at[k, 1])))
+    return boxes
