@@ -260,13 +260,12 @@ def test_the_default_framing_keeps_the_balls_names_inside_the_view(make_window, 
     host = win.host3d
     host.set_preset("default")
     vp = host.pointer("move", 0, 0)
-    x0 = host.view.width() - vp.w  # the scene viewport's left edge in the widget
-    boxes = host.actors.label_boxes()
+    host.draw()
+    boxes = host.actors.name_boxes  # where the names were placed (scene viewport px, y up)
     assert len(boxes) == 3
-    for anchor, w, h in boxes:  # "high" was cut at the view's right edge
-        x, y = host.scene_pixel(anchor)
-        assert x - x0 >= LABEL_MARGIN_PX - 0.5 and x - x0 + w <= vp.w - LABEL_MARGIN_PX + 0.5
-        assert y - h >= LABEL_MARGIN_PX - 0.5 and y <= vp.h - LABEL_MARGIN_PX + 0.5
+    for bx0, by0, bx1, by1 in boxes:  # "high" was cut at the view's right edge
+        assert bx0 >= LABEL_MARGIN_PX - 0.5 and bx1 <= vp.w - LABEL_MARGIN_PX + 0.5
+        assert by0 >= LABEL_MARGIN_PX - 0.5 and by1 <= vp.h - LABEL_MARGIN_PX + 0.5
     # the preset's direction and focal point are kept: only moved back along the sight
     cam, pre = host.camera(), default_camera(host.model.state, "default", vp.w / vp.h)
     d = np.subtract(cam.position, cam.focal_point)

@@ -484,9 +484,7 @@ def _labels(ax, state, scene, cam, aspect, part, shown, predictions=None) -> Non
         if predictions is not None and "predictions" in shown:
             gh = [(a.x, a.y, a.z, predictions.g) for a in predictions.ghosts()]
             others.append(np.array(gh, float).reshape(-1, 4))
-        named = Named3D(
-            balls[:, :3], balls[:, 3], _text_sizes(texts, size), np.concatenate(others)
-        )
+        named = Named3D(balls[:, :3], balls[:, 3], _text_sizes(texts, size), np.concatenate(others))
     else:
         return
     boxes = place_named(named, cam, w_pt, h_pt)

@@ -15,10 +15,10 @@ from vtkmodules.vtkRenderingCore import vtkActor
 
 from eyeviz.model import shapes3d
 from eyeviz.model.facets3d import EyeSurface
+from eyeviz.model.labels3d import Named3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.style3d import CONE_OPACITY, EYE_CONE
-from eyeviz.model.labels3d import Named3D
 from eyeviz.render.vtk.eyes3d import LABEL_PX
 from eyeviz.render.vtk.names3d import named_of
 from eyeviz.render.vtk.painter3d import Painter3D, lit, palette

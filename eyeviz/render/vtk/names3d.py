@@ -48,9 +48,7 @@ def named_of(
     oth = np.concatenate(
         [np.asarray(others, float).reshape(-1, 4), np.column_stack([c[hidden], r[hidden]])]
     )
-    named = Named3D(
-        c[shown], r[shown], np.asarray(sizes, float).reshape(-1, 2), oth, below=below
-    )
+    named = Named3D(c[shown], r[shown], np.asarray(sizes, float).reshape(-1, 2), oth, below=below)
     return shown, named
 
 
