@@ -8,6 +8,7 @@ fields.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from PyQt5 import QtCore, QtGui, QtWidgets
@@ -15,12 +16,13 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 from eyeviz.app.help import HELP_NAME
 from eyeviz.model.app_model import AppModel
 from eyeviz.model.app_model3d import AppModel3D
+from eyeviz.model.camera3d import Camera3D
 from eyeviz.model.scene import Scene, View
 
 if TYPE_CHECKING:
     from eyeviz.app.window import MainWindow
 
-__all__ = ["PLANAR_ONLY", "PLAY_SHORTCUT", "SceneCommand", "build_menus"]
+__all__ = ["PLANAR_ONLY", "PLAY_SHORTCUT", "CameraSceneCommand", "SceneCommand", "build_menus"]
 
 PLAY_SHORTCUT = "P"
 
@@ -65,6 +67,36 @@ class SceneCommand(QtWidgets.QUndoCommand):
             return False
         self.after = other.after
         return True
+
+
+class CameraSceneCommand(SceneCommand):
+    """A 3D drag's undo step: undo puts back the camera the drag started from as well as
+    the scene, redo the camera undo left (issue 32.5: after a drag the view may have been
+    re-framed, and Ctrl+Z restored the ball but not the view)."""
+
+    def __init__(
+        self,
+        model: AppModel3D,
+        before: Scene,
+        after: Scene,
+        text: str,
+        camera: tuple[Callable[[], Camera3D], Callable[[Camera3D], None]],
+        at_press: Camera3D,
+    ) -> None:
+        super().__init__(model, before, after, text, None, keep_view=False)
+        self.get_camera, self.set_camera = camera
+        self.at_press = at_press
+        self.at_undo: Camera3D | None = None
+
+    def redo(self) -> None:
+        super().redo()
+        if self.at_undo is not None:
+            self.set_camera(self.at_undo)
+
+    def undo(self) -> None:
+        self.at_undo = self.get_camera()
+        super().undo()
+        self.set_camera(self.at_press)
 
 
 def _action(win, menu, text, slot, shortcut=None) -> QtWidgets.QAction:

@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any
 
 from PyQt5 import QtCore, QtWidgets
 
-from eyeviz.app.actions import PLANAR_ONLY, SceneCommand
+from eyeviz.app.actions import PLANAR_ONLY, CameraSceneCommand, SceneCommand
 from eyeviz.app.help import LAYER3D_TEXT, view3d_help_text
 from eyeviz.app.predictions_layer3d import Predictions3DLayer
 from eyeviz.app.view import make_view
@@ -109,6 +109,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self.docks: dict[str, QtWidgets.QDockWidget] = {}
         self._hidden: list[QtWidgets.QWidget] = []
         self._drag: Generator[None, m3.Pointer, None] | None = None
+        self._press_cam: Camera3D | None = None  # the camera at a drag's press
         self._dirty = False
         self._panel_frames = 0  # drag frames drawn since the docks' last refresh
         self._frame_timer = QtCore.QTimer(self)
@@ -156,10 +157,12 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         # imported with the page: matplotlib's Qt canvas costs a planar window ~1 s
         from eyeviz.app.panels.bitmaps3d import Bitmaps3DPanel
         from eyeviz.app.panels.estimators3d import Estimators3DPanel
-        from eyeviz.app.panels.readout3d import Readout3DPanel
+        from eyeviz.app.panels.readout3d import Readout3DPanel, select_row, type_into
 
         self.bitmaps = Bitmaps3DPanel()
         self.readout = Readout3DPanel()
+        self.readout.on_type = lambda i, key, text: type_into(self.model, i, key, text)
+        self.readout.on_select = lambda i: select_row(self.model, i)
         self.estimators = Estimators3DPanel(self._set_estimators)
         self.docks["bitmaps3d"] = self._dock("Facets (Mollweide)", self.bitmaps, "bitmaps3d")
         self.docks["readout3d"] = self._dock("Balls (3D readout)", self.readout, "readout3d")
@@ -307,6 +310,11 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
     # --- model -> view -------------------------------------------------------------------
     def _push(self, before: Scene, after: Scene, text: str, merge_key=None) -> None:
         assert self.model is not None
+        cam0 = self._press_cam if self._drag is not None else None
+        if cam0 is not None:  # a drag: its undo puts the view back too
+            cam = (self.camera, self.set_camera)
+            self.win.undo_stack.push(CameraSceneCommand(self.model, before, after, text, cam, cam0))
+            return
         self.win.undo_stack.push(
             SceneCommand(self.model, before, after, text, merge_key, keep_view=False)
         )
@@ -371,7 +379,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         if self.bitmaps is not None:
             self.bitmaps.set_state(st, m.scene, m.selected)  # the selected ball outlined
         if self.readout is not None:
-            self.readout.set_state(st, m.scene)
+            self.readout.set_state(st, m.scene, m.selected)
             self.readout.set_predictions(self.preds, m.scene)
         if self.estimators is not None:
             self.estimators.refresh(m.scene, self.preds)
@@ -502,6 +510,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         if i is None:
             return False  # the background: VTK's camera interaction
         depth = bool(ev.modifiers() & _MOD_DEPTH)
+        self._press_cam = cam
         self._drag = m3.drag_ball(self.model, cam, p, i, depth)
         next(self._drag)
         return True

@@ -12,8 +12,10 @@ had at the press):
 - a left drag on a ball moves it in the plane through its centre facing the camera (the
   grab point stays under the cursor);
 - with Shift (or Ctrl) held at the press it moves along the line of sight instead: up is
-  farther, down nearer, by a factor ``exp(dy / DEPTH_PX)`` of its distance from the camera
-  (the ball stays under the cursor and grows or shrinks);
+  farther, down nearer, each pixel by what a pixel spans in the screen plane at the ball's
+  distance at the press (issue 32.5: a factor of the camera distance moved balls
+  thousands of units in a few pixels), never nearer the camera than MIN_DEPTH of that
+  distance (the ball stays under the cursor and grows or shrinks);
 - :func:`nudge` (the keyboard) moves the selected ball NUDGE_PX pixels across the screen
   or by a factor ``exp(NUDGE_DEPTH)`` along the line of sight; consecutive nudges of one
   ball are one undo step.
@@ -32,9 +34,10 @@ from eyeviz.model.camera3d import Camera3D, basis
 from eyeviz.model.edits import feature_value
 from eyeviz.model.scene import OKABE_ITO, Feature, Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d, eyes_name
+from eyeviz.model.typed3d import KEYS, typed_ball
 
 __all__ = [
-    "DEPTH_PX",
+    "MIN_DEPTH",
     "NUDGE_DEPTH",
     "NUDGE_PX",
     "PICK_PX",
@@ -50,7 +53,7 @@ __all__ = [
 
 DRAG_THRESHOLD_PX = 4.0  # released closer than this to the press: a click (select only)
 PICK_PX = 8.0  # a ball is grabbed within this many pixels of its drawn outline
-DEPTH_PX = 200.0  # a depth drag of this many pixels changes the distance by a factor e
+MIN_DEPTH = 0.05  # a depth drag stops at this fraction of the ball's distance from the camera
 NUDGE_PX = 10.0  # one arrow key
 NUDGE_DEPTH = 0.05  # one depth key: the distance times exp(+-0.05)
 #: The 3D view holds at most this many lit facets (both eyes, all balls; 128 MB of
@@ -235,6 +238,20 @@ class AppModel3D:
         )
         self.commit(after, text, merge_key)
 
+    def type_value(self, index: int, key: str, text: str) -> None:
+        """Ball ``index``'s coordinate ``key`` (x, y, z, g, r, az, el) typed as ``text``:
+        one undo step (:func:`eyeviz.model.typed3d.typed_ball`); a bad value raises
+        ValueError (one line) and changes nothing."""
+        f = self.scene.features[index]
+        x, y, z, g = typed_ball(f, key, text)
+        after = self.scene.copy()
+        a = after.features[index]
+        a.x, a.y, a.z, a.g = x, y, z, g
+        try:
+            self.commit(after, f"Type {KEYS[key]} of {f.name}")
+        except EyevizError as exc:
+            raise ValueError(str(exc)) from None
+
     def _name(self, base: str) -> str:
         names = {f.name for f in self.scene.features}
         i = 1
@@ -281,6 +298,8 @@ def drag_ball(
     grab = o + s0 * d0
     offset = c0 - grab
     dist0 = float(np.linalg.norm(c0 - o))
+    # a pixel of depth drag: a pixel's span in the screen plane at the ball's depth
+    per_px = _units_per_px(cam, max(float((o - c0) @ back), 0.0), press.h)
     dragging = False
     p = yield
     try:
@@ -290,8 +309,8 @@ def drag_ball(
                 model.begin_live(("Move " if not depth else "Push ") + f.name)
             if dragging:
                 if depth:
-                    k = math.exp(-(p.py - press.py) / DEPTH_PX)
-                    c = o + (c0 - o) * k if dist0 > 0 else c0
+                    dist = max(dist0 - (p.py - press.py) * per_px, MIN_DEPTH * dist0)
+                    c = o + (c0 - o) * (dist / dist0) if dist0 > 0 else c0
                 else:
                     _, d = ray(cam, p)
                     s = float((c0 - o) @ back) / float(d @ back)

@@ -13,6 +13,10 @@ azimuth and elevation and their errors against the true ball (r relative, in %; 
 angles absolute, in degrees), and a note: the limit's Monte-Carlo error of r, a flag when
 an answer is a fallback, or why there is no answer (in full in its tooltip).
 
+The r, azimuth, elevation and g cells can be typed into (double-click, or a key on the
+current cell; issue 32.6, :mod:`eyeviz.model.typed3d`): one undo step, or a one-line
+"Refused: ..." under the table with nothing changed. A click on a row selects its ball.
+
 Both tables fit the dock's width (no horizontal scroll bar, also at 1280x720): the
 columns take their contents' width and the first (the names) the rest, eliding a long
 name.
@@ -20,15 +24,18 @@ name.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from PyQt5 import QtCore, QtGui, QtWidgets
 
-from eyeviz.app.panels.common import user_message, wrap_label
+from eyeviz.app.panels.common import ERROR_STYLE, set_message, user_message, wrap_label
+from eyeviz.model.app_model3d import AppModel3D
 from eyeviz.model.predictions3d import Predictions3D, estimator_color3d, prediction_rows
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.mpl.figure3d import readout_rows
 
-__all__ = ["COLUMNS", "PRED_ROWS", "Readout3DPanel"]
+__all__ = ["COLUMNS", "PRED_ROWS", "Readout3DPanel", "select_row", "type_into"]
 
 #: (header, tooltip) per column, in readout_rows' order.
 COLUMNS = (
@@ -44,6 +51,8 @@ COLUMNS = (
 )
 TABLE_FONT = 0.8  # the tables' font, times the panel's
 CELL_PAD_PX = 9  # a column's width beyond its widest text
+#: column -> the coordinate typed there (eyeviz.model.typed3d.KEYS)
+TYPED = {1: "r", 2: "az", 3: "el", 4: "g"}
 NAME_MIN_PX = 40  # the names' column at least (elided)
 NAME_WANT_PX = 100  # ... and what the dock is widened for (eyeviz.app.view3d)
 NOTE_WANT_PX = 130  # an estimator's column with a long reason: what the dock widens for
@@ -159,6 +168,10 @@ def _cell(t: QtWidgets.QTableWidget, i: int, j: int) -> QtWidgets.QTableWidgetIt
             QtCore.Qt.AlignmentFlag.AlignLeft if j == 0 else QtCore.Qt.AlignmentFlag.AlignRight
         )
         item.setTextAlignment(int(align))
+        F = QtCore.Qt.ItemFlag
+        typed = t.objectName() == "readout3d" and j in TYPED
+        if not typed:
+            item.setFlags(QtCore.Qt.ItemFlags() | F.ItemIsEnabled | F.ItemIsSelectable)
         t.setItem(i, j, item)
     return item
 
@@ -172,6 +185,23 @@ class Readout3DPanel(QtWidgets.QWidget):
         self._colors: list[str] = []
         self.table = _table(COLUMNS)
         self.table.setObjectName("readout3d")
+        AV = QtWidgets.QAbstractItemView
+        trig = AV.EditTrigger
+        self.table.setEditTriggers(
+            AV.EditTriggers() | trig.DoubleClicked | trig.EditKeyPressed | trig.AnyKeyPressed
+        )
+        self.table.setSelectionMode(AV.SelectionMode.SingleSelection)
+        self.table.setSelectionBehavior(AV.SelectionBehavior.SelectRows)
+        #: ``on_type(row, key, text)`` -> None, or the one-line reason it was refused
+        self.on_type: Callable[[int, str, str], str | None] | None = None
+        #: ``on_select(row)``: a click on a row
+        self.on_select: Callable[[int], None] | None = None
+        self._filling = False
+        self.table.itemChanged.connect(self._typed)
+        self.table.cellPressed.connect(self._pressed)
+        self.message = wrap_label(QtWidgets.QLabel(""))
+        self.message.setStyleSheet(ERROR_STYLE)
+        self.message.setVisible(False)
         side = self.table.verticalHeader()
         row_h = side.defaultSectionSize() if side is not None else 20
         self.table.setMinimumHeight(3 * row_h + 4)  # the header and two balls at least
@@ -181,6 +211,7 @@ class Readout3DPanel(QtWidgets.QWidget):
         lay.setContentsMargins(4, 4, 4, 4)
         lay.setSpacing(3)  # with the predictions the dock still fits 1280x720
         lay.addWidget(self.table, 1)
+        lay.addWidget(self.message)
         lay.addWidget(self.note)
         self.pred_table = _table((("", ""),))
         self.pred_table.setObjectName("predictions3d")
@@ -194,8 +225,41 @@ class Readout3DPanel(QtWidgets.QWidget):
             t.installEventFilter(self)  # re-fitted whenever a table is resized or shown
         self.setMinimumWidth(200)
 
-    def set_state(self, state: SceneState3D, scene: Scene) -> None:
-        """Show ``state``'s values for ``scene``'s balls (the figure's readout rows)."""
+    def set_state(self, state: SceneState3D, scene: Scene, selected: int | None = None) -> None:
+        """Show ``state``'s values for ``scene``'s balls (the figure's readout rows), the
+        ``selected`` ball's row selected."""
+        self._filling = True
+        try:
+            self._fill(state, scene)
+            if selected is not None and 0 <= selected < self.table.rowCount():
+                if self.table.currentRow() != selected:
+                    self.table.selectRow(selected)
+            else:
+                self.table.clearSelection()
+        finally:
+            self._filling = False
+
+    def _typed(self, item: QtWidgets.QTableWidgetItem) -> None:
+        if self._filling or item.column() not in TYPED or self.on_type is None:
+            return
+        i, j = item.row(), item.column()
+        why = self.on_type(i, TYPED[j], item.text())
+        if why is None:
+            self.message.setVisible(False)
+            return
+        set_message(self.message, f"Refused: {why}")
+        self.message.setVisible(True)
+        self._filling = True
+        try:  # the cell shows the value kept
+            item.setText(self.rows[i][j] if i < len(self.rows) else "")
+        finally:
+            self._filling = False
+
+    def _pressed(self, row: int, _col: int) -> None:
+        if self.on_select is not None and not self._filling:
+            self.on_select(row)
+
+    def _fill(self, state: SceneState3D, scene: Scene) -> None:
         rows = readout_rows(state, scene)
         colors = [f.color for f in scene.features]
         reshaped = len(rows) != len(self.rows)
@@ -314,6 +378,25 @@ class Readout3DPanel(QtWidgets.QWidget):
         j = [h for h, _ in COLUMNS].index(column)
         item = self.table.item(i, j)
         return item.text() if item is not None else ""
+
+
+def select_row(model: AppModel3D | None, i: int) -> None:
+    """A click on row ``i``: its ball selected."""
+    if model is not None and 0 <= i < len(model.scene.features):
+        model.select(i)
+
+
+def type_into(model: AppModel3D | None, i: int, key: str, text: str) -> str | None:
+    """Ball ``i``'s ``key`` typed as ``text`` into ``model`` (one undo step, the ball
+    selected): None, or the one-line reason it was refused (nothing changed)."""
+    if model is None or not 0 <= i < len(model.scene.features):
+        return "no such ball"
+    try:
+        model.type_value(i, key, text)
+    except ValueError as exc:
+        return (str(exc).splitlines() or ["not a value"])[0]
+    model.select(i)
+    return None
 
 
 def _swatch(color: str) -> QtGui.QIcon:
