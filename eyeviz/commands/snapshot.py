@@ -102,10 +102,6 @@ def run(args: argparse.Namespace) -> int:
     if sc.kind == "spherical":  # HEALPix eyes: the view, the maps and the table (figure3d)
         from eyeviz import EyevizError
         from eyeviz.render.mpl.figure3d import check_drawable3d, export3d
-
-        if min_font is not None:
-            raise EyevizError("min-font: spherical scenes do not take it yet (planar only)")
-
         from eyeviz.render.mpl.glyphs import one_glyph_warning
 
         check_drawable3d(sc)
@@ -121,6 +117,7 @@ def run(args: argparse.Namespace) -> int:
             bitmaps=not args.no_bitmaps,
             aspect=None if args.aspect is None else aspect,
             view=args.view,
+            min_font=min_font,
         )
         with one_glyph_warning():  # an emoji name: one line, not a warning pair per glyph
             if format_of(args.output) == "png":  # the same figure, the view rendered by VTK

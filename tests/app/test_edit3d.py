@@ -92,7 +92,9 @@ def test_depth_drag_pixel_for_pixel_and_undo_puts_the_view_back(win, qapp):
     _xdo(qapp, "key", "ctrl+z")
     assert np.allclose(_centre(host, 0), c0)
     cam = host.camera()
-    assert np.allclose(cam.position, cam0.position) and np.allclose(cam.focal_point, cam0.focal_point)
+    assert np.allclose(cam.position, cam0.position) and np.allclose(
+        cam.focal_point, cam0.focal_point
+    )
 
 
 def _basis(cam):
@@ -130,7 +132,7 @@ def test_typed_coordinates_and_row_clicks(win, qapp):
     assert host.model.selected == 1
     # r typed: the distance changes, azimuth and elevation kept; one undo step
     st = host.model.state
-    az, el = math.degrees(st.azimuth[1]), math.degrees(st.elevation[1])
+    r0, az, el = float(st.r[1]), math.degrees(st.azimuth[1]), math.degrees(st.elevation[1])
     n0 = win.undo_stack.index()
     _type_cell(win, qapp, 1, 1, "2500")
     st = host.model.state
@@ -159,5 +161,5 @@ def test_typed_coordinates_and_row_clicks(win, qapp):
     # undo: the typed g, then the elevation, then r
     for _ in range(3):
         win.undo_stack.undo()
-    assert host.model.state.r[1] == pytest.approx(float(np.hypot(*_centre(host, 1))))
+    assert host.model.state.r[1] == pytest.approx(r0)
     assert math.degrees(host.model.state.elevation[1]) == pytest.approx(el)

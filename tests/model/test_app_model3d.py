@@ -112,7 +112,10 @@ def test_depth_drag_moves_along_the_line_of_sight():
     o = np.asarray(cam.position)
     new = np.array([f.x, f.y, f.z])
     old = np.array([0.0, 300.0, 0.0])
-    assert np.linalg.norm(new - o) == pytest.approx(np.linalg.norm(old - o) * math.exp(0.5))
+    # 100 px up: farther by 100 pixels' span in the screen plane at the ball's depth
+    _, _, back = basis(cam)
+    span = 100 * 2.0 * float((o - old) @ back) * math.tan(math.radians(cam.view_angle) / 2) / H
+    assert np.linalg.norm(new - o) == pytest.approx(np.linalg.norm(old - o) + span)
     assert _px(cam, new) == pytest.approx((c, r), abs=1e-6)  # still under the pointer
     assert len(steps) == 1
 

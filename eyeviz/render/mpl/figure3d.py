@@ -64,8 +64,12 @@ from eyeviz.render.mpl.style import (
     RC,
     SMALL,
     VECTOR_DPI,
+    check_min_font,
+    pt,
+    raise_fonts,
     short,
 )
+from eyeviz.render.mpl.style import min_font as font_floor
 
 __all__ = [
     "MAX_BALLS",
@@ -253,6 +257,7 @@ def figure3d(
     view_image: ViewImage | None = None,
     predictions: Predictions3D | None = None,
     ball: int = 0,
+    min_font: float | None = None,
 ) -> Figure:
     """The spherical scene as a Figure ``width`` inches wide (see the module docstring).
     ``title``, ``table`` and ``bitmaps`` (False) leave those parts out; ``aspect`` is the
@@ -270,7 +275,21 @@ def figure3d(
     With the predictions layer the view draws the estimators' ghosts and the limit's
     cloud for ball ``ball`` (the app passes its selection) and the readout their rows:
     ``predictions`` (:func:`eyeviz.model.predictions3d.scene_predictions3d`), computed
-    here (the limit included) when None."""
+    here (the limit included) when None.
+
+    ``min_font`` (points, ``snapshot --min-font``, as the planar figure's): no text
+    smaller; the title, the maps' captions and the table rows grow to match."""
+    floor = 0.0 if min_font is None else check_min_font(min_font)
+    with font_floor(floor):
+        fig = _figure3d(scene, state, width, title, table, bitmaps, aspect, camera, view, dpi,
+                        view_image, predictions, ball)  # fmt: skip
+    raise_fonts(fig, floor)
+    return fig
+
+
+def _figure3d(scene, state, width, title, table, bitmaps, aspect, camera, view, dpi,
+              view_image, predictions, ball) -> Figure:  # fmt: skip
+    """:func:`figure3d` at the font floor set (:func:`eyeviz.render.mpl.style.pt`)."""
     import matplotlib
 
     if view_image is not None and dpi is None:
@@ -295,18 +314,19 @@ def figure3d(
         aspect = 0.38 if side else 0.6
     m = 0.08  # margin, inches
     map_w = (width - 3 * m) / 2 if side else width - 2 * m
-    map_h = map_w / 2 + 0.3  # Mollweide is 2:1, a caption above and directions below
+    k = pt(SMALL) / SMALL  # text raised by --min-font: its lines grow as much
+    map_h = map_w / 2 + 0.3 * k  # Mollweide is 2:1, a caption above and directions below
     parts: list[tuple[str, float]] = []
     if title and scene.title:
-        parts.append(("title", 0.26))
+        parts.append(("title", 0.26 * k))
     if persp:
         parts.append(("persp", (width - 2 * m) * aspect))
     if maps:
         parts += [("maps", map_h)] if side else [("mapA", map_h), ("mapB", map_h)]
     if tab:
-        parts.append(("table", ROW_IN * (len(scene.features) + 1.3)))
+        parts.append(("table", k * ROW_IN * (len(scene.features) + 1.3)))
     if table and preds is not None and preds.answers:
-        parts.append(("preds", ROW_IN * (len(preds.answers) + 1.3)))
+        parts.append(("preds", k * ROW_IN * (len(preds.answers) + 1.3)))
     if not parts:
         parts.append(("empty", 0.3))
     height = sum(h for _, h in parts) + 2 * m
@@ -347,7 +367,7 @@ def figure3d(
                 eyes = "AB" if name == "maps" else name[-1]
                 for k, eye in enumerate(eyes):
                     x0 = m + k * (map_w + m)
-                    ax = fig.add_axes(rect(x0, map_w, map_w / 2, 0.18), axes_class=MapAxes)
+                    ax = fig.add_axes(rect(x0, map_w, map_w / 2, 0.18 * k), axes_class=MapAxes)
                     ax.set_gid(f"map{eye}")
                     _draw_map(ax, st, scene, eye)
             elif name == "table":
@@ -433,13 +453,15 @@ def export3d(
     view_image: ViewImage | None = None,
     predictions: Predictions3D | None = None,
     ball: int = 0,
+    min_font: float | None = None,
 ) -> Path:
     """Write the spherical scene's figure (:func:`figure3d`, through ``camera`` or the
     preset ``view``) to
     ``path`` (.png, .svg or .pdf) atomically, as :func:`eyeviz.render.mpl.export.export`
     writes a planar one. A PNG is ``width`` inches at 300 dpi times ``scale``, on whole
     pixels; ``view_image`` (PNG only, see :func:`figure3d`) gives its 3D view's picture
-    (:func:`eyeviz.render.vtk.png3d.export_png3d` passes the VTK render)."""
+    (:func:`eyeviz.render.vtk.png3d.export_png3d` passes the VTK render); ``min_font``:
+    no text smaller, in points (:func:`figure3d`)."""
     import matplotlib
 
     from eyeviz.render.mpl.export import MAX_PNG_PX, _check_scale, _metadata, format_of
@@ -462,6 +484,7 @@ def export3d(
         scene, width=width, title=title, table=table, bitmaps=bitmaps, aspect=aspect,
         camera=camera, view=view, dpi=dpi if fmt == "png" else None,
         view_image=view_image if fmt == "png" else None, predictions=predictions, ball=ball,
+        min_font=min_font,
     )  # fmt: skip
     with atomic_output(target) as tmp, matplotlib.rc_context(RC):
         fig.savefig(

@@ -50,7 +50,7 @@ from eyeviz.model.predictions3d import Predictions3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.mpl.ghosts3d import draw_ghosts
-from eyeviz.render.mpl.style import SMALL, short
+from eyeviz.render.mpl.style import SMALL, pt, short
 from eyeviz.render.style3d import (
     BALL_LIGHT,
     BFV_OPACITY,
@@ -470,7 +470,7 @@ def _labels(ax, state, scene, cam, aspect, part, shown, predictions=None) -> Non
     pos = ax.get_position()
     fig_w, fig_h = ax.figure.get_size_inches()
     w_pt, h_pt = max(pos.width * fig_w * 72.0, 1e-6), max(pos.height * fig_h * 72.0, 1e-6)
-    size = SMALL + 1
+    size = pt(SMALL + 1)  # raised by --min-font: the boxes placed are the drawn ones
     eyes = np.array([(*c, state.pair.l) for c in _centres(state)], float)
     feats = scene.features if "features" in shown else []
     balls = np.array([(f.x, f.y, f.z, f.g) for f in feats], float).reshape(-1, 4)

@@ -123,6 +123,7 @@ def export_png3d(
     selected: int | None = None,
     predictions: Predictions3D | None = None,
     ball: int | None = None,
+    min_font: float | None = None,
 ) -> Path:
     """Write the spherical scene's figure as a PNG (``width`` inches at 300 dpi times
     ``scale``), atomically: :func:`eyeviz.render.mpl.figure3d.export3d` with the 3D view
@@ -155,4 +156,5 @@ def export_png3d(
         scene, path, scale, transparent, width=width, title=title, table=table,
         bitmaps=bitmaps, aspect=aspect, camera=camera, view=view, view_image=vtk_view,
         predictions=preds, ball=ball if ball is not None else (selected or 0),
+        min_font=min_font,
     )  # fmt: skip
