@@ -198,22 +198,57 @@ def readout_rows(st: SceneState3D, scene: Scene) -> list[tuple[str, ...]]:
     return rows
 
 
+#: the readout table's headers, and the short ones a narrow figure uses (the app's)
+HEADS = ("ball", "r", "az\u00b0", "el\u00b0", "g", "BFV", "visible", "overlap", "facets A/B")
+SHORT_HEADS = ("ball", "r", "az\u00b0", "el\u00b0", "g", "BFV", "vis", "ovl", "lit A/B")
+_MARK = 0.12  # inches: the colour swatch before a name
+
+
+def _columns(ax, rows: list[tuple[str, ...]], heads: tuple[str, ...]) -> list[float] | None:
+    """Column left edges (axes fractions) from the texts' widths at the drawn size
+    (estimated from their lengths, as the 3D names), or None when they do not fit."""
+    size = pt(SMALL)
+    pos = ax.get_position()
+    avail = pos.width * ax.figure.get_figwidth()
+    gap = 0.45 * size / 72.0
+    widths = [
+        max(len(t) for t in [h] + [r[j] for r in rows]) * 0.6 * size / 72.0
+        for j, h in enumerate(heads)
+    ]
+    widths[0] += _MARK
+    need = sum(widths) + gap * (len(widths) - 1)
+    if need > avail:
+        return None
+    spare = (avail - need) / (len(widths) - 1)  # spread between the columns
+    edges, x = [], 0.0
+    for w in widths:
+        edges.append(x / avail)
+        x += w + gap + spare
+    return edges
+
+
 def _draw_table(ax, st: SceneState3D, scene: Scene) -> None:
     ax.set_axis_off()
     ax.set_xlim(0, 1)
     n = len(scene.features)
     ax.set_ylim(-(n + 0.5), 1.0)
-    # column left edges as fractions of the width: the name column widest
-    edges = [0.0, 0.2, 0.28, 0.37, 0.46, 0.53, 0.63, 0.74, 0.86]
-    heads = ("ball", "r", "az\u00b0", "el\u00b0", "g", "BFV", "visible", "overlap", "facets A/B")
+    rows = readout_rows(st, scene)
+    heads = HEADS
+    edges = _columns(ax, rows, HEADS)
+    if edges is None:  # narrow, or text raised by --min-font: the app's short headers
+        heads = SHORT_HEADS
+        edges = _columns(ax, rows, SHORT_HEADS) or [
+            0.0, 0.2, 0.28, 0.37, 0.46, 0.53, 0.63, 0.74, 0.86,
+        ]  # fmt: skip
+    mark = _MARK / (ax.get_position().width * ax.figure.get_figwidth())
     for x, t in zip(edges, heads, strict=True):
         ax.text(x, 0.0, t, fontsize=SMALL, color=GREY, ha="left", va="center")
     ax.plot([0, 1], [-0.5, -0.5], color=GREY, lw=0.4)
-    for i, row in enumerate(readout_rows(st, scene)):
+    for i, row in enumerate(rows):
         y = -(i + 1)
         ax.plot([0.008], [y], marker="s", ms=3.5, mew=0, color=scene.features[i].color)
         for j, (x, t) in enumerate(zip(edges, row, strict=True)):
-            ax.text(x + (0.02 if j == 0 else 0.0), y, t, fontsize=SMALL, color=INK, va="center",
+            ax.text(x + (mark if j == 0 else 0.0), y, t, fontsize=SMALL, color=INK, va="center",
                     parse_math=False)  # fmt: skip
 
 
