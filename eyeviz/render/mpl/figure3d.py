@@ -50,6 +50,7 @@ from eyeviz.model.predictions3d import (
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
 from eyeviz.render.mpl.facet_map import MapAxes, draw_eye_view, view_lonlat
+from eyeviz.render.mpl.inset3d import draw_ball_inset
 from eyeviz.render.mpl.perspective3d import (
     VIEW_LAYERS,
     default_camera,
@@ -121,6 +122,8 @@ def _draw_view(
     close up on the left, the scene through ``cam`` on the right (polygons, or ``image``:
     the VTK render of the same view, :func:`eyeviz.render.mpl.perspective3d.draw_panel`)."""
     eyes_ax, scene_ax = draw_panel(fig, box, st, scene, cam, image=image, predictions=predictions)
+    if predictions is not None and scene.shows("predictions"):  # the ghosts told apart
+        draw_ball_inset(scene_ax, st, scene, predictions, cam)
     scene_ax.text(
         0.02, 0.98, _view_caption(cam), transform=scene_ax.transAxes, fontsize=SMALL,
         color=GREY, ha="left", va="top",
@@ -349,19 +352,19 @@ def _figure3d(scene, state, width, title, table, bitmaps, aspect, camera, view, 
         aspect = 0.38 if side else 0.6
     m = 0.08  # margin, inches
     map_w = (width - 3 * m) / 2 if side else width - 2 * m
-    k = pt(SMALL) / SMALL  # text raised by --min-font: its lines grow as much
-    map_h = map_w / 2 + 0.3 * k  # Mollweide is 2:1, a caption above and directions below
+    grow = pt(SMALL) / SMALL  # text raised by --min-font: its lines grow as much
+    map_h = map_w / 2 + 0.3 * grow  # Mollweide is 2:1, a caption above and directions below
     parts: list[tuple[str, float]] = []
     if title and scene.title:
-        parts.append(("title", 0.26 * k))
+        parts.append(("title", 0.26 * grow))
     if persp:
         parts.append(("persp", (width - 2 * m) * aspect))
     if maps:
         parts += [("maps", map_h)] if side else [("mapA", map_h), ("mapB", map_h)]
     if tab:
-        parts.append(("table", k * ROW_IN * (len(scene.features) + 1.3)))
+        parts.append(("table", grow * ROW_IN * (len(scene.features) + 1.3)))
     if table and preds is not None and preds.answers:
-        parts.append(("preds", k * ROW_IN * (len(preds.answers) + 1.3)))
+        parts.append(("preds", grow * ROW_IN * (len(preds.answers) + 1.3)))
     if not parts:
         parts.append(("empty", 0.3))
     height = sum(h for _, h in parts) + 2 * m
@@ -402,7 +405,7 @@ def _figure3d(scene, state, width, title, table, bitmaps, aspect, camera, view, 
                 eyes = "AB" if name == "maps" else name[-1]
                 for k, eye in enumerate(eyes):
                     x0 = m + k * (map_w + m)
-                    ax = fig.add_axes(rect(x0, map_w, map_w / 2, 0.18 * k), axes_class=MapAxes)
+                    ax = fig.add_axes(rect(x0, map_w, map_w / 2, 0.18 * grow), axes_class=MapAxes)
                     ax.set_gid(f"map{eye}")
                     _draw_map(ax, st, scene, eye)
             elif name == "table":
