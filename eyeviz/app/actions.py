@@ -22,7 +22,14 @@ from eyeviz.model.scene import Scene, View
 if TYPE_CHECKING:
     from eyeviz.app.window import MainWindow
 
-__all__ = ["PLANAR_ONLY", "PLAY_SHORTCUT", "CameraSceneCommand", "SceneCommand", "build_menus"]
+__all__ = [
+    "PLANAR_ONLY",
+    "PLAY_SHORTCUT",
+    "CameraSceneCommand",
+    "SceneCommand",
+    "build_menus",
+    "command3d",
+]
 
 PLAY_SHORTCUT = "P"
 
@@ -67,6 +74,22 @@ class SceneCommand(QtWidgets.QUndoCommand):
             return False
         self.after = other.after
         return True
+
+
+def command3d(
+    model: AppModel3D,
+    before: Scene,
+    after: Scene,
+    text: str,
+    merge_key: object,
+    camera: tuple[Callable[[], Camera3D], Callable[[Camera3D], None]],
+    at_press: Camera3D | None,
+) -> SceneCommand:
+    """The 3D page's undo step: with ``at_press`` (a drag's camera at its press) one
+    that puts the view back too (:class:`CameraSceneCommand`)."""
+    if at_press is None:
+        return SceneCommand(model, before, after, text, merge_key, keep_view=False)
+    return CameraSceneCommand(model, before, after, text, camera, at_press)
 
 
 class CameraSceneCommand(SceneCommand):

@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any
 
 from PyQt5 import QtCore, QtWidgets
 
-from eyeviz.app.actions import PLANAR_ONLY, CameraSceneCommand, SceneCommand
+from eyeviz.app.actions import PLANAR_ONLY, command3d
 from eyeviz.app.help import LAYER3D_TEXT, view3d_help_text
 from eyeviz.app.predictions_layer3d import Predictions3DLayer
 from eyeviz.app.view import make_view
@@ -157,12 +157,10 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         # imported with the page: matplotlib's Qt canvas costs a planar window ~1 s
         from eyeviz.app.panels.bitmaps3d import Bitmaps3DPanel
         from eyeviz.app.panels.estimators3d import Estimators3DPanel
-        from eyeviz.app.panels.readout3d import Readout3DPanel, select_row, type_into
+        from eyeviz.app.panels.readout3d import Readout3DPanel
 
         self.bitmaps = Bitmaps3DPanel()
-        self.readout = Readout3DPanel()
-        self.readout.on_type = lambda i, key, text: type_into(self.model, i, key, text)
-        self.readout.on_select = lambda i: select_row(self.model, i)
+        self.readout = Readout3DPanel(lambda: self.model)  # typed values, row clicks
         self.estimators = Estimators3DPanel(self._set_estimators)
         self.docks["bitmaps3d"] = self._dock("Facets (Mollweide)", self.bitmaps, "bitmaps3d")
         self.docks["readout3d"] = self._dock("Balls (3D readout)", self.readout, "readout3d")
@@ -310,14 +308,9 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
     # --- model -> view -------------------------------------------------------------------
     def _push(self, before: Scene, after: Scene, text: str, merge_key=None) -> None:
         assert self.model is not None
-        cam0 = self._press_cam if self._drag is not None else None
-        if cam0 is not None:  # a drag: its undo puts the view back too
-            cam = (self.camera, self.set_camera)
-            self.win.undo_stack.push(CameraSceneCommand(self.model, before, after, text, cam, cam0))
-            return
-        self.win.undo_stack.push(
-            SceneCommand(self.model, before, after, text, merge_key, keep_view=False)
-        )
+        at = self._press_cam if self._drag is not None else None  # a drag: the view too
+        cams = (self.camera, self.set_camera)
+        self.win.undo_stack.push(command3d(self.model, before, after, text, merge_key, cams, at))
 
     def _on_model(self, what: str, index: int | None) -> None:
         if what == "feature":  # a live move: one frame pending at most

@@ -179,7 +179,12 @@ def _cell(t: QtWidgets.QTableWidget, i: int, j: int) -> QtWidgets.QTableWidgetIt
 class Readout3DPanel(QtWidgets.QWidget):
     """A compact table, one row per ball (see the module docstring)."""
 
-    def __init__(self, parent: QtWidgets.QWidget | None = None) -> None:
+    def __init__(
+        self,
+        model: Callable[[], AppModel3D | None] | None = None,
+        parent: QtWidgets.QWidget | None = None,
+    ) -> None:
+        """``model`` (the 3D page's model now) takes the typed values and the row clicks."""
         super().__init__(parent)
         self.rows: list[tuple[str, ...]] = []
         self._colors: list[str] = []
@@ -196,6 +201,9 @@ class Readout3DPanel(QtWidgets.QWidget):
         self.on_type: Callable[[int, str, str], str | None] | None = None
         #: ``on_select(row)``: a click on a row
         self.on_select: Callable[[int], None] | None = None
+        if model is not None:
+            self.on_type = lambda i, key, text: type_into(model(), i, key, text)
+            self.on_select = lambda i: select_row(model(), i)
         self._filling = False
         self.table.itemChanged.connect(self._typed)
         self.table.cellPressed.connect(self._pressed)
