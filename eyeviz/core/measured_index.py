@@ -27,7 +27,6 @@ import itertools
 import math
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from eyeviz.core.measured_grid import AxisGrid
 
@@ -42,6 +41,8 @@ class AxisIndex:
 
     def __init__(self, unit_axes: np.ndarray, centre: np.ndarray, lens_bound: float,
                  alpha_max: float) -> None:  # fmt: skip
+        from scipy.spatial import cKDTree  # here: a HEALPix scene never loads scipy.spatial
+
         self.n = int(unit_axes.shape[0])
         self.tree = cKDTree(unit_axes)
         self._unit = unit_axes

@@ -42,7 +42,6 @@ from functools import lru_cache
 from typing import Any, Protocol
 
 import numpy as np
-from scipy.spatial import QhullError, SphericalVoronoi, cKDTree
 
 from eyeviz.core import healpix
 
@@ -155,6 +154,8 @@ class VoronoiPatches:
         self.axes = u
         self.acceptance = acc
         # one generator per group of coinciding axes; rep[i] is facet i's generator
+        from scipy.spatial import cKDTree  # measured eyes only: HEALPix never loads it
+
         gen, rep = _merge_same(u)
         self.gen_axes = u[gen]
         self.rep = rep
@@ -175,6 +176,8 @@ class VoronoiPatches:
 
     def _build(self) -> tuple[np.ndarray, np.ndarray]:
         """Outlines (generators, width, 3) and counts of every generator's patch."""
+        from scipy.spatial import QhullError, SphericalVoronoi
+
         g = self.gen_axes
         k = len(g)
         try:
@@ -285,6 +288,8 @@ class VoronoiPatches:
 def _merge_same(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(generators: the first facet of each group of axes within SAME_AXIS of another,
     rep: each facet's generator number)."""
+    from scipy.spatial import cKDTree
+
     n = u.shape[0]
     pairs = cKDTree(u).query_pairs(2.0 * math.sin(SAME_AXIS / 2.0), output_type="ndarray")
     parent = np.arange(n)

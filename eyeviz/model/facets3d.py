@@ -26,7 +26,6 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from eyeviz.core.geometry3d import EyePair3D
 from eyeviz.core.measured import MeasuredEye, MeasuredEyePair
@@ -164,6 +163,8 @@ def hexagon_mesh(eye: MeasuredEye, k: int = 6, scale: float = 0.6) -> tuple[np.n
         size = np.full(n, 0.01 if n < 2 else 0.3 * float(np.linalg.norm(pos[1] - pos[0])))
         toward = np.zeros_like(pos)
     else:
+        from scipy.spatial import cKDTree  # measured eyes only (a HEALPix scene: not loaded)
+
         kk = min(k + 1, n)
         dist, idx = cKDTree(pos).query(pos, kk)
         nb = pos[idx[:, 1:]]  # (n, kk - 1, 3)
