@@ -51,9 +51,7 @@ def main() -> None:
         for _ in range(a.repeat):
             for side, path in scenes.items():
                 out = str(Path(tmp) / f"{side}.png")
-                times.setdefault(("snapshot", side), []).append(
-                    _run(["snapshot", path, "-o", out])
-                )
+                times.setdefault(("snapshot", side), []).append(_run(["snapshot", path, "-o", out]))
                 times.setdefault(("window", side), []).append(
                     _run(["app", path, "--screenshot", out, "--settings", settings])
                 )

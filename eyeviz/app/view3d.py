@@ -163,7 +163,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self.readout = Readout3DPanel(lambda: self.model)  # typed values, row clicks
         self.estimators = Estimators3DPanel(self._set_estimators)
         self.docks["bitmaps3d"] = self._dock("Facets (Mollweide)", self.bitmaps, "bitmaps3d")
-        self.docks["readout3d"] = self._dock("Balls (3D readout)", self.readout, "readout3d")
+        self.docks["readout3d"] = self._dock("Balls", self.readout, "readout3d")
         # as the planar window's: a tab beside the readout, greyed until the layer is on
         self.docks["estimators3d"] = self._dock("Estimators", self.estimators, "estimators3d")
         self.win.tabifyDockWidget(self.docks["readout3d"], self.docks["estimators3d"])

@@ -209,7 +209,8 @@ def to_pixels(xy_ndc: np.ndarray, width: int, height: int) -> np.ndarray:
 
 def view_side(cam: Camera3D) -> str:
     """Where ``cam`` looks from, in words (the model's axes), and which way round it
-    draws the eyes: "seen from front, right, above; eye A on the right". The facet maps
+    draws the eyes, on two lines: "seen from front, right, above" / "eye A on the right".
+    The facet maps
     show each eye from inside (eye A's left on the left), so a view from ahead is their
     mirror image; the 3D view and its figure say so in a corner (issue 32)."""
     d = np.asarray(cam.position, np.float64) - np.asarray(cam.focal_point, np.float64)
@@ -226,7 +227,7 @@ def view_side(cam: Camera3D) -> str:
     right, _up, _back = basis(cam)
     a_right = float(right[0]) < -0.25  # eye A (at -x) drawn right of eye B
     if a_right or float(right[0]) > 0.25:
-        text += f"; eye A on the {'right' if a_right else 'left'}"
+        text += f"\neye A on the {'right' if a_right else 'left'}"
     return text
 
 

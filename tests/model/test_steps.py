@@ -138,3 +138,41 @@ def test_the_sphere_lecture_walks_from_the_eyes_to_the_binocular_field():
     assert firsts == sorted(firsts)
     assert all(s.caption for s in sc.steps)
     assert sc.steps[-1].features is None  # every ball at the end
+
+
+@pytest.mark.parametrize(
+    ("step", "message"),
+    [
+        ('layers = ["eyes"]\ncamera = "top"', "steps[0].camera: unknown camera 'top'"),
+        ('layers = ["eyes"]\ncamera = 3', "steps[0].camera: must be a name or a table"),
+        ('layers = ["eyes"]\ncamera = { center = [0.0, 1.0] }', "steps[0].camera: missing width"),
+        ('layers = ["eyes"]\ncamera = { center = [0, 1], width = -2 }', "steps[0].camera.width"),
+        ('layers = ["eyes"]\ncamera = { center = [nan, 1], width = 2 }', "steps[0].camera.center"),
+        ('layers = ["eyes"]\npanels = ["maps"]', "steps[0].panels: unknown panel 'maps'"),
+    ],
+)
+def test_a_bad_step_camera_or_panel_is_refused_in_one_line(step, message):
+    with pytest.raises(SceneError) as err:
+        loads(HEAD + "\n[[steps]]\n" + step + "\n", "<s>")
+    assert message in str(err.value) and "\n" not in str(err.value)
+
+
+def test_step_cameras_and_panels_are_read_and_round_trip_on_both_sides():
+    planar = loads(
+        HEAD + '\n[[steps]]\ncaption = "a"\nlayers = ["eyes"]\n'
+        'camera = { center = [0.0, 150.0], width = 400.0 }\npanels = ["readout"]\n'
+    )
+    assert planar.steps[0].camera == {"center": [0.0, 150.0], "width": 400.0}
+    assert planar.steps[0].panels == ["readout"] and loads(dumps(planar)) == planar
+    cam = "{ position = [0, -900, 400], focal_point = [0, 200, 0], view_up = [0, 0, 1] }"
+    sphere = loads(
+        SPHERE_HEAD + f'\n[[steps]]\ncaption = "a"\nlayers = ["eyes"]\ncamera = {cam}\n'
+        '\n[[steps]]\ncaption = "b"\nlayers = ["eyes"]\ncamera = "side"\npanels = ["maps"]\n'
+    )
+    assert sphere.steps[0].camera["focal_point"] == [0.0, 200.0, 0.0]
+    assert sphere.steps[1].camera == "side" and sphere.steps[1].panels == ["maps"]
+    assert loads(dumps(sphere)) == sphere
+    same = SPHERE_HEAD + '\n[[steps]]\ncaption = "a"\nlayers = ["eyes"]\n'
+    with pytest.raises(SceneError, match="position must differ from focal_point"):
+        loads(same + "camera = { position = [1, 2, 3], focal_point = [1, 2, 3], "
+              "view_up = [0, 0, 1] }\n")  # fmt: skip

@@ -242,7 +242,10 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         for t, _pt in self._texts:
             if t.get_text() in ("left", "right"):
                 t.set_visible(wide)
-            elif t.get_text().startswith("equator"):  # only where it fits inside the map
+            elif t.get_text().startswith("equator"):  # whole, or "equator", where it fits
+                full = t.get_gid() or t.get_text()
+                t.set_gid(full)
+                t.set_text(full if len(full) * char_in <= 0.95 * map_in else "equator")
                 fits = len(t.get_text()) * char_in <= 0.95 * map_in
                 t.set_visible(fits and 1.35 * MAP_PT * s / 72.0 <= 0.2 * map_in)
 
