@@ -226,13 +226,25 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         if h_in <= 0:
             return
         s = text_scale()
-        title = 1.35 * MAP_TITLE_PT * s / 72.0 / h_in  # figure fractions
-        words = 1.35 * MAP_PT * s / 72.0 / h_in
-        pad = 0.01
-        room = max((1.0 - 2.0 * (title + words + 2 * pad)) / 2.0, 0.05)
-        top_b = 1.0 - pad - title - room
+        title = 1.2 * MAP_TITLE_PT * s / 72.0 / h_in  # figure fractions
+        words = 1.2 * MAP_PT * s / 72.0 / h_in
+        if title <= 0.065 and title + words <= 0.09:  # the words fit the margins
+            self.axes["A"].set_position((0.01, 0.535, 0.98, 0.40))
+            self.axes["B"].set_position((0.01, 0.045, 0.98, 0.40))
+            self._fit_words(s, h_in)
+            return
+        # larger text: the maps as large as the words leave them
+        room = max((1.0 - 2.0 * (title + words + 0.008)) / 2.0, 0.05)
+        gap = max((1.0 - 2.0 * (room + title + words)) / 3.0, 0.0)  # above, between, below
+        top_b = 1.0 - gap - title - room
         self.axes["A"].set_position((0.01, top_b, 0.98, room))
-        self.axes["B"].set_position((0.01, top_b - words - 2 * pad - title - room, 0.98, room))
+        self.axes["B"].set_position((0.01, top_b - words - gap - title - room, 0.98, room))
+        self._fit_words(s, h_in)
+
+    def _fit_words(self, s: float, h_in: float) -> None:
+        """The words that fit the maps' width now (see :meth:`_place_axes`)."""
+        room = self.axes["A"].get_position().height
+        px_per_in = self.fig.dpi / max(self.canvas.devicePixelRatioF(), 1.0)
         # left / forward / right need about 22 characters' width: on a map narrower than
         # that (large text in a small panel) only "forward" is kept
         w_in = self.canvas.width() / px_per_in
