@@ -99,7 +99,7 @@ PRIORS = ("single", "multi")
 #: the retries of keys with no accepted draw: (window and slack factor, batches of draws)
 RETRY = ((1.0, 8), (2.5, 24), (1.0, 96))
 #: the default accuracy: the relative Monte-Carlo error of r a key's draws are topped up
-#: to, batch by batch, at most MAX_BATCHES batches in all (docs/limit3d_accuracy.md)
+#: to, batch by batch, at most MAX_BATCHES batches in all (docs/limit3d.md)
 MC_TARGET = 0.01
 MAX_BATCHES = 16
 #: the largest ``max_batches`` a Limit3DEstimator takes

@@ -325,6 +325,8 @@ def figure3d(
     return fig
 
 
+# long: the figure's layout in one place (view, maps, table, close-up inset, legend), each
+# part placed relative to the ones before it; split, the parts would pass the layout around
 def _figure3d(scene, state, width, title, table, bitmaps, aspect, camera, view, dpi,
               view_image, predictions, ball) -> Figure:  # fmt: skip
     """:func:`figure3d` at the font floor set (:func:`eyeviz.render.mpl.style.pt`)."""
