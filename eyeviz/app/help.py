@@ -47,6 +47,7 @@ LAYER3D_TEXT = {
     "plane": "the plane z = 0",
     "predictions": "the estimators' answers",
     "cones": "the lit facets' acceptance cones",
+    "responses": "the lit facets' graded responses",
 }
 SPHERICAL_SECTION = "The spherical model (3D scenes)"  # docs/model.md's heading
 HELP_NAME = "eyeviz_help_name"  # a QAction property: its name in F1 (when its text changes)

@@ -24,7 +24,8 @@ y. A spherical scene may show only the layers in :data:`SPHERICAL_LAYERS` (eyes,
 bfv, bitmaps, readout, labels, and in the app's 3D view tangents: the tangent cones from
 each eye centre to each ball, and plane: the plane z = 0, a layer of spherical scenes only,
 :data:`SPHERICAL_ONLY`; and predictions: the spherical estimators' answers for one ball,
-:mod:`eyeviz.model.predictions3d`); the planar-only layers (sectors, ambiguity, posterior,
+:mod:`eyeviz.model.predictions3d`; and responses: each lit facet shaded by its graded
+response, :mod:`eyeviz.model.responses3d`); the planar-only layers (sectors, ambiguity, posterior,
 trajectory, and any registered layer) and a ``[trajectory]`` table are refused in one line.
 
 Measured eyes (docs/measured.md): ``[eyes] file = "..."`` (and ``units``) names an eye file,
@@ -83,14 +84,14 @@ DEFAULT_LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout"]
 #: The layers a spherical scene may show (see the module docstring).
 SPHERICAL_LAYERS = (
     "eyes", "features", "bfv", "bitmaps", "readout", "labels", "tangents", "plane", "predictions",
-    "cones",
+    "cones", "responses",
 )  # fmt: skip
 #: The estimators of a spherical scene's predictions layer when its file names none (the
 #: planar scenes' default is compact; a spherical scene naming a planar one is refused by
 #: eyeviz.model.predictions3d.check_estimators).
 SPHERICAL_ESTIMATORS = ("analytic3d", "learned3d", "limit3d")
 #: Layers of spherical scenes only (not in the planar layer table, eyeviz.model.layers).
-SPHERICAL_ONLY = ("plane", "cones")
+SPHERICAL_ONLY = ("plane", "cones", "responses")
 #: The spherical side's layers that apply to some eye models only (the others: to both):
 #: the estimators' answers to HEALPix eyes (no estimator of measured eyes in the app yet),
 #: the lit acceptance cones to measured eyes (a HEALPix facet has no lens).

@@ -43,6 +43,7 @@ from PyQt5 import QtCore, QtWidgets
 
 from eyeviz.app.panels.common import follows_text_scale, text_scale, wrap_label
 from eyeviz.app.panels.lit_raster import LitRaster
+from eyeviz.model import responses3d as r3
 from eyeviz.model.facet_patches import FacetPatches, facet_patches, patches_caption
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
@@ -174,6 +175,9 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self.names: list[str] = []
         self.update_ms = 0.0
         self.hover_pix: tuple[str, int] | None = None
+        self.values: dict[str, np.ndarray] = {}  # responses layer: per lit facet (owners')
+        self.kind = ""  # the responses' kind
+        self._unlit = to_rgba_array([UNLIT])[0]
         self._keys: dict[str, bytes] = {}
         self._bg = None
         self._lit: dict[str, tuple[PathCollection, ...]] = {}
@@ -295,7 +299,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
                 "bitmaps layer hidden" if not scene.shows("bitmaps") else "no lit sets"
             )
             self.message.show()
-            self.owners, self._keys, self._halo_keys = {}, {}, {}
+            self.owners, self._keys, self._halo_keys, self.values = {}, {}, {}, {}
             return
         self.message.hide()
         self.canvas.show()
@@ -310,12 +314,18 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         counts: list[str] = []
         n = len(scene.features)
         self.selected = selected if selected is not None and 0 <= selected < n else None
+        vals = r3.lit_responses(state, self.selected) if scene.shows("responses") else None
+        self.values, self.kind = {}, r3.LAYER_KIND.get(pair.kind, "")
         for eye, csr in zip(EYES, (state.lit_a, state.lit_b), strict=True):
-            pix, ball = lit_owners(csr)
-            key = b"".join((pix.tobytes(), ball.tobytes(), rgba.tobytes()))
-            self.owners[eye] = (pix, ball)
+            pix, owner = lit_owners(csr)
+            self.owners[eye] = (pix, owner)
+            ball, colours = owner, rgba
+            if vals is not None:  # each facet its ball's colour at its response's shade
+                self.values[eye] = r3.owner_values(csr, vals[eye])
+                ball, colours = r3.shaded_owners(owner, self.values[eye], rgba, self._unlit)
+            key = b"".join((pix.tobytes(), ball.tobytes(), colours.tobytes()))
             if eye in self._raster:
-                changed |= self._set_raster(eye, csr, pix, ball, rgba, key)
+                changed |= self._set_raster(eye, csr, pix, ball, colours, key)
                 counts.append(f"{eye} {pix.size:,}")
                 continue
             if self._set_halo(eye, csr, pix, key):
@@ -328,13 +338,13 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             base, over, dup, cnt = self._geom[eye][1:]
             # facets inside the map's outline need no clipping (2 ms a frame at nside 180)
             inner, edge = self._lit[eye]
-            paths, fc = _by_ball(base[~over], ball[~over], rgba, cnt[~over])
+            paths, fc = _by_ball(base[~over], ball[~over], colours, cnt[~over])
             inner.set_paths(paths)
             inner.set_facecolor(fc)
             paths, fc = _by_ball(
                 np.concatenate([base[over], dup[over]]),
                 np.tile(ball[over], 2),
-                rgba,
+                colours,
                 np.tile(cnt[over], 2),
             )
             edge.set_paths(paths)
@@ -558,6 +568,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         k = int(np.searchsorted(lit, pix))
         if k < lit.size and lit[k] == pix:
             text += f"; lit by {self.names[int(ball[k])]!r}"
+            if eye in self.values:
+                text += "; " + r3.response_text(float(self.values[eye][k]), self.kind)
         self.hover.setText(text)
         self.canvas.setToolTip(text)
         assert self._hover_coll is not None

@@ -10,6 +10,10 @@ place (pyvista's cell data, one ``Modified``). Beyond (HEALPix nside > 32: 388,8
 per eye at nside 180, each under a pixel) the unlit sphere is a smooth mesh drawn once,
 and each ball's lit facets are a small mesh of their own, rebuilt only when that ball's
 lit set changes.
+
+With the ``responses`` layer (:mod:`eyeviz.model.responses3d`) each lit facet of a full
+surface is its ball's colour blended towards the unlit grey by 1 - its response; the
+patches beyond the full LOD keep their ball's plain colour.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from vtkmodules.vtkRenderingCore import vtkActor
 
 from eyeviz.model import shapes3d
 from eyeviz.model.facets3d import EyeSurface
+from eyeviz.model.responses3d import lit_responses, owner_values, shade
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.style3d import EDGE_RGB, EDGES_MAX_NSIDE
@@ -131,10 +136,16 @@ class EyesPainter(Painter3D):
             a.SetVisibility(show)
         pal = palette(scene)
         if self.full:
+            vals = lit_responses(state, selected) if scene.shows("responses") else None
             for e, mesh in enumerate(self.meshes):
                 own = self._owner[e]
                 shapes3d.facet_owner(state, "AB"[e], own)
-                write_rgb(mesh, pal[own])
+                rgb = pal[own]
+                csr = state.lit_b if e else state.lit_a
+                if vals is not None and csr is not None and csr[1].size:
+                    pix = np.unique(csr[1])  # the lit facets, as owner_values orders them
+                    rgb[pix] = shade(rgb[pix], UNLIT, owner_values(csr, vals["AB"[e]]))
+                write_rgb(mesh, rgb)
         else:
             self._draw_patches(state, surface, pal, show)
         for eq in self.equators:
