@@ -30,6 +30,7 @@ Window-up: a whole process, start to the first rendered frame of sphere_paper.to
     xvfb-run -a .venv/bin/python scripts/bench_app3d.py [--events 240] [--predictions]
     xvfb-run -a .venv/bin/python scripts/bench_app3d.py --bee   # measured eyes only
 
+``--responses`` also drags each case with the responses layer on (issue 34 item 2).
 ``--predictions`` also drags each case with the predictions layer on (issue 23 item 4:
 the fast estimators answer the dragged ball on every frame, the limit waits for the
 drag's end) and prints its frames against the same run's layer-off drag.
@@ -98,8 +99,11 @@ def _bee():
     return load(scene_path("bee"))
 
 
-def bench_drag(nside, events: int, settings: str, predictions: bool = False) -> dict:
-    """One case: ``nside`` (HEALPix eyes, the balls of :func:`_scene`) or ``"bee"``."""
+def bench_drag(
+    nside, events: int, settings: str, predictions: bool = False, responses: bool = False
+) -> dict:
+    """One case: ``nside`` (HEALPix eyes, the balls of :func:`_scene`) or ``"bee"``;
+    ``responses``: with the responses layer on."""
     from PyQt5 import QtCore
     from PyQt5.QtTest import QTest
 
@@ -107,6 +111,8 @@ def bench_drag(nside, events: int, settings: str, predictions: bool = False) -> 
 
     app = make_app()
     scene = _bee() if nside == "bee" else _scene(nside, predictions)
+    if responses:
+        scene.layers = [*scene.layers, "responses"]
     win = MainWindow(scene, settings=make_settings(settings))
     win.resize(1280, 800)
     win.show()
@@ -235,6 +241,9 @@ def main() -> int:
     ap.add_argument(
         "--nside", type=int, action="append", help="only these nsides (repeatable), no window-up"
     )
+    ap.add_argument(
+        "--responses", action="store_true", help="also drag with the responses layer on"
+    )
     ap.add_argument("--profile", help="write a cProfile of the drags to this file")
     args = ap.parse_args()
     if not os.environ.get("DISPLAY"):
@@ -289,6 +298,16 @@ def main() -> int:
                 f"{q95 / p95:.2f}x; limit jobs started up to the release (the window's "
                 f"first ball, the press's selection) {q['jobs'][0]}, after it "
                 f"{q['jobs'][1] - q['jobs'][0]}"
+            )
+        if args.responses:
+            q = bench_drag(nside, args.events, settings, responses=True)
+            q50, q95 = _pct(q["lat"], 50), _pct(q["lat"], 95)
+            c50, c95 = _pct(q["base"], 50), _pct(q["base"], 95)
+            ok &= q50 / c50 <= P50_RATIO
+            print(
+                f"  responses on: drag p50 {q50:.1f} ms p95 {q95:.1f} ms; bare p50 "
+                f"{c50:.1f} ms p95 {c95:.1f} ms; ratio p50 {q50 / c50:.2f}x (<= {P50_RATIO}) "
+                f"p95 {q95 / c95:.2f}x; against the layer off p50 {q50 / p50:.2f}x"
             )
     if prof is not None:
         prof.dump_stats(args.profile)
