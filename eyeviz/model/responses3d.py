@@ -10,9 +10,10 @@ to :data:`LEVELS` steps so that the Facets dock keeps a small palette.
 Bounds (the GUI never waits for seconds): a measured eye's responses are computed for
 every ball, about 50 us per lit (ball, facet) pair, each ball's once per position
 (:class:`ResponseCache`); a HEALPix ``cell`` response costs about 1 ms a cell, so only the
-selected ball's are computed, and only on an eye where it lights at most
-:data:`MAX_CELLS` cells (about 50 ms a frame at most); other lit facets keep their ball's
-plain colour (value NaN: "not computed").
+selected ball's are computed, only on an eye where it lights at most :data:`MAX_CELLS`
+cells, and only while it stands still (:meth:`ResponseCache.at_rest`: not during a drag,
+from the release on): a call costs about 80 ms plus 1-10 ms a cell, once per position.
+Other lit facets keep their ball's plain colour (value NaN: "not computed").
 """
 
 from __future__ import annotations
@@ -89,7 +90,7 @@ def response_text(value: float, kind: str) -> str:
     """The hover's words for a lit facet's response (NaN: not computed, the bounds)."""
     if np.isfinite(value):
         return f"response {value:.3g} ({kind})"
-    return f"response not computed ({kind}: the selected ball's, <= {MAX_CELLS} cells)"
+    return f"response not computed ({kind}: the selected ball's at rest, <= {MAX_CELLS} cells)"
 
 
 class ResponseCache:
@@ -99,12 +100,29 @@ class ResponseCache:
     def __init__(self) -> None:
         self.pair: object | None = None
         self.rows: dict[tuple, np.ndarray] = {}
+        self.seen: dict[int, tuple[tuple[float, ...], object]] = {}  # ball: (where, state)
+
+    def at_rest(self, state: SceneState3D, i: int) -> bool:
+        """Whether ball ``i`` stands where it stood in an earlier state (or is new to the
+        cache): False on the frames of a move (a drag: every frame), True from the next
+        state on (the release's commit)."""
+        if state.pair is not self.pair:
+            self.pair, self.rows, self.seen = state.pair, {}, {}
+        where = (float(state.x[i]), float(state.y[i]), float(state.z[i]), float(state.g[i]))
+        was = self.seen.get(i)
+        if was is None:
+            self.seen[i] = (where, state)
+            return True
+        if was[0] != where:
+            self.seen[i] = (where, state)
+            return False
+        return was[1] is not state
 
     def row(self, state: SceneState3D, eye: str, i: int, idx: np.ndarray) -> np.ndarray:
         """Ball ``i``'s responses on its lit facets ``idx`` of ``eye`` (aligned)."""
         pair = state.pair
         if pair is not self.pair:
-            self.pair, self.rows = pair, {}
+            self.pair, self.rows, self.seen = pair, {}, {}
         ball = (float(state.x[i]), float(state.y[i]), float(state.z[i]), float(state.g[i]))
         key = (eye, ball, idx.tobytes())
         got = self.rows.get(key)
@@ -138,6 +156,8 @@ def lit_responses(
     cache = CACHE if cache is None else cache
     out: dict[str, np.ndarray] = {}
     healpix = isinstance(state.pair, EyePair3D)
+    rest = healpix and selected is not None and 0 <= selected < state.n
+    rest = rest and cache.at_rest(state, int(selected or 0))
     for eye, csr in (("A", state.lit_a), ("B", state.lit_b)):
         if csr is None:
             out[eye] = np.zeros(0)
@@ -146,7 +166,7 @@ def lit_responses(
         vals = np.full(idx.size, np.nan)
         for i in range(state.n):
             lo, hi = int(indptr[i]), int(indptr[i + 1])
-            if hi == lo or (healpix and (i != selected or hi - lo > MAX_CELLS)):
+            if hi == lo or (healpix and (i != selected or not rest or hi - lo > MAX_CELLS)):
                 continue
             vals[lo:hi] = cache.row(state, eye, i, idx[lo:hi])
         out[eye] = vals

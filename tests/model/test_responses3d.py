@@ -53,3 +53,17 @@ def test_healpix_cells_only_for_the_selected_ball_within_the_cap() -> None:
     assert np.isnan(r3.lit_responses(big, 0, r3.ResponseCache())["A"]).all()
     assert "not computed" in r3.response_text(float("nan"), "cell")
     assert r3.response_text(0.4242, "cell") == "response 0.424 (cell)"
+
+
+def test_healpix_cells_wait_for_the_ball_to_stand_still() -> None:
+    """A drag (a new position in each state) computes no cell; the release's state at the
+    same position does; the painter and the dock asking in one state agree."""
+    pair = EyePair3D(40.0, 20.0, nside=8)
+    cache = r3.ResponseCache()
+    s0 = _state(pair, [(0.0, 200.0, 0.0, 8.0)])
+    assert np.isfinite(r3.lit_responses(s0, 0, cache)["A"]).all()  # new: at rest
+    s1 = _state(pair, [(5.0, 200.0, 0.0, 8.0)])  # a drag frame
+    assert np.isnan(r3.lit_responses(s1, 0, cache)["A"]).all()
+    assert np.isnan(r3.lit_responses(s1, 0, cache)["B"]).all()  # the same frame, again
+    s2 = _state(pair, [(5.0, 200.0, 0.0, 8.0)])  # the release: same place, a new state
+    assert np.isfinite(r3.lit_responses(s2, 0, cache)["A"]).all()
