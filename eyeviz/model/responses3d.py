@@ -102,12 +102,22 @@ class ResponseCache:
         self.rows: dict[tuple, np.ndarray] = {}
         self.seen: dict[int, tuple[tuple[float, ...], object]] = {}  # ball: (where, state)
 
+    def _check_pair(self, pair: object) -> None:
+        """Forget everything for other eyes (HEALPix pairs are compared by their
+        parameters: a state may build its pair anew)."""
+        same = pair is self.pair or (
+            isinstance(pair, EyePair3D)
+            and isinstance(self.pair, EyePair3D)
+            and (pair.h, pair.l, pair.nside) == (self.pair.h, self.pair.l, self.pair.nside)
+        )
+        if not same:
+            self.pair, self.rows, self.seen = pair, {}, {}
+
     def at_rest(self, state: SceneState3D, i: int) -> bool:
         """Whether ball ``i`` stands where it stood in an earlier state (or is new to the
         cache): False on the frames of a move (a drag: every frame), True from the next
         state on (the release's commit)."""
-        if state.pair is not self.pair:
-            self.pair, self.rows, self.seen = state.pair, {}, {}
+        self._check_pair(state.pair)
         where = (float(state.x[i]), float(state.y[i]), float(state.z[i]), float(state.g[i]))
         was = self.seen.get(i)
         if was is None:
@@ -121,8 +131,7 @@ class ResponseCache:
     def row(self, state: SceneState3D, eye: str, i: int, idx: np.ndarray) -> np.ndarray:
         """Ball ``i``'s responses on its lit facets ``idx`` of ``eye`` (aligned)."""
         pair = state.pair
-        if pair is not self.pair:
-            self.pair, self.rows, self.seen = pair, {}, {}
+        self._check_pair(pair)
         ball = (float(state.x[i]), float(state.y[i]), float(state.z[i]), float(state.g[i]))
         key = (eye, ball, idx.tobytes())
         got = self.rows.get(key)

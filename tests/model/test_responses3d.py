@@ -62,6 +62,7 @@ def test_healpix_cells_wait_for_the_ball_to_stand_still() -> None:
     cache = r3.ResponseCache()
     s0 = _state(pair, [(0.0, 200.0, 0.0, 8.0)])
     assert np.isfinite(r3.lit_responses(s0, 0, cache)["A"]).all()  # new: at rest
+    pair = EyePair3D(40.0, 20.0, nside=8)  # a state may build its pair anew
     s1 = _state(pair, [(5.0, 200.0, 0.0, 8.0)])  # a drag frame
     assert np.isnan(r3.lit_responses(s1, 0, cache)["A"]).all()
     assert np.isnan(r3.lit_responses(s1, 0, cache)["B"]).all()  # the same frame, again
