@@ -111,7 +111,13 @@ def test_shift_drag_moves_along_the_line_of_sight(make_window, qtbot):
     assert win.undo_stack.count() == 1
     f = host.model.scene.features[0]
     d1 = np.linalg.norm(np.subtract((f.x, f.y, f.z), cam.position))
-    assert d1 == pytest.approx(d0 * np.exp(60 / 200), rel=1e-6)  # up: farther, e per 200 px
+    # up: farther, each pixel by a pixel's span in the screen plane at the ball's depth
+    # (issue 32.5; it was a factor e per 200 px, thousands of units in a few pixels)
+    back = np.subtract(cam.position, cam.focal_point)
+    back = back / np.linalg.norm(back)
+    depth = float(np.dot(np.subtract(cam.position, (f0.x, f0.y, f0.z)), back))
+    per_px = 2 * depth * np.tan(np.radians(cam.view_angle) / 2) / w.height()
+    assert d1 - d0 == pytest.approx(60 * per_px, rel=0.05)
 
 
 def test_keys_nudge_the_selected_ball(make_window, qtbot):
