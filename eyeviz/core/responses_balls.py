@@ -14,6 +14,8 @@ import math
 
 import numpy as np
 
+from eyeviz.core.exact import _expansion
+
 __all__ = ["ball_cap", "two_diff"]
 
 _SPLIT = 134217729.0  # 2^27 + 1, Dekker's splitter
@@ -25,12 +27,6 @@ def two_diff(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     bb = s - a
     e = (a - (s - bb)) + (-b - bb)
     return s, e
-
-
-def _two_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    s = a + b
-    bb = s - a
-    return s, (a - (s - bb)) + (b - bb)
 
 
 def _two_prod(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -49,14 +45,7 @@ def _two_prod(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _sum_exact(terms: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """(value, sign) of a sum of floats: a nonoverlapping expansion (error-free), its
     sign that of the largest non-zero component, its value summed smallest first."""
-    e: list[np.ndarray] = []
-    for t in terms:
-        q, grown = t, []
-        for comp in e:
-            q, h = _two_sum(q, comp)
-            grown.append(h)
-        grown.append(q)
-        e = grown
+    e = _expansion(terms)
     sign = np.zeros(e[0].shape)
     for comp in reversed(e):
         sign = np.where(sign == 0, np.sign(comp), sign)
