@@ -45,3 +45,76 @@ def toy_measured_pair(n_dirs: int = 600, acceptance: float = 0.2):
         for sx, nm in ((-2.0, "A"), (2.0, "B"))
     ]
     return MeasuredEyePair(eyes[0], eyes[1], name="toy", source="tests/conftest.py")
+
+
+class ToyEyes:
+    """docs/extending.md's toy eye model in space: seven facets per eye, a new kind.
+
+    Each eye has a central facet and six around it (``tilt`` away), their axes turned
+    ``squint`` towards the other eye, lenses at distance ``l`` from the eye's centre (-h or
+    +h on x) along their axes, each seeing a cone of full angle ``acceptance``. Its
+    geometry is written here, independently of the package: a facet sees a ball (c, g)
+    iff the ball's distance from the facet's cone (apex the lens, axis a, half-angle al)
+    is at most g, with d = |c - p| and t = angle(c - p, a): 0 for t <= al, d sin(t - al)
+    for t < al + pi/2, else d. It implements the protocol :class:`eyeviz.core.eyes.EyeModel`
+    and gives its facets (``facets(eye)``), which is all the pipeline asks of it.
+    """
+
+    kind = "toy"
+    dims = 3
+
+    def __init__(
+        self, h: float = 2.0, l: float = 0.5, tilt: float = 0.3, acceptance: float = 0.45
+    ) -> None:
+        self.h, self.l, self.tilt, self.acceptance = h, l, tilt, acceptance  # noqa: E741
+        self.squint = 0.5
+
+    @property
+    def facet_counts(self) -> tuple[int, int]:
+        return (7, 7)
+
+    @property
+    def design(self) -> dict[str, float]:
+        return {"h": self.h, "l": self.l, "tilt": self.tilt, "acceptance": self.acceptance}
+
+    def facets(self, eye: str):
+        import numpy as np
+
+        t = np.r_[0.0, np.full(6, self.tilt)]
+        p = np.r_[0.0, np.arange(6) * np.pi / 3]
+        u = np.c_[np.sin(t) * np.cos(p), np.cos(t), np.sin(t) * np.sin(p)]
+        sx = -1.0 if eye == "A" else 1.0
+        c, s = np.cos(sx * self.squint), np.sin(sx * self.squint)
+        u = np.c_[c * u[:, 0] - s * u[:, 1], s * u[:, 0] + c * u[:, 1], u[:, 2]]
+        return u * self.l + [sx * self.h, 0.0, 0.0], u, np.full(7, self.acceptance)
+
+    def _eye(self, eye: str, x, y, z, g):
+        import numpy as np
+
+        pos, ax, acc = self.facets(eye)
+        v = np.stack(np.broadcast_arrays(x, y, z), -1)[..., None, :] - pos  # (..., 7, 3)
+        d = np.linalg.norm(v, axis=-1)
+        t = np.arccos(np.clip((v * ax).sum(-1) / np.maximum(d, 1e-300), -1, 1))
+        al = acc / 2
+        dist = np.where(t <= al, 0.0, np.where(t < al + np.pi / 2, d * np.sin(t - al), d))
+        return dist <= np.asarray(g)[..., None], d.min(-1) <= np.asarray(g)
+
+    def bitmaps(self, x, y, z, g):
+        return self._eye("A", x, y, z, g)[0], self._eye("B", x, y, z, g)[0]
+
+    def visible(self, x, y, z, g):
+        a, b = self.bitmaps(x, y, z, g)
+        return a.sum(-1) >= 2, b.sum(-1) >= 2
+
+    def overlaps_eye(self, x, y, z, g):
+        return self._eye("A", x, y, z, g)[1], self._eye("B", x, y, z, g)[1]
+
+    def in_bfv(self, x, y, z, g):
+        (va, vb), (oa, ob) = self.visible(x, y, z, g), self.overlaps_eye(x, y, z, g)
+        return va & vb & ~oa & ~ob
+
+
+@pytest.fixture(scope="session")
+def toy_eyes() -> ToyEyes:
+    """docs/extending.md's toy eye model in space (:class:`ToyEyes`)."""
+    return ToyEyes()

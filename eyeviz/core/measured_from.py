@@ -52,9 +52,17 @@ def _eye(center_x: float, l: float, u: np.ndarray, acc: float, name: str) -> Mea
 def as_measured(eyes) -> MeasuredEyePair:
     """The measured version of an :class:`EyePair3D` (one ommatidium per HEALPix cell) or
     of an :class:`EyePair` (a ring of m ommatidia in the plane z = 0); a
-    :class:`MeasuredEyePair` is returned as it is."""
+    :class:`MeasuredEyePair` is returned as it is. Any other model whose facets are
+    acceptance cones enters by its ``facets(eye)`` (lens positions, axes, full acceptance
+    angles of eye ``"A"`` or ``"B"``, as :meth:`MeasuredEyePair.facets`): the door through
+    which a new eye model in space reaches the pipeline (docs/extending.md)."""
     if isinstance(eyes, MeasuredEyePair):
         return eyes
+    facets = getattr(eyes, "facets", None)
+    if callable(facets) and not isinstance(eyes, (EyePair3D, EyePair)):
+        a, b = (MeasuredEye(*facets(w)[:3], name=w) for w in "AB")
+        kind = getattr(eyes, "kind", type(eyes).__name__)
+        return MeasuredEyePair(a, b, name=f"{kind} eyes", source=f"eyeviz {kind} model")
     if isinstance(eyes, EyePair3D):
         u = healpix.centers(eyes.nside)
         u = u / np.linalg.norm(u, axis=1)[:, None]
@@ -66,7 +74,10 @@ def as_measured(eyes) -> MeasuredEyePair:
         acc = eyes.gamma
         name = f"planar ring m {eyes.m}, h {eyes.h:g}, l {eyes.l:g}"
     else:
-        raise TypeError(f"as_measured: expected an eyeviz eye pair, got {type(eyes).__name__}")
+        raise TypeError(
+            f"as_measured: expected an eyeviz eye pair or a model with facets(eye), "
+            f"got {type(eyes).__name__}"
+        )
     a = _eye(-eyes.h, eyes.l, u.copy(), acc, "A")
     b = _eye(eyes.h, eyes.l, u.copy(), acc, "B")
     return MeasuredEyePair(a, b, name=name, source=f"eyeviz {eyes.kind} model")
