@@ -60,7 +60,11 @@ def as_measured(eyes) -> MeasuredEyePair:
         return eyes
     facets = getattr(eyes, "facets", None)
     if callable(facets) and not isinstance(eyes, (EyePair3D, EyePair)):
-        a, b = (MeasuredEye(*facets(w)[:3], name=w) for w in "AB")
+        eyes = []
+        for w in "AB":
+            pos, ax, acc = facets(w)[:3]
+            eyes.append(MeasuredEye(pos, ax, acc, name=w))
+        a, b = eyes
         kind = getattr(eyes, "kind", type(eyes).__name__)
         return MeasuredEyePair(a, b, name=f"{kind} eyes", source=f"eyeviz {kind} model")
     if isinstance(eyes, EyePair3D):
