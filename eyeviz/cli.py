@@ -125,11 +125,19 @@ def _error(msg: str) -> None:
     print(f"eyeviz: error: {text}", file=sys.stderr)
 
 
-def build_parser():
+def build_parser(argv: list[str] | None = None):
+    """The whole command line's parser. With ``argv`` (a command line whose first word is
+    a command) only that command's options are built: a command's ``add_arguments`` may
+    import what its defaults need (the report kinds import their modules), and a command
+    line should pay for its own command only. ``eyeviz --help`` still lists every command
+    with its help line; a command that takes ``argv`` in its ``add_arguments`` gets the
+    words after its name (``report`` builds only the kind asked for)."""
     import argparse
+    import inspect
 
     from eyeviz import __version__
 
+    wanted = argv[0] if argv else None
     parser = argparse.ArgumentParser(
         prog="eyeviz",
         description="Planar binocular compound-eye model: app, datasets, estimators, reports.",
@@ -138,7 +146,11 @@ def build_parser():
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for mod in _command_modules():
         p = sub.add_parser(mod.NAME, help=mod.HELP, description=mod.HELP)
-        mod.add_arguments(p)
+        if wanted is None or wanted.startswith("-") or wanted == mod.NAME:
+            if "argv" in inspect.signature(mod.add_arguments).parameters:
+                mod.add_arguments(p, argv=argv[1:] if wanted == mod.NAME else None)
+            else:
+                mod.add_arguments(p)
         p.set_defaults(_run=mod.run, _outputs=getattr(mod, "OUTPUTS", None))
     _whole_floats_count(parser)
     return parser
@@ -197,13 +209,10 @@ def main(argv: list[str] | None = None) -> int:
     old_handlers: dict = {}
     try:
         argv = list(sys.argv[1:] if argv is None else argv)
-        parser = build_parser()
-        if (
-            not argv
-            or argv[0] not in parser._subparsers._group_actions[0].choices
-            and not argv[0].startswith("-")
-        ):
+        names = {mod.NAME for mod in _command_modules()}
+        if not argv or argv[0] not in names and not argv[0].startswith("-"):
             argv = [DEFAULT_COMMAND, *argv]
+        parser = build_parser(argv)
         args = parser.parse_args(argv)
         if getattr(args, "_run", None) is None:
             args = parser.parse_args([DEFAULT_COMMAND])

@@ -47,9 +47,17 @@ def register(kind: str, module: str) -> None:
     MODULES[kind] = module
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
+def add_arguments(parser: argparse.ArgumentParser, argv: list[str] | None = None) -> None:
+    """One sub-parser per kind. Given the words after ``report`` (``argv``), only the kind
+    they name imports its module and builds its options: a report's module may import
+    matplotlib, scipy or torch, and ``report study`` should not pay for the others."""
+    wanted = argv[0] if argv else None
+    every = wanted is None or wanted.startswith("-") or wanted not in MODULES
     sub = parser.add_subparsers(dest="kind", metavar="KIND", required=True)
     for kind, path in MODULES.items():
+        if not every and kind != wanted:
+            sub.add_parser(kind)
+            continue
         try:
             mod = importlib.import_module(path)
         except ModuleNotFoundError as exc:

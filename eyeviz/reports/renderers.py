@@ -22,7 +22,7 @@ from pathlib import Path
 
 from eyeviz.core.validation import check_int
 
-HELP = "sampled against exact graded responses: renderers' bias and rays for 1 % error"
+HELP = "sampled against exact graded responses: renderers' bias and rays for 1 %% error"
 
 #: Most balls in the population (--balls) and in the Monte-Carlo check (--mc-balls).
 MAX_BALLS = 10**6
