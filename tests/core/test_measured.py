@@ -418,3 +418,13 @@ def test_ball_validation_one_line(ball, message):
         with pytest.raises(ValueError) as err:
             call(*ball)
         assert message in str(err.value) and "\n" not in str(err.value)
+
+
+def test_h_l_and_centres_are_the_lens_centroids_half_distance_and_reach():
+    """h is half the distance of the two lens centroids (not of their sum: both lie off
+    the x axis here), l the largest lens distance from its eye's centroid."""
+    a = MeasuredEye([[-3.0, 4.0, 1.0], [-1.0, 4.0, 1.0]], [[0, 1, 0]] * 2, [0.2, 0.2])
+    b = MeasuredEye([[1.0, 5.0, 1.0], [3.0, 5.0, 1.0], [2.0, 2.0, 1.0]], [[0, 1, 0]] * 3, [0.2] * 3)
+    pair = MeasuredEyePair(a, b)
+    assert pair.centers == ((-2.0, 4.0, 1.0), (2.0, 4.0, 1.0))
+    assert pair.h == 2.0 and pair.l == 2.0  # b's third lens is 2 from its centroid (2, 4, 1)
