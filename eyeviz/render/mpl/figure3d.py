@@ -38,7 +38,7 @@ from eyeviz.core.geometry3d import EyePair3D
 from eyeviz.core.validation import check_choice
 from eyeviz.files.atomic import atomic_output
 from eyeviz.model import shapes3d
-from eyeviz.model.camera3d import PRESETS, Camera3D
+from eyeviz.model.camera3d import PRESETS, Camera3D, view_side
 from eyeviz.model.facet_patches import facet_patches
 from eyeviz.model.predictions3d import (
     Predictions3D,
@@ -140,18 +140,9 @@ def _draw_view(
 
 
 def _view_caption(cam: Camera3D) -> str:
-    """Where the camera looks from, in words (the model's axes)."""
-    d = np.asarray(cam.position, np.float64) - np.asarray(cam.focal_point, np.float64)
-    d /= np.linalg.norm(d)
-    words = []
-    for v, pos, neg in (
-        (d[1], "front", "behind"),
-        (d[0], "right", "left"),
-        (d[2], "above", "below"),
-    ):
-        if abs(v) > 0.25:
-            words.append(pos if v > 0 else neg)
-    return "seen from " + (", ".join(words) if words else "the focal point")
+    """Where the camera looks from, in words (the model's axes): the first line of the
+    app's :func:`eyeviz.model.camera3d.view_side`, the one place that words it."""
+    return view_side(cam).split("\n")[0]
 
 
 # --- the readout ---------------------------------------------------------------------
