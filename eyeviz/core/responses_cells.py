@@ -17,20 +17,29 @@ tolerance (the kinks where the cap's edge crosses a cell edge are found that way
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 
-from eyeviz.core import healpix
+from eyeviz.core import healpix, kernels
 
-__all__ = ["cell_fraction"]
+__all__ = ["cell_fraction", "cells_inside", "integrate", "integrate_compiled"]
 
 _NODES = 16
 _COARSE = 12  # the error estimate: |16-node - 12-node| (12 nodes converge on smooth pieces)
 _TOL = 1e-12  # on the fraction of the cell, summed over a cell's pieces
 _MAX_ROUNDS = 60
 _THIN = 1e-11
-_SAMPLES = 33  # per piece, in the piece's s variable: sign changes of the edge gaps
+#: A piece whose two rules differ by at most this share of the cell is taken as it is: the
+#: rounding of t next to a cap's square-root tip (t - (theta_c - b) has an absolute error
+#: of an ulp of t) keeps the two rules about 1e-15 of the cell apart there however thin
+#: the piece; a cell has at most a few hundred pieces, so these add well under 1e-11.
+_FLOOR = 1e-14
+_SAMPLES = 17  # per piece, in the piece's s variable: sign changes of the edge gaps
+#: Halvings of a sign change's sample interval (pi / 16 in s): 2^-40 of it, about 1e-13 of
+#: the piece; the kink left that near a piece's end costs the rule ~ (1e-13)^2 of it.
+_BISECT = 40
 _SHIFTS = (-2 * math.pi, 0.0, 2 * math.pi)
 
 
@@ -116,9 +125,14 @@ class _Cells:
         return np.stack(g, axis=-1)  # omega is 0 where no cap, pi where all: continuous
 
 
+@functools.lru_cache(maxsize=4)
+def _leggauss(nodes: int) -> tuple[np.ndarray, np.ndarray]:
+    return np.polynomial.legendre.leggauss(nodes)
+
+
 def _piece(cells: _Cells, k, lo, hi, nodes: int) -> np.ndarray:
     """int_lo^hi width(t) sin t dt on t = m - h cos s, s in [0, pi] (Gauss-Legendre)."""
-    x, w = np.polynomial.legendre.leggauss(nodes)
+    x, w = _leggauss(nodes)
     s = (x + 1) * math.pi / 2
     m, h = (lo + hi) / 2, (hi - lo) / 2
     t = m[:, None] - h[:, None] * np.cos(s)
@@ -144,7 +158,7 @@ def _split_at_crossings(cells: _Cells, k, lo, hi):
     a, b = s[si].copy(), s[si + 1].copy()
     kk, ll, hh = k[pi_], lo[pi_], hi[pi_]
     sa = np.signbit(cells.edges(_t_at(ll, hh, a), kk)[np.arange(pi_.size), ei])
-    for _ in range(60):
+    for _ in range(_BISECT):
         m = (a + b) / 2
         sm = np.signbit(cells.edges(_t_at(ll, hh, m), kk)[np.arange(pi_.size), ei])
         same = sm == sa
@@ -162,34 +176,93 @@ def _split_at_crossings(cells: _Cells, k, lo, hi):
     return k[owner[keep]], nlo[keep], nhi[keep]
 
 
-def cell_fraction(nside: int, pix, theta_c, phi_c, b) -> np.ndarray:
+def cells_inside(nside: int, pix, theta_c, phi_c, b) -> np.ndarray:
+    """Per pair: the closed cell ``pix`` lies in the closed cap (radius b <= pi/2 about
+    (theta_c, phi_c)) surely, so its share is exactly 1 (False: not sure; integrate).
+
+    The lit test's bound turned over (docs/spherical.md, step 4): on each edge P(t),
+    t in [0, 1], f(t) = |P(t) - c|^2 has |f''| <= M (2.5 times the proven |P''| bound),
+    so f(t) <= (1 - t) f_a + t f_b + M t (1 - t) / 2; its maximum below s2 = 4 sin^2(b/2)
+    by 1e-11 (some hundred times float64's error in f and s2) puts the edge in the cap.
+    A cap of radius <= pi/2 holding a cell's boundary holds the cell (the boundary's other
+    side holds the cap's complement, of area >= 2 pi, more than a cell)."""
+    from eyeviz.core.healpix_fast import _edge_bounds
+
+    pix, theta_c, phi_c, b = (
+        np.ravel(v)
+        for v in np.broadcast_arrays(
+            np.asarray(pix, np.int64), *(np.asarray(v, np.float64) for v in (theta_c, phi_c, b))
+        )
+    )
+    out = np.zeros(pix.size, bool)
+    ok = np.flatnonzero(b <= math.pi / 2)
+    if not ok.size:
+        return out
+    ix, iy, face = healpix.pix2xyf(nside, pix[ok])
+    fx, fy = ix.astype(np.float64), iy.astype(np.float64)
+    st = np.sin(theta_c[ok])
+    c = np.stack([st * np.cos(phi_c[ok]), st * np.sin(phi_c[ok]), np.cos(theta_c[ok])], axis=-1)
+    s2 = 4 * np.sin(b[ok] / 2) ** 2
+
+    def f(dx: int, dy: int) -> np.ndarray:
+        v = healpix.xyf2vec(nside, fx + dx, fy + dy, face)
+        return ((v - c) ** 2).sum(axis=-1)
+
+    f00, f10, f01, f11 = f(0, 0), f(1, 0), f(0, 1), f(1, 1)
+    inside = np.ones(ok.size, bool)
+    # (fixed_is_y, fixed, lo, f at lo, f at lo + 1): the four edges
+    for fixed_is_y, fixed, lo, fa, fb in (
+        (True, fy, fx, f00, f10),
+        (True, fy + 1, fx, f01, f11),
+        (False, fx, fy, f00, f01),
+        (False, fx + 1, fy, f10, f11),
+    ):
+        m = 2.5 * _edge_bounds(nside, face, fixed_is_y, fixed, lo)
+        dd = fb - fa
+        top = np.where(
+            np.abs(dd) <= 0.5 * m,
+            0.5 * (fa + fb) + 0.125 * m + dd * dd / (2 * m),
+            np.maximum(fa, fb),
+        )
+        inside &= top < s2 - 1e-11
+    out[ok] = inside
+    return out
+
+
+def cell_fraction(nside: int, pix, theta_c, phi_c, b, jit: bool | None = None) -> np.ndarray:
     """Share of each cell ``pix`` (RING) inside the cap of radius b (pi: the sphere)
-    about (theta_c, phi_c), per pair (arrays broadcast), in [0, 1]."""
+    about (theta_c, phi_c), per pair (arrays broadcast), in [0, 1]. Cells the cap surely
+    holds (:func:`cells_inside`) are 1 exactly; the others are integrated by the compiled
+    kernel (:mod:`eyeviz.core.kernels.healpix_cells`) where it is in use (``jit`` None:
+    :func:`eyeviz.core.kernels.use`), else by the numpy reference :func:`integrate`."""
     pix, theta_c, phi_c, b = np.broadcast_arrays(
         np.asarray(pix, np.int64), *(np.asarray(v, np.float64) for v in (theta_c, phi_c, b))
     )
     shape = pix.shape
     pix, theta_c, phi_c, b = (np.ravel(v) for v in (pix, theta_c, phi_c, b))
+    out = np.ones(pix.size)
+    rest = np.flatnonzero((b < math.pi) & ~cells_inside(nside, pix, theta_c, phi_c, b))
+    if rest.size:
+        args = (nside, pix[rest], theta_c[rest], phi_c[rest], b[rest])
+        if jit is None:
+            jit = kernels.use(rest.size)
+        if jit:
+            out[rest] = integrate_compiled(*args)
+            kernels.mark_ready()
+        else:
+            out[rest] = integrate(*args)
+    return out.reshape(shape)
+
+
+def integrate(nside: int, pix, theta_c, phi_c, b) -> np.ndarray:
+    """The reference: each pair's share by the adaptive quadrature of the module's
+    docstring (flat arrays; b < pi), in [0, 1]."""
     n = pix.size
     out = np.zeros(n)
     if n == 0:
-        return out.reshape(shape)
-    every = b >= math.pi  # a ball holding the eye's centre covers every direction
-    out[every] = 1.0
-    rest = np.flatnonzero(~every)
-    if rest.size < n:
-        out[rest] = cell_fraction(nside, pix[rest], theta_c[rest], phi_c[rest], b[rest])
-        return out.reshape(shape)
+        return out
     cells = _Cells(nside, pix, theta_c, phi_c, b)
-    top = _t_of_ys(cells.yc + cells.delta)
-    mid = _t_of_ys(cells.yc)
-    bot = _t_of_ys(cells.yc - cells.delta)
-    cuts = [top, mid, bot, np.full(n, math.acos(2 / 3)), np.full(n, math.acos(-2 / 3))]
-    cuts += [theta_c - b, theta_c + b, b - theta_c, 2 * math.pi - theta_c - b]
-    pts = np.stack(cuts, axis=1)
-    pts = np.where((pts > top[:, None]) & (pts < bot[:, None]), pts, np.nan)
-    pts = np.concatenate([top[:, None], pts, bot[:, None]], axis=1)
-    pts = np.sort(pts, axis=1)  # NaN last
+    top, bot, pts = _cuts(cells)
     lo_all, hi_all = pts[:, :-1], pts[:, 1:]
     ok = np.isfinite(lo_all) & np.isfinite(hi_all) & (hi_all > lo_all)
     k = np.repeat(np.arange(n), ok.sum(axis=1))
@@ -201,7 +274,7 @@ def cell_fraction(nside: int, pix, theta_c, phi_c, b) -> np.ndarray:
             break
         fine = _piece(cells, k, lo, hi, _NODES)
         coarse = _piece(cells, k, lo, hi, _COARSE)
-        good = np.abs(fine - coarse) <= _TOL * cells.area * (hi - lo) / span
+        good = np.abs(fine - coarse) <= cells.area * np.maximum(_TOL * (hi - lo) / span, _FLOOR)
         # a piece this thin holds at most its longitude width times 1e-11 of the cell's
         # height (well below 1e-9 of the cell): rounding, not the rule, limits it there
         good |= (hi - lo) <= _THIN * span
@@ -213,4 +286,47 @@ def cell_fraction(nside: int, pix, theta_c, phi_c, b) -> np.ndarray:
         span = np.concatenate([span[bad], span[bad]])
     if k.size:
         raise ArithmeticError(f"cell response: {k.size} piece(s) did not reach the tolerance")
-    return np.clip(out / cells.area, 0.0, 1.0).reshape(shape)
+    return np.clip(out / cells.area, 0.0, 1.0)
+
+
+def integrate_compiled(nside: int, pix, theta_c, phi_c, b) -> np.ndarray:
+    """:func:`integrate` by the compiled kernel
+    (:func:`eyeviz.core.kernels.healpix_cells.cell_fraction_kernel`), pair by pair."""
+    from eyeviz.core.kernels.healpix_cells import cell_fraction_kernel
+
+    n = pix.size
+    out = np.zeros(n)
+    if n == 0:
+        return out
+    cells = _Cells(nside, pix, theta_c, phi_c, b)
+    _, _, pts = _cuts(cells)
+    xf, wf = _leggauss(_NODES)
+    xc, wc = _leggauss(_COARSE)
+
+    def f64(v: np.ndarray) -> np.ndarray:
+        return np.ascontiguousarray(v, np.float64)
+
+    failed = cell_fraction_kernel(
+        f64(pts), f64(cells.phf), f64(cells.yc), f64(cells.xc), f64(cells.pole_gap),
+        float(cells.delta), f64(cells.theta_c), f64(cells.phi_c), f64(cells.b),
+        float(cells.area), xf, wf, xc, wc, out,
+    )  # fmt: skip
+    if failed:
+        raise ArithmeticError(f"cell response: {failed} piece(s) did not reach the tolerance")
+    return np.clip(out, 0.0, 1.0)
+
+
+def _cuts(cells: _Cells) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(top, bot, points): per pair the cell's colatitude range and the sorted cut points
+    (the cell's vertices, |z| = 2/3, the cap's extremes and polar colatitudes; NaN last)."""
+    n = cells.yc.size
+    top = _t_of_ys(cells.yc + cells.delta)
+    mid = _t_of_ys(cells.yc)
+    bot = _t_of_ys(cells.yc - cells.delta)
+    tc, b = cells.theta_c, cells.b
+    cuts = [top, mid, bot, np.full(n, math.acos(2 / 3)), np.full(n, math.acos(-2 / 3))]
+    cuts += [tc - b, tc + b, b - tc, 2 * math.pi - tc - b]
+    pts = np.stack(cuts, axis=1)
+    pts = np.where((pts > top[:, None]) & (pts < bot[:, None]), pts, np.nan)
+    pts = np.concatenate([top[:, None], pts, bot[:, None]], axis=1)
+    return top, bot, np.sort(pts, axis=1)

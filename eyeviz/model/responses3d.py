@@ -7,13 +7,12 @@ acceptance function of Snyder and the renderers, restricted to the cone), a HEAL
 ball's colour blended towards the unlit grey by ``1 - value`` (:func:`shade`), quantised
 to :data:`LEVELS` steps so that the Facets dock keeps a small palette.
 
-Bounds (the GUI never waits for seconds): a measured eye's responses are computed for
-every ball, about 50 us per lit (ball, facet) pair, each ball's once per position
-(:class:`ResponseCache`); a HEALPix ``cell`` response costs about 1 ms a cell, so only the
-selected ball's are computed, only on an eye where it lights at most :data:`MAX_CELLS`
-cells, and only while it stands still (:meth:`ResponseCache.at_rest`: not during a drag,
-from the release on): a call costs about 80 ms plus 1-10 ms a cell, once per position.
-Other lit facets keep their ball's plain colour (value NaN: "not computed").
+Cost: every ball's responses are computed, each ball's once per position
+(:class:`ResponseCache`: a drag recomputes the dragged ball's only, on every frame). A
+measured eye's cost about 50 us per lit (ball, facet) pair; a HEALPix eye's cells the cap
+surely holds are 1 from a vertex-and-edge test, and only the cells its edge crosses are
+integrated (:func:`eyeviz.core.responses_cells.cell_fraction`, compiled), about 80 us a
+boundary cell.
 """
 
 from __future__ import annotations
@@ -28,7 +27,6 @@ from eyeviz.model.state3d import SceneState3D
 __all__ = [
     "LAYER_KIND",
     "LEVELS",
-    "MAX_CELLS",
     "ResponseCache",
     "lit_responses",
     "owner_values",
@@ -41,8 +39,6 @@ __all__ = [
 
 #: The kind the layer shows per eye model (``Pair3D.kind``).
 LAYER_KIND = {"measured": "gaussian", "spherical": "cell"}
-#: HEALPix: the selected ball's cell responses on an eye where it lights at most this many.
-MAX_CELLS = 24
 #: The shades between unlit (value 0) and the ball's colour (value 1).
 LEVELS = 32
 
@@ -87,20 +83,20 @@ def shaded_owners(
 
 
 def response_text(value: float, kind: str) -> str:
-    """The hover's words for a lit facet's response (NaN: not computed, the bounds)."""
+    """The hover's words for a lit facet's response (NaN: not computed)."""
     if np.isfinite(value):
         return f"response {value:.3g} ({kind})"
-    return f"response not computed ({kind}: the selected ball's at rest, <= {MAX_CELLS} cells)"
+    return f"response not computed ({kind})"
 
 
 class ResponseCache:
     """Each (eye, ball) row's responses, kept while the pair and the ball stay the same:
-    a drag recomputes only the dragged ball's."""
+    a drag recomputes only the dragged ball's (each row holds its latest position only)."""
 
     def __init__(self) -> None:
         self.pair: object | None = None
-        self.rows: dict[tuple, np.ndarray] = {}
-        self.seen: dict[int, tuple[tuple[float, ...], object]] = {}  # ball: (where, state)
+        # (eye, ball index): (the ball's (x, y, z, g), its lit facets, their values)
+        self.rows: dict[tuple[str, int], tuple[tuple[float, ...], np.ndarray, np.ndarray]] = {}
 
     def _check_pair(self, pair: object) -> None:
         """Forget everything for other eyes (HEALPix pairs are compared by their
@@ -111,32 +107,16 @@ class ResponseCache:
             and (pair.h, pair.l, pair.nside) == (self.pair.h, self.pair.l, self.pair.nside)
         )
         if not same:
-            self.pair, self.rows, self.seen = pair, {}, {}
-
-    def at_rest(self, state: SceneState3D, i: int) -> bool:
-        """Whether ball ``i`` stands where it stood in an earlier state (or is new to the
-        cache): False on the frames of a move (a drag: every frame), True from the next
-        state on (the release's commit)."""
-        self._check_pair(state.pair)
-        where = (float(state.x[i]), float(state.y[i]), float(state.z[i]), float(state.g[i]))
-        was = self.seen.get(i)
-        if was is None:
-            self.seen[i] = (where, state)
-            return True
-        if was[0] != where:
-            self.seen[i] = (where, state)
-            return False
-        return was[1] is not state
+            self.pair, self.rows = pair, {}
 
     def row(self, state: SceneState3D, eye: str, i: int, idx: np.ndarray) -> np.ndarray:
         """Ball ``i``'s responses on its lit facets ``idx`` of ``eye`` (aligned)."""
         pair = state.pair
         self._check_pair(pair)
         ball = (float(state.x[i]), float(state.y[i]), float(state.z[i]), float(state.g[i]))
-        key = (eye, ball, idx.tobytes())
-        got = self.rows.get(key)
-        if got is not None:
-            return got
+        got = self.rows.get((eye, i))
+        if got is not None and got[0] == ball and np.array_equal(got[1], idx):
+            return got[2]
         balls = tuple(np.array([v]) for v in ball)
         indptr = np.array([0, idx.size], np.int64)
         if isinstance(pair, MeasuredEyePair):
@@ -148,9 +128,7 @@ class ResponseCache:
             vals = healpix_values(pair.nside, cx, balls, indptr, idx)
         else:  # pragma: no cover - the spherical side has these two models
             vals = np.full(idx.size, np.nan)
-        if len(self.rows) > 256:
-            self.rows.clear()
-        self.rows[key] = vals
+        self.rows[(eye, i)] = (ball, idx.copy(), vals)
         return vals
 
 
@@ -161,12 +139,9 @@ def lit_responses(
     state: SceneState3D, selected: int | None, cache: ResponseCache | None = None
 ) -> dict[str, np.ndarray]:
     """Per eye ("A", "B") the values aligned with the lit CSR's indices: each lit (ball,
-    facet) pair's response, NaN where it is not computed (the module docstring's bounds)."""
+    facet) pair's response (``selected`` is not needed: every ball's are computed)."""
     cache = CACHE if cache is None else cache
     out: dict[str, np.ndarray] = {}
-    healpix = isinstance(state.pair, EyePair3D)
-    rest = healpix and selected is not None and 0 <= selected < state.n
-    rest = rest and cache.at_rest(state, int(selected or 0))
     for eye, csr in (("A", state.lit_a), ("B", state.lit_b)):
         if csr is None:
             out[eye] = np.zeros(0)
@@ -175,9 +150,8 @@ def lit_responses(
         vals = np.full(idx.size, np.nan)
         for i in range(state.n):
             lo, hi = int(indptr[i]), int(indptr[i + 1])
-            if hi == lo or (healpix and (i != selected or not rest or hi - lo > MAX_CELLS)):
-                continue
-            vals[lo:hi] = cache.row(state, eye, i, idx[lo:hi])
+            if hi > lo:
+                vals[lo:hi] = cache.row(state, eye, i, idx[lo:hi])
         out[eye] = vals
     return out
 

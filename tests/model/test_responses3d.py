@@ -1,6 +1,6 @@
 """The responses layer's pure parts (eyeviz.model.responses3d): the shades, the owners'
-values, and the bounds on what is computed (HEALPix: the selected ball's, at most
-MAX_CELLS cells an eye)."""
+values, and what is computed (every ball's, each once per position: a drag recomputes the
+dragged ball's only)."""
 
 from __future__ import annotations
 
@@ -37,34 +37,32 @@ def _state(pair, balls) -> SceneState3D:
     return st
 
 
-def test_healpix_cells_only_for_the_selected_ball_within_the_cap() -> None:
+def test_healpix_cells_for_every_ball_of_any_size() -> None:
     pair = EyePair3D(40.0, 20.0, nside=8)
-    st = _state(pair, [(0.0, 200.0, 0.0, 8.0), (30.0, 300.0, 10.0, 9.0)])
-    small = [(int(np.diff(c[0])[i]) for c in (st.lit_a, st.lit_b)) for i in range(2)]
-    assert all(0 < n <= r3.MAX_CELLS for s in small for n in s)
-    got = r3.lit_responses(st, 1, r3.ResponseCache())
+    # a small ball, one lighting many cells, one holding eye A's centre
+    st = _state(pair, [(0.0, 200.0, 0.0, 8.0), (0.0, 60.0, 0.0, 20.0), (-38.0, 0.0, 1.0, 5.0)])
+    assert np.diff(st.lit_a[0])[1] > 24  # the old bound: no longer one
+    got = r3.lit_responses(st, None, r3.ResponseCache())
     (_, _, va), (_, _, vb) = pair.responses(st.x, st.y, st.z, st.g)
-    for eye, want, csr in (("A", va, st.lit_a), ("B", vb, st.lit_b)):
-        lo, hi = csr[0][1], csr[0][2]
-        assert np.isnan(got[eye][:lo]).all()  # ball 0: not selected
-        np.testing.assert_allclose(got[eye][lo:hi], want[lo:hi], atol=1e-12)
-    big = _state(pair, [(0.0, 60.0, 0.0, 20.0)])
-    assert np.diff(big.lit_a[0])[0] > r3.MAX_CELLS
-    assert np.isnan(r3.lit_responses(big, 0, r3.ResponseCache())["A"]).all()
+    for eye, want in (("A", va), ("B", vb)):
+        assert np.isfinite(got[eye]).all()
+        np.testing.assert_allclose(got[eye], want, atol=1e-12)
+    assert (got["A"][st.lit_a[0][2] :] == 1.0).all()
     assert "not computed" in r3.response_text(float("nan"), "cell")
     assert r3.response_text(0.4242, "cell") == "response 0.424 (cell)"
 
 
-def test_healpix_cells_wait_for_the_ball_to_stand_still() -> None:
-    """A drag (a new position in each state) computes no cell; the release's state at the
-    same position does; the painter and the dock asking in one state agree."""
+def test_a_drag_recomputes_the_dragged_ball_only() -> None:
+    """Each frame of a drag (a new position of ball 0) computes ball 0's row anew; ball 1's
+    is kept (the same array), also when a state builds its pair anew."""
     pair = EyePair3D(40.0, 20.0, nside=8)
     cache = r3.ResponseCache()
-    s0 = _state(pair, [(0.0, 200.0, 0.0, 8.0)])
-    assert np.isfinite(r3.lit_responses(s0, 0, cache)["A"]).all()  # new: at rest
-    pair = EyePair3D(40.0, 20.0, nside=8)  # a state may build its pair anew
-    s1 = _state(pair, [(5.0, 200.0, 0.0, 8.0)])  # a drag frame
-    assert np.isnan(r3.lit_responses(s1, 0, cache)["A"]).all()
-    assert np.isnan(r3.lit_responses(s1, 0, cache)["B"]).all()  # the same frame, again
-    s2 = _state(pair, [(5.0, 200.0, 0.0, 8.0)])  # the release: same place, a new state
-    assert np.isfinite(r3.lit_responses(s2, 0, cache)["A"]).all()
+    s0 = _state(pair, [(0.0, 200.0, 0.0, 8.0), (30.0, 300.0, 10.0, 9.0)])
+    r3.lit_responses(s0, 0, cache)
+    kept = cache.rows[("A", 1)][2]
+    pair = EyePair3D(40.0, 20.0, nside=8)
+    s1 = _state(pair, [(5.0, 200.0, 0.0, 8.0), (30.0, 300.0, 10.0, 9.0)])  # a drag frame
+    got = r3.lit_responses(s1, 0, cache)
+    assert cache.rows[("A", 1)][2] is kept and cache.rows[("A", 0)][0][0] == 5.0
+    (_, _, va), _ = pair.responses(s1.x, s1.y, s1.z, s1.g)
+    np.testing.assert_allclose(got["A"], va, atol=1e-12)

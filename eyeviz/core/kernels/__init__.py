@@ -45,10 +45,11 @@ def warm() -> None:
     """Compile (or load from numba's cache) every kernel by running it on small inputs."""
     if not enabled():
         return
-    from eyeviz.core.kernels import healpix_lit, measured_lit
+    from eyeviz.core.kernels import healpix_cells, healpix_lit, measured_lit
 
     healpix_lit.warm()
     measured_lit.warm()
+    healpix_cells.warm()
     _STATE["ready"] = True
 
 
