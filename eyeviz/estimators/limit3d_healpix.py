@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from eyeviz.core import kernels
 from eyeviz.core.domain3d import Domain3D
 from eyeviz.estimators.base3d import LitCSR
 from eyeviz.estimators.limit3d_exact import exact_hits, prior_density
@@ -112,21 +113,7 @@ class HealpixProposal:
         if d.r_min > d.h:
             u_hi = np.minimum(u_hi, 1.0 / (d.r_min - d.h))
         good = good & (u_hi > u_lo)
-        order = np.argsort(~good, axis=1, kind="stable")[:, : max(1, int(good.sum(1).max()))]
-        sel = np.take_along_axis(good, order, 1)
-
-        def pick(x: np.ndarray) -> np.ndarray:
-            return np.take_along_axis(x, order if x.ndim == 2 else order[..., None], 1)
-
-        c_lo = np.where(sel, pick(u_lo), 1.0 / d.r_max)
-        c_hi = np.where(sel, pick(u_hi), 1.0 / d.r_max)
-        c_lo, c_hi = _ray_in_region(eb, pick(ca), c_lo, c_hi, slack, RAY_GRID, RAY_ROUNDS)
-        rows = np.arange(n)[:, None]
-        u_lo, u_hi = u_lo.copy(), u_hi.copy()
-        u_lo[rows, order] = c_lo
-        u_hi[rows, order] = c_hi
-        u_lo = np.where(good, u_lo, 1.0 / d.r_max)
-        u_hi = np.where(good, u_hi, 1.0 / d.r_max)
+        u_lo, u_hi = _ray_region_draws(eb, ca, u_lo, u_hi, good, slack, 1.0 / d.r_max)
         uu = u_lo + (u_hi - u_lo) * u[..., 2]
         uu = np.where(good, uu, 1.0 / d.r_max)
         rho = 1.0 / uu
@@ -170,3 +157,35 @@ class HealpixProposal:
         w = np.where(hit.reshape(n, m), w, 0.0)
         return {"r": r, "az": az, "el": el, "g": gg, "x": p[..., 0], "y": p[..., 1],
                 "z": p[..., 2], "w": w}  # fmt: skip
+
+
+def _ray_region_draws(eb: _Eye, ca, u_lo, u_hi, good, slack, u_dead: float):
+    """Each live draw's u-interval (``good`` (N, M)) narrowed to B's region along its ray
+    (:func:`_ray_in_region`); the other draws' set to ``u_dead``. Compiled: in place on
+    the live draws; numpy: on the live draws moved to the front of each row."""
+    if kernels.use(good.size):
+        from eyeviz.core.kernels.limit3d_region import ray_region_kernel
+
+        lo, hi = np.array(u_lo, np.float64), np.array(u_hi, np.float64)
+        n = good.shape[0]
+        sl = np.ascontiguousarray(np.broadcast_to(slack, (n, 1))[:, 0], np.float64)
+        t = np.linspace(0.0, 1.0, RAY_GRID)
+        ray_region_kernel(eb.a_lit, eb.t_lit, eb.a_unl, eb.t_unl, eb.c, eb.e1, eb.e2,
+                          np.asarray(eb.a, np.float64), np.ascontiguousarray(ca, np.float64),
+                          lo, hi, sl, t, RAY_ROUNDS, np.ascontiguousarray(good))  # fmt: skip
+        return np.where(good, lo, u_dead), np.where(good, hi, u_dead)
+    n = good.shape[0]
+    order = np.argsort(~good, axis=1, kind="stable")[:, : max(1, int(good.sum(1).max()))]
+    sel = np.take_along_axis(good, order, 1)
+
+    def pick(x: np.ndarray) -> np.ndarray:
+        return np.take_along_axis(x, order if x.ndim == 2 else order[..., None], 1)
+
+    c_lo = np.where(sel, pick(u_lo), u_dead)
+    c_hi = np.where(sel, pick(u_hi), u_dead)
+    c_lo, c_hi = _ray_in_region(eb, pick(ca), c_lo, c_hi, slack, RAY_GRID, RAY_ROUNDS)
+    rows = np.arange(n)[:, None]
+    u_lo, u_hi = u_lo.copy(), u_hi.copy()
+    u_lo[rows, order] = c_lo
+    u_hi[rows, order] = c_hi
+    return np.where(good, u_lo, u_dead), np.where(good, u_hi, u_dead)

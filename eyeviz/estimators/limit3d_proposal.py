@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from eyeviz.core import healpix
+from eyeviz.core import healpix, kernels
 from eyeviz.core.domain3d import Domain3D
 from eyeviz.estimators.analytic3d import cap_estimates
 from eyeviz.estimators.base3d import LitCSR
@@ -246,7 +246,20 @@ class _Eye:
 
     def bounds(self, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(max over lit edge cells, min over unlit) of :meth:`model` at gnomonic offsets
-        delta (N, G, 2): arrays (N, G)."""
+        delta (N, G, 2): arrays (N, G). Compiled (bit for bit the same) unless
+        ``EYEVIZ_JIT=0``."""
+        if kernels.use(delta.shape[0] * delta.shape[1]):
+            from eyeviz.core.kernels.limit3d_region import affine_bounds_kernel
+
+            lo = np.empty(delta.shape[:2])
+            hi = np.empty(delta.shape[:2])
+            affine_bounds_kernel(self.a_lit, self.t_lit, self.a_unl, self.t_unl,
+                                 np.ascontiguousarray(delta, np.float64), lo, hi)  # fmt: skip
+            return lo, hi
+        return self._bounds_ref(delta)
+
+    def _bounds_ref(self, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`bounds` in numpy (the reference)."""
         dx = delta[:, None, :, 0]
         dy = delta[:, None, :, 1]
         v = self.t_lit[..., 0, None] * dx
@@ -391,7 +404,8 @@ def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack, grid: int = 12, rounds: int =
     and the view moves monotonically along a great circle, so those u form an interval:
     G on ``grid`` points, the interval from the grid point before the first inside to the
     one after the last (or the two neighbours of the best point when none is inside);
-    ``rounds`` times. Returns (lo, hi)."""
+    ``rounds`` times. Returns (lo, hi). (The numpy reference of
+    :func:`eyeviz.core.kernels.limit3d_region.ray_region_kernel`.)"""
     n, m = lo.shape
     t = np.linspace(0.0, 1.0, grid)
     for _ in range(rounds):

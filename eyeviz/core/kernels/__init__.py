@@ -45,11 +45,12 @@ def warm() -> None:
     """Compile (or load from numba's cache) every kernel by running it on small inputs."""
     if not enabled():
         return
-    from eyeviz.core.kernels import healpix_cells, healpix_lit, measured_lit
+    from eyeviz.core.kernels import healpix_cells, healpix_lit, limit3d_region, measured_lit
 
     healpix_lit.warm()
     measured_lit.warm()
     healpix_cells.warm()
+    limit3d_region.warm()
     _STATE["ready"] = True
 
 

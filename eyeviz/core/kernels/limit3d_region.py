@@ -1,0 +1,188 @@
+"""The spherical limit's proposal regions compiled (numba): the HEALPix eyes' affine model
+(:meth:`eyeviz.estimators.limit3d_proposal._Eye.bounds`), the search along A's rays for
+B's region (:func:`eyeviz.estimators.limit3d_proposal._ray_in_region`) and the measured
+eyes' cone distances (:meth:`eyeviz.estimators.limit3d_measured._Edges.bounds`).
+
+Scalar transcriptions of the numpy references, which ``EYEVIZ_JIT=0`` runs instead
+(docs/kernels.md). The HEALPix ones use only +, -, *, / and sqrt in the reference's order
+(numba compiles without fast-math: no reassociation, no fused multiply-add), and the
+reductions keep numpy's NaN rules (a NaN anywhere in a max or min gives NaN; argmax picks
+the first NaN), so their results are the reference's bit for bit. The measured one
+computes the same formulas, but the reference's matrix products (BLAS) and vectorised
+sin / arctan2 round differently: it agrees to a few units in the last place. Only where
+draws are proposed depends on these numbers; every draw is still checked exactly.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["affine_bounds_kernel", "ray_region_kernel", "cone_bounds_kernel", "warm"]
+
+_jit = njit(cache=True, nogil=True)
+
+
+@_jit
+def _max(m, x):
+    """numpy's maximum: NaN wins."""
+    if m != m:
+        return m
+    if x != x or x > m:
+        return x
+    return m
+
+
+@_jit
+def _min(m, x):
+    """numpy's minimum: NaN wins."""
+    if m != m:
+        return m
+    if x != x or x < m:
+        return x
+    return m
+
+
+@_jit
+def _affine_at(a_lit, t_lit, a_unl, t_unl, n, dx, dy):
+    """(max_lit, min_unlit) of the affine model of key n at one offset (dx, dy)."""
+    lo = -np.inf
+    hi2 = np.inf
+    for k in range(a_lit.shape[1]):
+        v = t_lit[n, k, 0] * dx
+        v = v + t_lit[n, k, 1] * dy
+        lo = _max(lo, a_lit[n, k] - v)
+        w = t_unl[n, k, 0] * dx
+        w = w + t_unl[n, k, 1] * dy
+        hi2 = _min(hi2, a_unl[n, k] - w)
+    hi2 = hi2 + (dx * dx + dy * dy)
+    return lo, math.sqrt(_max(hi2, 0.0))
+
+
+@_jit
+def affine_bounds_kernel(a_lit, t_lit, a_unl, t_unl, delta, lo, hi):
+    """_Eye.bounds: lo, hi (N, G) at gnomonic offsets delta (N, G, 2)."""
+    for n in range(delta.shape[0]):
+        for g in range(delta.shape[1]):
+            lo[n, g], hi[n, g] = _affine_at(
+                a_lit, t_lit, a_unl, t_unl, n, delta[n, g, 0], delta[n, g, 1]
+            )
+
+
+@_jit
+def _clean(x):
+    """numpy's nan_to_num(x, nan=1e3, posinf=1e3, neginf=-1e3)."""
+    if x != x:
+        return 1e3
+    if x == np.inf:
+        return 1e3
+    if x == -np.inf:
+        return -1e3
+    return x
+
+
+@_jit
+def _gap_at(a_lit, t_lit, a_unl, t_unl, c, e1, e2, a, n, cax, cay, caz, u):
+    """G = min_unlit - max_lit of B's model (key n) seen along A's ray at u."""
+    vx = cax + u * a[0]
+    vy = cay + u * a[1]
+    vz = caz + u * a[2]
+    nrm = math.sqrt(vx * vx + vy * vy + vz * vz)
+    vx, vy, vz = vx / nrm, vy / nrm, vz / nrm
+    cc = vx * c[n, 0] + vy * c[n, 1] + vz * c[n, 2]
+    x = vx * e1[n, 0] + vy * e1[n, 1] + vz * e1[n, 2]
+    y = vx * e2[n, 0] + vy * e2[n, 1] + vz * e2[n, 2]
+    lo, hi = _affine_at(a_lit, t_lit, a_unl, t_unl, n, _clean(x / cc), _clean(y / cc))
+    return hi - lo
+
+
+# long: one draw's search (grid, first / last inside, argmax fallback, rounds) is one loop
+# nest; split, it would pass a dozen scalars back and forth
+@_jit
+def ray_region_kernel(a_lit, t_lit, a_unl, t_unl, c, e1, e2, a, ca, lo, hi, slack, t,
+                      rounds, live):  # fmt: skip
+    """_ray_in_region on the draws where ``live`` (N, M): lo, hi (N, M) shrunk in place."""
+    grid = t.size
+    gv = np.empty(grid)
+    uu = np.empty(grid)
+    for n in range(ca.shape[0]):
+        for m in range(ca.shape[1]):
+            if not live[n, m]:
+                continue
+            lo_, hi_ = lo[n, m], hi[n, m]
+            for _ in range(rounds):
+                first = -1
+                last = -1
+                best = 0
+                for j in range(grid):
+                    uu[j] = lo_ + (hi_ - lo_) * t[j]
+                    gv[j] = _gap_at(a_lit, t_lit, a_unl, t_unl, c, e1, e2, a, n,
+                                    ca[n, m, 0], ca[n, m, 1], ca[n, m, 2], uu[j])  # fmt: skip
+                    if gv[j] >= -slack[n]:
+                        if first < 0:
+                            first = j
+                        last = j
+                    # argmax: the first maximum, the first NaN before any number
+                    gb = gv[best]
+                    if gb == gb and (gv[j] != gv[j] or gv[j] > gb):
+                        best = j
+                if first < 0:
+                    first = best
+                    last = best
+                lo_ = uu[max(first - 1, 0)]
+                hi_ = uu[min(last + 1, grid - 1)]
+            lo[n, m], hi[n, m] = lo_, hi_
+
+
+@_jit
+def cone_bounds_kernel(pos, ax, half, lit, pad, c, lo, hi):
+    """_Edges.bounds: (largest distance of a lit cone, smallest of an unlit cone or of a
+    lit lens) (N, G) at centres c (N, G, 3)."""
+    for n in range(c.shape[0]):
+        for g in range(c.shape[1]):
+            cx, cy, cz = c[n, g, 0], c[n, g, 1], c[n, g, 2]
+            lo_ = -np.inf
+            hi_ = np.inf
+            for k in range(pos.shape[1]):
+                if pad[n, k]:
+                    continue
+                px, py, pz = pos[n, k, 0], pos[n, k, 1], pos[n, k, 2]
+                s = ax[n, k, 0] * cx + ax[n, k, 1] * cy + ax[n, k, 2] * cz
+                s = s - (ax[n, k, 0] * px + ax[n, k, 1] * py + ax[n, k, 2] * pz)
+                v2 = (px * cx + py * cy + pz * cz) * -2.0
+                v2 = v2 + (px * px + py * py + pz * pz) + (cx * cx + cy * cy + cz * cz)
+                v2 = max(v2, 0.0)
+                q = math.sqrt(max(v2 - s * s, 0.0))
+                vn = math.sqrt(v2)
+                ex = math.atan2(q, s) - half[n, k]
+                if ex <= 0.0:
+                    d = 0.0
+                elif ex < math.pi / 2:
+                    d = vn * math.sin(ex)
+                else:
+                    d = vn
+                if lit[n, k]:
+                    lo_ = _max(lo_, d)
+                    hi_ = _min(hi_, vn)
+                else:
+                    hi_ = _min(hi_, d)
+            lo[n, g], hi[n, g] = lo_, hi_
+
+
+def warm() -> None:
+    """Compile (or load from the cache) the kernels for their one signature each."""
+    a2 = np.zeros((1, 1))
+    a3 = np.zeros((1, 1, 2))
+    d = np.zeros((1, 1, 2))
+    out = np.zeros((1, 1))
+    affine_bounds_kernel(a2, a3, a2, a3, d, out, out.copy())
+    v3 = np.ones(3)
+    c = np.ones((1, 3))
+    ca = np.ones((1, 1, 3))
+    b = np.ones((1, 1), np.bool_)
+    ray_region_kernel(a2, a3, a2, a3, c, c, c, v3, ca, out, out + 1, np.ones(1),
+                      np.linspace(0.0, 1.0, 3), 1, b)  # fmt: skip
+    p3 = np.ones((1, 1, 3))
+    cone_bounds_kernel(p3, p3, a2 + 0.1, b, ~b, p3, out, out.copy())
