@@ -112,6 +112,8 @@ MAX_SAMPLES = 1 << 14
 MAX_GRID = 64
 #: keys processed together
 _CHUNK = 8
+#: batches of draws of a retry proposed in one call (their arrays side by side)
+_GROUP = 8
 #: The most facets per eye a key may light and still be sampled: each exact check of a
 #: draw costs about its lit count, and a draw is checked up to (max_batches + sum of
 #: RETRY's batches) x samples times. A key beyond it, or beyond what any ball of the
@@ -203,7 +205,9 @@ class Limit3DEstimator(Estimator3D):
         eye model's proposal set up once, ``reps`` batches of draws)."""
         prop = self._proposal
         st = prop.setup(lit_a, lit_b, keys, wide)
-        parts = [prop.sample(st, keys, stream + 8 * rep) for rep in range(reps)]
+        # the batches ``_GROUP`` at a time (side by side; each as if drawn alone)
+        streams = [stream + 8 * rep for rep in range(reps)]
+        parts = [prop.sample(st, keys, streams[i : i + _GROUP]) for i in range(0, reps, _GROUP)]
         out = {k: np.concatenate([q[k] for q in parts], axis=1) for k in parts[0]}
         if reps > 1:
             return out
@@ -213,8 +217,7 @@ class Limit3DEstimator(Estimator3D):
             need = _needs_more(out["r"], out["w"], self.accuracy)
             if not need.any():
                 break
-            more = prop.sample(st, keys, stream + 8 * rep)
-            more["w"] = np.where(need[:, None], more["w"], 0.0)
+            more = prop.sample(st, keys, stream + 8 * rep, rows=need)
             out = {k: np.concatenate([out[k], more[k]], axis=1) for k in out}
         return out
 

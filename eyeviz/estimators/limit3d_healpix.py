@@ -22,7 +22,7 @@ from eyeviz.estimators.limit3d_proposal import (
     _prefilter,
     _ray_in_box,
     _ray_in_region,
-    _uniforms,
+    _batch_uniforms,
 )
 
 __all__ = ["HealpixProposal"]
@@ -85,17 +85,23 @@ class HealpixProposal:
 
     # long: the weighted draws of one chunk (propose, test the key, weigh) in one pass over shared
     # arrays
-    def sample(self, st: dict, keys: np.ndarray, stream: int) -> dict[str, np.ndarray]:
-        """``samples`` weighted draws per key of a chunk set up by :meth:`setup`."""
+    def sample(self, st: dict, keys: np.ndarray, stream, rows=None) -> dict[str, np.ndarray]:
+        """``samples`` weighted draws per key of a chunk set up by :meth:`setup`, per
+        stream (an int or a sequence: batches side by side, :func:`_batch_uniforms`); only
+        the keys ``rows`` (bool (N,), default all) get draws, the others weight 0."""
         d, A, B, ea, eb = self.domain, st["A"], st["B"], st["ea"], st["eb"]
         n, m, slack, ext, ext_b = st["n"], self.samples, st["slack"], st["ext"], st["ext_b"]
         box, th_lo, th_hi = st["box"], st["th_lo"], st["th_hi"]
-        u = _uniforms(keys, m, 4, stream)
+        u = _batch_uniforms(keys, m, 4, stream)
+        m = u.shape[1]
         th = th_lo[:, None] + (th_hi - th_lo)[:, None] * u[..., 0]
         ph = box[:, 2:3] + (box[:, 3] - box[:, 2])[:, None] * u[..., 1]
         sp = np.sin(ph)
         ca = np.stack([np.cos(ph), sp * np.cos(th), sp * np.sin(th)], axis=-1)
-        good = np.broadcast_to(((th_hi > th_lo) & (box[:, 3] > box[:, 2]))[:, None], (n, m))
+        good = (th_hi > th_lo) & (box[:, 3] > box[:, 2])
+        if rows is not None:
+            good = good & rows
+        good = np.broadcast_to(good[:, None], (n, m))
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             delta = ea.gnomonic(np.where(good[..., None], ca, ea.c[:, None, :]))
         # outside A's box the model region is empty: drawn, then dropped

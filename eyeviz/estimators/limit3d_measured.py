@@ -48,11 +48,12 @@ import math
 
 import numpy as np
 
+from eyeviz.core import kernels
 from eyeviz.core.domain3d import Domain3D
 from eyeviz.estimators.analytic3d import estimate
 from eyeviz.estimators.base3d import LitCSR
 from eyeviz.estimators.limit3d_exact import exact_hits, prior_density
-from eyeviz.estimators.limit3d_proposal import _frame, _uniforms
+from eyeviz.estimators.limit3d_proposal import _batch_uniforms, _frame, _uniforms
 from eyeviz.estimators.triangulation import facet_neighbours, triangulate_rays
 
 __all__ = ["MeasuredProposal"]
@@ -150,6 +151,7 @@ class _Edges:
         self.pad[r_all, slot] = False
         self.pa = np.einsum("nkj,nkj->nk", self.pos, self.ax)[..., None]
         self.pp = np.einsum("nkj,nkj->nk", self.pos, self.pos)[..., None]
+        self._cols: tuple[np.ndarray, ...] | None = None
 
     def prune(self, c: np.ndarray, keep_lit: float = 0.5, keep_unlit: float = 2.0) -> None:
         """Keep the facets that may bind near the centres c (N, 3): lit ones whose cone
@@ -169,6 +171,7 @@ class _Edges:
                 self, name, np.take_along_axis(v, order if v.ndim == 2 else order[..., None], 1)
             )
         self.pad = ~np.take_along_axis(keep, order, 1)
+        self._cols = None
 
     def _dist(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(dist(c, K_i), |c - p_i|) (N, K, G) at centres c (N, G, 3)."""
@@ -184,7 +187,27 @@ class _Edges:
 
     def bounds(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi) (N, G) at centres c (N, G, 3): the largest distance of a lit cone and
-        the smallest of an unlit cone or of a lit lens (module docstring)."""
+        the smallest of an unlit cone or of a lit lens (module docstring). Compiled
+        (to a few units in the last place the same) unless ``EYEVIZ_JIT=0``."""
+        if kernels.use(c.shape[0] * c.shape[1]):
+            from eyeviz.core.kernels.limit3d_region import cone_bounds_kernel
+
+            lo = np.empty(c.shape[:2])
+            hi = np.empty(c.shape[:2])
+            cone_bounds_kernel(*self.columns(), np.ascontiguousarray(c, np.float64), lo, hi)
+            return lo, hi
+        return self._bounds_ref(c)
+
+    def columns(self) -> tuple[np.ndarray, ...]:
+        """What the compiled kernels read: positions, axes, cos and sin of the half
+        acceptance angles, ``lit``, ``pad``."""
+        if self._cols is None:
+            self._cols = (self.pos, self.ax, np.cos(self.half), np.sin(self.half), self.lit,
+                          self.pad)  # fmt: skip
+        return self._cols
+
+    def _bounds_ref(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`bounds` in numpy (the reference)."""
         dist, vn = self._dist(c)
         lit = (self.lit & ~self.pad)[..., None]
         unl = (~self.lit & ~self.pad)[..., None]
@@ -249,6 +272,23 @@ class MeasuredProposal:
         r = np.linalg.norm(c - self.origin, axis=2)
         g_lo = np.maximum(np.maximum(lo_a, lo_b), r * self.s_half)
         g_hi = np.minimum(np.minimum(hi_a, hi_b), np.minimum(r, d.g_max))
+        return g_lo, g_hi
+
+    def _h_draws(self, st: dict, c: np.ndarray, live: np.ndarray):
+        """:meth:`_h` at the draws' centres c (N, M, 3) where ``live``. Compiled, a draw
+        is dropped at the first facet that empties its interval (its (g_lo, g_hi) then
+        partial, and empty all the same; kernels.limit3d_region.interval_kernel); the
+        live draws' intervals are :meth:`_h`'s."""
+        if not kernels.use(live.size):
+            return self._h(st, c)
+        from eyeviz.core.kernels.limit3d_region import interval_kernel
+
+        r = np.linalg.norm(c - self.origin, axis=2)
+        g_lo = r * self.s_half
+        g_hi = np.minimum(r, self.domain.g_max)
+        interval_kernel(*st["ea"].columns(), *st["eb"].columns(),
+                        np.ascontiguousarray(c, np.float64), np.ascontiguousarray(live), g_lo,
+                        g_hi)  # fmt: skip
         return g_lo, g_hi
 
     def _centres(self, st: dict, delta: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -362,18 +402,23 @@ class MeasuredProposal:
         st["box_lo"], st["box_hi"] = box_lo, box_hi
         return st
 
-    def sample(self, st: dict, keys: np.ndarray, stream: int) -> dict[str, np.ndarray]:
-        """``samples`` weighted draws per key of a chunk set up by :meth:`setup`."""
+    def sample(self, st: dict, keys: np.ndarray, stream, rows=None) -> dict[str, np.ndarray]:
+        """``samples`` weighted draws per key of a chunk set up by :meth:`setup`, per
+        stream (an int or a sequence: batches side by side, :func:`_batch_uniforms`); only
+        the keys ``rows`` (bool (N,), default all) get draws, the others weight 0."""
         d, m = self.domain, self.samples
         n = st["u0"].shape[0]
-        u = _uniforms(keys, m, 4, stream)
+        u = _batch_uniforms(keys, m, 4, stream)
+        m = u.shape[1]
         lo, hi = st["box_lo"], st["box_hi"]
         x = lo[:, None] + (hi - lo)[:, None] * u[..., :3]
         delta = x[..., :2]
         c, rho, drho = self._bcentres(st, delta, x[..., 2])
         good = np.isfinite(rho)
         c = np.where(good[..., None], c, self.fa.centre + st["u0"][:, None, :] / self.w_min)
-        g_lo, g_hi = self._h(st, c)
+        if rows is not None:
+            good &= rows[:, None]
+        g_lo, g_hi = self._h_draws(st, c, good)
         pad = 1e-9 * g_hi
         g_lo, g_hi = np.maximum(g_lo - pad, 0.0), g_hi + pad
         good &= g_hi > g_lo

@@ -67,6 +67,15 @@ def _uniforms(keys: np.ndarray, m: int, k: int, stream: int) -> np.ndarray:
     return u.reshape(keys.size, m, k)
 
 
+def _batch_uniforms(keys: np.ndarray, m: int, k: int, streams) -> np.ndarray:
+    """(N, m * len(streams), k) uniforms: :func:`_uniforms` of each stream (an int or a
+    sequence of them), side by side: one call draws several batches, each the same as if
+    drawn alone."""
+    if isinstance(streams, int | np.integer):
+        return _uniforms(keys, m, k, int(streams))
+    return np.concatenate([_uniforms(keys, m, k, int(s)) for s in streams], axis=1)
+
+
 def _frame(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """East and north unit vectors (N, 3) at unit vectors c (N, 3)."""
     e1 = np.stack([-c[:, 1], c[:, 0], np.zeros(len(c))], axis=1)
