@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from eyeviz.core import kernels
 from eyeviz.core.domain3d import Domain3D
 from eyeviz.estimators.base3d import LitCSR
 
@@ -51,8 +52,16 @@ def prior_density(domain: Domain3D, prior: str, r, g, el, az) -> np.ndarray:
 
 
 def same_rows(ptr: np.ndarray, ind: np.ndarray, key: LitCSR, row: np.ndarray) -> np.ndarray:
-    """Whether each CSR row i of (ptr, ind) equals the key's row ``row[i]``."""
+    """Whether each CSR row i of (ptr, ind) equals the key's row ``row[i]`` (compiled
+    unless ``EYEVIZ_JIT=0``)."""
     kp, ki = key
+    if kernels.use(row.size):
+        from eyeviz.core.kernels.limit3d_region import same_rows_kernel
+
+        out = np.empty(row.size, np.bool_)
+        p_, i_, kp_, ki_, r_ = (np.ascontiguousarray(a, np.int64) for a in (ptr, ind, kp, ki, row))
+        same_rows_kernel(p_, i_, kp_, ki_, r_, out)
+        return out
     cnt = np.diff(ptr)
     kc = np.diff(kp)[row]
     same = cnt == kc
@@ -82,6 +91,15 @@ def exact_hits(
     (pa, ia), (pb, ib) = domain.eyes.lit_csr(x, y, z, g)
     match = same_rows(pa, ia, lit_a, row) & same_rows(pb, ib, lit_b, row)
     at = np.flatnonzero(match)
-    if at.size:
+    if not at.size:
+        return hit
+    if domain.kind == "measured":
+        # a measured pair's field (MeasuredEyePair.in_bfv): each eye lights two facets or
+        # more, read here from the key (the ball's lit sets are the key's), and the ball
+        # holds no lens
+        ka, kb = (np.diff(k[0])[row[at]] >= 2 for k in (lit_a, lit_b))
+        oa, ob = domain.eyes.overlaps_eye(x[at], y[at], z[at], g[at])
+        hit[at] = ka & kb & ~oa & ~ob
+    else:
         hit[at] = domain.eyes.in_bfv(x[at], y[at], z[at], g[at])
     return hit

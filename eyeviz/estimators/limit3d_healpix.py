@@ -16,13 +16,13 @@ from eyeviz.estimators.base3d import LitCSR
 from eyeviz.estimators.limit3d_exact import exact_hits, prior_density
 from eyeviz.estimators.limit3d_proposal import (
     _angle_box,
+    _batch_uniforms,
     _extent,
     _Eye,
     _locate,
     _prefilter,
     _ray_in_box,
     _ray_in_region,
-    _batch_uniforms,
 )
 
 __all__ = ["HealpixProposal"]

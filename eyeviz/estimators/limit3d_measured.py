@@ -194,7 +194,10 @@ class _Edges:
 
             lo = np.empty(c.shape[:2])
             hi = np.empty(c.shape[:2])
-            cone_bounds_kernel(*self.columns(), np.ascontiguousarray(c, np.float64), lo, hi)
+            pos, ax, ch, sh, lit, pad = self.columns()
+            cone_bounds_kernel(
+                pos, ax, ch, sh, lit, pad, np.ascontiguousarray(c, np.float64), lo, hi
+            )
             return lo, hi
         return self._bounds_ref(c)
 
@@ -286,9 +289,11 @@ class MeasuredProposal:
         r = np.linalg.norm(c - self.origin, axis=2)
         g_lo = r * self.s_half
         g_hi = np.minimum(r, self.domain.g_max)
-        interval_kernel(*st["ea"].columns(), *st["eb"].columns(),
-                        np.ascontiguousarray(c, np.float64), np.ascontiguousarray(live), g_lo,
-                        g_hi)  # fmt: skip
+        pa, aa, ca, sa, la, da = st["ea"].columns()
+        pb, ab, cb, sb, lb, db = st["eb"].columns()
+        cc = np.ascontiguousarray(c, np.float64)
+        interval_kernel(pa, aa, ca, sa, la, da, pb, ab, cb, sb, lb, db, cc,
+                        np.ascontiguousarray(live), g_lo, g_hi)  # fmt: skip
         return g_lo, g_hi
 
     def _centres(self, st: dict, delta: np.ndarray, w: np.ndarray) -> np.ndarray:

@@ -26,6 +26,7 @@ __all__ = [
     "ray_region_kernel",
     "cone_bounds_kernel",
     "interval_kernel",
+    "same_rows_kernel",
     "warm",
 ]
 
@@ -248,6 +249,22 @@ def interval_kernel(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh
             lo[n, m], hi[n, m] = lo_, hi_
 
 
+@_jit
+def same_rows_kernel(ptr, ind, kp, ki, row, same):
+    """limit3d_exact.same_rows: CSR row i of (ptr, ind) equals the key's row ``row[i]``
+    of (kp, ki); stops at a row's first difference."""
+    for i in range(row.size):
+        a0, r = ptr[i], row[i]
+        b0 = kp[r]
+        n = ptr[i + 1] - a0
+        ok = n == kp[r + 1] - b0
+        j = 0
+        while ok and j < n:
+            ok = ind[a0 + j] == ki[b0 + j]
+            j += 1
+        same[i] = ok
+
+
 def warm() -> None:
     """Compile (or load from the cache) the kernels for their one signature each."""
     a2 = np.zeros((1, 1))
@@ -265,3 +282,5 @@ def warm() -> None:
     cs = (p3, p3, a2 + 0.9, a2 + 0.1, b, ~b)
     cone_bounds_kernel(*cs, p3, out, out.copy())
     interval_kernel(*cs, *cs, p3, b, out, out + 1)
+    i1 = np.zeros(2, np.int64)
+    same_rows_kernel(i1, i1[:0], i1, i1[:0], i1[:1], b[0])

@@ -1,0 +1,227 @@
+"""The spherical limit's compiled proposal kernels against their numpy references, element
+by element (issue 31 item 3, issue 33): the HEALPix model and ray search bit for bit, the
+measured cone distances to 1e-12, the early-exit interval kernel keeping exactly the draws
+the reference keeps, the row comparison exactly; and limit3d's answers with the kernels
+equal to the reference's (EYEVIZ_JIT=0)."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.measured import MeasuredEye, MeasuredEyePair
+from eyeviz.dataset.algorithm1_3d import generate3d
+from eyeviz.estimators import limit3d_exact, limit3d_healpix
+from eyeviz.estimators.base3d import take_rows
+from eyeviz.estimators.limit3d import Limit3DEstimator
+from eyeviz.estimators.limit3d_measured import MeasuredProposal, _Edges
+from eyeviz.estimators.limit3d_proposal import _Eye
+
+kr = pytest.importorskip("eyeviz.core.kernels.limit3d_region")
+
+SPECIAL = [np.inf, -np.inf, np.nan, 0.0, -0.0, 1e300, -1e300, 1e-300]
+
+
+def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:
+    """Equal element by element, NaN where NaN (the sign of a zero aside)."""
+    return bool(np.all((a == b) | (np.isnan(a) & np.isnan(b))))
+
+
+def _affine_eye(rng: np.random.Generator, n: int, k: int) -> SimpleNamespace:
+    """An _Eye's affine model: random distances and slopes, some cells padding."""
+    lit = rng.random((n, k)) < 0.5
+    pad = rng.random((n, k)) < 0.2
+    d = rng.uniform(0.0, 0.05, (n, k))
+    t = rng.normal(size=(n, k, 2))
+    t /= np.linalg.norm(t, axis=2, keepdims=True)
+    e = SimpleNamespace(lit=lit, pad=pad, d=d, t=t)
+    _Eye._affine(e)  # type: ignore[arg-type]
+    return e
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31), k=st.integers(1, 40), special=st.booleans())
+def test_affine_bounds_kernel_is_the_reference_bit_for_bit(seed, k, special):
+    rng = np.random.default_rng(seed)
+    e = _affine_eye(rng, 3, k)
+    delta = rng.normal(scale=0.03, size=(3, 17, 2))
+    if special:  # inf, NaN, huge and tiny offsets: numpy's NaN rules must hold
+        delta.ravel()[rng.integers(0, delta.size, 6)] = rng.choice(SPECIAL, 6)
+    lo, hi = np.empty((3, 17)), np.empty((3, 17))
+    kr.affine_bounds_kernel(e.a_lit, e.t_lit, e.a_unl, e.t_unl, delta, lo, hi)
+    with np.errstate(all="ignore"):
+        want_lo, want_hi = _Eye._bounds_ref(e, delta)  # type: ignore[arg-type]
+    assert _same_bits(lo, want_lo) and _same_bits(hi, want_hi)
+
+
+@pytest.fixture(scope="module")
+def healpix_chunk():
+    """A chunk of 6 nside-16 keys set up by the HEALPix proposal."""
+    d = Domain3D(nside=16)
+    ds = generate3d(6, d, seed=11)
+    rows = np.arange(6)
+    la = take_rows(ds.indptr_a, ds.indices_a, rows)
+    lb = take_rows(ds.indptr_b, ds.indices_b, rows)
+    prop = limit3d_healpix.HealpixProposal(d, "single", 64, 8)
+    keys = np.arange(6, dtype=np.uint64) * np.uint64(7919)
+    return prop, prop.setup(la, lb, keys, 1.0), keys
+
+
+@pytest.mark.parametrize("wide", [False, True])
+def test_ray_region_kernel_is_the_reference_bit_for_bit(healpix_chunk, monkeypatch, wide):
+    _, stt, _ = healpix_chunk
+    eb = stt["eb"]
+    rng = np.random.default_rng(5)
+    n = eb.c.shape[0]
+    ca = rng.normal(size=(n, 50, 3)) * (0.3 if wide else 0.02) + stt["ea"].c[:, None, :]
+    ca /= np.linalg.norm(ca, axis=2, keepdims=True)
+    lo = rng.uniform(0.0, 0.02, (n, 50))
+    hi = lo + rng.uniform(0.0, 0.05, (n, 50))
+    good = rng.random((n, 50)) < 0.8
+    args = (eb, ca, lo, hi, good, stt["slack"], 0.01)
+    got = limit3d_healpix._ray_region_draws(*args)
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want = limit3d_healpix._ray_region_draws(*args)
+    assert _same_bits(got[0], want[0]) and _same_bits(got[1], want[1])
+    assert not np.array_equal(got[0], np.where(good, lo, 0.01))  # it did narrow
+
+
+def test_healpix_draws_are_the_reference_bit_for_bit(healpix_chunk, monkeypatch):
+    prop, stt, keys = healpix_chunk
+    got = prop.sample(stt, keys, [3, 11])
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want = prop.sample(stt, keys, [3, 11])
+    assert (want["w"] > 0).sum() >= 10
+    for k in want:
+        assert _same_bits(got[k], want[k]), k
+
+
+def small_pair() -> MeasuredEyePair:
+    """As tests/estimators/test_limit3d_measured.py: 40 facets an eye on spheres of radius
+    0.5 about (-/+2, 0, 0), acceptance angles 0.3-0.5 rad per facet."""
+    rng = np.random.default_rng(0)
+    k = np.arange(90) + 0.5
+    z = 1 - 2 * k / 90
+    phi = np.pi * (1 + 5**0.5) * k
+    d = np.stack([np.sqrt(1 - z * z) * np.cos(phi), np.sqrt(1 - z * z) * np.sin(phi), z], 1)
+    d = d[d[:, 1] > 0.1]
+    eyes = [
+        MeasuredEye(np.array([sx, 0.0, 0.0]) + 0.5 * d, d, rng.uniform(0.3, 0.5, len(d)), name=nm)
+        for sx, nm in ((-2.0, "A"), (2.0, "B"))
+    ]
+    return MeasuredEyePair(eyes[0], eyes[1], name="small")
+
+
+@pytest.fixture(scope="module")
+def bee_small():
+    """The small measured pair (tests/estimators/test_limit3d_measured.py), a chunk of 6
+    keys set up by the measured proposal."""
+    dom = Domain3D.for_eyes(small_pair(), r_min=4.0, r_max=12.0, g_max=1.5, el_max=0.6)
+    ds = generate3d(6, dom, seed=4)
+    rows = np.arange(6)
+    la = take_rows(ds.indptr_a, ds.indices_a, rows)
+    lb = take_rows(ds.indptr_b, ds.indices_b, rows)
+    prop = MeasuredProposal(dom, "single", 128, 8)
+    keys = np.arange(6, dtype=np.uint64) * np.uint64(104729)
+    return dom, prop, prop.setup(la, lb, keys, 1.0), keys, (la, lb)
+
+
+def _centres(rng: np.random.Generator, e: _Edges, m: int, spread: float) -> np.ndarray:
+    """Centres about each key's lit facets: in their cones, near their edges, behind
+    their lenses (the apex case) and far off."""
+    n = e.pos.shape[0]
+    k = rng.integers(0, e.pos.shape[1], (n, m))
+    rows = np.arange(n)[:, None]
+    p, a = e.pos[rows, k], e.ax[rows, k]
+    dist = rng.choice([-0.5, 0.3, 3.0, 8.0], (n, m))[..., None]
+    return p + dist * a + rng.normal(scale=spread, size=(n, m, 3))
+
+
+@pytest.mark.parametrize("spread", [0.01, 0.3, 3.0])
+def test_cone_bounds_kernel_agrees_with_the_reference(bee_small, spread):
+    ea = bee_small[2]["ea"]
+    c = _centres(np.random.default_rng(int(spread * 100)), ea, 200, spread)
+    lo, hi = np.empty(c.shape[:2]), np.empty(c.shape[:2])
+    kr.cone_bounds_kernel(*ea.columns(), c, lo, hi)
+    want_lo, want_hi = ea._bounds_ref(c)
+    scale = np.linalg.norm(c, axis=2) + 1.0
+    assert np.all(np.abs(lo - want_lo) <= 1e-12 * scale)
+    assert np.all(np.abs(hi - want_hi) <= 1e-12 * scale)
+    assert (want_lo == 0).any() and (want_lo > 0).any()  # inside and outside cones
+
+
+def test_interval_kernel_keeps_the_draws_the_reference_keeps(bee_small, monkeypatch):
+    dom, prop, stt, _, _ = bee_small
+    rng = np.random.default_rng(1)
+    n = stt["u0"].shape[0]
+    near = prop.fa.centre + stt["u0"][:, None, :] / prop.w_max
+    far = prop.fa.centre + stt["u0"][:, None, :] / prop.w_min
+    c = near + (far - near) * rng.random((n, 400, 1)) + rng.normal(scale=0.3, size=(n, 400, 3))
+    live = rng.random((n, 400)) < 0.9
+
+    def kept(lo, hi):
+        pad = 1e-9 * hi
+        return (hi + pad > np.maximum(lo - pad, 0.0)) & live
+
+    lo, hi = prop._h_draws(stt, c, live)
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want_lo, want_hi = prop._h(stt, c)
+    k_got, k_want = kept(lo, hi), kept(want_lo, want_hi)
+    assert np.array_equal(k_got, k_want)
+    assert 10 <= k_want.sum() < live.sum()  # some kept, some dropped
+    assert np.allclose(lo[k_want], want_lo[k_want], rtol=1e-12, atol=0)
+    assert np.allclose(hi[k_want], want_hi[k_want], rtol=1e-12, atol=0)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31))
+def test_same_rows_kernel_is_the_reference(seed):
+    rng = np.random.default_rng(seed)
+    kc = rng.integers(0, 4, 5)
+    kp = np.concatenate([[0], np.cumsum(kc)])
+    ki = np.concatenate([np.sort(rng.choice(9, c, replace=False)) for c in kc]).astype(np.int64)
+    row = rng.integers(0, 5, 12)
+    # candidate rows: the key's own rows, some changed in one index or in length
+    sets = [ki[kp[r] : kp[r + 1]].copy() for r in row]
+    for s in sets:
+        if s.size and rng.random() < 0.4:
+            s[rng.integers(0, s.size)] += 1
+        elif rng.random() < 0.2:
+            s.resize(s.size + 1, refcheck=False)
+    ptr = np.concatenate([[0], np.cumsum([s.size for s in sets])]).astype(np.int64)
+    ind = np.concatenate(sets).astype(np.int64)
+    got = np.empty(row.size, np.bool_)
+    kr.same_rows_kernel(ptr, ind, kp, ki, row, got)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("EYEVIZ_JIT", "0")
+        want = limit3d_exact.same_rows(ptr, ind, (kp, ki), row)
+    assert np.array_equal(got, want)
+
+
+def test_limit3d_answers_with_the_kernels_are_the_reference_s_healpix(monkeypatch):
+    d = Domain3D(nside=8)
+    ds = generate3d(10, d, seed=21)
+    rows = np.arange(10)
+    la = take_rows(ds.indptr_a, ds.indices_a, rows)
+    lb = take_rows(ds.indptr_b, ds.indices_b, rows)
+    got = Limit3DEstimator(d, samples=64, max_batches=4).predict(la, lb)
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want = Limit3DEstimator(d, samples=64, max_batches=4).predict(la, lb)
+    for k in ("r", "azimuth", "elevation", "mc_error", "n_accepted", "flagged"):
+        assert _same_bits(np.asarray(getattr(got, k), float), np.asarray(getattr(want, k), float))
+
+
+def test_limit3d_answers_with_the_kernels_are_the_reference_s_measured(bee_small, monkeypatch):
+    dom, _, _, _, (la, lb) = bee_small
+    got = Limit3DEstimator(dom, samples=128, max_batches=4).predict(la, lb)
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want = Limit3DEstimator(dom, samples=128, max_batches=4).predict(la, lb)
+    assert np.array_equal(got.n_accepted, want.n_accepted) and got.n_accepted.sum() > 50
+    assert np.array_equal(got.flagged, want.flagged)
+    for k in ("r", "azimuth", "elevation"):
+        assert np.allclose(getattr(got, k), getattr(want, k), rtol=1e-10, atol=1e-12)
