@@ -1,0 +1,88 @@
+#!/usr/bin/env python
+"""Benchmark of the spherical limit's compiled kernels (issue 31 item 3: >= 500 keys/s at
+nside 180; issue 33: >= 200 keys/s on the honeybee).
+
+For each eye model, on the same fresh keys (Algorithm 1 in 3D, a seed no shipped model
+used), in this run: limit3d ``predict`` with the kernels, and with the numpy reference
+(``EYEVIZ_JIT=0``) as the baseline; keys/s of wall and of this process's CPU time, their
+ratio, the target's ratio, and whether the answers are the reference's (HEALPix: bit for
+bit; measured: to 1e-9, the accepted draws the same). The 1-minute load average is
+printed beside: on shared cores the wall figures count other jobs, the CPU ones less so.
+
+    .venv/bin/python scripts/bench_limit3d.py [--keys 40] [--ref-keys 16] [--which 180,32,bee]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+
+def run(est, la, lb):
+    t0, c0 = time.perf_counter(), time.process_time()
+    p = est.predict(la, lb)
+    return p, time.perf_counter() - t0, time.process_time() - c0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    ap.add_argument("--keys", type=int, default=40, help="keys timed with the kernels")
+    ap.add_argument("--ref-keys", type=int, default=16, help="of those, timed on the reference")
+    ap.add_argument("--which", default="180,32,bee")
+    ap.add_argument("--seed", type=int, default=7_310_551)
+    args = ap.parse_args(argv)
+
+    import numpy as np
+
+    from eyeviz.core import kernels
+    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.dataset.algorithm1_3d import generate3d
+    from eyeviz.estimators.base3d import take_rows
+    from eyeviz.estimators.limit3d import Limit3DEstimator
+    from eyeviz.files.eye_io import load_eyes, shipped_eye
+
+    kernels.warm()
+    for which in args.which.split(","):
+        if which == "bee":
+            d = Domain3D.for_eyes(load_eyes(shipped_eye("AM_60185-real.eye")))
+            name, target = "honeybee (AM_60185)", 200.0
+        else:
+            d = Domain3D(nside=int(which))
+            name, target = f"nside {which}", 500.0
+        ds = generate3d(max(args.keys, 50), d, seed=args.seed)
+        rows = np.arange(args.keys)
+        la = take_rows(ds.indptr_a, ds.indices_a, rows)
+        lb = take_rows(ds.indptr_b, ds.indices_b, rows)
+        p, wall, cpu = run(Limit3DEstimator(d), la, lb)
+        load = os.getloadavg()[0]
+        k = args.ref_keys
+        sa, sb = take_rows(*la, np.arange(k)), take_rows(*lb, np.arange(k))
+        os.environ["EYEVIZ_JIT"] = "0"
+        try:
+            q, wall_r, cpu_r = run(Limit3DEstimator(d), sa, sb)
+        finally:
+            del os.environ["EYEVIZ_JIT"]
+        rate, rate_c = args.keys / wall, args.keys / cpu
+        ref, ref_c = k / wall_r, k / cpu_r
+        acc_same = np.array_equal(p.n_accepted[:k], q.n_accepted)
+        if d.kind == "measured":
+            close = np.allclose(p.r[:k], q.r, rtol=1e-9) and acc_same
+            same = "same to 1e-9" if close else "DIFFERENT"
+        else:
+            bits = np.array_equal(p.r[:k], q.r) and np.array_equal(p.elevation[:k], q.elevation)
+            same = "bit for bit" if bits and acc_same else "DIFFERENT"
+        print(f"{name}: {args.keys} keys (reference {k}), load {load:.1f}")
+        print(f"  kernels    {rate:8.1f} keys/s wall {rate_c:8.1f} keys/s CPU")
+        print(f"  reference  {ref:8.1f} keys/s wall {ref_c:8.1f} keys/s CPU")
+        print(
+            f"  ratio      {rate / ref:8.2f}x wall {rate_c / ref_c:8.2f}x CPU; "
+            f"target {target:.0f}: {rate / target:.3g}x wall, {rate_c / target:.3g}x CPU "
+            f"({'met' if rate >= target else 'NOT met'}); answers {same}; median accepted "
+            f"{np.median(p.n_accepted):.0f}, flagged {int(p.flagged.sum())}"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
