@@ -112,8 +112,10 @@ MAX_SAMPLES = 1 << 14
 MAX_GRID = 64
 #: keys processed together
 _CHUNK = 8
-#: batches of draws of a retry proposed in one call (their arrays side by side)
+#: batches of draws of a retry proposed in one call (their arrays side by side), and of
+#: the top-ups (taken one by one: the answers are those of one batch a call)
 _GROUP = 8
+_TOPUP = 4
 #: The most facets per eye a key may light and still be sampled: each exact check of a
 #: draw costs about its lit count, and a draw is checked up to (max_batches + sum of
 #: RETRY's batches) x samples times. A key beyond it, or beyond what any ball of the
@@ -212,13 +214,24 @@ class Limit3DEstimator(Estimator3D):
         if reps > 1:
             return out
         # top-ups: a key with too few or too spread draws (_needs_more) gets another batch
-        # (its own stream; the other keys' draws are left as they are), up to max_batches
-        for rep in range(1, self.max_batches):
-            need = _needs_more(out["r"], out["w"], self.accuracy)
-            if not need.any():
-                break
-            more = prop.sample(st, keys, stream + 8 * rep, rows=need)
-            out = {k: np.concatenate([out[k], more[k]], axis=1) for k in out}
+        # (its own stream; the other keys' draws are left as they are, weight 0), up to
+        # max_batches. Up to _TOPUP batches are drawn in one call, then taken one by one
+        # as if drawn one at a time: a batch counts for a key only while the key still
+        # needs more after the batches before it (a key that needs no more keeps needing
+        # none: its new draws weigh 0), and none is taken once no key needs more.
+        rep, m = 1, self.samples
+        need = _needs_more(out["r"], out["w"], self.accuracy)
+        while rep < self.max_batches and need.any():
+            g = min(_TOPUP, self.max_batches - rep)
+            more = prop.sample(st, keys, [stream + 8 * (rep + j) for j in range(g)], rows=need)
+            for j in range(g):
+                part = {k: v[:, j * m : (j + 1) * m] for k, v in more.items()}
+                part["w"] = np.where(need[:, None], part["w"], 0.0)
+                out = {k: np.concatenate([out[k], part[k]], axis=1) for k in out}
+                rep += 1
+                need = _needs_more(out["r"], out["w"], self.accuracy)
+                if not need.any():
+                    break
         return out
 
     def _posterior(self, lit_a: LitCSR, lit_b: LitCSR):

@@ -98,10 +98,7 @@ class HealpixProposal:
         ph = box[:, 2:3] + (box[:, 3] - box[:, 2])[:, None] * u[..., 1]
         sp = np.sin(ph)
         ca = np.stack([np.cos(ph), sp * np.cos(th), sp * np.sin(th)], axis=-1)
-        good = (th_hi > th_lo) & (box[:, 3] > box[:, 2])
-        if rows is not None:
-            good = good & rows
-        good = np.broadcast_to(good[:, None], (n, m))
+        good = np.broadcast_to(((th_hi > th_lo) & (box[:, 3] > box[:, 2]))[:, None], (n, m))
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             delta = ea.gnomonic(np.where(good[..., None], ca, ea.c[:, None, :]))
         # outside A's box the model region is empty: drawn, then dropped
@@ -143,6 +140,8 @@ class HealpixProposal:
             vol = (th_hi - th_lo)[:, None] * (box[:, 3] - box[:, 2])[:, None]
             vol = vol * (u_hi - u_lo) * (g_hi - g_lo)
             w = prior_density(d, self.prior, r, gg, el, az) * rho**4 * sp * vol
+        if rows is not None:  # the other keys' draws as drawn (their weights 0: not checked)
+            good = good & rows[:, None]
         w = np.where(good & np.isfinite(w), w, 0.0)
         # the exact 0/1 likelihood on the draws with prior mass
         cand = np.flatnonzero(w.ravel() > 0)
