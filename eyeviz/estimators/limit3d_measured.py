@@ -277,11 +277,12 @@ class MeasuredProposal:
         g_hi = np.minimum(np.minimum(hi_a, hi_b), np.minimum(r, d.g_max))
         return g_lo, g_hi
 
-    def _h_draws(self, st: dict, c: np.ndarray, live: np.ndarray):
+    def _h_draws(self, st: dict, c: np.ndarray, live: np.ndarray, slack: float = -1.0):
         """:meth:`_h` at the draws' centres c (N, M, 3) where ``live``. Compiled, a draw
         is dropped at the first facet that empties its interval (its (g_lo, g_hi) then
         partial, and empty all the same; kernels.limit3d_region.interval_kernel); the
-        live draws' intervals are :meth:`_h`'s."""
+        live draws' intervals are :meth:`_h`'s. ``slack`` >= 0: the walk stops instead
+        where g_hi - g_lo < -slack (:meth:`_hb`)."""
         if not kernels.use(live.size):
             return self._h(st, c)
         from eyeviz.core.kernels.limit3d_region import interval_kernel
@@ -293,7 +294,7 @@ class MeasuredProposal:
         pb, ab, cb, sb, lb, db = st["eb"].columns()
         cc = np.ascontiguousarray(c, np.float64)
         interval_kernel(pa, aa, ca, sa, la, da, pb, ab, cb, sb, lb, db, cc,
-                        np.ascontiguousarray(live), g_lo, g_hi)  # fmt: skip
+                        np.ascontiguousarray(live), g_lo, g_hi, slack)  # fmt: skip
         return g_lo, g_hi
 
     def _centres(self, st: dict, delta: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -321,10 +322,14 @@ class MeasuredProposal:
         return self.fa.centre + v * rho[..., None], rho, drho
 
     def _hb(self, st: dict, x: np.ndarray) -> np.ndarray:
-        """H at points x (N, G, 3) = (delta_1, delta_2, beta) (-inf where undefined)."""
+        """H at points x (N, G, 3) = (delta_1, delta_2, beta) (-inf where undefined);
+        compiled, where H < -st["slack"] some value below it (the walk over the facets
+        stops there: :meth:`_h_draws`). Callers compare it with -st["slack"] only."""
         c, _, _ = self._bcentres(st, x[..., :2], x[..., 2])
         with np.errstate(invalid="ignore", over="ignore"):
-            g_lo, g_hi = self._h(st, np.nan_to_num(c, nan=1e300))
+            cc = np.nan_to_num(c, nan=1e300)
+            live = np.ones(cc.shape[:2], np.bool_)
+            g_lo, g_hi = self._h_draws(st, cc, live, float(st["slack"]))
         hv = g_hi - g_lo
         return np.where(np.isfinite(hv), hv, -np.inf)
 

@@ -103,7 +103,24 @@ def _prefilter(eye: _Eye, row: np.ndarray, c: np.ndarray, alpha: np.ndarray) -> 
     boundary samples' true distances: a lit cell needs alpha > dist(c, cell) >= d_s -
     gap (d_s: the nearest sample's distance, gap: :func:`_sample_gap`), an unlit one
     alpha <= dist(c, closure) <= d_s. Both with a 1e-9 rad margin for rounding. Draws
-    failing it would fail the exact check; the survivors get that check."""
+    failing it would fail the exact check; the survivors get that check. Compiled with
+    an early exit unless ``EYEVIZ_JIT=0`` (the same survivors among the draws the exact
+    check accepts: kernels.limit3d_region.prefilter_kernel)."""
+    if kernels.use(row.size):
+        from eyeviz.core.kernels.limit3d_region import prefilter_kernel
+
+        ok = np.empty(row.size, np.bool_)
+        s = 1.5 * math.sqrt(4 * math.pi / (12 * eye.nside**2)) / STEP
+        prefilter_kernel(np.ascontiguousarray(eye.pts), np.ascontiguousarray(eye.lit),
+                         np.ascontiguousarray(eye.pad), np.ascontiguousarray(row, np.int64),
+                         np.ascontiguousarray(c, np.float64),
+                         np.ascontiguousarray(alpha, np.float64), s, ok)  # fmt: skip
+        return ok
+    return _prefilter_ref(eye, row, c, alpha)
+
+
+def _prefilter_ref(eye: _Eye, row: np.ndarray, c: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """:func:`_prefilter` in numpy (the reference)."""
     ok = np.ones(row.size, bool)
     pp = eye.pts.shape[2]
     bounds = np.flatnonzero(np.diff(row)) + 1  # row is sorted: one product per key

@@ -225,3 +225,39 @@ def test_limit3d_answers_with_the_kernels_are_the_reference_s_measured(bee_small
     assert np.array_equal(got.flagged, want.flagged)
     for k in ("r", "azimuth", "elevation"):
         assert np.allclose(getattr(got, k), getattr(want, k), rtol=1e-10, atol=1e-12)
+
+
+def test_prefilter_kernel_keeps_what_the_reference_keeps(healpix_chunk):
+    """The early-exit prefilter against the numpy one, on caps about each key's centre
+    (some exact, some a little off in direction or radius)."""
+    from eyeviz.estimators.limit3d_proposal import STEP, _prefilter_ref
+
+    _, stt, _ = healpix_chunk
+    ea = stt["ea"]
+    rng = np.random.default_rng(2)
+    n = ea.c.shape[0]
+    row = np.repeat(np.arange(n), 300)
+    c = ea.c[row] + rng.normal(scale=2e-3, size=(row.size, 3))
+    c /= np.linalg.norm(c, axis=1, keepdims=True)
+    alpha = ea.alpha0[row] + rng.normal(scale=3e-3, size=row.size)
+    got = np.empty(row.size, np.bool_)
+    s = 1.5 * np.sqrt(4 * np.pi / (12 * ea.nside**2)) / STEP
+    kr.prefilter_kernel(ea.pts, ea.lit, ea.pad, row, c, alpha, s, got)
+    want = _prefilter_ref(ea, row, c, alpha)
+    assert np.array_equal(got, want)
+    assert 0 < want.sum() < want.size
+
+
+def test_region_test_with_early_exit_keeps_the_reference_s_verdicts(bee_small, monkeypatch):
+    """The box search's test H >= -slack (MeasuredProposal._hb), compiled with its early
+    exit, against numpy, about each key's box."""
+    _, prop, stt, _, _ = bee_small
+    rng = np.random.default_rng(3)
+    lo, hi = stt["box_lo"], stt["box_hi"]
+    span = hi - lo
+    x = lo[:, None] - span[:, None] + 3 * span[:, None] * rng.random((lo.shape[0], 500, 3))
+    got = prop._hb(stt, x) >= -stt["slack"]
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want = prop._hb(stt, x) >= -stt["slack"]
+    assert np.array_equal(got, want)
+    assert 0 < want.sum() < want.size

@@ -27,6 +27,7 @@ __all__ = [
     "cone_bounds_kernel",
     "interval_kernel",
     "same_rows_kernel",
+    "prefilter_kernel",
     "warm",
 ]
 
@@ -202,15 +203,25 @@ def _empty(lo, hi):
     return not (hi + pad > low)
 
 
+@_jit
+def _stop(lo, hi, slack):
+    """The walk's stopping test: slack < 0, the sampler's (:func:`_empty`); else the
+    region test's H = hi - lo >= -slack failing (or NaN). Both monotone."""
+    if slack < 0.0:
+        return _empty(lo, hi)
+    return not (hi - lo >= -slack)
+
+
 # long: one draw's walk over both eyes' facets with its early exit is one loop nest
 @_jit
 def interval_kernel(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b,
-                    pad_b, c, live, lo, hi):  # fmt: skip
+                    pad_b, c, live, lo, hi, slack):  # fmt: skip
     """The g interval (lo, hi) (N, M) of draws' centres c (N, M, 3) for both eyes, lo and
     hi coming in as the prior's bounds; only where ``live``. Stops at the first facet after
-    which the interval is empty (:func:`_empty`): a partial interval that is empty stays
-    empty (lo only grows, hi only shrinks), so the draw is dropped all the same, and its
-    (lo, hi) are the partial ones. Each key's last facet to empty a draw is tried first."""
+    which :func:`_stop` holds (``slack`` < 0: the interval is empty; else H < -slack): a
+    partial interval that fails fails all the same (lo only grows, hi only shrinks), and
+    its (lo, hi) are the partial ones. Each key's last facet to stop a draw is tried
+    first."""
     last_a = np.zeros(c.shape[0], np.int64)
     last_b = np.zeros(c.shape[0], np.int64)
     for n in range(c.shape[0]):
@@ -219,21 +230,21 @@ def interval_kernel(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh
                 continue
             cx, cy, cz = c[n, m, 0], c[n, m, 1], c[n, m, 2]
             lo_, hi_ = lo[n, m], hi[n, m]
-            out = _empty(lo_, hi_)
+            out = _stop(lo_, hi_, slack)
             if not out and not pad_a[n, last_a[n]]:
                 lo_, hi_ = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, last_a[n], cx, cy, cz,
                                       lo_, hi_)  # fmt: skip
-                out = _empty(lo_, hi_)
+                out = _stop(lo_, hi_, slack)
             if not out and not pad_b[n, last_b[n]]:
                 lo_, hi_ = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, last_b[n], cx, cy, cz,
                                       lo_, hi_)  # fmt: skip
-                out = _empty(lo_, hi_)
+                out = _stop(lo_, hi_, slack)
             k = 0
             while not out and k < pos_a.shape[1]:
                 if not pad_a[n, k]:
                     lo_, hi_ = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz,
                                           lo_, hi_)  # fmt: skip
-                    if _empty(lo_, hi_):
+                    if _stop(lo_, hi_, slack):
                         out = True
                         last_a[n] = k
                 k += 1
@@ -242,11 +253,50 @@ def interval_kernel(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh
                 if not pad_b[n, k]:
                     lo_, hi_ = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k, cx, cy, cz,
                                           lo_, hi_)  # fmt: skip
-                    if _empty(lo_, hi_):
+                    if _stop(lo_, hi_, slack):
                         out = True
                         last_b[n] = k
                 k += 1
             lo[n, m], hi[n, m] = lo_, hi_
+
+
+@_jit
+def _cell_fails(pts, lit, n, k, cx, cy, cz, a, s):
+    """Edge cell k of key n rules the cap (c, a) out (limit3d_proposal._prefilter): from
+    its nearest boundary sample's distance ds, a lit cell needs a + gap(ds) + 1e-9 > ds,
+    an unlit one a <= ds + 1e-9 (gap: _sample_gap, samples s apart)."""
+    best = -np.inf
+    for j in range(pts.shape[2]):
+        dot = pts[n, k, j, 0] * cx + pts[n, k, j, 1] * cy + pts[n, k, j, 2] * cz
+        best = max(best, dot)
+    ds = math.acos(min(max(best, -1.0), 1.0))
+    if lit[n, k]:
+        d_lo = math.sqrt(max(ds * ds - 0.25 * s * s, 0.0))
+        gap = 1.5 * (math.sqrt(d_lo * d_lo + 0.25 * s * s) - d_lo)
+        return a + gap + 1e-9 <= ds
+    return a > ds + 1e-9
+
+
+@_jit
+def prefilter_kernel(pts, lit, pad, row, c, alpha, s, ok):
+    """limit3d_proposal._prefilter with an early exit: a draw (key row[i], cap centre
+    c[i], radius alpha[i]) fails at its first edge cell that rules it out; each key's last
+    such cell is tried first. The condition keeps a 1e-9 rad margin, far above the
+    rounding in which this and the numpy reference differ (the order of a dot product's
+    terms, acos), so both keep every draw the exact check accepts."""
+    last = np.zeros(pts.shape[0], np.int64)
+    for i in range(row.size):
+        n = row[i]
+        cx, cy, cz, a = c[i, 0], c[i, 1], c[i, 2], alpha[i]
+        k0 = last[n]
+        bad = not pad[n, k0] and _cell_fails(pts, lit, n, k0, cx, cy, cz, a, s)
+        k = 0
+        while not bad and k < pts.shape[1]:
+            if k != k0 and not pad[n, k] and _cell_fails(pts, lit, n, k, cx, cy, cz, a, s):
+                bad = True
+                last[n] = k
+            k += 1
+        ok[i] = not bad
 
 
 @_jit
@@ -281,6 +331,8 @@ def warm() -> None:
     p3 = np.ones((1, 1, 3))
     cs = (p3, p3, a2 + 0.9, a2 + 0.1, b, ~b)
     cone_bounds_kernel(*cs, p3, out, out.copy())
-    interval_kernel(*cs, *cs, p3, b, out, out + 1)
+    interval_kernel(*cs, *cs, p3, b, out, out + 1, -1.0)
+    pts = np.ones((1, 1, 2, 3))
+    prefilter_kernel(pts, b, ~b, np.zeros(1, np.int64), c, np.ones(1), 0.01, b[0].copy())
     i1 = np.zeros(2, np.int64)
     same_rows_kernel(i1, i1[:0], i1, i1[:0], i1[:1], b[0])
