@@ -118,3 +118,35 @@ class ToyEyes:
 def toy_eyes() -> ToyEyes:
     """docs/extending.md's toy eye model in space (:class:`ToyEyes`)."""
     return ToyEyes()
+
+
+def _read_predictions3d(pred, npz):
+    """``eyeviz predict``'s CSV of a sparse 3D data set ``npz``, checked: the header, one
+    finite row per data row, r_hat within the domain. Returns (data set, values (n, 4),
+    each row's direction error in radians, the true unit directions from the origin)."""
+    import csv
+
+    import numpy as np
+
+    from eyeviz.dataset import sparse3d
+
+    with open(pred, newline="") as f:
+        rows = list(csv.reader(f))
+    ds = sparse3d.load3d(npz)
+    vals = np.array(rows[1:], float)
+    assert rows[0] == ["r_hat", "azimuth_hat", "elevation_hat", "flagged"]
+    assert vals.shape == (len(ds.r), 4) and np.isfinite(vals).all()
+    dom = ds.domain
+    assert (vals[:, 0] >= dom.r_min).all() and (vals[:, 0] <= dom.r_max).all()
+    d_true = np.c_[ds.x, ds.y, ds.z] - np.asarray(dom.origin)
+    unit = d_true / np.linalg.norm(d_true, axis=1)[:, None]
+    az, el = vals[:, 1], vals[:, 2]
+    d_hat = np.c_[np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)]
+    err = np.arccos(np.clip(np.einsum("ij,ij->i", d_hat, unit), -1, 1))
+    return ds, vals, err, unit
+
+
+@pytest.fixture
+def read_predictions3d():
+    """:func:`_read_predictions3d`: a predict CSV of a 3D data set, checked, with errors."""
+    return _read_predictions3d
