@@ -334,6 +334,10 @@ def test_compiled_and_numpy_decisions_agree(monkeypatch):
     rng = np.random.default_rng(21)
     pos, ax, acc = pair.facets("A")
     cs = [_tangent_ball(pos[i], ax[i], float(acc[i]), rng) for i in range(pos.shape[0])]
+    # graded near-ties: tangent balls grown and shrunk by 2^-52 .. 2^-40, where the
+    # certificate's bound (its scale: |v| |a|) decides which pairs are sure
+    k = np.ldexp(1.0, np.arange(-52, -39))
+    cs += [(c, d * (1 + s * e)) for c, d in cs[:8] for e in k for s in (-1, 1)]
     x, y, z, g = random_balls(pair, 300, seed=4)
     x = np.concatenate([x, [c[0] for c, _ in cs], [1e200, 1e-300, pos[0, 0]]])
     y = np.concatenate([y, [c[1] for c, _ in cs], [0.0, 0.0, pos[0, 1]]])
@@ -428,3 +432,27 @@ def test_h_l_and_centres_are_the_lens_centroids_half_distance_and_reach():
     pair = MeasuredEyePair(a, b)
     assert pair.centers == ((-2.0, 4.0, 1.0), (2.0, 4.0, 1.0))
     assert pair.h == 2.0 and pair.l == 2.0  # b's third lens is 2 from its centroid (2, 4, 1)
+
+
+def test_the_exact_signs_error_scale_bounds_the_terms(monkeypatch):
+    """_sign's ``scale`` must bound the sum of the terms' absolute values (its docstring),
+    or a sign is certified at a precision that cannot tell it: for each edge test of
+    seen_exact, scale >= |fun(1, 0)| + |fun(0, 1)| (the C terms, the S terms)."""
+    from eyeviz.core import measured_exact
+
+    calls = []
+    real = measured_exact._sign
+
+    def checked(fun, scale, half_dr):
+        with mpmath.workprec(200):  # the slack of the scale over the terms, relative
+            terms = abs(fun(1, 0)) + abs(fun(0, 1))
+            calls.append(float((scale() - terms) / terms))
+        return real(fun, scale, half_dr)
+
+    monkeypatch.setattr(measured_exact, "_sign", checked)
+    rng = np.random.default_rng(3)
+    for _ in range(40):  # balls behind and in front of a lens looking along +y
+        c = rng.normal(size=3) * 5
+        seen_exact(c.tolist(), float(rng.uniform(0.1, 2)), [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 0.4)
+    assert len(calls) > 40
+    assert min(calls) > -1e-50  # 200-bit rounding only
