@@ -172,3 +172,44 @@ def test_r_and_g_are_drawn_from_independent_uniforms(mode):
     u_g = (ds.g - g_min) / (DOM.g_max - g_min)
     assert abs(np.corrcoef(u_r, u_g)[0, 1]) < 0.15
     assert abs(np.corrcoef(u_r, np.cos(ds.azimuth))[0, 1]) < 0.15
+
+
+def test_sight_clear_is_the_segments_distance_from_the_other_eye():
+    """_sight_clear against a brute-force distance: 4,001 points along each segment from
+    the eye centre to the ball centre; cases within 1e-3 of the radius are left out."""
+    rng = np.random.default_rng(11)
+    x, y, z = rng.uniform(-80, 80, 400), rng.uniform(-15, 40, 400), rng.uniform(-15, 15, 400)
+    t = np.linspace(0, 1, 4001)[:, None]
+    for from_x, other_x in ((-30.0, 30.0), (30.0, -30.0)):
+        px, py, pz = from_x + t * (x - from_x), t * y, t * z
+        dist = np.sqrt(((px - other_x) ** 2 + py**2 + pz**2).min(axis=0))
+        got = A._sight_clear(x, y, z, from_x, other_x, 10.0)
+        sure = np.abs(dist - 10.0) > 1e-3
+        assert 20 < (~got[sure]).sum() < sure.sum() - 20  # both answers occur
+        assert np.array_equal(got[sure], dist[sure] > 10.0)
+
+
+def test_both_eyes_field_reaches_outside_the_wedge_and_measured_rows_are_about_the_origin(
+    toy_pair,
+):
+    """HEALPix eyes' both-eyes field is not the wedge (some of its rows lie outside it);
+    a measured pair's rows give (r, azimuth, elevation) about the domain's origin."""
+    ds = A.generate3d(60, DOM, seed=5, field="both-eyes")
+    assert (~DOM.eyes.in_bfv(ds.x, ds.y, ds.z, ds.g)).sum() >= 5
+    dom = Domain3D.for_eyes(toy_pair)
+    assert abs(dom.origin[1]) > 0.1  # the toy's lens centroids lie in front of x = 0
+    ds = A.generate3d(20, dom, seed=5)
+    want = spherical_to_xyz(ds.r, ds.azimuth, ds.elevation)
+    for have, w, o in zip((ds.x, ds.y, ds.z), want, dom.origin, strict=True):
+        assert np.allclose(have, w + o, rtol=0, atol=1e-12 * dom.r_max)
+    assert toy_pair.in_bfv(ds.x, ds.y, ds.z, ds.g).all()
+
+
+def test_a_rare_field_is_filled_the_generator_gives_up_only_after_many_draws():
+    """Step 9 keeps about 1 r in 1,000 here: the last slots wait hundreds of rounds of a
+    few draws each. The generator stops only after _MAX_IDLE_DRAWS idle draws *and*
+    _MAX_IDLE_ROUNDS idle rounds, so the rows come."""
+    s = math.sin(math.pi / 32)  # gamma / 2 at nside 8
+    dom = Domain3D(h=30, l=10, nside=8, r_min=100, r_max=500, g_max=100 * s * 1.004, el_max=0.4)
+    ds = A.generate3d(3, dom, seed=2)
+    assert len(ds) == 3 and (ds.r <= 100.4 * (1 + 1e-9)).all()
