@@ -257,6 +257,19 @@ def test_the_hand_built_zip_is_valid(tmp_path):
     assert len(sparse3d.load3d(_mutated(tmp_path, lambda m: None))) == 20
 
 
+@pytest.mark.parametrize("version", [(1, 0), (2, 0), (3, 0)])
+def test_every_npy_header_version_numpy_writes_is_read(tmp_path, version):
+    """numpy writes .npy headers 1.0, 2.0 (headers over 64 KiB) and 3.0 (utf-8 names);
+    a file whose members use any of them reads back the same rows."""
+    ds = rows(20, seed=2)
+    path = tmp_path / "v.npz"
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED) as zf:
+        for name, arr in _members(ds).items():
+            with zf.open(name + ".npy", "w") as f:
+                np.lib.format.write_array(f, np.asanyarray(arr), version=version)
+    same(sparse3d.load3d(path), ds)
+
+
 def test_truncated_and_garbage_files(small, tmp_path):
     path, _ = small
     data = path.read_bytes()
