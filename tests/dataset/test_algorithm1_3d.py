@@ -213,3 +213,13 @@ def test_a_rare_field_is_filled_the_generator_gives_up_only_after_many_draws():
     dom = Domain3D(h=30, l=10, nside=8, r_min=100, r_max=500, g_max=100 * s * 1.004, el_max=0.4)
     ds = A.generate3d(3, dom, seed=2)
     assert len(ds) == 3 and (ds.r <= 100.4 * (1 + 1e-9)).all()
+
+
+def test_a_design_exactly_at_gamma_half_plus_psi_equal_to_pi_half_is_refused():
+    """l = h cos(gamma / 2) puts gamma/2 + psi at pi/2 to the last bit (nside 2, h = 1):
+    no ball fits between the cones (the boundary counts as refused)."""
+    l_ = 0.9238795325112867
+    assert math.pi / 8 + math.asin(l_) == math.pi / 2
+    dom = Domain3D(h=1.0, l=l_, nside=2, r_min=100, r_max=400, g_max=60, el_max=0.4)
+    with pytest.raises(EyevizError, match="gamma/2 \\+ psi >= pi/2"):
+        A.generate3d(1, dom, seed=1)
