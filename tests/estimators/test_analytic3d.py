@@ -119,3 +119,42 @@ def test_the_report_counts_no_weights_for_the_analytic_estimator(ds16):
     (res,) = measure3d(ds16, ["analytic3d"], limit_rows=20)
     assert res.n_weights == 0
     assert Analytic3DEstimator(D16).metadata["train_seconds"] == 0.0
+
+
+def test_measured_rows_answer_their_direction_and_flagged_ones_r_max_along_the_mean_ray(
+    toy_pair,
+):
+    """A measured pair: rows of its own data set are answered in their direction (about
+    the domain's origin, to within a few facets); lit sets whose rays diverge (eye A's
+    leftmost facets, eye B's rightmost) are flagged and answered at r_max along the
+    mean of the two fitted rays, as estimate_measured's docstring says."""
+    from eyeviz.estimators.triangulation import boundary_rays, facet_neighbours
+
+    dom = Domain3D.for_eyes(toy_pair)
+    ds = generate3d(20, dom, seed=3)
+    est = Analytic3DEstimator(dom)
+    p = est.predict((ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b))
+    d = np.c_[ds.x, ds.y, ds.z] - np.asarray(dom.origin)
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    az, el = np.asarray(p[1]), np.asarray(p[2])
+    d_hat = np.c_[np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)]
+    err = np.arccos(np.clip((d * d_hat).sum(axis=1), -1, 1))
+    assert np.ptp(ds.azimuth) > 0.5 and np.median(err) < 0.15
+    pos_a, ax_a, _ = toy_pair.facets("A")
+    pos_b, ax_b, _ = toy_pair.facets("B")
+    ua, ub = (
+        ax_a / np.linalg.norm(ax_a, axis=1)[:, None],
+        ax_b / np.linalg.norm(ax_b, axis=1)[:, None],
+    )
+    lit_a = [np.flatnonzero((ua[:, 0] < -0.6) & (np.abs(ua[:, 2]) < 0.3))]
+    lit_b = [np.flatnonzero((ub[:, 0] > 0.6) & (ub[:, 2] > 0.3))]
+    assert lit_a[0].size >= 3 and lit_b[0].size >= 3
+    ca = (np.array([0, lit_a[0].size]), lit_a[0])
+    cb = (np.array([0, lit_b[0].size]), lit_b[0])
+    q = est.predict(ca, cb)
+    assert bool(q.flagged[0]) and float(q[0][0]) == dom.r_max
+    _, u, _ = boundary_rays(pos_a, ax_a, ca, facet_neighbours(ax_a))
+    _, v, _ = boundary_rays(pos_b, ax_b, cb, facet_neighbours(ax_b))
+    m = (u + v)[0] / np.linalg.norm((u + v)[0])
+    assert float(q[1][0]) == pytest.approx(math.atan2(m[1], m[0]), abs=1e-12)
+    assert float(q[2][0]) == pytest.approx(math.asin(m[2]), abs=1e-12)
