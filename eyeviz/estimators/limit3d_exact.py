@@ -59,7 +59,7 @@ def same_rows(ptr: np.ndarray, ind: np.ndarray, key: LitCSR, row: np.ndarray) ->
         from eyeviz.core.kernels.limit3d_region import same_rows_kernel
 
         out = np.empty(row.size, np.bool_)
-        p_, i_, kp_, ki_, r_ = (np.ascontiguousarray(a, np.int64) for a in (ptr, ind, kp, ki, row))
+        p_, i_, kp_, ki_, r_ = (kernels.arg(a, np.int64) for a in (ptr, ind, kp, ki, row))
         same_rows_kernel(p_, i_, kp_, ki_, r_, out)
         return out
     cnt = np.diff(ptr)

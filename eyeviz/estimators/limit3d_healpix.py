@@ -173,11 +173,11 @@ def _ray_region_draws(eb: _Eye, ca, u_lo, u_hi, good, slack, u_dead: float):
 
         lo, hi = np.array(u_lo, np.float64), np.array(u_hi, np.float64)
         n = good.shape[0]
-        sl = np.ascontiguousarray(np.broadcast_to(slack, (n, 1))[:, 0], np.float64)
+        sl = kernels.arg(np.broadcast_to(slack, (n, 1))[:, 0], np.float64)
         t = np.linspace(0.0, 1.0, RAY_GRID)
         ray_region_kernel(eb.a_lit, eb.t_lit, eb.a_unl, eb.t_unl, eb.c, eb.e1, eb.e2,
-                          np.asarray(eb.a, np.float64), np.ascontiguousarray(ca, np.float64),
-                          lo, hi, sl, t, RAY_ROUNDS, np.ascontiguousarray(good))  # fmt: skip
+                          kernels.arg(eb.a, np.float64), kernels.arg(ca, np.float64),
+                          lo, hi, sl, t, RAY_ROUNDS, kernels.arg(good))  # fmt: skip
         return np.where(good, lo, u_dead), np.where(good, hi, u_dead)
     n = good.shape[0]
     order = np.argsort(~good, axis=1, kind="stable")[:, : max(1, int(good.sum(1).max()))]

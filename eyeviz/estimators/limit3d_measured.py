@@ -195,9 +195,7 @@ class _Edges:
             lo = np.empty(c.shape[:2])
             hi = np.empty(c.shape[:2])
             pos, ax, ch, sh, lit, pad = self.columns()
-            cone_bounds_kernel(
-                pos, ax, ch, sh, lit, pad, np.ascontiguousarray(c, np.float64), lo, hi
-            )
+            cone_bounds_kernel(pos, ax, ch, sh, lit, pad, kernels.arg(c, np.float64), lo, hi)
             return lo, hi
         return self._bounds_ref(c)
 
@@ -292,9 +290,9 @@ class MeasuredProposal:
         g_hi = np.minimum(r, self.domain.g_max)
         pa, aa, ca, sa, la, da = st["ea"].columns()
         pb, ab, cb, sb, lb, db = st["eb"].columns()
-        cc = np.ascontiguousarray(c, np.float64)
+        cc = kernels.arg(c, np.float64)
         interval_kernel(pa, aa, ca, sa, la, da, pb, ab, cb, sb, lb, db, cc,
-                        np.ascontiguousarray(live), g_lo, g_hi, slack)  # fmt: skip
+                        kernels.arg(live), g_lo, g_hi, slack)  # fmt: skip
         return g_lo, g_hi
 
     def _centres(self, st: dict, delta: np.ndarray, w: np.ndarray) -> np.ndarray:

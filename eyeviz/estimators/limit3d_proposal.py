@@ -111,10 +111,10 @@ def _prefilter(eye: _Eye, row: np.ndarray, c: np.ndarray, alpha: np.ndarray) -> 
 
         ok = np.empty(row.size, np.bool_)
         s = 1.5 * math.sqrt(4 * math.pi / (12 * eye.nside**2)) / STEP
-        prefilter_kernel(np.ascontiguousarray(eye.pts), np.ascontiguousarray(eye.lit),
-                         np.ascontiguousarray(eye.pad), np.ascontiguousarray(row, np.int64),
-                         np.ascontiguousarray(c, np.float64),
-                         np.ascontiguousarray(alpha, np.float64), s, ok)  # fmt: skip
+        prefilter_kernel(kernels.arg(eye.pts), kernels.arg(eye.lit),
+                         kernels.arg(eye.pad), kernels.arg(row, np.int64),
+                         kernels.arg(c, np.float64),
+                         kernels.arg(alpha, np.float64), s, ok)  # fmt: skip
         return ok
     return _prefilter_ref(eye, row, c, alpha)
 
@@ -280,7 +280,7 @@ class _Eye:
             lo = np.empty(delta.shape[:2])
             hi = np.empty(delta.shape[:2])
             affine_bounds_kernel(self.a_lit, self.t_lit, self.a_unl, self.t_unl,
-                                 np.ascontiguousarray(delta, np.float64), lo, hi)  # fmt: skip
+                                 kernels.arg(delta, np.float64), lo, hi)  # fmt: skip
             return lo, hi
         return self._bounds_ref(delta)
 

@@ -9,7 +9,9 @@ from __future__ import annotations
 import importlib.util
 import os
 
-__all__ = ["enabled", "use", "warm", "warm_in_background", "defer_until_warm", "mark_ready"]
+import numpy as np
+
+__all__ = ["arg", "enabled", "use", "warm", "warm_in_background", "defer_until_warm", "mark_ready"]
 
 _STATE: dict[str, bool | None] = {"ready": False, "defer": False, "found": None}
 #: Calls of fewer items than this do not load cold kernels (see :func:`use`)
@@ -74,3 +76,9 @@ def warm_in_background():
 def mark_ready() -> None:
     """A kernel ran: it is loaded, later calls of any size use it."""
     _STATE["ready"] = True
+
+
+def arg(a, dtype=None) -> np.ndarray:
+    """``a`` as a kernel takes it: C-contiguous and writable (numba types a read-only
+    array, e.g. a broadcast view, apart: it would compile a new signature at run time)."""
+    return np.require(a, dtype, ("C", "W"))
