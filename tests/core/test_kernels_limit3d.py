@@ -44,7 +44,7 @@ def _affine_eye(rng: np.random.Generator, n: int, k: int) -> SimpleNamespace:
     return e
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=25, deadline=None)
 @given(seed=st.integers(0, 2**31), k=st.integers(1, 40), special=st.booleans())
 def test_affine_bounds_kernel_is_the_reference_bit_for_bit(seed, k, special):
     rng = np.random.default_rng(seed)
@@ -205,13 +205,14 @@ def test_same_rows_kernel_is_the_reference(seed):
 
 def test_limit3d_answers_with_the_kernels_are_the_reference_s_healpix(monkeypatch):
     d = Domain3D(nside=8)
-    ds = generate3d(10, d, seed=21)
-    rows = np.arange(10)
+    ds = generate3d(6, d, seed=21)
+    rows = np.arange(6)
     la = take_rows(ds.indptr_a, ds.indices_a, rows)
     lb = take_rows(ds.indptr_b, ds.indices_b, rows)
-    got = Limit3DEstimator(d, samples=64, max_batches=4).predict(la, lb)
+    got = Limit3DEstimator(d, samples=64, max_batches=3).predict(la, lb)
     monkeypatch.setenv("EYEVIZ_JIT", "0")
-    want = Limit3DEstimator(d, samples=64, max_batches=4).predict(la, lb)
+    want = Limit3DEstimator(d, samples=64, max_batches=3).predict(la, lb)
+    assert got.n_accepted.sum() > 20
     for k in ("r", "azimuth", "elevation", "mc_error", "n_accepted", "flagged"):
         assert _same_bits(np.asarray(getattr(got, k), float), np.asarray(getattr(want, k), float))
 
