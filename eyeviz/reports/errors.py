@@ -17,29 +17,9 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
+from eyeviz.estimators.metrics import N_BOOT, bootstrap_se
 
-__all__ = ["bootstrap_se", "with_error", "decimals_for"]
-
-#: resamples per standard error: the bootstrap's own relative error is about
-#: 1 / sqrt(2 * 1000) = 2 %, below the second significant digit printed
-N_BOOT = 1000
-
-
-def bootstrap_se(terms, n_boot: int = N_BOOT, seed: int = 0) -> float:
-    """The bootstrap standard error of ``mean(terms)``: the standard deviation of the
-    means of ``n_boot`` resamples of the rows with replacement. NaN for fewer than two
-    rows (one row says nothing about its spread)."""
-    t = np.asarray(terms, float).ravel()
-    if t.size < 2:
-        return math.nan
-    rng = np.random.default_rng(seed)
-    means = np.empty(n_boot)
-    chunk = max(1, 2_000_000 // t.size)  # bounded memory for large test sets
-    for lo in range(0, n_boot, chunk):
-        k = min(chunk, n_boot - lo)
-        means[lo : lo + k] = t[rng.integers(0, t.size, size=(k, t.size))].mean(axis=1)
-    return float(means.std(ddof=1))
+__all__ = ["N_BOOT", "bootstrap_se", "with_error", "decimals_for"]
 
 
 def decimals_for(se: float, digits: int = 2) -> int:

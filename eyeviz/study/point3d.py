@@ -18,7 +18,9 @@ the rays along the two lit caps' mean directions, an upper bound on the limit's 
 
 The errors per row: DD and AD MAPE (%) and R^2 (Eqs. 34-35, docs/conventions.md, as the
 planar study), the mean absolute elevation and azimuth error in degrees (MAPE is no
-measure for an elevation that crosses 0) and the elevation's R^2; overall (bin
+measure for an elevation that crosses 0) and the elevation's R^2, with the sampling
+errors of the DD and the elevation error (``dd_se``, ``el_se``: bootstrap standard errors
+over the bin's rows, NaN for a bin of one row; version 2 of the table); overall (bin
 ``"all"``), per distance bin (``"r0"``, ``"r1"``, ... of :data:`~eyeviz.study.point.BIN_WIDTH`)
 and per elevation bin (``"e0"`` ... ``"e5"``: :data:`EL_BINS` equal bins of
 [-el_max, el_max]). ``gamma`` is the equatorial facet width 2 pi / (4 nside), the planar
@@ -40,7 +42,7 @@ from eyeviz import EyevizError
 from eyeviz.core.domain import DEFAULTS
 from eyeviz.core.domain3d import DEFAULT_EL_MAX, Domain3D
 from eyeviz.core.validation import check_choice, check_int
-from eyeviz.estimators.metrics import mape, r2
+from eyeviz.estimators.metrics import bootstrap_se, mape, r2
 from eyeviz.study.point import BIN_WIDTH, distance_bins
 
 __all__ = [
@@ -54,7 +56,8 @@ __all__ = [
 ]
 
 #: Version of the 3D study table's columns; a file with another version is refused.
-STUDY3D_VERSION = 1
+#: 2: the sampling errors dd_se and el_se per bin (issue 38.3)
+STUDY3D_VERSION = 2
 #: Equal elevation bins over [-el_max, el_max] (10 degrees each at the default 30).
 EL_BINS = 6
 #: The default estimator: the closest-approach triangulation of the lit caps' mean
@@ -84,8 +87,10 @@ COLUMNS3D = (
     "hi",
     "count",
     "dd_mape",
+    "dd_se",
     "ad_mape",
     "el_mae_deg",
+    "el_se",
     "az_mae_deg",
     "dd_r2",
     "ad_r2",
@@ -184,10 +189,14 @@ def _load(point: Any):
 
 def _errors(r, az, el, rh, ah, eh) -> dict[str, float]:
     deg = 180.0 / math.pi
+    el_abs = np.abs(eh - el) * deg
     out = {
         "dd_mape": mape(r, rh),
+        # the sampling errors of the bin's DD and elevation error: bootstrap over its rows
+        "dd_se": bootstrap_se(100.0 * np.abs(rh - r) / np.abs(r)),
         "ad_mape": mape(az, ah),
-        "el_mae_deg": float(np.mean(np.abs(eh - el)) * deg),
+        "el_mae_deg": float(np.mean(el_abs)),
+        "el_se": bootstrap_se(el_abs),
         "az_mae_deg": float(np.mean(np.abs(ah - az)) * deg),
     }
     for name, y, yh in (("dd_r2", r, rh), ("ad_r2", az, ah), ("el_r2", el, eh)):
@@ -195,7 +204,8 @@ def _errors(r, az, el, rh, ah, eh) -> dict[str, float]:
     return out
 
 
-_METRICS = ("dd_mape", "ad_mape", "el_mae_deg", "az_mae_deg", "dd_r2", "ad_r2", "el_r2")
+_METRICS = ("dd_mape", "dd_se", "ad_mape", "el_mae_deg", "el_se", "az_mae_deg", "dd_r2",
+            "ad_r2", "el_r2")  # fmt: skip
 
 
 def evaluate3d(point: Any, bin_width: float = BIN_WIDTH) -> list[dict]:

@@ -41,7 +41,8 @@ __all__ = [
     "reshape_pair",
 ]
 
-VERSION = 1
+#: 2: the sampling errors dd_se and el_se (the 3D table's version 2)
+VERSION = 2
 #: The measured study's columns: the 3D study's with the eye, facets and widen in place
 #: of nside.
 COLUMNS_MEASURED = (
@@ -176,6 +177,7 @@ TABLE_MEASURED = TableFormat(
     bounds=("lo", "hi"),
     r_bin="r",
     el_bins=EL_BINS,
+    ses=("dd_se", "el_se"),
 )
 
 

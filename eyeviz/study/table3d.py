@@ -51,6 +51,7 @@ TABLE3D = TableFormat(
     bounds=("lo", "hi"),
     r_bin="r",
     el_bins=EL_BINS,
+    ses=("dd_se", "el_se"),
 )
 
 

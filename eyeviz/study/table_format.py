@@ -80,6 +80,9 @@ class TableFormat:
     bounds: tuple[str, str]
     r_bin: str = ""
     el_bins: int = 0
+    #: Standard errors of error metrics: >= 0 and finite, or NaN (a bin of one element
+    #: has no spread to measure).
+    ses: tuple[str, ...] = ()
     #: The header's first columns, which tell another version of this kind from another
     #: kind of file.
     family: int = 4
@@ -92,7 +95,7 @@ class TableFormat:
     @property
     def metrics(self) -> frozenset[str]:
         """Columns a bin may leave empty (pandas writes NaN as an empty field)."""
-        return frozenset(self.errors + self.r2)
+        return frozenset(self.errors + self.r2 + self.ses)
 
     @property
     def header(self) -> bytes:
@@ -214,7 +217,7 @@ def _check_values(fmt: TableFormat, where: str, row: dict, point) -> None:
         raise EyevizError(f"{where}: count {count} exceeds n = {row['n']}")
     if row["flagged"] > count:
         raise EyevizError(f"{where}: flagged {row['flagged']} exceeds count = {count}")
-    for col in (*fmt.errors, "seconds"):
+    for col in (*fmt.errors, *fmt.ses, "seconds"):
         v = row[col]
         if not (math.isnan(v) or 0 <= v < math.inf) or (col == "seconds" and math.isnan(v)):
             raise EyevizError(f"{where}: column {col}: must be >= 0 and finite, got {v:g}")
