@@ -7,7 +7,8 @@ rows). Prints a Markdown table and the keys/s of each.
 A target may run on the first ROWS rows only (``0.001:500``): its row is then compared on
 those rows, and the chain "target -> next tighter target on the rows both ran" is
 printed too, so an expensive tight target need not run on every row. The per-row errors
-are saved after each target (``--out``, npz) and ``--table`` reprints from that file.
+are saved after each target (``--out``, npz) and ``--table`` reprints from those files
+(several runs on the same rows merged).
 
     python scripts/check_limit3d_convergence.py [-n ROWS] [--seed SEED] [--nside NSIDE]
         [--targets 0.01,0.005,0.0025,0.001:500] [--out FILE.npz] [--table FILE.npz]
@@ -108,11 +109,21 @@ def main() -> None:
     ap.add_argument("--max-batches", type=int, default=64)
     ap.add_argument("--targets", default=TARGETS, help="comma-separated, each T or T:ROWS")
     ap.add_argument("--out", default="", help="save the per-row errors (npz)")
-    ap.add_argument("--table", default="", help="only print the table of a saved run")
+    ap.add_argument(
+        "--table",
+        nargs="+",
+        default=[],
+        help="only print the table of saved runs (of the "
+        "same rows: -n, --seed, --nside; several are merged)",
+    )
     a = ap.parse_args()
     if a.table:
-        with np.load(a.table) as z:
-            res = {k: z[k] for k in z.files}
+        res = {}
+        for f in a.table:
+            with np.load(f) as z:
+                if "meta" in res and not np.array_equal(res["meta"][:3], z["meta"][:3]):
+                    raise SystemExit(f"{f}: another data set (-n, --seed, --nside)")
+                res.update({k: z[k] for k in z.files})
     else:
         res = _run(a)
     print(table(res))

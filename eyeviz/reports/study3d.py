@@ -45,8 +45,10 @@ __all__ = [
     "FIT_MAX",
     "PAPER3D",
     "Design3D",
+    "bin_errors",
     "fit_power",
     "law_points3d",
+    "law_uncertainty",
     "read_study3d",
     "write_report3d",
 ]
@@ -171,6 +173,61 @@ def fit_power(points: list[LawPoint]) -> dict | None:
     return out
 
 
+#: resamples of the law's bootstrap (:func:`law_uncertainty`)
+LAW_BOOT = 1000
+
+
+def law_uncertainty(points: list[LawPoint], n_boot: int = LAW_BOOT, seed: int = 0) -> dict:
+    """The sampling spread of the fitted law, by a bootstrap over its fitted bins (each
+    resample refits both forms of :func:`~eyeviz.reports.study_law.fit_law`): the
+    standard deviation of log C (slope fixed at 1; ``C_factor_se`` = exp of it), of the
+    free slope and of log C_free. Empty below 3 fitted bins."""
+    use = [p for p in points if p.fitted]
+    if len(use) < 3:
+        return {}
+    lx = np.log([p.x for p in use])
+    ly = np.log([p.y for p in use])
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, lx.size, size=(n_boot, lx.size))
+    x, y = lx[idx], ly[idx]
+    log_c = (y - x).mean(axis=1)
+    xm, ym = x.mean(axis=1, keepdims=True), y.mean(axis=1, keepdims=True)
+    sxx = ((x - xm) ** 2).sum(axis=1)
+    ok = sxx > 0
+    slope = ((x - xm) * (y - ym)).sum(axis=1)[ok] / sxx[ok]
+    log_cf = ym[ok, 0] - slope * xm[ok, 0]
+    return {
+        "n_boot": n_boot,
+        "C_factor_se": float(math.exp(log_c.std(ddof=1))),
+        "free_slope_se": float(slope.std(ddof=1)),
+        "C_free_factor_se": float(math.exp(log_cf.std(ddof=1))),
+    }
+
+
+def bin_errors(designs: dict[tuple, Design3D]) -> list[dict]:
+    """Every distance bin of every design with its DD, its sampling error (``dd_se``,
+    bootstrap over the bin's rows) and that error relative to the DD."""
+    out = []
+    for d in sorted(designs.values(), key=lambda d: d.key):
+        for b in d.r_bins:
+            se = b.get("dd_se", math.nan)
+            out.append({
+                "h": d.h, "l": d.l, "nside": d.nside, "bin": b["bin"], "lo": b["lo"],
+                "hi": b["hi"], "count": b["count"], "dd_mape": b["dd_mape"], "dd_se": se,
+                "rel_se": se / b["dd_mape"] if b["dd_mape"] > 0 else math.nan,
+            })  # fmt: skip
+    return out
+
+
+def _no_nan(v):
+    """``v`` with every NaN float (a bin of one row has no standard error) as None."""
+    if isinstance(v, dict):
+        return {k: _no_nan(x) for k, x in v.items()}
+    if isinstance(v, list):
+        return [_no_nan(x) for x in v]
+    return None if isinstance(v, float) and math.isnan(v) else v
+
+
 def _nearest(values, want: float) -> float:
     return min(values, key=lambda v: (abs(math.log(v / want)), v))
 
@@ -230,6 +287,7 @@ def write_report3d(
             "n": fit.n,
             "free_slope": fit.slope,
             "C_free": fit.C_free,
+            **law_uncertainty(points),
         },
         "power_law": power,
         "fit_rule": f"interior distance bins, >= {MIN_COUNT} elements, <= {FLAG_MAX:.0%} "
@@ -246,8 +304,10 @@ def write_report3d(
                     k: d.all[k]
                     for k in (
                         "dd_mape",
+                        "dd_se",
                         "ad_mape",
                         "el_mae_deg",
+                        "el_se",
                         "az_mae_deg",
                         "flagged",
                         "seconds",
@@ -257,6 +317,7 @@ def write_report3d(
             }
             for d in sorted(designs.values(), key=lambda d: d.key)
         ],
+        "bins": bin_errors(designs),
         "other_estimators": [  # the table's other estimators, overall, beside the drawn one
             {
                 "estimator": r["estimator"],
@@ -271,6 +332,6 @@ def write_report3d(
             if r["bin"] == "all" and r["estimator"] != est and r["prior"] == prior
         ],
     }
-    text = json.dumps(summary, indent=1, allow_nan=False) + "\n"
+    text = json.dumps(_no_nan(summary), indent=1, allow_nan=False) + "\n"
     written.append(_write_text(outdir / "summary3d.json", text))
     return written

@@ -9,6 +9,7 @@ import pytest
 from eyeviz import EyevizError
 from eyeviz.core.domain3d import Domain3D
 from eyeviz.estimators import registry
+from eyeviz.estimators.metrics import bootstrap_se
 from eyeviz.study.grid3d import design_grid3d
 from eyeviz.study.point3d import COLUMNS3D, EL_BINS, DesignPoint3D, evaluate3d
 
@@ -138,3 +139,30 @@ def test_the_estimator_is_a_parameter_loaded_from_the_registry():
         registry.unregister("tri_for_test")
     with pytest.raises(EyevizError, match="unknown estimator 'tri_for_test'"):
         evaluate3d(q)
+
+
+def test_each_bin_states_the_sampling_error_of_its_dd_and_elevation_error():
+    """dd_se and el_se (issue 38.3) are the bootstrap standard errors of the bin's mean
+    over its own rows: recomputed here from the same test set and answers, they agree,
+    and both are close to the textbook sd / sqrt(count)."""
+    from eyeviz.dataset.algorithm1_3d import iter_chunks3d, make_params3d
+
+    p = DesignPoint3D(h=40, l=20, nside=16, n=500, seed=9)
+    rows = {r["bin"]: r for r in evaluate3d(p)}
+    est = registry.load(p.estimator, domain=p.domain)
+    parts = []
+    for c in iter_chunks3d(p.n, make_params3d(p.domain, p.prior, p.seed)):
+        q = est.predict((c.indptr_a, c.indices_a), (c.indptr_b, c.indices_b))
+        parts.append(np.column_stack([c.r, q.r, c.elevation, q.elevation]))
+    r, rh, el, eh = np.concatenate(parts).T
+    ape = 100 * np.abs(rh - r) / r
+    ele = np.degrees(np.abs(eh - el))
+    for name, sel in (("all", np.ones(r.size, bool)), ("r3", (r >= 2500) & (r < 3000))):
+        b = rows[name]
+        assert b["count"] == sel.sum() > 30
+        assert b["dd_mape"] == pytest.approx(ape[sel].mean(), rel=1e-9)
+        assert b["dd_se"] == pytest.approx(bootstrap_se(ape[sel]), rel=1e-9)
+        assert b["el_se"] == pytest.approx(bootstrap_se(ele[sel]), rel=1e-9)
+        textbook = ape[sel].std() / math.sqrt(sel.sum())
+        assert 0.85 * textbook < b["dd_se"] < 1.15 * textbook
+    assert rows["r3"]["dd_se"] > rows["all"]["dd_se"]  # fewer rows, larger error

@@ -114,7 +114,10 @@ HOSTILE = [
     (5, "bin", "r08", "bin must be 'all', 'r<i>' or 'e<j>'"),
     (13, "bin", "e\u0662", "bin must be 'all', 'r<i>' or 'e<j>'"),
     (2, "seconds", "nan", "column seconds: must be >= 0 and finite"),
-    (2, "version", "2", "written by 3D study version 2"),
+    (2, "version", "1", "written by 3D study version 1"),
+    (2, "dd_se", "-0.1", "column dd_se: must be >= 0"),
+    (3, "el_se", "inf", "column el_se: must be >= 0 and finite"),
+    (2, "dd_se", "1e13", "column dd_se: 1e+13 is no error a study measures"),
     (2, "el_max", "2.0", "el_max"),
     (2, "estimator", "no such", "estimator must be"),
 ]
