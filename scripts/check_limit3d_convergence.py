@@ -43,9 +43,10 @@ def _run(a: argparse.Namespace) -> dict[str, np.ndarray]:
     dom = Domain3D(nside=a.nside)
     ds = generate3d(a.n, dom, seed=a.seed)
     Limit3DEstimator(dom).predict_dataset(generate3d(4, dom, seed=1))  # warm
-    res: dict[str, np.ndarray] = {"meta": np.array([a.n, a.seed, a.nside, a.max_batches])}
+    meta = [a.n, a.seed, a.nside, a.max_batches, a.samples]
+    res: dict[str, np.ndarray] = {"meta": np.array(meta)}
     for t, k in _parse(a.targets, a.n):
-        est = Limit3DEstimator(dom, accuracy=t, max_batches=a.max_batches)
+        est = Limit3DEstimator(dom, accuracy=t, max_batches=a.max_batches, samples=a.samples)
         rows = np.arange(k)
         lit_a = take_rows(ds.indptr_a, ds.indices_a, rows)
         lit_b = take_rows(ds.indptr_b, ds.indices_b, rows)
@@ -67,7 +68,7 @@ def _run(a: argparse.Namespace) -> dict[str, np.ndarray]:
 
 def table(res: dict[str, np.ndarray]) -> str:
     """The Markdown convergence table of a run's per-row errors."""
-    n, seed, nside, mb = (int(v) for v in res["meta"])
+    n, seed, nside, mb = (int(v) for v in res["meta"][:4])
     ts = sorted((float(k[4:]) for k in res if k.startswith("rel_")), reverse=True)
     tight = ts[-1]
     ref = res[f"rel_{tight:g}"]
@@ -107,6 +108,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=5550123)
     ap.add_argument("--nside", type=int, default=180)
     ap.add_argument("--max-batches", type=int, default=64)
+    ap.add_argument("--samples", type=int, default=256, help="draws per batch")
     ap.add_argument("--targets", default=TARGETS, help="comma-separated, each T or T:ROWS")
     ap.add_argument("--out", default="", help="save the per-row errors (npz)")
     ap.add_argument(
