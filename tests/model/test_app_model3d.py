@@ -171,6 +171,14 @@ def test_edits_are_undo_steps():
     assert isinstance(preset("side", 40.0, 20.0, 1.0), Camera3D)
 
 
+def test_hiding_a_layer_removes_it_and_hiding_a_hidden_one_changes_nothing():
+    m, steps = _model()
+    m.set_layer("features", False)
+    assert m.scene.layers == ["eyes"] and steps[-1][2] == "Hide features"
+    m.set_layer("tangents", False)  # not shown: the scene keeps its layers
+    assert m.scene.layers == ["eyes"] and steps[-1][1].layers == ["eyes"]
+
+
 def test_lit_sets_beyond_the_view_bound_are_refused_and_nothing_moves(monkeypatch):
     m, steps = _model()
     n0 = sum(int(c[1].size) for c in (m.state.lit_a, m.state.lit_b))
