@@ -139,3 +139,27 @@ def test_project_checks_its_input():
         project(cam, np.zeros(3), 0.0)
     with pytest.raises(EyevizError, match="view_up"):
         basis(Camera3D((0, 0, 10.0), (0, 0, 0), (0, 0, 1.0)))
+
+
+def test_an_eye_preset_stands_back_by_half_the_extent_more():
+    """eye_a / eye_b: the fitting distance radius / sin(half angle) plus extent / 2."""
+    import math
+
+    h, l, extent = 40.0, 20.0, 3000.0
+    cam = preset("eye_a", h, l, extent)
+    radius = max(0.6 * extent, h + l)
+    want = radius / math.sin(math.radians(15.0)) + extent / 2
+    d = np.asarray(cam.position) - np.asarray(cam.focal_point)
+    assert tuple(cam.focal_point) == (-h, 0.0, 0.0)
+    assert float(np.linalg.norm(d)) == pytest.approx(want, rel=1e-12)
+
+
+def test_the_close_up_frames_one_eye_only_for_a_camera_on_that_eyes_centre():
+    """A focal point at x = h but off the eye's centre (y or z not 0) is no eye preset:
+    the close-up frames both eyes about the origin."""
+    h, l = 40.0, 20.0
+    on = eyes_camera(preset("eye_b", h, l, 3000.0), h, l)
+    assert tuple(on.focal_point) == (h, 0.0, 0.0)
+    for foc in ((h, 500.0, 0.0), (h, 0.0, 30.0), (-h, 500.0, 0.0)):
+        cam = Camera3D((h, 2000.0, 300.0), foc, (0.0, 0.0, 1.0))
+        assert tuple(eyes_camera(cam, h, l).focal_point) == (0.0, 0.0, 0.0), foc
