@@ -159,6 +159,16 @@ def test_wheel_zooms_about_the_cursor_even_over_a_feature():
     assert m.scene.view.width == pytest.approx(7000.0 / 1.15**4)
 
 
+@pytest.mark.parametrize("steps", [0.0, float("nan"), float("inf"), -float("inf")])
+def test_a_wheel_of_no_or_non_finite_notches_does_nothing(steps):
+    m, undo = make()
+    view = m.scene.view
+    px, py = camera.to_pixel(view, VP, 0.0, 1500.0)
+    for resize in (False, True):
+        assert interactions.wheel(m, "main", VP, px, py, steps, resize=resize) == "none"
+    assert m.scene.view == view and m.scene.features[0].g == 50.0 and undo.steps == []
+
+
 def test_zooming_out_never_resizes_a_feature_drifting_under_the_cursor():
     m, undo = make()
     px, py = camera.to_pixel(m.scene.view, VP, 600.0, 1500.0)  # empty space beside target
