@@ -408,3 +408,18 @@ def test_set_trajectory_of_the_present_kind_shows_a_hidden_layer_and_keeps_the_p
     assert m.scene.shows("trajectory") and m.scene.trajectory == path
     interactions.set_trajectory(m, "circular")
     assert m.scene.shows("trajectory") and m.scene.trajectory == path
+
+
+def test_set_trajectory_of_another_kind_replaces_the_path_at_the_selected_distance():
+    """Asking for the present kind keeps its path even after the feature moved; another
+    kind is a new path at the selected feature's distance and radius."""
+    m, _ = make()
+    m.select(0)
+    interactions.set_trajectory(m, "circular")
+    path = m.scene.trajectory
+    m.set_feature(0, x=0.0, y=2500.0)
+    interactions.set_trajectory(m, "circular")
+    assert m.scene.trajectory == path and path.distance == pytest.approx(1500.0)
+    interactions.set_trajectory(m, "vertical")
+    new = m.scene.trajectory
+    assert new.kind == "vertical" and new.distance == pytest.approx(2500.0)
