@@ -120,11 +120,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--responses",
-        choices=("flat", "gaussian"),
+        choices=("flat", "gaussian", "cell"),
         default=None,
-        help="with --eye: store each lit facet's graded response beside the lit sets "
-        "(flat: the covered share of the acceptance cone; gaussian: FWHM = the acceptance "
-        "angle; docs/responses.md)",
+        help="store each lit facet's graded response beside the lit sets; with --eye "
+        "flat (the covered share of the acceptance cone) or gaussian (FWHM = the acceptance "
+        "angle), with --nside cell (the covered share of the HEALPix cell; docs/responses.md)",
     )
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
@@ -205,10 +205,15 @@ def _refuse_ignored(args: argparse.Namespace) -> None:
         raise EyevizError(
             f"--field {args.field} needs --nside or --eye (the planar field is the paper's wedge)"
         )
-    if args.responses is not None and args.eye is None:
+    if args.responses in ("flat", "gaussian") and args.eye is None:
         raise EyevizError(
             f"--responses {args.responses} needs --eye (flat and gaussian responses are the "
             "measured eyes' acceptance cones)"
+        )
+    if args.responses == "cell" and args.nside is None:
+        raise EyevizError(
+            "--responses cell needs --nside (the share of each HEALPix cell; measured eyes "
+            "answer flat or gaussian)"
         )
 
 

@@ -52,7 +52,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--healpix-balls",
         type=int,
         default=8,
-        help="balls at the HEALPix pair (default 8, 0 leaves it out: about 5 s a ball)",
+        help="balls at the HEALPix pair (default 8, 0 leaves it out)",
     )
     parser.add_argument("--nside", type=int, default=180, help="the HEALPix pair's nside (180)")
     parser.add_argument(

@@ -133,6 +133,18 @@ def measured_fn(pair, kind: str) -> ResponseFn:
     return fn
 
 
+def healpix_fn(pair) -> ResponseFn:
+    """theta (n, 4) = (x, y, z, g) -> the HEALPix pair's exact ``cell`` responses of both
+    eyes (each lit cell's share of its area inside the ball's cap), (n, 2 npix) sparse."""
+    m = int(pair.npix)
+
+    def fn(t: np.ndarray) -> sparse.csr_matrix:
+        a, b = pair.responses(t[:, 0], t[:, 1], t[:, 2], t[:, 3], kind="cell")
+        return sparse.hstack([_csr(a, m), _csr(b, m)], format="csr")
+
+    return fn
+
+
 def _information(fn: ResponseFn, theta: np.ndarray, h: np.ndarray) -> np.ndarray:
     """J(theta) / N for each ball: (n, P, P), by central differences of step h (n,)."""
     n, p = theta.shape
@@ -277,11 +289,8 @@ def measure_measured(
 
 def measure_healpix(nside: int, n: int, seed: int, rel_step: float = STEP) -> ModelResult:
     """The HEALPix pair at ``nside``: the binary side is limit3d on its cells; the graded
-    side is the same pair written as a measured one (:func:`eyeviz.core.measured_from.
-    as_measured`: each cell's axis, acceptance the cell's width, Gaussian kernel), as the
-    core has no ``cell`` responses for HEALPix eyes yet."""
+    side the pair's exact ``cell`` responses (:func:`healpix_fn`)."""
     from eyeviz.core.domain3d import Domain3D
-    from eyeviz.core.measured_from import as_measured
     from eyeviz.dataset.algorithm1_3d import generate3d
     from eyeviz.estimators import limit3d
 
@@ -289,19 +298,14 @@ def measure_healpix(nside: int, n: int, seed: int, rel_step: float = STEP) -> Mo
     ds = generate3d(n, dom, seed=seed)
     theta = np.stack([ds.x, ds.y, ds.z, ds.g], axis=1)
     p = limit3d.load(dom).predict((ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b))
-    res = _result(
+    return _result(
         f"nside {nside}",
-        f"HEALPix nside {nside} (the cells as Gaussian discs of the cell's width)",
-        "gaussian",
+        f"HEALPix nside {nside} (exact cell responses)",
+        "cell",
         "information limit (limit3d)",
         theta,
         np.zeros(3),
-        measured_fn(as_measured(dom.eyes), "gaussian"),
+        healpix_fn(dom.eyes),
         np.asarray(p[0], float),
         rel_step,
     )
-    res.notes.append(
-        "graded side: the cells as measured facets (as_measured), Gaussian kernel; "
-        "HEALPix cell responses are not in the core yet"
-    )
-    return res

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+import mpmath as mp
 import numpy as np
 import pytest
 
@@ -86,3 +87,56 @@ def test_whole_cell_and_kinds(eyes):
     assert cell_fraction(8, 100, 0.3, 1.0, math.pi) == pytest.approx(1.0, abs=1e-13)
     with pytest.raises(EyevizError, match="spherical eyes answer responses of kind 'cell'"):
         eyes.responses(0.0, 100.0, 0.0, 5.0, kind="flat")
+
+
+def _rotate(v: np.ndarray, towards: np.ndarray, ang: float) -> np.ndarray:
+    """v turned by ang on the great circle from v through ``towards`` (unit vectors)."""
+    t = towards - (towards @ v) * v
+    t /= np.linalg.norm(t)
+    return v * math.cos(ang) + t * math.sin(ang)
+
+
+def _angles(w: np.ndarray) -> tuple[float, float]:
+    return math.acos(float(np.clip(w[2], -1, 1))), math.atan2(w[1], w[0]) % (2 * math.pi)
+
+
+# slow: four face-chart quadratures a cell, 5-7 s of CPU (the tip searches of the caps'
+# narrow chords); cell 300 is equatorial, 130 lies across |z| = 2/3
+@pytest.mark.slow
+@pytest.mark.parametrize("pix", [300, 130])
+def test_tangent_enclosing_and_tiny_caps_match_quadrature(pix):
+    """Done-when of issue 34 for the HEALPix ``cell`` kind: caps tangent to an edge of the
+    cell from outside (a sliver) and from inside, one holding it with its edge a hair
+    beyond the farthest vertex (enclosing: 1; exactly 1 once the inside test decides it),
+    against the face-chart quadrature; a tiny cap inside the cell against its exact area
+    2 pi (1 - cos b) in 50 digits."""
+    nside = 8
+    c = healpix.centers(nside, np.array([pix]))[0]
+    ix, iy, face = healpix.pix2xyf(nside, np.array([pix]))
+    corners = healpix.xyf2vec(nside, ix + np.array([0, 1, 0, 1]), iy + np.array([0, 0, 1, 1]), face)
+    far = max(math.acos(float(np.clip(c @ v, -1, 1))) for v in corners)
+    b = 0.15
+    # tangent from outside: the cap's edge through the midpoint of the cell's edge y = iy,
+    # its centre beyond it (the curved edge leaves a sliver inside); from inside: a small
+    # cap in the cell touching that point
+    mid = healpix.xyf2vec(nside, ix + 0.5, iy, face)[0]
+    w = _rotate(mid, -c, b)
+    got = float(cell_fraction(nside, pix, *_angles(w), b))
+    want = healpix_cell_share(nside, pix, w, b)
+    assert abs(got - want) <= TOL and 0 <= got < 0.05, (got, want)
+    w = _rotate(mid, c, 0.01)
+    got = float(cell_fraction(nside, pix, *_angles(w), 0.01))
+    want = healpix_cell_share(nside, pix, w, 0.01)
+    assert abs(got - want) <= TOL and 0 < got < 0.05, (got, want)
+    # enclosing: about the cell's centre, reaching 1e-6 beyond its farthest vertex
+    got = float(cell_fraction(nside, pix, *_angles(c), far + 1e-6))
+    want = healpix_cell_share(nside, pix, c, far + 1e-6)
+    assert abs(got - 1.0) <= TOL and abs(want - 1.0) <= TOL
+    assert float(cell_fraction(nside, pix, *_angles(c), far + 0.05)) == 1.0  # decided whole
+    # tiny: 1e-7 rad about a point inside the cell, a share of ~2e-13
+    with mp.workdps(50):
+        bt = mp.mpf(1e-7)
+        exact = float(2 * mp.pi * (1 - mp.cos(bt)) / (4 * mp.pi / healpix.npix(nside)))
+    w = _rotate(c, corners[0], 0.2 * far)
+    got = float(cell_fraction(nside, pix, *_angles(w), 1e-7))
+    assert abs(got - exact) <= 1e-6 * exact

@@ -93,3 +93,23 @@ def test_cli_generate_responses(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "--responses flat needs --eye" in err and err.count("\n") == 1
     assert not (tmp_path / "p.npz").exists()
+
+
+def test_cli_generate_healpix_cell_responses(tmp_path, capsys):
+    """``generate --nside N --responses cell``: the HEALPix cells' shares beside the lit
+    sets, checked on reading; ``cell`` without --nside is refused in one line."""
+    out = tmp_path / "h.npz"
+    args = ["generate", "--nside", "8", "-n", "6", "--seed", "3", "--responses", "cell"]
+    assert cli.main([*args, "-o", str(out), "--quiet"]) == 0
+    ds = sparse3d.load3d(out)
+    assert ds.params["responses"] == "cell" and ds.values_a.size == ds.indices_a.size
+    assert ((ds.values_a >= 0) & (ds.values_a <= 1)).all() and (ds.values_b > 0).any()
+    from eyeviz.measured import shipped_eye
+
+    bee = str(shipped_eye("AM_60185-real.eye"))
+    for extra in (["--eye", bee], []):
+        bad = ["generate", *extra, "-n", "5", "--responses", "cell"]
+        rc = cli.main([*bad, "-o", str(tmp_path / "p.npz"), "--quiet"])
+        err = capsys.readouterr().err
+        assert rc == 2 and "--responses cell needs --nside" in err and err.count("\n") == 1
+    assert not (tmp_path / "p.npz").exists()

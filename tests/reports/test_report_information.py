@@ -107,3 +107,22 @@ def test_bad_arguments_are_refused() -> None:
     args.planar_balls, args.nside = 5, 7
     with pytest.raises(ValueError, match="--nside must be an even integer >= 2 and <= 1024, got 7"):
         information._check(args)
+
+
+@pytest.mark.slow  # 36 response calls of the numpy reference: seconds
+def test_healpix_bound_from_the_exact_cell_responses() -> None:
+    """The HEALPix side's graded bound comes from the pair's own ``cell`` responses (no
+    stand-in): its finite differences settle, and it falls with the cells' size."""
+    from eyeviz.core.geometry3d import EyePair3D
+
+    theta = np.array([[30.0, 400.0, 20.0, 15.0]])
+    c = {}
+    for nside in (8, 16):
+        pair = EyePair3D(40.0, 20.0, nside)
+        fn = M.healpix_fn(pair)
+        got = fn(theta).toarray()
+        (ia, ja, va), _ = pair.responses(*theta.T, kind="cell")
+        np.testing.assert_array_equal(got[0, ja[ia[0] : ia[1]]], va[ia[0] : ia[1]])
+        c[nside], change, unresolved = M.crb_distance(fn, theta, np.zeros(3))
+        assert np.isfinite(c[nside]).all() and unresolved == 0 and change.max() < 1e-3
+    assert (c[16] < c[8]).all()
