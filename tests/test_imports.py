@@ -43,3 +43,27 @@ def test_the_command_line_parser_imports_nothing_heavy():
         "    cli.main(['--help'])\n"
     )
     assert loaded_after(code) == []
+
+
+def test_one_commands_parser_builds_only_its_own_options():
+    # `eyeviz app` paid for the estimators' and reports' option lists (issue 32 item 14)
+    code = (
+        "import sys\n"
+        "from eyeviz import cli\n"
+        "p = cli.build_parser(['app'])\n"
+        "print(' '.join(m for m in ('eyeviz.estimators.registry', 'eyeviz.reports.renderers')"
+        " if m in sys.modules))\n"
+        "p.parse_args(['app', '--help'])\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.splitlines()[0] == ""
+    assert "--screenshot" in out.stdout
+
+
+def test_report_help_lists_every_kind():
+    # a kind's help with "1 % error" made argparse raise TypeError on `report --help`
+    code = "from eyeviz import cli\ncli.main(['report', '--help'])\n"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "1 % error" in out.stdout

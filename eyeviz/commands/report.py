@@ -64,7 +64,8 @@ def add_arguments(parser: argparse.ArgumentParser, argv: list[str] | None = None
             if exc.name == path:
                 continue
             raise
-        p = sub.add_parser(kind, help=mod.HELP, description=mod.HELP)
+        # argparse %-formats a help ("1 % error" raised TypeError on `report --help`)
+        p = sub.add_parser(kind, help=mod.HELP.replace("%", "%%"), description=mod.HELP)
         mod.add_arguments(p)
         p.set_defaults(_report=mod.run)
 
