@@ -52,7 +52,12 @@ def grab_image(win: MainWindow) -> QtGui.QImage:
     vw, vh, _ = data.GetDimensions()
     arr = vtk_to_numpy(data.GetPointData().GetScalars()).reshape(vh, vw, 3)[::-1].copy()
     vtk_img = QtGui.QImage(arr.data, vw, vh, 3 * vw, QtGui.QImage.Format_RGB888).copy()
-    img = win.grab().toImage().convertToFormat(QtGui.QImage.Format_RGB888)
+    # the view's own paint would render once more a frame the line below paints over
+    view.grabbing = True
+    try:
+        img = win.grab().toImage().convertToFormat(QtGui.QImage.Format_RGB888)
+    finally:
+        view.grabbing = False
     p = QtGui.QPainter(img)
     top_left = view.mapTo(win, QtCore.QPoint(0, 0))
     p.drawImage(QtCore.QRect(top_left, view.size()), vtk_img)

@@ -71,6 +71,7 @@ class _Frames(_QWidget):
     closed = False
     frames = 0  # renders completed: the bench's "frame that reflects the event"
     before_render: Callable[[], None] | None = None  # run before each render (pending updates)
+    grabbing = False  # the window is being grabbed: its picture of this view is not used
 
     def _init_frames(self) -> None:
         self.frames = 0
@@ -97,7 +98,7 @@ class _Frames(_QWidget):
         self.frames += 1
 
     def paintEvent(self, ev) -> None:  # noqa: N802 (Qt name)
-        if self.isVisible():
+        if self.isVisible() and not self.grabbing:
             self.draw()
 
 

@@ -116,6 +116,11 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self._frame_timer.setSingleShot(True)
         self._frame_timer.setInterval(0)
         self._frame_timer.timeout.connect(self.draw)
+        # a window's first show resizes the view several times: one re-frame for all
+        self._resize_timer = QtCore.QTimer(self)
+        self._resize_timer.setSingleShot(True)
+        self._resize_timer.setInterval(0)
+        self._resize_timer.timeout.connect(self._resized)
         self._panel_timer = QtCore.QTimer(self)
         self._panel_timer.setSingleShot(True)
         self._panel_timer.setInterval(PANEL_MS)
@@ -345,11 +350,13 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
                     self._panel_timer.start()
 
     def draw(self) -> None:
-        """Update and render now."""
+        """Update and render now (a view not shown yet is only updated: its first paint
+        renders; the window's start rendered three frames nobody saw, issue 32.14)."""
         if self.view is None or not self.active:
             return
         self.flush()
-        self.view.draw()
+        if self.view.isVisible():
+            self.view.draw()
 
     def fit_docks(self) -> None:
         """Widen the readout's dock column to its tables' natural width (both whole: no
@@ -477,7 +484,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         if t == E.Wheel and self.pointer("move", ev.x(), ev.y()).px < 0:
             return True  # over the eyes' close-up: it follows the scene camera, not zoomed
         if t == E.Resize:
-            QtCore.QTimer.singleShot(0, self._resized)
+            self._resize_timer.start()
         return False
 
     def _forget_preset(self) -> None:
