@@ -4,24 +4,22 @@ directions (docs/spherical.md, docs/measured.md, docs/facet_maps.md).
 Each eye's facets on a Mollweide map seen from inside the eye (forward at the centre, the
 eye's right on the right, as the 3D figure draws them:
 :func:`eyeviz.render.mpl.facet_map.draw_eye_view`), lit facets in their features'
-colours (a later feature wins), the equator drawn. The facets' outlines come from the eye
-model's outline provider (:func:`eyeviz.model.facet_patches.facet_patches`): HEALPix
-cells for the spherical eyes (the equator is labelled: that row of facets is the planar
-eye's bitmap, m = 4 nside), the Voronoi patches of the axes for a measured eye. The
-selected ball's lit facets (all of them, those a later ball colours too) are outlined in
-ink: a thick stroke drawn under the lit facets' fills, so only the patch's border shows;
-it follows the selection (Tab in the 3D view).
+colours (a later feature wins), the equator drawn under them and labelled beside the map
+(for HEALPix eyes that row of facets is the planar eye's bitmap, m = 4 nside). The facets'
+outlines come from the eye model's provider (:func:`eyeviz.model.facet_patches.facet_patches`).
+The selected ball's lit facets are outlined in ink: a thick stroke under the fills (only
+the patch's border shows), and its facets a later ball colours outlined thinly over
+them; it follows the selection (Tab in the 3D view). The wheel zooms both maps, a drag
+pans them, a double click or "Whole map" goes back (:mod:`eyeviz.app.panels.map_zoom`).
 
 Fast updates: what does not change with the balls (the unlit sphere: at most
 :data:`~eyeviz.render.mpl.facet_map.MAX_ALL_FACETS` facets per eye every facet with its
 outline, otherwise one solid ellipse; the graticule) is drawn once and kept as a pixel
-background; a new state sets the lit facets' polygons in place and repaints them, the
-selected ball's outline and the equator over that background (blitting). Only the lit
-facets are polygons; above MAX_ALL_FACETS facets an eye (facets under a pixel wide) they
-are painted as pixels instead (:mod:`eyeviz.app.panels.lit_raster`). The maps are drawn
-in the exact Mollweide projection
-(:func:`eyeviz.render.mpl.facet_map.mollweide`) on plain axes, so the point under the
-mouse is inverted in closed form and handed to the provider
+background; a new state sets the lit facets' polygons in place and repaints them and the
+outlines over that background (blitting). Above MAX_ALL_FACETS facets an eye they are
+painted as pixels instead (:mod:`eyeviz.app.panels.lit_raster`). The maps are drawn
+in the exact Mollweide projection (:func:`eyeviz.render.mpl.facet_map.mollweide`) on plain
+axes, so the point under the mouse is inverted in closed form and handed to the provider
 (:func:`~eyeviz.render.mpl.facet_map.facet_at`): hovering shows the facet's index, its
 direction (azimuth from +x counter-clockwise seen from above, forward = 90 deg, and
 elevation, docs/conventions.md) and its size (a HEALPix facet's solid angle 4 pi / npix, a
@@ -43,6 +41,18 @@ from PyQt5 import QtCore, QtWidgets
 
 from eyeviz.app.panels.common import follows_text_scale, text_scale, wrap_label
 from eyeviz.app.panels.lit_raster import LitRaster
+from eyeviz.app.panels.map_geometry import (
+    R2,
+    Outlines,
+    by_ball,
+    edge_colour,
+    ellipse,
+    equator_fit,
+    label_side,
+    lit_owners,
+    map_polys,
+)
+from eyeviz.app.panels.map_zoom import MapZoom
 from eyeviz.model import responses3d as r3
 from eyeviz.model.facet_patches import FacetPatches, facet_patches, patches_caption
 from eyeviz.model.scene import Scene
@@ -51,12 +61,10 @@ from eyeviz.render.mpl.facet_map import (
     MAX_ALL_FACETS,
     compound_path,
     facet_at,
-    map_width,
     mollweide,
     view_lonlat,
-    view_polys,
 )
-from eyeviz.render.mpl.style import EDGE, GREY, INK, UNLIT
+from eyeviz.render.mpl.style import GREY, INK, UNLIT
 
 __all__ = ["Bitmaps3DPanel", "lit_owners"]
 
@@ -65,99 +73,10 @@ STEP = 2  # outline points per facet edge
 HALO_LW = 2.2  # the selected ball's outline (points; about half of it shows outside)
 MAP_PT = 8.0  # the maps' words (left / forward / right, the equator) at text scale 1
 MAP_TITLE_PT = 9.0  # each map's title at text scale 1
-R2 = math.sqrt(2.0)
-SQ_DEG = (180.0 / math.pi) ** 2
 
 
-def lit_owners(csr: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """(lit facets sorted, the ball that colours each) from an eye's CSR lit sets; a later
-    ball wins where several light a facet (as the planar app and the 3D figure)."""
-    indptr, idx = csr
-    ball = np.repeat(np.arange(indptr.size - 1), np.diff(indptr))
-    pix, first = np.unique(idx[::-1], return_index=True)  # the last ball's occurrence
-    return pix, ball[::-1][first]
-
-
-def _map_polys(patches: FacetPatches, pix: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Facet outlines in the Mollweide plane, those across the map's edge twice, and the
-    points that count per outline."""
-    verts, over, counts = view_polys(patches, pix)
-    x, y = mollweide(verts[..., 0], verts[..., 1])
-    return np.stack([x, y], axis=-1), over, counts
-
-
-class _Outlines:
-    """Facet outlines in the Mollweide plane of one eye, the last call's kept: a drag
-    lights mostly the facets lit a frame before, and only the others are computed."""
-
-    def __init__(self, patches: FacetPatches) -> None:
-        self.patches = patches
-        w = map_width(patches)
-        self.pix = np.zeros(0, np.int64)
-        self.base = np.zeros((0, w, 2))
-        self.dup = np.zeros((0, w, 2))  # the second copy (where ``over``)
-        self.over = np.zeros(0, bool)
-        self.counts = np.zeros(0, np.int64)
-
-    def get(self, pix: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(outlines, across the edge, second copies, points per outline) of the sorted
-        facets ``pix``."""
-        k = pix.size
-        w = self.base.shape[1]
-        at = np.minimum(np.searchsorted(self.pix, pix), max(self.pix.size - 1, 0))
-        hit = self.pix[at] == pix if self.pix.size else np.zeros(k, bool)
-        base = np.empty((k, w, 2))
-        dup = np.empty((k, w, 2))
-        over = np.zeros(k, bool)
-        counts = np.zeros(k, np.int64)
-        h = at[hit]
-        base[hit], dup[hit], over[hit], counts[hit] = (
-            self.base[h], self.dup[h], self.over[h], self.counts[h]
-        )  # fmt: skip
-        new = np.flatnonzero(~hit)
-        if new.size:
-            verts, o, c = _map_polys(self.patches, pix[new])
-            base[new], over[new], counts[new] = verts[: new.size], o, c[: new.size]
-            dup[new[o]] = verts[new.size :]
-        self.pix, self.base, self.dup, self.over, self.counts = pix, base, dup, over, counts
-        return base, over, dup, counts
-
-
-def _by_ball(verts: np.ndarray, owner: np.ndarray, rgba: np.ndarray, counts: np.ndarray):
-    """One compound path per ball (its facets' outlines) and the balls' colours."""
-    if owner.size == 0:
-        return [], np.zeros((0, 4))
-    order = np.argsort(owner, kind="stable")
-    groups = np.split(order, np.flatnonzero(np.diff(owner[order])) + 1)
-    paths = [compound_path(verts[g], counts[g]) for g in groups]
-    return paths, rgba[[int(owner[g[0]]) for g in groups]]
-
-
-#: Above this many facets an eye (HEALPix nside 16) the outlines are drawn lighter: a
-#: measured eye's 3,000 facets are a few pixels each in the dock, and EDGE turned the map grey
-DENSE = 3072
-EDGE_DENSE = "#cdcdcd"
-
-
-def _edge(n: int) -> str:
-    return EDGE if n <= DENSE else EDGE_DENSE
-
-
-def _label_side(patches: FacetPatches) -> int:
-    """-1 (left) or 1 (right): where the equator's label goes. The right only where the
-    outer 65 % of the left half map holds more than twice as many facets near the
-    equator as the right's (a measured left eye's); a HEALPix eye keeps it on the left."""
-    c = patches.centers(np.arange(patches.n))
-    lon, lat = view_lonlat(np.arctan2(c[:, 1], c[:, 0]), np.arcsin(np.clip(c[:, 2], -1, 1)))
-    near = np.abs(lat) < 0.25
-    left = int(np.count_nonzero(near & (lon < -0.35 * math.pi)))
-    right = int(np.count_nonzero(near & (lon > 0.35 * math.pi)))
-    return 1 if left > 2 * right else -1
-
-
-def _ellipse(n: int = 181) -> np.ndarray:
-    t = np.linspace(0.0, 2.0 * math.pi, n)
-    return np.stack([2 * R2 * np.cos(t), R2 * np.sin(t)], axis=-1)
+#: The whole map's limits without the equator's label (the Mollweide ellipse, 1 % margin)
+HOME = (-2 * R2 * 1.01, 2 * R2 * 1.01, -R2 * 1.01, R2 * 1.01)
 
 
 class Bitmaps3DPanel(QtWidgets.QWidget):
@@ -183,14 +102,19 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self._lit: dict[str, tuple[PathCollection, ...]] = {}
         self.selected: int | None = None
         self._halo: dict[str, PathCollection] = {}  # the selected ball's outline per eye
+        # per eye: the selected ball's facets a later ball colours, outlined over the fills
+        self._covered: dict[str, PathCollection] = {}
         self._clips: dict[str, Polygon] = {}  # each map's outline (the halo's clip)
         self._halo_keys: dict[str, bytes | None] = {}
         # per eye: the lit facets and their outlines (base, across the edge, second copies)
         self._geom: dict[str, tuple[np.ndarray, ...]] = {}
-        self._outlines: dict[str, _Outlines] = {}
+        self._outlines: dict[str, Outlines] = {}
         # eyes of sub-pixel facets (above MAX_ALL_FACETS): lit facets painted as pixels
         self._raster: dict[str, LitRaster] = {}
         self._over: list = []  # animated artists drawn over the lit facets, in order
+        self._under: list = []  # the equator: under the lit facets (never hiding a mark)
+        self._home_lim = HOME  # the whole map's limits (a margin for the equator's label)
+        self.zoom = MapZoom(lambda: self._home_lim, self._apply_limits)
         self._hover_coll: PolyCollection | None = None
         self._texts: list[tuple] = []  # the maps' words (matplotlib Text, size at scale 1)
         self.fig = Figure(figsize=(3.6, 4.2), facecolor="white")
@@ -206,11 +130,18 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self.counts = wrap_label(QtWidgets.QLabel(""))
         self.hover = wrap_label(QtWidgets.QLabel(""))
         self.hover.setObjectName("hover3d")
+        self.whole = QtWidgets.QPushButton("Whole map")
+        self.whole.setToolTip("Wheel: zoom the maps; drag: pan; double click: the whole map")
+        self.whole.setEnabled(False)
+        self.whole.clicked.connect(self.zoom.reset)
         self.message = wrap_label(QtWidgets.QLabel("bitmaps layer hidden"))
         self.message.setAlignment(QtCore.Qt.AlignmentFlag.AlignCenter)
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(2, 2, 2, 2)
-        lay.addWidget(self.counts)
+        top = QtWidgets.QHBoxLayout()
+        top.addWidget(self.counts, 1)
+        top.addWidget(self.whole, 0, QtCore.Qt.AlignmentFlag.AlignBottom)
+        lay.addLayout(top)
         lay.addWidget(self.canvas, 1)
         lay.addWidget(self.hover)
         lay.addWidget(self.message)
@@ -218,6 +149,9 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self.canvas.mpl_connect("draw_event", self._on_draw)
         self.canvas.mpl_connect("motion_notify_event", self._on_move)
         self.canvas.mpl_connect("figure_leave_event", self._on_leave)
+        self.canvas.mpl_connect("scroll_event", self._on_scroll)
+        self.canvas.mpl_connect("button_press_event", self._on_press)
+        self.canvas.mpl_connect("button_release_event", lambda _e: self.zoom.release())
         self.canvas.mpl_connect("resize_event", self._place_axes)
         self._fit_text()
 
@@ -246,24 +180,71 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self._fit_words(s, h_in)
 
     def _fit_words(self, s: float, h_in: float) -> None:
-        """The words that fit the maps' width now (see :meth:`_place_axes`)."""
+        """The words that fit the maps' width now (see :meth:`_place_axes`), and the room
+        beside the whole map that the equator's label takes (off the facets)."""
         room = self.axes["A"].get_position().height
         px_per_in = self.fig.dpi / max(self.canvas.devicePixelRatioF(), 1.0)
         # left / forward / right need about 22 characters' width: on a map narrower than
         # that (large text in a small panel) only "forward" is kept
         w_in = self.canvas.width() / px_per_in
-        map_in = min(0.98 * w_in, 2.0 * room * h_in)
-        wide = map_in >= 22 * 0.62 * MAP_PT * s / 72.0
+        box_w, box_h = 0.98 * w_in, room * h_in
+        map_in = min(box_w, 2.0 * box_h)
         char_in = 0.62 * MAP_PT * s / 72.0
+        wide = map_in >= 22 * char_in
+        zoomed = self.zoom.zoomed  # the words name the whole map's places
+        label_in = 0.0
         for t, _pt in self._texts:
             if t.get_text() in ("left", "right"):
-                t.set_visible(wide)
-            elif t.get_text().startswith("equator"):  # whole, or "equator", where it fits
-                full = t.get_gid() or t.get_text()
-                t.set_gid(full)
-                t.set_text(full if len(full) * char_in <= 0.95 * map_in else "equator")
-                fits = len(t.get_text()) * char_in <= 0.95 * map_in
-                t.set_visible(fits and 1.35 * MAP_PT * s / 72.0 <= 0.2 * map_in)
+                t.set_visible(wide and not zoomed)
+            elif t.get_text() == "forward":
+                t.set_visible(not zoomed)
+            elif t.get_gid() == "equator":
+                full = str(t.get_url() or t.get_text())
+                t.set_url(full)  # the whole label kept (the short form may be shown)
+                text, label_in = equator_fit(full, char_in, box_w, box_h)
+                t.set_text(text)
+                t.set_visible(bool(text) and not zoomed)
+        self._set_home(label_in, box_w, box_h)
+
+    def _set_home(self, label_in: float, box_w: float, box_h: float) -> None:
+        """The whole map's limits with ``label_in`` inches beside it for the equator's
+        label, on its side; the maps' limits follow unless zoomed."""
+        x0, x1, y0, y1 = HOME
+        if label_in > 0:
+            # map units per inch: the map fills the box's height, or its width less the label
+            per_in = max((y1 - y0) / box_h, (x1 - x0) / max(box_w - label_in, 1e-6))
+            side = label_side(self.patches["A"]) if self.patches else -1
+            m = (label_in + 0.04) * per_in
+            x0, x1 = (x0 - m, x1) if side < 0 else (x0, x1 + m)
+        self._home_lim = (x0, x1, y0, y1)
+        self._apply_limits(redraw=False)
+
+    def _apply_limits(self, redraw: bool = True) -> None:
+        """Both maps at the zoom's window (MapZoom.changed); the whole map's words shown
+        only on the whole map."""
+        x0, x1, y0, y1 = self.zoom.current()
+        for ax in self.axes.values():
+            ax.set_xlim(x0, x1)
+            ax.set_ylim(y0, y1)
+        self.whole.setEnabled(self.zoom.zoomed)
+        if redraw:
+            self._place_axes()
+            self._bg = None
+            self.canvas.draw_idle()
+
+    def _on_scroll(self, event) -> None:
+        if event.inaxes in self.axes.values() and event.xdata is not None:
+            self.zoom.wheel(event.xdata, event.ydata, event.step)
+
+    def _on_press(self, event) -> None:
+        ax = event.inaxes
+        if ax not in self.axes.values() or event.button != 1:
+            return
+        if event.dblclick:
+            self.zoom.reset()
+            return
+        x0, x1, y0, y1 = self.zoom.current()
+        self.zoom.press(event.x, event.y, (x1 - x0) / ax.bbox.width, (y1 - y0) / ax.bbox.height)
 
     def changeEvent(self, ev) -> None:  # noqa: N802 (Qt name)
         """Ctrl+= / Ctrl+- / F5 (the app font changed): the maps' words follow."""
@@ -338,10 +319,10 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             base, over, dup, cnt = self._geom[eye][1:]
             # facets inside the map's outline need no clipping (2 ms a frame at nside 180)
             inner, edge = self._lit[eye]
-            paths, fc = _by_ball(base[~over], ball[~over], colours, cnt[~over])
+            paths, fc = by_ball(base[~over], ball[~over], colours, cnt[~over])
             inner.set_paths(paths)
             inner.set_facecolor(fc)
-            paths, fc = _by_ball(
+            paths, fc = by_ball(
                 np.concatenate([base[over], dup[over]]),
                 np.tile(ball[over], 2),
                 colours,
@@ -389,6 +370,15 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         counts = np.concatenate([cnt[k], cnt[k[across]]])
         halo = self._halo[eye]
         halo.set_paths([compound_path(verts, counts)] if len(verts) else [])
+        # where a later ball colours its facets the stroke under the fills is hidden: those
+        # facets' outlines go over the fills (thin: the other ball's colour stays)
+        hid = k[self.owners[eye][1][k] != i] if i is not None else k[:0]
+        v2, c2 = (
+            np.concatenate([base[hid], dup[hid[over[hid]]]]),
+            np.concatenate([cnt[hid], cnt[hid[over[hid]]]]),
+        )
+        self._covered[eye].set_paths([compound_path(v2, c2)] if len(v2) else [])
+        self._covered[eye].set_clip_path(self._clips[eye] if over[hid].any() else None)
         # clipped to the map only when the patch crosses its edge (a clip path costs a
         # mask of the whole map at every repaint)
         halo.set_clip_path(self._clips[eye] if across.any() else None)
@@ -416,7 +406,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         """The static parts for the eyes' facets ``patches`` and empty lit collections."""
         self.nside = nside
         self.patches = patches
-        self._outlines = {e: _Outlines(p) for e, p in patches.items()}
+        self._outlines = {e: Outlines(p) for e, p in patches.items()}
         halo_px = round(HALO_LW / 2 * self.fig.dpi / 72)
         self._raster = {
             e: LitRaster(p, halo_px) for e, p in patches.items() if p.n > MAX_ALL_FACETS
@@ -425,27 +415,31 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self._halo_keys = {}
         self._geom = {}
         self._over = []
+        self._under = []
+        self.zoom.limits = None  # new eyes: the whole map
         self._texts = []
         self._bg = None
-        ell = _ellipse()
+        ell = ellipse()
         for eye, ax in self.axes.items():
             n_pix = patches[eye].n
             ax.clear()
             ax.set_axis_off()
-            ax.set_xlim(-2 * R2 * 1.01, 2 * R2 * 1.01)
-            ax.set_ylim(-R2 * 1.01, R2 * 1.01)
+            x0, x1, y0, y1 = self.zoom.current()
+            ax.set_xlim(x0, x1)
+            ax.set_ylim(y0, y1)
             ax.set_aspect("equal", adjustable="box", anchor="C")
             clip = Polygon(ell, closed=True, transform=ax.transData)
             if n_pix <= MAX_ALL_FACETS:  # every facet, outlined
-                verts, _, cnt = _map_polys(patches[eye], np.arange(n_pix))
+                verts, _, cnt = map_polys(patches[eye], np.arange(n_pix))
                 back = PolyCollection(
                     [v[:c] for v, c in zip(verts, cnt, strict=True)], facecolors=UNLIT,
-                    edgecolors=_edge(n_pix), linewidths=0.3,
+                    edgecolors=edge_colour(n_pix), linewidths=0.3,
                 )  # fmt: skip
             else:  # the unlit sphere as one solid ellipse
                 back = PolyCollection([ell], facecolors=UNLIT, edgecolors="none")
             back.set_clip_path(clip)
             ax.add_collection(back, autolim=False)
+            back.set_clip_box(ax.bbox)  # a zoomed map: within its axes too
             for deg in (-60, -30, 30, 60):  # a faint graticule: elevation seen from the eye
                 x, y = mollweide(np.linspace(-math.pi, math.pi, 2), np.full(2, math.radians(deg)))
                 ax.plot(x, y, color="#c8c8c8", lw=0.4)
@@ -465,7 +459,10 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             edged = n_pix <= MAX_ALL_FACETS
             lit = tuple(
                 PathCollection(
-                    [], edgecolors=_edge(n_pix), linewidths=0.3 if edged else 0.0, animated=True
+                    [],
+                    edgecolors=edge_colour(n_pix),
+                    linewidths=0.3 if edged else 0.0,
+                    animated=True,
                 )
                 for _ in range(2)
             )
@@ -476,25 +473,32 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
                 [], facecolors="none", edgecolors=INK, linewidths=HALO_LW, animated=True
             )
             halo.set_gid(f"selected{eye}")
+            covered = PathCollection(
+                [], facecolors="none", edgecolors=INK, linewidths=1.0, animated=True
+            )
+            self._covered[eye] = covered
             self._clips[eye] = clip
-            for c in (halo, *lit):
+            for c in (halo, *lit, covered):
                 ax.add_collection(c, autolim=False)
+                c.set_clip_box(ax.bbox)
             self._lit[eye] = lit
             self._halo[eye] = halo
             (eq,) = ax.plot([-2 * R2, 2 * R2], [0.0, 0.0], color=INK, lw=0.8, animated=True)
-            side = _label_side(patches[eye])
+            side = label_side(patches[eye])
+            # beside the map, off the facets (its room is kept in the limits: _fit_words)
             eq_word = ax.text(
-                side * 2 * R2 * 0.97, -0.04,
-                "equator: the plane z = 0" if nside is None
-                else f"equator: the planar eye, m = {4 * nside:,}",
-                color=INK, ha="left" if side < 0 else "right", va="top",
+                side * 2 * R2 * 1.02, 0.0,
+                "equator:\nthe plane\nz = 0" if nside is None
+                else f"equator:\nthe planar\neye, m = {4 * nside:,}",
+                color=INK, ha="right" if side < 0 else "left", va="center", gid="equator",
             )  # fmt: skip
             title = ax.text(
                 0.5, 1.0, f"eye {eye} ({'left' if eye == 'A' else 'right'}), seen from inside",
                 transform=ax.transAxes, color=INK, ha="center", va="bottom",
             )  # fmt: skip
             self._texts += [(eq_word, MAP_PT), (title, MAP_TITLE_PT)]
-            self._over += [(ax, halo), (ax, lit[0]), (ax, lit[1]), (ax, eq)]
+            self._under.append(eq)
+            self._over += [(ax, halo), (ax, lit[0]), (ax, lit[1]), (ax, covered)]
         self._hover_coll = PolyCollection(
             [], facecolors="none", edgecolors="#000000", linewidths=1.2, animated=True
         )
@@ -502,6 +506,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self._fit_text()
 
     def _draw_over(self) -> None:
+        for line in self._under:
+            self.fig.draw_artist(line)
         if self._raster:  # sub-pixel facets: straight into the canvas's pixels
             buf = np.asarray(self.canvas.buffer_rgba())
             ink = np.round(to_rgba_array([INK])[0] * 255).astype(np.uint8)
@@ -542,6 +548,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         return int(facet_at(self.patches[eye], x, y))
 
     def _on_move(self, event) -> None:
+        if self.zoom.drag(event.x, event.y):
+            return
         eye = next((e for e, ax in self.axes.items() if event.inaxes is ax), None)
         if eye is None or event.xdata is None or not self.patches:
             self._set_hover(None)
@@ -573,14 +581,15 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self.hover.setText(text)
         self.canvas.setToolTip(text)
         assert self._hover_coll is not None
-        verts, _, cnt = _map_polys(patches, np.array([pix]))
+        verts, _, cnt = map_polys(patches, np.array([pix]))
         self._hover_coll.set_verts([v[:c] for v, c in zip(verts, cnt, strict=True)])
         ax = self.axes[eye]
         if self._hover_coll.axes is not ax:
             if self._hover_coll.axes is not None:
                 self._hover_coll.remove()
             ax.add_collection(self._hover_coll, autolim=False)
-            self._hover_coll.set_clip_path(Polygon(_ellipse(), closed=True, transform=ax.transData))
+            self._hover_coll.set_clip_path(Polygon(ellipse(), closed=True, transform=ax.transData))
+            self._hover_coll.set_clip_box(ax.bbox)
         self._repaint()
 
     def map_point(self, eye: str, pix: int) -> tuple[float, float]:

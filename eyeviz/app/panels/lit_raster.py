@@ -8,8 +8,9 @@ ends up as a few hundred pixels. Here each pixel of the map knows the facet unde
 centre (:func:`eyeviz.render.mpl.facet_map.facet_at`, computed once per layout), so a
 frame is one gather of the lit facets' colours over the map's pixels; each lit facet also
 colours the pixel holding its centre (a ball lighting a few sub-pixel facets still
-shows). The selected ball's outline is the ring of pixels within the halo's half-width of
-its facets that no lit facet covers: what the thick stroke drawn under the fills shows.
+shows). The selected ball's outline is a ring of pixels, the halo's half-width wide, one
+pixel away from its facets, where no lit facet is: at nside 180 a ball is a dot of a few
+pixels, and a ring touching it made it a black blob.
 """
 
 from __future__ import annotations
@@ -21,7 +22,9 @@ import numpy as np
 from eyeviz.model.facet_patches import FacetPatches
 from eyeviz.render.mpl.facet_map import facet_at, mollweide, view_lonlat
 
-__all__ = ["LitRaster"]
+__all__ = ["GAP_PX", "LitRaster"]
+
+GAP_PX = 1  # unpainted pixels between the selected ball's dot and its outline
 
 
 class LitRaster:
@@ -86,8 +89,9 @@ class LitRaster:
         self.rgba = np.round(np.clip(np.asarray(rgba, np.float64), 0, 1) * 255).astype(np.uint8)
 
     def _centres(self, pix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Buffer (row, column) of the facets' centres, kept inside the axes' box; each
-        facet's computed once per layout (a drag lights mostly the facets lit before)."""
+        """Buffer (row, column) of the facets' centres, -2 outside the axes' box (a zoomed
+        map); each facet's computed once per layout (a drag lights mostly the facets lit
+        before)."""
         new = pix[self.crow[pix] < 0]
         if new.size:
             self.crow[new], self.ccol[new] = self._project(new)
@@ -100,8 +104,10 @@ class LitRaster:
         assert self.trans is not None and self.box is not None
         d = self.trans.transform(np.column_stack([x, y]))
         r0, r1, c0, c1 = self.box
-        rows = np.clip(self.height - 1 - np.floor(d[:, 1]).astype(np.int64), r0, r1 - 1)
-        cols = np.clip(np.floor(d[:, 0]).astype(np.int64), c0, c1 - 1)
+        rows = self.height - 1 - np.floor(d[:, 1]).astype(np.int64)
+        cols = np.floor(d[:, 0]).astype(np.int64)
+        out = (rows < r0) | (rows >= r1) | (cols < c0) | (cols >= c1)
+        rows[out] = cols[out] = -2
         return rows, cols
 
     def paint(self, buf: np.ndarray, ink: np.ndarray) -> int:
@@ -111,8 +117,9 @@ class LitRaster:
             return 0
         r, c, f = self._pixels(self.pix)
         cr, cc = self._centres(self.pix)
-        rows, cols = np.concatenate([r, cr]), np.concatenate([c, cc])
-        own = self.owner[np.concatenate([f, self.pix])]
+        shown = cr >= 0
+        rows, cols = np.concatenate([r, cr[shown]]), np.concatenate([c, cc[shown]])
+        own = self.owner[np.concatenate([f, self.pix[shown]])]
         done = 0
         if self.sel.size:
             done = self._halo(buf, ink, rows, cols)
@@ -120,29 +127,37 @@ class LitRaster:
         return done + rows.size
 
     def _halo(self, buf: np.ndarray, ink: np.ndarray, rows, cols) -> int:
-        """The selected ball's outline: its pixels grown by ``halo_px``, on the map, not
-        lit (``rows``, ``cols``: the lit pixels), within the box around its pixels."""
+        """The selected ball's outline: a ring ``halo_px`` wide one pixel away from its
+        pixels (a dot of a few pixels stays whole inside it, issue 32.9), on the map,
+        not lit (``rows``, ``cols``: the lit pixels), within the box around its pixels."""
         r0, r1, c0, c1 = self.box  # type: ignore[misc]
         sr, sc, _ = self._pixels(self.sel)
         cr, cc = self._centres(self.sel)
-        sr, sc = np.concatenate([sr, cr]), np.concatenate([sc, cc])
-        k = self.halo_px
+        sr, sc = np.concatenate([sr, cr[cr >= 0]]), np.concatenate([sc, cc[cr >= 0]])
+        if sr.size == 0:  # off a zoomed map
+            return 0
+        k = self.halo_px + GAP_PX
         ra, rb = max(r0, int(sr.min()) - k), min(r1, int(sr.max()) + k + 1)
         ca, cb = max(c0, int(sc.min()) - k), min(c1, int(sc.max()) + k + 1)
-        shape = (rb - ra, cb - ca)
-        sel = np.zeros(shape, bool)
+        sel = np.zeros((rb - ra, cb - ca), bool)
         sel[sr - ra, sc - ca] = True
-        grown = sel.copy()
-        h, w = shape
-        for dr in range(-k, k + 1):
-            for dc in range(-k, k + 1):
-                if dr * dr + dc * dc <= k * k + k and (dr or dc):
-                    grown[max(dr, 0) : h + min(dr, 0), max(dc, 0) : w + min(dc, 0)] |= sel[
-                        max(-dr, 0) : h - max(dr, 0), max(-dc, 0) : w - max(dc, 0)
-                    ]
+        ring = _grown(sel, k) & ~_grown(sel, GAP_PX)
         inside = (rows >= ra) & (rows < rb) & (cols >= ca) & (cols < cb)
-        grown[rows[inside] - ra, cols[inside] - ca] = False
-        grown &= self.on_img[ra - r0 : rb - r0, ca - c0 : cb - c0]
-        hr, hc = np.nonzero(grown)
+        ring[rows[inside] - ra, cols[inside] - ca] = False
+        ring &= self.on_img[ra - r0 : rb - r0, ca - c0 : cb - c0]
+        hr, hc = np.nonzero(ring)
         buf[hr + ra, hc + ca] = ink
         return int(hr.size)
+
+
+def _grown(sel: np.ndarray, k: int) -> np.ndarray:
+    """``sel`` grown by a disc of radius ``k`` pixels."""
+    grown = sel.copy()
+    h, w = sel.shape
+    for dr in range(-k, k + 1):
+        for dc in range(-k, k + 1):
+            if dr * dr + dc * dc <= k * k + k and (dr or dc):
+                grown[max(dr, 0) : h + min(dr, 0), max(dc, 0) : w + min(dc, 0)] |= sel[
+                    max(-dr, 0) : h - max(dr, 0), max(-dc, 0) : w - max(dc, 0)
+                ]
+    return grown

@@ -1,0 +1,124 @@
+"""Geometry of the Facets dock's Mollweide maps (:mod:`eyeviz.app.panels.bitmaps3d`): the
+lit facets' outlines in the map's plane (kept from frame to frame), one compound path per
+ball, the map's outline, and the side the equator's label goes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from eyeviz.model.facet_patches import FacetPatches
+from eyeviz.render.mpl.facet_map import compound_path, map_width, mollweide, view_lonlat, view_polys
+from eyeviz.render.mpl.style import EDGE
+
+__all__ = [
+    "Outlines", "by_ball", "edge_colour", "ellipse", "equator_fit", "label_side", "lit_owners",
+    "map_polys", "R2",
+]  # fmt: skip
+
+R2 = math.sqrt(2.0)
+
+
+def map_polys(patches: FacetPatches, pix: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Facet outlines in the Mollweide plane, those across the map's edge twice, and the
+    points that count per outline."""
+    verts, over, counts = view_polys(patches, pix)
+    x, y = mollweide(verts[..., 0], verts[..., 1])
+    return np.stack([x, y], axis=-1), over, counts
+
+
+class Outlines:
+    """Facet outlines in the Mollweide plane of one eye, the last call's kept: a drag
+    lights mostly the facets lit a frame before, and only the others are computed."""
+
+    def __init__(self, patches: FacetPatches) -> None:
+        self.patches = patches
+        w = map_width(patches)
+        self.pix = np.zeros(0, np.int64)
+        self.base = np.zeros((0, w, 2))
+        self.dup = np.zeros((0, w, 2))  # the second copy (where ``over``)
+        self.over = np.zeros(0, bool)
+        self.counts = np.zeros(0, np.int64)
+
+    def get(self, pix: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(outlines, across the edge, second copies, points per outline) of the sorted
+        facets ``pix``."""
+        k = pix.size
+        w = self.base.shape[1]
+        at = np.minimum(np.searchsorted(self.pix, pix), max(self.pix.size - 1, 0))
+        hit = self.pix[at] == pix if self.pix.size else np.zeros(k, bool)
+        base = np.empty((k, w, 2))
+        dup = np.empty((k, w, 2))
+        over = np.zeros(k, bool)
+        counts = np.zeros(k, np.int64)
+        h = at[hit]
+        base[hit], dup[hit], over[hit], counts[hit] = (
+            self.base[h], self.dup[h], self.over[h], self.counts[h]
+        )  # fmt: skip
+        new = np.flatnonzero(~hit)
+        if new.size:
+            verts, o, c = map_polys(self.patches, pix[new])
+            base[new], over[new], counts[new] = verts[: new.size], o, c[: new.size]
+            dup[new[o]] = verts[new.size :]
+        self.pix, self.base, self.dup, self.over, self.counts = pix, base, dup, over, counts
+        return base, over, dup, counts
+
+
+def by_ball(verts: np.ndarray, owner: np.ndarray, rgba: np.ndarray, counts: np.ndarray):
+    """One compound path per ball (its facets' outlines) and the balls' colours."""
+    if owner.size == 0:
+        return [], np.zeros((0, 4))
+    order = np.argsort(owner, kind="stable")
+    groups = np.split(order, np.flatnonzero(np.diff(owner[order])) + 1)
+    paths = [compound_path(verts[g], counts[g]) for g in groups]
+    return paths, rgba[[int(owner[g[0]]) for g in groups]]
+
+
+def label_side(patches: FacetPatches) -> int:
+    """-1 (left) or 1 (right): where the equator's label goes. The right only where the
+    outer 65 % of the left half map holds more than twice as many facets near the
+    equator as the right's (a measured left eye's); a HEALPix eye keeps it on the left."""
+    c = patches.centers(np.arange(patches.n))
+    lon, lat = view_lonlat(np.arctan2(c[:, 1], c[:, 0]), np.arcsin(np.clip(c[:, 2], -1, 1)))
+    near = np.abs(lat) < 0.25
+    left = int(np.count_nonzero(near & (lon < -0.35 * math.pi)))
+    right = int(np.count_nonzero(near & (lon > 0.35 * math.pi)))
+    return 1 if left > 2 * right else -1
+
+
+def ellipse(n: int = 181) -> np.ndarray:
+    t = np.linspace(0.0, 2.0 * math.pi, n)
+    return np.stack([2 * R2 * np.cos(t), R2 * np.sin(t)], axis=-1)
+
+
+def equator_fit(full: str, char_in: float, box_w: float, box_h: float) -> tuple[str, float]:
+    """The equator's label that fits beside the map (the whole one, else "equator", else
+    none) and its width in inches: at most a quarter of the box's width, and no taller
+    than the map's middle third."""
+    for text in (full, "equator"):
+        lines = text.split("\n")
+        w = max(len(x) for x in lines) * char_in
+        h = len(lines) * 1.25 * char_in / 0.62
+        if w <= 0.25 * box_w and h <= 0.6 * box_h:
+            return text, w
+    return "", 0.0
+
+
+def lit_owners(csr: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(lit facets sorted, the ball that colours each) from an eye's CSR lit sets; a later
+    ball wins where several light a facet (as the planar app and the 3D figure)."""
+    indptr, idx = csr
+    ball = np.repeat(np.arange(indptr.size - 1), np.diff(indptr))
+    pix, first = np.unique(idx[::-1], return_index=True)  # the last ball's occurrence
+    return pix, ball[::-1][first]
+
+
+#: Above this many facets an eye (HEALPix nside 16) the outlines are drawn lighter: a
+#: measured eye's 3,000 facets are a few pixels each in the dock, and EDGE turned the map grey
+DENSE = 3072
+EDGE_DENSE = "#cdcdcd"
+
+
+def edge_colour(n: int) -> str:
+    return EDGE if n <= DENSE else EDGE_DENSE
