@@ -70,6 +70,9 @@ VIEW3D_KEYS = (
     ("Nudge the selected ball across the screen", "arrow keys (view focused)"),
     ("Move the selected ball farther / nearer", "Shift+Up / Shift+Down (view focused)"),
     ("Select the next ball", "Tab (view focused)"),
+    ("Zoom the facet maps about the mouse", "wheel over a map (Facets dock)"),
+    ("Pan the zoomed facet maps", "left-drag on a map"),
+    ("The whole facet maps again", "double click on a map, or Whole map"),
 )
 #: What the 3D view's box says besides the rows (no keys of their own).
 VIEW3D_NOTES = (

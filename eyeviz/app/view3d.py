@@ -154,6 +154,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self.view = view
         self.actors = Scene3DActors(scene_ren, eyes_ren)
         self.side = SideNote(scene_ren)  # "seen from front, ...; eye A on the right"
+        self.actors.keep_clear.append(self.side.actor)  # no ball's name over it
         # the eyes' camera follows the scene's before every render (VTK's own too)
         view.ren_win.AddObserver(vtkCommand.StartEvent, lambda *_: self._sync_eyes())
         view.installEventFilter(self)

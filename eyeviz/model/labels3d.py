@@ -72,6 +72,7 @@ def place_boxes(
     *,
     below: bool = False,
     gap: float = GAP_PX,
+    keep_out: np.ndarray | None = None,
 ) -> np.ndarray:
     """Boxes (n, 4: x0, y0, x1, y1, pixels, y up) for n names: name i (``sizes[i]`` =
     width, height) beside the disc (``centres[i]``, ``radii[i]``) it names, covering no
@@ -79,7 +80,8 @@ def place_boxes(
     (x0, y0, x1, y1) where a place allows; else the place covering least (a box of NaN
     for a name whose centre is NaN: behind the camera). Names are placed in order: put
     the one that matters most (the selected ball's) first. ``below``: try under the disc
-    first (the eyes' names)."""
+    first (the eyes' names). ``keep_out`` (k, 4 boxes as the result's): the view's own
+    texts (its title, its side note), which a name covers no more than another name."""
     c = np.asarray(centres, float).reshape(-1, 2)
     r = np.asarray(radii, float).reshape(-1)
     s = np.asarray(sizes, float).reshape(-1, 2)
@@ -88,6 +90,8 @@ def place_boxes(
     dsc = np.concatenate([np.column_stack([c, r])[ok], ob[np.isfinite(ob).all(axis=1)]])
     out = np.full((len(c), 4), np.nan)
     placed: list[tuple[float, float, float, float]] = []
+    fixed = [tuple(b) for b in np.asarray(keep_out if keep_out is not None else [], float)
+             .reshape(-1, 4) if np.isfinite(b).all()]  # fmt: skip
     dirs = _DIRS_BELOW if below else _DIRS
     for i in np.flatnonzero(ok):
         w, h = float(s[i, 0]), float(s[i, 1])
@@ -100,6 +104,7 @@ def place_boxes(
                 depth = _disc_hits(box, dsc)
                 cost = (
                     _box_hits(box, placed)
+                    + _box_hits(box, fixed)
                     + float(np.sum(np.clip(depth, 0.0, None))) * h
                     + (out_x * h + out_y * w) * 4.0
                 )
@@ -146,13 +151,15 @@ class Named3D:
     ``centres`` (n, 3) and ``radii`` (n,) of the named spheres, ``sizes`` (n, 2) their
     names' width and height in pixels, ``others`` (m, 4: x, y, z, radius) the rest
     (every ball, eye and ghost not named here), ``below``: the names go under their
-    spheres first (the eyes')."""
+    spheres first (the eyes'), ``keep_out`` boxes no name may cover (the view's title and
+    side note, in the viewport's pixels, y up)."""
 
     centres: np.ndarray
     radii: np.ndarray
     sizes: np.ndarray
     others: np.ndarray
     below: bool = False
+    keep_out: np.ndarray | None = None  # (k, 4) boxes of the view's own texts, pixels y up
 
 
 def place_named(
@@ -168,4 +175,4 @@ def place_named(
     oc, orad = discs(cam, oth[:, :3], oth[:, 3], width, height)
     obs = np.column_stack([oc, orad]) if len(oth) else np.zeros((0, 3))
     bounds = (margin, margin, width - margin, height - margin)
-    return place_boxes(c, r, named.sizes, obs, bounds, below=named.below)
+    return place_boxes(c, r, named.sizes, obs, bounds, below=named.below, keep_out=named.keep_out)

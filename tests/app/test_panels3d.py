@@ -125,7 +125,8 @@ def test_bitmaps_at_nside_180_draw_only_the_lit_facets(qtbot):
     panel.set_state(st, sc)
     _settle(qtbot, panel)
     ax = panel.axes["A"]
-    (back,) = [c for c in ax.collections if c not in (*panel._lit["A"], panel._halo["A"])]
+    ours = (*panel._lit["A"], panel._halo["A"], panel._covered["A"])
+    (back,) = [c for c in ax.collections if c not in ours]
     assert len(back.get_paths()) == 1  # the unlit sphere: one solid ellipse
     inner, edge = panel._lit["A"]
     assert not inner.get_paths() and not edge.get_paths()  # painted as pixels instead

@@ -99,7 +99,8 @@ def test_measured_map_lights_the_balls_facets(qtbot, bee):
     for e, csr in zip("AB", (st.lit_a, st.lit_b), strict=True):
         np.testing.assert_array_equal(panel.lit_facets(e), lit_owners(csr)[0])
         # the unlit patches: every facet of the eye, each its own polygon
-        back = [c for c in panel.axes[e].collections if c not in (*panel._lit[e], panel._halo[e])]
+        ours = (*panel._lit[e], panel._halo[e], panel._covered[e])
+        back = [c for c in panel.axes[e].collections if c not in ours]
         _, over, _ = __import__("eyeviz.render.mpl.facet_map", fromlist=["x"]).view_polys(
             facet_patches(bee, e), np.arange(3187)
         )
@@ -110,7 +111,9 @@ def test_measured_map_lights_the_balls_facets(qtbot, bee):
             lit = st.lit(i, e)
             if len(lit) >= 3:
                 pt = _canvas_px(panel, e, _middle(bee, e, lit))
-                assert _near(_color_at(panel, pt), ball.color), (ball.name, e)
+                # facets ~3 px wide: the centre's pixel or one beside it (an edge's blend)
+                around = [pt + QtCore.QPoint(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)]
+                assert any(_near(_color_at(panel, q), ball.color) for q in around), (ball.name, e)
     # a ball moved out of the binocular field, up and to the right: eye A's patch goes grey
     far = _middle(bee, "A", st.lit(2, "A"))
     pt = _canvas_px(panel, "A", far)

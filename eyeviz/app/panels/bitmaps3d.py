@@ -130,18 +130,16 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self.counts = wrap_label(QtWidgets.QLabel(""))
         self.hover = wrap_label(QtWidgets.QLabel(""))
         self.hover.setObjectName("hover3d")
-        self.whole = QtWidgets.QPushButton("Whole map")
+        # over the canvas's top-right corner while zoomed: never moves the dock's layout
+        self.whole = QtWidgets.QPushButton("Whole map", self.canvas)
         self.whole.setToolTip("Wheel: zoom the maps; drag: pan; double click: the whole map")
-        self.whole.setEnabled(False)
+        self.whole.hide()
         self.whole.clicked.connect(self.zoom.reset)
         self.message = wrap_label(QtWidgets.QLabel("bitmaps layer hidden"))
         self.message.setAlignment(QtCore.Qt.AlignmentFlag.AlignCenter)
         lay = QtWidgets.QVBoxLayout(self)
         lay.setContentsMargins(2, 2, 2, 2)
-        top = QtWidgets.QHBoxLayout()
-        top.addWidget(self.counts, 1)
-        top.addWidget(self.whole, 0, QtCore.Qt.AlignmentFlag.AlignBottom)
-        lay.addLayout(top)
+        lay.addWidget(self.counts)
         lay.addWidget(self.canvas, 1)
         lay.addWidget(self.hover)
         lay.addWidget(self.message)
@@ -226,7 +224,9 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         for ax in self.axes.values():
             ax.set_xlim(x0, x1)
             ax.set_ylim(y0, y1)
-        self.whole.setEnabled(self.zoom.zoomed)
+        self.whole.adjustSize()
+        self.whole.move(max(self.canvas.width() - self.whole.width() - 2, 0), 2)
+        self.whole.setVisible(self.zoom.zoomed)
         if redraw:
             self._place_axes()
             self._bg = None

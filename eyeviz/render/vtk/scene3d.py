@@ -22,6 +22,7 @@ they see, with the level of detail of a large nside), :mod:`~eyeviz.render.vtk.b
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -100,6 +101,17 @@ def default_camera(state: SceneState3D, name: str = "default", aspect: float = 1
     return shapes3d.view_camera(state, name, aspect)
 
 
+def _covers(boxes: np.ndarray, keep_out: np.ndarray | None) -> bool:
+    """Whether any finite box of ``boxes`` overlaps one of ``keep_out`` (both (n, 4))."""
+    if keep_out is None or len(keep_out) == 0 or len(boxes) == 0:
+        return False
+    b = boxes[np.isfinite(boxes).all(axis=1)][:, None, :]
+    k = np.asarray(keep_out, float)[None, :, :]
+    ox = np.minimum(b[..., 2], k[..., 2]) - np.maximum(b[..., 0], k[..., 0])
+    oy = np.minimum(b[..., 3], k[..., 3]) - np.maximum(b[..., 1], k[..., 1])
+    return bool(np.any((ox > 0) & (oy > 0)))
+
+
 #: The ball labels' margin to the scene viewport's edges when a preset frames the scene.
 LABEL_MARGIN_PX = 6
 
@@ -115,11 +127,13 @@ def fit_labels(
     ``steps``) until every name, placed by :func:`eyeviz.model.labels3d.place_named`, is
     inside the viewport of ``size`` (width, height px) with ``margin`` pixels to spare.
     The presets frame the balls; a name beside a ball at the view's edge was cut
-    (sphere_predictions at its default framing)."""
+    (sphere_predictions at its default framing). Nor may a name cover the view's own
+    texts (``named.keep_out``: the title, at 175 % in a 1280 x 720 window)."""
     if len(named.centres) == 0:
         return cam
     w, h = size
     pos, focal = np.asarray(cam.position, float), np.asarray(cam.focal_point, float)
+    inside: Camera3D | None = None
     for _ in range(steps + 1):
         boxes = place_named(named, cam, w, h)
         ok = ~np.isfinite(boxes).all(axis=1) | (
@@ -129,11 +143,13 @@ def fit_labels(
             & (boxes[:, 3] <= h - margin + 0.5)
         )
         if bool(np.all(ok)):
-            return cam
+            if not _covers(boxes, named.keep_out):
+                return cam
+            inside = inside or cam  # the nearest with every name inside, if none is clear
         pos = focal + 1.1 * (pos - focal)
         x, y, z = (float(v) for v in pos)
         cam = Camera3D((x, y, z), cam.focal_point, cam.view_up, cam.view_angle)
-    return cam
+    return inside or cam
 
 
 def _aspect(ren: vtkRenderer) -> float:
@@ -155,6 +171,8 @@ class Scene3DActors:
         self.renderers = [r for r in (scene_ren, eyes_ren) if r is not None]
         self.title = screen_text(22, INK, (0.01, 0.985), top=True)
         scene_ren.AddViewProp(self.title)
+        # the view's own texts no ball's name may cover (the app adds its side note)
+        self.keep_clear: list = [self.title]
         # the title is broken into lines that fit the view, checked before each render
         # (the view's width and the title's font size change with the window and F5/Ctrl+=)
         self._title_text = ""
@@ -197,7 +215,19 @@ class Scene3DActors:
         st = self.state
         if st is None:
             return [], Named3D(np.zeros((0, 3)), np.zeros(0), np.zeros((0, 2)), np.zeros((0, 4)))
-        return self.balls.named(st, np.concatenate(others), self._dpi(), self.selected)
+        order, named = self.balls.named(st, np.concatenate(others), self._dpi(), self.selected)
+        return order, replace(named, keep_out=self._text_boxes())
+
+    def _text_boxes(self) -> np.ndarray:
+        """Boxes (k, 4, the scene viewport's pixels, y up) of :attr:`keep_clear`'s shown
+        texts: at 175 % in a small window a name printed over the title (issue 32.3)."""
+        out = []
+        for actor in self.keep_clear:
+            if actor.GetVisibility() and actor.GetInput():
+                b = [0.0] * 4  # x0, x1, y0, y1
+                actor.GetBoundingBox(self.scene_ren, b)
+                out.append((b[0], b[2], b[1], b[3]))
+        return np.array(out, float).reshape(-1, 4)
 
     def _place_names(self, *_args) -> None:
         """Before the scene renders: each ball's name beside it, over nothing (issue 32.4)."""
