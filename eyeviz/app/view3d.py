@@ -436,9 +436,9 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         vp = self.pointer("move", 0, 0)
         base = default_camera(self._framed, name, vp.w / max(vp.h, 1.0))
         cam = base
-        if keep and self._back is not None:  # a resize: as far back as the names needed
-            cam = dolly(base, self._back)
-        elif self.actors is not None and vp.w > 1 and vp.h > 1:  # the balls' names not cut
+        if keep and self._back is not None:  # a resize: as far back as the names needed,
+            cam = dolly(base, self._back)  # or further if the new size needs it
+        if self.actors is not None and vp.w > 1 and vp.h > 1:  # the balls' names not cut
             cam = fit_labels(cam, self.actors.named(), (vp.w, vp.h))
             d0 = math.dist(base.position, base.focal_point)
             self._back = math.dist(cam.position, cam.focal_point) / d0

@@ -1,0 +1,47 @@
+"""The spherical lecture at 175 % in a 1280 x 720 window in presentation mode (issue 32
+item 3): in every step no ball's name touches the 3D view's title or its side note (they
+printed over the title in steps 6 and 7). Real keys (xdotool) into the real window."""
+
+import numpy as np
+from test_lecture3d import _focus3d
+from test_presenting_real_x import _keys, window_manager  # noqa: F401
+
+from eyeviz.model.scene import load
+from eyeviz.resources import scene_path
+
+
+def _box(actor, ren) -> tuple[float, float, float, float]:
+    """A text actor's box in its viewport's pixels (x0, y0, x1, y1, y up)."""
+    b = [0.0] * 4
+    actor.GetBoundingBox(ren, b)
+    return b[0], b[2], b[1], b[3]
+
+
+def _overlap(a, b) -> bool:
+    return min(a[2], b[2]) > max(a[0], b[0]) and min(a[3], b[3]) > max(a[1], b[1])
+
+
+def test_names_clear_the_title_at_175_percent_in_every_step(make_window, qtbot):
+    path = scene_path("sphere_lecture")
+    win = make_window(load(path), path)
+    win.resize(1280, 720)
+    qtbot.waitUntil(lambda: win.width() == 1280, timeout=3000)
+    host = win.host3d
+    _focus3d(win, qtbot)
+    _keys(qtbot, "F5", until=lambda: win.presenter.presenting)
+    for _ in range(4):
+        _keys(qtbot, "ctrl+equal")
+    qtbot.waitUntil(lambda: win.presenter.scale == 1.75, timeout=3000)
+    ren = host.actors.scene_ren
+    checked = 0
+    for step in range(len(load(path).steps)):
+        _keys(qtbot, "Next", until=lambda s=step: win.step_index == s)
+        qtbot.wait(300)
+        host.draw()
+        title, side = _box(host.actors.title, ren), _box(host.side.actor, ren)
+        for box in host.actors.name_boxes:
+            if np.isfinite(box).all():
+                assert not _overlap(box, title), (step + 1, box, title)
+                assert not _overlap(box, side), (step + 1, box, side)
+                checked += 1
+    assert checked >= 8  # names were shown and checked
