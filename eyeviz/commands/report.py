@@ -64,8 +64,7 @@ def add_arguments(parser: argparse.ArgumentParser, argv: list[str] | None = None
             if exc.name == path:
                 continue
             raise
-        # argparse %-formats a help ("1 % error" raised TypeError on `report --help`)
-        p = sub.add_parser(kind, help=mod.HELP.replace("%", "%%"), description=mod.HELP)
+        p = sub.add_parser(kind, help=mod.HELP, description=mod.HELP)
         mod.add_arguments(p)
         p.set_defaults(_report=mod.run)
 
