@@ -8,6 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 from PyQt5 import QtCore, QtGui
 from PyQt5.QtTest import QTest
 
@@ -91,3 +92,38 @@ def test_the_responses_layer_shades_the_eye_and_the_map(make_window, qtbot):
     host.flush()
     rgb = np.asarray(host.actors.eyes.meshes[0].cell_data["rgb"])
     assert (rgb[idx[[lo, hi]]] == ball).all()
+
+
+@pytest.mark.slow  # a second window: 8-30 s on the shared machine
+def test_healpix_cells_are_shaded_at_any_size_and_during_a_drag(make_window, qtbot):
+    """A HEALPix pair (nside 16: the full surface): a ball lighting many cells (more than
+    the old 24-cell bound) and not selected is shaded by its cells' exact shares, at rest
+    and on a drag frame (the gesture still open), as the pair's own ``responses`` say."""
+    from eyeviz.model.scene import OKABE_ITO, Eyes, Feature, Scene
+
+    big = Feature("big", 0.0, 150.0, 25.0, OKABE_ITO[1], 0.0)
+    small = Feature("small", 60.0, 400.0, 12.0, OKABE_ITO[2], 30.0)
+    layers = ["eyes", "features", "bitmaps", "responses"]
+    win = make_window(Scene(Eyes(40.0, 20.0, nside=16), [big, small], layers))
+    host = win.host3d
+    host.model.select(1)
+    ball = hex_rgb(big.color)
+    for x in (None, 9.0):  # at rest, then a drag frame
+        if x is not None:
+            host.model.begin_live("Drag big")
+            host.model.live(0, x=x)
+        host.flush()
+        st = host.model.state
+        (ip, ix, vals), _ = st.pair.responses(st.x, st.y, st.z, st.g)
+        pix, owner = lit_owners((ip, ix))
+        mine = set(pix[owner == 0].tolist())
+        row = range(int(ip[0]), int(ip[1]))
+        assert len(row) > 24
+        keep = [k for k in row if int(ix[k]) in mine]
+        rgb = np.asarray(host.actors.eyes.meshes[0].cell_data["rgb"])
+        part = [k for k in keep if 0.1 < vals[k] < 0.9]
+        assert part and any(vals[k] == 1.0 for k in keep)
+        for k in part:
+            assert abs(_weight(rgb[ix[k]], ball) - vals[k]) < 0.06, (x, k, vals[k])
+    assert host.model.live_open  # the frame above was drawn inside the gesture
+    host.model.end_live()
