@@ -148,7 +148,8 @@ def build_parser(argv: list[str] | None = None):
         p = sub.add_parser(mod.NAME, help=mod.HELP, description=mod.HELP)
         if wanted is None or wanted.startswith("-") or wanted == mod.NAME:
             if "argv" in inspect.signature(mod.add_arguments).parameters:
-                mod.add_arguments(p, argv=argv[1:] if wanted == mod.NAME else None)
+                rest = argv[1:] if argv and wanted == mod.NAME else None
+                mod.add_arguments(p, argv=rest)
             else:
                 mod.add_arguments(p)
         p.set_defaults(_run=mod.run, _outputs=getattr(mod, "OUTPUTS", None))
