@@ -127,3 +127,38 @@ def test_healpix_cells_are_shaded_at_any_size_and_during_a_drag(make_window, qtb
             assert abs(_weight(rgb[ix[k]], ball) - vals[k]) < 0.06, (x, k, vals[k])
     assert host.model.live_open  # the frame above was drawn inside the gesture
     host.model.end_live()
+
+
+@pytest.mark.slow  # a third window at nside 64
+def test_healpix_patches_beyond_the_full_surface_are_shaded(make_window, qtbot):
+    """nside 64 (beyond the full surface: each ball's lit cells are a patch mesh of their
+    own, one cell per facet): with the layer on, each patch cell is its ball's colour at
+    the cell's exact share, at rest and after a move; with the layer off, the plain colour."""
+    from eyeviz.model.scene import OKABE_ITO, Eyes, Feature, Scene
+
+    big = Feature("big", 0.0, 150.0, 25.0, OKABE_ITO[1], 0.0)
+    layers = ["eyes", "features", "bitmaps", "responses"]
+    win = make_window(Scene(Eyes(40.0, 20.0, nside=64), [big], layers))
+    host = win.host3d
+    ball = hex_rgb(big.color)
+    painter = host.actors.eyes
+    assert not painter.full
+    for x in (None, 9.0):
+        if x is not None:
+            host.model.begin_live("Drag big")
+            host.model.live(0, x=x)
+            host.model.end_live()
+        host.flush()
+        st = host.model.state
+        (ip, ix, vals), _ = st.pair.responses(st.x, st.y, st.z, st.g)
+        mesh = painter.patches[0][0][0]
+        assert mesh.n_cells == int(ip[1] - ip[0]) > 24
+        rgb = np.asarray(mesh.cell_data["rgb"])
+        part = [k for k in range(mesh.n_cells) if 0.1 < vals[k] < 0.9]
+        assert part and any(vals[k] == 1.0 for k in range(mesh.n_cells))
+        for k in part:
+            assert abs(_weight(rgb[k], ball) - vals[k]) < 0.06, (x, k, vals[k])
+    host.model.set_layer("responses", False)
+    host.flush()
+    rgb = np.asarray(painter.patches[0][0][0].cell_data["rgb"])
+    assert (rgb == np.asarray(ball, np.uint8)).all()

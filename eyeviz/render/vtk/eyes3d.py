@@ -11,9 +11,11 @@ per eye at nside 180, each under a pixel) the unlit sphere is a smooth mesh draw
 and each ball's lit facets are a small mesh of their own, rebuilt only when that ball's
 lit set changes.
 
-With the ``responses`` layer (:mod:`eyeviz.model.responses3d`) each lit facet of a full
-surface is its ball's colour blended towards the unlit grey by 1 - its response; the
-patches beyond the full LOD keep their ball's plain colour.
+With the ``responses`` layer (:mod:`eyeviz.model.responses3d`) each lit facet is its
+ball's colour blended towards the unlit grey by 1 - its response: a full surface's cells,
+and beyond the full LOD each patch cell (one per lit facet); a patch drawn on the coarse
+grid (a ball lighting more than ``shapes3d.MAX_PATCH_FACETS`` facets) keeps its ball's
+plain colour, since its cells are not the facets.
 """
 
 from __future__ import annotations
@@ -115,7 +117,8 @@ class EyesPainter(Painter3D):
         for e in range(2):
             for _ in range(n):
                 mesh = pv.PolyData()
-                a = lit(actor(mesh, (0.5, 0.5, 0.5)))
+                set_rgb(mesh.GetCellData(), np.zeros((0, 3), np.uint8))
+                a = lit(actor(mesh, rgb=True))
                 self.patch_store.add(self.scene_ren, a)
                 if self.eyes_ren is not None:
                     self.patch_store.add(self.eyes_ren, a)
@@ -147,22 +150,32 @@ class EyesPainter(Painter3D):
                     rgb[pix] = shade(rgb[pix], UNLIT, owner_values(csr, vals["AB"[e]]))
                 write_rgb(mesh, rgb)
         else:
-            self._draw_patches(state, surface, pal, show)
+            vals = lit_responses(state, selected) if scene.shows("responses") else None
+            self._draw_patches(state, surface, pal, show, vals)
         for eq in self.equators:
             eq.SetVisibility(show and scene.shows("plane"))
         for lab in self.labels:
             lab.SetVisibility(show and scene.shows("labels"))
 
-    def _draw_patches(self, state, surface: EyeSurface, pal, show: bool) -> None:
+    def _draw_patches(self, state, surface: EyeSurface, pal, show: bool, vals=None) -> None:
+        """Each ball's lit facets as its own mesh, rebuilt when its lit set changes; the
+        cells' colours rewritten every frame (a response moves with its ball even where
+        the lit set stays)."""
         n = state.n
         for e, csr in enumerate((state.lit_a, state.lit_b)):
             for i, (mesh, a, was) in enumerate(self.patches[e]):
-                pix = csr[1][csr[0][i] : csr[0][i + 1]] if csr is not None else was[:0]
+                lo, hi = (int(csr[0][i]), int(csr[0][i + 1])) if csr is not None else (0, 0)
+                pix = csr[1][lo:hi] if csr is not None else was[:0]
                 a.SetVisibility(show and pix.size > 0)
-                if pix.size == was.size and np.array_equal(pix, was):
+                if pix.size != was.size or not np.array_equal(pix, was):
+                    lift = 1.0 + PATCH_LIFT * (1.0 + i / max(n, 1))
+                    fresh = pv.PolyData(*surface.patch(e, pix, lift)) if pix.size else pv.PolyData()
+                    set_rgb(fresh.GetCellData(), np.zeros((fresh.n_cells, 3), np.uint8))
+                    mesh.ShallowCopy(fresh)
+                    self.patches[e][i] = (mesh, a, pix.copy())
+                if mesh.n_cells == 0:
                     continue
-                lift = 1.0 + PATCH_LIFT * (1.0 + i / max(n, 1))
-                fresh = pv.PolyData(*surface.patch(e, pix, lift)) if pix.size else pv.PolyData()
-                mesh.ShallowCopy(fresh)
-                a.GetProperty().SetColor(*(pal[i] / 255.0))
-                self.patches[e][i] = (mesh, a, pix.copy())
+                rgb = np.broadcast_to(pal[i], (mesh.n_cells, 3))
+                if vals is not None and mesh.n_cells == pix.size:  # one cell per facet
+                    rgb = shade(rgb, UNLIT, vals["AB"[e]][lo:hi])
+                write_rgb(mesh, rgb)
