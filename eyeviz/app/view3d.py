@@ -40,12 +40,7 @@ from eyeviz.app.view import make_view
 from eyeviz.model import app_model3d as m3
 from eyeviz.model.camera3d import PRESETS, Camera3D, dolly
 from eyeviz.model.draw_bounds import check_drawable_eyes
-from eyeviz.model.predictions3d import (
-    LatestOnly,
-    Predictions3D,
-    Predictor3D,
-    check_estimators,
-)
+from eyeviz.model.predictions3d import LatestOnly, Predictions3D, Predictor3D, check_estimators
 from eyeviz.model.scene import SPHERICAL_LAYERS, Scene, layer_applies
 from eyeviz.render.vtk.scene3d import (
     Scene3DActors,
