@@ -3,6 +3,7 @@ the scenes and models (package data found with importlib.resources), so `eyeviz 
 and `eyeviz predict -e compact` run there with the source tree out of reach."""
 
 import os
+import shutil
 import subprocess
 import sys
 import sysconfig
@@ -12,17 +13,26 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-# the wheel is built in the source tree (build/, *.egg-info): under pytest-xdist both tests
-# run on one worker (--dist loadgroup), so one build at a time and once
+# both tests share one build (--dist loadgroup keeps them on one worker); the build runs in
+# a copy of what it needs, so it neither writes build/ or *.egg-info into the source tree
+# nor meets files that other tests' processes create and remove there meanwhile (a CI run
+# failed with "[Errno 2] No such file or directory" mid-build)
 pytestmark = pytest.mark.xdist_group("wheel")
 
 
 @pytest.fixture(scope="module")
 def clean_env(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("wheel")
+    src = tmp / "src"
+    src.mkdir()
+    for name in ("pyproject.toml", "README.md"):
+        shutil.copy2(ROOT / name, src / name)
+    shutil.copytree(
+        ROOT / "eyeviz", src / "eyeviz", ignore=shutil.ignore_patterns("__pycache__", "*.pyc")
+    )
     build = subprocess.run(
         [sys.executable, "-m", "build", "--wheel", "--no-isolation", "-o", str(tmp / "dist")],
-        cwd=ROOT,
+        cwd=src,
         capture_output=True,
         text=True,
         timeout=300,

@@ -116,7 +116,8 @@ def test_large_nside_draws_a_coarse_sphere_and_the_lit_patches(renderers):
         mesh, a, pix = act.eyes.patches[e][0]
         assert np.array_equal(pix, st.lit(0, "AB"[e]))
         assert mesh.n_cells == pix.size > 100
-        assert a.GetProperty().GetColor() == pytest.approx(np.array(hex_rgb("#D55E00")) / 255)
+        rgb = np.asarray(mesh.cell_data["rgb"])  # every cell in the ball's colour
+        assert (rgb == np.array(hex_rgb("#D55E00"), np.uint8)).all()
     # an unchanged lit set is not rebuilt
     mesh0 = act.eyes.patches[0][0][0]
     mt = mesh0.GetMTime()

@@ -14,6 +14,7 @@ import pytest
 from eyeviz import EyevizError
 from eyeviz.study import run_study
 from eyeviz.study.grid3d import design_grid3d
+from eyeviz.study.point3d import COLUMNS3D, STUDY3D_VERSION
 from eyeviz.study.table3d import StudyTable3D, read_rows3d
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -76,9 +77,15 @@ def _table(tmp_path):
     [
         (lambda ls: ls[:-1], ["has 14 of its 15 rows", "incomplete"]),
         (lambda ls: [ls[0].replace("version", "versio")] + ls[1:], ["not a 3D study table"]),
-        (lambda ls: ls[:1] + ["2" + ls[1][1:]] + ls[2:], ["line 2", "3D study version 2"]),
+        (
+            lambda ls: ls[:1] + [f"{STUDY3D_VERSION + 1}" + ls[1][1:]] + ls[2:],
+            ["line 2", f"3D study version {STUDY3D_VERSION + 1}"],
+        ),
         (lambda ls: ls[:2] + [ls[2].replace(",single,", ",sngle,")] + ls[3:], ["line 3", "prior"]),
-        (lambda ls: ls[:2] + [ls[2] + ",1"] + ls[3:], ["line 3", "28 fields, expected 27"]),
+        (
+            lambda ls: ls[:2] + [ls[2] + ",1"] + ls[3:],
+            ["line 3", f"{len(COLUMNS3D) + 1} fields, expected {len(COLUMNS3D)}"],
+        ),
         (
             lambda ls: ls[:2] + [ls[2].replace(",64,", ",65,", 1)] + ls[3:],
             ["line 3", "m = 65 is not 4 nside = 64"],

@@ -33,7 +33,7 @@ from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.style3d import EDGE_RGB, EDGES_MAX_NSIDE
 from eyeviz.render.vtk.painter3d import Painter3D, lit, palette
-from eyeviz.render.vtk.primitives import Store, actor, set_rgb, text3d, write_rgb
+from eyeviz.render.vtk.primitives import Store, actor, read_rgb, set_rgb, text3d, write_rgb
 from eyeviz.render.vtk.style import INK, UNLIT, rgbf
 
 __all__ = ["EyesPainter", "LABEL_PX", "PATCH_LIFT"]
@@ -178,4 +178,5 @@ class EyesPainter(Painter3D):
                 rgb = np.broadcast_to(pal[i], (mesh.n_cells, 3))
                 if vals is not None and mesh.n_cells == pix.size:  # one cell per facet
                     rgb = shade(rgb, UNLIT, vals["AB"[e]][lo:hi])
-                write_rgb(mesh, rgb)
+                if not np.array_equal(read_rgb(mesh), rgb):  # unchanged: no Modified
+                    write_rgb(mesh, rgb)

@@ -201,6 +201,11 @@ def set_rgb(data, rgb: np.ndarray) -> None:
     data.AddArray(arr)
 
 
+def read_rgb(mesh) -> np.ndarray:
+    """A mesh's cell "rgb" array (a view, not a copy)."""
+    return vtk_to_numpy(mesh.GetCellData().GetAbstractArray("rgb"))
+
+
 def write_rgb(mesh, rgb: np.ndarray) -> None:
     """Overwrite a mesh's cell "rgb" array in place (a drag frame: pyvista's cell_data
     lookup costs ~0.1 ms a call)."""
