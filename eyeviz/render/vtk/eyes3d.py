@@ -138,8 +138,8 @@ class EyesPainter(Painter3D):
         for _r, a in self.store.items:
             a.SetVisibility(show)
         pal = palette(scene)
+        vals = lit_responses(state, selected) if scene.shows("responses") else None
         if self.full:
-            vals = lit_responses(state, selected) if scene.shows("responses") else None
             for e, mesh in enumerate(self.meshes):
                 own = self._owner[e]
                 shapes3d.facet_owner(state, "AB"[e], own)
@@ -150,7 +150,6 @@ class EyesPainter(Painter3D):
                     rgb[pix] = shade(rgb[pix], UNLIT, owner_values(csr, vals["AB"[e]]))
                 write_rgb(mesh, rgb)
         else:
-            vals = lit_responses(state, selected) if scene.shows("responses") else None
             self._draw_patches(state, surface, pal, show, vals)
         for eq in self.equators:
             eq.SetVisibility(show and scene.shows("plane"))
