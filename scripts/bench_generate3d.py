@@ -37,7 +37,7 @@ os.sched_setaffinity(0, {cpu})
 kind, n, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 import numpy  # noqa: F401  (imports are not timed)
 from eyeviz import dataset
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import sparse3d
 t0 = time.perf_counter()
 c0 = time.process_time()

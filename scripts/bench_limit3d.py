@@ -36,7 +36,7 @@ def main(argv: list[str] | None = None) -> int:
     import numpy as np
 
     from eyeviz.core import kernels
-    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.core.domain import Domain3D
     from eyeviz.dataset.algorithm1_3d import generate3d
     from eyeviz.estimators.base3d import take_rows
     from eyeviz.estimators.limit3d import Limit3DEstimator

@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators.base3d import take_rows
 from eyeviz.estimators.limit3d import Limit3DEstimator

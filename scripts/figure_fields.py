@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import _sight_clear
 from eyeviz.dataset.records3d import spherical_to_xyz
 

@@ -3,7 +3,7 @@
 Planar eyes (default, ``--h --l --m``), HEALPix eyes (``--nside``) or a measured pair
 (``--eye FILE [--units mm]``): the last two write the sparse data set
 (:mod:`eyeviz.dataset.sparse3d`); a measured pair is embedded in it, and its ranges
-default to the animal's scale (:func:`eyeviz.core.domain3d.measured_ranges`)."""
+default to the animal's scale (:func:`eyeviz.core.domain.measured_ranges`)."""
 
 from __future__ import annotations
 
@@ -292,8 +292,7 @@ def _progress(args: argparse.Namespace, n: int, least: int):
 def _run3d(args: argparse.Namespace, drawn: bool = False) -> int:
     """``--nside``: Algorithm 1 in 3D, written as the sparse 3D data set."""
     from eyeviz import EyevizError
-    from eyeviz.core.domain import DEFAULTS
-    from eyeviz.core.domain3d import DEFAULTS3D, Domain3D
+    from eyeviz.core.domain import DEFAULTS, DEFAULTS3D, Domain3D
     from eyeviz.dataset import algorithm1_3d, sparse3d
     from eyeviz.files import limits
 
@@ -351,7 +350,7 @@ def _run_eye(args: argparse.Namespace, drawn: bool) -> int:
     """``--eye FILE``: Algorithm 1 on a measured pair, written as the sparse data set with
     the pair embedded."""
     from eyeviz import EyevizError
-    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.core.domain import Domain3D
     from eyeviz.dataset import algorithm1_3d, sparse3d
     from eyeviz.files import limits
     from eyeviz.files.eye_io import load_eyes

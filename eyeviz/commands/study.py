@@ -243,7 +243,7 @@ def run(args: argparse.Namespace) -> int:
     if args.eye is not None:
         points = _measured_points(args, given, seed)
     elif args.nside is not None:
-        from eyeviz.core.domain3d import DEFAULT_EL_MAX
+        from eyeviz.core.domain import DEFAULT_EL_MAX
         from eyeviz.study.grid3d import DEFAULT_N3D, design_grid3d
         from eyeviz.study.point3d import DEFAULT_ESTIMATOR
 

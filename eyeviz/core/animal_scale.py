@@ -1,6 +1,6 @@
 """The prior at the animal's scale for a measured eye pair: lengths in mm or in baselines.
 
-A measured pair's prior is Algorithm 1 on its :class:`~eyeviz.core.domain3d.Domain3D`
+A measured pair's prior is Algorithm 1 on its :class:`~eyeviz.core.domain.Domain3D`
 (docs/measured.md, "Data sets and estimators"): r uniform in [r_min, r_max] (single
 pass) or with density r^2 (multi pass), the radius g uniform in [r sin(dphi/2), g_max],
 the elevation in the band |el| <= el_max, the azimuth in front, and only the balls of the
@@ -13,7 +13,7 @@ contains no lens). This module states its lengths at the animal's scale:
 - every length of the prior (r_min, r_max, g_max) may be given in millimetres (a number,
   ``"30"`` or ``"30mm"``) or in baselines (``"12b"``): :func:`parse_length`,
   :func:`prior_ranges`;
-- the defaults are :func:`eyeviz.core.domain3d.measured_ranges`, whose reasons are:
+- the defaults are :func:`eyeviz.core.domain.measured_ranges`, whose reasons are:
   r_max = h / dphi, where the disparity 2h/r of a ball is two interommatidial angles, so
   r_max / b = 1 / (2 dphi) (25 b for the honeybee, dphi = 1.14 degrees: beyond it two
   facets of disparity are all a pair of eyes has); r_min = r_max / 5 (5 b) and
@@ -94,7 +94,7 @@ def to_mm(length: Any, eyes: Any, name: str = "length") -> float:
 def prior_ranges(eyes: Any, **given: Any) -> dict[str, float | None]:
     """The Domain3D ranges (r_min, r_max, g_max in mm; el_max in radians) of ``given``,
     each a length in mm or baselines (r_min, r_max, g_max) or None for the default
-    (:func:`eyeviz.core.domain3d.measured_ranges`); pass the result to
+    (:func:`eyeviz.core.domain.measured_ranges`); pass the result to
     ``Domain3D.for_eyes(eyes, **ranges)``."""
     unknown = sorted(set(given) - {*LENGTHS, "el_max"})
     if unknown:

@@ -7,7 +7,7 @@ parameter record, :class:`eyeviz.core.domain.Domain`, in place of ``eyes`` (or t
 and ranges separately); the defaults are Tables 3-4 (``eyeviz.core.domain.DEFAULTS``).
 The spherical (3D) model's sparse data set: :mod:`eyeviz.dataset.algorithm1_3d` samples,
 :mod:`eyeviz.dataset.sparse3d` writes and reads (:class:`Dataset3D`, over the record
-:class:`eyeviz.core.domain3d.Domain3D`).
+:class:`eyeviz.core.domain.Domain3D`).
 """
 
 from eyeviz.core.domain import Domain

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 
 __all__ = ["Dataset3D", "index_dtype", "spherical_to_xyz"]
 

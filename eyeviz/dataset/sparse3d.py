@@ -6,7 +6,7 @@ of ``.npy`` members (numpy's NPZ, readable by ``numpy.load`` without pickles):
 
 - ``meta``: a JSON string: ``format`` (:data:`FORMAT`), ``version``
   (:data:`VERSION`), ``n``, ``nnz_a``, ``nnz_b``, ``index_dtype``, ``domain`` (h, l,
-  nside, r_min, r_max, g_max, el_max: :class:`eyeviz.core.domain3d.Domain3D`) and
+  nside, r_min, r_max, g_max, el_max: :class:`eyeviz.core.domain.Domain3D`) and
   ``params`` (mode, seed, segments);
 - ``indptr_a``, ``indptr_b``: int64 (n + 1,), 0 first, nnz last, non-decreasing;
 - ``indices_a``, ``indices_b``: the RING indices (int32 while 12 nside^2 <= 2^31, int64
@@ -46,7 +46,7 @@ from typing import Any, BinaryIO
 import numpy as np
 
 from eyeviz import EyevizError
-from eyeviz.core.domain3d import FIELDS3D, Domain3D
+from eyeviz.core.domain import FIELDS3D, Domain3D
 from eyeviz.core.validation import check_int
 from eyeviz.dataset import embedded_eyes, responses3d
 from eyeviz.dataset.algorithm1_3d import check_n, iter_chunks3d, make_params3d

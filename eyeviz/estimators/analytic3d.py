@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from eyeviz.core.domain3d import PAPER_DOMAIN3D, Domain3D
+from eyeviz.core.domain import PAPER_DOMAIN3D, Domain3D
 from eyeviz.estimators.base3d import Estimator3D, LitCSR
 from eyeviz.estimators.triangulation import (
     boundary_rays,

@@ -30,7 +30,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from eyeviz import EyevizError
-from eyeviz.core.domain3d import PAPER_DOMAIN3D, Domain3D
+from eyeviz.core.domain import PAPER_DOMAIN3D, Domain3D
 from eyeviz.core.validation import check_int
 
 __all__ = [

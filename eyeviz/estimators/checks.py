@@ -200,7 +200,7 @@ CHECKS: tuple[Callable, ...] = (
 
 
 def _is_3d(est) -> bool:
-    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.core.domain import Domain3D
 
     return isinstance(getattr(est, "domain", None), Domain3D)
 

@@ -1,6 +1,6 @@
 """The battery every estimator of the spherical eyes passes (the 3D form of
 :mod:`eyeviz.estimators.checks`; :func:`eyeviz.estimators.checks.check_estimator` runs it
-for an estimator whose domain is a :class:`~eyeviz.core.domain3d.Domain3D`).
+for an estimator whose domain is a :class:`~eyeviz.core.domain.Domain3D`).
 
 Each check gets the estimator and a few rows of its own domain's 3D Algorithm 1
 (seeded) and raises AssertionError naming what is wrong. The lit sets are given both as
@@ -13,7 +13,7 @@ from collections.abc import Callable, Iterator
 
 import numpy as np
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 
 __all__ = ["CHECKS3D", "check_estimator3d", "estimator_checks3d"]
 

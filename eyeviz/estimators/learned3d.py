@@ -49,7 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from eyeviz import EyevizError
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.core.validation import check_int, num
 from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D
 from eyeviz.estimators.learned3d_features import (

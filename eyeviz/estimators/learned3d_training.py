@@ -25,8 +25,7 @@ from torch import nn
 
 from eyeviz import EyevizError
 from eyeviz.core.bounds import MAX_THREADS
-from eyeviz.core.domain import Domain
-from eyeviz.core.domain3d import DEFAULT_EL_MAX, Domain3D
+from eyeviz.core.domain import DEFAULT_EL_MAX, Domain, Domain3D
 from eyeviz.core.validation import check_int, check_real, num
 from eyeviz.dataset.records3d import Dataset3D
 from eyeviz.estimators import metrics

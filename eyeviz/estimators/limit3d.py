@@ -84,7 +84,7 @@ from typing import Any
 
 import numpy as np
 
-from eyeviz.core.domain3d import PAPER_DOMAIN3D, Domain3D
+from eyeviz.core.domain import PAPER_DOMAIN3D, Domain3D
 from eyeviz.estimators.analytic3d import estimate
 from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D, as_csr, take_rows
 from eyeviz.estimators.limit3d_exact import prior_density, same_rows

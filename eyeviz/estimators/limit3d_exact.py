@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from eyeviz.core import kernels
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.estimators.base3d import LitCSR
 
 __all__ = ["exact_hits", "prior_density", "same_rows"]

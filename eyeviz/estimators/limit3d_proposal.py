@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from eyeviz.core import healpix, kernels
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.estimators.analytic3d import cap_estimates
 from eyeviz.estimators.base3d import LitCSR
 

@@ -16,7 +16,7 @@ weights were made for (``design``), whether it needs torch, how to load it, how 
 Estimators of the spherical side (docs/spherical.md) are entries of ``kind="spherical"``,
 answering for the HEALPix eyes and, where ``models`` says so, for measured ones
 (docs/measured.md; :func:`available_for`),
-loaded with a :class:`~eyeviz.core.domain3d.Domain3D` and named with a ``3d`` suffix
+loaded with a :class:`~eyeviz.core.domain.Domain3D` and named with a ``3d`` suffix
 (``analytic3d``, ``limit3d``, ``learned3d``); :func:`entries` and :func:`available` list
 one kind at a time (planar by default, so every planar list is as it was):
 
@@ -43,8 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from eyeviz import EyevizError
-from eyeviz.core.domain import DEFAULTS, FIELDS, PAPER_DOMAIN, Domain
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import DEFAULTS, FIELDS, PAPER_DOMAIN, Domain, Domain3D
 
 __all__ = [
     "KINDS",

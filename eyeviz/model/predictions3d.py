@@ -15,7 +15,7 @@ between the eyes; the ghost is a ball of the true radius g at that answer's cent
 sin az, z = r sin el). The errors are against the true ball: r relative (in %), azimuth
 (wrapped to (-180, 180]) and elevation absolute, in degrees. Every estimator is loaded for
 the scene's design (h, l, nside) with Table 4's ranges of r and g and the elevation band
-of :class:`eyeviz.core.domain3d.Domain3D`; learned3d's weights answer only for the design
+of :class:`eyeviz.core.domain.Domain3D`; learned3d's weights answer only for the design
 they were trained for, and for other eyes its answer is the registry's one line (never an
 answer for the wrong eyes).
 
@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.records3d import spherical_to_xyz
 from eyeviz.model.palette import estimator_color
 from eyeviz.model.scene import SPHERICAL_ESTIMATORS, Scene

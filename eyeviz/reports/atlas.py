@@ -188,7 +188,7 @@ def _load(spec: str, units: str | None):
 def measure_pair(pair, args: argparse.Namespace, names: list[str]) -> PairAtlas:
     """The atlas of one pair (see the module docstring)."""
     from eyeviz.core.animal_scale import describe_prior, prior_ranges
-    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.core.domain import Domain3D
     from eyeviz.dataset.algorithm1_3d import generate3d
     from eyeviz.reports import atlas_measure as am
 

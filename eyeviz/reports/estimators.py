@@ -193,7 +193,7 @@ def run3d(args: argparse.Namespace) -> int:
             f"l = {d.l:g}, {eyes}, params {ds.params}."
         )
     elif getattr(args, "eye", None) is not None:
-        from eyeviz.core.domain3d import Domain3D
+        from eyeviz.core.domain import Domain3D
         from eyeviz.dataset.algorithm1_3d import generate3d
         from eyeviz.files.eye_io import load_eyes
 
@@ -210,7 +210,7 @@ def run3d(args: argparse.Namespace) -> int:
             f"{d.g_max:.4g} mm, about the lens centroids' midpoint."
         )
     else:
-        from eyeviz.core.domain3d import Domain3D
+        from eyeviz.core.domain import Domain3D
         from eyeviz.dataset.algorithm1_3d import generate3d
 
         check_int("--n-test", args.n_test, ge=10, le=limits.MAX_ROWS)

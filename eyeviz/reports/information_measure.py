@@ -261,7 +261,7 @@ def measure_measured(
     """A measured pair at its own scale (Domain3D.for_eyes), Algorithm 1 in 3D; the
     binary side is limit3d (the analytic triangulation where limit3d refuses the pair)."""
     from eyeviz import EyevizError
-    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.core.domain import Domain3D
     from eyeviz.dataset.algorithm1_3d import generate3d
     from eyeviz.estimators import limit3d
     from eyeviz.estimators.analytic3d import estimate_measured
@@ -290,7 +290,7 @@ def measure_measured(
 def measure_healpix(nside: int, n: int, seed: int, rel_step: float = STEP) -> ModelResult:
     """The HEALPix pair at ``nside``: the binary side is limit3d on its cells; the graded
     side the pair's exact ``cell`` responses (:func:`healpix_fn`)."""
-    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.core.domain import Domain3D
     from eyeviz.dataset.algorithm1_3d import generate3d
     from eyeviz.estimators import limit3d
 

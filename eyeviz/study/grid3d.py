@@ -18,8 +18,7 @@ from collections.abc import Iterable
 
 from eyeviz import EyevizError
 from eyeviz.core.bounds import check_nside
-from eyeviz.core.domain import DEFAULTS
-from eyeviz.core.domain3d import DEFAULT_EL_MAX
+from eyeviz.core.domain import DEFAULT_EL_MAX, DEFAULTS
 from eyeviz.core.validation import check_real, num
 from eyeviz.study.grid import DEFAULT_H, DEFAULT_L, grid_axes, grid_pairs
 from eyeviz.study.point3d import DEFAULT_ESTIMATOR, DesignPoint3D

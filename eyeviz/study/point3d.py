@@ -39,8 +39,7 @@ from typing import Any
 import numpy as np
 
 from eyeviz import EyevizError
-from eyeviz.core.domain import DEFAULTS
-from eyeviz.core.domain3d import DEFAULT_EL_MAX, Domain3D
+from eyeviz.core.domain import DEFAULT_EL_MAX, DEFAULTS, Domain3D
 from eyeviz.core.validation import check_choice, check_int
 from eyeviz.estimators.metrics import bootstrap_se, mape, r2
 from eyeviz.study.point import BIN_WIDTH, distance_bins

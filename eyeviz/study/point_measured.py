@@ -126,7 +126,7 @@ class DesignPointMeasured:
 
     @property
     def domain(self):
-        from eyeviz.core.domain3d import Domain3D
+        from eyeviz.core.domain import Domain3D
 
         return Domain3D.for_eyes(
             self.pair, r_min=self.r_min, r_max=self.r_max, g_max=self.g_max, el_max=self.el_max
@@ -148,7 +148,7 @@ class DesignPointMeasured:
     @property
     def gamma(self) -> float:
         """The reshaped pair's interommatidial angle (radians)."""
-        from eyeviz.core.domain3d import pair_spacing
+        from eyeviz.core.domain import pair_spacing
 
         return float(pair_spacing(self.pair))
 
@@ -199,8 +199,8 @@ def is_table_measured(path) -> bool:
 
 def measured_grid(eye: str, facets, widen, **common) -> list[DesignPointMeasured]:
     """Every (facets, widen) of the lists for the shipped ``eye``, the object ranges
-    defaulting to the real pair's (:func:`eyeviz.core.domain3d.measured_ranges`)."""
-    from eyeviz.core.domain3d import measured_ranges
+    defaulting to the real pair's (:func:`eyeviz.core.domain.measured_ranges`)."""
+    from eyeviz.core.domain import measured_ranges
     from eyeviz.study.grid import parse_list
 
     base = measured_ranges(_shipped(eye))

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from eyeviz import cli
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import algorithm1_3d, sparse3d
 
 SMALL = ["--h", "30", "--l", "10", "--r-min", "100", "--r-max", "400", "--g-max", "60"]

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from eyeviz import cli
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import algorithm1_3d, sparse3d
 from eyeviz.measured import shipped_eye
 

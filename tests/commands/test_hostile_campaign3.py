@@ -188,7 +188,7 @@ def test_report_estimators_names_a_data_set_without_rows(tmp_path, capsys):
 
     import numpy as np
 
-    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.core.domain import Domain3D
     from eyeviz.dataset import sparse3d
     from eyeviz.dataset.algorithm1_3d import generate3d, make_params3d
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from eyeviz import cli, dataset
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import sparse3d
 from eyeviz.estimators import learned3d, registry
 

@@ -14,7 +14,7 @@ import threading
 import pytest
 
 from eyeviz import EyevizError, cli
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import sparse3d
 from eyeviz.files.atomic import atomic_output
 from eyeviz.resources import scenes_dir

@@ -18,7 +18,7 @@ from eyeviz.core.animal_scale import (
     prior_ranges,
     to_mm,
 )
-from eyeviz.core.domain3d import Domain3D, measured_ranges
+from eyeviz.core.domain import Domain3D, measured_ranges
 from eyeviz.core.geometry3d import EyePair3D
 from eyeviz.core.measured_from import as_measured
 

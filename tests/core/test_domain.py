@@ -40,3 +40,41 @@ def test_bad_parameters_are_refused_naming_the_parameter(kw, name):
 def test_r_max_must_be_positive_itself():
     with pytest.raises(ValueError, match="^r_max"):
         Domain(r_min=1.0, r_max=0.0)
+
+
+def test_one_door_makes_the_domain_of_every_kind_of_eyes(toy_pair):
+    from eyeviz.core.domain import Domain3D, domain_for, domain_from_dict
+    from eyeviz.core.geometry import EyePair
+    from eyeviz.core.geometry3d import EyePair3D
+
+    planar = domain_for(EyePair(30.0, 10.0, 36), r_min=500.0, g_max=None)
+    assert planar == Domain(30.0, 10.0, 36, r_min=500.0) and planar.kind == "planar"
+    assert planar.facet_counts == (36, 36) and planar.origin == (0.0, 0.0)
+    assert Domain.from_eyes(EyePair(30.0, 10.0, 36), r_min=500.0) == planar
+    sph = domain_for(EyePair3D(30.0, 10.0, 4), r_min=500.0)
+    assert sph == Domain3D(30.0, 10.0, 4, r_min=500.0) and sph.kind == "spherical"
+    assert sph.facet_counts == (192, 192) and sph.origin == (0.0, 0.0, 0.0)
+    meas = domain_for(toy_pair)
+    assert meas == Domain3D.for_eyes(toy_pair) and meas.kind == "measured"
+    assert domain_from_dict(planar.to_dict()) == planar
+    assert domain_from_dict(sph.to_dict()) == sph
+    assert domain_from_dict(meas.to_dict(), eyes=toy_pair) == meas
+
+
+def test_a_record_takes_only_its_own_kinds_and_ranges():
+    from eyeviz.core.domain import Domain3D, domain_for, domain_from_dict
+    from eyeviz.core.geometry import EyePair
+    from eyeviz.core.geometry3d import EyePair3D
+
+    with pytest.raises(ValueError, match="^a planar domain takes planar eyes, got 'spherical'$"):
+        Domain.for_eyes(EyePair3D(30.0, 10.0, 4))
+    with pytest.raises(
+        ValueError, match="^a 3D domain takes spherical or measured eyes, got 'planar'$"
+    ):
+        Domain3D.for_eyes(EyePair(30.0, 10.0, 36))
+    with pytest.raises(ValueError, match="takes planar, spherical or measured eyes, got None"):
+        domain_for(object())
+    with pytest.raises(ValueError, match="^unknown range 'el_max' \\(r_min, r_max, g_max\\)$"):
+        domain_for(EyePair(30.0, 10.0, 36), el_max=0.5)
+    with pytest.raises(ValueError, match="exactly one of m .* got m and nside"):
+        domain_from_dict({"m": 36, "nside": 4})

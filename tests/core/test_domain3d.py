@@ -11,8 +11,7 @@ import pytest
 
 from eyeviz import EyevizError
 from eyeviz.core.bounds import MAX_NSIDE
-from eyeviz.core.domain import DEFAULTS
-from eyeviz.core.domain3d import DEFAULT_EL_MAX, DEFAULTS3D, PAPER_DOMAIN3D, Domain3D
+from eyeviz.core.domain import DEFAULT_EL_MAX, DEFAULTS, DEFAULTS3D, PAPER_DOMAIN3D, Domain3D
 
 
 def test_defaults_are_the_papers_and_the_stated_band():
@@ -88,7 +87,7 @@ def test_eyes_are_the_spherical_pair_of_the_design():
 def test_measured_domain_defaults_are_the_papers_ratios_at_the_animals_scale(honeybee):
     """r_max = h / dphi (the paper's r_max = 5000 is 40 / (2 pi / 720) = 4584 to 10 %),
     r_min = r_max / 5, g_max = r_min / 2, el_max = pi/2; h, l the pair's own."""
-    from eyeviz.core.domain3d import facet_spacing, measured_ranges
+    from eyeviz.core.domain import facet_spacing, measured_ranges
 
     d = Domain3D.for_eyes(honeybee)
     dphi = np.median([facet_spacing(e.unit_axes) for e in (honeybee.eye_a, honeybee.eye_b)])

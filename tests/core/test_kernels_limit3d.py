@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.core.measured import MeasuredEye, MeasuredEyePair
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import limit3d_exact, limit3d_healpix

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from eyeviz import EyevizError
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import algorithm1_3d as A
 from eyeviz.dataset import sparse3d
 from eyeviz.dataset.records3d import spherical_to_xyz

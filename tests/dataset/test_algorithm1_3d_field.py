@@ -6,7 +6,7 @@ import pytest
 
 from eyeviz import EyevizError
 from eyeviz.cli import main
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import _sight_clear, generate3d, make_params3d
 
 D = Domain3D(nside=8)

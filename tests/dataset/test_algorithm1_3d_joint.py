@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import algorithm1_3d as A
 
 DOM = Domain3D(h=30, l=10, nside=64, r_min=100, r_max=400, g_max=60, el_max=0.4)

@@ -59,7 +59,7 @@ def test_a_spherical_data_set_is_named_as_such(tmp_path):
 
 
 def _small_domain3d():
-    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.core.domain import Domain3D
 
     return Domain3D(nside=8, r_min=100.0, r_max=300.0, g_max=30.0)
 

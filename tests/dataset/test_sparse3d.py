@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from eyeviz import EyevizError
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import embedded_eyes, sparse3d
 from eyeviz.dataset.records3d import Dataset3D, index_dtype, spherical_to_xyz
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from eyeviz import EyevizError
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import embedded_eyes, kinds, sparse3d
 from eyeviz.dataset.algorithm1_3d import generate3d, make_params3d
 from eyeviz.dataset.records3d import spherical_to_xyz

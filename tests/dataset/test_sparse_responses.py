@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from eyeviz import EyevizError, cli
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import sparse3d
 from eyeviz.dataset.algorithm1_3d import generate3d
 

@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from eyeviz import EyevizError
-from eyeviz.core.domain import Domain
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain, Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import registry
 from eyeviz.estimators.analytic3d import Analytic3DEstimator, triangulate

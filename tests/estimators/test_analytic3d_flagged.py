@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.core.geometry3d import EyePair3D
 from eyeviz.estimators import load
 

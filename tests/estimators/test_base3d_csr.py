@@ -85,7 +85,7 @@ class _Unchecking(base3d.Estimator3D):
     checks_indices = True
 
     def __init__(self):
-        from eyeviz.core.domain3d import Domain3D
+        from eyeviz.core.domain import Domain3D
 
         super().__init__(Domain3D(nside=8))  # npix 768
         self.seen = []

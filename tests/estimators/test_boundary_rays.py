@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import analytic3d
 from eyeviz.estimators.triangulation import boundary_rays, lens_rays, triangulate_rays

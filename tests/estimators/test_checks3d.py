@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.estimators import registry
 from eyeviz.estimators.analytic3d import Analytic3DEstimator
 from eyeviz.estimators.checks import check_estimator, estimator_checks

@@ -11,8 +11,7 @@ import pytest
 
 from eyeviz import EyevizError
 from eyeviz.core import healpix
-from eyeviz.core.domain import Domain
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain, Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import learned3d, metrics
 from eyeviz.estimators.learned3d_features import (

@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from eyeviz.core import healpix
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import base3d, learned3d
 from eyeviz.estimators import healpix_summaries as lf

@@ -8,7 +8,7 @@ import re
 import numpy as np
 import pytest
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import registry
 from eyeviz.estimators.analytic3d import Analytic3DEstimator

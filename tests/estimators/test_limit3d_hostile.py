@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.estimators import limit3d
 from eyeviz.estimators.analytic3d import estimate
 

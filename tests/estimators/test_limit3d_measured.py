@@ -8,7 +8,7 @@ import collections
 import numpy as np
 import pytest
 
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.core.measured import MeasuredEye, MeasuredEyePair
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import registry

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from eyeviz import EyevizError
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.estimators import registry
 from eyeviz.model import predictions3d as p3
 from eyeviz.model import scene as scene_mod

@@ -90,7 +90,7 @@ def test_a_ball_at_an_eye_centre_has_no_cone_and_no_warning():
 
 def test_triangulation_near_the_float_range_flags_rather_than_warns():
     from eyeviz.core import healpix
-    from eyeviz.core.domain3d import Domain3D
+    from eyeviz.core.domain import Domain3D
     from eyeviz.estimators.analytic3d import estimate, triangulate
 
     nside = 8

@@ -5,7 +5,7 @@ import csv
 import numpy as np
 
 from eyeviz.cli import main
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.dataset.sparse3d import write3d
 from eyeviz.estimators import registry

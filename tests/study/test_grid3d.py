@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from eyeviz import EyevizError
-from eyeviz.core.domain3d import Domain3D
+from eyeviz.core.domain import Domain3D
 from eyeviz.estimators import registry
 from eyeviz.estimators.metrics import bootstrap_se
 from eyeviz.study.grid3d import design_grid3d
