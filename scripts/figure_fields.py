@@ -20,7 +20,7 @@ import numpy as np
 
 from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import _sight_clear
-from eyeviz.dataset.records3d import spherical_to_xyz
+from eyeviz.dataset.records import spherical_to_xyz
 
 
 def classify(d: Domain3D, n: int, seed: int):

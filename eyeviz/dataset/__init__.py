@@ -1,7 +1,8 @@
 """Algorithm 1 (single- and multi-pass) and the paper's data set files (CSV, NPZ).
 
-Stable public path ``eyeviz.dataset``: :mod:`eyeviz.dataset.records` holds the records
-(:class:`Dataset`, :class:`Chunk`; a leaf), :mod:`eyeviz.dataset.algorithm1` samples,
+Stable public path ``eyeviz.dataset``: :mod:`eyeviz.dataset.records` holds the records of
+every eye model (:class:`Dataset`, :class:`Chunk`, :class:`Dataset3D`; a leaf),
+:mod:`eyeviz.dataset.algorithm1` samples,
 :mod:`eyeviz.dataset.io` reads and writes. Every generator function takes the one
 parameter record, :class:`eyeviz.core.domain.Domain`, in place of ``eyes`` (or the eyes
 and ranges separately); the defaults are Tables 3-4 (``eyeviz.core.domain.DEFAULTS``).
@@ -30,7 +31,7 @@ from eyeviz.dataset.algorithm1 import (
     write,
 )
 from eyeviz.dataset.algorithm1_3d import generate3d, iter_chunks3d, make_params3d
-from eyeviz.dataset.records3d import Dataset3D
+from eyeviz.dataset.records import Dataset3D
 from eyeviz.dataset.sparse3d import Sparse3DReader, load3d, write3d
 
 __all__ = [

@@ -63,7 +63,7 @@ from eyeviz.core.bounds import check_r_min, check_segments
 from eyeviz.core.domain import Domain3D
 from eyeviz.core.validation import check_choice, check_int, num
 from eyeviz.dataset.algorithm1 import SEGMENT_WIDTH, segment_labels
-from eyeviz.dataset.records3d import Dataset3D, index_dtype, spherical_to_xyz
+from eyeviz.dataset.records import Dataset3D, index_dtype, spherical_to_xyz
 from eyeviz.files import limits
 
 __all__ = [

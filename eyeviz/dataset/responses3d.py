@@ -15,7 +15,7 @@ import numpy as np
 from eyeviz import EyevizError
 from eyeviz.core.responses import KINDS_BY_MODEL
 from eyeviz.dataset.embedded_eyes import LIT_CHECK_ROWS
-from eyeviz.dataset.records3d import Dataset3D
+from eyeviz.dataset.records import Dataset3D
 
 __all__ = ["VALUE_MEMBERS", "check_kind", "with_values", "check_values", "check_value_rows"]
 

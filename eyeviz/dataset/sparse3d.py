@@ -50,7 +50,7 @@ from eyeviz.core.domain import FIELDS3D, Domain3D
 from eyeviz.core.validation import check_int
 from eyeviz.dataset import embedded_eyes, responses3d
 from eyeviz.dataset.algorithm1_3d import check_n, iter_chunks3d, make_params3d
-from eyeviz.dataset.records3d import Dataset3D, index_dtype
+from eyeviz.dataset.records import Dataset3D, index_dtype
 from eyeviz.dataset.spools import Spools
 from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output

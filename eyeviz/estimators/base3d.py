@@ -5,13 +5,13 @@ facets are given, per eye, as one of
 
 - **CSR rows** ``(indptr, indices)`` (:data:`LitCSR`): row i lit the sorted RING indices
   ``indices[indptr[i]:indptr[i + 1]]``, as the 3D data set stores them
-  (:class:`eyeviz.dataset.records3d.Dataset3D`, ``EyePair3D.lit_csr``);
+  (:class:`eyeviz.dataset.records.Dataset3D`, ``EyePair3D.lit_csr``);
 - **dense bitmaps**: bool (or 0/1) arrays (npix,) for one row or (N, npix).
 
 ``predict(lit_a, lit_b)`` answers a :class:`Prediction3D` (r, azimuth, elevation) in the
 data set's convention: the ball's centre (x, y, z) = r (cos el cos az, cos el sin az,
 sin el) about the origin midway between the eyes, az = atan2(y, x) (in (0, pi) in front),
-el = asin(z / r) (:func:`eyeviz.dataset.records3d.spherical_to_xyz`).
+el = asin(z / r) (:func:`eyeviz.dataset.records.spherical_to_xyz`).
 ``predict_dataset(ds)`` takes a :class:`Dataset3D` (a generated chunk or a
 ``Sparse3DReader`` block) directly.
 
@@ -261,7 +261,7 @@ class Estimator3D:
         return Prediction3D(r, az, el, valid, in_dom, flagged)
 
     def predict_dataset(self, ds) -> Prediction3D:
-        """:meth:`predict` on the rows of a :class:`~eyeviz.dataset.records3d.Dataset3D`
+        """:meth:`predict` on the rows of a :class:`~eyeviz.dataset.records.Dataset3D`
         (a generated chunk, ``load3d``'s data set or a ``Sparse3DReader`` block)."""
         for k in ("indptr_a", "indices_a", "indptr_b", "indices_b"):
             if not hasattr(ds, k):

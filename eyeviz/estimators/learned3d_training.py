@@ -27,7 +27,7 @@ from eyeviz import EyevizError
 from eyeviz.core.bounds import MAX_THREADS
 from eyeviz.core.domain import DEFAULT_EL_MAX, Domain, Domain3D
 from eyeviz.core.validation import check_int, check_real, num
-from eyeviz.dataset.records3d import Dataset3D
+from eyeviz.dataset.records import Dataset3D
 from eyeviz.estimators import metrics
 from eyeviz.estimators.fit_loop import fit_one_cycle
 from eyeviz.estimators.learned3d import (

@@ -11,7 +11,7 @@ again; three ghosts and a cloud per ball would also bury a scene of several ball
 :mod:`eyeviz.estimators.registry`: analytic3d, learned3d, limit3d) take the ball's two lit
 sets (the 3D Proposition 2) and answer ``(r, azimuth, elevation)`` about the origin midway
 between the eyes; the ghost is a ball of the true radius g at that answer's centre
-(:func:`eyeviz.dataset.records3d.spherical_to_xyz`: x = r cos el cos az, y = r cos el
+(:func:`eyeviz.dataset.records.spherical_to_xyz`: x = r cos el cos az, y = r cos el
 sin az, z = r sin el). The errors are against the true ball: r relative (in %), azimuth
 (wrapped to (-180, 180]) and elevation absolute, in degrees. Every estimator is loaded for
 the scene's design (h, l, nside) with Table 4's ranges of r and g and the elevation band
@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from eyeviz.core.domain import Domain3D
-from eyeviz.dataset.records3d import spherical_to_xyz
+from eyeviz.dataset.records import spherical_to_xyz
 from eyeviz.model.palette import estimator_color
 from eyeviz.model.scene import SPHERICAL_ESTIMATORS, Scene
 from eyeviz.model.state3d import SceneState3D

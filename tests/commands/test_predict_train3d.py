@@ -132,7 +132,7 @@ def test_learned3d_over_the_poles_is_flagged_never_written_unmarked(tmp_path, ca
     assert bool(p.flagged[0])
     assert not np.isfinite(p.r[0]) or learned3d.inside_domain(d, p.r, p.azimuth, p.elevation)[0]
     # the CLI on a file holding such a row beside ordinary ones
-    from eyeviz.dataset.records3d import Dataset3D
+    from eyeviz.dataset.records import Dataset3D
 
     good = sparse3d.load3d(_shipped_like(tmp_path, d))
     rows = []

@@ -13,7 +13,7 @@ from eyeviz import EyevizError
 from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import algorithm1_3d as A
 from eyeviz.dataset import sparse3d
-from eyeviz.dataset.records3d import spherical_to_xyz
+from eyeviz.dataset.records import spherical_to_xyz
 
 DOM = Domain3D(h=30, l=10, nside=8, r_min=100, r_max=400, g_max=60, el_max=0.4)
 

@@ -21,7 +21,7 @@ import pytest
 from eyeviz import EyevizError
 from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import embedded_eyes, sparse3d
-from eyeviz.dataset.records3d import Dataset3D, index_dtype, spherical_to_xyz
+from eyeviz.dataset.records import Dataset3D, index_dtype, spherical_to_xyz
 
 DOM = Domain3D(h=30, l=10, nside=4, r_min=100, r_max=400, g_max=60, el_max=0.4)
 PARAMS = {"mode": "single", "seed": 3, "segments": None}

@@ -18,7 +18,7 @@ from eyeviz import EyevizError
 from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import embedded_eyes, kinds, sparse3d
 from eyeviz.dataset.algorithm1_3d import generate3d, make_params3d
-from eyeviz.dataset.records3d import spherical_to_xyz
+from eyeviz.dataset.records import spherical_to_xyz
 
 
 @pytest.fixture(scope="module")
