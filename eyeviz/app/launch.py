@@ -11,7 +11,7 @@ from PyQt5 import QtCore, QtWidgets
 from eyeviz import EyevizError
 from eyeviz.core import kernels
 
-__all__ = ["APP_FONT_PT", "check_display", "make_app"]
+__all__ = ["APP_FONT_PT", "check_display", "make_app", "warm_kernels"]
 
 APP_FONT_PT = 13
 
@@ -47,7 +47,12 @@ def check_display() -> None:
     x11.XCloseDisplay(dpy)
 
 
-def make_app() -> QtWidgets.QApplication:
+def make_app(warm: bool = True) -> QtWidgets.QApplication:
+    """The QApplication, set up for the view. ``warm``: start loading the compiled kernels
+    on a background thread now; else they wait for :func:`warm_kernels` (``eyeviz app``
+    starts them once the window is up: loading numba beside the window's own imports and
+    first frames held the GIL and made the start 1-2 s slower, issue 32.14). Either way,
+    until they are ready the core answers with its numpy reference."""
     app = QtWidgets.QApplication.instance()
     if app is None:
         QtWidgets.QApplication.setAttribute(QtCore.Qt.ApplicationAttribute.AA_ShareOpenGLContexts)
@@ -62,5 +67,12 @@ def make_app() -> QtWidgets.QApplication:
     app.setFont(font)
     # the compiled kernels load (or compile) on a background thread; until they are
     # ready the core answers with its numpy reference, so no drag waits for numba
-    kernels.warm_in_background()
+    kernels.defer_until_warm()
+    if warm:
+        kernels.warm_in_background()
     return app
+
+
+def warm_kernels() -> None:
+    """Start loading the compiled kernels on a background thread (see :func:`make_app`)."""
+    kernels.warm_in_background()

@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import os
 
-from eyeviz.app.launch import check_display, make_app
+from PyQt5 import QtCore
+
+from eyeviz.app.launch import check_display, make_app, warm_kernels
 from eyeviz.app.screenshot import screenshot_format
 from eyeviz.app.settings import make_settings
 from eyeviz.app.window import MainWindow
@@ -34,7 +36,7 @@ def run_app(
     settings = make_settings(settings_path)
     # a screenshot reads the saved window state but never changes it (nor recent files)
     settings.read_only = screenshot is not None
-    app = make_app()
+    app = make_app(warm=False)  # the kernels load once the window is up (below)
     win = MainWindow(scene, scene_path, settings=settings)
     if settings.refused:
         win.statusBar().showMessage(settings.refused, 15000)
@@ -50,5 +52,6 @@ def run_app(
         out = win.save_screenshot(screenshot)
         print(out)
         win.force_close()
-        return 0
+        return 0  # a screenshot never loads them: the reference drew it
+    QtCore.QTimer.singleShot(0, warm_kernels)  # the first event after the first frame
     return app.exec_()

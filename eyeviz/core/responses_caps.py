@@ -27,7 +27,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import special
 
 __all__ = [
     "FWHM_TO_SIGMA",
@@ -173,6 +172,8 @@ def kernel_G(psi, sigma) -> np.ndarray:
         z1 = (ps - 1j * sg * sg) / (sg * r2)
         z0 = -1j * sg / r2
         scale = np.exp(-sg * sg / 2) * sg * math.sqrt(math.pi / 2)
+        from scipy import special  # here: importing scipy.special costs an app start 0.2 s
+
         val = scale * (special.erf(z1) - special.erf(z0))
         out[big] = val.imag
     return out

@@ -268,6 +268,25 @@ def test_app_does_not_import_torch(tmp_path):
 
 
 @pytest.mark.slow
+def test_spherical_window_loads_nothing_its_first_frame_does_not_need(tmp_path):
+    # issue 32.14: numba (the kernels' warm-up thread), scipy and the data-set package
+    # were loaded while the window built its first frame; the kernels now load after it
+    # (a screenshot never needs them), scipy.special and eyeviz.dataset when first used
+    code = (
+        "import sys\n"
+        "from eyeviz.app.main import run_app\n"
+        f"run_app({str(ROOT / 'assets/scenes/sphere_lecture.toml')!r}, "
+        f"{str(tmp_path / 'w.png')!r}, {str(tmp_path / 's.ini')!r})\n"
+        "loaded = [m for m in ('numba', 'scipy', 'eyeviz.dataset') if m in sys.modules]\n"
+        "print('loaded:', *loaded)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "w.png").stat().st_size > 10_000
+    assert r.stdout.strip().splitlines()[-1] == "loaded:"
+
+
+@pytest.mark.slow
 def test_cli_screenshot(tmp_path):
     out = tmp_path / "cli.png"
     r = subprocess.run(

@@ -198,3 +198,23 @@ def test_the_png_is_the_whole_figure_with_the_vtk_view(name, scale, width, tmp_p
     wrong_img = _figure_rgb(turned, dpi)[r0:r1, c0:c1] / 255.0
     wrong = _agreement(got[r0:r1, c0:c1] / 255.0, wrong_img, colors)
     assert [r for r in wrong if not (r[2] <= CENTROID and r[3] >= IOU)], wrong
+
+
+@pytest.mark.parametrize("k", [2, 3, 4])
+def test_the_supersampled_view_is_averaged_by_alpha_weight(k):
+    # each output pixel: alpha the block's mean, colour the alpha-weighted mean (0 where
+    # the block is clear), rounded; summed in integers since issue 32.14
+    from eyeviz.render.vtk.png3d import _downsample
+
+    rng = np.random.default_rng(k)
+    img = rng.integers(0, 256, (6 * k, 5 * k, 4), dtype=np.uint8)
+    img[: 2 * k, :, 3] = 255  # opaque rows
+    img[2 * k : 3 * k, :k, 3] = 0  # one clear block
+    out = _downsample(img, k)
+    f = img.astype(np.float64).reshape(6, k, 5, k, 4)
+    a = f[..., 3].sum(axis=(1, 3))
+    rgb = (f[..., :3] * f[..., 3:4]).sum(axis=(1, 3)) / np.maximum(a, 1)[..., None]
+    want = np.concatenate([rgb, (a / (k * k))[..., None]], axis=-1)
+    assert out.shape == (6, 5, 4) and out.dtype == np.uint8
+    assert np.abs(out - want).max() <= 0.5 + 1e-9
+    assert (out[2, 0] == 0).all()

@@ -66,13 +66,21 @@ def view_rgba(
 
 
 def _downsample(img: np.ndarray, k: int) -> np.ndarray:
-    """``img`` (H k, W k, 4 uint8) averaged over k x k blocks, colours weighted by alpha."""
+    """``img`` (H k, W k, 4 uint8) averaged over k x k blocks, colours weighted by alpha.
+
+    Summed in integers block slice by block slice (k^2 adds of one output's size; the
+    float64 copy of the whole k^2-size image took 0.4 s of a 3D snapshot, issue 32.14)."""
     h, w = img.shape[0] // k, img.shape[1] // k
-    f = img.reshape(h, k, w, k, 4).astype(np.float64)
-    a = f[..., 3:4]
-    a_mean = a.mean(axis=(1, 3))
-    rgb = (f[..., :3] * a).mean(axis=(1, 3)) / np.maximum(a_mean, 1e-9)
-    out = np.concatenate([rgb, a_mean], axis=-1)
+    a_sum = np.zeros((h, w), np.uint32)
+    rgb_sum = np.zeros((h, w, 3), np.uint32)
+    for i in range(k):
+        for j in range(k):
+            block = img[i : h * k : k, j : w * k : k]
+            a = block[..., 3].astype(np.uint32)
+            a_sum += a
+            rgb_sum += block[..., :3] * a[..., None]
+    rgb = rgb_sum / np.maximum(a_sum, 1)[..., None]  # 0 where every pixel is clear
+    out = np.concatenate([rgb, (a_sum / float(k * k))[..., None]], axis=-1)
     return np.clip(np.round(out), 0, 255).astype(np.uint8)
 
 
