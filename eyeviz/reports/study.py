@@ -14,7 +14,8 @@ Okabe-Ito colours, text >= 7 pt at print size):
     every measured bin against gamma r / (2h) on log-log axes with the fitted C.
 
 A 3D study table (``eyeviz study --nside``) gets the 3D figures instead
-(:mod:`eyeviz.reports.study3d`).
+(:mod:`eyeviz.reports.study3d`); ``--band W`` merges its 500-wide distance bins into bands
+W wide first (3D only: a planar table is refused with it).
 
 For each h the panels and the heatmap use the paper's l (``--l``, default 20) when the
 table has it, else the l nearest to it (stated in the label). The paper's design
@@ -71,6 +72,7 @@ from eyeviz.reports.study_summary import (
     summary_json,
 )
 from eyeviz.reports.study_table import Row, read_study
+from eyeviz.study.point import BIN_WIDTH
 from eyeviz.study.table3d import is_table3d
 
 # The analysis, figures and summaries live in study_design, study_law, study_figures and
@@ -124,15 +126,22 @@ def write_report(
     l_wanted: float = PAPER[1],
     law_max: float = LAW_MAX,
     target: float = 5.0,
+    band: float | None = None,
 ) -> list[Path]:
-    """Read the study table at ``path`` and write every figure and summary into ``outdir``."""
-    for name, v in (("--at", at), ("--l", l_wanted), ("--law-max", law_max), ("--target", target)):
+    """Read the study table at ``path`` and write every figure and summary into ``outdir``
+    (``band``: a 3D table's distance bins merged into bands that wide)."""
+    checks = (("--at", at), ("--l", l_wanted), ("--law-max", law_max), ("--target", target))
+    for name, v in (*checks, ("--band", BIN_WIDTH if band is None else band)):
         if not (math.isfinite(v) and v > 0):
             raise EyevizError(f"{name} must be a finite number > 0, got {v!r}")
     if is_table3d(path):  # eyeviz study --nside: the 3D report (its own figures)
         from eyeviz.reports.study3d import write_report3d
 
-        return write_report3d(path, outdir, prior, l_wanted)
+        return write_report3d(
+            path, outdir, prior, l_wanted, band=BIN_WIDTH if band is None else band
+        )
+    if band is not None:
+        raise EyevizError(f"--band applies to a 3D study table only; {path} is a planar one")
     rows = read_study(path)
     if prior is None:  # the table's only prior, else the single-pass one
         have = sorted({r.prior for r in rows})
@@ -199,11 +208,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=5.0,
         help="DD error (%%) for the 'fewest ommatidia' table (default 5)",
     )
+    parser.add_argument(
+        "--band",
+        type=float,
+        default=None,
+        help=f"3D table: merge its {BIN_WIDTH:g}-wide distance bins into bands this wide "
+        "(a multiple) for the figures, the law's fit and the summary (default: as they are)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
     paths = write_report(
-        args.table, args.output, args.at, args.prior, args.l_wanted, args.law_max, args.target
+        args.table,
+        args.output,
+        args.at,
+        args.prior,
+        args.l_wanted,
+        args.law_max,
+        args.target,
+        args.band,
     )
     print(f"wrote {len(paths)} files into {args.output}")
     return 0

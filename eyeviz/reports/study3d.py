@@ -21,16 +21,21 @@ report answers the 3D study's questions:
 Fitted: distance bins with at least :data:`~eyeviz.reports.study_design.MIN_COUNT`
 elements, at most :data:`FLAG_MAX` of them flagged (the estimator fell back: diverging
 rays, an empty posterior), not the first or last bin of a design (the prior's bounds
-truncate there) and a relative error <= :data:`FIT_MAX` (where it saturates, the prior's
-range bounds it). The estimator is named in every figure's title: only the limit is the
-accuracy limit (``limit3d``); any other (``analytic3d``) is an upper bound on its MAPE.
+truncate there; a design of one or two bins keeps them), a relative error <=
+:data:`FIT_MAX` (where it saturates, the prior's range bounds it) and, where the table
+states it, a sampling error of the bin's DD at most :data:`REL_MAX` of the DD (issue
+38.3). ``band`` (``eyeviz report study --band W``) first merges the table's 500-wide
+distance bins into bands W wide (:func:`merge_bins`), so that each holds enough balls for
+that error; the figures, the fit and the summary then use the bands. The estimator is
+named in every figure's title: only the limit is the accuracy limit (``limit3d``); any
+other (``analytic3d``) is an upper bound on its MAPE.
 """
 
 from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -39,15 +44,19 @@ from eyeviz import EyevizError
 from eyeviz.core import paper
 from eyeviz.reports.study_design import MIN_COUNT
 from eyeviz.reports.study_law import LawFit, LawPoint, fit_law
+from eyeviz.study.point import BIN_WIDTH
 from eyeviz.study.table3d import iter_rows3d
 
 __all__ = [
     "FIT_MAX",
     "PAPER3D",
+    "REL_MAX",
     "Design3D",
+    "band_designs",
     "bin_errors",
     "fit_power",
     "law_points3d",
+    "merge_bins",
     "law_uncertainty",
     "read_study3d",
     "write_report3d",
@@ -61,6 +70,8 @@ LIMITS = ("limit3d", "limit")
 FLAG_MAX = 0.05
 #: Largest relative DD error (a fraction) of a bin used in the fits.
 FIT_MAX = 0.10
+#: Largest sampling error of a fitted bin's DD relative to the DD (issue 38.3: 5 %).
+REL_MAX = 0.05
 
 
 @dataclass
@@ -123,20 +134,69 @@ def designs3d(rows: list[dict], estimator: str, prior: str) -> dict[tuple, Desig
     return out
 
 
+_MERGED_MEANS = ("dd_mape", "ad_mape", "el_mae_deg", "az_mae_deg")
+
+
+def merge_bins(bins: list[dict], width: float) -> list[dict]:
+    """Consecutive distance bins (of :data:`~eyeviz.study.point.BIN_WIDTH`, in order of r)
+    merged into bands ``width`` wide, a whole multiple of the bin width; empty bands are
+    left out. The bins are disjoint sets of balls, so a band's mean errors (DD and AD
+    MAPE, elevation and azimuth mean |error|) are its bins' means weighted by their
+    counts, exactly the means over the band's balls, and a band's sampling error the
+    stratified one: se = sqrt(sum (count_i se_i)^2) / sum count_i (``dd_se``, ``el_se``).
+    ``r_mid`` is the mean of the bins' mid-distances weighted by their counts: the law's
+    r for the band (its predicted DD is the mean of C gamma r / (2h) over the balls)."""
+    k = width / BIN_WIDTH
+    if not (math.isfinite(k) and k >= 1 and abs(k - round(k)) < 1e-9):
+        raise EyevizError(
+            f"--band must be a whole multiple of the table's {BIN_WIDTH:g}-wide bins, got {width!r}"
+        )
+    per = round(k)
+    out = []
+    for j, i in enumerate(range(0, len(bins), per)):
+        part = [b for b in bins[i : i + per] if b["count"] > 0]
+        n = sum(b["count"] for b in part)
+        if not n:
+            continue
+        band = {"bin": f"r{j}", "lo": bins[i]["lo"], "hi": bins[min(i + per, len(bins)) - 1]["hi"]}
+        band["count"], band["flagged"] = n, sum(b["flagged"] for b in part)
+        for key in _MERGED_MEANS:
+            band[key] = sum(b["count"] * b.get(key, math.nan) for b in part) / n
+        for key in ("dd_se", "el_se"):
+            band[key] = math.sqrt(sum((b["count"] * b.get(key, math.nan)) ** 2 for b in part)) / n
+        band["r_mid"] = sum(b["count"] * 0.5 * (b["lo"] + b["hi"]) for b in part) / n
+        out.append(band)
+    return out
+
+
+def band_designs(designs: dict[tuple, Design3D], width: float) -> dict[tuple, Design3D]:
+    """The designs with their distance bins merged into bands ``width`` wide
+    (:func:`merge_bins`); the overall and elevation rows as they are."""
+    return {k: replace(d, r_bins=merge_bins(d.r_bins, width)) for k, d in designs.items()}
+
+
+def _precise(b: dict) -> bool:
+    """Whether the bin's stated sampling error is at most :data:`REL_MAX` of its DD (a bin
+    without a stated error, as in a version 1 table, passes: it has nothing to check)."""
+    se = b.get("dd_se", math.nan)
+    return not math.isfinite(se) or se <= REL_MAX * b["dd_mape"]
+
+
 def law_points3d(designs: dict[tuple, Design3D]) -> list[LawPoint]:
     """Every distance bin as (x = gamma r_mid / (2h), y = relative DD error); ``fitted``
-    as this module's docstring says. ``m`` holds 4 nside."""
+    as this module's docstring says. ``m`` holds 4 nside; ``r_mid`` is a merged band's
+    own (:func:`merge_bins`), else the bin's middle."""
     out = []
     for d in designs.values():
         n = len(d.r_bins)
         for i, b in enumerate(d.r_bins):
             if b["count"] < MIN_COUNT or not (b["dd_mape"] > 0):
                 continue
-            r_mid = 0.5 * (b["lo"] + b["hi"])
+            r_mid = b.get("r_mid", 0.5 * (b["lo"] + b["hi"]))
             y = b["dd_mape"] / 100.0
             interior = n < 3 or 0 < i < n - 1
             few_flags = b["flagged"] <= FLAG_MAX * b["count"]
-            fitted = interior and few_flags and y <= FIT_MAX
+            fitted = interior and few_flags and y <= FIT_MAX and _precise(b)
             paper = d.key == PAPER3D
             out.append(
                 LawPoint(
@@ -239,8 +299,10 @@ def write_report3d(
     prior: str | None = None,
     l_wanted: float = PAPER3D[1],
     estimator: str | None = None,
+    band: float = BIN_WIDTH,
 ) -> list[Path]:
-    """Read the 3D study table at ``path`` and write the figures and summary into ``outdir``."""
+    """Read the 3D study table at ``path`` and write the figures and summary into
+    ``outdir``, the distance bins merged into bands ``band`` wide (:func:`merge_bins`)."""
     import matplotlib
 
     from eyeviz.reports.study3d_figures import (
@@ -258,6 +320,8 @@ def write_report3d(
         prior = have[0] if len(have) == 1 else "single"
     est = estimator or choose_estimator(rows)
     designs = designs3d(rows, est, prior)
+    if band != BIN_WIDTH:
+        designs = band_designs(designs, band)
     points = law_points3d(designs)
     fit: LawFit = fit_law(points, x_max=math.inf)
     power = fit_power(points)
@@ -290,9 +354,10 @@ def write_report3d(
             **law_uncertainty(points),
         },
         "power_law": power,
-        "fit_rule": f"interior distance bins, >= {MIN_COUNT} elements, <= {FLAG_MAX:.0%} "
-        "flagged, "
-        f"relative DD error <= {FIT_MAX:g}",
+        "band": band,
+        "fit_rule": f"interior distance bins ({band:g} wide), >= {MIN_COUNT} elements, "
+        f"<= {FLAG_MAX:.0%} flagged, relative DD error <= {FIT_MAX:g}, sampling error of "
+        f"the DD <= {REL_MAX:.0%} of it where stated",
         "designs": [
             {
                 "h": d.h,

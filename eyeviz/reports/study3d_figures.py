@@ -116,8 +116,14 @@ def dd_figure(designs: dict, l_of: dict, fit: LawFit, estimator: str):
             if d is None:
                 continue
             bins = [b for b in d.r_bins if b["count"] >= MIN_COUNT]
-            r = np.array([0.5 * (b["lo"] + b["hi"]) for b in bins])
-            ax.plot(r, [b["dd_mape"] for b in bins], marker="o", ms=2.4, lw=1.3, **style[nv])
+            r = np.array([b.get("r_mid", 0.5 * (b["lo"] + b["hi"])) for b in bins])
+            dd = [b["dd_mape"] for b in bins]
+            ax.plot(r, dd, marker="o", ms=2.4, lw=1.3, **style[nv])
+            se = np.array([b.get("dd_se", math.nan) for b in bins], float)
+            if np.isfinite(se).any():  # each bin's sampling error, where the table states it
+                ax.errorbar(
+                    r, dd, yerr=se, fmt="none", lw=0.8, capsize=1.5, color=style[nv]["color"]
+                )
             if fit.C is not None and r.size:
                 law = 100 * fit.C * d.gamma * r / (2 * h)
                 ax.plot(r, law, lw=0.8, ls=(0, (3, 2)), color=style[nv]["color"])
@@ -137,7 +143,9 @@ def dd_figure(designs: dict, l_of: dict, fit: LawFit, estimator: str):
         handles.append(Line2D([], [], lw=0.8, ls=(0, (3, 2)), color="black"))
         labels.append(f"dashed: the planar law's form C·γr/(2h), C = {fit.C:.3g} fitted in 3D")
     fig.legend(handles, labels, loc="outside lower center", ncol=2, frameon=False)
-    _title(fig, "Distance error against r: does the γr/(2h) law carry over?", estimator)
+    have_se = any(np.isfinite(b.get("dd_se", math.nan)) for d in designs.values() for b in d.r_bins)
+    what = "Distance error against r: does the γr/(2h) law carry over?"
+    _title(fig, what + (" (bars: ± 1 s.e.)" if have_se else ""), estimator)
     return fig
 
 
