@@ -1,4 +1,5 @@
-"""The 3D check battery: the spherical estimators pass it, broken ones fail it."""
+"""The check battery of the eyes in space (checks.SPACE): the spherical estimators pass
+it, broken ones fail it."""
 
 from __future__ import annotations
 
@@ -28,7 +29,7 @@ def test_learned3d_passes_at_its_design():
     if "learned3d" not in registry.available("spherical"):
         pytest.skip("learned3d is not registered")
     est = registry.load("learned3d")
-    assert "check_masks3d" in check_estimator(est)
+    assert "check_masks" in check_estimator(est)
 
 
 class _OrderDependent(Analytic3DEstimator):
@@ -49,7 +50,7 @@ class _ElevationSlip(Analytic3DEstimator):
 
 @pytest.mark.parametrize(
     ("bad", "which"),
-    [(_OrderDependent, "check_rows_independent3d"), (_ElevationSlip, "check_sensible_answers3d")],
+    [(_OrderDependent, "check_rows_independent"), (_ElevationSlip, "check_sensible_answers")],
 )
 def test_broken_estimators_fail(bad, which):
     with pytest.raises(AssertionError, match=which):
@@ -61,4 +62,17 @@ def test_the_analytic_estimator_on_a_measured_pair_passes_the_battery(toy_pair):
     estimator passes the checks the HEALPix estimators pass."""
     est = registry.load("analytic3d", domain=Domain3D.for_eyes(toy_pair))
     done = check_estimator(est)
-    assert "check_rejects_bad_input3d" in done and "check_sensible_answers3d" in done
+    assert "check_rejects_bad_input" in done and "check_sensible_answers" in done
+
+
+def test_one_runner_has_a_battery_for_every_kind_of_domain():
+    from eyeviz.core.domain import RECORDS
+    from eyeviz.estimators import checks
+
+    assert set(checks.BATTERIES) == set(RECORDS)
+    assert checks.BATTERIES["measured"] is checks.BATTERIES["spherical"] is checks.SPACE
+    est = Analytic3DEstimator(D16)
+    assert [c for _, c in estimator_checks(est)] == list(checks.CHECKS3D)
+    est.domain = {"nside": 16}  # not a domain: the runner stops at the declaration
+    with pytest.raises(AssertionError, match="^analytic3d: check_declares_domain: domain must"):
+        check_estimator(est)
