@@ -114,6 +114,8 @@ def _covers(boxes: np.ndarray, keep_out: np.ndarray | None) -> bool:
 
 #: The ball labels' margin to the scene viewport's edges when a preset frames the scene.
 LABEL_MARGIN_PX = 6
+#: The pixels a ball's name keeps clear of the view's own texts (title, side note).
+KEEP_CLEAR_PX = 3
 
 
 def fit_labels(
@@ -218,23 +220,38 @@ class Scene3DActors:
         order, named = self.balls.named(st, np.concatenate(others), self._dpi(), self.selected)
         return order, replace(named, keep_out=self._text_boxes())
 
-    def _text_boxes(self) -> np.ndarray:
-        """Boxes (k, 4, the scene viewport's pixels, y up) of :attr:`keep_clear`'s shown
-        texts: at 175 % in a small window a name printed over the title (issue 32.3)."""
-        out = []
-        for actor in self.keep_clear:
+    def _text_boxes(self, actors=None) -> np.ndarray:
+        """Boxes (k, 4, the scene viewport's pixels, y up) of the shown texts among
+        ``actors`` (default :attr:`keep_clear`): at 175 % in a small window a name printed
+        over the title (issue 32.3).
+
+        A text actor's bounding box is relative to its anchor (the title's reached from
+        -57 to 0 px, under the view, so names were still placed over it at F11 + F5 +
+        175 % in 1280 x 720): moved by the anchor's viewport pixels, and grown by
+        :data:`KEEP_CLEAR_PX` so that no name touches it."""
+        ren, out, pad = self.scene_ren, [], KEEP_CLEAR_PX
+        for actor in self.keep_clear if actors is None else actors:
             if actor.GetVisibility() and actor.GetInput():
-                b = [0.0] * 4  # x0, x1, y0, y1
-                actor.GetBoundingBox(self.scene_ren, b)
-                out.append((b[0], b[2], b[1], b[3]))
+                b = [0.0] * 4  # x0, x1, y0, y1, relative to the anchor
+                actor.GetBoundingBox(ren, b)
+                ax, ay = actor.GetActualPositionCoordinate().GetComputedViewportValue(ren)
+                out.append((ax + b[0] - pad, ay + b[2] - pad, ax + b[1] + pad, ay + b[3] + pad))
         return np.array(out, float).reshape(-1, 4)
 
     def _place_names(self, *_args) -> None:
-        """Before the scene renders: each ball's name beside it, over nothing (issue 32.4)."""
+        """Before the scene renders: each ball's name beside it, over nothing (issue 32.4).
+        Where no place clear of the title is left (step 7 of sphere_lecture at F11 + F5 +
+        175 % in 1280 x 720: a 234 px high view, 51 px names, a 57 px title), the title
+        gives way until the view's size or text size changes (the step's caption says
+        more than the scene's title)."""
+        cam = camera_of(self.scene_ren)
         order, named = self._ball_names()
-        self.name_boxes = place_texts(
-            self.scene_ren, camera_of(self.scene_ren), self.balls.ball_labels, named, order
-        )
+        boxes = place_texts(self.scene_ren, cam, self.balls.ball_labels, named, order)
+        if self.title.GetInput() and _covers(boxes, self._text_boxes([self.title])):
+            self.title.SetInput("")
+            order, named = self._ball_names()
+            boxes = place_texts(self.scene_ren, cam, self.balls.ball_labels, named, order)
+        self.name_boxes = boxes
 
     def _place_eye_names(self, *_args) -> None:
         """Before the close-up renders: each eye's name under it, over nothing."""
@@ -255,7 +272,8 @@ class Scene3DActors:
     def _fit_title(self, *_args) -> None:
         """Break the title into lines that fit the scene's viewport (at most two, then
         "…"; one where two would take over a fifth of a short view's height: at 175 % in
-        a 1280 x 720 screen they left the balls' names no room); refitted only when the
+        a 1280 x 720 screen they left the balls' names no room; none while the names
+        find no place clear of it, see :meth:`_place_names`); refitted only when the
         view's size, the font size or the title change."""
         ren = self.scene_ren
         width, height = ren.GetSize()
