@@ -49,7 +49,7 @@ def main(argv: list[str] | None = None) -> int:
     from eyeviz.core.domain import Domain3D
     from eyeviz.dataset.algorithm1_3d import generate3d
     from eyeviz.estimators import registry
-    from eyeviz.estimators.base3d import take_rows
+    from eyeviz.estimators.base import take_rows
 
     d = Domain3D(nside=args.nside)
     ds = generate3d(args.n, d, seed=args.seed)

@@ -38,7 +38,7 @@ def main(argv: list[str] | None = None) -> int:
     from eyeviz.core import kernels
     from eyeviz.core.domain import Domain3D
     from eyeviz.dataset.algorithm1_3d import generate3d
-    from eyeviz.estimators.base3d import take_rows
+    from eyeviz.estimators.base import take_rows
     from eyeviz.estimators.limit3d import Limit3DEstimator
     from eyeviz.files.eye_io import load_eyes, shipped_eye
 

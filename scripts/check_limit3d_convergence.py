@@ -23,7 +23,7 @@ import numpy as np
 
 from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
-from eyeviz.estimators.base3d import take_rows
+from eyeviz.estimators.base import take_rows
 from eyeviz.estimators.limit3d import MC_TARGET, Limit3DEstimator
 from eyeviz.files.atomic import atomic_output
 from eyeviz.reports.errors import bootstrap_se

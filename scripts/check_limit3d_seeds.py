@@ -21,7 +21,7 @@ import numpy as np
 
 from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
-from eyeviz.estimators.base3d import take_rows
+from eyeviz.estimators.base import take_rows
 from eyeviz.estimators.limit3d import Limit3DEstimator
 from eyeviz.estimators.weighted import weighted_median
 from eyeviz.files.atomic import atomic_output

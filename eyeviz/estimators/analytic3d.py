@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from eyeviz.core.domain import PAPER_DOMAIN3D, Domain3D
-from eyeviz.estimators.base3d import Estimator3D, LitCSR
+from eyeviz.estimators.base import Estimator3D, LitCSR
 from eyeviz.estimators.triangulation import (
     boundary_rays,
     cap_estimates,

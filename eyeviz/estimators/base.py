@@ -1,13 +1,33 @@
-"""The estimator protocol: bitmaps (Omega_A, Omega_B) -> (r, phi) (docs/contract.md).
+"""The estimator protocol of every eye model: what each eye saw -> where the feature is.
 
-Every estimator sees the paper's half bitmaps of length m/2 (ommatidia 0..m/2-1, Section 4).
-A feature lights one contiguous run of ommatidia per eye (Prop. 2, Eq. 11), so a bitmap
-pair is fully described by four integers, the lit intervals (LA, RA, LB, RB):
-:func:`bitmaps_to_intervals` extracts them, vectorised, and every estimator shares it.
+One base, :class:`EstimatorBase`, holds what every estimator has: a ``name``, the eye
+models it answers for (``kinds``; a domain of another kind, or not a domain, is refused
+in one line), its domain and metadata, ``n_weights`` and its repr. Each model's input
+and answer are its subclass's (docs/contract.md; docs/spherical.md, "Estimators of the
+spherical eyes"):
 
-Rows that are not a single feature (an eye with nothing lit, or more than one lit run)
-get NaN and ``valid = False``; rows whose intervals could not come from the training
-domain (Table 3, Table 4) get ``in_domain = False``. Both masks travel with the result:
+- :class:`Estimator`, the planar eyes: the paper's half bitmaps (Omega_A, Omega_B) of
+  length m/2 (ommatidia 0..m/2-1, Section 4) -> :class:`Prediction` (r, phi). A feature
+  lights one contiguous run of ommatidia per eye (Prop. 2, Eq. 11), so a bitmap pair is
+  fully described by four integers, the lit intervals (LA, RA, LB, RB):
+  :func:`bitmaps_to_intervals` extracts them, vectorised, and every planar estimator
+  shares it. Rows that are not a single feature (an eye with nothing lit, or more than
+  one lit run) get NaN and ``valid = False``; rows whose intervals could not come from
+  the training domain (Table 3, Table 4) get ``in_domain = False``.
+- :class:`Estimator3D`, the eyes in space (HEALPix and measured): each eye's lit facets
+  as CSR rows or dense bitmaps (:mod:`eyeviz.estimators.lit_csr`) ->
+  :class:`Prediction3D` (r, azimuth, elevation) in the data set's convention: the
+  ball's centre (x, y, z) = r (cos el cos az, cos el sin az, sin el) about the domain's
+  origin, az = atan2(y, x) (in (0, pi) in front), el = asin(z / r)
+  (:func:`eyeviz.dataset.records.spherical_to_xyz`). ``predict_dataset(ds)`` takes a
+  :class:`~eyeviz.dataset.records.Dataset3D` (a generated chunk or a
+  ``Sparse3DReader`` block) directly. Rows where an eye lit nothing get NaN and
+  ``valid = False``; ``in_domain`` is False where the rows cannot come from the
+  domain's Algorithm 1 (fewer than two facets lit in an eye, Definition 1 in 3D);
+  ``flagged`` marks rows the estimator answered by a fallback (its own docstring says
+  which).
+
+Both masks travel with the result:
 
 >>> from eyeviz import dataset, estimators
 >>> ds = dataset.generate(50, seed=2)
@@ -27,36 +47,61 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from eyeviz.core.domain import PAPER_DOMAIN, Domain
+from eyeviz import EyevizError
+from eyeviz.core.domain import PAPER_DOMAIN, PAPER_DOMAIN3D, Domain, Domain3D
 from eyeviz.core.geometry import intervals_to_bitmap
+from eyeviz.core.validation import check_int
+from eyeviz.estimators.lit_csr import LitCSR, _check_indices, as_csr, take_rows
 
 __all__ = [
     "Domain",
     "PAPER_DOMAIN",
     "Estimator",
+    "Estimator3D",
+    "EstimatorBase",
+    "LitCSR",
     "Prediction",
+    "Prediction3D",
+    "as_csr",
     "bitmaps_to_intervals",
     "validate_bitmaps",
+    "take_rows",
     "triangulate",
     "in_domain",
 ]
 
 
-class Prediction(tuple):
+class _Answer(tuple):
+    """An estimator's answer: a tuple of its coordinates (``coords``) that carries the
+    boolean masks (``masks``) as attributes. For a single row all are numpy scalars."""
+
+    coords: ClassVar[tuple[str, ...]] = ()
+    masks: ClassVar[tuple[str, ...]] = ()
+
+    def __new__(cls, *values):
+        k, n = len(cls.coords), len(cls.coords) + len(cls.masks)
+        if len(values) != n:
+            raise TypeError(f"{cls.__name__} takes {n} values ({cls.coords + cls.masks})")
+        obj = super().__new__(cls, values[:k])
+        for name, v in zip(cls.masks, values[k:], strict=True):
+            setattr(obj, name, v)
+        return obj
+
+    def __getnewargs__(self):
+        return (*self, *(getattr(self, m) for m in self.masks))
+
+
+class Prediction(_Answer):
     """``(r, phi)`` that also carries ``valid`` and ``in_domain`` masks.
 
     Unpacks as a pair; ``r`` and ``phi`` are NaN where ``valid`` is False. For a single
     row all four are numpy scalars.
     """
 
+    coords = ("r", "phi")
+    masks = ("valid", "in_domain")
     valid: Any
     in_domain: Any
-
-    def __new__(cls, r, phi, valid, in_domain):
-        obj = super().__new__(cls, (r, phi))
-        obj.valid = valid
-        obj.in_domain = in_domain
-        return obj
 
     @property
     def r(self):
@@ -66,8 +111,29 @@ class Prediction(tuple):
     def phi(self):
         return self[1]
 
-    def __getnewargs__(self):
-        return (self[0], self[1], self.valid, self.in_domain)
+
+class Prediction3D(_Answer):
+    """``(r, azimuth, elevation)`` (radians) with ``valid``, ``in_domain`` and ``flagged``
+    masks; unpacks as a triple. For a single row every field is a numpy scalar. An
+    estimator may add per-row fields of its own (limit3d: ``mc_error``, ``n_accepted``)."""
+
+    coords = ("r", "azimuth", "elevation")
+    masks = ("valid", "in_domain", "flagged")
+    valid: Any
+    in_domain: Any
+    flagged: Any
+
+    @property
+    def r(self):
+        return self[0]
+
+    @property
+    def azimuth(self):
+        return self[1]
+
+    @property
+    def elevation(self):
+        return self[2]
 
 
 def validate_bitmaps(omega_a, omega_b, width: int) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -214,11 +280,49 @@ def in_domain(LA, RA, LB, RB, domain: Domain) -> np.ndarray:
     return inside & far_ok & near_ok & size_ok
 
 
+class EstimatorBase:
+    """What every estimator has, whatever its eyes: a name, the eye models it answers for,
+    its domain (checked here), its metadata."""
+
+    name: ClassVar[str] = "base"
+    #: the eye models (:attr:`~eyeviz.core.domain.Domain.kind`) the estimator answers
+    #: for; a domain of another kind is refused in one line naming these
+    kinds: ClassVar[tuple[str, ...]] = ()
+    #: the domain record the estimator takes (:mod:`eyeviz.core.domain`)
+    domain_type: ClassVar[type[Any]] = object
+    domain: Any
+
+    def __init__(self, domain: Any, metadata: dict | None = None) -> None:
+        if not isinstance(domain, self.domain_type):
+            raise ValueError(
+                f"domain must be a {self.domain_type.__name__}, got {type(domain).__name__}"
+            )
+        if domain.kind not in self.kinds:
+            raise EyevizError(
+                f"estimator {self.name!r} answers for {' and '.join(self.kinds)} eyes, not "
+                f"{domain.kind} ones"
+            )
+        self.domain = domain
+        self.metadata: dict[str, Any] = dict(metadata or {})
+
+    @property
+    def n_weights(self) -> int:
+        """Number of learned parameters (0 for estimators that do not learn)."""
+        return int(self.metadata.get("n_weights", 0))
+
+    def _eyes_text(self) -> str:
+        """The domain's eyes in the repr."""
+        return str(self.domain.design)
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name!r} {self._eyes_text()}>"
+
+
 _BLOCK = 1 << 16  # rows per block in Estimator.predict
 
 
-class Estimator:
-    """Base of every estimator: validation, interval extraction, masks.
+class Estimator(EstimatorBase):
+    """Base of every estimator of the planar eyes: validation, interval extraction, masks.
 
     Subclasses implement :meth:`_predict_intervals` (estimators of the four integers) or,
     when they read the raw bitmaps (``uses_bitmaps = True``), :meth:`_predict_bitmaps`.
@@ -226,11 +330,13 @@ class Estimator:
     """
 
     name: ClassVar[str] = "base"
+    kinds: ClassVar[tuple[str, ...]] = ("planar",)
+    domain_type: ClassVar[type[Any]] = Domain
     uses_bitmaps: ClassVar[bool] = False
+    domain: Domain
 
     def __init__(self, domain: Domain = PAPER_DOMAIN, metadata: dict | None = None) -> None:
-        self.domain = domain
-        self.metadata: dict[str, Any] = dict(metadata or {})
+        super().__init__(domain, metadata)
 
     # --- to implement -------------------------------------------------------------------
     def _predict_intervals(self, LA, RA, LB, RB) -> tuple[np.ndarray, np.ndarray]:
@@ -248,11 +354,6 @@ class Estimator:
         return self._predict_intervals(LA, RA, LB, RB)
 
     # --- public ---------------------------------------------------------------------------
-    @property
-    def n_weights(self) -> int:
-        """Number of learned parameters (0 for estimators that do not learn)."""
-        return int(self.metadata.get("n_weights", 0))
-
     def predict(self, omega_a, omega_b) -> Prediction:
         """(r, phi) per row of half bitmaps (N, m/2) or a single row (m/2,); phi in radians.
 
@@ -322,5 +423,106 @@ class Estimator:
             return Prediction(r[0], phi[0], valid[0], dom[0])
         return Prediction(r, phi, valid, dom)
 
-    def __repr__(self) -> str:
-        return f"<{type(self).__name__} {self.name!r} m={self.domain.m}>"
+    def _eyes_text(self) -> str:
+        return f"m={self.domain.m}"
+
+
+#: rows per block in :meth:`Estimator3D.predict`
+_BLOCK3D = 1 << 14
+
+
+class Estimator3D(EstimatorBase):
+    """Base of the estimators of the eyes in space (HEALPix; measured for an estimator
+    whose ``kinds`` name them): validation, blocks, masks.
+
+    Subclasses implement :meth:`_predict_csr`, which receives valid rows only (every
+    row lights at least one facet per eye) and returns float64 arrays
+    (r, azimuth, elevation, flagged).
+    """
+
+    name: ClassVar[str] = "base3d"
+    kinds: ClassVar[tuple[str, ...]] = ("spherical",)
+    domain_type: ClassVar[type[Any]] = Domain3D
+    #: True for an estimator whose :meth:`_predict_csr` reads every index anyway and
+    #: refuses indices out of range or not increasing within a row there, with
+    #: :func:`as_csr`'s ValueError naming ``lit_a`` or ``lit_b`` (one pass over the
+    #: indices instead of two); :meth:`predict` then checks only the rows it does not
+    #: hand over (those where an eye lit nothing).
+    checks_indices: ClassVar[bool] = False
+    #: rows per :meth:`_predict_csr` call (an integer >= 1, checked by :meth:`predict`)
+    block_rows: ClassVar[int] = _BLOCK3D
+    domain: Domain3D
+
+    def __init__(self, domain: Domain3D = PAPER_DOMAIN3D, metadata: dict | None = None) -> None:
+        super().__init__(domain, metadata)
+
+    # --- to implement -------------------------------------------------------------------
+    def _predict_csr(
+        self, lit_a: LitCSR, lit_b: LitCSR
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        raise NotImplementedError
+
+    # --- public ---------------------------------------------------------------------------
+    def predict(self, lit_a, lit_b) -> Prediction3D:
+        """(r, azimuth, elevation) per row from each eye's lit facets (CSR rows or dense
+        bitmaps, see the module docstring). ValueError naming the argument for malformed
+        input or a row-count mismatch; NaN and ``valid = False`` where an eye lit nothing."""
+        na, nb = self.domain.facet_counts
+        check = not self.checks_indices
+        pa, ia, single_a = as_csr("lit_a", lit_a, na, check_indices=check)
+        pb, ib, single_b = as_csr("lit_b", lit_b, nb, check_indices=check)
+        if pa.size != pb.size:
+            raise ValueError(
+                f"lit_a and lit_b have different row counts: {pa.size - 1} and {pb.size - 1}"
+            )
+        n = pa.size - 1
+        ca, cb = np.diff(pa), np.diff(pb)
+        valid = (ca > 0) & (cb > 0)
+        if not check and not valid.all():  # rows _predict_csr does not see
+            skip = np.flatnonzero(~valid)
+            _check_indices("lit_a", *take_rows(pa, ia, skip), na)
+            _check_indices("lit_b", *take_rows(pb, ib, skip), nb)
+        r = np.full(n, np.nan)
+        az = np.full(n, np.nan)
+        el = np.full(n, np.nan)
+        flagged = np.zeros(n, bool)
+        rows = np.flatnonzero(valid)
+        step = check_int("block_rows", self.block_rows, ge=1)
+        for s in range(0, rows.size, step):
+            blk = rows[s : s + step]
+            contiguous = blk.size and blk[-1] - blk[0] == blk.size - 1
+            if contiguous:
+                lo, hi = int(blk[0]), int(blk[-1]) + 1
+                sub_a = (pa[lo : hi + 1] - pa[lo], ia[pa[lo] : pa[hi]])
+                sub_b = (pb[lo : hi + 1] - pb[lo], ib[pb[lo] : pb[hi]])
+            else:
+                sub_a, sub_b = take_rows(pa, ia, blk), take_rows(pb, ib, blk)
+            rr, aa, ee, ff = self._predict_csr(sub_a, sub_b)
+            r[blk], az[blk], el[blk], flagged[blk] = rr, aa, ee, ff
+        in_dom = valid & (ca >= 2) & (cb >= 2)
+        if single_a and single_b and n == 1:
+            return Prediction3D(r[0], az[0], el[0], valid[0], in_dom[0], flagged[0])
+        return Prediction3D(r, az, el, valid, in_dom, flagged)
+
+    def predict_dataset(self, ds) -> Prediction3D:
+        """:meth:`predict` on the rows of a :class:`~eyeviz.dataset.records.Dataset3D`
+        (a generated chunk, ``load3d``'s data set or a ``Sparse3DReader`` block)."""
+        for k in ("indptr_a", "indices_a", "indptr_b", "indices_b"):
+            if not hasattr(ds, k):
+                raise ValueError(f"ds must be a Dataset3D (no {k}), got {type(ds).__name__}")
+        if ds.domain.design != self.domain.design:
+            raise ValueError(
+                f"ds has the eyes {_design_text(ds.domain)}, the estimator "
+                f"{_design_text(self.domain)}"
+            )
+        return self.predict((ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b))
+
+    def _eyes_text(self) -> str:
+        return _design_text(self.domain)
+
+
+def _design_text(d: Domain3D) -> str:
+    """The eyes of a domain in words: h, l, nside, or the measured pair's fingerprint."""
+    if d.kind == "measured":
+        return f"h={d.h:g} l={d.l:g} measured pair {str(d.eyes.fingerprint)[:12]}"
+    return f"(h, l, nside) = {d.design}"

@@ -325,7 +325,7 @@ def _space_data(est):
 
 
 def _space_take(lit, rows):
-    from eyeviz.estimators.base3d import take_rows
+    from eyeviz.estimators.base import take_rows
 
     return take_rows(lit[0], lit[1], np.asarray(rows))
 

@@ -29,7 +29,7 @@ direction, as the set of caps consistent with the lit set does).
 Speed (issue 23: the learned estimator's target is 10^5 rows/s at nside 180): the one
 pass over the indices also reads each run's first and last index while its block is in
 cache, and with a ``name`` it is the indices' only check (:func:`_check_runs`: range and
-order from the runs' ends, as :func:`eyeviz.estimators.base3d.as_csr` would refuse them);
+order from the runs' ends, as :func:`eyeviz.estimators.base.as_csr` would refuse them);
 per run, the ring, the edge longitudes and the sums' sines and cosines are gathered from
 per-pixel tables built once per nside (:class:`_PixelTables`, the same expressions
 evaluated once per pixel, so the same floats); a row's runs come in ring order, so the
@@ -258,7 +258,7 @@ def eye_summaries(
     Rows with no lit facet get count 0, a zero sum and NaN longitudes and z. With a
     ``name``, the indices are checked (each row strictly increasing, every index in
     [0, 12 nside^2)) on the runs, at no cost per index: ValueError naming ``name``,
-    with the messages of :func:`eyeviz.estimators.base3d.as_csr`."""
+    with the messages of :func:`eyeviz.estimators.base.as_csr`."""
     indptr = np.asarray(indptr, np.int64)
     indices = np.asarray(indices)
     if name and not (
@@ -560,7 +560,7 @@ def _check_runs(
     a row is strictly increasing iff each run starts above the previous run's end, and
     in range iff its runs' ends are (a run whose end lies below its start wrapped past
     the dtype's largest value, which it then holds). The messages are
-    :func:`eyeviz.estimators.base3d.as_csr`'s."""
+    :func:`eyeviz.estimators.base.as_csr`'s."""
     if s.size == 0:
         return
     npix = int(rings.first[-1])

@@ -51,7 +51,7 @@ import numpy as np
 from eyeviz import EyevizError
 from eyeviz.core.domain import Domain3D
 from eyeviz.core.validation import check_int, num
-from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D
+from eyeviz.estimators.base import Estimator3D, LitCSR, Prediction3D
 from eyeviz.estimators.learned3d_features import (
     N_FEATURES,
     EyeSummary,
@@ -278,7 +278,7 @@ class Learned3DEstimator(Estimator3D):
 def inside_domain(d: Domain3D, r, az, el) -> np.ndarray:
     """Whether each answer lies in the ranges the network was trained on, widened by
     :data:`DOMAIN_SLACK`: r in [r_min, r_max], azimuth in [0, pi], |elevation| <= el_max
-    (finite; the data set's convention, :mod:`eyeviz.estimators.base3d`)."""
+    (finite; the data set's convention, :mod:`eyeviz.estimators.base`)."""
     s = DOMAIN_SLACK
     with np.errstate(invalid="ignore"):
         ok = (r >= d.r_min * (1 - s)) & (r <= d.r_max * (1 + s))

@@ -86,7 +86,7 @@ import numpy as np
 
 from eyeviz.core.domain import PAPER_DOMAIN3D, Domain3D
 from eyeviz.estimators.analytic3d import estimate
-from eyeviz.estimators.base3d import Estimator3D, LitCSR, Prediction3D, as_csr, take_rows
+from eyeviz.estimators.base import Estimator3D, LitCSR, Prediction3D, as_csr, take_rows
 from eyeviz.estimators.limit3d_exact import prior_density, same_rows
 from eyeviz.estimators.limit3d_proposal import _Eye, _key_hash  # noqa: F401  (_Eye: read by tests)
 from eyeviz.estimators.weighted import weighted_median

@@ -11,7 +11,7 @@ import numpy as np
 
 from eyeviz.core import kernels
 from eyeviz.core.domain import Domain3D
-from eyeviz.estimators.base3d import LitCSR
+from eyeviz.estimators.base import LitCSR
 
 __all__ = ["exact_hits", "prior_density", "same_rows"]
 

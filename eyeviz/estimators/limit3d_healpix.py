@@ -12,7 +12,7 @@ import numpy as np
 
 from eyeviz.core import kernels
 from eyeviz.core.domain import Domain3D
-from eyeviz.estimators.base3d import LitCSR
+from eyeviz.estimators.base import LitCSR
 from eyeviz.estimators.limit3d_exact import exact_hits, prior_density
 from eyeviz.estimators.limit3d_proposal import (
     _angle_box,

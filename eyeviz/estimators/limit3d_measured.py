@@ -51,7 +51,7 @@ import numpy as np
 from eyeviz.core import kernels
 from eyeviz.core.domain import Domain3D
 from eyeviz.estimators.analytic3d import estimate
-from eyeviz.estimators.base3d import LitCSR
+from eyeviz.estimators.base import LitCSR
 from eyeviz.estimators.limit3d_exact import exact_hits, prior_density
 from eyeviz.estimators.limit3d_proposal import _batch_uniforms, _frame, _uniforms
 from eyeviz.estimators.triangulation import facet_neighbours, triangulate_rays

@@ -14,7 +14,7 @@ import numpy as np
 from eyeviz.core import healpix, kernels
 from eyeviz.core.domain import Domain3D
 from eyeviz.estimators.analytic3d import cap_estimates
-from eyeviz.estimators.base3d import LitCSR
+from eyeviz.estimators.base import LitCSR
 
 #: facet widths inside and outside the estimated cap where the cap's edge is looked for
 EDGE = 1.25

@@ -240,7 +240,7 @@ def errors3d(
 
 
 def answer_from(name: str, p: Any, truth: tuple[float, float, float]) -> Answer3D:
-    """An :class:`Answer3D` from a one-row :class:`~eyeviz.estimators.base3d.Prediction3D`
+    """An :class:`Answer3D` from a one-row :class:`~eyeviz.estimators.base.Prediction3D`
     ``p`` (arrays of length 1 or scalars) for a ball at ``truth`` = (r, az, el)."""
 
     def one(v) -> float:

@@ -134,7 +134,7 @@ def score(ds, names: list[str], limit_rows: int) -> list[BallScores]:
     load for these eyes is kept with its one-line reason."""
     from eyeviz import EyevizError
     from eyeviz.estimators import registry
-    from eyeviz.estimators.base3d import take_rows
+    from eyeviz.estimators.base import take_rows
 
     n = len(ds)
     subset = np.unique(np.linspace(0, n - 1, min(n, max(1, limit_rows))).astype(np.int64))

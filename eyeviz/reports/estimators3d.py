@@ -75,7 +75,7 @@ def measure3d(ds, names: list[str], limit_rows: int = 1000, progress=None) -> li
     """Score each estimator ``names`` (registry kind "spherical") on the Dataset3D ``ds``."""
     from eyeviz import EyevizError
     from eyeviz.estimators import registry
-    from eyeviz.estimators.base3d import take_rows
+    from eyeviz.estimators.base import take_rows
 
     n = len(ds)
     step = max(1, math.ceil(n / max(1, limit_rows)))

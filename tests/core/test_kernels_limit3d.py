@@ -17,7 +17,7 @@ from eyeviz.core.domain import Domain3D
 from eyeviz.core.measured import MeasuredEye, MeasuredEyePair
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import limit3d_exact, limit3d_healpix
-from eyeviz.estimators.base3d import take_rows
+from eyeviz.estimators.base import take_rows
 from eyeviz.estimators.limit3d import Limit3DEstimator
 from eyeviz.estimators.limit3d_measured import MeasuredProposal, _Edges
 from eyeviz.estimators.limit3d_proposal import _Eye

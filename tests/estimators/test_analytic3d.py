@@ -1,4 +1,4 @@
-"""The 3D estimator protocol (base3d) and the analytic triangulation of the spherical eyes."""
+"""The 3D estimator protocol (base.Estimator3D) and the analytic triangulation of the spherical eyes."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from eyeviz.core.domain import Domain, Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import registry
 from eyeviz.estimators.analytic3d import Analytic3DEstimator, triangulate
-from eyeviz.estimators.base3d import Prediction3D, as_csr
+from eyeviz.estimators.base import Prediction3D, as_csr
 from eyeviz.estimators.metrics import mape
 
 D16 = Domain3D(nside=16)

@@ -154,3 +154,37 @@ def test_in_domain_refuses_a_run_touching_either_end_of_either_eye():
         touching[k], inside[k] = end, one_in
         assert not bool(in_domain(*touching, wide)), touching
         assert bool(in_domain(*inside, wide)), inside
+
+
+def test_one_base_checks_the_domain_of_every_model():
+    from eyeviz.core.domain import Domain3D
+    from eyeviz.estimators.analytic import AnalyticEstimator
+    from eyeviz.estimators.analytic3d import Analytic3DEstimator
+    from eyeviz.estimators.base import Estimator3D, EstimatorBase
+
+    flat, space = AnalyticEstimator(Domain(m=36)), Analytic3DEstimator(Domain3D(nside=4))
+    assert isinstance(flat, EstimatorBase) and isinstance(space, EstimatorBase)
+    assert not isinstance(flat, Estimator3D) and flat.kinds == ("planar",)
+    assert repr(flat) == "<AnalyticEstimator 'analytic' m=36>"
+    assert repr(space) == "<Analytic3DEstimator 'analytic3d' (h, l, nside) = (40.0, 20.0, 4)>"
+    with pytest.raises(ValueError, match="^domain must be a Domain, got Domain3D$"):
+        AnalyticEstimator(Domain3D(nside=4))
+    with pytest.raises(ValueError, match="^domain must be a Domain3D, got Domain$"):
+        Analytic3DEstimator(Domain(m=36))
+
+
+def test_answers_unpack_carry_their_masks_and_pickle():
+    import pickle
+
+    from eyeviz.estimators.base import Prediction, Prediction3D
+
+    p = Prediction(np.array([1.0]), np.array([0.5]), np.array([True]), np.array([False]))
+    r, phi = p
+    assert (p.r is r, p.phi is phi, p.valid[0], p.in_domain[0]) == (True, True, True, False)
+    q = Prediction3D(1.0, 0.5, 0.25, True, False, True)
+    assert tuple(q) == (1.0, 0.5, 0.25) and (q.azimuth, q.elevation) == (0.5, 0.25)
+    back = pickle.loads(pickle.dumps(q))
+    assert type(back) is Prediction3D and tuple(back) == tuple(q)
+    assert (back.valid, back.in_domain, back.flagged) == (True, False, True)
+    with pytest.raises(TypeError, match="Prediction takes 4 values"):
+        Prediction(1.0, 0.5, True)

@@ -2,7 +2,7 @@
 the implementation it replaced, kept below as the reference: every summary and every
 prediction must be the same float (the shipped weights were trained on the reference's
 features). Also the checks of the indices that the run finder makes instead of
-``base3d.as_csr``'s separate pass: the same inputs refused, with the same messages."""
+``lit_csr.as_csr``'s separate pass: the same inputs refused, with the same messages."""
 
 from __future__ import annotations
 
@@ -17,8 +17,8 @@ from hypothesis import strategies as st
 from eyeviz.core import healpix
 from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
-from eyeviz.estimators import base3d, learned3d
 from eyeviz.estimators import healpix_summaries as lf
+from eyeviz.estimators import learned3d, lit_csr
 from eyeviz.estimators.healpix_summaries import (
     BANDS,
     N_BOUNDS,
@@ -464,7 +464,7 @@ def test_every_single_corruption_is_refused_as_as_csr_refuses_it(shipped, rows):
                 bad[j] = -1 - j % 3
             else:
                 bad[j], bad[j + 1] = bad[j + 1], bad[j]
-            want = _message(base3d.as_csr, "lit_a", (pa, bad), npix)
+            want = _message(lit_csr.as_csr, "lit_a", (pa, bad), npix)
             got = _message(shipped.predict, (pa, bad), lit_b)
             assert got == want, (j, kind)
             n_refused += want is not None
@@ -476,7 +476,7 @@ def test_a_run_that_wraps_past_the_dtype_is_refused(shipped, dtype):
     info = np.iinfo(dtype)
     lit_a = (np.array([0, 4]), np.array([info.max - 1, info.max, info.min, info.min + 1], dtype))
     lit_b = (np.array([0, 2]), np.array([5, 6]))
-    want = _message(base3d.as_csr, "lit_a", lit_a, shipped.domain.npix)
+    want = _message(lit_csr.as_csr, "lit_a", lit_a, shipped.domain.npix)
     assert want is not None and f"got {info.min}" in want
     assert _message(shipped.predict, lit_a, lit_b) == want
 
@@ -530,7 +530,7 @@ def test_empty_rows_between_consecutive_indices_are_not_refused(n_empty):
     nside = 4
     ptr = np.r_[0, [1] * (n_empty + 1), 3].astype(np.int64)  # [84], empty..., [85, 86]
     ind = np.array([84, 85, 86], np.int64)
-    base3d.as_csr("lit_a", (ptr, ind), 12 * nside * nside)  # valid
+    lit_csr.as_csr("lit_a", (ptr, ind), 12 * nside * nside)  # valid
     got = eye_summaries(nside, ptr, ind, name="lit_a")
     for row, want_ind in ((0, [84]), (ptr.size - 2, [85, 86])):
         want = eye_summaries(nside, np.array([0, len(want_ind)]), np.array(want_ind))
@@ -578,6 +578,6 @@ def test_the_check_on_the_runs_is_as_csr_s_on_any_rows(rows, dtype, tidy):
     ptr = np.r_[0, np.cumsum([len(r) for r in rows])].astype(np.int64)
     with np.errstate(all="ignore"):
         ind = np.array([v for r in rows for v in r], np.int64).astype(dtype)
-    want = _message(base3d.as_csr, "lit_a", (ptr, ind), npix)
-    p, i, _ = base3d.as_csr("lit_a", (ptr, ind), npix, check_indices=False)
+    want = _message(lit_csr.as_csr, "lit_a", (ptr, ind), npix)
+    p, i, _ = lit_csr.as_csr("lit_a", (ptr, ind), npix, check_indices=False)
     assert _message(eye_summaries, nside, p, i, "lit_a") == want

@@ -12,7 +12,7 @@ from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import registry
 from eyeviz.estimators.analytic3d import Analytic3DEstimator
-from eyeviz.estimators.base3d import take_rows
+from eyeviz.estimators.base import take_rows
 from eyeviz.estimators.limit import weighted_median
 from eyeviz.estimators.limit3d import Limit3DEstimator, posterior_samples3d, prior_density
 from eyeviz.estimators.metrics import mape

@@ -13,7 +13,7 @@ from eyeviz.core.measured import MeasuredEye, MeasuredEyePair
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import registry
 from eyeviz.estimators.analytic3d import estimate
-from eyeviz.estimators.base3d import take_rows
+from eyeviz.estimators.base import take_rows
 from eyeviz.estimators.limit3d import Limit3DEstimator, posterior_samples3d, prior_density
 from eyeviz.estimators.weighted import weighted_median
 

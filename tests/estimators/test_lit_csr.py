@@ -1,4 +1,4 @@
-"""``base3d.as_csr`` on CSR rows: int32/int64 indices come back as given (no copy), other
+"""``lit_csr.as_csr`` on CSR rows: int32/int64 indices come back as given (no copy), other
 integer types as int64; the blocked sortedness check accepts a drop only at a row start
 (empty rows included) and refuses any other non-rising step, whatever block it falls in."""
 
@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from eyeviz.estimators import base3d
-from eyeviz.estimators.base3d import as_csr
+from eyeviz.estimators import base, lit_csr
+from eyeviz.estimators.base import as_csr
 
 NPIX = 768
 
@@ -45,7 +45,7 @@ def test_non_rising_step_inside_a_row_is_refused(ptr, ind):
 
 
 def test_drops_across_blocks(monkeypatch):
-    monkeypatch.setattr(base3d, "_CHECK_BLOCK", 4)
+    monkeypatch.setattr(lit_csr, "_CHECK_BLOCK", 4)
     rng = np.random.default_rng(3)
     rows = [np.sort(rng.choice(NPIX, size=k, replace=False)) for k in (5, 0, 3, 7, 1, 0, 6)]
     ptr = np.concatenate([[0], np.cumsum([r.size for r in rows])])
@@ -79,7 +79,7 @@ def test_check_indices_false_leaves_out_only_the_pass_over_the_indices():
         as_csr("lit_a", (ptr, ind.astype(float)), NPIX, check_indices=False)
 
 
-class _Unchecking(base3d.Estimator3D):
+class _Unchecking(base.Estimator3D):
     """Claims to check the indices it is handed, and records them instead."""
 
     checks_indices = True
