@@ -1,4 +1,5 @@
-"""The 3D estimator protocol (base.Estimator3D) and the analytic triangulation of the spherical eyes."""
+"""The 3D estimator protocol (base.Estimator3D) and the analytic triangulation of the
+spherical eyes."""
 
 from __future__ import annotations
 
