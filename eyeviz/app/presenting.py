@@ -270,6 +270,7 @@ class Presenter(QtCore.QObject):
         self._scale_view_text()
         self.win.fit_caption()
         if self.win.isVisible():
+            QtCore.QTimer.singleShot(0, self.win.fit_readout)  # its values at the new size
             self.win.render()
             host = getattr(self.win, "host3d", None)
             if host is not None and host.active:
@@ -355,6 +356,7 @@ class Presenter(QtCore.QObject):
                 d.raise_()
                 self._step_shown.append(d)
         self._hide_docks()
+        QtCore.QTimer.singleShot(0, self.win.fit_readout)  # shown at the presenting size
 
     def toggle_presentation(self) -> None:
         """F5: large text, side panels hidden (but those the lecture step shown names),

@@ -84,6 +84,24 @@ class SideDocksMixin(_MainWindow):
         message wraps inside it instead of widening the side panel (issue 12 item 7)."""
         d.setMaximumWidth(max(SIDE_MIN_PX, int(self.width() * SIDE_MAX_FRACTION)))
 
+    def fit_readout(self) -> None:
+        """Widen the readout's dock column to the width its values need at the current
+        text size (F5, Ctrl+=: the planar lecture's step 7 read "yes / yes, in B..."), at
+        most SIDE_MAX_FRACTION of the window; never narrowed."""
+        d = self._docks.get("readout")
+        if d is None or not d.isVisible():
+            return
+        readout = d.widget()
+        inner = readout.widget() if isinstance(readout, QtWidgets.QScrollArea) else None
+        natural = getattr(inner, "natural_width", None)
+        if natural is None:
+            return
+        style = self.style()
+        bar = style.pixelMetric(style.PixelMetric.PM_ScrollBarExtent) if style else 16
+        want = min(natural() + bar + 8, int(SIDE_MAX_FRACTION * self.width()))
+        if d.width() < want:
+            self.resizeDocks([d], [want], QtCore.Qt.Orientation.Horizontal)
+
     def resizeEvent(self, ev) -> None:  # noqa: N802 (Qt name)
         for d in self._docks.values():
             self._limit_dock(d)

@@ -82,6 +82,13 @@ class ValueText(QtWidgets.QWidget):
     def sizeHint(self) -> QtCore.QSize:  # noqa: N802 (Qt name)
         return QtCore.QSize(120, self._height(self._lines))
 
+    def changeEvent(self, event) -> None:  # noqa: N802 (Qt name)
+        # F5 / Ctrl+= change the font: the fixed height follows (the values of the planar
+        # lecture's step 7 were cut at the bottom, kept at the height of the old font)
+        if event.type() == QtCore.QEvent.Type.FontChange:
+            self.setFixedHeight(self._height(self._lines))
+        super().changeEvent(event)
+
     def paintEvent(self, event) -> None:  # noqa: N802 (Qt name)
         p = QtGui.QPainter(self)
         p.setPen(self._color)
@@ -188,6 +195,22 @@ class ReadoutPanel(QtWidgets.QWidget):
             if self._cache.pop(k, None) is not None:
                 self._rows[k][0].hide()
                 self._rows[k][1].hide()
+
+    def natural_width(self) -> int:
+        """The width (px) its shown rows need at the current font, nothing elided: the
+        title line (name and radius) or the widest key plus the widest value line."""
+        lay = self.layout()
+        m = lay.contentsMargins() if lay is not None else QtCore.QMargins()
+        gap = self.grid.horizontalSpacing()
+        keys, vals = 0, 0
+        for key, val in self._rows:
+            if not val.isHidden():
+                keys = max(keys, key.sizeHint().width())
+                fm = val.fontMetrics()
+                vals = max([vals] + [fm.horizontalAdvance(t) for t in val.text().split("\n")])
+        title = self.title.sizeHint().width() + 14
+        title += self.size_text.fontMetrics().horizontalAdvance(self.size_text.text())
+        return m.left() + m.right() + max(keys + gap + vals, title) + 2
 
     def _set_title(self, text: str, color: str) -> None:
         if self._title_key != (text, color):
