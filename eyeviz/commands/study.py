@@ -178,7 +178,7 @@ def _seed(args: argparse.Namespace) -> int:
 
         keys, at = StudyTableMeasured.open(args.output).keys, -2  # (..., n, seed, estimator)
     elif args.nside is not None:
-        from eyeviz.study.table3d import StudyTable3D
+        from eyeviz.study.table import StudyTable3D
 
         keys, at = StudyTable3D.open(args.output).keys, -2  # (..., n, seed, estimator)
     else:
@@ -244,7 +244,7 @@ def run(args: argparse.Namespace) -> int:
         points = _measured_points(args, given, seed)
     elif args.nside is not None:
         from eyeviz.core.domain import DEFAULT_EL_MAX
-        from eyeviz.study.grid3d import DEFAULT_N3D, design_grid3d
+        from eyeviz.study.grid import DEFAULT_N3D, design_grid3d
         from eyeviz.study.point3d import DEFAULT_ESTIMATOR
 
         if args.m is not None:

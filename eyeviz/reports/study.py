@@ -73,7 +73,7 @@ from eyeviz.reports.study_summary import (
 )
 from eyeviz.reports.study_table import Row, read_study
 from eyeviz.study.point import BIN_WIDTH
-from eyeviz.study.table3d import is_table3d
+from eyeviz.study.table import is_table3d
 
 # The analysis, figures and summaries live in study_design, study_law, study_figures and
 # study_summary; their names stay importable from here (the tests use several of them).

@@ -1,6 +1,6 @@
 """``eyeviz report study STUDY3D.csv -o DIR`` for a 3D study table (``eyeviz study --nside``).
 
-The 3D table (:mod:`eyeviz.study.table3d`) holds, per design of the spherical eyes (h, l,
+The 3D table (:mod:`eyeviz.study.table`) holds, per design of the spherical eyes (h, l,
 nside) and estimator, the DD and AD error (MAPE, Eq. 34) and the elevation and azimuth
 error (mean absolute, degrees) overall, per distance bin and per elevation bin. This
 report answers the 3D study's questions:
@@ -45,7 +45,7 @@ from eyeviz.core import paper
 from eyeviz.reports.study_design import MIN_COUNT
 from eyeviz.reports.study_law import LawFit, LawPoint, fit_law
 from eyeviz.study.point import BIN_WIDTH
-from eyeviz.study.table3d import iter_rows3d
+from eyeviz.study.table import iter_rows3d
 
 __all__ = [
     "FIT_MAX",

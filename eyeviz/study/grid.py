@@ -1,12 +1,19 @@
-"""The design grid of the eye-design study: every (h, l, m) with l < h (Section 8).
+"""The design grids of the eye-design studies: every (h, l, m) or (h, l, nside) with l < h.
 
 The paper closes with the question of how azimuth and distance accuracy depend on the
-eye position h (eyes 2h apart), the eye radius l and the ommatidia per eye m (Table 3).
-A grid is the product of lists of h, l and m, keeping the designs whose eyes do not
-overlap (l < h), each with the same object ranges (Table 4), prior, n and seed.
+eye position h (eyes 2h apart), the eye radius l and the ommatidia per eye m (Table 3;
+Section 8). A grid is the product of lists of h, l and the resolution, keeping the
+designs whose eyes do not overlap (l < h), each with the same object ranges (Table 4),
+prior, n and seed: :func:`design_grid` for the planar eyes (m), :func:`design_grid3d`
+for the spherical ones (nside: the HEALPix resolution of each eye, 12 nside^2 facets,
+4 nside on the equator; docs/spherical.md), whose points also share the elevation band
+|el| <= el_max and the estimator (:class:`~eyeviz.study.point3d.DesignPoint3D`). Both
+read their axes through :func:`grid_axes`.
 
 Bad input ends in one :class:`eyeviz.EyevizError` naming it: ``parse_list("m", "180,x")``
--> "m: 'x' is not a number"; a grid with no design where l < h; m odd or < 4; n < 1.
+-> "m: 'x' is not a number"; a grid with no design where l < h; m odd or < 4;
+``design_grid3d(nside="7")`` -> "nside must be an even integer ..."; n < 1; a 3D design
+where no ball can be visible (the 3D generator's checks, naming the design).
 """
 
 from __future__ import annotations
@@ -18,20 +25,24 @@ from dataclasses import dataclass
 
 from eyeviz import EyevizError
 from eyeviz.core import paper
-from eyeviz.core.bounds import MAX_BINS, check_m, check_r_min
-from eyeviz.core.domain import DEFAULTS
-from eyeviz.core.validation import check_choice, check_int, check_real
+from eyeviz.core.bounds import MAX_BINS, check_m, check_nside, check_r_min
+from eyeviz.core.domain import DEFAULT_EL_MAX, DEFAULTS
+from eyeviz.core.validation import check_choice, check_int, check_real, num
 from eyeviz.estimators.limit import PRIORS
 from eyeviz.files.limits import MAX_ROWS
 from eyeviz.study.point import BIN_WIDTH, DesignPoint
+from eyeviz.study.point3d import DEFAULT_ESTIMATOR, DesignPoint3D
 
 __all__ = [
     "DEFAULT_H",
     "DEFAULT_L",
     "DEFAULT_M",
+    "DEFAULT_N3D",
+    "DEFAULT_NSIDE",
     "MAX_GRID_POINTS",
     "GridAxes",
     "design_grid",
+    "design_grid3d",
     "grid_axes",
     "grid_pairs",
     "parse_list",
@@ -126,7 +137,7 @@ def grid_axes(
     m and :func:`~eyeviz.core.bounds.check_m`, or nside and
     :func:`~eyeviz.core.bounds.check_nside`) and what every point shares, each checked
     with a one-line error naming it; for :func:`design_grid` and
-    :func:`eyeviz.study.grid3d.design_grid3d`."""
+    :func:`design_grid3d`."""
     name, values, check = resolution
     hs = _unique(parse_list("h", h))
     ls = _unique(parse_list("l", l))
@@ -202,3 +213,68 @@ def design_grid(
         for hv, lv in grid_pairs(axes)
         for mv in axes.resolution
     ]
+
+
+#: The default resolutions: m = 4 nside = 64, 128, 256 on the equator (the planar study's
+#: m = 180 ... 2880 span nside 45 ... 720; 3D lit sets grow as nside^2, so the default stays
+#: small; the paper's m = 720 is nside 180).
+DEFAULT_NSIDE = (16, 32, 64)
+#: Test elements per 3D design point by default.
+DEFAULT_N3D = 20_000
+
+
+def design_grid3d(
+    h: str | Iterable = DEFAULT_H,
+    l: str | Iterable = DEFAULT_L,  # noqa: E741  (the paper's name)
+    nside: str | Iterable = DEFAULT_NSIDE,
+    *,
+    r_min: float = DEFAULTS["r_min"],
+    r_max: float = DEFAULTS["r_max"],
+    g_max: float = DEFAULTS["g_max"],
+    el_max: float = DEFAULT_EL_MAX,
+    prior: str = "single",
+    n: int = DEFAULT_N3D,
+    seed: int = 0,
+    estimator: str = DEFAULT_ESTIMATOR,
+) -> list[DesignPoint3D]:
+    """The 3D study's design points: every (h, l, nside) of the lists with l < h, in the
+    order h, then l, then nside (duplicates dropped). Lists may be texts ("16,32,64").
+
+    Raises a one-line :class:`EyevizError` for a non-number, an odd nside or one < 2, n < 1
+    (or beyond :data:`~eyeviz.files.limits.MAX_ROWS`), a bad range, el_max outside
+    (0, pi/2), a bad prior, an estimator the registry does not list for the spherical
+    eyes, a grid where no design has l < h, or a
+    design where no ball can be visible in the binocular field.
+    """
+    axes = grid_axes(
+        h,
+        l,
+        ("nside", nside, check_nside),
+        r_min=r_min,
+        r_max=r_max,
+        prior=prior,
+        priors=("single", "multi"),
+        n=n,
+        seed=seed,
+    )
+    check_real("g_max", g_max, gt=0)
+    check_real("el_max", el_max, gt=0, lt=math.pi / 2)
+    from eyeviz.estimators import registry
+
+    have = registry.available("spherical")
+    if estimator not in have:
+        raise EyevizError(
+            f"estimator must be an estimator of the spherical eyes ({', '.join(have)}), "
+            f"got {estimator!r}"
+        )
+    pairs = grid_pairs(axes)
+    out = []
+    r_lo, r_hi, n, seed = axes.r_min, axes.r_max, axes.n, axes.seed
+    for hv, lv in pairs:
+        for nv in axes.resolution:
+            try:
+                p = DesignPoint3D(hv, lv, nv, r_lo, r_hi, g_max, el_max, prior, n, seed, estimator)
+            except EyevizError as exc:
+                raise EyevizError(f"design h={num(hv)}, l={num(lv)}, nside={nv}: {exc}") from None
+            out.append(p)
+    return out

@@ -2,7 +2,7 @@
 
 :mod:`eyeviz.study.runner` is one resumable Dask runner for both; what differs per kind
 is here: the point type, its table (:class:`~eyeviz.study.table.StudyTable` or
-:class:`~eyeviz.study.table3d.StudyTable3D`: one appender and one parser, with a format
+:class:`~eyeviz.study.table.StudyTable3D`: one appender and one parser, with a format
 each, told apart by their headers), its columns and the function a worker evaluates. A
 study's points are all of one kind.
 """
@@ -20,8 +20,7 @@ from eyeviz.study.point_measured import (
     StudyTableMeasured,
     is_table_measured,
 )
-from eyeviz.study.table import StudyTable
-from eyeviz.study.table3d import StudyTable3D, is_table3d
+from eyeviz.study.table import StudyTable, StudyTable3D, is_table3d
 
 __all__ = ["POINT_TYPES", "Point", "columns_of", "evaluate3d", "open_table"]
 

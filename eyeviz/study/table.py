@@ -2,8 +2,10 @@
 
 Both studies keep their results in a table of this one kind, read and written here for
 both: a :class:`~eyeviz.study.table_format.TableFormat` says what sets the planar table
-(:data:`PLANAR`) apart from the 3D one (:data:`eyeviz.study.table3d.TABLE3D`), and
-:mod:`eyeviz.study.table_format` holds the one parser of their lines
+(:data:`PLANAR`, :class:`StudyTable`) apart from the 3D one (:data:`TABLE3D`,
+:class:`StudyTable3D`; its header is :data:`~eyeviz.study.point3d.COLUMNS3D`, so neither
+reader takes the other's file, and :func:`is_table3d` tells them apart from the first
+line), and :mod:`eyeviz.study.table_format` holds the one parser of their lines
 (docs/study/README.md). pandas reads either file as it is (``pandas.read_csv(path)``).
 
 Rows are written a whole design point at a time (:func:`~eyeviz.study.point.evaluate`,
@@ -28,6 +30,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import stat
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,6 +42,7 @@ from eyeviz.files.limits import MAX_STUDY_BYTES, check_file_size
 from eyeviz.study.table_format import (
     MAX_LINE_CHARS,
     PLANAR,
+    TABLE3D,
     TableFormat,
     check_header,
     decode_line,
@@ -52,10 +56,16 @@ __all__ = [
     "MAX_STUDY_BYTES",
     "PLANAR",
     "StudyTable",
+    "StudyTable3D",
+    "TABLE3D",
     "TableFormat",
     "format_row",
+    "format_row3d",
+    "is_table3d",
     "iter_rows",
+    "iter_rows3d",
     "read_rows",
+    "read_rows3d",
 ]
 
 
@@ -134,7 +144,7 @@ class StudyTable:
 
     Holds the points' keys and the file's size, never its lines: appending writes only
     the new point's lines (memory bounded by one point). The planar study's table; the
-    3D study's (:class:`eyeviz.study.table3d.StudyTable3D`) is this with another
+    3D study's (:class:`StudyTable3D`) is this with another
     :attr:`fmt`."""
 
     fmt: ClassVar[TableFormat] = PLANAR
@@ -273,3 +283,41 @@ class StudyTable:
                 raise
         finally:
             os.close(fd)
+
+
+class StudyTable3D(StudyTable):
+    """A 3D study table on disk and the points it holds; :meth:`append` adds one point
+    (:class:`StudyTable` with the 3D format)."""
+
+    fmt = TABLE3D
+
+
+def format_row3d(row: dict) -> str:
+    """One CSV line (no newline) of a 3D study row, in :data:`COLUMNS3D` order."""
+    return format_row(row, TABLE3D.columns)
+
+
+def is_table3d(path) -> bool:
+    """Whether the file at ``path`` starts with the 3D study table's header (any version's
+    first column names; the reader then checks the version)."""
+    try:
+        if not stat.S_ISREG(os.stat(path).st_mode):  # a FIFO would block open() for good
+            return False  # (the reader then says what the file is)
+        with open(path, "rb") as f:
+            first = f.read(len(TABLE3D.header))
+    except OSError:
+        return False
+    return first.startswith((",".join(TABLE3D.columns[: TABLE3D.family]) + ",").encode("ascii"))
+
+
+def iter_rows3d(path, max_bytes: int = MAX_STUDY_BYTES) -> Iterator[tuple[str, dict]]:
+    """Stream a 3D study table (:func:`iter_rows` with :data:`TABLE3D`)."""
+    return iter_rows(path, max_bytes, TABLE3D)
+
+
+def read_rows3d(path, max_bytes: int = MAX_STUDY_BYTES) -> tuple[list[dict], list[str]]:
+    """A whole 3D study table: its rows (typed, with ``_key`` and ``_line``) and raw lines.
+
+    Raises a one-line :class:`EyevizError` naming the file and the first bad line.
+    """
+    return read_rows(path, max_bytes, TABLE3D)

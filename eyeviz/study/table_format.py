@@ -1,7 +1,7 @@
 """The study tables' format and its one parser (planar and 3D).
 
 What sets the planar table (:data:`PLANAR`, header :data:`~eyeviz.study.point.COLUMNS`)
-apart from the 3D one (:data:`eyeviz.study.table3d.TABLE3D`, header
+apart from the 3D one (:data:`TABLE3D`, header
 :data:`~eyeviz.study.point3d.COLUMNS3D`) is a :class:`TableFormat`: its columns, its
 version, its point type and its bins. Everything else is shared (docs/study/README.md):
 how a row is written (:func:`format_row`: repr floats that round-trip, nan as pandas reads
@@ -26,6 +26,7 @@ from eyeviz import EyevizError
 from eyeviz.core.bounds import MAX_BINS
 from eyeviz.core.validation import num
 from eyeviz.study.point import BIN_WIDTH, COLUMNS, STUDY_VERSION, DesignPoint
+from eyeviz.study.point3d import COLUMNS3D, EL_BINS, STUDY3D_VERSION, DesignPoint3D
 
 __all__ = [
     "MAX_LINE_CHARS",
@@ -129,6 +130,24 @@ PLANAR = TableFormat(
     errors=("dd_mape", "ad_mape"),
     r2=("dd_r2", "ad_r2"),
     bounds=("r_lo", "r_hi"),
+)
+
+#: The 3D study's table (:mod:`eyeviz.study.point3d`).
+TABLE3D = TableFormat(
+    name="3D study table",
+    study="3D study",
+    columns=COLUMNS3D,
+    version=STUDY3D_VERSION,
+    point=DesignPoint3D,
+    resolution="nside",
+    ints=frozenset({"version", "nside", "m", "n", "seed", "count", "flagged"}),
+    strs=frozenset({"prior", "estimator", "bin"}),
+    errors=("dd_mape", "ad_mape", "el_mae_deg", "az_mae_deg"),
+    r2=("dd_r2", "ad_r2", "el_r2"),
+    bounds=("lo", "hi"),
+    r_bin="r",
+    el_bins=EL_BINS,
+    ses=("dd_se", "el_se"),
 )
 
 

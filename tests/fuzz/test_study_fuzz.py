@@ -34,8 +34,7 @@ from eyeviz.reports.study3d import read_study3d
 from eyeviz.reports.study_table import read_study
 from eyeviz.study.point import COLUMNS, DesignPoint, evaluate
 from eyeviz.study.point3d import COLUMNS3D, DesignPoint3D, evaluate3d
-from eyeviz.study.table import StudyTable
-from eyeviz.study.table3d import StudyTable3D
+from eyeviz.study.table import StudyTable, StudyTable3D
 
 from .conftest import assert_one_line, count, digest, fuzz_settings
 

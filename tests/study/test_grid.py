@@ -95,7 +95,7 @@ def test_one_number_is_a_list_of_one_and_a_non_list_is_one_line():
 def test_a_seed_the_table_cannot_hold_is_refused_before_any_point(grid):
     """A 20-digit seed was taken, its first point computed, and then refused when its
     row was checked before the append (the tables' integers have at most 19 digits)."""
-    from eyeviz.study.grid3d import design_grid3d
+    from eyeviz.study.grid import design_grid3d
 
     make = design_grid if grid == "planar" else design_grid3d
     res = {"m": "16"} if grid == "planar" else {"nside": "4"}

@@ -15,7 +15,7 @@ import pytest
 from eyeviz.reports.study3d import fit_power, law_uncertainty, read_study3d
 from eyeviz.reports.study_law import LawPoint
 from eyeviz.study import run_study
-from eyeviz.study.grid3d import design_grid3d
+from eyeviz.study.grid import design_grid3d
 
 ROOT = Path(__file__).resolve().parents[2]
 STEMS = ("study3d_design", "study3d_dd", "study3d_law", "study3d_elevation")

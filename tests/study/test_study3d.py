@@ -13,9 +13,9 @@ import pytest
 
 from eyeviz import EyevizError
 from eyeviz.study import run_study
-from eyeviz.study.grid3d import design_grid3d
+from eyeviz.study.grid import design_grid3d
 from eyeviz.study.point3d import COLUMNS3D, STUDY3D_VERSION
-from eyeviz.study.table3d import StudyTable3D, read_rows3d
+from eyeviz.study.table import StudyTable3D, read_rows3d
 
 ROOT = Path(__file__).resolve().parents[2]
 pytest.importorskip("distributed")

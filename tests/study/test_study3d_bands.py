@@ -127,9 +127,9 @@ def _run(*args):
 
 @pytest.fixture(scope="module")
 def table3d(tmp_path_factory):
-    from eyeviz.study.grid3d import design_grid3d
+    from eyeviz.study.grid import design_grid3d
     from eyeviz.study.point3d import evaluate3d
-    from eyeviz.study.table3d import StudyTable3D
+    from eyeviz.study.table import StudyTable3D
 
     path = tmp_path_factory.mktemp("bands") / "s3.csv"
     for p in design_grid3d("20,40", "10", "16", n=3000, seed=4):

@@ -14,11 +14,10 @@ import pytest
 from eyeviz import EyevizError
 from eyeviz.study import run_study
 from eyeviz.study import table as table_mod
-from eyeviz.study.grid3d import design_grid3d
+from eyeviz.study.grid import design_grid3d
 from eyeviz.study.point import DesignPoint, evaluate
 from eyeviz.study.point3d import COLUMNS3D, DesignPoint3D, evaluate3d
-from eyeviz.study.table import StudyTable
-from eyeviz.study.table3d import StudyTable3D, read_rows3d
+from eyeviz.study.table import StudyTable, StudyTable3D, read_rows3d
 
 P1 = DesignPoint3D(h=20, l=10, nside=8, n=60, seed=1)
 P2 = DesignPoint3D(h=40, l=10, nside=8, n=60, seed=2)
@@ -244,7 +243,7 @@ def test_a_fifo_is_refused_without_opening_it(tmp_path):
     import threading
 
     from eyeviz.study.kinds import open_table
-    from eyeviz.study.table3d import is_table3d
+    from eyeviz.study.table import is_table3d
 
     fifo = tmp_path / "s.csv"
     os.mkfifo(fifo)
