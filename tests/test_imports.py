@@ -67,3 +67,22 @@ def test_report_help_lists_every_kind():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert "1 % error" in out.stdout
+
+
+def test_a_spherical_snapshot_loads_no_plotter_no_scipy_no_data_sets(tmp_path):
+    # issue 32.14: pyvista's plotting package (and matplotlib.pyplot with it) was imported
+    # for an off-screen plotter, scipy and eyeviz.dataset for what the figure never used;
+    # together about half a second of a 3D snapshot
+    out = tmp_path / "s.png"
+    code = (
+        "import sys\n"
+        "from eyeviz import cli\n"
+        "from eyeviz.resources import scene_path\n"
+        f"cli.main(['snapshot', str(scene_path('sphere_lecture')), '-o', {str(out)!r}])\n"
+        "names = ('pyvista.plotting', 'matplotlib.pyplot', 'scipy', 'numba', 'eyeviz.dataset')\n"
+        "print('loaded:', *[m for m in names if m in sys.modules])\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert out.stat().st_size > 10_000
+    assert r.stdout.strip().splitlines()[-1] == "loaded:"

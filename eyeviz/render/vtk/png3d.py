@@ -97,15 +97,15 @@ def _render(
     sc = scene.copy()
     sc.layers = [k for k in sc.layers if k != "labels"]
     st = compute_state3d(sc) if state is None else state
-    pl, actors = offscreen_view(width, height)
+    win, actors = offscreen_view(width, height)
     try:
         actors.update(sc, st, selected)
         actors.draw_predictions(predictions if sc.shows("predictions") else None)
         actors.title.SetVisibility(False)
         actors.eyes_caption.SetVisibility(False)
-        img = shoot(pl, actors, camera, transparent)
+        img = shoot(win, actors, camera, transparent)
     finally:
-        pl.close()
+        win.close()
     if img.shape[:2] != (height, width):
         raise EyevizError(
             f"VTK rendered {img.shape[1]} x {img.shape[0]} px, not {width} x {height}"

@@ -26,7 +26,6 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-import pyvista as pv
 from vtkmodules.vtkCommonCore import vtkCommand
 from vtkmodules.vtkRenderingCore import vtkRenderer
 
@@ -46,6 +45,7 @@ from eyeviz.render.vtk.eyes3d import EyesPainter
 from eyeviz.render.vtk.field3d import FieldPainter
 from eyeviz.render.vtk.ghosts3d import Ghosts3D, make_overlay
 from eyeviz.render.vtk.names3d import named_of, place_texts
+from eyeviz.render.vtk.offscreen import OffscreenWindow
 from eyeviz.render.vtk.painter3d import Painter3D
 from eyeviz.render.vtk.primitives import fit_lines, screen_text
 from eyeviz.render.vtk.style import BACKGROUND, INK, INSET_BACKGROUND
@@ -379,32 +379,32 @@ def png_size(width_px: float, aspect: float | None = None) -> tuple[int, int]:
     return w, h
 
 
-def offscreen_view(width: int, height: int) -> tuple[pv.Plotter, Scene3DActors]:
-    """An off-screen plotter laid out as the app's 3D view (the scene, the eyes' close-up),
+def offscreen_view(width: int, height: int) -> tuple[OffscreenWindow, Scene3DActors]:
+    """An off-screen window laid out as the app's 3D view (the scene, the eyes' close-up),
     with no multisampling and no depth peeling, and its empty actors: what
     :func:`render_png3d` and :mod:`eyeviz.render.vtk.png3d` render with. The caller
-    closes the plotter."""
-    pl = pv.Plotter(off_screen=True, window_size=[width, height], lighting="light kit")
+    closes the window. Plain VTK (:class:`eyeviz.render.vtk.offscreen.OffscreenWindow`,
+    lit as pyvista's light kit: the same pixels within one level in a thousandth of them):
+    a pyvista plotter cost a spherical snapshot a quarter of a second (issue 32.14)."""
+    win = OffscreenWindow(width, height)
     try:
-        ren_win = pl.ren_win
-        assert ren_win is not None
-        ren_win.SetMultiSamples(0)
-        main = pl.renderer
+        main = win.renderer
         main.SetUseOIT(False)
         main.SetUseDepthPeeling(False)
-        eyes = make_renderers(ren_win, main)
+        eyes = make_renderers(win.ren_win, main)
         layout(main, eyes, width, height)
-        return pl, Scene3DActors(main, eyes)
+        return win, Scene3DActors(main, eyes)
     except BaseException:
-        pl.close()
+        win.close()
         raise
 
 
-def shoot(pl: pv.Plotter, actors: Scene3DActors, camera: Camera3D, transparent: bool) -> np.ndarray:
-    """Render ``pl`` (from :func:`offscreen_view`) through ``camera`` and return its pixels."""
+def shoot(
+    win: OffscreenWindow, actors: Scene3DActors, camera: Camera3D, transparent: bool
+) -> np.ndarray:
+    """Render ``win`` (from :func:`offscreen_view`) through ``camera``; its pixels."""
     actors.set_cameras(camera)
-    pl.renderer.camera.is_set = True  # else pyvista's first render resets it (an isometric fit)
-    return np.asarray(pl.screenshot(return_img=True, transparent_background=transparent))
+    return win.pixels(transparent)
 
 
 def render_png3d(
@@ -434,16 +434,16 @@ def render_png3d(
     if not (target.parent if str(target.parent) else Path(".")).is_dir():
         raise EyevizError(f"{target}: directory {target.parent} does not exist")
     st = compute_state3d(scene) if state is None else state
-    pl, actors = offscreen_view(width, height)
+    win, actors = offscreen_view(width, height)
     try:
         actors.update(scene, st, selected)
         actors.draw_predictions(predictions if scene.shows("predictions") else None)
         if camera is None:
             left, _ = split_viewports(width, height)
             camera = default_camera(st, aspect=(1.0 - left[2]) * width / height)
-        img = shoot(pl, actors, camera, transparent)
+        img = shoot(win, actors, camera, transparent)
     finally:
-        pl.close()
+        win.close()
     from PIL import Image
 
     with atomic_output(target) as tmp:
