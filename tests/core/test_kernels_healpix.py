@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 import eyeviz.core.geometry3d as g3
 from eyeviz.core import kernels
 from eyeviz.core.kernels.healpix_lit import lit_runs_kernel
-from eyeviz.reference import stability_cases3d as sc3
+from eyeviz.reference import stability_cases as sc
 
 NSIDES = [2, 4, 6, 8, 10, 12, 16, 18, 64, 180]  # nside / 2 odd and even, small and large
 
@@ -48,12 +48,12 @@ def _compare(n, x, y, z, g):
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
-    name=st.sampled_from(sorted(sc3.CLASSES)),
+    name=st.sampled_from(sorted(sc.CLASSES3D)),
     seed=st.integers(0, 2**20),
     nside=st.sampled_from([None] + NSIDES),
 )
 def test_kernel_equals_the_reference_on_every_tie_class(name, seed, nside):
-    cs = sc3.make(name, 12, seed)
+    cs = sc.make(name, 12, seed, "spherical")
     n = cs.eyes.nside if nside is None else nside
     x, y, z, g = (np.ascontiguousarray(v, dtype=np.float64) for v in (cs.x, cs.y, cs.z, cs.g))
     _compare(n, x, y, z, g)
@@ -63,7 +63,7 @@ def test_kernel_equals_the_reference_on_every_tie_class(name, seed, nside):
 def test_kernel_decides_the_paper_regime_itself(n):
     """Nearly every paper-regime ball is decided in the kernel (not handed back), so the
     comparison above is a comparison of the kernel, not of the reference with itself."""
-    cs = sc3.make("paper", 60, n)
+    cs = sc.make("paper", 60, n, "spherical")
     x, y, z, g = (np.ascontiguousarray(v, dtype=np.float64) for v in (cs.x, cs.y, cs.z, cs.g))
     assert _compare(n, x, y, z, g) >= 2 * 60 - 2
 
