@@ -200,8 +200,16 @@ def law_points3d(designs: dict[tuple, Design3D]) -> list[LawPoint]:
             paper = d.key == PAPER3D
             out.append(
                 LawPoint(
-                    d.h, d.l, 4 * d.nside, r_mid, d.gamma * r_mid / (2 * d.h), y, fitted, paper
-                )
+                    d.h,
+                    d.l,
+                    4 * d.nside,
+                    r_mid,
+                    d.gamma * r_mid / (2 * d.h),
+                    y,
+                    fitted,
+                    paper,
+                    b.get("dd_se", math.nan) / 100.0,
+                )  # fmt: skip
             )
     return out
 

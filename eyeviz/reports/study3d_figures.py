@@ -95,14 +95,32 @@ def design_figure(designs: dict, l_of: dict, h_star: float, estimator: str):
     return fig
 
 
+def _dd_curves(designs: dict, l_of: dict) -> tuple[dict, dict, list[str]]:
+    """The curves of :func:`dd_figure`: for each h, its designs with a style key each; the
+    styles and the legend's labels. A curve per nside at each h's l; when the table has
+    one nside only, a curve per l instead (every l the table has at that h)."""
+    ns = sorted({k[2] for k in designs})
+    if len(ns) > 1:
+        per_h = {h: [(designs[k], k[2]) for nv in ns if (k := (h, l_of[h], nv)) in designs]
+                 for h in l_of}  # fmt: skip
+        return per_h, _m_style(ns), [_nside_label(nv) for nv in ns]
+    ls_ = sorted({k[1] for k in designs})
+    keys = [round(lv * 1000) for lv in ls_]
+    per_h = {h: [(designs[(h, lv, ns[0])], kv) for lv, kv in zip(ls_, keys, strict=True)
+                 if (h, lv, ns[0]) in designs] for h in l_of}  # fmt: skip
+    labels = [f"l = {lv:g}, {_nside_label(ns[0])}" for lv in ls_]
+    return per_h, _m_style(keys), labels
+
+
 def dd_figure(designs: dict, l_of: dict, fit: LawFit, estimator: str):
-    """DD MAPE against r, a panel per h (its l), a curve per nside; dashed: C gamma r/(2h)."""
+    """DD MAPE against r, a panel per h, a curve per nside at its l (or per l, for a table
+    of one nside; :func:`_dd_curves`), each bin's stated error as a bar; dashed:
+    C gamma r/(2h)."""
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
     hs = sorted(l_of)
-    ns = sorted({k[2] for k in designs})
-    style = _m_style(ns)
+    per_h, style, labels = _dd_curves(designs, l_of)
     vals = [b["dd_mape"] for d in designs.values() for b in d.r_bins if b["count"] >= MIN_COUNT]
     ncols = min(len(hs), 3)
     nrows = math.ceil(len(hs) / ncols)
@@ -111,23 +129,19 @@ def dd_figure(designs: dict, l_of: dict, fit: LawFit, estimator: str):
     )
     axes = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False).ravel()
     for ax, h in zip(axes, hs, strict=False):
-        for nv in ns:
-            d = designs.get((h, l_of[h], nv))
-            if d is None:
-                continue
+        for d, key in per_h[h]:
+            c = style[key]["color"]
             bins = [b for b in d.r_bins if b["count"] >= MIN_COUNT]
             r = np.array([b.get("r_mid", 0.5 * (b["lo"] + b["hi"])) for b in bins])
             dd = [b["dd_mape"] for b in bins]
-            ax.plot(r, dd, marker="o", ms=2.4, lw=1.3, **style[nv])
+            ax.plot(r, dd, marker="o", ms=2.4, lw=1.3, **style[key])
             se = np.array([b.get("dd_se", math.nan) for b in bins], float)
             if np.isfinite(se).any():  # each bin's sampling error, where the table states it
-                ax.errorbar(
-                    r, dd, yerr=se, fmt="none", lw=0.8, capsize=1.5, color=style[nv]["color"]
-                )
+                ax.errorbar(r, dd, yerr=se, fmt="none", lw=0.8, capsize=1.5, color=c)
             if fit.C is not None and r.size:
-                law = 100 * fit.C * d.gamma * r / (2 * h)
-                ax.plot(r, law, lw=0.8, ls=(0, (3, 2)), color=style[nv]["color"])
-        ax.set_title(f"h = {h:g}, l = {l_of[h]:g}", loc="left", pad=2)
+                ax.plot(r, 100 * fit.C * d.gamma * r / (2 * h), lw=0.8, ls=(0, (3, 2)), color=c)
+        ls_h = ", ".join(f"{d.l:g}" for d, _ in per_h[h])
+        ax.set_title(f"h = {h:g}, l = {ls_h}", loc="left", pad=2)
         _fmt_axis(ax, _log_helps(vals))
     for ax in axes[len(hs) :]:
         ax.set_axis_off()
@@ -137,15 +151,14 @@ def dd_figure(designs: dict, l_of: dict, fit: LawFit, estimator: str):
         if i >= len(hs) - ncols:
             ax.set_xlabel("distance r")
             ax.tick_params(labelbottom=True)
-    handles = [Line2D([], [], marker="o", ms=2.4, lw=1.3, **style[nv]) for nv in ns]
-    labels = [_nside_label(nv) for nv in ns]
+    handles = [Line2D([], [], marker="o", ms=2.4, lw=1.3, **st) for st in style.values()]
     if fit.C is not None:
         handles.append(Line2D([], [], lw=0.8, ls=(0, (3, 2)), color="black"))
         labels.append(f"dashed: the planar law's form C·γr/(2h), C = {fit.C:.3g} fitted in 3D")
-    fig.legend(handles, labels, loc="outside lower center", ncol=2, frameon=False)
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(ncols, 2), frameon=False)
     have_se = any(np.isfinite(b.get("dd_se", math.nan)) for d in designs.values() for b in d.r_bins)
-    what = "Distance error against r: does the γr/(2h) law carry over?"
-    _title(fig, what + (" (bars: ± 1 s.e.)" if have_se else ""), estimator)
+    bars = "\n(bars: ± 1 standard error of each bin)" if have_se else ""
+    _title(fig, "Distance error against r: does the γr/(2h) law carry over?" + bars, estimator)
     return fig
 
 
@@ -155,27 +168,28 @@ def law_figure3d(points: Sequence[LawPoint], fit: LawFit, power: dict | None, es
     from matplotlib.lines import Line2D
 
     ms = sorted({p.m for p in points})
-    style = _m_style(ms)
+    by_h = len(ms) == 1  # one nside: a colour per h, a marker per l
+    group = (lambda p: round(p.h * 1000)) if by_h else (lambda p: p.m)
+    keys = sorted({group(p) for p in points})
+    style = _m_style(keys)
+    ls_ = sorted({p.l for p in points}) if by_h else []
+    marker = {lv: "osD^v"[i % 5] for i, lv in enumerate(ls_)}
     fig = Figure(figsize=(ONE_COLUMN, 4.6), layout="constrained")
     ax = fig.add_subplot()
     ax.set_xscale("log")
     ax.set_yscale("log")
-    for m in ms:
-        for filled in (True, False):
-            sel = [p for p in points if p.m == m and p.fitted == filled]
-            c = style[m]["color"]
-            face = c if filled else "none"
-            ax.scatter(
-                [p.x for p in sel],
-                [p.y for p in sel],
-                s=7,
-                facecolor=face,
-                edgecolor=c,
-                lw=0.5,
-                zorder=3,
-            )
-    handles = [Line2D([], [], ls="", marker="o", ms=3, color=style[m]["color"]) for m in ms]
-    labels = [f"nside {m // 4}" for m in ms]
+    for p in points:
+        c = style[group(p)]["color"]
+        if math.isfinite(p.y_se):  # the bin's stated sampling error
+            ax.errorbar(p.x, p.y, yerr=p.y_se, fmt="none", lw=0.6, color=c, zorder=2.5)
+        face = c if p.fitted else "none"
+        mk = marker.get(p.l, "o")
+        ax.scatter(p.x, p.y, s=7, marker=mk, facecolor=face, edgecolor=c, lw=0.5, zorder=3)
+    handles = [Line2D([], [], ls="", marker="o", ms=3, color=style[k]["color"]) for k in keys]
+    labels = [f"h = {k / 1000:g}" if by_h else f"nside {k // 4}" for k in keys]
+    if by_h:
+        handles += [Line2D([], [], ls="", marker=marker[lv], ms=3, color="black") for lv in ls_]
+        labels += [f"l = {lv:g}, nside {ms[0] // 4}" for lv in ls_]
     xs = np.array([p.x for p in points])
     if fit.C is not None and xs.size:
         xx = np.geomspace(xs.min(), xs.max(), 50)
@@ -203,7 +217,8 @@ def law_figure3d(points: Sequence[LawPoint], fit: LawFit, power: dict | None, es
     ax.set_ylabel("relative DD error (MAPE / 100)")
     _fmt_axis(ax, False)
     fig.legend(handles, labels, loc="outside lower center", ncol=2, frameon=False)
-    _title(fig, "Every distance bin (filled: fitted)", estimator)
+    bars = ", bars: ± 1 s.e." if any(math.isfinite(p.y_se) for p in points) else ""
+    _title(fig, f"Every distance bin (filled: fitted{bars})", estimator)
     return fig
 
 
@@ -227,6 +242,10 @@ def elevation_figure(designs: dict, h: float, l_: float, estimator: str):
             az = [b["az_mae_deg"] for b in bins]
             vals += el + az
             ax.plot(x, el, marker="o", ms=2.4, lw=1.3, **style[nv])
+            se = np.array([b.get("el_se", math.nan) for b in bins], float)
+            if np.isfinite(se).any():  # each bin's sampling error, where the table states it
+                c = style[nv]["color"]
+                ax.errorbar(x, el, yerr=se, fmt="none", lw=0.8, capsize=1.5, color=c)
             ax.plot(x, az, lw=0.9, ls=":", color=style[nv]["color"])
     for ax in (ax_e, ax_r):
         _fmt_axis(ax, _log_helps(vals))
@@ -238,5 +257,9 @@ def elevation_figure(designs: dict, h: float, l_: float, estimator: str):
     handles.append(Line2D([], [], lw=0.9, ls=":", color="black"))
     labels.append("dotted: azimuth error, for comparison")
     fig.legend(handles, labels, loc="outside right center", frameon=False)
-    _title(fig, f"Elevation error (solid) at h = {h:g}, l = {l_:g}", estimator)
+    have_se = any(
+        np.isfinite(b.get("el_se", math.nan)) for nv in ns for b in designs[(h, l_, nv)].el_bins
+    )
+    bars = " (bars: ± 1 standard error of each bin)" if have_se else ""
+    _title(fig, f"Elevation error (solid) at h = {h:g}, l = {l_:g}{bars}", estimator)
     return fig

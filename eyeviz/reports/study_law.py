@@ -32,6 +32,7 @@ class LawPoint:
     y: float  # relative DD error (MAPE / 100)
     fitted: bool
     paper: bool
+    y_se: float = math.nan  # the sampling error of y, where the table states it (3D)
 
 
 @dataclass

@@ -179,3 +179,40 @@ def test_a_band_off_the_bins_or_on_a_planar_table_is_one_line(table3d, tmp_path)
     lines = out.stderr.strip().splitlines()
     assert out.returncode != 0 and len(lines) == 1 and "3D study table only" in lines[0]
     assert not (tmp_path / "g").exists()
+
+
+def _fine_design(h, l_, scale):
+    bins = [{"bin": f"r{i}", "lo": 1000.0 + 500 * i, "hi": 1500.0 + 500 * i, "count": 400,
+             "flagged": 0, "dd_mape": scale * (i + 1), "dd_se": 0.03 * scale * (i + 1)}
+            for i in range(8)]  # fmt: skip
+    all_ = {"n": 3200, "dd_mape": 4.5 * scale, "dd_se": 0.1}
+    return Design3D(h, l_, 180, 2 * math.pi / 720, all_, bins, [])
+
+
+def test_the_figures_of_one_nside_draw_a_curve_per_l_and_each_bins_error():
+    from matplotlib.container import ErrorbarContainer
+
+    from eyeviz.reports.study3d_figures import dd_figure, law_figure3d
+    from eyeviz.reports.study_law import fit_law
+
+    designs = {d.key: d for d in (_fine_design(40.0, 10.0, 0.2), _fine_design(40.0, 20.0, 0.15),
+                                  _fine_design(80.0, 10.0, 0.1))}  # fmt: skip
+    points = law_points3d(designs)
+    assert all(p.y_se == pytest.approx(0.03 * p.y) for p in points)
+    fit = fit_law(points, x_max=math.inf)
+    fig = dd_figure(designs, {40.0: 20.0, 80.0: 10.0}, fit, "limit3d")
+    ax40, ax80 = fig.axes[:2]
+    assert ax40.get_title(loc="left") == "h = 40, l = 10, 20"
+    # a curve per l with the bins' error bars, each beside its law line
+    bars = [c for c in ax40.containers if isinstance(c, ErrorbarContainer)]
+    assert len(bars) == 2
+    assert sorted(len(ln.get_xdata()) for ln in ax40.lines if ln.get_marker() == "o") == [8, 8]
+    texts = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert texts[:2] == ["l = 10, nside 180 (γ = 0.5°)", "l = 20, nside 180 (γ = 0.5°)"]
+    assert "standard error" in fig.texts[0].get_text()
+    law = law_figure3d(points, fit, None, "limit3d")
+    ax = law.axes[0]
+    bars = [c for c in ax.containers if isinstance(c, ErrorbarContainer)]
+    assert len(bars) == len(points)
+    texts = [t.get_text() for t in law.legends[0].get_texts()]
+    assert texts[:4] == ["h = 40", "h = 80", "l = 10, nside 180", "l = 20, nside 180"]
