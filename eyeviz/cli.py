@@ -17,6 +17,7 @@ ends in a one-line message on stderr and a non-zero exit, never a traceback:
 
 from __future__ import annotations
 
+import functools
 import os
 import signal
 import sys
@@ -187,7 +188,9 @@ def _whole_floats_count(parser) -> None:
                 _whole_floats_count(sub)
 
 
-def _command_modules() -> list:
+@functools.cache
+def _command_modules() -> tuple:
+    """The command modules, in name order (walked once a process)."""
     import importlib
     import pkgutil
 
@@ -200,7 +203,7 @@ def _command_modules() -> list:
         mod = importlib.import_module(f"eyeviz.commands.{info.name}")
         if hasattr(mod, "run") and hasattr(mod, "add_arguments"):
             mods.append(mod)
-    return mods
+    return tuple(mods)
 
 
 def main(argv: list[str] | None = None) -> int:
