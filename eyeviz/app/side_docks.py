@@ -21,14 +21,7 @@ if TYPE_CHECKING:
 else:
     _MainWindow = object  # MainWindow brings QMainWindow
 
-__all__ = [
-    "DOCK_MIN_PX",
-    "SIDE_MAX_FRACTION",
-    "SIDE_MIN_PX",
-    "SIDE_START_PX",
-    "SideDocksMixin",
-    "scrolling",
-]
+__all__ = ["DOCK_MIN_PX", "SIDE_MAX_FRACTION", "SIDE_MIN_PX", "SIDE_START_PX", "SideDocksMixin"]
 
 SIDE_MAX_FRACTION = 0.45  # the side panels never take more than this of the window width
 SIDE_MIN_PX = 260
@@ -43,21 +36,6 @@ class _SideScroll(QtWidgets.QScrollArea):
 
     def sizeHint(self) -> QtCore.QSize:  # noqa: N802 (Qt name)
         return QtCore.QSize(SIDE_START_PX, super().sizeHint().height())
-
-
-def scrolling(widget: QtWidgets.QWidget) -> QtWidgets.QScrollArea:
-    """``widget`` in a scroll area that scrolls up and down only, as wide as the dock: a
-    dock shorter than the panel's minimum scrolls instead of growing the window (the 3D
-    view's Facets panel needs 501 px at 175 %: F11 + F5 on a 1280 x 720 screen made the
-    window 824 px tall in sphere_lecture's step 8, its status bar off the screen)."""
-    scroll = QtWidgets.QScrollArea()
-    scroll.setWidgetResizable(True)
-    scroll.setFrameShape(QtWidgets.QFrame.NoFrame)
-    scroll.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
-    scroll.setWidget(widget)
-    scroll.setMinimumWidth(widget.minimumSizeHint().width())
-    scroll.setMinimumHeight(DOCK_MIN_PX)
-    return scroll
 
 
 class SideDocksMixin(_MainWindow):

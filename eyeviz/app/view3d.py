@@ -36,7 +36,6 @@ from PyQt5 import QtCore, QtWidgets
 from eyeviz.app.actions import PLANAR_ONLY, command3d
 from eyeviz.app.help import LAYER3D_TEXT, view3d_help_text
 from eyeviz.app.predictions_layer3d import Predictions3DLayer
-from eyeviz.app.side_docks import scrolling
 from eyeviz.app.view import make_view
 from eyeviz.model import app_model3d as m3
 from eyeviz.model.camera3d import PRESETS, Camera3D, dolly
@@ -164,8 +163,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self.bitmaps = Bitmaps3DPanel()
         self.readout = Readout3DPanel(lambda: self.model)  # typed values, row clicks
         self.estimators = Estimators3DPanel(self._set_estimators)
-        maps = scrolling(self.bitmaps)  # a short dock scrolls (175 % in 1280 x 720)
-        self.docks["bitmaps3d"] = self._dock("Facets (Mollweide)", maps, "bitmaps3d")
+        self.docks["bitmaps3d"] = self._dock("Facets (Mollweide)", self.bitmaps, "bitmaps3d")
         self.docks["readout3d"] = self._dock("Balls", self.readout, "readout3d")
         # as the planar window's: a tab beside the readout, greyed until the layer is on
         self.docks["estimators3d"] = self._dock("Estimators", self.estimators, "estimators3d")
