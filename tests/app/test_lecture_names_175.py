@@ -45,6 +45,15 @@ def test_names_clear_the_title_at_175_percent_in_every_step(make_window, qtbot):
         _keys(qtbot, "Next", until=lambda s=step: win.step_index == s)
         qtbot.wait(300)
         host.draw()
+        t = host.readout.table
+        if t.isVisible():  # numbers whole, not "..." in every cell (step 8 shows it)
+            head, fm = t.horizontalHeader(), t.fontMetrics()
+            for j in range(1, t.columnCount()):
+                for i in range(t.rowCount()):
+                    item = t.item(i, j)
+                    if item is not None and item.text():
+                        wide = fm.horizontalAdvance(item.text())
+                        assert wide <= head.sectionSize(j), (step + 1, item.text())
         title, side = _box(host.actors.title, ren), _box(host.side.actor, ren)
         for box in host.actors.name_boxes:
             if np.isfinite(box).all():

@@ -134,7 +134,8 @@ def natural_width(t: QtWidgets.QTableWidget) -> int:
 
 def fit_columns(t: QtWidgets.QTableWidget) -> None:
     """Columns 1... as wide as their header and cells; column 0 (the names, elided) the
-    rest of the viewport, at least NAME_MIN_PX: no horizontal scroll bar."""
+    rest of the viewport, at least NAME_MIN_PX: no horizontal scroll bar, unless the
+    numbers alone do not fit (then they stay whole and the table scrolls sideways)."""
     head = t.horizontalHeader()
     assert head is not None
     widths = _text_widths(t)
@@ -144,7 +145,19 @@ def fit_columns(t: QtWidgets.QTableWidget) -> None:
     tall = rows_h + head.height() + 2 * t.frameWidth() > t.height()
     avail = t.width() - 2 * t.frameWidth() - (bar if tall else 0)  # a vertical bar's room
     room = avail - NAME_MIN_PX
-    if len(widths) > 1 and sum(widths[1:]) > room:
+    # the numbers alone wider than the table (175 % in a 1280 x 720 screen: every cell
+    # was "..."): they keep their width, a note at most NOTE_WANT_PX; the table scrolls
+    # (a long note alone still elides, below)
+    short = [v for v in widths[1:] if v <= NOTE_WANT_PX]
+    sideways = sum(short) + 24 * (len(widths) - 1 - len(short)) > room
+    t.setHorizontalScrollBarPolicy(
+        QtCore.Qt.ScrollBarPolicy.ScrollBarAsNeeded
+        if sideways
+        else QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff
+    )
+    if sideways:
+        widths[1:] = [min(v, NOTE_WANT_PX) for v in widths[1:]]
+    elif len(widths) > 1 and sum(widths[1:]) > room:
         # too wide (a long reason): the narrow columns keep their width, the widest share
         # what is left, their text elided (water-filling)
         rest = sorted(range(1, len(widths)), key=lambda j: widths[j])
