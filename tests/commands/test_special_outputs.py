@@ -7,6 +7,7 @@ ones here are driven end to end."""
 from __future__ import annotations
 
 import os
+import select
 import socket
 import stat
 import threading
@@ -30,16 +31,36 @@ def _null_copy(path):
 
 
 class _Reader(threading.Thread):
-    """Reads a FIFO to its end, as `cat FIFO > file` would."""
+    """Reads a FIFO to its end, as `cat FIFO > file` would.
+
+    The read end is opened here, before the command runs, so the command always finds its
+    reader (a thread that had not yet reached open() made the command refuse the FIFO on a
+    loaded machine). poll() waits for data; it reports a hang-up only after a writer has
+    come and gone, so the read loop ends at the writer's close, not before it opens."""
 
     def __init__(self, fifo):
         super().__init__(daemon=True)
-        self.fifo, self.data = fifo, b""
+        self.fd = os.open(fifo, os.O_RDONLY | os.O_NONBLOCK)
+        self.data = b""
         self.start()
 
     def run(self):
-        with open(self.fifo, "rb") as f:  # blocks until the writer opens the FIFO
-            self.data = f.read()
+        poller = select.poll()
+        poller.register(self.fd, select.POLLIN)
+        chunks = []
+        try:
+            while True:
+                poller.poll()
+                try:
+                    chunk = os.read(self.fd, 1 << 16)
+                except BlockingIOError:
+                    continue
+                if not chunk:
+                    break
+                chunks.append(chunk)
+        finally:
+            os.close(self.fd)
+        self.data = b"".join(chunks)
 
 
 @pytest.fixture(scope="module")
