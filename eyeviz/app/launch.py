@@ -14,12 +14,13 @@ from eyeviz.core import kernels
 __all__ = ["APP_FONT_PT", "check_display", "make_app", "warm_kernels"]
 
 APP_FONT_PT = 13
+_HELD: dict[str, int] = {}  # the connection check_display keeps per display (see there)
 
 
 def check_display() -> None:
     """EyevizError (one line) when no display can be reached, before Qt aborts the process.
 
-    An X display named in $DISPLAY is opened with Xlib itself (and closed again): a stale
+    An X display named in $DISPLAY is opened with Xlib itself (and kept open): a stale
     DISPLAY (a closed ssh -X session, a stopped Xvfb) becomes a message, not Qt's
     "could not connect to display ... Reinstalling the application may fix this problem".
     """
@@ -31,6 +32,8 @@ def check_display() -> None:
         )
     if not display or os.environ.get("QT_QPA_PLATFORM", "xcb") not in ("xcb", ""):
         return
+    if display in _HELD:
+        return  # checked, and its connection kept (one a display, not one a call)
     lib = ctypes.util.find_library("X11")
     if lib is None:
         return  # cannot check without Xlib; Qt will try
@@ -44,7 +47,11 @@ def check_display() -> None:
             f"cannot connect to the X display {display!r} (stale DISPLAY?): "
             "unset it and use `xvfb-run -a eyeviz app --screenshot OUT.png`, or fix DISPLAY"
         )
-    x11.XCloseDisplay(dpy)
+    # kept open while the process lives: closing the only client of a fresh Xvfb (as
+    # `xvfb-run eyeviz app` starts one) resets the server, and Qt's own connection a
+    # moment later could meet the reset ("could not connect to display", SIGABRT: 1 run
+    # in 16-40 here, issue 32.14's benches)
+    _HELD[display] = dpy
 
 
 def make_app(warm: bool = True) -> QtWidgets.QApplication:
