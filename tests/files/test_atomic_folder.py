@@ -90,12 +90,16 @@ def test_signals_are_held_while_the_files_move_in(tmp_path):
         real(stage, path)
 
     atomic._move_in = move_with_a_signal
+    # Python's own Ctrl-C handler, whatever this process inherited (a shell's background
+    # job starts with SIGINT ignored, and the signal would then be held and dropped)
+    inherited = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         with pytest.raises(KeyboardInterrupt), atomic_folder(d) as stage:
             (stage / "study.md").write_text("new run")
             (stage / "study_dd.png").write_bytes(b"new png")
     finally:
         atomic._move_in = real
+        signal.signal(signal.SIGINT, inherited)
     assert (d / "study.md").read_text() == "new run"  # the whole new set, then the signal
     assert (d / "study_dd.png").read_bytes() == b"new png"
 
