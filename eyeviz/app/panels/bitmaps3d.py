@@ -39,7 +39,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 from PyQt5 import QtCore, QtWidgets
 
-from eyeviz.app.panels.common import follows_text_scale, text_scale, wrap_label
+from eyeviz.app.panels.common import LinesLabel, follows_text_scale, text_scale, wrap_label
 from eyeviz.app.panels.lit_raster import LitRaster
 from eyeviz.app.panels.map_geometry import (
     R2,
@@ -127,7 +127,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         }
         for eye, ax in self.axes.items():
             ax.set_gid(f"map{eye}")
-        self.counts = wrap_label(QtWidgets.QLabel(""))
+        self.counts = LinesLabel(2)  # elided: never taller at 175 %; gives way first
         self.hover = wrap_label(QtWidgets.QLabel(""))
         self.hover.setObjectName("hover3d")
         # over the canvas's top-right corner while zoomed: never moves the dock's layout
