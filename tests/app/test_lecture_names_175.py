@@ -1,7 +1,8 @@
 """The spherical lecture at 175 % in a 1280 x 720 window in presentation mode (issue 32
 item 3): in every step no ball's name touches the 3D view's title or its side note (they
 printed over the title in steps 6 and 7; then, with the title's box taken 57 px under the
-view, "target" still did in step 7; where no place is clear the title now gives way).
+view, "target" still did in step 7; where no place is clear the title now gives way), nor
+the close-up's names each other or its caption (item 4).
 Real keys (xdotool) into the real window."""
 
 import numpy as np
@@ -63,4 +64,13 @@ def test_names_clear_the_title_at_175_percent_in_every_step(make_window, qtbot):
                 assert not _overlap(box, title), (step + 1, box, title)
                 assert not _overlap(box, side), (step + 1, box, side)
                 checked += 1
+        # the close-up's names: clear of each other and of its caption where it is shown
+        # ("eye A" printed over the caption in steps 6-8, over "eye B" in step 8)
+        eyes_ren, cap = host.actors.eyes_ren, host.actors.eyes_caption
+        names = [b for b in host.actors.eye_name_boxes if np.isfinite(b).all()]
+        assert len(names) == 2, (step + 1, names)
+        assert not _overlap(names[0], names[1]), (step + 1, names)
+        if cap.GetVisibility() and cap.GetInput() and cap.GetTextProperty().GetOpacity() > 0:
+            for box in names:
+                assert not _overlap(box, _box(cap, eyes_ren)), (step + 1, box)
     assert checked >= 8  # names were shown and checked

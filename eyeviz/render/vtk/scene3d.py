@@ -187,6 +187,7 @@ class Scene3DActors:
         self.selected: int | None = None
         self.scene_shows_predictions = False
         self.name_boxes = np.zeros((0, 4))
+        self.eye_name_boxes = np.zeros((0, 4))  # the close-up's names' (its pixels, y up)
         self.eyes_caption = screen_text(16, (0.35, 0.35, 0.35), (0.03, 0.985), top=True)
         if eyes_ren is not None:
             eyes_ren.AddViewProp(self.eyes_caption)
@@ -220,7 +221,7 @@ class Scene3DActors:
         order, named = self.balls.named(st, np.concatenate(others), self._dpi(), self.selected)
         return order, replace(named, keep_out=self._text_boxes())
 
-    def _text_boxes(self, actors=None) -> np.ndarray:
+    def _text_boxes(self, actors=None, ren=None) -> np.ndarray:
         """Boxes (k, 4, the scene viewport's pixels, y up) of the shown texts among
         ``actors`` (default :attr:`keep_clear`): at 175 % in a small window a name printed
         over the title (issue 32.3).
@@ -229,7 +230,7 @@ class Scene3DActors:
         -57 to 0 px, under the view, so names were still placed over it at F11 + F5 +
         175 % in 1280 x 720): moved by the anchor's viewport pixels, and grown by
         :data:`KEEP_CLEAR_PX` so that no name touches it."""
-        ren, out, pad = self.scene_ren, [], KEEP_CLEAR_PX
+        ren, out, pad = ren or self.scene_ren, [], KEEP_CLEAR_PX
         for actor in self.keep_clear if actors is None else actors:
             if actor.GetVisibility() and actor.GetInput():
                 b = [0.0] * 4  # x0, x1, y0, y1, relative to the anchor
@@ -254,16 +255,30 @@ class Scene3DActors:
         self.name_boxes = boxes
 
     def _place_eye_names(self, *_args) -> None:
-        """Before the close-up renders: each eye's name under it, over nothing."""
-        if self.eyes_ren is None or self.state is None:
+        """Before the close-up renders: each eye's name under it, over nothing: not the
+        other's name nor the close-up's caption (F11 + F5 + 175 % in 1280 x 720: "eye A"
+        printed over it, or over "eye B", in sphere_lecture's steps 6-8). Where the names find
+        no places clear of the caption and of each other, the caption gives way (this frame:
+        each frame tries again)."""
+        ren, cap = self.eyes_ren, self.eyes_caption
+        if ren is None or self.state is None:
             return
         eyes = self._eye_spheres()  # the close-up draws no ball: the eyes are all there is
         labs = self.eyes.labels
         if len(labs) != len(eyes):
             return
-        none = np.zeros((0, 4))
-        order, named = named_of(labs, eyes[:, :3], eyes[:, 3], none, self._dpi(), below=True)
-        place_texts(self.eyes_ren, camera_of(self.eyes_ren), labs, named, order)
+        cap.GetTextProperty().SetOpacity(1.0)
+        keep = self._text_boxes([cap], ren)
+        order, named = named_of(
+            labs, eyes[:, :3], eyes[:, 3], np.zeros((0, 4)), self._dpi(), below=True
+        )
+        named = replace(named, keep_out=keep)
+        boxes = place_texts(ren, camera_of(ren), labs, named, order)
+        crossed = any(_covers(boxes[i : i + 1], boxes[i + 1 :]) for i in range(len(boxes)))
+        if crossed or _covers(boxes, keep):  # placed clear of it only over each other
+            cap.GetTextProperty().SetOpacity(0.0)
+            boxes = place_texts(ren, camera_of(ren), labs, replace(named, keep_out=None), order)
+        self.eye_name_boxes = boxes
 
     def _dpi(self) -> int:
         win = self.scene_ren.GetRenderWindow()
