@@ -128,7 +128,8 @@ def _color(name: str) -> str:
 
 
 def plot3d(results: list[Result3D]):
-    """Figure: DD and AD MAPE and elevation MAE on the subset against time per row."""
+    """Figure: DD and AD MAPE and elevation MAE on the subset against time per row, each
+    with its bootstrap standard error as an error bar (``Result3D.errors``)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -147,6 +148,11 @@ def plot3d(results: list[Result3D]):
             y = r.metrics["subset"][key]
             c = _color(r.name)
             ax.plot([x, r.single_ms * 1e-3], [y, y], color=c, lw=1.0, alpha=0.6)
+            se = r.errors.get("subset", {}).get(key, math.nan)
+            if math.isfinite(se):
+                ax.errorbar(
+                    [x], [y], yerr=[se], fmt="none", color="black", lw=1.0, capsize=5, zorder=4
+                )
             ax.scatter([x], [y], s=70, color=c, edgecolors="black", zorder=3, label=r.name)
             ax.annotate(r.name, (x, y), textcoords="offset points", xytext=(6, 6), fontsize=8)
         ax.set_xscale("log")

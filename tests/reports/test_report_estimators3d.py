@@ -76,3 +76,37 @@ def test_with_error_prints_to_the_precision_the_error_allows():
     assert with_error(0.0038123, 0.000104) == "0.00381 ± 0.00010"
     assert with_error(1580.4, 37.2) == "1580 ± 37"
     assert with_error(2.0, float("nan")) == "2"
+
+
+def test_the_figure_draws_each_estimators_standard_error():
+    """plot3d draws every measured estimator's bootstrap error as a bar of +- se about its
+    value in each of the three panels (issue 38: the figures carry their errors)."""
+    from matplotlib.collections import LineCollection
+
+    from eyeviz.reports.estimators3d import Result3D, plot3d
+
+    keys = ("dd", "ad", "el_mae_deg")
+    res = [
+        Result3D(
+            name,
+            rows=100,
+            metrics={"subset": {k: v * (i + 1) for i, k in enumerate(keys)}},
+            errors={"subset": {k: se for k in keys}},
+            batched_us=10.0,
+            single_ms=1.0,
+        )
+        for name, v, se in (("analytic3d", 1.5, 0.03), ("limit3d", 0.7, 0.02))
+    ]
+    fig = plot3d(res)
+    for i, ax in enumerate(fig.axes[:3]):
+        bars = sorted(
+            tuple(np.round(seg[:, 1], 9))
+            for c in ax.collections
+            if isinstance(c, LineCollection)
+            for seg in c.get_segments()
+        )
+        want = sorted(
+            (round(v * (i + 1) - se, 9), round(v * (i + 1) + se, 9))
+            for v, se in ((1.5, 0.03), (0.7, 0.02))
+        )
+        assert bars == want
