@@ -51,6 +51,9 @@ def test_names_clear_the_title_at_175_percent_in_every_step(make_window, qtbot):
         assert win.height() == 720, (step + 1, win.height())
         t = host.readout.table
         if t.isVisible():  # numbers whole, not "..." in every cell (step 8 shows it)
+            # and its rows shown: a row whole, not the header alone (step 8 showed no row)
+            bottom = t.rowViewportPosition(0) + t.rowHeight(0)
+            assert bottom <= t.viewport().height(), (step + 1, bottom, t.viewport().height())
             head, fm = t.horizontalHeader(), t.fontMetrics()
             for j in range(1, t.columnCount()):
                 for i in range(t.rowCount()):

@@ -128,7 +128,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         for eye, ax in self.axes.items():
             ax.set_gid(f"map{eye}")
         self.counts = LinesLabel(2)  # elided: never taller at 175 %; gives way first
-        self.hover = wrap_label(QtWidgets.QLabel(""))
+        self.hover = LinesLabel(2, wrap=True)  # kept free: the first hover moves nothing
         self.hover.setObjectName("hover3d")
         # over the canvas's top-right corner while zoomed: never moves the dock's layout
         self.whole = QtWidgets.QPushButton("Whole map", self.canvas)
@@ -253,14 +253,12 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             self._fit_text()
 
     def _fit_text(self) -> None:
-        """The maps' words at the text scale; the hover line's two lines kept free, so that
-        the first hover does not push the panels below it down (issue 32)."""
+        """The maps' words at the text scale (the hover line keeps its two lines free, so
+        that the first hover does not push the panels below it down: issue 32)."""
         s = text_scale()
         for t, pt in self._texts:
             t.set_fontsize(pt * s)
         self._place_axes()
-        fm = self.hover.fontMetrics()
-        self.hover.setMinimumHeight(2 * fm.lineSpacing() + 2 * self.hover.margin() + 4)
         self._bg = None
         self.canvas.draw_idle()
 

@@ -45,11 +45,14 @@ class LinesLabel(QtWidgets.QLabel):
     (large text on a small screen) it needs none: it gives way first in a short panel and
     shows the lines that fit (F11 + F5 + 175 % in 1280 x 720: the 3D Facets panel's two
     counts lines wrapped onto four, and its minimum made the window 824 px tall, the status
-    bar off the screen). The whole text is in the tooltip."""
+    bar off the screen). The whole text is in the tooltip. ``wrap``: the text is wrapped
+    instead, onto the lines there are room for (the Facets panel's hover line: its two
+    lines, 114 px at that size, left the Balls table no row in step 8)."""
 
-    def __init__(self, lines: int, text: str = "") -> None:
+    def __init__(self, lines: int, text: str = "", wrap: bool = False) -> None:
         super().__init__()
         self._full, self._lines = "", lines
+        self.setWordWrap(wrap)
         self.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Maximum)
         self.setMinimumSize(0, 0)
         self.setAlignment(QtCore.Qt.AlignmentFlag.AlignTop)  # and left
@@ -76,6 +79,9 @@ class LinesLabel(QtWidgets.QLabel):
         tall = screen is not None and h > LINES_SCREEN_SHARE * screen.availableGeometry().height()
         return QtCore.QSize(0, 0 if tall else h)
 
+    def hasHeightForWidth(self) -> bool:  # noqa: N802 (Qt name)
+        return False  # wrapped too: its lines' height, not its text's
+
     def resizeEvent(self, ev) -> None:  # noqa: N802 (Qt name)
         super().resizeEvent(ev)
         self._elide()
@@ -87,6 +93,9 @@ class LinesLabel(QtWidgets.QLabel):
             self.updateGeometry()
 
     def _elide(self) -> None:
+        if self.wordWrap():
+            super().setText(self._full)
+            return
         fm, width = self.fontMetrics(), max(self.contentsRect().width(), 1)
         lines = self._full.split("\n") if self._full else []
         while lines and self._height(len(lines)) > self.height():  # the last lines give way
