@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import itertools
 import math
 import subprocess
 import sys
@@ -15,6 +16,7 @@ from scipy import sparse
 
 from eyeviz.reports import information
 from eyeviz.reports import information_measure as M
+from eyeviz.reports.errors import with_error
 
 
 def _linear_fn(a: np.ndarray, b: np.ndarray):
@@ -62,12 +64,74 @@ def test_planar_bound(planar: M.ModelResult) -> None:
 
 
 def test_tables(planar: M.ModelResult) -> None:
-    md = information._markdown([planar], 1000.0)
+    e = M.ball_bootstrap(planar)
+    md = information._markdown([planar], 1000.0, [e])
     assert "the paper's planar design" in md and "information limit (limit)" in md
-    table, balls = information._csv([planar], 1000.0)
+    table, balls = information._csv([planar], 1000.0, [e])
     row = next(csv.DictReader(table.splitlines()))
     assert float(row["crossover_rms"]) == pytest.approx(planar.crossover, rel=1e-5)
     assert len(balls.splitlines()) == 21
+    # every figure has its bootstrap error, in the CSV and (to its precision) in the table
+    se = {
+        "binary_rms_se": e.se["binary_rms"],
+        "binary_median_se": e.se["binary_median"],
+        "graded_rms_at_n_se": e.se["graded_rms"] / math.sqrt(1000),
+        "graded_median_at_n_se": e.se["graded_median"] / math.sqrt(1000),
+        "crossover_rms_se": e.se["crossover"],
+        "crossover_median_se": e.se["crossover_median"],
+    }
+    for key, v in se.items():
+        assert v > 0 and float(row[key]) == pytest.approx(v, rel=1e-2), key
+    assert float(row["crossover_rms_low"]) < planar.crossover < float(row["crossover_rms_high"])
+    cells = md.splitlines()[-1].split(" | ")
+    assert cells[4] == with_error(100 * planar.binary_rms, 100 * e.se["binary_rms"]) + " %"
+    graded = planar.graded_rms(1000.0)
+    assert cells[6] == with_error(100 * graded, 100 * se["graded_rms_at_n_se"]) + " %"
+    med = planar.binary_median, planar.graded_median(1000.0)
+    assert cells[5] == with_error(100 * med[0], 100 * e.se["binary_median"]) + " %"
+    assert cells[7] == with_error(100 * med[1], 100 * se["graded_median_at_n_se"]) + " %"
+    assert cells[10].startswith(f"{planar.crossover:.3g} (")
+    # the ratio at N is sqrt(N / N*), its interval N*'s interval mapped
+    lo, hi = (math.sqrt(1000 / x) for x in (e.high["crossover"], e.low["crossover"]))
+    assert cells[8] == f"{planar.binary_rms / graded:.3g}x ({lo:.3g}-{hi:.3g})"
+
+
+def _exact_bootstrap_sd(m: M.ModelResult) -> dict[str, float]:
+    """The standard deviation of each statistic over every one of the n^n equally likely
+    resamples of the balls: the exact bootstrap, written out directly."""
+    ok = m.ok
+    vals = []
+    for idx in itertools.product(range(int(ok.sum())), repeat=int(ok.sum())):
+        sub = M.ModelResult(
+            "t", "t", "cell", "b", len(idx), m.r[ok][list(idx)], m.crb1[ok][list(idx)],
+            m.binary_rel[ok][list(idx)], 0.0, 0.0,
+        )  # fmt: skip
+        vals.append(
+            [sub.binary_rms, sub.graded_rms(1.0), sub.binary_median, sub.graded_median(1.0),
+             sub.crossover, sub.crossover_median]
+        )  # fmt: skip
+    return dict(zip(M.STATS, np.std(np.array(vals), axis=0), strict=True))
+
+
+def test_ball_bootstrap_matches_the_exact_bootstrap() -> None:
+    # five balls with a bound and a binary answer, one without a bound (left out)
+    r = np.array([100.0, 200.0, 300.0, 400.0, 500.0, 600.0])
+    crb1 = np.array([4.0, 90.0, 10.0, 400.0, 30.0, np.inf])
+    rel = np.array([0.02, -0.1, 0.05, 0.3, -0.01, 0.2])
+    m = M.ModelResult("t", "t", "cell", "b", 6, r, crb1, rel, 0.0, 0.0)
+    exact = _exact_bootstrap_sd(m)
+    got = M.ball_bootstrap(m, n_boot=20000, seed=1)
+    for k in M.STATS:
+        # Monte Carlo error of a standard deviation from 20,000 resamples: about 1 %
+        assert got.se[k] == pytest.approx(exact[k], rel=0.05), k
+        assert got.low[k] < got.high[k], k
+    assert got.low["crossover"] <= m.crossover <= got.high["crossover"]
+    # the graded errors scale as 1 / sqrt(N), as the figures do
+    assert got.graded_rms_se(400.0) == pytest.approx(got.se["graded_rms"] / 20, rel=1e-12)
+    # the same seed gives the same errors; a single ball has none
+    assert M.ball_bootstrap(m, n_boot=200, seed=3) == M.ball_bootstrap(m, n_boot=200, seed=3)
+    one = M.ModelResult("t", "t", "cell", "b", 1, r[:1], crb1[:1], rel[:1], 0.0, 0.0)
+    assert all(math.isnan(v) for v in M.ball_bootstrap(one).se.values())
 
 
 def test_bad_photons_exit_2_in_one_line(tmp_path: Path) -> None:
