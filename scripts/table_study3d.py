@@ -1,7 +1,7 @@
 """The 3D study's per-bin errors as Markdown (issue 38.3): for each design of a 3D study
 table (``eyeviz study --nside``), its DD per distance band with the band's sampling error,
 the band being ``--band`` wide (the table's 500-wide bins merged by
-:func:`eyeviz.reports.study3d.merge_bins`: the band's DD is the count-weighted mean of its
+:func:`eyeviz.reports.study_design.merge_bins`: the band's DD is the count-weighted mean of its
 bins', its standard error the stratified sqrt(sum (count_i se_i)^2) / sum count_i), the
 error relative to the DD (marked when above 5 %), and DD / (gamma r / 2h), the law's
 constant C for that band alone (r: the band's count-weighted mean distance). Then the law
@@ -17,16 +17,8 @@ import argparse
 import math
 
 from eyeviz.reports.errors import with_error
-from eyeviz.reports.study3d import (
-    REL_MAX,
-    band_designs,
-    choose_estimator,
-    designs3d,
-    law_points3d,
-    law_uncertainty,
-    read_study3d,
-)
-from eyeviz.reports.study_law import fit_law
+from eyeviz.reports.study_design import band_designs, choose_estimator, designs3d, read_study3d
+from eyeviz.reports.study_law import REL_MAX, fit_law, law_points3d, law_uncertainty
 
 
 def rows_md(designs: dict) -> tuple[list[str], int]:
@@ -55,7 +47,7 @@ def rows_md(designs: dict) -> tuple[list[str], int]:
 
 
 def law_md(designs: dict) -> str:
-    """The law fitted on the bands (:func:`~eyeviz.reports.study3d.law_points3d`'s rule)
+    """The law fitted on the bands (:func:`~eyeviz.reports.study_law.law_points3d`'s rule)
     with its bootstrap error, in one line."""
     points = law_points3d(designs)
     fit = fit_law(points, x_max=math.inf)

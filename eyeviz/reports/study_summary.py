@@ -1,8 +1,10 @@
 """The summary files of the eye-design study (:mod:`eyeviz.reports.study`).
 
-``summary.csv`` (the table behind the heatmap with the law's value per cell),
-``summary.json`` (the fitted constant, its spread and the paper's design) and the
-Markdown text of ``study.md``.
+Planar eyes: ``summary.csv`` (the table behind the heatmap with the law's value per
+cell), ``summary.json`` (the fitted constant, its spread and the paper's design) and the
+Markdown text of ``study.md``. Spherical eyes: ``summary3d.json`` (the estimator drawn,
+the law with its bootstrap spread and the free power law, every design and distance bin,
+the table's other estimators; :func:`summary3d_json`).
 """
 
 from __future__ import annotations
@@ -14,8 +16,15 @@ import math
 from pathlib import Path
 
 from eyeviz.files.atomic import atomic_output
-from eyeviz.reports.study_design import MIN_COUNT, PAPER
-from eyeviz.reports.study_law import LawFit
+from eyeviz.reports.study_design import MIN_COUNT, PAPER, Design3D, bin_errors
+from eyeviz.reports.study_law import (
+    FIT_MAX,
+    FLAG_MAX,
+    REL_MAX,
+    LawFit,
+    LawPoint,
+    law_uncertainty,
+)
 
 CAPTIONS = {
     "study_dd": "DD limit (MAPE %) against distance, a panel per h, a curve per m",
@@ -123,3 +132,86 @@ def markdown(table, fit, designs, l_of, best, args_d, figures) -> str:
     for f in figures:
         lines += [f"**{f}**: {CAPTIONS.get(f, '')}", "", f"![{f}]({f}.png)", ""]
     return "\n".join(lines) + "\n"
+
+
+def _no_nan(v):
+    """``v`` with every NaN float (a bin of one row has no standard error) as None."""
+    if isinstance(v, dict):
+        return {k: _no_nan(x) for k, x in v.items()}
+    if isinstance(v, list):
+        return [_no_nan(x) for x in v]
+    return None if isinstance(v, float) and math.isnan(v) else v
+
+
+def summary3d_json(
+    path: Path,
+    rows: list[dict],
+    prior: str,
+    est: str,
+    is_limit: bool,
+    designs: dict[tuple, Design3D],
+    points: list[LawPoint],
+    fit: LawFit,
+    power: dict | None,
+    band: float,
+) -> str:
+    """``summary3d.json`` of a 3D table's report: ``est``'s designs (of ``prior``), their
+    law with its spread, the free power law and the table's other estimators."""
+    summary = {
+        "table": str(path),
+        "estimator": est,
+        "is_the_limit": is_limit,
+        "prior": prior,
+        "law_slope_1": {
+            "C": fit.C,
+            "factor_1sd": fit.factor,
+            "n": fit.n,
+            "free_slope": fit.slope,
+            "C_free": fit.C_free,
+            **law_uncertainty(points),
+        },
+        "power_law": power,
+        "band": band,
+        "fit_rule": f"interior distance bins ({band:g} wide), >= {MIN_COUNT} elements, "
+        f"<= {FLAG_MAX:.0%} flagged, relative DD error <= {FIT_MAX:g}, sampling error of "
+        f"the DD <= {REL_MAX:.0%} of it where stated",
+        "designs": [
+            {
+                "h": d.h,
+                "l": d.l,
+                "nside": d.nside,
+                "gamma": d.gamma,
+                "n": d.all["n"],
+                **{
+                    k: d.all[k]
+                    for k in (
+                        "dd_mape",
+                        "dd_se",
+                        "ad_mape",
+                        "el_mae_deg",
+                        "el_se",
+                        "az_mae_deg",
+                        "flagged",
+                        "seconds",
+                    )
+                },
+                "el_mae_over_gamma": d.all["el_mae_deg"] / math.degrees(d.gamma),
+            }
+            for d in sorted(designs.values(), key=lambda d: d.key)
+        ],
+        "bins": bin_errors(designs),
+        "other_estimators": [  # the table's other estimators, overall, beside the drawn one
+            {
+                "estimator": r["estimator"],
+                "h": r["h"],
+                "l": r["l"],
+                "nside": r["nside"],
+                "n": r["n"],
+                "seed": r["seed"],
+                **{k: r[k] for k in ("dd_mape", "ad_mape", "el_mae_deg", "az_mae_deg")},
+            }
+            for r in rows
+            if r["bin"] == "all" and r["estimator"] != est and r["prior"] == prior
+        ],
+    }
+    return json.dumps(_no_nan(summary), indent=1, allow_nan=False) + "\n"

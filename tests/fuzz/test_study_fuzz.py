@@ -30,7 +30,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from eyeviz import EyevizError
-from eyeviz.reports.study3d import read_study3d
+from eyeviz.reports.study_design import read_study3d
 from eyeviz.reports.study_table import read_study
 from eyeviz.study.point import COLUMNS, DesignPoint, evaluate
 from eyeviz.study.point3d import COLUMNS3D, DesignPoint3D, evaluate3d

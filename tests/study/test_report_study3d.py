@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from eyeviz.reports.study3d import fit_power, law_uncertainty, read_study3d
-from eyeviz.reports.study_law import LawPoint
+from eyeviz.reports.study_design import read_study3d
+from eyeviz.reports.study_law import LawPoint, fit_power, law_uncertainty
 from eyeviz.study import run_study
 from eyeviz.study.grid import design_grid3d
 
@@ -108,7 +108,7 @@ def test_the_laws_bootstrap_error_matches_its_scatter():
 
 
 def test_the_report_draws_the_limit_else_the_estimator_of_the_most_designs():
-    from eyeviz.reports.study3d import choose_estimator
+    from eyeviz.reports.study_design import choose_estimator
 
     def rows(spec):
         return [{"estimator": e, "h": 40.0, "l": 20.0, "nside": n} for e, ns in spec for n in ns]

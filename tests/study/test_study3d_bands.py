@@ -15,13 +15,8 @@ import pytest
 
 from eyeviz import EyevizError
 from eyeviz.estimators.metrics import bootstrap_se
-from eyeviz.reports.study3d import (
-    REL_MAX,
-    Design3D,
-    band_designs,
-    law_points3d,
-    merge_bins,
-)
+from eyeviz.reports.study_design import Design3D, band_designs, merge_bins
+from eyeviz.reports.study_law import REL_MAX, law_points3d
 from eyeviz.study.point import BIN_WIDTH
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -152,7 +147,7 @@ def test_the_report_takes_the_bands(table3d, tmp_path):
 
 
 def test_the_table_script_marks_every_row_over_5_percent(table3d, tmp_path):
-    from eyeviz.reports.study3d import bin_errors, designs3d, read_study3d
+    from eyeviz.reports.study_design import bin_errors, designs3d, read_study3d
 
     designs = band_designs(designs3d(read_study3d(table3d), "analytic3d", "single"), 2000.0)
     s = {"bins": bin_errors(designs), "designs": [d.all for d in designs.values()]}
@@ -192,7 +187,7 @@ def _fine_design(h, l_, scale):
 def test_the_figures_of_one_nside_draw_a_curve_per_l_and_each_bins_error():
     from matplotlib.container import ErrorbarContainer
 
-    from eyeviz.reports.study3d_figures import dd_figure, law_figure3d
+    from eyeviz.reports.study_figures import dd_figure, law_figure3d
     from eyeviz.reports.study_law import fit_law
 
     designs = {d.key: d for d in (_fine_design(40.0, 10.0, 0.2), _fine_design(40.0, 20.0, 0.15),
