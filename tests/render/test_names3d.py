@@ -47,6 +47,19 @@ def test_a_name_leaves_an_obstacle_and_the_edge():
     assert 0 <= b[0] and b[2] <= 400
 
 
+def test_a_name_with_no_place_apart_gives_way():
+    # a view too small for both names (sphere_lecture's step 7 at 175 %): the first name
+    # keeps its place, the second is not drawn rather than printed over it
+    c = np.array([[200.0, 30.0], [120.0, 30.0]])
+    r = np.array([5.0, 5.0])
+    sizes = np.array([[170.0, 50.0], [170.0, 50.0]])
+    args = (c, r, sizes, np.zeros((0, 3)), (0, 0, 400, 60))
+    boxes = place_boxes(*args)
+    assert np.isfinite(boxes[0]).all() and np.isnan(boxes[1]).all()
+    crossed = place_boxes(*args, give_way=False)  # to frame: every name's least-bad place
+    assert np.isfinite(crossed).all() and not _apart(crossed[0], crossed[1])
+
+
 def test_behind_the_camera_is_nan():
     from eyeviz.model.camera3d import Camera3D
 

@@ -487,7 +487,8 @@ def _labels(ax, state, scene, cam, aspect, part, shown, predictions=None) -> Non
         named = Named3D(balls[:, :3], balls[:, 3], _text_sizes(texts, size), np.concatenate(others))
     else:
         return
-    boxes = place_named(named, cam, w_pt, h_pt)
+    # the balls' names give way to each other as in the app; both eyes are always named
+    boxes = place_named(named, cam, w_pt, h_pt, give_way=not named.below)
     for box, t, col in zip(boxes, texts, cols, strict=True):
         if not np.isfinite(box).all():
             continue

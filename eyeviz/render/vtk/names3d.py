@@ -58,15 +58,18 @@ def place_texts(
     labels: Sequence[vtkBillboardTextActor3D],
     named: Named3D,
     order: list[int],
+    *,
+    give_way: bool = True,
 ) -> np.ndarray:
     """Set each shown label's display offset so its box lands where
     :func:`place_named` puts it in ``ren``'s viewport (a name whose sphere is out of the
-    viewport or behind the camera made transparent); returns the boxes (pixels of the
-    viewport, y up), one per ``order`` entry."""
+    viewport or behind the camera, or that gives way to an earlier name (``give_way``,
+    as in :func:`eyeviz.model.labels3d.place_boxes`), made transparent); returns the
+    boxes (pixels of the viewport, y up), one per ``order`` entry."""
     w, h = ren.GetSize()
     if w <= 0 or h <= 0 or not order:
         return np.zeros((0, 4))
-    boxes = place_named(named, cam, float(w), float(h))
+    boxes = place_named(named, cam, float(w), float(h), give_way=give_way)
     at, _ = discs(cam, named.centres, named.radii, float(w), float(h))
     for k, i in enumerate(order):
         x0, y0 = boxes[k, 0], boxes[k, 1]

@@ -137,7 +137,7 @@ def fit_labels(
     pos, focal = np.asarray(cam.position, float), np.asarray(cam.focal_point, float)
     inside: Camera3D | None = None
     for _ in range(steps + 1):
-        boxes = place_named(named, cam, w, h)
+        boxes = place_named(named, cam, w, h, give_way=False)  # every name, to frame them
         ok = ~np.isfinite(boxes).all(axis=1) | (
             (boxes[:, 0] >= margin - 0.5)
             & (boxes[:, 2] <= w - margin + 0.5)
@@ -273,11 +273,13 @@ class Scene3DActors:
             labs, eyes[:, :3], eyes[:, 3], np.zeros((0, 4)), self._dpi(), below=True
         )
         named = replace(named, keep_out=keep)
-        boxes = place_texts(ren, camera_of(ren), labs, named, order)
+        # both eyes named always: where they cross, the caption gives way instead
+        boxes = place_texts(ren, camera_of(ren), labs, named, order, give_way=False)
         crossed = any(_covers(boxes[i : i + 1], boxes[i + 1 :]) for i in range(len(boxes)))
         if crossed or _covers(boxes, keep):  # placed clear of it only over each other
             cap.GetTextProperty().SetOpacity(0.0)
-            boxes = place_texts(ren, camera_of(ren), labs, replace(named, keep_out=None), order)
+            bare = replace(named, keep_out=None)
+            boxes = place_texts(ren, camera_of(ren), labs, bare, order, give_way=False)
         self.eye_name_boxes = boxes
 
     def _dpi(self) -> int:
