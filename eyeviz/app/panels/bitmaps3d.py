@@ -51,6 +51,7 @@ from eyeviz.app.panels.map_geometry import (
     label_side,
     lit_owners,
     map_polys,
+    title_fit,
 )
 from eyeviz.app.panels.map_zoom import MapZoom
 from eyeviz.model import responses3d as r3
@@ -178,12 +179,11 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self._fit_words(s, h_in)
 
     def _fit_words(self, s: float, h_in: float) -> None:
-        """The words that fit the maps' width now (see :meth:`_place_axes`), and the room
-        beside the whole map that the equator's label takes (off the facets)."""
+        """The words and titles that fit the maps' width now (see :meth:`_place_axes`), and
+        the room beside the whole map that the equator's label takes (off the facets)."""
         room = self.axes["A"].get_position().height
         px_per_in = self.fig.dpi / max(self.canvas.devicePixelRatioF(), 1.0)
-        # left / forward / right need about 22 characters' width: on a map narrower than
-        # that (large text in a small panel) only "forward" is kept
+        # left / forward / right need ~22 characters' width: on a narrower map only "forward"
         w_in = self.canvas.width() / px_per_in
         box_w, box_h = 0.98 * w_in, room * h_in
         map_in = min(box_w, 2.0 * box_h)
@@ -196,6 +196,8 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
                 t.set_visible(wide and not zoomed)
             elif t.get_text() == "forward":
                 t.set_visible(not zoomed)
+            elif t.get_gid() == "maptitle":
+                title_fit(t, 0.98 * w_in * self.fig.dpi, self.canvas.get_renderer())
             elif t.get_gid() == "equator":
                 full = str(t.get_url() or t.get_text())
                 t.set_url(full)  # the whole label kept (the short form may be shown)
@@ -492,7 +494,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             )  # fmt: skip
             title = ax.text(
                 0.5, 1.0, f"eye {eye} ({'left' if eye == 'A' else 'right'}), seen from inside",
-                transform=ax.transAxes, color=INK, ha="center", va="bottom",
+                transform=ax.transAxes, color=INK, ha="center", va="bottom", gid="maptitle",
             )  # fmt: skip
             self._texts += [(eq_word, MAP_PT), (title, MAP_TITLE_PT)]
             self._under.append(eq)

@@ -189,6 +189,8 @@ class Scene3DActors:
         self.name_boxes = np.zeros((0, 4))
         self.eye_name_boxes = np.zeros((0, 4))  # the close-up's names' (its pixels, y up)
         self.eyes_caption = screen_text(16, (0.35, 0.35, 0.35), (0.03, 0.985), top=True)
+        self._caption_fit: tuple | None = None  # fitted to: see _fit_caption
+        self._caption_shown = ""
         if eyes_ren is not None:
             eyes_ren.AddViewProp(self.eyes_caption)
         self.field = FieldPainter(scene_ren, eyes_ren)
@@ -268,6 +270,7 @@ class Scene3DActors:
         if len(labs) != len(eyes):
             return
         cap.GetTextProperty().SetOpacity(1.0)
+        self._fit_caption()
         keep = self._text_boxes([cap], ren)
         order, named = named_of(
             labs, eyes[:, :3], eyes[:, 3], np.zeros((0, 4)), self._dpi(), below=True
@@ -281,6 +284,27 @@ class Scene3DActors:
             bare = replace(named, keep_out=None)
             boxes = place_texts(ren, camera_of(ren), labs, bare, order, give_way=False)
         self.eye_name_boxes = boxes
+
+    def _fit_caption(self) -> None:
+        """The close-up's caption in lines that fit its pane: as it is where it fits, else
+        without its lead-in ("the eyes close up: "), broken at spaces into no more lines
+        than it has, the last ending in "…" past them (at F11 + F5 + 175 % in 1280 x 720
+        its 614 px line was cut at the right of a 305-355 px pane). Refitted when the
+        pane's width, the font size or the caption change."""
+        cap, ren = self.eyes_caption, self.eyes_ren
+        if ren is None or self.surface is None or not cap.GetInput():
+            return
+        tp, dpi, text = cap.GetTextProperty(), self._dpi(), self.surface.caption
+        key = (ren.GetSize()[0], tp.GetFontSize(), dpi, text)
+        if key == self._caption_fit and cap.GetInput() == self._caption_shown:
+            return
+        avail = ren.GetSize()[0] * (1.0 - 2.0 * cap.GetPosition()[0]) - 4.0
+        n = text.count("\n") + 1
+        shown = fit_lines(tp, text, avail, dpi, n)
+        if shown != text and ": " in text.split("\n")[0]:
+            shown = fit_lines(tp, text.split(": ", 1)[1], avail, dpi, n)
+        self._caption_fit, self._caption_shown = key, shown
+        cap.SetInput(shown)
 
     def _dpi(self) -> int:
         win = self.scene_ren.GetRenderWindow()
