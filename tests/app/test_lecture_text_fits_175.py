@@ -1,8 +1,9 @@
 """The spherical lecture at 175 % in a 1280 x 720 window in presentation mode (issue 32
 items 3-4): no text is cut at its pane's edges. The close-up's caption (614 px of text in
 a 305-355 px pane) was cut at the right; the Mollweide maps' titles ("eye A (left), seen
-from inside") at both sides of the 390 px dock in steps 4-7. Real keys (xdotool) into the
-real window."""
+from inside") at both sides of the 390 px dock in steps 4-7; the 3D view's side note
+("seen from front, right, above") at the right of its 533 px view in steps 2-5.
+Real keys (xdotool) into the real window."""
 
 from matplotlib.text import Text
 from test_lecture3d import _focus3d
@@ -24,7 +25,7 @@ def test_caption_and_map_titles_fit_their_panes_at_175_percent(make_window, qtbo
     for _ in range(4):
         _keys(qtbot, "ctrl+equal")
     qtbot.waitUntil(lambda: win.presenter.scale == 1.75, timeout=3000)
-    captions = titles = 0
+    captions = titles = notes = 0
     for step in range(len(load(path).steps)):
         _keys(qtbot, "Next", until=lambda s=step: win.step_index == s)
         qtbot.wait(300)
@@ -34,6 +35,11 @@ def test_caption_and_map_titles_fit_their_panes_at_175_percent(make_window, qtbo
             x0, _, x1, _ = _box(cap, ren)
             assert 0 <= x0 and x1 <= ren.GetSize()[0], (step + 1, x0, x1, ren.GetSize())
             captions += 1
+        side, scene_ren = host.side.actor, host.actors.scene_ren
+        if side.GetVisibility() and side.GetInput():  # "seen from front, right, above"
+            x0, _, x1, _ = _box(side, scene_ren)
+            assert 0 <= x0 and x1 <= scene_ren.GetSize()[0], (step + 1, side.GetInput(), x1)
+            notes += 1
         maps = host.bitmaps
         if maps.isVisible():
             maps.canvas.draw()
@@ -46,4 +52,8 @@ def test_caption_and_map_titles_fit_their_panes_at_175_percent(make_window, qtbo
                 assert t.get_text(), step + 1
                 assert 0 <= box.x0 and box.x1 <= fig.bbox.width, (step + 1, t.get_text(), box)
                 titles += 1
-    assert captions >= 4 and titles >= 8, (captions, titles)  # shown and checked
+    assert captions >= 4 and titles >= 8 and notes >= 8, (
+        captions,
+        titles,
+        notes,
+    )  # shown and checked
