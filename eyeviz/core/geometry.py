@@ -50,6 +50,11 @@ def _first_index(mask: np.ndarray) -> int | tuple[int, ...]:
     return idx[0] if len(idx) == 1 else idx
 
 
+def _first_at(mask: np.ndarray) -> str:
+    """'; first at index i' for an array of values; nothing for a single scalar."""
+    return "" if mask.ndim == 0 else f"; first at index {_first_index(mask)}"
+
+
 def validate_points(x, y) -> tuple[np.ndarray, np.ndarray]:
     """Broadcast x, y to float64 arrays; refuse NaN/inf with count and first index."""
     try:
@@ -64,8 +69,7 @@ def validate_points(x, y) -> tuple[np.ndarray, np.ndarray]:
         bad = ~np.isfinite(a)
         if bad.any():
             raise ValueError(
-                f"{name} has {int(bad.sum())} non-finite value(s) (NaN or inf); "
-                f"first at index {_first_index(bad)}"
+                f"{name} has {int(bad.sum())} non-finite value(s) (NaN or inf){_first_at(bad)}"
             )
     return xa, ya
 
@@ -80,14 +84,12 @@ def validate_features(x, y, g) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         bad = ~np.isfinite(a)
         if bad.any():
             raise ValueError(
-                f"{name} has {int(bad.sum())} non-finite value(s) (NaN or inf); "
-                f"first at index {_first_index(bad)}"
+                f"{name} has {int(bad.sum())} non-finite value(s) (NaN or inf){_first_at(bad)}"
             )
     bad = ga <= 0
     if bad.any():
         raise ValueError(
-            f"g (feature radius) must be > 0: {int(bad.sum())} value(s) are not; "
-            f"first at index {_first_index(bad)}"
+            f"g (feature radius) must be > 0: {int(bad.sum())} value(s) are not{_first_at(bad)}"
         )
     return xa, ya, ga
 

@@ -31,7 +31,7 @@ import numpy as np
 
 from eyeviz.core import exact3d, healpix, kernels, paper, tiny_caps
 from eyeviz.core.bounds import MAX_NSIDE, check_nside
-from eyeviz.core.geometry import _first_index, check_h_l, eye_x
+from eyeviz.core.geometry import _first_at, check_h_l, eye_x
 from eyeviz.core.healpix_fast import (
     _EPS,
     FALLBACK_COUNTS,
@@ -65,14 +65,12 @@ def validate_balls(x, y, z, g) -> tuple[np.ndarray, ...]:
         bad = ~np.isfinite(a)
         if bad.any():
             raise ValueError(
-                f"{name} has {int(bad.sum())} non-finite value(s) (NaN or inf); "
-                f"first at index {_first_index(bad)}"
+                f"{name} has {int(bad.sum())} non-finite value(s) (NaN or inf){_first_at(bad)}"
             )
     bad = arrs[3] <= 0
     if bad.any():
         raise ValueError(
-            f"g (feature radius) must be > 0: {int(bad.sum())} value(s) are not; "
-            f"first at index {_first_index(bad)}"
+            f"g (feature radius) must be > 0: {int(bad.sum())} value(s) are not{_first_at(bad)}"
         )
     return tuple(arrs)
 
