@@ -74,3 +74,36 @@ def test_eye_overlaps_at_the_eyes_scale_match_exact_arithmetic():
         ]
         assert got.tolist() == want
         assert 20 < sum(want) < 380
+
+
+@pytest.mark.parametrize("jit", ["0", "1"])
+def test_a_ball_whose_sphere_passes_a_few_ulps_from_the_eye_centre(monkeypatch, jit):
+    # the eye is whole (every facet lit) iff its centre is in the closed ball, d <= g;
+    # d is irrational here and g steps over the floats around it, where sqrt's and the
+    # squares' rounding leave the float comparison wrong for some
+    monkeypatch.setenv("EYEVIZ_JIT", jit)
+    if jit == "1":
+        kernels.warm()
+    pair = EyePair3D(40.0, 20.0, 2)
+    rng = np.random.default_rng(12)
+    xs, ys, zs, gs = [], [], [], []
+    for _ in range(60):
+        a, b, c = (float(v) for v in rng.uniform(-3, 3, 3))
+        a = (40.0 + a) - 40.0  # exact both ways: the ball's x is 40 + a to the bit
+        g = math.sqrt(a * a + b * b + c * c)
+        for _ in range(3):
+            g = math.nextafter(g, 0.0)
+        for _ in range(7):
+            xs.append(40.0 + a), ys.append(b), zs.append(c), gs.append(g)
+            g = math.nextafter(g, math.inf)
+    x, y, z, g = (np.array(v) for v in (xs, ys, zs, gs))
+    ((pb, _),) = pair.lit_csr(x, y, z, g)[1:]
+    got = np.diff(pb) == pair.npix
+    dx = x - 40.0  # exact (see a above)
+    want = [
+        Fraction(u) ** 2 + Fraction(v) ** 2 + Fraction(w) ** 2 <= Fraction(r) ** 2
+        for u, v, w, r in zip(dx, y, z, g, strict=True)
+    ]
+    assert got.tolist() == want
+    naive = np.sqrt(dx * dx + y * y + z * z) <= g
+    assert (naive != np.array(want)).sum() >= 3  # a plain sqrt comparison errs on some
