@@ -77,6 +77,12 @@ def test_names_clear_the_title_at_175_percent_in_every_step(make_window, qtbot):
         names = [b for b in host.actors.eye_name_boxes if np.isfinite(b).all()]
         assert len(names) == 2, (step + 1, names)
         assert not _overlap(names[0], names[1]), (step + 1, names)
+        # each name nearer its own eye than the other's ("eye A" sat under eye B in step 6)
+        at = host.actors.eye_name_anchors
+        for k, box in enumerate(names):
+            mid = np.array([box[0] + box[2], box[1] + box[3]]) / 2
+            near = np.linalg.norm(at - mid, axis=1)
+            assert near[k] < near[1 - k], (step + 1, k, box, at)
         if cap.GetVisibility() and cap.GetInput() and cap.GetTextProperty().GetOpacity() > 0:
             for box in names:
                 assert not _overlap(box, _box(cap, eyes_ren)), (step + 1, box)

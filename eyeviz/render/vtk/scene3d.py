@@ -33,7 +33,7 @@ from eyeviz.files.atomic import atomic_output
 from eyeviz.model import shapes3d
 from eyeviz.model.camera3d import Camera3D, eyes_camera
 from eyeviz.model.facets3d import EyeSurface, surface_of
-from eyeviz.model.labels3d import Named3D, place_named
+from eyeviz.model.labels3d import Named3D, discs, place_named
 from eyeviz.model.predictions3d import Predictions3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
@@ -99,6 +99,26 @@ def default_camera(state: SceneState3D, name: str = "default", aspect: float = 1
     """The preset ``name`` framing the scene's balls (:func:`shapes3d.scene_extent`) in a
     viewport ``aspect`` (width / height) wide."""
     return shapes3d.view_camera(state, name, aspect)
+
+
+def _misplaced(boxes: np.ndarray, at: np.ndarray) -> bool:
+    """Whether a name's box (row k of ``boxes``) has its middle nearer another disc's
+    centre (rows of ``at``, the same order) than its own."""
+    ok = np.isfinite(boxes).all(axis=1) & np.isfinite(at).all(axis=1)
+    if ok.sum() < 2:
+        return False
+    mid = np.column_stack([boxes[:, 0] + boxes[:, 2], boxes[:, 1] + boxes[:, 3]]) / 2
+    d = np.linalg.norm(mid[ok][:, None, :] - at[ok][None, :, :], axis=2)
+    return bool((d.argmin(axis=1) != np.arange(int(ok.sum()))).any())
+
+
+def _under(at: np.ndarray, rad: np.ndarray, sizes: np.ndarray, width: float) -> np.ndarray:
+    """Boxes (as :func:`eyeviz.model.labels3d.place_boxes`') of names centred under their
+    discs (``at``, ``rad``), moved sideways into [2, width - 2] px where they would leave it."""
+    w, h = np.asarray(sizes, float).T
+    x0 = np.clip(at[:, 0] - w / 2, 2.0, np.maximum(width - 2.0 - w, 2.0))
+    y1 = at[:, 1] - rad - 2.0
+    return np.column_stack([x0, y1 - h, x0 + w, y1])
 
 
 def _covers(boxes: np.ndarray, keep_out: np.ndarray | None) -> bool:
@@ -188,6 +208,7 @@ class Scene3DActors:
         self.scene_shows_predictions = False
         self.name_boxes = np.zeros((0, 4))
         self.eye_name_boxes = np.zeros((0, 4))  # the close-up's names' (its pixels, y up)
+        self.eye_name_anchors = np.zeros((0, 2))  # and its eyes' centres
         self.eyes_caption = screen_text(16, (0.35, 0.35, 0.35), (0.03, 0.985), top=True)
         self._caption_fit: tuple | None = None  # fitted to: see _fit_caption
         self._caption_shown = ""
@@ -278,12 +299,23 @@ class Scene3DActors:
         named = replace(named, keep_out=keep)
         # both eyes named always: where they cross, the caption gives way instead
         boxes = place_texts(ren, camera_of(ren), labs, named, order, give_way=False)
+        w, h = ren.GetSize()
+        at, rad = discs(camera_of(ren), named.centres, named.radii, float(w), float(h))
         crossed = any(_covers(boxes[i : i + 1], boxes[i + 1 :]) for i in range(len(boxes)))
-        if crossed or _covers(boxes, keep):  # placed clear of it only over each other
+        # a name placed nearer the other eye than its own reads as that eye's (a tiny
+        # pane at 175 %: "eye A" under eye B): the caption gives way too
+        if crossed or _covers(boxes, keep) or _misplaced(boxes, at):
             cap.GetTextProperty().SetOpacity(0.0)
             bare = replace(named, keep_out=None)
             boxes = place_texts(ren, camera_of(ren), labs, bare, order, give_way=False)
+            if _misplaced(boxes, at):  # no free place near its own eye: right under it
+                boxes = _under(at, rad, named.sizes, float(w))
+                for k, i in enumerate(order):
+                    if np.isfinite(boxes[k]).all():
+                        off = boxes[k, :2] - at[k]
+                        labs[i].SetDisplayOffset(int(round(off[0])), int(round(off[1])))
         self.eye_name_boxes = boxes
+        self.eye_name_anchors = at
 
     def _fit_caption(self) -> None:
         """The close-up's caption in lines that fit its pane: as it is where it fits, else
