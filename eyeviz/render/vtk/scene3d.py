@@ -102,14 +102,20 @@ def default_camera(state: SceneState3D, name: str = "default", aspect: float = 1
 
 
 def _misplaced(boxes: np.ndarray, at: np.ndarray) -> bool:
-    """Whether a name's box (row k of ``boxes``) has its middle nearer another disc's
-    centre (rows of ``at``, the same order) than its own."""
+    """Whether a name's box (row k of ``boxes``) has its middle clearly nearer another
+    disc's centre (rows of ``at``, the same order) than its own: by over a fifth of the
+    two centres' distance (discs seen one behind the other, as from the side, tell their
+    names apart by nothing)."""
     ok = np.isfinite(boxes).all(axis=1) & np.isfinite(at).all(axis=1)
     if ok.sum() < 2:
         return False
-    mid = np.column_stack([boxes[:, 0] + boxes[:, 2], boxes[:, 1] + boxes[:, 3]]) / 2
-    d = np.linalg.norm(mid[ok][:, None, :] - at[ok][None, :, :], axis=2)
-    return bool((d.argmin(axis=1) != np.arange(int(ok.sum()))).any())
+    b, a = boxes[ok], at[ok]
+    mid = np.column_stack([b[:, 0] + b[:, 2], b[:, 1] + b[:, 3]]) / 2
+    d = np.linalg.norm(mid[:, None, :] - a[None, :, :], axis=2)
+    k = np.arange(len(a))
+    j = d.argmin(axis=1)
+    apart = np.linalg.norm(a[k] - a[j], axis=1)
+    return bool(((j != k) & (d[k, k] - d[k, j] > 0.2 * apart)).any())
 
 
 def _under(at: np.ndarray, rad: np.ndarray, sizes: np.ndarray, width: float) -> np.ndarray:
