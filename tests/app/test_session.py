@@ -157,6 +157,12 @@ def test_export_runs_off_the_gui_thread_and_drags_stay_live(make_window, tmp_pat
     out = tmp_path / "big.png"
     job = win.export_to(out, scale=3.0, wait=False)
     assert win.jobs.busy()
+    # the export's start may change the window (its status line): let the layout and the
+    # view settle before the feature's pixel is read, as a user sees it before pressing
+    # (a fresh-clone CI run pressed beside the feature once: the drag moved nothing)
+    for _ in range(3):
+        QtWidgets.QApplication.processEvents()
+    win.ren_win.Render()
     drag(win, pixel_of(win, 0.0, 1500.0), pixel_of(win, 300.0, 1500.0))
     moved_while_busy = win.jobs.busy()
     assert win.model.scene.features[0].x == pytest.approx(300.0, abs=3 * win.units_per_px())
