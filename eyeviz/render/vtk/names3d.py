@@ -71,6 +71,15 @@ def place_texts(
         return np.zeros((0, 4))
     boxes = place_named(named, cam, float(w), float(h), give_way=give_way)
     at, _ = discs(cam, named.centres, named.radii, float(w), float(h))
+    show_at(labels, order, boxes, at)
+    return boxes
+
+
+def show_at(
+    labels: Sequence[vtkBillboardTextActor3D], order: list[int], boxes: np.ndarray, at: np.ndarray
+) -> None:
+    """Draw label ``order[k]`` with its box's corner at ``boxes[k]`` (pixels, y up), offset
+    from its sphere's disc centre ``at[k]``; a NaN box or centre is made transparent."""
     for k, i in enumerate(order):
         x0, y0 = boxes[k, 0], boxes[k, 1]
         drawn = bool(np.isfinite(x0) and np.isfinite(at[k, 0]))
@@ -78,4 +87,3 @@ def place_texts(
         if not drawn:
             continue
         labels[i].SetDisplayOffset(int(round(x0 - at[k, 0])), int(round(y0 - at[k, 1])))
-    return boxes

@@ -44,7 +44,7 @@ from eyeviz.render.vtk.eyes3d import LABEL_PX as EYES_LABEL_PX
 from eyeviz.render.vtk.eyes3d import EyesPainter
 from eyeviz.render.vtk.field3d import FieldPainter
 from eyeviz.render.vtk.ghosts3d import Ghosts3D, make_overlay
-from eyeviz.render.vtk.names3d import named_of, place_texts
+from eyeviz.render.vtk.names3d import named_of, place_texts, show_at
 from eyeviz.render.vtk.offscreen import OffscreenWindow
 from eyeviz.render.vtk.painter3d import Painter3D
 from eyeviz.render.vtk.primitives import fit_lines, screen_text
@@ -316,10 +316,7 @@ class Scene3DActors:
             boxes = place_texts(ren, camera_of(ren), labs, bare, order, give_way=False)
             if _misplaced(boxes, at):  # no free place near its own eye: right under it
                 boxes = _under(at, rad, named.sizes, float(w))
-                for k, i in enumerate(order):
-                    if np.isfinite(boxes[k]).all():
-                        off = boxes[k, :2] - at[k]
-                        labs[i].SetDisplayOffset(int(round(off[0])), int(round(off[1])))
+                show_at(labs, order, boxes, at)
         self.eye_name_boxes = boxes
         self.eye_name_anchors = at
 
