@@ -29,17 +29,24 @@ def _overlap(a, b) -> bool:
     return min(a[2], b[2]) > max(a[0], b[0]) and min(a[3], b[3]) > max(a[1], b[1])
 
 
-def test_names_clear_the_title_at_175_percent_in_every_step(make_window, qtbot):
+def lecture_at_175(make_window, qtbot):
+    """sphere_lecture in a 1280 x 720 window, presenting (F5), its text at 175 %
+    (Ctrl+= four times); returns (the window, the scene's path)."""
     path = scene_path("sphere_lecture")
     win = make_window(load(path), path)
     win.resize(1280, 720)
     qtbot.waitUntil(lambda: win.width() == 1280, timeout=3000)
-    host = win.host3d
     _focus3d(win, qtbot)
     _keys(qtbot, "F5", until=lambda: win.presenter.presenting)
     for _ in range(4):
         _keys(qtbot, "ctrl+equal")
     qtbot.waitUntil(lambda: win.presenter.scale == 1.75, timeout=3000)
+    return win, path
+
+
+def test_names_clear_the_title_at_175_percent_in_every_step(make_window, qtbot):
+    win, path = lecture_at_175(make_window, qtbot)
+    host = win.host3d
     ren = host.actors.scene_ren
     checked = 0
     for step in range(len(load(path).steps)):

@@ -6,25 +6,15 @@ from inside") at both sides of the 390 px dock in steps 4-7; the 3D view's side 
 Real keys (xdotool) into the real window."""
 
 from matplotlib.text import Text
-from test_lecture3d import _focus3d
-from test_lecture_names_175 import _box
+from test_lecture_names_175 import _box, lecture_at_175
 from test_presenting_real_x import _keys, window_manager  # noqa: F401
 
 from eyeviz.model.scene import load
-from eyeviz.resources import scene_path
 
 
 def test_caption_and_map_titles_fit_their_panes_at_175_percent(make_window, qtbot):
-    path = scene_path("sphere_lecture")
-    win = make_window(load(path), path)
-    win.resize(1280, 720)
-    qtbot.waitUntil(lambda: win.width() == 1280, timeout=3000)
+    win, path = lecture_at_175(make_window, qtbot)
     host = win.host3d
-    _focus3d(win, qtbot)
-    _keys(qtbot, "F5", until=lambda: win.presenter.presenting)
-    for _ in range(4):
-        _keys(qtbot, "ctrl+equal")
-    qtbot.waitUntil(lambda: win.presenter.scale == 1.75, timeout=3000)
     captions = titles = notes = 0
     for step in range(len(load(path).steps)):
         _keys(qtbot, "Next", until=lambda s=step: win.step_index == s)
