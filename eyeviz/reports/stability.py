@@ -118,9 +118,16 @@ def measure(n: int = 2000, seed: int = 0, progress=None) -> list[Row]:
     """Run every case class; returns one :class:`Row` per class."""
     from eyeviz.reference import stability_cases
 
+    return _measure_classes(stability_cases.CLASSES, "planar", measure_case, n, seed, progress)
+
+
+def _measure_classes(classes, kind: str, measure_one, n: int, seed: int, progress) -> list:
+    """``measure_one`` of each case class of ``kind`` (class i drawn with ``seed + i``)."""
+    from eyeviz.reference import stability_cases
+
     rows = []
-    for i, name in enumerate(stability_cases.CLASSES):
-        rows.append(measure_case(stability_cases.make(name, n, seed + i, "planar")))
+    for i, name in enumerate(classes):
+        rows.append(measure_one(stability_cases.make(name, n, seed + i, kind)))
         if progress:
             progress(name)
     return rows
@@ -311,12 +318,8 @@ def measure3d(n: int = 12, seed: int = 0, progress=None) -> list[Row3D]:
     """Run every 3D case class (``n`` balls each); one :class:`Row3D` per class."""
     from eyeviz.reference import stability_cases
 
-    rows = []
-    for i, name in enumerate(stability_cases.CLASSES3D):
-        rows.append(measure_case3d(stability_cases.make(name, n, seed + 100 + i, "spherical")))
-        if progress:
-            progress(name)
-    return rows
+    classes = stability_cases.CLASSES3D
+    return _measure_classes(classes, "spherical", measure_case3d, n, seed + 100, progress)
 
 
 def _markdown3d(rows: list[Row3D]) -> str:
