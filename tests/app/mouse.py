@@ -1,14 +1,17 @@
 """Real mouse input on the app's view, in model coordinates (shared by the app tests)."""
 
 import vtk
-from PyQt5 import QtCore
+from PyQt5 import QtCore, QtWidgets
 from PyQt5.QtTest import QTest
 
 from eyeviz.render.vtk.style import Z_FEAT
 
 
 def pixel_of(win, x, y):
-    """Model -> Qt widget pixel through VTK's own camera transform (not the app's maths)."""
+    """Model -> Qt widget pixel through VTK's own camera transform (not the app's maths),
+    once pending events have run: a layout change still queued (a status line, a dock's
+    size) would move the view after its pixel was read, and the press land beside it."""
+    QtWidgets.QApplication.processEvents()
     c = vtk.vtkCoordinate()
     c.SetCoordinateSystemToWorld()
     c.SetValue(x, y, Z_FEAT)
