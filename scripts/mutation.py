@@ -61,6 +61,7 @@ SKIP_MARK = "pragma: no mutate"
 #: the file's time stamp and size, so a same-size mutant written within the second could
 #: run the unmutated kernel. Ordered by the time their tests take, the slowest last.
 _G3 = (
+    "tests/core/test_geometry3d_edges.py",
     "tests/core/test_geometry3d_high_ties.py",
     "tests/core/test_healpix_conventions.py",
     "tests/core/test_geometry3d.py",

@@ -1,6 +1,8 @@
 """Spherical geometry at the edges its other tests do not reach: a one-ball call with a
 bad radius or a NaN (the compiled single-ball path), balls a hair from the binocular
-wedge's boundary, and eye overlaps of balls at the scale of the eyes."""
+wedge's boundary, eye overlaps of balls at the scale of the eyes, spheres a float off an
+eye's centre (the whole-eye margin) and caps that light a cell through one edge only
+(the sampled-edge stage)."""
 
 from __future__ import annotations
 
@@ -10,7 +12,8 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from eyeviz.core import kernels
+from eyeviz.core import healpix as hp
+from eyeviz.core import healpix_fast, kernels
 from eyeviz.core.geometry3d import EyePair3D
 
 
@@ -107,3 +110,78 @@ def test_a_ball_whose_sphere_passes_a_few_ulps_from_the_eye_centre(monkeypatch, 
     assert got.tolist() == want
     naive = np.sqrt(dx * dx + y * y + z * z) <= g
     assert (naive != np.array(want)).sum() >= 3  # a plain sqrt comparison errs on some
+
+
+def _sphere_a_float_off_the_centre(count: int) -> tuple[np.ndarray, ...]:
+    """Balls about eye B's centre (40, 0, 0) whose radius g is the float next to the
+    float-computed distance d = sqrt(dx^2 + dy^2 + dz^2), on the side where d's rounding
+    (up to about 2 ulps) puts the closed ball's answer the other way: d < g while the
+    centre is outside, or d > g while it is inside. ``count`` of each kind, found among
+    random offsets (about 1 in 500 draws is one)."""
+    rng = np.random.default_rng(37)
+    found: dict[bool, list[tuple[float, ...]]] = {True: [], False: []}
+    while min(len(v) for v in found.values()) < count:
+        u = rng.uniform(-1.0, 1.0, (3, 4000))
+        u[0] = (40.0 + u[0]) - 40.0  # exact both ways: the ball's x is 40 + u[0] to the bit
+        d = np.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
+        t = np.sqrt(u[0].astype(np.longdouble) ** 2 + u[1] ** 2 + u[2] ** 2)
+        for i in np.flatnonzero(t != d):  # a screen; the exact test decides below
+            d2 = sum(Fraction(float(v[i])) ** 2 for v in u)
+            for g in (np.nextafter(d[i], np.inf), np.nextafter(d[i], 0.0)):
+                inside = d2 <= Fraction(float(g)) ** 2
+                if inside != bool(d[i] < g) and len(found[inside]) < count:
+                    found[inside].append((40.0 + float(u[0, i]), *map(float, u[1:, i]), g))
+    return tuple(np.array(v) for v in zip(*found[True], *found[False], strict=True))
+
+
+@pytest.mark.parametrize("jit", ["0", "1"])
+def test_the_whole_eye_margin_covers_the_distances_rounding(monkeypatch, jit):
+    # the float test d < g is wrong for every ball here (g one float past d, the exact
+    # distance on the other side of g): the whole-eye margin (healpix_fast's 8 eps (d + g)^2)
+    # must send each to the exact test, on the numpy path and in the kernel
+    monkeypatch.setenv("EYEVIZ_JIT", jit)
+    if jit == "1":
+        kernels.warm()
+    x, y, z, g = _sphere_a_float_off_the_centre(6)
+    pair = EyePair3D(40.0, 20.0, 2)
+    ((pb, _),) = pair.lit_csr(x, y, z, g)[1:]
+    want = [True] * 6 + [False] * 6  # inside: every facet lit; outside: about half
+    assert (np.diff(pb) == pair.npix).tolist() == want
+    assert np.all(np.diff(pb)[6:] > 0)
+
+
+def _caps_across_a_cells_edge(n: int, h: float) -> tuple[np.ndarray, ...]:
+    """Balls seen from eye B whose caps cross one edge of a cell, the north-west (y = iy + 1)
+    or the north-east (x = ix + 1), about its middle and clear of the edge's two vertices,
+    centred just outside the cell: the cell is lit only where the edge is looked at between
+    its vertices. Returns x, y, z, g and the cell's RING index."""
+    rows = []
+    for face in range(12):
+        for ix, iy in ((2, 3), (5, 1), (0, 6), (6, 6)):
+            for across, inside in (((0.5, 1.12), (0.5, 0.95)), ((1.12, 0.5), (0.95, 0.5))):
+                c = hp.xyf2vec(n, ix + across[0], iy + across[1], face)
+                e = hp.xyf2vec(n, ix + inside[0], iy + inside[1], face)
+                alpha = 1.02 * math.acos(min(1.0, float(c @ e)))  # reaches (inside) in the cell
+                centre = hp.xyf2vec(n, ix + 0.5, iy + 0.5, face)
+                cell = int(hp.vec2pix_ring(n, *centre))
+                rows.append((h + 1000.0 * c[0], 1000.0 * c[1], 1000.0 * c[2],
+                             1000.0 * math.sin(alpha), cell))  # fmt: skip
+    return tuple(np.array(v) for v in zip(*rows, strict=True))
+
+
+@pytest.mark.parametrize("jit", ["0", "1"])
+def test_a_cap_crossing_a_cells_edge_between_its_vertices_lights_the_cell(monkeypatch, jit):
+    # no vertex of the cell is in the cap and its edge bound cannot clear the crossed
+    # edge: the cell is decided by sampling that edge (healpix_fast's sampled-edge stage,
+    # which must sample the edge it bounds: y = iy + 1, x = ix + 1, not y = iy - 1 ...)
+    monkeypatch.setenv("EYEVIZ_JIT", jit)
+    if jit == "1":
+        kernels.warm()
+    n, h = 8, 40.0
+    x, y, z, g, cell = _caps_across_a_cells_edge(n, h)
+    healpix_fast.FALLBACK_COUNTS.clear()
+    ((pb, ib),) = EyePair3D(h, 20.0, n).lit_csr(x, y, z, g)[1:]
+    lit = [int(c) in ib[pb[i] : pb[i + 1]] for i, c in enumerate(cell)]
+    assert all(lit)
+    if jit == "0":  # the numpy path reached the stage
+        assert healpix_fast.FALLBACK_COUNTS["edges sampled x16"] >= len(cell)
