@@ -1,7 +1,7 @@
 """Real mouse input on the app's view, in model coordinates (shared by the app tests)."""
 
 import vtk
-from PyQt5 import QtCore, QtWidgets
+from PyQt5 import QtCore, QtGui, QtWidgets
 from PyQt5.QtTest import QTest
 
 from eyeviz.render.vtk.style import Z_FEAT
@@ -20,10 +20,29 @@ def pixel_of(win, x, y):
     return QtCore.QPoint(round(dx), round(h - dy))
 
 
+def move(widget, pos, buttons=QtCore.Qt.LeftButton, modifiers=QtCore.Qt.NoModifier):
+    """A mouse move at ``pos`` (widget pixels) with ``buttons`` held, delivered now, then
+    pending events run.
+
+    Not ``QTest.mouseMove``: on a QWidget, Qt 5 warps the X pointer instead, and the move
+    reaches the app when the X server sends it back, without the button held. On a loaded
+    machine that was after the release had ended the drag, and the drag moved nothing."""
+    ev = QtGui.QMouseEvent(
+        QtCore.QEvent.MouseMove,
+        QtCore.QPointF(pos),
+        QtCore.QPointF(widget.mapToGlobal(pos)),
+        QtCore.Qt.NoButton,
+        buttons,
+        modifiers,
+    )
+    QtWidgets.QApplication.sendEvent(widget, ev)
+    QtWidgets.QApplication.processEvents()  # as QTest does: a frame it asked for may draw
+
+
 def drag(win, start, end, steps=12):
     """Left press at ``start``, ``steps`` moves to ``end``, release."""
     w = win.plotter
     QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
     for k in range(1, steps + 1):
-        QTest.mouseMove(w, start + (end - start) * (k / steps))
+        move(w, start + (end - start) * (k / steps))
     QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, end)

@@ -5,7 +5,7 @@ import collections
 import math
 import time
 
-from mouse import pixel_of
+from mouse import move, pixel_of
 from PyQt5 import QtCore, QtWidgets
 from PyQt5.QtTest import QTest
 
@@ -43,13 +43,13 @@ def test_a_drag_move_lays_out_nothing_and_paints_little(make_window):
         start = pixel_of(win, 0.0, 1500.0)
         QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
         for k in range(8):  # past the drag threshold, panels settled
-            QTest.mouseMove(w, start + QtCore.QPoint(3 * k, -k))
+            move(w, start + QtCore.QPoint(3 * k, -k))
             app.processEvents()
         n, frames0 = 30, w.frames
         x0 = win.model.scene.features[-1].x
         counter.on = True
         for k in range(n):
-            QTest.mouseMove(w, start + QtCore.QPoint(30 + 4 * k, -10 - 3 * k))
+            move(w, start + QtCore.QPoint(30 + 4 * k, -10 - 3 * k))
             # the move's (coalesced) frame: on a loaded machine three passes may not reach it
             target, deadline = w.frames + 1, time.monotonic() + 0.5
             for _ in range(3):
@@ -134,7 +134,7 @@ def test_panels_follow_a_live_change_coalesced_and_show_its_end(make_window, qtb
     w = win.plotter
     QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
     for k in range(1, 9):
-        QTest.mouseMove(w, start + (end - start) * (k / 8))
+        move(w, start + (end - start) * (k / 8))
         win.render()
     QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, end)
     assert win.model.scene.features[1].x != -400.0 and win.undo_stack.count() == 1

@@ -10,7 +10,7 @@ import threading
 
 import numpy as np
 import pytest
-from mouse import pixel_of
+from mouse import move, pixel_of
 from PyQt5 import QtCore
 from PyQt5.QtTest import QTest
 
@@ -104,7 +104,7 @@ def test_drag_moves_the_marker_without_recomputing(make_window, qtbot):
     start, end = pixel_of(win, -1200.0, 3000.0), pixel_of(win, -400.0, 2000.0)
     QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
     for k in range(1, 13):
-        QTest.mouseMove(w, start + (end - start) * (k / 12))
+        move(w, start + (end - start) * (k / 12))
     # during the drag (button still down) the marker follows
     f = win.model.scene.features[1]
     r_mid = math.hypot(f.x, f.y)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from mouse import drag, pixel_of
+from mouse import drag, move, pixel_of
 from PyQt5 import QtGui
 
 from eyeviz import estimators
@@ -205,7 +205,7 @@ def test_a_drag_rewrites_only_the_dragged_features_ghosts(make_window, qtbot):
     start = pixel_of(win, -900.0, 2000.0)
     QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
     for k in range(1, 9):
-        QTest.mouseMove(w, start + QtCore.QPoint(12 * k, -9 * k))
+        move(w, start + QtCore.QPoint(12 * k, -9 * k))
         qtbot.wait(5)  # the pending frame is drawn
     end = start + QtCore.QPoint(96, -72)
     QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, end)

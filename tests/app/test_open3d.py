@@ -13,6 +13,7 @@ from pathlib import Path
 import matplotlib.image as mpimg
 import numpy as np
 import pytest
+from mouse import move
 from PyQt5 import QtCore, QtWidgets
 from PyQt5.QtTest import QTest
 
@@ -106,7 +107,7 @@ def test_shift_drag_moves_along_the_line_of_sight(make_window, qtbot):
     w = host.view
     QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.ShiftModifier, p)
     for k in range(1, 7):
-        QTest.mouseMove(w, p + QtCore.QPoint(0, -10 * k))
+        move(w, p + QtCore.QPoint(0, -10 * k), modifiers=QtCore.Qt.ShiftModifier)
     QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.ShiftModifier, p + QtCore.QPoint(0, -60))
     assert win.undo_stack.count() == 1
     f = host.model.scene.features[0]
@@ -310,7 +311,7 @@ def test_the_docks_follow_a_drag_every_fourth_frame_at_most(make_window, qtbot, 
     frames0 = w.frames
     QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, p)
     for k in range(1, 13):
-        QTest.mouseMove(w, p + QtCore.QPoint(5 * k, 0))
+        move(w, p + QtCore.QPoint(5 * k, 0))
         qtbot.wait(250)  # longer than the docks' timer: only the frame count holds them
     n_frames = w.frames - frames0
     during = len(calls)

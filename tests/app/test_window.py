@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from mouse import drag, pixel_of
+from mouse import drag, move, pixel_of
 from PyQt5 import QtCore, QtGui
 from PyQt5.QtTest import QTest
 
@@ -348,7 +348,7 @@ def test_dragged_disc_is_drawn_at_its_new_place_during_and_after_the_drag(make_w
 
     QTest.mousePress(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, start)
     for k in range(1, 13):
-        QTest.mouseMove(w, start + (end - start) * (k / 12))
+        move(w, start + (end - start) * (k / 12))
     for _ in ("during the drag", "after the release"):
         f = win.model.scene.features[1]
         assert win.model.selected == 1 and f.g == 200.0 and abs(f.x + 400.0) < 30
