@@ -1,7 +1,7 @@
 """Benchmark: the compiled lit-set kernel against healpy and the numpy reference (issue 31).
 
-Paper-regime balls (scripts/bench_geometry3d.py's), both eyes, times measured in the same
-run, best of ``--repeat``:
+Paper-regime balls (scripts/bench_geometry3d.py's), both eyes, CPU times measured in the
+same run, best of ``--repeat``:
 
 1. Lit sets, exact, in 1000-ball and 10^4-ball calls at nside 16, 64 and 180: ours as
    runs (``geometry3d._lit_runs``: start and length per ring piece, the exact lit set
@@ -40,11 +40,13 @@ def paper_balls(n: int, nside: int, rng: np.random.Generator):
 
 
 def best_of(fun, repeat: int) -> float:
+    """The least CPU time of ``repeat`` runs: every side is single-threaded, and on a
+    shared machine CPU time holds where wall time swings 2x from run to run."""
     best = math.inf
     for _ in range(repeat):
-        t = time.perf_counter()
+        t = time.process_time()
         fun()
-        best = min(best, time.perf_counter() - t)
+        best = min(best, time.process_time() - t)
     return best
 
 
