@@ -94,6 +94,13 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self.error_box: QtWidgets.QMessageBox | None = None
         self.unsaved_box: QtWidgets.QMessageBox | None = None
         self._force_close = False
+        # the window fitted to the screen's free area again after a resize or once the
+        # window manager's frame is known (fit_screen)
+        self._fit_margins = (0, 0)
+        self._fit_timer = QtCore.QTimer(self)
+        self._fit_timer.setSingleShot(True)
+        self._fit_timer.setInterval(50)
+        self._fit_timer.timeout.connect(self.fit_screen)
         self.jobs = JobRunner(lambda text, ms: self.statusBar().showMessage(text, ms), self)
         self._eyes_key: tuple = (scene.eyes.h, scene.eyes.l)
 
@@ -205,11 +212,31 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         if not ev.spontaneous():
             QtCore.QTimer.singleShot(0, self.fit_screen)
 
+    def _margins(self) -> tuple[int, int]:
+        frame = self.frameGeometry()
+        return frame.width() - self.width(), frame.height() - self.height()
+
+    def resizeEvent(self, ev) -> None:  # noqa: N802 (Qt name)
+        """A window grown (a lecture step's panels) is fitted to the screen again."""
+        super().resizeEvent(ev)
+        if self.isVisible():
+            self._fit_timer.start()
+
+    def moveEvent(self, ev) -> None:  # noqa: N802 (Qt name)
+        """The window manager's frame came after the window was shown (its size was not
+        known at the show: a 1280x720 window on a 1280x720 screen kept its status bar 20
+        px under the screen's edge in every step of sphere_lecture): fitted again when the
+        frame's size changes; a move by the user is left alone."""
+        super().moveEvent(ev)
+        if self.isVisible() and self._margins() != self._fit_margins:
+            self._fit_timer.start()
+
     def fit_screen(self) -> None:
         """The whole window, its frame too, on the screen's free area: a 1280x720 window on
         a 1280x720 screen had its status bar below the screen's edge (issue 32)."""
         if self.isFullScreen() or self.isMaximized():
             return
+        self._fit_margins = self._margins()
         screen = self.screen() or QtWidgets.QApplication.primaryScreen()
         if screen is None:
             return
@@ -242,6 +269,7 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self._frame_pending = True  # no frame after close
         self._frame_timer.stop()
         self._table_timer.stop()  # nor a table refresh (it fired into a closed window)
+        self._fit_timer.stop()
         self._panel_timer.stop()
         self.host3d.close()
         self.plotter.close()

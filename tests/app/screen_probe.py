@@ -1,0 +1,96 @@
+"""Run by test_screen_fit.py under an X screen of its own (xvfb-run, 1280 x 720): the real
+window, 1280 x 720 under a window manager (openbox), through every step of a lecture
+scene with real keys (xdotool), at each text scale and mode asked for; prints one JSON
+line per step: the status bar's bottom, the screen's free area's bottom, the window's
+frame and its minimum height.
+
+    python tests/app/screen_probe.py sphere_lecture 1.0:0 1.75:1   (scale:presenting)
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+
+def _wait(app, until, timeout: float = 10.0) -> None:
+    end = time.monotonic() + timeout
+    while not until() and time.monotonic() < end:
+        app.processEvents()
+        time.sleep(0.02)
+    for _ in range(10):
+        app.processEvents()
+        time.sleep(0.02)
+
+
+def _key(app, win, key: str, until) -> None:
+    win.activateWindow()
+    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
+    subprocess.run(["xdotool", "key", "--delay", "40", key], check=True)
+    _wait(app, until)
+
+
+def main() -> None:
+    from PyQt5 import QtCore
+
+    from eyeviz.app.launch import make_app
+    from eyeviz.app.settings import make_settings
+    from eyeviz.app.window import MainWindow
+    from eyeviz.model.scene import load
+    from eyeviz.resources import scene_path
+
+    name, configs = sys.argv[1], sys.argv[2:]
+    app = make_app()
+    with tempfile.TemporaryDirectory() as tmp:
+        ready = Path(tmp) / "ready"
+        wm = subprocess.Popen(
+            [shutil.which("openbox") or "openbox", "--sm-disable", "--startup", f"touch {ready}"],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        for _ in range(200):
+            if ready.exists() or wm.poll() is not None:
+                break
+            time.sleep(0.05)
+        path = scene_path(name)
+        for k, cfg in enumerate(configs):
+            scale, present = float(cfg.split(":")[0]), cfg.split(":")[1] == "1"
+            scene = load(path)
+            win = MainWindow(scene, path, settings=make_settings(Path(tmp) / f"s{k}.json"))
+            win._force_close = True
+            win.resize(1280, 720)
+            win.show()
+            _wait(app, win.isVisible)
+            _wait(app, lambda: True, 0.5)  # the window manager's frame, then the fit
+            if scale != 1.0:
+                win.presenter.set_scale(scale)
+            if present:
+                _key(app, win, "F5", lambda w=win: w.presenter.presenting)
+            free = win.screen().availableGeometry()
+            for i in range(len(scene.steps)):
+                _key(app, win, "Next", lambda i=i, w=win: w.step_index == i)
+                win.jobs.wait()
+                _wait(app, lambda: True, 0.6)
+                bar = win.statusBar()
+                bottom = bar.mapToGlobal(QtCore.QPoint(0, bar.height())).y()
+                frame = win.frameGeometry()
+                row = {
+                    "config": cfg, "step": i + 1, "bar_bottom": bottom,
+                    "free_bottom": free.bottom() + 1, "frame_bottom": frame.bottom() + 1,
+                    "decorated": frame != win.geometry(), "height": win.height(),
+                    "min_height": win.minimumSizeHint().height(), "bar_shown": bar.isVisible(),
+                }  # fmt: skip
+                print(json.dumps(row), flush=True)
+            win.force_close()
+            app.processEvents()
+        wm.terminate()
+        wm.wait(10)
+
+
+if __name__ == "__main__":
+    main()
