@@ -29,8 +29,9 @@ def _wait(app, until, timeout: float = 10.0) -> None:
 
 
 def _key(app, win, key: str, until) -> None:
-    win.activateWindow()
-    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
+    from mouse import x_focus  # beside this script
+
+    x_focus(win)
     subprocess.run(["xdotool", "key", "--delay", "40", key], check=True)
     _wait(app, until)
 

@@ -7,6 +7,7 @@ import subprocess
 from pathlib import Path
 
 import numpy as np
+from mouse import x_focus
 
 from eyeviz.app.panels.bitmaps3d import Bitmaps3DPanel
 from eyeviz.model.scene import load
@@ -128,11 +129,7 @@ def test_tab_in_the_3d_view_moves_the_outline_to_the_next_ball(make_window, qtbo
     qtbot.waitUntil(lambda: bm._bg is not None, timeout=5000)
     assert bm.selected == 0
     before = bm._halo["A"].get_paths()[0].vertices.copy()
-    win.activateWindow()
-    win.raise_()
-    host.view.setFocus()
-    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
-    qtbot.waitUntil(host.view.hasFocus, timeout=3000)
+    x_focus(win, host.view)
     subprocess.run(["xdotool", "key", "--delay", "40", "Tab"], check=True)
     qtbot.waitUntil(lambda: host.model.selected == 1, timeout=5000)
     qtbot.waitUntil(lambda: bm.selected == 1, timeout=5000)

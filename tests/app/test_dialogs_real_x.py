@@ -6,6 +6,7 @@ import shutil
 import subprocess
 
 import pytest
+from mouse import x_focus
 from PyQt5 import QtCore, QtWidgets
 
 from eyeviz.model.scene import Eyes, Feature, Scene, View, load
@@ -51,11 +52,7 @@ def _run_keys(qtbot, *script: str, until=lambda: True) -> None:
 
 
 def _focus(win, qtbot):
-    win.activateWindow()
-    win.raise_()
-    win.plotter.setFocus()
-    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
-    qtbot.waitUntil(win.plotter.hasFocus, timeout=3000)
+    x_focus(win, win.plotter)
 
 
 def test_ctrl_s_on_an_untitled_scene_asks_for_a_name_and_saves_there(make_window, qtbot, tmp_path):

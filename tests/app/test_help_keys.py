@@ -7,6 +7,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
+from mouse import x_focus
 
 from eyeviz.app import help as app_help
 from eyeviz.app.view3d import PRESET_KEYS
@@ -18,11 +19,7 @@ SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 def _window3d(make_window, qtbot):
     win = make_window(load(SCENES / "sphere_teaching.toml"))
     assert win.host3d.active
-    win.activateWindow()
-    win.raise_()
-    win.host3d.view.setFocus()
-    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
-    qtbot.waitUntil(win.host3d.view.hasFocus, timeout=3000)
+    x_focus(win, win.host3d.view)
     return win
 
 

@@ -6,6 +6,7 @@ import subprocess
 
 import numpy as np
 import pytest
+from mouse import x_focus
 from PyQt5 import QtCore, QtGui, QtWidgets
 from test_presenting_real_x import _focus, _keys, _scene, window_manager  # noqa: F401
 
@@ -18,11 +19,7 @@ from eyeviz.resources import scene_path
 
 def _focus3d(win, qtbot):
     view = win.host3d.view
-    win.activateWindow()
-    win.raise_()
-    view.setFocus()
-    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
-    qtbot.waitUntil(view.hasFocus, timeout=3000)
+    x_focus(win, view)
 
 
 def _in_view(host, point, margin=0.0) -> bool:

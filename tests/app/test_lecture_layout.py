@@ -5,6 +5,7 @@ off the data, Eye design beside Eyes, the Estimators panel always there, no cut 
 import subprocess
 
 import pytest
+from mouse import x_focus
 from PyQt5 import QtWidgets
 
 from eyeviz.model.camera import to_pixel
@@ -13,11 +14,7 @@ from eyeviz.resources import scene_path
 
 
 def _focus(win, qtbot):
-    win.activateWindow()
-    win.raise_()
-    win.plotter.setFocus()
-    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
-    qtbot.waitUntil(win.plotter.hasFocus, timeout=3000)
+    x_focus(win, win.plotter)
 
 
 def _path_in_view(win) -> bool:

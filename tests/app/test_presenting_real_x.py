@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import pytest
+from mouse import x_focus
 from PyQt5 import QtCore, QtGui, QtWidgets
 
 from eyeviz.app.launch import APP_FONT_PT
@@ -57,11 +58,7 @@ def _scene():
 
 
 def _focus(win, qtbot):
-    win.activateWindow()
-    win.raise_()
-    win.plotter.setFocus()
-    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
-    qtbot.waitUntil(win.plotter.hasFocus, timeout=3000)
+    x_focus(win, win.plotter)
 
 
 def _keys(qtbot, *keys: str, until=lambda: True) -> None:
@@ -304,11 +301,7 @@ def test_the_step_caption_shows_whole_and_grows_in_presentation_mode(make_window
 
 def _focus3d(win, qtbot):
     view = win.host3d.view
-    win.activateWindow()
-    win.raise_()
-    view.setFocus()
-    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
-    qtbot.waitUntil(view.hasFocus, timeout=3000)
+    x_focus(win, view)
 
 
 def _shown3d(win) -> dict[str, bool]:
