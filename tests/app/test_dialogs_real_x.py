@@ -21,6 +21,16 @@ def _scene():
     )
 
 
+def _retried(step: str) -> str:
+    """A shell command for one xdotool step. A search is retried (up to 5 s): xdotool walks
+    the window tree and dies with BadWindow when a window in it is destroyed meanwhile (a
+    dialog closing under a loaded machine), or BadMatch when its window is not viewable
+    yet. Key presses are never retried: they would be typed twice."""
+    if not step.startswith("search"):
+        return f"xdotool {step}"
+    return f"(for i in $(seq 25); do xdotool {step} 2>/dev/null && exit 0; sleep 0.2; done; exit 1)"
+
+
 def _run_keys(qtbot, *script: str, until=lambda: True) -> None:
     """Run xdotool commands one after another in the background (a modal dialog runs its
     own event loop inside the key handler: the test cannot type into it from this thread)
@@ -39,7 +49,7 @@ def _run_keys(qtbot, *script: str, until=lambda: True) -> None:
     guard.setSingleShot(True)
     guard.timeout.connect(reject_modal)
     guard.start(15000)
-    cmd = " && ".join(f"xdotool {s}" for s in script)
+    cmd = " && ".join(map(_retried, script))
     proc = subprocess.Popen(["bash", "-c", cmd])
     try:
         qtbot.waitUntil(lambda: proc.poll() is not None and until(), timeout=20000)
