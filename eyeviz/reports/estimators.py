@@ -16,13 +16,31 @@ the reason, never crashed on. Output: ``estimators.md``, ``estimators.csv``,
 
 With ``--data FILE`` (a sparse data set of HEALPix or measured eyes), ``--nside N`` (a
 fresh HEALPix test set) or ``--eye FILE`` (a fresh test set of a measured pair) the report
-is the spherical side's instead (:mod:`eyeviz.reports.estimators3d`): DD, AD and
-elevation error of the estimators that answer for those eyes, and their run time.
+is that of the eyes that see lit sets instead: on that data set (or a fresh one of
+``--n-test`` rows drawn from the 3D Algorithm 1 with ``--seed``), every estimator that
+answers for those eyes (registry kind "spherical": analytic3d, limit3d, learned3d, ...)
+is scored on distance (DD: MAPE of r, Eq. 34), azimuth (AD: MAPE of the azimuth) and
+elevation (MAPE of the elevation, and its mean absolute error in degrees: the elevation
+crosses 0, where a relative error blows up, so the MAE is the figure to read), with the
+rows it flagged (answered by a fallback). Run time: microseconds per row when batched,
+milliseconds for one row alone. The limit costs milliseconds per row, so it is measured
+on at most ``--limit-rows`` evenly spaced rows; every estimator is also scored on those
+same rows (the "subset" columns), which is the like-for-like comparison. Output:
+``estimators3d.md``, ``estimators3d.csv``, ``estimators3d.png`` (error against run time,
+log axes).
+
+One report for every eye model: the measuring (:mod:`~eyeviz.reports.estimators_measure`:
+one :class:`~eyeviz.reports.estimators_measure.Result` for the planar eyes' two
+coordinates and the lit sets' three with their flagged rows), the tables
+(:mod:`~eyeviz.reports.estimators_table`) and the figures
+(:mod:`~eyeviz.reports.estimators_plot`) each hold both sides; :func:`write` picks the
+files' names and writers by the side of the data contract (:data:`WRITERS`).
 """
 
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 from pathlib import Path
 
 from eyeviz.core.validation import check_int
@@ -46,16 +64,19 @@ from eyeviz.reports.estimators_measure import (
     _time_single,
     make_test_sets,
     measure,
+    measure_lit,
     measure_one,
 )
-from eyeviz.reports.estimators_plot import _COLORS, plot
+from eyeviz.reports.estimators_plot import _COLORS, plot, plot_lit
 from eyeviz.reports.estimators_table import (
     CSV_FIELDS,
     _descriptions,
     _fmt,
     _fmt_time,
     to_csv,
+    to_csv_lit,
     to_markdown,
+    to_markdown_lit,
 )
 
 # The measuring, the tables and the figure live in estimators_measure, estimators_table and
@@ -64,6 +85,7 @@ from eyeviz.reports.estimators_table import (
 __all__ = [
     "CSV_FIELDS",
     "HELP",
+    "WRITERS",
     "PAPER_TABLE5",
     "TARGETS",
     "TEST_SEED",
@@ -81,13 +103,17 @@ __all__ = [
     "add_arguments",
     "make_test_sets",
     "measure",
+    "measure_lit",
     "measure_one",
     "parse_names",
     "plot",
+    "plot_lit",
     "run",
     "save_figure",
     "to_csv",
+    "to_csv_lit",
     "to_markdown",
+    "to_markdown_lit",
     "try_load",
     "write",
     "write_atomic",
@@ -96,17 +122,34 @@ __all__ = [
 HELP = "estimators' AD/DD error, training and inference time (error against run time)"
 
 
-def write(results: list[Result], outdir: Path, n_test: int, seed: int) -> list[Path]:
+def _markdown_planar(results: list[Result], what: tuple[int, int], png: str) -> str:
+    n_test, seed = what
+    return to_markdown(results, n_test, seed, png)
+
+
+#: Per side of the data contract, the planar eyes' bitmaps ("planar") or the lit sets of
+#: every other model ("lit": spherical, measured, a new one): the files' stem, the figure,
+#: the CSV, and the Markdown given the results, the test sets' description (planar:
+#: (n_test, seed); lit sets: the data set's sentence) and the figure's file name.
+WRITERS: dict[str, tuple[str, Callable, Callable, Callable]] = {
+    "planar": ("estimators", plot, to_csv, _markdown_planar),
+    "lit": ("estimators3d", plot_lit, to_csv_lit, to_markdown_lit),
+}
+
+
+def write(results: list[Result], outdir: Path, side: str, what) -> list[Path]:
+    """The report's Markdown, CSV and figure for one side of the data (:data:`WRITERS`)."""
     import matplotlib.pyplot as plt
 
+    stem, figure, table, markdown = WRITERS[side]
     outdir.mkdir(parents=True, exist_ok=True)
-    png = outdir / "estimators.png"
-    fig = plot(results)
+    png = outdir / f"{stem}.png"
+    fig = figure(results)
     save_figure(fig, png)
     plt.close(fig)
-    write_atomic(outdir / "estimators.csv", to_csv(results))
-    write_atomic(outdir / "estimators.md", to_markdown(results, n_test, seed, png.name))
-    return [outdir / "estimators.md", outdir / "estimators.csv", png]
+    write_atomic(outdir / f"{stem}.csv", table(results))
+    write_atomic(outdir / f"{stem}.md", markdown(results, what, png.name))
+    return [outdir / f"{stem}.md", outdir / f"{stem}.csv", png]
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -160,12 +203,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 # long: the report's one sequence (read or generate, predict each estimator, write), each step
 # with its own one-line error
-def run3d(args: argparse.Namespace) -> int:
-    """The spherical side's report (``--data``, ``--nside`` or ``--eye``)."""
+def run_lit(args: argparse.Namespace) -> int:
+    """The report of the eyes that see lit sets (``--data``, ``--nside`` or ``--eye``)."""
     from eyeviz import EyevizError
     from eyeviz.estimators import registry
     from eyeviz.reports.errors import with_error
-    from eyeviz.reports.estimators3d import measure3d, write3d
 
     given = [f for f in ("data", "nside", "eye") if getattr(args, f, None) is not None]
     if len(given) > 1:
@@ -230,8 +272,8 @@ def run3d(args: argparse.Namespace) -> int:
                 f"unknown 3D estimator(s) {', '.join(bad) or '(none given)'}; available: "
                 f"{', '.join(avail)}"
             )
-    results = measure3d(ds, names, args.limit_rows)
-    paths = write3d(results, args.output, what)
+    results = measure_lit(ds, names, args.limit_rows)
+    paths = write(results, args.output, "lit", what)
     for r in results:
         if r.ok:
             m, e = r.metrics["subset"], r.errors["subset"]
@@ -251,7 +293,7 @@ def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     if any(getattr(args, f, None) is not None for f in ("data", "nside", "eye")):
-        return run3d(args)
+        return run_lit(args)
     check_int("--n-test", args.n_test, ge=10, le=limits.MAX_ROWS)
     names = parse_names(args.estimators)
     bar = tqdm(total=len(names), desc="estimators", unit="est", leave=False)
@@ -262,7 +304,7 @@ def run(args: argparse.Namespace) -> int:
 
     results = measure(names, args.n_test, args.seed, progress)
     bar.close()
-    paths = write(results, args.output, args.n_test, args.seed)
+    paths = write(results, args.output, "planar", (args.n_test, args.seed))
     for r in results:
         if r.ok:
             e = r.metrics["single"]

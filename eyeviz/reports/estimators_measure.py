@@ -1,11 +1,16 @@
-"""Measuring for the estimators report (:mod:`eyeviz.reports.estimators`).
+"""Measuring for the estimators report (:mod:`eyeviz.reports.estimators`), every eye model.
 
-Fresh test sets with the paper's parameters (Tables 3 and 4), each estimator's metrics on
-them, its batched and single-sample inference time, and Table 5 of the paper quoted.
+Planar eyes (:func:`measure`): fresh test sets with the paper's parameters (Tables 3 and
+4), each estimator's metrics on them, its batched and single-sample inference time, and
+Table 5 of the paper quoted. Eyes that see lit sets, the spherical (HEALPix) and the
+measured ones (:func:`measure_lit`): one data set of (r, azimuth, elevation) rows, each
+estimator's error in the three coordinates with bootstrap standard errors, the rows it
+flagged, and its time per row. Both give :class:`Result`.
 """
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -13,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from eyeviz.reports.common import accuracy_metrics, try_load
+from eyeviz.reports.errors import bootstrap_se
 
 if TYPE_CHECKING:
     from eyeviz.estimators.base import Estimator, Prediction
@@ -41,18 +47,35 @@ PAPER_TABLE5: dict[str, Any] = {
 }
 
 
+#: estimators of lit sets measured on the subset only (milliseconds per row)
+SLOW = ("limit3d",)
+#: the figures of an estimator of lit sets: DD, AD (MAPE %), elevation MAPE % and MAE deg
+LIT_KEYS = ("dd", "ad", "el_mape", "el_mae_deg")
+
+
 @dataclass
 class Result:
-    """One estimator's figures; ``status`` is "ok" or the reason it is unavailable."""
+    """One estimator's figures, for every eye model; ``status`` is "ok" or the reason it is
+    unavailable.
+
+    ``metrics``: planar eyes, per test set ("single", "multi") ``{"n", "n_valid", "ad",
+    "dd"}`` with MAPE, MAE and R^2 of each; eyes that see lit sets, per part ("subset":
+    the rows every estimator is scored on, "all": every row) the :data:`LIT_KEYS` figures
+    of the three coordinates, ``errors`` their bootstrap standard errors and ``flagged``
+    the rows answered by a fallback, of ``rows`` scored.
+    """
 
     name: str
     status: str = "ok"
     label: str = ""
     n_weights: int | None = None
     train_seconds: float | None = None
-    batched_us: float | None = None  # per sample, batched over the single-pass test set
-    single_ms: float | None = None  # one sample alone, median
-    metrics: dict = field(default_factory=dict)  # test set -> {"n", "n_valid", "ad", "dd"}
+    batched_us: float | None = None  # per sample (row), batched
+    single_ms: float | None = None  # one sample alone (planar: the median)
+    metrics: dict = field(default_factory=dict)
+    errors: dict[str, dict[str, float]] = field(default_factory=dict)
+    flagged: dict[str, int] = field(default_factory=dict)
+    rows: int = 0
     table_keys: int | None = None  # lookup-table estimators (bayes): stored keys
 
     @property
@@ -151,6 +174,76 @@ def measure(names: list[str], n_test: int, seed: int = TEST_SEED, progress=None)
         out.append(
             measure_one(name, est, test_sets) if est is not None else Result(name=name, status=why)
         )
+        if progress is not None:
+            progress(name)
+    return out
+
+
+def _terms(ds, rows: np.ndarray, r, az, el) -> dict[str, np.ndarray]:
+    """Each figure's per-row terms: its value is their mean (MAPE, Eq. 34; MAE)."""
+    if np.any(ds.r[rows] == 0) or np.any(ds.azimuth[rows] == 0) or np.any(ds.elevation[rows] == 0):
+        raise ValueError("MAPE is undefined where the true value is 0")
+    return {
+        "dd": 100.0 * np.abs((r - ds.r[rows]) / ds.r[rows]),
+        "ad": 100.0 * np.abs((az - ds.azimuth[rows]) / ds.azimuth[rows]),
+        "el_mape": 100.0 * np.abs((el - ds.elevation[rows]) / ds.elevation[rows]),
+        "el_mae_deg": np.degrees(np.abs(el - ds.elevation[rows])),
+    }
+
+
+def _metrics(ds, rows: np.ndarray, r, az, el) -> tuple[dict[str, float], dict[str, float]]:
+    """The figures on ``rows`` and their bootstrap standard errors (eyeviz.reports.errors)."""
+    terms = _terms(ds, rows, r, az, el)
+    values = {k: float(np.mean(t)) for k, t in terms.items()}
+    return values, {k: bootstrap_se(t) for k, t in terms.items()}
+
+
+def measure_lit(ds, names: list[str], limit_rows: int = 1000, progress=None) -> list[Result]:
+    """Score each estimator ``names`` of lit sets (registry kind "spherical", for the
+    spherical or measured eyes) on the lit-set data set ``ds`` (a Dataset3D)."""
+    from eyeviz import EyevizError
+    from eyeviz.estimators import registry
+    from eyeviz.estimators.base import take_rows
+
+    n = len(ds)
+    step = max(1, math.ceil(n / max(1, limit_rows)))
+    subset = np.arange(0, n, step)
+    out = []
+    for name in names:
+        res = Result(name)
+        try:
+            est = registry.load(name, domain=ds.domain)
+        except (EyevizError, ValueError, OSError, ImportError, RuntimeError) as exc:
+            res.status = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            out.append(res)
+            continue
+        res.n_weights = int(getattr(est, "n_weights", 0))
+        rows = subset if name in SLOW else np.arange(n)
+        la = take_rows(ds.indptr_a, ds.indices_a, rows)
+        lb = take_rows(ds.indptr_b, ds.indices_b, rows)
+        t0 = time.perf_counter()
+        p = est.predict(la, lb)
+        res.batched_us = (time.perf_counter() - t0) / max(1, rows.size) * 1e6
+        valid = np.asarray(p.valid, bool)
+        if not valid.all():
+            res.status = f"no answer for {int((~valid).sum())} of {rows.size} rows"
+            out.append(res)
+            continue
+        res.rows = int(rows.size)
+        flagged = np.asarray(getattr(p, "flagged", np.zeros(rows.size, bool)), bool)
+        at = np.searchsorted(rows, subset)
+        r, az, el = (np.asarray(v, float) for v in (p[0], p[1], p[2]))
+        res.metrics["subset"], res.errors["subset"] = _metrics(ds, subset, r[at], az[at], el[at])
+        res.flagged["subset"] = int(flagged[at].sum())
+        if name not in SLOW:
+            res.metrics["all"], res.errors["all"] = _metrics(ds, rows, r, az, el)
+            res.flagged["all"] = int(flagged.sum())
+        one_a = take_rows(ds.indptr_a, ds.indices_a, subset[:1])
+        one_b = take_rows(ds.indptr_b, ds.indices_b, subset[:1])
+        t0 = time.perf_counter()
+        est.predict(one_a, one_b)
+        res.single_ms = (time.perf_counter() - t0) * 1e3
+        out.append(res)
         if progress is not None:
             progress(name)
     return out

@@ -1,4 +1,6 @@
-"""The figure of the estimators report (:mod:`eyeviz.reports.estimators`)."""
+"""The figures of the estimators report (:mod:`eyeviz.reports.estimators`): the planar
+eyes' (:func:`plot`) and those of the eyes that see lit sets, spherical or measured
+(:func:`plot_lit`)."""
 
 from __future__ import annotations
 
@@ -129,4 +131,44 @@ def plot(results: list[Result]):
         fontsize=8,
         frameon=False,
     )
+    return fig
+
+
+# long: the three panels' matplotlib calls, as plot's
+def plot_lit(results: list[Result]):
+    """Figure: DD and AD MAPE and elevation MAE on the subset against time per row, each
+    with its bootstrap standard error as an error bar (``Result.errors``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.6), constrained_layout=True)
+    ok = [r for r in results if r.ok]
+    panels = (
+        ("dd", "DD: distance, MAPE (%)"),
+        ("ad", "AD: azimuth, MAPE (%)"),
+        ("el_mae_deg", "elevation, MAE (degrees)"),
+    )
+    for ax, (key, title) in zip(axes, panels, strict=True):
+        for r in ok:
+            assert r.batched_us is not None and r.single_ms is not None  # measured
+            x = r.batched_us * 1e-6
+            y = r.metrics["subset"][key]
+            c = estimator_color(r.name.removesuffix("3d"))
+            ax.plot([x, r.single_ms * 1e-3], [y, y], color=c, lw=1.0, alpha=0.6)
+            se = r.errors.get("subset", {}).get(key, math.nan)
+            if math.isfinite(se):
+                ax.errorbar(
+                    [x], [y], yerr=[se], fmt="none", color="black", lw=1.0, capsize=5, zorder=4
+                )
+            ax.scatter([x], [y], s=70, color=c, edgecolors="black", zorder=3, label=r.name)
+            ax.annotate(r.name, (x, y), textcoords="offset points", xytext=(6, 6), fontsize=8)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_title(title)
+        ax.set_xlabel("seconds per row (marker: batched; line to: one row alone)")
+        ax.grid(True, which="both", alpha=0.3)
+    if ok:
+        axes[0].legend(loc="best", fontsize=8)
     return fig

@@ -1,4 +1,6 @@
-"""The CSV and Markdown of the estimators report (:mod:`eyeviz.reports.estimators`)."""
+"""The CSV and Markdown of the estimators report (:mod:`eyeviz.reports.estimators`): the
+planar eyes' (:func:`to_csv`, :func:`to_markdown`) and those of the eyes that see lit sets,
+spherical or measured (:func:`to_csv_lit`, :func:`to_markdown_lit`)."""
 
 from __future__ import annotations
 
@@ -7,7 +9,9 @@ import io
 import math
 
 from eyeviz.core.domain import DEFAULTS as _D
+from eyeviz.reports.errors import with_error
 from eyeviz.reports.estimators_measure import (
+    LIT_KEYS,
     PAPER_TABLE5,
     TEST_SETS,
     Result,
@@ -181,4 +185,89 @@ def to_markdown(results: list[Result], n_test: int, seed: int, png: str | None) 
         lines += ["Estimator details (from their metadata):", "", *notes, ""]
     if png:
         lines += [f"![error against inference time]({png})", ""]
+    return "\n".join(lines)
+
+
+# --- the eyes that see lit sets (spherical, measured) ----------------------------------------
+CSV_FIELDS_LIT = (
+    "estimator", "status", "rows", "subset_dd_mape", "subset_ad_mape", "subset_el_mape",
+    "subset_el_mae_deg", "subset_flagged", "all_dd_mape", "all_ad_mape", "all_el_mape",
+    "all_el_mae_deg", "all_flagged", "batched_us_per_row", "single_ms", "n_weights",
+    "subset_dd_se", "subset_ad_se", "subset_el_mape_se", "subset_el_mae_deg_se",
+    "all_dd_se", "all_ad_se", "all_el_mape_se", "all_el_mae_deg_se",
+)  # fmt: skip
+
+
+def _num(v: float | None) -> float:
+    """A time not measured (None) as NaN, as the lit-set tables print it."""
+    return math.nan if v is None else v
+
+
+def to_csv_lit(results: list[Result]) -> str:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(CSV_FIELDS_LIT)
+    for r in results:
+        row: list[object] = [r.name, r.status, r.rows]
+        for part in ("subset", "all"):
+            m = r.metrics.get(part, {})
+            row += [f"{m[k]:.6g}" if k in m else "" for k in LIT_KEYS]
+            row.append(r.flagged.get(part, ""))
+        row += [f"{_num(r.batched_us):.6g}", f"{_num(r.single_ms):.6g}", r.n_weights or 0]
+        for part in ("subset", "all"):
+            e = r.errors.get(part, {})
+            row += [f"{e[k]:.6g}" if k in e else "" for k in LIT_KEYS]
+        w.writerow(row)
+    return buf.getvalue()
+
+
+def _cell(m: dict[str, float], e: dict[str, float], k: str, best: float | None) -> str:
+    """``value ± se`` to the precision the bootstrap error allows; bold for the best."""
+    if k not in m:
+        return "—"
+    s = with_error(m[k], e.get(k, math.nan))
+    return f"**{s}**" if best is not None and m[k] == best else s
+
+
+def to_markdown_lit(results: list[Result], what: str, png: str) -> str:
+    ok = [r for r in results if r.ok]
+    lines = [
+        "# Estimators of the spherical eyes: error and run time",
+        "",
+        what,
+        "",
+        "DD, AD: MAPE (%) of r and of the azimuth (Eq. 34). Elevation: MAPE (%) and mean "
+        "absolute error (degrees); the elevation crosses 0, where a relative error blows "
+        "up, so read the MAE. Each figure is followed by its standard error (bootstrap "
+        "over the test rows) and printed to the precision that error allows. Bold: the "
+        "best on the subset.",
+        "",
+    ]
+    for part, head in (("subset", "Every estimator on the same rows (the subset)"),
+                       ("all", "Every row (the fast estimators)")):  # fmt: skip
+        have = [r for r in ok if part in r.metrics]
+        if not have:
+            continue
+        best = (
+            {k: min(r.metrics[part][k] for r in have) for k in LIT_KEYS} if part == "subset" else {}
+        )
+        lines += [
+            f"## {head}",
+            "",
+            "| estimator | DD MAPE % | AD MAPE % | el MAPE % | el MAE deg | flagged | "
+            "µs/row batched | ms one row | weights |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        ]
+        for r in have:
+            m, e = r.metrics[part], r.errors.get(part, {})
+            cells = " | ".join(_cell(m, e, k, best.get(k)) for k in LIT_KEYS)
+            lines.append(
+                f"| {r.name} | {cells} | {r.flagged.get(part, 0)} | "
+                f"{_num(r.batched_us):.3g} | {_num(r.single_ms):.3g} | {r.n_weights} |"
+            )
+        lines.append("")
+    bad = [r for r in results if not r.ok]
+    if bad:
+        lines += ["## Not measured", ""] + [f"- **{r.name}**: {r.status}" for r in bad] + [""]
+    lines += [f"![error against run time]({png})", ""]
     return "\n".join(lines)

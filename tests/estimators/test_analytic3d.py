@@ -112,11 +112,11 @@ def test_invalid_rows_and_errors(ds16):
 
 
 def test_the_report_counts_no_weights_for_the_analytic_estimator(ds16):
-    """`eyeviz report estimators` prints each estimator's weight count (measure3d): the
+    """`eyeviz report estimators` prints each estimator's weight count (measure_lit): the
     analytic estimator has none (a closed form, nothing trained)."""
-    from eyeviz.reports.estimators3d import measure3d
+    from eyeviz.reports.estimators import measure_lit
 
-    (res,) = measure3d(ds16, ["analytic3d"], limit_rows=20)
+    (res,) = measure_lit(ds16, ["analytic3d"], limit_rows=20)
     assert res.n_weights == 0
     assert Analytic3DEstimator(D16).metadata["train_seconds"] == 0.0
 

@@ -79,15 +79,15 @@ def test_with_error_prints_to_the_precision_the_error_allows():
 
 
 def test_the_figure_draws_each_estimators_standard_error():
-    """plot3d draws every measured estimator's bootstrap error as a bar of +- se about its
+    """plot_lit draws every measured estimator's bootstrap error as a bar of +- se about its
     value in each of the three panels (issue 38: the figures carry their errors)."""
     from matplotlib.collections import LineCollection
 
-    from eyeviz.reports.estimators3d import Result3D, plot3d
+    from eyeviz.reports.estimators import Result, plot_lit
 
     keys = ("dd", "ad", "el_mae_deg")
     res = [
-        Result3D(
+        Result(
             name,
             rows=100,
             metrics={"subset": {k: v * (i + 1) for i, k in enumerate(keys)}},
@@ -97,7 +97,7 @@ def test_the_figure_draws_each_estimators_standard_error():
         )
         for name, v, se in (("analytic3d", 1.5, 0.03), ("limit3d", 0.7, 0.02))
     ]
-    fig = plot3d(res)
+    fig = plot_lit(res)
     for i, ax in enumerate(fig.axes[:3]):
         bars = sorted(
             tuple(np.round(seg[:, 1], 9))
