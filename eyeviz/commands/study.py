@@ -1,7 +1,7 @@
 """``eyeviz study -o STUDY.csv``: the eye-design study (issue 11) on Dask.
 
 With ``--nside LIST`` the 3D design study of the spherical eyes instead (issue 23;
-:mod:`eyeviz.study.point3d`): the same resumable runner, a table of its own. With
+:mod:`eyeviz.study.point`): the same resumable runner, a table of its own. With
 ``--eye NAME`` the study over a shipped measured pair reshaped, fewer facets
 (``--facets``) or a wider head (``--widen``) (:mod:`eyeviz.study.point_measured`).
 
@@ -245,7 +245,7 @@ def run(args: argparse.Namespace) -> int:
     elif args.nside is not None:
         from eyeviz.core.domain import DEFAULT_EL_MAX
         from eyeviz.study.grid import DEFAULT_N3D, design_grid3d
-        from eyeviz.study.point3d import DEFAULT_ESTIMATOR
+        from eyeviz.study.point import DEFAULT_ESTIMATOR
 
         if args.m is not None:
             raise EyevizError("--m is the planar study's, --nside the 3D study's: give one")

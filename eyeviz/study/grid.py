@@ -7,7 +7,7 @@ designs whose eyes do not overlap (l < h), each with the same object ranges (Tab
 prior, n and seed: :func:`design_grid` for the planar eyes (m), :func:`design_grid3d`
 for the spherical ones (nside: the HEALPix resolution of each eye, 12 nside^2 facets,
 4 nside on the equator; docs/spherical.md), whose points also share the elevation band
-|el| <= el_max and the estimator (:class:`~eyeviz.study.point3d.DesignPoint3D`). Both
+|el| <= el_max and the estimator (:class:`~eyeviz.study.point.DesignPoint3D`). Both
 read their axes through :func:`grid_axes`.
 
 Bad input ends in one :class:`eyeviz.EyevizError` naming it: ``parse_list("m", "180,x")``
@@ -30,8 +30,7 @@ from eyeviz.core.domain import DEFAULT_EL_MAX, DEFAULTS
 from eyeviz.core.validation import check_choice, check_int, check_real, num
 from eyeviz.estimators.limit import PRIORS
 from eyeviz.files.limits import MAX_ROWS
-from eyeviz.study.point import BIN_WIDTH, DesignPoint
-from eyeviz.study.point3d import DEFAULT_ESTIMATOR, DesignPoint3D
+from eyeviz.study.point import BIN_WIDTH, DEFAULT_ESTIMATOR, DesignPoint, DesignPoint3D
 
 __all__ = [
     "DEFAULT_H",

@@ -12,8 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from eyeviz import EyevizError
-from eyeviz.study.point import COLUMNS, DesignPoint
-from eyeviz.study.point3d import COLUMNS3D, DesignPoint3D, evaluate3d
+from eyeviz.study.point import COLUMNS, COLUMNS3D, DesignPoint, DesignPoint3D, evaluate3d
 from eyeviz.study.point_measured import (
     COLUMNS_MEASURED,
     DesignPointMeasured,

@@ -15,7 +15,7 @@ Its test set is the 3D Algorithm 1 on the reshaped pair's domain with the object
 r_min, r_max, g_max (mm; the study command defaults them to the *real* pair's ranges, so
 every reshaped pair is tested at the same distances) and el_max, and the error of the
 estimator (``analytic3d``, or ``limit3d`` where it answers for measured eyes) is measured
-by :func:`eyeviz.study.point3d.evaluate3d`, whose rows this point's table holds
+by :func:`eyeviz.study.point.evaluate3d`, whose rows this point's table holds
 (:data:`TABLE_MEASURED`, :class:`StudyTableMeasured`). The runner distributes these
 points as it does the others (:mod:`eyeviz.study.kinds`).
 """
@@ -30,7 +30,7 @@ import numpy as np
 
 from eyeviz import EyevizError
 from eyeviz.core.validation import check_choice, check_int, check_real
-from eyeviz.study.point3d import COLUMNS3D, EL_BINS
+from eyeviz.study.point import COLUMNS3D, EL_BINS
 from eyeviz.study.table import StudyTable, TableFormat
 
 __all__ = [

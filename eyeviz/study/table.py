@@ -3,13 +3,13 @@
 Both studies keep their results in a table of this one kind, read and written here for
 both: a :class:`~eyeviz.study.table_format.TableFormat` says what sets the planar table
 (:data:`PLANAR`, :class:`StudyTable`) apart from the 3D one (:data:`TABLE3D`,
-:class:`StudyTable3D`; its header is :data:`~eyeviz.study.point3d.COLUMNS3D`, so neither
+:class:`StudyTable3D`; its header is :data:`~eyeviz.study.point.COLUMNS3D`, so neither
 reader takes the other's file, and :func:`is_table3d` tells them apart from the first
 line), and :mod:`eyeviz.study.table_format` holds the one parser of their lines
 (docs/study/README.md). pandas reads either file as it is (``pandas.read_csv(path)``).
 
 Rows are written a whole design point at a time (:func:`~eyeviz.study.point.evaluate`,
-MAPE Eq. 34, R^2 Eq. 35; :func:`~eyeviz.study.point3d.evaluate3d`):
+MAPE Eq. 34, R^2 Eq. 35; :func:`~eyeviz.study.point.evaluate3d`):
 :meth:`StudyTable.append` writes the first point with its header through
 :func:`eyeviz.files.atomic.atomic_output` and appends each later point's lines to the
 file (one write, fsync), cutting the file back to its former size should the write fail

@@ -2,7 +2,7 @@
 
 What sets the planar table (:data:`PLANAR`, header :data:`~eyeviz.study.point.COLUMNS`)
 apart from the 3D one (:data:`TABLE3D`, header
-:data:`~eyeviz.study.point3d.COLUMNS3D`) is a :class:`TableFormat`: its columns, its
+:data:`~eyeviz.study.point.COLUMNS3D`) is a :class:`TableFormat`: its columns, its
 version, its point type and its bins. Everything else is shared (docs/study/README.md):
 how a row is written (:func:`format_row`: repr floats that round-trip, nan as pandas reads
 it) and how a line is read and checked (:func:`parse_fields`: field count, ASCII numbers,
@@ -25,8 +25,16 @@ from typing import Any
 from eyeviz import EyevizError
 from eyeviz.core.bounds import MAX_BINS
 from eyeviz.core.validation import num
-from eyeviz.study.point import BIN_WIDTH, COLUMNS, STUDY_VERSION, DesignPoint
-from eyeviz.study.point3d import COLUMNS3D, EL_BINS, STUDY3D_VERSION, DesignPoint3D
+from eyeviz.study.point import (
+    BIN_WIDTH,
+    COLUMNS,
+    COLUMNS3D,
+    EL_BINS,
+    STUDY3D_VERSION,
+    STUDY_VERSION,
+    DesignPoint,
+    DesignPoint3D,
+)
 
 __all__ = [
     "MAX_LINE_CHARS",
@@ -132,7 +140,7 @@ PLANAR = TableFormat(
     bounds=("r_lo", "r_hi"),
 )
 
-#: The 3D study's table (:mod:`eyeviz.study.point3d`).
+#: The 3D study's table (:mod:`eyeviz.study.point`).
 TABLE3D = TableFormat(
     name="3D study table",
     study="3D study",
@@ -196,7 +204,7 @@ def _number(where: str, name: str, text: str, integer: bool):
 def _edge(lo: float, hi: float, k: int, i: int) -> float:
     """Edge i of ``numpy.linspace(lo, hi, k + 1)`` (the bins of
     :func:`~eyeviz.study.point.distance_bins` and
-    :func:`~eyeviz.study.point3d.elevation_bins`), no arrays."""
+    :func:`~eyeviz.study.point.elevation_bins`), no arrays."""
     return hi if i == k else lo + i * ((hi - lo) / k)
 
 

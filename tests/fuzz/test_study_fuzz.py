@@ -32,8 +32,7 @@ from hypothesis import strategies as st
 from eyeviz import EyevizError
 from eyeviz.reports.study_design import read_study3d
 from eyeviz.reports.study_table import read_study
-from eyeviz.study.point import COLUMNS, DesignPoint, evaluate
-from eyeviz.study.point3d import COLUMNS3D, DesignPoint3D, evaluate3d
+from eyeviz.study.point import COLUMNS, COLUMNS3D, DesignPoint, DesignPoint3D, evaluate, evaluate3d
 from eyeviz.study.table import StudyTable, StudyTable3D
 
 from .conftest import assert_one_line, count, digest, fuzz_settings

@@ -11,7 +11,7 @@ from eyeviz.core.domain import Domain3D
 from eyeviz.estimators import registry
 from eyeviz.estimators.metrics import bootstrap_se
 from eyeviz.study.grid import design_grid3d
-from eyeviz.study.point3d import COLUMNS3D, EL_BINS, DesignPoint3D, evaluate3d
+from eyeviz.study.point import COLUMNS3D, EL_BINS, DesignPoint3D, evaluate3d
 
 
 @pytest.mark.parametrize(

@@ -14,7 +14,7 @@ import pytest
 from eyeviz import EyevizError
 from eyeviz.study import run_study
 from eyeviz.study.grid import design_grid3d
-from eyeviz.study.point3d import COLUMNS3D, STUDY3D_VERSION
+from eyeviz.study.point import COLUMNS3D, STUDY3D_VERSION
 from eyeviz.study.table import StudyTable3D, read_rows3d
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -179,7 +179,7 @@ def test_the_3d_command_line_refuses_mixed_options_in_one_line(tmp_path):
 
 def test_a_point_that_would_pass_the_readers_bound_is_refused_before_writing(tmp_path, monkeypatch):
     from eyeviz.study import table
-    from eyeviz.study.point3d import evaluate3d
+    from eyeviz.study.point import evaluate3d
 
     path = tmp_path / "s3.csv"
     pts = design_grid3d("20", "10", "8,16", n=40)

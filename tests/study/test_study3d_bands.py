@@ -123,7 +123,7 @@ def _run(*args):
 @pytest.fixture(scope="module")
 def table3d(tmp_path_factory):
     from eyeviz.study.grid import design_grid3d
-    from eyeviz.study.point3d import evaluate3d
+    from eyeviz.study.point import evaluate3d
     from eyeviz.study.table import StudyTable3D
 
     path = tmp_path_factory.mktemp("bands") / "s3.csv"

@@ -10,7 +10,7 @@ import pytest
 from eyeviz import EyevizError
 from eyeviz.cli import main
 from eyeviz.study.kinds import columns_of, open_table
-from eyeviz.study.point3d import DesignPoint3D, evaluate3d
+from eyeviz.study.point import DesignPoint3D, evaluate3d
 from eyeviz.study.point_measured import (
     COLUMNS_MEASURED,
     DesignPointMeasured,

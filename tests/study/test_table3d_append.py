@@ -15,8 +15,7 @@ from eyeviz import EyevizError
 from eyeviz.study import run_study
 from eyeviz.study import table as table_mod
 from eyeviz.study.grid import design_grid3d
-from eyeviz.study.point import DesignPoint, evaluate
-from eyeviz.study.point3d import COLUMNS3D, DesignPoint3D, evaluate3d
+from eyeviz.study.point import COLUMNS3D, DesignPoint, DesignPoint3D, evaluate, evaluate3d
 from eyeviz.study.table import StudyTable, StudyTable3D, read_rows3d
 
 P1 = DesignPoint3D(h=20, l=10, nside=8, n=60, seed=1)
