@@ -21,6 +21,9 @@
   per eye (Definition 1), overlaps per eye and facets lit per eye.
 
 SVG and PDF are true vectors (one path per drawn facet, text as text, nothing rasterised).
+It stays apart from the planar figure (:mod:`eyeviz.render.mpl.vector`) because the
+mathematics differs: a perspective projection of spheres, cones and facets with culling and
+depth order here, a planar drawing in model coordinates there (that module's docstring).
 matplotlib is imported when this module is; callers that must stay light import it late.
 """
 

@@ -10,6 +10,18 @@ PDF hold one path per ommatidium (Figure 2), feature disc and the BFV wedge (Def
 follows the width: a journal column (3.5 in), a double column (7.2 in) or any width
 between 3 and 10 in.
 
+Why this is not one module with the spherical figure (:mod:`eyeviz.render.mpl.figure3d`,
+:mod:`eyeviz.render.mpl.perspective3d`; issue 37 asked for twins that do the same job to
+be merged): the mathematics of the two pictures differs. The planar scene lies in the
+plane it is drawn in: a feature is a disc, an ommatidium a triangle, the BFV a wedge, all
+drawn in model coordinates with an affine data-to-axes map, so the painters of the layer
+table draw straight from the Frame and matplotlib's own axes clip and scale. The spherical
+scene is a 3D one seen through a camera: every polygon (facets of a HEALPix or measured
+eye, balls, cones, the field's boundary) is put through VTK's perspective projection,
+back faces culled, sorted far to near (painter's algorithm) and shaded, and the eyes'
+facets are also drawn on Mollweide maps. What both need of a figure, the house style,
+fonts and the font floor, widths in inches, is shared (:mod:`eyeviz.render.mpl.style`).
+
 matplotlib is imported when this module is; callers that must stay light import it late.
 """
 
