@@ -185,3 +185,36 @@ def test_a_cap_crossing_a_cells_edge_between_its_vertices_lights_the_cell(monkey
     assert all(lit)
     if jit == "0":  # the numpy path reached the stage
         assert healpix_fast.FALLBACK_COUNTS["edges sampled x16"] >= len(cell)
+
+
+@pytest.mark.parametrize("jit", ["0", "1"])
+def test_a_grazing_cap_a_thousand_units_away_is_a_hemisphere(monkeypatch, jit):
+    # the ball's sphere passes 1e-10 from eye B's centre at |d| = 1000: the cap's
+    # half-angle is pi/2 - 1.4e-8, which float64 cannot get from g / |d|; cos(alpha) comes
+    # from the exact |d|^2 - g^2 (healpix_fast's grazing branch), relative to |d|^2
+    monkeypatch.setenv("EYEVIZ_JIT", jit)
+    if jit == "1":
+        kernels.warm()
+    n = 8
+    pair = EyePair3D(40.0, 20.0, n)
+    ((pb, ib),) = pair.lit_csr(40.0 + 600.0, 800.0, 0.0, 1000.0 - 1e-10)[1:]
+    lit = np.zeros(pair.npix, bool)
+    lit[ib[pb[0] : pb[1]]] = True
+    cos_to_axis = hp.centers(n) @ np.array([0.6, 0.8, 0.0])
+    assert lit[cos_to_axis > 0.02].all()  # every cell centred 1.1 degrees inside the cap
+    assert not lit[cos_to_axis < -0.2].any()  # none well outside
+
+
+def test_lit_sets_of_exactly_max_lit_facets_are_held_one_more_is_refused(monkeypatch):
+    # the refusal is of "more than MAX_LIT": three balls holding both eyes light 6 npix
+    # facets, an estimate exact in floats; the limit set to that is met, not exceeded
+    import eyeviz.core.geometry3d as g3
+
+    pair = EyePair3D(40.0, 20.0, 4)
+    balls = (np.zeros(3), np.zeros(3), np.zeros(3), np.full(3, 100.0))
+    monkeypatch.setattr(g3, "MAX_LIT", 6 * pair.npix)
+    (pa, _), (pb, _) = pair.lit_csr(*balls)
+    assert np.diff(pa).tolist() == np.diff(pb).tolist() == [pair.npix] * 3
+    monkeypatch.setattr(g3, "MAX_LIT", 6 * pair.npix - 1)
+    with pytest.raises(ValueError, match=f"more than {6 * pair.npix - 1}"):
+        pair.lit_csr(*balls)

@@ -25,6 +25,18 @@ def test_max_lit_bounds_the_largest_balls_of_the_domain():
     assert 0 < most <= limit3d.max_lit(d) < d.npix
 
 
+def test_max_lit_bounds_a_ball_r_min_from_the_origin_on_the_eyes_side():
+    # the bound's cap is that of a ball of g_max whose centre is r_min - h from an eye (r_min
+    # from the origin, on the line of the eyes): a domain whose r_min is near h, where that
+    # cap is wide (asin(50 / 60) = 56 degrees), and its nearest balls about that direction
+    d = Domain3D(h=40.0, l=20.0, nside=16, r_min=100.0, r_max=200.0, g_max=50.0)
+    a = np.linspace(-0.3, 0.3, 7)
+    x, y, z = d.r_min * np.cos(a), d.r_min * np.sin(a), np.zeros(a.size)
+    (_, _), (pb, _) = d.eyes.lit_csr(x, y, z, np.full(a.size, d.g_max))
+    most = int(np.diff(pb).max())
+    assert d.npix / 5 < most <= limit3d.max_lit(d) < d.npix
+
+
 def test_a_whole_eye_key_gets_no_draws_and_is_flagged(monkeypatch):
     d = Domain3D(nside=8)
     est = limit3d.load(d, samples=16)
