@@ -93,6 +93,14 @@ def test_hand_eye_random_balls_equal_the_reference(path):
     check_against_reference(pair, *random_balls(pair, 200, seed=2))
 
 
+@pytest.mark.parametrize("count", [1, 2, 3])
+def test_calls_of_one_two_and_three_balls_equal_the_reference(path, count):
+    # the index's candidate search has a branch of its own for a single ball: calls of
+    # a few balls must give every ball its own facets, not only the first
+    pair = hand_eye(1)
+    check_against_reference(pair, *(v[:count] for v in random_balls(pair, 3, seed=5)))
+
+
 @settings(max_examples=150, deadline=None, derandomize=True)
 @given(
     st.tuples(*[st.floats(-30, 30, allow_nan=False, allow_subnormal=False)] * 3),
