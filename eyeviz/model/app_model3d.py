@@ -1,10 +1,16 @@
-"""The 3D view's model: the open spherical-side scene (HEALPix or measured eyes), the
-selection, picking, and a ball's drag as one generator (no Qt, no VTK).
+"""The 3D view's gestures on the app model: picking, a ball's drag as one generator and
+the keyboard's nudges (no Qt, no VTK).
 
-As the planar :class:`eyeviz.model.app_model.AppModel` (docs/architecture.md): every edit
-goes through :meth:`AppModel3D.commit` (one undo step; the window installs a
-QUndoStack-backed ``push``); a drag changes the scene through :meth:`AppModel3D.live`
-between ``begin_live`` and ``end_live``, and the whole gesture is ONE undo step.
+The model is the one :class:`eyeviz.model.app_model.AppModel` of every eye model
+(issue 37.2), holding a spherical-side scene (HEALPix or measured eyes) with the state
+function ``checked_state`` of :mod:`eyeviz.model.state3d`; :data:`AppModel3D` is that
+class typed for the spherical state (the name the 3D page, its tests and plug-ins use).
+Every edit goes through ``commit`` (one undo step; the window installs a QUndoStack-backed
+``push``); a drag changes the scene through ``live`` between ``begin_live`` and
+``end_live``, and the whole gesture is ONE undo step. What stays here is the gestures'
+mathematics, which differs from the planar page's (:func:`eyeviz.model.app_model.drag_feature`
+moves a disc in the plane's own coordinates): a 3D press is a line of sight through a
+camera, picked against spheres, dragged in the plane facing the camera or along the ray.
 
 Gestures (pixels of the scene's viewport, y down, through the :class:`Camera3D` the view
 had at the press):
@@ -24,17 +30,14 @@ had at the press):
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Generator
+from collections.abc import Generator
 from dataclasses import dataclass
 
 import numpy as np
 
-from eyeviz import EyevizError
+from eyeviz.model.app_model import DRAG_THRESHOLD_PX, AppModel
 from eyeviz.model.camera3d import Camera3D, basis
-from eyeviz.model.edits import feature_value
-from eyeviz.model.scene import OKABE_ITO, Feature, Scene
-from eyeviz.model.state3d import SceneState3D, compute_state3d, eyes_name
-from eyeviz.model.typed3d import KEYS, typed_ball
+from eyeviz.model.state3d import MAX_VIEW_LIT, SceneState3D, checked_state
 
 __all__ = [
     "MIN_DEPTH",
@@ -51,14 +54,17 @@ __all__ = [
     "ray",
 ]
 
-DRAG_THRESHOLD_PX = 4.0  # released closer than this to the press: a click (select only)
 PICK_PX = 8.0  # a ball is grabbed within this many pixels of its drawn outline
 MIN_DEPTH = 0.05  # a depth drag stops at this fraction of the ball's distance from the camera
 NUDGE_PX = 10.0  # one arrow key
 NUDGE_DEPTH = 0.05  # one depth key: the distance times exp(+-0.05)
-#: The 3D view holds at most this many lit facets (both eyes, all balls; 128 MB of
-#: indices): a scene or an edit beyond it is refused in one line, the scene kept.
-MAX_VIEW_LIT = 1 << 24
+# DRAG_THRESHOLD_PX (released closer than this to the press: a click) is the planar page's
+# (eyeviz.model.app_model); MAX_VIEW_LIT and checked_state are the spherical state
+# function's (eyeviz.model.state3d), re-exported here where the 3D page imports them.
+
+#: The app model of a spherical-side scene: :class:`eyeviz.model.app_model.AppModel`
+#: typed for its state (:class:`eyeviz.model.state3d.SceneState3D`).
+AppModel3D = AppModel[SceneState3D]
 
 
 @dataclass(frozen=True)
@@ -106,180 +112,6 @@ def pick_ball(cam: Camera3D, p: Pointer, x, y, z, g) -> int | None:
         hit, along - np.sqrt(np.maximum(np.asarray(g, float) ** 2 - miss**2, 0)), np.inf
     )
     return int(np.argmin(front))
-
-
-def checked_state(scene: Scene) -> SceneState3D:
-    """:func:`compute_state3d`, refused (EyevizError, one line) beyond MAX_VIEW_LIT."""
-    st = compute_state3d(scene)
-    n = sum(int(c[1].size) for c in (st.lit_a, st.lit_b) if c is not None)
-    if n > MAX_VIEW_LIT:
-        raise EyevizError(
-            f"the balls light {n:,} facets ({eyes_name(st.pair)}); the 3D view draws at "
-            f"most {MAX_VIEW_LIT:,} (smaller balls, farther balls or a smaller nside)"
-        )
-    return st
-
-
-@dataclass
-class _Live:
-    before: Scene
-    text: str
-
-
-class AppModel3D:
-    """The open spherical scene plus the selection; notifies listeners ``fn(what, index)``
-    ("scene", "feature" (a live move of ball ``index``), "selection")."""
-
-    def __init__(self, scene: Scene):
-        self.scene = scene.copy()
-        self.selected: int | None = 0 if scene.features else None
-        self.listeners: list[Callable[[str, int | None], None]] = []
-        self.push: Callable[..., None] = self._push_plain
-        self._state: SceneState3D | None = None
-        self._live: _Live | None = None
-
-    @property
-    def state(self) -> SceneState3D:
-        """The scene's state (:func:`compute_state3d`), recomputed after each change."""
-        if self._state is None:
-            self._state = checked_state(self.scene)
-        return self._state
-
-    def _notify(self, what: str, index: int | None = None) -> None:
-        # a live move ("feature") has computed its state already (live())
-        if what not in ("selection", "feature"):
-            self._state = None
-        for fn in list(self.listeners):
-            fn(what, index)
-
-    def _push_plain(self, before: Scene, after: Scene, text: str, merge_key=None) -> None:
-        self.set_scene(after)
-
-    def set_scene(self, scene: Scene) -> None:
-        """Replace the scene (open, undo and redo land here)."""
-        self.scene = scene.copy()
-        n = len(self.scene.features)
-        if self.selected is not None and self.selected >= n:
-            self.selected = n - 1 if n else None
-        if self.selected is None and n:
-            self.selected = 0
-        self._notify("scene")
-
-    def commit(self, after: Scene, text: str, merge_key=None) -> None:
-        """One undoable edit to ``after`` (edits with one ``merge_key`` merge); an edit
-        whose state the view cannot hold raises EyevizError and changes nothing."""
-        self.end_live()
-        before = self.scene.copy()
-        if after != before:
-            checked_state(after)
-            self.push(before, after.copy(), text, merge_key)
-
-    @property
-    def live_open(self) -> bool:
-        return self._live is not None
-
-    def begin_live(self, text: str) -> None:
-        self.end_live()
-        self._live = _Live(self.scene.copy(), text)
-
-    def end_live(self) -> bool:
-        """End the gesture: one undo step from its start to now; True if it changed."""
-        live, self._live = self._live, None
-        if live is None:
-            return False
-        after = self.scene.copy()
-        if after == live.before:
-            return False
-        self.push(live.before, after, live.text, None)
-        return True
-
-    def finish_gestures(self) -> None:
-        self.end_live()
-
-    def live(self, index: int, **values: float) -> None:
-        """Move or resize ball ``index`` during a gesture (x, y, z, g only)."""
-        bad = set(values) - {"x", "y", "z", "g"}
-        if bad:
-            raise ValueError(f"live() changes x, y, z or g only, got {', '.join(sorted(bad))}")
-        checked = {k: feature_value(k, v, "ball radius") for k, v in values.items()}
-        f = self.scene.features[index]
-        old = {k: getattr(f, k) for k in checked}
-        for k, v in checked.items():
-            setattr(f, k, v)
-        self._state = None
-        try:
-            self.state  # noqa: B018 (computed now: a refused move leaves the ball where it was)
-        except EyevizError as exc:
-            for k, v in old.items():
-                setattr(f, k, v)
-            self._state = None
-            raise ValueError(str(exc)) from None
-        self._notify("feature", index)
-
-    def select(self, index: int | None) -> None:
-        if index != self.selected:
-            self.selected = index
-            self._notify("selection", index)
-
-    def set_layer(self, layer: str, on: bool) -> None:
-        after = self.scene.copy()
-        if on and layer not in after.layers:
-            after.layers.append(layer)
-        elif not on and layer in after.layers:
-            after.layers.remove(layer)
-        self.commit(after, f"{'Show' if on else 'Hide'} {layer}")
-
-    def move(self, index: int, centre, text: str, merge_key=None) -> None:
-        """Put ball ``index`` at ``centre`` (x, y, z) as one undo step."""
-        after = self.scene.copy()
-        f = after.features[index]
-        f.x, f.y, f.z = (
-            feature_value(k, v, "ball radius") for k, v in zip("xyz", centre, strict=True)
-        )
-        self.commit(after, text, merge_key)
-
-    def type_value(self, index: int, key: str, text: str) -> None:
-        """Ball ``index``'s coordinate ``key`` (x, y, z, g, r, az, el) typed as ``text``:
-        one undo step (:func:`eyeviz.model.typed3d.typed_ball`); a bad value raises
-        ValueError (one line) and changes nothing."""
-        f = self.scene.features[index]
-        x, y, z, g = typed_ball(f, key, text)
-        after = self.scene.copy()
-        a = after.features[index]
-        a.x, a.y, a.z, a.g = x, y, z, g
-        try:
-            self.commit(after, f"Type {KEYS[key]} of {f.name}")
-        except EyevizError as exc:
-            raise ValueError(str(exc)) from None
-
-    def _name(self, base: str) -> str:
-        names = {f.name for f in self.scene.features}
-        i = 1
-        while f"{base} {i}" in names:
-            i += 1
-        return f"{base} {i}"
-
-    def add_ball(self, x: float, y: float, z: float, g: float) -> None:
-        after = self.scene.copy()
-        color = OKABE_ITO[len(after.features) % len(OKABE_ITO)]
-        after.features.append(Feature(self._name("ball"), x, y, g, color, z))
-        self.commit(after, "Add ball")
-        self.select(len(self.scene.features) - 1)
-
-    def duplicate_ball(self, index: int) -> None:
-        after = self.scene.copy()
-        f = after.features[index]
-        color = OKABE_ITO[len(after.features) % len(OKABE_ITO)]
-        after.features.append(
-            Feature(self._name(f"{f.name} copy"), f.x + 2.5 * f.g, f.y, f.g, color, f.z)
-        )
-        self.commit(after, f"Duplicate {f.name}")
-        self.select(len(self.scene.features) - 1)
-
-    def delete_ball(self, index: int) -> None:
-        after = self.scene.copy()
-        name = after.features.pop(index).name
-        self.commit(after, f"Delete {name}")
 
 
 def drag_ball(

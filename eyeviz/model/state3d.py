@@ -30,7 +30,18 @@ from eyeviz.core.geometry3d import EyePair3D
 from eyeviz.core.measured import MeasuredEyePair
 from eyeviz.model.scene import Scene
 
-__all__ = ["Pair3D", "SceneState3D", "compute_state3d", "eyes_name"]
+__all__ = [
+    "MAX_VIEW_LIT",
+    "Pair3D",
+    "SceneState3D",
+    "checked_state",
+    "compute_state3d",
+    "eyes_name",
+]
+
+#: The 3D view holds at most this many lit facets (both eyes, all balls; 128 MB of
+#: indices): a scene or an edit beyond it is refused in one line, the scene kept.
+MAX_VIEW_LIT = 1 << 24
 
 #: The eye models of the spherical side: balls (x, y, z, g), lit sets per eye as CSR.
 Pair3D = EyePair3D | MeasuredEyePair
@@ -138,4 +149,17 @@ def compute_state3d(scene: Scene) -> SceneState3D:
         st.in_bfv = pair.in_bfv(x, y, z, g)
     if "readout" in shown:
         st.overlap_a, st.overlap_b = pair.overlaps_eye(x, y, z, g)
+    return st
+
+
+def checked_state(scene: Scene) -> SceneState3D:
+    """:func:`compute_state3d`, refused (EyevizError, one line) beyond MAX_VIEW_LIT: the
+    app model's state function of the spherical side (``eyeviz.model.app_model``)."""
+    st = compute_state3d(scene)
+    n = sum(int(c[1].size) for c in (st.lit_a, st.lit_b) if c is not None)
+    if n > MAX_VIEW_LIT:
+        raise EyevizError(
+            f"the balls light {n:,} facets ({eyes_name(st.pair)}); the 3D view draws at "
+            f"most {MAX_VIEW_LIT:,} (smaller balls, farther balls or a smaller nside)"
+        )
     return st

@@ -63,7 +63,7 @@ def test_a_drag_frame_updates_only_the_moved_row_of_the_state(monkeypatch):
 
     import numpy as np
 
-    import eyeviz.model.app_model as am
+    import eyeviz.model.state as am  # the planar state function (app_model.STATE_FUNCTIONS)
     from eyeviz.model.state import compute_state
 
     m, undo = make()

@@ -10,6 +10,7 @@ import pytest
 
 from eyeviz import EyevizError
 from eyeviz.model import app_model3d as m3
+from eyeviz.model import state3d
 from eyeviz.model.camera3d import Camera3D, basis, preset, project, to_pixels
 from eyeviz.model.scene import Eyes, Feature, Scene
 
@@ -182,7 +183,7 @@ def test_hiding_a_layer_removes_it_and_hiding_a_hidden_one_changes_nothing():
 def test_lit_sets_beyond_the_view_bound_are_refused_and_nothing_moves(monkeypatch):
     m, steps = _model()
     n0 = sum(int(c[1].size) for c in (m.state.lit_a, m.state.lit_b))
-    monkeypatch.setattr(m3, "MAX_VIEW_LIT", n0 + 10)
+    monkeypatch.setattr(state3d, "MAX_VIEW_LIT", n0 + 10)
     m.begin_live("Move a")
     with pytest.raises(ValueError, match="3D view draws at most"):
         m.live(0, y=60.0)  # next to the eyes: a large cap on each
@@ -198,8 +199,8 @@ def test_lit_sets_beyond_the_view_bound_are_refused_and_nothing_moves(monkeypatc
 def test_a_live_move_computes_the_state_once(monkeypatch):
     m, _ = _model()
     calls = []
-    real = m3.compute_state3d
-    monkeypatch.setattr(m3, "compute_state3d", lambda sc: (calls.append(1), real(sc))[1])
+    real = state3d.compute_state3d
+    monkeypatch.setattr(state3d, "compute_state3d", lambda sc: (calls.append(1), real(sc))[1])
     m.begin_live("Move a")
     m.live(0, x=-40.0)
     st = m.state
