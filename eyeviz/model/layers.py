@@ -27,6 +27,18 @@ Hooks (each optional):
   ``vtk_stage`` says which Frame it gets in the app: ``"scene"`` (built from the state at
   each update) or ``"overlay"`` (the parts the app model caches: predictions, the
   selected feature's ambiguity region, the trajectory path).
+- ``vtk3d``: the app's 3D view's painter (:class:`eyeviz.render.vtk.painter3d.Painter3D`),
+  a class made once per 3D view as ``cls(scene_renderer, eyes_renderer)`` whose
+  ``update(scene, state, selected, surface)`` draws the layer from a spherical-side state
+  or hides its actors; ``vtk3d_order`` its place among them. A painter may draw a few
+  layers that share its actors (the field's painter draws ``bfv`` and ``plane``); those
+  layers name no painter of their own.
+
+Every layer states the eye models it applies to (``kinds``, among :data:`MODEL_KINDS`:
+the planar eyes, the HEALPix eyes and measured eyes, ``Eyes.kind``): a scene of another
+model refuses it in one line, and the app's layer menus list it only for those models
+(:func:`layer_names`, :func:`applies`). A registered layer applies to the planar eyes
+unless it says otherwise.
 
 >>> from eyeviz.model.layers import layer, layer_names
 >>> layer("tangents").needs
@@ -44,7 +56,9 @@ from typing import Any
 
 __all__ = [
     "LAYERS",
+    "MODEL_KINDS",
     "NEEDS",
+    "applies",
     "LayerSpec",
     "Ref",
     "layer",
@@ -60,6 +74,10 @@ __all__ = [
 NEEDS = ("intervals", "owners", "readout")
 #: How the app's VTK view feeds a painter (see the module docstring).
 VTK_STAGES = ("scene", "overlay")
+#: The eye models a layer can apply to (``eyeviz.model.scene_eyes.Eyes.kind``).
+MODEL_KINDS = ("planar", "spherical", "measured")
+_EVERY = MODEL_KINDS
+_SPACE = ("spherical", "measured")
 
 Ref = str | Callable[..., Any]  # "package.module:attribute", or the object itself
 
@@ -77,6 +95,9 @@ class LayerSpec:
     mpl_order: float = 0.0
     vtk_order: float = 0.0
     vtk_stage: str = "scene"
+    kinds: tuple[str, ...] = ("planar",)
+    vtk3d: Ref | None = None
+    vtk3d_order: float = 0.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.isidentifier():
@@ -90,12 +111,19 @@ class LayerSpec:
         object.__setattr__(self, "needs", needs)
         if self.vtk_stage not in VTK_STAGES:
             raise ValueError(f"vtk_stage must be 'scene' or 'overlay', got {self.vtk_stage!r}")
+        kinds = tuple(self.kinds)
+        if not kinds or any(k not in MODEL_KINDS for k in kinds):
+            raise ValueError(f"kinds must be among {', '.join(MODEL_KINDS)}, got {kinds!r}")
+        object.__setattr__(self, "kinds", kinds)
 
 
 _F, _M, _V = "eyeviz.model.frame:", "eyeviz.render.mpl.layers.", "eyeviz.render.vtk.layers."
+_V3 = "eyeviz.render.vtk."
 
 #: The table, in the order the scene file and the app's Layers panel list the layers.
-#: ``bitmaps`` and ``readout`` have no VTK painter: the app draws them in Qt panels.
+#: ``bitmaps`` and ``readout`` have no VTK painter: the app draws them in Qt panels (the
+#: 3D page too). The spherical side's vector figure (eyeviz.render.mpl.figure3d) and its
+#: close-up panels are not hooks of this table yet: they draw from the state by layer name.
 LAYERS: list[LayerSpec] = [
     LayerSpec(
         "eyes",
@@ -106,6 +134,9 @@ LAYERS: list[LayerSpec] = [
         vtk=_V + "eyes:EyesLayer",
         mpl_order=30,
         vtk_order=10,
+        kinds=_EVERY,
+        vtk3d=_V3 + "eyes3d:EyesPainter",
+        vtk3d_order=20,
     ),
     LayerSpec(
         "bfv",
@@ -115,6 +146,9 @@ LAYERS: list[LayerSpec] = [
         vtk=_V + "bfv:BFVLayer",
         mpl_order=10,
         vtk_order=5,
+        kinds=_EVERY,
+        vtk3d=_V3 + "field3d:FieldPainter",
+        vtk3d_order=10,
     ),
     LayerSpec(
         "features",
@@ -124,6 +158,9 @@ LAYERS: list[LayerSpec] = [
         vtk=_V + "features:FeaturesLayer",
         mpl_order=70,
         vtk_order=20,
+        kinds=_EVERY,
+        vtk3d=_V3 + "balls3d:BallsPainter",
+        vtk3d_order=30,
     ),
     LayerSpec(
         "bitmaps",
@@ -132,6 +169,7 @@ LAYERS: list[LayerSpec] = [
         frame=_F + "build_eyes",
         mpl=_M + "bitmaps:paint",
         mpl_order=110,
+        kinds=_EVERY,
     ),
     LayerSpec(
         "readout",
@@ -139,6 +177,7 @@ LAYERS: list[LayerSpec] = [
         needs=frozenset({"intervals", "readout"}),
         mpl=_M + "table:paint",
         mpl_order=120,
+        kinds=_EVERY,
     ),
     LayerSpec(
         "tangents",
@@ -149,6 +188,7 @@ LAYERS: list[LayerSpec] = [
         vtk=_V + "tangents:TangentsLayer",
         mpl_order=40,
         vtk_order=40,
+        kinds=_EVERY,
     ),
     LayerSpec(
         "sectors",
@@ -169,6 +209,7 @@ LAYERS: list[LayerSpec] = [
         vtk=_V + "labels:LabelsLayer",
         mpl_order=100,
         vtk_order=30,
+        kinds=_EVERY,
     ),
     LayerSpec(
         "predictions",
@@ -180,6 +221,7 @@ LAYERS: list[LayerSpec] = [
         mpl_order=80,
         vtk_order=80,
         vtk_stage="overlay",
+        kinds=("planar", "spherical"),
     ),
     LayerSpec(
         "ambiguity",
@@ -212,15 +254,39 @@ LAYERS: list[LayerSpec] = [
         vtk_order=70,
         vtk_stage="overlay",
     ),
+    LayerSpec(
+        "plane",
+        "the plane z = 0 with a grid, and each eye's equator",
+        kinds=_SPACE,  # drawn by the field's painter (bfv) and the eyes' (their equators)
+    ),
+    LayerSpec(
+        "cones",
+        "the selected ball's lit facets' acceptance cones",
+        kinds=("measured",),  # a HEALPix facet has no lens
+        vtk3d=_V3 + "cones3d:ConesPainter",
+        vtk3d_order=40,
+    ),
+    LayerSpec(
+        "responses",
+        "the lit facets shaded by their graded response",
+        kinds=_SPACE,  # drawn by the eyes' painter and the 3D bitmaps panel
+    ),
 ]
 
 _RESOLVED: dict[str, Any] = {}
 _CACHE: dict[tuple, Any] = {}  # ordered() and needs_of() answers; cleared when LAYERS changes
 
 
-def layer_names() -> tuple[str, ...]:
-    """The names of every layer, in table order."""
-    return tuple(s.name for s in LAYERS)
+def layer_names(kind: str | None = None) -> tuple[str, ...]:
+    """The names of every layer, in table order; with ``kind``, of the layers that apply
+    to that eye model (:data:`MODEL_KINDS`)."""
+    return tuple(s.name for s in LAYERS if kind is None or kind in s.kinds)
+
+
+def applies(name: str, kind: str) -> bool:
+    """Whether layer ``name`` applies to eyes of model ``kind`` (False for an unknown
+    name)."""
+    return any(s.name == name and kind in s.kinds for s in LAYERS)
 
 
 def layer(name: str) -> LayerSpec:
@@ -252,15 +318,16 @@ def unregister_layer(name: str) -> None:
 
 
 def ordered(hook: str, shown: Iterable[str] | None = None) -> list[LayerSpec]:
-    """The entries with a ``hook`` ("frame", "mpl" or "vtk"), in that renderer's draw order
-    (``mpl_order`` / ``vtk_order``, then table order); only the names in ``shown`` if given."""
+    """The entries with a ``hook`` ("frame", "mpl", "vtk" or "vtk3d"), in that renderer's
+    draw order (``mpl_order`` / ``vtk_order`` / ``vtk3d_order``, then table order); only
+    the names in ``shown`` if given."""
     keep = None if shown is None else frozenset(shown)
     ck = ("ordered", hook, keep)
     if ck not in _CACHE:  # a drag frame asks again with the same layers
         specs = [s for s in LAYERS if getattr(s, hook) is not None]
         if keep is not None:
             specs = [s for s in specs if s.name in keep]
-        key = {"mpl": "mpl_order", "vtk": "vtk_order"}.get(hook)
+        key = {"mpl": "mpl_order", "vtk": "vtk_order", "vtk3d": "vtk3d_order"}.get(hook)
         _CACHE[ck] = specs if key is None else sorted(specs, key=lambda s: getattr(s, key))
     return list(_CACHE[ck])
 

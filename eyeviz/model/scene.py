@@ -57,7 +57,7 @@ import tomli_w
 from eyeviz import EyevizError
 from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
-from eyeviz.model.layers import layer_names
+from eyeviz.model.layers import applies, layer, layer_names
 from eyeviz.model.scene_eyes import Eyes, eyes_doc, eyes_from_table
 from eyeviz.model.steps import Step, check_steps, step_doc
 
@@ -81,7 +81,9 @@ TRAJECTORY_KINDS = ("horizontal", "circular", "vertical")
 # Okabe & Ito (2008) colour-blind-safe palette, black left out (it is the eyes' ink).
 OKABE_ITO = ("#D55E00", "#0072B2", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#F0E442")
 DEFAULT_LAYERS = ["eyes", "bfv", "features", "bitmaps", "readout"]
-#: The layers a spherical scene may show (see the module docstring).
+#: The layers a spherical scene may show (see the module docstring), in the order of the
+#: 3D page's layer menu: the layers of the table (eyeviz.model.layers.LAYERS) that apply
+#: to HEALPix or measured eyes (a test holds the two equal).
 SPHERICAL_LAYERS = (
     "eyes", "features", "bfv", "bitmaps", "readout", "labels", "tangents", "plane", "predictions",
     "cones", "responses",
@@ -90,17 +92,23 @@ SPHERICAL_LAYERS = (
 #: planar scenes' default is compact; a spherical scene naming a planar one is refused by
 #: eyeviz.model.predictions3d.check_estimators).
 SPHERICAL_ESTIMATORS = ("analytic3d", "learned3d", "limit3d")
-#: Layers of spherical scenes only (not in the planar layer table, eyeviz.model.layers).
-SPHERICAL_ONLY = ("plane", "cones", "responses")
-#: The spherical side's layers that apply to some eye models only (the others: to both):
-#: the estimators' answers to HEALPix eyes (no estimator of measured eyes in the app yet),
-#: the lit acceptance cones to measured eyes (a HEALPix facet has no lens).
-LAYER_KINDS: dict[str, tuple[str, ...]] = {"predictions": ("spherical",), "cones": ("measured",)}
+#: Layers of spherical scenes only (their table entries apply to no planar eyes).
+SPHERICAL_ONLY = tuple(n for n in SPHERICAL_LAYERS if not applies(n, "planar"))
+#: The spherical side's layers that apply to some eye models only (the others: to both),
+#: as their table entries state (``LayerSpec.kinds``): the estimators' answers to HEALPix
+#: eyes (no estimator of measured eyes in the app yet), the lit acceptance cones to
+#: measured eyes (a HEALPix facet has no lens).
+LAYER_KINDS: dict[str, tuple[str, ...]] = {
+    n: k
+    for n in SPHERICAL_LAYERS
+    if len(k := tuple(x for x in layer(n).kinds if x != "planar")) == 1
+}
 
 
 def layer_applies(layer: str, kind: str) -> bool:
-    """Whether a spherical-side ``layer`` applies to eyes of model ``kind``."""
-    return kind in LAYER_KINDS.get(layer, (kind,))
+    """Whether a spherical-side ``layer`` applies to eyes of model ``kind`` (its table
+    entry's ``kinds``)."""
+    return applies(layer, kind)
 
 
 _COLOR = re.compile(r"^#[0-9a-fA-F]{6}$")
@@ -353,9 +361,9 @@ def _scene_from_doc(doc: dict, text: str, source: str, base: Path | None) -> Sce
     layers_t = c.table(doc, "layers")
     c.keys(layers_t, "layers.", ("show",))
     layers = c.strings(layers_t, "show", "layers.", DEFAULT_LAYERS)
-    known = layer_names()  # the layer table (eyeviz.model.layers), registered layers too
-    if kind == "spherical":
-        known += SPHERICAL_ONLY
+    # the layer table (eyeviz.model.layers), registered layers too: a spherical scene
+    # knows them all (and refuses the planar-only ones below, in one line saying so)
+    known = layer_names() if kind == "spherical" else layer_names("planar")
     for name in layers:
         if name not in known:
             raise c.fail("layers.show", f"unknown layer {name!r} (known: {', '.join(known)})")

@@ -67,11 +67,34 @@ def _toml(names) -> str:
 
 
 def test_the_scene_file_accepts_exactly_the_tables_layers():
-    assert layer_names() == SHIPPED  # the shipped layers, in the panel's order
-    for name in layer_names():
+    assert layer_names("planar") == SHIPPED  # the shipped layers, in the panel's order
+    for name in layer_names("planar"):
         assert loads(_toml([name])).layers == [name]
     with pytest.raises(SceneError, match=r"layers.show: unknown layer 'wobble' \(known: eyes"):
         loads(_toml(["eyes", "wobble"]))
+    for name in ("plane", "cones", "responses"):  # the spherical side's own: not planar
+        with pytest.raises(SceneError, match=f"unknown layer '{name}'"):
+            loads(_toml([name]))
+
+
+def test_each_layer_states_the_eye_models_it_applies_to():
+    """The table says which models a layer applies to (issue 37.2); the spherical scene's
+    layers, its planar-only refusals and the 3D menu's per-model layers are read from it."""
+    from eyeviz.model.scene import LAYER_KINDS, SPHERICAL_LAYERS, SPHERICAL_ONLY
+
+    space = set(layer_names("spherical")) | set(layer_names("measured"))
+    assert set(SPHERICAL_LAYERS) == space and len(SPHERICAL_LAYERS) == len(space)
+    assert SPHERICAL_ONLY == ("plane", "cones", "responses")
+    assert LAYER_KINDS == {"predictions": ("spherical",), "cones": ("measured",)}
+    assert not layers.applies("sectors", "spherical") and layers.applies("cones", "measured")
+    assert not layers.applies("cones", "spherical") and not layers.applies("wobble", "planar")
+    with pytest.raises(ValueError, match="kinds must be among planar, spherical, measured"):
+        LayerSpec("odd", "a layer of this test", kinds=("toy",))
+    with pytest.raises(ValueError, match="kinds must be among"):
+        LayerSpec("odd", "a layer of this test", kinds=())
+    # the 3D view's painters come from the table, in their draw order
+    names = [s.name for s in layers.ordered("vtk3d")]
+    assert names == ["bfv", "eyes", "features", "cones"]
 
 
 def test_a_registered_layer_is_a_scene_layer_until_it_is_removed():
@@ -90,13 +113,14 @@ def test_a_registered_layer_is_a_scene_layer_until_it_is_removed():
 
 def test_every_hook_of_the_table_resolves_to_a_callable():
     for spec in layers.LAYERS:
-        for hook in ("frame", "mpl", "vtk"):
+        for hook in ("frame", "mpl", "vtk", "vtk3d"):
             ref = getattr(spec, hook)
             if ref is not None:
                 assert callable(layers.resolve(ref)), (spec.name, hook)
     # the Qt panels draw these in the app: no VTK painter, a matplotlib one
-    assert {s.name for s in layers.LAYERS if s.vtk is None} == {"bitmaps", "readout"}
-    assert all(s.mpl is not None for s in layers.LAYERS)
+    planar = [s for s in layers.LAYERS if "planar" in s.kinds]
+    assert {s.name for s in planar if s.vtk is None} == {"bitmaps", "readout"}
+    assert all(s.mpl is not None for s in planar)
 
 
 @pytest.mark.parametrize(

@@ -1,4 +1,5 @@
-"""The layers panel: one check box per layer of the layer table (its help as the tip)."""
+"""The layers panel: one check box per layer of the layer table that applies to the
+planar eyes (its help as the tip); the 3D page lists its layers in View > 3D view."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ class LayersPanel(QtWidgets.QWidget):
         self.installEventFilter(self._unelide)
         grid = QtWidgets.QGridLayout(self)
         self.boxes: dict[str, QtWidgets.QCheckBox] = {}
-        for i, spec in enumerate(LAYERS):
+        for i, spec in enumerate(s for s in LAYERS if "planar" in s.kinds):
             name = spec.name
             b = QtWidgets.QCheckBox(name)
             b.setToolTip(spec.help)

@@ -10,9 +10,11 @@ measured eyes (docs/measured.md): what differs is the model's
 :class:`eyeviz.model.facets3d.EyeSurface`. Every position drawn comes from
 :mod:`eyeviz.model.shapes3d`, the surface or the state; nothing here computes geometry.
 
-One painter per layer group (as the planar view's :mod:`eyeviz.render.vtk.layers`), each
-rebuilding its actors only when its structure changes and writing positions and colours
-in place every frame: :mod:`~eyeviz.render.vtk.field3d` (``bfv``, ``plane``),
+One painter per layer (as the planar view's :mod:`eyeviz.render.vtk.layers`), named by
+the layer table's ``vtk3d`` hooks (:data:`eyeviz.model.layers.LAYERS`, made in
+``vtk3d_order``), each rebuilding its actors only when its structure changes and writing
+positions and colours in place every frame; a painter draws the few layers that share its
+actors: :mod:`~eyeviz.render.vtk.field3d` (``bfv``, ``plane``),
 :mod:`~eyeviz.render.vtk.eyes3d` (``eyes``: the facets, lit in the colour of the ball
 they see, with the level of detail of a large nside), :mod:`~eyeviz.render.vtk.balls3d`
 (``features``, ``labels``, ``tangents``) and :mod:`~eyeviz.render.vtk.cones3d`
@@ -24,6 +26,7 @@ from __future__ import annotations
 import os
 from dataclasses import replace
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 from vtkmodules.vtkCommonCore import vtkCommand
@@ -34,6 +37,7 @@ from eyeviz.model import shapes3d
 from eyeviz.model.camera3d import Camera3D, eyes_camera
 from eyeviz.model.facets3d import EyeSurface, surface_of
 from eyeviz.model.labels3d import Named3D, discs, place_named
+from eyeviz.model.layers import ordered, resolve
 from eyeviz.model.predictions3d import Predictions3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D, compute_state3d
@@ -180,6 +184,17 @@ def fit_labels(
     return inside or cam
 
 
+P = TypeVar("P", bound=Painter3D)
+
+
+def _painter(painters: list[Painter3D], cls: type[P]) -> P:
+    """The painter of class ``cls`` among ``painters`` (the table's ``vtk3d`` hooks)."""
+    for p in painters:
+        if isinstance(p, cls):
+            return p
+    raise LookupError(f"no {cls.__name__} among the layer table's 3D painters")
+
+
 def _aspect(ren: vtkRenderer) -> float:
     """A renderer's width / height in pixels (1 before it has a window)."""
     w, h = ren.GetSize()
@@ -220,11 +235,16 @@ class Scene3DActors:
         self._caption_shown = ""
         if eyes_ren is not None:
             eyes_ren.AddViewProp(self.eyes_caption)
-        self.field = FieldPainter(scene_ren, eyes_ren)
-        self.eyes = EyesPainter(scene_ren, eyes_ren, self.eyes_caption)
-        self.balls = BallsPainter(scene_ren, eyes_ren)
-        self.cones = ConesPainter(scene_ren, eyes_ren)
-        self.painters: list[Painter3D] = [self.field, self.eyes, self.balls, self.cones]
+        # one painter per layer of the table that has one (LayerSpec.vtk3d), in draw order
+        self.painters: list[Painter3D] = [
+            resolve(spec.vtk3d)(scene_ren, eyes_ren) for spec in ordered("vtk3d")
+        ]
+        # the view's own uses of the shipped painters (names, the close-up's caption)
+        self.field = _painter(self.painters, FieldPainter)
+        self.eyes = _painter(self.painters, EyesPainter)
+        self.eyes.caption = self.eyes_caption
+        self.balls = _painter(self.painters, BallsPainter)
+        self.cones = _painter(self.painters, ConesPainter)
         self.surface: EyeSurface | None = None
         # the predictions layer: a renderer over the scene's, made on first use
         self.overlay: vtkRenderer | None = None
