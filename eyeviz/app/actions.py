@@ -15,7 +15,6 @@ from PyQt5 import QtCore, QtGui, QtWidgets
 
 from eyeviz.app.help import HELP_NAME
 from eyeviz.model.app_model import AppModel
-from eyeviz.model.app_model3d import AppModel3D
 from eyeviz.model.camera3d import Camera3D
 from eyeviz.model.scene import Scene, View
 
@@ -35,22 +34,35 @@ PLAY_SHORTCUT = "P"
 
 
 class SceneCommand(QtWidgets.QUndoCommand):
-    """One undo step of either page: the scene before and after. The planar page's view
-    is left where the user put it (``keep_view``); the 3D page's camera is not in its
-    scene (its model is an :class:`eyeviz.model.app_model3d.AppModel3D`)."""
+    """The one undo step of either page (issue 37.2): the scene before and after.
+
+    The planar page's view is left where the user put it (``keep_view``); the 3D page's
+    camera is not in its scene (``keep_view=False``). A 3D drag's step carries the camera
+    too (``camera``: the view's getter and setter, ``at_press``: the camera the drag
+    started from): undo puts back that camera as well as the scene, redo the camera undo
+    left (issue 32.5: after a drag the view may have been re-framed, and Ctrl+Z restored
+    the ball but not the view)."""
 
     def __init__(
         self,
-        model: AppModel | AppModel3D,
+        model: AppModel,
         before: Scene,
         after: Scene,
         text: str,
         merge_key: object = None,
         keep_view: bool = True,
+        camera: tuple[Callable[[], Camera3D], Callable[[Camera3D], None]] | None = None,
+        at_press: Camera3D | None = None,
     ) -> None:
         super().__init__(text)
         self.model, self.before, self.after, self.merge_key = model, before, after, merge_key
         self.keep_view = keep_view
+        self.get_camera: Callable[[], Camera3D] | None = None
+        self.set_camera: Callable[[Camera3D], None] | None = None
+        if camera is not None:
+            self.get_camera, self.set_camera = camera
+        self.at_press = at_press
+        self.at_undo: Camera3D | None = None
 
     def _set(self, scene: Scene) -> None:
         if not self.keep_view:
@@ -62,9 +74,15 @@ class SceneCommand(QtWidgets.QUndoCommand):
 
     def redo(self) -> None:
         self._set(self.after)
+        if self.at_undo is not None and self.set_camera is not None:
+            self.set_camera(self.at_undo)
 
     def undo(self) -> None:
+        if self.at_press is not None and self.get_camera is not None:
+            self.at_undo = self.get_camera()
         self._set(self.before)
+        if self.at_press is not None and self.set_camera is not None:
+            self.set_camera(self.at_press)
 
     def id(self) -> int:  # noqa: A003 (Qt name)
         return 1 if self.merge_key is not None else -1
@@ -77,7 +95,7 @@ class SceneCommand(QtWidgets.QUndoCommand):
 
 
 def command3d(
-    model: AppModel3D,
+    model: AppModel,
     before: Scene,
     after: Scene,
     text: str,
@@ -86,40 +104,16 @@ def command3d(
     at_press: Camera3D | None,
 ) -> SceneCommand:
     """The 3D page's undo step: with ``at_press`` (a drag's camera at its press) one
-    that puts the view back too (:class:`CameraSceneCommand`)."""
+    that puts the view back too; a drag's step merges with none."""
     if at_press is None:
         return SceneCommand(model, before, after, text, merge_key, keep_view=False)
-    return CameraSceneCommand(model, before, after, text, camera, at_press)
+    return SceneCommand(
+        model, before, after, text, None, keep_view=False, camera=camera, at_press=at_press
+    )
 
 
-class CameraSceneCommand(SceneCommand):
-    """A 3D drag's undo step: undo puts back the camera the drag started from as well as
-    the scene, redo the camera undo left (issue 32.5: after a drag the view may have been
-    re-framed, and Ctrl+Z restored the ball but not the view)."""
-
-    def __init__(
-        self,
-        model: AppModel3D,
-        before: Scene,
-        after: Scene,
-        text: str,
-        camera: tuple[Callable[[], Camera3D], Callable[[Camera3D], None]],
-        at_press: Camera3D,
-    ) -> None:
-        super().__init__(model, before, after, text, None, keep_view=False)
-        self.get_camera, self.set_camera = camera
-        self.at_press = at_press
-        self.at_undo: Camera3D | None = None
-
-    def redo(self) -> None:
-        super().redo()
-        if self.at_undo is not None:
-            self.set_camera(self.at_undo)
-
-    def undo(self) -> None:
-        self.at_undo = self.get_camera()
-        super().undo()
-        self.set_camera(self.at_press)
+#: The 3D drag's undo step is a :class:`SceneCommand` with a camera (the old name).
+CameraSceneCommand = SceneCommand
 
 
 def _action(win, menu, text, slot, shortcut=None) -> QtWidgets.QAction:

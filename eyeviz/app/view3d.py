@@ -26,7 +26,6 @@ from one list, eyeviz.app.help.VIEW3D_KEYS):
 from __future__ import annotations
 
 import math
-import os
 import time
 from collections.abc import Generator
 from typing import TYPE_CHECKING, Any
@@ -572,19 +571,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         if self.model is not None and self.model.selected is not None:
             self.model.delete_ball(self.model.selected)
 
-    # --- export ----------------------------------------------------------------------------
-    def export_to(
-        self,
-        path: str | os.PathLike,
-        scale: float = 1.0,
-        transparent: bool = False,
-        wait: bool = True,
-        **opts,
-    ):
-        """File > Export of a spherical scene (:func:`eyeviz.app.export3d.export_view3d`)."""
-        from eyeviz.app.export3d import export_view3d
-
-        return export_view3d(self, path, scale, transparent, wait, **opts)
+    # File > Export: the window's export_to (eyeviz.app.export3d.export_work3d's work)
 
     def scene_or(self, planar: Scene) -> Scene:
         """The scene the window shows: the 3D page's when active, else ``planar``."""

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from PyQt5 import QtCore, QtGui, QtWidgets
 from vtkmodules.vtkRenderingCore import vtkTextActor
@@ -420,24 +420,21 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         table: bool = True,
         bitmaps: bool = True,
     ) -> Job | Path | None:
-        """The scene as a figure (eyeviz.render.mpl.export: PNG, SVG, PDF) ``width`` wide
-        (single, double or inches) with or without its title, table and bitmaps, written
-        on a worker thread with a busy cursor; errors in a dialog. ``wait``: block until
-        done and return the path (None on error); otherwise return the job at once."""
-        if self.host3d.active:  # a spherical scene: the 3D view's PNG or vector figure
-            return self.host3d.export_to(
-                path, scale, transparent, wait, width=width, title=title, table=table,
-                bitmaps=bitmaps,
-            )  # fmt: skip
+        """The page's scene as a figure (PNG, SVG, PDF) ``width`` wide (single, double or
+        inches) with or without its title, table and bitmaps, written with a busy cursor
+        on a worker thread (a 3D PNG, rendered by VTK, on this one); errors in a dialog.
+        ``wait``: block until done and return the path (None on error); otherwise return
+        the job at once. The planar figure is :func:`eyeviz.render.mpl.export.export`'s,
+        the 3D page's :func:`eyeviz.app.export3d.export_work3d`'s: one door for both."""
         from eyeviz import EyevizError
-        from eyeviz.render.mpl.export import export
-        from eyeviz.render.mpl.layout import ASPECT_RANGE
 
-        scene = self.model.scene.copy()  # the job never sees later edits
-        vp = self.viewport("main")  # the figure frames what the window shows
-        lo, hi = ASPECT_RANGE
-        aspect = min(max(vp.height / max(vp.width, 1.0), lo), hi)
-        preds = dict(self.model.predictions) if scene.shows("predictions") else None
+        opts: dict[str, Any] = dict(width=width, title=title, table=table, bitmaps=bitmaps)
+        if self.host3d.active:  # a spherical scene: the 3D view's PNG or vector figure
+            from eyeviz.app.export3d import export_work3d
+
+            work, here = export_work3d(self.host3d, path, scale, transparent, **opts)
+        else:
+            work, here = self._export_work(path, scale, transparent, **opts), False
         result: list = []
 
         def done(out) -> None:
@@ -452,27 +449,32 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
             else:
                 self.show_error("Cannot export", f"unexpected error: {user_message(str(exc))}")
 
-        job = self.jobs.start(
-            lambda: export(
-                scene,
-                path,
-                scale,
-                transparent,
-                predictions=preds,
-                width=width,
-                title=title,
-                table=table,
-                bitmaps=bitmaps,
-                aspect=aspect,
-            ),
-            f"exporting {Path(path).name}…",
-            done,
-            failed,
-        )
+        if here:  # VTK renders on the GUI thread (its OpenGL context is per thread)
+            try:
+                done(work())
+            except Exception as exc:  # noqa: BLE001 (shown in a dialog, as the job's)
+                failed(exc)
+            return result[0] if result else None
+        job = self.jobs.start(work, f"exporting {Path(path).name}…", done, failed)
         if not wait:
             return job
         self.jobs.wait()
         return result[0] if result else None
+
+    def _export_work(self, path, scale, transparent, **opts):
+        """The planar page's figure as a job's work: the scene as it is now (the job never
+        sees later edits), framed as the window shows it."""
+        from eyeviz.render.mpl.export import export
+        from eyeviz.render.mpl.layout import ASPECT_RANGE
+
+        scene = self.model.scene.copy()
+        vp = self.viewport("main")  # the figure frames what the window shows
+        lo, hi = ASPECT_RANGE
+        aspect = min(max(vp.height / max(vp.width, 1.0), lo), hi)
+        preds = dict(self.model.predictions) if scene.shows("predictions") else None
+        return lambda: export(
+            scene, path, scale, transparent, predictions=preds, aspect=aspect, **opts
+        )
 
     def _flush(self) -> None:
         """Bring actors and panels up to the model's live changes (before a render)."""
