@@ -29,6 +29,13 @@ limit and its posterior run off the GUI thread when a drag ends (the app's job r
 one job at a time). A result is shown only if its key (the design and the two lit sets)
 is still the one wanted when it arrives: a result for a ball that has moved since is kept
 in the cache but never drawn over a newer answer.
+
+**Why apart from** :mod:`eyeviz.model.predictor` (issue 37.2 keeps the two): the planar
+layer asks every estimator for every feature's bitmaps at each frame, against designs
+(h, l, m) an estimator may or may not be trained for; this one answers one ball's lit
+sets in space with (r, azimuth, elevation), runs the limit and its posterior cloud off the
+GUI thread keyed by the lit sets, and shows only the latest. The answers, their errors
+and their staleness differ, not just the eye model.
 """
 
 from __future__ import annotations

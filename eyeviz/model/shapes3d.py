@@ -7,6 +7,13 @@ compute geometry). The eyes and the balls are those of docs/spherical.md: eye A 
 (-h, 0, 0), eye B at (h, 0, 0), facets the HEALPix cells in RING order; a measured pair's
 (docs/measured.md) are drawn through :mod:`eyeviz.model.facets3d`, and its h and l (half
 its eyes' distance, its largest lens distance from an eye's centroid) frame the cameras.
+
+Why it is not :mod:`eyeviz.model.frame_parts` (issue 37.2 keeps the two): the planar
+Frame's parts are polygons in the plane (wedges clipped to the view, runs of equal colour
+along an eye's m ommatidia, tangent segments), built per layer from Proposition 2's
+intervals; these are meshes in space (cells or lenses lit from CSR lit sets, tangent and
+acceptance cones, the plane z = 0) and the cameras that frame them. The same job, drawing
+what the state holds without computing it in a renderer, is done by different geometry.
 """
 
 from __future__ import annotations

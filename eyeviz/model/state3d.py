@@ -16,6 +16,13 @@ lit sets for eyes, bitmaps or readout; the BFV for bfv or readout; the overlaps 
 readout. A scene whose lit sets would be too large (``lit_csr``'s bound) is refused in one
 line naming the scene's eyes (their nside, or their file).
 
+:func:`checked_state` is the app model's state function of the spherical side
+(:data:`eyeviz.model.app_model.STATE_FUNCTIONS`). Why it is not
+:mod:`eyeviz.model.state` (issue 37.2 keeps the two): the planar state is Proposition 2's
+four integers per feature, per-ommatidium owners and a one-row update for a drag frame
+(:mod:`eyeviz.core.single`); this one is lit sets as CSR over any model's facets, with no
+row update (a ball's lit set changes size as it moves).
+
 Pure numpy; no Qt, VTK or matplotlib.
 """
 

@@ -20,6 +20,12 @@ current cell; issue 32.6, :mod:`eyeviz.model.typed3d`): one undo step, or a one-
 Both tables fit the dock's width (no horizontal scroll bar, also at 1280x720): the
 columns take their contents' width and the first (the names) the rest, eliding a long
 name.
+
+Why not :mod:`eyeviz.app.panels.readout` (issue 37.2 keeps the two): the planar readout
+is the selected feature's numbers (r, phi about each eye, Proposition 2's four integers,
+the ambiguity region) in labels; this is an editable table of every ball in r, azimuth
+and elevation, typed into (a ball has no planar page's drag handle). Merging them would
+change what either page shows.
 """
 
 from __future__ import annotations
