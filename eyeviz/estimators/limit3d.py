@@ -214,16 +214,19 @@ class Limit3DEstimator(Estimator3D):
         st = prop.setup(lit_a, lit_b, keys, wide)
         # the batches ``_GROUP`` at a time (side by side; each as if drawn alone)
         streams = [stream + 8 * rep for rep in range(reps)]
-        parts = [prop.sample(st, keys, streams[i : i + _GROUP]) for i in range(0, reps, _GROUP)]
+        parts = [
+            _compact(prop.sample(st, keys, streams[i : i + _GROUP])) for i in range(0, reps, _GROUP)
+        ]
         out = {k: np.concatenate([q[k] for q in parts], axis=1) for k in parts[0]}
         if reps > 1:
             return out
         # top-ups: a key with too few or too spread draws (_needs_more) gets another batch
-        # (its own stream; the other keys' draws are left as they are, weight 0), up to
-        # max_batches. Up to _TOPUP batches are drawn in one call, then taken one by one
-        # as if drawn one at a time: a batch counts for a key only while the key still
-        # needs more after the batches before it (a key that needs no more keeps needing
-        # none: its new draws weigh 0), and none is taken once no key needs more.
+        # (its own stream; the other keys get none), up to max_batches. Up to _TOPUP
+        # batches are drawn in one call, then taken one by one as if drawn one at a time:
+        # a batch counts for a key only while the key still needs more after the batches
+        # before it (a key that needs no more keeps needing none: its new draws weigh 0),
+        # and none is taken once no key needs more. Only accepted draws are kept
+        # (:func:`_compact`).
         rep, m = 1, self.samples
         need = _needs_more(out["r"], out["w"], self.accuracy)
         while rep < self.max_batches and need.any():
@@ -232,7 +235,7 @@ class Limit3DEstimator(Estimator3D):
             for j in range(g):
                 part = {k: v[:, j * m : (j + 1) * m] for k, v in more.items()}
                 part["w"] = np.where(need[:, None], part["w"], 0.0)
-                out = {k: np.concatenate([out[k], part[k]], axis=1) for k in out}
+                out = {k: np.concatenate([out[k], v], axis=1) for k, v in _compact(part).items()}
                 rep += 1
                 need = _needs_more(out["r"], out["w"], self.accuracy)
                 if not need.any():
@@ -255,7 +258,7 @@ class Limit3DEstimator(Estimator3D):
             s2 = self._draw(sub_a, sub_b, keys[few], wide, stream, reps)
             order = np.argsort(~(s2["w"] > 0), axis=1, kind="stable")[:, :m]
             s = _put_rows(s, few, {k: np.take_along_axis(v, order, 1) for k, v in s2.items()})
-        return s
+        return _compact(s)
 
     def _predict_csr(self, lit_a: LitCSR, lit_b: LitCSR):
         n = lit_a[0].size - 1
@@ -351,6 +354,30 @@ def _spread(r: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
         sd = np.sqrt(np.maximum((wn * (r - mean[:, None]) ** 2).sum(axis=1), 0.0))
         ess = tot**2 / (w**2).sum(axis=1)
     return mean, sd, ess
+
+
+def _compact(s: dict) -> dict:
+    """Each row's accepted draws (weight > 0) first, in draw order, the rest dropped: the
+    arrays are as wide as the most accepted draws of a row (at least 1). A row's padding
+    weighs 0 and holds, for each quantity, the row's largest accepted value (1 where
+    none is accepted), so it sorts after every accepted draw and no weighted median or
+    spread reads it (:func:`eyeviz.estimators.weighted.weighted_median` interpolates
+    between sorted draws: a rejected draw there would move the answer)."""
+    w = s["w"]
+    acc = w > 0
+    cnt = acc.sum(axis=1)
+    k = max(1, int(cnt.max()) if cnt.size else 1)
+    order = np.argsort(~acc, axis=1, kind="stable")[:, :k]
+    keep = np.arange(k)[None, :] < cnt[:, None]
+    out = {}
+    for name, v in s.items():
+        v = np.take_along_axis(v, order, 1)
+        if name == "w":
+            out[name] = np.where(keep, v, 0.0)
+            continue
+        top = np.where(keep, v, -np.inf).max(axis=1, keepdims=True)
+        out[name] = np.where(keep, v, np.where(np.isfinite(top), top, 1.0))
+    return out
 
 
 def _put_rows(s: dict, rows: np.ndarray, new: dict) -> dict:

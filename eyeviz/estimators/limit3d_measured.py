@@ -45,6 +45,7 @@ brute-force rejection sampling from the prior on a small measured eye."""
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -418,6 +419,56 @@ class MeasuredProposal:
         n = st["u0"].shape[0]
         u = _batch_uniforms(keys, m, 4, stream)
         m = u.shape[1]
+        if kernels.use(n * m):
+            out = self._draws_kernel(st, u, rows)
+        else:
+            out = self._draws_ref(st, u, rows)
+        wt = out["w"]
+        cand = np.flatnonzero(wt.ravel() > 0)
+        c = np.stack([out["x"], out["y"], out["z"]], axis=-1)
+        hit = np.zeros(n * m, bool)
+        hit[cand] = exact_hits(
+            d,
+            c.reshape(-1, 3)[cand],
+            out["g"].ravel()[cand],
+            cand // m,
+            st["lit_a"],
+            st["lit_b"],
+        )
+        out["w"] = np.where(hit.reshape(n, m), wt, 0.0)
+        return out
+
+    def _draws_kernel(self, st: dict, u: np.ndarray, rows) -> dict[str, np.ndarray]:
+        """:meth:`_draws_ref` compiled, draw by draw (kernels.limit3d_region.
+        measured_draws_kernel): the same draws, weights to about 1e-13 (its cone distances
+        and trigonometry round differently); a draw's values are set only where its
+        weight is above 0 (the others are never read: limit3d keeps accepted draws)."""
+        from eyeviz.core.kernels import limit3d_region
+
+        # Any: the kernel takes 37 arrays and numbers (numba's Dispatcher stub types fewer)
+        kernel: Any = limit3d_region.measured_draws_kernel
+        d = self.domain
+        n, m = u.shape[:2]
+        live = np.ones(n, np.bool_) if rows is None else kernels.arg(rows, np.bool_)
+        f64 = np.float64
+        outs = {k: np.zeros((n, m)) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
+        kernel(
+            kernels.arg(u, f64), kernels.arg(st["box_lo"], f64), kernels.arg(st["box_hi"], f64),
+            kernels.arg(st["u0"], f64), kernels.arg(st["e1"], f64), kernels.arg(st["e2"], f64),
+            kernels.arg(self.fa.centre, f64), kernels.arg(self.bhat, f64), self.blen,
+            kernels.arg(self.origin, f64), self.s_half, float(d.g_max), float(d.r_min),
+            float(d.r_max), float(d.el_max), self.prior == "multi", live,
+            *st["ea"].columns(), *st["eb"].columns(),
+            outs["x"], outs["y"], outs["z"], outs["g"], outs["r"], outs["az"], outs["el"],
+            outs["w"],
+        )  # fmt: skip
+        return outs
+
+    def _draws_ref(self, st: dict, u: np.ndarray, rows) -> dict[str, np.ndarray]:
+        """The weighted draws of the uniforms u (N, M, 4) before the exact check (numpy,
+        the reference): (delta, beta) uniform in the box, the centre, g uniform on its
+        interval, the weight."""
+        d = self.domain
         lo, hi = st["box_lo"], st["box_hi"]
         x = lo[:, None] + (hi - lo)[:, None] * u[..., :3]
         delta = x[..., :2]
@@ -441,11 +492,5 @@ class MeasuredProposal:
             vol = np.prod(hi - lo, axis=1)[:, None] * (g_hi - g_lo)
             wt = prior_density(d, self.prior, r, gg, el, az) * jac * vol
         wt = np.where(good & np.isfinite(wt), wt, 0.0)
-        cand = np.flatnonzero(wt.ravel() > 0)
-        hit = np.zeros(n * m, bool)
-        hit[cand] = exact_hits(
-            d, c.reshape(-1, 3)[cand], gg.ravel()[cand], cand // m, st["lit_a"], st["lit_b"]
-        )
-        wt = np.where(hit.reshape(n, m), wt, 0.0)
         return {"r": r, "az": az, "el": el, "g": gg, "x": c[..., 0], "y": c[..., 1],
                 "z": c[..., 2], "w": wt}  # fmt: skip

@@ -262,3 +262,106 @@ def test_region_test_with_early_exit_keeps_the_reference_s_verdicts(bee_small, m
     want = prop._hb(stt, x) >= -stt["slack"]
     assert np.array_equal(got, want)
     assert 0 < want.sum() < want.size
+
+
+@pytest.mark.parametrize("grow", [0.0, 1.0, 4.0])
+@pytest.mark.parametrize("multi", [False, True])
+def test_measured_draws_kernel_agrees_with_the_reference(bee_small, monkeypatch, grow, multi):
+    """MeasuredProposal's draws before the exact check, compiled draw by draw, against
+    numpy: the same draws weighted (> 0), their values and weights to 1e-12. The box grown
+    ``grow`` spans on each side sends draws behind the eyes (beta <= 0, no triangle),
+    outside the prior's r, elevation and azimuth ranges and out of every facet's reach;
+    ``rows`` leaves a key out."""
+    from eyeviz.estimators.limit3d_proposal import _batch_uniforms
+
+    dom, prop, stt, keys, _ = bee_small
+    prop = MeasuredProposal(dom, "multi" if multi else "single", 128, 8)
+    span = stt["box_hi"] - stt["box_lo"]
+    stt = dict(stt, box_lo=stt["box_lo"] - grow * span, box_hi=stt["box_hi"] + grow * span)
+    u = _batch_uniforms(keys, 1024, 4, [1, 9])
+    rows = np.ones(keys.size, bool)
+    rows[2] = False
+    got = prop._draws_kernel(stt, u, rows)
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want = prop._draws_ref(stt, u, rows)
+    kept = want["w"] > 0
+    assert np.array_equal(got["w"] > 0, kept)
+    assert (10 if grow < 2 else 1) <= kept.sum() < kept.size and not kept[2].any()
+    for k in want:
+        # the weight holds the g interval's length, a difference of two cone distances
+        # (each to ~1e-15): relative to the length, a few 1e-12
+        tol = 1e-10 if k == "w" else 1e-13
+        assert np.allclose(got[k][kept], want[k][kept], rtol=tol, atol=0), k
+
+
+def test_measured_draws_kernel_tries_the_facets_that_rule_draws_out_first(bee_small):
+    """The walk's order: a draw is dropped at its first facet that empties its interval,
+    and that facet moves to the front of the key's order (the kept draws' intervals do
+    not depend on the order: max and min are exact). Calling the kernel on the draws in
+    reverse order keeps the same draws with the same values."""
+    from eyeviz.estimators.limit3d_proposal import _batch_uniforms
+
+    _, prop, stt, keys, _ = bee_small
+    u = _batch_uniforms(keys, 512, 4, 3)
+    a = prop._draws_kernel(stt, u, None)
+    b = prop._draws_kernel(stt, np.ascontiguousarray(u[:, ::-1]), None)
+    for k in a:
+        assert _same_bits(a[k][a["w"] > 0], b[k][:, ::-1][b["w"][:, ::-1] > 0]), k
+
+
+def _ties(lo: float, hi: float) -> list[float]:
+    """The bounds lo and hi, one ulp in and one out of each, and a value between."""
+    up, down = np.inf, -np.inf
+    return [lo, hi, np.nextafter(lo, down), np.nextafter(lo, up), np.nextafter(hi, down),
+            np.nextafter(hi, up), 0.5 * (lo + hi)]  # fmt: skip
+
+
+@pytest.mark.parametrize("wide", [False, True])
+def test_measured_prior_is_the_reference_s(bee_small, wide):
+    """The compiled measured prior (one ball) against limit3d_exact.prior_density, on
+    every bound of its support, each exactly, one ulp in and one out: r at r_min and
+    r_max, g at r sin(gamma / 2), g_max and r, the elevation at +-el_max, the azimuth at 0
+    and pi. ``wide``: a domain where g <= r binds (g_max above r_min) and a ball at r = 0
+    (the density's 1 / r^2 infinite: 0 in both)."""
+    dom = bee_small[0]
+    if wide:
+        dom = SimpleNamespace(kind="measured", gamma=dom.gamma, psi=0.0, r_min=0.0,
+                              r_max=30.0, g_max=20.0, el_max=1.2)  # fmt: skip
+    s = np.sin(dom.gamma / 2)
+    rs = _ties(dom.r_min, dom.r_max) + ([0.0, 15.0] if wide else [])
+    cases = []
+    for r in rs:
+        for g in _ties(r * s, dom.g_max) + [r, np.nextafter(r, np.inf), np.nextafter(r, 0)]:
+            for el in _ties(-dom.el_max, dom.el_max):
+                for az in _ties(0.0, np.pi) + [-0.0]:
+                    cases.append((r, g, el, az))
+    r, g, el, az = np.array(cases).T
+    for multi in (False, True):
+        with np.errstate(all="ignore"):
+            want = limit3d_exact.prior_density(dom, "multi" if multi else "single", r, g, el, az)
+        got = np.array([kr.measured_prior(*c, s, dom.g_max, dom.r_min, dom.r_max, dom.el_max,
+                                          multi) for c in cases])  # fmt: skip
+        assert np.array_equal(got == 0, want == 0)
+        assert np.allclose(got, want, rtol=1e-14, atol=0)
+        assert 0.05 < (want > 0).mean() < 0.5
+
+
+def test_bcentre_is_the_reference_s(bee_small):
+    """The compiled centre of one draw against MeasuredProposal._bcentres, on offsets and
+    angles about each key's box and beyond it: beta <= 0 and a + beta >= pi give NaN."""
+    _, prop, stt, _, _ = bee_small
+    rng = np.random.default_rng(8)
+    n = stt["u0"].shape[0]
+    delta = rng.normal(scale=0.5, size=(n, 300, 2))
+    beta = rng.uniform(-0.5, np.pi + 0.5, (n, 300))
+    beta[:, :3] = [0.0, -0.0, np.pi]
+    c, rho, drho = prop._bcentres(stt, delta, beta)
+    for i in range(n):
+        for j in range(300):
+            frame = (stt["u0"][i], stt["e1"][i], stt["e2"][i])
+            d0, d1 = delta[i, j]
+            got = kr.bcentre(*frame, d0, d1, beta[i, j], prop.fa.centre, prop.bhat, prop.blen)
+            want = (*c[i, j], rho[i, j], drho[i, j])
+            assert np.isnan(got[3]) == np.isnan(want[3])
+            assert np.allclose(got, want, rtol=1e-12, atol=1e-12, equal_nan=True), (i, j)
+    assert np.isnan(rho).any() and np.isfinite(rho).any()

@@ -256,3 +256,35 @@ def test_the_accuracy_setting_adds_draws_until_the_error_is_met():
 def test_a_bad_accuracy_is_refused_in_one_line(kw, want):
     with pytest.raises(ValueError, match="^" + re.escape(want)):
         Limit3DEstimator(D16, **kw)
+
+
+def test_compact_keeps_the_accepted_draws_and_the_medians_read_no_padding():
+    """limit3d._compact: each row's accepted draws first, in draw order; the padding
+    weighs 0 and holds the row's largest accepted value, so the weighted medians of the
+    compacted rows are those of the accepted draws alone (a rejected draw's value between
+    two accepted ones would move an interpolated median)."""
+    from eyeviz.estimators.limit3d import _compact
+
+    rng = np.random.default_rng(3)
+    n, m = 7, 60
+    w = np.where(rng.random((n, m)) < 0.3, rng.random((n, m)), 0.0)
+    w[0] = 0.0  # nothing accepted
+    w[1] = 0.0
+    w[1, 5] = 0.7  # one accepted draw
+    r = rng.uniform(1.0, 5.0, (n, m))
+    el = rng.normal(size=(n, m))
+    c = _compact({"r": r, "el": el, "w": w})
+    cnt = (w > 0).sum(axis=1)
+    assert c["w"].shape[1] == cnt.max()
+    for i in range(n):
+        acc = w[i] > 0
+        k = int(cnt[i])
+        assert np.array_equal(c["r"][i, :k], r[i, acc]) and np.array_equal(c["w"][i, :k], w[i, acc])
+        assert (c["w"][i, k:] == 0).all()
+        assert (c["r"][i, k:] == (r[i, acc].max() if k else 1.0)).all()
+        assert (c["el"][i, k:] == (el[i, acc].max() if k else 1.0)).all()
+        if k:
+            want = weighted_median(r[i, acc][None], (w[i, acc] / r[i, acc])[None])[0]
+            assert weighted_median(c["r"][i : i + 1], (c["w"] / c["r"])[i : i + 1])[0] == want
+            want = weighted_median(el[i, acc][None], w[i, acc][None])[0]
+            assert weighted_median(c["el"][i : i + 1], c["w"][i : i + 1])[0] == want

@@ -26,12 +26,18 @@ __all__ = [
     "ray_region_kernel",
     "cone_bounds_kernel",
     "interval_kernel",
+    "measured_draws_kernel",
+    "measured_prior",
+    "bcentre",
     "same_rows_kernel",
     "prefilter_kernel",
     "warm",
 ]
 
 _jit = njit(cache=True, nogil=True)
+#: division as numpy's (x / 0 is inf or NaN, not an exception), for the kernels whose
+#: reference divides by numbers that can be 0 (the measured draws)
+_jit_np = njit(cache=True, nogil=True, error_model="numpy")
 
 
 @_jit
@@ -260,6 +266,120 @@ def interval_kernel(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh
             lo[n, m], hi[n, m] = lo_, hi_
 
 
+@_jit_np
+def _walk(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b, pad_b,
+          order, n, cx, cy, cz, lo_, hi_):  # fmt: skip
+    """One draw of :func:`interval_kernel` (slack < 0: stops once the interval is empty):
+    both eyes' facets in the key's order ``order[n]`` (index k < K_A: A's facet k, else
+    B's facet k - K_A); the facet that stops a draw is moved to the front, so the facets
+    that rule most draws out are tried first. Returns (stopped, lo, hi)."""
+    ka = pos_a.shape[1]
+    if _empty(lo_, hi_):
+        return True, lo_, hi_
+    for p in range(order.shape[1]):
+        k = order[n, p]
+        if k < ka:
+            if pad_a[n, k]:
+                continue
+            lo_, hi_ = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz, lo_, hi_)
+        else:
+            if pad_b[n, k - ka]:
+                continue
+            lo_, hi_ = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
+                                  lo_, hi_)  # fmt: skip
+        if _empty(lo_, hi_):
+            for j in range(p, 0, -1):
+                order[n, j] = order[n, j - 1]
+            order[n, 0] = k
+            return True, lo_, hi_
+    return False, lo_, hi_
+
+
+@_jit_np
+def bcentre(u0, e1, e2, d0, d1, beta, fa, bhat, blen):
+    """limit3d_measured.MeasuredProposal._bcentres for one draw: (centre x, y, z, rho,
+    d rho / d beta) at gnomonic offsets (d0, d1) of A's direction about u0 (frame e1, e2)
+    and angle beta at o_B (rho = |b| sin(beta) / sin(a + beta)); rho and d rho NaN where
+    the rays do not meet in front (beta <= 0 or a + beta >= pi)."""
+    vx = u0[0] + d0 * e1[0] + d1 * e2[0]
+    vy = u0[1] + d0 * e1[1] + d1 * e2[1]
+    vz = u0[2] + d0 * e1[2] + d1 * e2[2]
+    nv = math.sqrt(vx * vx + vy * vy + vz * vz)
+    vx, vy, vz = vx / nv, vy / nv, vz / nv
+    a = math.acos(min(max(vx * bhat[0] + vy * bhat[1] + vz * bhat[2], -1.0), 1.0))
+    rho, drho = np.nan, np.nan
+    if beta > 0 and a + beta < math.pi:
+        s_ab = math.sin(a + beta)
+        rho = blen * math.sin(beta) / s_ab
+        drho = blen * math.sin(a) / (s_ab * s_ab)
+    return fa[0] + vx * rho, fa[1] + vy * rho, fa[2] + vz * rho, rho, drho
+
+
+@_jit_np
+def measured_prior(r, g, el, az, s_half, g_max, r_min, r_max, el_max, multi):
+    """limit3d_exact.prior_density of a measured pair for one ball (no cones: the azimuth
+    uniform on [0, pi]); 0 outside the support."""
+    inside = r >= r_min and r <= r_max and g >= r * s_half and g <= g_max and g <= r
+    if not (inside and abs(el) <= el_max and az >= 0.0 and az <= math.pi):
+        return 0.0
+    cel = math.cos(el)
+    dens = r * r * cel if multi else 1.0
+    dens = dens / ((g_max - r * s_half) * math.pi * r * r * cel)
+    return dens if math.isfinite(dens) else 0.0
+
+
+# long: one draw of limit3d_measured.MeasuredProposal.sample (centre, g interval, g,
+# weight) is one loop body; split, it would pass a dozen scalars back and forth
+@_jit_np
+def measured_draws_kernel(u, box_lo, box_hi, u0, e1, e2, fa, bhat, blen, origin, s_half,
+                          g_max, r_min, r_max, el_max, multi, rows,
+                          pos_a, ax_a, ch_a, sh_a, lit_a, pad_a,
+                          pos_b, ax_b, ch_b, sh_b, lit_b, pad_b,
+                          x, y, z, g, r, az, el, w):  # fmt: skip
+    """limit3d_measured.MeasuredProposal.sample up to the exact check, draw by draw:
+    (delta, beta) and g from the uniforms u (N, M, 4), the centre, its g interval (the
+    walk of :func:`interval_kernel`, stopping once it is empty), the prior and the
+    weight. Writes x, y, z, g, r, az, el, w (N, M) where the weight is above 0 (w 0
+    elsewhere, the other outputs then unset); only the keys ``rows`` (N,) get draws."""
+    order = np.empty((u.shape[0], pos_a.shape[1] + pos_b.shape[1]), np.int64)
+    for n in range(u.shape[0]):
+        for k in range(order.shape[1]):
+            order[n, k] = k
+        if not rows[n]:
+            for m in range(u.shape[1]):
+                w[n, m] = 0.0
+            continue
+        vol0 = (box_hi[n, 0] - box_lo[n, 0]) * (box_hi[n, 1] - box_lo[n, 1])
+        vol0 = vol0 * (box_hi[n, 2] - box_lo[n, 2])
+        for m in range(u.shape[1]):
+            w[n, m] = 0.0
+            d0 = box_lo[n, 0] + (box_hi[n, 0] - box_lo[n, 0]) * u[n, m, 0]
+            d1 = box_lo[n, 1] + (box_hi[n, 1] - box_lo[n, 1]) * u[n, m, 1]
+            beta = box_lo[n, 2] + (box_hi[n, 2] - box_lo[n, 2]) * u[n, m, 2]
+            cx, cy, cz, rho, drho = bcentre(u0[n], e1[n], e2[n], d0, d1, beta, fa, bhat, blen)
+            if not math.isfinite(rho):
+                continue
+            qx, qy, qz = cx - origin[0], cy - origin[1], cz - origin[2]
+            rr = math.sqrt(qx * qx + qy * qy + qz * qz)
+            out, g_lo, g_hi = _walk(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b,
+                                    sh_b, lit_b, pad_b, order, n, cx, cy, cz, rr * s_half,
+                                    min(rr, g_max))  # fmt: skip
+            if out:
+                continue
+            pad = 1e-9 * g_hi
+            g_lo, g_hi = max(g_lo - pad, 0.0), g_hi + pad
+            gg = g_lo + (g_hi - g_lo) * u[n, m, 3]
+            e = math.asin(min(max(qz / rr, -1.0), 1.0))
+            phi = math.atan2(qy, qx)
+            dens = measured_prior(rr, gg, e, phi, s_half, g_max, r_min, r_max, el_max, multi)
+            jac = rho * rho * (1.0 + (d0 * d0 + d1 * d1)) ** -1.5 * drho
+            wt = dens * jac * (vol0 * (g_hi - g_lo))
+            if not (math.isfinite(wt) and wt > 0.0):
+                continue
+            x[n, m], y[n, m], z[n, m], g[n, m] = cx, cy, cz, gg
+            r[n, m], az[n, m], el[n, m], w[n, m] = rr, phi, e, wt
+
+
 @_jit
 def _cell_fails(pts, lit, n, k, cx, cy, cz, a, s):
     """Edge cell k of key n rules the cap (c, a) out (limit3d_proposal._prefilter): from
@@ -332,6 +452,12 @@ def warm() -> None:
     cs = (p3, p3, a2 + 0.9, a2 + 0.1, b, ~b)
     cone_bounds_kernel(*cs, p3, out, out.copy())
     interval_kernel(*cs, *cs, p3, b, out, out + 1, -1.0)
+    u4 = np.full((1, 1, 4), 0.5)
+    z3 = np.zeros((1, 3))
+    o1 = np.zeros((1, 1))
+    measured_draws_kernel(u4, z3, z3 + 1, c, c, c, v3, v3, 1.0, v3, 0.1, 1.0, 0.5, 9.0, 1.0,
+                          False, b[0].copy(), *cs, *cs, o1, o1.copy(), o1.copy(), o1.copy(),
+                          o1.copy(), o1.copy(), o1.copy(), o1.copy())  # fmt: skip
     pts = np.ones((1, 1, 2, 3))
     prefilter_kernel(pts, b, ~b, np.zeros(1, np.int64), c, np.ones(1), 0.01, b[0].copy())
     i1 = np.zeros(2, np.int64)
