@@ -9,14 +9,48 @@ ratio, the target's ratio, and whether the answers are the reference's (HEALPix:
 bit; measured: to 1e-9, the accepted draws the same). The 1-minute load average is
 printed beside: on shared cores the wall figures count other jobs, the CPU ones less so.
 
+With ``--before REV`` the same keys are also answered by the code of git revision REV
+(``git archive`` into a temporary directory, run in a subprocess of this run, kernels
+warmed first): its keys/s of CPU, the ratio, whether the accepted draws are the same, and
+how far the answers moved in units of their stated Monte-Carlo error (z = the relative
+difference of r, or of the azimuth, over the two errors in quadrature).
+
     .venv/bin/python scripts/bench_limit3d.py [--keys 40] [--ref-keys 16] [--which 180,32,bee]
+                                              [--before REV]
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
+
+#: what the subprocess of ``--before`` runs: the keys from an npz, the answers back
+_BEFORE = """
+import sys, time
+import numpy as np
+from eyeviz.core import kernels
+from eyeviz.core.domain import Domain3D
+from eyeviz.estimators.limit3d import Limit3DEstimator
+from eyeviz.files.eye_io import load_eyes, shipped_eye
+kernels.warm()
+f = np.load(sys.argv[1])
+which = str(f["which"])
+if which == "bee":
+    d = Domain3D.for_eyes(load_eyes(shipped_eye("AM_60185-real.eye")))
+else:
+    d = Domain3D(nside=int(which))
+la, lb = (f["pa"], f["ia"]), (f["pb"], f["ib"])
+c0 = time.process_time()
+p = Limit3DEstimator(d).predict(la, lb)
+cpu = time.process_time() - c0
+np.savez(sys.argv[2], r=p.r, az=p.azimuth, mc=p.mc_error, acc=p.n_accepted, flag=p.flagged,
+         cpu=cpu)
+"""
 
 
 def run(est, la, lb):
@@ -31,6 +65,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--ref-keys", type=int, default=16, help="of those, timed on the reference")
     ap.add_argument("--which", default="180,32,bee")
     ap.add_argument("--seed", type=int, default=7_310_551)
+    ap.add_argument("--before", help="a git revision to answer the same keys (see above)")
     args = ap.parse_args(argv)
 
     import numpy as np
@@ -83,7 +118,42 @@ def main(argv: list[str] | None = None) -> int:
             f"({'met' if rate >= target else 'NOT met'}); answers {same}; median accepted "
             f"{np.median(p.n_accepted):.0f}, flagged {int(p.flagged.sum())}"
         )
+        if args.before:
+            _before(args.before, which, la, lb, p, cpu)
     return 0
+
+
+def _before(rev: str, which: str, la, lb, p, cpu: float) -> None:
+    """The same keys answered by revision ``rev`` in a subprocess: CPU keys/s, the ratio,
+    the accepted draws and the answers' z-scores against this run's."""
+    import numpy as np
+
+    root = Path(__file__).resolve().parent.parent
+    with tempfile.TemporaryDirectory() as tmp:
+        src = Path(tmp) / "src"
+        src.mkdir()
+        arc = subprocess.run(["git", "-C", str(root), "archive", rev], capture_output=True,
+                             check=True).stdout  # fmt: skip
+        subprocess.run(["tar", "-x", "-C", str(src)], input=arc, check=True)
+        keys, out = Path(tmp) / "keys.npz", Path(tmp) / "out.npz"
+        np.savez(keys, which=which, pa=la[0], ia=la[1], pb=lb[0], ib=lb[1])
+        env = dict(os.environ, PYTHONPATH=str(src))
+        subprocess.run([sys.executable, "-c", _BEFORE, str(keys), str(out)], env=env, check=True)
+        q = np.load(out)
+        n = p.r.size
+        ok = ~q["flag"] & ~p.flagged
+        err = np.hypot(q["mc"], p.mc_error)[ok]
+        z_r = ((p.r - q["r"]) / q["r"])[ok] / err
+        z_az = ((p.azimuth - q["az"]) / q["az"])[ok] / err
+        same = np.array_equal(q["acc"], p.n_accepted)
+        print(
+            f"  before ({rev}) {n / float(q['cpu']):8.1f} keys/s CPU; now / before "
+            f"{float(q['cpu']) / cpu:.2f}x CPU; accepted draws {'the same' if same else 'DIFFER'}"
+            f"; answers moved |z| r max {np.abs(z_r).max():.2f} "
+            f"(rms {np.sqrt(np.mean(z_r**2)):.2f})"
+            f", azimuth max {np.abs(z_az).max():.2f}; flagged {int(q['flag'].sum())} -> "
+            f"{int(p.flagged.sum())}"
+        )
 
 
 if __name__ == "__main__":
