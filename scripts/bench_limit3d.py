@@ -48,8 +48,9 @@ la, lb = (f["pa"], f["ia"]), (f["pb"], f["ib"])
 c0 = time.process_time()
 p = Limit3DEstimator(d).predict(la, lb)
 cpu = time.process_time() - c0
+import eyeviz.estimators.limit3d as mod
 np.savez(sys.argv[2], r=p.r, az=p.azimuth, mc=p.mc_error, acc=p.n_accepted, flag=p.flagged,
-         cpu=cpu)
+         cpu=cpu, module=mod.__file__)
 """
 
 
@@ -138,8 +139,12 @@ def _before(rev: str, which: str, la, lb, p, cpu: float) -> None:
         keys, out = Path(tmp) / "keys.npz", Path(tmp) / "out.npz"
         np.savez(keys, which=which, pa=la[0], ia=la[1], pb=lb[0], ib=lb[1])
         env = dict(os.environ, PYTHONPATH=str(src))
-        subprocess.run([sys.executable, "-c", _BEFORE, str(keys), str(out)], env=env, check=True)
+        # cwd: ``-c`` puts the working directory first on sys.path, before PYTHONPATH
+        cmd = [sys.executable, "-c", _BEFORE, str(keys), str(out)]
+        subprocess.run(cmd, env=env, cwd=tmp, check=True)
         q = np.load(out)
+        if str(q["module"]) != str(src / "eyeviz" / "estimators" / "limit3d.py"):
+            raise RuntimeError(f"--before imported {q['module']}, not revision {rev}'s code")
         n = p.r.size
         ok = ~q["flag"] & ~p.flagged
         err = np.hypot(q["mc"], p.mc_error)[ok]
