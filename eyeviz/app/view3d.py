@@ -37,7 +37,7 @@ from eyeviz.app.help import LAYER3D_TEXT, view3d_help_text
 from eyeviz.app.predictions_layer3d import Predictions3DLayer
 from eyeviz.app.view import make_view
 from eyeviz.model import app_model3d as m3
-from eyeviz.model.camera3d import PRESETS, Camera3D, dolly
+from eyeviz.model.camera3d import PRESETS, Camera3D
 from eyeviz.model.draw_bounds import check_drawable_eyes
 from eyeviz.model.predictions3d import LatestOnly, Predictions3D, Predictor3D, check_estimators
 from eyeviz.model.scene import SPHERICAL_LAYERS, Scene, layer_applies
@@ -45,7 +45,6 @@ from eyeviz.render.vtk.scene3d import (
     Scene3DActors,
     camera_of,
     default_camera,
-    fit_labels,
     layout,
     make_renderers,
     split_viewports,
@@ -122,7 +121,6 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self.help_box: QtWidgets.QMessageBox | None = None  # 3D view > Mouse and keys
         self.preset: str | None = None  # the preset shown, until the user moves the camera
         self._framed: m3.SceneState3D | None = None  # the state the preset framed
-        self._back: float | None = None  # and how far fit_labels moved back from it
         self.preset_actions: dict[str, QtWidgets.QAction] = {}
         self.layer_actions: dict[str, QtWidgets.QAction] = {}
         self.menu = self._build_menu()
@@ -428,14 +426,11 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         if not keep or self._framed is None:
             self._framed = self.model.state
         vp = self.pointer("move", 0, 0)
-        base = default_camera(self._framed, name, vp.w / max(vp.h, 1.0))
-        cam = base
-        if keep and self._back is not None:  # a resize: as far back as the names needed,
-            cam = dolly(base, self._back)  # or further if the new size needs it
+        cam = default_camera(self._framed, name, vp.w / max(vp.h, 1.0))
         if self.actors is not None and vp.w > 1 and vp.h > 1:  # the balls' names not cut
-            cam = fit_labels(cam, self.actors.named(), (vp.w, vp.h))
-            d0 = math.dist(base.position, base.focal_point)
-            self._back = math.dist(cam.position, cam.focal_point) / d0
+            self._layout()  # the viewports as the view's size is now, to measure texts in
+            self.side.show_for(cam)  # its words and lines for this camera, to keep clear
+            cam = self.actors.frame_preset(cam, (vp.w, vp.h), keep)
         self.set_camera(cam)
 
     # --- pixels ----------------------------------------------------------------------------

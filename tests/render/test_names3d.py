@@ -90,9 +90,10 @@ def test_exported_names_cover_nothing(name, view):
     scene_ax = next(a for a in fig.axes if a.get_gid() == "perspective-scene")
     eyes_ax = next(a for a in fig.axes if a.get_gid() == "perspective-eyes")
     bb = scene_ax.get_window_extent()
-    from eyeviz.render.mpl.perspective3d import default_camera, scene_aspect
+    from eyeviz.render.mpl.perspective3d import framed_camera
 
-    cam = default_camera(st, view, scene_aspect(bb.width, bb.height))
+    to_pt = 72.0 / fig.dpi  # the figure's camera: its preset, framed for the names
+    cam = framed_camera(st, scene, view, bb.width * to_pt, bb.height * to_pt)
     eb = eyes_ax.get_window_extent()
     h = abs(st.pair.h)
     ecam = eyes_camera(cam, h, st.pair.l, eb.width / eb.height)

@@ -88,9 +88,11 @@ def test_vector_ghosts_at_the_projected_answers(scene_preds, tmp_path):
     ax = next(a for a in fig.axes if a.get_gid() == "perspective-scene")
     bbox = ax.get_position()
     aspect = bbox.width * fig.get_figwidth() / (bbox.height * fig.get_figheight())
-    from eyeviz.render.mpl.perspective3d import default_camera
+    from eyeviz.render.mpl.perspective3d import framed_camera
 
-    cam = default_camera(st, "default", aspect)
+    # the figure's camera: the preset, framed for the balls' names (as the app's)
+    w_pt, h_pt = 72 * bbox.width * fig.get_figwidth(), 72 * bbox.height * fig.get_figheight()
+    cam = framed_camera(st, sc, "default", w_pt, h_pt, predictions=preds)
     for a in preds.ghosts():
         patch = next(p for p in ax.patches if p.get_gid() == f"ghost-{a.name}")
         xy = patch.get_xy()

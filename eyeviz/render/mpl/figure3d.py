@@ -56,9 +56,9 @@ from eyeviz.render.mpl.facet_map import MapAxes, draw_eye_view, view_lonlat
 from eyeviz.render.mpl.inset3d import draw_ball_inset
 from eyeviz.render.mpl.perspective3d import (
     VIEW_LAYERS,
-    default_camera,
     draw_panel,
-    scene_aspect,
+    framed_camera,
+    split_viewports,
 )
 from eyeviz.render.mpl.style import (
     BASE_DPI,
@@ -387,8 +387,13 @@ def _figure3d(scene, state, width, title, table, bitmaps, aspect, camera, view, 
                 if dpi is not None:
                     box, (w_px, h_px) = _on_pixels(box, width * dpi, height * dpi)
                 cam = camera
-                if cam is None:
-                    cam = default_camera(st, view, scene_aspect(box[2] * width, box[3] * height))
+                if cam is None:  # the preset, moved back until the names are clear
+                    w_in, h_in = box[2] * width, box[3] * height
+                    _, (sx0, _, sx1, _) = split_viewports(w_in, h_in)
+                    cam = framed_camera(
+                        st, scene, view, (sx1 - sx0) * w_in * 72.0, h_in * 72.0,
+                        predictions=preds,
+                    )  # fmt: skip
                 if view_image is not None:
                     image = view_image(cam, w_px, h_px)
                     if image.shape[:2] != (h_px, w_px):

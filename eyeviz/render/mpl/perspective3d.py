@@ -45,7 +45,7 @@ from eyeviz.core import healpix
 from eyeviz.model import shapes3d
 from eyeviz.model.camera3d import Camera3D, eyes_camera, project
 from eyeviz.model.facets3d import surface_of
-from eyeviz.model.labels3d import Named3D, place_named
+from eyeviz.model.labels3d import Named3D, discs, fit_labels, leaders, place_named
 from eyeviz.model.predictions3d import Predictions3D
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
@@ -76,6 +76,7 @@ __all__ = [
     "VIEW_LAYERS",
     "Polygons",
     "default_camera",
+    "framed_camera",
     "draw_panel",
     "draw_view",
     "scene_aspect",
@@ -463,13 +464,10 @@ def draw_view(
     return coll
 
 
-def _labels(ax, state, scene, cam, aspect, part, shown, predictions=None) -> None:
-    """The eyes' names (close-up) and the balls' names (scene), each beside what it names
-    and over nothing else: :func:`eyeviz.model.labels3d.place_named`, as the app places
-    them (text boxes estimated from the text's length: the same in the PNG and the SVG)."""
-    pos = ax.get_position()
-    fig_w, fig_h = ax.figure.get_size_inches()
-    w_pt, h_pt = max(pos.width * fig_w * 72.0, 1e-6), max(pos.height * fig_h * 72.0, 1e-6)
+def _named(state, scene, part, shown, predictions=None):
+    """The names of view part ``part`` ("eyes": the eyes', "scene": the balls') as
+    (texts, colours, :class:`Named3D`), their boxes' sizes in points at the figure's name
+    size; None where the part names nothing."""
     size = pt(SMALL + 1)  # raised by --min-font: the boxes placed are the drawn ones
     eyes = np.array([(*c, state.pair.l) for c in _centres(state)], float)
     feats = scene.features if "features" in shown else []
@@ -486,15 +484,55 @@ def _labels(ax, state, scene, cam, aspect, part, shown, predictions=None) -> Non
             others.append(np.array(gh, float).reshape(-1, 4))
         named = Named3D(balls[:, :3], balls[:, 3], _text_sizes(texts, size), np.concatenate(others))
     else:
+        return None
+    return texts, cols, named
+
+
+def framed_camera(
+    state: SceneState3D,
+    scene: Scene,
+    view: str,
+    w_pt: float,
+    h_pt: float,
+    predictions: Predictions3D | None = None,
+) -> Camera3D:
+    """The preset ``view`` (:func:`default_camera`) for a scene part ``w_pt`` x ``h_pt``
+    points, moved back until the balls' names are clear of each other and of every ball
+    and eye (:func:`eyeviz.model.labels3d.fit_labels`, the app's framing): a crowded
+    scene's names covered balls in the export, which framed the balls alone."""
+    cam = default_camera(state, view, w_pt / max(h_pt, 1e-9))
+    shown = set(scene.layers)
+    got = _named(state, scene, "scene", shown, predictions) if "labels" in shown else None
+    if got is None:
+        return cam
+    return fit_labels(cam, got[2], (w_pt, h_pt))
+
+
+def _labels(ax, state, scene, cam, aspect, part, shown, predictions=None) -> None:
+    """The eyes' names (close-up) and the balls' names (scene), each beside what it names
+    and over nothing else: :func:`eyeviz.model.labels3d.place_named`, as the app places
+    them (text boxes estimated from the text's length: the same in the PNG and the SVG)."""
+    pos = ax.get_position()
+    fig_w, fig_h = ax.figure.get_size_inches()
+    w_pt, h_pt = max(pos.width * fig_w * 72.0, 1e-6), max(pos.height * fig_h * 72.0, 1e-6)
+    if (got := _named(state, scene, part, shown, predictions)) is None:
         return
+    texts, cols, named = got
     # the balls' names give way to each other as in the app; both eyes are always named
     boxes = place_named(named, cam, w_pt, h_pt, give_way=not named.below)
+    at, rad = discs(cam, named.centres, named.radii, w_pt, h_pt)
+    oc, orad = discs(cam, named.others[:, :3], named.others[:, 3], w_pt, h_pt)
+    lines = leaders(at, rad, boxes, np.column_stack([oc, orad]))
+    for seg, col in zip(lines, cols, strict=True):
+        if np.isfinite(seg).all():  # a name placed farther out: a line to its ball
+            xs, ys = 2.0 * seg[0::2] / w_pt - 1.0, 2.0 * seg[1::2] / h_pt - 1.0
+            ax.plot(xs, ys, color=col, lw=0.8, solid_capstyle="round", gid="leader3d")
     for box, t, col in zip(boxes, texts, cols, strict=True):
         if not np.isfinite(box).all():
             continue
         x, y = 2.0 * box[0] / w_pt - 1.0, 2.0 * box[1] / h_pt - 1.0
         if abs(x) < 1 and abs(y) < 1:
-            ax.text(x, y, t, fontsize=size, color=col, ha="left", va="bottom",
+            ax.text(x, y, t, fontsize=pt(SMALL + 1), color=col, ha="left", va="bottom",
                     parse_math=False, gid="name3d")  # fmt: skip
 
 

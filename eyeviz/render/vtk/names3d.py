@@ -12,13 +12,22 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from vtkmodules.vtkRenderingCore import vtkBillboardTextActor3D, vtkRenderer
+from vtkmodules.util.numpy_support import numpy_to_vtk
+from vtkmodules.vtkCommonCore import vtkPoints
+from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+from vtkmodules.vtkRenderingCore import (
+    vtkActor2D,
+    vtkBillboardTextActor3D,
+    vtkCoordinate,
+    vtkPolyDataMapper2D,
+    vtkRenderer,
+)
 
 from eyeviz.model.camera3d import Camera3D
-from eyeviz.model.labels3d import Named3D, discs, place_named
+from eyeviz.model.labels3d import Named3D, discs, leaders, place_named
 from eyeviz.render.vtk.primitives import text_size
 
-__all__ = ["named_of", "place_texts"]
+__all__ = ["Leaders", "named_of", "place_texts"]
 
 
 def named_of(
@@ -73,6 +82,62 @@ def place_texts(
     at, _ = discs(cam, named.centres, named.radii, float(w), float(h))
     show_at(labels, order, boxes, at)
     return boxes
+
+
+class Leaders:
+    """The leader lines of a viewport's names (:func:`eyeviz.model.labels3d.leaders`):
+    one 2D actor, its lines in the viewport's pixels, each in its name's colour."""
+
+    def __init__(self, ren: vtkRenderer, width: float = 2.0) -> None:
+        self.poly = vtkPolyData()
+        coord = vtkCoordinate()
+        coord.SetCoordinateSystemToViewport()
+        mapper = vtkPolyDataMapper2D()
+        mapper.SetInputData(self.poly)
+        mapper.SetTransformCoordinate(coord)
+        mapper.SetScalarModeToUseCellData()
+        mapper.SetColorModeToDirectScalars()
+        self.actor = vtkActor2D()
+        self.actor.SetMapper(mapper)
+        self.actor.GetProperty().SetLineWidth(width)
+        self.segments = np.zeros((0, 4))
+        ren.AddViewProp(self.actor)
+        self.set(np.zeros((0, 4)), [])
+
+    def set(self, segments: np.ndarray, colours: Sequence) -> None:
+        """Draw ``segments`` (n, 4: x0, y0, x1, y1, pixels, y up; NaN rows skipped) in
+        ``colours`` (n rgb triples, 0-1)."""
+        seg = np.asarray(segments, float).reshape(-1, 4)
+        keep = np.isfinite(seg).all(axis=1)
+        seg = seg[keep]
+        rgb = np.asarray(colours, float).reshape(-1, 3)[keep] if len(seg) else np.zeros((0, 3))
+        self.segments = seg
+        pts = vtkPoints()
+        lines = vtkCellArray()
+        for k, (x0, y0, x1, y1) in enumerate(seg):
+            pts.InsertNextPoint(x0, y0, 0.0)
+            pts.InsertNextPoint(x1, y1, 0.0)
+            lines.InsertNextCell(2)
+            lines.InsertCellPoint(2 * k)
+            lines.InsertCellPoint(2 * k + 1)
+        self.poly.SetPoints(pts)
+        self.poly.SetLines(lines)
+        cols = numpy_to_vtk(np.round(rgb * 255).astype(np.uint8).reshape(-1, 3), deep=True)
+        cols.SetName("rgb")
+        self.poly.GetCellData().SetScalars(cols)
+        self.poly.Modified()
+        self.actor.SetVisibility(bool(len(seg)))
+
+    def draw_for(
+        self, cam: Camera3D, named: Named3D, boxes: np.ndarray, colours: Sequence, size
+    ) -> None:
+        """The leaders of ``named``'s names placed at ``boxes`` (their order) through
+        ``cam`` in a viewport of ``size`` (width, height) pixels."""
+        w, h = float(size[0]), float(size[1])
+        at, rad = discs(cam, named.centres, named.radii, w, h)
+        oth = np.asarray(named.others, float).reshape(-1, 4)
+        oc, orad = discs(cam, oth[:, :3], oth[:, 3], w, h)
+        self.set(leaders(at, rad, boxes, np.column_stack([oc, orad])), colours)
 
 
 def show_at(

@@ -34,9 +34,20 @@ from vtkmodules.vtkRenderingCore import vtkRenderer
 
 from eyeviz.files.atomic import atomic_output
 from eyeviz.model import shapes3d
-from eyeviz.model.camera3d import Camera3D, eyes_camera
+from eyeviz.model.camera3d import Camera3D, dolly, eyes_camera
 from eyeviz.model.facets3d import EyeSurface, surface_of
-from eyeviz.model.labels3d import Named3D, discs, place_named
+from eyeviz.model.labels3d import (
+    KEEP_CLEAR_PX,
+    LABEL_MARGIN_PX,
+    Named3D,
+    _covers,
+    discs,
+    fit_labels,
+    frame_names,
+    gap_for,
+    pan,
+    shifted,
+)
 from eyeviz.model.layers import ordered, resolve
 from eyeviz.model.predictions3d import Predictions3D
 from eyeviz.model.scene import Scene
@@ -48,7 +59,7 @@ from eyeviz.render.vtk.eyes3d import LABEL_PX as EYES_LABEL_PX
 from eyeviz.render.vtk.eyes3d import EyesPainter
 from eyeviz.render.vtk.field3d import FieldPainter
 from eyeviz.render.vtk.ghosts3d import Ghosts3D, make_overlay
-from eyeviz.render.vtk.names3d import named_of, place_texts, show_at
+from eyeviz.render.vtk.names3d import Leaders, named_of, place_texts, show_at
 from eyeviz.render.vtk.offscreen import OffscreenWindow
 from eyeviz.render.vtk.painter3d import Painter3D
 from eyeviz.render.vtk.primitives import fit_lines, screen_text
@@ -62,7 +73,9 @@ __all__ = [
     "apply_camera",
     "camera_of",
     "fit_labels",
+    "frame_names",
     "default_camera",
+    "pan",
     "png_size",
     "render_png3d",
     "split_viewports",
@@ -122,66 +135,28 @@ def _misplaced(boxes: np.ndarray, at: np.ndarray) -> bool:
     return bool(((j != k) & (d[k, k] - d[k, j] > 0.2 * apart)).any())
 
 
-def _under(at: np.ndarray, rad: np.ndarray, sizes: np.ndarray, width: float) -> np.ndarray:
+def _under(
+    at: np.ndarray, rad: np.ndarray, sizes: np.ndarray, width: float, height: float = np.inf
+) -> np.ndarray:
     """Boxes (as :func:`eyeviz.model.labels3d.place_boxes`') of names centred under their
-    discs (``at``, ``rad``), moved sideways into [2, width - 2] px where they would leave it."""
+    discs (``at``, ``rad``), moved sideways into [2, width - 2] px where they would leave
+    it; where two of them cross, the name of the higher disc goes over it instead (the
+    close-up at F11 + F5 + 175 % in 1280 x 720, step 8: a 305 x 234 px pane, the two
+    names under their eyes crossed), if it fits under ``height``."""
     w, h = np.asarray(sizes, float).T
     x0 = np.clip(at[:, 0] - w / 2, 2.0, np.maximum(width - 2.0 - w, 2.0))
-    y1 = at[:, 1] - rad - 2.0
-    return np.column_stack([x0, y1 - h, x0 + w, y1])
-
-
-def _covers(boxes: np.ndarray, keep_out: np.ndarray | None) -> bool:
-    """Whether any finite box of ``boxes`` overlaps one of ``keep_out`` (both (n, 4))."""
-    if keep_out is None or len(keep_out) == 0 or len(boxes) == 0:
-        return False
-    b = boxes[np.isfinite(boxes).all(axis=1)][:, None, :]
-    k = np.asarray(keep_out, float)[None, :, :]
-    ox = np.minimum(b[..., 2], k[..., 2]) - np.maximum(b[..., 0], k[..., 0])
-    oy = np.minimum(b[..., 3], k[..., 3]) - np.maximum(b[..., 1], k[..., 1])
-    return bool(np.any((ox > 0) & (oy > 0)))
-
-
-#: The ball labels' margin to the scene viewport's edges when a preset frames the scene.
-LABEL_MARGIN_PX = 6
-#: The pixels a ball's name keeps clear of the view's own texts (title, side note).
-KEEP_CLEAR_PX = 3
-
-
-def fit_labels(
-    cam: Camera3D,
-    named: Named3D,
-    size: tuple[float, float],
-    margin: float = LABEL_MARGIN_PX,
-    steps: int = 16,
-) -> Camera3D:
-    """``cam`` moved back along its line of sight (10 % of the distance a step, at most
-    ``steps``) until every name, placed by :func:`eyeviz.model.labels3d.place_named`, is
-    inside the viewport of ``size`` (width, height px) with ``margin`` pixels to spare.
-    The presets frame the balls; a name beside a ball at the view's edge was cut
-    (sphere_predictions at its default framing). Nor may a name cover the view's own
-    texts (``named.keep_out``: the title, at 175 % in a 1280 x 720 window)."""
-    if len(named.centres) == 0:
-        return cam
-    w, h = size
-    pos, focal = np.asarray(cam.position, float), np.asarray(cam.focal_point, float)
-    inside: Camera3D | None = None
-    for _ in range(steps + 1):
-        boxes = place_named(named, cam, w, h, give_way=False)  # every name, to frame them
-        ok = ~np.isfinite(boxes).all(axis=1) | (
-            (boxes[:, 0] >= margin - 0.5)
-            & (boxes[:, 2] <= w - margin + 0.5)
-            & (boxes[:, 1] >= margin - 0.5)
-            & (boxes[:, 3] <= h - margin + 0.5)
-        )
-        if bool(np.all(ok)):
-            if not _covers(boxes, named.keep_out):
-                return cam
-            inside = inside or cam  # the nearest with every name inside, if none is clear
-        pos = focal + 1.1 * (pos - focal)
-        x, y, z = (float(v) for v in pos)
-        cam = Camera3D((x, y, z), cam.focal_point, cam.view_up, cam.view_angle)
-    return inside or cam
+    gap = np.array([gap_for(v) for v in h])
+    y1 = at[:, 1] - rad - gap
+    out = np.column_stack([x0, y1 - h, x0 + w, y1])
+    for i in range(len(out)):
+        for j in range(i + 1, len(out)):
+            if not _covers(out[i : i + 1], out[j : j + 1]):
+                continue
+            k = i if at[i, 1] > at[j, 1] else j  # the higher disc's name over it
+            y0 = at[k, 1] + rad[k] + gap[k]
+            if y0 + h[k] <= height - 2.0:
+                out[k, 1], out[k, 3] = y0, y0 + h[k]
+    return out
 
 
 P = TypeVar("P", bound=Painter3D)
@@ -219,13 +194,19 @@ class Scene3DActors:
         # the title is broken into lines that fit the view, checked before each render
         # (the view's width and the title's font size change with the window and F5/Ctrl+=)
         self._title_text = ""
+        self._title_lines = ""  # the title as fitted to the view (shown unless it gave way)
         self._title_fit: tuple | None = None
         scene_ren.AddObserver(vtkCommand.StartEvent, self._fit_title)
         scene_ren.AddObserver(vtkCommand.StartEvent, self._place_names)
+        self.leaders = Leaders(scene_ren)  # from a ball to its name placed farther out
         if eyes_ren is not None:
             eyes_ren.AddObserver(vtkCommand.StartEvent, self._place_eye_names)
         self.state: SceneState3D | None = None
         self.selected: int | None = None
+        # the last preset framing (frame_preset): how far back, how far aside, what size
+        self._back: float | None = None
+        self._aside = np.zeros(3)
+        self._framed_size: tuple[float, float] = (0.0, 0.0)
         self.scene_shows_predictions = False
         self.name_boxes = np.zeros((0, 4))
         self.eye_name_boxes = np.zeros((0, 4))  # the close-up's names' (its pixels, y up)
@@ -249,6 +230,51 @@ class Scene3DActors:
         # the predictions layer: a renderer over the scene's, made on first use
         self.overlay: vtkRenderer | None = None
         self.ghosts: Ghosts3D | None = None
+
+    def frame(
+        self, cam: Camera3D, size: tuple[float, float], pan_ok: bool = True
+    ) -> tuple[Camera3D, bool]:
+        """:func:`frame_names` for the names shown, clear of the view's title and side
+        note; where no framing keeps the names and balls clear of the title (a view a
+        few names high: sphere_lecture's step 7 at F11 + F5 + 175 % in 1280 x 720 is 234
+        px high, its title 57 px), the title gives way (until the view's size or text
+        size changes, as in :meth:`_place_names`) and the framing is made without it.
+        ``pan_ok`` as in :func:`frame_names`. Returns the camera and whether it is clear."""
+        self._fit_title()
+        saved = self._title_lines  # shown again if it gave way before: tried first
+        self.title.SetInput(saved)
+        framed, clear = frame_names(cam, self.named(), size, pan_ok=pan_ok)
+        if clear or not saved:
+            return framed, clear
+        self.title.SetInput("")
+        bare, clear = frame_names(cam, self.named(), size, pan_ok=pan_ok)
+        if clear:
+            return bare, True
+        self.title.SetInput(saved)
+        return framed, False
+
+    def frame_preset(self, base: Camera3D, size: tuple[float, float], keep: bool) -> Camera3D:
+        """A preset's camera ``base`` framed for the names (:meth:`frame`) in a view of
+        ``size`` pixels; ``keep`` (a resize) keeps it as far back as the last framing
+        and, while the view's height is the same, as far aside (the focal point kept: an
+        edit that grew a panel must not re-frame) unless that is not clear in a new
+        width; a new height moves the band between the view's texts, so the move aside
+        is made anew (the first framing, at the window's first layout, is of a 240 x 400
+        view)."""
+        same_h = size[1] == self._framed_size[1]
+        cam = base
+        if keep and self._back is not None:
+            cam = dolly(base, self._back)
+            if same_h:
+                cam = shifted(cam, self._aside)
+        framed, clear = self.frame(cam, size, pan_ok=not (keep and same_h))
+        if keep and same_h and not clear and size[0] != self._framed_size[0]:
+            framed, clear = self.frame(dolly(base, self._back or 1.0), size)
+        d0 = float(np.linalg.norm(np.subtract(base.position, base.focal_point)))
+        self._back = float(np.linalg.norm(np.subtract(framed.position, framed.focal_point))) / d0
+        self._aside = np.subtract(framed.focal_point, base.focal_point)
+        self._framed_size = size
+        return framed
 
     def named(self) -> Named3D:
         """The ball names shown and what they must not cover, for :func:`fit_labels`."""
@@ -302,6 +328,9 @@ class Scene3DActors:
             order, named = self._ball_names()
             boxes = place_texts(self.scene_ren, cam, self.balls.ball_labels, named, order)
         self.name_boxes = boxes
+        labs = self.balls.ball_labels
+        cols = [labs[i].GetTextProperty().GetColor() for i in order]
+        self.leaders.draw_for(cam, named, boxes, cols, self.scene_ren.GetSize())
 
     def _place_eye_names(self, *_args) -> None:
         """Before the close-up renders: each eye's name under it, over nothing: not the
@@ -335,7 +364,7 @@ class Scene3DActors:
             bare = replace(named, keep_out=None)
             boxes = place_texts(ren, camera_of(ren), labs, bare, order, give_way=False)
             if _misplaced(boxes, at):  # no free place near its own eye: right under it
-                boxes = _under(at, rad, named.sizes, float(w))
+                boxes = _under(at, rad, named.sizes, float(w), float(h))
                 show_at(labs, order, boxes, at)
         self.eye_name_boxes = boxes
         self.eye_name_anchors = at
@@ -381,7 +410,8 @@ class Scene3DActors:
         self._title_fit = key
         avail = width * (1.0 - 2.0 * self.title.GetPosition()[0]) - 4.0
         two = 2 * 1.2 * tp.GetFontSize() * dpi / 72.0 <= 0.2 * height
-        self.title.SetInput(fit_lines(tp, self._title_text, avail, dpi, max_lines=2 if two else 1))
+        self._title_lines = fit_lines(tp, self._title_text, avail, dpi, max_lines=2 if two else 1)
+        self.title.SetInput(self._title_lines)
 
     def update(self, scene: Scene, state: SceneState3D, selected: int | None) -> None:
         """Draw ``state`` (of ``scene``): each painter rebuilds only what changed."""
@@ -389,7 +419,7 @@ class Scene3DActors:
         if self.surface is None or surface.key != self.surface.key:
             self.surface = surface
         if scene.title != self._title_text:
-            self._title_text = scene.title
+            self._title_text = self._title_lines = scene.title
             self._title_fit = None
             self.title.SetInput(scene.title)
         for p in self.painters:

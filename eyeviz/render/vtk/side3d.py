@@ -48,6 +48,11 @@ class SideNote:
             self._full, self._fit = text, None
             self.actor.SetInput(text)
 
+    def show_for(self, cam: Camera3D) -> None:
+        """The note for ``cam``, its lines fitted now (before a framing measures it)."""
+        self.update(cam)
+        self._fit_width()
+
     def _fit_width(self, *_args) -> None:
         win, width = self._ren.GetRenderWindow(), self._ren.GetSize()[0]
         tp, dpi = self.actor.GetTextProperty(), win.GetDPI() if win is not None else 72
