@@ -51,6 +51,7 @@ from eyeviz.app.panels.map_geometry import (
     label_side,
     lit_owners,
     map_polys,
+    side_word,
     title_fit,
 )
 from eyeviz.app.panels.map_zoom import MapZoom
@@ -188,12 +189,11 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         box_w, box_h = 0.98 * w_in, room * h_in
         map_in = min(box_w, 2.0 * box_h)
         char_in = 0.62 * MAP_PT * s / 72.0
-        wide = map_in >= 22 * char_in
         zoomed = self.zoom.zoomed  # the words name the whole map's places
         label_in = 0.0
         for t, _pt in self._texts:
             if t.get_text() in ("left", "right"):
-                t.set_visible(wide and not zoomed)
+                side_word(t, map_in, box_w, char_in, zoomed)
             elif t.get_text() == "forward":
                 t.set_visible(not zoomed)
             elif t.get_gid() == "maptitle":

@@ -15,7 +15,7 @@ from eyeviz.render.mpl.style import EDGE
 
 __all__ = [
     "Outlines", "by_ball", "edge_colour", "ellipse", "equator_fit", "label_side", "lit_owners",
-    "map_polys", "R2", "title_fit",
+    "map_polys", "R2", "side_word", "title_fit",
 ]  # fmt: skip
 
 R2 = math.sqrt(2.0)
@@ -136,3 +136,19 @@ EDGE_DENSE = "#cdcdcd"
 
 def edge_colour(n: int) -> str:
     return EDGE if n <= DENSE else EDGE_DENSE
+
+
+def side_word(t: Any, map_in: float, box_w: float, char_in: float, zoomed: bool) -> None:
+    """Place the map's word "left" or "right" (text ``t``, under the map): flush with the
+    map's end inside it where the map is wide enough for left / forward / right (~22
+    characters of ``char_in`` inches), else beside that end, outside the map, where the
+    box (``box_w`` inches wide) leaves it room and "forward" still fits the map (F11 + F5
+    at 1280 x 720, sphere_lecture's step 8: the maps dropped them), else hidden; hidden
+    on a zoomed map (the words name the whole map's places)."""
+    word = t.get_text()
+    wide = map_in >= 22 * char_in
+    beside = (box_w - map_in) / 2.0 >= 6.5 * char_in and map_in >= 9 * char_in
+    t.set_x((-2.0 if word == "left" else 2.0) * R2 * (1.0 if wide else 1.03))
+    inner, outer = (word, "right" if word == "left" else "left")
+    t.set_horizontalalignment(inner if wide else outer)
+    t.set_visible((wide or beside) and not zoomed)

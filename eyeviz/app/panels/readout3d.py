@@ -56,7 +56,8 @@ COLUMNS = (
     ("lit A/B", "facets lit on eye A / eye B"),
 )
 TABLE_FONT = 0.8  # the tables' font, times the panel's
-CELL_PAD_PX = 9  # a column's width beyond its widest text
+CELL_PAD_PX = 7  # a column's width beyond its widest text (Qt's margins take 6; with 9
+# the Balls table wanted 534 px at F11 + F5 in 1280 x 720, its names elided in 512)
 #: column -> the coordinate typed there (eyeviz.model.typed3d.KEYS)
 TYPED = {1: "r", 2: "az", 3: "el", 4: "g"}
 NAME_MIN_PX = 40  # the names' column at least (elided)
