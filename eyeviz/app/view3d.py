@@ -70,7 +70,8 @@ PRESET_KEYS = (
 )
 PANEL_SHARE = 0.25  # the docks take at most about this share of a drag's time
 PANEL_FRAMES = 4  # and follow it at most every fourth frame
-DOCK_FRACTION = 0.4  # the 3D docks' column takes at most this share of the window's width
+DOCK_FRACTION = 0.41  # the 3D docks' column takes at most this share of the window's width
+# (0.4 left the Balls table's names 5 px short at F11 + F5 in 1280 x 720: "tar…")
 PANEL_MS = 250  # the docks follow a drag at <= 4 Hz (the Mollweide maps take 15-75 ms at
 # nside 180); the drag's end refreshes them at once
 _MOD_DEPTH = QtCore.Qt.KeyboardModifier.ShiftModifier | QtCore.Qt.KeyboardModifier.ControlModifier
@@ -121,6 +122,7 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self.help_box: QtWidgets.QMessageBox | None = None  # 3D view > Mouse and keys
         self.preset: str | None = None  # the preset shown, until the user moves the camera
         self._framed: m3.SceneState3D | None = None  # the state the preset framed
+        self._fit_width = 0  # the window's width the docks' column was last fitted to
         self.preset_actions: dict[str, QtWidgets.QAction] = {}
         self.layer_actions: dict[str, QtWidgets.QAction] = {}
         self.menu = self._build_menu()
@@ -481,6 +483,9 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self.preset = None
 
     def _resized(self) -> None:
+        if self.active and self.win.width() != self._fit_width:  # a wider window (F11):
+            self._fit_width = self.win.width()  # the docks' column may take its share
+            QtCore.QTimer.singleShot(0, self.fit_docks)
         if self.active and self.preset is not None:
             self.set_preset(self.preset, keep=True)
         elif self.active and self.actors is not None:

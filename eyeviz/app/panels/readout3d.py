@@ -209,6 +209,7 @@ class Readout3DPanel(QtWidgets.QWidget):
         self.rows: list[tuple[str, ...]] = []
         self._colors: list[str] = []
         self.table = _table(COLUMNS)
+        self.table.setIconSize(QtCore.QSize(10, 10))  # the 10 px swatch, not 16 px of room
         self.table.setObjectName("readout3d")
         AV = QtWidgets.QAbstractItemView
         trig = AV.EditTrigger
