@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import ClassVar
 
 import numpy as np
 
@@ -224,6 +225,9 @@ class EyePair3D(LitSetViews):
     h: float = paper.H
     l: float = paper.L
     nside: int = paper.NSIDE
+    #: the binocular fields Algorithm 1 draws in (eyeviz.dataset.algorithm1_3d.FIELDS),
+    #: the default first: the tangent cones' wedge, or what touches neither eye
+    binocular_fields: ClassVar[tuple[str, ...]] = ("wedge", "both-eyes")
 
     def __post_init__(self) -> None:
         h, l = check_h_l(self.h, self.l)

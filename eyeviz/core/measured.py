@@ -20,6 +20,7 @@ from __future__ import annotations
 import hashlib
 import math
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -134,6 +135,9 @@ class MeasuredEyePair(LitSetViews):
     name: str = "measured eyes"
     source: str = ""
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
+    #: the binocular fields Algorithm 1 draws in: a real pair's own (``in_bfv``), as no
+    #: tangent cones bound it
+    binocular_fields: ClassVar[tuple[str, ...]] = ("both-eyes",)
 
     # --- what the seam (eyeviz.core.eyes.EyeModel) asks -------------------------------
     @property

@@ -116,7 +116,8 @@ class Gen3DParams:
 
 
 def _default_field(domain: Domain3D) -> str:
-    return "both-eyes" if domain.kind == "measured" else "wedge"
+    """The eyes' default binocular field (the first they state)."""
+    return str(domain.eyes.binocular_fields[0])
 
 
 def make_params3d(
@@ -142,7 +143,7 @@ def make_params3d(
     check_choice("mode", mode, MODES)
     field = _default_field(domain) if field is None else field
     check_choice("field", field, FIELDS)
-    if domain.kind == "measured" and field != "both-eyes":
+    if field not in domain.eyes.binocular_fields:  # a measured pair has no wedge
         raise EyevizError(
             "field 'wedge' is the HEALPix eyes' (their tangent cones); a measured pair's "
             "binocular field is 'both-eyes'"
@@ -155,7 +156,7 @@ def make_params3d(
             f"no feature can be visible: g_max={num(domain.g_max)} <= r_min*sin(gamma/2)="
             f"{domain.r_min * s:.6g} (Algorithm 1 step 9 rejects every r >= r_min)"
         )
-    if domain.kind == "measured" or field == "both-eyes":
+    if field == "both-eyes":  # a measured pair's only field (checked above)
         pass  # no cones: the exact field test decides (module docstring)
     elif domain.gamma / 2 + domain.psi >= math.pi / 2:
         raise EyevizError(

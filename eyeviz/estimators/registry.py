@@ -43,7 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from eyeviz import EyevizError
-from eyeviz.core.domain import DEFAULTS, FIELDS, PAPER_DOMAIN, Domain, Domain3D
+from eyeviz.core.domain import DEFAULTS, FIELDS, PAPER_DOMAIN, RECORDS, Domain, Domain3D
 
 __all__ = [
     "KINDS",
@@ -158,7 +158,7 @@ class Entry:
         """The estimator (``load(**kw)`` of its module). EyevizError when ``domain`` is of
         the other kind (a Domain for a spherical entry, a Domain3D for a planar one)."""
         dom = kw.get("domain")
-        want = Domain3D if self.kind == "spherical" else Domain
+        want = RECORDS[self.kind]
         if dom is not None and not isinstance(dom, want):
             hint = (
                 f"; for the spherical eyes use {self.name}3d"
