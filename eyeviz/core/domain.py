@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, overload
 
 import numpy as np
 
@@ -41,6 +41,9 @@ from eyeviz.core.eyes import design_kind
 from eyeviz.core.geometry import EyePair
 from eyeviz.core.geometry3d import EyePair3D
 from eyeviz.core.validation import check_real
+
+if TYPE_CHECKING:
+    from eyeviz.core.measured import MeasuredEyePair
 
 __all__ = [
     "DEFAULTS",
@@ -386,6 +389,13 @@ class Domain3D(_Record):
             return (float(self.h), float(self.l), str(self.eyes.fingerprint))
         return (float(self.h), float(self.l), int(self.nside))
 
+    @property
+    def design_text(self) -> str:
+        """The design in words: (h, l, nside), or h, l and the measured pair's fingerprint."""
+        if self.nside is None:
+            return f"h={self.h:g} l={self.l:g} measured pair {str(self.eyes.fingerprint)[:12]}"
+        return f"(h, l, nside) = {self.design}"
+
     def to_dict(self) -> dict[str, Any]:
         """The fields (a measured pair: ``eye`` (its fingerprint), ``n_a``, ``n_b`` in place
         of nside; the arrays travel apart, e.g. embedded in a data set)."""
@@ -426,6 +436,12 @@ RECORDS: dict[str, type[_Record]] = {
 }
 
 
+@overload
+def domain_for(eyes: EyePair, **ranges: Any) -> Domain: ...
+@overload
+def domain_for(eyes: EyePair3D | MeasuredEyePair, **ranges: Any) -> Domain3D: ...
+@overload
+def domain_for(eyes: Any, **ranges: Any) -> Domain | Domain3D: ...
 def domain_for(eyes: Any, **ranges: Any) -> Domain | Domain3D:
     """The domain of any pair of eyes: ``eyes`` and the ranges given (r_min, r_max,
     g_max, in space el_max; None or absent: the model's default)."""

@@ -512,17 +512,9 @@ class Estimator3D(EstimatorBase):
                 raise ValueError(f"ds must be a Dataset3D (no {k}), got {type(ds).__name__}")
         if ds.domain.design != self.domain.design:
             raise ValueError(
-                f"ds has the eyes {_design_text(ds.domain)}, the estimator "
-                f"{_design_text(self.domain)}"
+                f"ds has the eyes {ds.domain.design_text}, the estimator {self.domain.design_text}"
             )
         return self.predict((ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b))
 
     def _eyes_text(self) -> str:
-        return _design_text(self.domain)
-
-
-def _design_text(d: Domain3D) -> str:
-    """The eyes of a domain in words: h, l, nside, or the measured pair's fingerprint."""
-    if d.kind == "measured":
-        return f"h={d.h:g} l={d.l:g} measured pair {str(d.eyes.fingerprint)[:12]}"
-    return f"(h, l, nside) = {d.design}"
+        return self.domain.design_text

@@ -188,7 +188,7 @@ def _load(spec: str, units: str | None):
 def measure_pair(pair, args: argparse.Namespace, names: list[str]) -> PairAtlas:
     """The atlas of one pair (see the module docstring)."""
     from eyeviz.core.animal_scale import describe_prior, prior_ranges
-    from eyeviz.core.domain import Domain3D
+    from eyeviz.core.domain import domain_for
     from eyeviz.dataset.algorithm1_3d import generate3d
     from eyeviz.reports import atlas_measure as am
 
@@ -196,7 +196,7 @@ def measure_pair(pair, args: argparse.Namespace, names: list[str]) -> PairAtlas:
     ranges = prior_ranges(
         pair, **{k: getattr(args, k) for k in ("r_min", "r_max", "g_max", "el_max")}
     )
-    domain = Domain3D.for_eyes(pair, **ranges)
+    domain = domain_for(pair, **ranges)
     prior = describe_prior(domain)
     out = PairAtlas(str(pair.name), domain.facet_counts, prior, args.field_step, args.ball_deg)
     lon, lat = am.grid(args.field_step)

@@ -126,9 +126,9 @@ class DesignPointMeasured:
 
     @property
     def domain(self):
-        from eyeviz.core.domain import Domain3D
+        from eyeviz.core.domain import domain_for
 
-        return Domain3D.for_eyes(
+        return domain_for(
             self.pair, r_min=self.r_min, r_max=self.r_max, g_max=self.g_max, el_max=self.el_max
         )
 
