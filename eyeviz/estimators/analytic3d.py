@@ -34,7 +34,9 @@ from eyeviz.estimators.triangulation import (
 __all__ = [
     "Analytic3DEstimator",
     "cap_estimates",
+    "ESTIMATES",
     "estimate",
+    "estimate_healpix",
     "estimate_measured",
     "load",
     "triangulate",
@@ -46,9 +48,17 @@ def estimate(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(r, azimuth, elevation, flagged) for rows that light at least one facet per eye:
     the public form of the analytic estimate other estimators (limit3d's fallback and
-    proposal) build on. A measured domain: :func:`estimate_measured`."""
-    if domain.kind == "measured":
-        return estimate_measured(domain, lit_a, lit_b)
+    proposal) build on, the eye model's own (:data:`ESTIMATES`)."""
+    return ESTIMATES[domain.kind](domain, lit_a, lit_b)
+
+
+def estimate_healpix(
+    domain: Domain3D, lit_a: LitCSR, lit_b: LitCSR
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The estimate for HEALPix eyes: per eye the centre of the lit cap (its facets'
+    mean direction, :func:`cap_estimates`), the two rays from the eye centres
+    triangulated (:func:`triangulate`); rays that do not meet are flagged and answered
+    at r_max along the mean of the two directions."""
     u, _ = cap_estimates(domain.nside, lit_a)
     v, _ = cap_estimates(domain.nside, lit_b)
     p, ok = triangulate(u, v, domain.h)
@@ -90,6 +100,9 @@ def estimate_measured(
     el = np.arcsin(np.clip(q[:, 2] / rho, -1.0, 1.0))
     return r, az, el, ~ok
 
+
+#: each eye model's (``domain.kind``) analytic estimate: a new model adds a row
+ESTIMATES = {"spherical": estimate_healpix, "measured": estimate_measured}
 
 _NEIGHBOURS: dict[tuple[str, str], np.ndarray] = {}
 

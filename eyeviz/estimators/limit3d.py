@@ -335,13 +335,23 @@ class Limit3DEstimator(Estimator3D):
 def _proposal(domain: Domain3D, prior: str, samples: int, grid: int) -> Any:
     """The eye model's proposal (``setup(lit_a, lit_b, keys, wide)`` then
     ``sample(state, keys, stream)``): HEALPix cells or measured facets' cones."""
-    if domain.kind == "measured":
-        from eyeviz.estimators.limit3d_measured import MeasuredProposal
+    return _PROPOSALS[domain.kind]()(domain, prior, samples, grid)
 
-        return MeasuredProposal(domain, prior, samples, grid)
+
+def _healpix_proposal() -> type:
     from eyeviz.estimators.limit3d_healpix import HealpixProposal
 
-    return HealpixProposal(domain, prior, samples, grid)
+    return HealpixProposal
+
+
+def _measured_proposal() -> type:
+    from eyeviz.estimators.limit3d_measured import MeasuredProposal
+
+    return MeasuredProposal
+
+
+#: each eye model's (``domain.kind``) proposal class, imported when first asked for
+_PROPOSALS = {"spherical": _healpix_proposal, "measured": _measured_proposal}
 
 
 def _spread(r: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
