@@ -281,7 +281,7 @@ def _run3d(args: argparse.Namespace, entry, registry, out: Path, kind: str) -> i
         kw["domain"] = dom
     est = entry.load_estimator(**kw)
     if est.domain.design != dom.design:
-        what = "(h, l, nside)" if kind == "spherical" else "(h, l, fingerprint)"
+        what = f"({', '.join(dom.design_names)})"
         raise EyevizError(
             f"data set {args.data} has the eyes {what} = {dom.design}, but estimator "
             f"{entry.name!r} answers for {est.domain.design}"

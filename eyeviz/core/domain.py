@@ -196,6 +196,11 @@ class Domain(_Record):
         """(h, l, m): the eye design, the part a data set must match."""
         return (float(self.h), float(self.l), int(self.m))
 
+    @property
+    def design_names(self) -> tuple[str, ...]:
+        """The names of :attr:`design`'s entries: ("h", "l", "m")."""
+        return ("h", "l", "m")
+
     def to_dict(self) -> dict[str, float]:
         return asdict(self)
 
@@ -390,11 +395,17 @@ class Domain3D(_Record):
         return (float(self.h), float(self.l), int(self.nside))
 
     @property
+    def design_names(self) -> tuple[str, ...]:
+        """The names of :attr:`design`'s entries: ("h", "l", "nside"), or ("h", "l",
+        "fingerprint") for a measured pair."""
+        return ("h", "l", "nside" if self.nside is not None else "fingerprint")
+
+    @property
     def design_text(self) -> str:
         """The design in words: (h, l, nside), or h, l and the measured pair's fingerprint."""
         if self.nside is None:
             return f"h={self.h:g} l={self.l:g} measured pair {str(self.eyes.fingerprint)[:12]}"
-        return f"(h, l, nside) = {self.design}"
+        return f"({', '.join(self.design_names)}) = {self.design}"
 
     def to_dict(self) -> dict[str, Any]:
         """The fields (a measured pair: ``eye`` (its fingerprint), ``n_a``, ``n_b`` in place

@@ -78,3 +78,20 @@ def test_a_record_takes_only_its_own_kinds_and_ranges():
         domain_for(EyePair(30.0, 10.0, 36), el_max=0.5)
     with pytest.raises(ValueError, match="exactly one of m .* got m and nside"):
         domain_from_dict({"m": 36, "nside": 4})
+
+
+def test_each_record_names_its_design_and_says_it_in_words(toy_pair):
+    """What callers ask the domain instead of comparing its kind (issue 37)."""
+    from eyeviz.core.domain import Domain3D, domain_for
+
+    planar = Domain(30.0, 10.0, 36)
+    assert dict(zip(planar.design_names, planar.design, strict=True)) == {
+        "h": 30.0, "l": 10.0, "m": 36}  # fmt: skip
+    sph = Domain3D(30.0, 10.0, 4)
+    assert sph.design_names == ("h", "l", "nside")
+    assert sph.design_text == "(h, l, nside) = (30.0, 10.0, 4)"
+    meas = domain_for(toy_pair)
+    assert meas.design_names == ("h", "l", "fingerprint")
+    assert meas.design[2] == toy_pair.fingerprint
+    fp = str(toy_pair.fingerprint)[:12]
+    assert meas.design_text == f"h={meas.h:g} l={meas.l:g} measured pair {fp}"
