@@ -235,7 +235,7 @@ def run_lit(args: argparse.Namespace) -> int:
             f"l = {d.l:g}, {eyes}, params {ds.params}."
         )
     elif getattr(args, "eye", None) is not None:
-        from eyeviz.core.domain import Domain3D
+        from eyeviz.core.domain import domain_for
         from eyeviz.dataset.algorithm1_3d import generate3d
         from eyeviz.files.eye_io import load_eyes
 
@@ -243,7 +243,7 @@ def run_lit(args: argparse.Namespace) -> int:
         if not args.eye.is_file():
             raise EyevizError(f"eye file {args.eye} not found")
         pair = load_eyes(args.eye)
-        ds = generate3d(args.n_test, Domain3D.for_eyes(pair), "single", args.seed)
+        ds = generate3d(args.n_test, domain_for(pair), "single", args.seed)
         d = ds.domain
         what = (
             f"A fresh test set: {len(ds)} rows of Algorithm 1 (single pass, seed {args.seed}) "
@@ -252,11 +252,12 @@ def run_lit(args: argparse.Namespace) -> int:
             f"{d.g_max:.4g} mm, about the lens centroids' midpoint."
         )
     else:
-        from eyeviz.core.domain import Domain3D
+        from eyeviz.core.domain import domain_for
+        from eyeviz.core.geometry3d import EyePair3D
         from eyeviz.dataset.algorithm1_3d import generate3d
 
         check_int("--n-test", args.n_test, ge=10, le=limits.MAX_ROWS)
-        ds = generate3d(args.n_test, Domain3D(nside=args.nside), "single", args.seed)
+        ds = generate3d(args.n_test, domain_for(EyePair3D(nside=args.nside)), "single", args.seed)
         what = (
             f"A fresh test set: {len(ds)} rows of the 3D Algorithm 1 (single pass, seed "
             f"{args.seed}), the paper's design at nside = {args.nside}."

@@ -320,15 +320,15 @@ def measure_planar(n: int, seed: int, rel_step: float = STEP) -> ModelResult:
 def measure_measured(
     name: str, pair, n: int, seed: int, kind: str = "gaussian", rel_step: float = STEP
 ) -> ModelResult:
-    """A measured pair at its own scale (Domain3D.for_eyes), Algorithm 1 in 3D; the
+    """A measured pair at its own scale (domain_for), Algorithm 1 in 3D; the
     binary side is limit3d (the analytic triangulation where limit3d refuses the pair)."""
     from eyeviz import EyevizError
-    from eyeviz.core.domain import Domain3D
+    from eyeviz.core.domain import domain_for
     from eyeviz.dataset.algorithm1_3d import generate3d
     from eyeviz.estimators import limit3d
     from eyeviz.estimators.analytic3d import estimate_measured
 
-    dom = Domain3D.for_eyes(pair)
+    dom = domain_for(pair)
     ds = generate3d(n, dom, seed=seed)
     theta = np.stack([ds.x, ds.y, ds.z, ds.g], axis=1)
     lit_a, lit_b = (ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b)
@@ -352,11 +352,12 @@ def measure_measured(
 def measure_healpix(nside: int, n: int, seed: int, rel_step: float = STEP) -> ModelResult:
     """The HEALPix pair at ``nside``: the binary side is limit3d on its cells; the graded
     side the pair's exact ``cell`` responses (:func:`healpix_fn`)."""
-    from eyeviz.core.domain import Domain3D
+    from eyeviz.core.domain import domain_for
+    from eyeviz.core.geometry3d import EyePair3D
     from eyeviz.dataset.algorithm1_3d import generate3d
     from eyeviz.estimators import limit3d
 
-    dom = Domain3D(nside=nside)
+    dom = domain_for(EyePair3D(nside=nside))
     ds = generate3d(n, dom, seed=seed)
     theta = np.stack([ds.x, ds.y, ds.z, ds.g], axis=1)
     p = limit3d.load(dom).predict((ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b))
