@@ -19,6 +19,11 @@ NAME = "train"
 HELP = "train an estimator that learns (compact networks, bayes table, the paper's networks)"
 #: What the command writes, checked before any work (eyeviz.files.outputs).
 OUTPUTS = {"out": "path"}
+#: The training data an estimator of each kind (its registry entry's ``kind``) reads.
+DATA = {
+    "planar": ".csv or .npz from `eyeviz generate`",
+    "spherical": "a sparse 3D .npz from `eyeviz generate --nside`",
+}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -34,12 +39,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                 "data",
                 nargs="?",
                 default=None,
-                help=(
-                    "training data (a sparse 3D .npz from `eyeviz generate --nside`)"
-                    if e.kind == "spherical"
-                    else "training data (.csv or .npz from `eyeviz generate`)"
-                )
-                + "; default: generate",
+                help=f"training data ({DATA[e.kind]}); default: generate",
             )
         out = p.add_mutually_exclusive_group()
         out.add_argument(
