@@ -63,7 +63,7 @@ __all__ = ["MeasuredProposal"]
 ITERS = 12
 #: widening of the bisection's box, and the pilot draws and rounds that widen it further
 WIDEN = 2.0
-PILOT = 128
+PILOT = 2048
 PILOT_ROUNDS = 4
 #: zoom levels of the centre search (each grid 1 / 2.5 as wide) and its points per axis
 LEVELS = 6
