@@ -353,7 +353,7 @@ def _run_eye(args: argparse.Namespace, drawn: bool) -> int:
     from eyeviz.core.domain import Domain3D
     from eyeviz.dataset import algorithm1_3d, sparse3d
     from eyeviz.files import limits
-    from eyeviz.files.eye_io import load_eyes
+    from eyeviz.files.eye_io import eye_path, load_eyes
 
     for flag in ("nside", "h", "l", "m"):
         if getattr(args, flag) is not None:
@@ -362,11 +362,10 @@ def _run_eye(args: argparse.Namespace, drawn: bool) -> int:
         raise EyevizError("--unique-bitmaps is for the planar data set only, not with --eye")
     sparse3d.check_output_path(args.output)
     n = algorithm1_3d.check_n(args.n)
-    if not os.path.isfile(args.eye):
-        raise EyevizError(f"eye file {args.eye} not found")
+    eye = eye_path(args.eye)  # a file, or a shipped eye's name
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        pair = load_eyes(args.eye, units=args.units)
+        pair = load_eyes(eye, units=args.units)
     for w in caught:  # e.g. a size that looks like the wrong unit: one line, no source
         print(f"generate: warning: {w.message}", file=sys.stderr)
     from eyeviz.core.animal_scale import prior_ranges

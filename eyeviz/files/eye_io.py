@@ -19,7 +19,7 @@ from eyeviz.core.measured import MeasuredEye, MeasuredEyePair
 from eyeviz.files import eye_compoundray, eye_frames
 from eyeviz.files.atomic import atomic_output
 
-__all__ = ["SUFFIXES", "load_eyes", "save_eyes", "shipped_eye", "EyeSizeWarning"]
+__all__ = ["SUFFIXES", "eye_path", "load_eyes", "save_eyes", "shipped_eye", "EyeSizeWarning"]
 
 EyeSizeWarning = eye_frames.EyeSizeWarning
 #: suffix -> (default units, default frame)
@@ -36,6 +36,18 @@ def shipped_eye(name: str) -> Path:
         names = sorted(q.name for q in base.glob("*.eye"))
         raise EyevizError(f"no shipped eye named {name!r} (shipped: {', '.join(names)})")
     return p
+
+
+def eye_path(spec: str | Path) -> Path:
+    """An eye file's path, or a shipped eye's name (``AM_60185-real.eye``): what every
+    ``--eye`` option takes. A path that names a missing file is refused in one line; a bare
+    name that is no file here is looked up among the shipped eyes (an error lists them)."""
+    path = Path(spec)
+    if path.is_file():
+        return path
+    if "/" in str(spec) or "\\" in str(spec):
+        raise EyevizError(f"eye file {spec} not found")
+    return shipped_eye(str(spec))
 
 
 def _suffix(path) -> str:

@@ -175,13 +175,9 @@ def _check(args: argparse.Namespace) -> list[str]:
 
 
 def _load(spec: str, units: str | None):
-    from eyeviz.files.eye_io import load_eyes, shipped_eye
+    from eyeviz.files.eye_io import eye_path, load_eyes
 
-    path = Path(spec)
-    if not path.is_file():
-        if "/" in spec or "\\" in spec:
-            raise EyevizError(f"eye file {spec} not found")
-        path = shipped_eye(spec)  # a shipped name, or a one-line error listing them
+    path = eye_path(spec)  # a file, or a shipped name (an error lists them)
     return load_eyes(path, units=units) if units else load_eyes(path)
 
 

@@ -237,11 +237,10 @@ def run_lit(args: argparse.Namespace) -> int:
     elif getattr(args, "eye", None) is not None:
         from eyeviz.core.domain import domain_for
         from eyeviz.dataset.algorithm1_3d import generate3d
-        from eyeviz.files.eye_io import load_eyes
+        from eyeviz.files.eye_io import eye_path, load_eyes
 
         check_int("--n-test", args.n_test, ge=10, le=limits.MAX_ROWS)
-        if not args.eye.is_file():
-            raise EyevizError(f"eye file {args.eye} not found")
+        args.eye = eye_path(args.eye)  # a file, or a shipped eye's name
         pair = load_eyes(args.eye)
         ds = generate3d(args.n_test, domain_for(pair), "single", args.seed)
         d = ds.domain

@@ -12,6 +12,7 @@ import pytest
 from eyeviz import cli
 from eyeviz.core.domain import Domain3D
 from eyeviz.dataset import algorithm1_3d, sparse3d
+from eyeviz.files.eye_io import load_eyes
 from eyeviz.measured import shipped_eye
 
 BEE = str(shipped_eye("AM_60185-real.eye"))
@@ -144,3 +145,21 @@ def test_predict_limit3d_on_a_measured_eye_data_set(bee_npz, tmp_path, capsys):
     assert len(vals) == 12 and np.isfinite(vals).all()
     assert ((vals[:, 0] >= dom.r_min) & (vals[:, 0] <= dom.r_max)).all()
     assert vals[:, 3].sum() <= 2
+
+
+def test_eye_options_take_a_shipped_eyes_name(tmp_path, capsys):
+    """``--eye AM_60185-real.eye`` (the README's commands) names the shipped honeybee
+    wherever no such file is here; a name that is neither is one line listing them."""
+    name, out = "AM_60185-real.eye", tmp_path / "named.npz"
+    rc = cli.main(["generate", "--eye", name, "-n", "12", "--seed", "4", "-o", str(out)])
+    assert rc == 0, capsys.readouterr().err
+    assert sparse3d.load3d(out).domain == Domain3D.for_eyes(load_eyes(BEE))
+    argv = ["report", "estimators", "--eye", name, "--n-test", "10", "--seed", "3"]
+    rc = cli.main([*argv, "--estimators", "analytic3d", "-o", str(tmp_path / "rep")])
+    assert rc == 0 and name in (tmp_path / "rep" / "estimators3d.md").read_text()
+    capsys.readouterr()
+    bad = tmp_path / "y.npz"
+    rc = cli.main(["generate", "--eye", "no-such-bee.eye", "-n", "5", "-o", str(bad)])
+    err = capsys.readouterr().err
+    assert rc == 2 and "no shipped eye named 'no-such-bee.eye'" in err and name in err
+    assert err.count("\n") == 1 and not bad.exists()
