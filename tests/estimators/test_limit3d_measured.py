@@ -151,7 +151,9 @@ def _outside_box(small, monkeypatch, **shrink) -> int:
     st = prop.setup(*lit, keys, 1.0)
     # the coordinates are the proposal's: its own draws' centres map back to them
     rng = np.random.default_rng(0)
-    x0 = st["box_lo"][:, None] + (st["box_hi"] - st["box_lo"])[:, None] * rng.random((len(groups), 50, 3))
+    x0 = st["box_lo"][:, None] + (st["box_hi"] - st["box_lo"])[:, None] * rng.random(
+        (len(groups), 50, 3)
+    )
     c0, rho, _ = prop._bcentres(st, x0[..., :2], x0[..., 2])
     ok = np.isfinite(rho)
     assert ok.sum() > 100
