@@ -359,19 +359,25 @@ def pan(cam: Camera3D, dy_px: float, height: float) -> Camera3D:
     return shifted(cam, -up * dy_px * 2.0 * float(np.linalg.norm(pos - foc)) * t / max(height, 1.0))
 
 
-def _discs_cover(named: Named3D, cam: Camera3D, w: float, h: float) -> bool:
-    """Whether a ball, an eye or a ghost (``named``'s spheres and its ``others``), as
-    ``cam`` draws it, covers one of the view's own texts (``named.keep_out``)."""
-    if named.keep_out is None or len(named.keep_out) == 0:
-        return False
+def _all_discs(named: Named3D, cam: Camera3D, w: float, h: float):
+    """The on-screen discs (centres (k, 2), radii (k,)) of every ball, eye and ghost
+    (``named``'s spheres and its ``others``) that ``cam`` draws in front of it."""
     oth = np.asarray(named.others, float).reshape(-1, 4)
     c = np.concatenate([np.asarray(named.centres, float).reshape(-1, 3), oth[:, :3]])
     r = np.concatenate([np.asarray(named.radii, float).reshape(-1), oth[:, 3]])
     at, rad = discs(cam, c, r, w, h)
     ok = np.isfinite(at).all(axis=1) & np.isfinite(rad)
-    if not ok.any():
+    return at[ok], rad[ok]
+
+
+def _discs_cover(named: Named3D, cam: Camera3D, w: float, h: float) -> bool:
+    """Whether a ball, an eye or a ghost (``named``'s spheres and its ``others``), as
+    ``cam`` draws it, covers one of the view's own texts (``named.keep_out``)."""
+    if named.keep_out is None or len(named.keep_out) == 0:
         return False
-    at, rad = at[ok], rad[ok]
+    at, rad = _all_discs(named, cam, w, h)
+    if len(rad) == 0:
+        return False
     for x0, y0, x1, y1 in np.asarray(named.keep_out, float).reshape(-1, 4):
         qx, qy = np.clip(at[:, 0], x0, x1), np.clip(at[:, 1], y0, y1)
         if bool(np.any(np.hypot(at[:, 0] - qx, at[:, 1] - qy) < rad)):
@@ -387,12 +393,7 @@ def _names_clear(boxes: np.ndarray, named: Named3D, cam: Camera3D, w: float, h: 
     for k in range(len(b)):
         if _covers(b[k : k + 1], b[k + 1 :]):
             return False
-    oth = np.asarray(named.others, float).reshape(-1, 4)
-    c = np.concatenate([np.asarray(named.centres, float).reshape(-1, 3), oth[:, :3]])
-    r = np.concatenate([np.asarray(named.radii, float).reshape(-1), oth[:, 3]])
-    at, rad = discs(cam, c, r, w, h)
-    ok = np.isfinite(at).all(axis=1) & np.isfinite(rad)
-    at, rad = at[ok], rad[ok]
+    at, rad = _all_discs(named, cam, w, h)
     for x0, y0, x1, y1 in b:
         qx, qy = np.clip(at[:, 0], x0, x1), np.clip(at[:, 1], y0, y1)
         gap = gap_for(y1 - y0) - 0.5  # as place_boxes keeps it
@@ -406,14 +407,10 @@ def _content_middle(
 ) -> float | None:
     """The middle (pixels, y up) of what ``cam`` shows of ``named``: its spheres' discs
     and the names at ``boxes``; None where nothing is in front of the camera."""
-    oth = np.asarray(named.others, float).reshape(-1, 4)
-    c = np.concatenate([np.asarray(named.centres, float).reshape(-1, 3), oth[:, :3]])
-    r = np.concatenate([np.asarray(named.radii, float).reshape(-1), oth[:, 3]])
-    at, rad = discs(cam, c, r, w, h)
-    ok = np.isfinite(at).all(axis=1) & np.isfinite(rad)
+    at, rad = _all_discs(named, cam, w, h)
     b = boxes[np.isfinite(boxes).all(axis=1)]
-    lo = np.concatenate([at[ok, 1] - rad[ok], b[:, 1]])
-    hi = np.concatenate([at[ok, 1] + rad[ok], b[:, 3]])
+    lo = np.concatenate([at[:, 1] - rad, b[:, 1]])
+    hi = np.concatenate([at[:, 1] + rad, b[:, 3]])
     if len(lo) == 0:
         return None
     return float(lo.min() + hi.max()) / 2.0
