@@ -132,19 +132,17 @@ def score(ds, names: list[str], limit_rows: int) -> list[BallScores]:
     a name containing "limit" on at most ``limit_rows`` evenly spaced rows (the limit
     costs milliseconds per row); the others on every row. A name the registry cannot
     load for these eyes is kept with its one-line reason."""
-    from eyeviz import EyevizError
-    from eyeviz.estimators import registry
     from eyeviz.estimators.base import take_rows
+    from eyeviz.reports.common import try_load
 
     n = len(ds)
     subset = np.unique(np.linspace(0, n - 1, min(n, max(1, limit_rows))).astype(np.int64))
     out = []
     for name in names:
         res = BallScores(name)
-        try:
-            est = registry.load(name, domain=ds.domain)
-        except (EyevizError, ValueError, OSError, ImportError, RuntimeError) as exc:
-            res.status = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        est, why = try_load(name, domain=ds.domain)
+        if est is None:
+            res.status = why
             out.append(res)
             continue
         rows = subset if "limit" in name else np.arange(n)

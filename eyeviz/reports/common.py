@@ -31,12 +31,13 @@ def parse_names(text: str | None) -> list[str]:
     return list(dict.fromkeys(names))
 
 
-def try_load(name: str):
-    """(estimator, "") or (None, one-line reason) — never raises for a missing estimator."""
+def try_load(name: str, **kw):
+    """(estimator, "") or (None, one-line reason) — never raises for a missing estimator
+    (keywords, e.g. ``domain``, go to :func:`eyeviz.estimators.load`)."""
     from eyeviz import estimators
 
     try:
-        return estimators.load(name), ""
+        return estimators.load(name, **kw), ""
     except (ValueError, OSError, ImportError, RuntimeError) as exc:
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         if name == "paper" and "not found" in msg:

@@ -201,8 +201,6 @@ def _metrics(ds, rows: np.ndarray, r, az, el) -> tuple[dict[str, float], dict[st
 def measure_lit(ds, names: list[str], limit_rows: int = 1000, progress=None) -> list[Result]:
     """Score each estimator ``names`` of lit sets (registry kind "spherical", for the
     spherical or measured eyes) on the lit-set data set ``ds`` (a Dataset3D)."""
-    from eyeviz import EyevizError
-    from eyeviz.estimators import registry
     from eyeviz.estimators.base import take_rows
 
     n = len(ds)
@@ -211,10 +209,9 @@ def measure_lit(ds, names: list[str], limit_rows: int = 1000, progress=None) -> 
     out = []
     for name in names:
         res = Result(name)
-        try:
-            est = registry.load(name, domain=ds.domain)
-        except (EyevizError, ValueError, OSError, ImportError, RuntimeError) as exc:
-            res.status = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        est, why = try_load(name, domain=ds.domain)
+        if est is None:
+            res.status = why
             out.append(res)
             continue
         res.n_weights = int(getattr(est, "n_weights", 0))
