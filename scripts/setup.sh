@@ -45,5 +45,14 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
 fi
 # Compile the numba kernels once into their cache (eyeviz/core/kernels/__pycache__), so
 # neither a first run nor a test worker compiles them (a few seconds when already warm).
-.venv/bin/python -c "from eyeviz.core import kernels; kernels.warm()" ||
+# Two processes, half the kernel modules each (a cold compile is single-threaded).
+warm_half() {
+    .venv/bin/python -c "from eyeviz.core import kernels as k; k.warm(k.KERNELS[$1::2])"
+}
+warm_half 0 &
+half=$!
+warm_ok=1
+warm_half 1 || warm_ok=0
+wait "$half" || warm_ok=0
+[ "$warm_ok" = 1 ] ||
     echo "eyeviz setup: warming the compiled kernels failed (they compile on first use)" >&2

@@ -113,6 +113,17 @@ def test_deferred_kernels_wait_for_the_warm_up(monkeypatch):
     assert kernels.use(1)
 
 
+def test_the_warm_up_list_names_every_kernel_module_and_refuses_others():
+    """scripts/setup.sh warms every other module of KERNELS in each of two processes: a
+    new kernel module must join the list, and an unknown one is named."""
+    import pkgutil
+
+    modules = {m.name for m in pkgutil.iter_modules(kernels.__path__)}
+    assert sorted(kernels.KERNELS) == sorted(modules)
+    with pytest.raises(ValueError, match="no kernel module 'nope'; known: healpix_lit"):
+        kernels.warm(("nope",))
+
+
 def test_lit_csr_through_the_kernel_equals_the_reference(monkeypatch):
     """EyePair3D.lit_csr and lit, kernel (both eyes and the indices in compiled code)
     against EYEVIZ_JIT=0, on a batch mixing ordinary, tiny, grazing and whole-eye balls
