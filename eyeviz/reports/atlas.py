@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from eyeviz import EyevizError
+from eyeviz.reports.common import add_formats_option, parse_formats
 
 HELP = "the atlas of measured eyes: binocular field, distance limit, rule of thumb"
 SHIPPED = ("AM_60185-real.eye", "BT_77967-real.eye", "BT_77973-real.eye")
@@ -62,14 +63,6 @@ class PairAtlas:
     overall: dict[str, dict[str, float]] = field(default_factory=dict)
     times: dict[str, float] = field(default_factory=dict)
     rows: int = 0
-
-
-def _formats(text: str) -> tuple[str, ...]:
-    got = tuple(dict.fromkeys(s for s in str(text).replace(",", " ").split() if s))
-    bad = [s for s in got if s not in ("png", "svg", "pdf")]
-    if bad or not got:
-        raise EyevizError(f"--formats takes png, svg and pdf, got {', '.join(bad) or '(none)'}")
-    return got
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -132,11 +125,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default="single",
         help="the prior's pass (default single)",
     )
-    parser.add_argument(
-        "--formats",
-        default="png,svg",
-        help="the figures' formats, of png, svg, pdf (default png,svg)",
-    )
+    add_formats_option(parser, ("png", "svg"))
 
 
 def _check(args: argparse.Namespace) -> list[str]:
@@ -152,7 +141,7 @@ def _check(args: argparse.Namespace) -> list[str]:
         raise EyevizError(
             f"--field-step must be in [{MIN_STEP:g}, {MAX_STEP:g}] degrees, got {args.field_step!r}"
         )
-    args.formats = _formats(args.formats)
+    args.formats = parse_formats(args.formats)
     for k in ("r_min", "r_max", "g_max"):
         if getattr(args, k) is not None:
             setattr(args, k, parse_length(getattr(args, k), "--" + k.replace("_", "-")))

@@ -13,7 +13,6 @@
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
@@ -41,21 +40,9 @@ def _style(name: str) -> tuple[str, str, str]:
 
 
 def _save(fig, outdir: Path, stem: str, formats: tuple[str, ...] = FORMATS) -> Path:
-    import matplotlib
+    from eyeviz.reports.common import save_formats
 
-    from eyeviz.reports.common import write_atomic
-
-    with matplotlib.rc_context(
-        {"svg.fonttype": "none", "svg.hashsalt": "eyeviz", "pdf.fonttype": 42}
-    ):
-        for fmt in formats:
-            buf = io.BytesIO()
-            meta = (
-                {"Date": None} if fmt == "svg" else {"CreationDate": None} if fmt == "pdf" else {}
-            )
-            fig.savefig(buf, format=fmt, dpi=DPI, metadata=meta)
-            write_atomic(outdir / f"{stem}.{fmt}", buf.getvalue())
-    return outdir / f"{stem}.{formats[0]}"
+    return save_formats(fig, outdir / stem, formats, dpi=DPI)[0]
 
 
 #: imshow extent of the whole-sphere grid: azimuth 270 ... -90 from left to right, so eye

@@ -1,8 +1,9 @@
-"""Helpers shared by the estimators and trajectories reports.
+"""Helpers shared by the reports.
 
 Estimator names from the command line, loading an estimator without crashing on a
-missing one, atomic writes of text and figures, and the accuracy metrics (MAPE, Eq. 34;
-MAE, Eq. 33; the standard R^2) over the finite predictions.
+missing one, atomic writes of text and figures (one figure in several formats, text kept
+as text and no dates, so a second run writes the same bytes), and the accuracy metrics
+(MAPE, Eq. 34; MAE, Eq. 33; the standard R^2) over the finite predictions.
 """
 
 from __future__ import annotations
@@ -52,6 +53,52 @@ def write_atomic(path: Path, data: bytes | str) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_output(path) as tmp:
         tmp.write_bytes(data.encode("utf-8") if isinstance(data, str) else data)
+
+
+#: The figure formats a report can write: PNG for screens, SVG and PDF for papers
+FORMATS = ("png", "svg", "pdf")
+
+
+def parse_formats(text: str) -> tuple[str, ...]:
+    """The formats of "png,svg" (or "png svg"), in order, once each; a one-line error
+    naming what is not one of :data:`FORMATS`."""
+    from eyeviz import EyevizError
+
+    got = tuple(dict.fromkeys(s for s in str(text).replace(",", " ").split() if s))
+    bad = [s for s in got if s not in FORMATS]
+    if bad or not got:
+        raise EyevizError(f"--formats takes png, svg and pdf, got {', '.join(bad) or '(none)'}")
+    return got
+
+
+def add_formats_option(parser, default: tuple[str, ...] = FORMATS) -> None:
+    """A ``--formats`` option (parse it with :func:`parse_formats`)."""
+    parser.add_argument(
+        "--formats",
+        default=",".join(default),
+        help=f"the figures' formats, of png, svg, pdf (default {','.join(default)})",
+    )
+
+
+def save_formats(
+    fig, base: Path, formats: tuple[str, ...] = FORMATS, dpi: int = 300, **savefig
+) -> list[Path]:
+    """``fig`` written to ``base`` with each of ``formats`` as its suffix, each file
+    atomically; SVG and PDF keep text as text, and carry no date."""
+    import matplotlib
+
+    written = []
+    with matplotlib.rc_context(
+        {"svg.fonttype": "none", "svg.hashsalt": "eyeviz", "pdf.fonttype": 42}
+    ):
+        for fmt in formats:
+            buf = io.BytesIO()
+            meta = {"svg": {"Date": None}, "pdf": {"CreationDate": None}}.get(fmt, {})
+            fig.savefig(buf, format=fmt, dpi=dpi, metadata=meta, **savefig)
+            target = base.with_name(f"{base.name}.{fmt}")
+            write_atomic(target, buf.getvalue())
+            written.append(target)
+    return written
 
 
 def save_figure(fig, path: Path, dpi: int = 150) -> None:

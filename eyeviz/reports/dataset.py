@@ -300,19 +300,9 @@ def _plot(paths, summaries, bins: int, max_points: int, path: Path) -> list[Path
         )
     fig.suptitle("Data set distribution (paper Figures 8-11)", fontsize=12)
     fig.tight_layout()
-    written = []
-    with matplotlib.rc_context(
-        {"svg.fonttype": "none", "pdf.fonttype": 42, "svg.hashsalt": "eyeviz"}
-    ):
-        for fmt in FORMATS:
-            buf = io.BytesIO()
-            meta = (
-                {"Date": None} if fmt == "svg" else {"CreationDate": None} if fmt == "pdf" else {}
-            )
-            fig.savefig(buf, format=fmt, dpi=DPI, metadata=meta)  # vectors: dpi for the scatter
-            target = path.with_suffix(f".{fmt}")
-            _write_atomic(target, buf.getvalue())
-            written.append(target)
+    from eyeviz.reports.common import save_formats
+
+    written = save_formats(fig, path.with_suffix(""), FORMATS, dpi=DPI)
     plt.close(fig)
     return written
 

@@ -195,7 +195,7 @@ def _plot(results, photons: float, path: Path, errors) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from eyeviz.reports.common import write_atomic
+    from eyeviz.reports.common import save_formats
 
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(12.5, 4.8), constrained_layout=True)
     ns = np.logspace(0, 6, 61)
@@ -230,16 +230,7 @@ def _plot(results, photons: float, path: Path, errors) -> None:
     fig.suptitle("What grades are worth (issue 34.5)", fontsize=11)
     fig.canvas.draw()
     fig.set_layout_engine("none")
-    with matplotlib.rc_context(
-        {"svg.fonttype": "none", "pdf.fonttype": 42, "svg.hashsalt": "eyeviz"}
-    ):
-        for fmt in FORMATS:
-            buf = io.BytesIO()
-            meta = (
-                {"Date": None} if fmt == "svg" else {"CreationDate": None} if fmt == "pdf" else {}
-            )
-            fig.savefig(buf, format=fmt, dpi=170, metadata=meta)
-            write_atomic(path.with_suffix(f".{fmt}"), buf.getvalue())
+    save_formats(fig, path.with_suffix(""), FORMATS, dpi=170)
     plt.close(fig)
 
 

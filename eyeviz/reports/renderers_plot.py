@@ -7,7 +7,6 @@ rays within an angle of the axis.
 
 from __future__ import annotations
 
-import io
 import math
 from pathlib import Path
 
@@ -131,7 +130,7 @@ def plot(rows, curves, cdf, dr: float, example: dict[str, float], path: Path) ->
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from eyeviz.reports.common import write_atomic
+    from eyeviz.reports.common import save_formats
 
     fig, axes = plt.subplots(1, 3, figsize=(15.5, 4.9), constrained_layout=True)
     _errors(axes[0], rows)
@@ -144,18 +143,6 @@ def plot(rows, curves, cdf, dr: float, example: dict[str, float], path: Path) ->
     )
     fig.canvas.draw()  # lay out once; the three formats reuse it
     fig.set_layout_engine("none")
-    written = []
-    with matplotlib.rc_context(
-        {"svg.fonttype": "none", "pdf.fonttype": 42, "svg.hashsalt": "eyeviz"}
-    ):
-        for fmt in FORMATS:
-            buf = io.BytesIO()
-            meta = (
-                {"Date": None} if fmt == "svg" else {"CreationDate": None} if fmt == "pdf" else {}
-            )
-            fig.savefig(buf, format=fmt, dpi=DPI, metadata=meta)
-            target = path.with_suffix(f".{fmt}")
-            write_atomic(target, buf.getvalue())
-            written.append(target)
+    written = save_formats(fig, path.with_suffix(""), FORMATS, dpi=DPI)
     plt.close(fig)
     return written

@@ -64,6 +64,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from eyeviz import EyevizError
+from eyeviz.reports.common import add_formats_option, parse_formats
 from eyeviz.reports.study_design import (
     LIMITS,
     MIN_COUNT,
@@ -177,6 +178,7 @@ class Asked:
     target: float
     band: float | None
     estimator: str | None = None
+    formats: tuple[str, ...] = FORMATS
 
 
 def _prior(have: set[str], prior: str | None) -> str:
@@ -199,18 +201,20 @@ def _write_planar(path: Path, outdir: Path, a: Asked) -> list[Path]:
     fit = fit_law(points, a.law_max)
     best = smallest_m(designs, l_of, a.at, a.target)
     outdir.mkdir(parents=True, exist_ok=True)
-    written = _save_figures(outdir, (
+    written = _save_figures(outdir, a.formats, (
         ("study_dd", lambda: curves_figure(designs, l_of, "dd", a.l_wanted)),
         ("study_ad", lambda: curves_figure(designs, l_of, "ad", a.l_wanted)),
         ("study_heatmap", lambda: heatmap_figure(table, l_of, a.at, a.l_wanted)),
         ("study_law", lambda: law_figure(points, fit)),
     ))  # fmt: skip
     args_d = {"table": str(path), "prior": prior, "at": a.at, "l": a.l_wanted, "target": a.target}
+    args_d["formats"] = a.formats
     written.append(_write_text(outdir / "summary.csv", summary_csv(table, fit)))
     written.append(
         _write_text(outdir / "summary.json", summary_json(table, fit, args_d, designs, best))
     )
-    figs = [p.stem for p in written if p.suffix == ".png"]  # in the order drawn
+    shown = "png" if "png" in a.formats else a.formats[0]  # the one study.md shows
+    figs = [p.name for p in written if p.suffix == f".{shown}"]  # in the order drawn
     written.append(
         _write_text(outdir / "study.md", markdown(table, fit, designs, l_of, best, args_d, figs))
     )
@@ -236,7 +240,7 @@ def _write_spherical(path: Path, outdir: Path, a: Asked) -> list[Path]:
     is_limit = est in LIMITS
     label = est if is_limit else f"{est} (an upper bound on the limit, not the limit)"
     outdir.mkdir(parents=True, exist_ok=True)
-    written = _save_figures(outdir, (
+    written = _save_figures(outdir, a.formats, (
         ("study3d_design", lambda: design_figure(designs, l_of, h_star, label)),
         ("study3d_dd", lambda: dd_figure(designs, l_of, fit, label)),
         ("study3d_law", lambda: law_figure3d(points, fit, power, label)),
@@ -247,14 +251,17 @@ def _write_spherical(path: Path, outdir: Path, a: Asked) -> list[Path]:
     return written
 
 
-def _save_figures(outdir: Path, figures: Sequence[tuple[str, Callable[[], object]]]) -> list[Path]:
-    """Each (stem, draw) figure drawn in the report's style and saved (:func:`save`)."""
+def _save_figures(
+    outdir: Path, formats: tuple[str, ...], figures: Sequence[tuple[str, Callable[[], object]]]
+) -> list[Path]:
+    """Each (stem, draw) figure drawn in the report's style and saved in ``formats``
+    (:func:`save`)."""
     import matplotlib
 
     written: list[Path] = []
     with matplotlib.rc_context(_rc()):
         for stem, draw in figures:
-            written += save(draw(), outdir, stem)
+            written += save(draw(), outdir, stem, formats)
     return written
 
 
@@ -284,16 +291,18 @@ def write_report(
     target: float = 5.0,
     band: float | None = None,
     estimator: str | None = None,
+    formats: tuple[str, ...] = FORMATS,
 ) -> list[Path]:
     """Read the study table at ``path`` and write every figure and summary of its eye
     model's part (:data:`PARTS`) into ``outdir`` (``band``: a 3D table's distance bins
     merged into bands that wide; ``estimator``: a 3D table's estimator to draw, default
-    the limit where the table has it)."""
+    the limit where the table has it; ``formats``: the figures' file formats)."""
     checks = (("--at", at), ("--l", l_wanted), ("--law-max", law_max), ("--target", target))
     for name, v in (*checks, ("--band", BIN_WIDTH if band is None else band)):
         if not (math.isfinite(v) and v > 0):
             raise EyevizError(f"{name} must be a finite number > 0, got {v!r}")
-    asked = Asked(prior, l_wanted, at, law_max, target, band, estimator)
+    formats = parse_formats(",".join(formats))
+    asked = Asked(prior, l_wanted, at, law_max, target, band, estimator, formats)
     part = next(p for p in PARTS if p.holds(path))
     return part.write(path, outdir, asked)
 
@@ -337,6 +346,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help=f"3D table: merge its {BIN_WIDTH:g}-wide distance bins into bands this wide "
         "(a multiple) for the figures, the law's fit and the summary (default: as they are)",
     )
+    add_formats_option(parser, FORMATS)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -349,6 +359,7 @@ def run(args: argparse.Namespace) -> int:
         args.law_max,
         args.target,
         args.band,
+        formats=parse_formats(args.formats),
     )
     print(f"wrote {len(paths)} files into {args.output}")
     return 0

@@ -15,7 +15,6 @@ from pathlib import Path
 
 import numpy as np
 
-from eyeviz.files.atomic import atomic_output
 from eyeviz.reports.study_design import MIN_COUNT, PAPER
 from eyeviz.reports.study_law import LawFit, LawPoint
 
@@ -299,16 +298,12 @@ def law_figure(points: Sequence[LawPoint], fit: LawFit):
     return fig
 
 
-def save(fig, outdir: Path, stem: str) -> list[Path]:
-    """The figure as PDF, SVG and PNG (300 dpi), each written atomically."""
-    paths = []
-    for ext in FORMATS:
-        path = outdir / f"{stem}.{ext}"
-        meta = {"CreationDate": None} if ext == "pdf" else {"Date": None} if ext == "svg" else {}
-        with atomic_output(path) as tmp:
-            fig.savefig(tmp, format=ext, dpi=PNG_DPI, metadata=meta, facecolor="white")
-        paths.append(path)
-    return paths
+def save(fig, outdir: Path, stem: str, formats: tuple[str, ...] = FORMATS) -> list[Path]:
+    """The figure in each of ``formats`` (PDF, SVG and PNG at 300 dpi by default), each
+    written atomically."""
+    from eyeviz.reports.common import save_formats
+
+    return save_formats(fig, outdir / stem, formats, dpi=PNG_DPI, facecolor="white")
 
 
 # The spherical eyes (a 3D study table)

@@ -128,9 +128,11 @@ def markdown(table, fit, designs, l_of, best, args_d, figures) -> str:
     ]
     for h, m in best.items():
         lines.append(f"| {h:g} | {l_of[h]:g} | {m if m is not None else 'none in the grid'} |")
-    lines += ["", "Figures (each as PDF, SVG and PNG):", ""]
-    for f in figures:
-        lines += [f"**{f}**: {CAPTIONS.get(f, '')}", "", f"![{f}]({f}.png)", ""]
+    formats = ", ".join(f.upper() for f in args_d.get("formats", ("pdf", "svg", "png")))
+    lines += ["", f"Figures (each as {formats}):", ""]
+    for name in figures:
+        f = Path(name).stem
+        lines += [f"**{f}**: {CAPTIONS.get(f, '')}", "", f"![{f}]({name})", ""]
     return "\n".join(lines) + "\n"
 
 

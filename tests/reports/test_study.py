@@ -229,6 +229,20 @@ def test_report_on_a_synthetic_table_states_c_everywhere(tmp_path):
         assert f"]({stem}.png)" in md and (out / f"{stem}.png").exists()
 
 
+def test_formats_chooses_the_figures_files_and_study_md_links_what_was_written(tmp_path):
+    path = write_table(tmp_path / "s.csv", synthetic_rows(ms=(720,), hs=(40.0,)))
+    out = tmp_path / "r"
+    written = study.write_report(path, out, formats=("svg",))
+    figures = sorted(p.name for p in out.iterdir() if p.suffix in (".png", ".pdf", ".svg"))
+    assert figures == [f"study_{s}.svg" for s in ("ad", "dd", "heatmap", "law")]
+    assert sorted(p.name for p in written) == sorted(p.name for p in out.iterdir())
+    md = (out / "study.md").read_text()
+    assert "](study_dd.svg)" in md and ".png" not in md and "(each as SVG)" in md
+    with pytest.raises(EyevizError, match="--formats takes png, svg and pdf, got gif"):
+        study.write_report(path, tmp_path / "x", formats=("gif",))
+    assert not (tmp_path / "x").exists()
+
+
 @pytest.mark.slow
 def test_one_m_only_still_draws_everything(tmp_path):
     path = write_table(tmp_path / "s.csv", synthetic_rows(ms=(720,), hs=(40.0,)))
@@ -244,7 +258,7 @@ def test_one_m_only_still_draws_everything(tmp_path):
 def test_a_table_without_the_papers_eyes_says_so(tmp_path):
     path = write_table(tmp_path / "s.csv", synthetic_rows(ms=(1440, 2880)))
     out = tmp_path / "r"
-    study.write_report(path, out)
+    study.write_report(path, out, formats=("svg",))
     assert "are not in this table" in (out / "study.md").read_text()
     assert json.loads((out / "summary.json").read_text())["paper_design"] is None
     svg = "".join(ET.fromstring((out / "study_dd.svg").read_text()).itertext())
@@ -326,6 +340,7 @@ def test_cli_one_line_errors_and_nothing_written(tmp_path):
         ([str(tmp_path / "ok.csv"), "--prior", "multi"], "no rows of prior 'multi'"),
         ([str(tmp_path / "ok.csv"), "--law-max", "-1"], "--law-max must be a finite number"),
         ([str(tmp_path / "ok.csv"), "--at", "nan"], "--at must be a finite number"),
+        ([str(tmp_path / "ok.csv"), "--formats", "png,eps"], "--formats takes png, svg and pdf"),
     ):
         res = subprocess.run(
             [sys.executable, "-m", "eyeviz", "report", "study", *args, "-o", str(out)],
@@ -342,11 +357,11 @@ def test_cli_one_line_errors_and_nothing_written(tmp_path):
 def test_the_prior_is_the_tables_own_unless_chosen(tmp_path):
     rows = [{**r, "prior": "multi"} for r in synthetic_rows(C=0.3)]
     path = write_table(tmp_path / "m.csv", rows)
-    study.write_report(path, tmp_path / "a", law_max=10.0)
+    study.write_report(path, tmp_path / "a", law_max=10.0, formats=("svg",))
     js = json.loads((tmp_path / "a" / "summary.json").read_text())
     assert js["source"]["prior"] == "multi" and js["law"]["C"] == pytest.approx(0.3)
     both = write_table(tmp_path / "b.csv", rows + synthetic_rows(C=0.2))
-    study.write_report(both, tmp_path / "b", law_max=10.0)
+    study.write_report(both, tmp_path / "b", law_max=10.0, formats=("svg",))
     js = json.loads((tmp_path / "b" / "summary.json").read_text())
     assert js["source"]["prior"] == "single" and js["law"]["C"] == pytest.approx(0.2)
     with pytest.raises(EyevizError, match="no rows of prior 'single'"):
