@@ -175,7 +175,7 @@ def _ray_region_draws(eb: _Eye, ca, u_lo, u_hi, good, slack, u_dead: float):
         n = good.shape[0]
         sl = kernels.arg(np.broadcast_to(slack, (n, 1))[:, 0], np.float64)
         t = np.linspace(0.0, 1.0, RAY_GRID)
-        ray_region_kernel(eb.a_lit, eb.t_lit, eb.a_unl, eb.t_unl, eb.c, eb.e1, eb.e2,
+        ray_region_kernel(eb.a_lit, eb.t_lit, eb.a_unl, eb.t_unl, eb.lists, eb.c, eb.e1, eb.e2,
                           kernels.arg(eb.a, np.float64), kernels.arg(ca, np.float64),
                           lo, hi, sl, t, RAY_ROUNDS, kernels.arg(good))  # fmt: skip
         return np.where(good, lo, u_dead), np.where(good, hi, u_dead)

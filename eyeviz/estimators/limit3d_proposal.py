@@ -252,6 +252,9 @@ class _Eye:
         self.t_lit = np.where(lit[..., None], self.t, 0.0)
         self.a_unl = np.where(unl, self.d * self.d, np.inf)
         self.t_unl = np.where(unl[..., None], 2.0 * self.d[..., None] * self.t, 0.0)
+        # the same forms of the lit cells alone and of the unlit ones alone, in slot order
+        # (the kernels' loops skip the others' -inf / +inf slots: _affine_lists)
+        self.lists = (*_packed(lit, self.a_lit, self.t_lit), *_packed(unl, self.a_unl, self.t_unl))
 
     def model(self, delta: np.ndarray) -> np.ndarray:
         """Each edge cell's modelled distance (N, K, G) at gnomonic offsets delta (N, G, 2).
@@ -279,7 +282,7 @@ class _Eye:
 
             lo = np.empty(delta.shape[:2])
             hi = np.empty(delta.shape[:2])
-            affine_bounds_kernel(self.a_lit, self.t_lit, self.a_unl, self.t_unl,
+            affine_bounds_kernel(self.a_lit, self.t_lit, self.a_unl, self.t_unl, self.lists,
                                  kernels.arg(delta, np.float64), lo, hi)  # fmt: skip
             return lo, hi
         return self._bounds_ref(delta)
@@ -312,6 +315,19 @@ class _Eye:
         x, y = np.einsum("nmj,nj->nm", v, self.e1), np.einsum("nmj,nj->nm", v, self.e2)
         with np.errstate(divide="ignore", invalid="ignore"):  # v at 90 deg: inf, no warning
             return np.stack([x / cc, y / cc], axis=-1)
+
+
+def _packed(sel: np.ndarray, a: np.ndarray, t: np.ndarray):
+    """The slots ``sel`` (N, K) of each row first, in slot order: (a (N, KS), t (N, KS, 2),
+    counts (N,)), KS >= 1 (beyond a row's count: any of its other slots)."""
+    cnt = sel.sum(axis=1)
+    ks = max(1, int(cnt.max()) if cnt.size else 1)
+    order = np.argsort(~sel, axis=1, kind="stable")[:, :ks]
+    return (
+        np.ascontiguousarray(np.take_along_axis(a, order, 1)),
+        np.ascontiguousarray(np.take_along_axis(t, order[..., None], 1)),
+        cnt.astype(np.int64),
+    )
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

@@ -53,7 +53,7 @@ def test_affine_bounds_kernel_is_the_reference_bit_for_bit(seed, k, special):
     if special:  # inf, NaN, huge and tiny offsets: numpy's NaN rules must hold
         delta.ravel()[rng.integers(0, delta.size, 6)] = rng.choice(SPECIAL, 6)
     lo, hi = np.empty((3, 17)), np.empty((3, 17))
-    kr.affine_bounds_kernel(e.a_lit, e.t_lit, e.a_unl, e.t_unl, delta, lo, hi)
+    kr.affine_bounds_kernel(e.a_lit, e.t_lit, e.a_unl, e.t_unl, e.lists, delta, lo, hi)
     with np.errstate(all="ignore"):
         want_lo, want_hi = _Eye._bounds_ref(e, delta)  # type: ignore[arg-type]
     assert _same_bits(lo, want_lo) and _same_bits(hi, want_hi)

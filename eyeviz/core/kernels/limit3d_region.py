@@ -77,12 +77,36 @@ def _affine_at(a_lit, t_lit, a_unl, t_unl, n, dx, dy):
 
 
 @_jit
-def affine_bounds_kernel(a_lit, t_lit, a_unl, t_unl, delta, lo, hi):
+def _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n, dx, dy):
+    """:func:`_affine_at` on the key's lit and unlit cells alone (``lists``: the model's
+    lit cells (l_a (N, KL), l_t (N, KL, 2), nl (N,)) and unlit ones (u_a, u_t, nu) in slot
+    order, _Eye._affine): a padding or unlit slot gives max_lit -inf - (0 dx + 0 dy) =
+    -inf, which changes no maximum, and likewise +inf for min_unlit, as long as dx and dy
+    are finite (0 * inf is NaN: then every slot, as the reference)."""
+    if not (math.isfinite(dx) and math.isfinite(dy)):
+        return _affine_at(a_lit, t_lit, a_unl, t_unl, n, dx, dy)
+    l_a, l_t, nl, u_a, u_t, nu = lists
+    lo = -np.inf
+    for k in range(nl[n]):
+        v = l_t[n, k, 0] * dx
+        v = v + l_t[n, k, 1] * dy
+        lo = _max(lo, l_a[n, k] - v)
+    hi2 = np.inf
+    for k in range(nu[n]):
+        w = u_t[n, k, 0] * dx
+        w = w + u_t[n, k, 1] * dy
+        hi2 = _min(hi2, u_a[n, k] - w)
+    hi2 = hi2 + (dx * dx + dy * dy)
+    return lo, math.sqrt(_max(hi2, 0.0))
+
+
+@_jit
+def affine_bounds_kernel(a_lit, t_lit, a_unl, t_unl, lists, delta, lo, hi):
     """_Eye.bounds: lo, hi (N, G) at gnomonic offsets delta (N, G, 2)."""
     for n in range(delta.shape[0]):
         for g in range(delta.shape[1]):
-            lo[n, g], hi[n, g] = _affine_at(
-                a_lit, t_lit, a_unl, t_unl, n, delta[n, g, 0], delta[n, g, 1]
+            lo[n, g], hi[n, g] = _affine_lists(
+                a_lit, t_lit, a_unl, t_unl, lists, n, delta[n, g, 0], delta[n, g, 1]
             )
 
 
@@ -99,7 +123,7 @@ def _clean(x):
 
 
 @_jit
-def _gap_at(a_lit, t_lit, a_unl, t_unl, c, e1, e2, a, n, cax, cay, caz, u):
+def _gap_at(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, caz, u):
     """G = min_unlit - max_lit of B's model (key n) seen along A's ray at u."""
     vx = cax + u * a[0]
     vy = cay + u * a[1]
@@ -109,15 +133,15 @@ def _gap_at(a_lit, t_lit, a_unl, t_unl, c, e1, e2, a, n, cax, cay, caz, u):
     cc = vx * c[n, 0] + vy * c[n, 1] + vz * c[n, 2]
     x = vx * e1[n, 0] + vy * e1[n, 1] + vz * e1[n, 2]
     y = vx * e2[n, 0] + vy * e2[n, 1] + vz * e2[n, 2]
-    lo, hi = _affine_at(a_lit, t_lit, a_unl, t_unl, n, _clean(x / cc), _clean(y / cc))
+    lo, hi = _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n, _clean(x / cc), _clean(y / cc))
     return hi - lo
 
 
 # long: one draw's search (grid, first / last inside, argmax fallback, rounds) is one loop
 # nest; split, it would pass a dozen scalars back and forth
 @_jit
-def ray_region_kernel(a_lit, t_lit, a_unl, t_unl, c, e1, e2, a, ca, lo, hi, slack, t,
-                      rounds, live):  # fmt: skip
+def ray_region_kernel(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, ca, lo, hi, slack,
+                      t, rounds, live):  # fmt: skip
     """_ray_in_region on the draws where ``live`` (N, M): lo, hi (N, M) shrunk in place."""
     grid = t.size
     gv = np.empty(grid)
@@ -133,7 +157,7 @@ def ray_region_kernel(a_lit, t_lit, a_unl, t_unl, c, e1, e2, a, ca, lo, hi, slac
                 best = 0
                 for j in range(grid):
                     uu[j] = lo_ + (hi_ - lo_) * t[j]
-                    gv[j] = _gap_at(a_lit, t_lit, a_unl, t_unl, c, e1, e2, a, n,
+                    gv[j] = _gap_at(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n,
                                     ca[n, m, 0], ca[n, m, 1], ca[n, m, 2], uu[j])  # fmt: skip
                     if gv[j] >= -slack[n]:
                         if first < 0:
@@ -441,12 +465,14 @@ def warm() -> None:
     a3 = np.zeros((1, 1, 2))
     d = np.zeros((1, 1, 2))
     out = np.zeros((1, 1))
-    affine_bounds_kernel(a2, a3, a2, a3, d, out, out.copy())
+    n1 = np.ones(1, np.int64)
+    lists = (a2, a3, n1, a2, a3, n1)
+    affine_bounds_kernel(a2, a3, a2, a3, lists, d, out, out.copy())
     v3 = np.ones(3)
     c = np.ones((1, 3))
     ca = np.ones((1, 1, 3))
     b = np.ones((1, 1), np.bool_)
-    ray_region_kernel(a2, a3, a2, a3, c, c, c, v3, ca, out, out + 1, np.ones(1),
+    ray_region_kernel(a2, a3, a2, a3, lists, c, c, c, v3, ca, out, out + 1, np.ones(1),
                       np.linspace(0.0, 1.0, 3), 1, b)  # fmt: skip
     p3 = np.ones((1, 1, 3))
     cs = (p3, p3, a2 + 0.9, a2 + 0.1, b, ~b)
