@@ -6,6 +6,7 @@ the pair's own exact ``lit_csr`` gives both of the key's lit sets and ``in_bfv``
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -88,8 +89,11 @@ def exact_hits(
     if not row.size:
         return hit
     x, y, z = p[:, 0], p[:, 1], p[:, 2]
-    (pa, ia), (pb, ib) = domain.eyes.lit_csr(x, y, z, g)
-    match = same_rows(pa, ia, lit_a, row) & same_rows(pb, ib, lit_b, row)
+    if domain.kind != "measured" and kernels.use(row.size):
+        match = _match_healpix(domain.eyes, x, y, z, g, row, lit_a, lit_b)
+    else:
+        (pa, ia), (pb, ib) = domain.eyes.lit_csr(x, y, z, g)
+        match = same_rows(pa, ia, lit_a, row) & same_rows(pb, ib, lit_b, row)
     at = np.flatnonzero(match)
     if not at.size:
         return hit
@@ -103,3 +107,44 @@ def exact_hits(
     else:
         hit[at] = domain.eyes.in_bfv(x[at], y[at], z[at], g[at])
     return hit
+
+
+def _match_healpix(eyes, x, y, z, g, row, lit_a: LitCSR, lit_b: LitCSR) -> np.ndarray:
+    """``same_rows`` of the pair's ``lit_csr`` of the balls against the key's rows ``row``
+    for both eyes, without the lit sets: the lit-set kernel's rings compared with the
+    key's as they come, each ball given up at its first ring that differs (eye B only
+    for the balls eye A did not rule out); the balls the kernel hands to the reference
+    (kernels.healpix_lit.match_kernel: 2) get ``lit_csr`` and ``same_rows``. The same
+    answer for every ball (tests/estimators/test_limit3d_match.py)."""
+    from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
+    from eyeviz.core.kernels import healpix_lit
+
+    # Any: the kernel takes 19 arrays and numbers (numba's Dispatcher stub types fewer)
+    match_kernel: Any = healpix_lit.match_kernel
+
+    xs, ys, zs, gs = (kernels.arg(v, np.float64) for v in (x, y, z, g))
+    if not (np.isfinite(xs).all() and np.isfinite(ys).all() and np.isfinite(zs).all()
+            and np.isfinite(gs).all() and (gs > 0).all()):  # fmt: skip
+        (pa, ia), (pb, ib) = eyes.lit_csr(x, y, z, g)  # lit_csr's refusal, as before
+        return same_rows(pa, ia, lit_a, row) & same_rows(pb, ib, lit_b, row)
+    n = eyes.nside
+    tabs = (*_ring_tables(n), *_ring_info_tables(n))
+    rows = kernels.arg(row, np.int64)
+    res = np.zeros(row.size, np.int64)
+    todo = np.arange(row.size)
+    vc = healpix_lit.vertex_cache()
+    for cx, (kp, ki) in ((-eyes.h, lit_a), (eyes.h, lit_b)):
+        out = np.empty(todo.size, np.int64)
+        match_kernel(n, xs[todo], ys[todo], zs[todo], gs[todo], float(cx), rows[todo],
+                     kernels.arg(kp, np.int64), kernels.arg(ki, np.int64), *tabs, vc,
+                     out)  # fmt: skip
+        # 0: this eye rules the ball out; 2 in either eye: the reference decides
+        res[todo] = np.maximum(res[todo], out) if cx > 0 else out
+        res[todo[out == 0]] = 0
+        todo = todo[out != 0]
+    match = res == 1
+    ref = np.flatnonzero(res == 2)
+    if ref.size:
+        (pa, ia), (pb, ib) = eyes.lit_csr(x[ref], y[ref], z[ref], g[ref])
+        match[ref] = same_rows(pa, ia, lit_a, row[ref]) & same_rows(pb, ib, lit_b, row[ref])
+    return match

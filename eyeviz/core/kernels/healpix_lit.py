@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["lit_runs_kernel", "csr_kernel", "warm"]
+__all__ = ["lit_runs_kernel", "csr_kernel", "match_kernel", "vertex_cache", "warm"]
 
 _EPS = 2.0**-52
 _DP = 64 * _EPS
@@ -159,9 +159,10 @@ def _tol(f, s2, ed, ds2):
 
 
 @_jit
-def _decide_cell(n, i, j, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit):
+def _decide_cell(n, i, j, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit, vc):
     """healpix_fast._decide_cells for one cell (the ball's centre pixel is lit before):
-    1 lit, 0 not lit, 2 left open (mpmath decides it in the reference)."""
+    1 lit, 0 not lit, 2 left open (mpmath decides it in the reference). ``vc``: a vertex
+    cache (:func:`_vertex`) or none (empty arrays)."""
     cxv, cyv, czv = c
     lw = 2 * j - (0 if shifted else 1)
     ui = unit[i]
@@ -190,10 +191,10 @@ def _decide_cell(n, i, j, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit):
             ls = 2 * Ks * f + 2 * p
         un = 0.25 * math.pi / max(Kn, 1) if Kn > 0 else 0.0
         us = 0.25 * math.pi / max(Ks, 1) if Ks > 0 else 0.0
-    fN = _vdist(sth[i - 1], zr[i - 1], ln * un, c)
-    fW = _vdist(sth[i], zr[i], lw * ui, c)
-    fS = _vdist(sth[i + 1], zr[i + 1], ls * us, c)
-    fE = _vdist(sth[i], zr[i], (lw + 2) * ui, c)
+    fN = _vdist_at(vc, n, i - 1, ln, sth[i - 1], zr[i - 1], ln * un, c)
+    fW = _vdist_at(vc, n, i, lw, sth[i], zr[i], lw * ui, c)
+    fS = _vdist_at(vc, n, i + 1, ls, sth[i + 1], zr[i + 1], ls * us, c)
+    fE = _vdist_at(vc, n, i, lw + 2, sth[i], zr[i], (lw + 2) * ui, c)
     vmin = min(min(fN, fW), min(fS, fE))
     if vmin < s2 - _tol(vmin, s2, ed, ds2):
         return 1
@@ -231,6 +232,29 @@ def _decide_cell(n, i, j, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit):
         if opened == 0:
             return 0
     return 2
+
+
+@_jit
+def _vdist_at(vc, n, r, l, sv, zv, ph, c):
+    """:func:`_vdist` of the vertex l of ring level r (longitude ph = l times the level's
+    unit, the same bits from whichever cell it is reached: _decide_cell), its coordinates
+    from the cache ``vc`` = (tags, xyz) where it holds them (the same products of
+    the same numbers, so the same bits), else computed (and kept there)."""
+    tags, xyz = vc
+    size = tags.shape[0]
+    if size == 0:
+        return _vdist(sv, zv, ph, c)
+    key = r * (16 * n + 16) + l + 1
+    h = (key * 0x9E3779B1) & (size - 1)
+    if tags[h] != key:
+        tags[h] = key
+        xyz[h, 0] = sv * math.cos(ph)
+        xyz[h, 1] = sv * math.sin(ph)
+        xyz[h, 2] = zv
+    vx = xyz[h, 0] - c[0]
+    vy = xyz[h, 1] - c[1]
+    vz = xyz[h, 2] - c[2]
+    return vx * vx + vy * vy + vz * vz
 
 
 @_jit
@@ -304,6 +328,78 @@ def _grow(buf, k):
     return new
 
 
+@_jit
+def _ball(n, xb, yb, zb, gb, cx):
+    """The per-ball steps of healpix_fast._lit_runs_fast before the rings, for one ball
+    and the eye at (cx, 0, 0): (kind, ring parameters, i_min, i_max); kind 0: go ring by
+    ring, 1: the reference decides (near the eye centre's sphere, grazing or tiny caps),
+    3: the ball holds the eye centre (every facet lit). The ring parameters are those
+    :func:`_ring` takes after ``i`` and before the ring tables."""
+    dx0 = xb - cx
+    bv = dx0 - xb
+    err = (xb - (dx0 - bv)) + (-cx - bv)
+    errabs0 = abs(err) + 2.0**-1070
+    big = max(max(abs(dx0), abs(yb)), max(abs(zb), gb))
+    ex = math.frexp(big)[1]
+    dx = math.ldexp(dx0, -ex)
+    dy = math.ldexp(yb, -ex)
+    dz = math.ldexp(zb, -ex)
+    gs = math.ldexp(gb, -ex)
+    errabs = math.ldexp(errabs0, -ex)
+    d = math.sqrt(dx * dx + dy * dy + dz * dz)
+    ed = 8 * _EPS + 4 * errabs / d
+    dmg = (d - gs) * (d + gs)
+    sep = 8 * _EPS * (d + gs) ** 2 + 4 * errabs * (d + gs)
+    c = (0.0, 0.0, 1.0)
+    none = (c, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, np.int64(0))
+    if abs(dmg) <= sep or not (math.isfinite(dmg) and math.isfinite(sep)):
+        return 1, none, np.int64(0), np.int64(-1)  # near the eye centre's sphere
+    if dmg < -sep:
+        return 3, none, np.int64(0), np.int64(-1)
+    q = gs / d
+    rdm = math.sqrt(max(dmg, 0.0))
+    dcos = (4 * _EPS * d + 4 * errabs) * (d + gs) / (rdm * d)
+    dcos = dcos + 4 * _EPS if math.isfinite(dcos) else 4.0
+    cosa = rdm / d
+    alpha = math.atan2(q, cosa)
+    if dcos > 1e-9 or not alpha > 1e6 * ed:
+        return 1, none, np.int64(0), np.int64(-1)  # grazing or tiny caps
+    s2 = 2 * q * q / (1 + cosa)
+    ds2 = 2 * dcos + 8 * _EPS * s2
+    dalpha = dcos / max(q, 1e-300) + 8 * _EPS
+    rxy = math.hypot(dx, dy)
+    rho_c = rxy / d
+    z_c = dz / d
+    theta_c = math.atan2(rxy, dz)
+    phi_c = math.atan2(dy, dx)
+    dphi = 4 * ed / max(rho_c, 1e-300) + 1e-12
+    pad_t = dalpha + 4 * ed + 1e-12
+    th_lo = min(max(theta_c - alpha - pad_t, 0.0), math.pi)
+    th_hi = min(max(theta_c + alpha + pad_t, 0.0), math.pi)
+    i_min = np.int64(math.floor(n * _jr_of_theta(th_lo) * (1 - 1e-12))) - 1
+    i_max = np.int64(math.ceil(n * _jr_of_theta(th_hi) * (1 + 1e-12))) + 1
+    i_min = min(max(i_min, np.int64(1)), 4 * n - 1)
+    i_max = min(max(i_max, np.int64(1)), 4 * n - 1)
+    zc_hi = math.cos(th_lo)
+    zc_lo = math.cos(th_hi)
+    c = (dx / d, dy / d, dz / d)
+    cpix = _ang2pix(n, min(max(z_c, -1.0), 1.0) if d > 0 else 1.0, phi_c)
+    dnum = dcos + 2 * ed + 4 * _EPS
+    drel = 2 * ed / max(rho_c, 1e-300) + 8 * _EPS
+    dph = dphi + 1e-9
+    par = (c, cosa, z_c, rho_c, phi_c, zc_lo, zc_hi, dnum, drel, dph, s2, ds2, ed, cpix)
+    return 0, par, i_min, i_max
+
+
+@_jit
+def _ring_at(n, i, par, sth, zr, unit, first_t, nr_t, shifted_t, delta_t, o_t, vc):
+    """:func:`_ring` of ring i with a ball's parameters ``par`` (:func:`_ball`)."""
+    c, cosa, z_c, rho_c, phi_c, zc_lo, zc_hi, dnum, drel, dph, s2, ds2, ed, cpix = par
+    return _ring(n, i, c, cosa, z_c, rho_c, phi_c, zc_lo, zc_hi, dnum, drel, dph, s2, ds2,
+                 ed, cpix, sth, zr, unit, first_t[i], nr_t[i], shifted_t[i], delta_t[i],
+                 o_t[i], vc)  # fmt: skip
+
+
 # long: the steps of healpix_fast._lit_runs_fast for each ball in compiled code, in the same
 # order, so the two read side by side
 @_jit
@@ -321,92 +417,22 @@ def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, 
     ln = np.empty(64 + 8 * nb, np.int64)
     bl = np.empty(64 + 8 * nb, np.int64)
     w = 0
+    vc = (np.empty(0, np.int64), np.empty((0, 3)))  # no vertex cache
     for b in range(nb):
         w0 = w
-        dx0 = x[b] - cx
-        bv = dx0 - x[b]
-        err = (x[b] - (dx0 - bv)) + (-cx - bv)
-        errabs0 = abs(err) + 2.0**-1070
-        big = max(max(abs(dx0), abs(y[b])), max(abs(z[b]), g[b]))
-        ex = math.frexp(big)[1]
-        dx = math.ldexp(dx0, -ex)
-        dy = math.ldexp(y[b], -ex)
-        dz = math.ldexp(z[b], -ex)
-        gs = math.ldexp(g[b], -ex)
-        errabs = math.ldexp(errabs0, -ex)
-        d = math.sqrt(dx * dx + dy * dy + dz * dz)
-        ed = 8 * _EPS + 4 * errabs / d
-        dmg = (d - gs) * (d + gs)
-        sep = 8 * _EPS * (d + gs) ** 2 + 4 * errabs * (d + gs)
-        if abs(dmg) <= sep or not (math.isfinite(dmg) and math.isfinite(sep)):
-            status[b] = 1  # near the eye centre's sphere: exact in the reference
+        kind, par, i_min, i_max = _ball(n, x[b], y[b], z[b], g[b], cx)
+        if kind == 1:
+            status[b] = 1  # the reference's exact branches
             continue
-        if dmg < -sep:
+        if kind == 3:
             st[w], ln[w], bl[w] = 0, npix, b
             w += 1
             per[b] = npix
             continue
-        q = gs / d
-        rdm = math.sqrt(max(dmg, 0.0))
-        dcos = (4 * _EPS * d + 4 * errabs) * (d + gs) / (rdm * d)
-        dcos = dcos + 4 * _EPS if math.isfinite(dcos) else 4.0
-        cosa = rdm / d
-        alpha = math.atan2(q, cosa)
-        if dcos > 1e-9 or not alpha > 1e6 * ed:
-            status[b] = 1  # grazing or tiny caps: the reference's exact branches
-            continue
-        s2 = 2 * q * q / (1 + cosa)
-        ds2 = 2 * dcos + 8 * _EPS * s2
-        dalpha = dcos / max(q, 1e-300) + 8 * _EPS
-        rxy = math.hypot(dx, dy)
-        rho_c = rxy / d
-        z_c = dz / d
-        theta_c = math.atan2(rxy, dz)
-        phi_c = math.atan2(dy, dx)
-        dphi = 4 * ed / max(rho_c, 1e-300) + 1e-12
-        pad_t = dalpha + 4 * ed + 1e-12
-        th_lo = min(max(theta_c - alpha - pad_t, 0.0), math.pi)
-        th_hi = min(max(theta_c + alpha + pad_t, 0.0), math.pi)
-        i_min = np.int64(math.floor(n * _jr_of_theta(th_lo) * (1 - 1e-12))) - 1
-        i_max = np.int64(math.ceil(n * _jr_of_theta(th_hi) * (1 + 1e-12))) + 1
-        i_min = min(max(i_min, np.int64(1)), 4 * n - 1)
-        i_max = min(max(i_max, np.int64(1)), 4 * n - 1)
-        zc_hi = math.cos(th_lo)
-        zc_lo = math.cos(th_hi)
-        c = (dx / d, dy / d, dz / d)
-        cpix = _ang2pix(n, min(max(z_c, -1.0), 1.0) if d > 0 else 1.0, phi_c)
-        dnum = dcos + 2 * ed + 4 * _EPS
-        drel = 2 * ed / max(rho_c, 1e-300) + 8 * _EPS
-        dph = dphi + 1e-9
         ok = True
         for i in range(i_min, i_max + 1):
-            res = _ring(
-                n,
-                i,
-                c,
-                cosa,
-                z_c,
-                rho_c,
-                phi_c,
-                zc_lo,
-                zc_hi,
-                dnum,
-                drel,
-                dph,
-                s2,
-                ds2,
-                ed,
-                cpix,
-                sth,
-                zr,
-                unit,
-                first_t[i],
-                nr_t[i],
-                shifted_t[i],
-                delta_t[i],
-                o_t[i],
-            )
-            kind, lo, hi = res
+            kind, lo, hi = _ring_at(n, i, par, sth, zr, unit, first_t, nr_t, shifted_t,
+                                    delta_t, o_t, vc)  # fmt: skip
             if kind == 2:
                 ok = False
                 break
@@ -434,11 +460,78 @@ def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, 
     return status, per, st[:w], ln[:w], bl[:w]
 
 
+def vertex_cache(size: int = 1 << 14) -> tuple[np.ndarray, np.ndarray]:
+    """An empty vertex cache of ``size`` (a power of 2; 0: none) for :func:`match_kernel`:
+    (tags, xyz), tags -1 where empty."""
+    return np.full(size, -1, np.int64), np.empty((size, 3))
+
+
+@_jit
+def _piece(ki, k, end, s, length):
+    """Whether the key's indices ki[k:end] begin with s, s + 1, ..., s + length - 1."""
+    if k + length > end:
+        return False
+    for j in range(length):
+        if ki[k + j] != s + j:
+            return False
+    return True
+
+
+# long: lit_runs_kernel's ring loop, its runs compared with the key's as they come
+@_jit
+def match_kernel(n, x, y, z, g, cx, row, kp, ki, sth, zr, unit, first_t, nr_t, shifted_t,
+                 delta_t, o_t, vc, out):  # fmt: skip
+    """Whether each ball b lights exactly the facets of row ``row[b]`` of the CSR (kp, ki)
+    (sorted indices) in this eye: out[b] 1 yes, 0 no, 2 the kernel cannot tell (a ball
+    lit_runs_kernel hands to the reference, met before a mismatch). The same rings and
+    decisions as :func:`lit_runs_kernel`, its runs compared with the key's as they come
+    (no indices written) and a ball given up at its first ring that differs: a decided
+    ring is the reference's, so a difference there is one of the exact lit sets. ``vc``:
+    a vertex cache (:func:`vertex_cache`; the balls of a call lie near a few keys' balls,
+    so their undecided cells share vertices)."""
+    npix = 12 * n * n
+    for b in range(x.shape[0]):
+        k, end = kp[row[b]], kp[row[b] + 1]
+        kind, par, i_min, i_max = _ball(n, x[b], y[b], z[b], g[b], cx)
+        if kind == 1:
+            out[b] = 2
+            continue
+        if kind == 3:
+            out[b] = 1 if _piece(ki, k, end, 0, npix) and end - k == npix else 0
+            continue
+        res = 1
+        for i in range(i_min, i_max + 1):
+            kind, lo, hi = _ring_at(n, i, par, sth, zr, unit, first_t, nr_t, shifted_t,
+                                    delta_t, o_t, vc)  # fmt: skip
+            if kind == 2:
+                res = 2
+                break
+            if kind == 0:
+                continue
+            f = first_t[i]
+            nr = nr_t[i]
+            lo_w = lo % nr
+            length = hi - lo + 1
+            e = lo_w + length
+            if e > nr:  # the piece at the ring's start first
+                ok = _piece(ki, k, end, f, e - nr) and _piece(ki, k + e - nr, end, f + lo_w,
+                                                               nr - lo_w)  # fmt: skip
+            else:
+                ok = _piece(ki, k, end, f + lo_w, length)
+            if not ok:
+                res = 0
+                break
+            k += length
+        if res == 1 and k != end:
+            res = 0  # the key lights more
+        out[b] = res
+
+
 # long: one (ball, ring) pair of healpix_fast._lit_runs_fast in compiled code, in the same
 # order, so the two read side by side
 @_jit
 def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2, ed,
-          cpix, sth, zr, unit, first, nr, shifted, delta, o):  # fmt: skip
+          cpix, sth, zr, unit, first, nr, shifted, delta, o, vc):  # fmt: skip
     """One (ball, ring) pair of healpix_fast._lit_runs_fast: (0, 0, 0) nothing lit,
     (1, lo, hi) the lit cells lo .. hi (unwrapped), (2, 0, 0) the reference decides."""
     zb_lo, zb_hi, z_i = zr[i + 1], zr[i - 1], zr[i]
@@ -507,7 +600,8 @@ def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2
             if pix == cpix:
                 r = 1
             else:
-                r = _decide_cell(n, i, jw, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit)
+                r = _decide_cell(n, i, jw, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit,
+                                 vc)  # fmt: skip
             if r == 2:
                 return 2, 0, 0
             if r == 1:
@@ -558,3 +652,6 @@ def warm() -> None:
         n, x, y, z, g, 40.0, sth, zr, unit, first, nr, shifted, delta, o
     )
     csr_kernel(status, per, st, ln)
+    i1 = np.zeros(1, np.int64)
+    match_kernel(n, x, y, z, g, 40.0, i1, np.array([0, 1]), i1, sth, zr, unit, first, nr,
+                 shifted, delta, o, vertex_cache(16), i1.copy())  # fmt: skip

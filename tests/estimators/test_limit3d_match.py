@@ -1,0 +1,166 @@
+"""The spherical limit's exact check without lit sets (issue 31 item 3):
+limit3d_exact._match_healpix (the lit-set kernel's rings compared with the key's as they
+come, kernels.healpix_lit.match_kernel) gives the same accept / reject as building both
+eyes' lit sets with ``lit_csr`` and comparing them with ``same_rows``, draw by draw: on
+every tie class of the spherical stability cases (poles, equator ties, vertices, grazing,
+extreme scales) with keys that are the ball's own lit sets and near misses of them, and on
+the HEALPix proposal's own candidate draws at nside 16 and 180."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import eyeviz.core.geometry3d as g3
+from eyeviz.core import kernels
+from eyeviz.core.domain import Domain3D
+from eyeviz.dataset.algorithm1_3d import generate3d
+from eyeviz.estimators import limit3d_exact, limit3d_healpix
+from eyeviz.estimators.base import take_rows
+from eyeviz.reference import stability_cases as sc
+
+pytest.importorskip("eyeviz.core.kernels.healpix_lit")
+
+NSIDES = [2, 4, 6, 8, 10, 12, 16, 18, 64, 180]
+
+
+def _csr(rows: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    ptr = np.zeros(len(rows) + 1, np.int64)
+    ptr[1:] = np.cumsum([r.size for r in rows])
+    ind = np.concatenate(rows).astype(np.int64) if rows else np.zeros(0, np.int64)
+    return ptr, ind
+
+
+def _variants(s: np.ndarray, other: np.ndarray, npix: int) -> list[np.ndarray]:
+    """A lit set and its near misses: itself, without its first / last / a middle cell,
+    with the cell after its last or before its first, with a far cell, another ball's."""
+    out = [s, s[1:], s[:-1], np.delete(s, s.size // 2) if s.size > 2 else s[:0], other]
+    if s.size and s[-1] + 1 < npix:
+        out.append(np.append(s, s[-1] + 1))
+    if s.size and s[0] > 0:
+        out.append(np.insert(s, 0, s[0] - 1))
+    far = npix - 1 if not s.size or s[-1] < npix - 1 else 0
+    out.append(np.union1d(s, [far]))
+    return out
+
+
+def _check(eyes, x, y, z, g) -> tuple[int, int]:
+    """Both checks on every ball against every variant of its lit sets (eye A's and B's
+    varied apart); returns (draws, matches)."""
+    x, y, z, g = (np.ascontiguousarray(v, dtype=np.float64).ravel() for v in (x, y, z, g))
+    (pa, ia), (pb, ib) = eyes.lit_csr(x, y, z, g)
+    sa = [ia[pa[i] : pa[i + 1]] for i in range(x.size)]
+    sb = [ib[pb[i] : pb[i + 1]] for i in range(x.size)]
+    keys_a, keys_b, ball = [], [], []
+    for i in range(x.size):
+        j = (i + 1) % x.size
+        va = _variants(sa[i], sa[j], eyes.npix)
+        vb = _variants(sb[i], sb[j], eyes.npix)
+        for ka, kb in [(a, sb[i]) for a in va] + [(sa[i], b) for b in vb[1:]]:
+            keys_a.append(ka)
+            keys_b.append(kb)
+            ball.append(i)
+    lit_a, lit_b = _csr(keys_a), _csr(keys_b)
+    row = np.arange(len(ball), dtype=np.int64)
+    b = np.array(ball)
+    got = limit3d_exact._match_healpix(eyes, x[b], y[b], z[b], g[b], row, lit_a, lit_b)
+    # lit_csr of the balls, compared with each key (same_rows: the check as it was)
+    qa, ja = _csr([sa[i] for i in ball])
+    qb, jb = _csr([sb[i] for i in ball])
+    want = limit3d_exact.same_rows(qa, ja, lit_a, row) & limit3d_exact.same_rows(qb, jb, lit_b, row)
+    bad = np.flatnonzero(got != want)
+    assert not bad.size, [(x[b][i], y[b][i], z[b][i], g[b][i], want[i]) for i in bad[:3]]
+    return row.size, int(want.sum())
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    name=st.sampled_from(sorted(sc.CLASSES3D)),
+    seed=st.integers(0, 2**20),
+    nside=st.sampled_from([None, *NSIDES]),
+)
+def test_match_equals_lit_sets_on_every_tie_class(name, seed, nside):
+    cs = sc.make(name, 5, seed, "spherical")
+    eyes = cs.eyes if nside is None else g3.EyePair3D(cs.eyes.h, cs.eyes.l, nside)
+    n, hits = _check(eyes, cs.x, cs.y, cs.z, cs.g)
+    assert 0 < hits < n
+
+
+def test_match_decides_the_paper_regime_in_the_kernel():
+    """The kernel itself answers nearly every paper-regime draw (2: the reference), so the
+    comparison above compares the kernel, not lit_csr with itself."""
+    from eyeviz.core.kernels.healpix_lit import match_kernel, vertex_cache
+
+    eyes = g3.EyePair3D(40.0, 20.0, 180)
+    cs = sc.make("paper", 40, 3, "spherical")
+    x, y, z, g = (np.ascontiguousarray(v, dtype=np.float64) for v in (cs.x, cs.y, cs.z, cs.g))
+    pa, ia = eyes.lit_csr(x, y, z, g)[0]
+    out = np.empty(x.size, np.int64)
+    tabs = (*g3._ring_tables(180), *g3._ring_info_tables(180))
+    match_kernel(180, x, y, z, g, -40.0, np.arange(x.size), pa, ia, *tabs, vertex_cache(), out)
+    assert (out == 1).sum() >= x.size - 1
+    out2 = np.empty(x.size, np.int64)
+    match_kernel(180, x, y, z, g, -40.0, (np.arange(x.size) + 1) % x.size, pa, ia, *tabs,
+                 vertex_cache(0), out2)  # fmt: skip
+    assert (out2 == 0).sum() >= x.size - 1
+
+
+def test_balls_holding_the_eye_and_on_its_sphere():
+    """Whole-eye balls (every facet lit: the kernel's own branch) and balls whose sphere
+    passes through the eye centre or graze it (handed to the reference)."""
+    eyes = g3.EyePair3D(40.0, 20.0, 8)
+    x = np.array([-40.0, -39.0, 40.0, 0.0, -40.0, 10.0])
+    y = np.array([0.0, 1.0, 2.0, 500.0, 300.0, 60.0])
+    z = np.array([0.0, 0.5, -1.0, 3.0, 0.0, 2.0])
+    g = np.array([5.0, 3.0, 4.0, float(np.hypot(40.0, np.hypot(500.0, 3.0))), 300.0, 1e-9])
+    _check(eyes, x, y, z, g)
+
+
+@pytest.mark.parametrize("nside", [16, 180])
+def test_match_equals_lit_sets_on_the_proposal_draws(nside, monkeypatch):
+    """The proposal's candidate draws of a few keys (before the prefilter, so most are
+    near misses): the same accept / reject draw by draw, and some of each."""
+    d = Domain3D(nside=nside)
+    ds = generate3d(4, d, seed=nside)
+    rows = np.arange(4)
+    la = take_rows(ds.indptr_a, ds.indices_a, rows)
+    lb = take_rows(ds.indptr_b, ds.indices_b, rows)
+    seen = []
+    real = limit3d_healpix._prefilter
+    monkeypatch.setattr(limit3d_healpix, "_prefilter", lambda e, r, c, a: np.ones(r.size, bool))
+
+    def spy(domain, p, g, row, lit_a, lit_b):
+        seen.append((p.copy(), g.copy(), row.copy()))
+        return limit3d_exact.exact_hits(domain, p, g, row, lit_a, lit_b)
+
+    monkeypatch.setattr(limit3d_healpix, "exact_hits", spy)
+    prop = limit3d_healpix.HealpixProposal(d, "single", 512, 8)
+    keys = np.arange(4, dtype=np.uint64) * np.uint64(7919)
+    prop.sample(prop.setup(la, lb, keys, 1.0), keys, 0)
+    assert real is not None and seen
+    p, g, row = seen[0]
+    assert kernels.use(row.size)
+    got = limit3d_exact._match_healpix(d.eyes, p[:, 0], p[:, 1], p[:, 2], g, row, la, lb)
+    (pa, ia), (pb, ib) = d.eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
+    want = limit3d_exact.same_rows(pa, ia, la, row) & limit3d_exact.same_rows(pb, ib, lb, row)
+    assert np.array_equal(got, want)
+    assert 5 <= want.sum() < want.size - 5
+
+
+def test_exact_hits_take_the_lit_sets_with_eyeviz_jit_0(monkeypatch):
+    """EYEVIZ_JIT=0: exact_hits builds the lit sets (the reference), never the kernel."""
+    import eyeviz.core.kernels.healpix_lit as hl
+
+    def boom(*a):
+        raise AssertionError("match kernel called with EYEVIZ_JIT=0")
+
+    monkeypatch.setattr(hl, "match_kernel", boom)
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    d = Domain3D(nside=8)
+    ds = generate3d(3, d, seed=1)
+    la, lb = (ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b)
+    p = np.stack([ds.x, ds.y, ds.z], axis=1)
+    hit = limit3d_exact.exact_hits(d, p, ds.g, np.arange(3), la, lb)
+    assert hit.all()
