@@ -80,17 +80,25 @@ def same_rows(ptr: np.ndarray, ind: np.ndarray, key: LitCSR, row: np.ndarray) ->
 
 
 def exact_hits(
-    domain: Domain3D, p: np.ndarray, g: np.ndarray, row: np.ndarray, lit_a: LitCSR, lit_b: LitCSR
+    domain: Domain3D,
+    p: np.ndarray,
+    g: np.ndarray,
+    row: np.ndarray,
+    lit_a: LitCSR,
+    lit_b: LitCSR,
+    bands: tuple | None = None,
 ) -> np.ndarray:
     """The 0/1 likelihood of draws (centres p (D, 3), radii g (D,)) of the keys ``row``
     (D,): the pair's exact ``lit_csr`` gives both of the key's lit sets and the ball is in
-    the binocular field (``in_bfv``, decided only on the draws that match)."""
+    the binocular field (``in_bfv``, decided only on the draws that match). HEALPix
+    ``bands``: per eye, the keys' band cells (limit3d_proposal._Eye.band), which decide
+    most draws first (:func:`_match_healpix`)."""
     hit = np.zeros(row.size, bool)
     if not row.size:
         return hit
     x, y, z = p[:, 0], p[:, 1], p[:, 2]
     if domain.kind != "measured" and kernels.use(row.size):
-        match = _match_healpix(domain.eyes, x, y, z, g, row, lit_a, lit_b)
+        match = _match_healpix(domain.eyes, x, y, z, g, row, lit_a, lit_b, bands)
     else:
         (pa, ia), (pb, ib) = domain.eyes.lit_csr(x, y, z, g)
         match = same_rows(pa, ia, lit_a, row) & same_rows(pb, ib, lit_b, row)
@@ -109,18 +117,23 @@ def exact_hits(
     return hit
 
 
-def _match_healpix(eyes, x, y, z, g, row, lit_a: LitCSR, lit_b: LitCSR) -> np.ndarray:
+def _match_healpix(
+    eyes, x, y, z, g, row, lit_a: LitCSR, lit_b: LitCSR, bands: tuple | None = None
+) -> np.ndarray:
     """``same_rows`` of the pair's ``lit_csr`` of the balls against the key's rows ``row``
-    for both eyes, without the lit sets: the lit-set kernel's rings compared with the
-    key's as they come, each ball given up at its first ring that differs (eye B only
-    for the balls eye A did not rule out); the balls the kernel hands to the reference
-    (kernels.healpix_lit.match_kernel: 2) get ``lit_csr`` and ``same_rows``. The same
-    answer for every ball (tests/estimators/test_limit3d_match.py)."""
+    for both eyes, without the lit sets (eye B only for the balls eye A did not rule
+    out): with ``bands``, from the key's band cells alone where the ball's cap lies
+    between the key's inner and outer caps (kernels.healpix_lit.edge_match_kernel);
+    the other balls by the lit-set kernel's rings compared with the key's as they come,
+    each ball given up at its first ring that differs (match_kernel); the balls that
+    kernel hands to the reference (2) get ``lit_csr`` and ``same_rows``. The same answer
+    for every ball (tests/estimators/test_limit3d_match.py)."""
     from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
     from eyeviz.core.kernels import healpix_lit
 
-    # Any: the kernel takes 19 arrays and numbers (numba's Dispatcher stub types fewer)
+    # Any: the kernels take 19-24 arrays and numbers (numba's Dispatcher stub types fewer)
     match_kernel: Any = healpix_lit.match_kernel
+    edge_kernel: Any = healpix_lit.edge_match_kernel
 
     xs, ys, zs, gs = (kernels.arg(v, np.float64) for v in (x, y, z, g))
     if not (np.isfinite(xs).all() and np.isfinite(ys).all() and np.isfinite(zs).all()
@@ -133,11 +146,19 @@ def _match_healpix(eyes, x, y, z, g, row, lit_a: LitCSR, lit_b: LitCSR) -> np.nd
     res = np.zeros(row.size, np.int64)
     todo = np.arange(row.size)
     vc = healpix_lit.vertex_cache()
-    for cx, (kp, ki) in ((-eyes.h, lit_a), (eyes.h, lit_b)):
-        out = np.empty(todo.size, np.int64)
-        match_kernel(n, xs[todo], ys[todo], zs[todo], gs[todo], float(cx), rows[todo],
-                     kernels.arg(kp, np.int64), kernels.arg(ki, np.int64), *tabs, vc,
-                     out)  # fmt: skip
+    for e, (cx, (kp, ki)) in enumerate(((-eyes.h, lit_a), (eyes.h, lit_b))):
+        out = np.full(todo.size, 2, np.int64)
+        xe, ye, ze, ge, re = xs[todo], ys[todo], zs[todo], gs[todo], rows[todo]
+        if bands is not None:
+            edge_kernel(n, xe, ye, ze, ge, float(cx), re, *bands[e], tabs[0], tabs[1],
+                        tabs[2], tabs[3], tabs[5], vc, out)  # fmt: skip
+        left = np.flatnonzero(out == 2)
+        if left.size:
+            o2 = np.empty(left.size, np.int64)
+            match_kernel(n, xe[left], ye[left], ze[left], ge[left], float(cx), re[left],
+                         kernels.arg(kp, np.int64), kernels.arg(ki, np.int64), *tabs, vc,
+                         o2)  # fmt: skip
+            out[left] = o2
         # 0: this eye rules the ball out; 2 in either eye: the reference decides
         res[todo] = np.maximum(res[todo], out) if cx > 0 else out
         res[todo[out == 0]] = 0

@@ -80,8 +80,11 @@ class HealpixProposal:
         box_b = _angle_box(eb, ext_b)
         th_lo = np.fmax(box[:, 0], box_b[:, 0])
         th_hi = np.fmin(box[:, 1], box_b[:, 1])
+        # the exact check's band cells about the located centres (compiled only)
+        bands = (ea.band(), eb.band()) if kernels.use(n) else None
         return dict(A=A, B=B, ea=ea, eb=eb, n=n, slack=slack, ext=ext, ext_b=ext_b,
-                    box=box, th_lo=th_lo, th_hi=th_hi, lit_a=lit_a, lit_b=lit_b)  # fmt: skip
+                    box=box, th_lo=th_lo, th_hi=th_hi, lit_a=lit_a, lit_b=lit_b,
+                    bands=bands)  # fmt: skip
 
     # long: the weighted draws of one chunk (propose, test the key, weigh) in one pass over shared
     # arrays
@@ -156,9 +159,8 @@ class HealpixProposal:
             sin_b = np.minimum(gg.ravel()[cand] / rb, 1.0)
             keep = _prefilter(eb, row, pb_ / rb[:, None], np.arcsin(sin_b))
             cand = cand[keep]
-        hit[cand] = exact_hits(
-            d, p.reshape(-1, 3)[cand], gg.ravel()[cand], cand // m, st["lit_a"], st["lit_b"]
-        )
+        hit[cand] = exact_hits(d, p.reshape(-1, 3)[cand], gg.ravel()[cand], cand // m,
+                               st["lit_a"], st["lit_b"], st["bands"])  # fmt: skip
         w = np.where(hit.reshape(n, m), w, 0.0)
         return {"r": r, "az": az, "el": el, "g": gg, "x": p[..., 0], "y": p[..., 1],
                 "z": p[..., 2], "w": w}  # fmt: skip

@@ -180,6 +180,21 @@ class _Eye:
         rows = codes // npix
         order = np.argsort(rows, kind="stable")
         codes, is_lit, rows = codes[order], is_lit[order], rows[order]
+        # for the exact check of the band alone (:meth:`band`): the inner and outer caps
+        # as lit_csr saw them (centre, half-angle of each ball), their cells between (all
+        # edge cells, before any pruning), and whether inner <= key <= outer holds
+        v = pos - np.asarray(centre)
+        dv = np.linalg.norm(v, axis=1)
+        self.u_io = v[:n] / dv[:n, None]
+        with np.errstate(invalid="ignore"):
+            half = np.arcsin(np.minimum(gs / dv, 1.0))
+        self.b_in = np.where(small, -np.inf, half[:n])
+        self.b_out = half[n:].copy()
+        odd = np.zeros(n, bool)
+        odd[c_in[~np.isin(c_in, key, assume_unique=True)] // npix] = True
+        odd[key[~np.isin(key, c_out, assume_unique=True)] // npix] = True
+        self.b_in[odd] = np.inf  # the band check never applies: match_kernel decides
+        self._band = (np.bincount(rows, minlength=n), codes % npix, is_lit)
         cnt = np.bincount(rows, minlength=n)
         kmax = max(1, int(cnt.max()) if cnt.size else 1)
         slot = np.arange(codes.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
@@ -195,6 +210,29 @@ class _Eye:
         self.centre = np.asarray(centre, float)
         self.a = np.zeros(3)  # the other eye's centre relative to this one (set by the caller)
         self.linearise(u)
+
+    def band(self) -> tuple[np.ndarray, ...]:
+        """The arguments of kernels.healpix_lit.edge_match_kernel for this eye's keys, from
+        u_io to far: the band cells' bounds about the current centres ``c`` (call after
+        the centre search, whose centres the draws lie near)."""
+        from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
+        from eyeviz.core.kernels.healpix_lit import band_bounds_kernel
+
+        cnt, pix, lit = self._band
+        n = self.nside
+        first = _ring_info_tables(n)[0]
+        ring = np.searchsorted(first[1 : 4 * n], pix, side="right").astype(np.int64)
+        bp = np.zeros(cnt.size + 1, np.int64)
+        np.cumsum(cnt, out=bp[1:])
+        key = np.repeat(np.arange(cnt.size, dtype=np.int64), cnt)
+        near, far = np.empty(pix.size), np.empty(pix.size)
+        u0 = kernels.arg(self.c, np.float64)
+        pix = kernels.arg(pix, np.int64)
+        band_bounds_kernel(n, pix, ring, key, u0, *_ring_tables(n),
+                           first, _ring_info_tables(n)[2], near, far)  # fmt: skip
+        u_io = kernels.arg(self.u_io, np.float64)
+        pix, lit = kernels.arg(pix, np.int64), kernels.arg(lit, np.bool_)
+        return u_io, self.b_in, self.b_out, u0, bp, pix, ring, lit, near, far
 
     def linearise(self, c: np.ndarray) -> None:
         """Distances d (N, K) and gradients t (N, K, 2) of every edge cell at centres c."""

@@ -19,6 +19,7 @@ from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import limit3d_exact, limit3d_healpix
 from eyeviz.estimators.base import take_rows
+from eyeviz.estimators.limit3d_proposal import _Eye
 from eyeviz.reference import stability_cases as sc
 
 pytest.importorskip("eyeviz.core.kernels.healpix_lit")
@@ -131,21 +132,23 @@ def test_match_equals_lit_sets_on_the_proposal_draws(nside, monkeypatch):
     real = limit3d_healpix._prefilter
     monkeypatch.setattr(limit3d_healpix, "_prefilter", lambda e, r, c, a: np.ones(r.size, bool))
 
-    def spy(domain, p, g, row, lit_a, lit_b):
-        seen.append((p.copy(), g.copy(), row.copy()))
-        return limit3d_exact.exact_hits(domain, p, g, row, lit_a, lit_b)
+    def spy(domain, p, g, row, lit_a, lit_b, bands=None):
+        seen.append((p.copy(), g.copy(), row.copy(), bands))
+        return limit3d_exact.exact_hits(domain, p, g, row, lit_a, lit_b, bands)
 
     monkeypatch.setattr(limit3d_healpix, "exact_hits", spy)
     prop = limit3d_healpix.HealpixProposal(d, "single", 512, 8)
     keys = np.arange(4, dtype=np.uint64) * np.uint64(7919)
     prop.sample(prop.setup(la, lb, keys, 1.0), keys, 0)
     assert real is not None and seen
-    p, g, row = seen[0]
+    p, g, row, _ = seen[0]
     assert kernels.use(row.size)
-    got = limit3d_exact._match_healpix(d.eyes, p[:, 0], p[:, 1], p[:, 2], g, row, la, lb)
     (pa, ia), (pb, ib) = d.eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
     want = limit3d_exact.same_rows(pa, ia, la, row) & limit3d_exact.same_rows(pb, ib, lb, row)
-    assert np.array_equal(got, want)
+    x, y, z = p[:, 0], p[:, 1], p[:, 2]
+    for bands in (None, seen[0][3]):  # the rings alone, and the band cells first
+        got = limit3d_exact._match_healpix(d.eyes, x, y, z, g, row, la, lb, bands)
+        assert np.array_equal(got, want)
     assert 5 <= want.sum() < want.size - 5
 
 
@@ -164,3 +167,69 @@ def test_exact_hits_take_the_lit_sets_with_eyeviz_jit_0(monkeypatch):
     p = np.stack([ds.x, ds.y, ds.z], axis=1)
     hit = limit3d_exact.exact_hits(d, p, ds.g, np.arange(3), la, lb)
     assert hit.all()
+
+
+def _bands_check(d: Domain3D, x, y, z, g, keys_of, lit_a, lit_b) -> tuple[int, int, int]:
+    """_match_healpix with the keys' band cells (limit3d_proposal._Eye.band) against
+    lit_csr + same_rows on balls (x, y, z, g) of the keys ``keys_of``; returns (balls,
+    matches, balls the band check decided in eye A)."""
+    from eyeviz.core.kernels.healpix_lit import edge_match_kernel, vertex_cache
+
+    ea = _Eye(d, lit_a, np.array([-d.h, 0.0, 0.0]), 0)
+    eb = _Eye(d, lit_b, np.array([d.h, 0.0, 0.0]), 1)
+    bands = (ea.band(), eb.band())
+    x, y, z, g = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, y, z, g))
+    row = np.asarray(keys_of, np.int64)
+    got = limit3d_exact._match_healpix(d.eyes, x, y, z, g, row, lit_a, lit_b, bands)
+    (pa, ia), (pb, ib) = d.eyes.lit_csr(x, y, z, g)
+    want = limit3d_exact.same_rows(pa, ia, lit_a, row) & limit3d_exact.same_rows(pb, ib, lit_b, row)
+    bad = np.flatnonzero(got != want)
+    assert not bad.size, [(x[i], y[i], z[i], g[i], want[i]) for i in bad[:3]]
+    out = np.full(x.size, 2, np.int64)
+    tabs = (*g3._ring_tables(d.nside), *g3._ring_info_tables(d.nside))
+    edge_match_kernel(d.nside, x, y, z, g, -d.h, row, *bands[0], *tabs[:4], tabs[5],
+                      vertex_cache(), out)  # fmt: skip
+    return x.size, int(want.sum()), int((out != 2).sum())
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    name=st.sampled_from(sorted(sc.CLASSES3D)),
+    seed=st.integers(0, 2**20),
+    nside=st.sampled_from([2, 4, 6, 8, 16, 18, 64, 180]),
+    scale=st.sampled_from([0.0, 1e-13, 1e-9, 1e-6, 1e-4, 1e-2]),
+)
+def test_band_check_equals_lit_sets_on_every_tie_class(name, seed, nside, scale):
+    """Keys: the lit sets of stability-case balls (ties, poles, vertices, grazing, extreme
+    scales); balls: those balls (ties included) and copies moved by ``scale`` of their
+    distance and radius, some matching and some not."""
+    cs = sc.make(name, 4, seed, "spherical")
+    d = Domain3D(nside=nside)
+    x, y, z, g = (np.asarray(v, np.float64).ravel() for v in (cs.x, cs.y, cs.z, cs.g))
+    (pa, ia), (pb, ib) = d.eyes.lit_csr(x, y, z, g)
+    rng = np.random.default_rng(seed)
+    k = np.repeat(np.arange(x.size), 6)
+    r = np.hypot(np.hypot(x, y), z)[k]
+    jit = rng.normal(size=(4, k.size)) * scale
+    jit[:, ::6] = 0.0  # the ball itself
+    bx, by, bz = x[k] + jit[0] * r, y[k] + jit[1] * r, z[k] + jit[2] * r
+    bg = g[k] * (1.0 + jit[3])
+    _bands_check(d, bx, by, bz, bg, k, (pa, ia), (pb, ib))
+
+
+@pytest.mark.parametrize("nside", [16, 64, 180])
+def test_band_check_decides_the_paper_regime(nside):
+    """Keys of Algorithm 1 balls and balls about them: the band check itself decides
+    most (so the comparison is of the band check, not of match_kernel), and some match."""
+    d = Domain3D(nside=nside)
+    ds = generate3d(12, d, seed=nside + 1)
+    la, lb = (ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b)
+    rng = np.random.default_rng(nside)
+    k = np.repeat(np.arange(12), 40)
+    fw = np.sqrt(4 * np.pi / d.npix)
+    step = rng.choice([0.0, 1e-4, 1e-3, 1e-2], k.size)[:, None] * fw * ds.r[k][:, None]
+    p = np.stack([ds.x, ds.y, ds.z], axis=1)[k] + rng.normal(size=(k.size, 3)) * step
+    gg = ds.g[k] * (1.0 + rng.normal(size=k.size) * step[:, 0] / ds.r[k])
+    n, hits, decided = _bands_check(d, p[:, 0], p[:, 1], p[:, 2], gg, k, la, lb)
+    assert hits >= n // 4 and hits < n
+    assert decided >= 0.8 * n

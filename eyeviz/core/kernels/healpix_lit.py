@@ -21,7 +21,15 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["lit_runs_kernel", "csr_kernel", "match_kernel", "vertex_cache", "warm"]
+__all__ = [
+    "lit_runs_kernel",
+    "csr_kernel",
+    "match_kernel",
+    "band_bounds_kernel",
+    "edge_match_kernel",
+    "vertex_cache",
+    "warm",
+]
 
 _EPS = 2.0**-52
 _DP = 64 * _EPS
@@ -159,11 +167,9 @@ def _tol(f, s2, ed, ds2):
 
 
 @_jit
-def _decide_cell(n, i, j, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit, vc):
-    """healpix_fast._decide_cells for one cell (the ball's centre pixel is lit before):
-    1 lit, 0 not lit, 2 left open (mpmath decides it in the reference). ``vc``: a vertex
-    cache (:func:`_vertex`) or none (empty arrays)."""
-    cxv, cyv, czv = c
+def _cell_fs(n, i, j, shifted, c, sth, zr, unit, vc):
+    """chord^2 from c to the N, W, S and E vertices of cell j of ring i (as
+    healpix.vertex_lon places them), and whether the ring is polar."""
     lw = 2 * j - (0 if shifted else 1)
     ui = unit[i]
     ln = lw + 1
@@ -195,6 +201,15 @@ def _decide_cell(n, i, j, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit, vc
     fW = _vdist_at(vc, n, i, lw, sth[i], zr[i], lw * ui, c)
     fS = _vdist_at(vc, n, i + 1, ls, sth[i + 1], zr[i + 1], ls * us, c)
     fE = _vdist_at(vc, n, i, lw + 2, sth[i], zr[i], (lw + 2) * ui, c)
+    return fN, fW, fS, fE, pol
+
+
+@_jit
+def _decide_cell(n, i, j, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit, vc):
+    """healpix_fast._decide_cells for one cell (the ball's centre pixel is lit before):
+    1 lit, 0 not lit, 2 left open (mpmath decides it in the reference). ``vc``: a vertex
+    cache (:func:`vertex_cache`) or none (empty arrays)."""
+    fN, fW, fS, fE, pol = _cell_fs(n, i, j, shifted, c, sth, zr, unit, vc)
     vmin = min(min(fN, fW), min(fS, fE))
     if vmin < s2 - _tol(vmin, s2, ed, ds2):
         return 1
@@ -331,10 +346,11 @@ def _grow(buf, k):
 @_jit
 def _ball(n, xb, yb, zb, gb, cx):
     """The per-ball steps of healpix_fast._lit_runs_fast before the rings, for one ball
-    and the eye at (cx, 0, 0): (kind, ring parameters, i_min, i_max); kind 0: go ring by
-    ring, 1: the reference decides (near the eye centre's sphere, grazing or tiny caps),
-    3: the ball holds the eye centre (every facet lit). The ring parameters are those
-    :func:`_ring` takes after ``i`` and before the ring tables."""
+    and the eye at (cx, 0, 0): (kind, ring parameters, i_min, i_max, alpha, pad); kind 0:
+    go ring by ring, 1: the reference decides (near the eye centre's sphere, grazing or
+    tiny caps), 3: the ball holds the eye centre (every facet lit). The ring parameters
+    are those :func:`_ring` takes after ``i`` and before the ring tables; alpha is the
+    cap's half-angle and pad bounds its error plus that of its centre's direction."""
     dx0 = xb - cx
     bv = dx0 - xb
     err = (xb - (dx0 - bv)) + (-cx - bv)
@@ -353,9 +369,9 @@ def _ball(n, xb, yb, zb, gb, cx):
     c = (0.0, 0.0, 1.0)
     none = (c, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, np.int64(0))
     if abs(dmg) <= sep or not (math.isfinite(dmg) and math.isfinite(sep)):
-        return 1, none, np.int64(0), np.int64(-1)  # near the eye centre's sphere
+        return 1, none, np.int64(0), np.int64(-1), 0.0, 0.0  # near the eye centre's sphere
     if dmg < -sep:
-        return 3, none, np.int64(0), np.int64(-1)
+        return 3, none, np.int64(0), np.int64(-1), 0.0, 0.0
     q = gs / d
     rdm = math.sqrt(max(dmg, 0.0))
     dcos = (4 * _EPS * d + 4 * errabs) * (d + gs) / (rdm * d)
@@ -363,7 +379,7 @@ def _ball(n, xb, yb, zb, gb, cx):
     cosa = rdm / d
     alpha = math.atan2(q, cosa)
     if dcos > 1e-9 or not alpha > 1e6 * ed:
-        return 1, none, np.int64(0), np.int64(-1)  # grazing or tiny caps
+        return 1, none, np.int64(0), np.int64(-1), 0.0, 0.0  # grazing or tiny caps
     s2 = 2 * q * q / (1 + cosa)
     ds2 = 2 * dcos + 8 * _EPS * s2
     dalpha = dcos / max(q, 1e-300) + 8 * _EPS
@@ -388,7 +404,7 @@ def _ball(n, xb, yb, zb, gb, cx):
     drel = 2 * ed / max(rho_c, 1e-300) + 8 * _EPS
     dph = dphi + 1e-9
     par = (c, cosa, z_c, rho_c, phi_c, zc_lo, zc_hi, dnum, drel, dph, s2, ds2, ed, cpix)
-    return 0, par, i_min, i_max
+    return 0, par, i_min, i_max, alpha, pad_t
 
 
 @_jit
@@ -420,7 +436,7 @@ def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, 
     vc = (np.empty(0, np.int64), np.empty((0, 3)))  # no vertex cache
     for b in range(nb):
         w0 = w
-        kind, par, i_min, i_max = _ball(n, x[b], y[b], z[b], g[b], cx)
+        kind, par, i_min, i_max, _, _ = _ball(n, x[b], y[b], z[b], g[b], cx)
         if kind == 1:
             status[b] = 1  # the reference's exact branches
             continue
@@ -460,6 +476,104 @@ def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, 
     return status, per, st[:w], ln[:w], bl[:w]
 
 
+@_jit
+def _angle(ch2):
+    """The angle of a chord of length sqrt(ch2) on the unit sphere."""
+    return 2.0 * math.asin(min(math.sqrt(max(ch2, 0.0)) * 0.5, 1.0))
+
+
+@_jit
+def _apart(c, u, k):
+    """The angle between c and row k of u (unit vectors), from their chord."""
+    dx, dy, dz = c[0] - u[k, 0], c[1] - u[k, 1], c[2] - u[k, 2]
+    return _angle(dx * dx + dy * dy + dz * dz)
+
+
+@_jit
+def band_bounds_kernel(n, pix, ring, key, u0, sth, zr, unit, first_t, shifted_t, near, far):
+    """For band cells ``pix`` (of rings ``ring``) of the keys ``key``: an upper bound
+    ``near`` on the angle from the key's centre u0[key] to the cell's closure (its nearest
+    vertex) and a lower bound ``far`` (the edges' lower bound of _decide_cell, less its
+    rounding bounds; 0 for the cell holding u0), both widened by 1e-12 rad."""
+    ed = 8 * _EPS
+    none = (np.empty(0, np.int64), np.empty((0, 3)))
+    for k in range(pix.shape[0]):
+        i = ring[k]
+        first = first_t[i]
+        c = (u0[key[k], 0], u0[key[k], 1], u0[key[k], 2])
+        fN, fW, fS, fE, pol = _cell_fs(n, i, pix[k] - first, shifted_t[i], c, sth, zr, unit,
+                                       none)  # fmt: skip
+        vmin = min(min(fN, fW), min(fS, fE))
+        near[k] = _angle(vmin + _tol(vmin, 0.0, ed, 0.0)) + 1e-12
+        ix, iy, face = _pix2xyf(n, pix[k], i, first)
+        lo = np.inf
+        for fa, fb, mf in ((fW, fN, _edge_m(n, pol, face, True, iy + 1, ix)),
+                           (fS, fW, _edge_m(n, pol, face, False, ix, iy)),
+                           (fS, fE, _edge_m(n, pol, face, True, iy, ix)),
+                           (fE, fN, _edge_m(n, pol, face, False, ix + 1, iy))):  # fmt: skip
+            low = _edge_lower(fa, fb, mf)
+            low = low - _tol(max(low, 0.0), 0.0, ed, 0.0) - 8 * _EPS * (fa + fb + mf)
+            lo = min(lo, low)
+        cpix = _ang2pix(n, min(max(c[2], -1.0), 1.0), math.atan2(c[1], c[0]))
+        far[k] = 0.0 if cpix == pix[k] else max(_angle(lo) - 1e-12, 0.0)
+
+
+# long: one draw's containment test and its band cells' walk with its early exit
+@_jit
+def edge_match_kernel(n, x, y, z, g, cx, row, u_io, b_in, b_out, u0, bp, pix, ring, lit,
+                      near, far, sth, zr, unit, first_t, shifted_t, vc, out):  # fmt: skip
+    """Whether ball b lights exactly key row[b]'s facets, from the key's band cells alone:
+    out[b] 1 yes, 0 no, 2 not decided here (then :func:`match_kernel`).
+
+    Per key, ``b_in`` and ``b_out`` are half-angles of caps about u_io such that the
+    inner cap's lit set lies in the key and the outer cap's holds it, and the band cells
+    (CSR ``bp``: ``pix``, rings, ``lit``: in the key) are the outer cap's cells not lit
+    by the inner one. A ball whose cap (c, alpha) holds the inner cap (alpha >= b_in +
+    |c - u_io|) and lies in the outer one (alpha + |c - u_io| <= b_out), each with 1e-9
+    rad to spare beyond the cap's error bound, lights every inner cell and no cell
+    outside the outer cap (a cell is lit iff the cap reaches its closure: monotone in
+    the cap), so it lights the key iff each band cell is lit exactly when in the key. A
+    band cell is lit when even its nearest vertex from u0 (``near``) moved by |c - u0|
+    lies inside the cap, unlit when the lower bound of its distance from u0 (``far``)
+    less |c - u0| lies outside it; else :func:`_decide_cell` decides it (with the ball's
+    own bounds, as lit_runs_kernel; its centre pixel is lit), and a cell it leaves open
+    leaves the ball to match_kernel. The first band cell that differs from the key rules
+    the ball out."""
+    for b in range(x.shape[0]):
+        r = row[b]
+        kind, par, _, _, alpha, pad = _ball(n, x[b], y[b], z[b], g[b], cx)
+        if kind != 0:
+            out[b] = 2
+            continue
+        c, s2, ds2, ed, cpix = par[0], par[10], par[11], par[12], par[13]
+        d_io = _apart(c, u_io, r) + 1e-12
+        a_lo = alpha - pad - 1e-9
+        a_hi = alpha + pad + 1e-9
+        if not (a_lo - d_io >= b_in[r] and a_hi + d_io <= b_out[r]):
+            out[b] = 2
+            continue
+        d0 = _apart(c, u0, r) + 1e-12
+        res = 1
+        for k in range(bp[r], bp[r + 1]):
+            if near[k] + d0 < a_lo:
+                on = 1
+            elif far[k] - d0 > a_hi:
+                on = 0
+            elif pix[k] == cpix:
+                on = 1
+            else:
+                i = ring[k]
+                on = _decide_cell(n, i, pix[k] - first_t[i], pix[k], shifted_t[i], first_t[i],
+                                  c, s2, ds2, ed, sth, zr, unit, vc)  # fmt: skip
+                if on == 2:
+                    res = 2
+                    break
+            if on != lit[k]:
+                res = 0
+                break
+        out[b] = res
+
+
 def vertex_cache(size: int = 1 << 14) -> tuple[np.ndarray, np.ndarray]:
     """An empty vertex cache of ``size`` (a power of 2; 0: none) for :func:`match_kernel`:
     (tags, xyz), tags -1 where empty."""
@@ -492,7 +606,7 @@ def match_kernel(n, x, y, z, g, cx, row, kp, ki, sth, zr, unit, first_t, nr_t, s
     npix = 12 * n * n
     for b in range(x.shape[0]):
         k, end = kp[row[b]], kp[row[b] + 1]
-        kind, par, i_min, i_max = _ball(n, x[b], y[b], z[b], g[b], cx)
+        kind, par, i_min, i_max, _, _ = _ball(n, x[b], y[b], z[b], g[b], cx)
         if kind == 1:
             out[b] = 2
             continue
@@ -655,3 +769,10 @@ def warm() -> None:
     i1 = np.zeros(1, np.int64)
     match_kernel(n, x, y, z, g, 40.0, i1, np.array([0, 1]), i1, sth, zr, unit, first, nr,
                  shifted, delta, o, vertex_cache(16), i1.copy())  # fmt: skip
+    u = np.array([[0.0, 1.0, 0.0]])
+    near, far = np.zeros(1), np.zeros(1)
+    pix, ring = np.array([10]), np.array([2])
+    band_bounds_kernel(n, pix, ring, i1, u, sth, zr, unit, first, shifted, near, far)
+    edge_match_kernel(n, x, y, z, g, 40.0, i1, u, np.zeros(1), np.ones(1), u, np.array([0, 1]),
+                      pix, ring, np.ones(1, np.bool_), near, far, sth, zr, unit, first, shifted,
+                      vertex_cache(16), i1.copy())  # fmt: skip
