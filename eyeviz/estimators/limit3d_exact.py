@@ -14,7 +14,7 @@ from eyeviz.core import kernels
 from eyeviz.core.domain import Domain3D
 from eyeviz.estimators.base import LitCSR
 
-__all__ = ["exact_hits", "prior_density", "same_rows"]
+__all__ = ["band_pass", "exact_hits", "prior_density", "same_rows"]
 
 
 def prior_density(domain: Domain3D, prior: str, r, g, el, az) -> np.ndarray:
@@ -87,17 +87,21 @@ def exact_hits(
     lit_a: LitCSR,
     lit_b: LitCSR,
     bands: tuple | None = None,
+    matched: np.ndarray | None = None,
 ) -> np.ndarray:
     """The 0/1 likelihood of draws (centres p (D, 3), radii g (D,)) of the keys ``row``
     (D,): the pair's exact ``lit_csr`` gives both of the key's lit sets and the ball is in
     the binocular field (``in_bfv``, decided only on the draws that match). HEALPix
     ``bands``: per eye, the keys' band cells (limit3d_proposal._Eye.band), which decide
-    most draws first (:func:`_match_healpix`)."""
+    most draws first (:func:`_match_healpix`). ``matched`` (D,): whether each draw lights
+    both lit sets, when the caller knows it already (only ``in_bfv`` is left)."""
     hit = np.zeros(row.size, bool)
     if not row.size:
         return hit
     x, y, z = p[:, 0], p[:, 1], p[:, 2]
-    if domain.kind != "measured" and kernels.use(row.size):
+    if matched is not None:
+        match = matched
+    elif domain.kind != "measured" and kernels.use(row.size):
         match = _match_healpix(domain.eyes, x, y, z, g, row, lit_a, lit_b, bands)
     else:
         (pa, ia), (pb, ib) = domain.eyes.lit_csr(x, y, z, g)
@@ -115,6 +119,31 @@ def exact_hits(
     else:
         hit[at] = domain.eyes.in_bfv(x[at], y[at], z[at], g[at])
     return hit
+
+
+def band_pass(eyes, p: np.ndarray, g: np.ndarray, row: np.ndarray, bands: tuple) -> np.ndarray:
+    """The band check alone (kernels.healpix_lit.edge_match_kernel, eye B only where A did
+    not rule the ball out): per ball 1 both eyes light the key's sets, 0 one does not, 2
+    not decided here."""
+    from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
+    from eyeviz.core.kernels import healpix_lit
+
+    edge_kernel: Any = healpix_lit.edge_match_kernel  # 24 arguments: the stub types fewer
+    n = eyes.nside
+    sth, zr, unit = _ring_tables(n)
+    first, _, shifted = _ring_info_tables(n)[:3]
+    xs, ys, zs = (kernels.arg(p[:, j], np.float64) for j in range(3))
+    gs, rows = kernels.arg(g, np.float64), kernels.arg(row, np.int64)
+    vc = healpix_lit.vertex_cache()
+    res = np.full(row.size, 2, np.int64)
+    edge_kernel(n, xs, ys, zs, gs, -eyes.h, rows, *bands[0], sth, zr, unit, first, shifted, vc,
+                res)  # fmt: skip
+    on = np.flatnonzero(res != 0)
+    out = np.full(on.size, 2, np.int64)
+    edge_kernel(n, xs[on], ys[on], zs[on], gs[on], eyes.h, rows[on], *bands[1], sth, zr, unit,
+                first, shifted, vc, out)  # fmt: skip
+    res[on] = np.where(out == 0, 0, np.maximum(res[on], out))
+    return res
 
 
 def _match_healpix(

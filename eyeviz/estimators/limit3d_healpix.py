@@ -13,7 +13,7 @@ import numpy as np
 from eyeviz.core import kernels
 from eyeviz.core.domain import Domain3D
 from eyeviz.estimators.base import LitCSR
-from eyeviz.estimators.limit3d_exact import exact_hits, prior_density
+from eyeviz.estimators.limit3d_exact import band_pass, exact_hits, prior_density
 from eyeviz.estimators.limit3d_proposal import (
     _angle_box,
     _batch_uniforms,
@@ -81,7 +81,7 @@ class HealpixProposal:
         th_lo = np.fmax(box[:, 0], box_b[:, 0])
         th_hi = np.fmin(box[:, 1], box_b[:, 1])
         # the exact check's band cells about the located centres (compiled only)
-        bands = (ea.band(), eb.band()) if kernels.use(n) else None
+        bands = (ea.band(), eb.band()) if kernels.use(n * self.samples) else None
         return dict(A=A, B=B, ea=ea, eb=eb, n=n, slack=slack, ext=ext, ext_b=ext_b,
                     box=box, th_lo=th_lo, th_hi=th_hi, lit_a=lit_a, lit_b=lit_b,
                     bands=bands)  # fmt: skip
@@ -149,6 +149,15 @@ class HealpixProposal:
         # the exact 0/1 likelihood on the draws with prior mass
         cand = np.flatnonzero(w.ravel() > 0)
         hit = np.zeros(n * m, bool)
+        if cand.size and st["bands"] is not None:
+            # the band check decides most draws at once (the prefilter below only drops
+            # draws the exact check rejects: it is left for the others)
+            sure = band_pass(d.eyes, p.reshape(-1, 3)[cand], gg.ravel()[cand], cand // m,
+                             st["bands"])  # fmt: skip
+            at = cand[sure != 2]
+            hit[at] = exact_hits(d, p.reshape(-1, 3)[at], gg.ravel()[at], at // m, st["lit_a"],
+                                 st["lit_b"], matched=sure[sure != 2] == 1)  # fmt: skip
+            cand = cand[sure == 2]
         if cand.size:  # a cheap necessary condition first
             row = cand // m
             pc = p.reshape(-1, 3)[cand]
@@ -160,7 +169,7 @@ class HealpixProposal:
             keep = _prefilter(eb, row, pb_ / rb[:, None], np.arcsin(sin_b))
             cand = cand[keep]
         hit[cand] = exact_hits(d, p.reshape(-1, 3)[cand], gg.ravel()[cand], cand // m,
-                               st["lit_a"], st["lit_b"], st["bands"])  # fmt: skip
+                               st["lit_a"], st["lit_b"])  # fmt: skip
         w = np.where(hit.reshape(n, m), w, 0.0)
         return {"r": r, "az": az, "el": el, "g": gg, "x": p[..., 0], "y": p[..., 1],
                 "z": p[..., 2], "w": w}  # fmt: skip

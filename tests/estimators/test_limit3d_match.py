@@ -121,35 +121,40 @@ def test_balls_holding_the_eye_and_on_its_sphere():
 
 @pytest.mark.parametrize("nside", [16, 180])
 def test_match_equals_lit_sets_on_the_proposal_draws(nside, monkeypatch):
-    """The proposal's candidate draws of a few keys (before the prefilter, so most are
-    near misses): the same accept / reject draw by draw, and some of each."""
+    """The proposal's candidate draws of a few keys (before the prefilter, so many are
+    near misses): the same accept / reject draw by draw, by the rings alone and by the
+    band cells first, and some of each; the proposal's draws the reference's."""
     d = Domain3D(nside=nside)
     ds = generate3d(4, d, seed=nside)
     rows = np.arange(4)
     la = take_rows(ds.indptr_a, ds.indices_a, rows)
     lb = take_rows(ds.indptr_b, ds.indices_b, rows)
     seen = []
-    real = limit3d_healpix._prefilter
-    monkeypatch.setattr(limit3d_healpix, "_prefilter", lambda e, r, c, a: np.ones(r.size, bool))
+    real = limit3d_healpix.band_pass
 
-    def spy(domain, p, g, row, lit_a, lit_b, bands=None):
+    def spy(eyes, p, g, row, bands):
         seen.append((p.copy(), g.copy(), row.copy(), bands))
-        return limit3d_exact.exact_hits(domain, p, g, row, lit_a, lit_b, bands)
+        return real(eyes, p, g, row, bands)
 
-    monkeypatch.setattr(limit3d_healpix, "exact_hits", spy)
+    monkeypatch.setattr(limit3d_healpix, "band_pass", spy)
     prop = limit3d_healpix.HealpixProposal(d, "single", 512, 8)
     keys = np.arange(4, dtype=np.uint64) * np.uint64(7919)
-    prop.sample(prop.setup(la, lb, keys, 1.0), keys, 0)
-    assert real is not None and seen
-    p, g, row, _ = seen[0]
+    got_w = prop.sample(prop.setup(la, lb, keys, 1.0), keys, 0)["w"]
+    assert seen
+    p, g, row, bands = seen[0]
     assert kernels.use(row.size)
     (pa, ia), (pb, ib) = d.eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
     want = limit3d_exact.same_rows(pa, ia, la, row) & limit3d_exact.same_rows(pb, ib, lb, row)
     x, y, z = p[:, 0], p[:, 1], p[:, 2]
-    for bands in (None, seen[0][3]):  # the rings alone, and the band cells first
-        got = limit3d_exact._match_healpix(d.eyes, x, y, z, g, row, la, lb, bands)
-        assert np.array_equal(got, want)
+    for b in (None, bands):  # the rings alone, and the band cells first
+        assert np.array_equal(
+            limit3d_exact._match_healpix(d.eyes, x, y, z, g, row, la, lb, b), want
+        )
+    sure = real(d.eyes, p, g, row, bands)
+    assert np.array_equal(sure[sure != 2] == 1, want[sure != 2])
     assert 5 <= want.sum() < want.size - 5
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    assert np.array_equal(got_w, prop.sample(prop.setup(la, lb, keys, 1.0), keys, 0)["w"])
 
 
 def test_exact_hits_take_the_lit_sets_with_eyeviz_jit_0(monkeypatch):
