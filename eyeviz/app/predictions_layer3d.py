@@ -35,7 +35,7 @@ class Predictions3DLayer:
     # the page's own (Scene3DHost)
     draw: Callable[[], None]
     refresh_panels: Callable[[], None]
-    _status: Callable[[], str]
+    show_status: Callable[[], None]
 
     def _predictions(self) -> None:
         """The layer's content for the selected ball: the fast estimators now, the limit
@@ -96,7 +96,7 @@ class Predictions3DLayer:
         if nxt is not None and self.model is not None and self.active:
             self._start_limit(nxt)
         if self.active and not self.win.jobs.busy():  # the runner cleared the status line
-            self.win.statusBar().showMessage(self._status(), 0)
+            self.show_status()
 
     def _limit_failed(self, key: bytes, exc: BaseException) -> None:
         self.latest.finish(key)

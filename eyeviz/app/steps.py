@@ -20,8 +20,9 @@ from __future__ import annotations
 import os
 from typing import TYPE_CHECKING
 
-from PyQt5 import QtCore, QtWidgets
+from PyQt5 import QtCore, QtGui, QtWidgets
 
+from eyeviz.app.launch import APP_FONT_PT
 from eyeviz.model.steps import Step, apply_step
 
 if TYPE_CHECKING:
@@ -34,10 +35,14 @@ if TYPE_CHECKING:
 else:
     _MainWindow = object  # MainWindow brings QMainWindow
 
-__all__ = ["CAPTION_MARGIN", "CAPTION_PT", "PANEL_DOCKS", "StepsMixin"]
+__all__ = ["CAPTION_MARGIN", "CAPTION_PT", "CAPTION_SHARE", "PANEL_DOCKS", "StepsMixin"]
 
 CAPTION_PT = 16  # the caption bar's text at text scale 1
 CAPTION_MARGIN = 6
+#: The most of the window's height the caption bar takes: a longer caption at a large
+#: text scale is set smaller, down to the window's own text size (F11 + F5 + 175 % in
+#: 1280 x 720: step 7's six 42 pt lines took 420 px and left the 3D view 165 px)
+CAPTION_SHARE = 0.3
 #: a step's panel names (eyeviz.model.steps.PANELS) -> the docks' object names, by side
 PANEL_DOCKS: dict[str, dict[str, str]] = {
     "planar": {
@@ -233,15 +238,29 @@ class StepsMixin(_MainWindow):
 
     def fit_caption(self) -> None:
         """The caption bar as tall as its wrapped text at the window's width (a splitter
-        does not ask a word-wrapped label for its height)."""
+        does not ask a word-wrapped label for its height), at most CAPTION_SHARE of the
+        window's height where a smaller font (not below the window's text) lets it."""
         bar = self.caption_bar
         if bar is None or not bar.isVisible():
             return
-        width = bar.width()
-        inner = max(width - 2 * CAPTION_MARGIN - 8, 50)
+        presenter = getattr(self, "presenter", None)
+        scale = presenter.effective_scale if presenter is not None else 1.0
+        pt, floor = CAPTION_PT * scale, APP_FONT_PT * scale
+        limit = CAPTION_SHARE * self.height()
+        inner = max(bar.width() - 2 * CAPTION_MARGIN - 8, 50)
         flags = int(QtCore.Qt.TextFlag.TextWordWrap) | int(QtCore.Qt.AlignmentFlag.AlignCenter)
-        text = bar.fontMetrics().boundingRect(QtCore.QRect(0, 0, inner, 0), flags, bar.text())
-        bar.setFixedHeight(text.height() + 2 * CAPTION_MARGIN + 4)
+        font = QtGui.QFont(bar.font())
+        while True:
+            font.setPointSizeF(pt)
+            fm = QtGui.QFontMetrics(font)
+            h = fm.boundingRect(QtCore.QRect(0, 0, inner, 0), flags, bar.text()).height()
+            h += 2 * CAPTION_MARGIN + 4
+            if h <= limit or pt <= floor:
+                break
+            pt = max(pt * 0.92, floor)
+        if abs(bar.font().pointSizeF() - pt) > 1e-6:
+            bar.setFont(font)
+        bar.setFixedHeight(h)
 
     def resizeEvent(self, ev) -> None:  # noqa: N802 (Qt name)
         super().resizeEvent(ev)

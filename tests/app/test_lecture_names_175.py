@@ -63,6 +63,8 @@ def test_names_clear_the_title_at_175_percent_in_every_step(make_window, qtbot):
             assert bottom <= t.viewport().height(), (step + 1, bottom, t.viewport().height())
             head, fm = t.horizontalHeader(), t.fontMetrics()
             for j in range(1, t.columnCount()):
+                if t.isColumnHidden(j):  # gave way for want of width (not cut)
+                    continue
                 for i in range(t.rowCount()):
                     item = t.item(i, j)
                     if item is not None and item.text():

@@ -188,7 +188,13 @@ def test_the_honeybee_scene_in_the_window_maps_its_lit_facets(make_window, qtbot
     mine = np.array([k for k, b in owner.items() if b == i])
     f = _middle(st.pair, "A", mine)
     pt = _canvas_px(panel, "A", f)
-    assert _near(_color_at(panel, pt), host.model.scene.features[i].color)
+    # the patch's facets are 1-2 px wide with an edge stroke (the map grew when the
+    # equator's label was measured instead of estimated): the ball's colour, blended with
+    # the edges but apart from grey and the other balls' (blue is 63 away), within a pixel
+    around = [pt + QtCore.QPoint(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)]
+    colour = host.model.scene.features[i].color
+    near = [_near(_color_at(panel, q), colour, tol=45) for q in around]
+    assert any(near), [_color_at(panel, q) for q in around]
     QTest.mouseMove(panel.canvas, pt)
     want = f"eye A, facet {f:,}: axis "
     qtbot.waitUntil(lambda: panel.hover.text().startswith(want), timeout=3000)

@@ -43,6 +43,7 @@ from eyeviz.app.panels.common import LinesLabel, follows_text_scale, text_scale,
 from eyeviz.app.panels.lit_raster import LitRaster
 from eyeviz.app.panels.map_geometry import (
     R2,
+    SIDE_WORDS,
     Outlines,
     by_ball,
     edge_colour,
@@ -51,7 +52,7 @@ from eyeviz.app.panels.map_geometry import (
     label_side,
     lit_owners,
     map_polys,
-    side_word,
+    side_words,
     title_fit,
 )
 from eyeviz.app.panels.map_zoom import MapZoom
@@ -75,10 +76,24 @@ STEP = 2  # outline points per facet edge
 HALO_LW = 2.2  # the selected ball's outline (points; about half of it shows outside)
 MAP_PT = 8.0  # the maps' words (left / forward / right, the equator) at text scale 1
 MAP_TITLE_PT = 9.0  # each map's title at text scale 1
+#: the maps' least height (px): normally, and at a text scale of LARGE_TEXT or more, where
+#: the Balls table's rows below need the room (F11 + F5 + 175 % in 1280 x 720: its three
+#: rows whole made the window 730 px tall)
+MAP_MIN_PX = (260, 220)
+LARGE_TEXT = 2.0
 
 
 #: The whole map's limits without the equator's label (the Mollweide ellipse, 1 % margin)
 HOME = (-2 * R2 * 1.01, 2 * R2 * 1.01, -R2 * 1.01, R2 * 1.01)
+
+
+def _inside(box, fig) -> bool:
+    """Whether ``box`` lies inside the figure's box ``fig`` (half a pixel's slack)."""
+    return (
+        box.x0 >= fig.x0 - 0.5
+        and box.x1 <= fig.x1 + 0.5
+        and (box.y0 >= fig.y0 - 0.5 and box.y1 <= fig.y1 + 0.5)
+    )
 
 
 class Bitmaps3DPanel(QtWidgets.QWidget):
@@ -122,14 +137,14 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         self.fig = Figure(figsize=(3.6, 4.2), facecolor="white")
         self.canvas = FigureCanvasQTAgg(self.fig)
         self.canvas.setSizePolicy(QtWidgets.QSizePolicy.Expanding, QtWidgets.QSizePolicy.Expanding)
-        self.canvas.setMinimumSize(240, 260)
+        self.canvas.setMinimumSize(240, MAP_MIN_PX[0])
         self.axes = {
             "A": self.fig.add_axes((0.01, 0.535, 0.98, 0.40)),
             "B": self.fig.add_axes((0.01, 0.045, 0.98, 0.40)),
         }
         for eye, ax in self.axes.items():
             ax.set_gid(f"map{eye}")
-        self.counts = LinesLabel(2)  # elided: never taller at 175 %; gives way first
+        self.counts = LinesLabel(2)  # shorter forms, never taller at 175 %; gives way first
         self.hover = LinesLabel(2, wrap=True)  # kept free: the first hover moves nothing
         self.hover.setObjectName("hover3d")
         # over the canvas's top-right corner while zoomed: never moves the dock's layout
@@ -181,30 +196,38 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
 
     def _fit_words(self, s: float, h_in: float) -> None:
         """The words and titles that fit the maps' width now (see :meth:`_place_axes`), and
-        the room beside the whole map that the equator's label takes (off the facets)."""
+        the room beside the whole map that the equator's label takes (off the facets).
+        Every word is measured as matplotlib draws it (its renderer at the text size now),
+        not estimated from a character count: "left" / "right" go where they overlap
+        nothing (:func:`side_words`)."""
         room = self.axes["A"].get_position().height
         px_per_in = self.fig.dpi / max(self.canvas.devicePixelRatioF(), 1.0)
-        # left / forward / right need ~22 characters' width: on a narrower map only "forward"
         w_in = self.canvas.width() / px_per_in
         box_w, box_h = 0.98 * w_in, room * h_in
-        map_in = min(box_w, 2.0 * box_h)
-        char_in = 0.62 * MAP_PT * s / 72.0
+        rend = self.canvas.get_renderer()
         zoomed = self.zoom.zoomed  # the words name the whole map's places
         label_in = 0.0
         for t, _pt in self._texts:
-            if t.get_text() in ("left", "right"):
-                side_word(t, map_in, box_w, char_in, zoomed)
-            elif t.get_text() == "forward":
+            if t.get_text() == "forward":
                 t.set_visible(not zoomed)
             elif t.get_gid() == "maptitle":
-                title_fit(t, 0.98 * w_in * self.fig.dpi, self.canvas.get_renderer())
+                t.set_visible(True)  # (hidden while the panel could not hold it)
+                title_fit(t, 0.98 * w_in * self.fig.dpi, rend)
             elif t.get_gid() == "equator":
                 full = str(t.get_url() or t.get_text())
                 t.set_url(full)  # the whole label kept (the short form may be shown)
-                text, label_in = equator_fit(full, char_in, box_w, box_h)
-                t.set_text(text)
+                text, label_in = equator_fit(t, full, rend, self.fig.dpi, box_w, box_h)
                 t.set_visible(bool(text) and not zoomed)
         self._set_home(label_in, box_w, box_h)
+        fig = self.fig.bbox
+        for ax in self.axes.values():
+            ax.apply_aspect()  # the map's box as it will be drawn (equal aspect)
+            for t in ax.texts:  # a word the panel cannot hold whole gives way (300 %)
+                if t.get_visible() and not _inside(t.get_window_extent(rend), fig):
+                    t.set_visible(False)
+            words = {t.get_text(): t for t in ax.texts if t.get_text() in SIDE_WORDS}
+            equator = [t for t in ax.texts if t.get_gid() == "equator" and t.get_visible()]
+            side_words(words, equator, rend, fig, zoomed)
 
     def _set_home(self, label_in: float, box_w: float, box_h: float) -> None:
         """The whole map's limits with ``label_in`` inches beside it for the equator's
@@ -258,6 +281,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         """The maps' words at the text scale (the hover line keeps its two lines free, so
         that the first hover does not push the panels below it down: issue 32)."""
         s = text_scale()
+        self.canvas.setMinimumHeight(MAP_MIN_PX[1] if s >= LARGE_TEXT else MAP_MIN_PX[0])
         for t, pt in self._texts:
             t.set_fontsize(pt * s)
         self._place_axes()
@@ -332,7 +356,10 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             edge.set_facecolor(fc)
             counts.append(f"{eye} {pix.size:,}")
         sel = "" if self.selected is None else f"; {self.names[self.selected]!r} outlined"
-        self.counts.setText(f"{patches_caption(pair)}\nlit: " + ", ".join(counts) + sel)
+        cap, lit = patches_caption(pair), "lit: " + ", ".join(counts)
+        short = cap.removesuffix(" per eye")  # "nside 8, 768 facets", then "768 facets"
+        forms = (cap, short, short.split(", ")[-1])
+        self.counts.set_lines([forms, (lit + sel, lit, lit.removeprefix("lit: "))])
         if changed:
             self._repaint()
         self.update_ms = (time.perf_counter() - t0) * 1e3

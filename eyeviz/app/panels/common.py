@@ -52,6 +52,7 @@ class LinesLabel(QtWidgets.QLabel):
     def __init__(self, lines: int, text: str = "", wrap: bool = False) -> None:
         super().__init__()
         self._full, self._lines = "", lines
+        self._forms: list[tuple[str, ...]] = []
         self.setWordWrap(wrap)
         self.setSizePolicy(QtWidgets.QSizePolicy.Ignored, QtWidgets.QSizePolicy.Maximum)
         self.setMinimumSize(0, 0)
@@ -63,7 +64,15 @@ class LinesLabel(QtWidgets.QLabel):
         return self._full
 
     def setText(self, text: str | None) -> None:  # noqa: N802 (Qt name)
-        self._full = text or ""
+        self.set_lines([(line,) for line in (text or "").split("\n")] if text else [])
+
+    def set_lines(self, lines: list[tuple[str, ...]]) -> None:
+        """Each line in the first of its forms that fits the width (the last one elided):
+        the Facets panel's "lit: A 15, B 15; 'target' outlined" was "lit: A 15, B 15;
+        'targ…" at F11 + F5 + 175 % in 1280 x 720, where "lit: A 15, B 15" fits whole.
+        :meth:`text` is the lines' first forms."""
+        self._forms = [tuple(f) for f in lines if f]
+        self._full = "\n".join(f[0] for f in self._forms)
         self.setToolTip(self._full)
         self._elide()
 
@@ -97,11 +106,16 @@ class LinesLabel(QtWidgets.QLabel):
             super().setText(self._full)
             return
         fm, width = self.fontMetrics(), max(self.contentsRect().width(), 1)
-        lines = self._full.split("\n") if self._full else []
+        lines = list(self._forms)
         while lines and self._height(len(lines)) > self.height():  # the last lines give way
             lines.pop()
         mode = QtCore.Qt.TextElideMode.ElideRight
-        super().setText("\n".join(fm.elidedText(t, mode, width) for t in lines))
+
+        def fit(forms: tuple[str, ...]) -> str:
+            text = next((f for f in forms if fm.horizontalAdvance(f) <= width), forms[-1])
+            return fm.elidedText(text, mode, width)
+
+        super().setText("\n".join(fit(f) for f in lines))
 
 
 def unelide_tabs(widget: QtWidgets.QWidget) -> None:

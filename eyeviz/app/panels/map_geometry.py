@@ -15,7 +15,7 @@ from eyeviz.render.mpl.style import EDGE
 
 __all__ = [
     "Outlines", "by_ball", "edge_colour", "ellipse", "equator_fit", "label_side", "lit_owners",
-    "map_polys", "R2", "side_word", "title_fit",
+    "map_polys", "R2", "SIDE_WORDS", "side_words", "title_fit",
 ]  # fmt: skip
 
 R2 = math.sqrt(2.0)
@@ -93,16 +93,21 @@ def ellipse(n: int = 181) -> np.ndarray:
     return np.stack([2 * R2 * np.cos(t), R2 * np.sin(t)], axis=-1)
 
 
-def equator_fit(full: str, char_in: float, box_w: float, box_h: float) -> tuple[str, float]:
-    """The equator's label that fits beside the map (the whole one, else "equator", else
-    none) and its width in inches: at most a quarter of the box's width, and no taller
-    than the map's middle third."""
+def equator_fit(
+    t: Any, full: str, renderer: Any, dpi: float, box_w: float, box_h: float
+) -> tuple[str, float]:
+    """Set the equator's label ``t`` (a matplotlib text) to the first form that fits
+    beside the map (the whole one ``full``, else "equator", else none) and return it with
+    its width in inches, as the renderer draws it: at most a quarter of the box's width
+    (``box_w`` inches), and no taller than 60 % of the map's box (``box_h``)."""
+    t.set_visible(True)  # matplotlib measures a hidden text as a 1 px box
     for text in (full, "equator"):
-        lines = text.split("\n")
-        w = max(len(x) for x in lines) * char_in
-        h = len(lines) * 1.25 * char_in / 0.62
+        t.set_text(text)
+        box = t.get_window_extent(renderer)
+        w, h = box.width / dpi, box.height / dpi
         if w <= 0.25 * box_w and h <= 0.6 * box_h:
             return text, w
+    t.set_text("")
     return "", 0.0
 
 
@@ -138,17 +143,56 @@ def edge_colour(n: int) -> str:
     return EDGE if n <= DENSE else EDGE_DENSE
 
 
-def side_word(t: Any, map_in: float, box_w: float, char_in: float, zoomed: bool) -> None:
-    """Place the map's word "left" or "right" (text ``t``, under the map): flush with the
-    map's end inside it where the map is wide enough for left / forward / right (~22
-    characters of ``char_in`` inches), else beside that end, outside the map, where the
-    box (``box_w`` inches wide) leaves it room and "forward" still fits the map (F11 + F5
-    at 1280 x 720, sphere_lecture's step 8: the maps dropped them), else hidden; hidden
-    on a zoomed map (the words name the whole map's places)."""
-    word = t.get_text()
-    wide = map_in >= 22 * char_in
-    beside = (box_w - map_in) / 2.0 >= 6.5 * char_in and map_in >= 9 * char_in
-    t.set_x((-2.0 if word == "left" else 2.0) * R2 * (1.0 if wide else 1.03))
-    inner, outer = (word, "right" if word == "left" else "left")
-    t.set_horizontalalignment(inner if wide else outer)
-    t.set_visible((wide or beside) and not zoomed)
+#: the words under each map, placed by :func:`side_words`
+SIDE_WORDS = ("left", "forward", "right")
+GAP_PX = 6.0  # the least room between two words
+
+
+def side_words(words: dict[str, Any], others: list[Any], renderer: Any, fig: Any,
+               zoomed: bool) -> None:  # fmt: skip
+    """Place a map's words "left" and "right" (matplotlib texts under the map, "forward"
+    at its middle), each measured as drawn: flush with the map's ends inside it where
+    none overlaps another (GAP_PX apart), else beside the ends, outside the map, where
+    they overlap neither "forward" nor ``others`` (the equator's label) and stay in the
+    figure (its box ``fig``, pixels), else hidden (F11 + F5 + 175 % at 1280 x 720: the
+    words had been placed by a width estimate of 0.62 em a character); hidden on a
+    zoomed map (the words name the whole map's places)."""
+    left, fwd, right = (words.get(w) for w in SIDE_WORDS)
+    if left is None or right is None:
+        return
+    pair = (left, right)
+    if zoomed:
+        for t in pair:
+            t.set_visible(False)
+        return
+    fixed = [t.get_window_extent(renderer) for t in others]
+    if fwd is not None and fwd.get_visible():
+        fixed.append(fwd.get_window_extent(renderer))
+
+    def clear(inside: bool) -> bool:
+        left.set_x(-2.0 * R2 * (1.0 if inside else 1.03))
+        right.set_x(2.0 * R2 * (1.0 if inside else 1.03))
+        left.set_horizontalalignment("left" if inside else "right")
+        right.set_horizontalalignment("right" if inside else "left")
+        for t in pair:
+            t.set_visible(True)  # measured as drawn (a hidden text is a 1 px box)
+        boxes = [t.get_window_extent(renderer) for t in pair]
+        if any(b.x0 < fig.x0 or b.x1 > fig.x1 or b.y0 < fig.y0 or b.y1 > fig.y1 for b in boxes):
+            return False
+        every = boxes + fixed
+        return not any(
+            _apart(every[i], every[j]) < GAP_PX
+            for i in range(len(boxes)) for j in range(i + 1, len(every))
+        )  # fmt: skip
+
+    shown = clear(True) or clear(False)
+    for t in pair:
+        t.set_visible(shown)
+
+
+def _apart(a: Any, b: Any) -> float:
+    """How far apart two boxes are in pixels (negative: they overlap) along the axis
+    that separates them best."""
+    dx = max(b.x0 - a.x1, a.x0 - b.x1)
+    dy = max(b.y0 - a.y1, a.y0 - b.y1)
+    return max(dx, dy)

@@ -61,6 +61,9 @@ CELL_PAD_PX = 7  # a column's width beyond its widest text (Qt's margins take 6;
 #: column -> the coordinate typed there (eyeviz.model.typed3d.KEYS)
 TYPED = {1: "r", 2: "az", 3: "el", 4: "g"}
 NAME_MIN_PX = 40  # the names' column at least (elided)
+MIN_ROWS = 4  # the Balls table's rows shown whole at any text size (more scroll)
+#: the Balls table's columns never hidden for want of width: ball, r, az°, el°, g
+KEEP_COLUMNS = 5
 NAME_WANT_PX = 100  # ... and what the dock is widened for (eyeviz.app.view3d)
 NOTE_WANT_PX = 130  # an estimator's column with a long reason: what the dock widens for
 NOTE_CHARS = 110  # a note below the predictions table at most (the dock keeps its size)
@@ -139,10 +142,14 @@ def natural_width(t: QtWidgets.QTableWidget) -> int:
             + 2 * t.frameWidth() + _bar_px(t))  # fmt: skip
 
 
-def fit_columns(t: QtWidgets.QTableWidget) -> None:
+def fit_columns(t: QtWidgets.QTableWidget, keep: int | None = None) -> None:
     """Columns 1... as wide as their header and cells; column 0 (the names, elided) the
-    rest of the viewport, at least NAME_MIN_PX: no horizontal scroll bar, unless the
-    numbers alone do not fit (then they stay whole and the table scrolls sideways)."""
+    rest of the viewport, at least NAME_MIN_PX: no horizontal scroll bar. ``keep``: where
+    the numbers and the names (up to NAME_WANT_PX) do not all fit, the columns past the
+    first ``keep`` give way from the last (hidden; named in the table's tooltip: F11 + F5
+    + 175 % in 1280 x 720, the Balls table scrolled sideways and cut its names); where
+    the numbers alone still do not fit (or without ``keep``) they stay whole and the table
+    scrolls sideways."""
     head = t.horizontalHeader()
     assert head is not None
     widths = _text_widths(t)
@@ -151,12 +158,30 @@ def fit_columns(t: QtWidgets.QTableWidget) -> None:
     rows_h = t.rowCount() * (side.defaultSectionSize() if side is not None else 20)
     tall = rows_h + head.height() + 2 * t.frameWidth() > t.height()
     avail = t.width() - 2 * t.frameWidth() - (bar if tall else 0)  # a vertical bar's room
+    hidden: list[int] = []
+    if keep is not None and widths:
+        names = min(widths[0], NAME_WANT_PX)
+        last = len(widths) - 1
+        while last >= keep and sum(min(v, NOTE_WANT_PX) for v in widths[1 : last + 1]) > (
+            avail - names
+        ):
+            hidden.insert(0, last)
+            last -= 1
+    for j in range(len(widths)):
+        if t.isColumnHidden(j) != (j in hidden):
+            t.setColumnHidden(j, j in hidden)
+    names_of = [t.horizontalHeaderItem(j) for j in hidden]
+    gone = ", ".join(h.text() for h in names_of if h is not None)
+    t.setToolTip(f"not shown at this width: {gone} (widen the panel)" if gone else "")
+    for j in hidden:
+        widths[j] = 0
     room = avail - NAME_MIN_PX
     # the numbers alone wider than the table (175 % in a 1280 x 720 screen: every cell
     # was "..."): they keep their width, a note at most NOTE_WANT_PX; the table scrolls
     # (a long note alone still elides, below)
-    short = [v for v in widths[1:] if v <= NOTE_WANT_PX]
-    sideways = sum(short) + 24 * (len(widths) - 1 - len(short)) > room
+    shown = [v for j, v in enumerate(widths) if j > 0 and j not in hidden]
+    short = [v for v in shown if v <= NOTE_WANT_PX]
+    sideways = sum(short) + 24 * (len(shown) - len(short)) > room
     t.setHorizontalScrollBarPolicy(
         QtCore.Qt.ScrollBarPolicy.ScrollBarAsNeeded
         if sideways
@@ -164,10 +189,12 @@ def fit_columns(t: QtWidgets.QTableWidget) -> None:
     )
     if sideways:
         widths[1:] = [min(v, NOTE_WANT_PX) for v in widths[1:]]
-    elif len(widths) > 1 and sum(widths[1:]) > room:
+    elif len(shown) and sum(shown) > room:
         # too wide (a long reason): the narrow columns keep their width, the widest share
         # what is left, their text elided (water-filling)
-        rest = sorted(range(1, len(widths)), key=lambda j: widths[j])
+        rest = sorted(
+            (j for j in range(1, len(widths)) if j not in hidden), key=lambda j: widths[j]
+        )
         while rest:
             fair = max(room // len(rest), 24)
             if widths[rest[0]] > fair:
@@ -177,7 +204,8 @@ def fit_columns(t: QtWidgets.QTableWidget) -> None:
             room -= widths[rest.pop(0)]
     widths[0] = max(NAME_MIN_PX, avail - sum(widths[1:]))
     for j, w in enumerate(widths):
-        head.resizeSection(j, int(w))
+        if j not in hidden:
+            head.resizeSection(j, int(w))
 
 
 def _cell(t: QtWidgets.QTableWidget, i: int, j: int) -> QtWidgets.QTableWidgetItem:
@@ -231,9 +259,7 @@ class Readout3DPanel(QtWidgets.QWidget):
         self.message = wrap_label(QtWidgets.QLabel(""))
         self.message.setStyleSheet(ERROR_STYLE)
         self.message.setVisible(False)
-        side = self.table.verticalHeader()
-        row_h = side.defaultSectionSize() if side is not None else 20
-        self.table.setMinimumHeight(3 * row_h + 4)  # the header and two balls at least
+        self._fit_height()
         self.note = QtWidgets.QLabel("")
         self.note.setWordWrap(True)
         lay = QtWidgets.QVBoxLayout(self)
@@ -294,6 +320,7 @@ class Readout3DPanel(QtWidgets.QWidget):
         reshaped = len(rows) != len(self.rows)
         if reshaped:
             self.table.setRowCount(len(rows))
+            self._fit_height()
         for i, row in enumerate(rows):
             old = self.rows[i] if i < len(self.rows) else None
             for j, text in enumerate(row):
@@ -305,7 +332,7 @@ class Readout3DPanel(QtWidgets.QWidget):
                     item.setIcon(_swatch(colors[i]))
                     item.setToolTip(scene.features[i].name)
         self.rows, self._colors = rows, colors
-        fit_columns(self.table)
+        fit_columns(self.table, KEEP_COLUMNS)
         hidden = [k for k in ("readout",) if not scene.shows(k)]
         self.note.setText("readout layer hidden: overlaps not computed" if hidden else "")
         self.note.setVisible(bool(hidden))
@@ -396,8 +423,21 @@ class Readout3DPanel(QtWidgets.QWidget):
                 side = obj.verticalHeader()
                 if side is not None:
                     side.setDefaultSectionSize(obj.fontMetrics().height() + 4)
-            fit_columns(obj)
+                if obj is self.table:
+                    self._fit_height()
+            fit_columns(obj, KEEP_COLUMNS if obj is self.table else None)
         return False
+
+    def _fit_height(self) -> None:
+        """The Balls table at least as tall as its header and its rows (two at least,
+        MIN_ROWS at most) at the text size now: at F11 + F5 + 175 % in 1280 x 720 it kept
+        the height of three rows at 100 % and showed one ball and half of the next."""
+        t = self.table
+        side, head = t.verticalHeader(), t.horizontalHeader()
+        row_h = side.defaultSectionSize() if side is not None else 20
+        head_h = head.sizeHint().height() if head is not None else row_h
+        rows = min(max(t.rowCount(), 2), MIN_ROWS)
+        t.setMinimumHeight(head_h + rows * row_h + 2 * t.frameWidth())
 
     def _recolor(self, i: int, colors: list[str]) -> bool:
         return i >= len(self._colors) or self._colors[i] != colors[i]

@@ -371,9 +371,9 @@ class Scene3DActors:
 
     def _fit_caption(self) -> None:
         """The close-up's caption in lines that fit its pane: as it is where it fits, else
-        without its lead-in ("the eyes close up: "), broken at spaces into no more lines
-        than it has, the last ending in "…" past them (at F11 + F5 + 175 % in 1280 x 720
-        its 614 px line was cut at the right of a 305-355 px pane). Refitted when the
+        without its lead-in ("the eyes close up: ") broken at spaces into one line more than
+        it has, else none: never cut with "…" (at F11 + F5 + 175 % in 1280 x 720 its 614 px
+        line was cut at the right of a 305-355 px pane, then "768 facet…"). Refitted when the
         pane's width, the font size or the caption change."""
         cap, ren = self.eyes_caption, self.eyes_ren
         if ren is None or self.surface is None or not cap.GetInput():
@@ -386,7 +386,9 @@ class Scene3DActors:
         n = text.count("\n") + 1
         shown = fit_lines(tp, text, avail, dpi, n)
         if shown != text and ": " in text.split("\n")[0]:
-            shown = fit_lines(tp, text.split(": ", 1)[1], avail, dpi, n)
+            shown = fit_lines(tp, text.split(": ", 1)[1], avail, dpi, n + 1)
+        if shown.endswith("…"):  # never cut: whole, or it gives way
+            shown = ""
         self._caption_fit, self._caption_shown = key, shown
         cap.SetInput(shown)
 
@@ -395,11 +397,11 @@ class Scene3DActors:
         return win.GetDPI() if win is not None else 72
 
     def _fit_title(self, *_args) -> None:
-        """Break the title into lines that fit the scene's viewport (at most two, then
-        "…"; one where two would take over a fifth of a short view's height: at 175 % in
-        a 1280 x 720 screen they left the balls' names no room; none while the names
-        find no place clear of it, see :meth:`_place_names`); refitted only when the
-        view's size, the font size or the title change."""
+        """Break the title into lines that fit the scene's viewport (at most two, else
+        none: never cut with "…"; one where two would take over a fifth of a short view's
+        height: at 175 % in a 1280 x 720 screen they left the balls' names no room; none
+        while the names find no place clear of it, see :meth:`_place_names`); refitted
+        only when the view's size, the font size or the title change."""
         ren = self.scene_ren
         width, height = ren.GetSize()
         tp = self.title.GetTextProperty()
@@ -410,7 +412,12 @@ class Scene3DActors:
         self._title_fit = key
         avail = width * (1.0 - 2.0 * self.title.GetPosition()[0]) - 4.0
         two = 2 * 1.2 * tp.GetFontSize() * dpi / 72.0 <= 0.2 * height
-        self._title_lines = fit_lines(tp, self._title_text, avail, dpi, max_lines=2 if two else 1)
+        lines = fit_lines(tp, self._title_text, avail, dpi, max_lines=2 if two else 1)
+        # never cut ("Spherical c…" at F11 + F5 + 175 % in 1280 x 720): whole, or it gives
+        # way (the step's caption says more)
+        self._title_lines = (
+            "" if lines.endswith("…") and not self._title_text.endswith("…") else lines
+        )
         self.title.SetInput(self._title_lines)
 
     def update(self, scene: Scene, state: SceneState3D, selected: int | None) -> None:

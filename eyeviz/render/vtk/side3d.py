@@ -17,21 +17,23 @@ SIDE_PX = 15  # the note's text at text scale 1 (the presenter scales it with th
 
 
 def _fit_line(tp: vtkTextProperty, line: str, avail: float, dpi: int) -> str:
-    """``line`` as it is where it fits ``avail`` pixels, else without "seen ", else cut
-    with "…" (:func:`eyeviz.render.vtk.primitives.fit_lines`, one line)."""
+    """``line`` as it is where it fits ``avail`` pixels, else without "seen ", else that
+    broken at spaces into the lines it needs (never cut with "…": "from front, right,…"
+    at F11 + F5 + 175 % in 1280 x 720; :func:`eyeviz.render.vtk.primitives.fit_lines`)."""
     for form in (line, line.removeprefix("seen ")):
         size = text_size(tp, form, dpi)
         if size is None or size[0] <= avail:
             return form
-    return fit_lines(tp, form, avail, dpi, 1)
+    return fit_lines(tp, form, avail, dpi, max_lines=form.count(" ") + 1)
 
 
 class SideNote:
     """A text actor at the scene viewport's bottom-left corner, updated per camera, its
     lines broken to fit the viewport's width before each render (at F11 + F5 + 175 % in
     1280 x 720, "seen from front, right, above" was cut at the right of sphere_lecture's
-    533 px view in steps 2-5): each line as it is, else without "seen ", else ending in
-    "…"; never more lines (a taller note left a ball's name no place clear of it)."""
+    533 px view in steps 2-5): each line as it is, else without "seen ", else broken at
+    spaces (then "from front, right,…" was cut in steps 4-5's 450 px view: a line more
+    beats a cut word; the names are placed clear of the note as it is drawn)."""
 
     def __init__(self, ren: vtkRenderer) -> None:
         self.actor: vtkTextActor = screen_text(SIDE_PX, INK, (0.01, 0.015))

@@ -1,0 +1,114 @@
+"""The spherical lecture at 175 % in a 1280 x 720 window in presentation mode (F5), every
+step (issue 32, the lecture-hall items left open): nothing cut, nothing elided, nothing
+scrolled sideways. Before, at F11 + F5 + 175 % on a 1280 x 720 screen:
+
+- the step's caption (42 pt, six lines in step 7) took 420 px and left the 3D view 165 px;
+- the Balls table scrolled sideways (its names cut at the left: "bal"), kept the height
+  of three rows at 100 % (one ball and half of the next shown);
+- the Facets panel's lines read "nside 8, 768 facets …" and "lit: A 15, B 15; 'targ…";
+- the status bar's line was cut at "facets lit A 15  B";
+- the 3D view's title read "Spherical c…", its side note "from front, right,…", the
+  close-up's caption "768 facet…".
+
+Real keys (xdotool) into the real window."""
+
+from PyQt5 import QtWidgets
+from test_lecture_names_175 import lecture_at_175
+from test_presenting_real_x import _keys, window_manager  # noqa: F401
+
+from eyeviz.app.launch import APP_FONT_PT
+from eyeviz.app.steps import CAPTION_SHARE
+from eyeviz.model.scene import load
+
+
+def _vtk_texts(host) -> dict[str, str]:
+    """The 3D view's texts as drawn: its title, side note and the close-up's caption (a
+    caption that gave way is transparent: not drawn)."""
+    a = host.actors
+    cap = a.eyes_caption
+    shown = cap.GetVisibility() and cap.GetTextProperty().GetOpacity() > 0
+    return {
+        "title": str(a.title.GetInput() or "") if a.title.GetVisibility() else "",
+        "side note": str(host.side.actor.GetInput() or ""),
+        "close-up caption": str(cap.GetInput() or "") if shown else "",
+    }
+
+
+def test_every_step_shows_its_words_whole_at_175_percent(make_window, qtbot):
+    win, path = lecture_at_175(make_window, qtbot)
+    host = win.host3d
+    maps_lines = tables = statuses = 0
+    for step in range(len(load(path).steps)):
+        _keys(qtbot, "Next", until=lambda s=step: win.step_index == s)
+        qtbot.wait(400)
+        host.draw()
+        at = step + 1
+        assert win.height() == 720, (at, win.height())  # the status bar on the screen
+        # the caption at most CAPTION_SHARE of the window, unless at the window's own size
+        bar = win.caption_bar
+        floor = APP_FONT_PT * win.presenter.effective_scale
+        small = bar.font().pointSizeF() <= floor + 1e-6
+        assert bar.height() <= CAPTION_SHARE * win.height() or small, (at, bar.height())
+        assert bar.font().pointSizeF() >= floor - 1e-6, at  # never smaller than the rest
+        # the 3D view: no text cut with "…"
+        for name, text in _vtk_texts(host).items():
+            assert "…" not in text, (at, name, text)
+        # the status bar's line whole
+        sb = win.statusBar()
+        msg = sb.currentMessage()
+        assert sb.fontMetrics().horizontalAdvance(msg) <= sb.width() - 8, (at, msg)
+        statuses += bool(msg)
+        # the Facets panel's lines, as shown: none elided
+        maps = host.bitmaps
+        if maps.isVisible():
+            shown = QtWidgets.QLabel.text(maps.counts)  # the lines drawn (not the whole text)
+            assert "…" not in shown, (at, shown)
+            fm = maps.counts.fontMetrics()
+            for line in shown.split("\n"):
+                assert fm.horizontalAdvance(line) <= maps.counts.contentsRect().width(), line
+            maps_lines += len([x for x in shown.split("\n") if x])
+        # the Balls table: no sideways scroll, every shown cell whole, every row whole
+        t = host.readout.table
+        if t.isVisible():
+            tables += 1
+            assert not t.horizontalScrollBar().isVisible(), at
+            head = t.horizontalHeader()
+            assert sum(head.sectionSize(j) for j in range(t.columnCount())
+                       if not t.isColumnHidden(j)) <= t.viewport().width(), at  # fmt: skip
+            fm, hfm = t.fontMetrics(), head.fontMetrics()
+            for j in range(t.columnCount()):
+                if t.isColumnHidden(j):
+                    continue
+                words = [t.horizontalHeaderItem(j).text()]
+                words += [t.item(i, j).text() for i in range(t.rowCount()) if t.item(i, j)]
+                room = head.sectionSize(j) - (24 if j == 0 else 0)  # the swatch's room
+                for k, w in enumerate(words):
+                    wide = (hfm if k == 0 else fm).horizontalAdvance(w)
+                    assert wide <= room, (at, j, w, wide, room)
+            for i in range(t.rowCount()):  # each ball's row whole in the table
+                bottom = t.rowViewportPosition(i) + t.rowHeight(i)
+                assert bottom <= t.viewport().height(), (at, i, bottom, t.viewport().height())
+            # r, azimuth and elevation, the step's words, are never the columns given way
+            assert not any(t.isColumnHidden(j) for j in range(5)), at
+    assert tables >= 1 and maps_lines >= 4 and statuses >= 7, (tables, maps_lines, statuses)
+
+
+def test_the_balls_table_columns_come_back_when_there_is_room(make_window, qtbot):
+    """A column that gave way at 175 % comes back at 100 % (Ctrl+0): the table keeps
+    nothing hidden that fits."""
+    win, path = lecture_at_175(make_window, qtbot)
+    for step in range(len(load(path).steps)):
+        _keys(qtbot, "Next", until=lambda s=step: win.step_index == s)
+    t = win.host3d.readout.table
+    qtbot.waitUntil(t.isVisible, timeout=3000)
+    qtbot.wait(300)
+    assert any(t.isColumnHidden(j) for j in range(t.columnCount()))  # some gave way
+    assert "not shown at this width" in t.toolTip()
+    _keys(qtbot, "ctrl+0", until=lambda: win.presenter.scale == 1.0)
+    _keys(qtbot, "F5", until=lambda: not win.presenter.presenting)
+    win.resize(1600, 900)
+    qtbot.waitUntil(lambda: win.width() == 1600, timeout=3000)
+    qtbot.waitUntil(
+        lambda: not any(t.isColumnHidden(j) for j in range(t.columnCount())), timeout=5000
+    )
+    assert t.toolTip() == ""
