@@ -5,7 +5,8 @@ PageDown once per step, all as real key presses (xdotool) under a window manager
     xvfb-run -a -s "-screen 0 1280x720x24" .venv/bin/python scripts/lecture_screenshots.py \
         --scene sphere_lecture --size 1280x720 docs/img/sphere_lecture_1280
 
-writes ``<prefix>_step<N>.png`` (N = 1 .. the number of steps) as 256-colour PNGs. The X
+writes ``<prefix>_step<N>.png`` (N = 1 .. the number of steps) as 256-colour PNGs;
+``--scale 1.75`` presses Ctrl+= until the text is at 175 % (before F11 and F5). The X
 screen must be the size asked for (F11 fills the screen). openbox is started for the run
 when no window manager runs; xdotool is needed.
 """
@@ -14,43 +15,10 @@ from __future__ import annotations
 
 import argparse
 import shutil
-import subprocess
 import tempfile
-import time
 from pathlib import Path
 
-
-def _window_manager(tmp: Path) -> subprocess.Popen | None:
-    if shutil.which("openbox") is None:
-        raise SystemExit("openbox is needed (apt-get install openbox)")
-    ready = tmp / "wm_ready"
-    proc = subprocess.Popen(
-        ["openbox", "--sm-disable", "--startup", f"touch {ready}"],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    for _ in range(200):
-        if ready.exists() or proc.poll() is not None:
-            break
-        time.sleep(0.05)
-    return proc if proc.poll() is None else None  # exited: another one runs
-
-
-def _wait(app, until, timeout: float = 10.0) -> None:
-    end = time.monotonic() + timeout
-    while not until() and time.monotonic() < end:
-        app.processEvents()
-        time.sleep(0.02)
-    for _ in range(10):
-        app.processEvents()
-        time.sleep(0.01)
-
-
-def _key(app, win, key: str, until) -> None:
-    win.activateWindow()
-    subprocess.run(["xdotool", "windowfocus", "--sync", str(int(win.winId()))], check=True)
-    subprocess.run(["xdotool", "key", "--delay", "40", key], check=True)
-    _wait(app, until)
+from real_x import key, start_window_manager, stop_window_manager, wait  # beside this script
 
 
 def _save(win, path: Path) -> None:
@@ -67,7 +35,12 @@ def main() -> None:
     ap.add_argument("prefix", help="output path prefix: <prefix>_step<N>.png")
     ap.add_argument("--scene", default="sphere_lecture", help="a bundled scene or a file")
     ap.add_argument("--size", default="1280x720", help="the screen's size WxH (checked)")
-    ap.add_argument("--scale", type=float, default=1.0, help="text scale (Ctrl+=)")
+    ap.add_argument(
+        "--scale",
+        type=float,
+        default=1.0,
+        help="text scale, reached by Ctrl+= / Ctrl+- key presses",
+    )
     a = ap.parse_args()
     w, h = (int(v) for v in a.size.lower().split("x"))
     if shutil.which("xdotool") is None:
@@ -88,30 +61,35 @@ def main() -> None:
     if (screen.width(), screen.height()) != (w, h):
         raise SystemExit(f"the X screen is {screen.width()}x{screen.height()}, not {w}x{h}")
     with tempfile.TemporaryDirectory() as tmp:
-        wm = _window_manager(Path(tmp))
+        wm = start_window_manager(Path(tmp))
         settings = make_settings(Path(tmp) / "settings.json")
         scene = load(path)
         win = MainWindow(scene, path, settings=settings)
         win.resize(min(w, 1200), min(h, 700))
         win.show()
-        _wait(app, win.isVisible)
-        if a.scale != 1.0:
-            win.presenter.set_scale(a.scale)
-        _key(app, win, "F11", lambda: win.isFullScreen() and win.width() == w)
-        _key(app, win, "F5", lambda: win.presenter.presenting)
+        wait(app, win.isVisible)
+        wait(app, lambda: True, 0.5)  # the window manager's frame
+        # the text scale as a lecturer sets it: Ctrl+= (or Ctrl+-) until it is reached
+        while abs(win.presenter.scale - a.scale) > 1e-9:
+            before, up = win.presenter.scale, win.presenter.scale < a.scale
+            key(app, win, "ctrl+equal" if up else "ctrl+minus",
+                lambda b=before: win.presenter.scale != b)  # fmt: skip
+            now = win.presenter.scale
+            if now == before or (now > a.scale if up else now < a.scale):  # stuck, past
+                raise SystemExit(f"Ctrl+=/- does not reach {a.scale} (at {win.presenter.scale})")
+        key(app, win, "F11", lambda: win.isFullScreen() and win.width() == w)
+        key(app, win, "F5", lambda: win.presenter.presenting)
         out = []
         for i in range(len(scene.steps)):
-            _key(app, win, "Next", lambda i=i: win.step_index == i)
+            key(app, win, "Next", lambda i=i: win.step_index == i)
             win.jobs.wait()
-            _wait(app, lambda: True, 0.5)
+            wait(app, lambda: True, 0.5)
             p = Path(f"{a.prefix}_step{i + 1}.png")
             _save(win, p)
             out.append(p)
         print(" ".join(str(p) for p in out), win.width(), win.height())
         win.force_close()
-        if wm is not None:
-            wm.terminate()
-            wm.wait(10)
+        stop_window_manager(wm)
 
 
 if __name__ == "__main__":

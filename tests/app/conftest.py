@@ -8,6 +8,8 @@ import pytest
 
 os.environ.setdefault("QT_API", "pyqt5")
 sys.path.insert(0, str(Path(__file__).parent))  # the shared helpers in mouse.py
+# the real-X helpers (openbox, the X focus, xdotool keys) shared with the scripts
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
 
 
 _XVFB: list = []

@@ -1,12 +1,13 @@
 """Real input on the app's windows (shared by the app tests): mouse drags in model
 coordinates, and the X keyboard focus that real key presses (xdotool) go to."""
 
-import subprocess
-import time
-
 import vtk
 from PyQt5 import QtCore, QtGui, QtWidgets
 from PyQt5.QtTest import QTest
+
+# the X keyboard focus: shared with the scripts that drive the window (scripts/real_x.py,
+# on the import path by conftest.py)
+from real_x import x_focus  # noqa: E402, F401
 
 from eyeviz.render.vtk.style import Z_FEAT
 
@@ -50,25 +51,3 @@ def drag(win, start, end, steps=12):
     for k in range(1, steps + 1):
         move(w, start + (end - start) * (k / steps))
     QTest.mouseRelease(w, QtCore.Qt.LeftButton, QtCore.Qt.NoModifier, end)
-
-
-def x_focus(win, widget=None, timeout=5.0):
-    """Give ``win`` the X keyboard focus (xdotool's key presses go there) and ``widget``
-    Qt's. Retried while X refuses: setting the focus on a window that is not viewable yet
-    fails with BadMatch, and a loaded machine (or a window manager) maps windows late."""
-    win.activateWindow()
-    win.raise_()
-    if widget is not None:
-        widget.setFocus()
-    deadline = time.monotonic() + timeout
-    cmd = ["xdotool", "windowfocus", "--sync", str(int(win.winId()))]
-    while (r := subprocess.run(cmd, capture_output=True, text=True)).returncode != 0:
-        if time.monotonic() > deadline:
-            raise AssertionError(f"xdotool could not focus the window: {r.stderr.strip()}")
-        QtWidgets.QApplication.processEvents()
-        time.sleep(0.05)
-    while widget is not None and not widget.hasFocus():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"{type(widget).__name__} did not take the keyboard focus")
-        QtWidgets.QApplication.processEvents()
-        time.sleep(0.02)

@@ -10,30 +10,13 @@ frame and its minimum height.
 from __future__ import annotations
 
 import json
-import shutil
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
-
-def _wait(app, until, timeout: float = 10.0) -> None:
-    end = time.monotonic() + timeout
-    while not until() and time.monotonic() < end:
-        app.processEvents()
-        time.sleep(0.02)
-    for _ in range(10):
-        app.processEvents()
-        time.sleep(0.02)
-
-
-def _key(app, win, key: str, until) -> None:
-    from mouse import x_focus  # beside this script
-
-    x_focus(win)
-    subprocess.run(["xdotool", "key", "--delay", "40", key], check=True)
-    _wait(app, until)
+# the real-X helpers shared with scripts/lecture_screenshots.py (scripts/real_x.py)
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "scripts"))
+from real_x import key, start_window_manager, stop_window_manager, wait  # noqa: E402
 
 
 def main() -> None:
@@ -48,16 +31,7 @@ def main() -> None:
     name, configs = sys.argv[1], sys.argv[2:]
     app = make_app()
     with tempfile.TemporaryDirectory() as tmp:
-        ready = Path(tmp) / "ready"
-        wm = subprocess.Popen(
-            [shutil.which("openbox") or "openbox", "--sm-disable", "--startup", f"touch {ready}"],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-        )
-        for _ in range(200):
-            if ready.exists() or wm.poll() is not None:
-                break
-            time.sleep(0.05)
+        wm = start_window_manager(Path(tmp))
         path = scene_path(name)
         for k, cfg in enumerate(configs):
             scale, present = float(cfg.split(":")[0]), cfg.split(":")[1] == "1"
@@ -66,17 +40,17 @@ def main() -> None:
             win._force_close = True
             win.resize(1280, 720)
             win.show()
-            _wait(app, win.isVisible)
-            _wait(app, lambda: True, 0.5)  # the window manager's frame, then the fit
+            wait(app, win.isVisible)
+            wait(app, lambda: True, 0.5)  # the window manager's frame, then the fit
             if scale != 1.0:
                 win.presenter.set_scale(scale)
             if present:
-                _key(app, win, "F5", lambda w=win: w.presenter.presenting)
+                key(app, win, "F5", lambda w=win: w.presenter.presenting)
             free = win.screen().availableGeometry()
             for i in range(len(scene.steps)):
-                _key(app, win, "Next", lambda i=i, w=win: w.step_index == i)
+                key(app, win, "Next", lambda i=i, w=win: w.step_index == i)
                 win.jobs.wait()
-                _wait(app, lambda: True, 0.6)
+                wait(app, lambda: True, 0.6)
                 bar = win.statusBar()
                 bottom = bar.mapToGlobal(QtCore.QPoint(0, bar.height())).y()
                 frame = win.frameGeometry()
@@ -89,8 +63,7 @@ def main() -> None:
                 print(json.dumps(row), flush=True)
             win.force_close()
             app.processEvents()
-        wm.terminate()
-        wm.wait(10)
+        stop_window_manager(wm)
 
 
 if __name__ == "__main__":

@@ -6,12 +6,12 @@ import json
 import shutil
 import subprocess
 import tempfile
-import time
 from pathlib import Path
 
 import pytest
 from mouse import x_focus
 from PyQt5 import QtCore, QtGui, QtWidgets
+from real_x import start_window_manager, stop_window_manager
 
 from eyeviz.app.launch import APP_FONT_PT
 from eyeviz.app.presenting import PRESENT_FACTOR, SCALE_KEY
@@ -29,22 +29,9 @@ def window_manager():
     if shutil.which("xdotool") is None:
         pytest.fail("xdotool is needed for these tests: apt-get install xdotool")
     with tempfile.TemporaryDirectory() as tmp:
-        ready = Path(tmp) / "ready"
-        proc = subprocess.Popen(
-            ["openbox", "--sm-disable", "--startup", f"touch {ready}"],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-        )
-        for _ in range(200):
-            if ready.exists() or proc.poll() is not None:
-                break
-            time.sleep(0.05)
-        # exited at once: another window manager runs on this display (then it is used)
-        assert ready.exists() or proc.poll() is not None, "openbox did not start"
+        proc = start_window_manager(Path(tmp))  # None: another one runs (then it is used)
         yield
-        if proc.poll() is None:
-            proc.terminate()
-            proc.wait(10)
+        stop_window_manager(proc)
 
 
 def _scene():
