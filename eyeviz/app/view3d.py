@@ -35,6 +35,7 @@ from PyQt5 import QtCore, QtWidgets
 from eyeviz.app.actions import PLANAR_ONLY, command3d
 from eyeviz.app.help import LAYER3D_TEXT, view3d_help_text
 from eyeviz.app.predictions_layer3d import Predictions3DLayer
+from eyeviz.app.status3d import StatusLine, ball_status
 from eyeviz.app.view import make_view
 from eyeviz.model import app_model3d as m3
 from eyeviz.model.camera3d import PRESETS, Camera3D
@@ -77,21 +78,6 @@ PANEL_MS = 250  # the docks follow a drag at <= 4 Hz (the Mollweide maps take 15
 _MOD_DEPTH = QtCore.Qt.KeyboardModifier.ShiftModifier | QtCore.Qt.KeyboardModifier.ControlModifier
 
 
-class _StatusWatch(QtCore.QObject):
-    """Calls ``refit`` (later) when the status bar's width or font changes."""
-
-    def __init__(self, bar: QtWidgets.QStatusBar, refit) -> None:
-        super().__init__(bar)
-        self._refit = refit
-        bar.installEventFilter(self)
-
-    def eventFilter(self, obj, ev) -> bool:  # noqa: N802 (Qt name)
-        E = QtCore.QEvent.Type
-        if ev.type() in (E.Resize, E.FontChange):
-            QtCore.QTimer.singleShot(0, self._refit)
-        return False
-
-
 class Scene3DHost(Predictions3DLayer, QtCore.QObject):
     """The window's 3D page: the view widget, its actors and model, the 3D docks, the
     View > 3D view menu. Built on the first spherical scene; ``active`` while shown."""
@@ -109,8 +95,8 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self.bitmaps: Bitmaps3DPanel | None = None
         self.readout: Readout3DPanel | None = None
         self.estimators: Estimators3DPanel | None = None
-        self._status_shown: str | None = None  # the status line this view showed last
-        self._status_watched = False  # its event filter on the status bar installed
+        # the selected ball's status line, in the first form that fits the bar
+        self.status_line = StatusLine(win, lambda: ball_status(self.model), lambda: self.active)
         # the predictions layer (eyeviz.model.predictions3d): the fast estimators answer
         # on every frame; the limit on the window's job runner after a drag, latest only
         self.predictor3d: Predictor3D | None = None
@@ -401,39 +387,8 @@ class Scene3DHost(Predictions3DLayer, QtCore.QObject):
         self._panel_timer.setInterval(max(PANEL_MS, int(took * (1.0 - PANEL_SHARE) / PANEL_SHARE)))
 
     def show_status(self) -> None:
-        """The selected ball in the status bar: in the first of :meth:`_status`'s forms
-        that fits it (at F11 + F5 + 175 % in 1280 x 720 the whole one was cut at "facets
-        lit A 15  B"); re-fitted when the bar's width or font changes."""
-        bar = self.win.statusBar()
-        if not self._status_watched:
-            _StatusWatch(bar, self._refit_status)
-            self._status_watched = True
-        forms = self._status()
-        room = bar.width() - 12
-        fm = bar.fontMetrics()
-        text = next((f for f in forms if fm.horizontalAdvance(f) <= room), forms[-1])
-        self._status_shown = text
-        bar.showMessage(text, 0)
-
-    def _refit_status(self) -> None:
-        """Only the message this view showed (not "text 175 %" nor a job's)."""
-        if self.active and self.win.statusBar().currentMessage() == self._status_shown:
-            self.show_status()
-
-    def _status(self) -> list[str]:
-        """The selected ball's status line, longest form first."""
-        m = self.model
-        if m is None or m.selected is None or m.selected >= len(m.scene.features):
-            return [""]
-        st, i = m.state, m.selected
-        f = m.scene.features[i]
-        lit = ""
-        if st.facets_a is not None and st.facets_b is not None:
-            lit = f"facets lit A {int(st.facets_a[i]):,}  B {int(st.facets_b[i]):,}"
-        where = f"{f.name}: x {f.x:,.1f}  y {f.y:,.1f}  z {f.z:,.1f}  g {f.g:,.1f}"
-        if not lit:
-            return [where, f.name]
-        return [f"{where}   {lit}", where, f"{f.name}: {lit}", f.name]
+        """The selected ball in the status bar (:class:`eyeviz.app.status3d.StatusLine`)."""
+        self.status_line.show()
 
     def _sync_eyes(self) -> None:
         if self.actors is not None and self.model is not None:

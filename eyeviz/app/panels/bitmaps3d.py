@@ -43,17 +43,15 @@ from eyeviz.app.panels.common import LinesLabel, follows_text_scale, text_scale,
 from eyeviz.app.panels.lit_raster import LitRaster
 from eyeviz.app.panels.map_geometry import (
     R2,
-    SIDE_WORDS,
     Outlines,
     by_ball,
     edge_colour,
     ellipse,
-    equator_fit,
+    fit_words,
     label_side,
     lit_owners,
     map_polys,
-    side_words,
-    title_fit,
+    place_side_words,
 )
 from eyeviz.app.panels.map_zoom import MapZoom
 from eyeviz.model import responses3d as r3
@@ -85,15 +83,6 @@ LARGE_TEXT = 2.0
 
 #: The whole map's limits without the equator's label (the Mollweide ellipse, 1 % margin)
 HOME = (-2 * R2 * 1.01, 2 * R2 * 1.01, -R2 * 1.01, R2 * 1.01)
-
-
-def _inside(box, fig) -> bool:
-    """Whether ``box`` lies inside the figure's box ``fig`` (half a pixel's slack)."""
-    return (
-        box.x0 >= fig.x0 - 0.5
-        and box.x1 <= fig.x1 + 0.5
-        and (box.y0 >= fig.y0 - 0.5 and box.y1 <= fig.y1 + 0.5)
-    )
 
 
 class Bitmaps3DPanel(QtWidgets.QWidget):
@@ -206,28 +195,10 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
         box_w, box_h = 0.98 * w_in, room * h_in
         rend = self.canvas.get_renderer()
         zoomed = self.zoom.zoomed  # the words name the whole map's places
-        label_in = 0.0
-        for t, _pt in self._texts:
-            if t.get_text() == "forward":
-                t.set_visible(not zoomed)
-            elif t.get_gid() == "maptitle":
-                t.set_visible(True)  # (hidden while the panel could not hold it)
-                title_fit(t, 0.98 * w_in * self.fig.dpi, rend)
-            elif t.get_gid() == "equator":
-                full = str(t.get_url() or t.get_text())
-                t.set_url(full)  # the whole label kept (the short form may be shown)
-                text, label_in = equator_fit(t, full, rend, self.fig.dpi, box_w, box_h)
-                t.set_visible(bool(text) and not zoomed)
+        texts = [t for t, _pt in self._texts]
+        label_in = fit_words(texts, rend, self.fig.dpi, 0.98 * w_in, box_h, zoomed)
         self._set_home(label_in, box_w, box_h)
-        fig = self.fig.bbox
-        for ax in self.axes.values():
-            ax.apply_aspect()  # the map's box as it will be drawn (equal aspect)
-            for t in ax.texts:  # a word the panel cannot hold whole gives way (300 %)
-                if t.get_visible() and not _inside(t.get_window_extent(rend), fig):
-                    t.set_visible(False)
-            words = {t.get_text(): t for t in ax.texts if t.get_text() in SIDE_WORDS}
-            equator = [t for t in ax.texts if t.get_gid() == "equator" and t.get_visible()]
-            side_words(words, equator, rend, fig, zoomed)
+        place_side_words(list(self.axes.values()), rend, self.fig.bbox, zoomed)
 
     def _set_home(self, label_in: float, box_w: float, box_h: float) -> None:
         """The whole map's limits with ``label_in`` inches beside it for the equator's

@@ -14,7 +14,8 @@ from eyeviz.render.mpl.facet_map import compound_path, map_width, mollweide, vie
 from eyeviz.render.mpl.style import EDGE
 
 __all__ = [
-    "Outlines", "by_ball", "edge_colour", "ellipse", "equator_fit", "label_side", "lit_owners",
+    "Outlines", "by_ball", "edge_colour", "ellipse", "equator_fit", "fit_words", "label_side",
+    "lit_owners", "place_side_words",
     "map_polys", "R2", "SIDE_WORDS", "side_words", "title_fit",
 ]  # fmt: skip
 
@@ -141,6 +142,51 @@ EDGE_DENSE = "#cdcdcd"
 
 def edge_colour(n: int) -> str:
     return EDGE if n <= DENSE else EDGE_DENSE
+
+
+def fit_words(texts: list[Any], renderer: Any, dpi: float, box_w: float, box_h: float,
+              zoomed: bool) -> float:  # fmt: skip
+    """The maps' words ``texts`` (matplotlib texts) at the maps' size now, measured as
+    the renderer draws them: "forward" shown on the whole map, each title in the first
+    form that fits the maps' width ``box_w`` inches (:func:`title_fit`), the equator's
+    label in the first that fits beside the map (:func:`equator_fit`). Returns the room
+    in inches the equator's label takes beside the whole map."""
+    label_in = 0.0
+    for t in texts:
+        if t.get_text() == "forward":
+            t.set_visible(not zoomed)
+        elif t.get_gid() == "maptitle":
+            t.set_visible(True)  # (hidden while the panel could not hold it)
+            title_fit(t, box_w * dpi, renderer)
+        elif t.get_gid() == "equator":
+            full = str(t.get_url() or t.get_text())
+            t.set_url(full)  # the whole label kept (the short form may be shown)
+            text, label_in = equator_fit(t, full, renderer, dpi, box_w, box_h)
+            t.set_visible(bool(text) and not zoomed)
+    return label_in
+
+
+def place_side_words(axes: list[Any], renderer: Any, fig: Any, zoomed: bool) -> None:
+    """On each map (matplotlib axes, their limits set): a word the figure (its box
+    ``fig``) cannot hold whole gives way (at 300 % "forward" fell off the bottom), then
+    "left" and "right" are placed (:func:`side_words`)."""
+    for ax in axes:
+        ax.apply_aspect()  # the map's box as it will be drawn (equal aspect)
+        for t in ax.texts:
+            if t.get_visible() and not _inside(t.get_window_extent(renderer), fig):
+                t.set_visible(False)
+        words = {t.get_text(): t for t in ax.texts if t.get_text() in SIDE_WORDS}
+        equator = [t for t in ax.texts if t.get_gid() == "equator" and t.get_visible()]
+        side_words(words, equator, renderer, fig, zoomed)
+
+
+def _inside(box: Any, fig: Any) -> bool:
+    """Whether ``box`` lies inside the figure's box ``fig`` (half a pixel's slack)."""
+    return (
+        fig.x0 - 0.5 <= box.x0
+        and box.x1 <= fig.x1 + 0.5
+        and (fig.y0 - 0.5 <= box.y0 and box.y1 <= fig.y1 + 0.5)
+    )
 
 
 #: the words under each map, placed by :func:`side_words`
