@@ -3,7 +3,9 @@
 Planar eyes (default, ``--h --l --m``), HEALPix eyes (``--nside``) or a measured pair
 (``--eye FILE [--units mm]``): the last two write the sparse data set
 (:mod:`eyeviz.dataset.sparse3d`); a measured pair is embedded in it, and its ranges
-default to the animal's scale (:func:`eyeviz.core.domain.measured_ranges`)."""
+default to the animal's scale (:func:`eyeviz.core.domain.measured_ranges`). The options
+make the domain; the rows are written by the data set format of its kind
+(:func:`eyeviz.dataset.kinds.write`)."""
 
 from __future__ import annotations
 
@@ -226,6 +228,7 @@ def run(args: argparse.Namespace) -> int:
     if args.nside is not None or args.el_max is not None:
         return _run3d(args, drawn)
     from eyeviz import EyevizError, dataset
+    from eyeviz.core.domain import Domain
     from eyeviz.core.geometry import EyePair
     from eyeviz.dataset import io as dataset_io
 
@@ -253,13 +256,9 @@ def run(args: argparse.Namespace) -> int:
     domain = {"h": eyes.h, "l": eyes.l, "m": eyes.m}
     domain.update(r_min=args.r_min, r_max=args.r_max, g_max=args.g_max)
     _say_seed(args, drawn, domain)
-    bar = _progress(args, args.n, _PROGRESS_MIN)
     t0 = time.perf_counter()
-    try:
-        dataset.write(args.output, args.n, progress=bar.update if bar else None, **kw)
-    finally:
-        if bar is not None:
-            bar.close()
+    dom = Domain(eyes.h, eyes.l, eyes.m, args.r_min, args.r_max, args.g_max)
+    _write(args, args.n, dom, _PROGRESS_MIN, unique_bitmaps=args.unique_bitmaps)
     if not args.quiet:
         size = os.path.getsize(args.output) / 1e6
         print(
@@ -323,14 +322,15 @@ def _run3d(args: argparse.Namespace, drawn: bool = False) -> int:
     return 0
 
 
-def _write_sparse(args: argparse.Namespace, n: int, domain) -> None:
-    """The sparse 3D data set of ``domain`` (HEALPix or measured eyes) to ``args.output``,
-    with a progress bar past _PROGRESS_MIN_3D rows."""
-    from eyeviz.dataset import sparse3d
+def _write(args: argparse.Namespace, n: int, domain, least: int, **own) -> None:
+    """Algorithm 1's ``n`` rows of ``domain`` to ``args.output`` through the data set
+    format of the domain's kind (:func:`eyeviz.dataset.kinds.write`; ``own``: that
+    format's own options), with a progress bar past ``least`` rows."""
+    from eyeviz.dataset import kinds
 
-    bar = _progress(args, n, _PROGRESS_MIN_3D)
+    bar = _progress(args, n, least)
     try:
-        sparse3d.write3d(
+        kinds.write(
             args.output,
             n,
             domain,
@@ -338,12 +338,17 @@ def _write_sparse(args: argparse.Namespace, n: int, domain) -> None:
             seed=args.seed,
             segments=args.segments,
             progress=bar.update if bar else None,
-            field=args.field,
-            responses=args.responses,
+            **own,
         )
     finally:
         if bar is not None:
             bar.close()
+
+
+def _write_sparse(args: argparse.Namespace, n: int, domain) -> None:
+    """The sparse 3D data set of ``domain`` (HEALPix or measured eyes) to ``args.output``,
+    with a progress bar past _PROGRESS_MIN_3D rows."""
+    _write(args, n, domain, _PROGRESS_MIN_3D, field=args.field, responses=args.responses)
 
 
 def _run_eye(args: argparse.Namespace, drawn: bool) -> int:

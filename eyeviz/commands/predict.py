@@ -3,7 +3,7 @@
 Reads a data set of docs/contract.md (.csv or .npz), writes a CSV with a header line
 ``r_hat,phi_hat`` and one row per input row (``nan`` where a row is not a single
 feature), atomically. Prints the metrics against the data's own r and phi. The data set is
-read block by block (:func:`eyeviz.dataset.io.iter_blocks`), so memory stays bounded
+read block by block (its format's reader, :mod:`eyeviz.dataset.kinds`), so memory stays bounded
 whatever its size.
 
 The data set's eye design (h, l, m) must be the estimator's: an NPZ carries it, a CSV is
@@ -14,13 +14,15 @@ not take (``--weights`` for analytic, ``--target`` for compact, ``--r-min`` for 
 fixed-design estimator) is refused, never ignored. ``-o`` may not be the input file
 (compared by device and inode, so links count).
 
-The file's eye design picks its reader (:func:`eyeviz.dataset.kinds.kind_of`, read
-from its meta). A sparse data set (``eyeviz generate --nside`` or ``--eye``) takes an
-estimator of the spherical side that answers for its eyes (``analytic3d``, ``limit3d``,
-``learned3d`` for HEALPix eyes; ``analytic3d`` and ``limit3d`` for a measured pair;
-docs/spherical.md, docs/measured.md): it is read in blocks
-(:class:`eyeviz.dataset.sparse3d.Sparse3DReader`), its design comes from the file (no
-``--h --l --m --r-min --r-max --g-max``), and the CSV has
+The file's eye design picks its data set format (:mod:`eyeviz.dataset.kinds`: the kind
+read from its meta, :func:`~eyeviz.dataset.kinds.kind_of`; a kind or format nobody
+registered is refused in one line naming the known kinds): its reader, and the columns
+and wording of its rows (:class:`~eyeviz.dataset.kinds.RowFormat`); one run loop
+(:func:`_predict_rows`) serves every kind. A sparse data set (``eyeviz generate --nside``
+or ``--eye``) takes an estimator of the spherical side that answers for its eyes
+(``analytic3d``, ``limit3d``, ``learned3d`` for HEALPix eyes; ``analytic3d`` and
+``limit3d`` for a measured pair; docs/spherical.md, docs/measured.md): its design comes
+from the file (no ``--h --l --m --r-min --r-max --g-max``), and the CSV has
 ``r_hat,azimuth_hat,elevation_hat,flagged`` (radians; ``flagged`` is 1 where the
 estimator answered by its fallback or the row lies outside its domain, e.g. learned3d
 past its training ranges, and the count is on stderr: no such answer is written
@@ -104,16 +106,16 @@ def _design_text(h: float, l: float, m: int) -> str:  # noqa: E741
     return f"h={num(h)}, l={num(l)}, m={m}"
 
 
-def _reader(args, registry):
-    """(block reader, design): the NPZ's own design, a CSV's from the flags (Tables 3-4)."""
+def _reader(args, registry, fmt):
+    """(block reader, design) of a planar data set (``fmt``, the planar format): the NPZ's
+    own design, a CSV's from the flags (Tables 3-4)."""
     from eyeviz import EyevizError
     from eyeviz.core.domain import PAPER_DOMAIN
-    from eyeviz.core.geometry import EyePair
-    from eyeviz.dataset.io import format_of, iter_blocks
+    from eyeviz.dataset.io import format_of
 
     path = Path(args.data)
     if format_of(path) == "npz":
-        reader = iter_blocks(path)
+        reader = fmt.call("reader", path)
         e = reader.eyes
         design = (float(e.h), float(e.l), int(e.m))
         given = {k: getattr(args, k, None) for k in ("h", "l", "m")}
@@ -129,7 +131,7 @@ def _reader(args, registry):
             )
         return reader, design
     dom = registry.domain_from_args(args, PAPER_DOMAIN)
-    return iter_blocks(path, eyes=EyePair(dom.h, dom.l, dom.m)), dom.design
+    return fmt.call("reader", path, eyes=dom.eyes), dom.design
 
 
 def _refuse_foreign_options(entry, args, registry) -> None:
@@ -165,16 +167,55 @@ def _with_weights(registry) -> list[str]:
     return [e.name for e in registry.entries(None) if e.weights_hint]
 
 
-# long: the command's one sequence (read, check, predict, write), each step with its own one-line
-# error
-def run(args: argparse.Namespace) -> int:
-    import numpy as np
-
+def _open_file_domain(args, entry, registry, fmt):
+    """(block reader, design names, design, domain) of a data set that carries its whole
+    domain (the sparse lit sets, HEALPix or measured): the design flags are refused."""
     from eyeviz import EyevizError
+
+    if registry.domain_given(args):
+        raise EyevizError(
+            f"{args.data} is a 3D data set that carries its design (its eyes and ranges); "
+            "--h --l --m --r-min --r-max --g-max are for planar data"
+        )
+    reader = fmt.call("reader", args.data)
+    dom = reader.domain
+    return reader, dom.design_names, dom.design, dom
+
+
+def _open_flag_domain(args, entry, registry, fmt):
+    """(block reader, design names, design, domain) of a planar data set: an NPZ's own
+    design, a CSV's from the flags (Tables 3-4); the domain (ranges from the flags) only
+    for an estimator of any design."""
     from eyeviz.core.domain import Domain
+
+    reader, design = _reader(args, registry, fmt)
+    dom = registry.domain_from_args(args, Domain(*design)) if entry.any_design else None
+    return reader, ("h", "l", "m"), design, dom
+
+
+def _open(args, entry, registry, kind: str):
+    """(format, block reader, design names, design, domain) for ``args.data`` of eye kind
+    ``kind``; the estimator is refused in one line when it does not answer for it."""
+    from eyeviz import EyevizError
+    from eyeviz.dataset.kinds import data_format
+
+    fmt = data_format(kind)
+    if kind not in entry.eye_models:
+        if fmt.domain_flags:  # or unreadable: an empty, garbage or truncated NPZ is
+            _reader(args, registry, fmt)  # named by the planar reader (issue 36)
+        raise EyevizError(
+            f"estimator {entry.name!r} answers for {' and '.join(entry.eye_models)} eyes, but "
+            f"{args.data} is {fmt.what}; use one of "
+            f"{', '.join(registry.available_for(kind)) or '(none registered)'}"
+        )
+    opener = _open_flag_domain if fmt.domain_flags else _open_file_domain
+    return (fmt, *opener(args, entry, registry, fmt))
+
+
+def run(args: argparse.Namespace) -> int:
+    from eyeviz import EyevizError
+    from eyeviz.dataset.kinds import kind_of
     from eyeviz.estimators import registry
-    from eyeviz.estimators.metrics import RunningSummary
-    from eyeviz.files.atomic import atomic_output
 
     entry = registry.get(args.estimator)
     _refuse_foreign_options(entry, args, registry)
@@ -186,148 +227,77 @@ def run(args: argparse.Namespace) -> int:
         raise EyevizError(f"output {args.out} is the input data file {args.data}; pick another -o")
     if not (out.parent if str(out.parent) else Path(".")).is_dir():
         raise EyevizError(f"output directory {out.parent} does not exist")
-    from eyeviz.dataset.kinds import kind_of
-
-    kind = kind_of(args.data)
-    if kind not in entry.eye_models:
-        if kind == "planar":  # or unreadable: an empty, garbage or truncated NPZ is
-            _reader(args, registry)  # named by the planar reader (issue 36)
-        which = {"planar": "a planar", "spherical": "a sparse 3D"}.get(kind, f"a {kind}-eye")
-        raise EyevizError(
-            f"estimator {entry.name!r} answers for {' and '.join(entry.eye_models)} eyes, but "
-            f"{args.data} is {which} data set; use one of "
-            f"{', '.join(registry.available_for(kind)) or '(none registered)'}"
-        )
-    if kind != "planar":
-        return _run3d(args, entry, registry, out, kind)
-    reader, design = _reader(args, registry)
-    kw = registry.options_from_args(entry.load_options, args)
-    if args.weights is not None:
-        kw["path"] = args.weights
-    if entry.any_design:
-        h, l, m = design  # noqa: E741
-        kw["domain"] = registry.domain_from_args(args, Domain(h, l, m))
-    est = entry.load_estimator(**kw)
-    if est.domain.design != design:
-        raise EyevizError(
-            f"data set {args.data} has design {_design_text(*design)}, but estimator "
-            f"{entry.name!r} answers for {_design_text(*est.domain.design)}"
-        )
-    n = invalid = outside = unanswered = 0
-    dd, ad = RunningSummary(), RunningSummary()
-    with atomic_output(out) as tmp, open(tmp, "w", encoding="ascii") as fh:
-        fh.write("r_hat,phi_hat\n")
-        for b in reader:  # bounded memory: one block of rows at a time
-            pred = est.predict(b.omega_a, b.omega_b)
-            np.savetxt(fh, np.column_stack([pred.r, pred.phi]), fmt="%.17g", delimiter=",")
-            valid = np.asarray(pred.valid)
-            answered = valid & np.isfinite(pred.r) & np.isfinite(pred.phi)
-            n += len(valid)
-            invalid += int((~valid).sum())
-            unanswered += int((valid & ~answered).sum())
-            outside += int((valid & ~np.asarray(pred.in_domain)).sum())
-            dd.update(b.r[answered], pred.r[answered])
-            ad.update(b.phi[answered], pred.phi[answered])
-    msg = f"{args.estimator}: {n} rows -> {out}"
-    if invalid:
-        msg += f"; {invalid} not a single feature (nan)"
-    if outside:
-        msg += f"; {outside} outside the training domain"
-    print(msg, file=sys.stderr)
-    if dd.n >= 2:
-        try:
-            d, a = dd.result(), ad.result()
-            ok = True
-        except ValueError:
-            ok = False
-        if ok:
-            print(
-                f"DD MAPE {d['mape']:.3f} %  MAE {d['mae']:.2f}  R^2 {d['r2']:.4f} | "
-                f"AD MAPE {a['mape']:.4f} %  MAE {a['mae']:.3g} rad  R^2 {a['r2']:.6f}",
-                file=sys.stderr,
-            )
-    if unanswered:
-        print(
-            f"eyeviz: warning: {out} written, but {args.estimator} gave no finite answer "
-            f"for {unanswered} of {n - invalid} single-feature rows (nan there; exit "
-            f"{EXIT_UNANSWERED})",
-            file=sys.stderr,
-        )
-        return EXIT_UNANSWERED
-    return 0
-
-
-def _run3d(args: argparse.Namespace, entry, registry, out: Path, kind: str) -> int:
-    """``predict`` on a sparse data set (HEALPix or measured eyes): r, azimuth, elevation
-    per row, block by block."""
-    import numpy as np
-
-    from eyeviz import EyevizError
-    from eyeviz.dataset.kinds import open_reader
-    from eyeviz.estimators.metrics import RunningSummary
-    from eyeviz.files.atomic import atomic_output
-
-    if registry.domain_given(args):
-        raise EyevizError(
-            f"{args.data} is a 3D data set that carries its design (its eyes and ranges); "
-            "--h --l --m --r-min --r-max --g-max are for planar data"
-        )
-    reader = open_reader(args.data, kind)
-    dom = reader.domain
+    fmt, reader, names, design, dom = _open(args, entry, registry, kind_of(args.data))
     kw = registry.options_from_args(entry.load_options, args)
     if args.weights is not None:
         kw["path"] = args.weights
     if entry.any_design:
         kw["domain"] = dom
     est = entry.load_estimator(**kw)
-    if est.domain.design != dom.design:
-        what = f"({', '.join(dom.design_names)})"
-        raise EyevizError(
-            f"data set {args.data} has the eyes {what} = {dom.design}, but estimator "
-            f"{entry.name!r} answers for {est.domain.design}"
+    if est.domain.design != design:
+        raise EyevizError(_mismatch(args.data, names, design, entry.name, est.domain.design))
+    return _predict_rows(fmt.rows, est, entry.name, reader, out)
+
+
+def _mismatch(data, names: tuple[str, ...], design: tuple, name: str, theirs: tuple) -> str:
+    """The one line refusing an estimator of another design than the data set's."""
+    if names == ("h", "l", "m"):  # the planar flags' wording: h=40, l=20, m=720
+        return (
+            f"data set {data} has design {_design_text(*design)}, but estimator "
+            f"{name!r} answers for {_design_text(*theirs)}"
         )
-    n = invalid = unanswered = flagged = 0
-    sums = [RunningSummary() for _ in range(3)]
+    return (
+        f"data set {data} has the eyes ({', '.join(names)}) = {design}, but estimator "
+        f"{name!r} answers for {theirs}"
+    )
+
+
+# long: the one run loop over a data set's rows for every kind (predict, write, count, the
+# metrics), each kind's columns and wording from its dataset.kinds.RowFormat
+def _predict_rows(rows, est, name: str, reader, out: Path) -> int:
+    """Predict every block of ``reader`` with ``est``, write the CSV of ``rows``
+    (:class:`eyeviz.dataset.kinds.RowFormat`) to ``out`` atomically, say the counts and
+    the metrics on stderr; the exit status."""
+    import numpy as np
+
+    from eyeviz.estimators.metrics import RunningSummary
+    from eyeviz.files.atomic import atomic_output
+
+    n = invalid = unanswered = aside = 0
+    sums = [RunningSummary() for _ in rows.truth]
+    fmt = ["%.17g"] * len(rows.truth) + (["%d"] if rows.flag_column else [])
     with atomic_output(out) as tmp, open(tmp, "w", encoding="ascii") as fh:
-        fh.write("r_hat,azimuth_hat,elevation_hat,flagged\n")
+        fh.write(rows.header + "\n")
         for b in reader:  # bounded memory: one block of rows at a time
             pred = est.predict_dataset(b)
             cols = [np.asarray(c, np.float64) for c in pred]
-            flag = np.asarray(pred.flagged, bool)
-            table = np.column_stack([*cols, flag])
-            np.savetxt(fh, table, fmt=["%.17g"] * 3 + ["%d"], delimiter=",")
+            table = [*cols, np.asarray(pred.flagged, bool)] if rows.flag_column else cols
+            np.savetxt(fh, np.column_stack(table), fmt=fmt, delimiter=",")
             valid = np.asarray(pred.valid)
-            answered = valid & np.isfinite(cols[0]) & np.isfinite(cols[1]) & np.isfinite(cols[2])
+            answered = valid & np.logical_and.reduce([np.isfinite(c) for c in cols])
             n += len(valid)
             invalid += int((~valid).sum())
             unanswered += int((valid & ~answered).sum())
-            flagged += int(flag.sum())
-            for acc, true, got in zip(sums, (b.r, b.azimuth, b.elevation), cols, strict=True):
-                acc.update(true[answered], got[answered])
-    msg = f"{entry.name}: {n} rows -> {out}"
+            aside += int(rows.aside(pred, valid).sum())
+            for acc, key, got in zip(sums, rows.truth, cols, strict=True):
+                acc.update(np.asarray(getattr(b, key))[answered], got[answered])
+    msg = f"{name}: {n} rows -> {out}"
     if invalid:
-        msg += f"; {invalid} with an eye that lit nothing (nan)"
-    if flagged:
-        msg += (
-            f"; {flagged} flagged (column 'flagged' = 1: answered by {entry.name}'s fallback "
-            "or outside its domain; not its own answer)"
-        )
+        msg += f"; {invalid} {rows.no_answer}"
+    if aside:
+        msg += rows.aside_text.format(k=aside, name=name)
     print(msg, file=sys.stderr)
     if sums[0].n >= 2:
         try:
-            d, a, e = (acc.result() for acc in sums)
+            results = [acc.result() for acc in sums]
         except ValueError:
             pass
         else:
-            print(
-                f"DD MAPE {d['mape']:.3f} %  MAE {d['mae']:.2f} | azimuth MAE "
-                f"{a['mae']:.3g} rad | elevation MAE {e['mae']:.3g} rad",
-                file=sys.stderr,
-            )
+            print(rows.summary.format(*results), file=sys.stderr)
     if unanswered:
         print(
-            f"eyeviz: warning: {out} written, but {entry.name} gave no finite answer for "
-            f"{unanswered} of {n - invalid} rows where both eyes lit facets (nan there; exit "
+            f"eyeviz: warning: {out} written, but {name} gave no finite answer for "
+            f"{unanswered} of {n - invalid} {rows.answerable} (nan there; exit "
             f"{EXIT_UNANSWERED})",
             file=sys.stderr,
         )

@@ -371,6 +371,11 @@ class Estimator(EstimatorBase):
             r[blk], phi[blk], valid[blk], dom[blk] = self._predict_block(a[blk], b[blk])
         return self._pack(r, phi, valid, dom, single)
 
+    def predict_dataset(self, ds) -> Prediction:
+        """:meth:`predict` on the rows of a planar data set or block (its ``omega_a``,
+        ``omega_b``): the call every kind's estimator answers on its kind's rows."""
+        return self.predict(ds.omega_a, ds.omega_b)
+
     def _predict_block(self, a, b):
         LA, RA, va = _runs(a)
         LB, RB, vb = _runs(b)

@@ -187,7 +187,11 @@ def test_kind_of_reads_the_design_from_the_meta(toy_file, tmp_path):
     assert isinstance(kinds.open_reader(path), sparse3d.Sparse3DReader)
     assert isinstance(kinds.open_reader(heal), sparse3d.Sparse3DReader)
     assert kinds.open_reader(planar).eyes.m == 720
-    with pytest.raises(EyevizError, match="no data set reader for eyes of kind 'cubic'"):
+    with pytest.raises(
+        EyevizError,
+        match=r"no data set format for eyes of kind 'cubic' "
+        r"\(known kinds: measured, planar, spherical\)$",
+    ):
         kinds.open_reader(path, kind="cubic")
     with pytest.raises(ValueError, match="module:callable"):
         kinds.register_reader("cubic", "nowhere")
