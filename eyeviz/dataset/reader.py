@@ -103,13 +103,14 @@ class BlockReader:
 
     def _open_npz(self, eyes: EyePair | None) -> None:
         try:
+            other = _other_kind(self.path)
+            if other is not None:
+                raise EyevizError(
+                    f"{self.path}: {other.what} ({other.kind} eyes), not a planar one: read "
+                    "it with eyeviz.dataset.kinds.open_reader (or kinds.load)"
+                )
             with zipfile.ZipFile(self.path) as zf:
                 infos = {i.filename: i for i in zf.infolist()}
-                if "rows.npy" not in infos and "indptr_a.npy" in infos:
-                    raise EyevizError(
-                        f"{self.path}: a data set of the spherical eyes (3D), not of the "
-                        "planar ones: read it with eyeviz.dataset.load3d"
-                    )
                 for name in ("meta.npy", "rows.npy"):
                     if name not in infos:
                         raise self._npz_fail(f"no member {name!r}")
@@ -285,6 +286,15 @@ class BlockReader:
 
     def __iter__(self) -> Iterator[Block]:
         return self._iter_npz() if self.fmt == "npz" else self._iter_csv()
+
+
+def _other_kind(path: Path):
+    """The data set format of ``path`` when its meta declares eyes of another kind than
+    this reader's (:func:`eyeviz.dataset.kinds.kind_of`), else None."""
+    from eyeviz.dataset.kinds import FORMATS, data_format, kind_of
+
+    fmt = data_format(kind_of(path))
+    return None if fmt.reader == FORMATS["planar"].reader else fmt
 
 
 def iter_blocks(path, block_rows: int = BLOCK_ROWS, eyes: EyePair | None = None) -> BlockReader:

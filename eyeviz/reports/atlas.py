@@ -174,7 +174,7 @@ def measure_pair(pair, args: argparse.Namespace, names: list[str]) -> PairAtlas:
     """The atlas of one pair (see the module docstring)."""
     from eyeviz.core.animal_scale import describe_prior, prior_ranges
     from eyeviz.core.domain import domain_for
-    from eyeviz.dataset.algorithm1_3d import generate3d
+    from eyeviz.dataset import kinds
     from eyeviz.reports import atlas_measure as am
 
     t0 = time.perf_counter()
@@ -202,7 +202,7 @@ def measure_pair(pair, args: argparse.Namespace, names: list[str]) -> PairAtlas:
         )
     out.times["field map"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    ds = generate3d(args.rows, domain, mode=args.mode, seed=args.seed)
+    ds = kinds.sample(args.rows, domain, mode=args.mode, seed=args.seed)
     out.rows = len(ds)
     out.times["test set"] = time.perf_counter() - t0
     t0 = time.perf_counter()

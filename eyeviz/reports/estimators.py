@@ -217,9 +217,16 @@ def run_lit(args: argparse.Namespace) -> int:
         )
     check_int("--limit-rows", args.limit_rows, ge=1, le=limits.MAX_ROWS)
     if args.data is not None:
-        from eyeviz.dataset.sparse3d import load3d
+        from eyeviz.dataset.kinds import data_format, kind_of
 
-        ds = load3d(args.data)
+        fmt = data_format(kind_of(args.data))
+        if fmt.domain_flags:  # a file that needs --h --l --m: not a data set of lit sets
+            raise EyevizError(
+                f"--data {args.data} is {fmt.what}; --data takes a data set that carries "
+                "its eyes (eyeviz generate --nside or --eye); the planar estimators are "
+                "scored on fresh test sets (no --data)"
+            )
+        ds = fmt.call("loader", args.data)
         if len(ds) == 0:  # "metrics need at least one value" named no file (issue 36)
             raise EyevizError(f"data set {args.data} has no rows: there is nothing to measure")
         d = ds.domain
@@ -236,13 +243,13 @@ def run_lit(args: argparse.Namespace) -> int:
         )
     elif getattr(args, "eye", None) is not None:
         from eyeviz.core.domain import domain_for
-        from eyeviz.dataset.algorithm1_3d import generate3d
+        from eyeviz.dataset import kinds
         from eyeviz.files.eye_io import eye_path, load_eyes
 
         check_int("--n-test", args.n_test, ge=10, le=limits.MAX_ROWS)
         args.eye = eye_path(args.eye)  # a file, or a shipped eye's name
         pair = load_eyes(args.eye)
-        ds = generate3d(args.n_test, domain_for(pair), "single", args.seed)
+        ds = kinds.sample(args.n_test, domain_for(pair), "single", args.seed)
         d = ds.domain
         what = (
             f"A fresh test set: {len(ds)} rows of Algorithm 1 (single pass, seed {args.seed}) "
@@ -253,10 +260,10 @@ def run_lit(args: argparse.Namespace) -> int:
     else:
         from eyeviz.core.domain import domain_for
         from eyeviz.core.geometry3d import EyePair3D
-        from eyeviz.dataset.algorithm1_3d import generate3d
+        from eyeviz.dataset import kinds
 
         check_int("--n-test", args.n_test, ge=10, le=limits.MAX_ROWS)
-        ds = generate3d(args.n_test, domain_for(EyePair3D(nside=args.nside)), "single", args.seed)
+        ds = kinds.sample(args.n_test, domain_for(EyePair3D(nside=args.nside)), "single", args.seed)
         what = (
             f"A fresh test set: {len(ds)} rows of the 3D Algorithm 1 (single pass, seed "
             f"{args.seed}), the paper's design at nside = {args.nside}."

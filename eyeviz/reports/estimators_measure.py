@@ -105,9 +105,13 @@ def _limit(results: list[Result]) -> Result | None:
 
 def make_test_sets(n: int, seed: int = TEST_SEED) -> dict:
     """Fresh single- and multi-pass test sets with the paper's parameters (Tables 3, 4)."""
-    from eyeviz import dataset
+    from eyeviz.core.domain import PAPER_DOMAIN
+    from eyeviz.dataset import kinds
 
-    return {mode: dataset.generate(n, mode=mode, seed=seed + i) for i, mode in enumerate(TEST_SETS)}
+    return {
+        mode: kinds.sample(n, PAPER_DOMAIN, mode=mode, seed=seed + i)
+        for i, mode in enumerate(TEST_SETS)
+    }
 
 
 def _time_batched(est: Estimator, oa: np.ndarray, ob: np.ndarray) -> tuple[Prediction, float]:

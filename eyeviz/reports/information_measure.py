@@ -296,10 +296,11 @@ def _result(name, description, kind, binary_name, theta, origin, fn, r_hat, rel_
 def measure_planar(n: int, seed: int, rel_step: float = STEP) -> ModelResult:
     """The paper's planar design (Tables 3, 4): Algorithm 1's features, ``cell`` responses,
     the planar information limit."""
-    from eyeviz.dataset.algorithm1 import generate
+    from eyeviz.core.domain import PAPER_DOMAIN
+    from eyeviz.dataset import kinds
     from eyeviz.estimators import limit
 
-    ds = generate(n, seed=seed)
+    ds = kinds.sample(n, PAPER_DOMAIN, seed=seed)
     eyes = ds.eyes
     x, y = ds.r * np.cos(ds.phi), ds.r * np.sin(ds.phi)
     theta = np.stack([x, y, ds.g], axis=1)
@@ -324,12 +325,12 @@ def measure_measured(
     binary side is limit3d (the analytic triangulation where limit3d refuses the pair)."""
     from eyeviz import EyevizError
     from eyeviz.core.domain import domain_for
-    from eyeviz.dataset.algorithm1_3d import generate3d
+    from eyeviz.dataset import kinds
     from eyeviz.estimators import limit3d
     from eyeviz.estimators.analytic3d import estimate_measured
 
     dom = domain_for(pair)
-    ds = generate3d(n, dom, seed=seed)
+    ds = kinds.sample(n, dom, seed=seed)
     theta = np.stack([ds.x, ds.y, ds.z, ds.g], axis=1)
     lit_a, lit_b = (ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b)
     try:
@@ -354,11 +355,11 @@ def measure_healpix(nside: int, n: int, seed: int, rel_step: float = STEP) -> Mo
     side the pair's exact ``cell`` responses (:func:`healpix_fn`)."""
     from eyeviz.core.domain import domain_for
     from eyeviz.core.geometry3d import EyePair3D
-    from eyeviz.dataset.algorithm1_3d import generate3d
+    from eyeviz.dataset import kinds
     from eyeviz.estimators import limit3d
 
     dom = domain_for(EyePair3D(nside=nside))
-    ds = generate3d(n, dom, seed=seed)
+    ds = kinds.sample(n, dom, seed=seed)
     theta = np.stack([ds.x, ds.y, ds.z, ds.g], axis=1)
     p = limit3d.load(dom).predict((ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b))
     return _result(

@@ -152,14 +152,13 @@ def evaluate(point: DesignPoint, bin_width: float = BIN_WIDTH) -> list[dict]:
     limit, how many answers came from triangulation because the prior cannot produce the
     key (``flagged``), and ``seconds`` (the whole point, on one core).
     """
-    from eyeviz.dataset.algorithm1 import iter_chunks, make_params
+    from eyeviz.dataset import kinds
 
     t0 = time.perf_counter()
     d = point.domain
-    params = make_params(d, mode=point.prior, seed=point.seed)
     est = LimitEstimator(d, point.prior)
     parts: dict[str, list[np.ndarray]] = {k: [] for k in ("r", "phi", "rh", "ph", "fl")}
-    for c in iter_chunks(point.n, params):
+    for c in kinds.chunks(point.n, d, point.prior, point.seed):
         p = est.predict_intervals(c.la, c.ra, c.lb, c.rb)
         if not np.all(p.valid):
             raise EyevizError("the limit could not answer a generated element (a bug)")
@@ -397,15 +396,14 @@ _METRICS = ("dd_mape", "dd_se", "ad_mape", "el_mae_deg", "el_se", "az_mae_deg", 
 def evaluate3d(point: Any, bin_width: float = BIN_WIDTH) -> list[dict]:
     """Rows of the 3D study table for one point: ``"all"``, the distance bins ``"r<i>"``,
     the elevation bins ``"e<j>"`` (see this module's docstring for the columns)."""
-    from eyeviz.dataset.algorithm1_3d import iter_chunks3d, make_params3d
+    from eyeviz.dataset import kinds
 
     t0 = time.perf_counter()
     d = point.domain
-    params = make_params3d(d, point.prior, point.seed)
     predict = _load(point)
     keys = ("r", "az", "el", "rh", "ah", "eh", "fl")
     parts: dict[str, list[np.ndarray]] = {k: [] for k in keys}
-    for c in iter_chunks3d(point.n, params):
+    for c in kinds.chunks(point.n, d, point.prior, point.seed):
         out = predict((c.indptr_a, c.indices_a), (c.indptr_b, c.indices_b))
         for k, v in zip(keys, (c.r, c.azimuth, c.elevation, *out), strict=True):
             parts[k].append(np.asarray(v))

@@ -54,7 +54,10 @@ def test_a_meta_member_declaring_gigabytes_is_refused_before_allocating(tmp_path
 def test_a_spherical_data_set_is_named_as_such(tmp_path):
     path = tmp_path / "sky.npz"
     D.write3d(path, 5, domain=_small_domain3d(), seed=1)
-    with pytest.raises(EyevizError, match="spherical eyes .*load3d"):
+    with pytest.raises(
+        EyevizError,
+        match=r"a sparse 3D data set \(spherical eyes\), not a planar one: .*kinds.open_reader",
+    ):
         D.load(path)
 
 
