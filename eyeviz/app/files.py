@@ -181,12 +181,12 @@ class FilesMixin(_MainWindow):
         except SceneError as exc:
             self.show_error("Cannot open scene", str(exc))
             return False
-        if scene.kind == "spherical" and not self.host3d.check(scene):
+        if scene.in_space and not self.host3d.check(scene):
             return False  # lit sets the 3D view cannot hold: one line, the scene kept
         self.model.finish_gestures()
         self._set_path(path)
         self.undo_stack.clear()
-        if scene.kind == "spherical":  # issue 22: the 3D page (eyeviz.app.view3d)
+        if scene.in_space:  # issue 22: the 3D page (eyeviz.app.view3d)
             self.host3d.open(scene)
         else:
             self.host3d.leave()

@@ -84,9 +84,7 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         self.settings = settings if settings is not None else make_settings()
         self._set_path(path)
         # a spherical scene opens in the 3D page; the planar page keeps a planar scene
-        planar = (
-            scene if scene.kind == "planar" else Scene(Eyes(scene.eyes.h, scene.eyes.l, paper.M))
-        )
+        planar = Scene(Eyes(scene.eyes.h, scene.eyes.l, paper.M)) if scene.in_space else scene
         self.model = AppModel(planar)
         self.undo_stack = QtWidgets.QUndoStack(self)
         self.model.push = self._push
@@ -194,7 +192,7 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
             self._add_recent(Path(path))  # the file named on the command line too
         self.fit_inset()
         self._on_model("scene", None)
-        if scene.kind == "spherical" and self.host3d.check(scene):
+        if scene.in_space and self.host3d.check(scene):
             self.host3d.open(scene)
         self._update_title()
 

@@ -90,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
     aspect = resolve_aspect(args.aspect, width)
     min_font = None if args.min_font is None else check_min_font(args.min_font)
     sc = scene_mod.load(args.scene)
-    if sc.kind == "spherical":
+    if sc.in_space:
         from eyeviz.core.validation import check_choice
         from eyeviz.model.camera3d import PRESETS
 
@@ -99,7 +99,7 @@ def run(args: argparse.Namespace) -> int:
         from eyeviz import EyevizError
 
         raise EyevizError("view: a planar scene has one view (--view is for spherical scenes)")
-    if sc.kind == "spherical":  # HEALPix eyes: the view, the maps and the table (figure3d)
+    if sc.in_space:  # HEALPix or measured eyes: the view, the maps and the table (figure3d)
         from eyeviz import EyevizError
         from eyeviz.render.mpl.figure3d import check_drawable3d, export3d
         from eyeviz.render.mpl.glyphs import one_glyph_warning

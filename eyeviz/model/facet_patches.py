@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 from collections import OrderedDict
+from collections.abc import Callable
 from functools import lru_cache
 from typing import Any, Protocol
 
@@ -314,31 +315,51 @@ def _healpix(nside: int, step: int) -> HealpixPatches:
 _MEASURED: OrderedDict[tuple[str, str, int], VoronoiPatches] = OrderedDict()
 
 
+def _healpix_patches(pair: Any, eye: str, step: int) -> FacetPatches:
+    return _healpix(int(pair.nside), int(step))
+
+
+def _measured_patches(pair: Any, eye: str, step: int) -> FacetPatches:
+    key = (pair.fingerprint, eye, int(step))
+    hit = _MEASURED.get(key)
+    if hit is None:
+        _pos, axes, acc = pair.facets(eye)
+        hit = _MEASURED[key] = VoronoiPatches(axes, acc, step)
+        while len(_MEASURED) > 2 * CACHE_PAIRS:
+            _MEASURED.popitem(last=False)
+    _MEASURED.move_to_end(key)
+    return hit
+
+
+#: Each eye model's facet outlines and their caption, by ``pair.kind`` (the row a new
+#: model in space adds): HEALPix cells of the spherical pair's nside; Voronoi patches
+#: about a measured pair's facet axes.
+PATCHES: dict[str, tuple[Callable[[Any, str, int], FacetPatches], Callable[[Any], str]]] = {
+    "spherical": (_healpix_patches, lambda p: f"nside {p.nside}, {p.npix:,} facets per eye"),
+    "measured": (
+        _measured_patches,
+        lambda p: f"{p.facet_counts[0]:,} (A) and {p.facet_counts[1]:,} (B) measured facets",
+    ),
+}
+
+
+def _row(pair: Any):
+    row = PATCHES.get(pair.kind)
+    if row is None:
+        raise ValueError(f"no facet map for {pair.kind!r} eyes (known: {', '.join(PATCHES)})")
+    return row
+
+
 def facet_patches(pair: Any, eye: str, step: int = 2) -> FacetPatches:
     """The outline provider of eye ``eye`` ("A" or "B") of an eye model: HEALPix cells of a
     spherical pair, Voronoi patches of a measured one (kept for the CACHE_PAIRS pairs
     used last, by fingerprint)."""
     if eye not in ("A", "B"):
         raise ValueError(f"eye must be 'A' or 'B', got {eye!r}")
-    if pair.kind == "spherical":
-        return _healpix(int(pair.nside), int(step))
-    if pair.kind == "measured":
-        key = (pair.fingerprint, eye, int(step))
-        hit = _MEASURED.get(key)
-        if hit is None:
-            _pos, axes, acc = pair.facets(eye)
-            hit = _MEASURED[key] = VoronoiPatches(axes, acc, step)
-            while len(_MEASURED) > 2 * CACHE_PAIRS:
-                _MEASURED.popitem(last=False)
-        _MEASURED.move_to_end(key)
-        return hit
-    raise ValueError(f"no facet map for {pair.kind!r} eyes")
+    return _row(pair)[0](pair, eye, step)
 
 
 def patches_caption(pair: Any) -> str:
     """The eyes' facets in a few words: 'nside 8, 768 facets per eye' or '3,187 (A) and
     3,187 (B) measured facets'."""
-    if pair.kind == "spherical":
-        return f"nside {pair.nside}, {pair.npix:,} facets per eye"
-    na, nb = pair.facet_counts
-    return f"{na:,} (A) and {nb:,} (B) measured facets"
+    return _row(pair)[1](pair)

@@ -58,7 +58,7 @@ from eyeviz import EyevizError
 from eyeviz.files import limits
 from eyeviz.files.atomic import atomic_output
 from eyeviz.model.layers import applies, layer, layer_names
-from eyeviz.model.scene_eyes import Eyes, eyes_doc, eyes_from_table
+from eyeviz.model.scene_eyes import SIDES, SPACE_SIDE, Eyes, eyes_doc, eyes_from_table
 from eyeviz.model.steps import Step, check_steps, step_doc
 
 __all__ = [
@@ -91,7 +91,7 @@ SPHERICAL_LAYERS = (
 #: The estimators of a spherical scene's predictions layer when its file names none (the
 #: planar scenes' default is compact; a spherical scene naming a planar one is refused by
 #: eyeviz.model.predictions3d.check_estimators).
-SPHERICAL_ESTIMATORS = ("analytic3d", "learned3d", "limit3d")
+SPHERICAL_ESTIMATORS = SPACE_SIDE.estimators
 #: Layers of spherical scenes only (their table entries apply to no planar eyes).
 SPHERICAL_ONLY = tuple(n for n in SPHERICAL_LAYERS if not applies(n, "planar"))
 #: The spherical side's layers that apply to some eye models only (the others: to both),
@@ -101,7 +101,7 @@ SPHERICAL_ONLY = tuple(n for n in SPHERICAL_LAYERS if not applies(n, "planar"))
 LAYER_KINDS: dict[str, tuple[str, ...]] = {
     n: k
     for n in SPHERICAL_LAYERS
-    if len(k := tuple(x for x in layer(n).kinds if x != "planar")) == 1
+    if len(k := tuple(x for x in layer(n).kinds if SIDES[x].in_space)) == 1
 }
 
 
@@ -196,6 +196,12 @@ class Scene:
 
     def shows(self, layer: str) -> bool:
         return layer in self.layers
+
+    @property
+    def in_space(self) -> bool:
+        """Whether the scene's features are balls in space (HEALPix or measured eyes: the
+        3D page, figure3d), not discs in the plane (the side's :class:`Side`)."""
+        return self.eyes.spec.in_space
 
     @property
     def kind(self) -> str:
@@ -323,7 +329,7 @@ def _scene_from_doc(doc: dict, text: str, source: str, base: Path | None) -> Sce
     title = c.string(doc, "title", "", default="")
 
     eyes = eyes_from_table(c, c.table(doc, "eyes"), base)
-    kind = eyes.side
+    side = eyes.spec  # what the scene's side decides (eyeviz.model.scene_eyes.SIDES)
     raw_features = doc.get("features", [])
     if not isinstance(raw_features, list):
         raise c.fail("features", "must be an array of tables ([[features]])")
@@ -344,7 +350,7 @@ def _scene_from_doc(doc: dict, text: str, source: str, base: Path | None) -> Sce
         x = c.number(ft, "x", p, rule="centre x in model units")
         y = c.number(ft, "y", p, rule="centre y in model units")
         z = c.number(ft, "z", p, default=0.0)
-        if z != 0.0 and kind == "planar":
+        if z != 0.0 and not side.in_space:
             raise c.fail(
                 f"{p}z",
                 f"feature {name!r} has z = {z!r}, but a planar scene's features lie on "
@@ -363,13 +369,13 @@ def _scene_from_doc(doc: dict, text: str, source: str, base: Path | None) -> Sce
     layers = c.strings(layers_t, "show", "layers.", DEFAULT_LAYERS)
     # the layer table (eyeviz.model.layers), registered layers too: a spherical scene
     # knows them all (and refuses the planar-only ones below, in one line saying so)
-    known = layer_names() if kind == "spherical" else layer_names("planar")
+    known = layer_names() if side.in_space else layer_names("planar")
     for name in layers:
         if name not in known:
             raise c.fail("layers.show", f"unknown layer {name!r} (known: {', '.join(known)})")
     if len(set(layers)) != len(layers):
         raise c.fail("layers.show", "a layer is named twice")
-    if kind == "spherical":
+    if side.in_space:
         for name in layers:
             if name not in SPHERICAL_LAYERS:
                 raise c.fail(
@@ -386,7 +392,7 @@ def _scene_from_doc(doc: dict, text: str, source: str, base: Path | None) -> Sce
 
     pred_t = c.table(doc, "predictions")
     c.keys(pred_t, "predictions.", ("estimators",))
-    default = list(SPHERICAL_ESTIMATORS) if kind == "spherical" else ["compact"]
+    default = list(side.estimators)
     estimators = c.strings(pred_t, "estimators", "predictions.", default)
     if not estimators and "predictions" in layers:
         raise c.fail("predictions.estimators", "needs at least one estimator name")
@@ -410,7 +416,7 @@ def _scene_from_doc(doc: dict, text: str, source: str, base: Path | None) -> Sce
     view = View((float(center[0]), float(center[1])), width)
 
     trajectory = None
-    if "trajectory" in doc and kind == "spherical":
+    if "trajectory" in doc and not side.trajectory:
         raise c.fail("trajectory", "a spherical scene has no trajectory (Figure 14 is planar)")
     if "trajectory" in doc:
         tt = c.table(doc, "trajectory")
@@ -431,11 +437,10 @@ def _scene_from_doc(doc: dict, text: str, source: str, base: Path | None) -> Sce
     if "steps" in doc:
         step_layers = (
             tuple(n for n in SPHERICAL_LAYERS if layer_applies(n, eyes.kind))
-            if eyes.side == "spherical"
+            if side.in_space
             else known
         )
-        side = "spherical" if eyes.side == "spherical" else "planar"
-        steps = check_steps(doc["steps"], c.fail, step_layers, sorted(names), _bad_text, side)
+        steps = check_steps(doc["steps"], c.fail, step_layers, sorted(names), _bad_text, side.name)
         if not estimators and any("predictions" in st.layers for st in steps):
             raise c.fail("predictions.estimators", "a step shows predictions: name an estimator")
 
@@ -493,7 +498,7 @@ def _doc(scene: Scene, base: Path | None = None) -> dict:
     if scene.features:
         doc["features"] = [
             {"name": f.name, "x": float(f.x), "y": float(f.y), "g": float(f.g), "color": f.color}
-            if e.kind == "planar"  # a planar scene's file never gains a z key
+            if not e.spec.in_space  # a planar scene's file never gains a z key
             else {
                 "name": f.name,
                 "x": float(f.x),

@@ -36,7 +36,7 @@ from eyeviz.core.geometry import EyePair
 if TYPE_CHECKING:
     from eyeviz.core.measured import MeasuredEyePair
 
-__all__ = ["EYE_UNITS", "Eyes", "eyes_doc", "eyes_from_table", "load_measured"]
+__all__ = ["EYE_UNITS", "SIDES", "Eyes", "Side", "eyes_doc", "eyes_from_table", "load_measured"]
 
 #: The units an eye file may be given in (``[eyes] units``).
 EYE_UNITS = ("mm", "m", "um")
@@ -77,6 +77,34 @@ def load_measured(
     return pair
 
 
+@dataclass(frozen=True)
+class Side:
+    """The half of the app and the pipeline a scene's eyes belong to, and what the scene
+    file, the app and the exports decide by it (a lookup in :data:`SIDES` by the eye
+    model's kind, not a branch on the kind)."""
+
+    #: ``"planar"`` or ``"spherical"`` (:attr:`eyeviz.model.scene.Scene.kind`)
+    name: str
+    #: features are balls (x, y, z, g) shown on the app's 3D page and by figure3d; else
+    #: discs on z = 0 (a scene file's features have no z), the planar page
+    in_space: bool
+    #: the ``[predictions] estimators`` of a scene file that names none
+    estimators: tuple[str, ...]
+    #: a scene file may have a ``[trajectory]`` (Figure 14's are planar)
+    trajectory: bool
+
+
+PLANAR_SIDE = Side("planar", in_space=False, estimators=("compact",), trajectory=True)
+SPACE_SIDE = Side(
+    "spherical",
+    in_space=True,
+    estimators=("analytic3d", "learned3d", "limit3d"),
+    trajectory=False,
+)
+#: The side of each eye model (``Eyes.kind``): the one row a new model adds here.
+SIDES: dict[str, Side] = {"planar": PLANAR_SIDE, "spherical": SPACE_SIDE, "measured": SPACE_SIDE}
+
+
 @dataclass
 class Eyes:
     """The scene's eye pair: h origin-to-centre, l eye radius, m ommatidia (Table 3); with
@@ -110,7 +138,12 @@ class Eyes:
     def side(self) -> str:
         """``"planar"`` (discs in the plane) or ``"spherical"`` (balls in space: HEALPix
         or measured eyes): which half of the app and the pipeline shows the scene."""
-        return "planar" if self.kind == "planar" else "spherical"
+        return self.spec.name
+
+    @property
+    def spec(self) -> Side:
+        """The :class:`Side` of the eye model (:data:`SIDES`)."""
+        return SIDES[self.kind]
 
     @property
     def design(self) -> dict[str, Any]:
@@ -124,7 +157,7 @@ class Eyes:
 
     def pair(self) -> EyePair:
         """The planar EyePair; a spherical scene's eyes are :meth:`model`'s."""
-        if self.kind != "planar":
+        if self.spec.in_space:
             raise EyevizError(f"the scene's eyes are {self.kind}: use Eyes.model()")
         return EyePair(self.h, self.l, self.m)
 
@@ -169,6 +202,39 @@ def _measured(c, eyes_t: dict, base: Path | None) -> Eyes:
     return Eyes(pair.h, pair.l, 0, None, p, units, frame)
 
 
+def _healpix_table(c, eyes_t: dict, h: float, l: float) -> Eyes:  # noqa: E741
+    """``[eyes] h, l, nside``: the HEALPix pair."""
+    try:
+        nside = check_nside(eyes_t["nside"])
+    except EyevizError as exc:
+        raise c.fail("eyes.nside", str(exc)) from None
+    try:
+        eyes_from_design({"h": h, "l": l, "nside": nside})
+    except ValueError as exc:
+        first = str(exc).split(" ")[0]
+        raise c.fail(f"eyes.{first if first in ('h', 'l') else 'h'}", str(exc)) from None
+    return Eyes(h, l, nside=nside)
+
+
+def _planar_table(c, eyes_t: dict, h: float, l: float) -> Eyes:  # noqa: E741
+    """``[eyes] h, l, m``: the paper's planar pair (m = 720 when not given)."""
+    try:
+        m = check_m(eyes_t.get("m", paper.M))
+    except EyevizError as exc:
+        raise c.fail("eyes.m", str(exc)) from None
+    try:
+        EyePair(h, l, m)
+    except ValueError as exc:
+        first = str(exc).split(" ")[0]
+        raise c.fail(f"eyes.{first if first in ('h', 'l', 'm') else 'h'}", str(exc)) from None
+    return Eyes(h, l, m)
+
+
+#: The ``[eyes]`` table of model eyes, read by the kind its design key names (``m``,
+#: ``nside``; :func:`eyeviz.core.eyes.design_kind`); a measured pair's names its file.
+_MODEL_TABLES = {"planar": _planar_table, "spherical": _healpix_table}
+
+
 def eyes_from_table(c, eyes_t: dict, base: Path | None) -> Eyes:
     """The :class:`Eyes` of a scene's ``[eyes]`` table; ``c`` the scene's checker (its
     ``fail`` names the file, the key's line and the rule), ``base`` the scene's folder."""
@@ -186,27 +252,7 @@ def eyes_from_table(c, eyes_t: dict, base: Path | None) -> Eyes:
             kind = design_kind(eyes_t)
         except EyevizError as exc:
             raise c.fail("eyes.nside", str(exc)) from None
-    if kind == "spherical":
-        try:
-            nside = check_nside(eyes_t["nside"])
-        except EyevizError as exc:
-            raise c.fail("eyes.nside", str(exc)) from None
-        try:
-            eyes_from_design({"h": h, "l": l, "nside": nside})
-        except ValueError as exc:
-            first = str(exc).split(" ")[0]
-            raise c.fail(f"eyes.{first if first in ('h', 'l') else 'h'}", str(exc)) from None
-        return Eyes(h, l, nside=nside)
-    try:
-        m = check_m(eyes_t.get("m", paper.M))
-    except EyevizError as exc:
-        raise c.fail("eyes.m", str(exc)) from None
-    try:
-        EyePair(h, l, m)
-    except ValueError as exc:
-        first = str(exc).split(" ")[0]
-        raise c.fail(f"eyes.{first if first in ('h', 'l', 'm') else 'h'}", str(exc)) from None
-    return Eyes(h, l, m)
+    return _MODEL_TABLES[kind](c, eyes_t, h, l)
 
 
 def eyes_doc(e: Eyes, base: Path | None) -> dict:

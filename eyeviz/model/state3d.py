@@ -126,7 +126,7 @@ def eyes_name(pair: Pair3D) -> str:
 def compute_state3d(scene: Scene) -> SceneState3D:
     """The state of a spherical-side scene (see the module docstring); EyevizError (one
     line) for a planar scene or lit sets beyond ``lit_csr``'s bound."""
-    if scene.kind != "spherical":
+    if not scene.in_space:
         raise EyevizError("compute_state3d needs a spherical-side scene ([eyes] nside or file)")
     pair = scene.eyes.model()
     assert isinstance(pair, EyePair3D | MeasuredEyePair)

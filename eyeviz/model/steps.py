@@ -163,7 +163,7 @@ def check_camera(
         raise fail(f"{key}.width", f"must be > 0, got {out['width']!r}")
     if "view_angle" in out and not 1.0 <= out["view_angle"] <= 170.0:
         raise fail(f"{key}.view_angle", f"must be in [1, 170] degrees, got {out['view_angle']!r}")
-    if side == "spherical" and out["position"] == out["focal_point"]:
+    if "focal_point" in spec and out["position"] == out["focal_point"]:  # a camera in space
         raise fail(key, "position must differ from focal_point")
     return out
 

@@ -20,7 +20,8 @@ class LayersPanel(QtWidgets.QWidget):
         self.installEventFilter(self._unelide)
         grid = QtWidgets.QGridLayout(self)
         self.boxes: dict[str, QtWidgets.QCheckBox] = {}
-        for i, spec in enumerate(s for s in LAYERS if "planar" in s.kinds):
+        kind = model.scene.eyes.kind  # the planar page's scene: the layers its eyes take
+        for i, spec in enumerate(s for s in LAYERS if kind in s.kinds):
             name = spec.name
             b = QtWidgets.QCheckBox(name)
             b.setToolTip(spec.help)

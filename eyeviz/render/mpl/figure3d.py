@@ -329,7 +329,7 @@ def _figure3d(scene, state, width, title, table, bitmaps, aspect, camera, view, 
     if view_image is not None and dpi is None:
         raise EyevizError("figure3d: view_image needs the PNG's dpi")
 
-    if scene.kind != "spherical":
+    if not scene.in_space:
         raise EyevizError("figure3d draws a spherical scene ([eyes] nside)")
     check_drawable3d(scene)
     st = compute_state3d(scene) if state is None else state

@@ -163,8 +163,8 @@ def _eye_batches(state: SceneState3D, scene: Scene, cam: Camera3D) -> list[_Batc
     :data:`SMALL_EYE` (its radius, a fraction of the view's half height) has its unlit
     sphere drawn at nside 4 under its lit facets, which keep the scene's nside. A
     measured pair's: :func:`_measured_eye_batches`."""
-    if state.pair.kind == "measured":
-        return _measured_eye_batches(state, scene)
+    if state.pair.kind == "measured":  # the mathematics differs: Voronoi patches about
+        return _measured_eye_batches(state, scene)  # its axes, not a sphere of HEALPix rings
     pair = state.healpix
     n = pair.nside
     colors = to_rgba_array([f.color for f in scene.features]) if scene.features else None
@@ -353,7 +353,8 @@ def scene_polygons(
     scene's) picks the parts among :data:`VIEW_LAYERS`."""
     shown = set(scene.layers if layers is None else layers)
     batches: list[_Batch] = []
-    healpix_eyes = state.pair.kind == "spherical"  # the cones of its BFV, its equators
+    # mathematics: only HEALPix eyes are spheres with tangent cones (its BFV) and equators
+    healpix_eyes = state.pair.kind == "spherical"
     if "bfv" in shown and part == "scene" and healpix_eyes:  # as VTK: not in the close-up
         batches += _bfv_batches(state)
     if "plane" in shown and part == "scene":
