@@ -398,6 +398,16 @@ def write(
     dataset_io.write_chunks(path, fmt, n, p.eyes.m, p.as_dict(), iter_chunks(n, p), progress)
 
 
+def sample_domain(n: int, domain: Domain, mode: str = "single", seed: int = 0) -> Dataset:
+    """:func:`generate` of ``domain`` (the planar row of :mod:`eyeviz.dataset.kinds`)."""
+    return generate(n, domain, mode=mode, seed=seed)
+
+
+def chunks_domain(n: int, domain: Domain, mode: str = "single", seed: int = 0):
+    """:func:`iter_chunks` of ``domain`` (the planar row of :mod:`eyeviz.dataset.kinds`)."""
+    return iter_chunks(n, make_params(domain, mode=mode, seed=seed))
+
+
 def save(ds: Dataset, path) -> None:
     """Write an in-memory data set to ``path`` (.csv or .npz), atomically."""
     dataset_io.save(ds, path)

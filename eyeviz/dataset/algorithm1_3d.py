@@ -403,3 +403,8 @@ def generate3d(
     n = check_n(n)
     p = make_params3d(domain, mode, seed, segments, field)
     return Dataset3D.concat(list(iter_chunks3d(n, p)))
+
+
+def chunks_domain3d(n: int, domain: Domain3D, mode: str = "single", seed: int = 0):
+    """:func:`iter_chunks3d` of ``domain`` (the sparse rows of :mod:`eyeviz.dataset.kinds`)."""
+    return iter_chunks3d(n, make_params3d(domain, mode, seed))

@@ -171,30 +171,6 @@ class DataFormat:
         return target(*args, **kw)
 
 
-def _planar_write(path, n, domain, **kw: Any) -> None:
-    from eyeviz.dataset.algorithm1 import write as write_planar
-
-    write_planar(path, n, domain, **kw)
-
-
-def _planar_sample(n, domain, mode="single", seed=0):
-    from eyeviz.dataset.algorithm1 import generate
-
-    return generate(n, domain, mode=mode, seed=seed)
-
-
-def _planar_chunks(n, domain, mode="single", seed=0):
-    from eyeviz.dataset.algorithm1 import iter_chunks, make_params
-
-    return iter_chunks(n, make_params(domain, mode=mode, seed=seed))
-
-
-def _sparse_chunks(n, domain, mode="single", seed=0):
-    from eyeviz.dataset.algorithm1_3d import iter_chunks3d, make_params3d
-
-    return iter_chunks3d(n, make_params3d(domain, mode, seed))
-
-
 def _sparse(kind: str, what: str) -> DataFormat:
     return DataFormat(
         kind,
@@ -202,7 +178,7 @@ def _sparse(kind: str, what: str) -> DataFormat:
         loader="eyeviz.dataset.sparse3d:load3d",
         writer="eyeviz.dataset.sparse3d:write3d",
         sampler="eyeviz.dataset.algorithm1_3d:generate3d",
-        chunker=_sparse_chunks,
+        chunker="eyeviz.dataset.algorithm1_3d:chunks_domain3d",
         rows=SPARSE_ROWS,
         what=what,
         meta_format=SPARSE_FORMAT,
@@ -217,9 +193,9 @@ FORMATS: dict[str, DataFormat] = {
         "planar",
         reader="eyeviz.dataset.reader:iter_blocks",
         loader="eyeviz.dataset.reader:load",
-        writer=_planar_write,
-        sampler=_planar_sample,
-        chunker=_planar_chunks,
+        writer="eyeviz.dataset.algorithm1:write",
+        sampler="eyeviz.dataset.algorithm1:sample_domain",
+        chunker="eyeviz.dataset.algorithm1:chunks_domain",
         rows=PLANAR_ROWS,
         what="a planar data set",
         domain_flags=True,
