@@ -252,7 +252,7 @@ def _mismatch(data, names: tuple[str, ...], design: tuple, name: str, theirs: tu
     )
 
 
-# long: the one run loop over a data set's rows for every kind (predict, write, count, the
+# the one run loop over a data set's rows for every kind (predict, write, count, the
 # metrics), each kind's columns and wording from its dataset.kinds.RowFormat
 def _predict_rows(rows, est, name: str, reader, out: Path) -> int:
     """Predict every block of ``reader`` with ``est``, write the CSV of ``rows``
