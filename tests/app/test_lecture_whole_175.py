@@ -13,12 +13,14 @@ scrolled sideways. Before, at F11 + F5 + 175 % on a 1280 x 720 screen:
 Real keys (xdotool) into the real window."""
 
 from PyQt5 import QtWidgets
-from test_lecture_names_175 import lecture_at_175
+from test_lecture_names_175 import _box, lecture_at_175
 from test_presenting_real_x import _keys, window_manager  # noqa: F401
 
 from eyeviz.app.launch import APP_FONT_PT
 from eyeviz.app.steps import CAPTION_SHARE
+from eyeviz.model.labels3d import discs
 from eyeviz.model.scene import load
+from eyeviz.render.vtk.scene3d import camera_of
 
 
 def _vtk_texts(host) -> dict[str, str]:
@@ -112,3 +114,47 @@ def test_the_balls_table_columns_come_back_when_there_is_room(make_window, qtbot
         lambda: not any(t.isColumnHidden(j) for j in range(t.columnCount())), timeout=5000
     )
     assert t.toolTip() == ""
+
+
+def test_the_close_up_names_each_read_as_their_own_eye_at_175_percent(make_window, qtbot):
+    """In the close-up (a 300 px pane at 175 %) each eye's name is clearly its own: its
+    middle nearer its eye's centre than 0.75 times the other eye's distance. In step 6
+    "eye A" and "eye B" both sat between the eyes, one over the other; where the whole
+    names cannot be placed so, they read "A" and "B"."""
+    import numpy as np
+
+    win, path = lecture_at_175(make_window, qtbot)
+    host = win.host3d
+    checked = captions = 0
+    for step in range(len(load(path).steps)):
+        _keys(qtbot, "Next", until=lambda s=step: win.step_index == s)
+        qtbot.wait(300)
+        host.draw()
+        boxes, at = host.actors.eye_name_boxes, host.actors.eye_name_anchors
+        labs = host.actors.eyes.labels
+        assert [lab.GetInput() for lab in labs] in (["eye A", "eye B"], ["A", "B"]), step + 1
+        if np.linalg.norm(at[0] - at[1]) < 1.0:  # one eye behind the other: no side
+            continue
+        cap = host.actors.eyes_caption  # drawn: never over an eye ("each" over eye A, step 7)
+        if cap.GetInput() and cap.GetTextProperty().GetOpacity() > 0:
+            x0, y0, x1, y1 = _box(cap, host.actors.eyes_ren)
+            w, h = host.actors.eyes_ren.GetSize()
+            _, rad = discs(camera_of(host.actors.eyes_ren), *_eye_discs(host), float(w), float(h))
+            for (cx, cy), r in zip(at, rad, strict=True):
+                nx, ny = min(max(cx, x0), x1), min(max(cy, y0), y1)
+                assert np.hypot(nx - cx, ny - cy) >= r, (step + 1, (x0, y0, x1, y1), cx, cy, r)
+            captions += 1
+        mid = np.column_stack([boxes[:, 0] + boxes[:, 2], boxes[:, 1] + boxes[:, 3]]) / 2
+        for k in range(2):
+            own, other = (float(np.linalg.norm(mid[k] - at[j])) for j in (k, 1 - k))
+            assert own <= 0.75 * other, (step + 1, labs[k].GetInput(), own, other)
+        checked += 1
+    assert checked >= 6 and captions >= 3, (checked, captions)
+
+
+def _eye_discs(host):
+    """The eyes' centres and radii (model units) as the close-up draws them."""
+    import numpy as np
+
+    s = host.actors.surface
+    return np.asarray(s.centres, float), np.full(len(s.centres), float(s.radius))

@@ -40,13 +40,14 @@ from eyeviz.model.labels3d import (
     KEEP_CLEAR_PX,
     LABEL_MARGIN_PX,
     Named3D,
-    _covers,
     discs,
     fit_labels,
     frame_names,
-    gap_for,
     pan,
     shifted,
+)
+from eyeviz.model.labels3d import (
+    _covers as covers,
 )
 from eyeviz.model.layers import ordered, resolve
 from eyeviz.model.predictions3d import Predictions3D
@@ -55,6 +56,14 @@ from eyeviz.model.state3d import SceneState3D, compute_state3d
 from eyeviz.render.style3d import EYES_FRACTION  # the looks the vector view shares
 from eyeviz.render.vtk.balls3d import BallsPainter
 from eyeviz.render.vtk.cones3d import ConesPainter
+from eyeviz.render.vtk.eye_names3d import (
+    EYE_NAMES,
+    SHORT_NAMES,
+    misplaced,
+    names_under,
+    over_discs,
+    unclear,
+)
 from eyeviz.render.vtk.eyes3d import LABEL_PX as EYES_LABEL_PX
 from eyeviz.render.vtk.eyes3d import EyesPainter
 from eyeviz.render.vtk.field3d import FieldPainter
@@ -116,47 +125,6 @@ def default_camera(state: SceneState3D, name: str = "default", aspect: float = 1
     """The preset ``name`` framing the scene's balls (:func:`shapes3d.scene_extent`) in a
     viewport ``aspect`` (width / height) wide."""
     return shapes3d.view_camera(state, name, aspect)
-
-
-def _misplaced(boxes: np.ndarray, at: np.ndarray) -> bool:
-    """Whether a name's box (row k of ``boxes``) has its middle clearly nearer another
-    disc's centre (rows of ``at``, the same order) than its own: by over a fifth of the
-    two centres' distance (discs seen one behind the other, as from the side, tell their
-    names apart by nothing)."""
-    ok = np.isfinite(boxes).all(axis=1) & np.isfinite(at).all(axis=1)
-    if ok.sum() < 2:
-        return False
-    b, a = boxes[ok], at[ok]
-    mid = np.column_stack([b[:, 0] + b[:, 2], b[:, 1] + b[:, 3]]) / 2
-    d = np.linalg.norm(mid[:, None, :] - a[None, :, :], axis=2)
-    k = np.arange(len(a))
-    j = d.argmin(axis=1)
-    apart = np.linalg.norm(a[k] - a[j], axis=1)
-    return bool(((j != k) & (d[k, k] - d[k, j] > 0.2 * apart)).any())
-
-
-def _under(
-    at: np.ndarray, rad: np.ndarray, sizes: np.ndarray, width: float, height: float = np.inf
-) -> np.ndarray:
-    """Boxes (as :func:`eyeviz.model.labels3d.place_boxes`') of names centred under their
-    discs (``at``, ``rad``), moved sideways into [2, width - 2] px where they would leave
-    it; where two of them cross, the name of the higher disc goes over it instead (the
-    close-up at F11 + F5 + 175 % in 1280 x 720, step 8: a 305 x 234 px pane, the two
-    names under their eyes crossed), if it fits under ``height``."""
-    w, h = np.asarray(sizes, float).T
-    x0 = np.clip(at[:, 0] - w / 2, 2.0, np.maximum(width - 2.0 - w, 2.0))
-    gap = np.array([gap_for(v) for v in h])
-    y1 = at[:, 1] - rad - gap
-    out = np.column_stack([x0, y1 - h, x0 + w, y1])
-    for i in range(len(out)):
-        for j in range(i + 1, len(out)):
-            if not _covers(out[i : i + 1], out[j : j + 1]):
-                continue
-            k = i if at[i, 1] > at[j, 1] else j  # the higher disc's name over it
-            y0 = at[k, 1] + rad[k] + gap[k]
-            if y0 + h[k] <= height - 2.0:
-                out[k, 1], out[k, 3] = y0, y0 + h[k]
-    return out
 
 
 P = TypeVar("P", bound=Painter3D)
@@ -323,7 +291,7 @@ class Scene3DActors:
         cam = camera_of(self.scene_ren)
         order, named = self._ball_names()
         boxes = place_texts(self.scene_ren, cam, self.balls.ball_labels, named, order)
-        if self.title.GetInput() and _covers(boxes, self._text_boxes([self.title])):
+        if self.title.GetInput() and covers(boxes, self._text_boxes([self.title])):
             self.title.SetInput("")
             order, named = self._ball_names()
             boxes = place_texts(self.scene_ren, cam, self.balls.ball_labels, named, order)
@@ -337,37 +305,56 @@ class Scene3DActors:
         other's name nor the close-up's caption (F11 + F5 + 175 % in 1280 x 720: "eye A"
         printed over it, or over "eye B", in sphere_lecture's steps 6-8). Where the names find
         no places clear of the caption and of each other, the caption gives way (this frame:
-        each frame tries again)."""
-        ren, cap = self.eyes_ren, self.eyes_caption
-        if ren is None or self.state is None:
+        each frame tries again). Where a whole name reads as neither eye's, the names are
+        "A" and "B" (:func:`eyeviz.render.vtk.eye_names3d.unclear`)."""
+        if self.eyes_ren is None or self.state is None:
             return
         eyes = self._eye_spheres()  # the close-up draws no ball: the eyes are all there is
         labs = self.eyes.labels
         if len(labs) != len(eyes):
             return
+        for names in (EYE_NAMES, SHORT_NAMES, EYE_NAMES):  # short ones no clearer: whole
+            for lab, name in zip(labs, names, strict=False):
+                if lab.GetInput() != name:
+                    lab.SetInput(name)
+            boxes, at = self._eye_names_once(eyes, labs)
+            # a name as near the other eye as its own (a 300 px pane at 175 %: both names
+            # between the eyes in sphere_lecture's step 6) reads as neither's: "A", "B"
+            if not unclear(boxes, at):
+                break
+        self.eye_name_boxes = boxes
+        self.eye_name_anchors = at
+
+    def _eye_names_once(self, eyes: np.ndarray, labs: list) -> tuple[np.ndarray, np.ndarray]:
+        """The close-up's names placed as they read now (see :meth:`_place_eye_names`):
+        their boxes and the eyes' disc centres (pixels)."""
+        ren, cap = self.eyes_ren, self.eyes_caption
+        assert ren is not None
         cap.GetTextProperty().SetOpacity(1.0)
         self._fit_caption()
         keep = self._text_boxes([cap], ren)
         order, named = named_of(
             labs, eyes[:, :3], eyes[:, 3], np.zeros((0, 4)), self._dpi(), below=True
         )
+        w, h = ren.GetSize()
+        at, rad = discs(camera_of(ren), named.centres, named.radii, float(w), float(h))
+        if over_discs(keep, at, rad):  # never over an eye (its third line, a short pane)
+            cap.GetTextProperty().SetOpacity(0.0)
+            keep = np.zeros((0, 4))
         named = replace(named, keep_out=keep)
         # both eyes named always: where they cross, the caption gives way instead
         boxes = place_texts(ren, camera_of(ren), labs, named, order, give_way=False)
-        w, h = ren.GetSize()
-        at, rad = discs(camera_of(ren), named.centres, named.radii, float(w), float(h))
-        crossed = any(_covers(boxes[i : i + 1], boxes[i + 1 :]) for i in range(len(boxes)))
+        crossed = any(covers(boxes[i : i + 1], boxes[i + 1 :]) for i in range(len(boxes)))
         # a name placed nearer the other eye than its own reads as that eye's (a tiny
         # pane at 175 %: "eye A" under eye B): the caption gives way too
-        if crossed or _covers(boxes, keep) or _misplaced(boxes, at):
+        if crossed or covers(boxes, keep) or misplaced(boxes, at):
             cap.GetTextProperty().SetOpacity(0.0)
             bare = replace(named, keep_out=None)
             boxes = place_texts(ren, camera_of(ren), labs, bare, order, give_way=False)
-            if _misplaced(boxes, at):  # no free place near its own eye: right under it
-                boxes = _under(at, rad, named.sizes, float(w), float(h))
+            if misplaced(boxes, at):  # no free place near its own eye: right under it
+                boxes = names_under(at, rad, named.sizes, float(w), float(h))
                 show_at(labs, order, boxes, at)
-        self.eye_name_boxes = boxes
-        self.eye_name_anchors = at
+        return boxes, at
 
     def _fit_caption(self) -> None:
         """The close-up's caption in lines that fit its pane: as it is where it fits, else
