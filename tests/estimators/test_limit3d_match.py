@@ -238,3 +238,32 @@ def test_band_check_decides_the_paper_regime(nside):
     n, hits, decided = _bands_check(d, p[:, 0], p[:, 1], p[:, 2], gg, k, la, lb)
     assert hits >= n // 4 and hits < n
     assert decided >= 0.8 * n
+
+
+def test_band_check_needs_the_draw_between_the_inner_and_outer_caps():
+    """With the inner and the outer cap both the key's own ball (so no band cells), a draw
+    is decided by the band check only if its cap lies between them: a larger or a smaller
+    ball about the same centre is left open (2), never taken for the key."""
+    from eyeviz.core.kernels.healpix_lit import edge_match_kernel, vertex_cache
+
+    n, h = 16, 40.0
+    tabs = (*g3._ring_tables(n), *g3._ring_info_tables(n))
+    x, y, z, g0 = 30.0, 900.0, 50.0, 60.0
+    v = np.array([x + h, y, z])
+    dist = float(np.linalg.norm(v))
+    u = (v / dist)[None, :]
+    a = np.array([np.arcsin(g0 / dist)])
+    empty = np.zeros(0, np.int64)
+    band = (u, a, a.copy(), u.copy(), np.zeros(2, np.int64), empty, empty,
+            np.zeros(0, np.bool_), np.zeros(0), np.zeros(0))  # fmt: skip
+    g = np.array([g0 * 0.8, g0, g0 * 1.2])
+    out = np.full(3, -1, np.int64)
+    ones = np.ones(3)
+    edge_match_kernel(n, x * ones, y * ones, z * ones, g, -h, np.zeros(3, np.int64), *band,
+                      *tabs[:4], tabs[5], vertex_cache(), out)  # fmt: skip
+    assert out.tolist() == [2, 2, 2]
+    # the caps 1e-6 rad inside and outside the ball's: the ball itself is then decided
+    band = (u, a - 1e-6, a + 1e-6, *band[3:])
+    edge_match_kernel(n, x * ones, y * ones, z * ones, g, -h, np.zeros(3, np.int64), *band,
+                      *tabs[:4], tabs[5], vertex_cache(), out)  # fmt: skip
+    assert out.tolist() == [2, 1, 2]
