@@ -122,19 +122,19 @@ def exact_hits(
 
 
 def band_pass(eyes, p: np.ndarray, g: np.ndarray, row: np.ndarray, bands: tuple) -> np.ndarray:
-    """The band check alone (kernels.healpix_lit.edge_match_kernel, eye B only where A did
+    """The band check alone (kernels.healpix_match.edge_match_kernel, eye B only where A did
     not rule the ball out): per ball 1 both eyes light the key's sets, 0 one does not, 2
     not decided here."""
     from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
-    from eyeviz.core.kernels import healpix_lit
+    from eyeviz.core.kernels import healpix_match
 
-    edge_kernel: Any = healpix_lit.edge_match_kernel  # 24 arguments: the stub types fewer
+    edge_kernel: Any = healpix_match.edge_match_kernel  # 24 arguments: the stub types fewer
     n = eyes.nside
     sth, zr, unit = _ring_tables(n)
     first, _, shifted = _ring_info_tables(n)[:3]
     xs, ys, zs = (kernels.arg(p[:, j], np.float64) for j in range(3))
     gs, rows = kernels.arg(g, np.float64), kernels.arg(row, np.int64)
-    vc = healpix_lit.vertex_cache()
+    vc = healpix_match.vertex_cache()
     res = np.full(row.size, 2, np.int64)
     edge_kernel(n, xs, ys, zs, gs, -eyes.h, rows, *bands[0], sth, zr, unit, first, shifted, vc,
                 res)  # fmt: skip
@@ -152,17 +152,17 @@ def _match_healpix(
     """``same_rows`` of the pair's ``lit_csr`` of the balls against the key's rows ``row``
     for both eyes, without the lit sets (eye B only for the balls eye A did not rule
     out): with ``bands``, from the key's band cells alone where the ball's cap lies
-    between the key's inner and outer caps (kernels.healpix_lit.edge_match_kernel);
+    between the key's inner and outer caps (kernels.healpix_match.edge_match_kernel);
     the other balls by the lit-set kernel's rings compared with the key's as they come,
     each ball given up at its first ring that differs (match_kernel); the balls that
     kernel hands to the reference (2) get ``lit_csr`` and ``same_rows``. The same answer
     for every ball (tests/estimators/test_limit3d_match.py)."""
     from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
-    from eyeviz.core.kernels import healpix_lit
+    from eyeviz.core.kernels import healpix_match
 
     # Any: the kernels take 19-24 arrays and numbers (numba's Dispatcher stub types fewer)
-    match_kernel: Any = healpix_lit.match_kernel
-    edge_kernel: Any = healpix_lit.edge_match_kernel
+    match_kernel: Any = healpix_match.match_kernel
+    edge_kernel: Any = healpix_match.edge_match_kernel
 
     xs, ys, zs, gs = (kernels.arg(v, np.float64) for v in (x, y, z, g))
     if not (np.isfinite(xs).all() and np.isfinite(ys).all() and np.isfinite(zs).all()
@@ -174,7 +174,7 @@ def _match_healpix(
     rows = kernels.arg(row, np.int64)
     res = np.zeros(row.size, np.int64)
     todo = np.arange(row.size)
-    vc = healpix_lit.vertex_cache()
+    vc = healpix_match.vertex_cache()
     for e, (cx, (kp, ki)) in enumerate(((-eyes.h, lit_a), (eyes.h, lit_b))):
         out = np.full(todo.size, 2, np.int64)
         xe, ye, ze, ge, re = xs[todo], ys[todo], zs[todo], gs[todo], rows[todo]

@@ -181,8 +181,8 @@ class _Eye:
         order = np.argsort(rows, kind="stable")
         codes, is_lit, rows = codes[order], is_lit[order], rows[order]
         # for the exact check of the band alone (:meth:`band`): the inner and outer caps
-        # as lit_csr saw them (centre, half-angle of each ball), their cells between (all
-        # edge cells, before any pruning), and whether inner <= key <= outer holds
+        # as lit_csr saw them (centre, half-angle of each ball) and the edge cells (all of
+        # them, before any pruning): key - inner and outer - key
         v = pos - np.asarray(centre)
         dv = np.linalg.norm(v, axis=1)
         self.u_io = v[:n] / dv[:n, None]
@@ -190,10 +190,6 @@ class _Eye:
             half = np.arcsin(np.minimum(gs / dv, 1.0))
         self.b_in = np.where(small, -np.inf, half[:n])
         self.b_out = half[n:].copy()
-        odd = np.zeros(n, bool)
-        odd[c_in[~np.isin(c_in, key, assume_unique=True)] // npix] = True
-        odd[key[~np.isin(key, c_out, assume_unique=True)] // npix] = True
-        self.b_in[odd] = np.inf  # the band check never applies: match_kernel decides
         self._band = (np.bincount(rows, minlength=n), codes % npix, is_lit)
         cnt = np.bincount(rows, minlength=n)
         kmax = max(1, int(cnt.max()) if cnt.size else 1)
@@ -212,11 +208,11 @@ class _Eye:
         self.linearise(u)
 
     def band(self) -> tuple[np.ndarray, ...]:
-        """The arguments of kernels.healpix_lit.edge_match_kernel for this eye's keys, from
+        """The arguments of kernels.healpix_match.edge_match_kernel for this eye's keys, from
         u_io to far: the band cells' bounds about the current centres ``c`` (call after
         the centre search, whose centres the draws lie near)."""
         from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
-        from eyeviz.core.kernels.healpix_lit import band_bounds_kernel
+        from eyeviz.core.kernels.healpix_match import band_bounds_kernel
 
         cnt, pix, lit = self._band
         n = self.nside

@@ -1,6 +1,6 @@
 """The spherical limit's exact check without lit sets (issue 31 item 3):
 limit3d_exact._match_healpix (the lit-set kernel's rings compared with the key's as they
-come, kernels.healpix_lit.match_kernel) gives the same accept / reject as building both
+come, kernels.healpix_match.match_kernel) gives the same accept / reject as building both
 eyes' lit sets with ``lit_csr`` and comparing them with ``same_rows``, draw by draw: on
 every tie class of the spherical stability cases (poles, equator ties, vertices, grazing,
 extreme scales) with keys that are the ball's own lit sets and near misses of them, and on
@@ -22,7 +22,7 @@ from eyeviz.estimators.base import take_rows
 from eyeviz.estimators.limit3d_proposal import _Eye
 from eyeviz.reference import stability_cases as sc
 
-pytest.importorskip("eyeviz.core.kernels.healpix_lit")
+pytest.importorskip("eyeviz.core.kernels.healpix_match")
 
 NSIDES = [2, 4, 6, 8, 10, 12, 16, 18, 64, 180]
 
@@ -92,7 +92,7 @@ def test_match_equals_lit_sets_on_every_tie_class(name, seed, nside):
 def test_match_decides_the_paper_regime_in_the_kernel():
     """The kernel itself answers nearly every paper-regime draw (2: the reference), so the
     comparison above compares the kernel, not lit_csr with itself."""
-    from eyeviz.core.kernels.healpix_lit import match_kernel, vertex_cache
+    from eyeviz.core.kernels.healpix_match import match_kernel, vertex_cache
 
     eyes = g3.EyePair3D(40.0, 20.0, 180)
     cs = sc.make("paper", 40, 3, "spherical")
@@ -159,7 +159,7 @@ def test_match_equals_lit_sets_on_the_proposal_draws(nside, monkeypatch):
 
 def test_exact_hits_take_the_lit_sets_with_eyeviz_jit_0(monkeypatch):
     """EYEVIZ_JIT=0: exact_hits builds the lit sets (the reference), never the kernel."""
-    import eyeviz.core.kernels.healpix_lit as hl
+    import eyeviz.core.kernels.healpix_match as hl
 
     def boom(*a):
         raise AssertionError("match kernel called with EYEVIZ_JIT=0")
@@ -178,7 +178,7 @@ def _bands_check(d: Domain3D, x, y, z, g, keys_of, lit_a, lit_b) -> tuple[int, i
     """_match_healpix with the keys' band cells (limit3d_proposal._Eye.band) against
     lit_csr + same_rows on balls (x, y, z, g) of the keys ``keys_of``; returns (balls,
     matches, balls the band check decided in eye A)."""
-    from eyeviz.core.kernels.healpix_lit import edge_match_kernel, vertex_cache
+    from eyeviz.core.kernels.healpix_match import edge_match_kernel, vertex_cache
 
     ea = _Eye(d, lit_a, np.array([-d.h, 0.0, 0.0]), 0)
     eb = _Eye(d, lit_b, np.array([d.h, 0.0, 0.0]), 1)
@@ -244,7 +244,7 @@ def test_band_check_needs_the_draw_between_the_inner_and_outer_caps():
     """With the inner and the outer cap both the key's own ball (so no band cells), a draw
     is decided by the band check only if its cap lies between them: a larger or a smaller
     ball about the same centre is left open (2), never taken for the key."""
-    from eyeviz.core.kernels.healpix_lit import edge_match_kernel, vertex_cache
+    from eyeviz.core.kernels.healpix_match import edge_match_kernel, vertex_cache
 
     n, h = 16, 40.0
     tabs = (*g3._ring_tables(n), *g3._ring_info_tables(n))
@@ -267,3 +267,38 @@ def test_band_check_needs_the_draw_between_the_inner_and_outer_caps():
     edge_match_kernel(n, x * ones, y * ones, z * ones, g, -h, np.zeros(3, np.int64), *band,
                       *tabs[:4], tabs[5], vertex_cache(), out)  # fmt: skip
     assert out.tolist() == [2, 1, 2]
+
+
+def test_band_check_on_one_cell_keys_and_keys_with_a_hole():
+    """Keys the band check must not be fooled by: a ball whose cap lies inside one cell
+    (the key's centre is then in a band cell, lit however far its edges are), and a key
+    with a hole in its middle (the inner cap lights a cell the key lacks: no band, those
+    draws go to the rings)."""
+    d = Domain3D(nside=16)
+    fw = np.sqrt(4 * np.pi / d.npix)
+    # cell centres seen from eye A at 600 units; caps of 0.15 facet widths
+    from eyeviz.core import healpix
+
+    v = np.asarray(healpix.centers(16, np.arange(0, d.npix, 97)), np.float64)
+    v = v[v[:, 1] > 0.5][:4]
+    p = np.array([-d.h, 0.0, 0.0]) + 600.0 * v
+    g = 600.0 * np.sin(0.15 * fw) * np.ones(len(p))
+    (pa, ia), (pb, ib) = d.eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
+    assert (np.diff(pa) == 1).any()  # some keys are one cell in eye A
+    k = np.repeat(np.arange(len(p)), 5)
+    jit = np.random.default_rng(3).normal(size=(k.size, 3)) * 1e-4 * fw * 600.0
+    jit[::5] = 0.0
+    q = p[k] + jit
+    n, hits, _ = _bands_check(d, q[:, 0], q[:, 1], q[:, 2], g[k], k, (pa, ia), (pb, ib))
+    assert hits >= n // 2
+    # a hole: Algorithm 1 keys without a cell from the middle of eye A's set (nside 64:
+    # keys large enough to have an inner cap)
+    d = Domain3D(nside=64)
+    ds = generate3d(6, d, seed=5)
+    la, lb = (ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b)
+    rows = [np.delete(ds.indices_a[la[0][i] : la[0][i + 1]], (la[0][i + 1] - la[0][i]) // 2)
+            for i in range(6)]  # fmt: skip
+    holed = _csr(rows)
+    x, y, z = ds.x, ds.y, ds.z
+    n, hits, _ = _bands_check(d, x, y, z, ds.g, np.arange(6), holed, lb)
+    assert hits == 0

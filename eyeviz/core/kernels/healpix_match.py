@@ -1,0 +1,251 @@
+"""The exact check of the spherical limit's HEALPix draws, compiled (numba): whether a
+ball lights exactly a key's facets, from the lit-set kernel's rings compared with the
+key's as they come (:func:`match_kernel`) or from the key's band cells alone
+(:func:`edge_match_kernel`, :func:`band_bounds_kernel`); docs/kernels.md.
+
+They call :mod:`.healpix_lit`'s functions (``_ball``, ``_ring_at``, ``_decide_cell``, ...),
+so their numba cache is stamped with that module's source as well as their own
+(:class:`_WithLitSource`): an edit of either recompiles them, as if they were one module.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+
+import numpy as np
+from numba.core import caching
+
+from eyeviz.core.kernels import healpix_lit
+from eyeviz.core.kernels.healpix_lit import (
+    _EPS,
+    _ang2pix,
+    _ball,
+    _cell_fs,
+    _decide_cell,
+    _edge_lower,
+    _edge_m,
+    _jit,
+    _pix2xyf,
+    _ring_at,
+    _tol,
+)
+
+__all__ = ["match_kernel", "edge_match_kernel", "band_bounds_kernel", "vertex_cache", "warm"]
+
+
+class _WithLitSource(caching.InTreeCacheLocator):
+    """numba's in-tree cache for this module's kernels, its source stamp that of this file
+    and of healpix_lit.py together (numba checks only the caller's file: a cached kernel
+    would otherwise keep a stale copy of an edited callee there)."""
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        if os.path.abspath(py_file) != os.path.abspath(__file__):
+            return None
+        return super().from_function(py_func, py_file)
+
+    def get_source_stamp(self):
+        digest = hashlib.sha256()
+        for path in (self._py_file, healpix_lit.__file__):
+            with open(path, "rb") as f:
+                digest.update(f.read())
+        return digest.hexdigest()
+
+
+_LOCATORS = caching.CacheImpl._locator_classes
+if _WithLitSource not in _LOCATORS:
+    _LOCATORS.insert(0, _WithLitSource)
+
+
+@_jit
+def _angle(ch2):
+    """The angle of a chord of length sqrt(ch2) on the unit sphere."""
+    return 2.0 * math.asin(min(math.sqrt(max(ch2, 0.0)) * 0.5, 1.0))
+
+
+@_jit
+def _apart(c, u, k):
+    """The angle between c and row k of u (unit vectors), from their chord."""
+    dx, dy, dz = c[0] - u[k, 0], c[1] - u[k, 1], c[2] - u[k, 2]
+    return _angle(dx * dx + dy * dy + dz * dz)
+
+
+@_jit
+def band_bounds_kernel(n, pix, ring, key, u0, sth, zr, unit, first_t, shifted_t, near, far):
+    """For band cells ``pix`` (of rings ``ring``) of the keys ``key``: an upper bound
+    ``near`` on the angle from the key's centre u0[key] to the cell's closure (its nearest
+    vertex) and a lower bound ``far`` (the edges' lower bound of _decide_cell, less its
+    rounding bounds; 0 for the cell holding u0), both widened by 1e-12 rad."""
+    ed = 8 * _EPS
+    none = (np.empty(0, np.int64), np.empty((0, 3)))
+    for k in range(pix.shape[0]):
+        i = ring[k]
+        first = first_t[i]
+        c = (u0[key[k], 0], u0[key[k], 1], u0[key[k], 2])
+        fN, fW, fS, fE, pol = _cell_fs(n, i, pix[k] - first, shifted_t[i], c, sth, zr, unit,
+                                       none)  # fmt: skip
+        vmin = min(min(fN, fW), min(fS, fE))
+        near[k] = _angle(vmin + _tol(vmin, 0.0, ed, 0.0)) + 1e-12
+        ix, iy, face = _pix2xyf(n, pix[k], i, first)
+        lo = np.inf
+        for fa, fb, mf in ((fW, fN, _edge_m(n, pol, face, True, iy + 1, ix)),
+                           (fS, fW, _edge_m(n, pol, face, False, ix, iy)),
+                           (fS, fE, _edge_m(n, pol, face, True, iy, ix)),
+                           (fE, fN, _edge_m(n, pol, face, False, ix + 1, iy))):  # fmt: skip
+            low = _edge_lower(fa, fb, mf)
+            low = low - _tol(max(low, 0.0), 0.0, ed, 0.0) - 8 * _EPS * (fa + fb + mf)
+            lo = min(lo, low)
+        cpix = _ang2pix(n, min(max(c[2], -1.0), 1.0), math.atan2(c[1], c[0]))
+        far[k] = 0.0 if cpix == pix[k] else max(_angle(lo) - 1e-12, 0.0)
+
+
+# long: one draw's containment test and its band cells' walk with its early exit
+@_jit
+def edge_match_kernel(n, x, y, z, g, cx, row, u_io, b_in, b_out, u0, bp, pix, ring, lit,
+                      near, far, sth, zr, unit, first_t, shifted_t, vc, out):  # fmt: skip
+    """Whether ball b lights exactly key row[b]'s facets, from the key's band cells alone:
+    out[b] 1 yes, 0 no, 2 not decided here (then :func:`match_kernel`).
+
+    Per key, ``b_in`` and ``b_out`` are half-angles of an inner and an outer cap about
+    u_io (I and O their lit sets), and the band cells (CSR ``bp``: ``pix``, rings, ``lit``:
+    in the key K) are K - I (lit) and O - K (unlit). A ball whose cap (c, alpha) holds
+    the inner cap (alpha >= b_in + |c - u_io|) and lies in the outer one (alpha + |c -
+    u_io| <= b_out), each with 1e-9 rad to spare beyond the cap's error bound, lights
+    every cell of I and none outside O (a cell is lit iff the cap reaches its closure:
+    monotone in the cap; I lies in O), so it lights K iff each band cell is lit exactly
+    when in K: K's cells in I are lit, and every other cell in K or in O is a band cell
+    (a cell of I missing from K is in O - K; a cell of K outside O is in K - I and is
+    then found unlit). A
+    band cell is lit when even its nearest vertex from u0 (``near``) moved by |c - u0|
+    lies inside the cap, unlit when the lower bound of its distance from u0 (``far``)
+    less |c - u0| lies outside it; else :func:`_decide_cell` decides it (with the ball's
+    own bounds, as lit_runs_kernel; its centre pixel is lit), and a cell it leaves open
+    leaves the ball to match_kernel. The first band cell that differs from the key rules
+    the ball out."""
+    for b in range(x.shape[0]):
+        r = row[b]
+        kind, par, _, _, alpha, pad = _ball(n, x[b], y[b], z[b], g[b], cx)
+        if kind != 0:
+            out[b] = 2
+            continue
+        c, s2, ds2, ed, cpix = par[0], par[10], par[11], par[12], par[13]
+        d_io = _apart(c, u_io, r) + 1e-12
+        a_lo = alpha - pad - 1e-9
+        a_hi = alpha + pad + 1e-9
+        if not (a_lo - d_io >= b_in[r] and a_hi + d_io <= b_out[r]):
+            out[b] = 2
+            continue
+        d0 = _apart(c, u0, r) + 1e-12
+        res = 1
+        for k in range(bp[r], bp[r + 1]):
+            if near[k] + d0 < a_lo:
+                on = 1
+            elif far[k] - d0 > a_hi:
+                on = 0
+            elif pix[k] == cpix:
+                on = 1
+            else:
+                i = ring[k]
+                on = _decide_cell(n, i, pix[k] - first_t[i], pix[k], shifted_t[i], first_t[i],
+                                  c, s2, ds2, ed, sth, zr, unit, vc)  # fmt: skip
+                if on == 2:
+                    res = 2
+                    break
+            if on != lit[k]:
+                res = 0
+                break
+        out[b] = res
+
+
+def vertex_cache(size: int = 1 << 14) -> tuple[np.ndarray, np.ndarray]:
+    """An empty vertex cache of ``size`` (a power of 2; 0: none) for :func:`match_kernel`:
+    (tags, xyz), tags -1 where empty."""
+    return np.full(size, -1, np.int64), np.empty((size, 3))
+
+
+@_jit
+def _piece(ki, k, end, s, length):
+    """Whether the key's indices ki[k:end] begin with s, s + 1, ..., s + length - 1."""
+    if k + length > end:
+        return False
+    for j in range(length):
+        if ki[k + j] != s + j:
+            return False
+    return True
+
+
+# long: lit_runs_kernel's ring loop, its runs compared with the key's as they come
+@_jit
+def match_kernel(n, x, y, z, g, cx, row, kp, ki, sth, zr, unit, first_t, nr_t, shifted_t,
+                 delta_t, o_t, vc, out):  # fmt: skip
+    """Whether each ball b lights exactly the facets of row ``row[b]`` of the CSR (kp, ki)
+    (sorted indices) in this eye: out[b] 1 yes, 0 no, 2 the kernel cannot tell (a ball
+    lit_runs_kernel hands to the reference, met before a mismatch). The same rings and
+    decisions as :func:`lit_runs_kernel`, its runs compared with the key's as they come
+    (no indices written) and a ball given up at its first ring that differs: a decided
+    ring is the reference's, so a difference there is one of the exact lit sets. ``vc``:
+    a vertex cache (:func:`vertex_cache`; the balls of a call lie near a few keys' balls,
+    so their undecided cells share vertices)."""
+    npix = 12 * n * n
+    for b in range(x.shape[0]):
+        k, end = kp[row[b]], kp[row[b] + 1]
+        kind, par, i_min, i_max, _, _ = _ball(n, x[b], y[b], z[b], g[b], cx)
+        if kind == 1:
+            out[b] = 2
+            continue
+        if kind == 3:
+            out[b] = 1 if _piece(ki, k, end, 0, npix) and end - k == npix else 0
+            continue
+        res = 1
+        for i in range(i_min, i_max + 1):
+            kind, lo, hi = _ring_at(n, i, par, sth, zr, unit, first_t, nr_t, shifted_t,
+                                    delta_t, o_t, vc)  # fmt: skip
+            if kind == 2:
+                res = 2
+                break
+            if kind == 0:
+                continue
+            f = first_t[i]
+            nr = nr_t[i]
+            lo_w = lo % nr
+            length = hi - lo + 1
+            e = lo_w + length
+            if e > nr:  # the piece at the ring's start first
+                ok = _piece(ki, k, end, f, e - nr) and _piece(ki, k + e - nr, end, f + lo_w,
+                                                               nr - lo_w)  # fmt: skip
+            else:
+                ok = _piece(ki, k, end, f + lo_w, length)
+            if not ok:
+                res = 0
+                break
+            k += length
+        if res == 1 and k != end:
+            res = 0  # the key lights more
+        out[b] = res
+
+
+def warm() -> None:
+    """Compile (or load from the cache) the kernels for their one signature each, on the
+    ring tables of nside 4."""
+    from eyeviz.core import healpix
+
+    n = 4
+    k = np.arange(4 * n + 1)
+    sth, zr = healpix.ring_sz(n, k)
+    q = np.minimum(np.minimum(k, n), 4 * n - k)
+    unit = np.where(q > 0, 0.25 * math.pi / np.maximum(q, 1), 0.0)
+    first, nr, shifted = healpix.ring_info(n, np.clip(k, 1, 4 * n - 1))
+    delta, o = 2 * math.pi / nr, np.where(shifted, 0.0, -0.5)
+    x, y, z, g = (np.array(v, np.float64) for v in ([0.0], [100.0], [5.0], [30.0]))
+    i1 = np.zeros(1, np.int64)
+    match_kernel(n, x, y, z, g, 40.0, i1, np.array([0, 1]), i1, sth, zr, unit, first, nr,
+                 shifted, delta, o, vertex_cache(16), i1.copy())  # fmt: skip
+    u = np.array([[0.0, 1.0, 0.0]])
+    near, far = np.zeros(1), np.zeros(1)
+    pix, ring = np.array([10]), np.array([2])
+    band_bounds_kernel(n, pix, ring, i1, u, sth, zr, unit, first, shifted, near, far)
+    edge_match_kernel(n, x, y, z, g, 40.0, i1, u, np.zeros(1), np.ones(1), u, np.array([0, 1]),
+                      pix, ring, np.ones(1, np.bool_), near, far, sth, zr, unit, first, shifted,
+                      vertex_cache(16), i1.copy())  # fmt: skip
