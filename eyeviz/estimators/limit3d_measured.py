@@ -32,15 +32,66 @@ from the cells (:mod:`.limit3d_healpix`), here without a linearisation:
    the angle at o_A): A's lit set bounds delta and B's bounds beta. The box: bisection
    along 26 directions of H >= -slack, the boundary points' box widened ``WIDEN`` times,
    then widened by half again on each face near which a pilot's feasible draws fall.
-5. A draw: (delta, beta) uniform in the box, g uniform on the feasible interval at that
-   centre. Weight: prior x rho^2 (1 + |delta|^2)^(-3/2) |b| sin(a) / sin(a + beta)^2
-   (d(x, y, z) / d(delta, beta)) x the box's volume x the interval's length. Every draw
-   with a weight is checked exactly (:func:`.limit3d_exact.exact_hits`: the pair's own
-   ``lit_csr``, then ``in_bfv``).
+5. A draw: (delta, beta) uniform in a box, g uniform on the feasible interval at that
+   centre. Where the provable box below holds, the first ``DEFEND`` of each batch's draws
+   come from it (every draw where the bisection found no feasible point) and the rest
+   from the box of step 4 cut to it, a deterministic mixture. Weight: prior x rho^2 (1 +
+   |delta|^2)^(-3/2) |b| sin(a) / sin(a + beta)^2 (d(x, y, z) / d(delta, beta)) x the
+   interval's length / the mixture's density in (delta, beta) (the box's volume alone
+   where there is no provable box). Every draw with a weight is checked exactly
+   (:func:`.limit3d_exact.exact_hits`: the pair's own ``lit_csr``, then ``in_bfv``).
 
-The proposal covers the posterior when the region is close to convex about the reference
-(the widening and the pilot are the margin); the tests compare the answers with
-brute-force rejection sampling from the prior on a small measured eye."""
+Where the provable box holds, the mixture's density is positive on all of it, so the
+estimate is unbiased whatever the box of step 4 covers (a part it misses is found by the
+defensive draws, at a weight as large as the two boxes' volumes are apart: the pilot
+keeps such parts small). Elsewhere the proposal covers the posterior when the region is
+close to convex about the reference (the widening and the pilot are the margin). The
+tests compare the answers with brute-force rejection sampling from the prior on a small
+measured eye, and check that every brute-force posterior sample lies in the provable box.
+
+**The provable box.** Take an eye (centroid o) and the key's constraining facets of it
+(any subset of the facets gives a valid bound: it only drops constraints), their lenses
+p_i within e of an apex o_k (their mean), axes a_i, half angles alpha_i. For a ball (c,
+g) of the posterior's support let D = |c - o_k|, u = (c - o_k) / D its direction, v_i = c
+- p_i, theta_i the angle between v_i and a_i and phi_i the angle between u and a_i. The
+prior gives D >= d_min = r_min - |o_k - origin|, g <= g_max, and the field test (no lens
+in the ball) g < |v_i|; assume d_min > e.
+
+(a) The lens seen from c: the angle between v_i and u is at most asin(e / D) (the
+    directions from c to the points within e of o_k form a cone of that half angle), so
+    |phi_i - theta_i| <= asin(e / D).
+(b) A lit facet i: dist(c, K_i) <= g with the cone distance above. If theta_i <=
+    alpha_i, theta_i - alpha_i <= 0; if 0 < theta_i - alpha_i < pi/2, |v_i| sin(theta_i
+    - alpha_i) <= g; if theta_i - alpha_i >= pi/2 the distance is |v_i| > g: not lit. So
+    theta_i - alpha_i <= asin(g / |v_i|) <= asin(g / (D - e)) (|v_i| >= D - e).
+(c) An unlit facet j: dist(c, K_j) > g > 0, so theta_j > alpha_j, and either theta_j -
+    alpha_j >= pi/2 or |v_j| sin(theta_j - alpha_j) > g: theta_j - alpha_j > asin(g /
+    |v_j|) >= asin(g / (D + e)).
+(d) With (a): L(u) = max over lit i of (phi_i - alpha_i) <= asin(min(1, g / (D - e))) +
+    asin(e / D) and F(u) = L(u) - min over unlit j of (phi_j - alpha_j) < asin(min(1, g
+    / (D - e))) - asin(g / (D + e)) + 2 asin(e / D). Both right sides grow with g and
+    shrink as D grows (the derivatives of the asin difference in g and in D have those
+    signs), so at g = g_max, D = d_min they are bounds S and T that hold for every ball
+    of the support (:func:`_lens_tolerances`).
+(e) Every angle above is 1-Lipschitz in u along the sphere, so L is too and F is
+    2-Lipschitz; the gnomonic map's inverse shrinks lengths (its singular values are 1 /
+    (1 + |x|^2) and 1 / sqrt(1 + |x|^2)), so a grid cell whose half diagonal in the plane
+    is h lies within h of its centre's direction. A cell whose centre has F > T + 2 h or
+    L > S + h holds no feasible direction; all of them lie in the cap of radius
+    alpha_i + S about any lit axis a_i, so the search starts from that cap's gnomonic
+    square and zooms onto the kept cells (:meth:`MeasuredProposal._dir_region`; a margin
+    of 1e-7 rad covers arccos's rounding near 1).
+(f) The box's coordinates are about the eye's centroid o, not o_k: the direction from o
+    lies within asin(|o_k - o| / (r_min - |o - origin|)) of the direction from o_k (as
+    in (a)), so each kept cell's directions from o lie within h plus that of its centre.
+    A's delta is gnomonic about u0 (its map stretches an angle by at most sec^2 of the
+    largest angle from u0), B's beta is the angle from -b, 1-Lipschitz. The bounding box
+    of the kept cells so widened holds every ball of the support
+    (:meth:`MeasuredProposal.provable_box`).
+The bound holds where d_min exceeds the lens offsets and the first cap stays within
+``PROOF_REACH`` rad of the reference (the honeybee's keys at its default domain; not the
+test pair at 4-12 eye radii, whose balls may nearly touch the eye); elsewhere a key's
+proposal is the box of step 4 alone, as before."""
 
 from __future__ import annotations
 
@@ -74,6 +125,14 @@ SEARCH = 1.5
 REACH = 6.0
 #: rings of axis neighbours of the lit facets whose unlit facets constrain
 RINGS = 2
+#: the provable box: grid points per axis and zoom levels of each eye's direction search,
+#: and the largest angle from the reference its first cap may reach (a gnomonic plane
+#: holds less than a hemisphere)
+PROOF_GRID = 12
+PROOF_LEVELS = 3
+PROOF_REACH = 1.4
+#: the share of each batch's draws from the provable box where it holds
+DEFEND = 0.0625
 
 
 _DIRS3 = np.array(
@@ -247,6 +306,36 @@ def _direction(e: _Edges, grid: int, levels: int = 6) -> np.ndarray:
     return c
 
 
+def _asin1(y):
+    return np.arcsin(np.clip(y, 0.0, 1.0))
+
+
+def _lens_tolerances(g_max: float, d_min: np.ndarray, e: np.ndarray):
+    """(T, S, ok) per key (module docstring, "A box that provably holds the posterior"):
+    every feasible ball at distance D >= d_min from the apex, radius g <= g_max, whose
+    eye's lenses lie within e of the apex, has F(u) < T and max over lit facets of
+    (angle(u, a_i) - alpha_i) <= S at its direction u from the apex; ``ok`` where d_min > e
+    (else the lens offsets bound nothing)."""
+    ok = d_min > e
+    dm = np.where(ok, d_min, 1.0)
+    em = np.where(ok, e, 0.0)
+    par = _asin1(em / dm)
+    near = _asin1(g_max / np.maximum(dm - em, 1e-300))
+    t = near - _asin1(g_max / (dm + em)) + 2.0 * par
+    return t, near + par, ok
+
+
+def _angles(e: _Edges, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(F, L) (N, G) at unit directions u (N, G, 3): F = max over lit facets of
+    (angle(a_i, u) - alpha_i) - min over unlit ones of (angle(a_j, u) - alpha_j), L the
+    first term alone."""
+    ang = np.arccos(np.clip(np.matmul(e.ax, np.swapaxes(u, 1, 2)), -1.0, 1.0)) - e.half[..., None]
+    lit = (e.lit & ~e.pad)[..., None]
+    unl = (~e.lit & ~e.pad)[..., None]
+    top = np.where(lit, ang, -np.inf).max(axis=1)
+    return top - np.where(unl, ang, np.inf).min(axis=1), top
+
+
 class MeasuredProposal:
     """Importance draws for keys of a measured pair (module docstring): :meth:`setup`
     once per chunk, then :meth:`sample` per batch of ``samples`` draws."""
@@ -332,6 +421,103 @@ class MeasuredProposal:
         hv = g_hi - g_lo
         return np.where(np.isfinite(hv), hv, -np.inf)
 
+    # --- the provable box --------------------------------------------------------------
+    def _dir_region(self, e: _Edges, apex: np.ndarray, w0: np.ndarray, d_min: np.ndarray):
+        """Step 1 of the provable box (module docstring): the directions from ``apex``
+        (N, 3) that a feasible ball at distance ``d_min`` (N,) or more can have, on
+        zooming gnomonic grids about w0 (N, 3), first the cap of the lit facets' bound S:
+        a cell whose centre has F > T + 2 h or L > S + h (h its half diagonal in the
+        plane, which bounds its geodesic radius) holds none; the next grid spans the kept
+        cells. Returns (the last grid's centres (N, G, 3) as unit vectors, kept (N, G), h
+        (N,), ok): ``ok`` where the bound holds (d_min above the lenses' offsets from the
+        apex, the cap within ``PROOF_REACH`` of w0, some cell kept)."""
+        live = ~e.pad
+        off = np.where(live, np.linalg.norm(e.pos - apex[:, None], axis=2), 0.0).max(axis=1)
+        t, s, ok = _lens_tolerances(float(self.domain.g_max), d_min, off)
+        e1, e2 = _frame(w0)
+        cos0 = np.clip(np.einsum("nkj,nj->nk", e.ax, w0), -1.0, 1.0)
+        reach = np.where(e.lit & live, np.arccos(cos0) + e.half, np.inf).min(axis=1) + s
+        ok &= reach < PROOF_REACH
+        w = np.tan(np.where(ok, reach, 0.1))
+        lo, hi = -np.stack([w, w], 1), np.stack([w, w], 1)
+        tt = (np.arange(PROOF_GRID) + 0.5) / PROOF_GRID
+        g2 = np.stack(np.meshgrid(tt, tt, indexing="ij"), axis=-1).reshape(-1, 2)
+        for _ in range(PROOF_LEVELS):
+            span = hi - lo
+            dd = lo[:, None] + span[:, None] * g2[None]
+            h = 0.5 * np.hypot(span[:, 0], span[:, 1]) / PROOF_GRID
+            v = w0[:, None] + dd[..., :1] * e1[:, None] + dd[..., 1:] * e2[:, None]
+            v = v / np.linalg.norm(v, axis=2, keepdims=True)
+            keep = self._keep_cells(e, v, t, s, h)
+            half = 0.5 * span[:, None] / PROOF_GRID
+            some: np.ndarray = np.asarray(keep.any(axis=1))
+            ok &= some
+            lo = np.where(some[:, None], np.where(keep[..., None], dd - half, np.inf).min(1), lo)
+            hi = np.where(some[:, None], np.where(keep[..., None], dd + half, -np.inf).max(1), hi)
+        return v, keep, h, ok
+
+    @staticmethod
+    def _keep_cells(e: _Edges, v: np.ndarray, t, s, h) -> np.ndarray:
+        """The cells (N, G) of :meth:`_dir_region`'s grid that may hold a feasible
+        direction: F <= t + 2 h and L <= s + h at their centres v (N, G, 3), with 1e-7 rad
+        for arccos's rounding near 1 (about 1.5e-8). Compiled with an early exit
+        (kernels.limit3d_region.direction_keep_kernel) unless ``EYEVIZ_JIT=0``."""
+        if kernels.use(v.shape[0] * v.shape[1]):
+            from eyeviz.core.kernels.limit3d_region import direction_keep_kernel
+
+            keep = np.empty(v.shape[:2], np.bool_)
+            f64 = np.float64
+            direction_keep_kernel(kernels.arg(e.ax, f64), kernels.arg(e.half, f64),
+                                  kernels.arg(e.lit), kernels.arg(e.pad), kernels.arg(v, f64),
+                                  kernels.arg(t, f64), kernels.arg(s, f64), kernels.arg(h, f64),
+                                  keep)  # fmt: skip
+            return keep
+        f, top = _angles(e, v)
+        tiny = 1e-7
+        return (f <= (t + 2 * h + tiny)[:, None]) & (top <= (s + h + tiny)[:, None])
+
+    def provable_box(self, st: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(lo, hi, proven): per key a box in (delta, beta) holding every ball of the
+        posterior's support where ``proven`` (module docstring, "The provable box")."""
+        d = self.domain
+        n = st["u0"].shape[0]
+        proven = np.ones(n, bool)
+        cells = []
+        for e, centre in ((st["ea"], self.fa.centre), (st["eb"], self.fb.centre)):
+            live = ~e.pad
+            apex = np.where(live[..., None], e.pos, 0.0).sum(axis=1)
+            apex = apex / np.maximum(live.sum(axis=1), 1)[:, None]
+            w0 = st["ref"] - apex
+            w0 = w0 / np.linalg.norm(w0, axis=1, keepdims=True)
+            # the least distance of a ball's centre from the apex and from the centroid
+            d_apex = d.r_min - np.linalg.norm(apex - self.origin, axis=1)
+            d_centre = d.r_min - float(np.linalg.norm(centre - self.origin))
+            v, keep, h, ok = self._dir_region(e, apex, w0, d_apex)
+            # step 2: from the centroid, a cell's directions lie within h + asin(|o_k -
+            # o| / d_centre) of its centre
+            q = np.linalg.norm(apex - centre, axis=1)
+            proven &= ok & (d_centre > q)
+            cells.append((v, keep, h + _asin1(q / max(d_centre, 1e-300))))
+        (va, ka, pa), (vb, kb, pb) = cells
+        # A's delta: gnomonic about u0, which stretches an angle by at most sec^2 of the
+        # largest angle from u0
+        cu = np.einsum("ngj,nj->ng", va, st["u0"])
+        ang = np.arccos(np.clip(cu, -1.0, 1.0)) + pa[:, None]
+        proven &= ~(ka & (ang >= 1.5)).any(axis=1)
+        grow = pa[:, None] / np.cos(np.minimum(ang, 1.5)) ** 2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dx = np.stack([np.einsum("ngj,nj->ng", va, st[k]) / cu for k in ("e1", "e2")], -1)
+        lo_a = np.where(ka[..., None], dx - grow[..., None], np.inf).min(axis=1)
+        hi_a = np.where(ka[..., None], dx + grow[..., None], -np.inf).max(axis=1)
+        # B's beta, the angle between -b and the direction from o_B: 1-Lipschitz
+        bc = np.arccos(np.clip(vb @ -self.bhat, -1.0, 1.0))
+        b_lo = np.where(kb, bc - pb[:, None], np.inf).min(axis=1)
+        b_hi = np.where(kb, bc + pb[:, None], -np.inf).max(axis=1)
+        lo = np.concatenate([lo_a, np.maximum(b_lo, 0.0)[:, None]], axis=1)
+        hi = np.concatenate([hi_a, np.minimum(b_hi, math.pi)[:, None]], axis=1)
+        proven &= np.isfinite(lo).all(axis=1) & np.isfinite(hi).all(axis=1)
+        return lo, hi, proven
+
     # --- the proposal ----------------------------------------------------------------------
     def setup(self, lit_a: LitCSR, lit_b: LitCSR, keys: np.ndarray, wide: float) -> dict:
         """Each eye's constraining facets, the reference direction and the box of
@@ -371,6 +557,7 @@ class MeasuredProposal:
             wc = ww[np.arange(n), b]
             half, wh = half / 2.5, wh / 2.5
         ref = self._centres(st, dc[:, None, :], wc[:, None])[:, 0]
+        st["ref"] = ref
         st["ea"].prune(ref)
         st["eb"].prune(ref)
         v = ref - self.fa.centre
@@ -396,6 +583,19 @@ class MeasuredProposal:
         box_hi = centre + np.maximum(pts.max(axis=1), 0.0) * WIDEN
         floor = 1e-9 * d.gamma
         box_lo, box_hi = np.minimum(box_lo, centre - floor), np.maximum(box_hi, centre + floor)
+        # the pilot: the box widened where feasible draws come near a face (the defensive
+        # share of the draws keeps the estimate unbiased where it still misses a part of
+        # the posterior; the pilot keeps that part, and so the weights' spread, small)
+        box_lo, box_hi = self._pilot(st, keys, box_lo, box_hi)
+        lo_p, hi_p, proven = self.provable_box(st)
+        st["box_lo"], st["box_hi"] = box_lo, box_hi
+        self._defend(st, lo_p, hi_p, proven)
+        return st
+
+    def _pilot(self, st: dict, keys: np.ndarray, box_lo: np.ndarray, box_hi: np.ndarray):
+        """The box widened by half on each face near which a pilot's feasible draws fall,
+        ``PILOT`` draws, up to ``PILOT_ROUNDS`` times."""
+        slack = st["slack"]
         up = _uniforms(keys, PILOT, 3, 7)
         for _ in range(PILOT_ROUNDS):
             x = box_lo[:, None] + (box_hi - box_lo)[:, None] * up
@@ -408,8 +608,26 @@ class MeasuredProposal:
             span = box_hi - box_lo
             box_lo = np.where(near_lo, box_lo - 0.5 * span, box_lo)
             box_hi = np.where(near_hi, box_hi + 0.5 * span, box_hi)
-        st["box_lo"], st["box_hi"] = box_lo, box_hi
-        return st
+        return box_lo, box_hi
+
+    def _defend(self, st: dict, lo, hi, proven) -> None:
+        """The defensive box of each key's proposal (module docstring, step 5): where the
+        provable box (lo, hi) holds (``proven``), the first ``DEFEND`` of each batch's
+        draws come from it and the box is cut to it; where the bisection found no
+        feasible point about the reference (the box at its floor), every draw."""
+        box_lo, box_hi = st["box_lo"], st["box_hi"]
+        cut_lo, cut_hi = np.maximum(box_lo, lo), np.minimum(box_hi, hi)
+        # the box's part in the provable box: nothing feasible lies outside it
+        lost = ((box_hi - box_lo) <= 2.5e-9 * self.domain.gamma).all(axis=1)
+        lost |= ~(cut_hi > cut_lo).all(axis=1)
+        n_def = np.where(proven, np.where(lost, self.samples, int(DEFEND * self.samples)), 0)
+        cut = (proven & ~lost)[:, None]
+        st["box_lo"] = np.where(cut, cut_lo, box_lo)
+        st["box_hi"] = np.where(cut, cut_hi, box_hi)
+        st["def_lo"] = np.where(proven[:, None], lo, box_lo)
+        st["def_hi"] = np.where(proven[:, None], hi, box_hi)
+        st["n_def"] = n_def.astype(np.int64)
+        st["proven"] = proven
 
     def sample(self, st: dict, keys: np.ndarray, stream, rows=None) -> dict[str, np.ndarray]:
         """``samples`` weighted draws per key of a chunk set up by :meth:`setup`, per
@@ -454,7 +672,9 @@ class MeasuredProposal:
         outs = {k: np.zeros((n, m)) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
         kernel(
             kernels.arg(u, f64), kernels.arg(st["box_lo"], f64), kernels.arg(st["box_hi"], f64),
-            kernels.arg(st["u0"], f64), kernels.arg(st["e1"], f64), kernels.arg(st["e2"], f64),
+            kernels.arg(st["def_lo"], f64), kernels.arg(st["def_hi"], f64),
+            kernels.arg(st["n_def"], np.int64), self.samples, kernels.arg(st["u0"], f64),
+            kernels.arg(st["e1"], f64), kernels.arg(st["e2"], f64),
             kernels.arg(self.fa.centre, f64), kernels.arg(self.bhat, f64), self.blen,
             kernels.arg(self.origin, f64), self.s_half, float(d.g_max), float(d.r_min),
             float(d.r_max), float(d.el_max), self.prior == "multi", live,
@@ -470,7 +690,12 @@ class MeasuredProposal:
         interval, the weight."""
         d = self.domain
         lo, hi = st["box_lo"], st["box_hi"]
-        x = lo[:, None] + (hi - lo)[:, None] * u[..., :3]
+        dlo, dhi, n_def = st["def_lo"], st["def_hi"], st["n_def"]
+        # the first n_def draws of each batch of ``samples`` from the defensive box
+        dfn = (np.arange(u.shape[1]) % self.samples)[None, :] < n_def[:, None]
+        blo = np.where(dfn[..., None], dlo[:, None], lo[:, None])
+        bhi = np.where(dfn[..., None], dhi[:, None], hi[:, None])
+        x = blo + (bhi - blo) * u[..., :3]
         delta = x[..., :2]
         c, rho, drho = self._bcentres(st, delta, x[..., 2])
         good = np.isfinite(rho)
@@ -489,7 +714,11 @@ class MeasuredProposal:
         with np.errstate(over="ignore", invalid="ignore"):
             # d(x, y, z) = rho^2 (1 + |delta|^2)^(-3/2) d(delta) d(rho), d(rho) = drho d(beta)
             jac = rho * rho * (1.0 + (delta * delta).sum(axis=2)) ** -1.5 * drho
-            vol = np.prod(hi - lo, axis=1)[:, None] * (g_hi - g_lo)
+            vol0 = np.prod(hi - lo, axis=1)[:, None]
+            lam = (n_def / self.samples)[:, None]
+            inside = ((x >= lo[:, None]) & (x <= hi[:, None])).all(axis=2)
+            q = lam / np.prod(dhi - dlo, axis=1)[:, None] + np.where(inside, (1 - lam) / vol0, 0)
+            vol = np.where(n_def[:, None] == 0, vol0 * (g_hi - g_lo), (g_hi - g_lo) / q)
             wt = prior_density(d, self.prior, r, gg, el, az) * jac * vol
         wt = np.where(good & np.isfinite(wt), wt, 0.0)
         return {"r": r, "az": az, "el": el, "g": gg, "x": c[..., 0], "y": c[..., 1],

@@ -365,3 +365,72 @@ def test_bcentre_is_the_reference_s(bee_small):
             assert np.isnan(got[3]) == np.isnan(want[3])
             assert np.allclose(got, want, rtol=1e-12, atol=1e-12, equal_nan=True), (i, j)
     assert np.isnan(rho).any() and np.isfinite(rho).any()
+
+
+@pytest.mark.parametrize("share", [0.0, 0.3, 1.0])
+def test_measured_draws_kernel_mixture_agrees_with_the_reference(bee_small, monkeypatch, share):
+    """The defensive mixture (issue 33): the first ``n_def`` draws of each batch from a
+    second box (here the box grown by two spans on each side), every weight over the two
+    boxes' mixture density; compiled against numpy, the same draws weighted, values and
+    weights to 1e-12 (one key gets none from the second box, one all)."""
+    from eyeviz.estimators.limit3d_proposal import _batch_uniforms
+
+    dom, _, stt, keys, _ = bee_small
+    prop = MeasuredProposal(dom, "single", 512, 8)
+    span = stt["box_hi"] - stt["box_lo"]
+    n_def = np.full(keys.size, int(share * 512), np.int64)
+    n_def[0], n_def[-1] = 0, 512
+    u = _batch_uniforms(keys, 512, 4, [2, 10])
+    if 0 < share < 1:
+        # key 2's split just before a draw the box alone keeps: the split's boundary shows
+        alone = prop._draws_ref(dict(stt, n_def=0 * n_def, def_lo=stt["box_lo"],
+                                     def_hi=stt["box_hi"]), u, None)  # fmt: skip
+        n_def[2] = np.flatnonzero(alone["w"][2, 1:512] > 0)[0] + 1
+    stt = dict(stt, def_lo=stt["box_lo"] - 2 * span, def_hi=stt["box_hi"] + 2 * span,
+               n_def=n_def)  # fmt: skip
+    got = prop._draws_kernel(stt, u, None)
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want = prop._draws_ref(stt, u, None)
+    kept = want["w"] > 0
+    assert np.array_equal(got["w"] > 0, kept)
+    assert 10 <= kept.sum() < kept.size
+    for k in want:
+        tol = 1e-10 if k == "w" else 1e-13
+        assert np.allclose(got[k][kept], want[k][kept], rtol=tol, atol=0), k
+    # the mixture's density is below the box's alone (the grown box takes a share), so a
+    # draw of the box (batch position >= n_def) weighs more than with every draw there
+    if 0 < share < 1:
+        alone = prop._draws_ref(dict(stt, n_def=np.zeros_like(n_def)), u, None)
+        assert kept[2, n_def[2] :].any()
+        both = kept[1] & (alone["w"][1] > 0) & (np.arange(1024) % 512 >= n_def[1])
+        assert both.any() and np.all(want["w"][1][both] > alone["w"][1][both])
+
+
+def test_direction_keep_kernel_agrees_with_the_reference(bee_small, monkeypatch):
+    """The provable box's cell test (MeasuredProposal._keep_cells), compiled with its
+    early exit, against numpy: the same cells kept, away from the 1e-7 margin's edge;
+    some kept, some dropped by F, some by L."""
+    ea = bee_small[2]["ea"]
+    rng = np.random.default_rng(5)
+    n = ea.pos.shape[0]
+    lit = ea.lit & ~ea.pad
+    mean = np.where(lit[..., None], ea.ax, 0.0).sum(axis=1)
+    spread = np.repeat([0.05, 0.5], 200)[None, :, None]  # about the lit facets, and wide
+    v = mean[:, None] + spread * rng.normal(size=(n, 400, 3))
+    v /= np.linalg.norm(v, axis=2, keepdims=True)
+    t = rng.uniform(0.0, 0.05, n)
+    s = rng.uniform(0.1, 0.6, n)
+    h = rng.uniform(0.0, 0.01, n)
+    got = MeasuredProposal._keep_cells(ea, v, t, s, h)
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want = MeasuredProposal._keep_cells(ea, v, t, s, h)
+    from eyeviz.estimators.limit3d_measured import _angles
+
+    f, top = _angles(ea, v)
+    margin = np.minimum(np.abs(f - (t + 2 * h + 1e-7)[:, None]),
+                        np.abs(top - (s + h + 1e-7)[:, None]))  # fmt: skip
+    sure = margin > 1e-12
+    assert np.array_equal(got[sure], want[sure])
+    assert want.any() and (~want).any()
+    assert ((f > (t + 2 * h)[:, None]) & (top <= s[:, None])).any()  # dropped by F alone
+    assert (top > (s + h + 1e-7)[:, None]).any()

@@ -27,6 +27,7 @@ __all__ = [
     "cone_bounds_kernel",
     "interval_kernel",
     "measured_draws_kernel",
+    "direction_keep_kernel",
     "measured_prior",
     "bcentre",
     "same_rows_kernel",
@@ -355,38 +356,49 @@ def measured_prior(r, g, el, az, s_half, g_max, r_min, r_max, el_max, multi):
 # long: one draw of limit3d_measured.MeasuredProposal.sample (centre, g interval, g,
 # weight) is one loop body; split, it would pass a dozen scalars back and forth
 @_jit_np
-def measured_draws_kernel(u, box_lo, box_hi, u0, e1, e2, fa, bhat, blen, origin, s_half,
-                          g_max, r_min, r_max, el_max, multi, rows,
-                          pos_a, ax_a, ch_a, sh_a, lit_a, pad_a,
+def measured_draws_kernel(u, box_lo, box_hi, def_lo, def_hi, n_def, samples, u0, e1, e2,
+                          fa, bhat, blen, origin, s_half, g_max, r_min, r_max, el_max, multi,
+                          rows, pos_a, ax_a, ch_a, sh_a, lit_a, pad_a,
                           pos_b, ax_b, ch_b, sh_b, lit_b, pad_b,
                           x, y, z, g, r, az, el, w):  # fmt: skip
     """limit3d_measured.MeasuredProposal.sample up to the exact check, draw by draw:
     (delta, beta) and g from the uniforms u (N, M, 4), the centre, its g interval (the
     walk of :func:`interval_kernel`, stopping once it is empty), the prior and the
-    weight. Writes x, y, z, g, r, az, el, w (N, M) where the weight is above 0 (w 0
-    elsewhere, the other outputs then unset); only the keys ``rows`` (N,) get draws."""
+    weight. Of each batch of ``samples`` draws the first ``n_def[n]`` come from the
+    defensive box (def_lo, def_hi), the rest from the box (box_lo, box_hi): the weight
+    divides by the two boxes' mixture density (the box's volume alone where n_def is 0).
+    Writes x, y, z, g, r, az, el, w (N, M) where the weight is above 0 (w 0 elsewhere,
+    the other outputs then unset); only the keys ``rows`` (N,) get draws."""
     order = np.empty((u.shape[0], pos_a.shape[1] + pos_b.shape[1]), np.int64)
+    order_d = np.empty_like(order)  # the defensive box's draws keep an order of their own
     for n in range(u.shape[0]):
         for k in range(order.shape[1]):
             order[n, k] = k
+            order_d[n, k] = k
         if not rows[n]:
             for m in range(u.shape[1]):
                 w[n, m] = 0.0
             continue
         vol0 = (box_hi[n, 0] - box_lo[n, 0]) * (box_hi[n, 1] - box_lo[n, 1])
         vol0 = vol0 * (box_hi[n, 2] - box_lo[n, 2])
+        vol1 = (def_hi[n, 0] - def_lo[n, 0]) * (def_hi[n, 1] - def_lo[n, 1])
+        vol1 = vol1 * (def_hi[n, 2] - def_lo[n, 2])
+        lam = n_def[n] / samples
         for m in range(u.shape[1]):
             w[n, m] = 0.0
-            d0 = box_lo[n, 0] + (box_hi[n, 0] - box_lo[n, 0]) * u[n, m, 0]
-            d1 = box_lo[n, 1] + (box_hi[n, 1] - box_lo[n, 1]) * u[n, m, 1]
-            beta = box_lo[n, 2] + (box_hi[n, 2] - box_lo[n, 2]) * u[n, m, 2]
+            lo_, hi_, ordr = box_lo, box_hi, order
+            if m % samples < n_def[n]:
+                lo_, hi_, ordr = def_lo, def_hi, order_d
+            d0 = lo_[n, 0] + (hi_[n, 0] - lo_[n, 0]) * u[n, m, 0]
+            d1 = lo_[n, 1] + (hi_[n, 1] - lo_[n, 1]) * u[n, m, 1]
+            beta = lo_[n, 2] + (hi_[n, 2] - lo_[n, 2]) * u[n, m, 2]
             cx, cy, cz, rho, drho = bcentre(u0[n], e1[n], e2[n], d0, d1, beta, fa, bhat, blen)
             if not math.isfinite(rho):
                 continue
             qx, qy, qz = cx - origin[0], cy - origin[1], cz - origin[2]
             rr = math.sqrt(qx * qx + qy * qy + qz * qz)
             out, g_lo, g_hi = _walk(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b,
-                                    sh_b, lit_b, pad_b, order, n, cx, cy, cz, rr * s_half,
+                                    sh_b, lit_b, pad_b, ordr, n, cx, cy, cz, rr * s_half,
                                     min(rr, g_max))  # fmt: skip
             if out:
                 continue
@@ -397,11 +409,54 @@ def measured_draws_kernel(u, box_lo, box_hi, u0, e1, e2, fa, bhat, blen, origin,
             phi = math.atan2(qy, qx)
             dens = measured_prior(rr, gg, e, phi, s_half, g_max, r_min, r_max, el_max, multi)
             jac = rho * rho * (1.0 + (d0 * d0 + d1 * d1)) ** -1.5 * drho
-            wt = dens * jac * (vol0 * (g_hi - g_lo))
+            if n_def[n] == 0:
+                wt = dens * jac * (vol0 * (g_hi - g_lo))
+            else:
+                inside = (d0 >= box_lo[n, 0] and d0 <= box_hi[n, 0] and d1 >= box_lo[n, 1]
+                          and d1 <= box_hi[n, 1] and beta >= box_lo[n, 2]
+                          and beta <= box_hi[n, 2])  # fmt: skip
+                q = lam / vol1
+                if inside:
+                    q += (1.0 - lam) / vol0
+                wt = dens * jac * ((g_hi - g_lo) / q)
             if not (math.isfinite(wt) and wt > 0.0):
                 continue
             x[n, m], y[n, m], z[n, m], g[n, m] = cx, cy, cz, gg
             r[n, m], az[n, m], el[n, m], w[n, m] = rr, phi, e, wt
+
+
+@_jit
+def direction_keep_kernel(ax, half, lit, pad, v, t, s, h, keep):
+    """limit3d_measured.MeasuredProposal._dir_region's test of its grid's cells: cell g of
+    key n (centre direction v[n, g], half diagonal h[n]) is kept unless F > t + 2 h or L >
+    s + h at its centre (F: the largest angle(a_i, v) - alpha_i of a lit facet less the
+    smallest of an unlit one; L: the first term; a 1e-7 rad margin for arccos's
+    rounding). Both terms only grow along the walk over the facets, so a cell is dropped
+    at its first facet that settles it; each key's last such facet is tried first."""
+    for n in range(v.shape[0]):
+        last = 0
+        lim_f = t[n] + 2.0 * h[n] + 1e-7
+        lim_l = s[n] + h[n] + 1e-7
+        for g in range(v.shape[1]):
+            vx, vy, vz = v[n, g, 0], v[n, g, 1], v[n, g, 2]
+            top, bot = -np.inf, np.inf
+            out = False
+            k0 = last
+            for j in range(ax.shape[1] + 1):
+                k = k0 if j == 0 else j - 1
+                if (j > 0 and k == k0) or pad[n, k]:
+                    continue
+                c = vx * ax[n, k, 0] + vy * ax[n, k, 1] + vz * ax[n, k, 2]
+                ang = math.acos(min(max(c, -1.0), 1.0)) - half[n, k]
+                if lit[n, k]:
+                    top = max(top, ang)
+                else:
+                    bot = min(bot, ang)
+                if top - bot > lim_f or top > lim_l:
+                    out = True
+                    last = k
+                    break
+            keep[n, g] = not out
 
 
 @_jit
@@ -481,9 +536,11 @@ def warm() -> None:
     u4 = np.full((1, 1, 4), 0.5)
     z3 = np.zeros((1, 3))
     o1 = np.zeros((1, 1))
-    measured_draws_kernel(u4, z3, z3 + 1, c, c, c, v3, v3, 1.0, v3, 0.1, 1.0, 0.5, 9.0, 1.0,
-                          False, b[0].copy(), *cs, *cs, o1, o1.copy(), o1.copy(), o1.copy(),
-                          o1.copy(), o1.copy(), o1.copy(), o1.copy())  # fmt: skip
+    measured_draws_kernel(u4, z3, z3 + 1, z3, z3 + 1, np.zeros(1, np.int64), 1, c, c, c, v3,
+                          v3, 1.0, v3, 0.1, 1.0, 0.5, 9.0, 1.0, False, b[0].copy(), *cs, *cs,
+                          o1, o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(),
+                          o1.copy())  # fmt: skip
+    direction_keep_kernel(p3, a2, b, ~b, p3, np.ones(1), np.ones(1), np.ones(1), b.copy())
     pts = np.ones((1, 1, 2, 3))
     prefilter_kernel(pts, b, ~b, np.zeros(1, np.int64), c, np.ones(1), 0.01, b[0].copy())
     i1 = np.zeros(2, np.int64)
