@@ -105,7 +105,7 @@ from eyeviz.core.domain import Domain3D
 from eyeviz.estimators.analytic3d import estimate
 from eyeviz.estimators.base import LitCSR
 from eyeviz.estimators.limit3d_exact import exact_hits, prior_density
-from eyeviz.estimators.limit3d_proposal import _batch_uniforms, _frame, _uniforms
+from eyeviz.estimators.limit3d_proposal import _batch_uniforms, _frame
 from eyeviz.estimators.triangulation import facet_neighbours, triangulate_rays
 
 __all__ = ["MeasuredProposal"]
@@ -304,6 +304,19 @@ def _direction(e: _Edges, grid: int, levels: int = 6) -> np.ndarray:
         c = v[np.arange(n), np.argmax(gv, axis=1)]
         half = half / 2.5
     return c
+
+
+def _uniforms(keys: np.ndarray, m: int, k: int, streams) -> np.ndarray:
+    """:func:`.limit3d_proposal._batch_uniforms` (an int stream or a sequence of them),
+    compiled unless ``EYEVIZ_JIT=0``: the same floats bit for bit."""
+    if not kernels.use(keys.size * m):
+        return _batch_uniforms(keys, m, k, streams)
+    from eyeviz.core.kernels.limit3d_region import uniforms_kernel
+
+    s = np.atleast_1d(np.asarray(streams, np.int64))
+    out = np.empty((keys.size, m * s.size, k))
+    uniforms_kernel(kernels.arg(keys, np.uint64), int(m), kernels.arg(s), out)
+    return out
 
 
 def _asin1(y):
@@ -635,7 +648,7 @@ class MeasuredProposal:
         the keys ``rows`` (bool (N,), default all) get draws, the others weight 0."""
         d, m = self.domain, self.samples
         n = st["u0"].shape[0]
-        u = _batch_uniforms(keys, m, 4, stream)
+        u = _uniforms(keys, m, 4, stream)
         m = u.shape[1]
         if kernels.use(n * m):
             out = self._draws_kernel(st, u, rows)

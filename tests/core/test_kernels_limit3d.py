@@ -434,3 +434,21 @@ def test_direction_keep_kernel_agrees_with_the_reference(bee_small, monkeypatch)
     assert want.any() and (~want).any()
     assert ((f > (t + 2 * h)[:, None]) & (top <= s[:, None])).any()  # dropped by F alone
     assert (top > (s + h + 1e-7)[:, None]).any()
+
+
+@pytest.mark.parametrize("streams", [0, 7, [1, 9, 17], [2**31 - 1]])
+def test_uniforms_kernel_is_the_reference_bit_for_bit(streams, monkeypatch):
+    """The measured proposal's uniforms compiled (limit3d_measured._uniforms) against
+    limit3d_proposal._batch_uniforms: the same floats bit for bit, keys with high bits
+    set, several streams side by side."""
+    from eyeviz.estimators import limit3d_measured as lm
+    from eyeviz.estimators.limit3d_proposal import _batch_uniforms
+
+    keys = np.array([0, 1, 2**63 + 5, 2**64 - 1, 0x1234_5678_9ABC_DEF0], np.uint64)
+    for k in (3, 4):
+        got = lm._uniforms(keys, 96, k, streams)
+        want = _batch_uniforms(keys, 96, k, streams)
+        assert got.shape == want.shape and np.array_equal(got, want)
+        assert 0 < got.min() and got.max() < 1
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    assert np.array_equal(lm._uniforms(keys, 96, 4, streams), want)

@@ -28,6 +28,7 @@ __all__ = [
     "interval_kernel",
     "measured_draws_kernel",
     "direction_keep_kernel",
+    "uniforms_kernel",
     "measured_prior",
     "bcentre",
     "same_rows_kernel",
@@ -425,6 +426,35 @@ def measured_draws_kernel(u, box_lo, box_hi, def_lo, def_hi, n_def, samples, u0,
             r[n, m], az[n, m], el[n, m], w[n, m] = rr, phi, e, wt
 
 
+_GOLD = np.uint64(0x9E3779B97F4A7C15)
+_M1 = np.uint64(0xBF58476D1CE4E5B9)
+_M2 = np.uint64(0x94D049BB133111EB)
+
+
+@_jit
+def _mix64(z):
+    """limit3d_proposal._mix of one uint64 (splitmix64's finaliser, wrapping)."""
+    z = z + _GOLD
+    z = (z ^ (z >> np.uint64(30))) * _M1
+    z = (z ^ (z >> np.uint64(27))) * _M2
+    return z ^ (z >> np.uint64(31))
+
+
+@_jit
+def uniforms_kernel(keys, m, streams, out):
+    """limit3d_proposal._batch_uniforms: out (N, m * len(streams), k) uniforms in (0, 1),
+    stream s's batch at columns s * m, each the same uint64 hash of the key and the
+    counter as the reference's, so the same floats bit for bit."""
+    k = out.shape[2]
+    for n in range(keys.size):
+        base = keys[n] * _M1
+        for si in range(streams.size):
+            off = np.uint64(streams[si]) << np.uint64(32)
+            for j in range(m * k):
+                z = _mix64(base + (np.uint64(j) + off))
+                out[n, si * m + j // k, j % k] = (np.float64(z >> np.uint64(11)) + 0.5) * 2.0**-53
+
+
 @_jit
 def direction_keep_kernel(ax, half, lit, pad, v, t, s, h, keep):
     """limit3d_measured.MeasuredProposal._dir_region's test of its grid's cells: cell g of
@@ -541,6 +571,7 @@ def warm() -> None:
                           o1, o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(),
                           o1.copy())  # fmt: skip
     direction_keep_kernel(p3, a2, b, ~b, p3, np.ones(1), np.ones(1), np.ones(1), b.copy())
+    uniforms_kernel(np.ones(1, np.uint64), 1, np.zeros(1, np.int64), np.empty((1, 1, 4)))
     pts = np.ones((1, 1, 2, 3))
     prefilter_kernel(pts, b, ~b, np.zeros(1, np.int64), c, np.ones(1), 0.01, b[0].copy())
     i1 = np.zeros(2, np.int64)
