@@ -246,7 +246,7 @@ class Limit3DEstimator(Estimator3D):
         keys = _key_hash(lit_a, lit_b) ^ np.uint64(self.seed)
         s = self._draw(lit_a, lit_b, keys, 1.0, 0)
         m = self.samples
-        for stream, (wide, reps) in enumerate(RETRY, start=1):
+        for stream, wide, reps in _retries(self._proposal):
             few = np.flatnonzero(~(s["w"].sum(axis=1) > 0))
             if not few.size:
                 break
@@ -336,6 +336,16 @@ def _proposal(domain: Domain3D, prior: str, samples: int, grid: int) -> Any:
     """The eye model's proposal (``setup(lit_a, lit_b, keys, wide)`` then
     ``sample(state, keys, stream)``): HEALPix cells or measured facets' cones."""
     return _PROPOSALS[domain.kind]()(domain, prior, samples, grid)
+
+
+def _retries(proposal: Any) -> tuple[tuple[int, float, int], ...]:
+    """The retries of keys with nothing accepted, as (stream, window and slack factor,
+    batches): ``RETRY`` in order from stream 1, or the proposal's own ``retries`` (the
+    measured one keeps only the stage that finds keys: limit3d_measured.RETRIES)."""
+    own = getattr(proposal, "retries", None)
+    if own is not None:
+        return tuple(own)
+    return tuple((i, wide, reps) for i, (wide, reps) in enumerate(RETRY, start=1))
 
 
 def _healpix_proposal() -> type:

@@ -308,3 +308,16 @@ def test_the_provable_box_holds_the_balls_of_honeybee_keys(monkeypatch):
     out, n, proven = _outside_provable(dom, ds, groups, lit)
     assert proven >= 0.9 * len(rows)
     assert out == 0
+
+
+def test_the_measured_retries_keep_the_stage_that_finds_keys(small):
+    """A key with nothing accepted is retried once, 24 batches in a window 2.5 times
+    wider, with stream 2 as in limit3d.RETRY's second stage; other proposals keep RETRY's
+    three stages, streams 1-3."""
+    from eyeviz.estimators import limit3d
+
+    est = Limit3DEstimator(small[0], samples=64)
+    assert limit3d._retries(est._proposal) == ((2, 2.5, 24),)
+    assert limit3d._retries(object()) == tuple(
+        (i, w, r) for i, (w, r) in enumerate(limit3d.RETRY, start=1)
+    )
