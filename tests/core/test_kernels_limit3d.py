@@ -407,7 +407,7 @@ def test_measured_draws_kernel_mixture_agrees_with_the_reference(bee_small, monk
 
 
 def test_direction_keep_kernel_agrees_with_the_reference(bee_small, monkeypatch):
-    """The provable box's cell test (MeasuredProposal._keep_cells), compiled with its
+    """The provable box's cell test (limit3d_provable.keep_cells), compiled with its
     early exit, against numpy: the same cells kept, away from the 1e-7 margin's edge;
     some kept, some dropped by F, some by L."""
     ea = bee_small[2]["ea"]
@@ -421,10 +421,11 @@ def test_direction_keep_kernel_agrees_with_the_reference(bee_small, monkeypatch)
     t = rng.uniform(0.0, 0.05, n)
     s = rng.uniform(0.1, 0.6, n)
     h = rng.uniform(0.0, 0.01, n)
-    got = MeasuredProposal._keep_cells(ea, v, t, s, h)
+    from eyeviz.estimators.limit3d_provable import _angles, keep_cells
+
+    got = keep_cells(ea, v, t, s, h)
     monkeypatch.setenv("EYEVIZ_JIT", "0")
-    want = MeasuredProposal._keep_cells(ea, v, t, s, h)
-    from eyeviz.estimators.limit3d_measured import _angles
+    want = keep_cells(ea, v, t, s, h)
 
     f, top = _angles(ea, v)
     margin = np.minimum(np.abs(f - (t + 2 * h + 1e-7)[:, None]),

@@ -270,20 +270,20 @@ def _outside_provable(dom, ds, groups, lit, chunk: int = 8) -> tuple[int, int, i
 
 def _shrunk_bound(monkeypatch) -> None:
     """The lit facets' bound S a third of itself: no longer a bound."""
-    from eyeviz.estimators import limit3d_measured as lm
+    from eyeviz.estimators import limit3d_provable as lp
 
-    real = lm._lens_tolerances
+    real = lp._lens_tolerances
 
     def third(g_max, d_min, e):
         t, s, ok = real(g_max, d_min, e)
         return t, s / 3, ok
 
-    monkeypatch.setattr(lm, "_lens_tolerances", third)
+    monkeypatch.setattr(lp, "_lens_tolerances", third)
 
 
 def test_the_provable_box_holds_every_brute_force_posterior_sample(far, monkeypatch):
     """Issue 33: the box from the acceptance cones (MeasuredProposal.provable_box, proved
-    in limit3d_measured's docstring) holds every rejection sample of each key's posterior
+    in limit3d_provable's docstring) holds every rejection sample of each key's posterior
     (4,600 samples of 30 keys), and the bound holds on every key of the far domain. It
     can fail: with the lit facets' bound S a third of itself, samples fall outside."""
     dom, ds, groups, lit = far

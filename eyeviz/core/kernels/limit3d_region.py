@@ -457,7 +457,7 @@ def uniforms_kernel(keys, m, streams, out):
 
 @_jit
 def direction_keep_kernel(ax, half, lit, pad, v, t, s, h, keep):
-    """limit3d_measured.MeasuredProposal._dir_region's test of its grid's cells: cell g of
+    """limit3d_provable.dir_region's test of its grid's cells: cell g of
     key n (centre direction v[n, g], half diagonal h[n]) is kept unless F > t + 2 h or L >
     s + h at its centre (F: the largest angle(a_i, v) - alpha_i of a lit facet less the
     smallest of an unlit one; L: the first term; a 1e-7 rad margin for arccos's
