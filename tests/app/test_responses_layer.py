@@ -14,6 +14,7 @@ from PyQt5.QtTest import QTest
 
 from eyeviz.app.panels.bitmaps3d import lit_owners
 from eyeviz.model.scene import load
+from eyeviz.render.vtk.primitives import read_rgb
 from eyeviz.render.vtk.style import UNLIT, hex_rgb
 
 BEE = Path(__file__).resolve().parents[2] / "eyeviz" / "assets" / "scenes" / "bee.toml"
@@ -58,12 +59,12 @@ def test_the_responses_layer_shades_the_eye_and_the_map(make_window, qtbot):
     lo, hi = _pick(idx, vals)
     ball = hex_rgb(host.model.scene.features[i].color)
     host.flush()
-    bare = np.asarray(host.actors.eyes.meshes[0].cell_data["rgb"]).copy()
+    bare = read_rgb(host.actors.eyes.meshes[0]).copy()
     assert (bare[idx[[lo, hi]]] == ball).all()  # without the layer: the plain colour
     act.trigger()  # the 3D view menu's "Show the lit facets' graded responses"
     assert host.model.scene.shows("responses")
     host.flush()
-    rgb = np.asarray(host.actors.eyes.meshes[0].cell_data["rgb"])
+    rgb = read_rgb(host.actors.eyes.meshes[0])
     w = [_weight(rgb[idx[k]], ball) for k in (lo, hi)]
     assert w[0] < w[1] - 0.2, w  # the higher response, nearer the ball's colour
     for k in (lo, hi):
@@ -90,7 +91,7 @@ def test_the_responses_layer_shades_the_eye_and_the_map(make_window, qtbot):
     assert seen[0] < seen[1] - 0.2, seen
     act.trigger()  # off again: the plain colour
     host.flush()
-    rgb = np.asarray(host.actors.eyes.meshes[0].cell_data["rgb"])
+    rgb = read_rgb(host.actors.eyes.meshes[0])
     assert (rgb[idx[[lo, hi]]] == ball).all()
 
 
@@ -120,7 +121,7 @@ def test_healpix_cells_are_shaded_at_any_size_and_during_a_drag(make_window, qtb
         row = range(int(ip[0]), int(ip[1]))
         assert len(row) > 24
         keep = [k for k in row if int(ix[k]) in mine]
-        rgb = np.asarray(host.actors.eyes.meshes[0].cell_data["rgb"])
+        rgb = read_rgb(host.actors.eyes.meshes[0])
         part = [k for k in keep if 0.1 < vals[k] < 0.9]
         assert part and any(vals[k] == 1.0 for k in keep)
         for k in part:
@@ -152,13 +153,13 @@ def test_healpix_patches_beyond_the_full_surface_are_shaded(make_window, qtbot):
         st = host.model.state
         (ip, ix, vals), _ = st.pair.responses(st.x, st.y, st.z, st.g)
         mesh = painter.patches[0][0][0]
-        assert mesh.n_cells == int(ip[1] - ip[0]) > 24
-        rgb = np.asarray(mesh.cell_data["rgb"])
-        part = [k for k in range(mesh.n_cells) if 0.1 < vals[k] < 0.9]
-        assert part and any(vals[k] == 1.0 for k in range(mesh.n_cells))
+        assert mesh.GetNumberOfCells() == int(ip[1] - ip[0]) > 24
+        rgb = read_rgb(mesh)
+        part = [k for k in range(mesh.GetNumberOfCells()) if 0.1 < vals[k] < 0.9]
+        assert part and any(vals[k] == 1.0 for k in range(mesh.GetNumberOfCells()))
         for k in part:
             assert abs(_weight(rgb[k], ball) - vals[k]) < 0.06, (x, k, vals[k])
     host.model.set_layer("responses", False)
     host.flush()
-    rgb = np.asarray(painter.patches[0][0][0].cell_data["rgb"])
+    rgb = read_rgb(painter.patches[0][0][0])
     assert (rgb == np.asarray(ball, np.uint8)).all()

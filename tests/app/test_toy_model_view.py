@@ -9,6 +9,7 @@ import numpy as np
 
 from eyeviz.measured import save_eyes
 from eyeviz.model.scene import load
+from eyeviz.render.vtk.primitives import read_rgb
 from eyeviz.render.vtk.style import UNLIT, hex_rgb
 
 # two balls in the toy's binocular field (each lights >= 2 facets of both eyes)
@@ -39,10 +40,10 @@ def test_the_toy_model_opens_in_the_3d_page_with_its_own_lit_facets(
     assert host.active and host.view.isVisible() and not win.plotter.isVisible()
     st = host.model.state
     assert st.facet_counts == (7, 7)
-    assert [m.n_cells for m in host.actors.eyes.meshes] == [7, 7]
+    assert [m.GetNumberOfCells() for m in host.actors.eyes.meshes] == [7, 7]
     want = toy_eyes.bitmaps(x, y, z, g)
     for e, eye in enumerate("AB"):
-        rgb = np.asarray(host.actors.eyes.meshes[e].cell_data["rgb"])
+        rgb = read_rgb(host.actors.eyes.meshes[e])
         for i in range(len(BALLS)):
             assert np.array_equal(st.lit(i, eye), np.flatnonzero(want[e][i]))
         for i, ball in enumerate(BALLS):  # a shared facet shows the later ball's colour

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pyvista as pv
+from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkRenderingCore import vtkActor
 
 from eyeviz.model import shapes3d
@@ -22,7 +22,15 @@ from eyeviz.render.style3d import CONE_OPACITY, EYE_CONE
 from eyeviz.render.vtk.eyes3d import LABEL_PX
 from eyeviz.render.vtk.names3d import named_of
 from eyeviz.render.vtk.painter3d import Painter3D, lit, palette
-from eyeviz.render.vtk.primitives import actor, set_rgb, text3d, write_points
+from eyeviz.render.vtk.primitives import (
+    actor,
+    point_cells,
+    poly,
+    set_rgb,
+    sphere,
+    text3d,
+    write_points,
+)
 from eyeviz.render.vtk.style import INK, rgbf
 
 __all__ = ["CONE_RES", "BallsPainter"]
@@ -32,7 +40,7 @@ RING = 1.3  # the selection's great circles' radius, in ball radii
 CONE_RES = 40
 
 
-def _great_circles(r: float, n: int = 96) -> pv.PolyData:
+def _great_circles(r: float, n: int = 96) -> vtkPolyData:
     """Three great circles of radius ``r`` (the selected ball's marker)."""
     t = np.linspace(0.0, 2.0 * math.pi, n + 1)
     c, s, z = r * np.cos(t), r * np.sin(t), 0.0 * t
@@ -40,9 +48,7 @@ def _great_circles(r: float, n: int = 96) -> pv.PolyData:
     lines = np.concatenate(
         [np.r_[n + 1, np.arange(k * (n + 1), (k + 1) * (n + 1))] for k in range(3)]
     )
-    mesh = pv.PolyData(pts)
-    mesh.lines = lines
-    return mesh
+    return poly(pts, lines=lines, verts=point_cells(len(pts)))
 
 
 class BallsPainter(Painter3D):
@@ -50,14 +56,14 @@ class BallsPainter(Painter3D):
 
     def __init__(self, scene_ren, eyes_ren) -> None:
         super().__init__(scene_ren, eyes_ren)
-        self.unit_ball = pv.Sphere(radius=1.0, theta_resolution=40, phi_resolution=24)
+        self.unit_ball = sphere(1.0, theta_resolution=40, phi_resolution=24)
         self.unit_ring = _great_circles(RING)
         self.ball_actors: list[vtkActor] = []
         self.ball_labels: list = []
         self.select_actor: vtkActor | None = None
-        self.cones: pv.PolyData | None = None
+        self.cones: vtkPolyData | None = None
         self.cone_actor: vtkActor | None = None
-        self.near_cones = pv.PolyData()
+        self.near_cones = poly()
         self.near_cone_actor: vtkActor = actor(self.near_cones)
 
     def _build(self, scene: Scene) -> None:
@@ -85,9 +91,8 @@ class BallsPainter(Painter3D):
             [faces + np.array([0, 1, 1, 1]) * k * (res + 1) for k in range(2 * n)]
             or [np.zeros((0, 4), dtype=int)]
         )
-        self.cones = pv.PolyData(
-            np.zeros((max(2 * n, 1) * (res + 1), 3)), allf.ravel() if n else None
-        )
+        zeros = np.zeros((max(2 * n, 1) * (res + 1), 3))
+        self.cones = poly(zeros, allf.ravel() if n else None)
         if n:
             cols = np.repeat(palette(scene)[:n], res, axis=0)
             set_rgb(self.cones.GetCellData(), np.concatenate([cols, cols]))
@@ -96,7 +101,7 @@ class BallsPainter(Painter3D):
         self.add(self.cone_actor, eyes=False)
         # in the eyes' close-up, the cones' first EYE_CONE eye radii only
         # (a mesh of its own: a shallow copy would share the points written in place)
-        self.near_cones = pv.PolyData(np.array(self.cones.points), allf.ravel() if n else None)
+        self.near_cones = poly(zeros, allf.ravel() if n else None)
         if n:
             set_rgb(self.near_cones.GetCellData(), np.concatenate([cols, cols]))
         self.near_cone_actor = actor(self.near_cones, rgb=bool(n))

@@ -10,7 +10,6 @@ eye).
 from __future__ import annotations
 
 import numpy as np
-import pyvista as pv
 
 from eyeviz.core.measured import MeasuredEyePair
 from eyeviz.model import shapes3d
@@ -18,7 +17,7 @@ from eyeviz.model.facets3d import EyeSurface
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.vtk.painter3d import Painter3D
-from eyeviz.render.vtk.primitives import actor
+from eyeviz.render.vtk.primitives import actor, poly
 from eyeviz.render.vtk.style import rgbf
 
 __all__ = ["ACCEPTANCE_OPACITY", "ConesPainter"]
@@ -32,7 +31,7 @@ class ConesPainter(Painter3D):
 
     def __init__(self, scene_ren, eyes_ren) -> None:
         super().__init__(scene_ren, eyes_ren)
-        self.mesh = pv.PolyData()
+        self.mesh = poly()
         self.cone_actor = actor(self.mesh, (0.5, 0.5, 0.5))
         self.cone_actor.GetProperty().SetOpacity(ACCEPTANCE_OPACITY)
         self.cone_actor.GetProperty().LightingOff()
@@ -76,8 +75,8 @@ class ConesPainter(Painter3D):
             pts.append(p)
             base += p.shape[0]
         if base == 0:
-            self.mesh.ShallowCopy(pv.PolyData())
+            self.mesh.ShallowCopy(poly())
         else:
-            fresh = pv.PolyData(np.concatenate(pts), np.concatenate(faces).ravel())
+            fresh = poly(np.concatenate(pts), np.concatenate(faces).ravel())
             self.mesh.ShallowCopy(fresh)
         self.cone_actor.GetProperty().SetColor(*rgbf(scene.features[selected].color))

@@ -6,7 +6,7 @@ eyes' names in the close-up.
 The facets come from the eye model's :class:`eyeviz.model.facets3d.EyeSurface`: HEALPix
 cells, or a measured eye's hexagonal patches at its lenses. When the surface is ``full``
 each eye is one mesh with one cell per facet, and a frame rewrites its cell colours in
-place (pyvista's cell data, one ``Modified``). Beyond (HEALPix nside > 32: 388,800 facets
+place (the cell data's array, one ``Modified``). Beyond (HEALPix nside > 32: 388,800 facets
 per eye at nside 180, each under a pixel) the unlit sphere is a smooth mesh drawn once,
 and each ball's lit facets are a small mesh of their own, rebuilt only when that ball's
 lit set changes.
@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pyvista as pv
+from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkRenderingCore import vtkActor
 
 from eyeviz.model import shapes3d
@@ -33,7 +33,17 @@ from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.style3d import EDGE_RGB, EDGES_MAX_NSIDE
 from eyeviz.render.vtk.painter3d import Painter3D, lit, palette
-from eyeviz.render.vtk.primitives import Store, actor, read_rgb, set_rgb, text3d, write_rgb
+from eyeviz.render.vtk.primitives import (
+    Store,
+    actor,
+    poly,
+    polyline,
+    read_rgb,
+    set_rgb,
+    sphere,
+    text3d,
+    write_rgb,
+)
 from eyeviz.render.vtk.style import INK, UNLIT, rgbf
 
 __all__ = ["EyesPainter", "LABEL_PX", "PATCH_LIFT"]
@@ -52,8 +62,8 @@ class EyesPainter(Painter3D):
         super().__init__(scene_ren, eyes_ren)
         self.caption = caption
         self.full = True
-        self.meshes: list[pv.PolyData] = []  # full: one per eye, cell i = facet i
-        self.patches: list[list[tuple[pv.PolyData, vtkActor, np.ndarray]]] = [[], []]
+        self.meshes: list[vtkPolyData] = []  # full: one per eye, cell i = facet i
+        self.patches: list[list[tuple[vtkPolyData, vtkActor, np.ndarray]]] = [[], []]
         self.patch_store = Store()
         self.equators: list[vtkActor] = []
         self.labels: list = []
@@ -70,8 +80,8 @@ class EyesPainter(Painter3D):
         for e, centre in enumerate(surface.centres):
             if self.full:
                 pts, faces = surface.mesh(e)
-                mesh = pv.PolyData(pts, faces)
-                set_rgb(mesh.GetCellData(), np.broadcast_to(UNLIT, (mesh.n_cells, 3)))
+                mesh = poly(pts, faces)
+                set_rgb(mesh.GetCellData(), np.broadcast_to(UNLIT, (mesh.GetNumberOfCells(), 3)))
                 a = lit(actor(mesh, rgb=True))
                 if edges:
                     p = a.GetProperty()
@@ -85,14 +95,12 @@ class EyesPainter(Painter3D):
                 # a smooth unlit sphere just inside the facets: the whole eye beyond the
                 # full LOD, and behind the facets' polygons (which share no points, so
                 # the rasteriser leaves pixel cracks between them) up to it
-                sphere = pv.Sphere(
-                    radius=surface.underlay, center=centre, theta_resolution=96, phi_resolution=48
-                )
-                self.add(lit(actor(sphere, rgbf("#E1E1E1"))))
+                under = sphere(surface.underlay, centre, theta_resolution=96, phi_resolution=48)
+                self.add(lit(actor(under, rgbf("#E1E1E1"))))
             if surface.equator is not None:
                 t = np.linspace(0.0, 2.0 * math.pi, 241)
                 r, (cx, cy, cz) = surface.equator, centre
-                ring = pv.lines_from_points(
+                ring = polyline(
                     np.column_stack([cx + r * np.cos(t), cy + r * np.sin(t), cz + 0 * t])
                 )
                 eq = actor(ring, (0.1, 0.1, 0.1))
@@ -116,7 +124,7 @@ class EyesPainter(Painter3D):
         self.patches = [[], []]
         for e in range(2):
             for _ in range(n):
-                mesh = pv.PolyData()
+                mesh = poly()
                 set_rgb(mesh.GetCellData(), np.zeros((0, 3), np.uint8))
                 a = lit(actor(mesh, rgb=True))
                 self.patch_store.add(self.scene_ren, a)
@@ -168,14 +176,15 @@ class EyesPainter(Painter3D):
                 a.SetVisibility(show and pix.size > 0)
                 if pix.size != was.size or not np.array_equal(pix, was):
                     lift = 1.0 + PATCH_LIFT * (1.0 + i / max(n, 1))
-                    fresh = pv.PolyData(*surface.patch(e, pix, lift)) if pix.size else pv.PolyData()
-                    set_rgb(fresh.GetCellData(), np.zeros((fresh.n_cells, 3), np.uint8))
+                    fresh = poly(*surface.patch(e, pix, lift)) if pix.size else poly()
+                    set_rgb(fresh.GetCellData(), np.zeros((fresh.GetNumberOfCells(), 3), np.uint8))
                     mesh.ShallowCopy(fresh)
                     self.patches[e][i] = (mesh, a, pix.copy())
-                if mesh.n_cells == 0:
+                cells = mesh.GetNumberOfCells()
+                if cells == 0:
                     continue
-                rgb = np.broadcast_to(pal[i], (mesh.n_cells, 3))
-                if vals is not None and mesh.n_cells == pix.size:  # one cell per facet
+                rgb = np.broadcast_to(pal[i], (cells, 3))
+                if vals is not None and cells == pix.size:  # one cell per facet
                     rgb = shade(rgb, UNLIT, vals["AB"[e]][lo:hi])
                 if not np.array_equal(read_rgb(mesh), rgb):  # unchanged: no Modified
                     write_rgb(mesh, rgb)

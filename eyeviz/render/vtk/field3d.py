@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pyvista as pv
 from vtkmodules.vtkRenderingCore import vtkActor
 
 from eyeviz.model import shapes3d
@@ -19,7 +18,7 @@ from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.style3d import BFV_OPACITY, BFV_RGB, PLANE_RGB
 from eyeviz.render.vtk.painter3d import Painter3D
-from eyeviz.render.vtk.primitives import actor
+from eyeviz.render.vtk.primitives import actor, point_cells, poly
 
 __all__ = ["FieldPainter"]
 
@@ -38,17 +37,17 @@ class FieldPainter(Painter3D):
         self.bfv_actor = None
         if surface.bfv:
             pts, faces = shapes3d.bfv_cones(pair.h, pair.l, reach)
-            self.bfv_actor = actor(pv.PolyData(pts, faces), BFV_RGB)
+            self.bfv_actor = actor(poly(pts, faces), BFV_RGB)
             self.bfv_actor.GetProperty().SetOpacity(BFV_OPACITY)
             self.add(self.bfv_actor, eyes=False)
         corners, segs = shapes3d.plane_z0(-reach * 0.8, reach * 0.8, -0.2 * reach, reach)
-        quad = pv.PolyData(corners, np.array([4, 0, 1, 2, 3]))
+        quad = poly(corners, np.array([4, 0, 1, 2, 3]))
         fill = actor(quad, PLANE_RGB)
         fill.GetProperty().SetOpacity(0.10)
-        grid = pv.PolyData(segs.reshape(-1, 3))
-        grid.lines = np.column_stack(
+        seg_lines = np.column_stack(
             [np.full(len(segs), 2), 2 * np.arange(len(segs)), 2 * np.arange(len(segs)) + 1]
         ).ravel()
+        grid = poly(segs.reshape(-1, 3), lines=seg_lines, verts=point_cells(2 * len(segs)))
         lines = actor(grid, PLANE_RGB)
         lines.GetProperty().SetOpacity(0.6)
         self.plane_actors = [fill, lines]

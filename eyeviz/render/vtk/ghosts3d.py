@@ -16,8 +16,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pyvista as pv
 from vtkmodules.util.numpy_support import numpy_to_vtk
+from vtkmodules.vtkCommonDataModel import vtkPolyData
 from vtkmodules.vtkRenderingCore import vtkActor, vtkFollower, vtkRenderer
 
 from eyeviz.model.predictions3d import LIMIT, Cloud, Predictions3D, estimator_color3d
@@ -28,7 +28,7 @@ from eyeviz.render.style3d import (
     GHOST_OPACITY,
     LINK_OPACITY,
 )
-from eyeviz.render.vtk.primitives import actor
+from eyeviz.render.vtk.primitives import actor, point_cells, poly, sphere, write_points
 from eyeviz.render.vtk.style import hex_rgb, rgbf
 
 __all__ = ["Ghosts3D", "make_overlay"]
@@ -55,18 +55,17 @@ def make_overlay(scene_ren: vtkRenderer) -> vtkRenderer | None:
     return ov
 
 
-def _unit_circle() -> pv.PolyData:
+def _unit_circle() -> vtkPolyData:
     t = np.linspace(0.0, 2.0 * math.pi, _RING_N + 1)
     pts = np.column_stack([np.cos(t), np.sin(t), np.zeros_like(t)])
-    mesh = pv.PolyData(pts)
-    mesh.lines = np.r_[_RING_N + 1, np.arange(_RING_N + 1)]
-    return mesh
+    lines = np.r_[_RING_N + 1, np.arange(_RING_N + 1)]
+    return poly(pts, lines=lines, verts=point_cells(_RING_N + 1))
 
 
 class _Ghost:
     """One estimator's ghost: ball, outline (a follower), centre dot and link."""
 
-    def __init__(self, ren: vtkRenderer, name: str, ball: pv.PolyData, circle: pv.PolyData):
+    def __init__(self, ren: vtkRenderer, name: str, ball: vtkPolyData, circle: vtkPolyData):
         rgb = rgbf(estimator_color3d(name))
         self.ball = actor(ball, rgb)
         p = self.ball.GetProperty()
@@ -77,13 +76,13 @@ class _Ghost:
         self.ring.GetProperty().SetColor(*rgb)
         self.ring.GetProperty().SetLineWidth(GHOST_LINE_PX)
         self.ring.SetCamera(ren.GetActiveCamera())
-        self.dot_mesh = pv.PolyData(np.zeros((1, 3)))
+        self.dot_mesh = poly(np.zeros((1, 3)))
         self.dot = actor(self.dot_mesh, rgb)
         dp = self.dot.GetProperty()
         dp.SetRepresentationToPoints()
         dp.SetPointSize(GHOST_DOT_PX)
         dp.RenderPointsAsSpheresOn()
-        self.link_mesh = pv.PolyData(np.zeros((2, 3)), lines=np.array([2, 0, 1]))
+        self.link_mesh = poly(np.zeros((2, 3)), lines=np.array([2, 0, 1]))
         self.link = actor(self.link_mesh, rgb)
         self.link.GetProperty().SetLineWidth(GHOST_LINE_PX * 0.6)
         self.link.GetProperty().SetOpacity(LINK_OPACITY)
@@ -100,10 +99,9 @@ class _Ghost:
         self.ball.SetScale(g)
         self.ring.SetPosition(*centre)
         self.ring.SetScale(g)
-        self.dot_mesh.points[0] = centre
+        write_points(self.dot_mesh, np.array([centre], np.float64))
         self.dot_mesh.Modified()
-        pts: np.ndarray = self.link_mesh.points
-        pts[:] = np.array([truth, centre], np.float64)
+        write_points(self.link_mesh, np.array([truth, centre], np.float64))
         self.link_mesh.Modified()
 
 
@@ -114,10 +112,10 @@ class Ghosts3D:
 
     def __init__(self, ren: vtkRenderer) -> None:
         self.ren = ren
-        self.ball = pv.Sphere(radius=1.0, theta_resolution=40, phi_resolution=24)
+        self.ball = sphere(1.0, theta_resolution=40, phi_resolution=24)
         self.circle = _unit_circle()
         self.ghosts: dict[str, _Ghost] = {}
-        self.cloud_mesh = pv.PolyData()
+        self.cloud_mesh = poly()
         self.cloud = actor(self.cloud_mesh)
         mapper = self.cloud.GetMapper()
         mapper.SetScalarModeToUsePointFieldData()
@@ -167,8 +165,7 @@ class Ghosts3D:
 
     def _set_cloud(self, cloud: Cloud) -> None:
         k = len(cloud.points)
-        fresh = pv.PolyData(np.asarray(cloud.points, np.float64))
-        fresh.verts = np.column_stack([np.ones(k, np.int64), np.arange(k)]).ravel()
+        fresh = poly(np.asarray(cloud.points, np.float64), verts=point_cells(k))
         rgba = np.empty((k, 4), np.uint8)
         rgba[:, :3] = hex_rgb(estimator_color3d(LIMIT))
         rgba[:, 3] = np.clip(np.round(255.0 * cloud.alpha), 1, 255).astype(np.uint8)

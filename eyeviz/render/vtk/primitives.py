@@ -7,11 +7,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pyvista as pv
 import vtkmodules.vtkRenderingFreeType  # noqa: F401  (vtkTextRenderer's FreeType override)
-from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray, vtk_to_numpy
 from vtkmodules.vtkCommonCore import vtkPoints
 from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+from vtkmodules.vtkCommonTransforms import vtkTransform
+from vtkmodules.vtkFiltersGeneral import vtkTransformFilter
+from vtkmodules.vtkFiltersSources import vtkSphereSource
 from vtkmodules.vtkRenderingCore import (
     vtkActor,
     vtkActor2D,
@@ -44,6 +46,10 @@ __all__ = [
     "border_actor",
     "ring",
     "set_rgb",
+    "poly",
+    "point_cells",
+    "polyline",
+    "sphere",
     "write_rgb",
     "unit_ring",
     "unit_fan",
@@ -214,10 +220,96 @@ def write_rgb(mesh, rgb: np.ndarray) -> None:
     arr.Modified()
 
 
-def write_points(mesh: pv.PolyData, pts: np.ndarray) -> None:
-    """Overwrite a mesh's points in place (pyvista's array marks the VTK points modified)."""
-    target: np.ndarray = mesh.points
-    target[:] = pts
+def write_points(mesh: vtkPolyData, pts: np.ndarray) -> None:
+    """Overwrite a mesh's points in place and mark them modified."""
+    points = mesh.GetPoints()
+    data = points.GetData()
+    vtk_to_numpy(data)[:] = pts
+    data.Modified()
+    points.Modified()
+
+
+# Meshes are made with VTK alone, not pyvista: importing pyvista costs a 3D snapshot about
+# 0.2 s (issue 32.14). poly, polyline and sphere make the very meshes pyvista's
+# PolyData(points, faces, lines=, verts=), lines_from_points and Sphere make (point for
+# point, cell for cell, normal for normal: tests/render/test_poly.py), so the pixels are
+# the same.
+
+
+def _cells(cells) -> vtkCellArray:
+    """A cell array from VTK's legacy flat format (n, i0, ..., n, ...)."""
+    ca = vtkCellArray()
+    flat = np.ascontiguousarray(np.asarray(cells).ravel(), dtype=np.int64)
+    ca.ImportLegacyFormat(numpy_to_vtkIdTypeArray(flat, deep=1))
+    return ca
+
+
+def point_cells(n: int) -> np.ndarray:
+    """One vertex cell per point of n (pyvista's point-cloud cells), legacy format."""
+    return np.column_stack([np.ones(n, np.int64), np.arange(n, dtype=np.int64)]).ravel()
+
+
+def poly(points=None, faces=None, lines=None, verts=None) -> vtkPolyData:
+    """The polydata ``pyvista.PolyData(points, faces, lines=lines, verts=verts)`` makes:
+    the points (a copy, float kept, else float32), cells in the legacy flat format, and,
+    given no cells at all, one vertex cell per point; no points: an empty polydata."""
+    mesh = vtkPolyData()
+    if points is None:
+        return mesh
+    pts = np.asarray(points)
+    if not np.issubdtype(pts.dtype, np.floating):
+        pts = pts.astype(np.float32)
+    pts = np.ascontiguousarray(pts.reshape(-1, 3))
+    vp = vtkPoints()
+    vp.SetData(numpy_to_vtk(pts, deep=1))
+    mesh.SetPoints(vp)
+    if faces is None and lines is None and verts is None:
+        verts = point_cells(len(pts))
+    if verts is not None:
+        mesh.SetVerts(_cells(verts))
+    if faces is not None:
+        mesh.SetPolys(_cells(faces))
+    if lines is not None:
+        mesh.SetLines(_cells(lines))
+    return mesh
+
+
+def polyline(points: np.ndarray) -> vtkPolyData:
+    """``pyvista.lines_from_points``: one 2-point line per consecutive pair."""
+    n = len(points)
+    i = np.arange(n - 1, dtype=np.int64)
+    return poly(points, lines=np.column_stack([np.full(n - 1, 2), i, i + 1]).ravel())
+
+
+def _transformed(mesh: vtkPolyData, matrix: list[float]) -> vtkPolyData:
+    t = vtkTransform()
+    t.SetMatrix(matrix)
+    f = vtkTransformFilter()
+    f.SetInputData(mesh)
+    f.SetTransform(t)
+    f.Update()
+    return f.GetOutput()
+
+
+def sphere(
+    radius: float, center=(0.0, 0.0, 0.0), theta_resolution: int = 30, phi_resolution: int = 30
+) -> vtkPolyData:
+    """``pyvista.Sphere(radius, center, theta_resolution=, phi_resolution=)`` (direction +z):
+    VTK's sphere source turned as pyvista turns it (a quarter turn about y and back, which
+    renormalises the normals) and moved to ``center`` in the points' float32."""
+    src = vtkSphereSource()
+    src.SetRadius(radius)
+    src.SetThetaResolution(theta_resolution)
+    src.SetPhiResolution(phi_resolution)
+    src.Update()
+    mesh = _transformed(src.GetOutput(), [0, 0, 1, 0, 0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 0, 1])
+    mesh = _transformed(mesh, [0, 0, -1, 0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 1])
+    if not np.allclose(center, [0.0, 0.0, 0.0]):
+        data = mesh.GetPoints().GetData()
+        pts = vtk_to_numpy(data)
+        pts += np.array(center, dtype=pts.dtype)
+        data.Modified()
+    return mesh
 
 
 def set_input(a: vtkActor, mesh) -> None:
@@ -227,11 +319,10 @@ def set_input(a: vtkActor, mesh) -> None:
     mapper.SetInputData(mesh)
 
 
-def unit_ring(z: float) -> pv.PolyData:
+def unit_ring(z: float) -> vtkPolyData:
     """The closed unit circle at height z (an outline template)."""
-    mesh = pv.PolyData(ring(0.0, 0.0, 1.0, z))
-    mesh.lines = np.concatenate([[CIRCLE_N + 1], np.arange(CIRCLE_N), [0]])
-    return mesh
+    lines = np.concatenate([[CIRCLE_N + 1], np.arange(CIRCLE_N), [0]])
+    return poly(ring(0.0, 0.0, 1.0, z), lines=lines, verts=point_cells(CIRCLE_N))
 
 
 def fans(idx: np.ndarray) -> np.ndarray:
@@ -240,11 +331,10 @@ def fans(idx: np.ndarray) -> np.ndarray:
     return np.stack(np.broadcast_arrays(3, idx[:, :1], idx[:, j], idx[:, j + 1]), axis=-1)
 
 
-def unit_fan() -> pv.PolyData:
+def unit_fan() -> vtkPolyData:
     """The unit disc as one triangle fan (a fill template)."""
-    mesh = pv.PolyData(ring(0.0, 0.0, 1.0, 0.0))
-    mesh.faces = fans(np.arange(CIRCLE_N)[None, :]).reshape(-1)
-    return mesh
+    faces = fans(np.arange(CIRCLE_N)[None, :]).reshape(-1)
+    return poly(ring(0.0, 0.0, 1.0, 0.0), faces, verts=point_cells(CIRCLE_N))
 
 
 class Store:
