@@ -16,6 +16,7 @@ from PyQt5 import QtCore
 
 from eyeviz.measured import shipped_eye
 from eyeviz.model.scene import load
+from eyeviz.render.vtk.primitives import read_rgb
 from eyeviz.render.vtk.style import UNLIT, hex_rgb
 
 SCENES = Path(__file__).resolve().parents[2] / "eyeviz" / "assets" / "scenes"
@@ -42,7 +43,7 @@ def _pixel(win, i):
 
 
 def _mesh_rgb(host, e: int) -> np.ndarray:
-    return np.asarray(host.actors.eyes.meshes[e].cell_data["rgb"]).copy()
+    return read_rgb(host.actors.eyes.meshes[e]).copy()
 
 
 def _close_up(host) -> np.ndarray:
@@ -79,7 +80,7 @@ def test_the_honeybee_opens_in_the_3d_page(make_window):
     st = host.model.state
     assert st.facet_counts == (3187, 3187)
     meshes = host.actors.eyes.meshes
-    assert [m.n_cells for m in meshes] == [3187, 3187]
+    assert [m.GetNumberOfCells() for m in meshes] == [3187, 3187]
     # every ball's lit facets are drawn in its colour (the last ball wins a shared facet)
     for e, eye in enumerate("AB"):
         rgb = _mesh_rgb(host, e)
@@ -187,9 +188,9 @@ def test_save_writes_the_eye_file_relative(make_window, tmp_path):
 
 def test_the_bumblebees_open_and_switch(make_window):
     win = make_window(load(SCENES / "bumblebees.toml"), SCENES / "bumblebees.toml")
-    assert [m.n_cells for m in win.host3d.actors.eyes.meshes] == [4827, 4827]
+    assert [m.GetNumberOfCells() for m in win.host3d.actors.eyes.meshes] == [4827, 4827]
     assert win.open_path(SCENES / "bumblebee_small.toml")
-    assert [m.n_cells for m in win.host3d.actors.eyes.meshes] == [1889, 1889]
+    assert [m.GetNumberOfCells() for m in win.host3d.actors.eyes.meshes] == [1889, 1889]
     assert win.open_path(SCENES / "sphere_teaching.toml")  # and back to HEALPix eyes
-    assert win.host3d.actors.eyes.meshes[0].n_cells == 768
+    assert win.host3d.actors.eyes.meshes[0].GetNumberOfCells() == 768
     assert not win.host3d.layer_actions["cones"].isVisible()

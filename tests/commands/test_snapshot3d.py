@@ -129,7 +129,7 @@ def test_snapshot3d_imports_no_vtk_qt_or_torch(tmp_path):
             capture_output=True, text=True, timeout=120, cwd=ROOT,
         )  # fmt: skip
         res = json.loads(out.stdout.strip().splitlines()[-1])
-        assert res["rc"] == 0 and res["heavy"] == ["vtk"], (name, res, out.stderr)
+        assert res == {"rc": 0, "heavy": []}, (name, out.stderr)
 
 
 def _maps(fig):

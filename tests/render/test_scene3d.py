@@ -62,7 +62,7 @@ def test_one_cell_per_facet_coloured_by_the_lit_sets(renderers):
     act = Scene3DActors(*renderers)
     act.update(sc, st, 0)
     assert act.eyes.full and len(act.eyes.meshes) == 2
-    for e, mesh in enumerate(act.eyes.meshes):
+    for e, mesh in enumerate(map(pv.wrap, act.eyes.meshes)):
         assert mesh.n_cells == healpix.npix(8)
         rgb = _cell_rgb(mesh)
         lit_a, lit_b = st.lit(0, "AB"[e]), st.lit(1, "AB"[e])
@@ -113,7 +113,8 @@ def test_large_nside_draws_a_coarse_sphere_and_the_lit_patches(renderers):
     act.update(sc, st, None)
     assert not act.eyes.full and not act.eyes.meshes
     for e in range(2):
-        mesh, a, pix = act.eyes.patches[e][0]
+        raw, a, pix = act.eyes.patches[e][0]
+        mesh = pv.wrap(raw)
         assert np.array_equal(pix, st.lit(0, "AB"[e]))
         assert mesh.n_cells == pix.size > 100
         rgb = np.asarray(mesh.cell_data["rgb"])  # every cell in the ball's colour
@@ -143,7 +144,7 @@ def test_cones_touch_their_balls(renderers):
     st = compute_state3d(sc)
     act = Scene3DActors(*renderers)
     act.update(sc, st, 0)
-    pts = np.asarray(act.balls.cones.points).reshape(4, -1, 3)  # A: a, b; then B: a, b
+    pts = np.asarray(pv.wrap(act.balls.cones).points).reshape(4, -1, 3)  # A: a, b; then B: a, b
     for k, (cx, i) in enumerate([(-40.0, 0), (-40.0, 1), (40.0, 0), (40.0, 1)]):
         apex, rim = pts[k, 0], pts[k, 1:]
         assert apex == pytest.approx((cx, 0.0, 0.0))
