@@ -199,7 +199,8 @@ def _bands_check(d: Domain3D, x, y, z, g, keys_of, lit_a, lit_b) -> tuple[int, i
     return x.size, int(want.sum()), int((out != 2).sum())
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+# 12 examples, as above: equator ties cost seconds each on the exact path
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     name=st.sampled_from(sorted(sc.CLASSES3D)),
     seed=st.integers(0, 2**20),
