@@ -575,10 +575,9 @@ def csr_kernel(status, per, st, ln):
     return indptr, out
 
 
-def warm() -> None:
-    """Compile (or load from the cache) :func:`lit_runs_kernel` and :func:`csr_kernel`
-    for their one signature, on the ring tables of nside 4 (geometry3d's, built here from
-    eyeviz.core.healpix)."""
+def warm_inputs():
+    """(nside 4, its ring tables in the kernels' argument order (sth, zr, unit, first,
+    nr, shifted, delta, o), one ball): what the warm-ups compile the kernels on."""
     from eyeviz.core import healpix
 
     n = 4
@@ -588,8 +587,14 @@ def warm() -> None:
     unit = np.where(q > 0, 0.25 * math.pi / np.maximum(q, 1), 0.0)
     first, nr, shifted = healpix.ring_info(n, np.clip(k, 1, 4 * n - 1))
     delta, o = 2 * math.pi / nr, np.where(shifted, 0.0, -0.5)
-    x, y, z, g = (np.array(v, np.float64) for v in ([0.0], [100.0], [5.0], [30.0]))
-    status, per, st, ln, _ = lit_runs_kernel(
-        n, x, y, z, g, 40.0, sth, zr, unit, first, nr, shifted, delta, o
-    )
+    ball = tuple(np.array(v, np.float64) for v in ([0.0], [100.0], [5.0], [30.0]))
+    return n, (sth, zr, unit, first, nr, shifted, delta, o), ball
+
+
+def warm() -> None:
+    """Compile (or load from the cache) :func:`lit_runs_kernel` and :func:`csr_kernel`
+    for their one signature, on the ring tables of nside 4 (geometry3d's, built here from
+    eyeviz.core.healpix)."""
+    n, tabs, (x, y, z, g) = warm_inputs()
+    status, per, st, ln, _ = lit_runs_kernel(n, x, y, z, g, 40.0, *tabs)
     csr_kernel(status, per, st, ln)

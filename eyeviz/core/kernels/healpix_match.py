@@ -228,17 +228,9 @@ def match_kernel(n, x, y, z, g, cx, row, kp, ki, sth, zr, unit, first_t, nr_t, s
 
 def warm() -> None:
     """Compile (or load from the cache) the kernels for their one signature each, on the
-    ring tables of nside 4."""
-    from eyeviz.core import healpix
-
-    n = 4
-    k = np.arange(4 * n + 1)
-    sth, zr = healpix.ring_sz(n, k)
-    q = np.minimum(np.minimum(k, n), 4 * n - k)
-    unit = np.where(q > 0, 0.25 * math.pi / np.maximum(q, 1), 0.0)
-    first, nr, shifted = healpix.ring_info(n, np.clip(k, 1, 4 * n - 1))
-    delta, o = 2 * math.pi / nr, np.where(shifted, 0.0, -0.5)
-    x, y, z, g = (np.array(v, np.float64) for v in ([0.0], [100.0], [5.0], [30.0]))
+    ring tables of nside 4 (:func:`healpix_lit.warm_inputs`)."""
+    n, tabs, (x, y, z, g) = healpix_lit.warm_inputs()
+    sth, zr, unit, first, nr, shifted, delta, o = tabs
     i1 = np.zeros(1, np.int64)
     match_kernel(n, x, y, z, g, 40.0, i1, np.array([0, 1]), i1, sth, zr, unit, first, nr,
                  shifted, delta, o, vertex_cache(16), i1.copy())  # fmt: skip

@@ -25,16 +25,25 @@ def over_discs(boxes: np.ndarray, at: np.ndarray, rad: np.ndarray) -> bool:
     return False
 
 
+def _middle_distances(boxes: np.ndarray, at: np.ndarray):
+    """(d, centres): d[k, j] the distance from the middle of name box k to disc centre j,
+    over the rows where both are finite; None when fewer than two are."""
+    ok = np.isfinite(boxes).all(axis=1) & np.isfinite(at).all(axis=1)
+    if ok.sum() < 2:
+        return None
+    b, a = boxes[ok], at[ok]
+    mid = np.column_stack([b[:, 0] + b[:, 2], b[:, 1] + b[:, 3]]) / 2
+    return np.linalg.norm(mid[:, None, :] - a[None, :, :], axis=2), a
+
+
 def unclear(boxes: np.ndarray, at: np.ndarray) -> bool:
     """Whether a name's box (row k of ``boxes``) has its middle not clearly nearer its
     own disc's centre (row k of ``at``) than another's: over UNCLEAR times the distance to
     the nearest other."""
-    ok = np.isfinite(boxes).all(axis=1) & np.isfinite(at).all(axis=1)
-    if ok.sum() < 2:
+    found = _middle_distances(boxes, at)
+    if found is None:
         return False
-    b, a = boxes[ok], at[ok]
-    mid = np.column_stack([b[:, 0] + b[:, 2], b[:, 1] + b[:, 3]]) / 2
-    d = np.linalg.norm(mid[:, None, :] - a[None, :, :], axis=2)
+    d, _ = found
     own = np.diag(d).copy()
     np.fill_diagonal(d, np.inf)
     return bool((own > UNCLEAR * d.min(axis=1)).any())
@@ -45,12 +54,10 @@ def misplaced(boxes: np.ndarray, at: np.ndarray) -> bool:
     disc's centre (rows of ``at``, the same order) than its own: by over a fifth of the
     two centres' distance (discs seen one behind the other, as from the side, tell their
     names apart by nothing)."""
-    ok = np.isfinite(boxes).all(axis=1) & np.isfinite(at).all(axis=1)
-    if ok.sum() < 2:
+    found = _middle_distances(boxes, at)
+    if found is None:
         return False
-    b, a = boxes[ok], at[ok]
-    mid = np.column_stack([b[:, 0] + b[:, 2], b[:, 1] + b[:, 3]]) / 2
-    d = np.linalg.norm(mid[:, None, :] - a[None, :, :], axis=2)
+    d, a = found
     k = np.arange(len(a))
     j = d.argmin(axis=1)
     apart = np.linalg.norm(a[k] - a[j], axis=1)
