@@ -93,6 +93,17 @@ def main(argv: list[str] | None = None) -> int:
         p, wall, cpu = run(Limit3DEstimator(d), la, lb)
         load = os.getloadavg()[0]
         k = args.ref_keys
+        rate, rate_c = args.keys / wall, args.keys / cpu
+        if k == 0:  # no reference run asked for: the kernels' rate only
+            print(f"{name}: {args.keys} keys, load {load:.1f}")
+            print(
+                f"  kernels    {rate:8.1f} keys/s wall {rate_c:8.1f} keys/s CPU; target "
+                f"{target:.0f}: {rate_c / target:.3g}x CPU; median accepted "
+                f"{np.median(p.n_accepted):.0f}, flagged {int(p.flagged.sum())}"
+            )
+            if args.before:
+                _before(args.before, which, la, lb, p, cpu)
+            continue
         sa, sb = take_rows(*la, np.arange(k)), take_rows(*lb, np.arange(k))
         _, wall_k, cpu_k = run(Limit3DEstimator(d), sa, sb)  # the ratio's keys, same run
         os.environ["EYEVIZ_JIT"] = "0"
@@ -100,7 +111,6 @@ def main(argv: list[str] | None = None) -> int:
             q, wall_r, cpu_r = run(Limit3DEstimator(d), sa, sb)
         finally:
             del os.environ["EYEVIZ_JIT"]
-        rate, rate_c = args.keys / wall, args.keys / cpu
         ref, ref_c = k / wall_r, k / cpu_r
         sub, sub_c = k / wall_k, k / cpu_k
         acc_same = np.array_equal(p.n_accepted[:k], q.n_accepted)
