@@ -227,6 +227,8 @@ class Limit3DEstimator(Estimator3D):
         # before it (a key that needs no more keeps needing none: its new draws weigh 0),
         # and none is taken once no key needs more. Only accepted draws are kept
         # (:func:`_compact`).
+        if getattr(prop, "batch_counts", False):
+            return self._topups_sized(st, keys, stream, out)
         rep, m = 1, self.samples
         need = _needs_more(out["r"], out["w"], self.accuracy)
         while rep < self.max_batches and need.any():
@@ -240,6 +242,30 @@ class Limit3DEstimator(Estimator3D):
                 need = _needs_more(out["r"], out["w"], self.accuracy)
                 if not need.any():
                     break
+        return out
+
+    def _topups_sized(self, st: dict, keys: np.ndarray, stream: int, out: dict) -> dict:
+        """The top-ups of :meth:`_draw` for a proposal that draws each key its own number
+        of batches (``sample_counts``): key n's k-th batch is its stream + 8 k, taken while
+        the key still needs more after the batches before it, as there, so a key gets the
+        same draws; but each round draws a key the batches its error predicts
+        (:func:`_more_batches`), not ``_TOPUP`` for every key."""
+        m = self.samples
+        rep = np.ones(keys.size, np.int64)
+        need = _needs_more(out["r"], out["w"], self.accuracy) & (rep < self.max_batches)
+        while need.any():
+            cnt = np.where(need, _more_batches(out, self.accuracy, rep), 0)
+            cnt = np.minimum(cnt, self.max_batches - rep)
+            more = self._proposal.sample_counts(st, keys, stream + 8 * rep, cnt)
+            for j in range(int(cnt.max())):
+                take = need & (cnt > j)
+                if not take.any():
+                    break
+                part = {k: v[:, j * m : (j + 1) * m] for k, v in more.items()}
+                part["w"] = np.where(take[:, None], part["w"], 0.0)
+                out = {k: np.concatenate([out[k], v], axis=1) for k, v in _compact(part).items()}
+                rep += take
+                need = _needs_more(out["r"], out["w"], self.accuracy) & (rep < self.max_batches)
         return out
 
     def _posterior(self, lit_a: LitCSR, lit_b: LitCSR):
@@ -423,6 +449,18 @@ def _needs_more(r: np.ndarray, w: np.ndarray, target: float = MC_TARGET) -> np.n
     with np.errstate(invalid="ignore", divide="ignore"):
         mc = 1.2533 * sd / np.sqrt(ess) / mean
     return ~(ess >= MIN_ESS) | ~(mc <= target)
+
+
+def _more_batches(s: dict, target: float, done: np.ndarray) -> np.ndarray:
+    """Per key, the batches of draws after ``done`` that its relative Monte-Carlo error of
+    r (1 / sqrt(batches)) or its ESS (as batches) predicts it needs to reach ``target``
+    and ``MIN_ESS``, at least 1; ``_TOPUP`` where nothing is accepted yet."""
+    mean, sd, ess = _spread(s["r"], s["w"])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mc = 1.2533 * sd / np.sqrt(ess) / mean
+        f = np.maximum((mc / target) ** 2, MIN_ESS / ess)
+        k = np.ceil(done * f) - done
+    return np.where(np.isfinite(k), np.clip(k, 1, MAX_BATCHES_BOUND), _TOPUP).astype(np.int64)
 
 
 def posterior_samples3d(est: Limit3DEstimator, lit_a, lit_b) -> dict[str, np.ndarray]:

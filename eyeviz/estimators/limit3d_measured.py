@@ -62,10 +62,11 @@ from eyeviz.core import kernels
 from eyeviz.core.domain import Domain3D
 from eyeviz.estimators import limit3d_provable
 from eyeviz.estimators.analytic3d import estimate
-from eyeviz.estimators.base import LitCSR
+from eyeviz.estimators.base import LitCSR, take_rows
+from eyeviz.estimators.limit3d_cones import RINGS, _direction, _Edges, _Facets, _facets
 from eyeviz.estimators.limit3d_exact import exact_hits, prior_density
 from eyeviz.estimators.limit3d_proposal import _batch_uniforms, _frame
-from eyeviz.estimators.triangulation import facet_neighbours, triangulate_rays
+from eyeviz.estimators.triangulation import triangulate_rays
 
 __all__ = ["MeasuredProposal"]
 
@@ -82,8 +83,6 @@ LOCATE = 5
 #: best direction at infinity, triangulated), and the reach of the box's bisection
 SEARCH = 1.5
 REACH = 6.0
-#: rings of axis neighbours of the lit facets whose unlit facets constrain
-RINGS = 2
 #: the retries of keys with nothing accepted (limit3d._retries): of limit3d.RETRY's three
 #: stages only the second, 24 batches with a window 2.5 times wider, its stream 2 as
 #: there. On 400 fresh honeybee keys (seeds 20261207-8) the first (8 batches, the same
@@ -105,164 +104,8 @@ _DIRS3 = np.array(
     float,
 )
 _DIRS3 /= np.linalg.norm(_DIRS3, axis=1, keepdims=True)
-
-
-class _Facets:
-    """One eye's facets as the proposal reads them: lens positions, unit axes, half
-    acceptance angles and each facet's axis neighbours."""
-
-    def __init__(self, eyes, which: str) -> None:
-        pos, axes, acc = eyes.facets(which)
-        self.pos = np.asarray(pos, np.float64)
-        self.ax = np.asarray(eyes.eye(which).unit_axes, np.float64)
-        self.half = np.asarray(acc, np.float64) / 2
-        self.nb = facet_neighbours(np.asarray(axes, np.float64))
-        self.centre = np.asarray(eyes.eye(which).centroid, np.float64)
-
-
-_FACETS: dict[tuple[str, str], _Facets] = {}
-
-
-def _facets(eyes, which: str) -> _Facets:
-    key = (str(eyes.fingerprint), which)
-    if key not in _FACETS:
-        if len(_FACETS) > 8:
-            _FACETS.clear()
-        _FACETS[key] = _Facets(eyes, which)
-    return _FACETS[key]
-
-
-class _Edges:
-    """The constraining facets of one eye for a chunk of keys, padded to (N, K):
-    positions, axes, half-angles, ``lit`` (must be seen) and ``pad``."""
-
-    def __init__(self, f: _Facets, lit: LitCSR) -> None:
-        ptr, ind = lit
-        n, nf = ptr.size - 1, f.pos.shape[0]
-        rows = np.repeat(np.arange(n), np.diff(ptr))
-        lit_codes = rows * nf + ind
-        ring = lit_codes
-        near = [lit_codes]
-        for _ in range(RINGS):
-            r_, i_ = np.divmod(ring, nf)
-            ring = np.repeat(r_, f.nb.shape[1]) * nf + f.nb[i_].ravel()
-            near.append(ring)
-        allc = np.unique(np.concatenate(near))
-        unlit = allc[~np.isin(allc, lit_codes, assume_unique=True)]
-        codes = np.concatenate([lit_codes, unlit])
-        is_lit = np.concatenate([np.ones(lit_codes.size, bool), np.zeros(unlit.size, bool)])
-        r_all, i_all = np.divmod(codes, nf)
-        order = np.argsort(r_all, kind="stable")
-        r_all, i_all, is_lit = r_all[order], i_all[order], is_lit[order]
-        cnt = np.bincount(r_all, minlength=n)
-        k = max(1, int(cnt.max()) if cnt.size else 1)
-        slot = np.arange(r_all.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-        self.pos = np.zeros((n, k, 3))
-        self.ax = np.zeros((n, k, 3))
-        self.ax[..., 0] = 1.0
-        self.half = np.zeros((n, k))
-        self.lit = np.zeros((n, k), bool)
-        self.pad = np.ones((n, k), bool)
-        self.pos[r_all, slot] = f.pos[i_all]
-        self.ax[r_all, slot] = f.ax[i_all]
-        self.half[r_all, slot] = f.half[i_all]
-        self.lit[r_all, slot] = is_lit
-        self.pad[r_all, slot] = False
-        self.pa = np.einsum("nkj,nkj->nk", self.pos, self.ax)[..., None]
-        self.pp = np.einsum("nkj,nkj->nk", self.pos, self.pos)[..., None]
-        self._cols: tuple[np.ndarray, ...] | None = None
-
-    def prune(self, c: np.ndarray, keep_lit: float = 0.5, keep_unlit: float = 2.0) -> None:
-        """Keep the facets that may bind near the centres c (N, 3): lit ones whose cone
-        lies at least ``keep_lit`` times lo from c, unlit ones within ``keep_unlit`` times
-        hi. (Dropping a constraint only enlarges the region: the exact check decides.)"""
-        dist, _ = self._dist(c[:, None, :])
-        dist = dist[..., 0]
-        live = ~self.pad
-        lo = np.where(self.lit & live, dist, -np.inf).max(axis=1, keepdims=True)
-        hi = np.where(~self.lit & live, dist, np.inf).min(axis=1, keepdims=True)
-        keep = live & np.where(self.lit, dist >= keep_lit * lo, dist <= keep_unlit * hi)
-        k = max(1, int(keep.sum(axis=1).max()))
-        order = np.argsort(~keep, axis=1, kind="stable")[:, :k]
-        for name in ("pos", "ax", "half", "lit", "pa", "pp"):
-            v = getattr(self, name)
-            setattr(
-                self, name, np.take_along_axis(v, order if v.ndim == 2 else order[..., None], 1)
-            )
-        self.pad = ~np.take_along_axis(keep, order, 1)
-        self._cols = None
-
-    def _dist(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(dist(c, K_i), |c - p_i|) (N, K, G) at centres c (N, G, 3)."""
-        ct = np.swapaxes(c, 1, 2)  # (N, 3, G)
-        s = np.matmul(self.ax, ct) - self.pa  # v . a
-        v2 = np.matmul(self.pos, ct) * -2.0 + self.pp + np.einsum("ngj,ngj->ng", c, c)[:, None]
-        v2 = np.maximum(v2, 0.0)
-        q = np.sqrt(np.maximum(v2 - s * s, 0.0))
-        vn = np.sqrt(v2)
-        ex = np.arctan2(q, s) - self.half[..., None]
-        dist = np.where(ex <= 0.0, 0.0, np.where(ex < math.pi / 2, vn * np.sin(ex), vn))
-        return dist, vn
-
-    def bounds(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(lo, hi) (N, G) at centres c (N, G, 3): the largest distance of a lit cone and
-        the smallest of an unlit cone or of a lit lens (module docstring). Compiled
-        (to a few units in the last place the same) unless ``EYEVIZ_JIT=0``."""
-        if kernels.use(c.shape[0] * c.shape[1]):
-            from eyeviz.core.kernels.limit3d_region import cone_bounds_kernel
-
-            lo = np.empty(c.shape[:2])
-            hi = np.empty(c.shape[:2])
-            pos, ax, ch, sh, lit, pad = self.columns()
-            cone_bounds_kernel(pos, ax, ch, sh, lit, pad, kernels.arg(c, np.float64), lo, hi)
-            return lo, hi
-        return self._bounds_ref(c)
-
-    def columns(self) -> tuple[np.ndarray, ...]:
-        """What the compiled kernels read: positions, axes, cos and sin of the half
-        acceptance angles, ``lit``, ``pad``."""
-        if self._cols is None:
-            self._cols = (self.pos, self.ax, np.cos(self.half), np.sin(self.half), self.lit,
-                          self.pad)  # fmt: skip
-        return self._cols
-
-    def _bounds_ref(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`bounds` in numpy (the reference)."""
-        dist, vn = self._dist(c)
-        lit = (self.lit & ~self.pad)[..., None]
-        unl = (~self.lit & ~self.pad)[..., None]
-        lo = np.where(lit, dist, -np.inf).max(axis=1)
-        hi = np.minimum(
-            np.where(unl, dist, np.inf).min(axis=1), np.where(lit, vn, np.inf).min(axis=1)
-        )
-        return lo, hi
-
-
-def _direction(e: _Edges, grid: int, levels: int = 6) -> np.ndarray:
-    """Per key (N, 3): the direction u maximising G(u) = min over unlit facets of
-    (angle(a_j, u) - alpha_j) - max over lit ones of (angle(a_i, u) - alpha_i), the eye's
-    feasible region at infinity (lens offsets ignored), on zooming grids about the lit
-    facets' mean axis, first as wide as the lit axes' spread and the widest cone."""
-    n = e.pos.shape[0]
-    lit = e.lit & ~e.pad
-    unl = ~e.lit & ~e.pad
-    c = np.where(lit[..., None], e.ax, 0.0).sum(axis=1)
-    c = c / np.linalg.norm(c, axis=1, keepdims=True)
-    spread = np.where(lit, np.arccos(np.clip(np.einsum("nkj,nj->nk", e.ax, c), -1, 1)), 0.0)
-    half = np.tan(np.minimum(spread.max(axis=1) + e.half.max(axis=1), 1.2))
-    t = (np.arange(grid) + 0.5) / grid * 2 - 1
-    g2 = np.stack(np.meshgrid(t, t, indexing="ij"), axis=-1).reshape(-1, 2)
-    for _ in range(levels):
-        e1, e2 = _frame(c)
-        dd = g2[None] * half[:, None, None]
-        v = c[:, None] + dd[..., :1] * e1[:, None] + dd[..., 1:] * e2[:, None]
-        v = v / np.linalg.norm(v, axis=2, keepdims=True)
-        ang = np.arccos(np.clip(np.matmul(e.ax, np.swapaxes(v, 1, 2)), -1, 1)) - e.half[..., None]
-        gv = np.where(unl[..., None], ang, np.inf).min(axis=1)
-        gv = gv - np.where(lit[..., None], ang, -np.inf).max(axis=1)
-        c = v[np.arange(n), np.argmax(gv, axis=1)]
-        half = half / 2.5
-    return c
+# the constraining facets (limit3d_cones), read here and by the tests under these names
+_CONES = (RINGS, _Edges, _Facets, _facets)
 
 
 def _uniforms(keys: np.ndarray, m: int, k: int, streams) -> np.ndarray:
@@ -355,7 +198,23 @@ class MeasuredProposal:
     def _hb(self, st: dict, x: np.ndarray) -> np.ndarray:
         """H at points x (N, G, 3) = (delta_1, delta_2, beta) (-inf where undefined);
         compiled, where H < -st["slack"] some value below it (the walk over the facets
-        stops there: :meth:`_h_draws`). Callers compare it with -st["slack"] only."""
+        stops there). Callers compare it with -st["slack"] only. Compiled: the centre and
+        the walk in one loop (kernels.measured_limit.region_kernel, the facet that rules
+        a point out tried first for the next); else numpy (:meth:`_bcentres`, :meth:`_h`)."""
+        if kernels.use(x.shape[0] * x.shape[1]):
+            from eyeviz.core.kernels import measured_limit
+
+            # Any: the kernel takes 24 arrays and numbers (numba's Dispatcher stub types fewer)
+            region_kernel: Any = measured_limit.region_kernel
+            f64 = np.float64
+            h = np.empty(x.shape[:2])
+            region_kernel(kernels.arg(x, f64), kernels.arg(st["u0"], f64),
+                          kernels.arg(st["e1"], f64), kernels.arg(st["e2"], f64),
+                          kernels.arg(self.fa.centre, f64), kernels.arg(self.bhat, f64),
+                          self.blen, kernels.arg(self.origin, f64), self.s_half,
+                          float(self.domain.g_max), float(st["slack"]), *st["ea"].columns(),
+                          *st["eb"].columns(), h)  # fmt: skip
+            return h
         c, _, _ = self._bcentres(st, x[..., :2], x[..., 2])
         with np.errstate(invalid="ignore", over="ignore"):
             cc = np.nan_to_num(c, nan=1e300)
@@ -480,6 +339,9 @@ class MeasuredProposal:
         st["n_def"] = n_def.astype(np.int64)
         st["proven"] = proven
 
+    #: limit3d's top-ups may draw each key its own batches (:meth:`sample_counts`)
+    batch_counts = True
+
     def sample(self, st: dict, keys: np.ndarray, stream, rows=None) -> dict[str, np.ndarray]:
         """``samples`` weighted draws per key of a chunk set up by :meth:`setup`, per
         stream (an int or a sequence: batches side by side, :func:`_batch_uniforms`); only
@@ -505,6 +367,26 @@ class MeasuredProposal:
             st["lit_b"],
         )
         out["w"] = np.where(hit.reshape(n, m), wt, 0.0)
+        return out
+
+    def sample_counts(self, st: dict, keys, first: np.ndarray, counts: np.ndarray) -> dict:
+        """:meth:`sample` of key n's batches of the streams first[n] + 8 j, j < counts[n],
+        side by side (weight 0 after them): the keys with the same streams together, each
+        as drawn alone."""
+        n, width = keys.size, int(counts.max()) * self.samples
+        out = {k: np.zeros((n, width)) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
+        groups = np.unique(np.stack([first, counts], axis=1)[counts > 0], axis=0)
+        for f0, c in groups:
+            idx = np.flatnonzero((first == f0) & (counts == c))
+            sub = {k: (v.take(idx) if isinstance(v, _Edges) else v[idx] if
+                       isinstance(v, np.ndarray) and v.ndim and v.shape[0] == n else v)
+                   for k, v in st.items()}  # fmt: skip
+            for name in ("lit_a", "lit_b"):
+                ptr, ind = st[name]
+                sub[name] = take_rows(ptr, ind, idx)
+            got = self.sample(sub, keys[idx], [int(f0) + 8 * j for j in range(int(c))])
+            for k, v in got.items():
+                out[k][idx, : v.shape[1]] = v
         return out
 
     def _draws_kernel(self, st: dict, u: np.ndarray, rows) -> dict[str, np.ndarray]:

@@ -321,3 +321,36 @@ def test_the_measured_retries_keep_the_stage_that_finds_keys(small):
     assert limit3d._retries(object()) == tuple(
         (i, w, r) for i, (w, r) in enumerate(limit3d.RETRY, start=1)
     )
+
+
+@pytest.mark.parametrize("jit", ["1", "0"])
+def test_sized_top_ups_give_the_answers_of_four_batches_at_a_time(far, monkeypatch, jit):
+    """limit3d's top-ups drawing each key the batches its error predicts (the measured
+    proposal's ``sample_counts``, keys grouped by their streams) give every key the same
+    draws, so the same answers bit for bit, as ``_TOPUP`` batches at a time for every key;
+    with fewer draws in all."""
+    from eyeviz.estimators import limit3d_measured as lm
+
+    monkeypatch.setenv("EYEVIZ_JIT", jit)
+    dom, _, _, lit = far
+    drawn = {True: 0, False: 0}
+    sample = lm.MeasuredProposal.sample
+
+    def counting(self, st, keys, stream, rows=None):
+        out = sample(self, st, keys, stream, rows)
+        live = out["w"].shape[0] if rows is None else int(np.sum(rows))
+        drawn[bool(lm.MeasuredProposal.batch_counts)] += live * out["w"].shape[1]
+        return out
+
+    monkeypatch.setattr(lm.MeasuredProposal, "sample", counting)
+    got = {}
+    for sized in (True, False):
+        monkeypatch.setattr(lm.MeasuredProposal, "batch_counts", sized)
+        p = Limit3DEstimator(dom, samples=256, accuracy=0.01).predict(*lit)
+        got[sized] = p
+    a, b = got[True], got[False]
+    assert 5 <= b.mc_capped.sum() <= 25 and (b.n_accepted > 0).all()
+    for k in ("r", "azimuth", "elevation", "n_accepted", "flagged", "mc_capped"):
+        assert np.array_equal(getattr(a, k), getattr(b, k)), k
+    assert np.allclose(a.mc_error, b.mc_error, rtol=1e-12, equal_nan=True)
+    assert drawn[True] < drawn[False]

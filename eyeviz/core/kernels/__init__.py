@@ -45,7 +45,14 @@ def use(work: int = 1 << 30) -> bool:
 
 #: The kernel modules, each with a ``warm()``; ordered so that every other one splits the
 #: cold compile time in two about equal halves (scripts/setup.sh compiles them so)
-KERNELS = ("healpix_lit", "healpix_match", "limit3d_region", "measured_lit", "healpix_cells")
+KERNELS = (
+    "healpix_lit",
+    "healpix_match",
+    "limit3d_region",
+    "measured_lit",
+    "healpix_cells",
+    "measured_limit",
+)
 
 
 def warm(names: tuple[str, ...] = KERNELS) -> None:
