@@ -6,15 +6,17 @@ the facets' tables per eye, the key's lit facets and the unlit ones near them pa
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
 from eyeviz.core import kernels
 from eyeviz.estimators.base import LitCSR
+from eyeviz.estimators.limit3d_exact import exact_hits
 from eyeviz.estimators.limit3d_proposal import _frame
 from eyeviz.estimators.triangulation import facet_neighbours
 
-__all__ = ["RINGS", "_Edges", "_Facets", "_direction", "_facets"]
+__all__ = ["RINGS", "key_hits", "_Edges", "_Facets", "_direction", "_facets"]
 
 
 #: rings of axis neighbours of the lit facets whose unlit facets constrain
@@ -185,3 +187,43 @@ def _direction(e: _Edges, grid: int, levels: int = 6) -> np.ndarray:
         c = v[np.arange(n), np.argmax(gv, axis=1)]
         half = half / 2.5
     return c
+
+
+def key_hits(domain, p: np.ndarray, g: np.ndarray, row: np.ndarray, lit_a: LitCSR,
+             lit_b: LitCSR) -> np.ndarray:  # fmt: skip
+    """:func:`.limit3d_exact.exact_hits` of a measured pair's draws (centres p (D, 3),
+    radii g, keys ``row`` (D,) non-decreasing): per key, a bound over its draws rules
+    most facets out at once and a bound per draw most of the rest; the few left get the
+    certified test (kernels.measured_lit.key_check_kernel); the draws it leaves go to
+    ``exact_hits``. The same answer, exactly (tests/estimators/test_limit3d_measured.py);
+    without the kernels (``EYEVIZ_JIT=0``) ``exact_hits`` alone."""
+    if not (row.size and kernels.use(row.size)):
+        return exact_hits(domain, p, g, row, lit_a, lit_b)
+    from eyeviz.core.kernels import measured_lit
+
+    # Any: the kernel takes 24 arrays and numbers (numba's Dispatcher stub types fewer)
+    check: Any = measured_lit.key_check_kernel
+    eyes = domain.eyes
+    f64 = np.float64
+    xs, ys, zs = (kernels.arg(p[:, j], f64) for j in range(3))
+    gs = kernels.arg(g, f64)
+    n = lit_a[0].size - 1
+    bounds = np.searchsorted(row, np.arange(n + 1)).astype(np.int64)
+    res = np.ones(row.size, np.int64)
+    for which, (kp, ki) in (("A", lit_a), ("B", lit_b)):
+        t, ix = eyes._prepared(which)
+        e = eyes.eye(which)
+        ua = e.unit_axes
+        rows = np.repeat(np.arange(n), np.diff(kp))
+        ki = kernels.arg(np.asarray(ki)[np.lexsort((ki, rows))], np.int64)
+        check(xs, ys, zs, gs, bounds, t.px, t.py, t.pz, t.ax, t.ay, t.az, t.nrm, t.cos, t.sin,
+              t.exact_only, *(kernels.arg(ua[:, j], f64) for j in range(3)),
+              kernels.arg(e.acceptance, f64) / 2, kernels.arg(ix.centre, f64), float(ix.lens),
+              kernels.arg(kp, np.int64), ki, res)  # fmt: skip
+    # a measured pair's field (limit3d_exact.exact_hits): each eye lights two facets or more
+    ka, kb = (np.diff(k[0])[row] >= 2 for k in (lit_a, lit_b))
+    hit = (res == 1) & ka & kb
+    left = np.flatnonzero(res == 2)
+    if left.size:
+        hit[left] = exact_hits(domain, p[left], g[left], row[left], lit_a, lit_b)
+    return hit

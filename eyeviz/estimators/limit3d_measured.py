@@ -33,19 +33,24 @@ from the cells (:mod:`.limit3d_healpix`), here without a linearisation:
    along 26 directions of H >= -slack, the boundary points' box widened ``WIDEN`` times,
    then widened by half again on each face near which a pilot's feasible draws fall.
 5. A draw: (delta, beta) uniform in a box, g uniform on the feasible interval at that
-   centre. Where the provable box below holds, the first ``DEFEND`` of each batch's draws
-   come from it (every draw where the bisection found no feasible point) and the rest
-   from the box of step 4 cut to it, a deterministic mixture. Weight: prior x rho^2 (1 +
-   |delta|^2)^(-3/2) |b| sin(a) / sin(a + beta)^2 (d(x, y, z) / d(delta, beta)) x the
-   interval's length / the mixture's density in (delta, beta) (the box's volume alone
-   where there is no provable box). Every draw with a weight is checked exactly
-   (:func:`.limit3d_exact.exact_hits`: the pair's own ``lit_csr``, then ``in_bfv``).
+   centre. Each batch's draws come from three boxes in turn, a deterministic mixture:
+   where the provable box below holds, the first ``DEFEND`` from it (every draw where the
+   bisection found no feasible point); then ``TIGHT`` from the tight box, the last pilot
+   round's feasible points' box widened ``TIGHT_WIDEN`` times (where it has
+   ``TIGHT_MIN`` points); the rest from the box of step 4 (cut to the provable box).
+   Weight: prior x rho^2 (1 + |delta|^2)^(-3/2) |b| sin(a) / sin(a + beta)^2 (d(x, y,
+   z) / d(delta, beta)) x the interval's length / the mixture's density in (delta, beta)
+   (the sum over the boxes holding the draw of share / volume). Every draw with a weight
+   is checked exactly (:func:`.limit3d_cones.key_hits`: a bound per key and per draw
+   leaves a few facets to the certified test; else :func:`.limit3d_exact.exact_hits`,
+   the pair's own ``lit_csr``, then ``in_bfv``).
 
 Where the provable box holds, the mixture's density is positive on all of it, so the
-estimate is unbiased whatever the box of step 4 covers (a part it misses is found by the
-defensive draws, at a weight as large as the two boxes' volumes are apart: the pilot
-keeps such parts small). Elsewhere the proposal covers the posterior when the region is
-close to convex about the reference (the widening and the pilot are the margin). The
+estimate is unbiased whatever the box of step 4 or the tight box covers (a part the box
+misses is found by the defensive draws, at a weight as large as the two boxes' volumes
+are apart: the pilot keeps such parts small; a part the tight box misses is drawn from
+the box, at the box's share). Elsewhere the proposal covers the posterior when the region
+is close to convex about the reference (the widening and the pilot are the margin). The
 tests compare the answers with brute-force rejection sampling from the prior on a small
 measured eye, and check that every brute-force posterior sample lies in the provable box.
 
@@ -63,8 +68,8 @@ from eyeviz.core.domain import Domain3D
 from eyeviz.estimators import limit3d_provable
 from eyeviz.estimators.analytic3d import estimate
 from eyeviz.estimators.base import LitCSR, take_rows
-from eyeviz.estimators.limit3d_cones import RINGS, _direction, _Edges, _Facets, _facets
-from eyeviz.estimators.limit3d_exact import exact_hits, prior_density
+from eyeviz.estimators.limit3d_cones import RINGS, _direction, _Edges, _Facets, _facets, key_hits
+from eyeviz.estimators.limit3d_exact import prior_density
 from eyeviz.estimators.limit3d_proposal import _batch_uniforms, _frame
 from eyeviz.estimators.triangulation import triangulate_rays
 
@@ -91,6 +96,12 @@ REACH = 6.0
 RETRIES = ((2, 2.5, 24),)
 #: the share of each batch's draws from the provable box where it holds
 DEFEND = 0.0625
+#: the tight box: the pilot's feasible points' box widened ``TIGHT_WIDEN`` times about its
+#: centre (cut to the box), its share of each batch's draws, and the feasible points it
+#: needs (fewer: no tight box)
+TIGHT_WIDEN = 1.5
+TIGHT = 0.6875
+TIGHT_MIN = 16
 
 
 _DIRS3 = np.array(
@@ -296,20 +307,26 @@ class MeasuredProposal:
         # the pilot: the box widened where feasible draws come near a face (the defensive
         # share of the draws keeps the estimate unbiased where it still misses a part of
         # the posterior; the pilot keeps that part, and so the weights' spread, small)
-        box_lo, box_hi = self._pilot(st, keys, box_lo, box_hi)
+        box_lo, box_hi, tight = self._pilot(st, keys, box_lo, box_hi)
         lo_p, hi_p, proven = self.provable_box(st)
         st["box_lo"], st["box_hi"] = box_lo, box_hi
         self._defend(st, lo_p, hi_p, proven)
+        self._mixture(st, *tight)
         return st
 
     def _pilot(self, st: dict, keys: np.ndarray, box_lo: np.ndarray, box_hi: np.ndarray):
         """The box widened by half on each face near which a pilot's feasible draws fall,
-        ``PILOT`` draws, up to ``PILOT_ROUNDS`` times."""
+        ``PILOT`` draws, up to ``PILOT_ROUNDS`` times; and the box of the last round's
+        feasible draws (lo, hi, their number)."""
         slack = st["slack"]
         up = _uniforms(keys, PILOT, 3, 7)
+        n = box_lo.shape[0]
+        tight = (box_lo, box_hi, np.zeros(n, np.int64))
         for _ in range(PILOT_ROUNDS):
             x = box_lo[:, None] + (box_hi - box_lo)[:, None] * up
             inside = (self._hb(st, x) >= -slack)[..., None]
+            t_lo = np.where(inside, x, np.inf).min(axis=1)
+            tight = (t_lo, np.where(inside, x, -np.inf).max(axis=1), inside[..., 0].sum(axis=1))
             band = 0.1 * (box_hi - box_lo)[:, None]
             near_lo = (inside & (x < box_lo[:, None] + band)).any(axis=1)
             near_hi = (inside & (x > box_hi[:, None] - band)).any(axis=1)
@@ -318,7 +335,7 @@ class MeasuredProposal:
             span = box_hi - box_lo
             box_lo = np.where(near_lo, box_lo - 0.5 * span, box_lo)
             box_hi = np.where(near_hi, box_hi + 0.5 * span, box_hi)
-        return box_lo, box_hi
+        return box_lo, box_hi, tight
 
     def _defend(self, st: dict, lo, hi, proven) -> None:
         """The defensive box of each key's proposal (module docstring, step 5): where the
@@ -339,6 +356,35 @@ class MeasuredProposal:
         st["n_def"] = n_def.astype(np.int64)
         st["proven"] = proven
 
+    def _mixture(self, st: dict, t_lo: np.ndarray, t_hi: np.ndarray, t_n: np.ndarray) -> None:
+        """The tight box of each key's mixture (module docstring, step 5): the pilot's
+        feasible points' box (t_lo, t_hi) widened ``TIGHT_WIDEN`` times and cut to the
+        box, ``TIGHT`` of each batch's draws where it has ``TIGHT_MIN`` points or more and
+        the key is not drawn from the defensive box alone (:meth:`_boxes`)."""
+        lo, hi = st["box_lo"], st["box_hi"]
+        mid, half = 0.5 * (t_lo + t_hi), 0.5 * TIGHT_WIDEN * (t_hi - t_lo)
+        with np.errstate(invalid="ignore"):
+            tl, th = np.maximum(mid - half, lo), np.minimum(mid + half, hi)
+            ok = (t_n >= TIGHT_MIN) & (th > tl).all(axis=1) & (st["n_def"] < self.samples)
+        st["tight_lo"] = np.where(ok[:, None], tl, lo)
+        st["tight_hi"] = np.where(ok[:, None], th, hi)
+        st["n_tight"] = np.where(ok, int(TIGHT * self.samples), 0).astype(np.int64)
+
+    def _boxes(self, st: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Each key's mixture: boxes (N, 3, 2, 3) (lo, hi) and each batch's draws from
+        them in turn, counts (N, 3): the defensive box's ``n_def``, the tight box's
+        ``n_tight`` (at most the rest), the rest from the box; dens = share / volume."""
+        m = self.samples
+        n_def = st["n_def"]
+        n_t = np.minimum(st.get("n_tight", 0 * n_def), m - n_def)
+        counts = np.stack([n_def, n_t, m - n_def - n_t], axis=1).astype(np.int64)
+        t_lo, t_hi = st.get("tight_lo", st["box_lo"]), st.get("tight_hi", st["box_hi"])
+        boxes = np.stack([np.stack([st["def_lo"], st["def_hi"]], 1), np.stack([t_lo, t_hi], 1),
+                          np.stack([st["box_lo"], st["box_hi"]], 1)], axis=1)  # fmt: skip
+        with np.errstate(divide="ignore"):
+            dens = counts / m / np.prod(boxes[:, :, 1] - boxes[:, :, 0], axis=2)
+        return boxes, counts, np.where(counts > 0, dens, 0.0)
+
     #: limit3d's top-ups may draw each key its own batches (:meth:`sample_counts`)
     batch_counts = True
 
@@ -358,7 +404,7 @@ class MeasuredProposal:
         cand = np.flatnonzero(wt.ravel() > 0)
         c = np.stack([out["x"], out["y"], out["z"]], axis=-1)
         hit = np.zeros(n * m, bool)
-        hit[cand] = exact_hits(
+        hit[cand] = key_hits(
             d,
             c.reshape(-1, 3)[cand],
             out["g"].ravel()[cand],
@@ -390,23 +436,23 @@ class MeasuredProposal:
         return out
 
     def _draws_kernel(self, st: dict, u: np.ndarray, rows) -> dict[str, np.ndarray]:
-        """:meth:`_draws_ref` compiled, draw by draw (kernels.limit3d_region.
-        measured_draws_kernel): the same draws, weights to about 1e-13 (its cone distances
+        """:meth:`_draws_ref` compiled, draw by draw (kernels.measured_limit.
+        mixture_draws_kernel): the same draws, weights to about 1e-13 (its cone distances
         and trigonometry round differently); a draw's values are set only where its
         weight is above 0 (the others are never read: limit3d keeps accepted draws)."""
-        from eyeviz.core.kernels import limit3d_region
+        from eyeviz.core.kernels import measured_limit
 
-        # Any: the kernel takes 37 arrays and numbers (numba's Dispatcher stub types fewer)
-        kernel: Any = limit3d_region.measured_draws_kernel
+        # Any: the kernel takes 38 arrays and numbers (numba's Dispatcher stub types fewer)
+        kernel: Any = measured_limit.mixture_draws_kernel
         d = self.domain
         n, m = u.shape[:2]
         live = np.ones(n, np.bool_) if rows is None else kernels.arg(rows, np.bool_)
         f64 = np.float64
         outs = {k: np.zeros((n, m)) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
+        boxes, counts, dens = self._boxes(st)
         kernel(
-            kernels.arg(u, f64), kernels.arg(st["box_lo"], f64), kernels.arg(st["box_hi"], f64),
-            kernels.arg(st["def_lo"], f64), kernels.arg(st["def_hi"], f64),
-            kernels.arg(st["n_def"], np.int64), self.samples, kernels.arg(st["u0"], f64),
+            kernels.arg(u, f64), kernels.arg(boxes, f64), kernels.arg(counts, np.int64),
+            kernels.arg(dens, f64), self.samples, kernels.arg(st["u0"], f64),
             kernels.arg(st["e1"], f64), kernels.arg(st["e2"], f64),
             kernels.arg(self.fa.centre, f64), kernels.arg(self.bhat, f64), self.blen,
             kernels.arg(self.origin, f64), self.s_half, float(d.g_max), float(d.r_min),
@@ -422,12 +468,13 @@ class MeasuredProposal:
         the reference): (delta, beta) uniform in the box, the centre, g uniform on its
         interval, the weight."""
         d = self.domain
-        lo, hi = st["box_lo"], st["box_hi"]
-        dlo, dhi, n_def = st["def_lo"], st["def_hi"], st["n_def"]
-        # the first n_def draws of each batch of ``samples`` from the defensive box
-        dfn = (np.arange(u.shape[1]) % self.samples)[None, :] < n_def[:, None]
-        blo = np.where(dfn[..., None], dlo[:, None], lo[:, None])
-        bhi = np.where(dfn[..., None], dhi[:, None], hi[:, None])
+        boxes, counts, dens = self._boxes(st)
+        # each batch's draws from the mixture's boxes in turn
+        j = np.arange(u.shape[1]) % self.samples
+        comp = (j[None, :, None] >= np.cumsum(counts, axis=1)[:, None, :]).sum(axis=2)
+        comp = np.minimum(comp, counts.shape[1] - 1)
+        key = np.arange(comp.shape[0])[:, None]
+        blo, bhi = boxes[key, comp, 0], boxes[key, comp, 1]
         x = blo + (bhi - blo) * u[..., :3]
         delta = x[..., :2]
         c, rho, drho = self._bcentres(st, delta, x[..., 2])
@@ -447,12 +494,12 @@ class MeasuredProposal:
         with np.errstate(over="ignore", invalid="ignore"):
             # d(x, y, z) = rho^2 (1 + |delta|^2)^(-3/2) d(delta) d(rho), d(rho) = drho d(beta)
             jac = rho * rho * (1.0 + (delta * delta).sum(axis=2)) ** -1.5 * drho
-            vol0 = np.prod(hi - lo, axis=1)[:, None]
-            lam = (n_def / self.samples)[:, None]
-            inside = ((x >= lo[:, None]) & (x <= hi[:, None])).all(axis=2)
-            q = lam / np.prod(dhi - dlo, axis=1)[:, None] + np.where(inside, (1 - lam) / vol0, 0)
-            vol = np.where(n_def[:, None] == 0, vol0 * (g_hi - g_lo), (g_hi - g_lo) / q)
-            wt = prior_density(d, self.prior, r, gg, el, az) * jac * vol
+            q = np.zeros(x.shape[:2])
+            for k in range(boxes.shape[1]):
+                lo, hi = boxes[:, k, 0][:, None], boxes[:, k, 1][:, None]
+                inside = ((x >= lo) & (x <= hi)).all(axis=2) & (dens[:, k] > 0)[:, None]
+                q = q + np.where(inside, dens[:, k][:, None], 0.0)
+            wt = prior_density(d, self.prior, r, gg, el, az) * jac * ((g_hi - g_lo) / q)
         wt = np.where(good & np.isfinite(wt), wt, 0.0)
         return {"r": r, "az": az, "el": el, "g": gg, "x": c[..., 0], "y": c[..., 1],
                 "z": c[..., 2], "w": wt}  # fmt: skip

@@ -18,9 +18,9 @@ import numpy as np
 from numba.core import caching
 
 from eyeviz.core.kernels import limit3d_region
-from eyeviz.core.kernels.limit3d_region import _cone_fold, _jit_np, bcentre
+from eyeviz.core.kernels.limit3d_region import _cone_fold, _jit_np, _walk, bcentre, measured_prior
 
-__all__ = ["region_kernel", "warm"]
+__all__ = ["mixture_draws_kernel", "region_kernel", "warm"]
 
 
 class _WithRegionSource(caching.InTreeCacheLocator):
@@ -102,8 +102,88 @@ def region_kernel(x, u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack,
             h[n, g] = hv if math.isfinite(hv) else -np.inf
 
 
+@_jit_np
+def _component(counts, n, j):
+    """The mixture component of a batch's draw j of key n: the first counts[n, 0] draws
+    come from component 0, the next counts[n, 1] from 1, ..., the rest from the last."""
+    c, acc = 0, counts[n, 0]
+    while j >= acc and c < counts.shape[1] - 1:
+        c += 1
+        acc += counts[n, c]
+    return c
+
+
+@_jit_np
+def _density(boxes, dens, n, d0, d1, beta):
+    """The mixture's density in (delta, beta) at a point: the sum of dens[n, c] (share /
+    volume) over the components whose box holds it."""
+    q = 0.0
+    for c in range(boxes.shape[1]):
+        if (dens[n, c] > 0.0 and boxes[n, c, 0, 0] <= d0 <= boxes[n, c, 1, 0]
+                and boxes[n, c, 0, 1] <= d1 <= boxes[n, c, 1, 1]
+                and boxes[n, c, 0, 2] <= beta <= boxes[n, c, 1, 2]):  # fmt: skip
+            q += dens[n, c]
+    return q
+
+
+# long: one draw of limit3d_measured.MeasuredProposal.sample (component, centre, g
+# interval, g, weight) is one loop body; split, it would pass a dozen scalars back and forth
+@_jit_np
+def mixture_draws_kernel(u, boxes, counts, dens, samples, u0, e1, e2, fa, bhat, blen, origin,
+                         s_half, g_max, r_min, r_max, el_max, multi, rows,
+                         pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b,
+                         pad_b, x, y, z, g, r, az, el, w):  # fmt: skip
+    """limit3d_measured.MeasuredProposal.sample up to the exact check, draw by draw, from
+    a deterministic mixture of boxes in (delta, beta) (boxes (N, C, 2, 3): lo, hi): of
+    each batch of ``samples`` draws, counts[n, c] from box c in turn (:func:`_component`),
+    (delta, beta) and g from the uniforms u (N, M, 4), the centre, its g interval (the
+    walk of limit3d_region._walk, stopping once it is empty; each component keeps its own
+    facet order), the prior and the weight prior x Jacobian x the interval's length / the
+    mixture's density (:func:`_density`, dens (N, C) = share / volume). Writes x, y, z,
+    g, r, az, el, w (N, M) where the weight is above 0 (w 0 elsewhere, the others then
+    unset); only the keys ``rows`` (N,) get draws."""
+    nc = boxes.shape[1]
+    order = np.empty((nc, u.shape[0], pos_a.shape[1] + pos_b.shape[1]), np.int64)
+    for n in range(u.shape[0]):
+        for m in range(u.shape[1]):
+            w[n, m] = 0.0
+        if not rows[n]:
+            continue
+        for c in range(nc):
+            for k in range(order.shape[2]):
+                order[c, n, k] = k
+        for m in range(u.shape[1]):
+            c = _component(counts, n, m % samples)
+            lo_, hi_ = boxes[n, c, 0], boxes[n, c, 1]
+            d0 = lo_[0] + (hi_[0] - lo_[0]) * u[n, m, 0]
+            d1 = lo_[1] + (hi_[1] - lo_[1]) * u[n, m, 1]
+            beta = lo_[2] + (hi_[2] - lo_[2]) * u[n, m, 2]
+            cx, cy, cz, rho, drho = bcentre(u0[n], e1[n], e2[n], d0, d1, beta, fa, bhat, blen)
+            if not math.isfinite(rho):
+                continue
+            qx, qy, qz = cx - origin[0], cy - origin[1], cz - origin[2]
+            rr = math.sqrt(qx * qx + qy * qy + qz * qz)
+            out, g_lo, g_hi = _walk(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b,
+                                    sh_b, lit_b, pad_b, order[c], n, cx, cy, cz,
+                                    rr * s_half, min(rr, g_max))  # fmt: skip
+            if out:
+                continue
+            pad = 1e-9 * g_hi
+            g_lo, g_hi = max(g_lo - pad, 0.0), g_hi + pad
+            gg = g_lo + (g_hi - g_lo) * u[n, m, 3]
+            e = math.asin(min(max(qz / rr, -1.0), 1.0))
+            phi = math.atan2(qy, qx)
+            dens_p = measured_prior(rr, gg, e, phi, s_half, g_max, r_min, r_max, el_max, multi)
+            jac = rho * rho * (1.0 + (d0 * d0 + d1 * d1)) ** -1.5 * drho
+            wt = dens_p * jac * ((g_hi - g_lo) / _density(boxes, dens, n, d0, d1, beta))
+            if not (math.isfinite(wt) and wt > 0.0):
+                continue
+            x[n, m], y[n, m], z[n, m], g[n, m] = cx, cy, cz, gg
+            r[n, m], az[n, m], el[n, m], w[n, m] = rr, phi, e, wt
+
+
 def warm() -> None:
-    """Compile (or load from the cache) the kernel for its one signature."""
+    """Compile (or load from the cache) the kernels for their one signature each."""
     a2 = np.zeros((1, 1))
     p3 = np.ones((1, 1, 3))
     b = np.ones((1, 1), np.bool_)
@@ -111,3 +191,11 @@ def warm() -> None:
     c = np.ones((1, 3))
     v3 = np.ones(3)
     region_kernel(p3, c, c, c, v3, v3, 1.0, v3, 0.1, 1.0, 1e-7, *cs, *cs, a2.copy())
+    u4 = np.full((1, 1, 4), 0.5)
+    boxes = np.zeros((1, 2, 2, 3))
+    boxes[:, :, 1] = 1.0
+    o1 = np.zeros((1, 1))
+    mixture_draws_kernel(u4, boxes, np.ones((1, 2), np.int64), np.ones((1, 2)), 2, c, c, c, v3,
+                         v3, 1.0, v3, 0.1, 1.0, 0.5, 9.0, 1.0, False, b[0].copy(), *cs, *cs,
+                         o1, o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(),
+                         o1.copy())  # fmt: skip

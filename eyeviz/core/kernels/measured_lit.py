@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["certified_kernel", "scan_kernel", "warm", "LEVELS"]
+__all__ = ["certified_kernel", "key_check_kernel", "scan_kernel", "warm", "LEVELS"]
 
 _U = 2.0**-53
 _LO, _HI = 2.0**-480, 2.0**480
@@ -27,39 +27,188 @@ _jit = njit(cache=True, nogil=True)
 
 
 @_jit
+def _certify(cx, cy, cz, gb, px, py, pz, ax, ay, az, nrm, cs, sn, exact_only, i):
+    """(seen, sure, lens) of facet i and the ball (c, g): the certified float64 test of
+    :mod:`eyeviz.core.measured_fast` (``seen`` the answer where ``sure``), and whether its
+    lens lies in the closed ball: 1 surely, 0 surely not, 2 not decided here."""
+    vx, vy, vz = cx - px[i], cy - py[i], cz - pz[i]
+    mag = max(abs(vx), abs(vy), abs(vz))
+    if mag == 0.0:  # c = p exactly: the lens is in the ball
+        return True, True, 1
+    if not (_LO <= mag <= _HI and gb <= _HI) or exact_only[i]:
+        return False, False, 2
+    a0, a1, a2 = ax[i], ay[i], az[i]
+    v2 = vx * vx + vy * vy + vz * vz
+    g2 = gb * gb
+    da = v2 - g2
+    ba = 16 * _U * (v2 + g2)
+    s = vx * a0 + vy * a1 + vz * a2
+    wx = vy * a2 - vz * a1
+    wy = vz * a0 - vx * a2
+    wz = vx * a1 - vy * a0
+    q = math.sqrt(wx * wx + wy * wy + wz * wz)
+    cc, ss, nn = cs[i], sn[i], nrm[i]
+    vn = math.sqrt(v2) * (1 + 4 * _U) * nn
+    e = s * cc + q * ss
+    be = 32 * _U * vn
+    m = q * cc - s * ss - gb * nn
+    bm = 32 * _U * (vn + gb * nn)
+    yes = da <= -ba or (e >= be and m <= -bm)
+    no = da > ba and (e < -be or m > bm)
+    lens = 1 if da <= -ba else (0 if da > ba else 2)
+    return yes, yes or no, lens
+
+
+@_jit
 def certified_kernel(
     cx, cy, cz, g, bi, fi, px, py, pz, ax, ay, az, nrm, cs, sn, exact_only, seen, sure
 ):
     for k in range(bi.size):
-        b, i = bi[k], fi[k]
-        gb = g[b]
-        vx, vy, vz = cx[b] - px[i], cy[b] - py[i], cz[b] - pz[i]
-        mag = max(abs(vx), abs(vy), abs(vz))
-        if mag == 0.0:  # c = p exactly: the lens is in the ball
-            seen[k], sure[k] = True, True
+        b = bi[k]
+        seen[k], sure[k], _ = _certify(cx[b], cy[b], cz[b], g[b], px, py, pz, ax, ay, az, nrm,
+                                       cs, sn, exact_only, fi[k])  # fmt: skip
+
+
+_REL = 1e-9  # the slack of the key's bound, relative and in radians (as measured_index)
+
+
+@_jit
+def _key_spread(cx, cy, cz, g, s, e, ox, oy, oz):
+    """Of the balls s..e-1: their mean direction w from o (unit), the largest angle A of
+    a ball's direction from w, the largest g and the least distance D from o, each with
+    a relative slack of 1e-9 (and 1e-9 rad) beyond its rounding; D = 0 where any is not
+    finite."""
+    wx, wy, wz, big, near = 0.0, 0.0, 0.0, 0.0, math.inf
+    for b in range(s, e):
+        dx, dy, dz = cx[b] - ox, cy[b] - oy, cz[b] - oz
+        d = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if not (d > 0.0 and d < math.inf and g[b] < math.inf):
+            return 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        wx, wy, wz = wx + dx / d, wy + dy / d, wz + dz / d
+        big, near = max(big, g[b]), min(near, d)
+    wn = math.sqrt(wx * wx + wy * wy + wz * wz)
+    if not wn > 0.0:
+        return 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    wx, wy, wz = wx / wn, wy / wn, wz / wn
+    top = 0.0
+    for b in range(s, e):
+        dx, dy, dz = cx[b] - ox, cy[b] - oy, cz[b] - oz
+        top = max(top, _angle(dx, dy, dz, wx, wy, wz))
+    return wx, wy, wz, top * (1 + _REL) + _REL, big * (1 + _REL), near * (1 - _REL), 1.0
+
+
+@_jit
+def _angle(x, y, z, wx, wy, wz):
+    """The angle between (x, y, z) and the unit w, from atan2 (accurate near 0 and pi)."""
+    cx_, cy_, cz_ = y * wz - z * wy, z * wx - x * wz, x * wy - y * wx
+    return math.atan2(math.sqrt(cx_ * cx_ + cy_ * cy_ + cz_ * cz_), x * wx + y * wy + z * wz)
+
+
+@_jit
+def _reach(alpha, g, d, e):
+    """An upper bound of alpha + asin(g / (d - e)) + asin(e / d) (measured_index: the
+    largest angle between a facet's axis and the direction from o of a ball it sees, its
+    lens within e of o, the ball at d > e + g from o), or inf where d <= e + g."""
+    if not d > (e + g) * (1 + _REL):
+        return math.inf
+    r = alpha + math.asin(min(1.0, g / (d - e))) + math.asin(min(1.0, e / d))
+    return r * (1 + _REL) + _REL
+
+
+# long: the key's facet list (a bound over all its balls, then each facet's own) and the
+# balls' certified tests against it are one pass per key; split, they would share a
+# dozen per-key scalars and three scratch arrays
+@_jit
+def key_check_kernel(cx, cy, cz, g, bounds, px, py, pz, ax, ay, az, nrm, cs, sn, exact_only,
+                     ux, uy, uz, half, centre, lens, kp, ki, res):  # fmt: skip
+    """One eye's part of the exact check of a chunk's draws (balls c, g; key n's balls at
+    bounds[n]..bounds[n + 1] - 1), folded into ``res`` (1 a hit so far, 0 not a hit, 2
+    not decided here: the index and ``lit_csr`` decide).
+
+    measured_index's argument, about o (the mean lens of the key's lit facets; kp, ki:
+    the keys' lit facets, CSR, sorted): facet j (lens within e_j of o, half acceptance
+    alpha_j) sees no ball at distance D > e_j + g from o whose direction from o lies
+    more than alpha_j + asin(g / (D - e_j)) + asin(e_j / D) from its axis. Per key, over
+    its balls (w their mean direction from o, A the largest angle from w, G the largest
+    g, D0 the least distance), a facet whose axis lies more than A + that bound at (G,
+    D0) from w sees none of them: the others, the key's list (the eye's lens bound
+    ``lens`` about ``centre`` rules most facets out first), are
+    sorted by k_j = angle(a_j, w) - alpha_j - asin(e_j / D0). A ball (direction at
+    angle A_b from w, distance D_b, radius g) then sees none with k_j > A_b + asin(g /
+    (D_b - E)) (E the list's largest e_j), so only the list's first facets get the
+    certified test of measured_fast (:func:`_certify`): the ball must see exactly the
+    key's lit ones, and none of their lenses may lie in it (an unseen facet's lens does
+    not). Every bound carries a relative slack of 1e-9 (and 1e-9 rad)."""
+    nf = px.size
+    lst = np.empty(nf, np.int64)
+    islit = np.empty(nf, np.bool_)
+    kj = np.empty(nf)
+    amax = 0.0
+    for j in range(nf):
+        amax = max(amax, half[j])
+    for n in range(bounds.size - 1):
+        s, e = bounds[n], bounds[n + 1]
+        l0, l1 = kp[n], kp[n + 1]
+        if s == e:
             continue
-        if not (_LO <= mag <= _HI and gb <= _HI) or exact_only[i]:
-            seen[k], sure[k] = False, False
-            continue
-        a0, a1, a2 = ax[i], ay[i], az[i]
-        v2 = vx * vx + vy * vy + vz * vz
-        g2 = gb * gb
-        da = v2 - g2
-        ba = 16 * _U * (v2 + g2)
-        s = vx * a0 + vy * a1 + vz * a2
-        wx = vy * a2 - vz * a1
-        wy = vz * a0 - vx * a2
-        wz = vx * a1 - vy * a0
-        q = math.sqrt(wx * wx + wy * wy + wz * wz)
-        cc, ss, nn = cs[i], sn[i], nrm[i]
-        vn = math.sqrt(v2) * (1 + 4 * _U) * nn
-        e = s * cc + q * ss
-        be = 32 * _U * vn
-        m = q * cc - s * ss - gb * nn
-        bm = 32 * _U * (vn + gb * nn)
-        yes = da <= -ba or (e >= be and m <= -bm)
-        no = da > ba and (e < -be or m > bm)
-        seen[k], sure[k] = yes, yes or no
+        ok = l1 > l0
+        ox, oy, oz = 0.0, 0.0, 0.0
+        for t in range(l0, l1):
+            ox, oy, oz = ox + px[ki[t]], oy + py[ki[t]], oz + pz[ki[t]]
+        if ok:
+            ox, oy, oz = ox / (l1 - l0), oy / (l1 - l0), oz / (l1 - l0)
+        wx, wy, wz, top, big, near, fine = _key_spread(cx, cy, cz, g, s, e, ox, oy, oz)
+        dc = math.sqrt((ox - centre[0]) ** 2 + (oy - centre[1]) ** 2 + (oz - centre[2]) ** 2)
+        cut = top + _reach(amax, big, near, (lens + dc) * (1 + _REL))
+        ok = ok and fine > 0.0 and cut < math.pi
+        n_l, t, emax = 0, l0, 0.0
+        if ok:
+            cosc = math.cos(cut) - _REL
+            for j in range(nf):
+                if ux[j] * wx + uy[j] * wy + uz[j] * wz < cosc:
+                    continue
+                ej = math.sqrt((px[j] - ox) ** 2 + (py[j] - oy) ** 2 + (pz[j] - oz) ** 2)
+                ej = ej * (1 + _REL)
+                th = _angle(ux[j], uy[j], uz[j], wx, wy, wz)
+                if th - top > _reach(half[j], big, near, ej):
+                    continue
+                while t < l1 and ki[t] < j:
+                    t += 1
+                k = th - half[j] - math.asin(min(1.0, ej / near))
+                lst[n_l], islit[n_l], kj[n_l] = j, t < l1 and ki[t] == j, k - _REL * (1 + abs(k))
+                emax = max(emax, ej)
+                n_l += 1
+        by = np.argsort(kj[:n_l])
+        for b in range(s, e):
+            if res[b] == 0:
+                continue
+            if not ok:
+                res[b] = 2
+                continue
+            dx, dy, dz = cx[b] - ox, cy[b] - oy, cz[b] - oz
+            db = math.sqrt(dx * dx + dy * dy + dz * dz) * (1 - _REL)
+            reach = math.inf
+            if db > (emax + g[b]) * (1 + _REL):
+                reach = _angle(dx, dy, dz, wx, wy, wz) + math.asin(min(1.0, g[b] / (db - emax)))
+                reach = reach * (1 + _REL) + _REL
+            verdict, n_lit = 1, 0
+            for q in range(n_l):
+                t = by[q]
+                if kj[t] > reach:
+                    break
+                n_lit += islit[t]
+                seen, sure, inside = _certify(cx[b], cy[b], cz[b], g[b], px, py, pz, ax, ay,
+                                              az, nrm, cs, sn, exact_only, lst[t])  # fmt: skip
+                if not sure:
+                    verdict = 2
+                elif seen != islit[t] or (seen and inside == 1):
+                    verdict = 0
+                    break
+                elif seen and inside == 2:
+                    verdict = 2
+            if n_lit < l1 - l0:  # a lit facet ruled out: not seen
+                verdict = 0
+            res[b] = 0 if verdict == 0 else max(res[b], verdict)
 
 
 @_jit
