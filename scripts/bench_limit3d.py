@@ -156,8 +156,10 @@ def _before(rev: str, which: str, la, lb, p, cpu: float) -> None:
         if str(q["module"]) != str(src / "eyeviz" / "estimators" / "limit3d.py"):
             raise RuntimeError(f"--before imported {q['module']}, not revision {rev}'s code")
         n = p.r.size
-        ok = ~q["flag"] & ~p.flagged
-        err = np.hypot(q["mc"], p.mc_error)[ok]
+        # keys flagged in either run, or with no stated error in both (0 or NaN), are left out
+        err = np.hypot(q["mc"], p.mc_error)
+        ok = ~q["flag"] & ~p.flagged & (err > 0)
+        err = err[ok]
         z_r = ((p.r - q["r"]) / q["r"])[ok] / err
         z_az = ((p.azimuth - q["az"]) / q["az"])[ok] / err
         same = np.array_equal(q["acc"], p.n_accepted)
