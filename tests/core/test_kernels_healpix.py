@@ -6,6 +6,8 @@ balls it hands back (status 1) are few and go through the reference in geometry3
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -78,6 +80,28 @@ def test_kernel_equals_the_reference_on_random_balls(nside, p, q):
     r = float(np.linalg.norm(np.subtract(p, (40.0, 0.0, 0.0)))) + 1e-9
     x, y, z, g = (np.array([v], np.float64) for v in (*p, q * r))
     _compare(nside, x, y, z, g)
+
+
+@pytest.mark.parametrize("n", [2, 4, 6, 18, 64])
+def test_kernel_equals_the_reference_on_caps_of_a_cell_about_its_corners(n):
+    """Caps of 0.1 to 1.5 cells centred near a cell's vertices and edges (every ring,
+    the first and last cells of rings, polar and equatorial): the boundary cells on both
+    sides of the centre's cell, whose vertices the ring loop shares between neighbours,
+    are the ones decided one by one."""
+    from eyeviz.core import healpix
+
+    rng = np.random.default_rng(n)
+    npix = 12 * n * n
+    first, nr, _ = healpix.ring_info(n, np.arange(1, 4 * n))
+    pix = np.concatenate([first, first + nr - 1, rng.integers(0, npix, 60)])
+    pts = healpix.boundaries(n, pix, step=4)[:, rng.integers(0, 16, pix.size) % 16]
+    u = pts[np.arange(pix.size), np.arange(pix.size)] + rng.normal(0, 1e-3 / n, (pix.size, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    alpha = rng.uniform(0.1, 1.5, pix.size) * math.sqrt(4 * math.pi / npix)
+    d = rng.uniform(500, 3000, pix.size)
+    x, y, z = (np.ascontiguousarray(v) for v in (40.0 + d * u[:, 0], d * u[:, 1], d * u[:, 2]))
+    g = d * np.sin(alpha)
+    assert _compare(n, x, y, z, g) >= 2 * pix.size - 4
 
 
 def test_eyeviz_jit_0_runs_the_reference(monkeypatch):

@@ -52,6 +52,7 @@ KERNELS = (
     "measured_lit",
     "healpix_cells",
     "measured_limit",
+    "healpix_boundary",
 )
 
 

@@ -19,17 +19,25 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from eyeviz.core.kernels import healpix_boundary
+from eyeviz.core.kernels.healpix_boundary import (
+    _EPS,
+    _cell_lons,
+    _decide_fs,
+    _jit,
+    _jit_inline,
+    _vdist_at,
+    stamp_with,
+)
+
+# before the first kernel: this module's cache carries healpix_boundary.py's source too
+stamp_with(__file__, healpix_boundary.__file__)
 
 __all__ = ["lit_runs_kernel", "csr_kernel", "warm"]
 
-_EPS = 2.0**-52
-_DP = 64 * _EPS
-_JRLL = np.array([2, 2, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4], np.int64)
-_JPLL = np.array([1, 3, 5, 7, 0, 2, 4, 6, 1, 3, 5, 7], np.int64)
 _HALF_PI = 0.5 * math.pi
 _SQ6 = math.sqrt(6.0)
-_jit = njit(cache=True, error_model="numpy", nogil=True)
 
 
 @_jit
@@ -70,251 +78,6 @@ def _ang2pix(n, z, phi):
 
 
 @_jit
-def _pix2xyf(n, p, ring, first):
-    """healpix.pix2xyf of pixel p (of ring ``ring`` whose first pixel is ``first``)."""
-    iphi = p - first + 1
-    if ring < n:
-        nr = ring
-        kshift = 0
-        face = (iphi - 1) // nr
-    elif ring > 3 * n:
-        nr = 4 * n - ring
-        kshift = 0
-        face = (iphi - 1) // nr + 8
-    else:
-        nr = n
-        kshift = (ring + n) & 1
-        ire = ring - n + 1
-        irm = 2 * n + 2 - ire
-        ifm = (iphi - (ire >> 1) + n - 1) // n
-        ifp = (iphi - (irm >> 1) + n - 1) // n
-        if ifp == ifm:
-            face = ifp | 4
-        elif ifp < ifm:
-            face = ifp
-        else:
-            face = ifm + 8
-    irt = ring - (2 + (face >> 2)) * n + 1
-    ipt = 2 * iphi - _JPLL[face] * nr - kshift - 1
-    if ipt >= 2 * n:
-        ipt -= 8 * n
-    return (ipt - irt) >> 1, (-ipt - irt) >> 1, face
-
-
-@_jit
-def _xyf2vec(n, px, py, face):
-    """healpix.xyf2vec of one face point (pixel units)."""
-    fx = px / n
-    fy = py / n
-    jr = _JRLL[face] - fx - fy
-    if jr < 1:
-        nr = jr
-        z = 1.0 - jr * jr / 3.0
-    elif jr > 3:
-        nr = 4.0 - jr
-        z = (4.0 - jr) ** 2 / 3.0 - 1.0
-    else:
-        nr = 1.0
-        z = (2.0 - jr) * (2.0 / 3.0)
-    if jr < 1 or jr > 3:
-        sth = nr * math.sqrt(max(2.0 - nr * nr / 3.0, 0.0) / 3.0)
-    else:
-        sth = math.sqrt(1.0 - z * z)
-    t = _JPLL[face] * nr + fx - fy
-    phi = (0.25 * math.pi) * t / nr if nr > 0 else 0.0
-    return sth * math.cos(phi), sth * math.sin(phi), z
-
-
-@_jit
-def _edge_bound(n, face, fixed_is_y, fixed, lo):
-    """healpix_fast._edge_bounds for one edge."""
-    out = 2.0 / (n * n)
-    if face < 4 or face >= 8:
-        fx = fixed / n
-        lo_f = lo / n
-        north = face < 4
-        a = 1.0 - fx if north else fx
-        nr_min = 2.0 - fx - lo_f - 1.0 / n if north else fx + lo_f
-        if nr_min < 1.0 and a > 0:
-            out += 7.2 * a / max(nr_min, 1e-300) ** 2 / (n * n)
-    return out
-
-
-@_jit
-def _edge_lower(fa, fb, mf):
-    dd = fb - fa
-    if abs(dd) <= 0.5 * mf:
-        return 0.5 * (fa + fb) - 0.125 * mf - dd * dd / (2 * mf)
-    return min(fa, fb)
-
-
-@_jit
-def _quarter(n, k):
-    return min(min(k, n), 4 * n - k)
-
-
-@_jit
-def _tol(f, s2, ed, ds2):
-    return 4 * (math.sqrt(f) + math.sqrt(s2)) * (_DP + ed) + ds2 + 1e-300
-
-
-@_jit
-def _cell_fs(n, i, j, shifted, c, sth, zr, unit, vc):
-    """chord^2 from c to the N, W, S and E vertices of cell j of ring i (as
-    healpix.vertex_lon places them), and whether the ring is polar."""
-    lw = 2 * j - (0 if shifted else 1)
-    ui = unit[i]
-    ln = lw + 1
-    ls = lw + 1
-    un = ui
-    us = ui
-    pol = i <= n or i >= 3 * n
-    if pol:  # healpix.vertex_lon
-        K = _quarter(n, i)
-        Kn = _quarter(n, i - 1)
-        Ks = _quarter(n, i + 1)
-        f = j // K
-        p = j - f * K
-        if Kn == K:
-            ln = lw + 1
-        elif Kn < K:
-            ln = 2 * Kn * f + 2 * p
-        else:
-            ln = 2 * Kn * f + 2 * p + 2
-        if Ks == K:
-            ls = lw + 1
-        elif Ks > K:
-            ls = 2 * Ks * f + 2 * p + 2
-        else:
-            ls = 2 * Ks * f + 2 * p
-        un = 0.25 * math.pi / max(Kn, 1) if Kn > 0 else 0.0
-        us = 0.25 * math.pi / max(Ks, 1) if Ks > 0 else 0.0
-    fN = _vdist_at(vc, n, i - 1, ln, sth[i - 1], zr[i - 1], ln * un, c)
-    fW = _vdist_at(vc, n, i, lw, sth[i], zr[i], lw * ui, c)
-    fS = _vdist_at(vc, n, i + 1, ls, sth[i + 1], zr[i + 1], ls * us, c)
-    fE = _vdist_at(vc, n, i, lw + 2, sth[i], zr[i], (lw + 2) * ui, c)
-    return fN, fW, fS, fE, pol
-
-
-@_jit
-def _decide_cell(n, i, j, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit, vc):
-    """healpix_fast._decide_cells for one cell (the ball's centre pixel is lit before):
-    1 lit, 0 not lit, 2 left open (mpmath decides it in the reference). ``vc``: a vertex
-    cache (:func:`vertex_cache`) or none (empty arrays)."""
-    fN, fW, fS, fE, pol = _cell_fs(n, i, j, shifted, c, sth, zr, unit, vc)
-    vmin = min(min(fN, fW), min(fS, fE))
-    if vmin < s2 - _tol(vmin, s2, ed, ds2):
-        return 1
-    ix, iy, face = 0, 0, 0
-    if pol:
-        ix, iy, face = _pix2xyf(n, pix, i, first)
-    # edges W-N, S-W, S-E, E-N: (fixed_is_y, fixed - its base, f_a, f_b); bit k of
-    # ``opened`` says edge k is not cleared
-    m0 = _edge_m(n, pol, face, True, iy + 1, ix)
-    m1 = _edge_m(n, pol, face, False, ix, iy)
-    m2 = _edge_m(n, pol, face, True, iy, ix)
-    m3 = _edge_m(n, pol, face, False, ix + 1, iy)
-    opened = (
-        _not_clear(fW, fN, m0, s2, ed, ds2)
-        | (_not_clear(fS, fW, m1, s2, ed, ds2) << 1)
-        | (_not_clear(fS, fE, m2, s2, ed, ds2) << 2)
-        | (_not_clear(fE, fN, m3, s2, ed, ds2) << 3)
-    )
-    if opened == 0:
-        return 0
-    if not pol:
-        ix, iy, face = _pix2xyf(n, pix, i, first)
-    fas = (fW, fS, fS, fE)
-    fbs = (fN, fW, fE, fN)
-    mfs = (m0, m1, m2, m3)
-    for samples in (16, 256, 4096):
-        for k in range(4):
-            if not (opened >> k) & 1:
-                continue
-            r = _sample_edge(n, ix, iy, face, k, samples, c, s2, ds2, ed, fas[k], fbs[k], mfs[k])
-            if r == 1:
-                return 1
-            if r == 0:
-                opened &= ~(1 << k)
-        if opened == 0:
-            return 0
-    return 2
-
-
-@_jit
-def _vdist_at(vc, n, r, l, sv, zv, ph, c):
-    """:func:`_vdist` of the vertex l of ring level r (longitude ph = l times the level's
-    unit, the same bits from whichever cell it is reached: _decide_cell), its coordinates
-    from the cache ``vc`` = (tags, xyz) where it holds them (the same products of
-    the same numbers, so the same bits), else computed (and kept there)."""
-    tags, xyz = vc
-    size = tags.shape[0]
-    if size == 0:
-        return _vdist(sv, zv, ph, c)
-    key = r * (16 * n + 16) + l + 1
-    h = (key * 0x9E3779B1) & (size - 1)
-    if tags[h] != key:
-        tags[h] = key
-        xyz[h, 0] = sv * math.cos(ph)
-        xyz[h, 1] = sv * math.sin(ph)
-        xyz[h, 2] = zv
-    vx = xyz[h, 0] - c[0]
-    vy = xyz[h, 1] - c[1]
-    vz = xyz[h, 2] - c[2]
-    return vx * vx + vy * vy + vz * vz
-
-
-@_jit
-def _vdist(sv, zv, ph, c):
-    """chord^2 from c to the vertex (sin theta, z, longitude)."""
-    vx = sv * math.cos(ph) - c[0]
-    vy = sv * math.sin(ph) - c[1]
-    vz = zv - c[2]
-    return vx * vx + vy * vy + vz * vz
-
-
-@_jit
-def _edge_m(n, pol, face, fixed_is_y, fixed, lo):
-    """2.5 times the curvature bound of an edge (healpix_fast._decide_cells)."""
-    if pol:
-        return 2.5 * _edge_bound(n, face, fixed_is_y, float(fixed), float(lo))
-    return 2.5 * 2.0 / (n * n)
-
-
-@_jit
-def _not_clear(fa, fb, mf, s2, ed, ds2):
-    lower = _edge_lower(fa, fb, mf)
-    clear = lower > s2 + _tol(max(lower, 0.0), s2, ed, ds2) + 8 * _EPS * (fa + fb + mf)
-    return 0 if clear else 1
-
-
-@_jit
-def _sample_edge(n, ix, iy, face, k, samples, c, s2, ds2, ed, fa, fb, mf):
-    """One edge-sample stage of _decide_cells on edge k (W-N, S-W, S-E, E-N):
-    1 a sample is lit, 0 the edge is cleared, 2 still open."""
-    fmin = min(fa, fb)
-    for m in range(1, samples):
-        t = m / samples
-        if k == 0:
-            vx, vy, vz = _xyf2vec(n, ix + t, float(iy + 1), face)
-        elif k == 1:
-            vx, vy, vz = _xyf2vec(n, float(ix), iy + t, face)
-        elif k == 2:
-            vx, vy, vz = _xyf2vec(n, ix + t, float(iy), face)
-        else:
-            vx, vy, vz = _xyf2vec(n, float(ix + 1), iy + t, face)
-        f = (vx - c[0]) ** 2 + (vy - c[1]) ** 2 + (vz - c[2]) ** 2
-        tl = 4 * (math.sqrt(f) + math.sqrt(s2)) * (_DP + ed) + ds2
-        if f < s2 - tl:
-            return 1
-        fmin = min(fmin, f)
-    lower = fmin - mf / (8 * samples * samples)
-    lw0 = max(lower, 0.0)
-    tle = 4 * (math.sqrt(lw0) + math.sqrt(s2)) * (_DP + ed) + ds2 + 1e-300
-    return 2 if not (lower > s2 + tle) else 0
-
-
-@_jit
 def _arg_bound(cos_p, zc_p, rc_p, dnum, drel, zz, rr, upper):
     """Lower (upper) bound of the acos argument on z = zz (rr: its sin theta)."""
     den = rc_p * rr
@@ -324,15 +87,6 @@ def _arg_bound(cos_p, zc_p, rc_p, dnum, drel, zz, rr, upper):
     if not (math.isfinite(out) and den > 0):
         return math.inf if upper else -math.inf
     return out
-
-
-@_jit
-def _grow(buf, k):
-    if k < buf.shape[0]:
-        return buf
-    new = np.empty(2 * buf.shape[0] + 16, np.int64)
-    new[: buf.shape[0]] = buf
-    return new
 
 
 @_jit
@@ -400,12 +154,60 @@ def _ball(n, xb, yb, zb, gb, cx):
 
 
 @_jit
-def _ring_at(n, i, par, sth, zr, unit, first_t, nr_t, shifted_t, delta_t, o_t, vc):
+def _lower(par, zz):
+    """The lower bound of the acos argument (:func:`_arg_bound`) on z = zz."""
+    c, cosa, z_c, rho_c, phi_c, zc_lo, zc_hi, dnum, drel, dph, s2, ds2, ed, cpix = par
+    return _arg_bound(cosa, z_c, rho_c, dnum, drel, zz, math.sqrt(max(1.0 - zz * zz, 0.0)), False)
+
+
+@_jit_inline
+def _band_lower(par, zz, k, zk, memo):
+    """:func:`_lower` at zz (the band edge max(zr[k], zc_lo) or min(zr[k], zc_hi)),
+    taken from ``memo`` (the last two levels k computed unclipped: k1, v1, k2, v2) when
+    zz is zr[k] and k is there (the same inputs, so the same bits), else computed."""
+    k1, v1, k2, v2 = memo
+    if zz != zk:
+        return _lower(par, zz), memo
+    if k == k2:
+        return v2, memo
+    if k == k1:
+        return v1, memo
+    v = _lower(par, zz)
+    return v, (k2, v2, k, v)
+
+
+_NO_MEMO = (np.int64(-9), 0.0, np.int64(-9), 0.0)
+
+
+@_jit_inline
+def _ring_at(n, i, par, sth, zr, unit, first_t, nr_t, shifted_t, delta_t, o_t, vc, memo):
     """:func:`_ring` of ring i with a ball's parameters ``par`` (:func:`_ball`)."""
     c, cosa, z_c, rho_c, phi_c, zc_lo, zc_hi, dnum, drel, dph, s2, ds2, ed, cpix = par
-    return _ring(n, i, c, cosa, z_c, rho_c, phi_c, zc_lo, zc_hi, dnum, drel, dph, s2, ds2,
-                 ed, cpix, sth, zr, unit, first_t[i], nr_t[i], shifted_t[i], delta_t[i],
-                 o_t[i], vc)  # fmt: skip
+    za = max(zr[i + 1], zc_lo)
+    zb = min(zr[i - 1], zc_hi)
+    if za > zb:
+        return 0, np.int64(0), np.int64(0), memo
+    # level i - 1 first: ring i - 2 computed it, ring i + 1 looks up level i + 1
+    lo_b, memo = _band_lower(par, zb, i - 1, zr[i - 1], memo)
+    lo_a, memo = _band_lower(par, za, i + 1, zr[i + 1], memo)
+    zstar = z_c / cosa
+    lo_s = lo_a
+    if zstar >= za and zstar <= zb and zstar != za:
+        lo_s = _lower(par, zstar)
+    amin = min(min(lo_a, lo_b), lo_s)
+    if amin > 1.0:
+        return 0, np.int64(0), np.int64(0), memo
+    kind, lo, hi = _ring(n, i, c, cosa, z_c, rho_c, phi_c, zc_lo, zc_hi, dnum, drel, dph, s2,
+                         ds2, ed, cpix, sth, zr, unit, first_t[i], nr_t[i], shifted_t[i],
+                         delta_t[i], o_t[i], vc, amin)  # fmt: skip
+    return kind, lo, hi, memo
+
+
+@_jit
+def _grown(buf, k):
+    new = np.empty(max(2 * buf.shape[0], k) + 16, np.int64)
+    new[: buf.shape[0]] = buf
+    return new
 
 
 # long: the steps of healpix_fast._lit_runs_fast for each ball in compiled code, in the same
@@ -437,10 +239,14 @@ def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, 
             w += 1
             per[b] = npix
             continue
+        need = w + 2 * (i_max - i_min + 1) + 2
+        if need > st.shape[0]:
+            st, ln, bl = _grown(st, need), _grown(ln, need), _grown(bl, need)
         ok = True
+        memo = _NO_MEMO
         for i in range(i_min, i_max + 1):
-            kind, lo, hi = _ring_at(n, i, par, sth, zr, unit, first_t, nr_t, shifted_t,
-                                    delta_t, o_t, vc)  # fmt: skip
+            kind, lo, hi, memo = _ring_at(n, i, par, sth, zr, unit, first_t, nr_t, shifted_t,
+                                          delta_t, o_t, vc, memo)  # fmt: skip
             if kind == 2:
                 ok = False
                 break
@@ -450,9 +256,6 @@ def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, 
             lo_w = lo % nr
             length = hi - lo + 1
             end = lo_w + length
-            st = _grow(st, w + 2)
-            ln = _grow(ln, w + 2)
-            bl = _grow(bl, w + 2)
             if end > nr:  # the piece at the ring's start comes first (sorted by start)
                 st[w], ln[w], bl[w] = first_t[i], end - nr, b
                 w += 1
@@ -470,26 +273,13 @@ def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, 
 
 # long: one (ball, ring) pair of healpix_fast._lit_runs_fast in compiled code, in the same
 # order, so the two read side by side
-@_jit
+@_jit_inline
 def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2, ed,
-          cpix, sth, zr, unit, first, nr, shifted, delta, o, vc):  # fmt: skip
+          cpix, sth, zr, unit, first, nr, shifted, delta, o, vc, amin):  # fmt: skip
     """One (ball, ring) pair of healpix_fast._lit_runs_fast: (0, 0, 0) nothing lit,
     (1, lo, hi) the lit cells lo .. hi (unwrapped), (2, 0, 0) the reference decides."""
-    zb_lo, zb_hi, z_i = zr[i + 1], zr[i - 1], zr[i]
-    za = max(zb_lo, zc_lo)
-    zb = min(zb_hi, zc_hi)
-    empty = za > zb
-    zstar = zc_p / cos_p
-    zs_in = zstar >= za and zstar <= zb
-    rza = math.sqrt(max(1.0 - za * za, 0.0))
-    rzb = math.sqrt(max(1.0 - zb * zb, 0.0))
-    lo_a = _arg_bound(cos_p, zc_p, rc_p, dnum, drel, za, rza, False)
-    lo_b = _arg_bound(cos_p, zc_p, rc_p, dnum, drel, zb, rzb, False)
-    zs = zstar if zs_in else za
-    lo_s = _arg_bound(cos_p, zc_p, rc_p, dnum, drel, zs, math.sqrt(max(1.0 - zs * zs, 0.0)), False)
-    amin = min(min(lo_a, lo_b), lo_s)
-    W = math.acos(min(max(amin, -1.0), 1.0)) + dph
-    no_cand = empty or amin > 1.0
+    z_i = zr[i]
+    W = math.acos(max(amin, -1.0)) + dph
     full_c = W >= math.pi or amin <= -1.0
     jc_lo = np.int64(0)
     jc_hi = np.int64(-1)
@@ -498,28 +288,29 @@ def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2
         jc_hi = np.int64(math.floor((pc + W) / delta - o))
         full_c = jc_hi - jc_lo + 1 >= nr
     hi_i = _arg_bound(cos_p, zc_p, rc_p, dnum, drel, z_i, sth[i], True)
-    in_z = z_i > zc_lo and z_i < zc_hi
-    has_s = in_z and hi_i < 1.0 and not no_cand
-    ws = math.acos(min(max(hi_i, -1.0), 1.0)) - dph
-    has_s = has_s and ws > 0
-    full_s = has_s and hi_i <= -1.0
+    has_s = z_i > zc_lo and z_i < zc_hi and hi_i < 1.0
+    full_s = False
     js_lo = np.int64(0)
     js_hi = np.int64(-1)
     if has_s:
-        js_lo = np.int64(math.floor((pc - ws) / delta - o - 1)) + 1
-        js_hi = np.int64(math.ceil((pc + ws) / delta - o)) - 1
-        has_s = js_hi >= js_lo
+        ws = math.acos(max(hi_i, -1.0)) - dph
+        has_s = ws > 0
+        full_s = has_s and hi_i <= -1.0
+        if has_s:
+            js_lo = np.int64(math.floor((pc - ws) / delta - o - 1)) + 1
+            js_hi = np.int64(math.ceil((pc + ws) / delta - o)) - 1
+            has_s = js_hi >= js_lo
     full_s = full_s or (has_s and js_hi - js_lo + 1 >= nr)
     if full_s:
         js_lo, js_hi = np.int64(0), np.int64(nr - 1)
-    if has_s and not full_c and not no_cand:
+    if has_s and not full_c:
         js_lo = max(js_lo, jc_lo)
         js_hi = min(js_hi, jc_hi)
     has_s = has_s and js_hi >= js_lo
-    if no_cand or full_s:
-        if has_s and not no_cand:
+    if full_s:
+        if has_s:
             return 1, js_lo, js_hi
-        return 0, 0, 0
+        return 0, np.int64(0), np.int64(0)
     # the undecided cells: blocks [u1_lo, u1_hi] and [u2_lo, u2_hi] (unwrapped j)
     if full_c:
         u1_lo = js_hi + 1 if has_s else np.int64(0)
@@ -533,26 +324,38 @@ def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2
     lo = js_lo if has_s else big
     hi = js_hi if has_s else -big
     num = js_hi - js_lo + 1 if has_s else 0
+    ui = unit[i]
+    s_i, z_i = sth[i], zr[i]
     for blk in range(2):
         a, e = (u1_lo, u1_hi) if blk == 0 else (u2_lo, u2_hi)
+        jw = a % nr
+        have = False  # fE of the cell before (this cell's fW: the same vertex and bits)
+        fE = 0.0
         for uj in range(a, e + 1):
-            jw = uj % nr
             pix = first + jw
-            if pix == cpix:
-                r = 1
-            else:
-                r = _decide_cell(n, i, jw, pix, shifted, first, c, s2, ds2, ed, sth, zr, unit,
-                                 vc)  # fmt: skip
+            lw, ln, ls, un, us, pol = _cell_lons(n, i, jw, shifted, ui)
+            fN = _vdist_at(vc, n, i - 1, ln, sth[i - 1], zr[i - 1], ln * un, c)
+            fW = fE if have else _vdist_at(vc, n, i, lw, s_i, z_i, lw * ui, c)
+            fS = _vdist_at(vc, n, i + 1, ls, sth[i + 1], zr[i + 1], ls * us, c)
+            fE = _vdist_at(vc, n, i, lw + 2, s_i, z_i, (lw + 2) * ui, c)
+            have = True
+            r = 1  # the centre's cell is lit
+            if pix != cpix:
+                r = _decide_fs(n, i, pix, first, c, s2, ds2, ed, fN, fW, fS, fE, pol)
             if r == 2:
-                return 2, 0, 0
+                return 2, np.int64(0), np.int64(0)
             if r == 1:
                 lo = min(lo, np.int64(uj))
                 hi = max(hi, np.int64(uj))
                 num += 1
+            jw += 1
+            if jw == nr:
+                jw = 0
+                have = False  # the vertex past the wrap has another longitude's bits
     if num == 0:
-        return 0, 0, 0
+        return 0, np.int64(0), np.int64(0)
     if hi - lo + 1 != num:
-        return 2, 0, 0  # not one run: the reference keeps it cell by cell
+        return 2, np.int64(0), np.int64(0)  # not one run: the reference keeps it cell by cell
     return 1, lo, hi
 
 

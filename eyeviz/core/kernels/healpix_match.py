@@ -3,60 +3,35 @@ ball lights exactly a key's facets, from the lit-set kernel's rings compared wit
 key's as they come (:func:`match_kernel`) or from the key's band cells alone
 (:func:`edge_match_kernel`, :func:`band_bounds_kernel`); docs/kernels.md.
 
-They call :mod:`.healpix_lit`'s functions (``_ball``, ``_ring_at``, ``_decide_cell``, ...),
-so their numba cache is stamped with that module's source as well as their own
-(:class:`_WithLitSource`): an edit of either recompiles them, as if they were one module.
+They call :mod:`.healpix_lit`'s and :mod:`.healpix_boundary`'s functions (``_ball``,
+``_ring_at``, ``_decide_cell``, ...), so their numba cache is stamped with those modules'
+source as well as their own (:func:`.healpix_boundary.stamp_with`): an edit of any of
+them recompiles them, as if they were one module.
 """
 
 from __future__ import annotations
 
-import hashlib
 import math
-import os
 
 import numpy as np
-from numba.core import caching
 
-from eyeviz.core.kernels import healpix_lit
-from eyeviz.core.kernels.healpix_lit import (
+from eyeviz.core.kernels import healpix_boundary, healpix_lit
+from eyeviz.core.kernels.healpix_boundary import (
     _EPS,
-    _ang2pix,
-    _ball,
     _cell_fs,
     _decide_cell,
     _edge_lower,
     _edge_m,
-    _jit,
     _pix2xyf,
-    _ring_at,
     _tol,
+    stamp_with,
 )
+from eyeviz.core.kernels.healpix_lit import _NO_MEMO, _ang2pix, _ball, _jit, _ring_at
+
+# before the first kernel: its cache carries the source of the modules it calls as well
+stamp_with(__file__, healpix_lit.__file__, healpix_boundary.__file__)
 
 __all__ = ["match_kernel", "edge_match_kernel", "band_bounds_kernel", "vertex_cache", "warm"]
-
-
-class _WithLitSource(caching.InTreeCacheLocator):
-    """numba's in-tree cache for this module's kernels, its source stamp that of this file
-    and of healpix_lit.py together (numba checks only the caller's file: a cached kernel
-    would otherwise keep a stale copy of an edited callee there)."""
-
-    @classmethod
-    def from_function(cls, py_func, py_file):
-        if os.path.abspath(py_file) != os.path.abspath(__file__):
-            return None
-        return super().from_function(py_func, py_file)
-
-    def get_source_stamp(self):
-        digest = hashlib.sha256()
-        for path in (self._py_file, healpix_lit.__file__):
-            with open(path, "rb") as f:
-                digest.update(f.read())
-        return digest.hexdigest()
-
-
-_LOCATORS = caching.CacheImpl._locator_classes
-if _WithLitSource not in _LOCATORS:
-    _LOCATORS.insert(0, _WithLitSource)
 
 
 @_jit
@@ -199,9 +174,10 @@ def match_kernel(n, x, y, z, g, cx, row, kp, ki, sth, zr, unit, first_t, nr_t, s
             out[b] = 1 if _piece(ki, k, end, 0, npix) and end - k == npix else 0
             continue
         res = 1
+        memo = _NO_MEMO
         for i in range(i_min, i_max + 1):
-            kind, lo, hi = _ring_at(n, i, par, sth, zr, unit, first_t, nr_t, shifted_t,
-                                    delta_t, o_t, vc)  # fmt: skip
+            kind, lo, hi, memo = _ring_at(n, i, par, sth, zr, unit, first_t, nr_t, shifted_t,
+                                          delta_t, o_t, vc, memo)  # fmt: skip
             if kind == 2:
                 res = 2
                 break
