@@ -34,6 +34,7 @@ class _Facets:
         self.half = np.asarray(acc, np.float64) / 2
         self.nb = facet_neighbours(np.asarray(axes, np.float64))
         self.centre = np.asarray(eyes.eye(which).centroid, np.float64)
+        self.ax_cols = tuple(np.ascontiguousarray(self.ax[:, j]) for j in range(3))
 
 
 _FACETS: dict[tuple[str, str], _Facets] = {}
@@ -166,7 +167,10 @@ def _direction(e: _Edges, grid: int, levels: int = 6) -> np.ndarray:
     """Per key (N, 3): the direction u maximising G(u) = min over unlit facets of
     (angle(a_j, u) - alpha_j) - max over lit ones of (angle(a_i, u) - alpha_i), the eye's
     feasible region at infinity (lens offsets ignored), on zooming grids about the lit
-    facets' mean axis, first as wide as the lit axes' spread and the widest cone."""
+    facets' mean axis, first as wide as the lit axes' spread and the widest cone.
+    Compiled (kernels.measured_limit.direction_kernel: the same grids, a point given up
+    once its G falls to the best so far) unless ``EYEVIZ_JIT=0``; its arccos and dot
+    products round differently, so a near tie may pick another grid point."""
     n = e.pos.shape[0]
     lit = e.lit & ~e.pad
     unl = ~e.lit & ~e.pad
@@ -174,6 +178,14 @@ def _direction(e: _Edges, grid: int, levels: int = 6) -> np.ndarray:
     c = c / np.linalg.norm(c, axis=1, keepdims=True)
     spread = np.where(lit, np.arccos(np.clip(np.einsum("nkj,nj->nk", e.ax, c), -1, 1)), 0.0)
     half = np.tan(np.minimum(spread.max(axis=1) + e.half.max(axis=1), 1.2))
+    if kernels.use(n * grid * grid):
+        from eyeviz.core.kernels.measured_limit import direction_kernel
+
+        c = kernels.arg(c, np.float64)
+        direction_kernel(kernels.arg(e.ax, np.float64), kernels.arg(e.half, np.float64),
+                         kernels.arg(e.lit), kernels.arg(e.pad), c,
+                         kernels.arg(half, np.float64), int(grid), int(levels))  # fmt: skip
+        return c
     t = (np.arange(grid) + 0.5) / grid * 2 - 1
     g2 = np.stack(np.meshgrid(t, t, indexing="ij"), axis=-1).reshape(-1, 2)
     for _ in range(levels):
@@ -212,13 +224,11 @@ def key_hits(domain, p: np.ndarray, g: np.ndarray, row: np.ndarray, lit_a: LitCS
     res = np.ones(row.size, np.int64)
     for which, (kp, ki) in (("A", lit_a), ("B", lit_b)):
         t, ix = eyes._prepared(which)
-        e = eyes.eye(which)
-        ua = e.unit_axes
+        f = _facets(eyes, which)
         rows = np.repeat(np.arange(n), np.diff(kp))
         ki = kernels.arg(np.asarray(ki)[np.lexsort((ki, rows))], np.int64)
         check(xs, ys, zs, gs, bounds, t.px, t.py, t.pz, t.ax, t.ay, t.az, t.nrm, t.cos, t.sin,
-              t.exact_only, *(kernels.arg(ua[:, j], f64) for j in range(3)),
-              kernels.arg(e.acceptance, f64) / 2, kernels.arg(ix.centre, f64), float(ix.lens),
+              t.exact_only, *f.ax_cols, f.half, kernels.arg(ix.centre, f64), float(ix.lens),
               kernels.arg(kp, np.int64), ki, res)  # fmt: skip
     # a measured pair's field (limit3d_exact.exact_hits): each eye lights two facets or more
     ka, kb = (np.diff(k[0])[row] >= 2 for k in (lit_a, lit_b))

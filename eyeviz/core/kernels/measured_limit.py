@@ -20,7 +20,7 @@ from numba.core import caching
 from eyeviz.core.kernels import limit3d_region
 from eyeviz.core.kernels.limit3d_region import _cone_fold, _jit_np, _walk, bcentre, measured_prior
 
-__all__ = ["mixture_draws_kernel", "region_kernel", "warm"]
+__all__ = ["direction_kernel", "mixture_draws_kernel", "region_kernel", "warm"]
 
 
 class _WithRegionSource(caching.InTreeCacheLocator):
@@ -182,6 +182,61 @@ def mixture_draws_kernel(u, boxes, counts, dens, samples, u0, e1, e2, fa, bhat, 
             r[n, m], az[n, m], el[n, m], w[n, m] = rr, phi, e, wt
 
 
+@_jit_np
+def _grid_value(ax, half, lit, pad, n, vx, vy, vz, best):
+    """G(v) = min over unlit facets of (angle(a_j, v) - alpha_j) - max over lit ones of
+    (angle(a_i, v) - alpha_i) of key n at the unit v; stops once G <= best (G only falls
+    as facets are folded in: such a point is not the first maximum)."""
+    lo, hi = np.inf, -np.inf
+    for k in range(ax.shape[1]):
+        if pad[n, k]:
+            continue
+        dot = ax[n, k, 0] * vx + ax[n, k, 1] * vy + ax[n, k, 2] * vz
+        ang = math.acos(min(max(dot, -1.0), 1.0)) - half[n, k]
+        if lit[n, k]:
+            hi = max(hi, ang)
+        else:
+            lo = min(lo, ang)
+        if lo - hi <= best:
+            return lo - hi
+    return lo - hi
+
+
+@_jit_np
+def direction_kernel(ax, half, lit, pad, c, hw, grid, levels):
+    """limit3d_cones._direction's zooming grids, key by key: about each key's c (N, 3)
+    (unit; replaced by the result), grid x grid points of half width hw[n] (then / 2.5
+    each level) in gnomonic coordinates, the first point of largest G (:func:`_grid_value`,
+    early exit) the next centre."""
+    for n in range(c.shape[0]):
+        cx, cy, cz, h = c[n, 0], c[n, 1], c[n, 2], hw[n]
+        for _ in range(levels):
+            ex, ey = -cy, cx
+            nn = math.sqrt(ex * ex + ey * ey)
+            if nn > 1e-12:
+                ex, ey, ez = ex / nn, ey / nn, 0.0
+            else:
+                ex, ey, ez = 1.0, 0.0, 0.0
+            fx, fy, fz = cy * ez - cz * ey, cz * ex - cx * ez, cx * ey - cy * ex
+            best, bx, by, bz = -np.inf, cx, cy, cz
+            for i in range(grid):
+                di = ((i + 0.5) / grid * 2 - 1) * h
+                for j in range(grid):
+                    dj = ((j + 0.5) / grid * 2 - 1) * h
+                    vx, vy, vz = (
+                        cx + di * ex + dj * fx,
+                        cy + di * ey + dj * fy,
+                        cz + di * ez + dj * fz,
+                    )
+                    nv = math.sqrt(vx * vx + vy * vy + vz * vz)
+                    vx, vy, vz = vx / nv, vy / nv, vz / nv
+                    gv = _grid_value(ax, half, lit, pad, n, vx, vy, vz, best)
+                    if gv > best or (i == 0 and j == 0):
+                        best, bx, by, bz = gv, vx, vy, vz
+            cx, cy, cz, h = bx, by, bz, h / 2.5
+        c[n, 0], c[n, 1], c[n, 2] = cx, cy, cz
+
+
 def warm() -> None:
     """Compile (or load from the cache) the kernels for their one signature each."""
     a2 = np.zeros((1, 1))
@@ -191,6 +246,7 @@ def warm() -> None:
     c = np.ones((1, 3))
     v3 = np.ones(3)
     region_kernel(p3, c, c, c, v3, v3, 1.0, v3, 0.1, 1.0, 1e-7, *cs, *cs, a2.copy())
+    direction_kernel(p3, a2, b, ~b, np.array([[0.0, 0.0, 1.0]]), np.ones(1), 2, 1)
     u4 = np.full((1, 1, 4), 0.5)
     boxes = np.zeros((1, 2, 2, 3))
     boxes[:, :, 1] = 1.0
