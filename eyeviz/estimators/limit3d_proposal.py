@@ -194,9 +194,7 @@ class _Eye:
         cnt = np.bincount(rows, minlength=n)
         kmax = max(1, int(cnt.max()) if cnt.size else 1)
         slot = np.arange(codes.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-        pts = healpix.boundaries(self.nside, codes % npix, STEP)  # (T, P, 3)
-        self.pts = np.zeros((n, kmax, pts.shape[1], 3))
-        self.pts[rows, slot] = pts
+        self.pts = _boundaries(self.nside, codes % npix, rows, slot, (n, kmax))
         self.lit = np.zeros((n, kmax), bool)
         self.lit[rows, slot] = is_lit
         self.pad = np.ones((n, kmax), bool)
@@ -231,9 +229,26 @@ class _Eye:
         return u_io, self.b_in, self.b_out, u0, bp, pix, ring, lit, near, far
 
     def linearise(self, c: np.ndarray) -> None:
-        """Distances d (N, K) and gradients t (N, K, 2) of every edge cell at centres c."""
+        """Distances d (N, K) and gradients t (N, K, 2) of every edge cell at centres c.
+        Compiled unless ``EYEVIZ_JIT=0`` (kernels.limit3d_affine.linearise_kernel: the same
+        formulas, to a few ulps; padding slots 0 there)."""
         self.c = c / np.linalg.norm(c, axis=1, keepdims=True)
         self.e1, self.e2 = _frame(self.c)
+        if kernels.use(self.pts.shape[0] * self.pts.shape[1]):
+            from eyeviz.core.kernels.limit3d_affine import linearise_kernel
+
+            self.d = np.empty(self.pts.shape[:2])
+            self.t = np.empty((*self.pts.shape[:2], 2))
+            s = 1.5 * math.sqrt(4 * math.pi / (12 * self.nside**2)) / STEP
+            linearise_kernel(kernels.arg(self.pts), kernels.arg(self.lit), kernels.arg(self.pad),
+                             kernels.arg(self.c), kernels.arg(self.e1), kernels.arg(self.e2), s,
+                             self.d, self.t)  # fmt: skip
+        else:
+            self._linearise_ref()
+        self._affine()
+
+    def _linearise_ref(self) -> None:
+        """:meth:`linearise`'s d and t in numpy (the reference)."""
         dots = np.einsum("nkpj,nj->nkp", self.pts, self.c)
         best = np.argmax(dots, axis=2)
         p = np.take_along_axis(self.pts, best[:, :, None, None], 2)[:, :, 0]
@@ -249,7 +264,6 @@ class _Eye:
             t1 = np.einsum("nkj,nj->nk", tang, self.e1) / tn
             t2 = np.einsum("nkj,nj->nk", tang, self.e2) / tn
         self.t = np.stack([np.nan_to_num(t1), np.nan_to_num(t2)], axis=-1)
-        self._affine()
 
     def prune(self, reach: np.ndarray) -> None:
         """Drop the edge cells that cannot bind anywhere within ``reach`` (N,) of the
@@ -279,9 +293,26 @@ class _Eye:
         """The model as affine forms in delta: a lit cell's distance is d - t . delta, an
         unlit one's squared distance is d^2 - 2 d t . delta + |delta|^2 (the same value as
         (d - t . delta)^2 + |delta_perp|^2, |t| = 1), so max_lit and min_unlit are one
-        matrix product and one reduction each (padding: -inf / +inf, zero slope)."""
+        matrix product and one reduction each (padding: -inf / +inf, zero slope).
+        Compiled unless ``EYEVIZ_JIT=0`` (kernels.limit3d_affine.affine_kernel, the same
+        bits; the packed lists' slots beyond a row's count hold zeros there)."""
         lit = self.lit & ~self.pad
         unl = ~self.lit & ~self.pad
+        if kernels.use(lit.size):
+            from eyeviz.core.kernels.limit3d_affine import affine_kernel
+
+            n, k = lit.shape
+            kl = max(1, int(lit.sum(axis=1).max()) if n else 1)
+            ku = max(1, int(unl.sum(axis=1).max()) if n else 1)
+            self.a_lit, self.a_unl = np.empty((n, k)), np.empty((n, k))
+            self.t_lit, self.t_unl = np.empty((n, k, 2)), np.empty((n, k, 2))
+            lists = (np.zeros((n, kl)), np.zeros((n, kl, 2)), np.zeros(n, np.int64),
+                     np.zeros((n, ku)), np.zeros((n, ku, 2)), np.zeros(n, np.int64))  # fmt: skip
+            affine_kernel(kernels.arg(self.d, np.float64), kernels.arg(self.t, np.float64),
+                          kernels.arg(self.lit), kernels.arg(self.pad), self.a_lit, self.t_lit,
+                          self.a_unl, self.t_unl, *lists)  # fmt: skip
+            self.lists = lists
+            return
         self.a_lit = np.where(lit, self.d, -np.inf)
         self.t_lit = np.where(lit[..., None], self.t, 0.0)
         self.a_unl = np.where(unl, self.d * self.d, np.inf)
@@ -349,6 +380,27 @@ class _Eye:
         x, y = np.einsum("nmj,nj->nm", v, self.e1), np.einsum("nmj,nj->nm", v, self.e2)
         with np.errstate(divide="ignore", invalid="ignore"):  # v at 90 deg: inf, no warning
             return np.stack([x / cc, y / cc], axis=-1)
+
+
+def _boundaries(nside: int, pix: np.ndarray, rows, slot, shape: tuple[int, int]) -> np.ndarray:
+    """The boundary samples (healpix.boundaries, STEP a side) of the cells ``pix`` (T,) at
+    [rows, slot] of a zero array (*shape, 4 STEP, 3). Compiled unless ``EYEVIZ_JIT=0``
+    (kernels.limit3d_affine.boundaries_kernel: the same formulas, to a few ulps)."""
+    out = np.zeros((*shape, 4 * STEP, 3))
+    if kernels.use(pix.size):
+        from eyeviz.core.kernels.limit3d_affine import boundaries_kernel
+
+        ix, iy, f = healpix.pix2xyf(nside, pix)
+        t = np.arange(STEP) / STEP
+        dx = np.concatenate([1 - t, np.zeros(STEP), t, np.ones(STEP)])
+        dy = np.concatenate([np.ones(STEP), 1 - t, np.zeros(STEP), t])
+        boundaries_kernel(nside, kernels.arg(ix, np.int64), kernels.arg(iy, np.int64),
+                          kernels.arg(f, np.int64), kernels.arg(rows, np.int64),
+                          kernels.arg(slot, np.int64), dx, dy, healpix.JRLL, healpix.JPLL,
+                          out)  # fmt: skip
+        return out
+    out[rows, slot] = healpix.boundaries(nside, pix, STEP)
+    return out
 
 
 def _packed(sel: np.ndarray, a: np.ndarray, t: np.ndarray):

@@ -53,6 +53,7 @@ KERNELS = (
     "healpix_cells",
     "measured_limit",
     "healpix_boundary",
+    "limit3d_affine",
 )
 
 

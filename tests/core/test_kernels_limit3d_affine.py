@@ -1,0 +1,152 @@
+"""The HEALPix proposal's compiled set-up (eyeviz/core/kernels/limit3d_affine.py) against
+its numpy reference (EYEVIZ_JIT=0): the same formulas, so the same values to a few ulps,
+on the edge cells of real keys (nside 2-180, nside / 2 odd and even) and on random points."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from eyeviz.core.domain import Domain3D
+from eyeviz.dataset.algorithm1_3d import generate3d
+from eyeviz.estimators.base import take_rows
+from eyeviz.estimators.limit3d_proposal import STEP, _Eye
+
+ks = pytest.importorskip("eyeviz.core.kernels.limit3d_affine")
+
+
+def _eyes(nside: int, seed: int, n: int = 5) -> list[_Eye]:
+    d = Domain3D(nside=nside)
+    ds = generate3d(n, d, seed=seed)
+    rows = np.arange(n)
+    la = take_rows(ds.indptr_a, ds.indices_a, rows)
+    lb = take_rows(ds.indptr_b, ds.indices_b, rows)
+    return [_Eye(d, la, np.array([-d.h, 0, 0]), 0), _Eye(d, lb, np.array([d.h, 0, 0]), 1)]
+
+
+def _kernel(e: _Eye, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    e.c = c / np.linalg.norm(c, axis=1, keepdims=True)
+    from eyeviz.estimators.limit3d_proposal import _frame
+
+    e.e1, e.e2 = _frame(e.c)
+    d, t = np.empty(e.pts.shape[:2]), np.empty((*e.pts.shape[:2], 2))
+    s = 1.5 * math.sqrt(4 * math.pi / (12 * e.nside**2)) / STEP
+    ks.linearise_kernel(e.pts, e.lit, e.pad, e.c, e.e1, e.e2, s, d, t)
+    return d, t
+
+
+def _reference(e: _Eye, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    e.c = c / np.linalg.norm(c, axis=1, keepdims=True)
+    from eyeviz.estimators.limit3d_proposal import _frame
+
+    e.e1, e.e2 = _frame(e.c)
+    with np.errstate(all="ignore"):
+        e._linearise_ref()
+    return e.d.copy(), e.t.copy()
+
+
+@pytest.mark.parametrize("nside,seed", [(2, 1), (6, 2), (10, 3), (16, 4), (18, 5), (180, 6)])
+def test_linearise_kernel_is_the_reference_to_a_few_ulps(nside, seed):
+    rng = np.random.default_rng(seed)
+    for e in _eyes(nside, seed):
+        live = ~e.pad
+        assert live.sum() > 0
+        for c in (e.u0, e.c, e.u0 + rng.normal(scale=0.01, size=e.u0.shape)):
+            got_d, got_t = _kernel(e, c)
+            want_d, want_t = _reference(e, c)
+            assert np.allclose(got_d[live], want_d[live], rtol=1e-13, atol=1e-15)
+            assert np.allclose(got_t[live], want_t[live], rtol=0, atol=1e-12)
+            assert np.all(got_d[~live] == 0) and np.all(got_t[~live] == 0)
+            # the lit cells' sample gap is taken off (and only theirs)
+            assert np.any(e.lit & live) and np.any(~e.lit & live)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31), p=st.integers(1, 30), zero=st.booleans())
+def test_linearise_kernel_on_random_points(seed, p, zero):
+    """Random boundary samples (also the centre itself: tangent 0) and padding."""
+    rng = np.random.default_rng(seed)
+    n, k = 3, 7
+    pts = rng.normal(size=(n, k, p, 3))
+    pts /= np.linalg.norm(pts, axis=3, keepdims=True)
+    c = rng.normal(size=(n, 3))
+    c /= np.linalg.norm(c, axis=1, keepdims=True)
+    if zero:
+        pts[0, 1, :, :] = c[0]
+    e = _Eye.__new__(_Eye)
+    e.nside, e.pts = 16, pts
+    e.lit = rng.random((n, k)) < 0.5
+    e.pad = rng.random((n, k)) < 0.2
+    got_d, got_t = _kernel(e, c)
+    want_d, want_t = _reference(e, c)
+    live = ~e.pad
+    assert np.allclose(got_d[live], want_d[live], rtol=1e-13, atol=1e-15)
+    # a sample at the centre itself: d 0 and its tangent that of the rounding errors, in
+    # either path (the model's slope there is arbitrary and multiplies d = 0 in w)
+    far = live.copy()
+    far[0, 1] &= not zero
+    assert np.allclose(got_t[far], want_t[far], rtol=0, atol=1e-12)
+    assert np.all(np.hypot(*np.moveaxis(got_t[live], -1, 0)) <= 1 + 1e-12)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31), k=st.integers(1, 25), special=st.booleans())
+def test_affine_kernel_is_the_reference_bit_for_bit(seed, k, special):
+    """_Eye._affine compiled against numpy: the full forms and each kind's packed list
+    (up to its count), bit for bit, also with inf and NaN distances."""
+    from types import SimpleNamespace
+
+    rng = np.random.default_rng(seed)
+    n = 4
+    d = rng.uniform(0.0, 0.05, (n, k))
+    t = rng.normal(size=(n, k, 2))
+    if special:
+        d.ravel()[rng.integers(0, d.size, 3)] = rng.choice([np.inf, -np.inf, np.nan, -0.0], 3)
+    lit = rng.random((n, k)) < 0.5
+    pad = rng.random((n, k)) < 0.25
+    got = SimpleNamespace(d=d, t=t, lit=lit, pad=pad)
+    want = SimpleNamespace(d=d, t=t, lit=lit, pad=pad)
+    _Eye._affine(got)  # type: ignore[arg-type]
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("EYEVIZ_JIT", "0")
+        _Eye._affine(want)  # type: ignore[arg-type]
+    for name in ("a_lit", "t_lit", "a_unl", "t_unl"):
+        a, b = getattr(got, name), getattr(want, name)
+        assert np.array_equal(a, b, equal_nan=True), name
+    for j in (0, 3):  # each kind's list: values up to the row's count
+        assert np.array_equal(got.lists[j + 2], want.lists[j + 2])
+        for r in range(n):
+            c = want.lists[j + 2][r]
+            for i in (0, 1):
+                x, y = got.lists[j + i][r, :c], want.lists[j + i][r, :c]
+                assert np.array_equal(x, y, equal_nan=True), (j, i)
+
+
+@pytest.mark.parametrize("nside", [1, 2, 6, 10, 16, 180])
+def test_boundaries_kernel_is_healpix_boundaries_to_a_few_ulps(nside, monkeypatch):
+    """Every cell of small nsides (both poles, the equator, faces' corners), random ones
+    at nside 180, each written to its padded slot."""
+    from eyeviz.core import healpix, kernels
+
+    monkeypatch.setitem(kernels._STATE, "ready", True)  # small calls too take the kernel
+    from eyeviz.estimators.limit3d_proposal import _boundaries
+
+    rng = np.random.default_rng(nside)
+    npix = 12 * nside * nside
+    pix = np.arange(npix) if npix < 5000 else rng.integers(0, npix, 3000)
+    rows = rng.integers(0, 4, pix.size)
+    order = np.argsort(rows, kind="stable")
+    pix, rows = pix[order], rows[order]
+    slot = np.arange(pix.size) - np.searchsorted(rows, rows)
+    shape = (4, int(slot.max()) + 2)
+    got = _boundaries(nside, pix, rows, slot, shape)
+    want = np.zeros_like(got)
+    want[rows, slot] = healpix.boundaries(nside, pix, STEP)
+    assert np.allclose(got, want, rtol=0, atol=4e-16)
+    filled = np.zeros(shape, bool)
+    filled[rows, slot] = True
+    assert np.all(got[~filled] == 0) and np.allclose(np.linalg.norm(got[filled], axis=-1), 1)
