@@ -86,16 +86,65 @@ class HealpixProposal:
                     box=box, th_lo=th_lo, th_hi=th_hi, lit_a=lit_a, lit_b=lit_b,
                     bands=bands)  # fmt: skip
 
-    # long: the weighted draws of one chunk (propose, test the key, weigh) in one pass over shared
-    # arrays
     def sample(self, st: dict, keys: np.ndarray, stream, rows=None) -> dict[str, np.ndarray]:
         """``samples`` weighted draws per key of a chunk set up by :meth:`setup`, per
         stream (an int or a sequence: batches side by side, :func:`_batch_uniforms`); only
-        the keys ``rows`` (bool (N,), default all) get draws, the others weight 0."""
+        the keys ``rows`` (bool (N,), default all) get draws, the others weight 0. The
+        draws are one kernel unless ``EYEVIZ_JIT=0`` (:meth:`_draws_kernel`; the numpy
+        :meth:`_draws_ref` is the reference), then each draw with prior mass is checked
+        exactly (:meth:`_check`)."""
+        if rows is None:
+            rows = np.ones(keys.size, bool)
+        if kernels.use(keys.size * self.samples):
+            from eyeviz.core.kernels.limit3d_region import uniforms_kernel
+
+            # the uniforms of _batch_uniforms, bit for bit (as limit3d_measured's)
+            s = np.atleast_1d(np.asarray(stream, np.int64))
+            u = np.empty((keys.size, self.samples * s.size, 4))
+            uniforms_kernel(kernels.arg(keys, np.uint64), self.samples, kernels.arg(s), u)
+            out, ca, alpha = self._draws_kernel(st, u, rows)
+        else:
+            u = _batch_uniforms(keys, self.samples, 4, stream)
+            out, ca, alpha = self._draws_ref(st, u, rows)
+        out["w"] = self._check(st, out, ca, alpha)
+        return out
+
+    def _draws_kernel(self, st: dict, u: np.ndarray, rows: np.ndarray):
+        """:meth:`_draws_ref` compiled (kernels.limit3d_affine.healpix_draws_kernel): the
+        same formulas draw by draw, each draw given up at its first failed test; values
+        written only where the weight is above 0 (zeros elsewhere)."""
+        from eyeviz.core.kernels.limit3d_affine import healpix_draws_kernel
+
+        d, ea, eb = self.domain, st["ea"], st["eb"]
+        n, m = u.shape[:2]
+        out = {k: np.zeros((n, m)) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
+        ca, alpha = np.zeros((n, m, 3)), np.zeros((n, m))
+        u_max = 1.0 / (d.r_min - d.h) if d.r_min > d.h else np.inf
+        f64 = np.float64
+        fa = (ea.a_lit, ea.t_lit, ea.a_unl, ea.t_unl, ea.lists)
+        fb = (eb.a_lit, eb.t_lit, eb.a_unl, eb.t_unl, eb.lists)
+        arg = kernels.arg
+        healpix_draws_kernel(u, arg(rows, np.bool_), arg(st["th_lo"], f64), arg(st["th_hi"], f64),
+                             arg(st["box"], f64), arg(st["ext"], f64), arg(st["ext_b"], f64),
+                             arg(st["slack"][:, 0], f64), fa, arg(ea.c, f64), arg(ea.e1, f64),
+                             arg(ea.e2, f64), fb, arg(eb.c, f64), arg(eb.e1, f64), arg(eb.e2, f64),
+                             arg(eb.a, f64), arg(st["A"], f64), arg(st["B"], f64),
+                             1.0 / (d.r_max + d.h), u_max, math.sin(d.gamma / 2), float(d.g_max),
+                             float(d.r_min), float(d.r_max), float(d.el_max), float(d.psi),
+                             self.prior == "multi", np.linspace(0.0, 1.0, RAY_GRID), RAY_ROUNDS,
+                             out["x"], out["y"], out["z"], out["g"], out["r"], out["az"],
+                             out["el"], out["w"], ca, alpha)  # fmt: skip
+        return out, ca, alpha
+
+    # long: the weighted draws of one chunk (propose, weigh) in one pass over shared arrays
+    def _draws_ref(self, st: dict, u: np.ndarray, rows: np.ndarray):
+        """The draws before the exact check in numpy (the reference): (theta, phi) of A's
+        direction, u = 1 / rho along its ray, g; every draw's values, its weight (prior
+        over the proposal's density, 0 where a test fails), A's direction and the cap's
+        half-angle seen from A."""
         d, A, B, ea, eb = self.domain, st["A"], st["B"], st["ea"], st["eb"]
-        n, m, slack, ext, ext_b = st["n"], self.samples, st["slack"], st["ext"], st["ext_b"]
+        n, slack, ext, ext_b = st["n"], st["slack"], st["ext"], st["ext_b"]
         box, th_lo, th_hi = st["box"], st["th_lo"], st["th_hi"]
-        u = _batch_uniforms(keys, m, 4, stream)
         m = u.shape[1]
         th = th_lo[:, None] + (th_hi - th_lo)[:, None] * u[..., 0]
         ph = box[:, 2:3] + (box[:, 3] - box[:, 2])[:, None] * u[..., 1]
@@ -143,9 +192,20 @@ class HealpixProposal:
             vol = (th_hi - th_lo)[:, None] * (box[:, 3] - box[:, 2])[:, None]
             vol = vol * (u_hi - u_lo) * (g_hi - g_lo)
             w = prior_density(d, self.prior, r, gg, el, az) * rho**4 * sp * vol
-        if rows is not None:  # the other keys' draws as drawn (their weights 0: not checked)
-            good = good & rows[:, None]
+        good = good & rows[:, None]  # the other keys' draws as drawn (weights 0: not checked)
         w = np.where(good & np.isfinite(w), w, 0.0)
+        out = {"r": r, "az": az, "el": el, "g": gg, "x": p[..., 0], "y": p[..., 1],
+               "z": p[..., 2], "w": w}  # fmt: skip
+        return out, ca, alpha
+
+    def _check(self, st: dict, out: dict, ca: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+        """The weights ``out["w"]`` (N, M) kept where the draw reproduces the key exactly
+        (the 0/1 likelihood), 0 elsewhere."""
+        d, B, ea, eb = self.domain, st["B"], st["ea"], st["eb"]
+        w = out["w"]
+        n, m = w.shape
+        p = np.stack([out["x"], out["y"], out["z"]], axis=-1)
+        gg = out["g"]
         # the exact 0/1 likelihood on the draws with prior mass
         cand = np.flatnonzero(w.ravel() > 0)
         hit = np.zeros(n * m, bool)
@@ -171,8 +231,7 @@ class HealpixProposal:
         hit[cand] = exact_hits(d, p.reshape(-1, 3)[cand], gg.ravel()[cand], cand // m,
                                st["lit_a"], st["lit_b"])  # fmt: skip
         w = np.where(hit.reshape(n, m), w, 0.0)
-        return {"r": r, "az": az, "el": el, "g": gg, "x": p[..., 0], "y": p[..., 1],
-                "z": p[..., 2], "w": w}  # fmt: skip
+        return w
 
 
 def _ray_region_draws(eb: _Eye, ca, u_lo, u_hi, good, slack, u_dead: float):
@@ -180,7 +239,7 @@ def _ray_region_draws(eb: _Eye, ca, u_lo, u_hi, good, slack, u_dead: float):
     (:func:`_ray_in_region`); the other draws' set to ``u_dead``. Compiled: in place on
     the live draws; numpy: on the live draws moved to the front of each row."""
     if kernels.use(good.size):
-        from eyeviz.core.kernels.limit3d_region import ray_region_kernel
+        from eyeviz.core.kernels.limit3d_affine import ray_region_kernel
 
         lo, hi = np.array(u_lo, np.float64), np.array(u_hi, np.float64)
         n = good.shape[0]

@@ -343,7 +343,7 @@ class _Eye:
         delta (N, G, 2): arrays (N, G). Compiled (bit for bit the same) unless
         ``EYEVIZ_JIT=0``."""
         if kernels.use(delta.shape[0] * delta.shape[1]):
-            from eyeviz.core.kernels.limit3d_region import affine_bounds_kernel
+            from eyeviz.core.kernels.limit3d_affine import affine_bounds_kernel
 
             lo = np.empty(delta.shape[:2])
             hi = np.empty(delta.shape[:2])
@@ -533,7 +533,7 @@ def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack, grid: int = 12, rounds: int =
     G on ``grid`` points, the interval from the grid point before the first inside to the
     one after the last (or the two neighbours of the best point when none is inside);
     ``rounds`` times. Returns (lo, hi). (The numpy reference of
-    :func:`eyeviz.core.kernels.limit3d_region.ray_region_kernel`.)"""
+    :func:`eyeviz.core.kernels.limit3d_affine.ray_region_kernel`.)"""
     n, m = lo.shape
     t = np.linspace(0.0, 1.0, grid)
     for _ in range(rounds):

@@ -150,3 +150,65 @@ def test_boundaries_kernel_is_healpix_boundaries_to_a_few_ulps(nside, monkeypatc
     filled = np.zeros(shape, bool)
     filled[rows, slot] = True
     assert np.all(got[~filled] == 0) and np.allclose(np.linalg.norm(got[filled], axis=-1), 1)
+
+
+@pytest.mark.parametrize("nside,prior", [(16, "single"), (180, "single"), (32, "multi")])
+def test_healpix_draws_kernel_agrees_with_the_reference(nside, prior, monkeypatch):
+    """HealpixProposal's draws before the exact check, kernel against numpy on the same
+    set-up and uniforms (two batches side by side, one key without draws): the same draws
+    with a weight, their values to 1e-12 and weights to 1e-9 (a weight holds differences
+    of nearly equal radii)."""
+    from eyeviz.core import kernels
+    from eyeviz.estimators import limit3d_healpix as lh
+
+    monkeypatch.setitem(kernels._STATE, "ready", True)
+    d = Domain3D(nside=nside)
+    ds = generate3d(6, d, seed=nside + 1)
+    rows = np.arange(6)
+    la = take_rows(ds.indptr_a, ds.indices_a, rows)
+    lb = take_rows(ds.indptr_b, ds.indices_b, rows)
+    prop = lh.HealpixProposal(d, prior, 384, 8)
+    keys = np.arange(6, dtype=np.uint64) * np.uint64(7919)
+    st_ = prop.setup(la, lb, keys, 1.0)
+    u = lh._batch_uniforms(keys, 384, 4, [0, 8])
+    on = np.ones(6, bool)
+    on[2] = False
+    got, ca, alpha = prop._draws_kernel(st_, u, on)
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want, ca_r, alpha_r = prop._draws_ref(st_, u, on)
+    kw = got["w"] > 0
+    assert np.array_equal(kw, want["w"] > 0)
+    assert kw.sum() >= 100 and not kw[2].any() and kw.sum(axis=1)[on].min() > 0
+    assert np.all(got["w"][~kw] == 0)
+    for k in ("x", "y", "z", "g", "r", "az", "el"):
+        assert np.allclose(got[k][kw], want[k][kw], rtol=1e-12, atol=1e-15), k
+    assert np.allclose(got["w"][kw], want["w"][kw], rtol=1e-9, atol=0)
+    assert np.allclose(ca[kw], ca_r[kw], rtol=0, atol=1e-15)
+    assert np.allclose(alpha[kw], alpha_r[kw], rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize("multi", [False, True])
+def test_healpix_prior_is_prior_density(multi):
+    """The kernel's prior against limit3d_exact.prior_density on balls across and beyond
+    the support (and on each bound of r, g and el exactly)."""
+    from eyeviz.estimators.limit3d_exact import prior_density
+
+    ka = pytest.importorskip("eyeviz.core.kernels.limit3d_affine")
+    d = Domain3D(nside=16)
+    rng = np.random.default_rng(3 + multi)
+    k = 4000
+    r = rng.uniform(d.r_min * 0.9, d.r_max * 1.1, k)
+    g = rng.uniform(0.0, d.g_max * 1.1, k)
+    el = rng.uniform(-1.2 * d.el_max, 1.2 * d.el_max, k)
+    az = rng.uniform(-0.2, math.pi + 0.2, k)
+    r[:3] = d.r_min, d.r_max, d.r_max
+    g[3:6] = d.g_max, r[3] * math.sin(d.gamma / 2), r[5]
+    el[6:8] = d.el_max, -d.el_max
+    want = prior_density(d, "multi" if multi else "single", r, g, el, az)
+    s = math.sin(d.gamma / 2)
+    got = np.array([ka.healpix_prior(r[i], g[i], el[i], az[i], s, float(d.g_max),
+                                     float(d.r_min), float(d.r_max), float(d.el_max),
+                                     float(d.psi), multi) for i in range(k)])  # fmt: skip
+    assert np.array_equal(got > 0, want > 0)
+    assert 0.2 < (want > 0).mean() < 0.9
+    assert np.allclose(got, want, rtol=1e-12, atol=0)

@@ -1,17 +1,14 @@
-"""The spherical limit's proposal regions compiled (numba): the HEALPix eyes' affine model
-(:meth:`eyeviz.estimators.limit3d_proposal._Eye.bounds`), the search along A's rays for
-B's region (:func:`eyeviz.estimators.limit3d_proposal._ray_in_region`) and the measured
-eyes' cone distances (:meth:`eyeviz.estimators.limit3d_measured._Edges.bounds`).
+"""The spherical limit's proposal regions compiled (numba): the measured eyes' cone
+distances (:meth:`eyeviz.estimators.limit3d_measured._Edges.bounds`), their draws, the
+HEALPix prefilter and the exact check's row comparison. (The HEALPix eyes' affine model
+and its ray search are in :mod:`.limit3d_affine`, with the draws that call them.)
 
 Scalar transcriptions of the numpy references, which ``EYEVIZ_JIT=0`` runs instead
-(docs/kernels.md). The HEALPix ones use only +, -, *, / and sqrt in the reference's order
-(numba compiles without fast-math: no reassociation, no fused multiply-add), and the
-reductions keep numpy's NaN rules (a NaN anywhere in a max or min gives NaN; argmax picks
-the first NaN), so their results are the reference's bit for bit. The measured one
-computes the same distances without the reference's arctan2 and sin (:func:`_cone`), and
-the reference's matrix products (BLAS) round differently: they agree to about 1e-13 of
-the distances. Only where draws are proposed depends on these numbers; every draw is
-still checked exactly.
+(docs/kernels.md). The reductions keep numpy's NaN rules (a NaN anywhere in a max or min
+gives NaN). The measured cone distances are computed without the reference's arctan2 and
+sin (:func:`_cone`), and the reference's matrix products (BLAS) round differently: they
+agree to about 1e-13 of the distances. Only where draws are proposed depends on these
+numbers; every draw is still checked exactly.
 """
 
 from __future__ import annotations
@@ -22,8 +19,6 @@ import numpy as np
 from numba import njit
 
 __all__ = [
-    "affine_bounds_kernel",
-    "ray_region_kernel",
     "cone_bounds_kernel",
     "interval_kernel",
     "measured_draws_kernel",
@@ -60,121 +55,6 @@ def _min(m, x):
     if x != x or x < m:
         return x
     return m
-
-
-@_jit
-def _affine_at(a_lit, t_lit, a_unl, t_unl, n, dx, dy):
-    """(max_lit, min_unlit) of the affine model of key n at one offset (dx, dy)."""
-    lo = -np.inf
-    hi2 = np.inf
-    for k in range(a_lit.shape[1]):
-        v = t_lit[n, k, 0] * dx
-        v = v + t_lit[n, k, 1] * dy
-        lo = _max(lo, a_lit[n, k] - v)
-        w = t_unl[n, k, 0] * dx
-        w = w + t_unl[n, k, 1] * dy
-        hi2 = _min(hi2, a_unl[n, k] - w)
-    hi2 = hi2 + (dx * dx + dy * dy)
-    return lo, math.sqrt(_max(hi2, 0.0))
-
-
-@_jit
-def _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n, dx, dy):
-    """:func:`_affine_at` on the key's lit and unlit cells alone (``lists``: the model's
-    lit cells (l_a (N, KL), l_t (N, KL, 2), nl (N,)) and unlit ones (u_a, u_t, nu) in slot
-    order, _Eye._affine): a padding or unlit slot gives max_lit -inf - (0 dx + 0 dy) =
-    -inf, which changes no maximum, and likewise +inf for min_unlit, as long as dx and dy
-    are finite (0 * inf is NaN: then every slot, as the reference)."""
-    if not (math.isfinite(dx) and math.isfinite(dy)):
-        return _affine_at(a_lit, t_lit, a_unl, t_unl, n, dx, dy)
-    l_a, l_t, nl, u_a, u_t, nu = lists
-    lo = -np.inf
-    for k in range(nl[n]):
-        v = l_t[n, k, 0] * dx
-        v = v + l_t[n, k, 1] * dy
-        lo = _max(lo, l_a[n, k] - v)
-    hi2 = np.inf
-    for k in range(nu[n]):
-        w = u_t[n, k, 0] * dx
-        w = w + u_t[n, k, 1] * dy
-        hi2 = _min(hi2, u_a[n, k] - w)
-    hi2 = hi2 + (dx * dx + dy * dy)
-    return lo, math.sqrt(_max(hi2, 0.0))
-
-
-@_jit
-def affine_bounds_kernel(a_lit, t_lit, a_unl, t_unl, lists, delta, lo, hi):
-    """_Eye.bounds: lo, hi (N, G) at gnomonic offsets delta (N, G, 2)."""
-    for n in range(delta.shape[0]):
-        for g in range(delta.shape[1]):
-            lo[n, g], hi[n, g] = _affine_lists(
-                a_lit, t_lit, a_unl, t_unl, lists, n, delta[n, g, 0], delta[n, g, 1]
-            )
-
-
-@_jit
-def _clean(x):
-    """numpy's nan_to_num(x, nan=1e3, posinf=1e3, neginf=-1e3)."""
-    if x != x:
-        return 1e3
-    if x == np.inf:
-        return 1e3
-    if x == -np.inf:
-        return -1e3
-    return x
-
-
-@_jit
-def _gap_at(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, caz, u):
-    """G = min_unlit - max_lit of B's model (key n) seen along A's ray at u."""
-    vx = cax + u * a[0]
-    vy = cay + u * a[1]
-    vz = caz + u * a[2]
-    nrm = math.sqrt(vx * vx + vy * vy + vz * vz)
-    vx, vy, vz = vx / nrm, vy / nrm, vz / nrm
-    cc = vx * c[n, 0] + vy * c[n, 1] + vz * c[n, 2]
-    x = vx * e1[n, 0] + vy * e1[n, 1] + vz * e1[n, 2]
-    y = vx * e2[n, 0] + vy * e2[n, 1] + vz * e2[n, 2]
-    lo, hi = _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n, _clean(x / cc), _clean(y / cc))
-    return hi - lo
-
-
-# long: one draw's search (grid, first / last inside, argmax fallback, rounds) is one loop
-# nest; split, it would pass a dozen scalars back and forth
-@_jit
-def ray_region_kernel(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, ca, lo, hi, slack,
-                      t, rounds, live):  # fmt: skip
-    """_ray_in_region on the draws where ``live`` (N, M): lo, hi (N, M) shrunk in place."""
-    grid = t.size
-    gv = np.empty(grid)
-    uu = np.empty(grid)
-    for n in range(ca.shape[0]):
-        for m in range(ca.shape[1]):
-            if not live[n, m]:
-                continue
-            lo_, hi_ = lo[n, m], hi[n, m]
-            for _ in range(rounds):
-                first = -1
-                last = -1
-                best = 0
-                for j in range(grid):
-                    uu[j] = lo_ + (hi_ - lo_) * t[j]
-                    gv[j] = _gap_at(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n,
-                                    ca[n, m, 0], ca[n, m, 1], ca[n, m, 2], uu[j])  # fmt: skip
-                    if gv[j] >= -slack[n]:
-                        if first < 0:
-                            first = j
-                        last = j
-                    # argmax: the first maximum, the first NaN before any number
-                    gb = gv[best]
-                    if gb == gb and (gv[j] != gv[j] or gv[j] > gb):
-                        best = j
-                if first < 0:
-                    first = best
-                    last = best
-                lo_ = uu[max(first - 1, 0)]
-                hi_ = uu[min(last + 1, grid - 1)]
-            lo[n, m], hi[n, m] = lo_, hi_
 
 
 @_jit
@@ -547,18 +427,10 @@ def same_rows_kernel(ptr, ind, kp, ki, row, same):
 def warm() -> None:
     """Compile (or load from the cache) the kernels for their one signature each."""
     a2 = np.zeros((1, 1))
-    a3 = np.zeros((1, 1, 2))
-    d = np.zeros((1, 1, 2))
     out = np.zeros((1, 1))
-    n1 = np.ones(1, np.int64)
-    lists = (a2, a3, n1, a2, a3, n1)
-    affine_bounds_kernel(a2, a3, a2, a3, lists, d, out, out.copy())
     v3 = np.ones(3)
     c = np.ones((1, 3))
-    ca = np.ones((1, 1, 3))
     b = np.ones((1, 1), np.bool_)
-    ray_region_kernel(a2, a3, a2, a3, lists, c, c, c, v3, ca, out, out + 1, np.ones(1),
-                      np.linspace(0.0, 1.0, 3), 1, b)  # fmt: skip
     p3 = np.ones((1, 1, 3))
     cs = (p3, p3, a2 + 0.9, a2 + 0.1, b, ~b)
     cone_bounds_kernel(*cs, p3, out, out.copy())
