@@ -463,9 +463,10 @@ def warm() -> None:
     ray_region_kernel(a2, a3, a2, a3, lists, c, c, c, v3, ca, out, out + 1, np.ones(1), tt, 1,
                       bb)  # fmt: skip
     f = (a2, a3, a2, a3, lists)
-    o = [np.zeros((1, 1)) for _ in range(8)]
+    o = [np.zeros((1, 1)) for _ in range(8)]  # x, y, z, g, r, az, el, w
     one, b4 = np.ones(1), np.ones((1, 4))
     healpix_draws_kernel(np.full((1, 1, 4), 0.5), np.ones(1, np.bool_), one * 0, one, b4,
                          c[:, :2].copy(), c[:, :2].copy(), one, f, c, c, c, f, c, c, c, v3, v3,
-                         v3, 0.01, np.inf, 0.1, 1.0, 1.0, 10.0, 1.0, 0.1, False, tt, 1, *o,
-                         ca.copy(), out.copy())  # fmt: skip
+                         v3, 0.01, np.inf, 0.1, 1.0, 1.0, 10.0, 1.0, 0.1, False, tt, 1,
+                         o[0], o[1], o[2], o[3], o[4], o[5], o[6], o[7], ca.copy(),
+                         out.copy())  # fmt: skip
