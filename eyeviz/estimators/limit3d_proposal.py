@@ -280,6 +280,19 @@ class _Eye:
         kmax = max(1, int(cnt.max()) if cnt.size else 1)
         if kmax >= keep.shape[1]:
             return
+        if kernels.use(keep.size):  # the same copies, compiled
+            from eyeviz.core.kernels.limit3d_affine import compact_kernel
+
+            n = keep.shape[0]
+            o_pts = np.empty((n, kmax, *self.pts.shape[2:]))
+            o_lit, o_pad = np.empty((n, kmax), bool), np.empty((n, kmax), bool)
+            o_d, o_t = np.empty((n, kmax)), np.empty((n, kmax, 2))
+            compact_kernel(kernels.arg(keep), kernels.arg(self.pts), kernels.arg(self.lit),
+                           kernels.arg(self.d), kernels.arg(self.t), o_pts, o_lit, o_pad, o_d,
+                           o_t)  # fmt: skip
+            self.pts, self.lit, self.pad, self.d, self.t = o_pts, o_lit, o_pad, o_d, o_t
+            self._affine()
+            return
         order = np.argsort(~keep, axis=1, kind="stable")[:, :kmax]
         rows = np.arange(keep.shape[0])[:, None]
         self.pts = self.pts[rows, order]

@@ -212,3 +212,45 @@ def test_healpix_prior_is_prior_density(multi):
     assert np.array_equal(got > 0, want > 0)
     assert 0.2 < (want > 0).mean() < 0.9
     assert np.allclose(got, want, rtol=1e-12, atol=0)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31), k=st.integers(1, 20), km=st.integers(1, 20))
+def test_compact_kernel_is_the_stable_argsort_gather(seed, k, km):
+    """_Eye.prune's compiled gather against numpy's stable argsort of ~keep."""
+    rng = np.random.default_rng(seed)
+    n, km = 4, min(km, k)
+    keep = rng.random((n, k)) < 0.5
+    pts = rng.normal(size=(n, k, 3, 3))
+    lit = rng.random((n, k)) < 0.5
+    d, t = rng.normal(size=(n, k)), rng.normal(size=(n, k, 2))
+    o = (np.empty((n, km, 3, 3)), np.empty((n, km), bool), np.empty((n, km), bool),
+         np.empty((n, km)), np.empty((n, km, 2)))  # fmt: skip
+    ks.compact_kernel(keep, pts, lit, d, t, *o)
+    order = np.argsort(~keep, axis=1, kind="stable")[:, :km]
+    rows = np.arange(n)[:, None]
+    want = (pts[rows, order], lit[rows, order], ~keep[rows, order], d[rows, order],
+            t[rows, order])  # fmt: skip
+    for a, b in zip(o, want, strict=True):
+        assert np.array_equal(a, b)
+
+
+def test_prune_with_the_kernel_is_the_reference_s(monkeypatch):
+    """_Eye.prune on real keys (nside 180), compiled and in numpy: the same cells kept in
+    the same slots, the same model."""
+    import copy
+
+    from eyeviz.core import kernels
+
+    monkeypatch.setitem(kernels._STATE, "ready", True)
+    for e in _eyes(180, 9):
+        f = copy.deepcopy(e)
+        k0 = e.pad.shape[1]
+        reach = np.full(e.c.shape[0], 0.0015)
+        e.prune(reach)
+        with monkeypatch.context() as mp:
+            mp.setenv("EYEVIZ_JIT", "0")
+            f.prune(reach)
+        assert e.pad.shape[1] < k0 and (~e.pad).sum() > 0  # it pruned, and kept some
+        for name in ("pts", "lit", "pad", "d", "t", "a_lit", "t_lit", "a_unl", "t_unl"):
+            assert np.array_equal(getattr(e, name), getattr(f, name)), name

@@ -28,6 +28,7 @@ __all__ = [
     "linearise_kernel",
     "affine_kernel",
     "boundaries_kernel",
+    "compact_kernel",
     "warm",
 ]
 
@@ -293,6 +294,29 @@ def boundaries_kernel(nside, ix, iy, face, rows, slot, dx, dy, jrll, jpll, out):
             o[2] = z
 
 
+@_jit
+def compact_kernel(keep, pts, lit, d, t, o_pts, o_lit, o_pad, o_d, o_t):
+    """_Eye.prune's gather: per row, the slots ``keep`` (N, K) first, then the others, each
+    in slot order (numpy's stable argsort of ~keep), the first KM = o_d.shape[1] of them
+    copied from pts, lit, d, t to o_pts (N, KM, P, 3), o_lit, o_d, o_t; o_pad = not kept."""
+    km = o_d.shape[1]
+    for n in range(keep.shape[0]):
+        j = 0
+        for phase in range(2):
+            for k in range(keep.shape[1]):
+                if j >= km:
+                    break
+                if keep[n, k] != (phase == 0):
+                    continue
+                o_pts[n, j] = pts[n, k]
+                o_lit[n, j] = lit[n, k]
+                o_pad[n, j] = phase == 1
+                o_d[n, j] = d[n, k]
+                o_t[n, j, 0] = t[n, k, 0]
+                o_t[n, j, 1] = t[n, k, 1]
+                j += 1
+
+
 _jit_np = njit(cache=True, nogil=True, error_model="numpy")
 
 
@@ -448,6 +472,7 @@ def warm() -> None:
     n1 = np.zeros(1, np.int64)
     f12 = np.zeros(12, np.int64)
     boundaries_kernel(2, n1, n1, n1, n1, n1, np.zeros(2), np.zeros(2), f12, f12, pts)
+    compact_kernel(b, pts, b, d, t, pts.copy(), b.copy(), b.copy(), d.copy(), t.copy())
     affine_kernel(d, t, b, b.copy(), d.copy(), t.copy(), d.copy(), t.copy(), d.copy(), t.copy(),
                   n1, d.copy(), t.copy(), n1.copy())  # fmt: skip
     a2 = np.zeros((1, 1))
