@@ -362,8 +362,8 @@ class MeasuredProposal:
         box, ``TIGHT`` of each batch's draws where it has ``TIGHT_MIN`` points or more and
         the key is not drawn from the defensive box alone (:meth:`_boxes`)."""
         lo, hi = st["box_lo"], st["box_hi"]
-        mid, half = 0.5 * (t_lo + t_hi), 0.5 * TIGHT_WIDEN * (t_hi - t_lo)
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore"):  # no feasible point: inf - inf
+            mid, half = 0.5 * (t_lo + t_hi), 0.5 * TIGHT_WIDEN * (t_hi - t_lo)
             tl, th = np.maximum(mid - half, lo), np.minimum(mid + half, hi)
             ok = (t_n >= TIGHT_MIN) & (th > tl).all(axis=1) & (st["n_def"] < self.samples)
         st["tight_lo"] = np.where(ok[:, None], tl, lo)
