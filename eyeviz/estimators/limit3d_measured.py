@@ -316,26 +316,47 @@ class MeasuredProposal:
 
     def _pilot(self, st: dict, keys: np.ndarray, box_lo: np.ndarray, box_hi: np.ndarray):
         """The box widened by half on each face near which a pilot's feasible draws fall,
-        ``PILOT`` draws, up to ``PILOT_ROUNDS`` times; and the box of the last round's
-        feasible draws (lo, hi, their number)."""
+        ``PILOT`` draws, up to ``PILOT_ROUNDS`` times; and the box of each key's last
+        round's feasible draws (lo, hi, their number). A round tries only the keys whose
+        box the last one widened (the others' draws and verdicts would be the same)."""
         slack = st["slack"]
         up = _uniforms(keys, PILOT, 3, 7)
         n = box_lo.shape[0]
-        tight = (box_lo, box_hi, np.zeros(n, np.int64))
+        box_lo, box_hi = box_lo.copy(), box_hi.copy()
+        t_lo, t_hi = np.full((n, 3), np.inf), np.full((n, 3), -np.inf)
+        t_n = np.zeros(n, np.int64)
+        live = np.arange(n)
         for _ in range(PILOT_ROUNDS):
-            x = box_lo[:, None] + (box_hi - box_lo)[:, None] * up
-            inside = (self._hb(st, x) >= -slack)[..., None]
-            t_lo = np.where(inside, x, np.inf).min(axis=1)
-            tight = (t_lo, np.where(inside, x, -np.inf).max(axis=1), inside[..., 0].sum(axis=1))
-            band = 0.1 * (box_hi - box_lo)[:, None]
-            near_lo = (inside & (x < box_lo[:, None] + band)).any(axis=1)
-            near_hi = (inside & (x > box_hi[:, None] - band)).any(axis=1)
-            if not (near_lo.any() or near_hi.any()):
+            lo, hi = box_lo[live], box_hi[live]
+            x = lo[:, None] + (hi - lo)[:, None] * up[live]
+            sub = st if live.size == n else self._keys(st, live)
+            inside = (self._hb(sub, x) >= -slack)[..., None]
+            t_lo[live] = np.where(inside, x, np.inf).min(axis=1)
+            t_hi[live] = np.where(inside, x, -np.inf).max(axis=1)
+            t_n[live] = inside[..., 0].sum(axis=1)
+            band = 0.1 * (hi - lo)[:, None]
+            near_lo = (inside & (x < lo[:, None] + band)).any(axis=1)
+            near_hi = (inside & (x > hi[:, None] - band)).any(axis=1)
+            grow = near_lo.any(axis=1) | near_hi.any(axis=1)
+            if not grow.any():
                 break
-            span = box_hi - box_lo
-            box_lo = np.where(near_lo, box_lo - 0.5 * span, box_lo)
-            box_hi = np.where(near_hi, box_hi + 0.5 * span, box_hi)
-        return box_lo, box_hi, tight
+            span = hi - lo
+            box_lo[live] = np.where(near_lo, lo - 0.5 * span, lo)
+            box_hi[live] = np.where(near_hi, hi + 0.5 * span, hi)
+            live = live[grow]
+        return box_lo, box_hi, (t_lo, t_hi, t_n)
+
+    def _keys(self, st: dict, idx: np.ndarray) -> dict:
+        """The state of the chunk's keys ``idx`` alone."""
+        n = st["u0"].shape[0]
+        sub = {k: (v.take(idx) if isinstance(v, _Edges) else v[idx] if
+                   isinstance(v, np.ndarray) and v.ndim and v.shape[0] == n else v)
+               for k, v in st.items()}  # fmt: skip
+        for name in ("lit_a", "lit_b"):
+            if name in st:
+                ptr, ind = st[name]
+                sub[name] = take_rows(ptr, ind, idx)
+        return sub
 
     def _defend(self, st: dict, lo, hi, proven) -> None:
         """The defensive box of each key's proposal (module docstring, step 5): where the
@@ -424,12 +445,7 @@ class MeasuredProposal:
         groups = np.unique(np.stack([first, counts], axis=1)[counts > 0], axis=0)
         for f0, c in groups:
             idx = np.flatnonzero((first == f0) & (counts == c))
-            sub = {k: (v.take(idx) if isinstance(v, _Edges) else v[idx] if
-                       isinstance(v, np.ndarray) and v.ndim and v.shape[0] == n else v)
-                   for k, v in st.items()}  # fmt: skip
-            for name in ("lit_a", "lit_b"):
-                ptr, ind = st[name]
-                sub[name] = take_rows(ptr, ind, idx)
+            sub = self._keys(st, idx)
             got = self.sample(sub, keys[idx], [int(f0) + 8 * j for j in range(int(c))])
             for k, v in got.items():
                 out[k][idx, : v.shape[1]] = v
