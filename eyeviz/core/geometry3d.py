@@ -117,9 +117,9 @@ def _merge_ref(n: int, x, y, z, g, cx: float, status, per, st, ln, bl):
 
 
 def _lit_csr_jit(n: int, x, y, z, g, h: float) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
-    """:meth:`EyePair3D.lit_csr` through the kernel: both eyes in one compiled call that
-    writes the indices from the runs (no temporaries per ball, no Python per block)."""
-    from eyeviz.core.kernels.healpix_lit import csr_kernel, lit_runs_kernel
+    """:meth:`EyePair3D.lit_csr` through the kernel: per eye the runs, then the indices
+    written from them in compiled code (no temporaries per ball, no Python per block)."""
+    from eyeviz.core.kernels.healpix_lit import csr_kernel, empty_indices, lit_runs_kernel
 
     sth, zr, unit = _ring_tables(n)
     first, nr, shifted, delta, o = _ring_info_tables(n)
@@ -130,10 +130,11 @@ def _lit_csr_jit(n: int, x, y, z, g, h: float) -> tuple[tuple[np.ndarray, np.nda
         status, per, st, ln, bl = lit_runs_kernel(
             n, x, y, z, g, cx, sth, zr, unit, first, nr, shifted, delta, o
         )
-        indptr, idx = csr_kernel(status, per, st, ln)
         if status.any():
-            per = np.diff(indptr)
             indptr, idx = _runs_to_csr(*_merge_ref(n, x, y, z, g, cx, status, per, st, ln, bl))
+        else:
+            idx = empty_indices(int(per.sum()))
+            indptr = csr_kernel(per, st, ln, idx)
         out.append((indptr, idx))
     kernels.mark_ready()
     return out[0], out[1]

@@ -180,6 +180,26 @@ def test_lit_csr_through_the_kernel_equals_the_reference(monkeypatch):
         g3.EyePair3D(40.0, 20.0, 1 << 20).lit(0.0, 100.0, 0.0, 50.0)
 
 
+@pytest.mark.parametrize("huge_up_to", [0, 1 << 40])
+def test_lit_csr_indices_from_either_allocator(monkeypatch, huge_up_to):
+    """The CSR indices go into numpy's array (huge pages) or numba's (past
+    HUGE_PAGES_UP_TO): the same sets either way."""
+    import eyeviz.core.kernels.healpix_lit as hl
+
+    rng = np.random.default_rng(7)
+    p = rng.uniform(-800, 800, (30, 3))
+    g = rng.uniform(5, 400, 30)
+    eyes = g3.EyePair3D(40.0, 20.0, 64)
+    monkeypatch.setitem(kernels._STATE, "ready", True)
+    monkeypatch.setattr(hl, "HUGE_PAGES_UP_TO", huge_up_to)
+    got = eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
+    monkeypatch.setenv("EYEVIZ_JIT", "0")
+    want = eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
+    for (a, b), (c, d) in zip(got, want, strict=True):
+        np.testing.assert_array_equal(a, c)
+        np.testing.assert_array_equal(b, d)
+
+
 def test_one_ball_estimate_equals_the_arrays():
     """The one-ball path's size estimate (Python floats) is lit_csr's on arrays."""
     for x, y, z, g in [(0.0, 100.0, 5.0, 30.0), (40.0, 0.0, 0.0, 1.0), (1e308, 1e308, 0, 1.0)]:

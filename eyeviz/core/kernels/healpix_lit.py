@@ -34,7 +34,7 @@ from eyeviz.core.kernels.healpix_boundary import (
 # before the first kernel: this module's cache carries healpix_boundary.py's source too
 stamp_with(__file__, healpix_boundary.__file__)
 
-__all__ = ["lit_runs_kernel", "csr_kernel", "warm"]
+__all__ = ["lit_runs_kernel", "csr_kernel", "empty_indices", "warm"]
 
 _HALF_PI = 0.5 * math.pi
 _SQ6 = math.sqrt(6.0)
@@ -360,22 +360,37 @@ def _ring(n, i, c, cos_p, zc_p, rc_p, pc, zc_lo, zc_hi, dnum, drel, dph, s2, ds2
 
 
 @_jit
-def csr_kernel(status, per, st, ln):
-    """(indptr, indices) from the runs (geometry3d._runs_to_csr, compiled); no indices
-    when a ball was handed back (geometry3d merges the reference's runs first)."""
+def csr_kernel(per, st, ln, out):
+    """The CSR indptr of the runs (geometry3d._runs_to_csr, compiled), their indices
+    written into ``out`` (per.sum() int64, the caller's: :func:`empty_indices`)."""
     indptr = np.zeros(per.shape[0] + 1, np.int64)
     for b in range(per.shape[0]):
         indptr[b + 1] = indptr[b] + per[b]
-    if status.any():
-        return indptr, np.empty(0, np.int64)
-    out = np.empty(indptr[-1], np.int64)
     k = 0
     for r in range(st.shape[0]):
         s = st[r]
         for j in range(ln[r]):
             out[k + j] = s + j
         k += ln[r]
-    return indptr, out
+    return indptr
+
+
+#: Indices up to this many come from numpy's allocator, which asks Linux for huge pages
+#: (madvise) for arrays over 4 MB: fresh 4 KiB pages' faults cost more than writing the
+#: indices (nside 180, 1000 balls: 13 -> 6 us a ball). Past about 128 MB the kernel
+#: compacts memory to find huge pages on a process's first use, 2-3x slower than small
+#: pages here (measured: 9-11 ns an index against 3.5-4), so larger ones take numba's.
+HUGE_PAGES_UP_TO = 1 << 24
+
+
+def empty_indices(k: int) -> np.ndarray:
+    """An uninitialised int64 array of k indices for :func:`csr_kernel`."""
+    return np.empty(k, np.int64) if k <= HUGE_PAGES_UP_TO else _empty_small_pages(k)
+
+
+@_jit
+def _empty_small_pages(k):
+    return np.empty(k, np.int64)
 
 
 def warm_inputs():
@@ -400,4 +415,5 @@ def warm() -> None:
     eyeviz.core.healpix)."""
     n, tabs, (x, y, z, g) = warm_inputs()
     status, per, st, ln, _ = lit_runs_kernel(n, x, y, z, g, 40.0, *tabs)
-    csr_kernel(status, per, st, ln)
+    csr_kernel(per, st, ln, empty_indices(int(per.sum())))
+    _empty_small_pages(1)
