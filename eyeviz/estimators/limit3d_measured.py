@@ -162,6 +162,24 @@ class MeasuredProposal:
         g_hi = np.minimum(np.minimum(hi_a, hi_b), np.minimum(r, d.g_max))
         return g_lo, g_hi
 
+    def _locate(self, st: dict, c: np.ndarray, ww: np.ndarray) -> np.ndarray:
+        """Per key the first of the centres c (N, G, 3) of largest H x ww (H / distance:
+        an angle), the reference search's step. Compiled with an early exit
+        (kernels.measured_limit.locate_kernel, the same point) unless ``EYEVIZ_JIT=0``."""
+        if kernels.use(c.shape[0] * c.shape[1]):
+            from eyeviz.core.kernels import measured_limit
+
+            # Any: the kernel takes 18 arrays and numbers (numba's Dispatcher stub types fewer)
+            locate: Any = measured_limit.locate_kernel
+            r = np.linalg.norm(c - self.origin, axis=2)
+            best = np.empty(c.shape[0], np.int64)
+            locate(kernels.arg(c, np.float64), r, kernels.arg(ww, np.float64), self.s_half,
+                   float(self.domain.g_max), *st["ea"].columns(), *st["eb"].columns(),
+                   best)  # fmt: skip
+            return best
+        g_lo, g_hi = self._h(st, c)
+        return np.argmax((g_hi - g_lo) * ww, axis=1)
+
     def _h_draws(self, st: dict, c: np.ndarray, live: np.ndarray, slack: float = -1.0):
         """:meth:`_h` at the draws' centres c (N, M, 3) where ``live``. Compiled, a draw
         is dropped at the first facet that empties its interval (its (g_lo, g_hi) then
@@ -272,8 +290,7 @@ class MeasuredProposal:
         for _ in range(LEVELS):
             dd = dc[:, None, :] + g3[None, :, :2] * half
             ww = np.clip(wc[:, None] + g3[None, :, 2] * wh[:, None], self.w_min, self.w_max)
-            g_lo, g_hi = self._h(st, self._centres(st, dd, ww))
-            b = np.argmax((g_hi - g_lo) * ww, axis=1)  # H / distance: an angle
+            b = self._locate(st, self._centres(st, dd, ww), ww)
             dc = dd[np.arange(n), b]
             wc = ww[np.arange(n), b]
             half, wh = half / 2.5, wh / 2.5

@@ -493,3 +493,24 @@ def test_direction_kernel_agrees_with_the_reference(monkeypatch):
             ang = np.arccos(np.clip((got * want).sum(axis=1), -1.0, 1.0))
             assert np.all(ang < 1e-6), (which, ang.max())
             assert np.allclose(np.linalg.norm(got, axis=1), 1.0)
+
+
+def test_locate_kernel_picks_the_reference_s_point(bee_small, monkeypatch):
+    """The reference search's step (MeasuredProposal._locate: the first grid point of
+    largest H x w), compiled with its early exit, against numpy: the same point on every
+    key, on grids about each key's reference and on grids far off (where H < 0 all over),
+    with the best point again at the grid's end (a tie: the first is the answer)."""
+    _, prop, stt, _, _ = bee_small
+    rng = np.random.default_rng(5)
+    n = stt["u0"].shape[0]
+    for spread in (0.02, 0.3, 3.0):
+        delta = rng.normal(scale=spread * prop.domain.gamma, size=(n, 125, 2))
+        ww = rng.uniform(prop.w_min, prop.w_max, size=(n, 125))
+        c = prop._centres(stt, delta, ww)
+        monkeypatch.setenv("EYEVIZ_JIT", "0")
+        first = prop._locate(stt, c, ww)
+        # the best point again at the grid's end: still the first one
+        c[:, -1], ww[:, -1] = c[np.arange(n), first], ww[np.arange(n), first]
+        for jit in ("1", "0"):
+            monkeypatch.setenv("EYEVIZ_JIT", jit)
+            assert np.array_equal(prop._locate(stt, c, ww), first), (spread, jit)

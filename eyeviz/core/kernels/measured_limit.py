@@ -20,7 +20,7 @@ from numba.core import caching
 from eyeviz.core.kernels import limit3d_region
 from eyeviz.core.kernels.limit3d_region import _cone_fold, _jit_np, _walk, bcentre, measured_prior
 
-__all__ = ["direction_kernel", "mixture_draws_kernel", "region_kernel", "warm"]
+__all__ = ["direction_kernel", "locate_kernel", "mixture_draws_kernel", "region_kernel", "warm"]
 
 
 class _WithRegionSource(caching.InTreeCacheLocator):
@@ -237,6 +237,39 @@ def direction_kernel(ax, half, lit, pad, c, hw, grid, levels):
         c[n, 0], c[n, 1], c[n, 2] = cx, cy, cz
 
 
+@_jit_np
+def locate_kernel(c, r, ww, s_half, g_max, pos_a, ax_a, ch_a, sh_a, lit_a, pad_a,
+                  pos_b, ax_b, ch_b, sh_b, lit_b, pad_b, best):  # fmt: skip
+    """The reference search's step (limit3d_measured.MeasuredProposal.setup): per key n
+    the first grid point g of largest (g_hi - g_lo) x ww[n, g] at the centres c (N, G, 3)
+    (r (N, G) their distance from the origin), g_lo and g_hi over the prior's g range and
+    both eyes' facets (as MeasuredProposal._h: max and min are exact, so the same values);
+    a point is given up once its value falls to the best so far (it only falls as facets
+    are folded in, and a product by ww > 0 keeps the order)."""
+    for n in range(c.shape[0]):
+        top, arg = -np.inf, 0
+        for g in range(c.shape[1]):
+            cx, cy, cz, w = c[n, g, 0], c[n, g, 1], c[n, g, 2], ww[n, g]
+            lo, hi = r[n, g] * s_half, min(r[n, g], g_max)
+            out = False
+            for k in range(pos_a.shape[1]):
+                if not pad_a[n, k]:
+                    lo, hi = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz, lo, hi)
+                    if g > 0 and (hi - lo) * w <= top:
+                        out = True
+                        break
+            for k in range(pos_b.shape[1]):
+                if out:
+                    break
+                if not pad_b[n, k]:
+                    lo, hi = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k, cx, cy, cz, lo, hi)
+                    if g > 0 and (hi - lo) * w <= top:
+                        out = True
+            if not out and (g == 0 or (hi - lo) * w > top):
+                top, arg = (hi - lo) * w, g
+        best[n] = arg
+
+
 def warm() -> None:
     """Compile (or load from the cache) the kernels for their one signature each."""
     a2 = np.zeros((1, 1))
@@ -247,6 +280,7 @@ def warm() -> None:
     v3 = np.ones(3)
     region_kernel(p3, c, c, c, v3, v3, 1.0, v3, 0.1, 1.0, 1e-7, *cs, *cs, a2.copy())
     direction_kernel(p3, a2, b, ~b, np.array([[0.0, 0.0, 1.0]]), np.ones(1), 2, 1)
+    locate_kernel(p3, a2 + 1, a2 + 1, 0.1, 1.0, *cs, *cs, np.zeros(1, np.int64))
     u4 = np.full((1, 1, 4), 0.5)
     boxes = np.zeros((1, 2, 2, 3))
     boxes[:, :, 1] = 1.0
