@@ -260,6 +260,8 @@ def _vdist_at(vc, n, r, l, sv, zv, ph, c):
     unit, the same bits from whichever cell it is reached: _decide_cell), its coordinates
     from the cache ``vc`` = (tags, xyz) where it holds them (the same products of
     the same numbers, so the same bits), else computed (and kept there)."""
+    if vc is None:  # compiled away: no cache, and no reference counts of its arrays
+        return _vdist(sv, zv, ph, c)
     tags, xyz = vc
     size = tags.shape[0]
     if size == 0:

@@ -227,7 +227,7 @@ def lit_runs_kernel(n, x, y, z, g, cx, sth, zr, unit, first_t, nr_t, shifted_t, 
     ln = np.empty(64 + 8 * nb, np.int64)
     bl = np.empty(64 + 8 * nb, np.int64)
     w = 0
-    vc = (np.empty(0, np.int64), np.empty((0, 3)))  # no vertex cache
+    vc = None  # no vertex cache (match_kernel passes one)
     for b in range(nb):
         w0 = w
         kind, par, i_min, i_max, _, _ = _ball(n, x[b], y[b], z[b], g[b], cx)
