@@ -280,7 +280,7 @@ def scan_kernel(cx, cy, cz, g, centre, lens, alpha, keys, starts, counts, pux, p
 
 
 def warm() -> None:
-    """Compile (or load from the cache) both kernels for their one signature."""
+    """Compile (or load from the cache) the kernels for their one signature each."""
     f = np.zeros(1)
     i = np.zeros(1, np.int64)
     b = np.zeros(1, np.bool_)
@@ -290,3 +290,7 @@ def warm() -> None:
     pu = np.zeros(LEVELS)
     perm = np.zeros(LEVELS, np.int64)
     scan_kernel(f, f, f, f + 1, np.zeros(3), 0.5, 0.1, keys, i, i + 1, pu, pu, pu, perm)
+    bounds = np.array([0, 1], np.int64)
+    key_check_kernel(f + 2, f, f, f + 1, bounds, f, f, f, f + 1, f, f, f + 1, f + 1, f, b,
+                     f + 1, f, f, f + 0.1, np.zeros(3), 0.5, bounds, i.copy(),
+                     np.ones(1, np.int64))  # fmt: skip
