@@ -32,9 +32,12 @@ __all__ = ["HealpixProposal"]
 PRUNE = 0.25
 #: zoom levels of the search for the centre (each grid a third as wide)
 LEVELS = 4
-#: grid points and rounds of the search along the ray for B's region
+#: grid points and rounds of the search along the ray for where the g test can pass
 RAY_GRID = 8
-RAY_ROUNDS = 2
+RAY_ROUNDS = 1
+#: the share of each batch's draws whose u is uniform on B's box along the ray (the
+#: defensive component: the search's bracket is not a proven hull of the posterior)
+DEFENSIVE = 1 / 16
 #: the per-key slack: this many times the model's second-order error in the box
 SLACK_SAFETY = 4.0
 
@@ -132,8 +135,9 @@ class HealpixProposal:
                              1.0 / (d.r_max + d.h), u_max, math.sin(d.gamma / 2), float(d.g_max),
                              float(d.r_min), float(d.r_max), float(d.el_max), float(d.psi),
                              self.prior == "multi", np.linspace(0.0, 1.0, RAY_GRID), RAY_ROUNDS,
-                             out["x"], out["y"], out["z"], out["g"], out["r"], out["az"],
-                             out["el"], out["w"], ca, alpha)  # fmt: skip
+                             int(self.samples * DEFENSIVE), self.samples, out["x"], out["y"],
+                             out["z"], out["g"], out["r"], out["az"], out["el"], out["w"], ca,
+                             alpha)  # fmt: skip
         return out, ca, alpha
 
     # long: the weighted draws of one chunk (propose, weigh) in one pass over shared arrays
@@ -168,8 +172,22 @@ class HealpixProposal:
         if d.r_min > d.h:
             u_hi = np.minimum(u_hi, 1.0 / (d.r_min - d.h))
         good = good & (u_hi > u_lo)
-        u_lo, u_hi = _ray_region_draws(eb, ca, u_lo, u_hi, good, slack, 1.0 / d.r_max)
-        uu = u_lo + (u_hi - u_lo) * u[..., 2]
+        # then narrowed to where the g test can pass (the search's bracket); a defensive
+        # share of the draws takes u on the box's interval, every weight over the mixture
+        with np.errstate(invalid="ignore"):
+            sa = (np.sin(np.clip(lo_a - slack, 0.0, math.pi / 2)),
+                  np.sin(np.clip(hi_a + slack, 0.0, math.pi / 2)))  # fmt: skip
+        h_lo, h_hi = _ray_region_draws(eb, ca, u_lo, u_hi, good, slack, 1.0 / d.r_max, sa)
+        wide = ~(h_hi > h_lo)  # a bracket of no width: the box's interval instead
+        h_lo, h_hi = np.where(wide, u_lo, h_lo), np.where(wide, u_hi, h_hi)
+        n_def = int(self.samples * DEFENSIVE)
+        lam = n_def / self.samples
+        box_u = (np.arange(m) % self.samples < n_def)[None, :]
+        uu = np.where(box_u, u_lo + (u_hi - u_lo) * u[..., 2], h_lo + (h_hi - h_lo) * u[..., 2])
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            q = lam / (u_hi - u_lo) + np.where(
+                (uu >= h_lo) & (uu <= h_hi), (1.0 - lam) / (h_hi - h_lo), 0.0
+            )
         uu = np.where(good, uu, 1.0 / d.r_max)
         rho = 1.0 / uu
         p = A + rho[..., None] * ca
@@ -190,7 +208,7 @@ class HealpixProposal:
         # d(x, y, z, g) = rho^4 sin(phi) d(u, theta, phi, g); 1 / q = the boxes' volume
         with np.errstate(over="ignore", invalid="ignore"):
             vol = (th_hi - th_lo)[:, None] * (box[:, 3] - box[:, 2])[:, None]
-            vol = vol * (u_hi - u_lo) * (g_hi - g_lo)
+            vol = vol * ((g_hi - g_lo) / q)
             w = prior_density(d, self.prior, r, gg, el, az) * rho**4 * sp * vol
         good = good & rows[:, None]  # the other keys' draws as drawn (weights 0: not checked)
         w = np.where(good & np.isfinite(w), w, 0.0)
@@ -234,11 +252,13 @@ class HealpixProposal:
         return w
 
 
-def _ray_region_draws(eb: _Eye, ca, u_lo, u_hi, good, slack, u_dead: float):
+def _ray_region_draws(eb: _Eye, ca, u_lo, u_hi, good, slack, u_dead: float, sa=None):
     """Each live draw's u-interval (``good`` (N, M)) narrowed to B's region along its ray
-    (:func:`_ray_in_region`); the other draws' set to ``u_dead``. Compiled: in place on
-    the live draws; numpy: on the live draws moved to the front of each row."""
-    if kernels.use(good.size):
+    (:func:`_ray_in_region`), or with ``sa`` (A's sin(lo_A - s), sin(hi_A + s), (N, M)
+    each) to where the g test can pass (numpy only: the draws' kernel searches so itself);
+    the other draws' set to ``u_dead``. Compiled: in place on the live draws; numpy: on
+    the live draws moved to the front of each row."""
+    if sa is None and kernels.use(good.size):
         from eyeviz.core.kernels.limit3d_affine import ray_region_kernel
 
         lo, hi = np.array(u_lo, np.float64), np.array(u_hi, np.float64)
@@ -258,7 +278,8 @@ def _ray_region_draws(eb: _Eye, ca, u_lo, u_hi, good, slack, u_dead: float):
 
     c_lo = np.where(sel, pick(u_lo), u_dead)
     c_hi = np.where(sel, pick(u_hi), u_dead)
-    c_lo, c_hi = _ray_in_region(eb, pick(ca), c_lo, c_hi, slack, RAY_GRID, RAY_ROUNDS)
+    aim = None if sa is None else (pick(sa[0]), pick(sa[1]))
+    c_lo, c_hi = _ray_in_region(eb, pick(ca), c_lo, c_hi, slack, RAY_GRID, RAY_ROUNDS, aim)
     rows = np.arange(n)[:, None]
     u_lo, u_hi = u_lo.copy(), u_hi.copy()
     u_lo[rows, order] = c_lo

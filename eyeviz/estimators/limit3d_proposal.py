@@ -539,25 +539,38 @@ def _ray_in_box(eye_b: _Eye, ca: np.ndarray, ext: np.ndarray) -> tuple[np.ndarra
     return lo, hi
 
 
-def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack, grid: int = 12, rounds: int = 2):
+def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack, grid: int = 12, rounds: int = 2, aim=None):
     """Shrink each draw's u-interval [lo, hi] (N, M) to one holding every u whose view
     from B lies in B's modelled region G = min_unlit - max_lit >= -slack. G is concave
     and the view moves monotonically along a great circle, so those u form an interval:
     G on ``grid`` points, the interval from the grid point before the first inside to the
     one after the last (or the two neighbours of the best point when none is inside);
     ``rounds`` times. Returns (lo, hi). (The numpy reference of
-    :func:`eyeviz.core.kernels.limit3d_affine.ray_region_kernel`.)"""
+    :func:`eyeviz.core.kernels.limit3d_affine.ray_region_kernel`.) With ``aim`` = (A's
+    sin(lo_A - s), sin(hi_A + s)) (N, M) each: the g test's gap instead, inside where
+    above 0 (``_gap_g`` there; the draws' kernel's search)."""
     n, m = lo.shape
     t = np.linspace(0.0, 1.0, grid)
     for _ in range(rounds):
         uu = lo[..., None] + (hi - lo)[..., None] * t  # (N, M, grid)
         v = ca[:, :, None, :] + uu[..., None] * eye_b.a
-        v = v / np.linalg.norm(v, axis=-1, keepdims=True)
+        nrm = np.linalg.norm(v, axis=-1, keepdims=True)
+        v = v / nrm
         with np.errstate(invalid="ignore", divide="ignore"):
             dl = eye_b.gnomonic(v.reshape(n, m * grid, 3))
             blo, bhi = eye_b.bounds(np.nan_to_num(dl, nan=1e3, posinf=1e3, neginf=-1e3))
-        g = (bhi - blo).reshape(n, m, grid)
-        inside = g >= -slack[..., None]
+        if aim is None:
+            g = (bhi - blo).reshape(n, m, grid)
+            inside = g >= -slack[..., None]
+        else:
+            k = nrm[..., 0]
+            s3 = slack[..., None]
+            with np.errstate(invalid="ignore"):
+                sb_lo = np.sin(np.clip(blo.reshape(n, m, grid) - s3, 0.0, math.pi / 2))
+                sb_hi = np.sin(np.clip(bhi.reshape(n, m, grid) + s3, 0.0, math.pi / 2))
+                g = np.minimum(sb_hi, aim[1][..., None] / k)
+                g = g - np.maximum(sb_lo, aim[0][..., None] / k)
+            inside = g > 0.0
         anyin = inside.any(axis=2)
         first = np.where(anyin, inside.argmax(axis=2), g.argmax(axis=2))
         last = np.where(anyin, grid - 1 - inside[..., ::-1].argmax(axis=2), first)

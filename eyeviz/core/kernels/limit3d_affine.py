@@ -133,10 +133,41 @@ def _gap_at(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, caz, u
 
 
 @_jit
+def _gap_g(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, caz, u, sa_lo, sa_hi,
+           slack):  # fmt: skip
+    """The g test's gap along A's ray at u, in B's sin-angle: min(sin(hi_B + s), sin_hi_A /
+    k) - max(sin(lo_B - s), sin_lo_A / k), k = |c_A + u (A - B)| = rho_B / rho (the
+    angles clipped to [0, pi / 2]; sa_lo, sa_hi: A's sin(lo_A - s), sin(hi_A + s)). A
+    draw's g interval is not empty iff it is above 0 (the prior's g range aside)."""
+    vx = cax + u * a[0]
+    vy = cay + u * a[1]
+    vz = caz + u * a[2]
+    nrm = math.sqrt(vx * vx + vy * vy + vz * vz)
+    vx, vy, vz = vx / nrm, vy / nrm, vz / nrm
+    cc = vx * c[n, 0] + vy * c[n, 1] + vz * c[n, 2]
+    x = vx * e1[n, 0] + vy * e1[n, 1] + vz * e1[n, 2]
+    y = vx * e2[n, 0] + vy * e2[n, 1] + vz * e2[n, 2]
+    lo, hi = _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n, _clean(x / cc), _clean(y / cc))
+    h2 = 0.5 * math.pi
+    sb_lo = math.sin(_clip_nan(lo - slack, 0.0, h2))
+    sb_hi = math.sin(_clip_nan(hi + slack, 0.0, h2))
+    return _min(sb_hi, sa_hi / nrm) - _max(sb_lo, sa_lo / nrm)
+
+
+@_jit
+def _clip_nan(x, lo, hi):
+    """numpy's clip (NaN stays NaN)."""
+    if x != x:
+        return x
+    return min(max(x, lo), hi)
+
+
+@_jit
 def _ray_search(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, caz, lo_, hi_,
-                slack, t, rounds, gv, uu):  # fmt: skip
+                slack, t, rounds, gv, uu, aim=False, sa_lo=0.0, sa_hi=0.0):  # fmt: skip
     """One draw's search of :func:`ray_region_kernel`: (lo, hi) shrunk ``rounds`` times
-    on the grid t (gv, uu: work arrays of its size)."""
+    on the grid t (gv, uu: work arrays of its size). ``aim``: for the g test's gap
+    (:func:`_gap_g`, inside where > 0), not B's region (inside where >= -slack)."""
     grid = t.size
     for _ in range(rounds):
         first = -1
@@ -144,9 +175,15 @@ def _ray_search(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, ca
         best = 0
         for j in range(grid):
             uu[j] = lo_ + (hi_ - lo_) * t[j]
-            gv[j] = _gap_at(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, caz,
-                            uu[j])  # fmt: skip
-            if gv[j] >= -slack:
+            if aim:
+                gv[j] = _gap_g(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, caz,
+                               uu[j], sa_lo, sa_hi, slack)  # fmt: skip
+                inside = gv[j] > 0.0
+            else:
+                gv[j] = _gap_at(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay,
+                                caz, uu[j])  # fmt: skip
+                inside = gv[j] >= -slack
+            if inside:
                 if first < 0:
                     first = j
                 last = j
@@ -385,13 +422,17 @@ def _clip(x, lo, hi):
 @_jit_np
 def healpix_draws_kernel(u, rows, th_lo, th_hi, box, ext, ext_b, slack, fa, ca_, e1a, e2a,
                          fb, cb, e1b, e2b, ab, pa, pb, u_min, u_max, s_half, g_max, r_min,
-                         r_max, el_max, psi, multi, t, rounds,
+                         r_max, el_max, psi, multi, t, rounds, n_def, samples,
                          x, y, z, g, r, az, el, w, ca, alpha):  # fmt: skip
     """HealpixProposal.sample's draws before the exact check, one at a time, each given up
     at its first test that fails: (theta, phi) of A's direction from the uniforms u
     (N, M, 4), inside A's box of centres and A's modelled region, u = 1 / rho in B's box
-    along the ray (:func:`_ray_box`) then in B's region (:func:`_ray_search`), g where
-    both eyes' modelled radii and the prior allow it, the prior and the weight. fa, fb:
+    along the ray (:func:`_ray_box`), then narrowed to where the g test can pass
+    (:func:`_ray_search` of :func:`_gap_g`), g where both eyes' modelled radii and the
+    prior allow it, the prior and the weight. Of each batch of ``samples`` draws the first
+    ``n_def`` take u uniform on B's box along the ray (the defensive share: the narrowed
+    interval is a search's bracket, not a proven hull), the others on the narrowed
+    interval; every weight divides by the two's mixture density at its u. fa, fb:
     each eye's affine forms (a_lit, t_lit, a_unl, t_unl, lists); ab = A - B; pa, pb the
     eyes' centres. Writes x, y, z, g, r, az, el, w, ca (N, M, 3) and alpha (N, M) where
     the weight is above 0 (w 0 elsewhere, the others then unset); only the keys ``rows``
@@ -401,6 +442,7 @@ def healpix_draws_kernel(u, rows, th_lo, th_hi, box, ext, ext_b, slack, fa, ca_,
     gv = np.empty(t.size)
     uu = np.empty(t.size)
     h2 = 0.5 * math.pi
+    lam = n_def / samples
     for n in range(u.shape[0]):
         sn = slack[n]
         dth = th_hi[n] - th_lo[n]
@@ -428,9 +470,20 @@ def healpix_draws_kernel(u, rows, th_lo, th_hi, box, ext, ext_b, slack, fa, ca_,
             uhi = _min(uhi, u_max)
             if not uhi > ulo:
                 continue
-            ulo, uhi = _ray_search(bl, sl_, bu, su, lb, cb, e1b, e2b, ab, n, cx, cy, cz, ulo, uhi,
-                                   sn, t, rounds, gv, uu)  # fmt: skip
-            rho = 1.0 / (ulo + (uhi - ulo) * u[n, m, 2])
+            sa_lo = math.sin(_clip(lo_a - sn, 0.0, h2))
+            sa_hi = math.sin(_clip(hi_a + sn, 0.0, h2))
+            hlo, hhi = _ray_search(bl, sl_, bu, su, lb, cb, e1b, e2b, ab, n, cx, cy, cz, ulo, uhi,
+                                   sn, t, rounds, gv, uu, True, sa_lo, sa_hi)  # fmt: skip
+            if not hhi > hlo:  # a bracket of no width: the box's interval instead
+                hlo, hhi = ulo, uhi
+            if m % samples < n_def:
+                uv = ulo + (uhi - ulo) * u[n, m, 2]
+            else:
+                uv = hlo + (hhi - hlo) * u[n, m, 2]
+            q = lam / (uhi - ulo)
+            if uv >= hlo and uv <= hhi:
+                q += (1.0 - lam) / (hhi - hlo)
+            rho = 1.0 / uv
             px, py, pz = pa[0] + rho * cx, pa[1] + rho * cy, pa[2] + rho * cz
             rr = math.sqrt(px * px + py * py + pz * pz)
             vx, vy, vz = px - pb[0], py - pb[1], pz - pb[2]
@@ -452,7 +505,7 @@ def healpix_draws_kernel(u, rows, th_lo, th_hi, box, ext, ext_b, slack, fa, ca_,
             e = math.asin(_clip(pz / rr, -1.0, 1.0))
             phi = math.atan2(py, px)
             dens = healpix_prior(rr, gg, e, phi, s_half, g_max, r_min, r_max, el_max, psi, multi)
-            vol = vol0 * (uhi - ulo) * (g_hi - g_lo)
+            vol = vol0 * ((g_hi - g_lo) / q)
             wt = dens * rho**4 * sp * vol
             if not (math.isfinite(wt) and wt > 0.0):
                 continue
@@ -492,6 +545,6 @@ def warm() -> None:
     one, b4 = np.ones(1), np.ones((1, 4))
     healpix_draws_kernel(np.full((1, 1, 4), 0.5), np.ones(1, np.bool_), one * 0, one, b4,
                          c[:, :2].copy(), c[:, :2].copy(), one, f, c, c, c, f, c, c, c, v3, v3,
-                         v3, 0.01, np.inf, 0.1, 1.0, 1.0, 10.0, 1.0, 0.1, False, tt, 1,
+                         v3, 0.01, np.inf, 0.1, 1.0, 1.0, 10.0, 1.0, 0.1, False, tt, 1, 0, 1,
                          o[0], o[1], o[2], o[3], o[4], o[5], o[6], o[7], ca.copy(),
                          out.copy())  # fmt: skip
