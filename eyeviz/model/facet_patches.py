@@ -54,6 +54,7 @@ __all__ = [
     "direction_text",
     "facet_patches",
     "patches_caption",
+    "patches_caption_forms",
 ]
 
 #: Bearings about its axis at which a cell cut by its cap is outlined.
@@ -331,15 +332,25 @@ def _measured_patches(pair: Any, eye: str, step: int) -> FacetPatches:
     return hit
 
 
-#: Each eye model's facet outlines and their caption, by ``pair.kind`` (the row a new
-#: model in space adds): HEALPix cells of the spherical pair's nside; Voronoi patches
-#: about a measured pair's facet axes.
-PATCHES: dict[str, tuple[Callable[[Any, str, int], FacetPatches], Callable[[Any], str]]] = {
-    "spherical": (_healpix_patches, lambda p: f"nside {p.nside}, {p.npix:,} facets per eye"),
-    "measured": (
-        _measured_patches,
-        lambda p: f"{p.facet_counts[0]:,} (A) and {p.facet_counts[1]:,} (B) measured facets",
-    ),
+def _healpix_caption(p: Any) -> tuple[str, ...]:
+    return (f"nside {p.nside}, {p.npix:,} facets per eye", f"nside {p.nside}, {p.npix:,} facets",
+            f"{p.npix:,} facets")  # fmt: skip
+
+
+def _measured_caption(p: Any) -> tuple[str, ...]:
+    a, b = p.facet_counts
+    return (f"{a:,} (A) and {b:,} (B) measured facets", f"{a:,} + {b:,} measured facets",
+            f"{a:,} + {b:,} facets")  # fmt: skip
+
+
+#: Each eye model's facet outlines and their caption's forms, longest first, by
+#: ``pair.kind`` (the row a new model in space adds): HEALPix cells of the spherical
+#: pair's nside; Voronoi patches about a measured pair's facet axes.
+PATCHES: dict[
+    str, tuple[Callable[[Any, str, int], FacetPatches], Callable[[Any], tuple[str, ...]]]
+] = {
+    "spherical": (_healpix_patches, _healpix_caption),
+    "measured": (_measured_patches, _measured_caption),
 }
 
 
@@ -362,4 +373,11 @@ def facet_patches(pair: Any, eye: str, step: int = 2) -> FacetPatches:
 def patches_caption(pair: Any) -> str:
     """The eyes' facets in a few words: 'nside 8, 768 facets per eye' or '3,187 (A) and
     3,187 (B) measured facets'."""
+    return _row(pair)[1](pair)[0]
+
+
+def patches_caption_forms(pair: Any) -> tuple[str, ...]:
+    """:func:`patches_caption` and its shorter forms, longest first, for a panel that
+    shows the first one its width holds: '3,187 (A) and 3,187 (B) measured facets',
+    '3,187 + 3,187 measured facets', '3,187 + 3,187 facets'."""
     return _row(pair)[1](pair)

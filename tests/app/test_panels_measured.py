@@ -199,3 +199,30 @@ def test_the_honeybee_scene_in_the_window_maps_its_lit_facets(make_window, qtbot
     want = f"eye A, facet {f:,}: axis "
     qtbot.waitUntil(lambda: panel.hover.text().startswith(want), timeout=3000)
     assert panel.hover.text().endswith(f"lit by {host.model.scene.features[i].name!r}")
+
+
+def test_the_facets_caption_of_the_honeybee_fits_a_1280x720_window(make_window, qtbot):
+    """bee.toml in a 1280 x 720 window: the Facets dock's first line was "3,187 (A) and
+    3,187 (B) measured fac…"; it now takes a shorter form that fits, whole."""
+    from pathlib import Path
+
+    from PyQt5 import QtWidgets
+
+    from eyeviz.model.facet_patches import patches_caption_forms
+    from eyeviz.model.scene import load
+
+    path = Path(__file__).resolve().parents[2] / "assets" / "scenes" / "bee.toml"
+    win = make_window(load(path), path)
+    win.resize(1280, 720)
+    qtbot.waitUntil(lambda: win.width() == 1280, timeout=3000)
+    host = win.host3d
+    host.docks["bitmaps3d"].show()
+    host.docks["bitmaps3d"].raise_()
+    panel = host.bitmaps
+    qtbot.waitUntil(lambda: panel.canvas.isVisible() and panel._bg is not None, timeout=8000)
+    qtbot.wait(300)
+    shown = QtWidgets.QLabel.text(panel.counts).split("\n")
+    assert "\N{HORIZONTAL ELLIPSIS}" not in shown[0], shown
+    assert shown[0] in patches_caption_forms(host.model.state.pair), shown
+    room = panel.counts.contentsRect().width()
+    assert panel.counts.fontMetrics().horizontalAdvance(shown[0]) <= room, (shown, room)

@@ -17,6 +17,7 @@ from eyeviz.model.facet_patches import (
     VoronoiPatches,
     facet_patches,
     patches_caption,
+    patches_caption_forms,
 )
 
 
@@ -123,6 +124,12 @@ def test_patches_are_kept_per_pair_and_eye(bee):
     assert facet_patches(pair, "A").n == 192
     assert patches_caption(pair) == "nside 4, 192 facets per eye"
     assert patches_caption(bee) == "3,187 (A) and 3,187 (B) measured facets"
+    # shorter forms for a narrow panel, each shorter than the last, keeping the counts
+    for p, counts in ((pair, ["192"]), (bee, ["3,187", "3,187"])):
+        forms = patches_caption_forms(p)
+        assert forms[0] == patches_caption(p) and len(forms) == 3
+        assert all(len(a) > len(b) for a, b in zip(forms[:-1], forms[1:], strict=True))
+        assert all(f.count(c) >= counts.count(c) for f in forms for c in counts)
     with pytest.raises(ValueError, match="eye must be"):
         facet_patches(bee, "C")
     d = facet_patches(bee, "A").describe(0)

@@ -55,7 +55,7 @@ from eyeviz.app.panels.map_geometry import (
 )
 from eyeviz.app.panels.map_zoom import MapZoom
 from eyeviz.model import responses3d as r3
-from eyeviz.model.facet_patches import FacetPatches, facet_patches, patches_caption
+from eyeviz.model.facet_patches import FacetPatches, facet_patches, patches_caption_forms
 from eyeviz.model.scene import Scene
 from eyeviz.model.state3d import SceneState3D
 from eyeviz.render.mpl.facet_map import (
@@ -327,10 +327,10 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             edge.set_facecolor(fc)
             counts.append(f"{eye} {pix.size:,}")
         sel = "" if self.selected is None else f"; {self.names[self.selected]!r} outlined"
-        cap, lit = patches_caption(pair), "lit: " + ", ".join(counts)
-        short = cap.removesuffix(" per eye")  # "nside 8, 768 facets", then "768 facets"
-        forms = (cap, short, short.split(", ")[-1])
-        self.counts.set_lines([forms, (lit + sel, lit, lit.removeprefix("lit: "))])
+        lit = "lit: " + ", ".join(counts)
+        self.counts.set_lines(
+            [patches_caption_forms(pair), (lit + sel, lit, lit.removeprefix("lit: "))]
+        )
         if changed:
             self._repaint()
         self.update_ms = (time.perf_counter() - t0) * 1e3
