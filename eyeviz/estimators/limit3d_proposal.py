@@ -457,11 +457,19 @@ def _locate(eye: _Eye, half: float, n: int, levels: int) -> None:
 
 def _extent(eye: _Eye, reach: float, slack, iters: int = 12) -> np.ndarray:
     """Half-widths (N, 2) of a box about the centre holding every delta with
-    G(delta) >= -slack (bisection along NDIR directions: G is concave)."""
+    G(delta) >= -slack (bisection along NDIR directions: G is concave). The bisection is
+    compiled unless ``EYEVIZ_JIT=0`` (kernels.limit3d_affine.extent_kernel, the same bits)."""
     n = eye.c.shape[0]
     dirs = _dirs(NDIR)
     lo = np.zeros((n, NDIR))
     hi = np.full((n, NDIR), reach)
+    if kernels.use(n * NDIR * iters):
+        from eyeviz.core.kernels.limit3d_affine import extent_kernel
+
+        sl = kernels.arg(np.broadcast_to(slack, (n, 1))[:, 0], np.float64)
+        extent_kernel(eye.a_lit, eye.t_lit, eye.a_unl, eye.t_unl, eye.lists, dirs,
+                      float(reach), sl, iters, hi)  # fmt: skip
+        iters = 0
     for _ in range(iters):
         mid = 0.5 * (lo + hi)
         a, b = eye.bounds(mid[..., None] * dirs[None])

@@ -254,3 +254,24 @@ def test_prune_with_the_kernel_is_the_reference_s(monkeypatch):
         assert e.pad.shape[1] < k0 and (~e.pad).sum() > 0  # it pruned, and kept some
         for name in ("pts", "lit", "pad", "d", "t", "a_lit", "t_lit", "a_unl", "t_unl"):
             assert np.array_equal(getattr(e, name), getattr(f, name)), name
+
+
+@pytest.mark.parametrize("nside,seed", [(16, 11), (180, 12)])
+def test_extent_with_the_kernel_is_the_reference_bit_for_bit(nside, seed, monkeypatch):
+    """_extent's bisection compiled (extent_kernel) and in numpy, on real keys' models at
+    their located centres, with a scalar slack and a per-key one: the same box."""
+    from eyeviz.core import kernels
+    from eyeviz.estimators.limit3d_proposal import _extent, _locate
+
+    monkeypatch.setitem(kernels._STATE, "ready", True)
+    fw = math.sqrt(4 * math.pi / (12 * nside**2))
+    for e in _eyes(nside, seed):
+        _locate(e, 0.25 * fw, 8, 4)
+        n = e.c.shape[0]
+        for slack in (0.002 * fw, np.linspace(1e-7, 0.01, n)[:, None] * fw):
+            got = _extent(e, 0.5 * fw, slack)
+            with monkeypatch.context() as mp:
+                mp.setenv("EYEVIZ_JIT", "0")
+                want = _extent(e, 0.5 * fw, slack)
+            assert np.array_equal(got, want)
+            assert (got > 1e-12).any() and (got < 0.5 * fw * 1.5).all()

@@ -22,6 +22,7 @@ from numba import njit
 
 __all__ = [
     "affine_bounds_kernel",
+    "extent_kernel",
     "ray_region_kernel",
     "healpix_draws_kernel",
     "healpix_prior",
@@ -112,6 +113,27 @@ def affine_bounds_kernel(a_lit, t_lit, a_unl, t_unl, lists, delta, lo, hi):
             lo[n, g], hi[n, g] = _affine_lists(
                 a_lit, t_lit, a_unl, t_unl, lists, n, delta[n, g, 0], delta[n, g, 1]
             )
+
+
+@_jit
+def extent_kernel(a_lit, t_lit, a_unl, t_unl, lists, dirs, reach, slack, iters, hi):
+    """limit3d_proposal._extent's bisection: along each direction dirs[k] (K, 2) from each
+    key's centre, ``iters`` halvings of [0, reach] keeping the model's G = min_unlit -
+    max_lit >= -slack[n] below; hi (N, K) the outer ends (the same arithmetic as numpy's:
+    the same bits)."""
+    for n in range(hi.shape[0]):
+        for k in range(dirs.shape[0]):
+            lo_ = 0.0
+            hi_ = reach
+            for _ in range(iters):
+                mid = 0.5 * (lo_ + hi_)
+                a, b = _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n, mid * dirs[k, 0],
+                                     mid * dirs[k, 1])  # fmt: skip
+                if (b - a) >= -slack[n]:
+                    lo_ = mid
+                else:
+                    hi_ = mid
+            hi[n, k] = hi_
 
 
 @_jit
@@ -543,6 +565,7 @@ def warm() -> None:
     out = np.zeros((1, 1))
     lists = (a2, a3, n1 + 1, a2, a3, n1 + 1)
     affine_bounds_kernel(a2, a3, a2, a3, lists, dl, out, out.copy())
+    extent_kernel(a2, a3, a2, a3, lists, np.ones((1, 2)), 1.0, np.ones(1), 2, out.copy())
     v3 = np.ones(3)
     ca = np.ones((1, 1, 3))
     bb = np.ones((1, 1), np.bool_)
