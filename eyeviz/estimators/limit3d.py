@@ -209,14 +209,24 @@ class Limit3DEstimator(Estimator3D):
         reps: int = 1,
     ) -> dict[str, np.ndarray]:
         """Weighted posterior samples of a chunk: dict of (N, reps * samples) arrays (the
-        eye model's proposal set up once, ``reps`` batches of draws)."""
+        eye model's proposal set up once, ``reps`` batches of draws). With ``reps`` > 1
+        (the retries: their caller keeps each key's first ``samples`` accepted draws in
+        draw order) a key gets no more groups of batches once it has ``samples``."""
         prop = self._proposal
         st = prop.setup(lit_a, lit_b, keys, wide)
         # the batches ``_GROUP`` at a time (side by side; each as if drawn alone)
         streams = [stream + 8 * rep for rep in range(reps)]
-        parts = [
-            _compact(prop.sample(st, keys, streams[i : i + _GROUP])) for i in range(0, reps, _GROUP)
-        ]
+        parts: list[dict] = []
+        got = np.zeros(keys.size, np.int64)
+        for i in range(0, reps, _GROUP):
+            rows = got < self.samples
+            if not rows.any():
+                break
+            part = _compact(
+                prop.sample(st, keys, streams[i : i + _GROUP], None if rows.all() else rows)
+            )
+            got += (part["w"] > 0).sum(axis=1)
+            parts.append(part)
         out = {k: np.concatenate([q[k] for q in parts], axis=1) for k in parts[0]}
         if reps > 1:
             return out

@@ -143,6 +143,7 @@ def key_check_kernel(cx, cy, cz, g, bounds, px, py, pz, ax, ay, az, nrm, cs, sn,
     lst = np.empty(nf, np.int64)
     islit = np.empty(nf, np.bool_)
     kj = np.empty(nf)
+    kl = np.empty(nf)
     amax = 0.0
     for j in range(nf):
         amax = max(amax, half[j])
@@ -176,6 +177,10 @@ def key_check_kernel(cx, cy, cz, g, bounds, px, py, pz, ax, ay, az, nrm, cs, sn,
                     t += 1
                 k = th - half[j] - math.asin(min(1.0, ej / near))
                 lst[n_l], islit[n_l], kj[n_l] = j, t < l1 and ki[t] == j, k - _REL * (1 + abs(k))
+                kl[n_l] = math.inf
+                if islit[n_l] and not exact_only[j] and ej < near:
+                    k = th - half[j] + math.asin(ej / near)
+                    kl[n_l] = k + _REL * (1 + abs(k))
                 emax = max(emax, ej)
                 n_l += 1
         by = np.argsort(kj[:n_l])
@@ -187,16 +192,23 @@ def key_check_kernel(cx, cy, cz, g, bounds, px, py, pz, ax, ay, az, nrm, cs, sn,
                 continue
             dx, dy, dz = cx[b] - ox, cy[b] - oy, cz[b] - oz
             db = math.sqrt(dx * dx + dy * dy + dz * dz) * (1 - _REL)
-            reach = math.inf
+            reach, safe = math.inf, -math.inf
             if db > (emax + g[b]) * (1 + _REL):
-                reach = _angle(dx, dy, dz, wx, wy, wz) + math.asin(min(1.0, g[b] / (db - emax)))
+                ab = _angle(dx, dy, dz, wx, wy, wz)
+                reach = ab + math.asin(min(1.0, g[b] / (db - emax)))
                 reach = reach * (1 + _REL) + _REL
+                # no lens of the list in the ball; a lit facet with kl_j <= safe sees it
+                dh = (db / (1 - _REL)) * (1 + _REL) + emax
+                safe = math.asin(g[b] / (dh * (1 + _REL))) * (1 - _REL) - _REL
+                safe = safe - (ab * (1 + _REL) + _REL)
             verdict, n_lit = 1, 0
             for q in range(n_l):
                 t = by[q]
                 if kj[t] > reach:
                     break
                 n_lit += islit[t]
+                if kl[t] <= safe:  # a lit facet that surely sees the ball
+                    continue
                 seen, sure, inside = _certify(cx[b], cy[b], cz[b], g[b], px, py, pz, ax, ay,
                                               az, nrm, cs, sn, exact_only, lst[t])  # fmt: skip
                 if not sure:
