@@ -21,7 +21,6 @@ from numba import njit
 __all__ = [
     "cone_bounds_kernel",
     "interval_kernel",
-    "measured_draws_kernel",
     "direction_keep_kernel",
     "uniforms_kernel",
     "measured_prior",
@@ -234,78 +233,6 @@ def measured_prior(r, g, el, az, s_half, g_max, r_min, r_max, el_max, multi):
     return dens if math.isfinite(dens) else 0.0
 
 
-# long: one draw of limit3d_measured.MeasuredProposal.sample (centre, g interval, g,
-# weight) is one loop body; split, it would pass a dozen scalars back and forth
-@_jit_np
-def measured_draws_kernel(u, box_lo, box_hi, def_lo, def_hi, n_def, samples, u0, e1, e2,
-                          fa, bhat, blen, origin, s_half, g_max, r_min, r_max, el_max, multi,
-                          rows, pos_a, ax_a, ch_a, sh_a, lit_a, pad_a,
-                          pos_b, ax_b, ch_b, sh_b, lit_b, pad_b,
-                          x, y, z, g, r, az, el, w):  # fmt: skip
-    """limit3d_measured.MeasuredProposal.sample up to the exact check, draw by draw:
-    (delta, beta) and g from the uniforms u (N, M, 4), the centre, its g interval (the
-    walk of :func:`interval_kernel`, stopping once it is empty), the prior and the
-    weight. Of each batch of ``samples`` draws the first ``n_def[n]`` come from the
-    defensive box (def_lo, def_hi), the rest from the box (box_lo, box_hi): the weight
-    divides by the two boxes' mixture density (the box's volume alone where n_def is 0).
-    Writes x, y, z, g, r, az, el, w (N, M) where the weight is above 0 (w 0 elsewhere,
-    the other outputs then unset); only the keys ``rows`` (N,) get draws."""
-    order = np.empty((u.shape[0], pos_a.shape[1] + pos_b.shape[1]), np.int64)
-    order_d = np.empty_like(order)  # the defensive box's draws keep an order of their own
-    for n in range(u.shape[0]):
-        for k in range(order.shape[1]):
-            order[n, k] = k
-            order_d[n, k] = k
-        if not rows[n]:
-            for m in range(u.shape[1]):
-                w[n, m] = 0.0
-            continue
-        vol0 = (box_hi[n, 0] - box_lo[n, 0]) * (box_hi[n, 1] - box_lo[n, 1])
-        vol0 = vol0 * (box_hi[n, 2] - box_lo[n, 2])
-        vol1 = (def_hi[n, 0] - def_lo[n, 0]) * (def_hi[n, 1] - def_lo[n, 1])
-        vol1 = vol1 * (def_hi[n, 2] - def_lo[n, 2])
-        lam = n_def[n] / samples
-        for m in range(u.shape[1]):
-            w[n, m] = 0.0
-            lo_, hi_, ordr = box_lo, box_hi, order
-            if m % samples < n_def[n]:
-                lo_, hi_, ordr = def_lo, def_hi, order_d
-            d0 = lo_[n, 0] + (hi_[n, 0] - lo_[n, 0]) * u[n, m, 0]
-            d1 = lo_[n, 1] + (hi_[n, 1] - lo_[n, 1]) * u[n, m, 1]
-            beta = lo_[n, 2] + (hi_[n, 2] - lo_[n, 2]) * u[n, m, 2]
-            cx, cy, cz, rho, drho = bcentre(u0[n], e1[n], e2[n], d0, d1, beta, fa, bhat, blen)
-            if not math.isfinite(rho):
-                continue
-            qx, qy, qz = cx - origin[0], cy - origin[1], cz - origin[2]
-            rr = math.sqrt(qx * qx + qy * qy + qz * qz)
-            out, g_lo, g_hi = _walk(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b,
-                                    sh_b, lit_b, pad_b, ordr, n, cx, cy, cz, rr * s_half,
-                                    min(rr, g_max))  # fmt: skip
-            if out:
-                continue
-            pad = 1e-9 * g_hi
-            g_lo, g_hi = max(g_lo - pad, 0.0), g_hi + pad
-            gg = g_lo + (g_hi - g_lo) * u[n, m, 3]
-            e = math.asin(min(max(qz / rr, -1.0), 1.0))
-            phi = math.atan2(qy, qx)
-            dens = measured_prior(rr, gg, e, phi, s_half, g_max, r_min, r_max, el_max, multi)
-            jac = rho * rho * (1.0 + (d0 * d0 + d1 * d1)) ** -1.5 * drho
-            if n_def[n] == 0:
-                wt = dens * jac * (vol0 * (g_hi - g_lo))
-            else:
-                inside = (d0 >= box_lo[n, 0] and d0 <= box_hi[n, 0] and d1 >= box_lo[n, 1]
-                          and d1 <= box_hi[n, 1] and beta >= box_lo[n, 2]
-                          and beta <= box_hi[n, 2])  # fmt: skip
-                q = lam / vol1
-                if inside:
-                    q += (1.0 - lam) / vol0
-                wt = dens * jac * ((g_hi - g_lo) / q)
-            if not (math.isfinite(wt) and wt > 0.0):
-                continue
-            x[n, m], y[n, m], z[n, m], g[n, m] = cx, cy, cz, gg
-            r[n, m], az[n, m], el[n, m], w[n, m] = rr, phi, e, wt
-
-
 _GOLD = np.uint64(0x9E3779B97F4A7C15)
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
 _M2 = np.uint64(0x94D049BB133111EB)
@@ -428,20 +355,12 @@ def warm() -> None:
     """Compile (or load from the cache) the kernels for their one signature each."""
     a2 = np.zeros((1, 1))
     out = np.zeros((1, 1))
-    v3 = np.ones(3)
     c = np.ones((1, 3))
     b = np.ones((1, 1), np.bool_)
     p3 = np.ones((1, 1, 3))
     cs = (p3, p3, a2 + 0.9, a2 + 0.1, b, ~b)
     cone_bounds_kernel(*cs, p3, out, out.copy())
     interval_kernel(*cs, *cs, p3, b, out, out + 1, -1.0)
-    u4 = np.full((1, 1, 4), 0.5)
-    z3 = np.zeros((1, 3))
-    o1 = np.zeros((1, 1))
-    measured_draws_kernel(u4, z3, z3 + 1, z3, z3 + 1, np.zeros(1, np.int64), 1, c, c, c, v3,
-                          v3, 1.0, v3, 0.1, 1.0, 0.5, 9.0, 1.0, False, b[0].copy(), *cs, *cs,
-                          o1, o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(),
-                          o1.copy())  # fmt: skip
     direction_keep_kernel(p3, a2, b, ~b, p3, np.ones(1), np.ones(1), np.ones(1), b.copy())
     uniforms_kernel(np.ones(1, np.uint64), 1, np.zeros(1, np.int64), np.empty((1, 1, 4)))
     pts = np.ones((1, 1, 2, 3))
