@@ -423,16 +423,20 @@ def _compact(s: dict) -> dict:
     acc = w > 0
     cnt = acc.sum(axis=1)
     k = max(1, int(cnt.max()) if cnt.size else 1)
-    order = np.argsort(~acc, axis=1, kind="stable")[:, :k]
-    keep = np.arange(k)[None, :] < cnt[:, None]
+    # the accepted draws row by row in draw order, each to its place among its row's
+    rows, cols = np.nonzero(acc)
+    at = np.arange(rows.size) - (np.cumsum(cnt) - cnt)[rows]
     out = {}
     for name, v in s.items():
-        v = np.take_along_axis(v, order, 1)
+        got = v[rows, cols]
         if name == "w":
-            out[name] = np.where(keep, v, 0.0)
-            continue
-        top = np.where(keep, v, -np.inf).max(axis=1, keepdims=True)
-        out[name] = np.where(keep, v, np.where(np.isfinite(top), top, 1.0))
+            pad = np.zeros(cnt.size)
+        else:
+            top = np.where(acc, v, -np.inf).max(axis=1) if v.size else np.full(cnt.size, np.inf)
+            pad = np.where(np.isfinite(top), top, 1.0)
+        o = np.repeat(pad[:, None], k, axis=1)
+        o[rows, at] = got
+        out[name] = o
     return out
 
 

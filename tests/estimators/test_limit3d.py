@@ -291,3 +291,32 @@ def test_compact_keeps_the_accepted_draws_and_the_medians_read_no_padding():
             assert weighted_median(c["r"][i : i + 1], (c["w"] / c["r"])[i : i + 1])[0] == want
             want = weighted_median(el[i, acc][None], w[i, acc][None])[0]
             assert weighted_median(c["el"][i : i + 1], c["w"][i : i + 1])[0] == want
+
+
+def test_compact_keeps_each_rows_accepted_draws_in_order_then_its_largest_value():
+    """limit3d._compact against a row-by-row reading of its docstring: each row's draws
+    of weight > 0 first, in draw order; then padding of weight 0 holding the row's
+    largest accepted value of each quantity (1 where none is accepted), as wide as the
+    most accepted draws of a row (at least 1). NaN and negative weights are not accepted;
+    NaN values stay as they are."""
+    from eyeviz.estimators.limit3d import _compact
+
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        n, m = int(rng.integers(0, 6)), int(rng.integers(1, 30))
+        w = rng.random((n, m))
+        w[rng.random((n, m)) < rng.random()] = 0.0
+        w[rng.random((n, m)) < 0.05] = np.nan
+        w[rng.random((n, m)) < 0.05] = -1.0
+        r = np.where(rng.random((n, m)) < 0.1, np.nan, rng.normal(size=(n, m)))
+        got = _compact({"r": r, "w": w})
+        acc = w > 0
+        k = max(1, int(acc.sum(axis=1).max()) if n else 1)
+        for name, v in (("r", r), ("w", w)):
+            assert got[name].shape == (n, k)
+            for i in range(n):
+                kept = v[i][acc[i]]
+                pad = 0.0 if name == "w" else (np.max(kept) if kept.size else 1.0)
+                pad = pad if np.isfinite(pad) else 1.0
+                want = np.concatenate([kept, np.full(k - kept.size, pad)])
+                assert np.array_equal(got[name][i], want, equal_nan=True), (name, i)
