@@ -423,20 +423,21 @@ def _compact(s: dict) -> dict:
     acc = w > 0
     cnt = acc.sum(axis=1)
     k = max(1, int(cnt.max()) if cnt.size else 1)
-    # the accepted draws row by row in draw order, each to its place among its row's
-    rows, cols = np.nonzero(acc)
-    at = np.arange(rows.size) - (np.cumsum(cnt) - cnt)[rows]
+    # the accepted draws row by row in draw order (row-major), each to its place in its row
+    rows = np.repeat(np.arange(cnt.size), cnt)
+    first = np.cumsum(cnt) - cnt
+    at = rows * k + (np.arange(rows.size) - first[rows])
+    some = cnt > 0
     out = {}
     for name, v in s.items():
-        got = v[rows, cols]
-        if name == "w":
-            pad = np.zeros(cnt.size)
-        else:
-            top = np.where(acc, v, -np.inf).max(axis=1) if v.size else np.full(cnt.size, np.inf)
-            pad = np.where(np.isfinite(top), top, 1.0)
-        o = np.repeat(pad[:, None], k, axis=1)
-        o[rows, at] = got
-        out[name] = o
+        got = v[acc]
+        pad = np.zeros(cnt.size) if name == "w" else np.ones(cnt.size)
+        if name != "w" and got.size:
+            top = np.maximum.reduceat(got, first[some])
+            pad[some] = np.where(np.isfinite(top), top, 1.0)
+        o = np.repeat(pad, k)
+        o[at] = got
+        out[name] = o.reshape(cnt.size, k)
     return out
 
 
