@@ -356,6 +356,33 @@ def test_sized_top_ups_give_the_answers_of_four_batches_at_a_time(far, monkeypat
     assert drawn[True] < drawn[False]
 
 
+def test_the_retries_stop_drawing_a_key_once_it_has_its_draws(small, monkeypatch):
+    """limit3d._draw with reps > 1 (the retries, which keep each key's first ``samples``
+    accepted draws in draw order) gives a key no more groups of batches once it has
+    ``samples`` accepted draws: those first draws are the ones all the batches give, bit
+    for bit, and some keys stop early while others go on (groups of 2 batches here)."""
+    from eyeviz.estimators import limit3d
+
+    monkeypatch.setattr(limit3d, "_GROUP", 2)
+    dom, _, _, lit = small
+    m = 32
+    est = Limit3DEstimator(dom, samples=m)
+    keys = _key_hash(*lit) ^ np.uint64(est.seed)
+    got = est._draw(*lit, keys, 2.5, 2, reps=24)
+    prop = est._proposal
+    st = prop.setup(*lit, keys, 2.5)
+    full = limit3d._compact(prop.sample(st, keys, [2 + 8 * rep for rep in range(24)]))
+    got = limit3d._compact(got)  # the groups' accepted draws first, as _posterior takes them
+    n_got, n_full = (got["w"] > 0).sum(axis=1), (full["w"] > 0).sum(axis=1)
+    assert np.array_equal(np.minimum(n_got, m), np.minimum(n_full, m))
+    assert (n_got < n_full).any() and ((n_got > m) & (n_full > n_got)).sum() < n_got.size
+    assert (n_full > m).any() and (n_full < m).any()
+    for n in range(n_got.size):
+        k = min(int(n_got[n]), m)
+        for name in full:
+            assert np.array_equal(got[name][n, :k], full[name][n, :k]), (name, n)
+
+
 def point_pair() -> MeasuredEyePair:
     """The small pair's facets with every lens of an eye at one point, its centre: the key
     check's bound (limit3d_cones.key_hits) is then tight, angle(a_j, c - o) <= alpha_j +
