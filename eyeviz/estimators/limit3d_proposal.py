@@ -444,9 +444,18 @@ _DIRS = np.stack([np.cos(np.arange(8) * math.pi / 4), np.sin(np.arange(8) * math
 
 def _locate(eye: _Eye, half: float, n: int, levels: int) -> None:
     """Move the eye's centre to the maximum of G (zooming grids of n x n about the best
-    point, each a third as wide) and linearise there."""
+    point, each a third as wide) and linearise there. Compiled unless ``EYEVIZ_JIT=0``
+    (kernels.limit3d_locate.locate_kernel: the same formulas, in place)."""
     rows = np.arange(eye.c.shape[0])
     g0 = _grid(n)
+    if kernels.use(eye.pts.shape[0] * eye.pts.shape[1]) and hasattr(eye, "lists"):
+        from eyeviz.core.kernels.limit3d_locate import locate_kernel
+
+        s = 1.5 * math.sqrt(4 * math.pi / (12 * eye.nside**2)) / STEP
+        locate_kernel(eye.pts, eye.lit, eye.pad, s, g0, half, levels, eye.c, eye.e1, eye.e2,
+                      eye.d, eye.t, eye.a_lit, eye.t_lit, eye.a_unl, eye.t_unl, eye.lists,
+                      np.empty(g0.shape[0]))  # fmt: skip
+        return
     for _ in range(levels):
         g = g0[None] * half
         lo, hi = eye.bounds(np.broadcast_to(g, (rows.size, *g0.shape)))

@@ -275,3 +275,55 @@ def test_extent_with_the_kernel_is_the_reference_bit_for_bit(nside, seed, monkey
                 want = _extent(e, 0.5 * fw, slack)
             assert np.array_equal(got, want)
             assert (got > 1e-12).any() and (got < 0.5 * fw * 1.5).all()
+
+
+@pytest.mark.parametrize("nside,seed", [(16, 13), (180, 14)])
+def test_locate_kernel_is_the_numpy_loop_bit_for_bit(nside, seed, monkeypatch):
+    """_locate compiled (limit3d_locate.locate_kernel) and as its numpy loop of kernel
+    calls (the grid's bounds, argmax, direction, linearise): the same centres, frames and
+    model to the bit; and the numpy reference (EYEVIZ_JIT=0) to 1e-9."""
+    import copy
+
+    from eyeviz.core import kernels
+    from eyeviz.estimators.limit3d_proposal import _grid, _locate
+
+    monkeypatch.setitem(kernels._STATE, "ready", True)
+    fw = math.sqrt(4 * math.pi / (12 * nside**2))
+    for e in _eyes(nside, seed):
+        e.prune(np.full(e.c.shape[0], 0.25 * fw))
+        f, r = copy.deepcopy(e), copy.deepcopy(e)
+        _locate(e, 0.25 * fw, 8, 4)
+        half, g0 = 0.25 * fw, _grid(8)
+        for _ in range(4):  # the loop the kernel replaces, each step compiled
+            g = g0[None] * half
+            lo, hi = f.bounds(np.broadcast_to(g, (f.c.shape[0], *g0.shape)))
+            f.linearise(f.direction(g[0][np.argmax(hi - lo, axis=1)][:, None, :])[:, 0])
+            half = half / 3.0
+        assert not np.array_equal(e.c, r.c)  # it moved
+        for name in ("c", "e1", "e2", "d", "t", "a_lit", "t_lit", "a_unl", "t_unl"):
+            assert np.array_equal(getattr(e, name), getattr(f, name)), name
+        for a, b in zip(e.lists, f.lists, strict=True):
+            assert np.array_equal(a, b)
+        with monkeypatch.context() as mp:
+            mp.setenv("EYEVIZ_JIT", "0")
+            _locate(r, 0.25 * fw, 8, 4)
+        assert np.allclose(e.c, r.c, rtol=0, atol=1e-9)
+
+
+def test_locate_kernel_takes_the_first_of_equal_points_as_argmax():
+    """A key whose model has no cells (G = inf at every grid point): the centre moves to
+    the grid's first point, as numpy's argmax picks (the kernel's ties)."""
+    from eyeviz.core.kernels.limit3d_locate import locate_kernel
+    from eyeviz.estimators.limit3d_proposal import _frame, _grid
+
+    c = np.array([[0.0, 0.6, 0.8]])
+    e1, e2 = _frame(c)
+    g0 = _grid(4)
+    pad = np.ones((1, 1), np.bool_)
+    d, t = np.zeros((1, 1)), np.zeros((1, 1, 2))
+    n0 = np.zeros(1, np.int64)
+    lists = (d.copy(), t.copy(), n0, d.copy(), t.copy(), n0.copy())
+    want = c + 0.1 * g0[0, 0] * e1 + 0.1 * g0[0, 1] * e2
+    locate_kernel(np.ones((1, 1, 2, 3)), ~pad, pad, 0.01, g0, 0.1, 1, c, e1, e2, d, t,
+                  d.copy(), t.copy(), d.copy(), t.copy(), lists, np.empty(g0.shape[0]))  # fmt: skip
+    assert np.allclose(c, want / np.linalg.norm(want), atol=1e-15)

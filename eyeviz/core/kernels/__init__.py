@@ -54,6 +54,7 @@ KERNELS = (
     "measured_limit",
     "healpix_boundary",
     "limit3d_affine",
+    "limit3d_locate",
 )
 
 
