@@ -27,6 +27,23 @@ if [ -n "$missing" ]; then
     fi
 fi
 
+# Compile the numba kernels once into their cache (eyeviz/core/kernels/__pycache__), so
+# neither a first run nor a test worker compiles them (a few seconds when already warm).
+# Two processes, half the kernel modules each (a cold compile is single-threaded). On a
+# first install they start as soon as numpy and numba are in, beside pip's install of
+# the rest (the kernels import nothing else: PYTHONPATH finds eyeviz before its install).
+warm_half() {
+    PYTHONPATH=$PWD${PYTHONPATH:+:$PYTHONPATH} \
+        .venv/bin/python -c "from eyeviz.core import kernels as k; k.warm(k.KERNELS[$1::2])"
+}
+warm_kernels() {
+    warm_half 0 &
+    local half=$! ok=1
+    warm_half 1 || ok=0
+    wait "$half" || ok=0
+    [ "$ok" = 1 ]
+}
+
 PY=${PYTHON:-python3}
 if [ ! -x .venv/bin/python ]; then
     "$PY" -m venv .venv
@@ -37,22 +54,21 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
     log=.venv/setup.log
     {
         .venv/bin/python -m pip install --upgrade pip &&
-        # torch first, pinned: any other request pulls a multi-GB CUDA build.
-        .venv/bin/python -m pip install "torch==2.13.0" &&
+        # torch first, pinned: any other request pulls a multi-GB CUDA build; with it
+        # what the kernels need (pyproject's bounds), so that they compile beside the rest
+        .venv/bin/python -m pip install "torch==2.13.0" "numpy>=1.26" "numba>=0.60" &&
+        { warm_kernels & } &&
         .venv/bin/python -m pip install -e ".[app,ml,study,dev]"
-    } >"$log" 2>&1 || { tail -n 30 "$log" >&2; echo "eyeviz setup: pip failed (log: $log)" >&2; exit 1; }
+    } >"$log" 2>&1 || {
+        wait
+        tail -n 30 "$log" >&2
+        echo "eyeviz setup: pip failed (log: $log)" >&2
+        exit 1
+    }
     touch "$stamp"
 fi
-# Compile the numba kernels once into their cache (eyeviz/core/kernels/__pycache__), so
-# neither a first run nor a test worker compiles them (a few seconds when already warm).
-# Two processes, half the kernel modules each (a cold compile is single-threaded).
-warm_half() {
-    .venv/bin/python -c "from eyeviz.core import kernels as k; k.warm(k.KERNELS[$1::2])"
-}
-warm_half 0 &
-half=$!
-warm_ok=1
-warm_half 1 || warm_ok=0
-wait "$half" || warm_ok=0
-[ "$warm_ok" = 1 ] ||
+# Wait for the warm begun beside pip, then warm (again): the cache is read in a few seconds,
+# and what pip's second step changed (a numba or numpy version) compiles now.
+wait
+warm_kernels ||
     echo "eyeviz setup: warming the compiled kernels failed (they compile on first use)" >&2
