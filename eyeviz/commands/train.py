@@ -67,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from eyeviz import EyevizError
-    from eyeviz.estimators import registry, store
+    from eyeviz.estimators import fit_checks, registry, store
 
     e = registry.get(args.what)
     options = registry.options_from_args(e.fit_options, args)
@@ -93,6 +93,8 @@ def run(args: argparse.Namespace) -> int:
     data = getattr(args, "data", None)
     if data is not None and not Path(data).is_file():
         raise EyevizError(f"data file {data} not found")
+    # before the fit's import (torch, seconds): a bad number is refused at once
+    fit_checks.check(e.name, options, data is not None)
     print(f"{e.name}: training into {out_dir}", file=sys.stderr)
     bar = _progress(e.name, options)
     try:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -154,21 +155,22 @@ def test_train_bayes_npz_name_into_user_dir(tmp_path):
     assert est.metadata["sample_size"] == 20000
 
 
+#: eyeviz train options refused in one line (before the fit, and torch, is imported)
+BAD_TRAINING_OPTIONS = [
+    (["paper", "--ad-lr", "nan"], "ad_lr must be a finite number > 0 and <= 10, got nan"),
+    (["paper", "--ad-lr", "inf"], "ad_lr must be a finite number > 0 and <= 10, got inf"),
+    (["paper", "--ad-lr", "0"], "ad_lr must be a finite number > 0 and <= 10, got 0.0"),
+    (["paper", "--dd-momentum", "1", "-n", "20"], "dd_momentum must be"),
+    (["paper", "-n", "5"], "n must be an integer >= 10, got 5"),
+    (["paper", "--budget", "-3"], "budget must be a finite number > 0"),
+    (["compact", "-n", "1000"], "-n must be >= 4096 (one batch"),
+    (["compact", "--threads", "0"], "threads must be an integer >= 1 and <= 1024, got 0"),
+    (["bayes", "-n", "0"], "n must be an integer >= 1 and <= 1000000000, got 0"),
+]
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize(
-    "args, message",
-    [
-        (["paper", "--ad-lr", "nan"], "ad_lr must be a finite number > 0 and <= 10, got nan"),
-        (["paper", "--ad-lr", "inf"], "ad_lr must be a finite number > 0 and <= 10, got inf"),
-        (["paper", "--ad-lr", "0"], "ad_lr must be a finite number > 0 and <= 10, got 0.0"),
-        (["paper", "--dd-momentum", "1", "-n", "20"], "dd_momentum must be"),
-        (["paper", "-n", "5"], "n must be an integer >= 10, got 5"),
-        (["paper", "--budget", "-3"], "budget must be a finite number > 0"),
-        (["compact", "-n", "1000"], "-n must be >= 4096 (one batch"),
-        (["compact", "--threads", "0"], "threads must be an integer >= 1 and <= 1024, got 0"),
-        (["bayes", "-n", "0"], "n must be an integer >= 1 and <= 1000000000, got 0"),
-    ],
-)
+@pytest.mark.parametrize("args, message", BAD_TRAINING_OPTIONS)
 def test_bad_training_options_one_line(tmp_path, args, message):
     res = _run(["train", *args], tmp_path)
     assert res.returncode == 2
@@ -176,6 +178,25 @@ def test_bad_training_options_one_line(tmp_path, args, message):
     assert last.startswith("eyeviz: error: ") and message in last, res.stderr
     assert "Traceback" not in res.stderr
     assert not (tmp_path / "models").exists() or not any((tmp_path / "models").rglob("*.pt"))
+
+
+@pytest.mark.parametrize("args, message", BAD_TRAINING_OPTIONS)
+def test_bad_training_options_are_refused_before_the_fit_is_imported(
+    tmp_path, monkeypatch, args, message
+):
+    """`eyeviz train` checks the numbers before it imports the fit (torch, seconds): the
+    same one-line refusal, the fit never reached (eyeviz.estimators.fit_checks)."""
+    from eyeviz import cli
+    from eyeviz.estimators import registry
+
+    def no_fit(*_a, **_k):
+        raise AssertionError("the fit was reached")
+
+    monkeypatch.setattr(registry.Entry, "fit_estimator", no_fit)
+    monkeypatch.setenv("EYEVIZ_HOME", str(tmp_path))
+    parsed = cli.build_parser().parse_args(["train", *args, "--seed", "1"])
+    with pytest.raises(EyevizError, match=re.escape(message)):
+        parsed._run(parsed)
 
 
 def test_into_assets_and_out_together_refused(tmp_path):
