@@ -48,6 +48,9 @@ PY=${PYTHON:-python3}
 if [ ! -x .venv/bin/python ]; then
     "$PY" -m venv .venv
 fi
+# eyeviz's byte code, written even under PYTHONDONTWRITEBYTECODE (read all the same): the
+# tests' Python processes then load it, not compile it (beside pip; quick when current)
+.venv/bin/python -m compileall -q eyeviz >/dev/null 2>&1 &
 stamp=.venv/.eyeviz-installed
 if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
     echo "eyeviz setup: installing Python packages into .venv (first run takes a few minutes)" >&2
