@@ -5,6 +5,7 @@ import collections
 import math
 import time
 
+import pytest
 from mouse import move, pixel_of
 from PyQt5 import QtCore, QtWidgets
 from PyQt5.QtTest import QTest
@@ -30,6 +31,7 @@ class Counter(QtCore.QObject):
         return sum(v for (t, _), v in self.counts.items() if t == int(kind))
 
 
+@pytest.mark.slow
 def test_a_drag_move_lays_out_nothing_and_paints_little(make_window):
     fs = [Feature(f"f{i}", -2000.0 + 400 * i, 3000.0, 60.0) for i in range(8)]
     fs.append(Feature("dragged", 0.0, 1500.0, 50.0, "#D55E00"))

@@ -44,6 +44,7 @@ def _shown(dock) -> bool:
     return dock.isVisible() and not dock.visibleRegion().isEmpty()
 
 
+@pytest.mark.slow
 def test_sphere_lecture_frames_each_step_and_keeps_its_panels_in_f5(make_window, qtbot):
     path = scene_path("sphere_lecture")
     whole = load(path)
@@ -133,6 +134,7 @@ def _settled(host, qtbot):
     return last
 
 
+@pytest.mark.slow
 def test_sphere_view_nothing_moves_on_its_own_and_the_menus_speak_plainly(make_window, qtbot):
     path = scene_path("sphere_lecture")
     win = make_window(load(path), path)

@@ -15,6 +15,7 @@ texts' boxes),
 Real keys (xdotool) into the real window."""
 
 import numpy as np
+import pytest
 from test_labels3d import _boxes, _disc
 from test_lecture_names_175 import _box, lecture_at_175
 from test_presenting_real_x import _keys, window_manager  # noqa: F401
@@ -50,6 +51,7 @@ def _leader_to(segments, disc, box, origin) -> bool:
     return False
 
 
+@pytest.mark.slow
 def test_balls_clear_the_texts_and_names_stay_near_their_balls_at_175(make_window, qtbot):
     win, path = lecture_at_175(make_window, qtbot)
     scale = win.presenter.scale

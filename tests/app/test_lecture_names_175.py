@@ -6,6 +6,7 @@ the close-up's names each other or its caption (item 4).
 Real keys (xdotool) into the real window."""
 
 import numpy as np
+import pytest
 from test_lecture3d import _focus3d
 from test_presenting_real_x import _keys, window_manager  # noqa: F401
 
@@ -44,6 +45,7 @@ def lecture_at_175(make_window, qtbot):
     return win, path
 
 
+@pytest.mark.slow
 def test_names_clear_the_title_at_175_percent_in_every_step(make_window, qtbot):
     win, path = lecture_at_175(make_window, qtbot)
     host = win.host3d

@@ -6,6 +6,7 @@ dock as narrow as at the normal text size), the bitmaps
 panel's four rows show whole, no feature sits under the title; after F5 on and off the
 panel's rows fit its width again."""
 
+import pytest
 from test_presenting_real_x import _focus, _keys, _screen_size, window_manager  # noqa: F401
 
 from eyeviz.app.panels.readout import ValueText
@@ -39,6 +40,7 @@ def _lecture(make_window, qtbot):
     return win
 
 
+@pytest.mark.slow
 def test_each_step_shows_the_readout_the_bitmaps_and_the_features_whole(make_window, qtbot):
     win = _lecture(make_window, qtbot)
     _keys(qtbot, "F5", until=lambda: win.presenter.presenting)

@@ -5,6 +5,7 @@ from inside") at both sides of the 390 px dock in steps 4-7; the 3D view's side 
 ("seen from front, right, above") at the right of its 533 px view in steps 2-5.
 Real keys (xdotool) into the real window."""
 
+import pytest
 from matplotlib.text import Text
 from test_lecture_names_175 import _box, lecture_at_175
 from test_presenting_real_x import _keys, window_manager  # noqa: F401
@@ -12,6 +13,7 @@ from test_presenting_real_x import _keys, window_manager  # noqa: F401
 from eyeviz.model.scene import load
 
 
+@pytest.mark.slow
 def test_caption_and_map_titles_fit_their_panes_at_175_percent(make_window, qtbot):
     win, path = lecture_at_175(make_window, qtbot)
     host = win.host3d

@@ -12,6 +12,7 @@ scrolled sideways. Before, at F11 + F5 + 175 % on a 1280 x 720 screen:
 
 Real keys (xdotool) into the real window."""
 
+import pytest
 from PyQt5 import QtWidgets
 from test_lecture_names_175 import _box, lecture_at_175
 from test_presenting_real_x import _keys, window_manager  # noqa: F401
@@ -36,6 +37,7 @@ def _vtk_texts(host) -> dict[str, str]:
     }
 
 
+@pytest.mark.slow
 def test_every_step_shows_its_words_whole_at_175_percent(make_window, qtbot):
     win, path = lecture_at_175(make_window, qtbot)
     host = win.host3d
@@ -95,6 +97,7 @@ def test_every_step_shows_its_words_whole_at_175_percent(make_window, qtbot):
     assert tables >= 1 and maps_lines >= 4 and statuses >= 7, (tables, maps_lines, statuses)
 
 
+@pytest.mark.slow
 def test_the_balls_table_columns_come_back_when_there_is_room(make_window, qtbot):
     """A column that gave way at 175 % comes back at 100 % (Ctrl+0): the table keeps
     nothing hidden that fits."""
@@ -116,6 +119,7 @@ def test_the_balls_table_columns_come_back_when_there_is_room(make_window, qtbot
     assert t.toolTip() == ""
 
 
+@pytest.mark.slow
 def test_the_close_up_names_each_read_as_their_own_eye_at_175_percent(make_window, qtbot):
     """In the close-up (a 300 px pane at 175 %) each eye's name is clearly its own: its
     middle nearer its eye's centre than 0.75 times the other eye's distance. In step 6

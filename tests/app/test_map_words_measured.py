@@ -6,6 +6,7 @@ and each lies inside the panel; and where "left" and "right" fit beside the map 
 shown (at F5 + 175 % in 1280 x 720 the estimate hid them where they fit whole).
 Real keys (xdotool) into the real window."""
 
+import pytest
 from matplotlib.text import Text
 from PyQt5 import QtCore
 from test_lecture3d import _focus3d
@@ -28,6 +29,7 @@ def _apart(a, b) -> bool:
     return min(a.x1, b.x1) <= max(a.x0, b.x0) or min(a.y1, b.y1) <= max(a.y0, b.y0)
 
 
+@pytest.mark.slow
 def test_map_words_never_overlap_at_any_zoom_and_show_where_they_fit(make_window, qtbot):
     path = scene_path("sphere_lecture")
     win = make_window(load(path), path)

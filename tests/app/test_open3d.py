@@ -297,6 +297,7 @@ def test_cli_screenshot_of_a_spherical_scene(tmp_path):
         assert (np.abs(view - rgb).sum(axis=1) < 60).sum() > 20, color
 
 
+@pytest.mark.slow
 def test_the_docks_follow_a_drag_every_fourth_frame_at_most(make_window, qtbot, monkeypatch):
     """The Mollweide maps cost ~75 ms at nside 180: during a drag they are refreshed at
     most every fourth frame (and at the drag's end), however slow the frames."""

@@ -19,6 +19,7 @@ import pytest
 HERE = Path(__file__).resolve().parent
 
 
+@pytest.mark.slow
 def test_the_status_bar_stays_on_a_1280x720_screen_in_every_lecture_step():
     for tool in ("xvfb-run", "openbox", "xdotool"):
         if shutil.which(tool) is None:

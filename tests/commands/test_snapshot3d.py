@@ -108,6 +108,7 @@ def test_bad_spherical_scene_exit_2_in_a_process(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
 
 
+@pytest.mark.slow
 def test_snapshot3d_imports_no_vtk_qt_or_torch(tmp_path):
     probe = (
         "import json, sys\nfrom eyeviz.cli import main\nrc = main(sys.argv[1:])\n"
@@ -237,6 +238,7 @@ def test_transparent_export_keeps_the_unlit_sphere(tmp_path, capsys):
     assert img[int((1 - box.y1) * h) + 1, int(box.x0 * w) + 1, 3] == 0.0  # outside the map
 
 
+@pytest.mark.slow
 def test_snapshot3d_view_presets(tmp_path, capsys):
     """--view picks the 3D view's camera preset (vector and PNG); a bad name or a planar
     scene is refused in one line naming --view, before anything is written."""

@@ -70,6 +70,7 @@ def test_png_size_does_not_grow_with_features(tmp_path):
     assert sizes[400][0] == 1050 and sizes[400][1] < 3000
 
 
+@pytest.mark.slow
 def test_min_font_makes_a_taller_figure_and_bad_values_are_refused(tmp_path):
     scene = SCENES / "default.toml"
     heights = {}

@@ -31,6 +31,7 @@ def seeds(path) -> set[int]:
     return {int(k[-1]) for k in StudyTable.open(path).keys}
 
 
+@pytest.mark.slow
 def test_new_study_draws_a_seed_and_a_resume_keeps_it(tmp_path):
     a, b = tmp_path / "a.csv", tmp_path / "b.csv"
     out_a = study("-o", a, *ONE)

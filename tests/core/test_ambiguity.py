@@ -183,6 +183,7 @@ def test_issue_example_is_flagged_unknown_and_radius_range_holds_g():
     assert g0 <= ISSUE_FEATURE[2] <= g1
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(annulus_features())
 def test_feature_in_its_own_region_or_unknown(feat):

@@ -48,6 +48,7 @@ def _compare(n, x, y, z, g):
     return decided
 
 
+@pytest.mark.slow
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     name=st.sampled_from(sorted(sc.CLASSES3D)),

@@ -393,6 +393,7 @@ def _reference_predict(est, ds):
     )
 
 
+@pytest.mark.slow
 def test_shipped_predictions_are_the_reference_floats():
     """More rows than one batch of the network (16,384): predict's blocks of 32,768 rows
     still feed it the batches it had (the reference's network chunks them the same way),

@@ -79,6 +79,7 @@ def _check(eyes, x, y, z, g) -> tuple[int, int]:
 # Every class on every run, two hypothesis draws of seed and nside each: an equator-ties
 # example costs over a second (its balls go to the exact path), so the examples are
 # counted per class, and the suite's time does not depend on which classes were drawn
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(sc.CLASSES3D))
 @settings(max_examples=2, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(0, 2**20), nside=st.sampled_from([None, *NSIDES]))
@@ -202,6 +203,7 @@ def _bands_check(d: Domain3D, x, y, z, g, keys_of, lit_a, lit_b) -> tuple[int, i
 
 
 # Every class on every run, as above (grazing balls at nside 180 cost seconds)
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(sc.CLASSES3D))
 @settings(max_examples=2, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(

@@ -94,6 +94,7 @@ def test_the_camera_is_the_views_and_a_preset_changes_the_picture(tmp_path):
     np.testing.assert_allclose(coll.get_paths()[-1].vertices[:-1], ref.verts[-1], atol=1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["svg", "pdf"])
 def test_vector_export_is_true_vector_and_sane_in_size(tmp_path, fmt):
     """nside 180 with every view layer: polygons only (no raster image), a few MB."""

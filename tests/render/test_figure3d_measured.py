@@ -46,6 +46,7 @@ def _owner(st, eye):
     return own
 
 
+@pytest.mark.slow
 def test_svg_snapshot_draws_the_patches_as_paths(bee, tmp_path, capsys):
     sc, st = bee
     out = tmp_path / "bee.svg"

@@ -160,6 +160,7 @@ SAME_FRACTION = 1e-4  # ... but on this fraction of them
 
 # nside 180's lit patches in the close-up are compared at a double column (a view 2112 px
 # wide; at a single one, IoU 0.62-0.8 at scales 1.2-1.6: patches of a few pixels)
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "scale", "width"), [("sphere_teaching", 0.6, 3.5), ("sphere_paper", 1.0, 7.2)]
 )

@@ -21,6 +21,7 @@ ROOT = Path(__file__).resolve().parents[2]
 STEMS = ("study3d_design", "study3d_dd", "study3d_law", "study3d_elevation")
 
 
+@pytest.mark.slow
 def test_report_study_draws_the_3d_figures_and_opens_them(tmp_path):
     pytest.importorskip("distributed")
     import matplotlib.image as mpimg

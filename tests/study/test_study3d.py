@@ -28,6 +28,7 @@ def rows_without_seconds(path):
     )
 
 
+@pytest.mark.slow
 def test_a_tiny_3d_study_runs_and_resumes_skipping_finished_points(tmp_path):
     path = tmp_path / "s3.csv"
     first = design_grid3d("20,40", "10", "8,16", n=150, seed=2)
