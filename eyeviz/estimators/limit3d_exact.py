@@ -13,6 +13,7 @@ import numpy as np
 from eyeviz.core import kernels
 from eyeviz.core.domain import Domain3D
 from eyeviz.estimators.base import LitCSR
+from eyeviz.estimators.lit_csr import take_rows
 
 __all__ = ["band_pass", "exact_hits", "prior_density", "same_rows"]
 
@@ -195,6 +196,12 @@ def _match_healpix(
     match = res == 1
     ref = np.flatnonzero(res == 2)
     if ref.size:
-        (pa, ia), (pb, ib) = eyes.lit_csr(x[ref], y[ref], z[ref], g[ref])
+        # the reference's exact path is slow (mpmath at ties): a ball in many rows once
+        balls = np.stack((xs[ref], ys[ref], zs[ref], gs[ref]), axis=1)
+        uniq, inv = np.unique(balls, axis=0, return_inverse=True)
+        (pa, ia), (pb, ib) = eyes.lit_csr(*uniq.T)
+        inv = inv.reshape(-1)
+        pa, ia = take_rows(pa, ia, inv)
+        pb, ib = take_rows(pb, ib, inv)
         match[ref] = same_rows(pa, ia, lit_a, row[ref]) & same_rows(pb, ib, lit_b, row[ref])
     return match
