@@ -85,14 +85,13 @@ def _frame(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return e1, e2
 
 
-def _sample_gap(nside: int, d: np.ndarray) -> np.ndarray:
+def _sample_gap(s: float, d: np.ndarray) -> np.ndarray:
     """How much farther than a cell's closure its nearest boundary sample can be, given
     that sample's distance d: samples are s = 1.5 fw / STEP apart along edges (edges are
     at most 1.5 facet widths fw long), so the nearest sample to the closure's nearest
     point q lies within s / 2 of q along the edge: d <= sqrt(D^2 + s^2 / 4) with D the
     true distance, hence D >= D_lo = sqrt(d^2 - s^2 / 4) and d - D <= sqrt(D_lo^2 +
-    s^2 / 4) - D_lo. Times 1.5 for the edges' curvature."""
-    s = 1.5 * math.sqrt(4 * math.pi / (12 * nside**2)) / STEP
+    s^2 / 4) - D_lo (s: ``_Eye.step``). Times 1.5 for the edges' curvature."""
     d_lo = np.sqrt(np.maximum(d * d - 0.25 * s * s, 0.0))
     return 1.5 * (np.sqrt(d_lo * d_lo + 0.25 * s * s) - d_lo)
 
@@ -110,11 +109,10 @@ def _prefilter(eye: _Eye, row: np.ndarray, c: np.ndarray, alpha: np.ndarray) -> 
         from eyeviz.core.kernels.limit3d_region import prefilter_kernel
 
         ok = np.empty(row.size, np.bool_)
-        s = 1.5 * math.sqrt(4 * math.pi / (12 * eye.nside**2)) / STEP
         prefilter_kernel(kernels.arg(eye.pts), kernels.arg(eye.lit),
                          kernels.arg(eye.pad), kernels.arg(row, np.int64),
                          kernels.arg(c, np.float64),
-                         kernels.arg(alpha, np.float64), s, ok)  # fmt: skip
+                         kernels.arg(alpha, np.float64), eye.step, ok)  # fmt: skip
         return ok
     return _prefilter_ref(eye, row, c, alpha)
 
@@ -135,7 +133,7 @@ def _prefilter_ref(eye: _Eye, row: np.ndarray, c: np.ndarray, alpha: np.ndarray)
         ds = np.arccos(np.clip(dots, -1.0, 1.0))  # (K, Dk)
         a = alpha[idx][None, :]
         lit = eye.lit[r][live][:, None]
-        bad = np.where(lit, a + _sample_gap(eye.nside, ds) + 1e-9 <= ds, a > ds + 1e-9)
+        bad = np.where(lit, a + _sample_gap(eye.step, ds) + 1e-9 <= ds, a > ds + 1e-9)
         ok[idx] = ~bad.any(axis=0)
     return ok
 
@@ -228,6 +226,10 @@ class _Eye:
         pix, lit = kernels.arg(pix, np.int64), kernels.arg(lit, np.bool_)
         return u_io, self.b_in, self.b_out, u0, bp, pix, ring, lit, near, far
 
+    @property
+    def step(self) -> float:  # the boundary samples' spacing (edges <= 1.5 fw long)
+        return 1.5 * math.sqrt(4 * math.pi / (12 * self.nside**2)) / STEP
+
     def linearise(self, c: np.ndarray) -> None:
         """Distances d (N, K) and gradients t (N, K, 2) of every edge cell at centres c.
         Compiled unless ``EYEVIZ_JIT=0`` (kernels.limit3d_affine.linearise_kernel: the same
@@ -239,10 +241,9 @@ class _Eye:
 
             self.d = np.empty(self.pts.shape[:2])
             self.t = np.empty((*self.pts.shape[:2], 2))
-            s = 1.5 * math.sqrt(4 * math.pi / (12 * self.nside**2)) / STEP
             linearise_kernel(kernels.arg(self.pts), kernels.arg(self.lit), kernels.arg(self.pad),
-                             kernels.arg(self.c), kernels.arg(self.e1), kernels.arg(self.e2), s,
-                             self.d, self.t)  # fmt: skip
+                             kernels.arg(self.c), kernels.arg(self.e1), kernels.arg(self.e2),
+                             self.step, self.d, self.t)  # fmt: skip
         else:
             self._linearise_ref()
         self._affine()
@@ -259,7 +260,7 @@ class _Eye:
         # the nearest boundary sample is farther than the cell by at most _sample_gap:
         # lit cells' distances are lowered by that much, so the linearised region holds
         # the true one; unlit cells' samples lie in the cell's closure
-        self.d = np.where(self.lit, d - _sample_gap(self.nside, d), d)
+        self.d = np.where(self.lit, d - _sample_gap(self.step, d), d)
         with np.errstate(invalid="ignore", divide="ignore"):
             t1 = np.einsum("nkj,nj->nk", tang, self.e1) / tn
             t2 = np.einsum("nkj,nj->nk", tang, self.e2) / tn
@@ -448,11 +449,10 @@ def _locate(eye: _Eye, half: float, n: int, levels: int) -> None:
     (kernels.limit3d_locate.locate_kernel: the same formulas, in place)."""
     rows = np.arange(eye.c.shape[0])
     g0 = _grid(n)
-    if kernels.use(eye.pts.shape[0] * eye.pts.shape[1]) and hasattr(eye, "lists"):
+    if kernels.use(eye.pts.shape[0] * eye.pts.shape[1]):
         from eyeviz.core.kernels.limit3d_locate import locate_kernel
 
-        s = 1.5 * math.sqrt(4 * math.pi / (12 * eye.nside**2)) / STEP
-        locate_kernel(eye.pts, eye.lit, eye.pad, s, g0, half, levels, eye.c, eye.e1, eye.e2,
+        locate_kernel(eye.pts, eye.lit, eye.pad, eye.step, g0, half, levels, eye.c, eye.e1, eye.e2,
                       eye.d, eye.t, eye.a_lit, eye.t_lit, eye.a_unl, eye.t_unl, eye.lists,
                       np.empty(g0.shape[0]))  # fmt: skip
         return

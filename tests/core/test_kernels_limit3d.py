@@ -243,7 +243,7 @@ def test_limit3d_answers_with_the_kernels_are_the_reference_s_measured(bee_small
 def test_prefilter_kernel_keeps_what_the_reference_keeps(healpix_chunk):
     """The early-exit prefilter against the numpy one, on caps about each key's centre
     (some exact, some a little off in direction or radius)."""
-    from eyeviz.estimators.limit3d_proposal import STEP, _prefilter_ref
+    from eyeviz.estimators.limit3d_proposal import _prefilter_ref
 
     _, stt, _ = healpix_chunk
     ea = stt["ea"]
@@ -254,8 +254,7 @@ def test_prefilter_kernel_keeps_what_the_reference_keeps(healpix_chunk):
     c /= np.linalg.norm(c, axis=1, keepdims=True)
     alpha = ea.alpha0[row] + rng.normal(scale=3e-3, size=row.size)
     got = np.empty(row.size, np.bool_)
-    s = 1.5 * np.sqrt(4 * np.pi / (12 * ea.nside**2)) / STEP
-    kr.prefilter_kernel(ea.pts, ea.lit, ea.pad, row, c, alpha, s, got)
+    kr.prefilter_kernel(ea.pts, ea.lit, ea.pad, row, c, alpha, ea.step, got)
     want = _prefilter_ref(ea, row, c, alpha)
     assert np.array_equal(got, want)
     assert 0 < want.sum() < want.size

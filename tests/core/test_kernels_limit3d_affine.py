@@ -34,8 +34,7 @@ def _kernel(e: _Eye, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
     e.e1, e.e2 = _frame(e.c)
     d, t = np.empty(e.pts.shape[:2]), np.empty((*e.pts.shape[:2], 2))
-    s = 1.5 * math.sqrt(4 * math.pi / (12 * e.nside**2)) / STEP
-    ks.linearise_kernel(e.pts, e.lit, e.pad, e.c, e.e1, e.e2, s, d, t)
+    ks.linearise_kernel(e.pts, e.lit, e.pad, e.c, e.e1, e.e2, e.step, d, t)
     return d, t
 
 
