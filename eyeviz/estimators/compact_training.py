@@ -29,6 +29,7 @@ from eyeviz.estimators.compact_net import (
     save_net,
     write_atomic,
 )
+from eyeviz.estimators.fit_checks import COMPACT_BATCH, check_compact_rows
 from eyeviz.estimators.fit_loop import fit_one_cycle
 from eyeviz.estimators.store import staged, user_models_dir
 from eyeviz.files import limits
@@ -95,7 +96,7 @@ def train(
     epochs: int = 12,
     hidden: int = 32,
     hidden_ad: int = 8,
-    batch: int = 4096,
+    batch: int = COMPACT_BATCH,
     lr: float = 4e-3,
     patience: int = 3,
     domain: Domain = PAPER_DOMAIN,
@@ -122,10 +123,7 @@ def train(
     threads = check_int("threads", threads, ge=1, le=MAX_THREADS)
     t0 = time.perf_counter()
     if data is None:
-        if n_train < batch:
-            raise EyevizError(
-                f"-n must be >= {batch} (one batch of the one-cycle schedule), got {n_train}"
-            )
+        check_compact_rows(n_train, batch)
         tr = _generate(n_train, domain, seed)
         va = _generate(n_val, domain, seed + 1)
     else:
