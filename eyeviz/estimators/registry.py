@@ -44,6 +44,7 @@ from typing import Any
 
 from eyeviz import EyevizError
 from eyeviz.core.domain import DEFAULTS, FIELDS, PAPER_DOMAIN, RECORDS, Domain, Domain3D
+from eyeviz.estimators.fit_checks import COMPACT_BATCH
 
 __all__ = [
     "KINDS",
@@ -343,7 +344,7 @@ for _entry in (
                 dest="n",
                 type=int,
                 default=None,
-                help="training elements (default 10^6; at least one batch, 4096)",
+                help=f"training elements (default 10^6; at least one batch, {COMPACT_BATCH})",
             ),
             _opt("--n-val", type=int, default=None, help="validation elements (10^5)"),
             _opt("--epochs", type=int, default=None, help="at most this many (12)"),

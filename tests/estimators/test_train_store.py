@@ -217,3 +217,12 @@ def test_staged_moves_the_json_metadata_last(tmp_path, monkeypatch):
     assert moved[-2:] == ["b_meta.json", "z_meta.json"]
     assert sorted(moved[:-2]) == ["a_weights.pt", "m.npz"]
     assert (tmp_path / "out" / "m.npz").read_text() == "m.npz"
+
+
+def test_compact_help_states_the_batch_the_check_enforces():
+    """The help of `train compact -n` names the one-batch floor fit_checks refuses below."""
+    from eyeviz.estimators import registry
+    from eyeviz.estimators.fit_checks import COMPACT_BATCH
+
+    (n_option,) = [o for o in registry.get("compact").fit_options if "--n-train" in o.flags]
+    assert f"at least one batch, {COMPACT_BATCH})" in n_option.kwargs["help"]
