@@ -13,18 +13,24 @@ missing=""
 for p in $APT_PACKAGES; do
     dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
 done
-if [ -n "$missing" ]; then
+# On a fresh machine the system packages install beside pip's (apt waits on the network
+# and dpkg on the disk, pip on its own downloads): both finish before this script does.
+apt_install() {
+    export DEBIAN_FRONTEND=noninteractive
     if [ "$(id -u)" = 0 ]; then
-        echo "eyeviz setup: installing system packages:$missing" >&2
-        export DEBIAN_FRONTEND=noninteractive
-        apt-get update -qq >/dev/null
-        apt-get install -y -qq $missing >/dev/null
+        apt-get update -qq >/dev/null && apt-get install -y -qq $missing >/dev/null
     elif command -v sudo >/dev/null 2>&1; then
-        sudo apt-get update -qq >/dev/null
-        sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $missing >/dev/null
+        sudo apt-get update -qq >/dev/null &&
+            sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $missing >/dev/null
     else
         echo "eyeviz setup: missing system packages (install them as root):$missing" >&2
     fi
+}
+apt_pid=""
+if [ -n "$missing" ]; then
+    echo "eyeviz setup: installing system packages:$missing" >&2
+    apt_install &
+    apt_pid=$!
 fi
 
 # Compile the numba kernels once into their cache (eyeviz/core/kernels/__pycache__), so
@@ -69,6 +75,10 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
         exit 1
     }
     touch "$stamp"
+fi
+if [ -n "$apt_pid" ] && ! wait "$apt_pid"; then
+    echo "eyeviz setup: installing the system packages failed:$missing" >&2
+    exit 1
 fi
 # Wait for the warm begun beside pip, then warm (again): the cache is read in a few seconds,
 # and what pip's second step changed (a numba or numpy version) compiles now.
