@@ -26,7 +26,7 @@ direction. So the proposal is built from each eye's feasible caps, as the planar
 integrates over eye A's tangent sectors and then along the ray (:mod:`.limit`):
 
 1. Per eye, the cells where the cap's edge can lie: the key's lit cells that a cap
-   ``EDGE`` facet widths (:mod:`.limit3d_proposal`) smaller than the lit set's cap
+   ``EDGE`` facet widths (:mod:`.limit3d_eye`) smaller than the lit set's cap
    (:func:`.analytic3d.cap_estimates`)
    does not light, and the unlit cells a cap as much larger lights. For each, its
    boundary point nearest the cap centre (``STEP`` points per edge) linearises its
@@ -88,7 +88,8 @@ from eyeviz.core.domain import PAPER_DOMAIN3D, Domain3D
 from eyeviz.estimators.analytic3d import estimate
 from eyeviz.estimators.base import Estimator3D, LitCSR, Prediction3D, as_csr, take_rows
 from eyeviz.estimators.limit3d_exact import prior_density, same_rows
-from eyeviz.estimators.limit3d_proposal import _Eye, _key_hash  # noqa: F401  (_Eye: read by tests)
+from eyeviz.estimators.limit3d_eye import _Eye  # noqa: F401  (read by tests)
+from eyeviz.estimators.limit3d_proposal import _key_hash
 from eyeviz.estimators.weighted import weighted_median
 
 __all__ = ["PRIORS", "Limit3DEstimator", "load", "posterior_samples3d", "prior_density"]

@@ -93,7 +93,7 @@ def exact_hits(
     """The 0/1 likelihood of draws (centres p (D, 3), radii g (D,)) of the keys ``row``
     (D,): the pair's exact ``lit_csr`` gives both of the key's lit sets and the ball is in
     the binocular field (``in_bfv``, decided only on the draws that match). HEALPix
-    ``bands``: per eye, the keys' band cells (limit3d_proposal._Eye.band), which decide
+    ``bands``: per eye, the keys' band cells (limit3d_eye._Eye.band), which decide
     most draws first (:func:`_match_healpix`). ``matched`` (D,): whether each draw lights
     both lit sets, when the caller knows it already (only ``in_bfv`` is left)."""
     hit = np.zeros(row.size, bool)

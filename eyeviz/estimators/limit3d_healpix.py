@@ -1,7 +1,7 @@
 """The HEALPix proposal of the spherical limit (:mod:`eyeviz.estimators.limit3d`, module
 docstring steps 1-5): per chunk of keys, each eye's feasible caps from its edge cells
-(:mod:`.limit3d_proposal`), A's box of centres, B's region along A's rays, g where both
-eyes' modelled radii allow it, the prefilter, then the exact check. Only HEALPix eyes
+(:mod:`.limit3d_eye`), A's box of centres, B's region along A's rays (:mod:`.limit3d_proposal`),
+g where both eyes' modelled radii allow it, the prefilter, then the exact check. Only HEALPix eyes
 come here; a measured pair has its own proposal (:mod:`.limit3d_measured`)."""
 
 from __future__ import annotations
@@ -14,11 +14,11 @@ from eyeviz.core import kernels
 from eyeviz.core.domain import Domain3D
 from eyeviz.estimators.base import LitCSR
 from eyeviz.estimators.limit3d_exact import band_pass, exact_hits, prior_density
+from eyeviz.estimators.limit3d_eye import _Eye
 from eyeviz.estimators.limit3d_proposal import (
     _angle_box,
     _batch_uniforms,
     _extent,
-    _Eye,
     _locate,
     _prefilter,
     _ray_in_box,

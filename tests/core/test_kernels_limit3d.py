@@ -20,8 +20,8 @@ from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import limit3d_exact, limit3d_healpix
 from eyeviz.estimators.base import take_rows
 from eyeviz.estimators.limit3d import Limit3DEstimator
+from eyeviz.estimators.limit3d_eye import _Eye
 from eyeviz.estimators.limit3d_measured import MeasuredProposal, _Edges
-from eyeviz.estimators.limit3d_proposal import _Eye
 
 kr = pytest.importorskip("eyeviz.core.kernels.limit3d_region")
 ka = pytest.importorskip("eyeviz.core.kernels.limit3d_affine")

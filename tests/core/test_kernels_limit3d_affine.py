@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators.base import take_rows
-from eyeviz.estimators.limit3d_proposal import STEP, _Eye
+from eyeviz.estimators.limit3d_eye import STEP, _Eye
 
 ks = pytest.importorskip("eyeviz.core.kernels.limit3d_affine")
 
@@ -30,7 +30,7 @@ def _eyes(nside: int, seed: int, n: int = 5) -> list[_Eye]:
 
 def _kernel(e: _Eye, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     e.c = c / np.linalg.norm(c, axis=1, keepdims=True)
-    from eyeviz.estimators.limit3d_proposal import _frame
+    from eyeviz.estimators.limit3d_eye import _frame
 
     e.e1, e.e2 = _frame(e.c)
     d, t = np.empty(e.pts.shape[:2]), np.empty((*e.pts.shape[:2], 2))
@@ -40,7 +40,7 @@ def _kernel(e: _Eye, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def _reference(e: _Eye, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     e.c = c / np.linalg.norm(c, axis=1, keepdims=True)
-    from eyeviz.estimators.limit3d_proposal import _frame
+    from eyeviz.estimators.limit3d_eye import _frame
 
     e.e1, e.e2 = _frame(e.c)
     with np.errstate(all="ignore"):
@@ -132,7 +132,7 @@ def test_boundaries_kernel_is_healpix_boundaries_to_a_few_ulps(nside, monkeypatc
     from eyeviz.core import healpix, kernels
 
     monkeypatch.setitem(kernels._STATE, "ready", True)  # small calls too take the kernel
-    from eyeviz.estimators.limit3d_proposal import _boundaries
+    from eyeviz.estimators.limit3d_eye import _boundaries
 
     rng = np.random.default_rng(nside)
     npix = 12 * nside * nside
@@ -313,7 +313,8 @@ def test_locate_kernel_takes_the_first_of_equal_points_as_argmax():
     """A key whose model has no cells (G = inf at every grid point): the centre moves to
     the grid's first point, as numpy's argmax picks (the kernel's ties)."""
     from eyeviz.core.kernels.limit3d_locate import locate_kernel
-    from eyeviz.estimators.limit3d_proposal import _frame, _grid
+    from eyeviz.estimators.limit3d_eye import _frame
+    from eyeviz.estimators.limit3d_proposal import _grid
 
     c = np.array([[0.0, 0.6, 0.8]])
     e1, e2 = _frame(c)

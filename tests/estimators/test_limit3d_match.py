@@ -19,7 +19,7 @@ from eyeviz.core.domain import Domain3D
 from eyeviz.dataset.algorithm1_3d import generate3d
 from eyeviz.estimators import limit3d_exact, limit3d_healpix
 from eyeviz.estimators.base import take_rows
-from eyeviz.estimators.limit3d_proposal import _Eye
+from eyeviz.estimators.limit3d_eye import _Eye
 from eyeviz.reference import stability_cases as sc
 
 pytest.importorskip("eyeviz.core.kernels.healpix_match")
@@ -180,7 +180,7 @@ def test_exact_hits_take_the_lit_sets_with_eyeviz_jit_0(monkeypatch):
 
 
 def _bands_check(d: Domain3D, x, y, z, g, keys_of, lit_a, lit_b) -> tuple[int, int, int]:
-    """_match_healpix with the keys' band cells (limit3d_proposal._Eye.band) against
+    """_match_healpix with the keys' band cells (limit3d_eye._Eye.band) against
     lit_csr + same_rows on balls (x, y, z, g) of the keys ``keys_of``; returns (balls,
     matches, balls the band check decided in eye A)."""
     from eyeviz.core.kernels.healpix_match import edge_match_kernel, vertex_cache

@@ -1,5 +1,5 @@
 """The HEALPix proposal's set-up compiled (numba): the linearisation of each edge cell's
-distance about a key's centre (:meth:`eyeviz.estimators.limit3d_proposal._Eye.linearise`,
+distance about a key's centre (:meth:`eyeviz.estimators.limit3d_eye._Eye.linearise`,
 called at every zoom level of the centre search) and the affine forms of the model built
 from it (``_Eye._affine``, bit for bit), and the edge cells' boundary samples
 (``healpix.boundaries``, to a few ulps).
@@ -251,7 +251,7 @@ def linearise_kernel(pts, lit, pad, c, e1, e2, s, d, t):
     """_Eye.linearise on the live slots (``pad`` False) of pts (N, K, P, 3) about the unit
     centres c (N, 3) with frames e1, e2 (N, 3): d (N, K) the distance to the nearest
     boundary sample (lit cells: less the sample gap for spacing s, as
-    limit3d_proposal._sample_gap), t (N, K, 2) the unit tangent towards it in (e1, e2)
+    limit3d_eye._sample_gap), t (N, K, 2) the unit tangent towards it in (e1, e2)
     (0 where the sample is the centre itself). Padding slots get d = 0 and t = 0."""
     q = 0.25 * s * s
     for n in range(pts.shape[0]):

@@ -34,7 +34,7 @@ def locate_kernel(pts, lit, pad, s, g0, half, levels, c, e1, e2, d, t, a_lit, t_
     """``levels`` times: each key's model G = min_unlit - max_lit on the grid g0 (G, 2)
     times ``half`` about its centre, the centre moved to the best point (numpy's argmax:
     the first maximum, a NaN before any number) as _Eye.direction then _Eye.linearise
-    normalise it, its frame as limit3d_proposal._frame, the model linearised there
+    normalise it, its frame as limit3d_eye._frame, the model linearised there
     (linearise_kernel, affine_kernel), and the grid a third as wide. c, e1, e2 (N, 3), d,
     t and the affine forms and lists are updated in place (their counts do not change:
     the cells stay). vals (G,): work."""

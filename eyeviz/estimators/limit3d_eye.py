@@ -1,0 +1,337 @@
+"""One eye's edge-cell model of the spherical limit's HEALPix proposal
+(:mod:`eyeviz.estimators.limit3d_proposal`, whose searches use it): for a chunk of keys,
+the cells where the cap's edge can lie (the key's lit cells a cap ``EDGE`` facet widths
+smaller does not light, and the unlit ones as much larger lights), their boundary samples
+(``STEP`` a side), the linearisation of their distances about each key's centre, the
+model's affine forms and its evaluation, the pruning of cells that cannot bind, and the
+exact check's band (limit3d module docstring, step 1)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from eyeviz.core import healpix, kernels
+from eyeviz.core.domain import Domain3D
+from eyeviz.estimators.analytic3d import cap_estimates
+from eyeviz.estimators.base import LitCSR
+
+#: facet widths inside and outside the estimated cap where the cap's edge is looked for
+EDGE = 1.25
+
+
+#: boundary points per cell edge for the nearest point of a cell
+STEP = 6
+
+
+def _frame(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """East and north unit vectors (N, 3) at unit vectors c (N, 3)."""
+    e1 = np.stack([-c[:, 1], c[:, 0], np.zeros(len(c))], axis=1)
+    n1 = np.linalg.norm(e1, axis=1, keepdims=True)
+    e1 = np.where(n1 > 1e-12, e1 / np.maximum(n1, 1e-300), [1.0, 0.0, 0.0])
+    e2 = np.cross(c, e1)
+    return e1, e2
+
+
+def _sample_gap(s: float, d: np.ndarray) -> np.ndarray:
+    """How much farther than a cell's closure its nearest boundary sample can be, given
+    that sample's distance d: samples are s = 1.5 fw / STEP apart along edges (edges are
+    at most 1.5 facet widths fw long), so the nearest sample to the closure's nearest
+    point q lies within s / 2 of q along the edge: d <= sqrt(D^2 + s^2 / 4) with D the
+    true distance, hence D >= D_lo = sqrt(d^2 - s^2 / 4) and d - D <= sqrt(D_lo^2 +
+    s^2 / 4) - D_lo (s: ``_Eye.step``). Times 1.5 for the edges' curvature."""
+    d_lo = np.sqrt(np.maximum(d * d - 0.25 * s * s, 0.0))
+    return 1.5 * (np.sqrt(d_lo * d_lo + 0.25 * s * s) - d_lo)
+
+
+def _codes(ptr: np.ndarray, ind: np.ndarray, npix: int) -> np.ndarray:
+    rows = np.repeat(np.arange(ptr.size - 1, dtype=np.int64), np.diff(ptr))
+    return rows * npix + ind
+
+
+class _Eye:
+    """The edge cells of one eye for a chunk of keys: their boundary points, padded to
+    (N, K, P, 3), with ``lit`` (N, K) (True: must stay lit), ``pad`` (N, K)."""
+
+    def __init__(self, domain: Domain3D, lit: LitCSR, centre: np.ndarray, eye: int):
+        self.nside = domain.nside
+        npix = domain.npix
+        u, alpha = cap_estimates(domain.nside, lit)
+        self.u0 = u
+        self.alpha0 = alpha
+        fw = math.sqrt(4 * math.pi / npix)
+        n = u.shape[0]
+        dist = 1000.0
+        a_in = np.maximum(alpha - EDGE * fw, 0.5 * fw)
+        a_out = np.minimum(alpha + EDGE * fw, math.pi / 2 - 1e-6)
+        gs = dist * np.sin(np.concatenate([a_in, a_out]))
+        pos = np.asarray(centre) + dist * np.concatenate([u, u])
+        res = domain.eyes.lit_csr(pos[:, 0], pos[:, 1], pos[:, 2], gs)[eye]
+        ptr, ind = res
+        inner = (ptr[: n + 1], ind[: ptr[n]])
+        outer = (ptr[n:] - ptr[n], ind[ptr[n] :])
+        key = _codes(*lit, npix)
+        c_in = _codes(*inner, npix)
+        # a key too small for an inner cap of half a facet: every lit cell is an edge cell
+        # (a cap of 1e-9 rad would send its cells to the exact fallback, ~10 ms each)
+        small = alpha - EDGE * fw < 0.5 * fw
+        c_in = c_in[~small[c_in // npix]]
+        c_out = _codes(*outer, npix)
+        lit_edge = key[~np.isin(key, c_in, assume_unique=True)]
+        unlit = c_out[~np.isin(c_out, key, assume_unique=True)]
+        codes = np.concatenate([lit_edge, unlit])
+        is_lit = np.concatenate([np.ones(lit_edge.size, bool), np.zeros(unlit.size, bool)])
+        rows = codes // npix
+        order = np.argsort(rows, kind="stable")
+        codes, is_lit, rows = codes[order], is_lit[order], rows[order]
+        # for the exact check of the band alone (:meth:`band`): the inner and outer caps
+        # as lit_csr saw them (centre, half-angle of each ball) and the edge cells (all of
+        # them, before any pruning): key - inner and outer - key
+        v = pos - np.asarray(centre)
+        dv = np.linalg.norm(v, axis=1)
+        self.u_io = v[:n] / dv[:n, None]
+        with np.errstate(invalid="ignore"):
+            half = np.arcsin(np.minimum(gs / dv, 1.0))
+        self.b_in = np.where(small, -np.inf, half[:n])
+        self.b_out = half[n:].copy()
+        self._band = (np.bincount(rows, minlength=n), codes % npix, is_lit)
+        cnt = np.bincount(rows, minlength=n)
+        kmax = max(1, int(cnt.max()) if cnt.size else 1)
+        slot = np.arange(codes.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        self.pts = _boundaries(self.nside, codes % npix, rows, slot, (n, kmax))
+        self.lit = np.zeros((n, kmax), bool)
+        self.lit[rows, slot] = is_lit
+        self.pad = np.ones((n, kmax), bool)
+        self.pad[rows, slot] = False
+        self.n_lit_edge = np.bincount(rows[is_lit], minlength=n)
+        self.n_unlit = np.bincount(rows[~is_lit], minlength=n)
+        self.centre = np.asarray(centre, float)
+        self.a = np.zeros(3)  # the other eye's centre relative to this one (set by the caller)
+        self.linearise(u)
+
+    def band(self) -> tuple[np.ndarray, ...]:
+        """The arguments of kernels.healpix_match.edge_match_kernel for this eye's keys, from
+        u_io to far: the band cells' bounds about the current centres ``c`` (call after
+        the centre search, whose centres the draws lie near)."""
+        from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
+        from eyeviz.core.kernels.healpix_match import band_bounds_kernel
+
+        cnt, pix, lit = self._band
+        n = self.nside
+        first = _ring_info_tables(n)[0]
+        ring = np.searchsorted(first[1 : 4 * n], pix, side="right").astype(np.int64)
+        bp = np.zeros(cnt.size + 1, np.int64)
+        np.cumsum(cnt, out=bp[1:])
+        key = np.repeat(np.arange(cnt.size, dtype=np.int64), cnt)
+        near, far = np.empty(pix.size), np.empty(pix.size)
+        u0 = kernels.arg(self.c, np.float64)
+        pix = kernels.arg(pix, np.int64)
+        band_bounds_kernel(n, pix, ring, key, u0, *_ring_tables(n),
+                           first, _ring_info_tables(n)[2], near, far)  # fmt: skip
+        u_io = kernels.arg(self.u_io, np.float64)
+        pix, lit = kernels.arg(pix, np.int64), kernels.arg(lit, np.bool_)
+        return u_io, self.b_in, self.b_out, u0, bp, pix, ring, lit, near, far
+
+    @property
+    def step(self) -> float:  # the boundary samples' spacing (edges <= 1.5 fw long)
+        return 1.5 * math.sqrt(4 * math.pi / (12 * self.nside**2)) / STEP
+
+    def linearise(self, c: np.ndarray) -> None:
+        """Distances d (N, K) and gradients t (N, K, 2) of every edge cell at centres c.
+        Compiled unless ``EYEVIZ_JIT=0`` (kernels.limit3d_affine.linearise_kernel: the same
+        formulas, to a few ulps; padding slots 0 there)."""
+        self.c = c / np.linalg.norm(c, axis=1, keepdims=True)
+        self.e1, self.e2 = _frame(self.c)
+        if kernels.use(self.pts.shape[0] * self.pts.shape[1]):
+            from eyeviz.core.kernels.limit3d_affine import linearise_kernel
+
+            self.d = np.empty(self.pts.shape[:2])
+            self.t = np.empty((*self.pts.shape[:2], 2))
+            linearise_kernel(kernels.arg(self.pts), kernels.arg(self.lit), kernels.arg(self.pad),
+                             kernels.arg(self.c), kernels.arg(self.e1), kernels.arg(self.e2),
+                             self.step, self.d, self.t)  # fmt: skip
+        else:
+            self._linearise_ref()
+        self._affine()
+
+    def _linearise_ref(self) -> None:
+        """:meth:`linearise`'s d and t in numpy (the reference)."""
+        dots = np.einsum("nkpj,nj->nkp", self.pts, self.c)
+        best = np.argmax(dots, axis=2)
+        p = np.take_along_axis(self.pts, best[:, :, None, None], 2)[:, :, 0]
+        cp = np.einsum("nkj,nj->nk", p, self.c)
+        tang = p - cp[..., None] * self.c[:, None, :]
+        tn = np.linalg.norm(tang, axis=2)
+        d = np.arctan2(tn, cp)
+        # the nearest boundary sample is farther than the cell by at most _sample_gap:
+        # lit cells' distances are lowered by that much, so the linearised region holds
+        # the true one; unlit cells' samples lie in the cell's closure
+        self.d = np.where(self.lit, d - _sample_gap(self.step, d), d)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t1 = np.einsum("nkj,nj->nk", tang, self.e1) / tn
+            t2 = np.einsum("nkj,nj->nk", tang, self.e2) / tn
+        self.t = np.stack([np.nan_to_num(t1), np.nan_to_num(t2)], axis=-1)
+
+    def prune(self, reach: np.ndarray) -> None:
+        """Drop the edge cells that cannot bind anywhere within ``reach`` (N,) of the
+        centre: a lit cell's modelled distance moves by at most |delta| and an unlit
+        one's by at most |delta| + |delta|^2 / (2 d), so a lit cell below max_lit - 2.2
+        reach or an unlit one above min_unlit + 2.2 reach never decides. (Dropping
+        constraints only loosens the model: the exact check decides.)"""
+        live = ~self.pad
+        lo0 = np.where(self.lit & live, self.d, -np.inf).max(axis=1)
+        hi0 = np.where(~self.lit & live, self.d, np.inf).min(axis=1)
+        m = 2.2 * reach[:, None]
+        keep = live & np.where(self.lit, self.d >= lo0[:, None] - m, self.d <= hi0[:, None] + m)
+        cnt = keep.sum(axis=1)
+        kmax = max(1, int(cnt.max()) if cnt.size else 1)
+        if kmax >= keep.shape[1]:
+            return
+        if kernels.use(keep.size):  # the same copies, compiled
+            from eyeviz.core.kernels.limit3d_affine import compact_kernel
+
+            n = keep.shape[0]
+            o_pts = np.empty((n, kmax, *self.pts.shape[2:]))
+            o_lit, o_pad = np.empty((n, kmax), bool), np.empty((n, kmax), bool)
+            o_d, o_t = np.empty((n, kmax)), np.empty((n, kmax, 2))
+            compact_kernel(kernels.arg(keep), kernels.arg(self.pts), kernels.arg(self.lit),
+                           kernels.arg(self.d), kernels.arg(self.t), o_pts, o_lit, o_pad, o_d,
+                           o_t)  # fmt: skip
+            self.pts, self.lit, self.pad, self.d, self.t = o_pts, o_lit, o_pad, o_d, o_t
+            self._affine()
+            return
+        order = np.argsort(~keep, axis=1, kind="stable")[:, :kmax]
+        rows = np.arange(keep.shape[0])[:, None]
+        self.pts = self.pts[rows, order]
+        self.lit = self.lit[rows, order]
+        self.pad = ~keep[rows, order]
+        self.d = self.d[rows, order]
+        self.t = self.t[rows, order]
+        self._affine()
+
+    def _affine(self) -> None:
+        """The model as affine forms in delta: a lit cell's distance is d - t . delta, an
+        unlit one's squared distance is d^2 - 2 d t . delta + |delta|^2 (the same value as
+        (d - t . delta)^2 + |delta_perp|^2, |t| = 1), so max_lit and min_unlit are one
+        matrix product and one reduction each (padding: -inf / +inf, zero slope).
+        Compiled unless ``EYEVIZ_JIT=0`` (kernels.limit3d_affine.affine_kernel, the same
+        bits; the packed lists' slots beyond a row's count hold zeros there)."""
+        lit = self.lit & ~self.pad
+        unl = ~self.lit & ~self.pad
+        if kernels.use(lit.size):
+            from eyeviz.core.kernels.limit3d_affine import affine_kernel
+
+            n, k = lit.shape
+            kl = max(1, int(lit.sum(axis=1).max()) if n else 1)
+            ku = max(1, int(unl.sum(axis=1).max()) if n else 1)
+            self.a_lit, self.a_unl = np.empty((n, k)), np.empty((n, k))
+            self.t_lit, self.t_unl = np.empty((n, k, 2)), np.empty((n, k, 2))
+            lists = (np.zeros((n, kl)), np.zeros((n, kl, 2)), np.zeros(n, np.int64),
+                     np.zeros((n, ku)), np.zeros((n, ku, 2)), np.zeros(n, np.int64))  # fmt: skip
+            affine_kernel(kernels.arg(self.d, np.float64), kernels.arg(self.t, np.float64),
+                          kernels.arg(self.lit), kernels.arg(self.pad), self.a_lit, self.t_lit,
+                          self.a_unl, self.t_unl, *lists)  # fmt: skip
+            self.lists = lists
+            return
+        self.a_lit = np.where(lit, self.d, -np.inf)
+        self.t_lit = np.where(lit[..., None], self.t, 0.0)
+        self.a_unl = np.where(unl, self.d * self.d, np.inf)
+        self.t_unl = np.where(unl[..., None], 2.0 * self.d[..., None] * self.t, 0.0)
+        # the same forms of the lit cells alone and of the unlit ones alone, in slot order
+        # (the kernels' loops skip the others' -inf / +inf slots: _affine_lists)
+        self.lists = (*_packed(lit, self.a_lit, self.t_lit), *_packed(unl, self.a_unl, self.t_unl))
+
+    def model(self, delta: np.ndarray) -> np.ndarray:
+        """Each edge cell's modelled distance (N, K, G) at gnomonic offsets delta (N, G, 2).
+
+        Lit cells: d - t . delta, below the true distance (the distance to an edge is
+        linear to first order and to a vertex convex), so their constraint alpha > dist
+        is loosened. Unlit cells: the distance to their nearest sample point p,
+        sqrt((d - t . delta)^2 + |delta_perp|^2), above the true distance (p lies in the
+        cell), so alpha <= dist is loosened too: the modelled region holds the true one.
+        (Padding cells: any value; callers mask them with ``pad``.)
+        """
+        dt = np.swapaxes(delta, 1, 2)  # (N, 2, G)
+        td = np.matmul(self.t, dt)
+        v = self.d[:, :, None] - td
+        sq = np.einsum("ngj,ngj->ng", delta, delta)[:, None, :]
+        w = self.d[:, :, None] * (self.d[:, :, None] - 2.0 * td) + sq
+        return np.where(self.lit[:, :, None], v, np.sqrt(np.maximum(w, 0.0)))
+
+    def bounds(self, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(max over lit edge cells, min over unlit) of :meth:`model` at gnomonic offsets
+        delta (N, G, 2): arrays (N, G). Compiled (bit for bit the same) unless
+        ``EYEVIZ_JIT=0``."""
+        if kernels.use(delta.shape[0] * delta.shape[1]):
+            from eyeviz.core.kernels.limit3d_affine import affine_bounds_kernel
+
+            lo = np.empty(delta.shape[:2])
+            hi = np.empty(delta.shape[:2])
+            affine_bounds_kernel(self.a_lit, self.t_lit, self.a_unl, self.t_unl, self.lists,
+                                 kernels.arg(delta, np.float64), lo, hi)  # fmt: skip
+            return lo, hi
+        return self._bounds_ref(delta)
+
+    def _bounds_ref(self, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`bounds` in numpy (the reference)."""
+        dx = delta[:, None, :, 0]
+        dy = delta[:, None, :, 1]
+        v = self.t_lit[..., 0, None] * dx
+        v += self.t_lit[..., 1, None] * dy
+        lo = (self.a_lit[..., None] - v).max(axis=1)
+        v = self.t_unl[..., 0, None] * dx
+        v += self.t_unl[..., 1, None] * dy
+        hi2 = (self.a_unl[..., None] - v).min(axis=1)
+        hi2 += np.einsum("ngj,ngj->ng", delta, delta)
+        return lo, np.sqrt(np.maximum(hi2, 0.0))
+
+    def direction(self, delta: np.ndarray) -> np.ndarray:
+        """Unit vectors (N, M, 3) at gnomonic offsets delta (N, M, 2)."""
+        v = (
+            self.c[:, None, :]
+            + delta[..., :1] * self.e1[:, None, :]
+            + delta[..., 1:] * self.e2[:, None, :]
+        )
+        return v / np.linalg.norm(v, axis=2, keepdims=True)
+
+    def gnomonic(self, v: np.ndarray) -> np.ndarray:
+        """Gnomonic offsets (N, M, 2) of unit vectors v (N, M, 3) about the centre."""
+        cc = np.einsum("nmj,nj->nm", v, self.c)
+        x, y = np.einsum("nmj,nj->nm", v, self.e1), np.einsum("nmj,nj->nm", v, self.e2)
+        with np.errstate(divide="ignore", invalid="ignore"):  # v at 90 deg: inf, no warning
+            return np.stack([x / cc, y / cc], axis=-1)
+
+
+def _boundaries(nside: int, pix: np.ndarray, rows, slot, shape: tuple[int, int]) -> np.ndarray:
+    """The boundary samples (healpix.boundaries, STEP a side) of the cells ``pix`` (T,) at
+    [rows, slot] of a zero array (*shape, 4 STEP, 3). Compiled unless ``EYEVIZ_JIT=0``
+    (kernels.limit3d_affine.boundaries_kernel: the same formulas, to a few ulps)."""
+    out = np.zeros((*shape, 4 * STEP, 3))
+    if kernels.use(pix.size):
+        from eyeviz.core.kernels.limit3d_affine import boundaries_kernel
+
+        ix, iy, f = healpix.pix2xyf(nside, pix)
+        t = np.arange(STEP) / STEP
+        dx = np.concatenate([1 - t, np.zeros(STEP), t, np.ones(STEP)])
+        dy = np.concatenate([np.ones(STEP), 1 - t, np.zeros(STEP), t])
+        boundaries_kernel(nside, kernels.arg(ix, np.int64), kernels.arg(iy, np.int64),
+                          kernels.arg(f, np.int64), kernels.arg(rows, np.int64),
+                          kernels.arg(slot, np.int64), dx, dy, healpix.JRLL, healpix.JPLL,
+                          out)  # fmt: skip
+        return out
+    out[rows, slot] = healpix.boundaries(nside, pix, STEP)
+    return out
+
+
+def _packed(sel: np.ndarray, a: np.ndarray, t: np.ndarray):
+    """The slots ``sel`` (N, K) of each row first, in slot order: (a (N, KS), t (N, KS, 2),
+    counts (N,)), KS >= 1 (beyond a row's count: any of its other slots)."""
+    cnt = sel.sum(axis=1)
+    ks = max(1, int(cnt.max()) if cnt.size else 1)
+    order = np.argsort(~sel, axis=1, kind="stable")[:, :ks]
+    return (
+        np.ascontiguousarray(np.take_along_axis(a, order, 1)),
+        np.ascontiguousarray(np.take_along_axis(t, order[..., None], 1)),
+        cnt.astype(np.int64),
+    )
