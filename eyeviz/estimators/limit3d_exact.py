@@ -129,7 +129,7 @@ def band_pass(eyes, p: np.ndarray, g: np.ndarray, row: np.ndarray, bands: tuple)
     from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
     from eyeviz.core.kernels import healpix_match
 
-    edge_kernel: Any = healpix_match.edge_match_kernel  # 24 arguments: the stub types fewer
+    edge_kernel: Any = healpix_match.edge_match_kernel  # 25 arguments: the stub types fewer
     n = eyes.nside
     sth, zr, unit = _ring_tables(n)
     first, _, shifted = _ring_info_tables(n)[:3]

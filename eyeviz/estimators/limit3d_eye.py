@@ -113,7 +113,10 @@ class _Eye:
     def band(self) -> tuple[np.ndarray, ...]:
         """The arguments of kernels.healpix_match.edge_match_kernel for this eye's keys, from
         u_io to far: the band cells' bounds about the current centres ``c`` (call after
-        the centre search, whose centres the draws lie near)."""
+        the centre search, whose centres the draws lie near), each key's lit cells first
+        by ``near`` from the largest, then its unlit ones by ``far`` from the smallest
+        (``bl``: where each key's unlit cells start), the order in which the kernel can
+        stop at the first cell its bounds settle."""
         from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
         from eyeviz.core.kernels.healpix_match import band_bounds_kernel
 
@@ -129,9 +132,13 @@ class _Eye:
         pix = kernels.arg(pix, np.int64)
         band_bounds_kernel(n, pix, ring, key, u0, *_ring_tables(n),
                            first, _ring_info_tables(n)[2], near, far)  # fmt: skip
+        # per key: lit cells (near descending), then unlit ones (far ascending)
+        order = np.lexsort((np.where(lit, -near, far), ~lit, key))
+        pix, ring, lit, near, far = pix[order], ring[order], lit[order], near[order], far[order]
+        bl = bp[:-1] + np.bincount(key[lit], minlength=cnt.size)
         u_io = kernels.arg(self.u_io, np.float64)
         pix, lit = kernels.arg(pix, np.int64), kernels.arg(lit, np.bool_)
-        return u_io, self.b_in, self.b_out, u0, bp, pix, ring, lit, near, far
+        return u_io, self.b_in, self.b_out, u0, bp, bl, pix, ring, lit, near, far
 
     @property
     def step(self) -> float:  # the boundary samples' spacing (edges <= 1.5 fw long)

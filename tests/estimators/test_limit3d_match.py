@@ -261,7 +261,7 @@ def test_band_check_needs_the_draw_between_the_inner_and_outer_caps():
     u = (v / dist)[None, :]
     a = np.array([np.arcsin(g0 / dist)])
     empty = np.zeros(0, np.int64)
-    band = (u, a, a.copy(), u.copy(), np.zeros(2, np.int64), empty, empty,
+    band = (u, a, a.copy(), u.copy(), np.zeros(2, np.int64), np.zeros(1, np.int64), empty, empty,
             np.zeros(0, np.bool_), np.zeros(0), np.zeros(0))  # fmt: skip
     g = np.array([g0 * 0.8, g0, g0 * 1.2])
     out = np.full(3, -1, np.int64)
@@ -309,3 +309,32 @@ def test_band_check_on_one_cell_keys_and_keys_with_a_hole():
     x, y, z = ds.x, ds.y, ds.z
     n, hits, _ = _bands_check(d, x, y, z, ds.g, np.arange(6), holed, lb)
     assert hits == 0
+
+
+def test_the_band_checks_cap_is_the_lit_set_kernels_ball():
+    """healpix_match._cap (the band check's share of healpix_lit._ball) gives _ball's
+    kind (3, a ball holding the eye centre, as 1), centre, alpha, pad, s2, ds2 and ed bit
+    for bit, and _cap_pix its centre pixel, on every tie class's balls at several scales,
+    at ordinary, grazing, tiny and enclosing radii."""
+    from eyeviz.core.kernels.healpix_lit import _ball
+    from eyeviz.core.kernels.healpix_match import _cap, _cap_pix
+
+    kinds = set()
+    for name in sorted(sc.CLASSES3D):
+        cs = sc.make(name, 3, 5, "spherical")
+        x, y, z, g = (np.asarray(v, np.float64).ravel() for v in (cs.x, cs.y, cs.z, cs.g))
+        for i in range(x.size):
+            r = float(np.sqrt(x[i] ** 2 + y[i] ** 2 + z[i] ** 2))
+            for gg in (g[i], g[i] * (1 + 1e-15), r * 1e-12, r - 40.0, r + 40.0, r * 0.3):
+                for n, cx in ((180, -40.0), (16, 40.0), (3, -40.0)):
+                    want = _ball(n, x[i], y[i], z[i], gg, cx)
+                    got = _cap(x[i], y[i], z[i], gg, cx)
+                    kinds.add(want[0])
+                    assert got[0] == (0 if want[0] == 0 else 1)
+                    if want[0] != 0:
+                        continue
+                    par = want[1]
+                    assert got[1] == par[0] and got[2:4] == want[4:6]
+                    assert got[4:7] == (par[10], par[11], par[12])
+                    assert _cap_pix(n, *got[7:]) == par[13]
+    assert kinds == {0, 1, 3}

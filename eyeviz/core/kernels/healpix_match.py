@@ -48,6 +48,56 @@ def _apart(c, u, k):
 
 
 @_jit
+def _cap(xb, yb, zb, gb, cx):
+    """The steps of healpix_lit._ball that the band check reads, in its operations (the
+    same bits): (kind 0 or 1 as there, the cap's centre c, alpha, pad, s2, ds2, ed, and
+    the scaled centre (dx, dy, dz, d) for its pixel, :func:`_cap_pix`); not the rings'
+    range, its trigonometry or the centre's pixel, which a ball decided by its band
+    cells' bounds alone never needs. kind 1 also where _ball gives 3 (the ball holds the
+    eye centre): the band check leaves both to the other checks."""
+    dx0 = xb - cx
+    bv = dx0 - xb
+    err = (xb - (dx0 - bv)) + (-cx - bv)
+    errabs0 = abs(err) + 2.0**-1070
+    big = max(max(abs(dx0), abs(yb)), max(abs(zb), gb))
+    ex = math.frexp(big)[1]
+    dx = math.ldexp(dx0, -ex)
+    dy = math.ldexp(yb, -ex)
+    dz = math.ldexp(zb, -ex)
+    gs = math.ldexp(gb, -ex)
+    errabs = math.ldexp(errabs0, -ex)
+    d = math.sqrt(dx * dx + dy * dy + dz * dz)
+    ed = 8 * _EPS + 4 * errabs / d
+    dmg = (d - gs) * (d + gs)
+    sep = 8 * _EPS * (d + gs) ** 2 + 4 * errabs * (d + gs)
+    c = (0.0, 0.0, 1.0)
+    if abs(dmg) <= sep or not (math.isfinite(dmg) and math.isfinite(sep)) or dmg < -sep:
+        return 1, c, 0.0, 0.0, 0.0, 0.0, 0.0, dx, dy, dz, d
+    q = gs / d
+    rdm = math.sqrt(max(dmg, 0.0))
+    dcos = (4 * _EPS * d + 4 * errabs) * (d + gs) / (rdm * d)
+    dcos = dcos + 4 * _EPS if math.isfinite(dcos) else 4.0
+    cosa = rdm / d
+    alpha = math.atan2(q, cosa)
+    if dcos > 1e-9 or not alpha > 1e6 * ed:
+        return 1, c, 0.0, 0.0, 0.0, 0.0, 0.0, dx, dy, dz, d
+    s2 = 2 * q * q / (1 + cosa)
+    ds2 = 2 * dcos + 8 * _EPS * s2
+    dalpha = dcos / max(q, 1e-300) + 8 * _EPS
+    pad_t = dalpha + 4 * ed + 1e-12
+    c = (dx / d, dy / d, dz / d)
+    return 0, c, alpha, pad_t, s2, ds2, ed, dx, dy, dz, d
+
+
+@_jit
+def _cap_pix(n, dx, dy, dz, d):
+    """healpix_lit._ball's pixel of the cap's centre (its ``cpix``), from :func:`_cap`."""
+    z_c = dz / d
+    phi_c = math.atan2(dy, dx)
+    return _ang2pix(n, min(max(z_c, -1.0), 1.0) if d > 0 else 1.0, phi_c)
+
+
+@_jit
 def band_bounds_kernel(n, pix, ring, key, u0, sth, zr, unit, first_t, shifted_t, near, far):
     """For band cells ``pix`` (of rings ``ring``) of the keys ``key``: an upper bound
     ``near`` on the angle from the key's centre u0[key] to the cell's closure (its nearest
@@ -78,7 +128,7 @@ def band_bounds_kernel(n, pix, ring, key, u0, sth, zr, unit, first_t, shifted_t,
 
 # long: one draw's containment test and its band cells' walk with its early exit
 @_jit
-def edge_match_kernel(n, x, y, z, g, cx, row, u_io, b_in, b_out, u0, bp, pix, ring, lit,
+def edge_match_kernel(n, x, y, z, g, cx, row, u_io, b_in, b_out, u0, bp, bl, pix, ring, lit,
                       near, far, sth, zr, unit, first_t, shifted_t, vc, out):  # fmt: skip
     """Whether ball b lights exactly key row[b]'s facets, from the key's band cells alone:
     out[b] 1 yes, 0 no, 2 not decided here (then :func:`match_kernel`).
@@ -98,14 +148,24 @@ def edge_match_kernel(n, x, y, z, g, cx, row, u_io, b_in, b_out, u0, bp, pix, ri
     less |c - u0| lies outside it; else :func:`_decide_cell` decides it (with the ball's
     own bounds, as lit_runs_kernel; its centre pixel is lit), and a cell it leaves open
     leaves the ball to match_kernel. The first band cell that differs from the key rules
-    the ball out."""
+    the ball out.
+
+    Each key's lit band cells come first (``bp[r]`` to ``bl[r]``), by ``near`` from the
+    largest, then its unlit ones (to ``bp[r + 1]``) by ``far`` from the smallest
+    (limit3d_eye._Eye.band). So the walk over the lit ones stops at the first with near +
+    d0 < a_lo: every later one has a ``near`` as small, so its bound says lit too, as the
+    key does; the walk over the unlit ones stops at the first with far - d0 > a_hi
+    likewise (each would be found as the key has it). The cells skipped so are exactly
+    those the full walk would find as the key has them from their bounds alone: the
+    verdict 1 is the same; 0 and 2 may come in another order (a ball with a differing
+    cell and an open one), and both are exact or left to match_kernel."""
     for b in range(x.shape[0]):
         r = row[b]
-        kind, par, _, _, alpha, pad = _ball(n, x[b], y[b], z[b], g[b], cx)
+        kind, c, alpha, pad, s2, ds2, ed, dx, dy, dz, dd = _cap(x[b], y[b], z[b], g[b], cx)
         if kind != 0:
             out[b] = 2
             continue
-        c, s2, ds2, ed, cpix = par[0], par[10], par[11], par[12], par[13]
+        cpix = -1  # the centre's pixel, computed when first needed
         d_io = _apart(c, u_io, r) + 1e-12
         a_lo = alpha - pad - 1e-9
         a_hi = alpha + pad + 1e-9
@@ -114,23 +174,33 @@ def edge_match_kernel(n, x, y, z, g, cx, row, u_io, b_in, b_out, u0, bp, pix, ri
             continue
         d0 = _apart(c, u0, r) + 1e-12
         res = 1
-        for k in range(bp[r], bp[r + 1]):
+        k, lit_end, end = bp[r], bl[r], bp[r + 1]
+        while k < end:
             if near[k] + d0 < a_lo:
+                if k < lit_end:  # this and every later lit cell are lit
+                    k = lit_end
+                    continue
                 on = 1
             elif far[k] - d0 > a_hi:
-                on = 0
-            elif pix[k] == cpix:
-                on = 1
-            else:
-                i = ring[k]
-                on = _decide_cell(n, i, pix[k] - first_t[i], pix[k], shifted_t[i], first_t[i],
-                                  c, s2, ds2, ed, sth, zr, unit, vc)  # fmt: skip
-                if on == 2:
-                    res = 2
+                if k >= lit_end:  # this and every later unlit cell are unlit
                     break
+                on = 0
+            else:
+                if cpix < 0:
+                    cpix = _cap_pix(n, dx, dy, dz, dd)
+                if pix[k] == cpix:
+                    on = 1
+                else:
+                    i = ring[k]
+                    on = _decide_cell(n, i, pix[k] - first_t[i], pix[k], shifted_t[i],
+                                      first_t[i], c, s2, ds2, ed, sth, zr, unit, vc)  # fmt: skip
+                    if on == 2:
+                        res = 2
+                        break
             if on != lit[k]:
                 res = 0
                 break
+            k += 1
         out[b] = res
 
 
@@ -215,5 +285,5 @@ def warm() -> None:
     pix, ring = np.array([10]), np.array([2])
     band_bounds_kernel(n, pix, ring, i1, u, sth, zr, unit, first, shifted, near, far)
     edge_match_kernel(n, x, y, z, g, 40.0, i1, u, np.zeros(1), np.ones(1), u, np.array([0, 1]),
-                      pix, ring, np.ones(1, np.bool_), near, far, sth, zr, unit, first, shifted,
-                      vertex_cache(16), i1.copy())  # fmt: skip
+                      np.ones(1, np.int64), pix, ring, np.ones(1, np.bool_), near, far, sth, zr,
+                      unit, first, shifted, vertex_cache(16), i1.copy())  # fmt: skip
