@@ -180,26 +180,6 @@ class MeasuredProposal:
         g_lo, g_hi = self._h(st, c)
         return np.argmax((g_hi - g_lo) * ww, axis=1)
 
-    def _h_draws(self, st: dict, c: np.ndarray, live: np.ndarray, slack: float = -1.0):
-        """:meth:`_h` at the draws' centres c (N, M, 3) where ``live``. Compiled, a draw
-        is dropped at the first facet that empties its interval (its (g_lo, g_hi) then
-        partial, and empty all the same; kernels.limit3d_region.interval_kernel); the
-        live draws' intervals are :meth:`_h`'s. ``slack`` >= 0: the walk stops instead
-        where g_hi - g_lo < -slack (:meth:`_hb`)."""
-        if not kernels.use(live.size):
-            return self._h(st, c)
-        from eyeviz.core.kernels.limit3d_region import interval_kernel
-
-        r = np.linalg.norm(c - self.origin, axis=2)
-        g_lo = r * self.s_half
-        g_hi = np.minimum(r, self.domain.g_max)
-        pa, aa, ca, sa, la, da = st["ea"].columns()
-        pb, ab, cb, sb, lb, db = st["eb"].columns()
-        cc = kernels.arg(c, np.float64)
-        interval_kernel(pa, aa, ca, sa, la, da, pb, ab, cb, sb, lb, db, cc,
-                        kernels.arg(live), g_lo, g_hi, slack)  # fmt: skip
-        return g_lo, g_hi
-
     def _centres(self, st: dict, delta: np.ndarray, w: np.ndarray) -> np.ndarray:
         """Centres (N, G, 3) at gnomonic offsets delta (N, G, 2) about the reference and
         w = 1 / distance from o_A (N, G)."""
@@ -247,8 +227,7 @@ class MeasuredProposal:
         c, _, _ = self._bcentres(st, x[..., :2], x[..., 2])
         with np.errstate(invalid="ignore", over="ignore"):
             cc = np.nan_to_num(c, nan=1e300)
-            live = np.ones(cc.shape[:2], np.bool_)
-            g_lo, g_hi = self._h_draws(st, cc, live, float(st["slack"]))
+            g_lo, g_hi = self._h(st, cc)
         hv = g_hi - g_lo
         return np.where(np.isfinite(hv), hv, -np.inf)
 
@@ -515,7 +494,7 @@ class MeasuredProposal:
         c = np.where(good[..., None], c, self.fa.centre + st["u0"][:, None, :] / self.w_min)
         if rows is not None:
             good &= rows[:, None]
-        g_lo, g_hi = self._h_draws(st, c, good)
+        g_lo, g_hi = self._h(st, c)
         pad = 1e-9 * g_hi
         g_lo, g_hi = np.maximum(g_lo - pad, 0.0), g_hi + pad
         good &= g_hi > g_lo

@@ -163,29 +163,6 @@ def test_cone_bounds_kernel_agrees_with_the_reference(bee_small, spread):
     assert (want_lo == 0).any() and (want_lo > 0).any()  # inside and outside cones
 
 
-def test_interval_kernel_keeps_the_draws_the_reference_keeps(bee_small, monkeypatch):
-    dom, prop, stt, _, _ = bee_small
-    rng = np.random.default_rng(1)
-    n = stt["u0"].shape[0]
-    near = prop.fa.centre + stt["u0"][:, None, :] / prop.w_max
-    far = prop.fa.centre + stt["u0"][:, None, :] / prop.w_min
-    c = near + (far - near) * rng.random((n, 400, 1)) + rng.normal(scale=0.3, size=(n, 400, 3))
-    live = rng.random((n, 400)) < 0.9
-
-    def kept(lo, hi):
-        pad = 1e-9 * hi
-        return (hi + pad > np.maximum(lo - pad, 0.0)) & live
-
-    lo, hi = prop._h_draws(stt, c, live)
-    monkeypatch.setenv("EYEVIZ_JIT", "0")
-    want_lo, want_hi = prop._h(stt, c)
-    k_got, k_want = kept(lo, hi), kept(want_lo, want_hi)
-    assert np.array_equal(k_got, k_want)
-    assert 10 <= k_want.sum() < live.sum()  # some kept, some dropped
-    assert np.allclose(lo[k_want], want_lo[k_want], rtol=1e-12, atol=0)
-    assert np.allclose(hi[k_want], want_hi[k_want], rtol=1e-12, atol=0)
-
-
 @settings(max_examples=40, deadline=None)
 @given(seed=st.integers(0, 2**31))
 def test_same_rows_kernel_is_the_reference(seed):

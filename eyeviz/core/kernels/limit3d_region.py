@@ -20,7 +20,6 @@ from numba import njit
 
 __all__ = [
     "cone_bounds_kernel",
-    "interval_kernel",
     "direction_keep_kernel",
     "uniforms_kernel",
     "measured_prior",
@@ -34,9 +33,16 @@ _jit = njit(cache=True, nogil=True)
 #: division as numpy's (x / 0 is inf or NaN, not an exception), for the kernels whose
 #: reference divides by numbers that can be 0 (the measured draws)
 _jit_np = njit(cache=True, nogil=True, error_model="numpy")
+#: the measured draws' helpers (per facet and per draw), inlined into their callers by
+#: numba: a call it does not inline counts a reference on every array it passes and is
+#: not inlined by LLVM either, which cost more than a cone distance's arithmetic
+#: (docs/limit3d.md, "bee33c"). The cone bounds and the region test keep calls (their
+#: compile time; they are not where the draws' time goes).
+_inline = njit(cache=True, nogil=True, inline="always")
+_inline_np = njit(cache=True, nogil=True, error_model="numpy", inline="always")
 
 
-@_jit
+@_inline
 def _max(m, x):
     """numpy's maximum: NaN wins."""
     if m != m:
@@ -46,7 +52,7 @@ def _max(m, x):
     return m
 
 
-@_jit
+@_inline
 def _min(m, x):
     """numpy's minimum: NaN wins."""
     if m != m:
@@ -56,7 +62,7 @@ def _min(m, x):
     return m
 
 
-@_jit
+@_inline
 def _cone(pos, ax, ch, sh, n, k, cx, cy, cz):
     """(dist(c, K_k), |c - p_k|) of facet k of key n: with v = c - p, s = v . a and
     q = |v x a| (a unit), |v| sin(theta - alpha) = q C - s S and |v| cos(theta - alpha)
@@ -88,6 +94,10 @@ def _cone_fold(pos, ax, ch, sh, lit, n, k, cx, cy, cz, lo, hi):
     return lo, _min(hi, d)
 
 
+#: :func:`_cone_fold` inlined, for the draws' walks (:func:`_walk`, measured_limit's)
+_cone_fold_inline = _inline(_cone_fold.py_func)
+
+
 @_jit
 def cone_bounds_kernel(pos, ax, ch, sh, lit, pad, c, lo, hi):
     """_Edges.bounds: (largest distance of a lit cone, smallest of an unlit cone or of a
@@ -102,7 +112,7 @@ def cone_bounds_kernel(pos, ax, ch, sh, lit, pad, c, lo, hi):
             lo[n, g], hi[n, g] = lo_, hi_
 
 
-@_jit
+@_inline
 def _empty(lo, hi):
     """The sampler's test of an empty g interval (limit3d_measured.MeasuredProposal.sample:
     pad = 1e-9 g_hi, then g_hi + pad > max(g_lo - pad, 0) keeps the draw), in the same
@@ -114,70 +124,16 @@ def _empty(lo, hi):
     return not (hi + pad > low)
 
 
-@_jit
-def _stop(lo, hi, slack):
-    """The walk's stopping test: slack < 0, the sampler's (:func:`_empty`); else the
-    region test's H = hi - lo >= -slack failing (or NaN). Both monotone."""
-    if slack < 0.0:
-        return _empty(lo, hi)
-    return not (hi - lo >= -slack)
-
-
-# long: one draw's walk over both eyes' facets with its early exit is one loop nest
-@_jit
-def interval_kernel(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b,
-                    pad_b, c, live, lo, hi, slack):  # fmt: skip
-    """The g interval (lo, hi) (N, M) of draws' centres c (N, M, 3) for both eyes, lo and
-    hi coming in as the prior's bounds; only where ``live``. Stops at the first facet after
-    which :func:`_stop` holds (``slack`` < 0: the interval is empty; else H < -slack): a
-    partial interval that fails fails all the same (lo only grows, hi only shrinks), and
-    its (lo, hi) are the partial ones. Each key's last facet to stop a draw is tried
-    first."""
-    last_a = np.zeros(c.shape[0], np.int64)
-    last_b = np.zeros(c.shape[0], np.int64)
-    for n in range(c.shape[0]):
-        for m in range(c.shape[1]):
-            if not live[n, m]:
-                continue
-            cx, cy, cz = c[n, m, 0], c[n, m, 1], c[n, m, 2]
-            lo_, hi_ = lo[n, m], hi[n, m]
-            out = _stop(lo_, hi_, slack)
-            if not out and not pad_a[n, last_a[n]]:
-                lo_, hi_ = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, last_a[n], cx, cy, cz,
-                                      lo_, hi_)  # fmt: skip
-                out = _stop(lo_, hi_, slack)
-            if not out and not pad_b[n, last_b[n]]:
-                lo_, hi_ = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, last_b[n], cx, cy, cz,
-                                      lo_, hi_)  # fmt: skip
-                out = _stop(lo_, hi_, slack)
-            k = 0
-            while not out and k < pos_a.shape[1]:
-                if not pad_a[n, k]:
-                    lo_, hi_ = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz,
-                                          lo_, hi_)  # fmt: skip
-                    if _stop(lo_, hi_, slack):
-                        out = True
-                        last_a[n] = k
-                k += 1
-            k = 0
-            while not out and k < pos_b.shape[1]:
-                if not pad_b[n, k]:
-                    lo_, hi_ = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k, cx, cy, cz,
-                                          lo_, hi_)  # fmt: skip
-                    if _stop(lo_, hi_, slack):
-                        out = True
-                        last_b[n] = k
-                k += 1
-            lo[n, m], hi[n, m] = lo_, hi_
-
-
-@_jit_np
+@_inline_np
 def _walk(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b, pad_b,
           order, n, cx, cy, cz, lo_, hi_):  # fmt: skip
-    """One draw of :func:`interval_kernel` (slack < 0: stops once the interval is empty):
-    both eyes' facets in the key's order ``order[n]`` (index k < K_A: A's facet k, else
-    B's facet k - K_A); the facet that stops a draw is moved to the front, so the facets
-    that rule most draws out are tried first. Returns (stopped, lo, hi)."""
+    """One draw's g interval (lo_, hi_ coming in as the prior's bounds), the early exit: the
+    facets are folded in one at a time, stopping at the first after which the interval is
+    empty (lo only grows and hi only shrinks, and :func:`_empty` is monotone, so a partial
+    interval that is empty gives the full one's verdict); both eyes' facets in the key's
+    order ``order[n]`` (index k < K_A: A's facet k, else B's facet k - K_A); the facet
+    that stops a draw is moved to the front, so the facets that rule most draws out are
+    tried first. Returns (stopped, lo, hi)."""
     ka = pos_a.shape[1]
     if _empty(lo_, hi_):
         return True, lo_, hi_
@@ -186,12 +142,13 @@ def _walk(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b,
         if k < ka:
             if pad_a[n, k]:
                 continue
-            lo_, hi_ = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz, lo_, hi_)
+            lo_, hi_ = _cone_fold_inline(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz,
+                                         lo_, hi_)  # fmt: skip
         else:
             if pad_b[n, k - ka]:
                 continue
-            lo_, hi_ = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
-                                  lo_, hi_)  # fmt: skip
+            lo_, hi_ = _cone_fold_inline(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
+                                         lo_, hi_)  # fmt: skip
         if _empty(lo_, hi_):
             for j in range(p, 0, -1):
                 order[n, j] = order[n, j - 1]
@@ -200,7 +157,7 @@ def _walk(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b,
     return False, lo_, hi_
 
 
-@_jit_np
+@_inline_np
 def bcentre(u0, e1, e2, d0, d1, beta, fa, bhat, blen):
     """limit3d_measured.MeasuredProposal._bcentres for one draw: (centre x, y, z, rho,
     d rho / d beta) at gnomonic offsets (d0, d1) of A's direction about u0 (frame e1, e2)
@@ -220,7 +177,7 @@ def bcentre(u0, e1, e2, d0, d1, beta, fa, bhat, blen):
     return fa[0] + vx * rho, fa[1] + vy * rho, fa[2] + vz * rho, rho, drho
 
 
-@_jit_np
+@_inline_np
 def measured_prior(r, g, el, az, s_half, g_max, r_min, r_max, el_max, multi):
     """limit3d_exact.prior_density of a measured pair for one ball (no cones: the azimuth
     uniform on [0, pi]); 0 outside the support."""
@@ -360,7 +317,6 @@ def warm() -> None:
     p3 = np.ones((1, 1, 3))
     cs = (p3, p3, a2 + 0.9, a2 + 0.1, b, ~b)
     cone_bounds_kernel(*cs, p3, out, out.copy())
-    interval_kernel(*cs, *cs, p3, b, out, out + 1, -1.0)
     direction_keep_kernel(p3, a2, b, ~b, p3, np.ones(1), np.ones(1), np.ones(1), b.copy())
     uniforms_kernel(np.ones(1, np.uint64), 1, np.zeros(1, np.int64), np.empty((1, 1, 4)))
     pts = np.ones((1, 1, 2, 3))

@@ -18,7 +18,15 @@ import numpy as np
 from numba.core import caching
 
 from eyeviz.core.kernels import limit3d_region
-from eyeviz.core.kernels.limit3d_region import _cone_fold, _jit_np, _walk, bcentre, measured_prior
+from eyeviz.core.kernels.limit3d_region import (
+    _cone_fold,
+    _cone_fold_inline,
+    _inline_np,
+    _jit_np,
+    _walk,
+    bcentre,
+    measured_prior,
+)
 
 __all__ = ["direction_kernel", "locate_kernel", "mixture_draws_kernel", "region_kernel", "warm"]
 
@@ -46,7 +54,7 @@ if _WithRegionSource not in _LOCATORS:
     _LOCATORS.insert(0, _WithRegionSource)
 
 
-@_jit_np
+@_inline_np
 def _walk_slack(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b, pad_b,
                 order, n, cx, cy, cz, lo_, hi_, slack):  # fmt: skip
     """limit3d_region._walk with the region test's stop, H = hi - lo < -slack (or NaN):
@@ -61,12 +69,13 @@ def _walk_slack(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, 
         if k < ka:
             if pad_a[n, k]:
                 continue
-            lo_, hi_ = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz, lo_, hi_)
+            lo_, hi_ = _cone_fold_inline(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz,
+                                         lo_, hi_)  # fmt: skip
         else:
             if pad_b[n, k - ka]:
                 continue
-            lo_, hi_ = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
-                                  lo_, hi_)  # fmt: skip
+            lo_, hi_ = _cone_fold_inline(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
+                                         lo_, hi_)  # fmt: skip
         if not (hi_ - lo_ >= -slack):
             for j in range(p, 0, -1):
                 order[n, j] = order[n, j - 1]
@@ -102,7 +111,7 @@ def region_kernel(x, u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack,
             h[n, g] = hv if math.isfinite(hv) else -np.inf
 
 
-@_jit_np
+@_inline_np
 def _component(counts, n, j):
     """The mixture component of a batch's draw j of key n: the first counts[n, 0] draws
     come from component 0, the next counts[n, 1] from 1, ..., the rest from the last."""
@@ -113,7 +122,7 @@ def _component(counts, n, j):
     return c
 
 
-@_jit_np
+@_inline_np
 def _density(boxes, dens, n, d0, d1, beta):
     """The mixture's density in (delta, beta) at a point: the sum of dens[n, c] (share /
     volume) over the components whose box holds it."""
