@@ -50,6 +50,25 @@ warm_kernels() {
     [ "$ok" = 1 ]
 }
 
+# Byte code of the packages eyeviz runs on, written once here (even under
+# PYTHONDONTWRITEBYTECODE, which these machines set: an app start would otherwise compile
+# them again each time). pip installs with --no-compile: compiling every file of every
+# wheel (13,900, torch's and sympy's included) cost about 50 CPU-seconds, on one core in
+# pip's own step, where importing what eyeviz uses compiles about a third of that. What no
+# import here reaches compiles on its first use, as any Python does.
+warm_imports() {
+    env -u PYTHONDONTWRITEBYTECODE PYTHONPATH=$PWD${PYTHONPATH:+:$PYTHONPATH} \
+        .venv/bin/python -c "import $1" >/dev/null 2>&1
+}
+warm_all_imports() {
+    warm_imports "torch, numba, scipy.optimize, scipy.stats, scipy.spatial, scipy.special, pandas" &
+    local torch=$! ok=1
+    warm_imports "eyeviz.app.window, matplotlib.pyplot, distributed, dask.array, \
+hypothesis, pytest, xdist, pytestqt, pytest_timeout" || ok=0
+    wait "$torch" || ok=0
+    [ "$ok" = 1 ]
+}
+
 PY=${PYTHON:-python3}
 if [ ! -x .venv/bin/python ]; then
     "$PY" -m venv .venv
@@ -58,6 +77,7 @@ fi
 # tests' Python processes then load it, not compile it (beside pip; quick when current)
 .venv/bin/python -m compileall -q eyeviz >/dev/null 2>&1 &
 stamp=.venv/.eyeviz-installed
+fresh=0
 if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
     echo "eyeviz setup: installing Python packages into .venv (first run takes a few minutes)" >&2
     log=.venv/setup.log
@@ -65,9 +85,9 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
         .venv/bin/python -m pip install --upgrade pip &&
         # torch first, pinned: any other request pulls a multi-GB CUDA build; with it
         # what the kernels need (pyproject's bounds), so that they compile beside the rest
-        .venv/bin/python -m pip install "torch==2.13.0" "numpy>=1.26" "numba>=0.60" &&
+        .venv/bin/python -m pip install --no-compile "torch==2.13.0" "numpy>=1.26" "numba>=0.60" &&
         { warm_kernels & } &&
-        .venv/bin/python -m pip install -e ".[app,ml,study,dev]"
+        .venv/bin/python -m pip install --no-compile -e ".[app,ml,study,dev]"
     } >"$log" 2>&1 || {
         wait
         tail -n 30 "$log" >&2
@@ -75,6 +95,7 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
         exit 1
     }
     touch "$stamp"
+    fresh=1
 fi
 if [ -n "$apt_pid" ] && ! wait "$apt_pid"; then
     echo "eyeviz setup: installing the system packages failed:$missing" >&2
@@ -82,6 +103,16 @@ if [ -n "$apt_pid" ] && ! wait "$apt_pid"; then
 fi
 # Wait for the warm begun beside pip, then warm (again): the cache is read in a few seconds,
 # and what pip's second step changed (a numba or numpy version) compiles now.
+# After an install, the packages' byte code too (beside it).
 wait
+imports=
+if [ "$fresh" = 1 ]; then
+    warm_all_imports &
+    imports=$!
+fi
 warm_kernels ||
     echo "eyeviz setup: warming the compiled kernels failed (they compile on first use)" >&2
+if [ -n "$imports" ] && ! wait "$imports"; then
+    echo "eyeviz setup: importing the installed packages failed:" \
+        ".venv/bin/python -c 'import torch, eyeviz.app.window' shows why" >&2
+fi
