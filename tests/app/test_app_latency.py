@@ -51,9 +51,12 @@ def test_a_drag_move_lays_out_nothing_and_paints_little(make_window):
         x0 = win.model.scene.features[-1].x
         counter.on = True
         for k in range(n):
-            move(w, start + QtCore.QPoint(30 + 4 * k, -10 - 3 * k))
-            # the move's (coalesced) frame: on a loaded machine three passes may not reach it
+            # the move's (coalesced) frame, counted from before the move: move() runs the
+            # pending events, which usually draw it already (counted after, every move
+            # waited out its 0.5 s: 15 s of a busy loop); on a loaded machine three more
+            # passes may not reach it
             target, deadline = w.frames + 1, time.monotonic() + 0.5
+            move(w, start + QtCore.QPoint(30 + 4 * k, -10 - 3 * k))
             for _ in range(3):
                 app.processEvents()
             while w.frames < target and time.monotonic() < deadline:
