@@ -163,3 +163,36 @@ def _read_predictions3d(pred, npz):
 def read_predictions3d():
     """:func:`_read_predictions3d`: a predict CSV of a 3D data set, checked, with errors."""
     return _read_predictions3d
+
+
+def _eyeviz_main(*args):
+    """``eyeviz ARGS`` run in this process through :func:`eyeviz.cli.main`, what the
+    command line runs once Python has started: a CompletedProcess with its exit code and
+    what it wrote to stdout and stderr (argparse's usage errors exit 2 there too).
+
+    For tests whose point is a command's result (files, exit codes, one-line messages),
+    not its process: each subprocess costs a Python start and eyeviz's imports, 1-2
+    CPU-seconds (issue 31: the CI's 10 minutes). Signals, import isolation, output written
+    below Python (a C library's) and the real entry point keep a process of their own."""
+    import contextlib
+    import io
+    import subprocess
+
+    from eyeviz.cli import main
+
+    argv = [str(a) for a in args]
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(argv)
+        except SystemExit as exc:  # argparse: --help, usage errors
+            code = exc.code if isinstance(exc.code, int) else 0 if exc.code is None else 1
+            if isinstance(exc.code, str):
+                print(exc.code, file=err)
+    return subprocess.CompletedProcess(["eyeviz", *argv], code, out.getvalue(), err.getvalue())
+
+
+@pytest.fixture
+def eyeviz_main():
+    """:func:`_eyeviz_main`: ``eyeviz ARGS`` in this process, as a CompletedProcess."""
+    return _eyeviz_main

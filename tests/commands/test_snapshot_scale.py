@@ -58,12 +58,12 @@ def _png_size(path: Path) -> tuple[int, int]:
 
 
 @pytest.mark.slow
-def test_png_size_does_not_grow_with_features(tmp_path):
+def test_png_size_does_not_grow_with_features(tmp_path, eyeviz_main):
     """400 features once made a 1050 x 31,620 px PNG; now 400 and 4000 are one size."""
     sizes = {}
     for n in (400, 4000):
         out = tmp_path / f"o{n}.png"
-        run = _snapshot(_scene_file(tmp_path, n), "-o", out)
+        run = eyeviz_main("snapshot", _scene_file(tmp_path, n), "-o", out)
         assert run.returncode == 0, run.stderr
         sizes[n] = _png_size(out)
     assert sizes[400] == sizes[4000]
@@ -71,18 +71,18 @@ def test_png_size_does_not_grow_with_features(tmp_path):
 
 
 @pytest.mark.slow
-def test_min_font_makes_a_taller_figure_and_bad_values_are_refused(tmp_path):
+def test_min_font_makes_a_taller_figure_and_bad_values_are_refused(tmp_path, eyeviz_main):
     scene = SCENES / "default.toml"
     heights = {}
     for pt in (None, "8"):
         out = tmp_path / f"m{pt}.png"
         extra = [] if pt is None else ["--min-font", pt]
-        run = _snapshot(scene, "-o", out, *extra)
+        run = eyeviz_main("snapshot", scene, "-o", out, *extra)
         assert run.returncode == 0, run.stderr
         heights[pt] = _png_size(out)[1]
     assert heights["8"] > heights[None]
     for bad in ("4", "30", "nan", "big"):
-        run = _snapshot(scene, "-o", tmp_path / "bad.png", "--min-font", bad)
+        run = eyeviz_main("snapshot", scene, "-o", tmp_path / "bad.png", "--min-font", bad)
         assert run.returncode == 2, run.stderr
         assert run.stderr.count("\n") == 1 and "min-font" in run.stderr, run.stderr
     assert not (tmp_path / "bad.png").exists()
