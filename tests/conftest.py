@@ -165,7 +165,7 @@ def read_predictions3d():
     return _read_predictions3d
 
 
-def _eyeviz_main(*args):
+def _eyeviz_main(*args, cwd=None):
     """``eyeviz ARGS`` run in this process through :func:`eyeviz.cli.main`, what the
     command line runs once Python has started: a CompletedProcess with its exit code and
     what it wrote to stdout and stderr (argparse's usage errors exit 2 there too).
@@ -173,7 +173,8 @@ def _eyeviz_main(*args):
     For tests whose point is a command's result (files, exit codes, one-line messages),
     not its process: each subprocess costs a Python start and eyeviz's imports, 1-2
     CPU-seconds (issue 31: the CI's 10 minutes). Signals, import isolation, output written
-    below Python (a C library's) and the real entry point keep a process of their own."""
+    below Python (a C library's) and the real entry point keep a process of their own.
+    ``cwd``: the working directory meanwhile (relative paths)."""
     import contextlib
     import io
     import subprocess
@@ -182,7 +183,8 @@ def _eyeviz_main(*args):
 
     argv = [str(a) for a in args]
     out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+    where = contextlib.chdir(cwd) if cwd is not None else contextlib.nullcontext()
+    with where, contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         try:
             code = main(argv)
         except SystemExit as exc:  # argparse: --help, usage errors

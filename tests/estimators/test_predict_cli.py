@@ -4,8 +4,6 @@ estimator's, builds an any-design estimator's domain from flags."""
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,19 +11,11 @@ import pytest
 
 from eyeviz import dataset
 
-ROOT = Path(__file__).resolve().parents[2]
 
-
-def _run(*args, cwd=None):
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
-    return subprocess.run(
-        [sys.executable, "-m", "eyeviz", *map(str, args)],
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=cwd,
-    )
+@pytest.fixture
+def cli(eyeviz_main):
+    """``eyeviz ARGS`` in this process (the command's result is the point here)."""
+    return eyeviz_main
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +37,7 @@ def _one_line_error(res, *parts):
 
 
 @pytest.mark.parametrize("how", ["same", "symlink", "hardlink", "relative"])
-def test_output_equal_to_input_refused(data, tmp_path, how):
+def test_output_equal_to_input_refused(data, tmp_path, how, cli):
     src = tmp_path / "in.csv"
     src.write_bytes((data / "paper.csv").read_bytes())
     before = src.read_bytes()
@@ -56,62 +46,62 @@ def test_output_equal_to_input_refused(data, tmp_path, how):
         out.symlink_to(src)
     elif how == "hardlink":
         os.link(src, out)
-    res = _run("predict", "-e", "analytic", src, "-o", out, cwd=tmp_path)
+    res = cli("predict", "-e", "analytic", src, "-o", out, cwd=tmp_path)
     _one_line_error(res, "is the input data file")
     assert src.read_bytes() == before
 
 
 @pytest.mark.slow
-def test_npz_design_mismatch_names_both(data, tmp_path):
-    res = _run("predict", "-e", "compact", data / "m360.npz", "-o", tmp_path / "p.csv")
+def test_npz_design_mismatch_names_both(data, tmp_path, cli):
+    res = cli("predict", "-e", "compact", data / "m360.npz", "-o", tmp_path / "p.csv")
     _one_line_error(res, "h=40, l=20, m=360", "'compact'", "h=40, l=20, m=720")
     assert not (tmp_path / "p.csv").exists()
 
 
 @pytest.mark.slow
-def test_csv_design_from_flags(data, tmp_path):
-    res = _run("predict", "-e", "compact", "--m", "360", data / "m360.csv", "-o", tmp_path / "p")
+def test_csv_design_from_flags(data, tmp_path, cli):
+    res = cli("predict", "-e", "compact", "--m", "360", data / "m360.csv", "-o", tmp_path / "p")
     _one_line_error(res, "m=360", "'compact' answers for h=40, l=20, m=720")
-    res = _run("predict", "-e", "bayes", data / "m360.csv", "-o", tmp_path / "p.csv")
+    res = cli("predict", "-e", "bayes", data / "m360.csv", "-o", tmp_path / "p.csv")
     _one_line_error(res, "m=360", "m=720")  # no --m: the default (Table 3) does not fit
 
 
-def test_npz_flags_contradicting_the_file_refused(data, tmp_path):
-    res = _run("predict", "-e", "analytic", "--h", "30", data / "paper.npz", "-o", tmp_path / "p")
+def test_npz_flags_contradicting_the_file_refused(data, tmp_path, cli):
+    res = cli("predict", "-e", "analytic", "--h", "30", data / "paper.npz", "-o", tmp_path / "p")
     _one_line_error(res, "has design h=40, l=20, m=720", "--h 30")
 
 
-def test_any_design_estimator_takes_the_data_design(data, tmp_path):
+def test_any_design_estimator_takes_the_data_design(data, tmp_path, cli):
     out = tmp_path / "p.csv"
-    res = _run("predict", "-e", "analytic", "--m", "360", data / "m360.csv", "-o", out)
+    res = cli("predict", "-e", "analytic", "--m", "360", data / "m360.csv", "-o", out)
     assert res.returncode == 0, res.stderr
     pred = np.loadtxt(out, delimiter=",", skiprows=1)
     truth = dataset.load(data / "m360.npz")
     assert pred.shape == (300, 2)
     assert np.median(np.abs(pred[:, 0] / truth.r - 1)) < 0.5  # answers in the right design
-    res = _run("predict", "-e", "analytic", data / "m360.npz", "-o", out)
+    res = cli("predict", "-e", "analytic", data / "m360.npz", "-o", out)
     assert res.returncode == 0, res.stderr
 
 
-def test_csv_and_npz_give_the_same_predictions(data, tmp_path):
+def test_csv_and_npz_give_the_same_predictions(data, tmp_path, cli):
     for name in ("paper.csv", "paper.npz"):
-        res = _run("predict", "-e", "bayes", data / name, "-o", tmp_path / f"{name}.out")
+        res = cli("predict", "-e", "bayes", data / name, "-o", tmp_path / f"{name}.out")
         assert res.returncode == 0, res.stderr
     a = np.loadtxt(tmp_path / "paper.csv.out", delimiter=",", skiprows=1)
     b = np.loadtxt(tmp_path / "paper.npz.out", delimiter=",", skiprows=1)
     assert np.allclose(a, b, equal_nan=True)
 
 
-def test_unknown_estimator_lists_the_registry(data, tmp_path):
-    res = _run("predict", "-e", "nope", data / "paper.npz", "-o", tmp_path / "p.csv")
+def test_unknown_estimator_lists_the_registry(data, tmp_path, cli):
+    res = cli("predict", "-e", "nope", data / "paper.npz", "-o", tmp_path / "p.csv")
     _one_line_error(res, "unknown estimator 'nope'", "analytic", "bayes", "compact", "paper")
 
 
-def test_streamed_output_equals_in_memory_prediction(data, tmp_path):
+def test_streamed_output_equals_in_memory_prediction(data, tmp_path, cli):
     from eyeviz import estimators
 
     out = tmp_path / "p.csv"
-    res = _run("predict", "-e", "bayes", data / "paper.npz", "-o", out)
+    res = cli("predict", "-e", "bayes", data / "paper.npz", "-o", out)
     assert res.returncode == 0, res.stderr
     assert out.read_text().splitlines()[0] == "r_hat,phi_hat"
     got = np.loadtxt(out, delimiter=",", skiprows=1)
@@ -122,11 +112,11 @@ def test_streamed_output_equals_in_memory_prediction(data, tmp_path):
     assert "300 rows" in res.stderr and "DD MAPE" in res.stderr
 
 
-def test_limit_domain_and_prior_from_flags(data, tmp_path):
+def test_limit_domain_and_prior_from_flags(data, tmp_path, cli):
     out = tmp_path / "p.csv"
     args = ["predict", "-e", "limit", "--m", "360", "--r-min", "1000", "--r-max", "5000"]
     args += ["--g-max", "500", "--prior", "multi", data / "m360.csv", "-o", out]
-    res = _run(*args)
+    res = cli(*args)
     assert res.returncode == 0, res.stderr
     got = np.loadtxt(out, delimiter=",", skiprows=1)
     from eyeviz import estimators
@@ -137,7 +127,7 @@ def test_limit_domain_and_prior_from_flags(data, tmp_path):
     assert np.allclose(got[:, 0], want.r, equal_nan=True)
     single = estimators.load("limit", domain=dom, prior="single").predict(ds.omega_a, ds.omega_b)
     assert not np.allclose(got[:, 0], single.r, equal_nan=True)  # --prior reached the estimator
-    res = _run("predict", "-e", "limit", "--prior", "triple", data / "m360.csv", "-o", out)
+    res = cli("predict", "-e", "limit", "--prior", "triple", data / "m360.csv", "-o", out)
     assert res.returncode == 2 and "triple" in res.stderr
 
 
@@ -149,15 +139,15 @@ def test_limit_domain_and_prior_from_flags(data, tmp_path):
         (["--device", "cpu"], ("--device is an option of estimator 'paper'",)),
     ],
 )
-def test_options_the_estimator_does_not_take_are_refused(data, tmp_path, extra, parts):
+def test_options_the_estimator_does_not_take_are_refused(data, tmp_path, extra, parts, cli):
     out = tmp_path / "p.csv"
-    res = _run("predict", "-e", "analytic", *extra, data / "paper.npz", "-o", out)
+    res = cli("predict", "-e", "analytic", *extra, data / "paper.npz", "-o", out)
     _one_line_error(res, *parts)
     assert not out.exists()
 
 
-def test_ranges_for_a_fixed_design_estimator_are_refused(data, tmp_path):
-    res = _run("predict", "-e", "bayes", "--r-min", "10", data / "paper.npz", "-o", tmp_path / "p")
+def test_ranges_for_a_fixed_design_estimator_are_refused(data, tmp_path, cli):
+    res = cli("predict", "-e", "bayes", "--r-min", "10", data / "paper.npz", "-o", tmp_path / "p")
     _one_line_error(res, "--r-min is for estimators of any design", "'bayes'")
 
 
@@ -211,6 +201,6 @@ def test_valid_rows_left_unanswered_exit_3_after_writing(data, tmp_path, capsys)
     assert "DD MAPE" in err  # the metrics still cover the answered rows
 
 
-def test_help_documents_the_exit_status():
-    res = _run("predict", "--help")
+def test_help_documents_the_exit_status(cli):
+    res = cli("predict", "--help")
     assert res.returncode == 0 and "exit status: 0 written" in " ".join(res.stdout.split())
