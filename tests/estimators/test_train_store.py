@@ -146,10 +146,10 @@ def test_train_leaves_shipped_assets_unchanged(tmp_path):
     assert len((tmp_path / "p.csv").read_text().splitlines()) == 101
 
 
-def test_train_bayes_npz_name_into_user_dir(tmp_path):
-    home = tmp_path / "home"
+def test_train_bayes_npz_name_into_user_dir(tmp_path, monkeypatch, eyeviz_main):
+    monkeypatch.setenv("EYEVIZ_HOME", str(tmp_path / "home"))
     out = tmp_path / "t" / "b.npz"
-    res = _run(["train", "bayes", "-n", "20000", "-o", str(out)], home)
+    res = eyeviz_main("train", "bayes", "-n", "20000", "-o", out)
     assert res.returncode == 0, res.stderr
     est = estimators.load("bayes", path=out)
     assert est.metadata["sample_size"] == 20000
@@ -169,10 +169,10 @@ BAD_TRAINING_OPTIONS = [
 ]
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("args, message", BAD_TRAINING_OPTIONS)
-def test_bad_training_options_one_line(tmp_path, args, message):
-    res = _run(["train", *args], tmp_path)
+def test_bad_training_options_one_line(tmp_path, monkeypatch, eyeviz_main, args, message):
+    monkeypatch.setenv("EYEVIZ_HOME", str(tmp_path))
+    res = eyeviz_main("train", *args)  # in this process: the refusal, not the process, is the point
     assert res.returncode == 2
     last = res.stderr.strip().splitlines()[-1]
     assert last.startswith("eyeviz: error: ") and message in last, res.stderr
@@ -199,8 +199,9 @@ def test_bad_training_options_are_refused_before_the_fit_is_imported(
         parsed._run(parsed)
 
 
-def test_into_assets_and_out_together_refused(tmp_path):
-    res = _run(["train", "compact", "-o", str(tmp_path), "--into-assets"], tmp_path)
+def test_into_assets_and_out_together_refused(tmp_path, monkeypatch, eyeviz_main):
+    monkeypatch.setenv("EYEVIZ_HOME", str(tmp_path))
+    res = eyeviz_main("train", "compact", "-o", tmp_path, "--into-assets")
     assert res.returncode == 2
     assert "not allowed with" in res.stderr
 
