@@ -6,8 +6,6 @@ import argparse
 import csv
 import itertools
 import math
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -134,27 +132,18 @@ def test_ball_bootstrap_matches_the_exact_bootstrap() -> None:
     assert all(math.isnan(v) for v in M.ball_bootstrap(one).se.values())
 
 
-def test_bad_photons_exit_2_in_one_line(tmp_path: Path) -> None:
-    res = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "report", "information", "-o", str(tmp_path / "x")]
-        + ["--photons", "0"],
-        capture_output=True,
-        text=True,
-    )
+def test_bad_photons_exit_2_in_one_line(tmp_path: Path, eyeviz_main) -> None:
+    res = eyeviz_main("report", "information", "-o", tmp_path / "x", "--photons", "0")
     assert res.returncode == 2
     assert res.stderr.strip() == "eyeviz: error: --photons must be > 0 and <= 1e12, got 0.0"
     assert not (tmp_path / "x").exists()
 
 
 @pytest.mark.slow
-def test_report_writes_its_files(tmp_path: Path) -> None:
+def test_report_writes_its_files(tmp_path: Path, eyeviz_main) -> None:
     out = tmp_path / "r"
     args = ["--planar-balls", "20", "--bee-balls", "6", "--healpix-balls", "0"]
-    res = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "report", "information", "-o", str(out), *args],
-        capture_output=True,
-        text=True,
-    )
+    res = eyeviz_main("report", "information", "-o", out, *args)
     assert res.returncode == 0, res.stderr
     rows = list(csv.DictReader((out / "information.csv").read_text().splitlines()))
     assert [r["model"] for r in rows] == ["planar", "honeybee"]

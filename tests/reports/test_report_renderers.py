@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 import csv
 import math
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -58,14 +56,9 @@ def test_tables(measured) -> None:
 
 
 @pytest.mark.slow
-def test_report_writes_its_files(tmp_path: Path) -> None:
+def test_report_writes_its_files(tmp_path: Path, eyeviz_main) -> None:
     out = tmp_path / "r"
-    res = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "report", "renderers", "-o", str(out)]
-        + ["--balls", "300", "--mc-balls", "20"],
-        capture_output=True,
-        text=True,
-    )
+    res = eyeviz_main("report", "renderers", "-o", out, "--balls", "300", "--mc-balls", "20")
     assert res.returncode == 0, res.stderr
     for name in ("renderers.md", "renderers.csv", "curves.csv", "renderers.svg"):
         assert (out / name).stat().st_size > 100
@@ -75,13 +68,8 @@ def test_report_writes_its_files(tmp_path: Path) -> None:
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
 
 
-def test_bad_arguments_exit_2_in_one_line(tmp_path: Path) -> None:
-    res = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "report", "renderers", "-o", str(tmp_path / "x")]
-        + ["--acceptance", "0"],
-        capture_output=True,
-        text=True,
-    )
+def test_bad_arguments_exit_2_in_one_line(tmp_path: Path, eyeviz_main) -> None:
+    res = eyeviz_main("report", "renderers", "-o", tmp_path / "x", "--acceptance", "0")
     assert res.returncode == 2
     assert res.stderr.strip() == "eyeviz: error: --acceptance must be in (0, 180) degrees, got 0.0"
     assert not (tmp_path / "x").exists()

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import csv
-import subprocess
-import sys
 
 import pytest
 
@@ -12,14 +10,9 @@ from eyeviz.reports import stability
 
 
 @pytest.mark.slow
-def test_report_writes_table_csv_and_plot(tmp_path):
+def test_report_writes_table_csv_and_plot(tmp_path, eyeviz_main):
     out = tmp_path / "report"
-    res = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "report", "stability", "-o", str(out), "-n", "150"]
-        + ["--n3d", "1"],
-        capture_output=True,
-        text=True,
-    )
+    res = eyeviz_main("report", "stability", "-o", out, "-n", "150", "--n3d", "1")
     assert res.returncode == 0, res.stderr
     md = (out / "stability.md").read_text()
     assert "| grazing |" in md and "eyeviz core diffs" in md
@@ -48,12 +41,8 @@ def test_report_writes_table_csv_and_plot(tmp_path):
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
 
 
-def test_bad_n_is_refused_in_one_line(tmp_path):
-    res = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "report", "stability", "-o", str(tmp_path), "-n", "0"],
-        capture_output=True,
-        text=True,
-    )
+def test_bad_n_is_refused_in_one_line(tmp_path, eyeviz_main):
+    res = eyeviz_main("report", "stability", "-o", tmp_path, "-n", "0")
     assert res.returncode == 2
     assert res.stderr.strip() == "eyeviz: error: -n must be an integer >= 1 and <= 100000, got 0"
 
