@@ -128,13 +128,9 @@ def test_reader_reads_a_real_table(real_table, tmp_path):
 
 
 @pytest.mark.slow
-def test_report_writes_figures_a_paper_can_use(real_table, tmp_path):
+def test_report_writes_figures_a_paper_can_use(real_table, tmp_path, eyeviz_main):
     out = tmp_path / "report"
-    res = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "report", "study", str(real_table), "-o", str(out)],
-        capture_output=True,
-        text=True,
-    )
+    res = eyeviz_main("report", "study", real_table, "-o", out)
     assert res.returncode == 0, res.stderr
     for stem in ("study_dd", "study_ad", "study_heatmap", "study_law"):
         for ext in ("pdf", "svg", "png"):
@@ -326,7 +322,7 @@ def test_empty_and_oversized_and_binary_tables(tmp_path, monkeypatch):
 
 
 @pytest.mark.slow
-def test_cli_one_line_errors_and_nothing_written(tmp_path):
+def test_cli_one_line_errors_and_nothing_written(tmp_path, eyeviz_main):
     rows = synthetic_rows()
     rows[0]["version"] = 7
     bad = write_table(tmp_path / "bad.csv", rows)
@@ -342,11 +338,7 @@ def test_cli_one_line_errors_and_nothing_written(tmp_path):
         ([str(tmp_path / "ok.csv"), "--at", "nan"], "--at must be a finite number"),
         ([str(tmp_path / "ok.csv"), "--formats", "png,eps"], "--formats takes png, svg and pdf"),
     ):
-        res = subprocess.run(
-            [sys.executable, "-m", "eyeviz", "report", "study", *args, "-o", str(out)],
-            capture_output=True,
-            text=True,
-        )
+        res = eyeviz_main("report", "study", *args, "-o", out)
         assert res.returncode == 2, res.stderr
         err = res.stderr.strip()
         assert err.startswith("eyeviz: error:") and want in err and "\n" not in err, err

@@ -3,11 +3,7 @@ summary names the estimator, and the power-law fit recovers known exponents."""
 
 import json
 import math
-import os
-import subprocess
-import sys
 import xml.etree.ElementTree as ET
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,12 +13,11 @@ from eyeviz.reports.study_law import LawPoint, fit_power, law_uncertainty
 from eyeviz.study import run_study
 from eyeviz.study.grid import design_grid3d
 
-ROOT = Path(__file__).resolve().parents[2]
 STEMS = ("study3d_design", "study3d_dd", "study3d_law", "study3d_elevation")
 
 
 @pytest.mark.slow
-def test_report_study_draws_the_3d_figures_and_opens_them(tmp_path):
+def test_report_study_draws_the_3d_figures_and_opens_them(tmp_path, eyeviz_main):
     pytest.importorskip("distributed")
     import matplotlib.image as mpimg
 
@@ -30,14 +25,7 @@ def test_report_study_draws_the_3d_figures_and_opens_them(tmp_path):
     run_study(
         table, design_grid3d("20,40", "5,10", "16,32", n=800, seed=1), workers=1, progress=False
     )
-    out = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "report", "study", str(table), "-o", str(tmp_path / "f")],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        timeout=300,
-        env={**os.environ, "MPLBACKEND": "Agg"},
-    )
+    out = eyeviz_main("report", "study", table, "-o", tmp_path / "f")
     assert out.returncode == 0, out.stderr
     assert "wrote 13 files" in out.stdout
     for stem in STEMS:

@@ -162,15 +162,13 @@ def test_the_table_script_marks_every_row_over_5_percent(table3d, tmp_path):
     assert "the law over" in text.stdout or "fewer than 2 bands" in text.stdout
 
 
-def test_a_band_off_the_bins_or_on_a_planar_table_is_one_line(table3d, tmp_path):
-    out = _run("-m", "eyeviz", "report", "study", str(table3d), "-o", str(tmp_path / "f"),
-               "--band", "750")  # fmt: skip
+def test_a_band_off_the_bins_or_on_a_planar_table_is_one_line(table3d, tmp_path, eyeviz_main):
+    out = eyeviz_main("report", "study", table3d, "-o", tmp_path / "f", "--band", "750")
     assert out.returncode != 0
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and "--band must be a whole multiple" in lines[0], out.stderr
     planar = ROOT / "docs" / "study" / "study.csv"
-    out = _run("-m", "eyeviz", "report", "study", str(planar), "-o", str(tmp_path / "g"),
-               "--band", "1000")  # fmt: skip
+    out = eyeviz_main("report", "study", planar, "-o", tmp_path / "g", "--band", "1000")
     lines = out.stderr.strip().splitlines()
     assert out.returncode != 0 and len(lines) == 1 and "3D study table only" in lines[0]
     assert not (tmp_path / "g").exists()
