@@ -63,8 +63,10 @@ warm_imports() {
 warm_all_imports() {
     warm_imports "torch, numba, scipy.optimize, scipy.stats, scipy.spatial, scipy.special, pandas" &
     local torch=$! ok=1
-    warm_imports "eyeviz.app.window, matplotlib.pyplot, distributed, dask.array, \
-hypothesis, pytest, xdist, pytestqt, pytest_timeout" || ok=0
+    warm_imports "eyeviz.app.window, pyvistaqt, vtkmodules.util.vtkAlgorithm, matplotlib.pyplot, \
+matplotlib.backends.backend_agg, matplotlib.backends.backend_qt5agg, PIL.features, \
+PIL.JpegImagePlugin, PIL.GifImagePlugin, PIL.BmpImagePlugin, PIL.PpmImagePlugin, \
+distributed, dask.array, hypothesis, pytest, xdist, pytestqt, pytest_timeout" || ok=0
     wait "$torch" || ok=0
     [ "$ok" = 1 ]
 }
