@@ -54,7 +54,18 @@ class _Eye:
     """The edge cells of one eye for a chunk of keys: their boundary points, padded to
     (N, K, P, 3), with ``lit`` (N, K) (True: must stay lit), ``pad`` (N, K)."""
 
-    def __init__(self, domain: Domain3D, lit: LitCSR, centre: np.ndarray, eye: int):
+    def __init__(
+        self,
+        domain: Domain3D,
+        lit: LitCSR,
+        centre: np.ndarray,
+        eye: int,
+        reach: np.ndarray | None = None,
+    ):
+        """The edge cells of the keys ``lit`` in eye ``eye`` (at ``centre``), linearised
+        at each key's cap estimate. With ``reach`` (N,), the reach of the first
+        :meth:`prune` the caller makes: the cells that prune surely drops get no boundary
+        samples (compiled only: :meth:`_candidates`; the same cells survive it)."""
         self.nside = domain.nside
         npix = domain.npix
         u, alpha = cap_estimates(domain.nside, lit)
@@ -96,6 +107,12 @@ class _Eye:
         self.b_in = np.where(small, -np.inf, half[:n])
         self.b_out = half[n:].copy()
         self._band = (np.bincount(rows, minlength=n), codes % npix, is_lit)
+        self.n_lit_edge = np.bincount(rows[is_lit], minlength=n)
+        self.n_unlit = np.bincount(rows[~is_lit], minlength=n)
+        self._ring: np.ndarray | None = None  # the band cells' rings, if known
+        if reach is not None and kernels.use(codes.size):
+            keep = self._candidates(u, rows, reach)
+            codes, is_lit, rows = codes[keep], is_lit[keep], rows[keep]
         cnt = np.bincount(rows, minlength=n)
         kmax = max(1, int(cnt.max()) if cnt.size else 1)
         slot = np.arange(codes.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
@@ -104,11 +121,54 @@ class _Eye:
         self.lit[rows, slot] = is_lit
         self.pad = np.ones((n, kmax), bool)
         self.pad[rows, slot] = False
-        self.n_lit_edge = np.bincount(rows[is_lit], minlength=n)
-        self.n_unlit = np.bincount(rows[~is_lit], minlength=n)
         self.centre = np.asarray(centre, float)
         self.a = np.zeros(3)  # the other eye's centre relative to this one (set by the caller)
         self.linearise(u)
+
+    def _candidates(self, u: np.ndarray, rows: np.ndarray, reach: np.ndarray) -> np.ndarray:
+        """The edge cells (bool, in ``_band``'s order; ``rows`` their keys) that
+        :meth:`prune` with ``reach`` after the first :meth:`linearise` (at c = u / |u|) may
+        keep: it surely drops the others.
+
+        Proof. At c, linearise gives each cell the distance d_s of its nearest boundary
+        sample (lit cells: d_s - gap(d_s), :func:`_sample_gap`). The samples lie on the
+        cell's boundary and include its four vertices, so dist(c, closure) <= d_s <=
+        the nearest vertex's distance; kernels.healpix_match.band_bounds_kernel bounds both
+        about c (``far`` below the first, less 1e-12 rad beyond its rounding bounds;
+        ``near`` above the second, plus 1e-12). x - gap(x) is increasing (for x >= s / 2
+        it is 1.5 sqrt(x^2 - s^2 / 4) - x / 2, slope >= 1; below, x - 0.75 s), so each
+        cell's d lies in [L, U] = [f(far), f(near)] (f: x - gap(x) for lit cells, x for
+        unlit ones). prune keeps a lit cell iff d >= max_lit - m and an unlit one iff
+        d <= min_unlit + m (m = 2.2 reach); max_lit >= max of the lit cells' L and
+        min_unlit <= min of the unlit cells' U. So a lit cell with U < max L - m - 1e-9,
+        or an unlit one with L > min U + m + 1e-9, is dropped (the 1e-9 rad far above the
+        rounding of d, L and U). The cell that attains max_lit (min_unlit) is never among
+        them (its U >= d = max_lit >= max L), so prune's max_lit and min_unlit, and hence
+        every verdict, are the same on the candidates as on all cells; and the candidates
+        keep their slot order, so the kept cells are the same, in the same order, with
+        the same samples and linearisation (tests/core/test_kernels_limit3d_affine.py)."""
+        from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
+        from eyeviz.core.kernels.healpix_match import band_bounds_kernel
+
+        _, pix, lit = self._band
+        n = self.nside
+        first, _, shifted = _ring_info_tables(n)[:3]
+        ring = np.searchsorted(first[1 : 4 * n], pix, side="right").astype(np.int64)
+        self._ring = ring  # band() takes them again
+        c = u / np.linalg.norm(u, axis=1, keepdims=True)  # as linearise normalises it
+        near, far = np.empty(pix.size), np.empty(pix.size)
+        band_bounds_kernel(n, kernels.arg(pix, np.int64), ring, kernels.arg(rows, np.int64),
+                           kernels.arg(c, np.float64), *_ring_tables(n), first, shifted, near,
+                           far)  # fmt: skip
+        s = self.step
+        lo = np.where(lit, far - _sample_gap(s, far), far)
+        hi = np.where(lit, near - _sample_gap(s, near), near)
+        m = 2.2 * np.asarray(reach, np.float64)[rows] + 1e-9
+        lo_lit = np.full(u.shape[0], -np.inf)
+        np.maximum.at(lo_lit, rows[lit], lo[lit])
+        hi_unl = np.full(u.shape[0], np.inf)
+        np.minimum.at(hi_unl, rows[~lit], hi[~lit])
+        return np.where(lit, hi >= lo_lit[rows] - m, lo <= hi_unl[rows] + m)
 
     def band(self) -> tuple[np.ndarray, ...]:
         """The arguments of kernels.healpix_match.edge_match_kernel for this eye's keys, from
@@ -123,7 +183,9 @@ class _Eye:
         cnt, pix, lit = self._band
         n = self.nside
         first = _ring_info_tables(n)[0]
-        ring = np.searchsorted(first[1 : 4 * n], pix, side="right").astype(np.int64)
+        ring = self._ring
+        if ring is None:
+            ring = np.searchsorted(first[1 : 4 * n], pix, side="right").astype(np.int64)
         bp = np.zeros(cnt.size + 1, np.int64)
         np.cumsum(cnt, out=bp[1:])
         key = np.repeat(np.arange(cnt.size, dtype=np.int64), cnt)
@@ -185,7 +247,9 @@ class _Eye:
         centre: a lit cell's modelled distance moves by at most |delta| and an unlit
         one's by at most |delta| + |delta|^2 / (2 d), so a lit cell below max_lit - 2.2
         reach or an unlit one above min_unlit + 2.2 reach never decides. (Dropping
-        constraints only loosens the model: the exact check decides.)"""
+        constraints only loosens the model: the exact check decides.) The dropped cells
+        are dropped whether or not the arrays get narrower, so the cells kept do not depend
+        on the other keys of the chunk (nor on which cells got samples: _candidates)."""
         live = ~self.pad
         lo0 = np.where(self.lit & live, self.d, -np.inf).max(axis=1)
         hi0 = np.where(~self.lit & live, self.d, np.inf).min(axis=1)
@@ -193,7 +257,10 @@ class _Eye:
         keep = live & np.where(self.lit, self.d >= lo0[:, None] - m, self.d <= hi0[:, None] + m)
         cnt = keep.sum(axis=1)
         kmax = max(1, int(cnt.max()) if cnt.size else 1)
-        if kmax >= keep.shape[1]:
+        if kmax >= keep.shape[1]:  # no narrower: the dropped cells become padding in place
+            if not (keep == live).all():
+                self.pad = ~keep
+                self._affine()
             return
         if kernels.use(keep.size):  # the same copies, compiled
             from eyeviz.core.kernels.limit3d_affine import compact_kernel

@@ -55,12 +55,13 @@ class HealpixProposal:
         fw = math.sqrt(4 * math.pi / d.npix)
         A = np.array([-d.h, 0.0, 0.0])
         B = np.array([d.h, 0.0, 0.0])
-        ea = _Eye(d, lit_a, A, 0)
-        eb = _Eye(d, lit_b, B, 1)
+        reach = np.full(lit_a[0].size - 1, PRUNE * wide * fw)
+        ea = _Eye(d, lit_a, A, 0, reach)
+        eb = _Eye(d, lit_b, B, 1, reach)
         n = ea.c.shape[0]
         slack0 = wide * 0.002 * fw
         for e in (ea, eb):
-            e.prune(np.full(n, PRUNE * wide * fw))
+            e.prune(reach)
             _locate(e, 0.25 * wide * fw, self.grid, LEVELS)
         ext = _extent(ea, wide * 0.5 * fw, slack0)
         eb.a = A - B

@@ -327,3 +327,64 @@ def test_locate_kernel_takes_the_first_of_equal_points_as_argmax():
     locate_kernel(np.ones((1, 1, 2, 3)), ~pad, pad, 0.01, g0, 0.1, 1, c, e1, e2, d, t,
                   d.copy(), t.copy(), d.copy(), t.copy(), lists, np.empty(g0.shape[0]))  # fmt: skip
     assert np.allclose(c, want / np.linalg.norm(want), atol=1e-15)
+
+
+def _same_live(a: _Eye, b: _Eye) -> bool:
+    """The two eyes' live cells are the same, key by key in slot order: their samples,
+    lit, d and t bit for bit."""
+    for n in range(a.pad.shape[0]):
+        ka, kb = ~a.pad[n], ~b.pad[n]
+        for x, y in ((a.pts, b.pts), (a.lit, b.lit), (a.d, b.d), (a.t, b.t)):
+            if not np.array_equal(x[n][ka], y[n][kb]):
+                return False
+    return True
+
+
+def test_the_first_prunes_candidates_keep_every_cell_it_keeps(monkeypatch):
+    """_Eye with ``reach`` (boundary samples only for the cells the first prune may keep,
+    _Eye._candidates) then prune gives the same live cells, samples, d and t bit for bit as
+    every cell's samples then prune, and drops some cells before their samples: on Algorithm
+    1 keys (nside 6, 16, 180) and on every stability class's keys (ties, poles, vertices,
+    grazing, extreme scales; nside 16 and 180; the keys limit3d samples), at the set-up's
+    reach, 2.5x it and 1e-12 rad."""
+    from eyeviz.core import kernels
+    from eyeviz.estimators.limit3d import max_lit
+    from eyeviz.reference import stability_cases as sc
+
+    # the kernels for calls of every size, as once warm (else a call of few cells takes
+    # the reference, a few ulps away)
+    monkeypatch.setitem(kernels._STATE, "ready", True)
+
+    keysets = []
+    for nside, seed in ((6, 1), (16, 2), (180, 3)):
+        d = Domain3D(nside=nside)
+        ds = generate3d(8, d, seed=seed)
+        keysets.append((d, (ds.indptr_a, ds.indices_a), (ds.indptr_b, ds.indices_b)))
+    for name in sorted(sc.CLASSES3D):
+        cs = sc.make(name, 4, 7, "spherical")
+        x, y, z, g = (np.asarray(v, np.float64).ravel() for v in (cs.x, cs.y, cs.z, cs.g))
+        for nside in (180,) if name == "base_vertices" else (16, 180):  # (16: ties, 3 s)
+            d = Domain3D(nside=nside)
+            la, lb = d.eyes.lit_csr(x, y, z, g)
+            na, nb = np.diff(la[0]), np.diff(lb[0])
+            # keys limit3d samples (a key past max_lit gets no draws)
+            ok = np.flatnonzero((na > 0) & (nb > 0) & (np.maximum(na, nb) <= max_lit(d)))
+            if ok.size:
+                keysets.append((d, take_rows(*la, ok), take_rows(*lb, ok)))
+    dropped = 0
+    for d, la, lb in keysets:
+        fw = math.sqrt(4 * math.pi / d.npix)
+        n = la[0].size - 1
+        for eye, lit, cx in ((0, la, -d.h), (1, lb, d.h)):
+            for f in (0.25, 0.625, 1e-12 / fw):
+                reach = np.full(n, f * fw)
+                full = _Eye(d, lit, np.array([cx, 0, 0]), eye)
+                full.prune(reach)
+                cand = _Eye(d, lit, np.array([cx, 0, 0]), eye, reach)
+                dropped += len(full._band[1]) - int((~cand.pad).sum())
+                cand.prune(reach)
+                assert _same_live(cand, full), (d.nside, eye, f)
+                for a, b in zip(cand.lists, full.lists, strict=True):
+                    k = a.shape[1] if a.ndim > 1 else None
+                    assert np.array_equal(a[:, :k] if k else a, b[:, :k] if k else b)
+    assert dropped > 0
