@@ -82,20 +82,10 @@ class _Eye:
         ptr, ind = res
         inner = (ptr[: n + 1], ind[: ptr[n]])
         outer = (ptr[n:] - ptr[n], ind[ptr[n] :])
-        key = _codes(*lit, npix)
-        c_in = _codes(*inner, npix)
         # a key too small for an inner cap of half a facet: every lit cell is an edge cell
         # (a cap of 1e-9 rad would send its cells to the exact fallback, ~10 ms each)
         small = alpha - EDGE * fw < 0.5 * fw
-        c_in = c_in[~small[c_in // npix]]
-        c_out = _codes(*outer, npix)
-        lit_edge = key[~np.isin(key, c_in, assume_unique=True)]
-        unlit = c_out[~np.isin(c_out, key, assume_unique=True)]
-        codes = np.concatenate([lit_edge, unlit])
-        is_lit = np.concatenate([np.ones(lit_edge.size, bool), np.zeros(unlit.size, bool)])
-        rows = codes // npix
-        order = np.argsort(rows, kind="stable")
-        codes, is_lit, rows = codes[order], is_lit[order], rows[order]
+        codes, is_lit, rows = _band_cells(lit, inner, outer, small, npix)
         # for the exact check of the band alone (:meth:`band`): the inner and outer caps
         # as lit_csr saw them (centre, half-angle of each ball) and the edge cells (all of
         # them, before any pruning): key - inner and outer - key
@@ -375,6 +365,32 @@ class _Eye:
         x, y = np.einsum("nmj,nj->nm", v, self.e1), np.einsum("nmj,nj->nm", v, self.e2)
         with np.errstate(divide="ignore", invalid="ignore"):  # v at 90 deg: inf, no warning
             return np.stack([x / cc, y / cc], axis=-1)
+
+
+def _band_cells(lit: LitCSR, inner: LitCSR, outer: LitCSR, small: np.ndarray, npix: int):
+    """The band cells of each key (codes row * npix + pixel, lit, row), by key, each key's
+    lit ones first: key - inner (key where ``small``), then outer - key, each ascending.
+    Compiled unless ``EYEVIZ_JIT=0`` (kernels.healpix_match.band_cells_kernel, a merge of
+    the sorted rows: the same arrays)."""
+    if kernels.use(lit[1].size):
+        from eyeviz.core.kernels.healpix_match import band_cells_kernel
+
+        size = lit[1].size + outer[1].size
+        pix, is_lit, rows = np.empty(size, np.int64), np.empty(size, bool), np.empty(size, np.int64)
+        ar = [kernels.arg(a, np.int64) for a in (*lit, *inner, *outer)]
+        m = band_cells_kernel(*ar, kernels.arg(small, np.bool_), pix, is_lit, rows)
+        return rows[:m] * npix + pix[:m], is_lit[:m], rows[:m]
+    key = _codes(*lit, npix)
+    c_in = _codes(*inner, npix)
+    c_in = c_in[~small[c_in // npix]]
+    c_out = _codes(*outer, npix)
+    lit_edge = key[~np.isin(key, c_in, assume_unique=True)]
+    unlit = c_out[~np.isin(c_out, key, assume_unique=True)]
+    codes = np.concatenate([lit_edge, unlit])
+    is_lit = np.concatenate([np.ones(lit_edge.size, bool), np.zeros(unlit.size, bool)])
+    rows = codes // npix
+    order = np.argsort(rows, kind="stable")
+    return codes[order], is_lit[order], rows[order]
 
 
 def _boundaries(nside: int, pix: np.ndarray, rows, slot, shape: tuple[int, int]) -> np.ndarray:

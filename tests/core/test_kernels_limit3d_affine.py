@@ -388,3 +388,32 @@ def test_the_first_prunes_candidates_keep_every_cell_it_keeps(monkeypatch):
                     k = a.shape[1] if a.ndim > 1 else None
                     assert np.array_equal(a[:, :k] if k else a, b[:, :k] if k else b)
     assert dropped > 0
+
+
+def test_band_cells_kernel_is_the_set_differences(monkeypatch):
+    """_band_cells compiled (healpix_match.band_cells_kernel, a merge of sorted rows) and
+    in numpy (set differences, a stable sort by key): the same codes, lit flags and rows,
+    on random rows that overlap, miss each other, are empty or hold every cell, with some
+    keys ``small`` (every lit cell an edge cell)."""
+    from eyeviz.core import kernels
+    from eyeviz.estimators.limit3d_eye import _band_cells
+
+    monkeypatch.setitem(kernels._STATE, "ready", True)
+    rng = np.random.default_rng(21)
+    npix = 48
+
+    def rows(n: int, p: float) -> tuple[np.ndarray, np.ndarray]:
+        sel = [np.flatnonzero(rng.random(npix) < q) for q in rng.choice([0.0, p, 1.0], n)]
+        ptr = np.concatenate([[0], np.cumsum([s.size for s in sel])]).astype(np.int64)
+        return ptr, np.concatenate(sel).astype(np.int64)
+
+    for _ in range(40):
+        n = int(rng.integers(1, 7))
+        key, inner, outer = rows(n, 0.5), rows(n, 0.3), rows(n, 0.7)
+        small = rng.random(n) < 0.3
+        got = _band_cells(key, inner, outer, small, npix)
+        with monkeypatch.context() as mp:
+            mp.setenv("EYEVIZ_JIT", "0")
+            want = _band_cells(key, inner, outer, small, npix)
+        for a, b in zip(got, want, strict=True):
+            assert np.array_equal(a, b)

@@ -31,7 +31,14 @@ from eyeviz.core.kernels.healpix_lit import _NO_MEMO, _ang2pix, _ball, _jit, _ri
 # before the first kernel: its cache carries the source of the modules it calls as well
 stamp_with(__file__, healpix_lit.__file__, healpix_boundary.__file__)
 
-__all__ = ["match_kernel", "edge_match_kernel", "band_bounds_kernel", "vertex_cache", "warm"]
+__all__ = [
+    "match_kernel",
+    "edge_match_kernel",
+    "band_bounds_kernel",
+    "band_cells_kernel",
+    "vertex_cache",
+    "warm",
+]
 
 
 @_jit
@@ -98,13 +105,47 @@ def _cap_pix(n, dx, dy, dz, d):
 
 
 @_jit
+def band_cells_kernel(kp, ki, ip, ii, op, oi, small, pix, lit, rows):
+    """limit3d_eye._Eye's band cells of each key r (CSR rows of strictly increasing
+    indices: the key (kp, ki), the inner cap's lit set (ip, ii), the outer cap's (op, oi)):
+    the key's cells not in the inner cap's set (all of them where ``small[r]``), lit,
+    then the outer cap's cells not in the key, unlit, each in increasing order, as the
+    numpy reference's set differences and stable sort by key give them; written to pix,
+    lit, rows (each at least as long as ki and oi together). Returns their number."""
+    m = 0
+    for r in range(kp.size - 1):
+        j, je = ip[r], ip[r + 1]
+        for a in range(kp[r], kp[r + 1]):
+            v = ki[a]
+            if not small[r]:
+                while j < je and ii[j] < v:
+                    j += 1
+                if j < je and ii[j] == v:
+                    continue
+            pix[m], lit[m], rows[m] = v, True, r
+            m += 1
+        j, je = kp[r], kp[r + 1]
+        for a in range(op[r], op[r + 1]):
+            v = oi[a]
+            while j < je and ki[j] < v:
+                j += 1
+            if j < je and ki[j] == v:
+                continue
+            pix[m], lit[m], rows[m] = v, False, r
+            m += 1
+    return m
+
+
+@_jit
 def band_bounds_kernel(n, pix, ring, key, u0, sth, zr, unit, first_t, shifted_t, near, far):
     """For band cells ``pix`` (of rings ``ring``) of the keys ``key``: an upper bound
     ``near`` on the angle from the key's centre u0[key] to the cell's closure (its nearest
     vertex) and a lower bound ``far`` (the edges' lower bound of _decide_cell, less its
-    rounding bounds; 0 for the cell holding u0), both widened by 1e-12 rad."""
+    rounding bounds; 0 for the cell holding u0), both widened by 1e-12 rad. (u0's pixel
+    is found once for each run of cells of one key.)"""
     ed = 8 * _EPS
     none = (np.empty(0, np.int64), np.empty((0, 3)))
+    last, cpix = -1, -1  # the key whose centre's pixel cpix is (cells come by key)
     for k in range(pix.shape[0]):
         i = ring[k]
         first = first_t[i]
@@ -122,7 +163,9 @@ def band_bounds_kernel(n, pix, ring, key, u0, sth, zr, unit, first_t, shifted_t,
             low = _edge_lower(fa, fb, mf)
             low = low - _tol(max(low, 0.0), 0.0, ed, 0.0) - 8 * _EPS * (fa + fb + mf)
             lo = min(lo, low)
-        cpix = _ang2pix(n, min(max(c[2], -1.0), 1.0), math.atan2(c[1], c[0]))
+        if key[k] != last:
+            last = key[k]
+            cpix = _ang2pix(n, min(max(c[2], -1.0), 1.0), math.atan2(c[1], c[0]))
         far[k] = 0.0 if cpix == pix[k] else max(_angle(lo) - 1e-12, 0.0)
 
 
@@ -284,6 +327,9 @@ def warm() -> None:
     near, far = np.zeros(1), np.zeros(1)
     pix, ring = np.array([10]), np.array([2])
     band_bounds_kernel(n, pix, ring, i1, u, sth, zr, unit, first, shifted, near, far)
+    p2 = np.array([0, 1])
+    band_cells_kernel(p2, i1, p2, i1, p2, i1, np.zeros(1, np.bool_), i1.copy(),
+                      np.zeros(1, np.bool_), i1.copy())  # fmt: skip
     edge_match_kernel(n, x, y, z, g, 40.0, i1, u, np.zeros(1), np.ones(1), u, np.array([0, 1]),
                       np.ones(1, np.int64), pix, ring, np.ones(1, np.bool_), near, far, sth, zr,
                       unit, first, shifted, vertex_cache(16), i1.copy())  # fmt: skip
