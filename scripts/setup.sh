@@ -85,11 +85,12 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
     log=.venv/setup.log
     {
         .venv/bin/python -m pip install --upgrade pip &&
-        # torch first, pinned: any other request pulls a multi-GB CUDA build; with it
-        # what the kernels need (pyproject's bounds), so that they compile beside the rest
-        .venv/bin/python -m pip install --no-compile "torch==2.13.0" "numpy>=1.26" "numba>=0.60" &&
+        # what the kernels need first (pyproject's bounds), so that their cold compile
+        # (the set-up's longest part on 2 cores) starts seconds in and runs beside the
+        # rest; torch pinned (its CPU build: any other request pulls a multi-GB CUDA one)
+        .venv/bin/python -m pip install --no-compile "numpy>=1.26" "numba>=0.60" &&
         { warm_kernels & } &&
-        .venv/bin/python -m pip install --no-compile -e ".[app,ml,study,dev]"
+        .venv/bin/python -m pip install --no-compile "torch==2.13.0" -e ".[app,ml,study,dev]"
     } >"$log" 2>&1 || {
         wait
         tail -n 30 "$log" >&2
