@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Idempotent set-up on a fresh Debian machine: system packages for Qt/Xvfb,
-# a virtual environment in .venv/, torch (CPU build, pinned) first, then eyeviz.
+# a virtual environment in .venv/, numpy and numba first (the kernels compile beside the
+# rest), then torch (CPU build, pinned) and eyeviz.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
