@@ -49,6 +49,11 @@ def _facets(eyes, which: str) -> _Facets:
     return _FACETS[key]
 
 
+#: a padded facet's values in each of _Edges' tables
+_PADS = {"pos": 0.0, "ax": (1.0, 0.0, 0.0), "half": 0.0, "lit": False, "pad": True, "pa": 0.0,
+         "pp": 0.0}  # fmt: skip
+
+
 class _Edges:
     """The constraining facets of one eye for a chunk of keys, padded to (N, K):
     positions, axes, half-angles, ``lit`` (must be seen) and ``pad``."""
@@ -116,6 +121,21 @@ class _Edges:
             setattr(out, name, getattr(self, name)[rows])
         out._cols = None if self._cols is None else tuple(v[rows] for v in self._cols)
         return out
+
+    def put(self, rows: np.ndarray, other: _Edges) -> None:
+        """The keys ``rows`` replaced by ``other``'s (both padded to the wider)."""
+        k = max(self.pos.shape[1], other.pos.shape[1])
+        for e in (self, other):
+            extra = k - e.pos.shape[1]
+            for name, fill in _PADS.items():
+                v = getattr(e, name)
+                if extra:
+                    block = np.empty((v.shape[0], extra) + v.shape[2:], v.dtype)
+                    block[...] = fill
+                    setattr(e, name, np.concatenate([v, block], axis=1))
+            e._cols = None
+        for name in _PADS:
+            getattr(self, name)[rows] = getattr(other, name)
 
     def _dist(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(dist(c, K_i), |c - p_i|) (N, K, G) at centres c (N, G, 3)."""

@@ -24,8 +24,9 @@ from the cells (:mod:`.limit3d_healpix`), here without a linearisation:
 3. A reference centre: each eye's best direction at infinity (the maximum of min over
    unlit facets of (angle(a_j, u) - alpha_j) - max over lit ones of (angle(a_i, u) -
    alpha_i), zooming grids), the two rays triangulated, then moved to the maximum of H / |c
-   - o_A| on zooming grids (o_A: eye A's lens centroid); facets far from binding there
-   are dropped.
+   - o_A| on zooming grids (o_A: eye A's lens centroid); where that point is not
+   feasible, the grids again ``FAR`` times as wide, their point taken if it is;
+   facets far from binding there are dropped.
 4. Coordinates that make the region close to a box: delta, A's direction in gnomonic
    coordinates about the reference, and beta, the angle at o_B between the baseline and
    the ball (the triangle o_A, o_B, c gives |c - o_A| = |b| sin(beta) / sin(a + beta), a
@@ -88,6 +89,11 @@ LOCATE = 5
 #: best direction at infinity, triangulated), and the reach of the box's bisection
 SEARCH = 1.5
 REACH = 6.0
+#: keys whose reference search found no feasible centre search again, ``FAR`` times as
+#: wide with ``FAR_LEVELS`` more levels (the first pass's misses lie 3-9 facet spacings
+#: from the rays' triangulation on the honeybee: docs/limit3d.md, "bee33c")
+FAR = 5.0
+FAR_LEVELS = 2
 #: the retries of keys with nothing accepted (limit3d._retries): of limit3d.RETRY's three
 #: stages only the second, 24 batches with a window 2.5 times wider, its stream 2 as
 #: there. On 400 fresh honeybee keys (seeds 20261207-8) the first (8 batches, the same
@@ -204,6 +210,25 @@ class MeasuredProposal:
             drho = np.where(ok, self.blen * np.sin(a) / (s_ab * s_ab), np.nan)
         return self.fa.centre + v * rho[..., None], rho, drho
 
+    def _search(self, st: dict, wc: np.ndarray, wh: np.ndarray, half: float, levels: int):
+        """The reference search (module docstring, step 3): zooming grids of ``LOCATE``^3
+        points over (delta, w) about (0, wc), half-widths ``half`` and wh (each level
+        1 / 2.5 as wide), to the first point of largest H x w. Returns (delta (N, 2), w
+        (N,), H x w there)."""
+        n = wc.size
+        t = (np.arange(LOCATE) + 0.5) / LOCATE * 2 - 1
+        g3 = np.stack(np.meshgrid(t, t, t, indexing="ij"), axis=-1).reshape(-1, 3)
+        dc = np.zeros((n, 2))
+        for _ in range(levels):
+            dd = dc[:, None, :] + g3[None, :, :2] * half
+            ww = np.clip(wc[:, None] + g3[None, :, 2] * wh[:, None], self.w_min, self.w_max)
+            b = self._locate(st, self._centres(st, dd, ww), ww)
+            dc = dd[np.arange(n), b]
+            wc = ww[np.arange(n), b]
+            half, wh = half / 2.5, wh / 2.5
+        g_lo, g_hi = self._h(st, self._centres(st, dc[:, None, :], wc[:, None]))
+        return dc, wc, (g_hi - g_lo)[:, 0] * wc
+
     def _hb(self, st: dict, x: np.ndarray) -> np.ndarray:
         """H at points x (N, G, 3) = (delta_1, delta_2, beta) (-inf where undefined);
         compiled, where H < -st["slack"] some value below it (the walk over the facets
@@ -259,20 +284,43 @@ class MeasuredProposal:
         slack = 1e-7 * d.g_max
         st["slack"] = slack
         # the reference: zooming grids over (delta, w) to the maximum of H
-        half = wide * SEARCH * d.gamma
         wc = np.clip(1.0 / np.linalg.norm(u0, axis=1), self.w_min, self.w_max)
         wc = np.where(np.isfinite(wc), wc, 0.5 * (self.w_min + self.w_max))
         wh = np.full(n, 0.5 * (self.w_max - self.w_min))
-        t = (np.arange(LOCATE) + 0.5) / LOCATE * 2 - 1
-        g3 = np.stack(np.meshgrid(t, t, t, indexing="ij"), axis=-1).reshape(-1, 3)
-        dc = np.zeros((n, 2))
-        for _ in range(LEVELS):
-            dd = dc[:, None, :] + g3[None, :, :2] * half
-            ww = np.clip(wc[:, None] + g3[None, :, 2] * wh[:, None], self.w_min, self.w_max)
-            b = self._locate(st, self._centres(st, dd, ww), ww)
-            dc = dd[np.arange(n), b]
-            wc = ww[np.arange(n), b]
-            half, wh = half / 2.5, wh / 2.5
+        dc, wr, top = self._search(st, wc, wh, wide * SEARCH * d.gamma, LEVELS)
+        bad = np.flatnonzero(~(top >= 0.0))
+        pre = self._keys(st, bad) if bad.size and FAR > 0 else None  # facets not yet pruned
+        box_lo, box_hi, tight = self._around(st, keys, dc, wr, wide)
+        # keys whose reference is not feasible (H < 0 there) and whose box holds no
+        # feasible pilot point: the search again, FAR times as wide, and where its point
+        # is feasible the box about it (module docstring, step 3)
+        if pre is not None:
+            lost = np.flatnonzero(tight[2][bad] == 0)
+            if lost.size:
+                sub = self._keys(pre, lost)
+                far = FAR * wide * SEARCH * d.gamma
+                dc_f, wc_f, top_f = self._search(sub, wc[bad[lost]], wh[bad[lost]], far,
+                                                 LEVELS + FAR_LEVELS)  # fmt: skip
+                ok = np.flatnonzero(top_f >= 0.0)
+                if ok.size:
+                    sub = self._keys(sub, ok)
+                    rows = bad[lost[ok]]
+                    b_lo, b_hi, t = self._around(sub, keys[rows], dc_f[ok], wc_f[ok], wide)
+                    self._put(st, rows, sub)
+                    box_lo[rows], box_hi[rows] = b_lo, b_hi
+                    for whole, part in zip(tight, t, strict=True):
+                        whole[rows] = part
+        lo_p, hi_p, proven = self.provable_box(st)
+        st["box_lo"], st["box_hi"] = box_lo, box_hi
+        self._defend(st, lo_p, hi_p, proven)
+        self._mixture(st, *tight)
+        return st
+
+    def _around(self, st: dict, keys: np.ndarray, dc: np.ndarray, wc: np.ndarray, wide: float):
+        """About the reference (gnomonic offset dc (N, 2) about u0, w = 1 / distance wc):
+        the facets pruned there and the box in (delta, beta) (module docstring, steps 3-4),
+        as :meth:`_pilot` returns it; sets ``st``'s reference and frame."""
+        d, n, slack = self.domain, dc.shape[0], st["slack"]
         ref = self._centres(st, dc[:, None, :], wc[:, None])[:, 0]
         st["ref"] = ref
         st["ea"].prune(ref)
@@ -303,12 +351,7 @@ class MeasuredProposal:
         # the pilot: the box widened where feasible draws come near a face (the defensive
         # share of the draws keeps the estimate unbiased where it still misses a part of
         # the posterior; the pilot keeps that part, and so the weights' spread, small)
-        box_lo, box_hi, tight = self._pilot(st, keys, box_lo, box_hi)
-        lo_p, hi_p, proven = self.provable_box(st)
-        st["box_lo"], st["box_hi"] = box_lo, box_hi
-        self._defend(st, lo_p, hi_p, proven)
-        self._mixture(st, *tight)
-        return st
+        return self._pilot(st, keys, box_lo, box_hi)
 
     def _pilot(self, st: dict, keys: np.ndarray, box_lo: np.ndarray, box_hi: np.ndarray):
         """The box widened by half on each face near which a pilot's feasible draws fall,
@@ -353,6 +396,16 @@ class MeasuredProposal:
                 ptr, ind = st[name]
                 sub[name] = take_rows(ptr, ind, idx)
         return sub
+
+    def _put(self, st: dict, rows: np.ndarray, sub: dict) -> None:
+        """The chunk's keys ``rows`` of ``st`` replaced by the state ``sub`` of those keys
+        (the facets' tables padded to the wider)."""
+        n = st["u0"].shape[0]
+        for k, v in sub.items():
+            if isinstance(v, _Edges):
+                st[k].put(rows, v)
+            elif isinstance(v, np.ndarray) and v.ndim and st[k].shape[0] == n and k[:3] != "lit":
+                st[k][rows] = v
 
     def _defend(self, st: dict, lo, hi, proven) -> None:
         """The defensive box of each key's proposal (module docstring, step 5): where the

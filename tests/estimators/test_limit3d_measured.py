@@ -472,3 +472,36 @@ def _cone_interval(dom, c: np.ndarray, row: np.ndarray, lit) -> tuple[np.ndarray
         lo = np.maximum(lo, np.where(is_lit, dist, 0.0).max(axis=1))
         hi = np.minimum(hi, np.where(is_lit, np.inf, dist).min(axis=1))
     return lo, hi
+
+
+def test_a_key_the_reference_search_misses_is_found_by_the_wider_search(monkeypatch):
+    """Honeybee keys (fresh rows of the bench's seed) whose rays' triangulation lies 3-9
+    facet spacings from their posterior: the first reference search ends at an infeasible
+    centre (H < 0) and the box about it holds nothing; the wider search (``FAR``) finds a
+    feasible reference and a box holding the ball that made the key."""
+    from eyeviz.estimators import limit3d_measured as lm
+    from eyeviz.files.eye_io import load_eyes, shipped_eye
+
+    dom = Domain3D.for_eyes(load_eyes(shipped_eye("AM_60185-real.eye")))
+    a = [[3167, 3168, 3177, 3179, 3180, 3184, 3185], [1970, 2066, 2087, 2159, 2254, 2277, 2340]]
+    b = [[3181, 3183, 3186], [1774, 1775, 1776, 1873, 1874, 1875, 1907, 1970, 1971, 2001,
+         2003, 2066, 2087, 2089, 2091, 2159, 2160, 2215, 2254, 2277, 2279, 2340, 2365]]  # fmt: skip
+    balls = np.array([[-6.9989, 2.2332, -52.3497], [0.6343, 13.0075, 13.8416]])
+    csr = [(np.array([0, len(s[0]), len(s[0]) + len(s[1])]), np.array(s[0] + s[1])) for s in (a, b)]
+    prop = lm.MeasuredProposal(dom, "single", 64, 8)
+    keys = _key_hash(*csr)
+    for far, found in ((0.0, False), (lm.FAR, True)):
+        monkeypatch.setattr(lm, "FAR", far)
+        st = prop.setup(*csr, keys, 1.0)
+        g_lo, g_hi = prop._h(st, st["ref"][:, None, :])
+        assert np.all((g_hi > g_lo)[:, 0] == found)
+        # the balls in (delta, beta): A's direction about u0, B's angle to the baseline
+        v = balls - prop.fa.centre
+        v /= np.linalg.norm(v, axis=1, keepdims=True)
+        cu = np.einsum("nj,nj->n", v, st["u0"])
+        x = np.stack([np.einsum("nj,nj->n", v, st[e]) / cu for e in ("e1", "e2")], 1)
+        u = balls - prop.fb.centre
+        beta = np.arccos(u @ -prop.bhat / np.linalg.norm(u, axis=1))
+        x = np.concatenate([x, beta[:, None]], axis=1)
+        inside = ((x >= st["box_lo"]) & (x <= st["box_hi"])).all(axis=1)
+        assert np.all(inside == found)
