@@ -36,8 +36,9 @@ _jit_np = njit(cache=True, nogil=True, error_model="numpy")
 #: the measured draws' helpers (per facet and per draw), inlined into their callers by
 #: numba: a call it does not inline counts a reference on every array it passes and is
 #: not inlined by LLVM either, which cost more than a cone distance's arithmetic
-#: (docs/limit3d.md, "bee33c"). The cone bounds and the region test keep calls (their
-#: compile time; they are not where the draws' time goes).
+#: (docs/limit3d.md, "bee33c"). Only the draws' kernel inlines the array-taking ones
+#: (``_cone_fold_inline``, ``_walk``, ``bcentre_inline``): each inlined copy costs
+#: compile time, and the cone bounds, the region test and the centre search keep calls.
 _inline = njit(cache=True, nogil=True, inline="always")
 _inline_np = njit(cache=True, nogil=True, error_model="numpy", inline="always")
 
@@ -157,7 +158,7 @@ def _walk(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b,
     return False, lo_, hi_
 
 
-@_inline_np
+@_jit_np
 def bcentre(u0, e1, e2, d0, d1, beta, fa, bhat, blen):
     """limit3d_measured.MeasuredProposal._bcentres for one draw: (centre x, y, z, rho,
     d rho / d beta) at gnomonic offsets (d0, d1) of A's direction about u0 (frame e1, e2)
@@ -175,6 +176,10 @@ def bcentre(u0, e1, e2, d0, d1, beta, fa, bhat, blen):
         rho = blen * math.sin(beta) / s_ab
         drho = blen * math.sin(a) / (s_ab * s_ab)
     return fa[0] + vx * rho, fa[1] + vy * rho, fa[2] + vz * rho, rho, drho
+
+
+#: :func:`bcentre` inlined, for the draws' kernel (measured_limit.mixture_draws_kernel)
+bcentre_inline = _inline_np(bcentre.py_func)
 
 
 @_inline_np

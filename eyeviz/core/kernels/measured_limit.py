@@ -20,11 +20,11 @@ from numba.core import caching
 from eyeviz.core.kernels import limit3d_region
 from eyeviz.core.kernels.limit3d_region import (
     _cone_fold,
-    _cone_fold_inline,
     _inline_np,
     _jit_np,
     _walk,
     bcentre,
+    bcentre_inline,
     measured_prior,
 )
 
@@ -54,7 +54,7 @@ if _WithRegionSource not in _LOCATORS:
     _LOCATORS.insert(0, _WithRegionSource)
 
 
-@_inline_np
+@_jit_np
 def _walk_slack(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b, pad_b,
                 order, n, cx, cy, cz, lo_, hi_, slack):  # fmt: skip
     """limit3d_region._walk with the region test's stop, H = hi - lo < -slack (or NaN):
@@ -69,12 +69,12 @@ def _walk_slack(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, 
         if k < ka:
             if pad_a[n, k]:
                 continue
-            lo_, hi_ = _cone_fold_inline(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz,
+            lo_, hi_ = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz,
                                          lo_, hi_)  # fmt: skip
         else:
             if pad_b[n, k - ka]:
                 continue
-            lo_, hi_ = _cone_fold_inline(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
+            lo_, hi_ = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
                                          lo_, hi_)  # fmt: skip
         if not (hi_ - lo_ >= -slack):
             for j in range(p, 0, -1):
@@ -167,7 +167,9 @@ def mixture_draws_kernel(u, boxes, counts, dens, samples, u0, e1, e2, fa, bhat, 
             d0 = lo_[0] + (hi_[0] - lo_[0]) * u[n, m, 0]
             d1 = lo_[1] + (hi_[1] - lo_[1]) * u[n, m, 1]
             beta = lo_[2] + (hi_[2] - lo_[2]) * u[n, m, 2]
-            cx, cy, cz, rho, drho = bcentre(u0[n], e1[n], e2[n], d0, d1, beta, fa, bhat, blen)
+            cx, cy, cz, rho, drho = bcentre_inline(
+                u0[n], e1[n], e2[n], d0, d1, beta, fa, bhat, blen
+            )
             if not math.isfinite(rho):
                 continue
             qx, qy, qz = cx - origin[0], cy - origin[1], cz - origin[2]

@@ -24,9 +24,6 @@ LEVELS = 10
 _SLACK = 1e-9  # as measured_index
 _SHIFT = (56, 36, 18)  # level, x, y (z in the low bits)
 _jit = njit(cache=True, nogil=True)
-#: inlined into their callers by numba (a call it does not inline counts a reference on
-#: every array it passes: docs/limit3d.md, "bee33c")
-_inline = njit(cache=True, nogil=True, inline="always")
 
 
 @_jit
@@ -60,10 +57,6 @@ def _certify(cx, cy, cz, gb, px, py, pz, ax, ay, az, nrm, cs, sn, exact_only, i)
     no = da > ba and (e < -be or m > bm)
     lens = 1 if da <= -ba else (0 if da > ba else 2)
     return yes, yes or no, lens
-
-
-#: :func:`_certify` inlined, for the key check's loop over balls and facets
-_certify_inline = _inline(_certify.py_func)
 
 
 @_jit
@@ -216,9 +209,8 @@ def key_check_kernel(cx, cy, cz, g, bounds, px, py, pz, ax, ay, az, nrm, cs, sn,
                 n_lit += islit[t]
                 if kl[t] <= safe:  # a lit facet that surely sees the ball
                     continue
-                seen, sure, inside = _certify_inline(cx[b], cy[b], cz[b], g[b], px, py, pz, ax,
-                                                     ay, az, nrm, cs, sn, exact_only,
-                                                     lst[t])  # fmt: skip
+                seen, sure, inside = _certify(cx[b], cy[b], cz[b], g[b], px, py, pz, ax, ay,
+                                              az, nrm, cs, sn, exact_only, lst[t])  # fmt: skip
                 if not sure:
                     verdict = 2
                 elif seen != islit[t] or (seen and inside == 1):
