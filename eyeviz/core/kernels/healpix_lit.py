@@ -89,14 +89,14 @@ def _arg_bound(cos_p, zc_p, rc_p, dnum, drel, zz, rr, upper):
     return out
 
 
-@_jit
-def _ball(n, xb, yb, zb, gb, cx):
-    """The per-ball steps of healpix_fast._lit_runs_fast before the rings, for one ball
-    and the eye at (cx, 0, 0): (kind, ring parameters, i_min, i_max, alpha, pad); kind 0:
-    go ring by ring, 1: the reference decides (near the eye centre's sphere, grazing or
-    tiny caps), 3: the ball holds the eye centre (every facet lit). The ring parameters
-    are those :func:`_ring` takes after ``i`` and before the ring tables; alpha is the
-    cap's half-angle and pad bounds its error plus that of its centre's direction."""
+@_jit_inline
+def _cap_steps(xb, yb, zb, gb, cx):
+    """The first steps of :func:`_ball`, shared with healpix_match._cap (the same
+    operations, so the same bits): the ball's centre relative to the eye at (cx, 0, 0),
+    scaled by a power of two, and its cap. Returns (kind, dx, dy, dz, d, ed, q, cosa,
+    alpha, dcos, s2, ds2, dalpha); kind 0: a cap, 1: the reference decides (near the eye
+    centre's sphere, grazing or tiny caps), 3: the ball holds the eye centre; past kind,
+    only dx, dy, dz, d and ed are set where kind is not 0."""
     dx0 = xb - cx
     bv = dx0 - xb
     err = (xb - (dx0 - bv)) + (-cx - bv)
@@ -112,12 +112,10 @@ def _ball(n, xb, yb, zb, gb, cx):
     ed = 8 * _EPS + 4 * errabs / d
     dmg = (d - gs) * (d + gs)
     sep = 8 * _EPS * (d + gs) ** 2 + 4 * errabs * (d + gs)
-    c = (0.0, 0.0, 1.0)
-    none = (c, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, np.int64(0))
     if abs(dmg) <= sep or not (math.isfinite(dmg) and math.isfinite(sep)):
-        return 1, none, np.int64(0), np.int64(-1), 0.0, 0.0  # near the eye centre's sphere
+        return 1, dx, dy, dz, d, ed, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     if dmg < -sep:
-        return 3, none, np.int64(0), np.int64(-1), 0.0, 0.0
+        return 3, dx, dy, dz, d, ed, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     q = gs / d
     rdm = math.sqrt(max(dmg, 0.0))
     dcos = (4 * _EPS * d + 4 * errabs) * (d + gs) / (rdm * d)
@@ -125,10 +123,26 @@ def _ball(n, xb, yb, zb, gb, cx):
     cosa = rdm / d
     alpha = math.atan2(q, cosa)
     if dcos > 1e-9 or not alpha > 1e6 * ed:
-        return 1, none, np.int64(0), np.int64(-1), 0.0, 0.0  # grazing or tiny caps
+        return 1, dx, dy, dz, d, ed, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     s2 = 2 * q * q / (1 + cosa)
     ds2 = 2 * dcos + 8 * _EPS * s2
     dalpha = dcos / max(q, 1e-300) + 8 * _EPS
+    return 0, dx, dy, dz, d, ed, q, cosa, alpha, dcos, s2, ds2, dalpha
+
+
+@_jit
+def _ball(n, xb, yb, zb, gb, cx):
+    """The per-ball steps of healpix_fast._lit_runs_fast before the rings, for one ball
+    and the eye at (cx, 0, 0): (kind, ring parameters, i_min, i_max, alpha, pad); kind 0:
+    go ring by ring, 1: the reference decides (near the eye centre's sphere, grazing or
+    tiny caps), 3: the ball holds the eye centre (every facet lit). The ring parameters
+    are those :func:`_ring` takes after ``i`` and before the ring tables; alpha is the
+    cap's half-angle and pad bounds its error plus that of its centre's direction."""
+    kind, dx, dy, dz, d, ed, q, cosa, alpha, dcos, s2, ds2, dalpha = _cap_steps(xb, yb, zb, gb, cx)
+    if kind != 0:
+        c = (0.0, 0.0, 1.0)
+        none = (c, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, np.int64(0))
+        return kind, none, np.int64(0), np.int64(-1), 0.0, 0.0
     rxy = math.hypot(dx, dy)
     rho_c = rxy / d
     z_c = dz / d

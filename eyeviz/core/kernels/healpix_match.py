@@ -26,7 +26,14 @@ from eyeviz.core.kernels.healpix_boundary import (
     _tol,
     stamp_with,
 )
-from eyeviz.core.kernels.healpix_lit import _NO_MEMO, _ang2pix, _ball, _jit, _ring_at
+from eyeviz.core.kernels.healpix_lit import (
+    _NO_MEMO,
+    _ang2pix,
+    _ball,
+    _cap_steps,
+    _jit,
+    _ring_at,
+)
 
 # before the first kernel: its cache carries the source of the modules it calls as well
 stamp_with(__file__, healpix_lit.__file__, healpix_boundary.__file__)
@@ -56,41 +63,15 @@ def _apart(c, u, k):
 
 @_jit
 def _cap(xb, yb, zb, gb, cx):
-    """The steps of healpix_lit._ball that the band check reads, in its operations (the
-    same bits): (kind 0 or 1 as there, the cap's centre c, alpha, pad, s2, ds2, ed, and
+    """The steps of healpix_lit._ball that the band check reads (healpix_lit._cap_steps,
+    the same bits): (kind 0 or 1 as there, the cap's centre c, alpha, pad, s2, ds2, ed, and
     the scaled centre (dx, dy, dz, d) for its pixel, :func:`_cap_pix`); not the rings'
     range, its trigonometry or the centre's pixel, which a ball decided by its band
     cells' bounds alone never needs. kind 1 also where _ball gives 3 (the ball holds the
     eye centre): the band check leaves both to the other checks."""
-    dx0 = xb - cx
-    bv = dx0 - xb
-    err = (xb - (dx0 - bv)) + (-cx - bv)
-    errabs0 = abs(err) + 2.0**-1070
-    big = max(max(abs(dx0), abs(yb)), max(abs(zb), gb))
-    ex = math.frexp(big)[1]
-    dx = math.ldexp(dx0, -ex)
-    dy = math.ldexp(yb, -ex)
-    dz = math.ldexp(zb, -ex)
-    gs = math.ldexp(gb, -ex)
-    errabs = math.ldexp(errabs0, -ex)
-    d = math.sqrt(dx * dx + dy * dy + dz * dz)
-    ed = 8 * _EPS + 4 * errabs / d
-    dmg = (d - gs) * (d + gs)
-    sep = 8 * _EPS * (d + gs) ** 2 + 4 * errabs * (d + gs)
-    c = (0.0, 0.0, 1.0)
-    if abs(dmg) <= sep or not (math.isfinite(dmg) and math.isfinite(sep)) or dmg < -sep:
-        return 1, c, 0.0, 0.0, 0.0, 0.0, 0.0, dx, dy, dz, d
-    q = gs / d
-    rdm = math.sqrt(max(dmg, 0.0))
-    dcos = (4 * _EPS * d + 4 * errabs) * (d + gs) / (rdm * d)
-    dcos = dcos + 4 * _EPS if math.isfinite(dcos) else 4.0
-    cosa = rdm / d
-    alpha = math.atan2(q, cosa)
-    if dcos > 1e-9 or not alpha > 1e6 * ed:
-        return 1, c, 0.0, 0.0, 0.0, 0.0, 0.0, dx, dy, dz, d
-    s2 = 2 * q * q / (1 + cosa)
-    ds2 = 2 * dcos + 8 * _EPS * s2
-    dalpha = dcos / max(q, 1e-300) + 8 * _EPS
+    kind, dx, dy, dz, d, ed, q, cosa, alpha, dcos, s2, ds2, dalpha = _cap_steps(xb, yb, zb, gb, cx)
+    if kind != 0:
+        return 1, (0.0, 0.0, 1.0), 0.0, 0.0, 0.0, 0.0, 0.0, dx, dy, dz, d
     pad_t = dalpha + 4 * ed + 1e-12
     c = (dx / d, dy / d, dz / d)
     return 0, c, alpha, pad_t, s2, ds2, ed, dx, dy, dz, d
