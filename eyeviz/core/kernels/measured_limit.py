@@ -194,12 +194,15 @@ def mixture_draws_kernel(u, boxes, counts, dens, samples, u0, e1, e2, fa, bhat, 
 
 
 @_jit_np
-def _grid_value(ax, half, lit, pad, n, vx, vy, vz, best):
+def _grid_value(ax, half, lit, pad, order, n, vx, vy, vz, best):
     """G(v) = min over unlit facets of (angle(a_j, v) - alpha_j) - max over lit ones of
-    (angle(a_i, v) - alpha_i) of key n at the unit v; stops once G <= best (G only falls
-    as facets are folded in: such a point is not the first maximum)."""
+    (angle(a_i, v) - alpha_i) of key n at the unit v, the facets in the key's order
+    ``order`` (K,); stops once G <= best (G only falls as facets are folded in: such a
+    point is not the first maximum), the facet that stopped it moved to the front (max
+    and min are exact, so the order changes no value that is not cut)."""
     lo, hi = np.inf, -np.inf
-    for k in range(ax.shape[1]):
+    for p in range(order.shape[0]):
+        k = order[p]
         if pad[n, k]:
             continue
         dot = ax[n, k, 0] * vx + ax[n, k, 1] * vy + ax[n, k, 2] * vz
@@ -209,6 +212,9 @@ def _grid_value(ax, half, lit, pad, n, vx, vy, vz, best):
         else:
             lo = min(lo, ang)
         if lo - hi <= best:
+            for j in range(p, 0, -1):
+                order[j] = order[j - 1]
+            order[0] = k
             return lo - hi
     return lo - hi
 
@@ -219,7 +225,10 @@ def direction_kernel(ax, half, lit, pad, c, hw, grid, levels):
     (unit; replaced by the result), grid x grid points of half width hw[n] (then / 2.5
     each level) in gnomonic coordinates, the first point of largest G (:func:`_grid_value`,
     early exit) the next centre."""
+    order = np.empty(ax.shape[1], np.int64)
     for n in range(c.shape[0]):
+        for k in range(order.shape[0]):
+            order[k] = k
         cx, cy, cz, h = c[n, 0], c[n, 1], c[n, 2], hw[n]
         for _ in range(levels):
             ex, ey = -cy, cx
@@ -241,7 +250,7 @@ def direction_kernel(ax, half, lit, pad, c, hw, grid, levels):
                     )
                     nv = math.sqrt(vx * vx + vy * vy + vz * vz)
                     vx, vy, vz = vx / nv, vy / nv, vz / nv
-                    gv = _grid_value(ax, half, lit, pad, n, vx, vy, vz, best)
+                    gv = _grid_value(ax, half, lit, pad, order, n, vx, vy, vz, best)
                     if gv > best or (i == 0 and j == 0):
                         best, bx, by, bz = gv, vx, vy, vz
             cx, cy, cz, h = bx, by, bz, h / 2.5
@@ -254,28 +263,38 @@ def locate_kernel(c, r, ww, s_half, g_max, pos_a, ax_a, ch_a, sh_a, lit_a, pad_a
     """The reference search's step (limit3d_measured.MeasuredProposal.setup): per key n
     the first grid point g of largest (g_hi - g_lo) x ww[n, g] at the centres c (N, G, 3)
     (r (N, G) their distance from the origin), g_lo and g_hi over the prior's g range and
-    both eyes' facets (as MeasuredProposal._h: max and min are exact, so the same values);
-    a point is given up once its value falls to the best so far (it only falls as facets
-    are folded in, and a product by ww > 0 keeps the order)."""
+    both eyes' facets (as MeasuredProposal._h: max and min are exact, so the same values
+    in any order); a point is given up once its value falls to the best so far (it only
+    falls as facets are folded in, and a product by ww > 0 keeps the order), the facet
+    that gave it up moved to the front of the key's order (both eyes' facets: index k <
+    K_A A's facet k, else B's facet k - K_A), as the draws' walk."""
+    ka = pos_a.shape[1]
+    order = np.empty(ka + pos_b.shape[1], np.int64)
     for n in range(c.shape[0]):
+        for k in range(order.shape[0]):
+            order[k] = k
         top, arg = -np.inf, 0
         for g in range(c.shape[1]):
             cx, cy, cz, w = c[n, g, 0], c[n, g, 1], c[n, g, 2], ww[n, g]
             lo, hi = r[n, g] * s_half, min(r[n, g], g_max)
             out = False
-            for k in range(pos_a.shape[1]):
-                if not pad_a[n, k]:
+            for p in range(order.shape[0]):
+                k = order[p]
+                if k < ka:
+                    if pad_a[n, k]:
+                        continue
                     lo, hi = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz, lo, hi)
-                    if g > 0 and (hi - lo) * w <= top:
-                        out = True
-                        break
-            for k in range(pos_b.shape[1]):
-                if out:
+                else:
+                    if pad_b[n, k - ka]:
+                        continue
+                    lo, hi = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
+                                        lo, hi)  # fmt: skip
+                if g > 0 and (hi - lo) * w <= top:
+                    for j in range(p, 0, -1):
+                        order[j] = order[j - 1]
+                    order[0] = k
+                    out = True
                     break
-                if not pad_b[n, k]:
-                    lo, hi = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k, cx, cy, cz, lo, hi)
-                    if g > 0 and (hi - lo) * w <= top:
-                        out = True
             if not out and (g == 0 or (hi - lo) * w > top):
                 top, arg = (hi - lo) * w, g
         best[n] = arg
