@@ -237,11 +237,13 @@ class Limit3DEstimator(Estimator3D):
         # a batch counts for a key only while the key still needs more after the batches
         # before it (a key that needs no more keeps needing none: its new draws weigh 0),
         # and none is taken once no key needs more. Only accepted draws are kept
-        # (:func:`_compact`).
+        # (:func:`_compact`). A proposal with ``retry_empty`` tops up no key whose first
+        # batch found nothing (:func:`_tops_up`): such a key goes to the retries at once.
         if getattr(prop, "batch_counts", False):
             return self._topups_sized(st, keys, stream, out)
         rep, m = 1, self.samples
-        need = _needs_more(out["r"], out["w"], self.accuracy)
+        ok = _tops_up(prop, out)
+        need = _needs_more(out["r"], out["w"], self.accuracy) & ok
         while rep < self.max_batches and need.any():
             g = min(_TOPUP, self.max_batches - rep)
             more = prop.sample(st, keys, [stream + 8 * (rep + j) for j in range(g)], rows=need)
@@ -250,7 +252,7 @@ class Limit3DEstimator(Estimator3D):
                 part["w"] = np.where(need[:, None], part["w"], 0.0)
                 out = {k: np.concatenate([out[k], v], axis=1) for k, v in _compact(part).items()}
                 rep += 1
-                need = _needs_more(out["r"], out["w"], self.accuracy)
+                need = _needs_more(out["r"], out["w"], self.accuracy) & ok
                 if not need.any():
                     break
         return out
@@ -263,7 +265,8 @@ class Limit3DEstimator(Estimator3D):
         (:func:`_more_batches`), not ``_TOPUP`` for every key."""
         m = self.samples
         rep = np.ones(keys.size, np.int64)
-        need = _needs_more(out["r"], out["w"], self.accuracy) & (rep < self.max_batches)
+        ok = _tops_up(self._proposal, out)
+        need = _needs_more(out["r"], out["w"], self.accuracy) & (rep < self.max_batches) & ok
         while need.any():
             cnt = np.where(need, _more_batches(out, self.accuracy, rep), 0)
             cnt = np.minimum(cnt, self.max_batches - rep)
@@ -277,6 +280,7 @@ class Limit3DEstimator(Estimator3D):
                 out = {k: np.concatenate([out[k], v], axis=1) for k, v in _compact(part).items()}
                 rep += take
                 need = _needs_more(out["r"], out["w"], self.accuracy) & (rep < self.max_batches)
+                need &= ok
         return out
 
     def _posterior(self, lit_a: LitCSR, lit_b: LitCSR):
@@ -455,6 +459,16 @@ def _put_rows(s: dict, rows: np.ndarray, new: dict) -> dict:
     for k in s:
         s[k][rows] = new[k]
     return s
+
+
+def _tops_up(proposal: Any, s: dict) -> np.ndarray:
+    """The keys that may be topped up after their first batch: all, or for a proposal with
+    ``retry_empty`` (the measured one) those with a draw accepted (a key whose first batch
+    found nothing goes to the retries at once: its later batches rarely find it,
+    limit3d_measured.RETRY_EMPTY)."""
+    if getattr(proposal, "retry_empty", False):
+        return (s["w"] > 0).any(axis=1)
+    return np.ones(s["w"].shape[0], bool)
 
 
 def _needs_more(r: np.ndarray, w: np.ndarray, target: float = MC_TARGET) -> np.ndarray:

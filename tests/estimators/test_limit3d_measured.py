@@ -505,3 +505,34 @@ def test_a_key_the_reference_search_misses_is_found_by_the_wider_search(monkeypa
         x = np.concatenate([x, beta[:, None]], axis=1)
         inside = ((x >= st["box_lo"]) & (x <= st["box_hi"])).all(axis=1)
         assert np.all(inside == found)
+
+
+def test_a_key_whose_first_batch_finds_nothing_goes_to_the_retry_at_once(far, monkeypatch):
+    """The measured proposal's ``retry_empty`` (limit3d._tops_up): a key with nothing
+    accepted in its first batch gets no top-ups (its later batches rarely find it) but the
+    retry at once; without it such keys are topped up."""
+    from eyeviz.estimators import limit3d_measured as lm
+
+    dom, _, _, lit = far
+    first: dict = {}
+    sample = lm.MeasuredProposal.sample
+
+    def counting(self, st, keys, stream, rows=None):
+        out = sample(self, st, keys, stream, rows)
+        m = self.samples
+        for j, s in enumerate(np.atleast_1d(stream)):
+            for i, k in enumerate(keys):
+                if (rows is None or rows[i]) and s % 8 == 0:
+                    first.setdefault(int(k), []).append(
+                        int((out["w"][i, j * m : (j + 1) * m] > 0).sum())
+                    )
+        return out
+
+    monkeypatch.setattr(lm.MeasuredProposal, "sample", counting)
+    for empty, most in ((True, 1), (False, 16)):
+        monkeypatch.setattr(lm, "RETRY_EMPTY", empty)
+        first.clear()
+        Limit3DEstimator(dom, samples=8).predict(*lit)
+        missed = [b for b in first.values() if b[0] == 0]
+        assert len(missed) >= 2
+        assert max(len(b) for b in missed) == most, empty
