@@ -266,9 +266,12 @@ class Limit3DEstimator(Estimator3D):
         m = self.samples
         rep = np.ones(keys.size, np.int64)
         ok = _tops_up(self._proposal, out)
-        need = _needs_more(out["r"], out["w"], self.accuracy) & (rep < self.max_batches) & ok
+        # the batches' compacted draws, concatenated once at the end; r and w (all the
+        # decisions read) as they grow
+        parts, rw = [out], {"r": out["r"], "w": out["w"]}
+        need = _needs_more(rw["r"], rw["w"], self.accuracy) & (rep < self.max_batches) & ok
         while need.any():
-            cnt = np.where(need, _more_batches(out, self.accuracy, rep), 0)
+            cnt = np.where(need, _more_batches(rw, self.accuracy, rep), 0)
             cnt = np.minimum(cnt, self.max_batches - rep)
             more = self._proposal.sample_counts(st, keys, stream + 8 * rep, cnt)
             for j in range(int(cnt.max())):
@@ -277,11 +280,12 @@ class Limit3DEstimator(Estimator3D):
                     break
                 part = {k: v[:, j * m : (j + 1) * m] for k, v in more.items()}
                 part["w"] = np.where(take[:, None], part["w"], 0.0)
-                out = {k: np.concatenate([out[k], v], axis=1) for k, v in _compact(part).items()}
+                parts.append(_compact(part))
+                rw = {k: np.concatenate([rw[k], parts[-1][k]], axis=1) for k in rw}
                 rep += take
-                need = _needs_more(out["r"], out["w"], self.accuracy) & (rep < self.max_batches)
+                need = _needs_more(rw["r"], rw["w"], self.accuracy) & (rep < self.max_batches)
                 need &= ok
-        return out
+        return {k: np.concatenate([q[k] for q in parts], axis=1) for k in out}
 
     def _posterior(self, lit_a: LitCSR, lit_b: LitCSR):
         keys = _key_hash(lit_a, lit_b) ^ np.uint64(self.seed)

@@ -376,13 +376,20 @@ class MeasuredProposal:
             lo, hi = box_lo[live], box_hi[live]
             x = lo[:, None] + (hi - lo)[:, None] * up[live]
             sub = st if live.size == n else self._keys(st, live)
-            inside = (self._hb(sub, x) >= -slack)[..., None]
-            t_lo[live] = np.where(inside, x, np.inf).min(axis=1)
-            t_hi[live] = np.where(inside, x, -np.inf).max(axis=1)
-            t_n[live] = inside[..., 0].sum(axis=1)
-            band = 0.1 * (hi - lo)[:, None]
-            near_lo = (inside & (x < lo[:, None] + band)).any(axis=1)
-            near_hi = (inside & (x > hi[:, None] - band)).any(axis=1)
+            # the feasible points alone (a few per cent of them): their box, number and
+            # whether any lies within a tenth of the box's extent of a face
+            row, col = np.nonzero(self._hb(sub, x) >= -slack)
+            xs = x[row, col]
+            m = live.size
+            low, high = np.full((m, 3), np.inf), np.full((m, 3), -np.inf)
+            np.minimum.at(low, row, xs)
+            np.maximum.at(high, row, xs)
+            t_lo[live], t_hi[live] = low, high
+            t_n[live] = np.bincount(row, minlength=m)
+            band = 0.1 * (hi - lo)
+            near_lo, near_hi = np.zeros((m, 3), bool), np.zeros((m, 3), bool)
+            np.logical_or.at(near_lo, row, xs < (lo + band)[row])
+            np.logical_or.at(near_hi, row, xs > (hi - band)[row])
             grow = near_lo.any(axis=1) | near_hi.any(axis=1)
             if not grow.any():
                 break
@@ -479,16 +486,9 @@ class MeasuredProposal:
             out = self._draws_ref(st, u, rows)
         wt = out["w"]
         cand = np.flatnonzero(wt.ravel() > 0)
-        c = np.stack([out["x"], out["y"], out["z"]], axis=-1)
+        c = np.stack([out[k].ravel()[cand] for k in ("x", "y", "z")], axis=1)
         hit = np.zeros(n * m, bool)
-        hit[cand] = key_hits(
-            d,
-            c.reshape(-1, 3)[cand],
-            out["g"].ravel()[cand],
-            cand // m,
-            st["lit_a"],
-            st["lit_b"],
-        )
+        hit[cand] = key_hits(d, c, out["g"].ravel()[cand], cand // m, st["lit_a"], st["lit_b"])
         out["w"] = np.where(hit.reshape(n, m), wt, 0.0)
         return out
 
