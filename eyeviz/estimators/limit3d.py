@@ -208,11 +208,13 @@ class Limit3DEstimator(Estimator3D):
         wide: float,
         stream: int,
         reps: int = 1,
+        top_all: bool = False,
     ) -> dict[str, np.ndarray]:
         """Weighted posterior samples of a chunk: dict of (N, reps * samples) arrays (the
         eye model's proposal set up once, ``reps`` batches of draws). With ``reps`` > 1
         (the retries: their caller keeps each key's first ``samples`` accepted draws in
-        draw order) a key gets no more groups of batches once it has ``samples``."""
+        draw order) a key gets no more groups of batches once it has ``samples``. With
+        ``top_all`` every key may be topped up (:func:`_tops_up` not asked)."""
         prop = self._proposal
         st = prop.setup(lit_a, lit_b, keys, wide)
         # the batches ``_GROUP`` at a time (side by side; each as if drawn alone)
@@ -238,11 +240,12 @@ class Limit3DEstimator(Estimator3D):
         # before it (a key that needs no more keeps needing none: its new draws weigh 0),
         # and none is taken once no key needs more. Only accepted draws are kept
         # (:func:`_compact`). A proposal with ``retry_empty`` tops up no key whose first
-        # batch found nothing (:func:`_tops_up`): such a key goes to the retries at once.
+        # batch found nothing (:func:`_tops_up`): such a key goes to the retries at once
+        # (and gets these top-ups only if they find nothing either: :meth:`_posterior`).
+        ok = np.ones(keys.size, bool) if top_all else _tops_up(prop, out)
         if getattr(prop, "batch_counts", False):
-            return self._topups_sized(st, keys, stream, out)
+            return self._topups_sized(st, keys, stream, out, ok)
         rep, m = 1, self.samples
-        ok = _tops_up(prop, out)
         need = _needs_more(out["r"], out["w"], self.accuracy) & ok
         while rep < self.max_batches and need.any():
             g = min(_TOPUP, self.max_batches - rep)
@@ -257,15 +260,16 @@ class Limit3DEstimator(Estimator3D):
                     break
         return out
 
-    def _topups_sized(self, st: dict, keys: np.ndarray, stream: int, out: dict) -> dict:
+    def _topups_sized(
+        self, st: dict, keys: np.ndarray, stream: int, out: dict, ok: np.ndarray
+    ) -> dict:
         """The top-ups of :meth:`_draw` for a proposal that draws each key its own number
         of batches (``sample_counts``): key n's k-th batch is its stream + 8 k, taken while
         the key still needs more after the batches before it, as there, so a key gets the
         same draws; but each round draws a key the batches its error predicts
-        (:func:`_more_batches`), not ``_TOPUP`` for every key."""
+        (:func:`_more_batches`), not ``_TOPUP`` for every key. Only the keys ``ok``."""
         m = self.samples
         rep = np.ones(keys.size, np.int64)
-        ok = _tops_up(self._proposal, out)
         # the batches' compacted draws, concatenated once at the end; r and w (all the
         # decisions read) as they grow
         parts, rw = [out], {"r": out["r"], "w": out["w"]}
@@ -303,6 +307,12 @@ class Limit3DEstimator(Estimator3D):
             s2 = self._draw(sub_a, sub_b, keys[few], wide, stream, reps)
             order = np.argsort(~(s2["w"] > 0), axis=1, kind="stable")[:, :m]
             s = _put_rows(s, few, {k: np.take_along_axis(v, order, 1) for k, v in s2.items()})
+        few = np.flatnonzero(~(s["w"].sum(axis=1) > 0))
+        if few.size and getattr(self._proposal, "retry_empty", False):
+            # keys the retries did not find either: the first pass's top-ups after all
+            # (the same draws as without ``retry_empty``: a few accepted draws beat none)
+            sub_a, sub_b = take_rows(*lit_a, few), take_rows(*lit_b, few)
+            s = _put_rows(s, few, self._draw(sub_a, sub_b, keys[few], 1.0, 0, top_all=True))
         return _compact(s)
 
     def _predict_csr(self, lit_a: LitCSR, lit_b: LitCSR):
@@ -469,7 +479,7 @@ def _tops_up(proposal: Any, s: dict) -> np.ndarray:
     """The keys that may be topped up after their first batch: all, or for a proposal with
     ``retry_empty`` (the measured one) those with a draw accepted (a key whose first batch
     found nothing goes to the retries at once: its later batches rarely find it,
-    limit3d_measured.RETRY_EMPTY)."""
+    limit3d_measured.RETRY_EMPTY; it gets them if the retries find nothing either)."""
     if getattr(proposal, "retry_empty", False):
         return (s["w"] > 0).any(axis=1)
     return np.ones(s["w"].shape[0], bool)
