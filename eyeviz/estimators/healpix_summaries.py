@@ -251,14 +251,16 @@ def _runs(indptr: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 
 def eye_summaries(
-    nside: int, indptr: np.ndarray, indices: np.ndarray, name: str = ""
+    nside: int, indptr: np.ndarray, indices: np.ndarray, name: str = "", bounds: bool = True
 ) -> EyeSummary:
     """The summaries of every row of one eye's CSR lit sets (sorted RING indices).
 
     Rows with no lit facet get count 0, a zero sum and NaN longitudes and z. With a
     ``name``, the indices are checked (each row strictly increasing, every index in
     [0, 12 nside^2)) on the runs, at no cost per index: ValueError naming ``name``,
-    with the messages of :func:`eyeviz.estimators.base.as_csr`."""
+    with the messages of :func:`eyeviz.estimators.base.as_csr`. With ``bounds`` False
+    the longitude bounds are not computed (left at -1 and 1: no bound; the other
+    fields are the same), for callers that read only the count and the sum."""
     indptr = np.asarray(indptr, np.int64)
     indices = np.asarray(indices)
     if name and not (
@@ -276,9 +278,9 @@ def eye_summaries(
     lon_e = np.full(n, np.nan)
     z_top = np.full(n, np.nan)
     z_bottom = np.full(n, np.nan)
-    bounds = np.empty((n, N_BOUNDS))
-    bounds[:, 0::2] = -_NO_BOUND
-    bounds[:, 1::2] = _NO_BOUND
+    lon_bounds = np.empty((n, N_BOUNDS))
+    lon_bounds[:, 0::2] = -_NO_BOUND
+    lon_bounds[:, 1::2] = _NO_BOUND
     # rows in groups whose per-run temporaries stay in cache (every value is per run or
     # per row, so the grouping changes no float)
     for lo in range(0, n, _ROWS):
@@ -289,8 +291,9 @@ def eye_summaries(
         fr = first_run[lo:hi] - r0
         out = (sum_xyz[lo:hi], lon_w[lo:hi], lon_e[lo:hi], z_top[lo:hi], z_bottom[lo:hi])
         runs = _summarise(rings, count[lo:hi], fr, s[r0:r1], e[r0:r1], out)
-        _bounds(rings, count[lo:hi], sum_xyz[lo:hi], fr, *runs, out=bounds[lo:hi])
-    return EyeSummary(count, sum_xyz, lon_w, lon_e, z_top, z_bottom, bounds)
+        if bounds:
+            _bounds(rings, count[lo:hi], sum_xyz[lo:hi], fr, *runs, out=lon_bounds[lo:hi])
+    return EyeSummary(count, sum_xyz, lon_w, lon_e, z_top, z_bottom, lon_bounds)
 
 
 def _summarise(

@@ -102,7 +102,7 @@ def cap_estimates(nside: int, lit: LitCSR) -> tuple[np.ndarray, np.ndarray]:
     lit facets' centres, and its angular radius from the lit solid angle, 2 pi (1 - cos a)
     = count 4 pi / npix, less 0.635 facet widths (the boundary facets are only partly
     covered; the mean overhang measured at nside 180). Rows lighting nothing get NaN."""
-    s = eye_summaries(nside, lit[0], lit[1])
+    s = eye_summaries(nside, lit[0], lit[1], bounds=False)  # the count and the sum alone
     norm = np.linalg.norm(s.sum_xyz, axis=1, keepdims=True)
     with np.errstate(divide="ignore", invalid="ignore"):
         u = s.sum_xyz / norm

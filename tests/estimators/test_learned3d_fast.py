@@ -6,6 +6,7 @@ features). Also the checks of the indices that the run finder makes instead of
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import threading
 
@@ -267,6 +268,10 @@ def test_summaries_are_the_reference_floats(nside):
         _assert_same(eye_summaries(nside, ptr, ind), want)
         _assert_same(eye_summaries(nside, ptr, ind, name="lit_a"), want)
         _assert_same(eye_summaries(nside, ptr, ind.astype(np.int64)), want)
+        # without the longitude bounds (cap_estimates): the rest the same, no bound
+        got = eye_summaries(nside, ptr, ind, bounds=False)
+        assert np.all(got.bounds == np.where(np.arange(got.bounds.shape[1]) % 2, 1.0, -1.0))
+        _assert_same(dataclasses.replace(got, bounds=want.bounds), want)
 
 
 @pytest.mark.parametrize("tables", [True, False])
