@@ -100,13 +100,15 @@ class _Eye:
         self.n_lit_edge = np.bincount(rows[is_lit], minlength=n)
         self.n_unlit = np.bincount(rows[~is_lit], minlength=n)
         self._ring: np.ndarray | None = None  # the band cells' rings, if known
+        ring = None
         if reach is not None and kernels.use(codes.size):
-            keep = self._candidates(u, rows, reach)
+            keep = self._candidates(u, rows, reach)  # sets _ring: the band cells' rings
             codes, is_lit, rows = codes[keep], is_lit[keep], rows[keep]
+            ring = None if self._ring is None else self._ring[keep]
         cnt = np.bincount(rows, minlength=n)
         kmax = max(1, int(cnt.max()) if cnt.size else 1)
         slot = np.arange(codes.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-        self.pts = _boundaries(self.nside, codes % npix, rows, slot, (n, kmax))
+        self.pts = _boundaries(self.nside, codes % npix, rows, slot, (n, kmax), ring)
         self.lit = np.zeros((n, kmax), bool)
         self.lit[rows, slot] = is_lit
         self.pad = np.ones((n, kmax), bool)
@@ -393,22 +395,27 @@ def _band_cells(lit: LitCSR, inner: LitCSR, outer: LitCSR, small: np.ndarray, np
     return codes[order], is_lit[order], rows[order]
 
 
-def _boundaries(nside: int, pix: np.ndarray, rows, slot, shape: tuple[int, int]) -> np.ndarray:
+def _boundaries(nside: int, pix: np.ndarray, rows, slot, shape: tuple[int, int],
+                ring=None) -> np.ndarray:  # fmt: skip
     """The boundary samples (healpix.boundaries, STEP a side) of the cells ``pix`` (T,) at
     [rows, slot] of a zero array (*shape, 4 STEP, 3). Compiled unless ``EYEVIZ_JIT=0``
-    (kernels.limit3d_affine.boundaries_kernel: the same formulas, to a few ulps)."""
+    (kernels.limit3d_affine.boundaries_kernel: the same formulas, to a few ulps; the
+    cells' rings ``ring`` (T,) if known)."""
     out = np.zeros((*shape, 4 * STEP, 3))
     if kernels.use(pix.size):
+        from eyeviz.core.healpix_fast import _ring_info_tables
         from eyeviz.core.kernels.limit3d_affine import boundaries_kernel
 
-        ix, iy, f = healpix.pix2xyf(nside, pix)
+        first = _ring_info_tables(nside)[0]
+        if ring is None:
+            ring = np.searchsorted(first[1 : 4 * nside], pix, side="right")
         t = np.arange(STEP) / STEP
         dx = np.concatenate([1 - t, np.zeros(STEP), t, np.ones(STEP)])
         dy = np.concatenate([np.ones(STEP), 1 - t, np.zeros(STEP), t])
-        boundaries_kernel(nside, kernels.arg(ix, np.int64), kernels.arg(iy, np.int64),
-                          kernels.arg(f, np.int64), kernels.arg(rows, np.int64),
-                          kernels.arg(slot, np.int64), dx, dy, healpix.JRLL, healpix.JPLL,
-                          out)  # fmt: skip
+        i64 = np.int64
+        boundaries_kernel(nside, kernels.arg(pix, i64), kernels.arg(ring, i64), first,
+                          kernels.arg(rows, i64), kernels.arg(slot, i64), dx, dy, healpix.JRLL,
+                          healpix.JPLL, out)  # fmt: skip
         return out
     out[rows, slot] = healpix.boundaries(nside, pix, STEP)
     return out

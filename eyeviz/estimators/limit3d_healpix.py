@@ -114,10 +114,10 @@ class HealpixProposal:
         return out
 
     def _draws_kernel(self, st: dict, u: np.ndarray, rows: np.ndarray):
-        """:meth:`_draws_ref` compiled (kernels.limit3d_affine.healpix_draws_kernel): the
+        """:meth:`_draws_ref` compiled (kernels.limit3d_draws.healpix_draws_kernel): the
         same formulas draw by draw, each draw given up at its first failed test; values
         written only where the weight is above 0 (zeros elsewhere)."""
-        from eyeviz.core.kernels.limit3d_affine import healpix_draws_kernel
+        from eyeviz.core.kernels.limit3d_draws import healpix_draws_kernel
 
         d, ea, eb = self.domain, st["ea"], st["eb"]
         n, m = u.shape[:2]
@@ -255,20 +255,23 @@ class HealpixProposal:
 
 def _ray_region_draws(eb: _Eye, ca, u_lo, u_hi, good, slack, u_dead: float, sa=None):
     """Each live draw's u-interval (``good`` (N, M)) narrowed to B's region along its ray
-    (:func:`_ray_in_region`), or with ``sa`` (A's sin(lo_A - s), sin(hi_A + s), (N, M)
-    each) to where the g test can pass (numpy only: the draws' kernel searches so itself);
-    the other draws' set to ``u_dead``. Compiled: in place on the live draws; numpy: on
-    the live draws moved to the front of each row."""
-    if sa is None and kernels.use(good.size):
-        from eyeviz.core.kernels.limit3d_affine import ray_region_kernel
+    (:func:`_ray_in_region`; numpy only: no draw uses it now), or with ``sa`` (A's
+    sin(lo_A - s), sin(hi_A + s), (N, M) each) to where the g test can pass (the draws'
+    kernel's search, compiled there: kernels.limit3d_draws.ray_region_kernel, in place on
+    the live draws); the other draws' set to ``u_dead``. numpy: on the live draws moved to
+    the front of each row."""
+    if sa is not None and kernels.use(good.size):
+        from eyeviz.core.kernels.limit3d_draws import ray_region_kernel
 
         lo, hi = np.array(u_lo, np.float64), np.array(u_hi, np.float64)
         n = good.shape[0]
         sl = kernels.arg(np.broadcast_to(slack, (n, 1))[:, 0], np.float64)
         t = np.linspace(0.0, 1.0, RAY_GRID)
+        f64 = np.float64
         ray_region_kernel(eb.a_lit, eb.t_lit, eb.a_unl, eb.t_unl, eb.lists, eb.c, eb.e1, eb.e2,
-                          kernels.arg(eb.a, np.float64), kernels.arg(ca, np.float64),
-                          lo, hi, sl, t, RAY_ROUNDS, kernels.arg(good))  # fmt: skip
+                          kernels.arg(eb.a, f64), kernels.arg(ca, f64), lo, hi, sl, t, RAY_ROUNDS,
+                          kernels.arg(good), kernels.arg(sa[0], f64),
+                          kernels.arg(sa[1], f64))  # fmt: skip
         return np.where(good, lo, u_dead), np.where(good, hi, u_dead)
     n = good.shape[0]
     order = np.argsort(~good, axis=1, kind="stable")[:, : max(1, int(good.sum(1).max()))]

@@ -244,9 +244,10 @@ def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack, grid: int = 12, rounds: int =
     G on ``grid`` points, the interval from the grid point before the first inside to the
     one after the last (or the two neighbours of the best point when none is inside);
     ``rounds`` times. Returns (lo, hi). (The numpy reference of
-    :func:`eyeviz.core.kernels.limit3d_affine.ray_region_kernel`.) With ``aim`` = (A's
+    :func:`eyeviz.core.kernels.limit3d_draws.ray_region_kernel`.) With ``aim`` = (A's
     sin(lo_A - s), sin(hi_A + s)) (N, M) each: the g test's gap instead, inside where
-    above 0 (``_gap_g`` there; the draws' kernel's search)."""
+    above 0 (``_gap_g`` there; the draws' kernel's search), and the inside run the
+    kernel's search finds (:func:`_ray_bracket`), not every inside point."""
     n, m = lo.shape
     t = np.linspace(0.0, 1.0, grid)
     for _ in range(rounds):
@@ -269,9 +270,12 @@ def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack, grid: int = 12, rounds: int =
                 g = np.minimum(sb_hi, aim[1][..., None] / k)
                 g = g - np.maximum(sb_lo, aim[0][..., None] / k)
             inside = g > 0.0
-        anyin = inside.any(axis=2)
-        first = np.where(anyin, inside.argmax(axis=2), g.argmax(axis=2))
-        last = np.where(anyin, grid - 1 - inside[..., ::-1].argmax(axis=2), first)
+        if aim is None:
+            anyin = inside.any(axis=2)
+            first = np.where(anyin, inside.argmax(axis=2), g.argmax(axis=2))
+            last = np.where(anyin, grid - 1 - inside[..., ::-1].argmax(axis=2), first)
+        else:
+            first, last = (x.reshape(n, m) for x in _ray_bracket(g.reshape(n * m, grid)))
         i0 = np.maximum(first - 1, 0)
         i1 = np.minimum(last + 1, grid - 1)
         lo, hi = (
@@ -279,3 +283,39 @@ def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack, grid: int = 12, rounds: int =
             np.take_along_axis(uu, i1[..., None], 2)[..., 0],
         )
     return lo, hi
+
+
+def _ray_bracket(g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The inside run (first, last) (R,) that the draws' kernel's search along the ray
+    finds (kernels.limit3d_draws._aim_next) on gap values g (R, grid), grid >= 2, all
+    evaluated here: the middle pair, a binary search on the slope of pairs stopped at
+    the first point inside (g > 0), the first maximum of the window it leaves where none
+    is, then the run of inside points about the hit (without a hit: the maximum)."""
+    r, grid = g.shape
+    rows = np.arange(r)
+    ins = g > 0.0
+    m0 = (grid - 2) // 2
+    hit = np.where(ins[:, m0], m0, np.where(ins[:, m0 + 1], m0 + 1, -1))
+    up = g[:, m0] < g[:, m0 + 1]
+    lo, hi = np.where(up, m0 + 1, 0), np.where(up, grid - 1, m0)
+    while True:
+        act = (hit < 0) & (hi - lo > 1)
+        if not act.any():
+            break
+        mid = (lo + hi) // 2
+        g0, g1 = g[rows, mid], g[rows, np.minimum(mid + 1, grid - 1)]
+        hit = np.where(act & (g0 > 0.0), mid, np.where(act & (g1 > 0.0), mid + 1, hit))
+        act &= hit < 0
+        lo = np.where(act & (g0 < g1), mid + 1, lo)
+        hi = np.where(act & ~(g0 < g1), mid, hi)
+    best, scan = lo.copy(), hit < 0
+    for j in range(grid):  # the window's points in turn: the first inside, else the maximum
+        on = scan & (j >= lo) & (j <= hi)
+        hit = np.where(on & ins[:, j], j, hit)
+        best = np.where(on & ~ins[:, j] & (g[:, j] > g[rows, best]), j, best)
+        scan &= ~(on & ins[:, j])
+    first, last = hit.copy(), hit.copy()
+    for _ in range(grid):
+        first -= (first > 0) & ins[rows, np.maximum(first - 1, 0)]
+        last += (last >= 0) & (last < grid - 1) & ins[rows, np.minimum(last + 1, grid - 1)]
+    return np.where(hit >= 0, first, best), np.where(hit >= 0, last, best)

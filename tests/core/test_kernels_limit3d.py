@@ -25,6 +25,7 @@ from eyeviz.estimators.limit3d_measured import MeasuredProposal, _Edges
 
 kr = pytest.importorskip("eyeviz.core.kernels.limit3d_region")
 ka = pytest.importorskip("eyeviz.core.kernels.limit3d_affine")
+kd = pytest.importorskip("eyeviz.core.kernels.limit3d_draws")
 
 SPECIAL = [np.inf, -np.inf, np.nan, 0.0, -0.0, 1e300, -1e300, 1e-300]
 
@@ -76,27 +77,71 @@ def healpix_chunk():
 
 @pytest.mark.parametrize("wide", [False, True])
 def test_ray_region_kernel_is_the_reference_bit_for_bit(healpix_chunk, monkeypatch, wide):
-    _, stt, _ = healpix_chunk
-    eb = stt["eb"]
+    """The draws' kernel's search along A's rays for where the g test can pass (its points
+    chosen one by one, _aim_next) against the numpy reference (_ray_bracket on every
+    point), on rays through B's region, A's sin radii about B's so that rays with no point
+    inside, short runs and the whole ray all occur."""
+    prop, stt, _ = healpix_chunk
+    eb, d = stt["eb"], prop.domain
     rng = np.random.default_rng(5)
     n = eb.c.shape[0]
-    ca = rng.normal(size=(n, 50, 3)) * (0.3 if wide else 0.02) + stt["ea"].c[:, None, :]
-    ca /= np.linalg.norm(ca, axis=2, keepdims=True)
-    lo = rng.uniform(0.0, 0.02, (n, 50))
-    hi = lo + rng.uniform(0.0, 0.05, (n, 50))
+    rho_b = rng.uniform(d.r_min, d.r_max, (n, 50, 1))
+    v = eb.c[:, None, :] + rng.normal(size=(n, 50, 3)) * (0.02 if wide else 0.005)
+    ca = stt["B"] + rho_b * v / np.linalg.norm(v, axis=2, keepdims=True) - stt["A"]
+    rho = np.linalg.norm(ca, axis=2)
+    ca /= rho[..., None]
+    lo, hi = rng.uniform(0.7, 1.0, (n, 50)) / rho, rng.uniform(1.0, 1.3, (n, 50)) / rho
     good = rng.random((n, 50)) < 0.8
-    args = (eb, ca, lo, hi, good, stt["slack"], 0.01)
+    b_lo, b_hi = eb.bounds(np.zeros((n, 1, 2)))
+    k = rho_b[..., 0] / rho  # rho_B / rho: A's sin radius of B's cap
+    s_lo = np.sin(b_lo) * k * rng.uniform(0.6, 1.1, (n, 50))
+    s_hi = np.maximum(np.sin(b_hi) * k * rng.uniform(0.9, 1.6, (n, 50)), s_lo)
+    args = (eb, ca, lo, hi, good, stt["slack"], 0.01, (s_lo, s_hi))
     got = limit3d_healpix._ray_region_draws(*args)
     monkeypatch.setenv("EYEVIZ_JIT", "0")
     want = limit3d_healpix._ray_region_draws(*args)
     assert _same_bits(got[0], want[0]) and _same_bits(got[1], want[1])
-    assert not np.array_equal(got[0], np.where(good, lo, 0.01))  # it did narrow
+    # brackets of every width occur: short runs (or none inside) to the whole ray
+    step = (hi - lo) / (limit3d_healpix.RAY_GRID - 1)
+    width = np.round(((got[1] - got[0]) / step)[good]).astype(int)
+    assert set(width) == set(range(1, limit3d_healpix.RAY_GRID))
+
+
+def test_the_ray_search_picks_the_reference_s_bracket():
+    """The draws' kernel's search along the ray (_aim_next, replayed point by point) against
+    its numpy reference (_ray_bracket, every point known) on gap profiles of 2-10 points
+    with ties, plateaus, NaN and several peaks; on unimodal profiles it is the full scan's
+    bracket (the first and last point inside, else the first maximum)."""
+    from eyeviz.estimators.limit3d_proposal import _ray_bracket
+
+    rng = np.random.default_rng(3)
+    for _ in range(1500):
+        grid = int(rng.integers(2, 11))
+        g = rng.choice([-2.0, -1.0, 0.0, 0.5, 1.0, np.nan], grid)
+        if rng.random() < 0.5:  # unimodal: up then down
+            g = -np.abs(np.arange(grid) - rng.uniform(-1, grid)) + rng.uniform(-3, 3)
+            if rng.random() < 0.3:
+                g = np.round(g)  # plateaus and exact zeros
+        seen, evals = 0, 0
+        while True:
+            j, first, last = kd._aim_next(g, seen, grid)
+            if j < 0:
+                break
+            assert not (seen >> j) & 1
+            seen |= 1 << j
+            evals += 1
+        want = _ray_bracket(g[None, :])
+        assert (first, last) == (int(want[0][0]), int(want[1][0])), g
+        if np.all(np.diff(np.sign(np.diff(g))) <= 0) and not np.isnan(g).any():
+            ins = np.flatnonzero(g > 0)
+            full = (ins[0], ins[-1]) if ins.size else (int(np.argmax(g)),) * 2
+            assert (first, last) == full, g
 
 
 def test_healpix_draws_are_the_reference_s(healpix_chunk, monkeypatch):
     """The whole sample (draws, exact check), compiled against EYEVIZ_JIT=0: the same
     accepted draws, their values to 1e-12 and weights to 1e-9 (the draws' kernel rounds
-    as math does, not as numpy: kernels.limit3d_affine)."""
+    as math does, not as numpy: kernels.limit3d_draws)."""
     prop, stt, keys = healpix_chunk
     got = prop.sample(stt, keys, [3, 11])
     monkeypatch.setenv("EYEVIZ_JIT", "0")

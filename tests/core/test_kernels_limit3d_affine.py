@@ -192,7 +192,7 @@ def test_healpix_prior_is_prior_density(multi):
     the support (and on each bound of r, g and el exactly)."""
     from eyeviz.estimators.limit3d_exact import prior_density
 
-    ka = pytest.importorskip("eyeviz.core.kernels.limit3d_affine")
+    ka = pytest.importorskip("eyeviz.core.kernels.limit3d_draws")
     d = Domain3D(nside=16)
     rng = np.random.default_rng(3 + multi)
     k = 4000

@@ -55,6 +55,7 @@ KERNELS = (
     "healpix_boundary",
     "limit3d_affine",
     "limit3d_locate",
+    "limit3d_draws",
 )
 
 

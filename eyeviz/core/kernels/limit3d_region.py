@@ -1,7 +1,8 @@
 """The spherical limit's proposal regions compiled (numba): the measured eyes' cone
 distances (:meth:`eyeviz.estimators.limit3d_measured._Edges.bounds`), their draws, the
 HEALPix prefilter and the exact check's row comparison. (The HEALPix eyes' affine model
-and its ray search are in :mod:`.limit3d_affine`, with the draws that call them.)
+is in :mod:`.limit3d_affine`, its ray search with the draws that call it in
+:mod:`.limit3d_draws`.)
 
 Scalar transcriptions of the numpy references, which ``EYEVIZ_JIT=0`` runs instead
 (docs/kernels.md). The reductions keep numpy's NaN rules (a NaN anywhere in a max or min
