@@ -243,11 +243,11 @@ def _ray_in_region(eye_b: _Eye, ca, lo, hi, slack, grid: int = 12, rounds: int =
     and the view moves monotonically along a great circle, so those u form an interval:
     G on ``grid`` points, the interval from the grid point before the first inside to the
     one after the last (or the two neighbours of the best point when none is inside);
-    ``rounds`` times. Returns (lo, hi). (The numpy reference of
-    :func:`eyeviz.core.kernels.limit3d_draws.ray_region_kernel`.) With ``aim`` = (A's
-    sin(lo_A - s), sin(hi_A + s)) (N, M) each: the g test's gap instead, inside where
-    above 0 (``_gap_g`` there; the draws' kernel's search), and the inside run the
-    kernel's search finds (:func:`_ray_bracket`), not every inside point."""
+    ``rounds`` times. Returns (lo, hi). (No draw uses this search now: numpy only.) With
+    ``aim`` = (A's sin(lo_A - s), sin(hi_A + s)) (N, M) each: the g test's gap instead,
+    inside where above 0, and the inside run the draws' kernel's search finds
+    (:func:`_ray_bracket`), not every inside point: the numpy reference of
+    :func:`eyeviz.core.kernels.limit3d_draws.ray_region_kernel` (``_gap_g`` there)."""
     n, m = lo.shape
     t = np.linspace(0.0, 1.0, grid)
     for _ in range(rounds):

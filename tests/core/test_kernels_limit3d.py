@@ -115,7 +115,7 @@ def test_the_ray_search_picks_the_reference_s_bracket():
     from eyeviz.estimators.limit3d_proposal import _ray_bracket
 
     rng = np.random.default_rng(3)
-    for _ in range(1500):
+    for _ in range(600):
         grid = int(rng.integers(2, 11))
         g = rng.choice([-2.0, -1.0, 0.0, 0.5, 1.0, np.nan], grid)
         if rng.random() < 0.5:  # unimodal: up then down
