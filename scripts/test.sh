@@ -2,7 +2,7 @@
 # The README's test command. Sets up everything (scripts/setup.sh), then runs three stages
 # and reports each, carrying on when one fails (the exit status is non-zero if any did):
 #   1. the guardrails: ruff lint and format, import-linter's layer contracts, mypy (in
-#      the full run they run beside stage 2: a minute of one core, overlapped);
+#      the full run they run beside stage 3: half a minute of one core, overlapped);
 #   2. the display-free tests (everything but tests/app);
 #   3. the GUI tests under a virtual X display (they drive a real Qt/VTK window).
 # The tests run on every core (pytest-xdist, `-n <cores>`; EYEVIZ_TEST_WORKERS=N sets
@@ -86,8 +86,13 @@ if [ "$quick" = 1 ]; then
         env -u DISPLAY .venv/bin/python -m pytest --ignore=tests/app -p no:cacheprovider \
         -m "not slow and not gui" "${par[@]}" "$@"
 else
-    # The guardrails are single-threaded (mypy is most of their minute): they run beside
-    # the display-free tests, and their output is shown when both have finished.
+    stage "display-free tests" "$logs/free" \
+        env -u DISPLAY .venv/bin/python -m pytest --ignore=tests/app -p no:cacheprovider \
+        "${par[@]}" "$@"
+    # The guardrails are single-threaded (mypy is most of their half minute): they run
+    # beside the GUI tests, whose two workers leave part of the cores idle (they wait for
+    # windows, X and timers; the display-free tests keep both cores busy), and their
+    # output is shown when both have finished.
     guard_t0=$SECONDS
     (
         guardrails >"$logs/guard" 2>&1
@@ -95,11 +100,9 @@ else
         echo $((SECONDS - guard_t0)) >"$logs/guard.time"
     ) &
     guard_pid=$!
-    stage "display-free tests" "$logs/free" \
-        env -u DISPLAY .venv/bin/python -m pytest --ignore=tests/app -p no:cacheprovider \
-        "${par[@]}" "$@"
+    stage "GUI tests (Xvfb)" "$logs/gui" gui_tests "$@"
     wait "$guard_pid"
-    echo "== guardrails (ruff, import-linter, mypy; ran beside the display-free tests)" >&2
+    echo "== guardrails (ruff, import-linter, mypy; ran beside the GUI tests)" >&2
     cat "$logs/guard"
     if [ "$(cat "$logs/guard.rc" 2>/dev/null)" = 0 ]; then
         summary=("guardrails (ruff, import-linter, mypy): ok, $(cat "$logs/guard.time") s" \
@@ -109,7 +112,6 @@ else
             "${summary[@]}")
         failed=1
     fi
-    stage "GUI tests (Xvfb)" "$logs/gui" gui_tests "$@"
 fi
 
 echo "== summary ($((SECONDS - start)) s, ${workers} worker(s))" >&2
