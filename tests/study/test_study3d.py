@@ -67,10 +67,13 @@ def test_planar_and_3d_points_and_tables_do_not_mix(tmp_path):
         run_study(planar, design_grid3d("20", "10", "8", n=50), workers=1, progress=False)
 
 
-def _table(tmp_path):
-    path = tmp_path / "s3.csv"
+@pytest.fixture(scope="module")
+def table_lines(tmp_path_factory) -> tuple[str, ...]:
+    """The lines of a whole 3D table of two points, computed once per module (per pytest
+    worker): each test below edits a copy of them in its own file."""
+    path = tmp_path_factory.mktemp("table3d") / "s3.csv"
     run_study(path, design_grid3d("20", "10", "8,16", n=60), workers=1, progress=False)
-    return path, path.read_text().splitlines()
+    return tuple(path.read_text().splitlines())
 
 
 @pytest.mark.parametrize(
@@ -94,9 +97,11 @@ def _table(tmp_path):
         (lambda ls: ls + [ls[1]], ["line 32", "bin all of this design point appears twice"]),
     ],
 )
-def test_a_bad_3d_table_is_refused_naming_the_line_and_left_as_it_is(tmp_path, edit, words):
-    path, lines = _table(tmp_path)
-    path.write_text("\n".join(edit(lines)) + "\n")
+def test_a_bad_3d_table_is_refused_naming_the_line_and_left_as_it_is(
+    tmp_path, table_lines, edit, words
+):
+    path = tmp_path / "s3.csv"
+    path.write_text("\n".join(edit(list(table_lines))) + "\n")
     before = path.read_bytes()
     with pytest.raises(EyevizError) as err:
         run_study(path, design_grid3d("20", "10", "8", n=60), workers=1, progress=False)
@@ -152,9 +157,9 @@ def test_a_3d_study_killed_mid_way_resumes_to_the_rows_of_an_uninterrupted_one(t
     assert out.returncode == 0, out.stderr
     assert f"{6 - len(kept)} point(s) computed, {len(kept)} skipped" in out.stdout
     assert path.read_text().splitlines()[: len(lines_before)] == lines_before
-    whole = tmp_path / "whole.csv"
+    whole = tmp_path / "whole.csv"  # (one worker: the rows do not depend on how many)
     run_study(
-        whole, design_grid3d("20,40,80", "10", "32,64", n=6000, seed=4), workers=2, progress=False
+        whole, design_grid3d("20,40,80", "10", "32,64", n=6000, seed=4), workers=1, progress=False
     )
     assert rows_without_seconds(path) == rows_without_seconds(whole)
 
