@@ -12,15 +12,15 @@ texts' boxes),
 - every name keeps at least 4 px x the text scale from every ball, eye and selection ring
   (names touched their ball or ring with 0-2 px to spare in several steps).
 
-Real keys (xdotool) into the real window."""
+Checked in every step of test_lecture_whole_175's walk (real keys, xdotool, into the real
+window), with the other checks of the lecture at 175 %: one window and one walk for all."""
+
+from collections import Counter
 
 import numpy as np
-import pytest
 from test_labels3d import _boxes, _disc
-from test_lecture_names_175 import _box, lecture_at_175
-from test_presenting_real_x import _keys, window_manager  # noqa: F401
+from test_lecture_names_175 import _box
 
-from eyeviz.model.scene import load
 from eyeviz.render.vtk.balls3d import RING
 
 
@@ -51,66 +51,65 @@ def _leader_to(segments, disc, box, origin) -> bool:
     return False
 
 
-@pytest.mark.slow
-def test_balls_clear_the_texts_and_names_stay_near_their_balls_at_175(make_window, qtbot):
-    win, path = lecture_at_175(make_window, qtbot)
+def check_balls(win, step: int, tally: Counter) -> None:
+    """One step of the walk at 175 % (test_lecture_whole_175): balls and eyes clear of the
+    view's texts, every ball named near its ball (or led to its name), 4 px x scale apart."""
     scale = win.presenter.scale
     host = win.host3d
     act = host.actors
     ren = act.scene_ren
     dpi = ren.GetRenderWindow().GetDPI()
-    named = near = 0
-    for step in range(len(load(path).steps)):
-        _keys(qtbot, "Next", until=lambda s=step: win.step_index == s)
-        qtbot.wait(300)
-        host.draw()
-        ren.GetRenderWindow().Render()
-        st, surf = host.model.state, act.surface
-        ox, oy = ren.GetOrigin()
-        w, h = ren.GetSize()
-        balls = [_disc(ren, (st.x[i], st.y[i], st.z[i]), st.g[i]) for i in range(st.n)]
-        eyes = [_disc(ren, c, surf.radius) for c in surf.centres]
-        # the view's own texts, in display pixels
-        texts = []
-        for actor in (host.side.actor, act.title):
-            if actor.GetVisibility() and actor.GetInput():
-                x0, y0, x1, y1 = _box(actor, ren)
-                texts.append((actor.GetInput(), (x0 + ox, y0 + oy, x1 + ox, y1 + oy)))
-        assert texts, step + 1  # the side note at least
-        shows = host.model.scene.shows("features")
-        for k, d in enumerate(balls + eyes):
-            for text, tb in texts:
-                # a ball's disc (or an eye's) over the note or the title
-                assert _clearance(tb, d) > 0.0, (step + 1, k, text, d, tb)
-        if not shows:
+    ren.GetRenderWindow().Render()
+    st, surf = host.model.state, act.surface
+    ox, oy = ren.GetOrigin()
+    w, h = ren.GetSize()
+    balls = [_disc(ren, (st.x[i], st.y[i], st.z[i]), st.g[i]) for i in range(st.n)]
+    eyes = [_disc(ren, c, surf.radius) for c in surf.centres]
+    # the view's own texts, in display pixels
+    texts = []
+    for actor in (host.side.actor, act.title):
+        if actor.GetVisibility() and actor.GetInput():
+            x0, y0, x1, y1 = _box(actor, ren)
+            texts.append((actor.GetInput(), (x0 + ox, y0 + oy, x1 + ox, y1 + oy)))
+    assert texts, step + 1  # the side note at least
+    shows = host.model.scene.shows("features")
+    for k, d in enumerate(balls + eyes):
+        for text, tb in texts:
+            # a ball's disc (or an eye's) over the note or the title
+            assert _clearance(tb, d) > 0.0, (step + 1, k, text, d, tb)
+    if not shows:
+        return
+    labels = act.balls.ball_labels[: st.n]
+    drawn = dict(_boxes(ren, labels, dpi))
+    segments = act.leaders.segments
+    sel = host.model.selected
+    for i, lab in enumerate(labels):
+        cx, cy, r = balls[i]
+        if not (ox <= cx <= ox + w and oy <= cy <= oy + h) or not lab.GetVisibility():
             continue
-        labels = act.balls.ball_labels[: st.n]
-        drawn = dict(_boxes(ren, labels, dpi))
-        segments = act.leaders.segments
-        sel = host.model.selected
-        for i, lab in enumerate(labels):
-            cx, cy, r = balls[i]
-            if not (ox <= cx <= ox + w and oy <= cy <= oy + h) or not lab.GetVisibility():
-                continue
-            name = lab.GetInput()
-            # every ball in the view named: none gives way
-            assert name in drawn, (step + 1, name, sorted(drawn))
-            box = drawn[name]
-            bh = box[3] - box[1]
-            own = (cx, cy, r * RING + 1.0) if i == sel else (cx, cy, r)  # the ring's line
-            # a margin of 4 px at 100 %, scaled with the text
-            for k, d in enumerate(balls + eyes):
-                dd = own if k == i else ((d[0], d[1], d[2] * RING + 1.0) if k == sel else d)
-                gap = _clearance(box, dd)
-                assert gap >= 4.0 * scale, (step + 1, name, k, round(gap, 2))
-            # near its own ball, or a leader line to it
-            rim = _clearance(box, (cx, cy, r))
-            others = [_clearance(box, d) for k, d in enumerate(balls) if k != i]
-            nearer = bool(others) and min(others) < rim - 1.0
-            led = _leader_to(segments, (cx, cy, r), box, (ox, oy))
-            if rim > 4.0 * scale + 2.0 + bh or nearer:
-                assert led, (step + 1, name, round(rim, 1), nearer)
-            else:
-                near += 1
-            named += 1
+        name = lab.GetInput()
+        # every ball in the view named: none gives way
+        assert name in drawn, (step + 1, name, sorted(drawn))
+        box = drawn[name]
+        bh = box[3] - box[1]
+        own = (cx, cy, r * RING + 1.0) if i == sel else (cx, cy, r)  # the ring's line
+        # a margin of 4 px at 100 %, scaled with the text
+        for k, d in enumerate(balls + eyes):
+            dd = own if k == i else ((d[0], d[1], d[2] * RING + 1.0) if k == sel else d)
+            gap = _clearance(box, dd)
+            assert gap >= 4.0 * scale, (step + 1, name, k, round(gap, 2))
+        # near its own ball, or a leader line to it
+        rim = _clearance(box, (cx, cy, r))
+        others = [_clearance(box, d) for k, d in enumerate(balls) if k != i]
+        nearer = bool(others) and min(others) < rim - 1.0
+        led = _leader_to(segments, (cx, cy, r), box, (ox, oy))
+        if rim > 4.0 * scale + 2.0 + bh or nearer:
+            assert led, (step + 1, name, round(rim, 1), nearer)
+        else:
+            tally["balls_near"] += 1
+        tally["balls_named"] += 1
+
+
+def balls_checked(tally: Counter) -> None:
+    named, near = tally["balls_named"], tally["balls_near"]
     assert named >= 13 and near >= 8, (named, near)  # names were shown and checked
