@@ -69,10 +69,6 @@ def certified_kernel(
                                        cs, sn, exact_only, fi[k])  # fmt: skip
 
 
-#: :func:`_certify` inlined, for the key check's loop over a ball's few facets (a call numba
-#: does not inline counts a reference on each of its eleven arrays: docs/limit3d.md, "bee33c")
-_certify_inline = njit(cache=True, nogil=True, inline="always")(_certify.py_func)
-
 _REL = 1e-9  # the slack of the key's bound, relative and in radians (as measured_index)
 
 
@@ -213,9 +209,8 @@ def key_check_kernel(cx, cy, cz, g, bounds, px, py, pz, ax, ay, az, nrm, cs, sn,
                 n_lit += islit[t]
                 if kl[t] <= safe:  # a lit facet that surely sees the ball
                     continue
-                seen, sure, inside = _certify_inline(cx[b], cy[b], cz[b], g[b], px, py, pz, ax,
-                                                     ay, az, nrm, cs, sn, exact_only,
-                                                     lst[t])  # fmt: skip
+                seen, sure, inside = _certify(cx[b], cy[b], cz[b], g[b], px, py, pz, ax, ay,
+                                              az, nrm, cs, sn, exact_only, lst[t])  # fmt: skip
                 if not sure:
                     verdict = 2
                 elif seen != islit[t] or (seen and inside == 1):
