@@ -100,8 +100,6 @@ class _Eye:
         self.n_lit_edge = np.bincount(rows[is_lit], minlength=n)
         self.n_unlit = np.bincount(rows[~is_lit], minlength=n)
         self._ring: np.ndarray | None = None  # the band cells' rings, if known
-        # the band cells' bounds about the first centres (u0, near, far), if known
-        self._bounds0: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         ring = None
         if reach is not None and kernels.use(codes.size):
             keep = self._candidates(u, rows, reach)  # sets _ring: the band cells' rings
@@ -151,10 +149,9 @@ class _Eye:
         self._ring = ring  # band() takes them again
         c = u / np.linalg.norm(u, axis=1, keepdims=True)  # as linearise normalises it
         near, far = np.empty(pix.size), np.empty(pix.size)
-        c = kernels.arg(c, np.float64)
-        band_bounds_kernel(n, kernels.arg(pix, np.int64), ring, kernels.arg(rows, np.int64), c,
-                           *_ring_tables(n), first, shifted, near, far)  # fmt: skip
-        self._bounds0 = (c, near, far)  # band() takes them again
+        band_bounds_kernel(n, kernels.arg(pix, np.int64), ring, kernels.arg(rows, np.int64),
+                           kernels.arg(c, np.float64), *_ring_tables(n), first, shifted, near,
+                           far)  # fmt: skip
         s = self.step
         lo = np.where(lit, far - _sample_gap(s, far), far)
         hi = np.where(lit, near - _sample_gap(s, near), near)
@@ -167,15 +164,11 @@ class _Eye:
 
     def band(self) -> tuple[np.ndarray, ...]:
         """The arguments of kernels.healpix_match.edge_match_kernel for this eye's keys, from
-        u_io to far: the band cells' bounds about a centre u0 per key, each key's lit cells
-        first by ``near`` from the largest, then its unlit ones by ``far`` from the smallest
+        u_io to far: the band cells' bounds about the current centres ``c`` (call after
+        the centre search, whose centres the draws lie near), each key's lit cells first
+        by ``near`` from the largest, then its unlit ones by ``far`` from the smallest
         (``bl``: where each key's unlit cells start), the order in which the kernel can
-        stop at the first cell its bounds settle. u0: the first centre (the cap estimate),
-        whose bounds :meth:`_candidates` has computed, else the current centres ``c``
-        (call after the centre search, whose centres the draws lie near). Any u0 gives
-        exact verdicts (the kernel moves the bounds by each draw's distance from it); the
-        centre search moves a key's centre by well under a facet width, and on 400 bench
-        keys not one draw was left undecided either way."""
+        stop at the first cell its bounds settle."""
         from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
         from eyeviz.core.kernels.healpix_match import band_bounds_kernel
 
@@ -188,14 +181,11 @@ class _Eye:
         bp = np.zeros(cnt.size + 1, np.int64)
         np.cumsum(cnt, out=bp[1:])
         key = np.repeat(np.arange(cnt.size, dtype=np.int64), cnt)
+        near, far = np.empty(pix.size), np.empty(pix.size)
+        u0 = kernels.arg(self.c, np.float64)
         pix = kernels.arg(pix, np.int64)
-        if self._bounds0 is not None:
-            u0, near, far = self._bounds0
-        else:
-            near, far = np.empty(pix.size), np.empty(pix.size)
-            u0 = kernels.arg(self.c, np.float64)
-            band_bounds_kernel(n, pix, ring, key, u0, *_ring_tables(n),
-                               first, _ring_info_tables(n)[2], near, far)  # fmt: skip
+        band_bounds_kernel(n, pix, ring, key, u0, *_ring_tables(n),
+                           first, _ring_info_tables(n)[2], near, far)  # fmt: skip
         # per key: lit cells (near descending), then unlit ones (far ascending)
         order = np.lexsort((np.where(lit, -near, far), ~lit, key))
         pix, ring, lit, near, far = pix[order], ring[order], lit[order], near[order], far[order]
