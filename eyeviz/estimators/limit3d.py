@@ -241,7 +241,7 @@ class Limit3DEstimator(Estimator3D):
         # and none is taken once no key needs more. Only accepted draws are kept
         # (:func:`_compact`). A proposal with ``retry_empty`` tops up no key whose first
         # batch found nothing (:func:`_tops_up`): such a key goes to the retries at once
-        # (and gets these top-ups only if they find nothing either: :meth:`_posterior`).
+        # (and gets these top-ups too only if they find it less: :meth:`_posterior`).
         ok = np.ones(keys.size, bool) if top_all else _tops_up(prop, out)
         if getattr(prop, "batch_counts", False):
             return self._topups_sized(st, keys, stream, out, ok)
@@ -295,10 +295,12 @@ class Limit3DEstimator(Estimator3D):
         keys = _key_hash(lit_a, lit_b) ^ np.uint64(self.seed)
         s = self._draw(lit_a, lit_b, keys, 1.0, 0)
         m = self.samples
+        retried = np.zeros(keys.size, bool)
         for stream, wide, reps in _retries(self._proposal):
             few = np.flatnonzero(~(s["w"].sum(axis=1) > 0))
             if not few.size:
                 break
+            retried[few] = True
             # keys with nothing accepted: their posterior is a small part of the proposal
             # (the misses are found with more draws, not with wider windows): ``reps``
             # times the draws, the window and slack ``wide`` times wider; the accepted
@@ -307,12 +309,17 @@ class Limit3DEstimator(Estimator3D):
             s2 = self._draw(sub_a, sub_b, keys[few], wide, stream, reps)
             order = np.argsort(~(s2["w"] > 0), axis=1, kind="stable")[:, :m]
             s = _put_rows(s, few, {k: np.take_along_axis(v, order, 1) for k, v in s2.items()})
-        few = np.flatnonzero(~(s["w"].sum(axis=1) > 0))
+        got = (s["w"] > 0).sum(axis=1)
+        few = np.flatnonzero(retried & (got < MIN_ESS))
         if few.size and getattr(self._proposal, "retry_empty", False):
-            # keys the retries did not find either: the first pass's top-ups after all
-            # (the same draws as without ``retry_empty``: a few accepted draws beat none)
+            # keys sent to the retries by an empty first batch (``retry_empty``) that the
+            # retries found fewer than MIN_ESS draws for: the first pass's top-ups too (the
+            # draws they had without the rule), and whichever found more is kept
             sub_a, sub_b = take_rows(*lit_a, few), take_rows(*lit_b, few)
-            s = _put_rows(s, few, self._draw(sub_a, sub_b, keys[few], 1.0, 0, top_all=True))
+            s2 = self._draw(sub_a, sub_b, keys[few], 1.0, 0, top_all=True)
+            more = (s2["w"] > 0).sum(axis=1) > got[few]
+            if more.any():
+                s = _put_rows(s, few[more], {k: v[more] for k, v in s2.items()})
         return _compact(s)
 
     def _predict_csr(self, lit_a: LitCSR, lit_b: LitCSR):
@@ -479,7 +486,7 @@ def _tops_up(proposal: Any, s: dict) -> np.ndarray:
     """The keys that may be topped up after their first batch: all, or for a proposal with
     ``retry_empty`` (the measured one) those with a draw accepted (a key whose first batch
     found nothing goes to the retries at once: its later batches rarely find it,
-    limit3d_measured.RETRY_EMPTY; it gets them if the retries find nothing either)."""
+    limit3d_measured.RETRY_EMPTY; it gets them too if the retries find under MIN_ESS draws)."""
     if getattr(proposal, "retry_empty", False):
         return (s["w"] > 0).any(axis=1)
     return np.ones(s["w"].shape[0], bool)
