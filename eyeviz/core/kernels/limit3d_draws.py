@@ -237,14 +237,6 @@ def _ray_box(c, e1, e2, a, ext0, ext1, cax, cay, caz):
     return lo, hi
 
 
-@_jit_np
-def _clip(x, lo, hi):
-    """numpy's clip (NaN stays NaN)."""
-    if x != x:
-        return x
-    return min(max(x, lo), hi)
-
-
 # long: one draw of limit3d_healpix.HealpixProposal.sample up to the exact check (A's
 # direction, A's model, B's box and region along the ray, g, prior, weight) is one loop
 # body; split, it would pass a dozen scalars back and forth
@@ -299,8 +291,8 @@ def healpix_draws_kernel(u, rows, th_lo, th_hi, box, ext, ext_b, slack, fa, ca_,
             uhi = _min(uhi, u_max)
             if not uhi > ulo:
                 continue
-            sa_lo = math.sin(_clip(lo_a - sn, 0.0, h2))
-            sa_hi = math.sin(_clip(hi_a + sn, 0.0, h2))
+            sa_lo = math.sin(_clip_nan(lo_a - sn, 0.0, h2))
+            sa_hi = math.sin(_clip_nan(hi_a + sn, 0.0, h2))
             hlo, hhi = _ray_search(bl, sl_, bu, su, lb, cb, e1b, e2b, ab, n, cx, cy, cz, ulo, uhi,
                                    sn, t, rounds, gv, uu, sa_lo, sa_hi)  # fmt: skip
             if not hhi > hlo:  # a bracket of no width: the box's interval instead
@@ -324,14 +316,14 @@ def healpix_draws_kernel(u, rows, th_lo, th_hi, box, ext, ext_b, slack, fa, ca_,
             lo_b, hi_b = _affine_lists(bl, sl_, bu, su, lb, n, bx, by)
             g_lo = rr * s_half
             g_hi = g_max
-            g_lo = _max(g_lo, rho * math.sin(_clip(lo_a - sn, 0.0, h2)))
-            g_hi = _min(g_hi, rho * math.sin(_clip(hi_a + sn, 0.0, h2)))
-            g_lo = _max(g_lo, rho_b * math.sin(_clip(lo_b - sn, 0.0, h2)))
-            g_hi = _min(g_hi, rho_b * math.sin(_clip(hi_b + sn, 0.0, h2)))
+            g_lo = _max(g_lo, rho * math.sin(_clip_nan(lo_a - sn, 0.0, h2)))
+            g_hi = _min(g_hi, rho * math.sin(_clip_nan(hi_a + sn, 0.0, h2)))
+            g_lo = _max(g_lo, rho_b * math.sin(_clip_nan(lo_b - sn, 0.0, h2)))
+            g_hi = _min(g_hi, rho_b * math.sin(_clip_nan(hi_b + sn, 0.0, h2)))
             if not g_hi > g_lo:
                 continue
             gg = g_lo + (g_hi - g_lo) * u[n, m, 3]
-            e = math.asin(_clip(pz / rr, -1.0, 1.0))
+            e = math.asin(_clip_nan(pz / rr, -1.0, 1.0))
             phi = math.atan2(py, px)
             dens = healpix_prior(rr, gg, e, phi, s_half, g_max, r_min, r_max, el_max, psi, multi)
             vol = vol0 * ((g_hi - g_lo) / q)
@@ -341,7 +333,7 @@ def healpix_draws_kernel(u, rows, th_lo, th_hi, box, ext, ext_b, slack, fa, ca_,
             x[n, m], y[n, m], z[n, m], g[n, m] = px, py, pz, gg
             r[n, m], az[n, m], el[n, m], w[n, m] = rr, phi, e, wt
             ca[n, m, 0], ca[n, m, 1], ca[n, m, 2] = cx, cy, cz
-            alpha[n, m] = math.asin(_clip(gg / rho, 0.0, 1.0))
+            alpha[n, m] = math.asin(_clip_nan(gg / rho, 0.0, 1.0))
 
 
 def warm() -> None:
