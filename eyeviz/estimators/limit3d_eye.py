@@ -34,6 +34,16 @@ def _frame(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return e1, e2
 
 
+def _rings(nside: int, pix: np.ndarray) -> np.ndarray:
+    """The ring of each RING pixel ``pix`` (int64, 1 .. 4 nside - 1: the row of the ring
+    tables, healpix_fast._ring_info_tables, as the kernels take it): first[ring] <= pix <
+    first[ring] + pixels[ring]."""
+    from eyeviz.core.healpix_fast import _ring_info_tables
+
+    first = _ring_info_tables(nside)[0]
+    return np.searchsorted(first[1 : 4 * nside], pix, side="right").astype(np.int64)
+
+
 def _sample_gap(s: float, d: np.ndarray) -> np.ndarray:
     """How much farther than a cell's closure its nearest boundary sample can be, given
     that sample's distance d: samples are s = 1.5 fw / STEP apart along edges (edges are
@@ -145,7 +155,7 @@ class _Eye:
         _, pix, lit = self._band
         n = self.nside
         first, _, shifted = _ring_info_tables(n)[:3]
-        ring = np.searchsorted(first[1 : 4 * n], pix, side="right").astype(np.int64)
+        ring = _rings(n, pix)
         self._ring = ring  # band() takes them again
         c = u / np.linalg.norm(u, axis=1, keepdims=True)  # as linearise normalises it
         near, far = np.empty(pix.size), np.empty(pix.size)
@@ -175,9 +185,7 @@ class _Eye:
         cnt, pix, lit = self._band
         n = self.nside
         first = _ring_info_tables(n)[0]
-        ring = self._ring
-        if ring is None:
-            ring = np.searchsorted(first[1 : 4 * n], pix, side="right").astype(np.int64)
+        ring = _rings(n, pix) if self._ring is None else self._ring
         bp = np.zeros(cnt.size + 1, np.int64)
         np.cumsum(cnt, out=bp[1:])
         key = np.repeat(np.arange(cnt.size, dtype=np.int64), cnt)
@@ -408,7 +416,7 @@ def _boundaries(nside: int, pix: np.ndarray, rows, slot, shape: tuple[int, int],
 
         first = _ring_info_tables(nside)[0]
         if ring is None:
-            ring = np.searchsorted(first[1 : 4 * nside], pix, side="right")
+            ring = _rings(nside, pix)
         t = np.arange(STEP) / STEP
         dx = np.concatenate([1 - t, np.zeros(STEP), t, np.ones(STEP)])
         dy = np.concatenate([np.ones(STEP), 1 - t, np.zeros(STEP), t])
