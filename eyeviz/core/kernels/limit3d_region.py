@@ -164,18 +164,25 @@ def bcentre(u0, e1, e2, d0, d1, beta, fa, bhat, blen):
     """limit3d_measured.MeasuredProposal._bcentres for one draw: (centre x, y, z, rho,
     d rho / d beta) at gnomonic offsets (d0, d1) of A's direction about u0 (frame e1, e2)
     and angle beta at o_B (rho = |b| sin(beta) / sin(a + beta)); rho and d rho NaN where
-    the rays do not meet in front (beta <= 0 or a + beta >= pi)."""
+    the rays do not meet in front (beta <= 0 or a + beta >= pi). Without the reference's
+    arccos and three sines: cos a = v . b_hat, sin a = sqrt((1 - cos a)(1 + cos a)) (a in
+    [0, pi]), sin(a + beta) = sin a cos beta + cos a sin beta; for beta in (0, pi), a +
+    beta lies in (0, 2 pi), so the rays meet in front iff sin(a + beta) > 0 (the draws'
+    kernel 1.1-1.2x, docs/limit3d.md "bee33e")."""
     vx = u0[0] + d0 * e1[0] + d1 * e2[0]
     vy = u0[1] + d0 * e1[1] + d1 * e2[1]
     vz = u0[2] + d0 * e1[2] + d1 * e2[2]
     nv = math.sqrt(vx * vx + vy * vy + vz * vz)
     vx, vy, vz = vx / nv, vy / nv, vz / nv
-    a = math.acos(min(max(vx * bhat[0] + vy * bhat[1] + vz * bhat[2], -1.0), 1.0))
+    ca = min(max(vx * bhat[0] + vy * bhat[1] + vz * bhat[2], -1.0), 1.0)
+    sa = math.sqrt((1.0 - ca) * (1.0 + ca))
     rho, drho = np.nan, np.nan
-    if beta > 0 and a + beta < math.pi:
-        s_ab = math.sin(a + beta)
-        rho = blen * math.sin(beta) / s_ab
-        drho = blen * math.sin(a) / (s_ab * s_ab)
+    if beta > 0 and beta < math.pi:
+        sb, cb = math.sin(beta), math.cos(beta)
+        s_ab = sa * cb + ca * sb
+        if s_ab > 0.0:
+            rho = blen * sb / s_ab
+            drho = blen * sa / (s_ab * s_ab)
     return fa[0] + vx * rho, fa[1] + vy * rho, fa[2] + vz * rho, rho, drho
 
 
