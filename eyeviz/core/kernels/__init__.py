@@ -43,8 +43,9 @@ def use(work: int = 1 << 30) -> bool:
     return not _STATE["defer"] and work >= COLD_WORK
 
 
-#: The kernel modules, each with a ``warm()``; ordered so that every other one splits the
-#: cold compile time in two about equal halves (scripts/setup.sh compiles them so)
+#: The kernel modules, each with a ``warm()`` (scripts/setup.sh compiles the healpix_*
+#: ones in one process and the others in another: about equal halves of the cold compile,
+#: each half's modules sharing their helpers)
 KERNELS = (
     "healpix_lit",
     "healpix_match",

@@ -264,8 +264,8 @@ def match_kernel(n, x, y, z, g, cx, row, kp, ki, sth, zr, unit, first_t, nr_t, s
         if kind == 1:
             out[b] = 2
             continue
-        if kind == 3:
-            out[b] = 1 if _piece(ki, k, end, 0, npix) and end - k == npix else 0
+        if kind == 3:  # s an int64 as at the other call sites (a literal 0: a second compile)
+            out[b] = 1 if _piece(ki, k, end, np.int64(0), npix) and end - k == npix else 0
             continue
         res = 1
         memo = _NO_MEMO

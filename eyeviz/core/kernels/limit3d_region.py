@@ -296,7 +296,7 @@ def prefilter_kernel(pts, lit, pad, row, c, alpha, s, ok):
         cx, cy, cz, a = c[i, 0], c[i, 1], c[i, 2], alpha[i]
         k0 = last[n]
         bad = not pad[n, k0] and _cell_fails(pts, lit, n, k0, cx, cy, cz, a, s)
-        k = 0
+        k = np.int64(0)  # as k0: one signature of _cell_fails (a literal 0 compiled another)
         while not bad and k < pts.shape[1]:
             if k != k0 and not pad[n, k] and _cell_fails(pts, lit, n, k, cx, cy, cz, a, s):
                 bad = True
