@@ -220,7 +220,7 @@ class Presenter(QtCore.QObject):
         elif t == QtCore.QEvent.Type.Hide and not ev.spontaneous():
             self._restore_app()  # closed: other windows get the app's own font and palette
         elif t == QtCore.QEvent.Type.Show and not ev.spontaneous():
-            self.apply()
+            self.apply(render=False)  # the views' first paints, which follow, render
         return False
 
     # --- text scale ----------------------------------------------------------------------
@@ -244,9 +244,10 @@ class Presenter(QtCore.QObject):
             ):
                 w.setProperty(_BASE_PT, w.font().pointSizeF() / eff)
 
-    def apply(self) -> None:
+    def apply(self, render: bool = True) -> None:
         """Give the app, the window's own-font widgets and the view's text the effective
-        scale (a widget that set its own font keeps its size relative to the rest)."""
+        scale (a widget that set its own font keeps its size relative to the rest), and
+        render the views (``render``; not when the window is being shown: its paints do)."""
         eff = self.effective_scale
         self._remember_fonts(self._applied)  # widgets made since the last apply
         app = _app()
@@ -271,10 +272,14 @@ class Presenter(QtCore.QObject):
         self.win.fit_caption()
         if self.win.isVisible():
             QtCore.QTimer.singleShot(0, self.win.fit_readout)  # its values at the new size
-            self.win.render()
+            if render:  # else the view's first paint renders (its live changes applied)
+                self.win.render()
             host = getattr(self.win, "host3d", None)
             if host is not None and host.active:
-                host.draw()
+                if render:
+                    host.draw()
+                else:  # the actors brought up to the model; its view's paint renders
+                    host.flush()
                 QtCore.QTimer.singleShot(0, host.fit_docks)  # the readout's wider text
 
     def _vtk_texts(self):

@@ -127,7 +127,7 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
 
         self.plotter = VtkView(self)
         self.plotter.set_background(BACKGROUND)
-        self.plotter.before_render = self._flush
+        self.plotter.before_render = self._before_render
         # Space plays while it has focus
         self.plotter.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         self.ren_win = self.plotter.ren_win
@@ -324,7 +324,10 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
             if self.model.inset_auto:  # h or l changed: the inset shows both eyes again
                 self.fit_inset()
         self._refresh(what, index)
-        self.render()
+        if self.plotter.isVisible():
+            self.render()
+        # else nothing is on the screen yet: the view's first paint renders (the window's
+        # start rendered a frame nobody saw; _refresh brought the actors up to date)
 
     def _refresh(self, what: str, index: int | None, live: bool = False) -> None:
         scene = self.model.scene
@@ -473,6 +476,15 @@ class MainWindow(CanvasMixin, StepsMixin, FilesMixin, SideDocksMixin, QtWidgets.
         return lambda: export(
             scene, path, scale, transparent, predictions=preds, aspect=aspect, **opts
         )
+
+    def _before_render(self) -> None:
+        """Before any render of the view (a frame, a paint, a draw): the live changes
+        applied, and a frame still pending dropped, as this render draws what it would (a
+        paint's render and then the frame's drew the same picture twice)."""
+        if self._frame_pending and not self.plotter.closed:
+            self._frame_pending = False
+            self._frame_timer.stop()
+        self._flush()
 
     def _flush(self) -> None:
         """Bring actors and panels up to the model's live changes (before a render)."""
