@@ -94,7 +94,7 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
         # (the set-up's longest part on 2 cores) starts seconds in and runs beside the
         # rest; torch pinned (its CPU build: any other request pulls a multi-GB CUDA one)
         .venv/bin/python -m pip install --no-compile "numpy>=1.26" "numba>=0.60" &&
-        { warm_kernels & } &&
+        { { warm_kernels && echo "$SECONDS" >.venv/.kernels-compiled-at; } & } &&
         .venv/bin/python -m pip install --no-compile "torch==2.13.0" -e ".[app,ml,study,dev]"
     } >"$log" 2>&1 || {
         wait
@@ -104,6 +104,7 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
     }
     touch "$stamp"
     fresh=1
+    pip_done=$SECONDS
 fi
 if [ -n "$apt_pid" ] && ! wait "$apt_pid"; then
     echo "eyeviz setup: installing the system packages failed:$missing" >&2
@@ -123,4 +124,8 @@ warm_kernels ||
 if [ -n "$imports" ] && ! wait "$imports"; then
     echo "eyeviz setup: importing the installed packages failed:" \
         ".venv/bin/python -c 'import torch, eyeviz.app.window' shows why" >&2
+fi
+if [ "$fresh" = 1 ]; then  # where a first install's time went (CI logs show it)
+    echo "eyeviz setup: ${SECONDS} s (pip's install ended at ${pip_done} s, the kernels'" \
+        "cold compile at $(cat .venv/.kernels-compiled-at 2>/dev/null || echo '?') s)" >&2
 fi

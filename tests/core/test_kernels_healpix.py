@@ -139,8 +139,9 @@ def test_deferred_kernels_wait_for_the_warm_up(monkeypatch):
 
 
 def test_the_warm_up_list_names_every_kernel_module_and_refuses_others():
-    """scripts/setup.sh warms every other module of KERNELS in each of two processes: a
-    new kernel module must join the list, and an unknown one is named."""
+    """scripts/setup.sh warms the modules of KERNELS (the healpix_* ones in one process,
+    the others in another): a new kernel module must join the list, and an unknown one
+    is named."""
     import pkgutil
 
     modules = {m.name for m in pkgutil.iter_modules(kernels.__path__)}

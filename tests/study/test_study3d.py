@@ -147,8 +147,11 @@ def test_a_3d_study_killed_mid_way_resumes_to_the_rows_of_an_uninterrupted_one(t
     kept = StudyTable3D.open(path).keys  # whole points only
     assert 1 <= len(kept) < 6, "the study finished before the kill: the test proved nothing"
     lines_before = path.read_text().splitlines()
+    # the resume on one local worker, as the reference below (the default, one per CPU,
+    # started a nanny and a worker process more, each importing dask and eyeviz)
     out = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "study", *map(str, args), "--no-progress"],
+        [sys.executable, "-m", "eyeviz", "study", *map(str, args), "--workers", "1"]
+        + ["--no-progress"],
         capture_output=True,
         text=True,
         cwd=ROOT,
