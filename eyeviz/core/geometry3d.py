@@ -43,7 +43,7 @@ from eyeviz.core.healpix_fast import (
 )
 from eyeviz.core.lit_views import LitSetViews
 
-__all__ = ["EyePair3D", "validate_balls", "MAX_NSIDE", "MAX_LIT", "FALLBACK_COUNTS"]
+__all__ = ["EyePair3D", "lit_csr_eye", "validate_balls", "MAX_NSIDE", "MAX_LIT", "FALLBACK_COUNTS"]
 
 _BLOCK = 512  # balls per block of the fast path at nside 64 (more at smaller nside)
 
@@ -119,25 +119,39 @@ def _merge_ref(n: int, x, y, z, g, cx: float, status, per, st, ln, bl):
 def _lit_csr_jit(n: int, x, y, z, g, h: float) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
     """:meth:`EyePair3D.lit_csr` through the kernel: per eye the runs, then the indices
     written from them in compiled code (no temporaries per ball, no Python per block)."""
+    out = _lit_csr_eye_jit(n, x, y, z, g, -h), _lit_csr_eye_jit(n, x, y, z, g, h)
+    kernels.mark_ready()
+    return out
+
+
+def _lit_csr_eye_jit(n: int, x, y, z, g, cx: float) -> tuple[np.ndarray, np.ndarray]:
+    """One eye's (at x = ``cx``) part of :func:`_lit_csr_jit` (flat float64 arrays)."""
     from eyeviz.core.kernels.healpix_lit import csr_kernel, empty_indices, lit_runs_kernel
 
     sth, zr, unit = _ring_tables(n)
     first, nr, shifted, delta, o = _ring_info_tables(n)
-    out = []
-    for cx in (-h, h):
-        # two compiled calls per eye: lit_runs_kernel called from another kernel ran
-        # 1.6x slower (measured), so the CSR is written by a kernel of its own
-        status, per, st, ln, bl = lit_runs_kernel(
-            n, x, y, z, g, cx, sth, zr, unit, first, nr, shifted, delta, o
-        )
-        if status.any():
-            indptr, idx = _runs_to_csr(*_merge_ref(n, x, y, z, g, cx, status, per, st, ln, bl))
-        else:
-            idx = empty_indices(int(per.sum()))
-            indptr = csr_kernel(per, st, ln, idx)
-        out.append((indptr, idx))
-    kernels.mark_ready()
-    return out[0], out[1]
+    # two compiled calls: lit_runs_kernel called from another kernel ran 1.6x slower
+    # (measured), so the CSR is written by a kernel of its own
+    status, per, st, ln, bl = lit_runs_kernel(
+        n, x, y, z, g, cx, sth, zr, unit, first, nr, shifted, delta, o
+    )
+    if status.any():
+        return _runs_to_csr(*_merge_ref(n, x, y, z, g, cx, status, per, st, ln, bl))
+    idx = empty_indices(int(per.sum()))
+    return csr_kernel(per, st, ln, idx), idx
+
+
+def lit_csr_eye(pair: EyePair3D, eye: int, x, y, z, g) -> tuple[np.ndarray, np.ndarray]:
+    """``pair.lit_csr(x, y, z, g)[eye]`` (finite flat float64 arrays, g > 0) without the
+    other eye's lit sets: the same (indptr, indices) at half the cost (the spherical
+    limit's inner and outer caps, limit3d_eye._Eye, need one eye each). Through the
+    kernel where :func:`kernels.use`, else ``pair.lit_csr`` itself (the reference)."""
+    if kernels.use(x.shape[0]):
+        out = _lit_csr_eye_jit(pair.nside, *(np.ascontiguousarray(v, np.float64)
+                                              for v in (x, y, z, g)), (-pair.h, pair.h)[eye])  # fmt: skip
+        kernels.mark_ready()
+        return out
+    return pair.lit_csr(x, y, z, g)[eye]
 
 
 def _one_ball(x, y, z, g) -> tuple[float, float, float, float] | None:

@@ -14,6 +14,7 @@ import numpy as np
 
 from eyeviz.core import healpix, kernels
 from eyeviz.core.domain import Domain3D
+from eyeviz.core.geometry3d import lit_csr_eye
 from eyeviz.estimators.analytic3d import cap_estimates
 from eyeviz.estimators.base import LitCSR
 
@@ -30,7 +31,11 @@ def _frame(c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     e1 = np.stack([-c[:, 1], c[:, 0], np.zeros(len(c))], axis=1)
     n1 = np.linalg.norm(e1, axis=1, keepdims=True)
     e1 = np.where(n1 > 1e-12, e1 / np.maximum(n1, 1e-300), [1.0, 0.0, 0.0])
-    e2 = np.cross(c, e1)
+    # np.cross(c, e1) written out (the same products and differences, so the same bits):
+    # np.cross costs more than the rest of the frame
+    c0, c1, c2 = c[:, 0], c[:, 1], c[:, 2]
+    f0, f1, f2 = e1[:, 0], e1[:, 1], e1[:, 2]
+    e2 = np.stack([c1 * f2 - c2 * f1, c2 * f0 - c0 * f2, c0 * f1 - c1 * f0], axis=1)
     return e1, e2
 
 
@@ -88,8 +93,8 @@ class _Eye:
         a_out = np.minimum(alpha + EDGE * fw, math.pi / 2 - 1e-6)
         gs = dist * np.sin(np.concatenate([a_in, a_out]))
         pos = np.asarray(centre) + dist * np.concatenate([u, u])
-        res = domain.eyes.lit_csr(pos[:, 0], pos[:, 1], pos[:, 2], gs)[eye]
-        ptr, ind = res
+        # this eye's lit sets only (the other eye's would be thrown away)
+        ptr, ind = lit_csr_eye(domain.eyes, eye, pos[:, 0], pos[:, 1], pos[:, 2], gs)
         inner = (ptr[: n + 1], ind[: ptr[n]])
         outer = (ptr[n:] - ptr[n], ind[ptr[n] :])
         # a key too small for an inner cap of half a facet: every lit cell is an edge cell
@@ -315,6 +320,49 @@ class _Eye:
         # the same forms of the lit cells alone and of the unlit ones alone, in slot order
         # (the kernels' loops skip the others' -inf / +inf slots: _affine_lists)
         self.lists = (*_packed(lit, self.a_lit, self.t_lit), *_packed(unl, self.a_unl, self.t_unl))
+
+    def box_lists(self, ext: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The model's packed forms (``lists``) less those that never give its value on
+        each key's box |delta_k| <= ext[:, k] (N, 2): a form another one exceeds (lit;
+        unlit: undercuts) everywhere there by more than both values' rounding. Wherever
+        the draws evaluate the model (inside the boxes: A's draws are tested against A's
+        box first, B's search and draw lie on the ray's interval inside B's box, up to
+        rounding, which the box's widening covers) its values are the same bits with
+        these lists, with about a quarter of the forms at nside 180. Compiled unless
+        ``EYEVIZ_JIT=0`` (kernels.limit3d_affine.box_lists_kernel, its proof there;
+        :meth:`_box_lists_ref` the reference)."""
+        if kernels.use(ext.shape[0]):
+            from eyeviz.core.kernels.limit3d_affine import box_lists_kernel
+
+            out = tuple(np.zeros_like(x) for x in self.lists)
+            box_lists_kernel(self.lists, kernels.arg(ext, np.float64), out)
+            return out
+        return self._box_lists_ref(ext)
+
+    def _box_lists_ref(self, ext: np.ndarray) -> tuple[np.ndarray, ...]:
+        """:meth:`box_lists` in numpy (the reference; the slots beyond a row's count are
+        0)."""
+        from eyeviz.core.kernels.limit3d_affine import BOX_ABS, BOX_REL, BOX_TOL
+
+        e = (ext * (1.0 + BOX_REL) + BOX_ABS)[:, None, None, :]  # (N, 1, 1, 2)
+        out: list[np.ndarray] = []
+        for a, t, cnt, sgn in ((*self.lists[:3], 1.0), (*self.lists[3:], -1.0)):
+            k = a.shape[1]
+            live = np.arange(k)[None, :] < cnt[:, None]  # (N, K)
+            with np.errstate(invalid="ignore", over="ignore"):
+                spread = (np.abs(t[:, None, :, :] - t[:, :, None, :]) * e).sum(-1)  # [n, i, j]
+                mag = np.abs(a) + (np.abs(t) * e[:, 0]).sum(-1)  # (N, K)
+                gap = sgn * (a[:, None, :] - a[:, :, None]) - spread
+                tol = BOX_TOL * (1.0 + mag[:, :, None] + mag[:, None, :])
+                dom = (gap > tol) & live[:, None, :] & ~np.eye(k, dtype=bool)[None]
+            keep = live & ~dom.any(axis=2)
+            n_keep = keep.sum(axis=1)
+            order = np.argsort(~keep, axis=1, kind="stable")
+            slot = np.arange(k)[None, :] < n_keep[:, None]
+            oa = np.where(slot, np.take_along_axis(a, order, 1), 0.0)
+            ot = np.where(slot[..., None], np.take_along_axis(t, order[..., None], 1), 0.0)
+            out += [oa, ot, n_keep.astype(np.int64)]
+        return tuple(out)
 
     def model(self, delta: np.ndarray) -> np.ndarray:
         """Each edge cell's modelled distance (N, K, G) at gnomonic offsets delta (N, G, 2).

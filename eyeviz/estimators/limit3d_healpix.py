@@ -86,9 +86,12 @@ class HealpixProposal:
         th_hi = np.fmin(box[:, 1], box_b[:, 1])
         # the exact check's band cells about the located centres (compiled only)
         bands = (ea.band(), eb.band()) if kernels.use(n * self.samples) else None
+        # the draws' kernel evaluates each eye's model in its box only: the forms that
+        # never give its value there dropped (the same values, bit for bit)
+        boxl = (ea.box_lists(ext), eb.box_lists(ext_b)) if bands is not None else None
         return dict(A=A, B=B, ea=ea, eb=eb, n=n, slack=slack, ext=ext, ext_b=ext_b,
                     box=box, th_lo=th_lo, th_hi=th_hi, lit_a=lit_a, lit_b=lit_b,
-                    bands=bands)  # fmt: skip
+                    bands=bands, box_lists=boxl)  # fmt: skip
 
     def sample(self, st: dict, keys: np.ndarray, stream, rows=None) -> dict[str, np.ndarray]:
         """``samples`` weighted draws per key of a chunk set up by :meth:`setup`, per
@@ -125,8 +128,9 @@ class HealpixProposal:
         ca, alpha = np.zeros((n, m, 3)), np.zeros((n, m))
         u_max = 1.0 / (d.r_min - d.h) if d.r_min > d.h else np.inf
         f64 = np.float64
-        fa = (ea.a_lit, ea.t_lit, ea.a_unl, ea.t_unl, ea.lists)
-        fb = (eb.a_lit, eb.t_lit, eb.a_unl, eb.t_unl, eb.lists)
+        la, lb = st.get("box_lists") or (ea.lists, eb.lists)  # (Eye.box_lists)
+        fa = (ea.a_lit, ea.t_lit, ea.a_unl, ea.t_unl, la)
+        fb = (eb.a_lit, eb.t_lit, eb.a_unl, eb.t_unl, lb)
         arg = kernels.arg
         healpix_draws_kernel(u, arg(rows, np.bool_), arg(st["th_lo"], f64), arg(st["th_hi"], f64),
                              arg(st["box"], f64), arg(st["ext"], f64), arg(st["ext_b"], f64),

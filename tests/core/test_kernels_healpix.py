@@ -154,7 +154,7 @@ def test_lit_csr_through_the_kernel_equals_the_reference(monkeypatch):
     """EyePair3D.lit_csr and lit, kernel (both eyes and the indices in compiled code)
     against EYEVIZ_JIT=0, on a batch mixing ordinary, tiny, grazing and whole-eye balls
     (the last three handed back to the reference and merged), and one-ball calls of
-    Python and numpy scalars."""
+    Python and numpy scalars; and one eye's alone (lit_csr_eye, kernel) the same."""
     rng = np.random.default_rng(4)
     p = rng.uniform(-500, 500, (40, 3))
     g = rng.uniform(1, 300, 40)
@@ -164,10 +164,11 @@ def test_lit_csr_through_the_kernel_equals_the_reference(monkeypatch):
     eyes = g3.EyePair3D(40.0, 20.0, 18)
     monkeypatch.setitem(kernels._STATE, "ready", True)
     got = eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
+    got += tuple(g3.lit_csr_eye(eyes, e, p[:, 0], p[:, 1], p[:, 2], g) for e in (0, 1))
     ones = [eyes.lit(float(p[i, 0]), p[i, 1], p[i, 2], g[i]) for i in range(40)]
     monkeypatch.setenv("EYEVIZ_JIT", "0")
     want = eyes.lit_csr(p[:, 0], p[:, 1], p[:, 2], g)
-    for (a, b), (c, d) in zip(got, want, strict=True):
+    for (a, b), (c, d) in zip(got, want + want, strict=True):
         np.testing.assert_array_equal(a, c)
         np.testing.assert_array_equal(b, d)
     for i, one in enumerate(ones):

@@ -417,3 +417,67 @@ def test_band_cells_kernel_is_the_set_differences(monkeypatch):
             want = _band_cells(key, inner, outer, small, npix)
         for a, b in zip(got, want, strict=True):
             assert np.array_equal(a, b)
+
+
+def _forms(rng, n: int, k: int) -> tuple[np.ndarray, ...]:
+    """Packed lit and unlit forms (_Eye._affine's ``lists``) of n keys, k slots each, with
+    the adversarial cases: exact duplicates (ties), near-ties at the domination margin,
+    one form, none, and equal gradients."""
+    out: list[np.ndarray] = []
+    for _ in range(2):
+        a = rng.uniform(0.1, 0.3, (n, k))
+        t = rng.normal(size=(n, k, 2))
+        t /= np.linalg.norm(t, axis=2, keepdims=True)
+        cnt = np.full(n, k, np.int64)
+        a[0, 1], t[0, 1] = a[0, 0], t[0, 0]  # a tie: neither dominates the other
+        t[1, :] = t[1, 0]  # equal gradients: the largest (smallest) offset alone decides
+        a[1, 1] = a[1, 0]
+        cnt[2], cnt[3] = 1, 0
+        out += [a, t, cnt]
+    return tuple(out)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_box_lists_kernel_is_the_reference_and_keeps_the_models_values(seed, monkeypatch):
+    """_Eye.box_lists, kernel against numpy bit for bit, on random forms with ties and on
+    real keys' boxes (nside 16 and 180); and the model (_affine_lists) from the kept
+    forms is the whole model's bit for bit at the boxes' corners, edges and inside, and
+    just outside by rounding, while dropping forms (a quarter or more kept)."""
+    from eyeviz.core import kernels
+    from eyeviz.core.kernels.limit3d_affine import _affine_lists, affine_bounds_kernel
+    from eyeviz.estimators import limit3d_healpix as lh
+
+    monkeypatch.setitem(kernels._STATE, "ready", True)
+    rng = np.random.default_rng(seed)
+    cases = []
+    e = _eyes(16, seed)[0]
+    e.lists = _forms(rng, 6, 9)
+    cases.append((e, rng.uniform(0.0, 0.05, (6, 2)) * (np.arange(6) != 4)[:, None]))
+    for nside in (16, 180):
+        d = Domain3D(nside=nside)
+        ds = generate3d(6, d, seed=seed + 5)
+        la, lb = (take_rows(p, i, np.arange(6)) for p, i in ((ds.indptr_a, ds.indices_a),
+                                                             (ds.indptr_b, ds.indices_b)))  # fmt: skip
+        st_ = lh.HealpixProposal(d, "single", 64, 8).setup(la, lb, np.arange(6, dtype=np.uint64), 1.0)
+        cases += [(st_["ea"], st_["ext"]), (st_["eb"], st_["ext_b"])]
+    kept = total = 0
+    for e, ext in cases:
+        got = e.box_lists(ext)
+        want = e._box_lists_ref(ext)
+        for g_, w_ in zip(got, want, strict=True):
+            assert np.array_equal(g_, w_)
+        kept += int(got[2].sum() + got[5].sum())
+        total += int(e.lists[2].sum() + e.lists[5].sum())
+        n = ext.shape[0]
+        s = np.array([-1.0, -0.5, 0.0, 0.3, 1.0, 1.0 + 2.0**-50])
+        sx, sy = np.meshgrid(s, s[::-1], indexing="ij")
+        pts = np.stack([sx.ravel(), sy.ravel()], -1)
+        pts = np.concatenate([pts, rng.uniform(-1, 1, (40, 2))])[None] * ext[:, None, :]
+        lo, hi = np.empty(pts.shape[:2]), np.empty(pts.shape[:2])
+        lo2, hi2 = lo.copy(), hi.copy()
+        f = (e.a_lit, e.t_lit, e.a_unl, e.t_unl)
+        affine_bounds_kernel(*f, e.lists, pts, lo, hi)
+        affine_bounds_kernel(*f, got, pts, lo2, hi2)
+        assert np.array_equal(lo, lo2) and np.array_equal(hi, hi2)
+        assert _affine_lists(*f, got, 0, 0.0, 0.0) == _affine_lists(*f, e.lists, 0, 0.0, 0.0)
+    assert kept < 0.5 * total

@@ -98,4 +98,8 @@ def mark_ready() -> None:
 def arg(a, dtype=None) -> np.ndarray:
     """``a`` as a kernel takes it: C-contiguous and writable (numba types a read-only
     array, e.g. a broadcast view, apart: it would compile a new signature at run time)."""
+    if type(a) is np.ndarray and (dtype is None or a.dtype == dtype):  # as it is: no copy
+        f = a.flags
+        if f.c_contiguous and f.writeable:
+            return a
     return np.require(a, dtype, ("C", "W"))

@@ -35,6 +35,7 @@ __all__ = [
     "affine_kernel",
     "boundaries_kernel",
     "compact_kernel",
+    "box_lists_kernel",
     "warm",
 ]
 
@@ -283,6 +284,60 @@ def compact_kernel(keep, pts, lit, d, t, o_pts, o_lit, o_pad, o_d, o_t):
                 j += 1
 
 
+#: the box of box_lists_kernel widened by this relative and absolute amount (rad) beyond the
+#: rounding of the points evaluated in it, and its domination margin over the forms' size
+BOX_REL, BOX_ABS, BOX_TOL = 1e-9, 1e-12, 1e-12
+
+
+@_jit
+def _undominated(a, t, cnt, n, e0, e1, sgn, oa, ot):
+    """The forms 0 .. cnt - 1 of row n (a (N, K), t (N, K, 2)) that no other form
+    dominates on the box |dx| <= e0, |dy| <= e1 (sgn 1: for the maximum, the others
+    below another by more than the margin; -1: for the minimum, above), copied in order
+    to oa, ot; returns their number (box_lists_kernel)."""
+    m = 0
+    for i in range(cnt):
+        ai, ti0, ti1 = a[n, i], t[n, i, 0], t[n, i, 1]
+        mi = abs(ai) + abs(ti0) * e0 + abs(ti1) * e1
+        dom = False
+        for j in range(cnt):
+            if j == i:
+                continue
+            aj, tj0, tj1 = a[n, j], t[n, j, 0], t[n, j, 1]
+            spread = abs(tj0 - ti0) * e0 + abs(tj1 - ti1) * e1
+            mj = abs(aj) + abs(tj0) * e0 + abs(tj1) * e1
+            if sgn * (aj - ai) - spread > BOX_TOL * (1.0 + mi + mj):
+                dom = True
+                break
+        if not dom:
+            oa[n, m] = ai
+            ot[n, m, 0] = ti0
+            ot[n, m, 1] = ti1
+            m += 1
+    return m
+
+
+@_jit
+def box_lists_kernel(lists, ext, out):
+    """limit3d_eye._Eye.box_lists: of the model's packed forms ``lists`` (l_a, l_t, nl,
+    u_a, u_t, nu: _Eye._affine), per key n those not dominated on its box |delta_k| <=
+    ext[n, k] (widened by BOX_REL, BOX_ABS), in slot order, into ``out`` (the same six
+    arrays' shapes; slots beyond a row's count left as they were). A lit form i is
+    dominated when another j has a_j - a_i - sum_k |t_jk - t_ik| e_k > BOX_TOL (1 + m_i +
+    m_j) (m: |a| + sum_k |t_k| e_k), an unlit one when a_i - a_j - ... does: then form j
+    is above (below) form i by more than that margin everywhere on the box, and far more
+    than both values' rounding (below 4 2^-53 m each), so the computed maximum (minimum) of
+    the forms at any point of the box is never form i's alone: the kept forms give
+    _affine_lists' values there bit for bit (the proof: docs/kernels.md)."""
+    l_a, l_t, nl, u_a, u_t, nu = lists
+    o_la, o_lt, o_nl, o_ua, o_ut, o_nu = out
+    for n in range(nl.size):
+        e0 = ext[n, 0] * (1.0 + BOX_REL) + BOX_ABS
+        e1 = ext[n, 1] * (1.0 + BOX_REL) + BOX_ABS
+        o_nl[n] = _undominated(l_a, l_t, nl[n], n, e0, e1, 1.0, o_la, o_lt)
+        o_nu[n] = _undominated(u_a, u_t, nu[n], n, e0, e1, -1.0, o_ua, o_ut)
+
+
 def warm() -> None:
     """Compile (or load from the cache) the kernels for their one signature each."""
     pts = np.ones((1, 1, 2, 3))
@@ -303,4 +358,5 @@ def warm() -> None:
     out = np.zeros((1, 1))
     lists = (a2, a3, n1 + 1, a2, a3, n1 + 1)
     affine_bounds_kernel(a2, a3, a2, a3, lists, dl, out, out.copy())
+    box_lists_kernel(lists, np.ones((1, 2)), tuple(x.copy() for x in lists))
     extent_kernel(a2, a3, a2, a3, lists, np.ones((1, 2)), 1.0, np.ones(1), 2, out.copy())
