@@ -147,8 +147,8 @@ def lit_csr_eye(pair: EyePair3D, eye: int, x, y, z, g) -> tuple[np.ndarray, np.n
     limit's inner and outer caps, limit3d_eye._Eye, need one eye each). Through the
     kernel where :func:`kernels.use`, else ``pair.lit_csr`` itself (the reference)."""
     if kernels.use(x.shape[0]):
-        out = _lit_csr_eye_jit(pair.nside, *(np.ascontiguousarray(v, np.float64)
-                                              for v in (x, y, z, g)), (-pair.h, pair.h)[eye])  # fmt: skip
+        xf, yf, zf, gf = (np.ascontiguousarray(v, np.float64) for v in (x, y, z, g))
+        out = _lit_csr_eye_jit(pair.nside, xf, yf, zf, gf, (-pair.h, pair.h)[eye])
         kernels.mark_ready()
         return out
     return pair.lit_csr(x, y, z, g)[eye]

@@ -456,9 +456,10 @@ def test_box_lists_kernel_is_the_reference_and_keeps_the_models_values(seed, mon
     for nside in (16, 180):
         d = Domain3D(nside=nside)
         ds = generate3d(6, d, seed=seed + 5)
-        la, lb = (take_rows(p, i, np.arange(6)) for p, i in ((ds.indptr_a, ds.indices_a),
-                                                             (ds.indptr_b, ds.indices_b)))  # fmt: skip
-        st_ = lh.HealpixProposal(d, "single", 64, 8).setup(la, lb, np.arange(6, dtype=np.uint64), 1.0)
+        la = take_rows(ds.indptr_a, ds.indices_a, np.arange(6))
+        lb = take_rows(ds.indptr_b, ds.indices_b, np.arange(6))
+        keys = np.arange(6, dtype=np.uint64)
+        st_ = lh.HealpixProposal(d, "single", 64, 8).setup(la, lb, keys, 1.0)
         cases += [(st_["ea"], st_["ext"]), (st_["eb"], st_["ext_b"])]
     kept = total = 0
     for e, ext in cases:
@@ -468,7 +469,6 @@ def test_box_lists_kernel_is_the_reference_and_keeps_the_models_values(seed, mon
             assert np.array_equal(g_, w_)
         kept += int(got[2].sum() + got[5].sum())
         total += int(e.lists[2].sum() + e.lists[5].sum())
-        n = ext.shape[0]
         s = np.array([-1.0, -0.5, 0.0, 0.3, 1.0, 1.0 + 2.0**-50])
         sx, sy = np.meshgrid(s, s[::-1], indexing="ij")
         pts = np.stack([sx.ravel(), sy.ravel()], -1)
