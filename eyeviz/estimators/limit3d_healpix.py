@@ -103,27 +103,24 @@ class HealpixProposal:
         if rows is None:
             rows = np.ones(keys.size, bool)
         if kernels.use(keys.size * self.samples):
-            from eyeviz.core.kernels.limit3d_region import uniforms_kernel
-
-            # the uniforms of _batch_uniforms, bit for bit (as limit3d_measured's)
-            s = np.atleast_1d(np.asarray(stream, np.int64))
-            u = np.empty((keys.size, self.samples * s.size, 4))
-            uniforms_kernel(kernels.arg(keys, np.uint64), self.samples, kernels.arg(s), u)
-            out, ca, alpha = self._draws_kernel(st, u, rows)
+            out, ca, alpha = self._draws_kernel(st, keys, stream, rows)
         else:
             u = _batch_uniforms(keys, self.samples, 4, stream)
             out, ca, alpha = self._draws_ref(st, u, rows)
         out["w"] = self._check(st, out, ca, alpha)
         return out
 
-    def _draws_kernel(self, st: dict, u: np.ndarray, rows: np.ndarray):
+    def _draws_kernel(self, st: dict, keys: np.ndarray, stream, rows: np.ndarray):
         """:meth:`_draws_ref` compiled (kernels.limit3d_draws.healpix_draws_kernel): the
-        same formulas draw by draw, each draw given up at its first failed test; values
-        written only where the weight is above 0 (zeros elsewhere)."""
+        same formulas draw by draw, each draw given up at its first failed test, on the
+        uniforms of :func:`_batch_uniforms` (keys, ``samples``, 4, stream) drawn inside
+        as they are read (the same bits); values written only where the weight is above 0
+        (zeros elsewhere)."""
         from eyeviz.core.kernels.limit3d_draws import healpix_draws_kernel
 
         d, ea, eb = self.domain, st["ea"], st["eb"]
-        n, m = u.shape[:2]
+        s = kernels.arg(np.atleast_1d(np.asarray(stream, np.int64)))
+        n, m = keys.size, self.samples * s.size
         out = {k: np.zeros((n, m)) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
         ca, alpha = np.zeros((n, m, 3)), np.zeros((n, m))
         u_max = 1.0 / (d.r_min - d.h) if d.r_min > d.h else np.inf
@@ -132,7 +129,8 @@ class HealpixProposal:
         fa = (ea.a_lit, ea.t_lit, ea.a_unl, ea.t_unl, la)
         fb = (eb.a_lit, eb.t_lit, eb.a_unl, eb.t_unl, lb)
         arg = kernels.arg
-        healpix_draws_kernel(u, arg(rows, np.bool_), arg(st["th_lo"], f64), arg(st["th_hi"], f64),
+        healpix_draws_kernel(arg(keys, np.uint64), s, arg(rows, np.bool_), arg(st["th_lo"], f64),
+                             arg(st["th_hi"], f64),
                              arg(st["box"], f64), arg(st["ext"], f64), arg(st["ext_b"], f64),
                              arg(st["slack"][:, 0], f64), fa, arg(ea.c, f64), arg(ea.e1, f64),
                              arg(ea.e2, f64), fb, arg(eb.c, f64), arg(eb.e1, f64), arg(eb.e2, f64),

@@ -150,7 +150,7 @@ def _extent(eye: _Eye, reach: float, slack, iters: int = 12) -> np.ndarray:
     G(delta) >= -slack (bisection along NDIR directions: G is concave). The bisection is
     compiled unless ``EYEVIZ_JIT=0`` (kernels.limit3d_affine.extent_kernel, the same bits)."""
     n = eye.c.shape[0]
-    dirs = _dirs(NDIR)
+    dirs = _DIRS_NDIR
     lo = np.zeros((n, NDIR))
     hi = np.full((n, NDIR), reach)
     if kernels.use(n * NDIR * iters):
@@ -177,6 +177,8 @@ def _dirs(k: int) -> np.ndarray:
     t = np.arange(k) * 2 * math.pi / k
     return np.stack([np.cos(t), np.sin(t)], axis=1)
 
+
+_DIRS_NDIR = _dirs(NDIR)  # the bisection's directions, made once
 
 _BOX = np.array(
     [(x, y) for x in (-1.0, -0.5, 0.0, 0.5, 1.0) for y in (-1.0, 1.0)]

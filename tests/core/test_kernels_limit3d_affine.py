@@ -172,7 +172,7 @@ def test_healpix_draws_kernel_agrees_with_the_reference(nside, prior, monkeypatc
     u = lh._batch_uniforms(keys, 384, 4, [0, 8])
     on = np.ones(6, bool)
     on[2] = False
-    got, ca, alpha = prop._draws_kernel(st_, u, on)
+    got, ca, alpha = prop._draws_kernel(st_, keys, [0, 8], on)  # its own uniforms: u's
     monkeypatch.setenv("EYEVIZ_JIT", "0")
     want, ca_r, alpha_r = prop._draws_ref(st_, u, on)
     kw = got["w"] > 0

@@ -17,12 +17,13 @@ import math
 import numpy as np
 from numba import njit
 
-from eyeviz.core.kernels import limit3d_affine
+from eyeviz.core.kernels import limit3d_affine, limit3d_region
 from eyeviz.core.kernels.healpix_boundary import stamp_with
 from eyeviz.core.kernels.limit3d_affine import _affine_lists, _max, _min
+from eyeviz.core.kernels.limit3d_region import _M1, _mix64
 
-# before the first kernel: its cache carries the source of the module it inlines as well
-stamp_with(__file__, limit3d_affine.__file__)
+# before the first kernel: its cache carries the source of the modules it calls as well
+stamp_with(__file__, limit3d_affine.__file__, limit3d_region.__file__)
 
 __all__ = ["ray_region_kernel", "healpix_draws_kernel", "healpix_prior", "warm"]
 
@@ -237,45 +238,57 @@ def _ray_box(c, e1, e2, a, ext0, ext1, cax, cay, caz):
     return lo, hi
 
 
+@_jit
+def _uniform(base, s, j):
+    """limit3d_proposal._uniforms' uniform of counter j in stream s, for a key whose
+    hash times _M1 is ``base`` (as limit3d_region.uniforms_kernel: the same bits)."""
+    z = _mix64(base + (np.uint64(j) + (np.uint64(s) << np.uint64(32))))
+    return (np.float64(z >> np.uint64(11)) + 0.5) * 2.0**-53
+
+
 # long: one draw of limit3d_healpix.HealpixProposal.sample up to the exact check (A's
 # direction, A's model, B's box and region along the ray, g, prior, weight) is one loop
 # body; split, it would pass a dozen scalars back and forth
 @_jit_np
-def healpix_draws_kernel(u, rows, th_lo, th_hi, box, ext, ext_b, slack, fa, ca_, e1a, e2a,
-                         fb, cb, e1b, e2b, ab, pa, pb, u_min, u_max, s_half, g_max, r_min,
+def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, slack, fa, ca_,
+                         e1a, e2a, fb, cb, e1b, e2b, ab, pa, pb, u_min, u_max, s_half, g_max, r_min,
                          r_max, el_max, psi, multi, t, rounds, n_def, samples,
                          x, y, z, g, r, az, el, w, ca, alpha):  # fmt: skip
     """HealpixProposal.sample's draws before the exact check, one at a time, each given up
-    at its first test that fails: (theta, phi) of A's direction from the uniforms u
-    (N, M, 4), inside A's box of centres and A's modelled region, u = 1 / rho in B's box
-    along the ray (:func:`_ray_box`), then narrowed to where the g test can pass
-    (:func:`_ray_search` of :func:`_gap_g`), g where both eyes' modelled radii and the
-    prior allow it, the prior and the weight. Of each batch of ``samples`` draws the first
-    ``n_def`` take u uniform on B's box along the ray (the defensive share: the narrowed
-    interval is a search's bracket, not a proven hull), the others on the narrowed
-    interval; every weight divides by the two's mixture density at its u. fa, fb:
-    each eye's affine forms (a_lit, t_lit, a_unl, t_unl, lists); ab = A - B; pa, pb the
-    eyes' centres. Writes x, y, z, g, r, az, el, w, ca (N, M, 3) and alpha (N, M) where
-    the weight is above 0 (w 0 elsewhere, the others then unset); only the keys ``rows``
-    (N,) get draws."""
+    at its first test that fails: (theta, phi) of A's direction from the uniforms
+    (limit3d_proposal._batch_uniforms of the key hashes ``keys`` (N,) and ``streams``,
+    ``samples`` draws of 4 each, the same bits; each drawn when first read: a draw given up
+    early never draws its last two), inside A's box of centres and A's modelled region, u =
+    1 / rho in B's box along the ray (:func:`_ray_box`), then narrowed to where the g test
+    can pass (:func:`_ray_search` of :func:`_gap_g`), g where both eyes' modelled radii and
+    the prior allow it, the prior and the weight. Of each batch of ``samples`` draws the
+    first ``n_def`` take u uniform on B's box along the ray (the defensive share: the
+    narrowed interval is a search's bracket, not a proven hull), the others on the narrowed
+    interval; every weight divides by the two's mixture density at its u. fa, fb: each eye's
+    affine forms (a_lit, t_lit, a_unl, t_unl, lists); ab = A - B; pa, pb the eyes' centres.
+    Writes x, y, z, g, r, az, el, w, ca (N, M, 3) and alpha (N, M) where the weight is above
+    0 (w 0 elsewhere, the others then unset); only the keys ``rows`` (N,) get draws."""
     al, tl, au, tu, la = fa
     bl, sl_, bu, su, lb = fb
     gv = np.empty(t.size)
     uu = np.empty(t.size)
     h2 = 0.5 * math.pi
     lam = n_def / samples
-    for n in range(u.shape[0]):
+    for n in range(keys.size):
+        base = keys[n] * _M1
         sn = slack[n]
         dth = th_hi[n] - th_lo[n]
         dph = box[n, 3] - box[n, 2]
         live = rows[n] and dth > 0 and dph > 0
         vol0 = dth * dph
-        for m in range(u.shape[1]):
+        for m in range(samples * streams.size):
             w[n, m] = 0.0
             if not live:
                 continue
-            th = th_lo[n] + dth * u[n, m, 0]
-            ph = box[n, 2] + dph * u[n, m, 1]
+            s_m = streams[m // samples]
+            j4 = 4 * (m % samples)
+            th = th_lo[n] + dth * _uniform(base, s_m, j4)
+            ph = box[n, 2] + dph * _uniform(base, s_m, j4 + 1)
             sp = math.sin(ph)
             cx, cy, cz = math.cos(ph), sp * math.cos(th), sp * math.sin(th)
             cc = cx * ca_[n, 0] + cy * ca_[n, 1] + cz * ca_[n, 2]
@@ -297,10 +310,11 @@ def healpix_draws_kernel(u, rows, th_lo, th_hi, box, ext, ext_b, slack, fa, ca_,
                                    sn, t, rounds, gv, uu, sa_lo, sa_hi)  # fmt: skip
             if not hhi > hlo:  # a bracket of no width: the box's interval instead
                 hlo, hhi = ulo, uhi
+            u2 = _uniform(base, s_m, j4 + 2)
             if m % samples < n_def:
-                uv = ulo + (uhi - ulo) * u[n, m, 2]
+                uv = ulo + (uhi - ulo) * u2
             else:
-                uv = hlo + (hhi - hlo) * u[n, m, 2]
+                uv = hlo + (hhi - hlo) * u2
             q = lam / (uhi - ulo)
             if uv >= hlo and uv <= hhi:
                 q += (1.0 - lam) / (hhi - hlo)
@@ -322,7 +336,7 @@ def healpix_draws_kernel(u, rows, th_lo, th_hi, box, ext, ext_b, slack, fa, ca_,
             g_hi = _min(g_hi, rho_b * math.sin(_clip_nan(hi_b + sn, 0.0, h2)))
             if not g_hi > g_lo:
                 continue
-            gg = g_lo + (g_hi - g_lo) * u[n, m, 3]
+            gg = g_lo + (g_hi - g_lo) * _uniform(base, s_m, j4 + 3)
             e = math.asin(_clip_nan(pz / rr, -1.0, 1.0))
             phi = math.atan2(py, px)
             dens = healpix_prior(rr, gg, e, phi, s_half, g_max, r_min, r_max, el_max, psi, multi)
@@ -353,7 +367,8 @@ def warm() -> None:
     f = (a2, a3, a2, a3, lists)
     o = [np.zeros((1, 1)) for _ in range(8)]  # x, y, z, g, r, az, el, w
     one, b4 = np.ones(1), np.ones((1, 4))
-    healpix_draws_kernel(np.full((1, 1, 4), 0.5), np.ones(1, np.bool_), one * 0, one, b4,
+    healpix_draws_kernel(np.ones(1, np.uint64), np.zeros(1, np.int64), np.ones(1, np.bool_),
+                         one * 0, one, b4,
                          c[:, :2].copy(), c[:, :2].copy(), one, f, c, c, c, f, c, c, c, v3, v3,
                          v3, 0.01, np.inf, 0.1, 1.0, 1.0, 10.0, 1.0, 0.1, False, tt, 1, 0, 1,
                          o[0], o[1], o[2], o[3], o[4], o[5], o[6], o[7], ca.copy(),
