@@ -5,11 +5,12 @@ ball, the map's outline, and the side the equator's label goes."""
 from __future__ import annotations
 
 import math
+import weakref
 from typing import Any
 
 import numpy as np
 
-from eyeviz.model.facet_patches import FacetPatches
+from eyeviz.model.facet_patches import FacetPatches, HealpixPatches
 from eyeviz.render.mpl.facet_map import compound_path, map_width, mollweide, view_lonlat, view_polys
 from eyeviz.render.mpl.style import EDGE
 
@@ -77,10 +78,33 @@ def by_ball(verts: np.ndarray, owner: np.ndarray, rgba: np.ndarray, counts: np.n
     return paths, rgba[[int(owner[g[0]]) for g in groups]]
 
 
+#: label_side's answers, by the patches' cells: every facet's centre is computed (388,800
+#: of them at nside 180), and the maps asked it at each layout (each text scale, resize
+#: and lecture step) of every window
+_SIDES: weakref.WeakKeyDictionary[Any, int] = weakref.WeakKeyDictionary()
+_HEALPIX_SIDES: dict[int, int] = {}
+
+
 def label_side(patches: FacetPatches) -> int:
     """-1 (left) or 1 (right): where the equator's label goes. The right only where the
     outer 65 % of the left half map holds more than twice as many facets near the
-    equator as the right's (a measured left eye's); a HEALPix eye keeps it on the left."""
+    equator as the right's (a measured left eye's); a HEALPix eye keeps it on the left.
+    Computed once for each patches (a HEALPix eye's once for each nside)."""
+    if isinstance(patches, HealpixPatches):
+        side = _HEALPIX_SIDES.get(patches.nside)
+        if side is None:
+            side = _HEALPIX_SIDES[patches.nside] = _label_side(patches)
+        return side
+    try:
+        side = _SIDES.get(patches)
+    except TypeError:  # not weakly referable: computed each time
+        return _label_side(patches)
+    if side is None:
+        side = _SIDES[patches] = _label_side(patches)
+    return side
+
+
+def _label_side(patches: FacetPatches) -> int:
     c = patches.centers(np.arange(patches.n))
     lon, lat = view_lonlat(np.arctan2(c[:, 1], c[:, 0]), np.arcsin(np.clip(c[:, 2], -1, 1)))
     near = np.abs(lat) < 0.25
