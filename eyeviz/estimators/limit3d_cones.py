@@ -16,7 +16,7 @@ from eyeviz.estimators.limit3d_exact import exact_hits
 from eyeviz.estimators.limit3d_proposal import _frame
 from eyeviz.estimators.triangulation import facet_neighbours
 
-__all__ = ["RINGS", "key_hits", "_Edges", "_Facets", "_direction", "_facets"]
+__all__ = ["RINGS", "both_columns", "key_hits", "_Edges", "_Facets", "_direction", "_facets"]
 
 
 #: rings of axis neighbours of the lit facets whose unlit facets constrain
@@ -57,6 +57,9 @@ _PADS = {"pos": 0.0, "ax": (1.0, 0.0, 0.0), "half": 0.0, "lit": False, "pad": Tr
 class _Edges:
     """The constraining facets of one eye for a chunk of keys, padded to (N, K):
     positions, axes, half-angles, ``lit`` (must be seen) and ``pad``."""
+
+    #: both eyes' table (:func:`both_columns`), kept with the columns it was made from
+    _both: Any = None
 
     def __init__(self, f: _Facets, lit: LitCSR) -> None:
         ptr, ind = lit
@@ -181,6 +184,29 @@ class _Edges:
             np.where(unl, dist, np.inf).min(axis=1), np.where(lit, vn, np.inf).min(axis=1)
         )
         return lo, hi
+
+
+def both_columns(ea: _Edges, eb: _Edges) -> tuple[np.ndarray, ...]:
+    """Both eyes' constraining facets of each key as one table of its live facets, what
+    the measured region test and draws walk (kernels.measured_limit): positions, axes, cos
+    and sin of the half acceptance angles, ``lit`` (N, K_A + K_B, ...), A's live facets
+    then B's in index order, then padding, and the live count per key (N,). A walk over
+    its first count facets folds the same facets in the same order as one over both
+    eyes' tables with their padding skipped. Kept on ``ea`` while both eyes' columns are
+    the same objects (:meth:`_Edges.prune` and :meth:`_Edges.put` renew them)."""
+    ca, cb = ea.columns(), eb.columns()
+    kept = getattr(ea, "_both", None)
+    if kept is not None and kept[0] is ca and kept[1] is cb:
+        return kept[2]
+    pad = np.concatenate([ca[5], cb[5]], axis=1)
+    order = np.argsort(pad, axis=1, kind="stable")  # the live facets first, in order
+    out = []
+    for x, y in zip(ca[:5], cb[:5], strict=True):
+        v = np.concatenate([x, y], axis=1)
+        out.append(np.take_along_axis(v, order if v.ndim == 2 else order[..., None], 1))
+    both = (*out, (~pad).sum(axis=1).astype(np.int64))
+    ea._both = (ca, cb, both)
+    return both
 
 
 def _direction(e: _Edges, grid: int, levels: int = 6) -> np.ndarray:

@@ -69,7 +69,15 @@ from eyeviz.core.domain import Domain3D
 from eyeviz.estimators import limit3d_provable
 from eyeviz.estimators.analytic3d import estimate
 from eyeviz.estimators.base import LitCSR, take_rows
-from eyeviz.estimators.limit3d_cones import RINGS, _direction, _Edges, _Facets, _facets, key_hits
+from eyeviz.estimators.limit3d_cones import (
+    RINGS,
+    _direction,
+    _Edges,
+    _Facets,
+    _facets,
+    both_columns,
+    key_hits,
+)
 from eyeviz.estimators.limit3d_exact import prior_density
 from eyeviz.estimators.limit3d_proposal import _batch_uniforms, _frame
 from eyeviz.estimators.triangulation import triangulate_rays
@@ -251,8 +259,8 @@ class MeasuredProposal:
                           kernels.arg(st["e1"], f64), kernels.arg(st["e2"], f64),
                           kernels.arg(self.fa.centre, f64), kernels.arg(self.bhat, f64),
                           self.blen, kernels.arg(self.origin, f64), self.s_half,
-                          float(self.domain.g_max), float(st["slack"]), *st["ea"].columns(),
-                          *st["eb"].columns(), h)  # fmt: skip
+                          float(self.domain.g_max), float(st["slack"]),
+                          *both_columns(st["ea"], st["eb"]), h)  # fmt: skip
             return h
         c, _, _ = self._bcentres(st, x[..., :2], x[..., 2])
         with np.errstate(invalid="ignore", over="ignore"):
@@ -529,7 +537,7 @@ class MeasuredProposal:
             kernels.arg(self.fa.centre, f64), kernels.arg(self.bhat, f64), self.blen,
             kernels.arg(self.origin, f64), self.s_half, float(d.g_max), float(d.r_min),
             float(d.r_max), float(d.el_max), self.prior == "multi", live,
-            *st["ea"].columns(), *st["eb"].columns(),
+            *both_columns(st["ea"], st["eb"]),
             outs["x"], outs["y"], outs["z"], outs["g"], outs["r"], outs["az"], outs["el"],
             outs["w"],
         )  # fmt: skip

@@ -37,9 +37,9 @@ _jit_np = njit(cache=True, nogil=True, error_model="numpy")
 #: the measured draws' helpers (per facet and per draw), inlined into their callers by
 #: numba: a call it does not inline counts a reference on every array it passes and is
 #: not inlined by LLVM either, which cost more than a cone distance's arithmetic
-#: (docs/limit3d.md, "bee33c"). Only the draws' kernel inlines the array-taking ones
-#: (``_cone_fold_inline``, ``_walk``, ``bcentre_inline``): each inlined copy costs
-#: compile time, and the cone bounds, the region test and the centre search keep calls.
+#: (docs/limit3d.md, "bee33c"). Only measured_limit's kernels inline array-taking ones
+#: (its fold and walks over one table of both eyes' live facets, ``bcentre_inline`` in
+#: the draws' kernel): each inlined copy costs compile time; the cone bounds keep calls.
 _inline = njit(cache=True, nogil=True, inline="always")
 _inline_np = njit(cache=True, nogil=True, error_model="numpy", inline="always")
 
@@ -96,10 +96,6 @@ def _cone_fold(pos, ax, ch, sh, lit, n, k, cx, cy, cz, lo, hi):
     return lo, _min(hi, d)
 
 
-#: :func:`_cone_fold` inlined, for the draws' walks (:func:`_walk`, measured_limit's)
-_cone_fold_inline = _inline(_cone_fold.py_func)
-
-
 @_jit
 def cone_bounds_kernel(pos, ax, ch, sh, lit, pad, c, lo, hi):
     """_Edges.bounds: (largest distance of a lit cone, smallest of an unlit cone or of a
@@ -124,39 +120,6 @@ def _empty(lo, hi):
     if low < 0.0:
         low = 0.0
     return not (hi + pad > low)
-
-
-@_inline_np
-def _walk(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b, pad_b,
-          order, n, cx, cy, cz, lo_, hi_):  # fmt: skip
-    """One draw's g interval (lo_, hi_ coming in as the prior's bounds), the early exit: the
-    facets are folded in one at a time, stopping at the first after which the interval is
-    empty (lo only grows and hi only shrinks, and :func:`_empty` is monotone, so a partial
-    interval that is empty gives the full one's verdict); both eyes' facets in the key's
-    order ``order[n]`` (index k < K_A: A's facet k, else B's facet k - K_A); the facet
-    that stops a draw is moved to the front, so the facets that rule most draws out are
-    tried first. Returns (stopped, lo, hi)."""
-    ka = pos_a.shape[1]
-    if _empty(lo_, hi_):
-        return True, lo_, hi_
-    for p in range(order.shape[1]):
-        k = order[n, p]
-        if k < ka:
-            if pad_a[n, k]:
-                continue
-            lo_, hi_ = _cone_fold_inline(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz,
-                                         lo_, hi_)  # fmt: skip
-        else:
-            if pad_b[n, k - ka]:
-                continue
-            lo_, hi_ = _cone_fold_inline(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
-                                         lo_, hi_)  # fmt: skip
-        if _empty(lo_, hi_):
-            for j in range(p, 0, -1):
-                order[n, j] = order[n, j - 1]
-            order[n, 0] = k
-            return True, lo_, hi_
-    return False, lo_, hi_
 
 
 @_jit_np

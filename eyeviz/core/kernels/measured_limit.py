@@ -1,10 +1,13 @@
-"""The measured proposal's region test compiled (numba): H >= -slack at points (delta,
-beta) of the box search and the pilot (:meth:`eyeviz.estimators.limit3d_measured.
-MeasuredProposal._hb`), the centre and the walk over both eyes' facets in one loop, the
-facet that rules a point out moved to the front (as the draws' walk,
-:func:`eyeviz.core.kernels.limit3d_region._walk`).
+"""The measured proposal's kernels compiled (numba): the region test, H >= -slack at
+points (delta, beta) of the box search and the pilot (:meth:`eyeviz.estimators.
+limit3d_measured.MeasuredProposal._hb`), the draws, the direction search and the
+reference search's step. The region test and the draws walk both eyes' constraining
+facets of a key as one table of its live facets (limit3d_cones.both_columns), the facet
+that rules a point out moved to the front (:func:`_walk1`): no branch per facet on its
+eye or its padding (a mispredicted branch costs more than a fold: docs/limit3d.md,
+"bee33e").
 
-It calls :mod:`.limit3d_region`'s functions (``bcentre``, ``_cone_fold``), so its numba
+It calls :mod:`.limit3d_region`'s functions (``bcentre``, ``_empty``), so its numba
 cache is stamped with that module's source as well as its own (:class:`_WithRegionSource`,
 as healpix_match does for healpix_lit): an edit of either recompiles it."""
 
@@ -20,9 +23,11 @@ from numba.core import caching
 from eyeviz.core.kernels import limit3d_region
 from eyeviz.core.kernels.limit3d_region import (
     _cone_fold,
+    _empty,
     _inline_np,
     _jit_np,
-    _walk,
+    _max,
+    _min,
     bcentre,
     bcentre_inline,
     measured_prior,
@@ -54,28 +59,61 @@ if _WithRegionSource not in _LOCATORS:
     _LOCATORS.insert(0, _WithRegionSource)
 
 
+@_inline_np
+def _fold1(pos, ax, ch, sh, lit, n, k, cx, cy, cz, lo, hi):
+    """limit3d_region._cone_fold, the lens distance |c - p_k| taken only where it is read
+    (a lit facet's lens, an unlit cone's apex): the same values."""
+    vx, vy, vz = cx - pos[n, k, 0], cy - pos[n, k, 1], cz - pos[n, k, 2]
+    a0, a1, a2 = ax[n, k, 0], ax[n, k, 1], ax[n, k, 2]
+    s = vx * a0 + vy * a1 + vz * a2
+    wx, wy, wz = vy * a2 - vz * a1, vz * a0 - vx * a2, vx * a1 - vy * a0
+    q = math.sqrt(wx * wx + wy * wy + wz * wz)
+    c, sn = ch[n, k], sh[n, k]
+    m = q * c - s * sn
+    if m <= 0.0:
+        d = 0.0
+    elif s * c + q * sn > 0.0:
+        d = m
+    else:
+        d = math.sqrt(vx * vx + vy * vy + vz * vz)
+    if lit[n, k]:
+        return _max(lo, d), _min(hi, math.sqrt(vx * vx + vy * vy + vz * vz))
+    return lo, _min(hi, d)
+
+
+@_inline_np
+def _walk1(pos, ax, ch, sh, lit, order, nl, n, cx, cy, cz, lo_, hi_):
+    """One draw's g interval (lo_, hi_ coming in as the prior's bounds) over key n's nl
+    live facets of both eyes' table (limit3d_cones.both_columns), the early exit: the facets are
+    folded in one at a time in the key's order ``order[n]``, stopping at the first after
+    which the interval is empty (lo only grows and hi only shrinks, and
+    limit3d_region._empty is monotone, so a partial interval that is empty gives the full
+    one's verdict); the facet that stops a draw is moved to the front, so the facets that
+    rule most draws out are tried first. Returns (stopped, lo, hi)."""
+    if _empty(lo_, hi_):
+        return True, lo_, hi_
+    for p in range(nl):
+        k = order[n, p]
+        lo_, hi_ = _fold1(pos, ax, ch, sh, lit, n, k, cx, cy, cz, lo_, hi_)
+        if _empty(lo_, hi_):
+            for j in range(p, 0, -1):
+                order[n, j] = order[n, j - 1]
+            order[n, 0] = k
+            return True, lo_, hi_
+    return False, lo_, hi_
+
+
 @_jit_np
-def _walk_slack(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b, pad_b,
-                order, n, cx, cy, cz, lo_, hi_, slack):  # fmt: skip
-    """limit3d_region._walk with the region test's stop, H = hi - lo < -slack (or NaN):
-    both eyes' facets in the key's order ``order[n]``, the facet that stops a point moved
-    to the front. Returns (lo, hi): the whole walk's where it does not stop, else the
-    partial ones (then H < -slack all the same: lo only grows, hi only shrinks)."""
-    ka = pos_a.shape[1]
+def _walk_slack(pos, ax, ch, sh, lit, order, nl, n, cx, cy, cz, lo_, hi_, slack):
+    """:func:`_walk1` with the region test's stop, H = hi - lo < -slack (or NaN): the facet
+    that stops a point moved to the front. Returns (lo, hi): the whole walk's where it
+    does not stop, else the partial ones (then H < -slack all the same: lo only grows, hi
+    only shrinks)."""
     if not (hi_ - lo_ >= -slack):
         return lo_, hi_
-    for p in range(order.shape[1]):
+    for p in range(nl):
         k = order[n, p]
-        if k < ka:
-            if pad_a[n, k]:
-                continue
-            lo_, hi_ = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz,
-                                         lo_, hi_)  # fmt: skip
-        else:
-            if pad_b[n, k - ka]:
-                continue
-            lo_, hi_ = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
-                                         lo_, hi_)  # fmt: skip
+        lo_, hi_ = _fold1(pos, ax, ch, sh, lit, n, k, cx, cy, cz, lo_, hi_)
         if not (hi_ - lo_ >= -slack):
             for j in range(p, 0, -1):
                 order[n, j] = order[n, j - 1]
@@ -86,13 +124,12 @@ def _walk_slack(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, 
 
 @_jit_np
 def region_kernel(x, u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack,
-                  pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b, pad_b,
-                  h):  # fmt: skip
+                  pos, ax, ch, sh, lit, nls, h):  # fmt: skip
     """MeasuredProposal._hb: H (N, G) at the points x (N, G, 3) = (delta_1, delta_2, beta)
     of each key: the centre (``bcentre``; -inf where the rays do not meet in front), then
     g_hi - g_lo over the prior's g range and both eyes' constraining facets, the walk
     stopped once H < -slack (H then some value below -slack)."""
-    order = np.empty((x.shape[0], pos_a.shape[1] + pos_b.shape[1]), np.int64)
+    order = np.empty((x.shape[0], pos.shape[1]), np.int64)
     for n in range(x.shape[0]):
         for k in range(order.shape[1]):
             order[n, k] = k
@@ -104,9 +141,8 @@ def region_kernel(x, u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack,
                 continue
             qx, qy, qz = cx - origin[0], cy - origin[1], cz - origin[2]
             rr = math.sqrt(qx * qx + qy * qy + qz * qz)
-            lo_, hi_ = _walk_slack(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b,
-                                   sh_b, lit_b, pad_b, order, n, cx, cy, cz, rr * s_half,
-                                   min(rr, g_max), slack)  # fmt: skip
+            lo_, hi_ = _walk_slack(pos, ax, ch, sh, lit, order, nls[n], n, cx, cy, cz,
+                                   rr * s_half, min(rr, g_max), slack)  # fmt: skip
             hv = hi_ - lo_
             h[n, g] = hv if math.isfinite(hv) else -np.inf
 
@@ -140,24 +176,24 @@ def _density(boxes, dens, n, d0, d1, beta):
 @_jit_np
 def mixture_draws_kernel(u, boxes, counts, dens, samples, u0, e1, e2, fa, bhat, blen, origin,
                          s_half, g_max, r_min, r_max, el_max, multi, rows,
-                         pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b, lit_b,
-                         pad_b, x, y, z, g, r, az, el, w):  # fmt: skip
+                         pos, ax, ch, sh, lit, nls, x, y, z, g, r, az, el, w):  # fmt: skip
     """limit3d_measured.MeasuredProposal.sample up to the exact check, draw by draw, from
     a deterministic mixture of boxes in (delta, beta) (boxes (N, C, 2, 3): lo, hi): of
     each batch of ``samples`` draws, counts[n, c] from box c in turn (:func:`_component`),
     (delta, beta) and g from the uniforms u (N, M, 4), the centre, its g interval (the
-    walk of limit3d_region._walk, stopping once it is empty; each component keeps its own
+    walk of :func:`_walk1`, stopping once it is empty; each component keeps its own
     facet order), the prior and the weight prior x Jacobian x the interval's length / the
     mixture's density (:func:`_density`, dens (N, C) = share / volume). Writes x, y, z,
     g, r, az, el, w (N, M) where the weight is above 0 (w 0 elsewhere, the others then
     unset); only the keys ``rows`` (N,) get draws."""
     nc = boxes.shape[1]
-    order = np.empty((nc, u.shape[0], pos_a.shape[1] + pos_b.shape[1]), np.int64)
+    order = np.empty((nc, u.shape[0], pos.shape[1]), np.int64)
     for n in range(u.shape[0]):
         for m in range(u.shape[1]):
             w[n, m] = 0.0
         if not rows[n]:
             continue
+        nl = nls[n]
         for c in range(nc):
             for k in range(order.shape[2]):
                 order[c, n, k] = k
@@ -174,9 +210,8 @@ def mixture_draws_kernel(u, boxes, counts, dens, samples, u0, e1, e2, fa, bhat, 
                 continue
             qx, qy, qz = cx - origin[0], cy - origin[1], cz - origin[2]
             rr = math.sqrt(qx * qx + qy * qy + qz * qz)
-            out, g_lo, g_hi = _walk(pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b,
-                                    sh_b, lit_b, pad_b, order[c], n, cx, cy, cz,
-                                    rr * s_half, min(rr, g_max))  # fmt: skip
+            out, g_lo, g_hi = _walk1(pos, ax, ch, sh, lit, order[c], nl, n, cx, cy, cz,
+                                     rr * s_half, min(rr, g_max))  # fmt: skip
             if out:
                 continue
             pad = 1e-9 * g_hi
@@ -308,7 +343,8 @@ def warm() -> None:
     cs = (p3, p3, a2 + 0.9, a2 + 0.1, b, ~b)
     c = np.ones((1, 3))
     v3 = np.ones(3)
-    region_kernel(p3, c, c, c, v3, v3, 1.0, v3, 0.1, 1.0, 1e-7, *cs, *cs, a2.copy())
+    both = (p3, p3, a2 + 0.9, a2 + 0.1, b, np.ones(1, np.int64))
+    region_kernel(p3, c, c, c, v3, v3, 1.0, v3, 0.1, 1.0, 1e-7, *both, a2.copy())
     direction_kernel(p3, a2, b, ~b, np.array([[0.0, 0.0, 1.0]]), np.ones(1), 2, 1)
     locate_kernel(p3, a2 + 1, a2 + 1, 0.1, 1.0, *cs, *cs, np.zeros(1, np.int64))
     u4 = np.full((1, 1, 4), 0.5)
@@ -316,6 +352,6 @@ def warm() -> None:
     boxes[:, :, 1] = 1.0
     o1 = np.zeros((1, 1))
     mixture_draws_kernel(u4, boxes, np.ones((1, 2), np.int64), np.ones((1, 2)), 2, c, c, c, v3,
-                         v3, 1.0, v3, 0.1, 1.0, 0.5, 9.0, 1.0, False, b[0].copy(), *cs, *cs,
+                         v3, 1.0, v3, 0.1, 1.0, 0.5, 9.0, 1.0, False, b[0].copy(), *both,
                          o1, o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(),
                          o1.copy())  # fmt: skip
