@@ -44,6 +44,7 @@ from eyeviz.app.panels.lit_raster import LitRaster
 from eyeviz.app.panels.map_geometry import (
     R2,
     Outlines,
+    all_polys,
     by_ball,
     edge_colour,
     ellipse,
@@ -428,7 +429,7 @@ class Bitmaps3DPanel(QtWidgets.QWidget):
             ax.set_aspect("equal", adjustable="box", anchor="C")
             clip = Polygon(ell, closed=True, transform=ax.transData)
             if n_pix <= MAX_ALL_FACETS:  # every facet, outlined
-                verts, _, cnt = map_polys(patches[eye], np.arange(n_pix))
+                verts, _, cnt = all_polys(patches[eye])
                 back = PolyCollection(
                     [v[:c] for v, c in zip(verts, cnt, strict=True)], facecolors=UNLIT,
                     edgecolors=edge_colour(n_pix), linewidths=0.3,
