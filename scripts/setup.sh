@@ -95,6 +95,7 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
         # rest; torch pinned (its CPU build: any other request pulls a multi-GB CUDA one)
         .venv/bin/python -m pip install --no-compile "numpy>=1.26" "numba>=0.60" &&
         { { warm_kernels && echo "$SECONDS" >.venv/.kernels-compiled-at; } & } &&
+        warm_pid=$! &&
         .venv/bin/python -m pip install --no-compile "torch==2.13.0" -e ".[app,ml,study,dev]"
     } >"$log" 2>&1 || {
         wait
@@ -110,14 +111,18 @@ if [ -n "$apt_pid" ] && ! wait "$apt_pid"; then
     echo "eyeviz setup: installing the system packages failed:$missing" >&2
     exit 1
 fi
-# Wait for the warm begun beside pip, then warm (again): the cache is read in a few seconds,
-# and what pip's second step changed (a numba or numpy version) compiles now.
-# After an install, the packages' byte code too (beside it).
-wait
+# After an install, the packages' byte code (beside the compile begun beside pip, which
+# often runs on after pip: started after it, the imports left a core idle while one
+# half of the compile finished). Then wait for that compile and warm (again): the cache
+# is read in a few seconds, and what pip's second step changed (a numba or numpy
+# version) compiles now.
 imports=
 if [ "$fresh" = 1 ]; then
     warm_all_imports &
     imports=$!
+fi
+if [ -n "${warm_pid:-}" ]; then
+    wait "$warm_pid" || true
 fi
 warm_kernels ||
     echo "eyeviz setup: warming the compiled kernels failed (they compile on first use)" >&2
@@ -125,6 +130,7 @@ if [ -n "$imports" ] && ! wait "$imports"; then
     echo "eyeviz setup: importing the installed packages failed:" \
         ".venv/bin/python -c 'import torch, eyeviz.app.window' shows why" >&2
 fi
+wait  # eyeviz's byte code (compileall, begun first)
 if [ "$fresh" = 1 ]; then  # where a first install's time went (CI logs show it)
     echo "eyeviz setup: ${SECONDS} s (pip's install ended at ${pip_done} s, the kernels'" \
         "cold compile at $(cat .venv/.kernels-compiled-at 2>/dev/null || echo '?') s)" >&2
