@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # The README's test command. Sets up everything (scripts/setup.sh), then runs three stages
 # and reports each, carrying on when one fails (the exit status is non-zero if any did):
-#   1. the guardrails: ruff lint and format, import-linter's layer contracts, mypy (in
-#      the full run they run beside stage 3: half a minute of one core, overlapped);
+#   1. the guardrails: ruff lint and format, import-linter's layer contracts, mypy;
 #   2. the display-free tests (everything but tests/app);
 #   3. the GUI tests under a virtual X display (they drive a real Qt/VTK window).
+# In the full run the three run at once (see below); --quick runs 1 then 2.
 # The tests run on every core (pytest-xdist, `-n <cores>`; EYEVIZ_TEST_WORKERS=N sets
 # the number, 1 runs them in this process); under xdist each GUI worker starts an Xvfb
 # display of its own (tests/app/conftest.py), so real key presses never meet another
@@ -39,6 +39,19 @@ summary=()
 failed=0
 start=$SECONDS
 
+# summarise NAME LOG RC SECONDS: one summary line for a stage (its pytest result line)
+summarise() {
+    local name=$1 log=$2 rc=${3:-1} secs=${4:-?} last
+    last=$(grep -E '^(=+ )?[0-9]+ (passed|failed|error|skipped|deselected).* in [0-9.]+s' "$log" |
+        tail -n 1 | sed -E 's/^=+ //; s/ =+$//')
+    if [ "$rc" -eq 0 ]; then
+        summary+=("$name: ok${last:+ ($last)}, $secs s")
+    else
+        summary+=("$name: FAILED (exit $rc)${last:+ ($last)}, $secs s")
+        failed=1
+    fi
+}
+
 # stage NAME LOG CMD...: run CMD, its output also to LOG; one summary line for NAME
 stage() {
     local name=$1 log=$2 t0=$SECONDS rc
@@ -46,15 +59,7 @@ stage() {
     echo "== $name" >&2
     "$@" 2>&1 | tee "$log"
     rc=${PIPESTATUS[0]}
-    local last
-    last=$(grep -E '^(=+ )?[0-9]+ (passed|failed|error|skipped|deselected).* in [0-9.]+s' "$log" |
-        tail -n 1 | sed -E 's/^=+ //; s/ =+$//')
-    if [ "$rc" -eq 0 ]; then
-        summary+=("$name: ok${last:+ ($last)}, $((SECONDS - t0)) s")
-    else
-        summary+=("$name: FAILED (exit $rc)${last:+ ($last)}, $((SECONDS - t0)) s")
-        failed=1
-    fi
+    summarise "$name" "$log" "$rc" "$((SECONDS - t0))"
 }
 
 guardrails() {
@@ -86,24 +91,34 @@ if [ "$quick" = 1 ]; then
         env -u DISPLAY .venv/bin/python -m pytest --ignore=tests/app -p no:cacheprovider \
         -m "not slow and not gui" "${par[@]}" "$@"
 else
+    # The three run at once: the GUI tests' workers wait for windows, X and timers, and
+    # the guardrails are one core's half minute, so beside the display-free tests (both
+    # cores busy, but for their processes' start-ups and the studies' waits) they fill
+    # the idle part of the cores that running one stage after another left (issue 31).
+    # Each writes its own log, shown when all have finished.
+    background() {  # background NAME CMD...: CMD's output, exit code and seconds to files
+        local name=$1 t0=$SECONDS
+        shift
+        "$@" >"$logs/$name" 2>&1
+        echo $? >"$logs/$name.rc"
+        echo $((SECONDS - t0)) >"$logs/$name.time"
+    }
+    background guard guardrails &
+    guard_pid=$!
+    background gui gui_tests "$@" &
+    gui_pid=$!
+    # a script's background jobs ignore Ctrl-C: on Ctrl-C or SIGTERM every stage ends
+    trap 'trap - INT TERM; echo "scripts/test.sh: interrupted" >&2; kill -TERM 0' INT TERM
     stage "display-free tests" "$logs/free" \
         env -u DISPLAY .venv/bin/python -m pytest --ignore=tests/app -p no:cacheprovider \
         "${par[@]}" "$@"
-    # The guardrails are single-threaded (mypy is most of their half minute): they run
-    # beside the GUI tests, whose two workers leave part of the cores idle (they wait for
-    # windows, X and timers; the display-free tests keep both cores busy), and their
-    # output is shown when both have finished.
-    guard_t0=$SECONDS
-    (
-        guardrails >"$logs/guard" 2>&1
-        echo $? >"$logs/guard.rc"
-        echo $((SECONDS - guard_t0)) >"$logs/guard.time"
-    ) &
-    guard_pid=$!
-    stage "GUI tests (Xvfb)" "$logs/gui" gui_tests "$@"
-    wait "$guard_pid"
-    echo "== guardrails (ruff, import-linter, mypy; ran beside the GUI tests)" >&2
+    wait "$gui_pid" "$guard_pid"
+    echo "== GUI tests (Xvfb; ran beside the display-free tests)" >&2
+    cat "$logs/gui"
+    echo "== guardrails (ruff, import-linter, mypy; ran beside the display-free tests)" >&2
     cat "$logs/guard"
+    summarise "GUI tests (Xvfb)" "$logs/gui" "$(cat "$logs/gui.rc" 2>/dev/null)" \
+        "$(cat "$logs/gui.time" 2>/dev/null)"
     if [ "$(cat "$logs/guard.rc" 2>/dev/null)" = 0 ]; then
         summary=("guardrails (ruff, import-linter, mypy): ok, $(cat "$logs/guard.time") s" \
             "${summary[@]}")
