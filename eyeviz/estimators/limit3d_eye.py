@@ -115,6 +115,8 @@ class _Eye:
         self.n_lit_edge = np.bincount(rows[is_lit], minlength=n)
         self.n_unlit = np.bincount(rows[~is_lit], minlength=n)
         self._ring: np.ndarray | None = None  # the band cells' rings, if known
+        # the band cells' vertices (T, 4, 3), once _candidates has computed them
+        self._verts: np.ndarray | None = None
         ring = None
         if reach is not None and kernels.use(codes.size):
             keep = self._candidates(u, rows, reach)  # sets _ring: the band cells' rings
@@ -164,9 +166,10 @@ class _Eye:
         self._ring = ring  # band() takes them again
         c = u / np.linalg.norm(u, axis=1, keepdims=True)  # as linearise normalises it
         near, far = np.empty(pix.size), np.empty(pix.size)
+        self._verts = np.empty((pix.size, 4, 3))  # band() reads them again
         band_bounds_kernel(n, kernels.arg(pix, np.int64), ring, kernels.arg(rows, np.int64),
-                           kernels.arg(c, np.float64), *_ring_tables(n), first, shifted, near,
-                           far)  # fmt: skip
+                           kernels.arg(c, np.float64), *_ring_tables(n), first, shifted,
+                           self._verts, False, near, far)  # fmt: skip
         s = self.step
         lo = np.where(lit, far - _sample_gap(s, far), far)
         hi = np.where(lit, near - _sample_gap(s, near), near)
@@ -197,8 +200,10 @@ class _Eye:
         near, far = np.empty(pix.size), np.empty(pix.size)
         u0 = kernels.arg(self.c, np.float64)
         pix = kernels.arg(pix, np.int64)
-        band_bounds_kernel(n, pix, ring, key, u0, *_ring_tables(n),
-                           first, _ring_info_tables(n)[2], near, far)  # fmt: skip
+        have = self._verts is not None  # the same cells' vertices, from _candidates
+        verts = self._verts if self._verts is not None else np.empty((pix.size, 4, 3))
+        band_bounds_kernel(n, pix, ring, key, u0, *_ring_tables(n), first,
+                           _ring_info_tables(n)[2], verts, have, near, far)  # fmt: skip
         # per key: lit cells (near descending), then unlit ones (far ascending)
         order = np.lexsort((np.where(lit, -near, far), ~lit, key))
         pix, ring, lit, near, far = pix[order], ring[order], lit[order], near[order], far[order]

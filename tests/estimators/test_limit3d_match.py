@@ -338,3 +338,56 @@ def test_the_band_checks_cap_is_the_lit_set_kernels_ball():
                     assert got[4:7] == (par[10], par[11], par[12])
                     assert _cap_pix(n, *got[7:]) == par[13]
     assert kinds == {0, 1, 3}
+
+
+@pytest.mark.parametrize("n", [4, 5, 180])
+def test_band_bounds_from_stored_vertices_are_the_cells_own_bit_for_bit(n):
+    """band_bounds_kernel's vertices (_cell_vertices, written on a first call, read on a
+    second: _Eye._candidates then band) are healpix_boundary._cell_fs's to the bit (the
+    chord^2 of each of the four, _chord2), and a second call about other centres from
+    the stored vertices gives the bounds a fresh call gives, bit for bit: on every cell
+    of the polar caps' first and last rings, the rings beside the polar / equatorial
+    seams and the equator (nside even and odd), about the poles, a cell's vertex (a tie
+    of two cells), a point 1e-15 off it and random centres."""
+    from eyeviz.core import healpix
+    from eyeviz.core.kernels.healpix_boundary import _cell_fs
+    from eyeviz.core.kernels.healpix_match import _cell_vertices, _chord2, band_bounds_kernel
+
+    sth, zr, unit = g3._ring_tables(n)
+    first, _, shifted = g3._ring_info_tables(n)[:3]
+    rings = sorted({i for i in (1, 2, n - 1, n, n + 1, 2 * n, 3 * n - 1, 3 * n, 3 * n + 1,
+                                4 * n - 2, 4 * n - 1) if 1 <= i <= 4 * n - 1})  # fmt: skip
+    pix = np.concatenate([np.arange(first[i], first[i + 1])[:: max(1, n // 8)] for i in rings])
+    ring = np.concatenate([np.full(np.arange(first[i], first[i + 1])[:: max(1, n // 8)].size, i)
+                           for i in rings]).astype(np.int64)  # fmt: skip
+    vtx = healpix.boundaries(n, pix[3:4], 1)[0, 0]
+    mids = healpix.boundaries(n, pix[[3, -2]], 2)[:, 1::2].reshape(-1, 3)  # edges' midpoints
+    dense = healpix.boundaries(n, pix, 32)  # (T, 128, 3): the closures' distances, nearly
+    rng = np.random.default_rng(n)
+    rnd = rng.normal(size=(3, 3))
+    cs = np.array([[0, 0, 1.0], [0, 0, -1.0], vtx, vtx + 1e-15, *rnd, *mids])
+    cs /= np.linalg.norm(cs, axis=1, keepdims=True)
+    none = (np.empty(0, np.int64), np.empty((0, 3)))
+    key = np.zeros(pix.size, np.int64)
+    verts = np.empty((pix.size, 4, 3))
+    near0, far0 = np.empty(pix.size), np.empty(pix.size)
+    band_bounds_kernel(n, pix, ring, key, cs[6:7], sth, zr, unit, first, shifted, verts, False,
+                       near0, far0)  # fmt: skip
+    for c in cs:
+        for k in range(pix.size):
+            i = ring[k]
+            want = _cell_fs(n, i, pix[k] - first[i], shifted[i], c, sth, zr, unit, none)
+            assert tuple(_chord2(verts, k, q, c) for q in range(4)) == want[:4]
+            assert _cell_vertices(n, i, pix[k] - first[i], shifted[i], sth, zr, unit,
+                                  np.empty((1, 4, 3)), 0) == want[4]  # fmt: skip
+        got = [np.empty(pix.size) for _ in range(4)]
+        band_bounds_kernel(n, pix, ring, key, c[None], sth, zr, unit, first, shifted,
+                           np.empty((pix.size, 4, 3)), False, got[0], got[1])  # fmt: skip
+        band_bounds_kernel(n, pix, ring, key, c[None], sth, zr, unit, first, shifted, verts,
+                           True, got[2], got[3])  # fmt: skip
+        assert np.array_equal(got[0], got[2]) and np.array_equal(got[1], got[3])
+        # bounds: far below the closure's distance (its boundary's, densely sampled, is
+        # at most 1e-4 fw above it), near above it
+        ang = np.arccos(np.clip(dense @ c, -1, 1)).min(axis=1)
+        fw = np.sqrt(np.pi / 3) / n
+        assert (got[1] <= ang + 1e-12).all() and (got[0] >= ang - 1e-4 * fw).all()

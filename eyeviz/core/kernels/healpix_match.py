@@ -18,7 +18,7 @@ import numpy as np
 from eyeviz.core.kernels import healpix_boundary, healpix_lit
 from eyeviz.core.kernels.healpix_boundary import (
     _EPS,
-    _cell_fs,
+    _cell_lons,
     _decide_cell,
     _edge_lower,
     _edge_m,
@@ -118,21 +118,53 @@ def band_cells_kernel(kp, ki, ip, ii, op, oi, small, pix, lit, rows):
 
 
 @_jit
-def band_bounds_kernel(n, pix, ring, key, u0, sth, zr, unit, first_t, shifted_t, near, far):
+def _cell_vertices(n, i, j, shifted, sth, zr, unit, v, k):
+    """The N, W, S and E vertices of cell j of ring i into v[k] (4, 3), as
+    healpix_boundary._cell_fs places them (its _vdist_at's products: the same bits)."""
+    ui = unit[i]
+    lw, ln, ls, un, us, pol = _cell_lons(n, i, j, shifted, ui)
+    for q, r, lv, u in ((0, i - 1, ln, un), (1, i, lw, ui), (2, i + 1, ls, us), (3, i, lw + 2, ui)):
+        ph = lv * u
+        v[k, q, 0] = sth[r] * math.cos(ph)
+        v[k, q, 1] = sth[r] * math.sin(ph)
+        v[k, q, 2] = zr[r]
+    return pol
+
+
+@_jit
+def _chord2(v, k, q, c):
+    """chord^2 from c to vertex q of row k of v (healpix_boundary._vdist's arithmetic)."""
+    vx = v[k, q, 0] - c[0]
+    vy = v[k, q, 1] - c[1]
+    vz = v[k, q, 2] - c[2]
+    return vx * vx + vy * vy + vz * vz
+
+
+@_jit
+def band_bounds_kernel(n, pix, ring, key, u0, sth, zr, unit, first_t, shifted_t, verts, have,
+                       near, far):  # fmt: skip
     """For band cells ``pix`` (of rings ``ring``) of the keys ``key``: an upper bound
     ``near`` on the angle from the key's centre u0[key] to the cell's closure (its nearest
     vertex) and a lower bound ``far`` (the edges' lower bound of _decide_cell, less its
     rounding bounds; 0 for the cell holding u0), both widened by 1e-12 rad. (u0's pixel
-    is found once for each run of cells of one key.)"""
+    is found once for each run of cells of one key.) ``verts`` (T, 4, 3): the cells' N, W,
+    S and E vertices, computed and written there unless ``have`` (then read: a second
+    call on the same cells about other centres, limit3d_eye._Eye.band, skips their
+    cosines and sines, two thirds of a call). A vertex is the same product of the same
+    numbers either way, and its chord to the centre the same operations as
+    healpix_boundary._cell_fs's, so the bounds are the same bits."""
     ed = 8 * _EPS
-    none = (np.empty(0, np.int64), np.empty((0, 3)))
     last, cpix = -1, -1  # the key whose centre's pixel cpix is (cells come by key)
     for k in range(pix.shape[0]):
         i = ring[k]
         first = first_t[i]
         c = (u0[key[k], 0], u0[key[k], 1], u0[key[k], 2])
-        fN, fW, fS, fE, pol = _cell_fs(n, i, pix[k] - first, shifted_t[i], c, sth, zr, unit,
-                                       none)  # fmt: skip
+        if have:
+            pol = i <= n or i >= 3 * n
+        else:
+            pol = _cell_vertices(n, i, pix[k] - first, shifted_t[i], sth, zr, unit, verts, k)
+        fN, fW = _chord2(verts, k, 0, c), _chord2(verts, k, 1, c)
+        fS, fE = _chord2(verts, k, 2, c), _chord2(verts, k, 3, c)
         vmin = min(min(fN, fW), min(fS, fE))
         near[k] = _angle(vmin + _tol(vmin, 0.0, ed, 0.0)) + 1e-12
         ix, iy, face = _pix2xyf(n, pix[k], i, first)
@@ -307,7 +339,8 @@ def warm() -> None:
     u = np.array([[0.0, 1.0, 0.0]])
     near, far = np.zeros(1), np.zeros(1)
     pix, ring = np.array([10]), np.array([2])
-    band_bounds_kernel(n, pix, ring, i1, u, sth, zr, unit, first, shifted, near, far)
+    band_bounds_kernel(n, pix, ring, i1, u, sth, zr, unit, first, shifted, np.empty((1, 4, 3)),
+                       False, near, far)  # fmt: skip
     p2 = np.array([0, 1])
     band_cells_kernel(p2, i1, p2, i1, p2, i1, np.zeros(1, np.bool_), i1.copy(),
                       np.zeros(1, np.bool_), i1.copy())  # fmt: skip
