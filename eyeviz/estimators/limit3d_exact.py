@@ -135,14 +135,12 @@ def band_pass(eyes, p: np.ndarray, g: np.ndarray, row: np.ndarray, bands: tuple)
     first, _, shifted = _ring_info_tables(n)[:3]
     xs, ys, zs = (kernels.arg(p[:, j], np.float64) for j in range(3))
     gs, rows = kernels.arg(g, np.float64), kernels.arg(row, np.int64)
-    vc = healpix_match.vertex_cache()
     res = np.full(row.size, 2, np.int64)
-    edge_kernel(n, xs, ys, zs, gs, -eyes.h, rows, *bands[0], sth, zr, unit, first, shifted, vc,
-                res)  # fmt: skip
+    edge_kernel(n, xs, ys, zs, gs, -eyes.h, rows, *bands[0], sth, zr, unit, first, shifted, res)
     on = np.flatnonzero(res != 0)
     out = np.full(on.size, 2, np.int64)
     edge_kernel(n, xs[on], ys[on], zs[on], gs[on], eyes.h, rows[on], *bands[1], sth, zr, unit,
-                first, shifted, vc, out)  # fmt: skip
+                first, shifted, out)  # fmt: skip
     res[on] = np.where(out == 0, 0, np.maximum(res[on], out))
     return res
 
@@ -181,7 +179,7 @@ def _match_healpix(
         xe, ye, ze, ge, re = xs[todo], ys[todo], zs[todo], gs[todo], rows[todo]
         if bands is not None:
             edge_kernel(n, xe, ye, ze, ge, float(cx), re, *bands[e], tabs[0], tabs[1],
-                        tabs[2], tabs[3], tabs[5], vc, out)  # fmt: skip
+                        tabs[2], tabs[3], tabs[5], out)  # fmt: skip
         left = np.flatnonzero(out == 2)
         if left.size:
             o2 = np.empty(left.size, np.int64)

@@ -207,10 +207,11 @@ class _Eye:
         # per key: lit cells (near descending), then unlit ones (far ascending)
         order = np.lexsort((np.where(lit, -near, far), ~lit, key))
         pix, ring, lit, near, far = pix[order], ring[order], lit[order], near[order], far[order]
+        verts = verts[order]  # the band check's _decide_fs reads them (edge_match_kernel)
         bl = bp[:-1] + np.bincount(key[lit], minlength=cnt.size)
         u_io = kernels.arg(self.u_io, np.float64)
         pix, lit = kernels.arg(pix, np.int64), kernels.arg(lit, np.bool_)
-        return u_io, self.b_in, self.b_out, u0, bp, bl, pix, ring, lit, near, far
+        return u_io, self.b_in, self.b_out, u0, bp, bl, pix, ring, lit, near, far, verts
 
     @property
     def step(self) -> float:  # the boundary samples' spacing (edges <= 1.5 fw long)

@@ -183,7 +183,7 @@ def _bands_check(d: Domain3D, x, y, z, g, keys_of, lit_a, lit_b) -> tuple[int, i
     """_match_healpix with the keys' band cells (limit3d_eye._Eye.band) against
     lit_csr + same_rows on balls (x, y, z, g) of the keys ``keys_of``; returns (balls,
     matches, balls the band check decided in eye A)."""
-    from eyeviz.core.kernels.healpix_match import edge_match_kernel, vertex_cache
+    from eyeviz.core.kernels.healpix_match import edge_match_kernel
 
     ea = _Eye(d, lit_a, np.array([-d.h, 0.0, 0.0]), 0)
     eb = _Eye(d, lit_b, np.array([d.h, 0.0, 0.0]), 1)
@@ -197,8 +197,7 @@ def _bands_check(d: Domain3D, x, y, z, g, keys_of, lit_a, lit_b) -> tuple[int, i
     assert not bad.size, [(x[i], y[i], z[i], g[i], want[i]) for i in bad[:3]]
     out = np.full(x.size, 2, np.int64)
     tabs = (*g3._ring_tables(d.nside), *g3._ring_info_tables(d.nside))
-    edge_match_kernel(d.nside, x, y, z, g, -d.h, row, *bands[0], *tabs[:4], tabs[5],
-                      vertex_cache(), out)  # fmt: skip
+    edge_match_kernel(d.nside, x, y, z, g, -d.h, row, *bands[0], *tabs[:4], tabs[5], out)
     return x.size, int(want.sum()), int((out != 2).sum())
 
 
@@ -251,7 +250,7 @@ def test_band_check_needs_the_draw_between_the_inner_and_outer_caps():
     """With the inner and the outer cap both the key's own ball (so no band cells), a draw
     is decided by the band check only if its cap lies between them: a larger or a smaller
     ball about the same centre is left open (2), never taken for the key."""
-    from eyeviz.core.kernels.healpix_match import edge_match_kernel, vertex_cache
+    from eyeviz.core.kernels.healpix_match import edge_match_kernel
 
     n, h = 16, 40.0
     tabs = (*g3._ring_tables(n), *g3._ring_info_tables(n))
@@ -262,17 +261,17 @@ def test_band_check_needs_the_draw_between_the_inner_and_outer_caps():
     a = np.array([np.arcsin(g0 / dist)])
     empty = np.zeros(0, np.int64)
     band = (u, a, a.copy(), u.copy(), np.zeros(2, np.int64), np.zeros(1, np.int64), empty, empty,
-            np.zeros(0, np.bool_), np.zeros(0), np.zeros(0))  # fmt: skip
+            np.zeros(0, np.bool_), np.zeros(0), np.zeros(0), np.zeros((0, 4, 3)))  # fmt: skip
     g = np.array([g0 * 0.8, g0, g0 * 1.2])
     out = np.full(3, -1, np.int64)
     ones = np.ones(3)
     edge_match_kernel(n, x * ones, y * ones, z * ones, g, -h, np.zeros(3, np.int64), *band,
-                      *tabs[:4], tabs[5], vertex_cache(), out)  # fmt: skip
+                      *tabs[:4], tabs[5], out)  # fmt: skip
     assert out.tolist() == [2, 2, 2]
     # the caps 1e-6 rad inside and outside the ball's: the ball itself is then decided
     band = (u, a - 1e-6, a + 1e-6, *band[3:])
     edge_match_kernel(n, x * ones, y * ones, z * ones, g, -h, np.zeros(3, np.int64), *band,
-                      *tabs[:4], tabs[5], vertex_cache(), out)  # fmt: skip
+                      *tabs[:4], tabs[5], out)  # fmt: skip
     assert out.tolist() == [2, 1, 2]
 
 
@@ -351,7 +350,12 @@ def test_band_bounds_from_stored_vertices_are_the_cells_own_bit_for_bit(n):
     of two cells), a point 1e-15 off it and random centres."""
     from eyeviz.core import healpix
     from eyeviz.core.kernels.healpix_boundary import _cell_fs
-    from eyeviz.core.kernels.healpix_match import _cell_vertices, _chord2, band_bounds_kernel
+    from eyeviz.core.kernels.healpix_match import (
+        _cell_vertices,
+        _chord2,
+        _polar,
+        band_bounds_kernel,
+    )
 
     sth, zr, unit = g3._ring_tables(n)
     first, _, shifted = g3._ring_info_tables(n)[:3]
@@ -379,7 +383,7 @@ def test_band_bounds_from_stored_vertices_are_the_cells_own_bit_for_bit(n):
             want = _cell_fs(n, i, pix[k] - first[i], shifted[i], c, sth, zr, unit, none)
             assert tuple(_chord2(verts, k, q, c) for q in range(4)) == want[:4]
             assert _cell_vertices(n, i, pix[k] - first[i], shifted[i], sth, zr, unit,
-                                  np.empty((1, 4, 3)), 0) == want[4]  # fmt: skip
+                                  np.empty((1, 4, 3)), 0) == want[4] == _polar(n, i)  # fmt: skip
         got = [np.empty(pix.size) for _ in range(4)]
         band_bounds_kernel(n, pix, ring, key, c[None], sth, zr, unit, first, shifted,
                            np.empty((pix.size, 4, 3)), False, got[0], got[1])  # fmt: skip

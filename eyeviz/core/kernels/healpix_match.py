@@ -19,7 +19,7 @@ from eyeviz.core.kernels import healpix_boundary, healpix_lit
 from eyeviz.core.kernels.healpix_boundary import (
     _EPS,
     _cell_lons,
-    _decide_cell,
+    _decide_fs,
     _edge_lower,
     _edge_m,
     _pix2xyf,
@@ -132,6 +132,12 @@ def _cell_vertices(n, i, j, shifted, sth, zr, unit, v, k):
 
 
 @_jit
+def _polar(n, i):
+    """Whether ring i is polar, as healpix_boundary._cell_lons says (its ``pol``)."""
+    return i <= n or i >= 3 * n
+
+
+@_jit
 def _chord2(v, k, q, c):
     """chord^2 from c to vertex q of row k of v (healpix_boundary._vdist's arithmetic)."""
     vx = v[k, q, 0] - c[0]
@@ -160,7 +166,7 @@ def band_bounds_kernel(n, pix, ring, key, u0, sth, zr, unit, first_t, shifted_t,
         first = first_t[i]
         c = (u0[key[k], 0], u0[key[k], 1], u0[key[k], 2])
         if have:
-            pol = i <= n or i >= 3 * n
+            pol = _polar(n, i)
         else:
             pol = _cell_vertices(n, i, pix[k] - first, shifted_t[i], sth, zr, unit, verts, k)
         fN, fW = _chord2(verts, k, 0, c), _chord2(verts, k, 1, c)
@@ -185,7 +191,7 @@ def band_bounds_kernel(n, pix, ring, key, u0, sth, zr, unit, first_t, shifted_t,
 # long: one draw's containment test and its band cells' walk with its early exit
 @_jit
 def edge_match_kernel(n, x, y, z, g, cx, row, u_io, b_in, b_out, u0, bp, bl, pix, ring, lit,
-                      near, far, sth, zr, unit, first_t, shifted_t, vc, out):  # fmt: skip
+                      near, far, verts, sth, zr, unit, first_t, shifted_t, out):  # fmt: skip
     """Whether ball b lights exactly key row[b]'s facets, from the key's band cells alone:
     out[b] 1 yes, 0 no, 2 not decided here (then :func:`match_kernel`).
 
@@ -202,8 +208,10 @@ def edge_match_kernel(n, x, y, z, g, cx, row, u_io, b_in, b_out, u0, bp, bl, pix
     band cell is lit when even its nearest vertex from u0 (``near``) moved by |c - u0|
     lies inside the cap, unlit when the lower bound of its distance from u0 (``far``)
     less |c - u0| lies outside it; else :func:`_decide_cell` decides it (with the ball's
-    own bounds, as lit_runs_kernel; its centre pixel is lit), and a cell it leaves open
-    leaves the ball to match_kernel. The first band cell that differs from the key rules
+    own bounds, as lit_runs_kernel; its centre pixel is lit; from the cell's vertices
+    ``verts`` (T, 4, 3) as band_bounds_kernel stored them, whose chords are _cell_fs's
+    bit for bit: healpix_boundary._decide_fs, the same verdict), and a cell it leaves
+    open leaves the ball to match_kernel. The first band cell that differs from the key rules
     the ball out.
 
     Each key's lit band cells come first (``bp[r]`` to ``bl[r]``), by ``near`` from the
@@ -248,8 +256,10 @@ def edge_match_kernel(n, x, y, z, g, cx, row, u_io, b_in, b_out, u0, bp, bl, pix
                     on = 1
                 else:
                     i = ring[k]
-                    on = _decide_cell(n, i, pix[k] - first_t[i], pix[k], shifted_t[i],
-                                      first_t[i], c, s2, ds2, ed, sth, zr, unit, vc)  # fmt: skip
+                    on = _decide_fs(n, i, pix[k], first_t[i], c, s2, ds2, ed,
+                                    _chord2(verts, k, 0, c), _chord2(verts, k, 1, c),
+                                    _chord2(verts, k, 2, c), _chord2(verts, k, 3, c),
+                                    _polar(n, i))  # fmt: skip
                     if on == 2:
                         res = 2
                         break
@@ -345,5 +355,5 @@ def warm() -> None:
     band_cells_kernel(p2, i1, p2, i1, p2, i1, np.zeros(1, np.bool_), i1.copy(),
                       np.zeros(1, np.bool_), i1.copy())  # fmt: skip
     edge_match_kernel(n, x, y, z, g, 40.0, i1, u, np.zeros(1), np.ones(1), u, np.array([0, 1]),
-                      np.ones(1, np.int64), pix, ring, np.ones(1, np.bool_), near, far, sth, zr,
-                      unit, first, shifted, vertex_cache(16), i1.copy())  # fmt: skip
+                      np.ones(1, np.int64), pix, ring, np.ones(1, np.bool_), near, far,
+                      np.zeros((1, 4, 3)), sth, zr, unit, first, shifted, i1.copy())  # fmt: skip
