@@ -37,24 +37,34 @@ def map_polys(patches: FacetPatches, pix: np.ndarray) -> tuple[np.ndarray, np.nd
 _ALL: weakref.WeakKeyDictionary[Any, tuple[np.ndarray, np.ndarray, np.ndarray]] = (
     weakref.WeakKeyDictionary()
 )
-_HEALPIX_ALL: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+_HEALPIX_ALL: dict[tuple[int, ...], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
 
 def all_polys(patches: FacetPatches) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`map_polys` of every facet of ``patches``, computed once for each patches (a
     HEALPix eye's once for each nside and step); the arrays are read-only."""
+    return _once(
+        _ALL, _HEALPIX_ALL, ("nside", "step"), patches,
+        lambda: _frozen(map_polys(patches, np.arange(patches.n))),
+    )  # fmt: skip
+
+
+def _once(weak, healpix: dict, fields: tuple[str, ...], patches: FacetPatches, compute):
+    """``compute()`` once for each ``patches``: a HEALPix eye's kept in ``healpix`` by
+    its ``fields`` (every window's eye of one nside shares it), another's in ``weak`` by
+    the patches themselves (or computed each time if they are not weakly referable)."""
     if isinstance(patches, HealpixPatches):
-        key = (patches.nside, patches.step)
-        got = _HEALPIX_ALL.get(key)
+        key = tuple(getattr(patches, f) for f in fields)
+        got = healpix.get(key)
         if got is None:
-            got = _HEALPIX_ALL[key] = _frozen(map_polys(patches, np.arange(patches.n)))
+            got = healpix[key] = compute()
         return got
     try:
-        got = _ALL.get(patches)
+        got = weak.get(patches)
     except TypeError:  # not weakly referable: computed each time
-        return map_polys(patches, np.arange(patches.n))
+        return compute()
     if got is None:
-        got = _ALL[patches] = _frozen(map_polys(patches, np.arange(patches.n)))
+        got = weak[patches] = compute()
     return got
 
 
@@ -115,7 +125,7 @@ def by_ball(verts: np.ndarray, owner: np.ndarray, rgba: np.ndarray, counts: np.n
 #: of them at nside 180), and the maps asked it at each layout (each text scale, resize
 #: and lecture step) of every window
 _SIDES: weakref.WeakKeyDictionary[Any, int] = weakref.WeakKeyDictionary()
-_HEALPIX_SIDES: dict[int, int] = {}
+_HEALPIX_SIDES: dict[tuple[int, ...], int] = {}
 
 
 def label_side(patches: FacetPatches) -> int:
@@ -123,18 +133,7 @@ def label_side(patches: FacetPatches) -> int:
     outer 65 % of the left half map holds more than twice as many facets near the
     equator as the right's (a measured left eye's); a HEALPix eye keeps it on the left.
     Computed once for each patches (a HEALPix eye's once for each nside)."""
-    if isinstance(patches, HealpixPatches):
-        side = _HEALPIX_SIDES.get(patches.nside)
-        if side is None:
-            side = _HEALPIX_SIDES[patches.nside] = _label_side(patches)
-        return side
-    try:
-        side = _SIDES.get(patches)
-    except TypeError:  # not weakly referable: computed each time
-        return _label_side(patches)
-    if side is None:
-        side = _SIDES[patches] = _label_side(patches)
-    return side
+    return _once(_SIDES, _HEALPIX_SIDES, ("nside",), patches, lambda: _label_side(patches))
 
 
 def _label_side(patches: FacetPatches) -> int:
