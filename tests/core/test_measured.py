@@ -362,6 +362,56 @@ def test_compiled_and_numpy_decisions_agree(monkeypatch):
     assert 0 < (~sure_k).sum() < bi.size // 10
 
 
+def _near_tie_balls(p, a, acc, rng):
+    """Balls packed about two near-ties of facet (p, a, acc), every offset a multiple of
+    2^-52 of the distance r: the lens on the ball's sphere (c behind the lens, g = r (1 + j
+    2^-52)), and the apex corner (c at r from the cone's edge line, its foot moved along
+    the line by i 2^-52 r, g = r (1 + j 2^-52)), where the lens test's margin and both edge
+    margins decide which pairs are sure."""
+    u = np.asarray(a, dtype=np.float64) / np.linalg.norm(a)
+    w = np.cross(u, rng.normal(size=3))
+    w /= np.linalg.norm(w)
+    half = float(acc) / 2
+    t = math.cos(half) * u + math.sin(half) * w  # the cone's edge line
+    n = -math.sin(half) * u + math.cos(half) * w  # outward, normal to it
+    r = rng.uniform(0.5, 20)
+    k = np.ldexp(np.arange(-48.0, 49.0), -52)
+    behind = p - r * u
+    cs = [(behind, r * (1 + j)) for j in k]
+    cs += [(p + r * n + i * r * t, r * (1 + j)) for i in k for j in k[::4]]
+    return cs
+
+
+def test_compiled_and_numpy_margins_agree_on_dense_near_ties():
+    """The kernel's rounding margins are the reference's to the bit: on balls packed
+    about the lens and apex near-ties (offsets 2^-52 apart) both leave the same pairs
+    to the exact path and agree on the rest (halving any one margin of ``_certify``
+    moves some pair across)."""
+    pair = hand_eye(3)
+    tables, _ = pair._prepared("A")
+    rng = np.random.default_rng(33)
+    pos, ax, acc = pair.facets("A")
+    xs, ys, zs, gs, fs = [], [], [], [], []
+    for i in rng.choice(pos.shape[0], 4, replace=False).tolist():
+        for c, g in _near_tie_balls(pos[i], ax[i], acc[i], rng):
+            xs.append(c[0])
+            ys.append(c[1])
+            zs.append(c[2])
+            gs.append(g)
+            fs.append(i)
+    x, y, z, g = (np.array(v, dtype=np.float64) for v in (xs, ys, zs, gs))
+    fi = np.array(fs, dtype=np.int64)
+    bi = np.arange(x.size, dtype=np.int64)
+    seen_k, sure_k = measured_fast._certified_jit(tables, (x, y, z, g), bi, fi)
+    with np.errstate(all="ignore"):
+        seen_n, sure_n = measured_fast._certified(tables, x, y, z, g, fi)
+    assert np.array_equal(sure_k, sure_n)
+    assert np.array_equal(seen_k[sure_k], seen_n[sure_n])
+    # both kinds of answer and the undecided band are all present
+    assert seen_k[sure_k].any() and not seen_k[sure_k].all()
+    assert 0 < (~sure_k).sum() < bi.size
+
+
 def test_an_axis_the_scaling_would_round_is_decided_exactly(path):
     """An axis whose components are 2^1080 apart cannot be scaled to [1, 2) exactly: its
     facet skips the fast path and goes to the exact one, and the answer stays right."""
