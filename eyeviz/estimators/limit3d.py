@@ -225,9 +225,7 @@ class Limit3DEstimator(Estimator3D):
             rows = got < self.samples
             if not rows.any():
                 break
-            part = _compact(
-                prop.sample(st, keys, streams[i : i + _GROUP], None if rows.all() else rows)
-            )
+            part = _sampled(prop, st, keys, streams[i : i + _GROUP], None if rows.all() else rows)
             got += (part["w"] > 0).sum(axis=1)
             parts.append(part)
         out = {k: np.concatenate([q[k] for q in parts], axis=1) for k in parts[0]}
@@ -277,14 +275,18 @@ class Limit3DEstimator(Estimator3D):
         while need.any():
             cnt = np.where(need, _more_batches(rw, self.accuracy, rep), 0)
             cnt = np.minimum(cnt, self.max_batches - rep)
-            more = self._proposal.sample_counts(st, keys, stream + 8 * rep, cnt)
+            # the accepted draws alone (flat indices n W + m, W = max(cnt) batches), batch
+            # by batch: the same arrays as _compact of the batch's dense draws
+            at, more = self._proposal.sample_counts_sparse(st, keys, stream + 8 * rep, cnt)
+            width = int(cnt.max()) * m
+            row, col = at // width, at % width
             for j in range(int(cnt.max())):
                 take = need & (cnt > j)
                 if not take.any():
                     break
-                part = {k: v[:, j * m : (j + 1) * m] for k, v in more.items()}
-                part["w"] = np.where(take[:, None], part["w"], 0.0)
-                parts.append(_compact(part))
+                sel = np.flatnonzero(take[row] & (col // m == j))
+                parts.append(_compact_sparse(keys.size, row[sel], {k: v[sel] for k, v in
+                                                                   more.items()}))  # fmt: skip
                 rw = {k: np.concatenate([rw[k], parts[-1][k]], axis=1) for k in rw}
                 rep += take
                 need = _needs_more(rw["r"], rw["w"], self.accuracy) & (rep < self.max_batches)
@@ -447,7 +449,19 @@ def _compact(s: dict) -> dict:
     between sorted draws: a rejected draw there would move the answer)."""
     w = s["w"]
     acc = w > 0
-    cnt = acc.sum(axis=1)
+    return _rows_of(acc.sum(axis=1), {name: v[acc] for name, v in s.items()})
+
+
+def _compact_sparse(n: int, row: np.ndarray, vals: dict) -> dict:
+    """:func:`_compact` of n rows given their accepted draws alone: ``row`` (D,) the row
+    of each, non-decreasing, and vals {name: (D,)} in draw order (a proposal's
+    ``sample_sparse``): the same arrays bit for bit."""
+    return _rows_of(np.bincount(row, minlength=n), vals)
+
+
+def _rows_of(cnt: np.ndarray, got: dict) -> dict:
+    """:func:`_compact`'s arrays from each row's count of accepted draws and their values
+    (row by row, in draw order)."""
     k = max(1, int(cnt.max()) if cnt.size else 1)
     # the accepted draws row by row in draw order (row-major), each to its place in its row
     rows = np.repeat(np.arange(cnt.size), cnt)
@@ -455,16 +469,24 @@ def _compact(s: dict) -> dict:
     at = rows * k + (np.arange(rows.size) - first[rows])
     some = cnt > 0
     out = {}
-    for name, v in s.items():
-        got = v[acc]
+    for name, v in got.items():
         pad = np.zeros(cnt.size) if name == "w" else np.ones(cnt.size)
-        if name != "w" and got.size:
-            top = np.maximum.reduceat(got, first[some])
+        if name != "w" and v.size:
+            top = np.maximum.reduceat(v, first[some])
             pad[some] = np.where(np.isfinite(top), top, 1.0)
         o = np.repeat(pad, k)
-        o[at] = got
+        o[at] = v
         out[name] = o.reshape(cnt.size, k)
     return out
+
+
+def _sampled(prop: Any, st: dict, keys: np.ndarray, streams, rows) -> dict:
+    """:func:`_compact` of ``prop.sample`` (its ``sample_sparse`` where it has one: the
+    same arrays without the dense ones)."""
+    if not hasattr(prop, "sample_sparse"):
+        return _compact(prop.sample(st, keys, streams, rows))
+    at, vals, m = prop.sample_sparse(st, keys, streams, rows)
+    return _compact_sparse(keys.size, at // m, vals)
 
 
 def _put_rows(s: dict, rows: np.ndarray, new: dict) -> dict:

@@ -483,65 +483,111 @@ class MeasuredProposal:
     def sample(self, st: dict, keys: np.ndarray, stream, rows=None) -> dict[str, np.ndarray]:
         """``samples`` weighted draws per key of a chunk set up by :meth:`setup`, per
         stream (an int or a sequence: batches side by side, :func:`_batch_uniforms`); only
-        the keys ``rows`` (bool (N,), default all) get draws, the others weight 0."""
+        the keys ``rows`` (bool (N,), default all) get draws, the others weight 0. Dense
+        (N, M) arrays: :meth:`sample_sparse`'s draws in their places, weight 0 elsewhere
+        (where the other arrays hold 0)."""
+        n = st["u0"].shape[0]
+        at, vals, m = self.sample_sparse(st, keys, stream, rows)
+        out = {}
+        for k, v in vals.items():
+            o = np.zeros(n * m)
+            o[at] = v
+            out[k] = o.reshape(n, m)
+        return out
+
+    def sample_sparse(self, st: dict, keys: np.ndarray, stream, rows=None):
+        """:meth:`sample`'s accepted draws alone: (their flat indices n M + m in order,
+        {x, y, z, g, r, az, el, w} of them, M), the draws weighted above 0 by the proposal
+        that also pass the exact check."""
         d, m = self.domain, self.samples
         n = st["u0"].shape[0]
-        u = _uniforms(keys, m, 4, stream)
-        m = u.shape[1]
+        streams = np.atleast_1d(np.asarray(stream, np.int64))
+        m = m * streams.size
         if kernels.use(n * m):
-            out = self._draws_kernel(st, u, rows)
+            at, out = self._draws_sparse(st, keys, streams, None, rows)
         else:
-            out = self._draws_ref(st, u, rows)
-        wt = out["w"]
-        cand = np.flatnonzero(wt.ravel() > 0)
-        c = np.stack([out[k].ravel()[cand] for k in ("x", "y", "z")], axis=1)
-        hit = np.zeros(n * m, bool)
-        hit[cand] = key_hits(d, c, out["g"].ravel()[cand], cand // m, st["lit_a"], st["lit_b"])
-        out["w"] = np.where(hit.reshape(n, m), wt, 0.0)
-        return out
+            dense = self._draws_ref(st, _uniforms(keys, self.samples, 4, stream), rows)
+            at = np.flatnonzero(dense["w"].ravel() > 0)
+            out = {k: v.ravel()[at] for k, v in dense.items()}
+        c = np.stack([out["x"], out["y"], out["z"]], axis=1)
+        hit = key_hits(d, c, out["g"], at // m, st["lit_a"], st["lit_b"])
+        return at[hit], {k: v[hit] for k, v in out.items()}, m
 
     def sample_counts(self, st: dict, keys, first: np.ndarray, counts: np.ndarray) -> dict:
         """:meth:`sample` of key n's batches of the streams first[n] + 8 j, j < counts[n],
         side by side (weight 0 after them): the keys with the same streams together, each
         as drawn alone."""
         n, width = keys.size, int(counts.max()) * self.samples
-        out = {k: np.zeros((n, width)) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
+        at, vals = self.sample_counts_sparse(st, keys, first, counts)
+        out = {}
+        for k, v in vals.items():
+            o = np.zeros(n * width)
+            o[at] = v
+            out[k] = o.reshape(n, width)
+        return out
+
+    def sample_counts_sparse(self, st: dict, keys, first: np.ndarray, counts: np.ndarray):
+        """:meth:`sample_counts`' accepted draws alone: (their flat indices n W + m, W =
+        max(counts) x samples, in order; {x, y, z, g, r, az, el, w} of them)."""
+        width = int(counts.max()) * self.samples
         groups = np.unique(np.stack([first, counts], axis=1)[counts > 0], axis=0)
+        ats, parts = [], []
         for f0, c in groups:
             idx = np.flatnonzero((first == f0) & (counts == c))
             sub = self._keys(st, idx)
-            got = self.sample(sub, keys[idx], [int(f0) + 8 * j for j in range(int(c))])
-            for k, v in got.items():
-                out[k][idx, : v.shape[1]] = v
-        return out
+            at, got, m = self.sample_sparse(sub, keys[idx],
+                                            [int(f0) + 8 * j for j in range(int(c))])  # fmt: skip
+            ats.append(idx[at // m] * width + at % m)
+            parts.append(got)
+        at = np.concatenate(ats)
+        order = np.argsort(at, kind="stable")
+        return at[order], {k: np.concatenate([q[k] for q in parts])[order] for k in parts[0]}
 
-    def _draws_kernel(self, st: dict, u: np.ndarray, rows) -> dict[str, np.ndarray]:
-        """:meth:`_draws_ref` compiled, draw by draw (kernels.measured_limit.
-        mixture_draws_kernel): the same draws, weights to about 1e-13 (its cone distances
-        and trigonometry round differently); a draw's values are set only where its
-        weight is above 0 (the others are never read: limit3d keeps accepted draws)."""
+    def _draws_sparse(self, st: dict, keys, streams, u, rows):
+        """The compiled draws before the exact check (kernels.measured_limit.
+        mixture_draws_kernel): (flat indices n M + m of the draws weighted above 0, in
+        order; their x, y, z, g, r, az, el, w). The uniforms those of ``streams``, drawn
+        inside, or u (N, M, 4) where given. The same draws as :meth:`_draws_ref`, weights
+        to about 1e-13 (its cone distances and trigonometry round differently)."""
         from eyeviz.core.kernels import measured_limit
 
         # Any: the kernel takes 38 arrays and numbers (numba's Dispatcher stub types fewer)
         kernel: Any = measured_limit.mixture_draws_kernel
         d = self.domain
-        n, m = u.shape[:2]
+        n = st["u0"].shape[0]
+        m = u.shape[1] if u is not None else self.samples * streams.size
+        uu = kernels.arg(u, np.float64) if u is not None else np.zeros((0, 1, 4))
         live = np.ones(n, np.bool_) if rows is None else kernels.arg(rows, np.bool_)
         f64 = np.float64
-        outs = {k: np.zeros((n, m)) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
+        at = np.empty(n * m, np.int64)
+        outs = {k: np.empty(n * m) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
         boxes, counts, dens = self._boxes(st)
-        kernel(
-            kernels.arg(u, f64), kernels.arg(boxes, f64), kernels.arg(counts, np.int64),
+        cnt = kernel(
+            kernels.arg(keys, np.uint64), kernels.arg(streams, np.int64), uu,
+            kernels.arg(boxes, f64), kernels.arg(counts, np.int64),
             kernels.arg(dens, f64), self.samples, kernels.arg(st["u0"], f64),
             kernels.arg(st["e1"], f64), kernels.arg(st["e2"], f64),
             kernels.arg(self.fa.centre, f64), kernels.arg(self.bhat, f64), self.blen,
             kernels.arg(self.origin, f64), self.s_half, float(d.g_max), float(d.r_min),
             float(d.r_max), float(d.el_max), self.prior == "multi", live,
-            *both_columns(st["ea"], st["eb"]),
+            *both_columns(st["ea"], st["eb"]), at,
             outs["x"], outs["y"], outs["z"], outs["g"], outs["r"], outs["az"], outs["el"],
             outs["w"],
         )  # fmt: skip
-        return outs
+        return at[:cnt].copy(), {k: v[:cnt].copy() for k, v in outs.items()}
+
+    def _draws_kernel(self, st: dict, u: np.ndarray, rows) -> dict[str, np.ndarray]:
+        """:meth:`_draws_ref` compiled, draw by draw, of the uniforms u (N, M, 4)
+        (:meth:`_draws_sparse`): the same draws, weights to about 1e-13; dense (N, M)
+        arrays, 0 where the weight is not above 0."""
+        n, m = u.shape[:2]
+        at, vals = self._draws_sparse(st, np.zeros(n, np.uint64), np.zeros(1, np.int64), u, rows)
+        out = {}
+        for k, v in vals.items():
+            o = np.zeros(n * m)
+            o[at] = v
+            out[k] = o.reshape(n, m)
+        return out
 
     def _draws_ref(self, st: dict, u: np.ndarray, rows) -> dict[str, np.ndarray]:
         """The weighted draws of the uniforms u (N, M, 4) before the exact check (numpy,

@@ -535,3 +535,28 @@ def test_locate_kernel_picks_the_reference_s_point(bee_small, monkeypatch):
         for jit in ("1", "0"):
             monkeypatch.setenv("EYEVIZ_JIT", jit)
             assert np.array_equal(prop._locate(stt, c, ww), first), (spread, jit)
+
+
+@pytest.mark.parametrize("grow", [0.0, 2.0])
+def test_measured_draws_kernel_draws_the_reference_s_uniforms(bee_small, grow):
+    """The measured draws' kernel drawing its uniforms inside (limit3d_measured.
+    MeasuredProposal._draws_sparse without u: each drawn when first read) against the
+    same kernel given limit3d_proposal._batch_uniforms of the same keys and streams: the
+    same draws, bit for bit, over two streams side by side, keys with high bits, a key
+    left out and (``grow``) a box where most draws are given up before their g."""
+    from eyeviz.estimators.limit3d_proposal import _batch_uniforms
+
+    _, prop, stt, _, _ = bee_small
+    span = stt["box_hi"] - stt["box_lo"]
+    stt = dict(stt, box_lo=stt["box_lo"] - grow * span, box_hi=stt["box_hi"] + grow * span)
+    keys = np.arange(6, dtype=np.uint64) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(7)
+    rows = np.ones(keys.size, bool)
+    rows[3] = False
+    streams = np.array([2, 10], np.int64)
+    u = _batch_uniforms(keys, prop.samples, 4, [2, 10])
+    at, got = prop._draws_sparse(stt, keys, streams, None, rows)
+    at_u, want = prop._draws_sparse(stt, keys, streams, u, rows)
+    assert np.array_equal(at, at_u) and 10 <= at.size
+    assert not ((at // u.shape[1]) == 3).any()
+    for k in want:
+        assert _same_bits(got[k], want[k]), k

@@ -320,3 +320,24 @@ def test_compact_keeps_each_rows_accepted_draws_in_order_then_its_largest_value(
                 pad = pad if np.isfinite(pad) else 1.0
                 want = np.concatenate([kept, np.full(k - kept.size, pad)])
                 assert np.array_equal(got[name][i], want, equal_nan=True), (name, i)
+
+
+def test_compact_sparse_is_compact_of_the_dense_draws():
+    """limit3d._compact_sparse (a proposal's accepted draws alone, row by row in draw
+    order) against limit3d._compact of the same draws in dense rows: the same arrays bit
+    for bit, rows with none accepted and NaN values included."""
+    from eyeviz.estimators.limit3d import _compact, _compact_sparse
+
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        n, m = int(rng.integers(1, 6)), int(rng.integers(1, 30))
+        w = np.where(rng.random((n, m)) < rng.random(), rng.random((n, m)) + 0.01, 0.0)
+        r = np.where(rng.random((n, m)) < 0.1, np.nan, rng.normal(size=(n, m)))
+        el = rng.normal(size=(n, m))
+        want = _compact({"r": r, "el": el, "w": w})
+        at = np.flatnonzero(w.ravel() > 0)
+        got = _compact_sparse(n, at // m, {k: v.ravel()[at] for k, v in
+                                           (("r", r), ("el", el), ("w", w))})  # fmt: skip
+        assert list(got) == list(want)
+        for k in want:
+            assert np.array_equal(got[k], want[k], equal_nan=True), k

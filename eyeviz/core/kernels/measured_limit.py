@@ -22,6 +22,9 @@ from numba.core import caching
 
 from eyeviz.core.kernels import limit3d_region
 from eyeviz.core.kernels.limit3d_region import (
+    _GOLD,
+    _M1,
+    _M2,
     _cone_fold,
     _empty,
     _inline_np,
@@ -171,38 +174,68 @@ def _density(boxes, dens, n, d0, d1, beta):
     return q
 
 
+@_inline_np
+def _u01(base, s, j):
+    """limit3d_proposal._uniforms' uniform of counter j in stream s of a key whose hash
+    times _M1 is ``base`` (limit3d_region.uniforms_kernel's hash: the same bits)."""
+    z = base + (np.uint64(j) + (np.uint64(s) << np.uint64(32)))
+    z = z + _GOLD
+    z = (z ^ (z >> np.uint64(30))) * _M1
+    z = (z ^ (z >> np.uint64(27))) * _M2
+    z = z ^ (z >> np.uint64(31))
+    return (np.float64(z >> np.uint64(11)) + 0.5) * 2.0**-53
+
+
 # long: one draw of limit3d_measured.MeasuredProposal.sample (component, centre, g
 # interval, g, weight) is one loop body; split, it would pass a dozen scalars back and forth
 @_jit_np
-def mixture_draws_kernel(u, boxes, counts, dens, samples, u0, e1, e2, fa, bhat, blen, origin,
-                         s_half, g_max, r_min, r_max, el_max, multi, rows,
-                         pos, ax, ch, sh, lit, nls, x, y, z, g, r, az, el, w):  # fmt: skip
+def mixture_draws_kernel(keys, streams, u, boxes, counts, dens, samples, u0, e1, e2, fa, bhat,
+                         blen, origin, s_half, g_max, r_min, r_max, el_max, multi, rows,
+                         pos, ax, ch, sh, lit, nls, at, x, y, z, g, r, az, el, w):  # fmt: skip
     """limit3d_measured.MeasuredProposal.sample up to the exact check, draw by draw, from
     a deterministic mixture of boxes in (delta, beta) (boxes (N, C, 2, 3): lo, hi): of
     each batch of ``samples`` draws, counts[n, c] from box c in turn (:func:`_component`),
-    (delta, beta) and g from the uniforms u (N, M, 4), the centre, its g interval (the
-    walk of :func:`_walk1`, stopping once it is empty; each component keeps its own
-    facet order), the prior and the weight prior x Jacobian x the interval's length / the
-    mixture's density (:func:`_density`, dens (N, C) = share / volume). Writes x, y, z,
-    g, r, az, el, w (N, M) where the weight is above 0 (w 0 elsewhere, the others then
-    unset); only the keys ``rows`` (N,) get draws."""
+    (delta, beta) and g from four uniforms, the centre, its g interval (the walk of
+    :func:`_walk1`, stopping once it is empty; each component keeps its own facet order),
+    the prior and the weight prior x Jacobian x the interval's length / the mixture's
+    density (:func:`_density`, dens (N, C) = share / volume). Only the keys ``rows`` (N,)
+    get draws.
+
+    The uniforms: u (N, M, 4) where given (u.shape[0] == N), else those of
+    limit3d_proposal._batch_uniforms of the key hashes ``keys`` (N,) and ``streams`` (M =
+    samples x len(streams) draws a key), each drawn when first read (the same bits; a draw
+    given up before its g never draws its last). The draws weighted above 0 only, in draw
+    order (key by key): at (their flat index n M + m), x, y, z, g, r, az, el, w, the first
+    returned-count entries of each (arrays of N M or more)."""
     nc = boxes.shape[1]
-    order = np.empty((nc, u.shape[0], pos.shape[1]), np.int64)
-    for n in range(u.shape[0]):
-        for m in range(u.shape[1]):
-            w[n, m] = 0.0
+    given = u.shape[0] == rows.shape[0]
+    mm = u.shape[1] if given else samples * streams.size
+    order = np.empty((nc, rows.shape[0], pos.shape[1]), np.int64)
+    cnt = 0
+    for n in range(rows.shape[0]):
         if not rows[n]:
             continue
         nl = nls[n]
+        base = keys[n] * _M1
         for c in range(nc):
             for k in range(order.shape[2]):
                 order[c, n, k] = k
-        for m in range(u.shape[1]):
-            c = _component(counts, n, m % samples)
+        for m in range(mm):
+            jm = m % samples
+            sm = streams[m // samples] if not given else 0
+            c = _component(counts, n, jm)
             lo_, hi_ = boxes[n, c, 0], boxes[n, c, 1]
-            d0 = lo_[0] + (hi_[0] - lo_[0]) * u[n, m, 0]
-            d1 = lo_[1] + (hi_[1] - lo_[1]) * u[n, m, 1]
-            beta = lo_[2] + (hi_[2] - lo_[2]) * u[n, m, 2]
+            if given:
+                u0_, u1_, u2_ = u[n, m, 0], u[n, m, 1], u[n, m, 2]
+            else:
+                u0_, u1_, u2_ = (
+                    _u01(base, sm, 4 * jm),
+                    _u01(base, sm, 4 * jm + 1),
+                    _u01(base, sm, 4 * jm + 2),
+                )
+            d0 = lo_[0] + (hi_[0] - lo_[0]) * u0_
+            d1 = lo_[1] + (hi_[1] - lo_[1]) * u1_
+            beta = lo_[2] + (hi_[2] - lo_[2]) * u2_
             cx, cy, cz, rho, drho = bcentre_inline(
                 u0[n], e1[n], e2[n], d0, d1, beta, fa, bhat, blen
             )
@@ -216,7 +249,8 @@ def mixture_draws_kernel(u, boxes, counts, dens, samples, u0, e1, e2, fa, bhat, 
                 continue
             pad = 1e-9 * g_hi
             g_lo, g_hi = max(g_lo - pad, 0.0), g_hi + pad
-            gg = g_lo + (g_hi - g_lo) * u[n, m, 3]
+            u3_ = u[n, m, 3] if given else _u01(base, sm, 4 * jm + 3)
+            gg = g_lo + (g_hi - g_lo) * u3_
             e = math.asin(min(max(qz / rr, -1.0), 1.0))
             phi = math.atan2(qy, qx)
             dens_p = measured_prior(rr, gg, e, phi, s_half, g_max, r_min, r_max, el_max, multi)
@@ -224,8 +258,11 @@ def mixture_draws_kernel(u, boxes, counts, dens, samples, u0, e1, e2, fa, bhat, 
             wt = dens_p * jac * ((g_hi - g_lo) / _density(boxes, dens, n, d0, d1, beta))
             if not (math.isfinite(wt) and wt > 0.0):
                 continue
-            x[n, m], y[n, m], z[n, m], g[n, m] = cx, cy, cz, gg
-            r[n, m], az[n, m], el[n, m], w[n, m] = rr, phi, e, wt
+            at[cnt] = n * mm + m
+            x[cnt], y[cnt], z[cnt], g[cnt] = cx, cy, cz, gg
+            r[cnt], az[cnt], el[cnt], w[cnt] = rr, phi, e, wt
+            cnt += 1
+    return cnt
 
 
 @_jit_np
@@ -350,8 +387,9 @@ def warm() -> None:
     u4 = np.full((1, 1, 4), 0.5)
     boxes = np.zeros((1, 2, 2, 3))
     boxes[:, :, 1] = 1.0
-    o1 = np.zeros((1, 1))
-    mixture_draws_kernel(u4, boxes, np.ones((1, 2), np.int64), np.ones((1, 2)), 2, c, c, c, v3,
-                         v3, 1.0, v3, 0.1, 1.0, 0.5, 9.0, 1.0, False, b[0].copy(), *both,
-                         o1, o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(), o1.copy(),
-                         o1.copy())  # fmt: skip
+    o1 = np.zeros(2)
+    mixture_draws_kernel(np.ones(1, np.uint64), np.zeros(1, np.int64), u4, boxes,
+                         np.ones((1, 2), np.int64), np.ones((1, 2)), 2, c, c, c, v3, v3, 1.0,
+                         v3, 0.1, 1.0, 0.5, 9.0, 1.0, False, b[0].copy(), *both,
+                         np.zeros(2, np.int64), o1, o1.copy(), o1.copy(), o1.copy(), o1.copy(),
+                         o1.copy(), o1.copy(), o1.copy())  # fmt: skip
