@@ -26,18 +26,22 @@ _SHIFT = (56, 36, 18)  # level, x, y (z in the low bits)
 _jit = njit(cache=True, nogil=True)
 
 
-@_jit
-def _certify(cx, cy, cz, gb, px, py, pz, ax, ay, az, nrm, cs, sn, exact_only, i):
-    """(seen, sure, lens) of facet i and the ball (c, g): the certified float64 test of
-    :mod:`eyeviz.core.measured_fast` (``seen`` the answer where ``sure``), and whether its
-    lens lies in the closed ball: 1 surely, 0 surely not, 2 not decided here."""
-    vx, vy, vz = cx - px[i], cy - py[i], cz - pz[i]
+_inline = njit(cache=True, nogil=True, inline="always")
+
+
+@_inline
+def _certify_at(cx, cy, cz, gb, p0, p1, p2, a0, a1, a2, nn, cc, ss, exact):
+    """(seen, sure, lens) of the ball (c, g) and a facet given by its values (lens p, unit
+    axis a, nrm, cos and sin of its half acceptance angle, exact_only): the certified
+    float64 test of :mod:`eyeviz.core.measured_fast` (``seen`` the answer where
+    ``sure``), and whether its lens lies in the closed ball: 1 surely, 0 surely not, 2
+    not decided here."""
+    vx, vy, vz = cx - p0, cy - p1, cz - p2
     mag = max(abs(vx), abs(vy), abs(vz))
     if mag == 0.0:  # c = p exactly: the lens is in the ball
         return True, True, 1
-    if not (_LO <= mag <= _HI and gb <= _HI) or exact_only[i]:
+    if not (_LO <= mag <= _HI and gb <= _HI) or exact:
         return False, False, 2
-    a0, a1, a2 = ax[i], ay[i], az[i]
     v2 = vx * vx + vy * vy + vz * vz
     g2 = gb * gb
     da = v2 - g2
@@ -47,7 +51,6 @@ def _certify(cx, cy, cz, gb, px, py, pz, ax, ay, az, nrm, cs, sn, exact_only, i)
     wy = vz * a0 - vx * a2
     wz = vx * a1 - vy * a0
     q = math.sqrt(wx * wx + wy * wy + wz * wz)
-    cc, ss, nn = cs[i], sn[i], nrm[i]
     vn = math.sqrt(v2) * (1 + 4 * _U) * nn
     e = s * cc + q * ss
     be = 32 * _U * vn
@@ -57,6 +60,13 @@ def _certify(cx, cy, cz, gb, px, py, pz, ax, ay, az, nrm, cs, sn, exact_only, i)
     no = da > ba and (e < -be or m > bm)
     lens = 1 if da <= -ba else (0 if da > ba else 2)
     return yes, yes or no, lens
+
+
+@_jit
+def _certify(cx, cy, cz, gb, px, py, pz, ax, ay, az, nrm, cs, sn, exact_only, i):
+    """:func:`_certify_at` of facet i of the eye's arrays."""
+    return _certify_at(cx, cy, cz, gb, px[i], py[i], pz[i], ax[i], ay[i], az[i], nrm[i], cs[i],
+                       sn[i], exact_only[i])  # fmt: skip
 
 
 @_jit
@@ -144,6 +154,11 @@ def key_check_kernel(cx, cy, cz, g, bounds, px, py, pz, ax, ay, az, nrm, cs, sn,
     islit = np.empty(nf, np.bool_)
     kj = np.empty(nf)
     kl = np.empty(nf)
+    # the key's list sorted by k_j, each facet's values side by side, read in order by
+    # every ball (read through the sort and the list from the eye's arrays, the balls'
+    # tests took about 4 times as long: docs/limit3d.md, bee33f)
+    vals = np.empty((nf, 11))
+    flags = np.empty((nf, 2), np.bool_)
     amax = 0.0
     for j in range(nf):
         amax = max(amax, half[j])
@@ -184,6 +199,13 @@ def key_check_kernel(cx, cy, cz, g, bounds, px, py, pz, ax, ay, az, nrm, cs, sn,
                 emax = max(emax, ej)
                 n_l += 1
         by = np.argsort(kj[:n_l])
+        for q in range(n_l):
+            t, f = by[q], lst[by[q]]
+            vals[q, 0], vals[q, 1], vals[q, 2] = px[f], py[f], pz[f]
+            vals[q, 3], vals[q, 4], vals[q, 5] = ax[f], ay[f], az[f]
+            vals[q, 6], vals[q, 7], vals[q, 8] = nrm[f], cs[f], sn[f]
+            vals[q, 9], vals[q, 10] = kj[t], kl[t]
+            flags[q, 0], flags[q, 1] = islit[t], exact_only[f]
         for b in range(s, e):
             if res[b] == 0:
                 continue
@@ -203,17 +225,19 @@ def key_check_kernel(cx, cy, cz, g, bounds, px, py, pz, ax, ay, az, nrm, cs, sn,
                 safe = safe - (ab * (1 + _REL) + _REL)
             verdict, n_lit = 1, 0
             for q in range(n_l):
-                t = by[q]
-                if kj[t] > reach:
+                if vals[q, 9] > reach:
                     break
-                n_lit += islit[t]
-                if kl[t] <= safe:  # a lit facet that surely sees the ball
+                lit_q = flags[q, 0]
+                n_lit += lit_q
+                if vals[q, 10] <= safe:  # a lit facet that surely sees the ball
                     continue
-                seen, sure, inside = _certify(cx[b], cy[b], cz[b], g[b], px, py, pz, ax, ay,
-                                              az, nrm, cs, sn, exact_only, lst[t])  # fmt: skip
+                seen, sure, inside = _certify_at(cx[b], cy[b], cz[b], g[b], vals[q, 0],
+                                                 vals[q, 1], vals[q, 2], vals[q, 3], vals[q, 4],
+                                                 vals[q, 5], vals[q, 6], vals[q, 7], vals[q, 8],
+                                                 flags[q, 1])  # fmt: skip
                 if not sure:
                     verdict = 2
-                elif seen != islit[t] or (seen and inside == 1):
+                elif seen != lit_q or (seen and inside == 1):
                     verdict = 0
                     break
                 elif seen and inside == 2:
