@@ -3,30 +3,23 @@ work or allocation; the API raises EyevizError."""
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
 
 from eyeviz import EyevizError
 from eyeviz import dataset as D
 from eyeviz.files import limits
 
-ROOT = Path(__file__).resolve().parents[2]
 
+@pytest.fixture
+def run_eyeviz(eyeviz_main):
+    """``eyeviz ARGS`` in this process (the exit code and message are the point, not the
+    process): (exit code, stderr's lines)."""
 
-def _eyeviz(*args, cwd):
-    p = subprocess.run(
-        [sys.executable, "-m", "eyeviz", *args],
-        cwd=cwd,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
-    return p.returncode, p.stderr.strip().splitlines()
+    def run(*args, cwd):
+        p = eyeviz_main(*args, cwd=cwd)
+        return p.returncode, p.stderr.strip().splitlines()
+
+    return run
 
 
 @pytest.mark.parametrize(
@@ -43,8 +36,8 @@ def _eyeviz(*args, cwd):
         (["-n", "inf"], "invalid int value"),
     ],
 )
-def test_generate_bounds(tmp_path, args, words):
-    code, err = _eyeviz("generate", *args, "-o", "x.csv", cwd=tmp_path)
+def test_generate_bounds(tmp_path, run_eyeviz, args, words):
+    code, err = run_eyeviz("generate", *args, "-o", "x.csv", cwd=tmp_path)
     assert code == 2 and words in err[-1], err
     assert err[-1].startswith("eyeviz")
     assert list(tmp_path.iterdir()) == []
@@ -94,7 +87,7 @@ def test_api_generate_bounds():
         ("nul.toml", "control character"),
     ],
 )
-def test_snapshot_hostile_scene_files(tmp_path, scene, words):
+def test_snapshot_hostile_scene_files(tmp_path, run_eyeviz, scene, words):
     files = {
         "m2e9.toml": "[eyes]\nm = 2000000000\n",
         "deep.toml": "a = " + "[" * 50_000 + "]" * 50_000 + "\n",
@@ -104,7 +97,7 @@ def test_snapshot_hostile_scene_files(tmp_path, scene, words):
     }
     if scene in files:
         (tmp_path / scene).write_text(files[scene])
-    code, err = _eyeviz("snapshot", scene, "-o", "out.png", cwd=tmp_path)
+    code, err = run_eyeviz("snapshot", scene, "-o", "out.png", cwd=tmp_path)
     assert code == 2 and len(err) == 1 and words in err[0], err
     assert not (tmp_path / "out.png").exists()
 
