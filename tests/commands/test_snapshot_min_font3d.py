@@ -5,8 +5,6 @@ and the journal widths taken as for the planar figures."""
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -14,17 +12,11 @@ import pytest
 SCENES = Path(__file__).resolve().parents[2] / "eyeviz" / "assets" / "scenes"
 
 
-def _snapshot(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "eyeviz", "snapshot", *args], capture_output=True, text=True
-    )
-
-
 @pytest.mark.parametrize("width", ["single", "double"])
-def test_svg_has_no_text_below_the_minimum(tmp_path, width):
+def test_svg_has_no_text_below_the_minimum(tmp_path, width, eyeviz_main):
     out = tmp_path / "f.svg"
-    r = _snapshot(str(SCENES / "sphere_teaching.toml"), "-o", str(out), "--min-font", "8",
-                  "--width", width)  # fmt: skip
+    scene = SCENES / "sphere_teaching.toml"  # in this process: the SVG is the point
+    r = eyeviz_main("snapshot", scene, "-o", out, "--min-font", "8", "--width", width)
     assert r.returncode == 0, r.stderr
     svg = out.read_text()
     sizes = [float(v) for v in re.findall(r"font-size: ([0-9.]+)px", svg)]

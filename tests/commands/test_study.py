@@ -1,5 +1,6 @@
 """`eyeviz study` through the real command line (subprocesses, real LocalClusters): exit
-codes, one-line messages, resuming, and Ctrl-C or a crash mid-study keeping whole points."""
+codes, one-line messages, resuming, and Ctrl-C or a crash mid-study keeping whole points.
+The refusals before any cluster starts run in the test's process (``eyeviz_main``)."""
 
 import os
 import signal
@@ -49,8 +50,8 @@ def one_error_line(out) -> str:
         (["--seed", "-2"], ["seed", "-2"]),
     ],
 )
-def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, words):
-    out = eyeviz("-o", tmp_path / "s.csv", *args)
+def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, words, eyeviz_main):
+    out = eyeviz_main("study", "-o", tmp_path / "s.csv", *args)  # refused before any cluster
     line = one_error_line(out)
     for w in words:
         assert w in line, line
@@ -70,11 +71,11 @@ def test_an_unreachable_scheduler_is_named(tmp_path):
     assert os.listdir(tmp_path) == []
 
 
-def test_a_file_of_another_version_is_refused_untouched(tmp_path):
+def test_a_file_of_another_version_is_refused_untouched(tmp_path, eyeviz_main):
     path = tmp_path / "s.csv"
     path.write_text("version,h,l,m,dd_mape\n0,40,20,720,5.0\n")
     before = path.read_bytes()
-    line = one_error_line(eyeviz("-o", path, "--n", "10"))
+    line = one_error_line(eyeviz_main("study", "-o", path, "--n", "10"))
     assert "another version of the study table" in line and str(path) in line
     assert path.read_bytes() == before
 

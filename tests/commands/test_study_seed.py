@@ -2,29 +2,26 @@
 carries it); a resume without --seed takes the table's; a given --seed is used as is."""
 
 import re
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
 from eyeviz.study.table import StudyTable
 
-ROOT = Path(__file__).resolve().parents[2]
 pytest.importorskip("distributed")
 ONE = ["--h", "20", "--l", "10", "--m", "8", "--n", "200", "--workers", "1", "--no-progress"]
 
 
-def study(*args):
-    out = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "study", *map(str, args)],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=ROOT,
-    )
-    assert out.returncode == 0, out.stderr
-    return out.stdout
+@pytest.fixture
+def study(eyeviz_main):
+    """``eyeviz study ARGS`` in this process (its seeds and rows are the point, not its
+    process; the study's worker processes are real): its stdout."""
+
+    def run(*args):
+        out = eyeviz_main("study", *args)
+        assert out.returncode == 0, out.stderr
+        return out.stdout
+
+    return run
 
 
 def seeds(path) -> set[int]:
@@ -32,7 +29,7 @@ def seeds(path) -> set[int]:
 
 
 @pytest.mark.slow
-def test_new_study_draws_a_seed_and_a_resume_keeps_it(tmp_path):
+def test_new_study_draws_a_seed_and_a_resume_keeps_it(tmp_path, study):
     a, b = tmp_path / "a.csv", tmp_path / "b.csv"
     out_a = study("-o", a, *ONE)
     drawn = re.search(r"seed (\d+) \(drawn afresh; --seed \1 repeats", out_a)
@@ -49,7 +46,7 @@ def test_new_study_draws_a_seed_and_a_resume_keeps_it(tmp_path):
     assert seeds(a) == {seed_a}
 
 
-def test_a_given_seed_is_used(tmp_path):
+def test_a_given_seed_is_used(tmp_path, study):
     path = tmp_path / "s.csv"
     out = study("-o", path, *ONE, "--seed", "7")
     assert "drawn afresh" not in out and seeds(path) == {7}

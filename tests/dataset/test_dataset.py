@@ -279,7 +279,7 @@ def test_bad_parameters_refused(kw, msg):
         D.generate(**kw)
 
 
-def test_cli_refuses_bad_parameters_before_any_work(tmp_path):
+def test_cli_refuses_bad_parameters_before_any_work(tmp_path, eyeviz_main):
     out = tmp_path / "x.csv"
     for args, msg in [
         (["-n", "0"], "n must be an integer >= 1 and <= 1000000000, got 0"),
@@ -288,20 +288,17 @@ def test_cli_refuses_bad_parameters_before_any_work(tmp_path):
         (["-n", "5", "--g-max", "1"], "no feature can be visible"),
         (["-n", "5", "--m", "7"], "m must be an even integer"),
     ]:
-        res = subprocess.run(
-            [*EYEVIZ, "generate", *args, "-o", str(out)], capture_output=True, text=True, timeout=60
-        )
+        res = eyeviz_main("generate", *args, "-o", out)  # the refusal is the point
         assert res.returncode == 2, res.stderr
         assert msg in res.stderr and res.stderr.count("\n") == 1, res.stderr
         assert "Traceback" not in res.stderr
     assert list(tmp_path.iterdir()) == []
 
 
-def test_cli_writes_npz_and_csv(tmp_path):
-    for name in ("a.npz", "a.csv"):
-        res = subprocess.run(
-            [
-                *EYEVIZ,
+def test_cli_writes_npz_and_csv(tmp_path, eyeviz_main):
+    for name in ("a.npz", "a.csv"):  # in this process: the files are the point
+        res = eyeviz_main(
+            *[
                 "generate",
                 "-n",
                 "300",
@@ -323,10 +320,7 @@ def test_cli_writes_npz_and_csv(tmp_path):
                 "60",
                 "-o",
                 str(tmp_path / name),
-            ],
-            capture_output=True,
-            text=True,
-            timeout=60,
+            ]
         )
         assert res.returncode == 0, res.stderr
     a, b = D.load(tmp_path / "a.npz"), D.load(tmp_path / "a.csv")

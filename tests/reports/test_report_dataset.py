@@ -22,24 +22,18 @@ def files(tmp_path_factory):
 
 
 @pytest.mark.slow
-def test_report_side_by_side(files, tmp_path):
+def test_report_side_by_side(files, tmp_path, eyeviz_main):
     out = tmp_path / "rep"
-    res = subprocess.run(
-        [
-            *EYEVIZ,
-            "report",
-            "dataset",
-            str(files / "single.npz"),
-            str(files / "multi.csv"),
-            "--labels",
-            "one pass",
-            "multi-pass",
-            "-o",
-            str(out),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
+    res = eyeviz_main(  # in this process: the report's files are the point
+        "report",
+        "dataset",
+        files / "single.npz",
+        files / "multi.csv",
+        "--labels",
+        "one pass",
+        "multi-pass",
+        "-o",
+        out,
     )
     assert res.returncode == 0, res.stderr
     png = (out / "dataset.png").read_bytes()
