@@ -133,6 +133,8 @@ _DIRS3 = np.array(
     float,
 )
 _DIRS3 /= np.linalg.norm(_DIRS3, axis=1, keepdims=True)
+#: the quantities of a draw, in the order the proposal returns them
+_VALUES = ("x", "y", "z", "g", "r", "az", "el", "w")
 # the constraining facets (limit3d_cones), read here and by the tests under these names
 _CONES = (RINGS, _Edges, _Facets, _facets)
 
@@ -499,24 +501,41 @@ class MeasuredProposal:
         """:meth:`sample`'s accepted draws alone: (their flat indices n M + m in order,
         {x, y, z, g, r, az, el, w} of them, M), the draws weighted above 0 by the proposal
         that also pass the exact check."""
-        d, m = self.domain, self.samples
         n = st["u0"].shape[0]
-        streams = np.atleast_1d(np.asarray(stream, np.int64))
-        m = m * streams.size
+        s = np.atleast_1d(np.asarray(stream, np.int64))
+        streams = np.broadcast_to(s, (n, s.size))
+        return self._sampled(st, keys, streams, np.full(n, s.size, np.int64), rows)
+
+    def _sampled(self, st: dict, keys: np.ndarray, streams: np.ndarray, nst: np.ndarray, rows):
+        """The accepted draws of key n's batches of the streams streams[n, :nst[n]] (N, S),
+        side by side: (their flat indices n M + m in order, M = samples x S; {x, y, z, g,
+        r, az, el, w} of them, M)."""
+        d = self.domain
+        n, m = st["u0"].shape[0], self.samples * streams.shape[1]
         if kernels.use(n * m):
-            at, out = self._draws_sparse(st, keys, streams, None, rows)
-        else:
-            dense = self._draws_ref(st, _uniforms(keys, self.samples, 4, stream), rows)
-            at = np.flatnonzero(dense["w"].ravel() > 0)
-            out = {k: v.ravel()[at] for k, v in dense.items()}
+            at, out = self._draws_sparse(st, keys, streams, nst, None, rows)
+        else:  # numpy (the reference): the keys with the same streams together
+            at_l, outs = [np.zeros(0, np.int64)], [{k: np.zeros(0) for k in _VALUES}]
+            key = np.concatenate([streams, nst[:, None]], axis=1)
+            live = nst > 0 if rows is None else (nst > 0) & rows
+            for grp in np.unique(key[live], axis=0):
+                idx = np.flatnonzero(live & (key == grp).all(axis=1))
+                u = _uniforms(keys[idx], self.samples, 4, [int(v) for v in grp[: grp[-1]]])
+                dense = self._draws_ref(self._keys(st, idx), u, None)
+                flat = np.flatnonzero(dense["w"].ravel() > 0)
+                at_l.append(idx[flat // u.shape[1]] * m + flat % u.shape[1])
+                outs.append({k: dense[k].ravel()[flat] for k in _VALUES})
+            at = np.concatenate(at_l)
+            order = np.argsort(at, kind="stable")
+            at = at[order]
+            out = {k: np.concatenate([q[k] for q in outs])[order] for k in _VALUES}
         c = np.stack([out["x"], out["y"], out["z"]], axis=1)
         hit = key_hits(d, c, out["g"], at // m, st["lit_a"], st["lit_b"])
         return at[hit], {k: v[hit] for k, v in out.items()}, m
 
     def sample_counts(self, st: dict, keys, first: np.ndarray, counts: np.ndarray) -> dict:
         """:meth:`sample` of key n's batches of the streams first[n] + 8 j, j < counts[n],
-        side by side (weight 0 after them): the keys with the same streams together, each
-        as drawn alone."""
+        side by side (weight 0 after them), each key as drawn alone."""
         n, width = keys.size, int(counts.max()) * self.samples
         at, vals = self.sample_counts_sparse(st, keys, first, counts)
         out = {}
@@ -529,44 +548,36 @@ class MeasuredProposal:
     def sample_counts_sparse(self, st: dict, keys, first: np.ndarray, counts: np.ndarray):
         """:meth:`sample_counts`' accepted draws alone: (their flat indices n W + m, W =
         max(counts) x samples, in order; {x, y, z, g, r, az, el, w} of them)."""
-        width = int(counts.max()) * self.samples
-        groups = np.unique(np.stack([first, counts], axis=1)[counts > 0], axis=0)
-        ats, parts = [], []
-        for f0, c in groups:
-            idx = np.flatnonzero((first == f0) & (counts == c))
-            sub = self._keys(st, idx)
-            at, got, m = self.sample_sparse(sub, keys[idx],
-                                            [int(f0) + 8 * j for j in range(int(c))])  # fmt: skip
-            ats.append(idx[at // m] * width + at % m)
-            parts.append(got)
-        at = np.concatenate(ats)
-        order = np.argsort(at, kind="stable")
-        return at[order], {k: np.concatenate([q[k] for q in parts])[order] for k in parts[0]}
+        streams = first[:, None] + 8 * np.arange(int(counts.max()))[None, :]
+        at, vals, _ = self._sampled(st, keys, streams.astype(np.int64), counts.astype(np.int64),
+                                    counts > 0)  # fmt: skip
+        return at, vals
 
-    def _draws_sparse(self, st: dict, keys, streams, u, rows):
+    def _draws_sparse(self, st: dict, keys, streams, nst, u, rows):
         """The compiled draws before the exact check (kernels.measured_limit.
         mixture_draws_kernel): (flat indices n M + m of the draws weighted above 0, in
-        order; their x, y, z, g, r, az, el, w). The uniforms those of ``streams``, drawn
-        inside, or u (N, M, 4) where given. The same draws as :meth:`_draws_ref`, weights
-        to about 1e-13 (its cone distances and trigonometry round differently)."""
+        order; their x, y, z, g, r, az, el, w). The uniforms those of key n's streams
+        streams[n, :nst[n]] (N, S), drawn inside, or u (N, M, 4) where given. The same
+        draws as :meth:`_draws_ref`, weights to about 1e-13 (its cone distances and
+        trigonometry round differently)."""
         from eyeviz.core.kernels import measured_limit
 
         # Any: the kernel takes 38 arrays and numbers (numba's Dispatcher stub types fewer)
         kernel: Any = measured_limit.mixture_draws_kernel
         d = self.domain
         n = st["u0"].shape[0]
-        m = u.shape[1] if u is not None else self.samples * streams.size
+        m = u.shape[1] if u is not None else self.samples * streams.shape[1]
         uu = kernels.arg(u, np.float64) if u is not None else np.zeros((0, 1, 4))
         live = np.ones(n, np.bool_) if rows is None else kernels.arg(rows, np.bool_)
         f64 = np.float64
         at = np.empty(n * m, np.int64)
-        outs = {k: np.empty(n * m) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
+        outs = {k: np.empty(n * m) for k in _VALUES}
         boxes, counts, dens = self._boxes(st)
         cnt = kernel(
-            kernels.arg(keys, np.uint64), kernels.arg(streams, np.int64), uu,
-            kernels.arg(boxes, f64), kernels.arg(counts, np.int64),
-            kernels.arg(dens, f64), self.samples, kernels.arg(st["u0"], f64),
-            kernels.arg(st["e1"], f64), kernels.arg(st["e2"], f64),
+            kernels.arg(keys, np.uint64), np.ascontiguousarray(streams, np.int64),
+            kernels.arg(nst, np.int64), uu, kernels.arg(boxes, f64),
+            kernels.arg(counts, np.int64), kernels.arg(dens, f64), self.samples,
+            kernels.arg(st["u0"], f64), kernels.arg(st["e1"], f64), kernels.arg(st["e2"], f64),
             kernels.arg(self.fa.centre, f64), kernels.arg(self.bhat, f64), self.blen,
             kernels.arg(self.origin, f64), self.s_half, float(d.g_max), float(d.r_min),
             float(d.r_max), float(d.el_max), self.prior == "multi", live,
@@ -581,7 +592,8 @@ class MeasuredProposal:
         (:meth:`_draws_sparse`): the same draws, weights to about 1e-13; dense (N, M)
         arrays, 0 where the weight is not above 0."""
         n, m = u.shape[:2]
-        at, vals = self._draws_sparse(st, np.zeros(n, np.uint64), np.zeros(1, np.int64), u, rows)
+        none = np.zeros((n, 1), np.int64)
+        at, vals = self._draws_sparse(st, np.zeros(n, np.uint64), none, none[:, 0], u, rows)
         out = {}
         for k, v in vals.items():
             o = np.zeros(n * m)

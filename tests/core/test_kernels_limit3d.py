@@ -552,10 +552,11 @@ def test_measured_draws_kernel_draws_the_reference_s_uniforms(bee_small, grow):
     keys = np.arange(6, dtype=np.uint64) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(7)
     rows = np.ones(keys.size, bool)
     rows[3] = False
-    streams = np.array([2, 10], np.int64)
+    streams = np.tile(np.array([2, 10], np.int64), (keys.size, 1))
+    nst = np.full(keys.size, 2, np.int64)
     u = _batch_uniforms(keys, prop.samples, 4, [2, 10])
-    at, got = prop._draws_sparse(stt, keys, streams, None, rows)
-    at_u, want = prop._draws_sparse(stt, keys, streams, u, rows)
+    at, got = prop._draws_sparse(stt, keys, streams, nst, None, rows)
+    at_u, want = prop._draws_sparse(stt, keys, streams, nst, u, rows)
     assert np.array_equal(at, at_u) and 10 <= at.size
     assert not ((at // u.shape[1]) == 3).any()
     for k in want:

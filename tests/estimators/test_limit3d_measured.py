@@ -334,15 +334,15 @@ def test_sized_top_ups_give_the_answers_of_four_batches_at_a_time(far, monkeypat
     monkeypatch.setenv("EYEVIZ_JIT", jit)
     dom, _, _, lit = far
     drawn = {True: 0, False: 0}
-    sample = lm.MeasuredProposal.sample_sparse
+    sample = lm.MeasuredProposal._sampled
 
-    def counting(self, st, keys, stream, rows=None):
-        out = sample(self, st, keys, stream, rows)
-        live = keys.size if rows is None else int(np.sum(rows))
-        drawn[bool(lm.MeasuredProposal.batch_counts)] += live * out[2]
+    def counting(self, st, keys, streams, nst, rows):
+        out = sample(self, st, keys, streams, nst, rows)
+        live = np.ones(keys.size, bool) if rows is None else rows
+        drawn[bool(lm.MeasuredProposal.batch_counts)] += int(nst[live].sum()) * self.samples
         return out
 
-    monkeypatch.setattr(lm.MeasuredProposal, "sample_sparse", counting)
+    monkeypatch.setattr(lm.MeasuredProposal, "_sampled", counting)
     got = {}
     for sized in (True, False):
         monkeypatch.setattr(lm.MeasuredProposal, "batch_counts", sized)
@@ -517,20 +517,20 @@ def test_a_key_whose_first_batch_finds_nothing_goes_to_the_retry_at_once(far, mo
 
     dom, _, _, lit = far
     seen: dict = {}
-    sample = lm.MeasuredProposal.sample_sparse
+    sample = lm.MeasuredProposal._sampled
 
-    def counting(self, st, keys, stream, rows=None):
-        at, vals, width = sample(self, st, keys, stream, rows)
+    def counting(self, st, keys, streams, nst, rows):
+        at, vals, width = sample(self, st, keys, streams, nst, rows)
         m = self.samples
         row, col = at // width, at % width
-        for j, s in enumerate(np.atleast_1d(stream)):
-            for i, k in enumerate(keys):
-                if rows is None or rows[i]:
+        for i, k in enumerate(keys):
+            if rows is None or rows[i]:
+                for j in range(int(nst[i])):
                     got = int(((row == i) & (col // m == j)).sum())
-                    seen.setdefault((int(k), int(s) % 8), []).append(got)
+                    seen.setdefault((int(k), int(streams[i, j]) % 8), []).append(got)
         return at, vals, width
 
-    monkeypatch.setattr(lm.MeasuredProposal, "sample_sparse", counting)
+    monkeypatch.setattr(lm.MeasuredProposal, "_sampled", counting)
     runs = {}
     for empty in (True, False):
         monkeypatch.setattr(lm, "RETRY_EMPTY", empty)

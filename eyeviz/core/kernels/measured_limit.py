@@ -189,8 +189,8 @@ def _u01(base, s, j):
 # long: one draw of limit3d_measured.MeasuredProposal.sample (component, centre, g
 # interval, g, weight) is one loop body; split, it would pass a dozen scalars back and forth
 @_jit_np
-def mixture_draws_kernel(keys, streams, u, boxes, counts, dens, samples, u0, e1, e2, fa, bhat,
-                         blen, origin, s_half, g_max, r_min, r_max, el_max, multi, rows,
+def mixture_draws_kernel(keys, streams, nst, u, boxes, counts, dens, samples, u0, e1, e2, fa,
+                         bhat, blen, origin, s_half, g_max, r_min, r_max, el_max, multi, rows,
                          pos, ax, ch, sh, lit, nls, at, x, y, z, g, r, az, el, w):  # fmt: skip
     """limit3d_measured.MeasuredProposal.sample up to the exact check, draw by draw, from
     a deterministic mixture of boxes in (delta, beta) (boxes (N, C, 2, 3): lo, hi): of
@@ -202,14 +202,15 @@ def mixture_draws_kernel(keys, streams, u, boxes, counts, dens, samples, u0, e1,
     get draws.
 
     The uniforms: u (N, M, 4) where given (u.shape[0] == N), else those of
-    limit3d_proposal._batch_uniforms of the key hashes ``keys`` (N,) and ``streams`` (M =
-    samples x len(streams) draws a key), each drawn when first read (the same bits; a draw
-    given up before its g never draws its last). The draws weighted above 0 only, in draw
-    order (key by key): at (their flat index n M + m), x, y, z, g, r, az, el, w, the first
+    limit3d_proposal._batch_uniforms of the key hashes ``keys`` (N,) and key n's streams
+    ``streams[n, :nst[n]]`` (``samples`` draws each, side by side; M = samples x
+    streams.shape[1]), each drawn when first read (the same bits; a draw given up before
+    its g never draws its last). The draws weighted above 0 only, in draw order (key by
+    key): at (their flat index n M + m), x, y, z, g, r, az, el, w, the first
     returned-count entries of each (arrays of N M or more)."""
     nc = boxes.shape[1]
     given = u.shape[0] == rows.shape[0]
-    mm = u.shape[1] if given else samples * streams.size
+    mm = u.shape[1] if given else samples * streams.shape[1]
     order = np.empty((nc, rows.shape[0], pos.shape[1]), np.int64)
     cnt = 0
     for n in range(rows.shape[0]):
@@ -220,9 +221,9 @@ def mixture_draws_kernel(keys, streams, u, boxes, counts, dens, samples, u0, e1,
         for c in range(nc):
             for k in range(order.shape[2]):
                 order[c, n, k] = k
-        for m in range(mm):
+        for m in range(mm if given else samples * nst[n]):
             jm = m % samples
-            sm = streams[m // samples] if not given else 0
+            sm = streams[n, m // samples] if not given else 0
             c = _component(counts, n, jm)
             lo_, hi_ = boxes[n, c, 0], boxes[n, c, 1]
             if given:
@@ -388,7 +389,8 @@ def warm() -> None:
     boxes = np.zeros((1, 2, 2, 3))
     boxes[:, :, 1] = 1.0
     o1 = np.zeros(2)
-    mixture_draws_kernel(np.ones(1, np.uint64), np.zeros(1, np.int64), u4, boxes,
+    mixture_draws_kernel(np.ones(1, np.uint64), np.zeros((1, 1), np.int64),
+                         np.ones(1, np.int64), u4, boxes,
                          np.ones((1, 2), np.int64), np.ones((1, 2)), 2, c, c, c, v3, v3, 1.0,
                          v3, 0.1, 1.0, 0.5, 9.0, 1.0, False, b[0].copy(), *both,
                          np.zeros(2, np.int64), o1, o1.copy(), o1.copy(), o1.copy(), o1.copy(),
