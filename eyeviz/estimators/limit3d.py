@@ -84,6 +84,7 @@ from typing import Any
 
 import numpy as np
 
+from eyeviz.core import kernels
 from eyeviz.core.domain import PAPER_DOMAIN3D, Domain3D
 from eyeviz.estimators.analytic3d import estimate
 from eyeviz.estimators.base import Estimator3D, LitCSR, Prediction3D, as_csr, take_rows
@@ -249,9 +250,8 @@ class Limit3DEstimator(Estimator3D):
             g = min(_TOPUP, self.max_batches - rep)
             more = prop.sample(st, keys, [stream + 8 * (rep + j) for j in range(g)], rows=need)
             for j in range(g):
-                part = {k: v[:, j * m : (j + 1) * m] for k, v in more.items()}
-                part["w"] = np.where(need[:, None], part["w"], 0.0)
-                out = {k: np.concatenate([out[k], v], axis=1) for k, v in _compact(part).items()}
+                part = _compact(more, j * m, (j + 1) * m, need)
+                out = {k: np.concatenate([out[k], v], axis=1) for k, v in part.items()}
                 rep += 1
                 need = _needs_more(out["r"], out["w"], self.accuracy) & ok
                 if not need.any():
@@ -440,13 +440,35 @@ def _spread(r: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
     return mean, sd, ess
 
 
-def _compact(s: dict) -> dict:
+def _compact(s: dict, lo: int = 0, hi: int | None = None, rows: np.ndarray | None = None) -> dict:
     """Each row's accepted draws (weight > 0) first, in draw order, the rest dropped: the
     arrays are as wide as the most accepted draws of a row (at least 1). A row's padding
     weighs 0 and holds, for each quantity, the row's largest accepted value (1 where
     none is accepted), so it sorts after every accepted draw and no weighted median or
     spread reads it (:func:`eyeviz.estimators.weighted.weighted_median` interpolates
-    between sorted draws: a rejected draw there would move the answer)."""
+    between sorted draws: a rejected draw there would move the answer). Only the columns
+    lo .. hi - 1 of ``s``, and with ``rows`` (bool (N,)) the other rows weigh 0.
+    Compiled unless ``EYEVIZ_JIT=0`` (kernels.limit3d_region.compact_draws_kernel, the same
+    arrays; :func:`_compact_ref` the reference)."""
+    vals = tuple(s.values())
+    if kernels.use(vals[0].size) and all(
+        type(v) is np.ndarray and v.ndim == 2 and v.dtype == np.float64 for v in vals
+    ):
+        from eyeviz.core.kernels.limit3d_region import compact_draws_kernel
+
+        n, m = vals[0].shape
+        keep = np.ones(n, np.bool_) if rows is None else kernels.arg(rows, np.bool_)
+        o = compact_draws_kernel(tuple(kernels.arg(v) for v in vals), list(s).index("w"), lo,
+                                 m if hi is None else hi, keep)  # fmt: skip
+        return dict(zip(s, o, strict=True))
+    return _compact_ref(s, lo, hi, rows)
+
+
+def _compact_ref(s: dict, lo: int = 0, hi: int | None = None, rows=None) -> dict:
+    """:func:`_compact` in numpy (the reference)."""
+    s = {k: v[:, lo:hi] for k, v in s.items()}
+    if rows is not None:
+        s["w"] = np.where(rows[:, None], s["w"], 0.0)
     w = s["w"]
     acc = w > 0
     return _rows_of(acc.sum(axis=1), {name: v[acc] for name, v in s.items()})

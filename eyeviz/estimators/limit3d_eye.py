@@ -170,6 +170,14 @@ class _Eye:
         band_bounds_kernel(n, kernels.arg(pix, np.int64), ring, kernels.arg(rows, np.int64),
                            kernels.arg(c, np.float64), *_ring_tables(n), first, shifted,
                            self._verts, False, near, far)  # fmt: skip
+        if kernels.use(pix.size):  # the same verdicts, compiled
+            from eyeviz.core.kernels.limit3d_affine import candidates_kernel
+
+            keep = np.empty(pix.size, np.bool_)
+            candidates_kernel(kernels.arg(lit, np.bool_), kernels.arg(rows, np.int64), near, far,
+                              self.step, kernels.arg(reach, np.float64), u.shape[0],
+                              keep)  # fmt: skip
+            return keep
         s = self.step
         lo = np.where(lit, far - _sample_gap(s, far), far)
         hi = np.where(lit, near - _sample_gap(s, near), near)
@@ -188,7 +196,7 @@ class _Eye:
         (``bl``: where each key's unlit cells start), the order in which the kernel can
         stop at the first cell its bounds settle."""
         from eyeviz.core.healpix_fast import _ring_info_tables, _ring_tables
-        from eyeviz.core.kernels.healpix_match import band_bounds_kernel
+        from eyeviz.core.kernels.healpix_match import band_bounds_kernel, band_order_kernel
 
         cnt, pix, lit = self._band
         n = self.nside
@@ -204,13 +212,11 @@ class _Eye:
         verts = self._verts if self._verts is not None else np.empty((pix.size, 4, 3))
         band_bounds_kernel(n, pix, ring, key, u0, *_ring_tables(n), first,
                            _ring_info_tables(n)[2], verts, have, near, far)  # fmt: skip
-        # per key: lit cells (near descending), then unlit ones (far ascending)
-        order = np.lexsort((np.where(lit, -near, far), ~lit, key))
-        pix, ring, lit, near, far = pix[order], ring[order], lit[order], near[order], far[order]
-        verts = verts[order]  # the band check's _decide_fs reads them (edge_match_kernel)
-        bl = bp[:-1] + np.bincount(key[lit], minlength=cnt.size)
+        # per key: lit cells (near descending), then unlit ones (far ascending); the band
+        # check's _decide_fs reads the vertices in that order too (edge_match_kernel)
+        pix, ring, lit, near, far, verts, bl = band_order_kernel(
+            bp, pix, ring, kernels.arg(lit, np.bool_), near, far, verts)  # fmt: skip
         u_io = kernels.arg(self.u_io, np.float64)
-        pix, lit = kernels.arg(pix, np.int64), kernels.arg(lit, np.bool_)
         return u_io, self.b_in, self.b_out, u0, bp, bl, pix, ring, lit, near, far, verts
 
     @property
@@ -302,23 +308,15 @@ class _Eye:
         matrix product and one reduction each (padding: -inf / +inf, zero slope).
         Compiled unless ``EYEVIZ_JIT=0`` (kernels.limit3d_affine.affine_kernel, the same
         bits; the packed lists' slots beyond a row's count hold zeros there)."""
+        if kernels.use(self.lit.size):
+            from eyeviz.core.kernels.limit3d_affine import affine_forms_kernel
+
+            self.a_lit, self.t_lit, self.a_unl, self.t_unl, self.lists = affine_forms_kernel(
+                kernels.arg(self.d, np.float64), kernels.arg(self.t, np.float64),
+                kernels.arg(self.lit), kernels.arg(self.pad))  # fmt: skip
+            return
         lit = self.lit & ~self.pad
         unl = ~self.lit & ~self.pad
-        if kernels.use(lit.size):
-            from eyeviz.core.kernels.limit3d_affine import affine_kernel
-
-            n, k = lit.shape
-            kl = max(1, int(lit.sum(axis=1).max()) if n else 1)
-            ku = max(1, int(unl.sum(axis=1).max()) if n else 1)
-            self.a_lit, self.a_unl = np.empty((n, k)), np.empty((n, k))
-            self.t_lit, self.t_unl = np.empty((n, k, 2)), np.empty((n, k, 2))
-            lists = (np.zeros((n, kl)), np.zeros((n, kl, 2)), np.zeros(n, np.int64),
-                     np.zeros((n, ku)), np.zeros((n, ku, 2)), np.zeros(n, np.int64))  # fmt: skip
-            affine_kernel(kernels.arg(self.d, np.float64), kernels.arg(self.t, np.float64),
-                          kernels.arg(self.lit), kernels.arg(self.pad), self.a_lit, self.t_lit,
-                          self.a_unl, self.t_unl, *lists)  # fmt: skip
-            self.lists = lists
-            return
         self.a_lit = np.where(lit, self.d, -np.inf)
         self.t_lit = np.where(lit[..., None], self.t, 0.0)
         self.a_unl = np.where(unl, self.d * self.d, np.inf)
@@ -457,6 +455,17 @@ def _band_cells(lit: LitCSR, inner: LitCSR, outer: LitCSR, small: np.ndarray, np
     return codes[order], is_lit[order], rows[order]
 
 
+def _offsets() -> tuple[np.ndarray, np.ndarray]:
+    """The face offsets (dx, dy) of healpix.boundaries' STEP points a side (N, W, S, E)."""
+    t = np.arange(STEP) / STEP
+    dx = np.concatenate([1 - t, np.zeros(STEP), t, np.ones(STEP)])
+    dy = np.concatenate([np.ones(STEP), 1 - t, np.zeros(STEP), t])
+    return dx, dy
+
+
+_OFFSETS = _offsets()  # made once: the kernel only reads them
+
+
 def _boundaries(nside: int, pix: np.ndarray, rows, slot, shape: tuple[int, int],
                 ring=None) -> np.ndarray:  # fmt: skip
     """The boundary samples (healpix.boundaries, STEP a side) of the cells ``pix`` (T,) at
@@ -471,9 +480,7 @@ def _boundaries(nside: int, pix: np.ndarray, rows, slot, shape: tuple[int, int],
         first = _ring_info_tables(nside)[0]
         if ring is None:
             ring = _rings(nside, pix)
-        t = np.arange(STEP) / STEP
-        dx = np.concatenate([1 - t, np.zeros(STEP), t, np.ones(STEP)])
-        dy = np.concatenate([np.ones(STEP), 1 - t, np.zeros(STEP), t])
+        dx, dy = _OFFSETS
         i64 = np.int64
         boundaries_kernel(nside, kernels.arg(pix, i64), kernels.arg(ring, i64), first,
                           kernels.arg(rows, i64), kernels.arg(slot, i64), dx, dy, healpix.JRLL,

@@ -74,8 +74,11 @@ class HealpixProposal:
         for e, x in ((ea, ext), (eb, ext_b)):
             sec = np.maximum(sec, (x * x).sum(axis=1) * (1.0 / e.alpha0 + 1.0))
         slack = np.minimum(slack0, wide * (SLACK_SAFETY * sec + 1e-7 * fw))[:, None]
-        ext = _extent(ea, wide * 0.5 * fw, slack)
-        ext_b = _extent(eb, wide * 0.5 * fw, slack)
+        # the keys whose slack is still the window's have these boxes already (the same
+        # model, reach and slack: the same bits)
+        same = slack[:, 0] == slack0
+        ext = _extent(ea, wide * 0.5 * fw, slack, known=(same, ext))
+        ext_b = _extent(eb, wide * 0.5 * fw, slack, known=(same, ext_b))
         ea.prune(1.2 * math.sqrt(2.0) * ext.max(axis=1))
         eb.prune(1.2 * math.sqrt(2.0) * ext_b.max(axis=1))
         # A's centre: uniform in (theta, phi) over the bounds of A's box, theta cut to
@@ -121,8 +124,9 @@ class HealpixProposal:
         d, ea, eb = self.domain, st["ea"], st["eb"]
         s = kernels.arg(np.atleast_1d(np.asarray(stream, np.int64)))
         n, m = keys.size, self.samples * s.size
-        out = {k: np.zeros((n, m)) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
-        ca, alpha = np.zeros((n, m, 3)), np.zeros((n, m))
+        # the kernel writes every weight, the rest only where the weight is above 0
+        out = {k: np.empty((n, m)) for k in ("x", "y", "z", "g", "r", "az", "el", "w")}
+        ca, alpha = np.empty((n, m, 3)), np.empty((n, m))
         u_max = 1.0 / (d.r_min - d.h) if d.r_min > d.h else np.inf
         f64 = np.float64
         la, lb = st.get("box_lists") or (ea.lists, eb.lists)  # (Eye.box_lists)
@@ -225,32 +229,34 @@ class HealpixProposal:
         d, B, ea, eb = self.domain, st["B"], st["ea"], st["eb"]
         w = out["w"]
         n, m = w.shape
-        p = np.stack([out["x"], out["y"], out["z"]], axis=-1)
-        gg = out["g"]
-        # the exact 0/1 likelihood on the draws with prior mass
+        # the exact 0/1 likelihood on the draws with prior mass (only theirs are read: the
+        # kernel leaves the others' values unset)
         cand = np.flatnonzero(w.ravel() > 0)
-        hit = np.zeros(n * m, bool)
+        pc = np.stack([out[k].ravel()[cand] for k in ("x", "y", "z")], axis=1)
+        gc = out["g"].ravel()[cand]
+        ok = np.zeros(cand.size, bool)  # each candidate's verdict
+        todo = np.arange(cand.size)  # the candidates not decided yet
         if cand.size and st["bands"] is not None:
             # the band check decides most draws at once (the prefilter below only drops
             # draws the exact check rejects: it is left for the others)
-            sure = band_pass(d.eyes, p.reshape(-1, 3)[cand], gg.ravel()[cand], cand // m,
-                             st["bands"])  # fmt: skip
-            at = cand[sure != 2]
-            hit[at] = exact_hits(d, p.reshape(-1, 3)[at], gg.ravel()[at], at // m, st["lit_a"],
-                                 st["lit_b"], matched=sure[sure != 2] == 1)  # fmt: skip
-            cand = cand[sure == 2]
-        if cand.size:  # a cheap necessary condition first
-            row = cand // m
-            pc = p.reshape(-1, 3)[cand]
-            pb_ = pc - B
+            sure = band_pass(d.eyes, pc, gc, cand // m, st["bands"])
+            at = np.flatnonzero(sure != 2)
+            ok[at] = exact_hits(d, pc[at], gc[at], cand[at] // m, st["lit_a"], st["lit_b"],
+                                matched=sure[at] == 1)  # fmt: skip
+            todo = np.flatnonzero(sure == 2)
+        if todo.size:  # a cheap necessary condition first
+            c = cand[todo]
+            row = c // m
+            pb_ = pc[todo] - B
             rb = np.linalg.norm(pb_, axis=1)
-            keep = _prefilter(ea, row, ca.reshape(-1, 3)[cand], alpha.ravel()[cand])
-            cand, row, pb_, rb = cand[keep], row[keep], pb_[keep], rb[keep]
-            sin_b = np.minimum(gg.ravel()[cand] / rb, 1.0)
+            keep = _prefilter(ea, row, ca.reshape(-1, 3)[c], alpha.ravel()[c])
+            todo, row, pb_, rb = todo[keep], row[keep], pb_[keep], rb[keep]
+            sin_b = np.minimum(gc[todo] / rb, 1.0)
             keep = _prefilter(eb, row, pb_ / rb[:, None], np.arcsin(sin_b))
-            cand = cand[keep]
-        hit[cand] = exact_hits(d, p.reshape(-1, 3)[cand], gg.ravel()[cand], cand // m,
-                               st["lit_a"], st["lit_b"])  # fmt: skip
+            todo = todo[keep]
+        ok[todo] = exact_hits(d, pc[todo], gc[todo], cand[todo] // m, st["lit_a"], st["lit_b"])
+        hit = np.zeros(n * m, bool)
+        hit[cand[ok]] = True
         w = np.where(hit.reshape(n, m), w, 0.0)
         return w
 

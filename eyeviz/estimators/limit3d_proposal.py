@@ -115,10 +115,16 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
+_GRIDS: dict[int, np.ndarray] = {}  # _grid's arrays, made once per n (read only by callers)
+
+
 def _grid(n: int) -> np.ndarray:
-    t = (np.arange(n) + 0.5) / n * 2 - 1
-    a, b = np.meshgrid(t, t, indexing="ij")
-    return np.stack([a.ravel(), b.ravel()], axis=1)  # (n*n, 2) in (-1, 1)
+    g = _GRIDS.get(n)
+    if g is None:
+        t = (np.arange(n) + 0.5) / n * 2 - 1
+        a, b = np.meshgrid(t, t, indexing="ij")
+        g = _GRIDS[n] = np.stack([a.ravel(), b.ravel()], axis=1)  # (n*n, 2) in (-1, 1)
+    return g
 
 
 _DIRS = np.stack([np.cos(np.arange(8) * math.pi / 4), np.sin(np.arange(8) * math.pi / 4)], axis=1)
@@ -128,7 +134,6 @@ def _locate(eye: _Eye, half: float, n: int, levels: int) -> None:
     """Move the eye's centre to the maximum of G (zooming grids of n x n about the best
     point, each a third as wide) and linearise there. Compiled unless ``EYEVIZ_JIT=0``
     (kernels.limit3d_locate.locate_kernel: the same formulas, in place)."""
-    rows = np.arange(eye.c.shape[0])
     g0 = _grid(n)
     if kernels.use(eye.pts.shape[0] * eye.pts.shape[1]):
         from eyeviz.core.kernels.limit3d_locate import locate_kernel
@@ -137,6 +142,7 @@ def _locate(eye: _Eye, half: float, n: int, levels: int) -> None:
                       eye.d, eye.t, eye.a_lit, eye.t_lit, eye.a_unl, eye.t_unl, eye.lists,
                       np.empty(g0.shape[0]))  # fmt: skip
         return
+    rows = np.arange(eye.c.shape[0])
     for _ in range(levels):
         g = g0[None] * half
         lo, hi = eye.bounds(np.broadcast_to(g, (rows.size, *g0.shape)))
@@ -145,10 +151,13 @@ def _locate(eye: _Eye, half: float, n: int, levels: int) -> None:
         half = half / 3.0
 
 
-def _extent(eye: _Eye, reach: float, slack, iters: int = 12) -> np.ndarray:
+def _extent(eye: _Eye, reach: float, slack, iters: int = 12, known=None) -> np.ndarray:
     """Half-widths (N, 2) of a box about the centre holding every delta with
     G(delta) >= -slack (bisection along NDIR directions: G is concave). The bisection is
-    compiled unless ``EYEVIZ_JIT=0`` (kernels.limit3d_affine.extent_kernel, the same bits)."""
+    compiled unless ``EYEVIZ_JIT=0`` (kernels.limit3d_affine.extent_kernel, the same bits).
+    ``known`` (same (N,), prev (N, 2)): the keys ``same`` take their rows of ``prev``, an
+    earlier call's answer on the same model, reach and slack (the same bits: compiled,
+    their bisection is skipped)."""
     n = eye.c.shape[0]
     dirs = _DIRS_NDIR
     lo = np.zeros((n, NDIR))
@@ -157,8 +166,11 @@ def _extent(eye: _Eye, reach: float, slack, iters: int = 12) -> np.ndarray:
         from eyeviz.core.kernels.limit3d_affine import extent_kernel
 
         sl = kernels.arg(np.broadcast_to(slack, (n, 1))[:, 0], np.float64)
+        todo = np.ones(n, np.bool_) if known is None else ~known[0]
+        if not todo.any():
+            return known[1].copy()
         extent_kernel(eye.a_lit, eye.t_lit, eye.a_unl, eye.t_unl, eye.lists, dirs,
-                      float(reach), sl, iters, hi)  # fmt: skip
+                      float(reach), sl, iters, todo, hi)  # fmt: skip
         iters = 0
     for _ in range(iters):
         mid = 0.5 * (lo + hi)
@@ -170,7 +182,8 @@ def _extent(eye: _Eye, reach: float, slack, iters: int = 12) -> np.ndarray:
     # the box of the boundary points, widened: a convex polygon between two of them
     # bulges out by at most tan(pi / NDIR) times their distance
     ext = np.abs(pts).max(axis=1) * (1.0 + math.tan(math.pi / NDIR))
-    return np.maximum(ext, 1e-12)
+    ext = np.maximum(ext, 1e-12)
+    return ext if known is None else np.where(known[0][:, None], known[1], ext)
 
 
 def _dirs(k: int) -> np.ndarray:

@@ -233,6 +233,39 @@ def test_same_rows_kernel_is_the_reference(seed):
     assert np.array_equal(got, want)
 
 
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31), m=st.integers(1, 40), special=st.booleans())
+def test_compact_draws_kernel_is_the_reference(seed, m, special):
+    """limit3d._compact compiled (limit3d_region.compact_draws_kernel) and in numpy: the
+    same arrays bit for bit, over all columns and over a range of them with some rows
+    weighing 0 (the top-ups' batches), with weights 0, negative or NaN, values inf or NaN
+    (the padding: the row's largest accepted value, 1 where that is not finite or there
+    is none), rows with nothing accepted and a strided view of the draws."""
+    from eyeviz.core import kernels
+    from eyeviz.estimators import limit3d
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 6))
+    names = ("x", "y", "z", "g", "r", "az", "el", "w")
+    big = {k: rng.normal(size=(n, 2 * m)) for k in names}
+    big["w"] = np.where(rng.random((n, 2 * m)) < 0.4, rng.exponential(size=(n, 2 * m)), 0.0)
+    big["w"][0] = 0.0  # a row with nothing accepted
+    if special:
+        for k in names:
+            big[k].ravel()[rng.integers(0, 2 * n * m, 3)] = rng.choice(SPECIAL, 3)
+    s = {k: v[:, ::2] for k, v in big.items()}  # strided views
+    rows = rng.random(n) < 0.7
+    lo = int(rng.integers(0, m))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(kernels._STATE, "ready", True)
+        got = [limit3d._compact(s), limit3d._compact(big, lo, 2 * m - lo // 2, rows)]
+    want = [limit3d._compact_ref(s), limit3d._compact_ref(big, lo, 2 * m - lo // 2, rows)]
+    for g, w in zip(got, want, strict=True):
+        assert list(g) == list(w)
+        for k in names:
+            assert g[k].shape == w[k].shape and np.array_equal(g[k], w[k], equal_nan=True), k
+
+
 def test_limit3d_answers_with_the_kernels_are_the_reference_s_healpix(monkeypatch):
     d = Domain3D(nside=8)
     ds = generate3d(6, d, seed=21)

@@ -274,6 +274,16 @@ def test_extent_with_the_kernel_is_the_reference_bit_for_bit(nside, seed, monkey
                 want = _extent(e, 0.5 * fw, slack)
             assert np.array_equal(got, want)
             assert (got > 1e-12).any() and (got < 0.5 * fw * 1.5).all()
+        # an earlier box on the same model taken for the keys whose slack it had (the
+        # others bisected again): the same as a fresh call, and each part is used
+        first = _extent(e, 0.5 * fw, 0.002 * fw)
+        slack = np.where(np.arange(n) % 2 == 0, 0.002, 0.0005)[:, None] * fw
+        same = slack[:, 0] == 0.002 * fw
+        got = _extent(e, 0.5 * fw, slack, known=(same, first))
+        assert np.array_equal(got, _extent(e, 0.5 * fw, slack))
+        assert not np.array_equal(got[~same], first[~same])
+        assert np.array_equal(_extent(e, 0.5 * fw, 0.002 * fw, known=(np.ones(n, bool), first)),
+                              first)  # fmt: skip
 
 
 @pytest.mark.parametrize("nside,seed", [(16, 13), (180, 14)])
@@ -390,6 +400,29 @@ def test_the_first_prunes_candidates_keep_every_cell_it_keeps(monkeypatch):
     assert dropped > 0
 
 
+@pytest.mark.parametrize("nside,seed", [(16, 31), (180, 32)])
+def test_candidates_kernel_gives_the_numpy_verdicts(nside, seed, monkeypatch):
+    """_Eye._candidates' verdicts compiled (limit3d_affine.candidates_kernel) and in numpy
+    (the sample gap, each key's largest lit L and smallest unlit U by ufunc.at, the
+    margins) on real keys' band cells at several reaches: the same, cell by cell."""
+    from eyeviz.core import kernels
+
+    monkeypatch.setitem(kernels._STATE, "ready", True)
+    fw = math.sqrt(4 * math.pi / (12 * nside**2))
+    for e in _eyes(nside, seed):
+        cnt = e._band[0]
+        rows = np.repeat(np.arange(cnt.size), cnt)
+        for f in (0.05, 0.25, 1.0):
+            reach = np.full(cnt.size, f * fw) * np.linspace(0.5, 1.5, cnt.size)
+            got = e._candidates(e.u0, rows, reach)
+            with monkeypatch.context() as mp:
+                mp.setenv("EYEVIZ_JIT", "0")
+                want = e._candidates(e.u0, rows, reach)
+            assert np.array_equal(got, want)
+            if f == 0.05:
+                assert got.any() and not got.all()
+
+
 def test_band_cells_kernel_is_the_set_differences(monkeypatch):
     """_band_cells compiled (healpix_match.band_cells_kernel, a merge of sorted rows) and
     in numpy (set differences, a stable sort by key): the same codes, lit flags and rows,
@@ -417,6 +450,37 @@ def test_band_cells_kernel_is_the_set_differences(monkeypatch):
             want = _band_cells(key, inner, outer, small, npix)
         for a, b in zip(got, want, strict=True):
             assert np.array_equal(a, b)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31), ties=st.booleans())
+def test_band_order_kernel_is_the_lexsort(seed, ties):
+    """_Eye.band's order (healpix_match.band_order_kernel) against numpy's stable lexsort
+    of (where(lit, -near, far), ~lit, key): per key the lit cells by near from the
+    largest, then the unlit ones by far from the smallest, ties (and NaN, last) in cell
+    order; every array in that order and where each key's unlit cells start."""
+    from eyeviz.core.kernels.healpix_match import band_order_kernel
+
+    rng = np.random.default_rng(seed)
+    cnt = rng.integers(0, 90, int(rng.integers(1, 6)))  # sorts past insertion sort's size
+    bp = np.concatenate([[0], np.cumsum(cnt)]).astype(np.int64)
+    t = int(bp[-1])
+    lit = rng.random(t) < 0.5
+    near, far = rng.random(t), rng.random(t)
+    if ties:  # equal bounds, zeros of both signs and a NaN
+        near, far = np.round(near, 1), np.round(far, 1)
+        far[rng.random(t) < 0.2] = -0.0
+        if t:
+            near[rng.integers(0, t)] = np.nan
+    pix, ring = rng.permutation(t).astype(np.int64), rng.integers(1, 9, t).astype(np.int64)
+    verts = rng.normal(size=(t, 4, 3))
+    got = band_order_kernel(bp, pix, ring, lit, near, far, verts)
+    key = np.repeat(np.arange(cnt.size), cnt)
+    order = np.lexsort((np.where(lit, -near, far), ~lit, key))
+    want = (pix[order], ring[order], lit[order], near[order], far[order], verts[order],
+            bp[:-1] + np.bincount(key[lit], minlength=cnt.size))  # fmt: skip
+    for a, b in zip(got, want, strict=True):
+        assert np.array_equal(a, b, equal_nan=True)
 
 
 def _forms(rng, n: int, k: int) -> tuple[np.ndarray, ...]:

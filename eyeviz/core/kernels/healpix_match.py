@@ -42,6 +42,7 @@ __all__ = [
     "match_kernel",
     "edge_match_kernel",
     "band_bounds_kernel",
+    "band_order_kernel",
     "band_cells_kernel",
     "vertex_cache",
     "warm",
@@ -186,6 +187,47 @@ def band_bounds_kernel(n, pix, ring, key, u0, sth, zr, unit, first_t, shifted_t,
             last = key[k]
             cpix = _ang2pix(n, min(max(c[2], -1.0), 1.0), math.atan2(c[1], c[0]))
         far[k] = 0.0 if cpix == pix[k] else max(_angle(lo) - 1e-12, 0.0)
+
+
+@_jit
+def band_order_kernel(bp, pix, ring, lit, near, far, verts):
+    """limit3d_eye._Eye.band's order of the band cells (CSR ``bp`` by key): per key its lit
+    cells by ``near`` from the largest, then its unlit ones by ``far`` from the smallest,
+    ties in their order (numpy's lexsort of (where(lit, -near, far), ~lit, key): stable
+    sorts of -near and far, NaN last). Returns pix, ring, lit, near, far and verts in that
+    order and bl (where each key's unlit cells start)."""
+    nk = bp.size - 1
+    order = np.empty(pix.size, np.int64)
+    bl = np.empty(nk, np.int64)
+    o = 0
+    for i in range(nk):
+        a, b = bp[i], bp[i + 1]
+        idx = np.empty(b - a, np.int64)
+        vals = np.empty(b - a)
+        for phase in range(2):
+            m = 0
+            for j in range(a, b):
+                if lit[j] == (phase == 0):
+                    idx[m] = j
+                    vals[m] = -near[j] if phase == 0 else far[j]
+                    m += 1
+            srt = np.argsort(vals[:m], kind="mergesort")
+            for q in range(m):
+                order[o] = idx[srt[q]]
+                o += 1
+            if phase == 0:
+                bl[i] = o
+    t = pix.size  # the gathers as loops (numba's fancy indexing costs twice as much)
+    o_pix, o_ring, o_lit = np.empty(t, pix.dtype), np.empty(t, ring.dtype), np.empty(t, np.bool_)
+    o_near, o_far, o_verts = np.empty(t), np.empty(t), np.empty((t, 4, 3))
+    for k in range(t):
+        j = order[k]
+        o_pix[k], o_ring[k], o_lit[k] = pix[j], ring[j], lit[j]
+        o_near[k], o_far[k] = near[j], far[j]
+        for q in range(4):
+            for c in range(3):
+                o_verts[k, q, c] = verts[j, q, c]
+    return o_pix, o_ring, o_lit, o_near, o_far, o_verts, bl
 
 
 # long: one draw's containment test and its band cells' walk with its early exit
@@ -352,6 +394,7 @@ def warm() -> None:
     band_bounds_kernel(n, pix, ring, i1, u, sth, zr, unit, first, shifted, np.empty((1, 4, 3)),
                        False, near, far)  # fmt: skip
     p2 = np.array([0, 1])
+    band_order_kernel(p2, pix, ring, np.ones(1, np.bool_), near, far, np.zeros((1, 4, 3)))
     band_cells_kernel(p2, i1, p2, i1, p2, i1, np.zeros(1, np.bool_), i1.copy(),
                       np.zeros(1, np.bool_), i1.copy())  # fmt: skip
     edge_match_kernel(n, x, y, z, g, 40.0, i1, u, np.zeros(1), np.ones(1), u, np.array([0, 1]),

@@ -33,6 +33,8 @@ __all__ = [
     "extent_kernel",
     "linearise_kernel",
     "affine_kernel",
+    "affine_forms_kernel",
+    "candidates_kernel",
     "boundaries_kernel",
     "compact_kernel",
     "box_lists_kernel",
@@ -111,6 +113,35 @@ def _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n, dx, dy):
     return lo, math.sqrt(_max(hi2, 0.0))
 
 
+@_jit_inline
+def _affine_points(lists, n, gx, gy, m, lo, hi):
+    """:func:`_affine_lists` of key n at the m points (gx[j], gy[j]) (finite), into lo[j],
+    hi[j]: the same operations on each point in the same order (a form's products, its
+    difference, the running max and min, the squared offset, the root), with the points
+    as the inner loop (vectorised by the compiler), so the same bits."""
+    l_a, l_t, nl, u_a, u_t, nu = lists
+    for j in range(m):
+        lo[j] = -np.inf
+        hi[j] = np.inf
+    for k in range(nl[n]):
+        a, t0, t1 = l_a[n, k], l_t[n, k, 0], l_t[n, k, 1]
+        for j in range(m):
+            v = t0 * gx[j]
+            v = v + t1 * gy[j]
+            v = a - v
+            lo[j] = v if v > lo[j] else lo[j]
+    for k in range(nu[n]):
+        a, t0, t1 = u_a[n, k], u_t[n, k, 0], u_t[n, k, 1]
+        for j in range(m):
+            w = t0 * gx[j]
+            w = w + t1 * gy[j]
+            w = a - w
+            hi[j] = w if w < hi[j] else hi[j]
+    for j in range(m):
+        h = hi[j] + (gx[j] * gx[j] + gy[j] * gy[j])
+        hi[j] = math.sqrt(_max(h, 0.0))
+
+
 @_jit
 def affine_bounds_kernel(a_lit, t_lit, a_unl, t_unl, lists, delta, lo, hi):
     """_Eye.bounds: lo, hi (N, G) at gnomonic offsets delta (N, G, 2)."""
@@ -122,24 +153,48 @@ def affine_bounds_kernel(a_lit, t_lit, a_unl, t_unl, lists, delta, lo, hi):
 
 
 @_jit
-def extent_kernel(a_lit, t_lit, a_unl, t_unl, lists, dirs, reach, slack, iters, hi):
+def extent_kernel(a_lit, t_lit, a_unl, t_unl, lists, dirs, reach, slack, iters, todo, hi):
     """limit3d_proposal._extent's bisection: along each direction dirs[k] (K, 2) from each
     key's centre, ``iters`` halvings of [0, reach] keeping the model's G = min_unlit -
     max_lit >= -slack[n] below; hi (N, K) the outer ends (the same arithmetic as numpy's:
-    the same bits)."""
+    the same bits), on the keys ``todo`` (N,) only (the others' rows left as they were)."""
+    nd = dirs.shape[0]
+    lo_, hi_, mid = np.empty(nd), np.empty(nd), np.empty(nd)
+    gx, gy, a, b = np.empty(nd), np.empty(nd), np.empty(nd), np.empty(nd)
     for n in range(hi.shape[0]):
-        for k in range(dirs.shape[0]):
-            lo_ = 0.0
-            hi_ = reach
-            for _ in range(iters):
-                mid = 0.5 * (lo_ + hi_)
-                a, b = _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n, mid * dirs[k, 0],
-                                     mid * dirs[k, 1])  # fmt: skip
-                if (b - a) >= -slack[n]:
-                    lo_ = mid
+        if not todo[n]:
+            continue
+        if not math.isfinite(reach):  # the model's non-finite path: one point at a time
+            for k in range(nd):
+                lo1 = 0.0
+                hi1 = reach
+                for _ in range(iters):
+                    m1 = 0.5 * (lo1 + hi1)
+                    a1, b1 = _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n,
+                                           m1 * dirs[k, 0], m1 * dirs[k, 1])  # fmt: skip
+                    if (b1 - a1) >= -slack[n]:
+                        lo1 = m1
+                    else:
+                        hi1 = m1
+                hi[n, k] = hi1
+            continue
+        # every direction's bisection at once (each the same steps as alone)
+        for k in range(nd):
+            lo_[k] = 0.0
+            hi_[k] = reach
+        for _ in range(iters):
+            for k in range(nd):
+                mid[k] = 0.5 * (lo_[k] + hi_[k])
+                gx[k] = mid[k] * dirs[k, 0]
+                gy[k] = mid[k] * dirs[k, 1]
+            _affine_points(lists, n, gx, gy, nd, a, b)
+            for k in range(nd):
+                if (b[k] - a[k]) >= -slack[n]:
+                    lo_[k] = mid[k]
                 else:
-                    hi_ = mid
-            hi[n, k] = hi_
+                    hi_[k] = mid[k]
+        for k in range(nd):
+            hi[n, k] = hi_[k]
 
 
 # long: the nearest sample, its distance and its tangent are one pass over a cell's samples
@@ -223,6 +278,63 @@ def affine_kernel(d, t, lit, pad, a_lit, t_lit, a_unl, t_unl, l_a, l_t, nl, u_a,
                 t_unl[n, k, 1] = 0.0
         nl[n] = il
         nu[n] = iu
+
+
+@_jit
+def affine_forms_kernel(d, t, lit, pad):
+    """_Eye._affine with its arrays made here: (a_lit, t_lit, a_unl, t_unl, lists) of
+    :func:`affine_kernel`, the lists as wide as the most live lit (unlit) cells of a row
+    (at least 1) and zero beyond each row's count."""
+    n, k = d.shape
+    kl = 1
+    ku = 1
+    for i in range(n):
+        cl = 0
+        cu = 0
+        for j in range(k):
+            if not pad[i, j]:
+                if lit[i, j]:
+                    cl += 1
+                else:
+                    cu += 1
+        kl = max(kl, cl)
+        ku = max(ku, cu)
+    a_lit, a_unl = np.empty((n, k)), np.empty((n, k))
+    t_lit, t_unl = np.empty((n, k, 2)), np.empty((n, k, 2))
+    lists = (np.zeros((n, kl)), np.zeros((n, kl, 2)), np.zeros(n, np.int64),
+             np.zeros((n, ku)), np.zeros((n, ku, 2)), np.zeros(n, np.int64))  # fmt: skip
+    affine_kernel(d, t, lit, pad, a_lit, t_lit, a_unl, t_unl, *lists)
+    return a_lit, t_lit, a_unl, t_unl, lists
+
+
+@_jit
+def _gap(s, d):
+    """limit3d_eye._sample_gap for one distance: the same operations (NaN as numpy's)."""
+    d_lo = math.sqrt(_max(d * d - 0.25 * s * s, 0.0))
+    return 1.5 * (math.sqrt(d_lo * d_lo + 0.25 * s * s) - d_lo)
+
+
+@_jit
+def candidates_kernel(lit, rows, near, far, s, reach, nkeys, keep):
+    """limit3d_eye._Eye._candidates' verdicts from the cells' bounds (``near``, ``far``;
+    the keys ``rows``, sorted or not, of ``nkeys``): L and U (lit cells less the sample
+    gap for spacing s), each key's largest lit L and smallest unlit U (numpy's maximum and
+    minimum: NaN wins), and keep = U >= max L - m (lit) or L <= min U + m (unlit), m = 2.2
+    reach[key] + 1e-9: numpy's operations, so the same verdicts."""
+    t = rows.size
+    lo, hi = np.empty(t), np.empty(t)
+    lo_lit, hi_unl = np.full(nkeys, -np.inf), np.full(nkeys, np.inf)
+    for k in range(t):
+        if lit[k]:
+            lo[k] = far[k] - _gap(s, far[k])
+            hi[k] = near[k] - _gap(s, near[k])
+            lo_lit[rows[k]] = _max(lo_lit[rows[k]], lo[k])
+        else:
+            lo[k], hi[k] = far[k], near[k]
+            hi_unl[rows[k]] = _min(hi_unl[rows[k]], hi[k])
+    for k in range(t):
+        m = 2.2 * reach[rows[k]] + 1e-9
+        keep[k] = hi[k] >= lo_lit[rows[k]] - m if lit[k] else lo[k] <= hi_unl[rows[k]] + m
 
 
 @_jit
@@ -352,6 +464,9 @@ def warm() -> None:
     compact_kernel(b, pts, b, d, t, pts.copy(), b.copy(), b.copy(), d.copy(), t.copy())
     affine_kernel(d, t, b, b.copy(), d.copy(), t.copy(), d.copy(), t.copy(), d.copy(), t.copy(),
                   n1, d.copy(), t.copy(), n1.copy())  # fmt: skip
+    affine_forms_kernel(d, t, b, b.copy())
+    i1 = np.zeros(1, np.int64)
+    candidates_kernel(b[0], i1, np.ones(1), np.ones(1), 0.01, np.ones(1), 1, b[0].copy())
     a2 = np.zeros((1, 1))
     a3 = np.zeros((1, 1, 2))
     dl = np.zeros((1, 1, 2))
@@ -359,4 +474,5 @@ def warm() -> None:
     lists = (a2, a3, n1 + 1, a2, a3, n1 + 1)
     affine_bounds_kernel(a2, a3, a2, a3, lists, dl, out, out.copy())
     box_lists_kernel(lists, np.ones((1, 2)), tuple(x.copy() for x in lists))
-    extent_kernel(a2, a3, a2, a3, lists, np.ones((1, 2)), 1.0, np.ones(1), 2, out.copy())
+    extent_kernel(a2, a3, a2, a3, lists, np.ones((1, 2)), 1.0, np.ones(1), 2,
+                  np.ones(1, np.bool_), out.copy())  # fmt: skip

@@ -330,8 +330,8 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
             lo_b, hi_b = _affine_lists(bl, sl_, bu, su, lb, n, bx, by)
             g_lo = rr * s_half
             g_hi = g_max
-            g_lo = _max(g_lo, rho * math.sin(_clip_nan(lo_a - sn, 0.0, h2)))
-            g_hi = _min(g_hi, rho * math.sin(_clip_nan(hi_a + sn, 0.0, h2)))
+            g_lo = _max(g_lo, rho * sa_lo)  # A's sines, as the search took them
+            g_hi = _min(g_hi, rho * sa_hi)
             g_lo = _max(g_lo, rho_b * math.sin(_clip_nan(lo_b - sn, 0.0, h2)))
             g_hi = _min(g_hi, rho_b * math.sin(_clip_nan(hi_b + sn, 0.0, h2)))
             if not g_hi > g_lo:

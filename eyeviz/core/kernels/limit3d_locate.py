@@ -19,7 +19,12 @@ from numba import njit
 
 from eyeviz.core.kernels import limit3d_affine
 from eyeviz.core.kernels.healpix_boundary import stamp_with
-from eyeviz.core.kernels.limit3d_affine import _affine_lists, affine_kernel, linearise_kernel
+from eyeviz.core.kernels.limit3d_affine import (
+    _affine_lists,
+    _affine_points,
+    affine_kernel,
+    linearise_kernel,
+)
 
 # before the first kernel: its cache carries the source of the module it calls as well
 stamp_with(__file__, limit3d_affine.__file__)
@@ -38,13 +43,24 @@ def locate_kernel(pts, lit, pad, s, g0, half, levels, c, e1, e2, d, t, a_lit, t_
     (linearise_kernel, affine_kernel), and the grid a third as wide. c, e1, e2 (N, 3), d,
     t and the affine forms and lists are updated in place (their counts do not change:
     the cells stay). vals (G,): work."""
+    ng = g0.shape[0]
+    gx, gy, lo_, hi_ = np.empty(ng), np.empty(ng), np.empty(ng), np.empty(ng)
     for _ in range(levels):
         for n in range(c.shape[0]):
+            if math.isfinite(half):  # the grid's points at once (the same bits)
+                for j in range(ng):
+                    gx[j] = g0[j, 0] * half
+                    gy[j] = g0[j, 1] * half
+                _affine_points(lists, n, gx, gy, ng, lo_, hi_)
+                for j in range(ng):
+                    vals[j] = hi_[j] - lo_[j]
+            else:
+                for j in range(ng):
+                    lo, hi = _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n,
+                                           g0[j, 0] * half, g0[j, 1] * half)  # fmt: skip
+                    vals[j] = hi - lo
             best = 0
-            for j in range(g0.shape[0]):
-                lo, hi = _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n, g0[j, 0] * half,
-                                       g0[j, 1] * half)  # fmt: skip
-                vals[j] = hi - lo
+            for j in range(ng):
                 vb = vals[best]
                 if vb == vb and (vals[j] != vals[j] or vals[j] > vb):
                     best = j

@@ -27,6 +27,7 @@ __all__ = [
     "bcentre",
     "same_rows_kernel",
     "prefilter_kernel",
+    "compact_draws_kernel",
     "warm",
 ]
 
@@ -284,6 +285,57 @@ def same_rows_kernel(ptr, ind, kp, ki, row, same):
         same[i] = ok
 
 
+@_jit
+def compact_draws_kernel(vals, iw, lo, hi, rows):
+    """limit3d._compact of the draws ``vals`` (a tuple of (N, M) arrays, the weights at
+    ``iw``) in the columns lo .. hi - 1, the rows not ``rows`` (N,) weighing 0: per row the
+    accepted draws (weight > 0) first, in draw order, padded to the widest row's count K
+    (at least 1) with 0 for the weights and, for the others, the row's largest accepted
+    value (1 where there is none, or where that is not finite: numpy's maximum, NaN
+    wins); returns (len(vals), N, K)."""
+    w = vals[iw]
+    n = w.shape[0]
+    cnt = np.zeros(n, np.int64)
+    k = 1
+    for i in range(n):
+        if rows[i]:
+            c = 0
+            for j in range(lo, hi):
+                if w[i, j] > 0.0:
+                    c += 1
+            cnt[i] = c
+            k = max(k, c)
+    at = np.empty((n, k), np.int64)  # each row's accepted columns
+    for i in range(n):
+        if cnt[i]:
+            c = 0
+            for j in range(lo, hi):
+                if w[i, j] > 0.0:
+                    at[i, c] = j
+                    c += 1
+    out = np.empty((len(vals), n, k))
+    for q in range(len(vals)):
+        v = vals[q]
+        for i in range(n):
+            top = -np.inf
+            nan = False
+            for o in range(cnt[i]):
+                x = v[i, at[i, o]]
+                out[q, i, o] = x
+                if x != x:
+                    nan = True
+                elif x > top:
+                    top = x
+            pad = 1.0
+            if q == iw:
+                pad = 0.0
+            elif cnt[i] > 0 and not nan and math.isfinite(top):
+                pad = top
+            for j in range(cnt[i], k):
+                out[q, i, j] = pad
+    return out
+
+
 def warm() -> None:
     """Compile (or load from the cache) the kernels for their one signature each."""
     a2 = np.zeros((1, 1))
@@ -299,3 +351,4 @@ def warm() -> None:
     prefilter_kernel(pts, b, ~b, np.zeros(1, np.int64), c, np.ones(1), 0.01, b[0].copy())
     i1 = np.zeros(2, np.int64)
     same_rows_kernel(i1, i1[:0], i1, i1[:0], i1[:1], b[0])
+    compact_draws_kernel(tuple(np.ones((1, 2)) for _ in range(8)), 7, 0, 2, b[0].copy())
