@@ -162,7 +162,7 @@ def group_gone(pgid, timeout=60) -> bool:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL])
-def test_ctrl_c_or_a_crash_mid_study_keeps_whole_points_and_resumes(tmp_path, sig):
+def test_ctrl_c_or_a_crash_mid_study_keeps_whole_points_and_resumes(tmp_path, sig, eyeviz_main):
     path = tmp_path / "s.csv"
     proc, args = start_study(path)
     try:
@@ -188,8 +188,9 @@ def test_ctrl_c_or_a_crash_mid_study_keeps_whole_points_and_resumes(tmp_path, si
     assert 1 <= len(kept) < 6
     lines_before = path.read_text().splitlines()
     # one worker: two Python processes fewer than two (a nanny and its worker, each
-    # importing dask and eyeviz), for points of half a second each
-    out = eyeviz(*args, "--workers", "1", "--no-progress")
+    # importing dask and eyeviz), for points of half a second each; the resume in this
+    # process (its rows are the point, the signal went to the other)
+    out = eyeviz_main("study", *args, "--workers", "1", "--no-progress")
     assert out.returncode == 0, out.stderr
     assert f"{6 - len(kept)} point(s) computed, {len(kept)} skipped" in out.stdout
     assert path.read_text().splitlines()[: len(lines_before)] == lines_before
