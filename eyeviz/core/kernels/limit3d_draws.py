@@ -270,10 +270,14 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
     0 (w 0 elsewhere, the others then unset); only the keys ``rows`` (N,) get draws."""
     al, tl, au, tu, la = fa
     bl, sl_, bu, su, lb = fb
-    gv = np.empty(t.size)
-    uu = np.empty(t.size)
     h2 = 0.5 * math.pi
     lam = n_def / samples
+    mt = samples * streams.size
+    # a key's draws that reach the ray search: their index and state (A's direction, its
+    # sp, the box's u interval, A's sines), then their brackets
+    q_m = np.empty(mt, np.int64)
+    q_v = np.empty((mt, 8))
+    q_h = np.empty((mt, 2))
     for n in range(keys.size):
         base = keys[n] * _M1
         sn = slack[n]
@@ -281,7 +285,8 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
         dph = box[n, 3] - box[n, 2]
         live = rows[n] and dth > 0 and dph > 0
         vol0 = dth * dph
-        for m in range(samples * streams.size):
+        nq = 0
+        for m in range(mt):
             w[n, m] = 0.0
             if not live:
                 continue
@@ -304,10 +309,21 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
             uhi = _min(uhi, u_max)
             if not uhi > ulo:
                 continue
-            sa_lo = math.sin(_clip_nan(lo_a - sn, 0.0, h2))
-            sa_hi = math.sin(_clip_nan(hi_a + sn, 0.0, h2))
-            hlo, hhi = _ray_search(bl, sl_, bu, su, lb, cb, e1b, e2b, ab, n, cx, cy, cz, ulo, uhi,
-                                   sn, t, rounds, gv, uu, sa_lo, sa_hi)  # fmt: skip
+            q_m[nq] = m
+            v = q_v[nq]
+            v[0], v[1], v[2], v[3] = cx, cy, cz, sp
+            v[4], v[5] = ulo, uhi
+            v[6] = math.sin(_clip_nan(lo_a - sn, 0.0, h2))
+            v[7] = math.sin(_clip_nan(hi_a + sn, 0.0, h2))
+            nq += 1
+        _ray_searches(bl, sl_, bu, su, lb, cb, e1b, e2b, ab, n, q_v, nq, sn, t, rounds, q_h)
+        for q in range(nq):
+            m = q_m[q]
+            v = q_v[q]
+            cx, cy, cz, sp, ulo, uhi, sa_lo, sa_hi = v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]
+            hlo, hhi = q_h[q, 0], q_h[q, 1]
+            s_m = streams[m // samples]
+            j4 = 4 * (m % samples)
             if not hhi > hlo:  # a bracket of no width: the box's interval instead
                 hlo, hhi = ulo, uhi
             u2 = _uniform(base, s_m, j4 + 2)
@@ -315,9 +331,9 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
                 uv = ulo + (uhi - ulo) * u2
             else:
                 uv = hlo + (hhi - hlo) * u2
-            q = lam / (uhi - ulo)
+            qd = lam / (uhi - ulo)
             if uv >= hlo and uv <= hhi:
-                q += (1.0 - lam) / (hhi - hlo)
+                qd += (1.0 - lam) / (hhi - hlo)
             rho = 1.0 / uv
             px, py, pz = pa[0] + rho * cx, pa[1] + rho * cy, pa[2] + rho * cz
             rr = math.sqrt(px * px + py * py + pz * pz)
@@ -340,7 +356,7 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
             e = math.asin(_clip_nan(pz / rr, -1.0, 1.0))
             phi = math.atan2(py, px)
             dens = healpix_prior(rr, gg, e, phi, s_half, g_max, r_min, r_max, el_max, psi, multi)
-            vol = vol0 * ((g_hi - g_lo) / q)
+            vol = vol0 * ((g_hi - g_lo) / qd)
             wt = dens * rho**4 * sp * vol
             if not (math.isfinite(wt) and wt > 0.0):
                 continue
@@ -348,6 +364,62 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
             r[n, m], az[n, m], el[n, m], w[n, m] = rr, phi, e, wt
             ca[n, m, 0], ca[n, m, 1], ca[n, m, 2] = cx, cy, cz
             alpha[n, m] = math.asin(_clip_nan(gg / rho, 0.0, 1.0))
+
+
+#: rays searched side by side (:func:`_ray_searches`)
+_LANES = 4
+
+
+@_jit_inline
+def _ray_searches(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, qv, nq, slack, t, rounds,
+                  out):  # fmt: skip
+    """:func:`_ray_search` of the rays 0 .. nq - 1 of key n (qv[q]: c_A's x, y, z, sp, the
+    box's lo, hi along the ray, A's sin(lo_A - s), sin(hi_A + s)), ``_LANES`` of them side
+    by side: each takes the points :func:`_aim_next` asks for in turn, a point of each ray
+    evaluated before the next of any, so the rays' chains of operations (a normalisation,
+    B's model, two sines) overlap; each ray's points, values and bracket are its own search's
+    (a point's value is a function of its u alone). out[q] = (lo, hi)."""
+    grid = t.size
+    gvs = np.empty((_LANES, grid))
+    uus = np.empty((_LANES, grid))
+    seen = np.zeros(_LANES, np.int64)
+    pend = np.zeros(_LANES, np.int64)
+    act = np.zeros(_LANES, np.bool_)
+    for q0 in range(0, nq, _LANES):
+        k = min(_LANES, nq - q0)
+        for i in range(k):
+            out[q0 + i, 0] = qv[q0 + i, 4]
+            out[q0 + i, 1] = qv[q0 + i, 5]
+        for _ in range(rounds):
+            for i in range(k):
+                lo_, hi_ = out[q0 + i, 0], out[q0 + i, 1]
+                for j in range(grid):
+                    uus[i, j] = lo_ + (hi_ - lo_) * t[j]
+                seen[i] = 0
+                act[i] = True
+            while True:
+                more = False
+                for i in range(k):
+                    if not act[i]:
+                        continue
+                    j, first, last = _aim_next(gvs[i], seen[i], grid)
+                    if j < 0:
+                        act[i] = False
+                        out[q0 + i, 0] = uus[i, max(first - 1, 0)]
+                        out[q0 + i, 1] = uus[i, min(last + 1, grid - 1)]
+                    else:
+                        pend[i] = j
+                        more = True
+                if not more:
+                    break
+                for i in range(k):
+                    if act[i]:
+                        q = q0 + i
+                        j = pend[i]
+                        gvs[i, j] = _gap_g(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n,
+                                           qv[q, 0], qv[q, 1], qv[q, 2], uus[i, j], qv[q, 6],
+                                           qv[q, 7], slack)  # fmt: skip
+                        seen[i] |= 1 << j
 
 
 def warm() -> None:
