@@ -265,18 +265,24 @@ class Limit3DEstimator(Estimator3D):
         of batches (``sample_counts``): key n's k-th batch is its stream + 8 k, taken while
         the key still needs more after the batches before it, as there, so a key gets the
         same draws; but each round draws a key the batches its error predicts
-        (:func:`_more_batches`), not ``_TOPUP`` for every key. Only the keys ``ok``."""
-        m = self.samples
-        rep = np.ones(keys.size, np.int64)
-        # the batches' compacted draws, concatenated once at the end; r and w (all the
-        # decisions read) as they grow
-        parts, rw = [out], {"r": out["r"], "w": out["w"]}
-        need = _needs_more(rw["r"], rw["w"], self.accuracy) & (rep < self.max_batches) & ok
+        (:func:`_more_batches`), not ``_TOPUP`` for every key. Only the keys ``ok``.
+        Returns :func:`_compact` of the draws (what the caller's ``_compact`` makes of
+        them): the accepted draws are kept flat, batch after batch (each batch's rows in
+        order), the decisions read r and w from them (:func:`_spread_flat`), and the
+        arrays are built once at the end."""
+        m, n = self.samples, keys.size
+        rep = np.ones(n, np.int64)
+        acc = out["w"] > 0
+        rows = [np.nonzero(acc)[0]]
+        vals = [{k: v[acc] for k, v in out.items()}]
+        row_all, r_all, w_all = rows[0], vals[0]["r"], vals[0]["w"]
+        sp = _spread_flat(n, row_all, r_all, w_all)
+        need = _needs_more_of(*sp, self.accuracy) & (rep < self.max_batches) & ok
         while need.any():
-            cnt = np.where(need, _more_batches(rw, self.accuracy, rep), 0)
+            cnt = np.where(need, _more_batches_of(*sp, self.accuracy, rep), 0)
             cnt = np.minimum(cnt, self.max_batches - rep)
             # the accepted draws alone (flat indices n W + m, W = max(cnt) batches), batch
-            # by batch: the same arrays as _compact of the batch's dense draws
+            # by batch
             at, more = self._proposal.sample_counts_sparse(st, keys, stream + 8 * rep, cnt)
             width = int(cnt.max()) * m
             row, col = at // width, at % width
@@ -285,13 +291,19 @@ class Limit3DEstimator(Estimator3D):
                 if not take.any():
                     break
                 sel = np.flatnonzero(take[row] & (col // m == j))
-                parts.append(_compact_sparse(keys.size, row[sel], {k: v[sel] for k, v in
-                                                                   more.items()}))  # fmt: skip
-                rw = {k: np.concatenate([rw[k], parts[-1][k]], axis=1) for k in rw}
+                rows.append(row[sel])
+                vals.append({k: v[sel] for k, v in more.items()})
+                row_all = np.concatenate([row_all, rows[-1]])
+                r_all = np.concatenate([r_all, vals[-1]["r"]])
+                w_all = np.concatenate([w_all, vals[-1]["w"]])
                 rep += take
-                need = _needs_more(rw["r"], rw["w"], self.accuracy) & (rep < self.max_batches)
+                sp = _spread_flat(n, row_all, r_all, w_all)
+                need = _needs_more_of(*sp, self.accuracy) & (rep < self.max_batches)
                 need &= ok
-        return {k: np.concatenate([q[k] for q in parts], axis=1) for k in out}
+        # each row's accepted draws in draw order: batch after batch, stably by row
+        by = np.argsort(row_all, kind="stable")
+        got = {k: np.concatenate([v[k] for v in vals])[by] for k in out}
+        return _rows_of(np.bincount(row_all, minlength=n), got)
 
     def _posterior(self, lit_a: LitCSR, lit_b: LitCSR):
         keys = _key_hash(lit_a, lit_b) ^ np.uint64(self.seed)
@@ -536,11 +548,35 @@ def _tops_up(proposal: Any, s: dict) -> np.ndarray:
     return np.ones(s["w"].shape[0], bool)
 
 
+def _spread_flat(
+    n: int, row: np.ndarray, r: np.ndarray, w: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_spread` of n rows given their accepted draws alone, flat: ``row`` (D,) the
+    row of each, r and w (D,), every w > 0. The sums run in storage order
+    (``np.bincount``), not numpy's pairwise order over a padded row: the same values to
+    rounding (NaN where a row has none, as there)."""
+    if not row.size:  # (np.bincount's sums of no weights are integers)
+        return np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan)
+    tot = np.bincount(row, w, n)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        wn = w / tot[row]
+        mean = np.bincount(row, wn * r, n)
+        sd = np.sqrt(np.maximum(np.bincount(row, wn * (r - mean[row]) ** 2, n), 0.0))
+        ess = tot**2 / np.bincount(row, w * w, n)
+    none = ~(tot > 0)
+    mean[none] = sd[none] = np.nan
+    return mean, sd, ess
+
+
 def _needs_more(r: np.ndarray, w: np.ndarray, target: float = MC_TARGET) -> np.ndarray:
     """The keys to top up: the relative Monte-Carlo error of r, 1.2533 sd_w(r) / sqrt(ESS)
     / mean_w(r), above ``target``, or an ESS below ``MIN_ESS`` (one or two accepted
     draws give an error of 0 or none at all, not a small one), or nothing accepted."""
-    mean, sd, ess = _spread(r, w)
+    return _needs_more_of(*_spread(r, w), target)
+
+
+def _needs_more_of(mean, sd, ess, target: float) -> np.ndarray:
+    """:func:`_needs_more` from the rows' :func:`_spread`."""
     with np.errstate(invalid="ignore", divide="ignore"):
         mc = 1.2533 * sd / np.sqrt(ess) / mean
     return ~(ess >= MIN_ESS) | ~(mc <= target)
@@ -550,7 +586,11 @@ def _more_batches(s: dict, target: float, done: np.ndarray) -> np.ndarray:
     """Per key, the batches of draws after ``done`` that its relative Monte-Carlo error of
     r (1 / sqrt(batches)) or its ESS (as batches) predicts it needs to reach ``target``
     and ``MIN_ESS``, at least 1; ``_TOPUP`` where nothing is accepted yet."""
-    mean, sd, ess = _spread(s["r"], s["w"])
+    return _more_batches_of(*_spread(s["r"], s["w"]), target, done)
+
+
+def _more_batches_of(mean, sd, ess, target: float, done: np.ndarray) -> np.ndarray:
+    """:func:`_more_batches` from the rows' :func:`_spread`."""
     with np.errstate(invalid="ignore", divide="ignore"):
         mc = 1.2533 * sd / np.sqrt(ess) / mean
         f = np.maximum((mc / target) ** 2, MIN_ESS / ess)

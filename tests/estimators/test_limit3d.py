@@ -341,3 +341,29 @@ def test_compact_sparse_is_compact_of_the_dense_draws():
         assert list(got) == list(want)
         for k in want:
             assert np.array_equal(got[k], want[k], equal_nan=True), k
+
+
+def test_spread_flat_is_spread_of_the_compacted_rows():
+    """limit3d._spread_flat (the top-ups' decisions from the accepted draws alone, batch
+    after batch, rows interleaved) against limit3d._spread of the same draws compacted
+    into rows: the same values to rounding, the same decisions of _needs_more_of and
+    _more_batches_of, rows with nothing accepted (NaN, topped up by _TOPUP) included."""
+    from eyeviz.estimators import limit3d as l3
+
+    rng = np.random.default_rng(11)
+    for _ in range(200):
+        n, d = int(rng.integers(1, 7)), int(rng.integers(0, 60))
+        row = rng.integers(0, n, d)
+        r = rng.uniform(5.0, 80.0, d)
+        w = rng.random(d) + 1e-3
+        by = np.argsort(row, kind="stable")
+        dense = l3._compact_sparse(n, row[by], {"r": r[by], "w": w[by]})
+        want = l3._spread(dense["r"], dense["w"])
+        got = l3._spread_flat(n, row, r, w)
+        for a, b in zip(got, want, strict=True):
+            assert np.allclose(a, b, rtol=1e-12, atol=0.0, equal_nan=True)
+        done = rng.integers(1, 10, n)
+        for target in (0.01, 0.05, 0.2):
+            assert np.array_equal(l3._needs_more_of(*got, target), l3._needs_more_of(*want, target))
+            assert np.array_equal(l3._more_batches_of(*got, target, done),
+                                  l3._more_batches_of(*want, target, done))  # fmt: skip
