@@ -112,6 +112,9 @@ RETRIES = ((2, 2.5, 24),)
 #: (limit3d._tops_up): on the bench's 160 honeybee keys and three fresh sets, such a key's
 #: next 15 batches found nothing, or a few draws, on every key (docs/limit3d.md, "bee33d")
 RETRY_EMPTY = True
+#: :meth:`MeasuredProposal._around`'s box search and pilot as one compiled call (the same
+#: boxes as its numpy loops, which the tests compare with it)
+BOX_KERNEL = True
 #: the share of each batch's draws from the provable box where it holds
 DEFEND = 0.0625
 #: the tight box: the pilot's feasible points' box widened ``TIGHT_WIDEN`` times about its
@@ -351,6 +354,9 @@ class MeasuredProposal:
         cs = st["u0"] / wc[:, None] - (self.fb.centre - self.fa.centre)
         cb = np.einsum("nj,j->n", cs, -self.bhat) / np.linalg.norm(cs, axis=1)
         st["beta0"] = np.arccos(np.clip(cb, -1.0, 1.0))
+        floor = 1e-9 * d.gamma
+        if BOX_KERNEL and kernels.use(n * PILOT):
+            return self._box_compiled(st, keys, wide * REACH * d.gamma, floor)
         centre = np.stack([np.zeros(n), np.zeros(n), st["beta0"]], axis=1)
         lo = np.zeros((n, _DIRS3.shape[0]))
         hi = np.full((n, _DIRS3.shape[0]), wide * REACH * d.gamma)
@@ -363,12 +369,32 @@ class MeasuredProposal:
         pts = hi[..., None] * _DIRS3[None]  # (N, 26, 3) about the centre
         box_lo = centre + np.minimum(pts.min(axis=1), 0.0) * WIDEN
         box_hi = centre + np.maximum(pts.max(axis=1), 0.0) * WIDEN
-        floor = 1e-9 * d.gamma
         box_lo, box_hi = np.minimum(box_lo, centre - floor), np.maximum(box_hi, centre + floor)
         # the pilot: the box widened where feasible draws come near a face (the defensive
         # share of the draws keeps the estimate unbiased where it still misses a part of
         # the posterior; the pilot keeps that part, and so the weights' spread, small)
         return self._pilot(st, keys, box_lo, box_hi)
+
+    def _box_compiled(self, st: dict, keys: np.ndarray, reach: float, floor: float):
+        """:meth:`_around`'s bisection, widening and :meth:`_pilot` in one call
+        (kernels.measured_limit.box_kernel, key by key; the same arithmetic and verdicts
+        as the numpy loops with the compiled region test, so the same boxes bit for bit)."""
+        from eyeviz.core.kernels import measured_limit
+
+        # Any: the kernel takes 29 arrays and numbers (numba's Dispatcher stub types fewer)
+        box_kernel: Any = measured_limit.box_kernel
+        n, f64 = keys.size, np.float64
+        box_lo, box_hi = np.empty((n, 3)), np.empty((n, 3))
+        t_lo, t_hi, t_n = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, np.int64)
+        box_kernel(kernels.arg(st["u0"], f64), kernels.arg(st["e1"], f64),
+                   kernels.arg(st["e2"], f64), kernels.arg(self.fa.centre, f64),
+                   kernels.arg(self.bhat, f64), self.blen, kernels.arg(self.origin, f64),
+                   self.s_half, float(self.domain.g_max), float(st["slack"]),
+                   *both_columns(st["ea"], st["eb"]), kernels.arg(st["beta0"], f64),
+                   float(reach), WIDEN, float(floor), _DIRS3, ITERS,
+                   _uniforms(keys, PILOT, 3, 7), PILOT_ROUNDS, box_lo, box_hi, t_lo, t_hi,
+                   t_n)  # fmt: skip
+        return box_lo, box_hi, (t_lo, t_hi, t_n)
 
     def _pilot(self, st: dict, keys: np.ndarray, box_lo: np.ndarray, box_hi: np.ndarray):
         """The box widened by half on each face near which a pilot's feasible draws fall,

@@ -552,3 +552,42 @@ def test_a_key_whose_first_batch_finds_nothing_goes_to_the_retry_at_once(far, mo
         assert on[(int(keys[n]), 0)][1:] == tops
         if sum(tops) > min(retry[n], 8):  # they found more: their answer
             assert p.r[n] == q.r[n] and p.flagged[n] == q.flagged[n]
+
+
+def test_the_compiled_box_search_gives_the_numpy_loops_boxes(far, monkeypatch):
+    """MeasuredProposal._around's bisection, widening and pilot as one compiled call
+    (``BOX_KERNEL``, kernels.measured_limit.box_kernel) against its numpy loops with the
+    compiled region test: every array of the set-up bit for bit (the boxes, the pilot's
+    feasible points' box and number, the mixture), on 48 fresh honeybee keys in chunks of
+    8, the two the first reference search misses (the wider search's chunk) and the far
+    test pair's 30 keys."""
+    from eyeviz.estimators import limit3d_measured as lm
+    from eyeviz.files.eye_io import load_eyes, shipped_eye
+
+    bee = Domain3D.for_eyes(load_eyes(shipped_eye("AM_60185-real.eye")))
+    ds = generate3d(48, bee, seed=20261208)
+    cases = []
+    for s0 in range(0, 48, 8):
+        rows = np.arange(s0, s0 + 8)
+        cases.append((bee, take_rows(ds.indptr_a, ds.indices_a, rows),
+                      take_rows(ds.indptr_b, ds.indices_b, rows)))  # fmt: skip
+    a = [[3167, 3168, 3177, 3179, 3180, 3184, 3185], [1970, 2066, 2087, 2159, 2254, 2277, 2340]]
+    b = [[3181, 3183, 3186], [1774, 1775, 1776, 1873, 1874, 1875, 1907, 1970, 1971, 2001,
+         2003, 2066, 2087, 2089, 2091, 2159, 2160, 2215, 2254, 2277, 2279, 2340, 2365]]  # fmt: skip
+    cases.append((bee, *[(np.array([0, len(s[0]), len(s[0]) + len(s[1])]),
+                          np.array(s[0] + s[1])) for s in (a, b)]))  # fmt: skip
+    cases.append((far[0], *far[3]))
+    tight = 0
+    for dom, la, lb in cases:
+        prop = lm.MeasuredProposal(dom, "single", 64, 8)
+        keys = _key_hash(la, lb)
+        got = {}
+        for compiled in (True, False):
+            monkeypatch.setattr(lm, "BOX_KERNEL", compiled)
+            got[compiled] = prop.setup(la, lb, keys, 1.0)
+        assert got[True].keys() == got[False].keys()
+        for k, v in got[False].items():
+            if isinstance(v, np.ndarray):
+                assert np.array_equal(got[True][k], v, equal_nan=True), k
+        tight += int(np.sum(got[True]["n_tight"] > 0))
+    assert tight > 40

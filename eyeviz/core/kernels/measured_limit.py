@@ -1,11 +1,11 @@
 """The measured proposal's kernels compiled (numba): the region test, H >= -slack at
 points (delta, beta) of the box search and the pilot (:meth:`eyeviz.estimators.
-limit3d_measured.MeasuredProposal._hb`), the draws, the direction search and the
-reference search's step. The region test and the draws walk both eyes' constraining
-facets of a key as one table of its live facets (limit3d_cones.both_columns), the facet
-that rules a point out moved to the front (:func:`_walk1`): no branch per facet on its
-eye or its padding (a mispredicted branch costs more than a fold: docs/limit3d.md,
-"bee33e").
+limit3d_measured.MeasuredProposal._hb`; both searches key by key in one call:
+``box_kernel``), the draws, the direction search and the reference search's step.
+The region test and the draws walk both eyes' constraining facets of a key as one
+table of its live facets (limit3d_cones.both_columns), the facet that rules a point out
+moved to the front (:func:`_walk1`): no branch per facet on its eye or its padding (a
+mispredicted branch costs more than a fold: docs/limit3d.md, "bee33e").
 
 It calls :mod:`.limit3d_region`'s functions (``bcentre``, ``_empty``), so its numba
 cache is stamped with that module's source as well as its own (:class:`_WithRegionSource`,
@@ -36,7 +36,14 @@ from eyeviz.core.kernels.limit3d_region import (
     measured_prior,
 )
 
-__all__ = ["direction_kernel", "locate_kernel", "mixture_draws_kernel", "region_kernel", "warm"]
+__all__ = [
+    "box_kernel",
+    "direction_kernel",
+    "locate_kernel",
+    "mixture_draws_kernel",
+    "region_kernel",
+    "warm",
+]
 
 
 class _WithRegionSource(caching.InTreeCacheLocator):
@@ -148,6 +155,105 @@ def region_kernel(x, u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack,
                                    rr * s_half, min(rr, g_max), slack)  # fmt: skip
             hv = hi_ - lo_
             h[n, g] = hv if math.isfinite(hv) else -np.inf
+
+
+@_jit_np
+def _feasible(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos, ax, ch, sh,
+              lit, nls, order, n, d0, d1, beta):  # fmt: skip
+    """region_kernel's verdict H >= -slack at one point (d0, d1, beta) of key n (its
+    walk's facet order ``order[n]``, moved to the front as there: max and min are exact,
+    so the verdict is the same in any order)."""
+    cx, cy, cz, rho, _ = bcentre(u0[n], e1[n], e2[n], d0, d1, beta, fa, bhat, blen)
+    if not math.isfinite(rho):
+        return False
+    qx, qy, qz = cx - origin[0], cy - origin[1], cz - origin[2]
+    rr = math.sqrt(qx * qx + qy * qy + qz * qz)
+    lo_, hi_ = _walk_slack(pos, ax, ch, sh, lit, order, nls[n], n, cx, cy, cz, rr * s_half,
+                           min(rr, g_max), slack)  # fmt: skip
+    hv = hi_ - lo_
+    return math.isfinite(hv) and hv >= -slack
+
+
+@_jit_np
+def box_kernel(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos, ax, ch, sh,
+               lit, nls, beta0, reach, widen, floor, dirs, iters, up, rounds, box_lo, box_hi,
+               t_lo, t_hi, t_n):  # fmt: skip
+    """limit3d_measured.MeasuredProposal._around's box search and its ``_pilot``, key by
+    key in one call (each key's search reads its own points alone): the bisection of H >=
+    -slack along ``dirs`` (26 unit directions in (delta_1, delta_2, beta) from (0, 0,
+    beta0[n]), ``iters`` steps from [0, reach]), the boundary points' box widened
+    ``widen`` times (at least ``floor`` about the centre); then up to ``rounds`` pilot
+    rounds of the points lo + (hi - lo) up[n, j] (up (N, J, 3)): the box widened by half
+    its span on each face within a tenth of the span of which a feasible point lies,
+    until no face is; t_lo, t_hi, t_n the last round's feasible points' box and number.
+    The same arithmetic as the numpy loops there, so the same boxes bit for bit."""
+    order = np.empty((u0.shape[0], pos.shape[1]), np.int64)
+    nd = dirs.shape[0]
+    lo = np.empty(nd)
+    hi = np.empty(nd)
+    for n in range(u0.shape[0]):
+        for k in range(order.shape[1]):
+            order[n, k] = k
+        c = (0.0, 0.0, beta0[n])
+        for q in range(nd):
+            lo[q] = 0.0
+            hi[q] = reach
+        for _ in range(iters):
+            for q in range(nd):
+                mid = 0.5 * (lo[q] + hi[q])
+                if _feasible(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos,
+                             ax, ch, sh, lit, nls, order, n, c[0] + mid * dirs[q, 0],
+                             c[1] + mid * dirs[q, 1], c[2] + mid * dirs[q, 2]):  # fmt: skip
+                    lo[q] = mid
+                else:
+                    hi[q] = mid
+        for j in range(3):
+            pmin, pmax = np.inf, -np.inf
+            for q in range(nd):
+                v = hi[q] * dirs[q, j]
+                pmin = min(pmin, v)
+                pmax = max(pmax, v)
+            box_lo[n, j] = min(c[j] + min(pmin, 0.0) * widen, c[j] - floor)
+            box_hi[n, j] = max(c[j] + max(pmax, 0.0) * widen, c[j] + floor)
+        for _ in range(rounds):
+            l0, l1, l2 = box_lo[n, 0], box_lo[n, 1], box_lo[n, 2]
+            s0, s1, s2 = box_hi[n, 0] - l0, box_hi[n, 1] - l1, box_hi[n, 2] - l2
+            b0, b1, b2 = 0.1 * s0, 0.1 * s1, 0.1 * s2
+            a0, a1, a2 = l0 + b0, l1 + b1, l2 + b2
+            z0, z1, z2 = box_hi[n, 0] - b0, box_hi[n, 1] - b1, box_hi[n, 2] - b2
+            m0 = m1 = m2 = np.inf
+            x0 = x1 = x2 = -np.inf
+            nlo0 = nlo1 = nlo2 = nhi0 = nhi1 = nhi2 = False
+            cnt = 0
+            for g in range(up.shape[1]):
+                p0 = l0 + s0 * up[n, g, 0]
+                p1 = l1 + s1 * up[n, g, 1]
+                p2 = l2 + s2 * up[n, g, 2]
+                if not _feasible(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack,
+                                 pos, ax, ch, sh, lit, nls, order, n, p0, p1, p2):  # fmt: skip
+                    continue
+                cnt += 1
+                m0, m1, m2 = min(m0, p0), min(m1, p1), min(m2, p2)
+                x0, x1, x2 = max(x0, p0), max(x1, p1), max(x2, p2)
+                nlo0, nlo1, nlo2 = nlo0 or p0 < a0, nlo1 or p1 < a1, nlo2 or p2 < a2
+                nhi0, nhi1, nhi2 = nhi0 or p0 > z0, nhi1 or p1 > z1, nhi2 or p2 > z2
+            t_lo[n, 0], t_lo[n, 1], t_lo[n, 2] = m0, m1, m2
+            t_hi[n, 0], t_hi[n, 1], t_hi[n, 2] = x0, x1, x2
+            t_n[n] = cnt
+            if not (nlo0 or nlo1 or nlo2 or nhi0 or nhi1 or nhi2):
+                break
+            if nlo0:
+                box_lo[n, 0] = l0 - 0.5 * s0
+            if nlo1:
+                box_lo[n, 1] = l1 - 0.5 * s1
+            if nlo2:
+                box_lo[n, 2] = l2 - 0.5 * s2
+            if nhi0:
+                box_hi[n, 0] = box_hi[n, 0] + 0.5 * s0
+            if nhi1:
+                box_hi[n, 1] = box_hi[n, 1] + 0.5 * s1
+            if nhi2:
+                box_hi[n, 2] = box_hi[n, 2] + 0.5 * s2
 
 
 @_inline_np
@@ -383,6 +489,9 @@ def warm() -> None:
     v3 = np.ones(3)
     both = (p3, p3, a2 + 0.9, a2 + 0.1, b, np.ones(1, np.int64))
     region_kernel(p3, c, c, c, v3, v3, 1.0, v3, 0.1, 1.0, 1e-7, *both, a2.copy())
+    box_kernel(c, c, c, v3, v3, 1.0, v3, 0.1, 1.0, 1e-7, *both, np.ones(1), 0.5, 2.0, 1e-9,
+               c, 2, p3 * 0.5, 2, c.copy(), c.copy(), c.copy(), c.copy(),
+               np.zeros(1, np.int64))  # fmt: skip
     direction_kernel(p3, a2, b, ~b, np.array([[0.0, 0.0, 1.0]]), np.ones(1), 2, 1)
     locate_kernel(p3, a2 + 1, a2 + 1, 0.1, 1.0, *cs, *cs, np.zeros(1, np.int64))
     u4 = np.full((1, 1, 4), 0.5)
