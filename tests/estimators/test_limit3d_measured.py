@@ -554,14 +554,17 @@ def test_a_key_whose_first_batch_finds_nothing_goes_to_the_retry_at_once(far, mo
             assert p.r[n] == q.r[n] and p.flagged[n] == q.flagged[n]
 
 
-def test_the_compiled_box_search_gives_the_numpy_loops_boxes(far, monkeypatch):
+@pytest.mark.parametrize("flag", ["BOX_KERNEL", "GRID_KERNEL"])
+def test_the_compiled_searches_give_the_numpy_loops_set_up(far, monkeypatch, flag):
     """MeasuredProposal._around's bisection, widening and pilot as one compiled call
-    (``BOX_KERNEL``, kernels.measured_limit.box_kernel) against its numpy loops with the
-    compiled region test: every array of the set-up bit for bit (the boxes, the pilot's
-    feasible points' box and number, the mixture), on 48 fresh honeybee keys in chunks of
-    8, the two the first reference search misses (the wider search's chunk) and the far
-    test pair's 30 keys."""
+    (``BOX_KERNEL``, kernels.measured_limit.box_kernel), and limit3d_provable.dir_region's
+    grids as one (``GRID_KERNEL``, kernels.limit3d_region.dir_grid_kernel), against their
+    numpy loops with the compiled region and cell tests: every array of the set-up bit
+    for bit (the boxes, the pilot's feasible points' box and number, the provable box,
+    the mixture), on 48 fresh honeybee keys in chunks of 8, the two the first reference
+    search misses (the wider search's chunk) and the far test pair's 30 keys."""
     from eyeviz.estimators import limit3d_measured as lm
+    from eyeviz.estimators import limit3d_provable as lp
     from eyeviz.files.eye_io import load_eyes, shipped_eye
 
     bee = Domain3D.for_eyes(load_eyes(shipped_eye("AM_60185-real.eye")))
@@ -583,7 +586,7 @@ def test_the_compiled_box_search_gives_the_numpy_loops_boxes(far, monkeypatch):
         keys = _key_hash(la, lb)
         got = {}
         for compiled in (True, False):
-            monkeypatch.setattr(lm, "BOX_KERNEL", compiled)
+            monkeypatch.setattr(lm if flag == "BOX_KERNEL" else lp, flag, compiled)
             got[compiled] = prop.setup(la, lb, keys, 1.0)
         assert got[True].keys() == got[False].keys()
         for k, v in got[False].items():

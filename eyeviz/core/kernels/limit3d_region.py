@@ -23,6 +23,7 @@ __all__ = [
     "cone_bounds_kernel",
     "direction_keep_kernel",
     "uniforms_kernel",
+    "dir_grid_kernel",
     "measured_prior",
     "bcentre",
     "same_rows_kernel",
@@ -196,6 +197,26 @@ def uniforms_kernel(keys, m, streams, out):
                 out[n, si * m + j // k, j % k] = (np.float64(z >> np.uint64(11)) + 0.5) * 2.0**-53
 
 
+@_inline
+def _cell_out(ax, half, lit, pad, n, vx, vy, vz, lim_f, lim_l, last):
+    """direction_keep_kernel's test of one cell of key n (centre direction v): (dropped,
+    the facet that settled it, else ``last``), the walk starting at facet ``last``."""
+    top, bot = -np.inf, np.inf
+    for j in range(ax.shape[1] + 1):
+        k = last if j == 0 else j - 1
+        if (j > 0 and k == last) or pad[n, k]:
+            continue
+        c = vx * ax[n, k, 0] + vy * ax[n, k, 1] + vz * ax[n, k, 2]
+        ang = math.acos(min(max(c, -1.0), 1.0)) - half[n, k]
+        if lit[n, k]:
+            top = max(top, ang)
+        else:
+            bot = min(bot, ang)
+        if top - bot > lim_f or top > lim_l:
+            return True, k
+    return False, last
+
+
 @_jit
 def direction_keep_kernel(ax, half, lit, pad, v, t, s, h, keep):
     """limit3d_provable.dir_region's test of its grid's cells: cell g of
@@ -209,25 +230,51 @@ def direction_keep_kernel(ax, half, lit, pad, v, t, s, h, keep):
         lim_f = t[n] + 2.0 * h[n] + 1e-7
         lim_l = s[n] + h[n] + 1e-7
         for g in range(v.shape[1]):
-            vx, vy, vz = v[n, g, 0], v[n, g, 1], v[n, g, 2]
-            top, bot = -np.inf, np.inf
-            out = False
-            k0 = last
-            for j in range(ax.shape[1] + 1):
-                k = k0 if j == 0 else j - 1
-                if (j > 0 and k == k0) or pad[n, k]:
-                    continue
-                c = vx * ax[n, k, 0] + vy * ax[n, k, 1] + vz * ax[n, k, 2]
-                ang = math.acos(min(max(c, -1.0), 1.0)) - half[n, k]
-                if lit[n, k]:
-                    top = max(top, ang)
-                else:
-                    bot = min(bot, ang)
-                if top - bot > lim_f or top > lim_l:
-                    out = True
-                    last = k
-                    break
+            out, last = _cell_out(ax, half, lit, pad, n, v[n, g, 0], v[n, g, 1], v[n, g, 2],
+                                  lim_f, lim_l, last)  # fmt: skip
             keep[n, g] = not out
+
+
+@_jit
+def dir_grid_kernel(ax, half, lit, pad, w0, e1, e2, t, s, lo, hi, g2, grid, levels, v, keep,
+                    h, ok):  # fmt: skip
+    """limit3d_provable.dir_region's zooming grids, key by key in one call: per level the
+    cells of the box [lo, hi] (gnomonic, about w0 in the frame e1, e2; g2 the cells'
+    centres in [0, 1]^2, ``grid`` a side), their centres' directions, the test of
+    direction_keep_kernel, and the next box the kept cells' span (ok[n] False and the box
+    kept where none is). v, keep and h are the last level's. The same arithmetic as the
+    numpy loop there (its norm's sums in the same order), so the same cells bit for bit."""
+    for n in range(w0.shape[0]):
+        last = 0
+        lo0, lo1, hi0, hi1 = lo[n, 0], lo[n, 1], hi[n, 0], hi[n, 1]
+        for _ in range(levels):
+            sp0, sp1 = hi0 - lo0, hi1 - lo1
+            hn = 0.5 * math.hypot(sp0, sp1) / grid
+            h[n] = hn
+            lim_f = t[n] + 2.0 * hn + 1e-7
+            lim_l = s[n] + hn + 1e-7
+            hf0, hf1 = 0.5 * sp0 / grid, 0.5 * sp1 / grid
+            n0, n1, x0, x1 = np.inf, np.inf, -np.inf, -np.inf
+            some = False
+            for g in range(g2.shape[0]):
+                d0 = lo0 + sp0 * g2[g, 0]
+                d1 = lo1 + sp1 * g2[g, 1]
+                vx = w0[n, 0] + d0 * e1[n, 0] + d1 * e2[n, 0]
+                vy = w0[n, 1] + d0 * e1[n, 1] + d1 * e2[n, 1]
+                vz = w0[n, 2] + d0 * e1[n, 2] + d1 * e2[n, 2]
+                nv = math.sqrt(vx * vx + vy * vy + vz * vz)
+                vx, vy, vz = vx / nv, vy / nv, vz / nv
+                v[n, g, 0], v[n, g, 1], v[n, g, 2] = vx, vy, vz
+                out, last = _cell_out(ax, half, lit, pad, n, vx, vy, vz, lim_f, lim_l, last)
+                keep[n, g] = not out
+                if not out:
+                    some = True
+                    n0, n1 = min(n0, d0 - hf0), min(n1, d1 - hf1)
+                    x0, x1 = max(x0, d0 + hf0), max(x1, d1 + hf1)
+            if some:
+                lo0, lo1, hi0, hi1 = n0, n1, x0, x1
+            else:
+                ok[n] = False
 
 
 @_jit
@@ -346,6 +393,9 @@ def warm() -> None:
     cs = (p3, p3, a2 + 0.9, a2 + 0.1, b, ~b)
     cone_bounds_kernel(*cs, p3, out, out.copy())
     direction_keep_kernel(p3, a2, b, ~b, p3, np.ones(1), np.ones(1), np.ones(1), b.copy())
+    one = np.ones(1)
+    dir_grid_kernel(p3, a2, b, ~b, c, c, c, one, one, -c[:, :2], c[:, :2], np.full((1, 2), 0.5),
+                    1, 1, p3.copy(), b.copy(), one.copy(), b[0].copy())  # fmt: skip
     uniforms_kernel(np.ones(1, np.uint64), 1, np.zeros(1, np.int64), np.empty((1, 1, 4)))
     pts = np.ones((1, 1, 2, 3))
     prefilter_kernel(pts, b, ~b, np.zeros(1, np.int64), c, np.ones(1), 0.01, b[0].copy())
