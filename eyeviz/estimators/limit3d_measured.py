@@ -115,6 +115,9 @@ RETRY_EMPTY = True
 #: :meth:`MeasuredProposal._around`'s box search and pilot as one compiled call (the same
 #: boxes as its numpy loops, which the tests compare with it)
 BOX_KERNEL = True
+#: :meth:`MeasuredProposal._search`'s grids as one compiled call (the same points as its
+#: numpy loop with the compiled step, which the tests compare with it)
+SEARCH_KERNEL = True
 #: the share of each batch's draws from the provable box where it holds
 DEFEND = 0.0625
 #: the tight box: the pilot's feasible points' box widened ``TIGHT_WIDEN`` times about its
@@ -237,13 +240,28 @@ class MeasuredProposal:
         t = (np.arange(LOCATE) + 0.5) / LOCATE * 2 - 1
         g3 = np.stack(np.meshgrid(t, t, t, indexing="ij"), axis=-1).reshape(-1, 3)
         dc = np.zeros((n, 2))
-        for _ in range(levels):
-            dd = dc[:, None, :] + g3[None, :, :2] * half
-            ww = np.clip(wc[:, None] + g3[None, :, 2] * wh[:, None], self.w_min, self.w_max)
-            b = self._locate(st, self._centres(st, dd, ww), ww)
-            dc = dd[np.arange(n), b]
-            wc = ww[np.arange(n), b]
-            half, wh = half / 2.5, wh / 2.5
+        if SEARCH_KERNEL and kernels.use(n * g3.shape[0]):
+            from eyeviz.core.kernels import measured_limit
+
+            # Any: the kernel takes 28 arrays and numbers (numba's Dispatcher stub types fewer)
+            search: Any = measured_limit.search_kernel
+            f64 = np.float64
+            wr = np.empty(n)
+            search(kernels.arg(st["u0"], f64), kernels.arg(st["e1"], f64),
+                   kernels.arg(st["e2"], f64), kernels.arg(self.fa.centre, f64),
+                   kernels.arg(self.origin, f64), kernels.arg(wc, f64), kernels.arg(wh, f64),
+                   float(half), int(levels), g3, self.w_min, self.w_max, self.s_half,
+                   float(self.domain.g_max), *st["ea"].columns(), *st["eb"].columns(), dc,
+                   wr)  # fmt: skip
+            wc = wr
+        else:
+            for _ in range(levels):
+                dd = dc[:, None, :] + g3[None, :, :2] * half
+                ww = np.clip(wc[:, None] + g3[None, :, 2] * wh[:, None], self.w_min, self.w_max)
+                b = self._locate(st, self._centres(st, dd, ww), ww)
+                dc = dd[np.arange(n), b]
+                wc = ww[np.arange(n), b]
+                half, wh = half / 2.5, wh / 2.5
         g_lo, g_hi = self._h(st, self._centres(st, dc[:, None, :], wc[:, None]))
         return dc, wc, (g_hi - g_lo)[:, 0] * wc
 

@@ -554,11 +554,12 @@ def test_a_key_whose_first_batch_finds_nothing_goes_to_the_retry_at_once(far, mo
             assert p.r[n] == q.r[n] and p.flagged[n] == q.flagged[n]
 
 
-@pytest.mark.parametrize("flag", ["BOX_KERNEL", "GRID_KERNEL"])
+@pytest.mark.parametrize("flag", ["BOX_KERNEL", "GRID_KERNEL", "SEARCH_KERNEL"])
 def test_the_compiled_searches_give_the_numpy_loops_set_up(far, monkeypatch, flag):
     """MeasuredProposal._around's bisection, widening and pilot as one compiled call
-    (``BOX_KERNEL``, kernels.measured_limit.box_kernel), and limit3d_provable.dir_region's
-    grids as one (``GRID_KERNEL``, kernels.limit3d_region.dir_grid_kernel), against their
+    (``BOX_KERNEL``, kernels.measured_limit.box_kernel), limit3d_provable.dir_region's
+    grids as one (``GRID_KERNEL``, kernels.limit3d_region.dir_grid_kernel) and the
+    reference search's (``SEARCH_KERNEL``, kernels.measured_limit.search_kernel), against their
     numpy loops with the compiled region and cell tests: every array of the set-up bit
     for bit (the boxes, the pilot's feasible points' box and number, the provable box,
     the mixture), on 48 fresh honeybee keys in chunks of 8, the two the first reference
@@ -586,7 +587,7 @@ def test_the_compiled_searches_give_the_numpy_loops_set_up(far, monkeypatch, fla
         keys = _key_hash(la, lb)
         got = {}
         for compiled in (True, False):
-            monkeypatch.setattr(lm if flag == "BOX_KERNEL" else lp, flag, compiled)
+            monkeypatch.setattr(lp if flag == "GRID_KERNEL" else lm, flag, compiled)
             got[compiled] = prop.setup(la, lb, keys, 1.0)
         assert got[True].keys() == got[False].keys()
         for k, v in got[False].items():

@@ -42,6 +42,7 @@ __all__ = [
     "locate_kernel",
     "mixture_draws_kernel",
     "region_kernel",
+    "search_kernel",
     "warm",
 ]
 
@@ -157,7 +158,7 @@ def region_kernel(x, u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack,
             h[n, g] = hv if math.isfinite(hv) else -np.inf
 
 
-@_jit_np
+@_inline_np
 def _feasible(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos, ax, ch, sh,
               lit, nls, order, n, d0, d1, beta):  # fmt: skip
     """region_kernel's verdict H >= -slack at one point (d0, d1, beta) of key n (its
@@ -446,37 +447,86 @@ def locate_kernel(c, r, ww, s_half, g_max, pos_a, ax_a, ch_a, sh_a, lit_a, pad_a
     in any order); a point is given up once its value falls to the best so far (it only
     falls as facets are folded in, and a product by ww > 0 keeps the order), the facet
     that gave it up moved to the front of the key's order (both eyes' facets: index k <
-    K_A A's facet k, else B's facet k - K_A), as the draws' walk."""
-    ka = pos_a.shape[1]
-    order = np.empty(ka + pos_b.shape[1], np.int64)
+    K_A A's facet k, else B's facet k - K_A), as the draws' walk (:func:`_locate1`)."""
+    order = np.empty(pos_a.shape[1] + pos_b.shape[1], np.int64)
     for n in range(c.shape[0]):
-        for k in range(order.shape[0]):
-            order[k] = k
-        top, arg = -np.inf, 0
-        for g in range(c.shape[1]):
-            cx, cy, cz, w = c[n, g, 0], c[n, g, 1], c[n, g, 2], ww[n, g]
-            lo, hi = r[n, g] * s_half, min(r[n, g], g_max)
-            out = False
-            for p in range(order.shape[0]):
-                k = order[p]
-                if k < ka:
-                    if pad_a[n, k]:
-                        continue
-                    lo, hi = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz, lo, hi)
-                else:
-                    if pad_b[n, k - ka]:
-                        continue
-                    lo, hi = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
-                                        lo, hi)  # fmt: skip
-                if g > 0 and (hi - lo) * w <= top:
-                    for j in range(p, 0, -1):
-                        order[j] = order[j - 1]
-                    order[0] = k
-                    out = True
-                    break
-            if not out and (g == 0 or (hi - lo) * w > top):
-                top, arg = (hi - lo) * w, g
-        best[n] = arg
+        best[n] = _locate1(c[n], r[n], ww[n], n, s_half, g_max, pos_a, ax_a, ch_a, sh_a, lit_a,
+                           pad_a, pos_b, ax_b, ch_b, sh_b, lit_b, pad_b, order)  # fmt: skip
+
+
+@_jit_np
+def _locate1(c, r, ww, n, s_half, g_max, pos_a, ax_a, ch_a, sh_a, lit_a, pad_a,
+             pos_b, ax_b, ch_b, sh_b, lit_b, pad_b, order):  # fmt: skip
+    """locate_kernel for key n, its points c (G, 3), r and ww (G,); ``order`` its facets'
+    order, reset here."""
+    ka = pos_a.shape[1]
+    for k in range(order.shape[0]):
+        order[k] = k
+    top, arg = -np.inf, 0
+    for g in range(c.shape[0]):
+        cx, cy, cz, w = c[g, 0], c[g, 1], c[g, 2], ww[g]
+        lo, hi = r[g] * s_half, min(r[g], g_max)
+        out = False
+        for p in range(order.shape[0]):
+            k = order[p]
+            if k < ka:
+                if pad_a[n, k]:
+                    continue
+                lo, hi = _cone_fold(pos_a, ax_a, ch_a, sh_a, lit_a, n, k, cx, cy, cz, lo, hi)
+            else:
+                if pad_b[n, k - ka]:
+                    continue
+                lo, hi = _cone_fold(pos_b, ax_b, ch_b, sh_b, lit_b, n, k - ka, cx, cy, cz,
+                                    lo, hi)  # fmt: skip
+            if g > 0 and (hi - lo) * w <= top:
+                for j in range(p, 0, -1):
+                    order[j] = order[j - 1]
+                order[0] = k
+                out = True
+                break
+        if not out and (g == 0 or (hi - lo) * w > top):
+            top, arg = (hi - lo) * w, g
+    return arg
+
+
+@_jit_np
+def search_kernel(u0, e1, e2, fa, origin, wc, wh, half, levels, g3, w_min, w_max, s_half,
+                  g_max, pos_a, ax_a, ch_a, sh_a, lit_a, pad_a, pos_b, ax_b, ch_b, sh_b,
+                  lit_b, pad_b, dc, wr):  # fmt: skip
+    """limit3d_measured.MeasuredProposal._search's zooming grids key by key in one call:
+    per level the points (delta, w) = (dc, wc) + g3 x (half, wh) (w clipped to [w_min,
+    w_max]), their centres fa + v / w (v the unit direction u0 + delta_1 e1 + delta_2 e2,
+    normalised), :func:`_locate1`'s point, then half and wh / 2.5. dc (N, 2) and wr (N,)
+    the last point. The same arithmetic as the numpy loop (its norms' sums in the same
+    order), so the same points bit for bit."""
+    ng = g3.shape[0]
+    c = np.empty((ng, 3))
+    r = np.empty(ng)
+    ww = np.empty(ng)
+    d0 = np.empty(ng)
+    d1 = np.empty(ng)
+    order = np.empty(pos_a.shape[1] + pos_b.shape[1], np.int64)
+    for n in range(u0.shape[0]):
+        c0, c1, wcn, whn, hf = 0.0, 0.0, wc[n], wh[n], half
+        for _ in range(levels):
+            for g in range(ng):
+                d0[g] = c0 + g3[g, 0] * hf
+                d1[g] = c1 + g3[g, 1] * hf
+                ww[g] = min(max(wcn + g3[g, 2] * whn, w_min), w_max)
+                vx = u0[n, 0] + d0[g] * e1[n, 0] + d1[g] * e2[n, 0]
+                vy = u0[n, 1] + d0[g] * e1[n, 1] + d1[g] * e2[n, 1]
+                vz = u0[n, 2] + d0[g] * e1[n, 2] + d1[g] * e2[n, 2]
+                nv = math.sqrt(vx * vx + vy * vy + vz * vz)
+                c[g, 0] = fa[0] + vx / nv / ww[g]
+                c[g, 1] = fa[1] + vy / nv / ww[g]
+                c[g, 2] = fa[2] + vz / nv / ww[g]
+                qx, qy, qz = c[g, 0] - origin[0], c[g, 1] - origin[1], c[g, 2] - origin[2]
+                r[g] = math.sqrt(qx * qx + qy * qy + qz * qz)
+            b = _locate1(c, r, ww, n, s_half, g_max, pos_a, ax_a, ch_a, sh_a, lit_a, pad_a,
+                         pos_b, ax_b, ch_b, sh_b, lit_b, pad_b, order)  # fmt: skip
+            c0, c1, wcn = d0[b], d1[b], ww[b]
+            hf, whn = hf / 2.5, whn / 2.5
+        dc[n, 0], dc[n, 1], wr[n] = c0, c1, wcn
 
 
 def warm() -> None:
@@ -494,6 +544,8 @@ def warm() -> None:
                np.zeros(1, np.int64))  # fmt: skip
     direction_kernel(p3, a2, b, ~b, np.array([[0.0, 0.0, 1.0]]), np.ones(1), 2, 1)
     locate_kernel(p3, a2 + 1, a2 + 1, 0.1, 1.0, *cs, *cs, np.zeros(1, np.int64))
+    search_kernel(c, c, c, v3, v3, np.ones(1), np.ones(1), 0.1, 1, c, 0.5, 2.0, 0.1, 1.0, *cs,
+                  *cs, np.zeros((1, 2)), np.ones(1))  # fmt: skip
     u4 = np.full((1, 1, 4), 0.5)
     boxes = np.zeros((1, 2, 2, 3))
     boxes[:, :, 1] = 1.0
