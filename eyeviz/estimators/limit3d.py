@@ -554,9 +554,18 @@ def _spread_flat(
     """:func:`_spread` of n rows given their accepted draws alone, flat: ``row`` (D,) the
     row of each, r and w (D,), every w > 0. The sums run in storage order
     (``np.bincount``), not numpy's pairwise order over a padded row: the same values to
-    rounding (NaN where a row has none, as there)."""
+    rounding (NaN where a row has none, as there). Compiled (kernels.limit3d_region.
+    spread_rows_kernel: the same sums in the same order, bit for bit) unless
+    ``EYEVIZ_JIT=0``."""
     if not row.size:  # (np.bincount's sums of no weights are integers)
         return np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan)
+    if kernels.use(row.size):
+        from eyeviz.core.kernels.limit3d_region import spread_rows_kernel
+
+        mean, sd, ess = np.empty(n), np.empty(n), np.empty(n)
+        spread_rows_kernel(kernels.arg(row, np.int64), kernels.arg(r, np.float64),
+                           kernels.arg(w, np.float64), mean, sd, ess)  # fmt: skip
+        return mean, sd, ess
     tot = np.bincount(row, w, n)
     with np.errstate(invalid="ignore", divide="ignore"):
         wn = w / tot[row]

@@ -343,16 +343,17 @@ def test_compact_sparse_is_compact_of_the_dense_draws():
             assert np.array_equal(got[k], want[k], equal_nan=True), k
 
 
-def test_spread_flat_is_spread_of_the_compacted_rows():
+def test_spread_flat_is_spread_of_the_compacted_rows(monkeypatch):
     """limit3d._spread_flat (the top-ups' decisions from the accepted draws alone, batch
     after batch, rows interleaved) against limit3d._spread of the same draws compacted
     into rows: the same values to rounding, the same decisions of _needs_more_of and
-    _more_batches_of, rows with nothing accepted (NaN, topped up by _TOPUP) included."""
+    _more_batches_of, rows with nothing accepted (NaN, topped up by _TOPUP) included;
+    compiled and in numpy (``np.bincount``) bit for bit."""
     from eyeviz.estimators import limit3d as l3
 
     rng = np.random.default_rng(11)
     for _ in range(200):
-        n, d = int(rng.integers(1, 7)), int(rng.integers(0, 60))
+        n, d = int(rng.integers(1, 7)), int(rng.integers(0, 200))  # 64 or more: compiled
         row = rng.integers(0, n, d)
         r = rng.uniform(5.0, 80.0, d)
         w = rng.random(d) + 1e-3
@@ -362,6 +363,11 @@ def test_spread_flat_is_spread_of_the_compacted_rows():
         got = l3._spread_flat(n, row, r, w)
         for a, b in zip(got, want, strict=True):
             assert np.allclose(a, b, rtol=1e-12, atol=0.0, equal_nan=True)
+        with monkeypatch.context() as m:
+            m.setenv("EYEVIZ_JIT", "0")
+            ref = l3._spread_flat(n, row, r, w)
+        for a, b in zip(got, ref, strict=True):  # the kernel's sums are np.bincount's
+            assert np.array_equal(a, b, equal_nan=True)
         done = rng.integers(1, 10, n)
         for target in (0.01, 0.05, 0.2):
             assert np.array_equal(l3._needs_more_of(*got, target), l3._needs_more_of(*want, target))

@@ -27,6 +27,7 @@ __all__ = [
     "measured_prior",
     "bcentre",
     "same_rows_kernel",
+    "spread_rows_kernel",
     "prefilter_kernel",
     "compact_draws_kernel",
     "warm",
@@ -316,6 +317,32 @@ def prefilter_kernel(pts, lit, pad, row, c, alpha, s, ok):
         ok[i] = not bad
 
 
+@_jit_np
+def spread_rows_kernel(row, r, w, mean, sd, ess):
+    """limit3d._spread_flat's sums, each in storage order as ``np.bincount``'s: per row
+    of the accepted draws (row, r, w) the weighted mean and standard deviation of r and
+    the effective sample size; the same values bit for bit (NaN where a row has none)."""
+    n = mean.size
+    tot = np.zeros(n)
+    sw2 = np.zeros(n)
+    var = np.zeros(n)
+    mean[:] = 0.0
+    for d in range(row.size):
+        tot[row[d]] += w[d]
+        sw2[row[d]] += w[d] * w[d]
+    for d in range(row.size):
+        mean[row[d]] += w[d] / tot[row[d]] * r[d]
+    for d in range(row.size):
+        dr = r[d] - mean[row[d]]
+        var[row[d]] += w[d] / tot[row[d]] * (dr * dr)
+    for i in range(n):
+        if tot[i] > 0.0:
+            sd[i] = math.sqrt(max(var[i], 0.0))
+            ess[i] = tot[i] * tot[i] / sw2[i]
+        else:
+            mean[i] = sd[i] = ess[i] = np.nan
+
+
 @_jit
 def same_rows_kernel(ptr, ind, kp, ki, row, same):
     """limit3d_exact.same_rows: CSR row i of (ptr, ind) equals the key's row ``row[i]``
@@ -402,3 +429,5 @@ def warm() -> None:
     i1 = np.zeros(2, np.int64)
     same_rows_kernel(i1, i1[:0], i1, i1[:0], i1[:1], b[0])
     compact_draws_kernel(tuple(np.ones((1, 2)) for _ in range(8)), 7, 0, 2, b[0].copy())
+    one = np.ones(1)
+    spread_rows_kernel(i1[:1], one, one, one.copy(), one.copy(), one.copy())
