@@ -71,6 +71,10 @@ def main(argv: list[str] | None = None) -> int:
 
     import numpy as np
 
+    # this checkout's eyeviz, not the one the venv's editable install points at (a
+    # worktree sharing another checkout's venv would time that checkout's code)
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+    import eyeviz
     from eyeviz.core import kernels
     from eyeviz.core.domain import Domain3D
     from eyeviz.dataset.algorithm1_3d import generate3d
@@ -78,6 +82,7 @@ def main(argv: list[str] | None = None) -> int:
     from eyeviz.estimators.limit3d import Limit3DEstimator
     from eyeviz.files.eye_io import load_eyes, shipped_eye
 
+    print(f"eyeviz from {Path(eyeviz.__file__).parent}")
     kernels.warm()
     for which in args.which.split(","):
         if which == "bee":

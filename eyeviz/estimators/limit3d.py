@@ -562,10 +562,10 @@ def _spread_flat(
     if kernels.use(row.size):
         from eyeviz.core.kernels.limit3d_region import spread_rows_kernel
 
-        mean, sd, ess = np.empty(n), np.empty(n), np.empty(n)
+        out = np.empty(n), np.empty(n), np.empty(n)
         spread_rows_kernel(kernels.arg(row, np.int64), kernels.arg(r, np.float64),
-                           kernels.arg(w, np.float64), mean, sd, ess)  # fmt: skip
-        return mean, sd, ess
+                           kernels.arg(w, np.float64), *out)  # fmt: skip
+        return out
     tot = np.bincount(row, w, n)
     with np.errstate(invalid="ignore", divide="ignore"):
         wn = w / tot[row]
