@@ -14,7 +14,7 @@ import pytest
 from eyeviz import EyevizError
 from eyeviz.study import run_study
 from eyeviz.study.grid import design_grid3d
-from eyeviz.study.point import COLUMNS3D, STUDY3D_VERSION
+from eyeviz.study.point import COLUMNS3D, STUDY3D_VERSION, evaluate3d
 from eyeviz.study.table import StudyTable3D, read_rows3d
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -127,7 +127,9 @@ def _start(path, extra=()):
 
 
 @pytest.mark.slow
-def test_a_3d_study_killed_mid_way_resumes_to_the_rows_of_an_uninterrupted_one(tmp_path):
+def test_a_3d_study_killed_mid_way_resumes_to_the_rows_of_an_uninterrupted_one(
+    tmp_path, eyeviz_main
+):
     path = tmp_path / "killed.csv"
     proc, args = _start(path)
     try:
@@ -147,24 +149,18 @@ def test_a_3d_study_killed_mid_way_resumes_to_the_rows_of_an_uninterrupted_one(t
     kept = StudyTable3D.open(path).keys  # whole points only
     assert 1 <= len(kept) < 6, "the study finished before the kill: the test proved nothing"
     lines_before = path.read_text().splitlines()
-    # the resume on one local worker, as the reference below (the default, one per CPU,
-    # started a nanny and a worker process more, each importing dask and eyeviz)
-    out = subprocess.run(
-        [sys.executable, "-m", "eyeviz", "study", *map(str, args), "--workers", "1"]
-        + ["--no-progress"],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        timeout=300,
-    )
+    # the resume in this process (its rows are the point, the kill went to the other), on
+    # one local worker (the default, one per CPU, started a nanny and a worker more)
+    out = eyeviz_main("study", *args, "--workers", "1", "--no-progress")
     assert out.returncode == 0, out.stderr
     assert f"{6 - len(kept)} point(s) computed, {len(kept)} skipped" in out.stdout
     assert path.read_text().splitlines()[: len(lines_before)] == lines_before
-    whole = tmp_path / "whole.csv"  # (one worker: the rows do not depend on how many)
-    run_study(
-        whole, design_grid3d("20,40,80", "10", "32,64", n=6000, seed=4), workers=1, progress=False
-    )
-    assert rows_without_seconds(path) == rows_without_seconds(whole)
+    # the uninterrupted study's rows: each point evaluated here, in order, and appended to a
+    # table of its own (what a worker computes and the runner writes, without a cluster)
+    whole = StudyTable3D.open(tmp_path / "whole.csv")
+    for p in design_grid3d("20,40,80", "10", "32,64", n=6000, seed=4):
+        whole.append(evaluate3d(p))
+    assert rows_without_seconds(path) == rows_without_seconds(tmp_path / "whole.csv")
 
 
 def test_the_3d_command_line_refuses_mixed_options_in_one_line(tmp_path):
@@ -188,7 +184,6 @@ def test_the_3d_command_line_refuses_mixed_options_in_one_line(tmp_path):
 
 def test_a_point_that_would_pass_the_readers_bound_is_refused_before_writing(tmp_path, monkeypatch):
     from eyeviz.study import table
-    from eyeviz.study.point import evaluate3d
 
     path = tmp_path / "s3.csv"
     pts = design_grid3d("20", "10", "8,16", n=40)
