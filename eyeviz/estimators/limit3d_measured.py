@@ -617,8 +617,10 @@ class MeasuredProposal:
         at = np.empty(n * m, np.int64)
         outs = {k: np.empty(n * m) for k in _VALUES}
         boxes, counts, dens = self._boxes(st)
+        # a copy: a read-only broadcast (one key's, contiguous) would be another signature,
+        # loaded from numba's cache at the first predict's retry (docs/limit3d.md, bee33g)
         cnt = kernel(
-            kernels.arg(keys, np.uint64), np.ascontiguousarray(streams, np.int64),
+            kernels.arg(keys, np.uint64), np.array(streams, np.int64, order="C"),
             kernels.arg(nst, np.int64), uu, kernels.arg(boxes, f64),
             kernels.arg(counts, np.int64), kernels.arg(dens, f64), self.samples,
             kernels.arg(st["u0"], f64), kernels.arg(st["e1"], f64), kernels.arg(st["e2"], f64),

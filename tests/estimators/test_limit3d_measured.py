@@ -595,3 +595,19 @@ def test_the_compiled_searches_give_the_numpy_loops_set_up(far, monkeypatch, fla
                 assert np.array_equal(got[True][k], v, equal_nan=True), k
         tight += int(np.sum(got[True]["n_tight"] > 0))
     assert tight > 40
+
+
+def test_one_key_s_draws_take_the_warmed_signature(far):
+    """The draws' kernel gets its streams as a writable copy: one key's broadcast streams
+    (read-only and contiguous) were a second signature, loaded from numba's cache at the
+    first predict's retry of a single key (kernels.warm compiles the writable one)."""
+    from eyeviz.core.kernels import measured_limit
+    from eyeviz.estimators import limit3d_measured as lm
+
+    dom, _, _, (la, lb) = far
+    one = (take_rows(*la, np.array([0])), take_rows(*lb, np.array([0])))
+    keys = _key_hash(*one)
+    prop = lm.MeasuredProposal(dom, "single", 64, 8)
+    prop.sample_sparse(prop.setup(*one, keys, 1.0), keys, 3)
+    sigs = measured_limit.mixture_draws_kernel.signatures
+    assert sigs and all(sig[1].mutable for sig in sigs)
