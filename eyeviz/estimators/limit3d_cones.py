@@ -21,6 +21,9 @@ __all__ = ["RINGS", "both_columns", "key_hits", "_Edges", "_Facets", "_direction
 
 #: rings of axis neighbours of the lit facets whose unlit facets constrain
 RINGS = 2
+#: _Edges' constraining facets found by one compiled call (the same facets in the same
+#: order as the numpy sets' way, which the tests compare with it)
+EDGES_KERNEL = True
 
 
 class _Facets:
@@ -64,22 +67,35 @@ class _Edges:
     def __init__(self, f: _Facets, lit: LitCSR) -> None:
         ptr, ind = lit
         n, nf = ptr.size - 1, f.pos.shape[0]
-        rows = np.repeat(np.arange(n), np.diff(ptr))
-        lit_codes = rows * nf + ind
-        ring = lit_codes
-        near = [lit_codes]
-        for _ in range(RINGS):
-            r_, i_ = np.divmod(ring, nf)
-            ring = np.repeat(r_, f.nb.shape[1]) * nf + f.nb[i_].ravel()
-            near.append(ring)
-        allc = np.unique(np.concatenate(near))
-        unlit = allc[~np.isin(allc, lit_codes, assume_unique=True)]
-        codes = np.concatenate([lit_codes, unlit])
-        is_lit = np.concatenate([np.ones(lit_codes.size, bool), np.zeros(unlit.size, bool)])
-        r_all, i_all = np.divmod(codes, nf)
-        order = np.argsort(r_all, kind="stable")
-        r_all, i_all, is_lit = r_all[order], i_all[order], is_lit[order]
-        cnt = np.bincount(r_all, minlength=n)
+        if EDGES_KERNEL and RINGS == 2 and kernels.use(ind.size * f.nb.shape[1] ** 2):
+            from eyeviz.core.kernels.limit3d_region import constraining_kernel
+
+            per = np.minimum(np.diff(ptr) * (1 + f.nb.shape[1] * (1 + f.nb.shape[1])), nf)
+            i_all = np.empty(int(per.sum()), np.int64)
+            is_lit = np.empty(i_all.size, np.bool_)
+            cnt = np.empty(n, np.int64)
+            constraining_kernel(kernels.arg(ptr, np.int64), kernels.arg(ind, np.int64),
+                                kernels.arg(f.nb, np.int64), np.full(nf, -1, np.int64),
+                                i_all, is_lit, cnt)  # fmt: skip
+            i_all, is_lit = i_all[: cnt.sum()], is_lit[: cnt.sum()]
+            r_all = np.repeat(np.arange(n), cnt)
+        else:
+            rows = np.repeat(np.arange(n), np.diff(ptr))
+            lit_codes = rows * nf + ind
+            ring = lit_codes
+            near = [lit_codes]
+            for _ in range(RINGS):
+                r_, i_ = np.divmod(ring, nf)
+                ring = np.repeat(r_, f.nb.shape[1]) * nf + f.nb[i_].ravel()
+                near.append(ring)
+            allc = np.unique(np.concatenate(near))
+            unlit = allc[~np.isin(allc, lit_codes, assume_unique=True)]
+            codes = np.concatenate([lit_codes, unlit])
+            is_lit = np.concatenate([np.ones(lit_codes.size, bool), np.zeros(unlit.size, bool)])
+            r_all, i_all = np.divmod(codes, nf)
+            order = np.argsort(r_all, kind="stable")
+            r_all, i_all, is_lit = r_all[order], i_all[order], is_lit[order]
+            cnt = np.bincount(r_all, minlength=n)
         k = max(1, int(cnt.max()) if cnt.size else 1)
         slot = np.arange(r_all.size) - np.repeat(np.cumsum(cnt) - cnt, cnt)
         self.pos = np.zeros((n, k, 3))

@@ -554,16 +554,19 @@ def test_a_key_whose_first_batch_finds_nothing_goes_to_the_retry_at_once(far, mo
             assert p.r[n] == q.r[n] and p.flagged[n] == q.flagged[n]
 
 
-@pytest.mark.parametrize("flag", ["BOX_KERNEL", "GRID_KERNEL", "SEARCH_KERNEL"])
+@pytest.mark.parametrize("flag", ["BOX_KERNEL", "GRID_KERNEL", "SEARCH_KERNEL", "EDGES_KERNEL"])
 def test_the_compiled_searches_give_the_numpy_loops_set_up(far, monkeypatch, flag):
     """MeasuredProposal._around's bisection, widening and pilot as one compiled call
     (``BOX_KERNEL``, kernels.measured_limit.box_kernel), limit3d_provable.dir_region's
     grids as one (``GRID_KERNEL``, kernels.limit3d_region.dir_grid_kernel) and the
-    reference search's (``SEARCH_KERNEL``, kernels.measured_limit.search_kernel), against their
+    reference search's (``SEARCH_KERNEL``, kernels.measured_limit.search_kernel), and the
+    constraining facets' (``EDGES_KERNEL``, kernels.limit3d_region.constraining_kernel),
+    against their
     numpy loops with the compiled region and cell tests: every array of the set-up bit
     for bit (the boxes, the pilot's feasible points' box and number, the provable box,
     the mixture), on 48 fresh honeybee keys in chunks of 8, the two the first reference
     search misses (the wider search's chunk) and the far test pair's 30 keys."""
+    from eyeviz.estimators import limit3d_cones as lc
     from eyeviz.estimators import limit3d_measured as lm
     from eyeviz.estimators import limit3d_provable as lp
     from eyeviz.files.eye_io import load_eyes, shipped_eye
@@ -587,12 +590,16 @@ def test_the_compiled_searches_give_the_numpy_loops_set_up(far, monkeypatch, fla
         keys = _key_hash(la, lb)
         got = {}
         for compiled in (True, False):
-            monkeypatch.setattr(lp if flag == "GRID_KERNEL" else lm, flag, compiled)
+            where = {"GRID_KERNEL": lp, "EDGES_KERNEL": lc}.get(flag, lm)
+            monkeypatch.setattr(where, flag, compiled)
             got[compiled] = prop.setup(la, lb, keys, 1.0)
         assert got[True].keys() == got[False].keys()
         for k, v in got[False].items():
             if isinstance(v, np.ndarray):
                 assert np.array_equal(got[True][k], v, equal_nan=True), k
+        for eye in ("ea", "eb"):
+            for name in ("pos", "ax", "half", "lit", "pad", "pa", "pp"):
+                assert np.array_equal(getattr(got[True][eye], name), getattr(got[False][eye], name))
         tight += int(np.sum(got[True]["n_tight"] > 0))
     assert tight > 40
 

@@ -28,6 +28,7 @@ __all__ = [
     "bcentre",
     "same_rows_kernel",
     "spread_rows_kernel",
+    "constraining_kernel",
     "prefilter_kernel",
     "compact_draws_kernel",
     "warm",
@@ -317,6 +318,39 @@ def prefilter_kernel(pts, lit, pad, row, c, alpha, s, ok):
         ok[i] = not bad
 
 
+@_jit
+def constraining_kernel(ptr, ind, nb, seen, fac, lit, cnt):
+    """limit3d_cones._Edges' constraining facets of each CSR row (ptr, ind) of an eye of
+    ``seen.size`` facets: its lit facets in row order, then, ascending, the unlit facets
+    within two rings of axis neighbours (nb (F, K)) of them; written row after row into
+    fac and lit (capacity enough), each row's count in cnt. ``seen`` (F,) all -1 on entry
+    (a row's stamps; the same facets and order as the numpy sets' way)."""
+    at = 0
+    for n in range(ptr.size - 1):
+        start = at
+        own, near = 2 * n, 2 * n + 1
+        for q in range(ptr[n], ptr[n + 1]):
+            seen[ind[q]] = own
+        for q in range(ptr[n], ptr[n + 1]):
+            fac[at] = ind[q]
+            lit[at] = True
+            at += 1
+            for a in range(nb.shape[1]):
+                j = nb[ind[q], a]
+                if seen[j] != own:
+                    seen[j] = near
+                for b in range(nb.shape[1]):
+                    k = nb[j, b]
+                    if seen[k] != own:
+                        seen[k] = near
+        for i in range(seen.size):
+            if seen[i] == near:
+                fac[at] = i
+                lit[at] = False
+                at += 1
+        cnt[n] = at - start
+
+
 @_jit_np
 def spread_rows_kernel(row, r, w, mean, sd, ess):
     """limit3d._spread_flat's sums, each in storage order as ``np.bincount``'s: per row
@@ -431,3 +465,5 @@ def warm() -> None:
     compact_draws_kernel(tuple(np.ones((1, 2)) for _ in range(8)), 7, 0, 2, b[0].copy())
     one = np.ones(1)
     spread_rows_kernel(i1[:1], one, one, one.copy(), one.copy(), one.copy())
+    constraining_kernel(i1, i1[:0], np.zeros((1, 1), np.int64), np.full(1, -1, np.int64),
+                        i1.copy(), b[0].copy(), i1[:1].copy())  # fmt: skip
