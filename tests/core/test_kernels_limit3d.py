@@ -236,13 +236,13 @@ def test_same_rows_kernel_is_the_reference(seed):
 @settings(max_examples=40, deadline=None)
 @given(seed=st.integers(0, 2**31), m=st.integers(1, 40), special=st.booleans())
 def test_compact_draws_kernel_is_the_reference(seed, m, special):
-    """limit3d._compact compiled (limit3d_region.compact_draws_kernel) and in numpy: the
+    """limit3d_rows._compact compiled (limit3d_region.compact_draws_kernel) and in numpy: the
     same arrays bit for bit, over all columns and over a range of them with some rows
     weighing 0 (the top-ups' batches), with weights 0, negative or NaN, values inf or NaN
     (the padding: the row's largest accepted value, 1 where that is not finite or there
     is none), rows with nothing accepted and a strided view of the draws."""
     from eyeviz.core import kernels
-    from eyeviz.estimators import limit3d
+    from eyeviz.estimators import limit3d_rows
 
     rng = np.random.default_rng(seed)
     n = int(rng.integers(1, 6))
@@ -258,8 +258,8 @@ def test_compact_draws_kernel_is_the_reference(seed, m, special):
     lo = int(rng.integers(0, m))
     with pytest.MonkeyPatch.context() as mp:
         mp.setitem(kernels._STATE, "ready", True)
-        got = [limit3d._compact(s), limit3d._compact(big, lo, 2 * m - lo // 2, rows)]
-    want = [limit3d._compact_ref(s), limit3d._compact_ref(big, lo, 2 * m - lo // 2, rows)]
+        got = [limit3d_rows._compact(s), limit3d_rows._compact(big, lo, 2 * m - lo // 2, rows)]
+    want = [limit3d_rows._compact_ref(s), limit3d_rows._compact_ref(big, lo, 2 * m - lo // 2, rows)]
     for g, w in zip(got, want, strict=True):
         assert list(g) == list(w)
         for k in names:

@@ -353,7 +353,7 @@ def constraining_kernel(ptr, ind, nb, seen, fac, lit, cnt):
 
 @_jit_np
 def spread_rows_kernel(row, r, w, mean, sd, ess):
-    """limit3d._spread_flat's sums, each in storage order as ``np.bincount``'s: per row
+    """limit3d_rows._spread_flat's sums, each in storage order as ``np.bincount``'s: per row
     of the accepted draws (row, r, w) the weighted mean and standard deviation of r and
     the effective sample size; the same values bit for bit (NaN where a row has none)."""
     n = mean.size
@@ -395,7 +395,7 @@ def same_rows_kernel(ptr, ind, kp, ki, row, same):
 
 @_jit
 def compact_draws_kernel(vals, iw, lo, hi, rows):
-    """limit3d._compact of the draws ``vals`` (a tuple of (N, M) arrays, the weights at
+    """limit3d_rows._compact of the draws ``vals`` (a tuple of (N, M) arrays, the weights at
     ``iw``) in the columns lo .. hi - 1, the rows not ``rows`` (N,) weighing 0: per row the
     accepted draws (weight > 0) first, in draw order, padded to the widest row's count K
     (at least 1) with 0 for the weights and, for the others, the row's largest accepted
