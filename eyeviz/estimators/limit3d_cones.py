@@ -125,12 +125,10 @@ class _Edges:
         keep = live & np.where(self.lit, dist >= keep_lit * lo, dist <= keep_unlit * hi)
         k = max(1, int(keep.sum(axis=1).max()))
         order = np.argsort(~keep, axis=1, kind="stable")[:, :k]
+        rows = np.arange(order.shape[0])[:, None]  # (a gather: np.take_along_axis's values)
         for name in ("pos", "ax", "half", "lit", "pa", "pp"):
-            v = getattr(self, name)
-            setattr(
-                self, name, np.take_along_axis(v, order if v.ndim == 2 else order[..., None], 1)
-            )
-        self.pad = ~np.take_along_axis(keep, order, 1)
+            setattr(self, name, getattr(self, name)[rows, order])
+        self.pad = ~keep[rows, order]
         self._cols = None
 
     def take(self, rows: np.ndarray) -> _Edges:
@@ -216,10 +214,8 @@ def both_columns(ea: _Edges, eb: _Edges) -> tuple[np.ndarray, ...]:
         return kept[2]
     pad = np.concatenate([ca[5], cb[5]], axis=1)
     order = np.argsort(pad, axis=1, kind="stable")  # the live facets first, in order
-    out = []
-    for x, y in zip(ca[:5], cb[:5], strict=True):
-        v = np.concatenate([x, y], axis=1)
-        out.append(np.take_along_axis(v, order if v.ndim == 2 else order[..., None], 1))
+    rows = np.arange(order.shape[0])[:, None]
+    out = [np.concatenate([x, y], axis=1)[rows, order] for x, y in zip(ca[:5], cb[:5], strict=True)]
     both = (*out, (~pad).sum(axis=1).astype(np.int64))
     ea._both = (ca, cb, both)
     return both
