@@ -280,33 +280,36 @@ class Limit3DEstimator(Estimator3D):
         m, n = self.samples, keys.size
         rep = np.ones(n, np.int64)
         acc = out["w"] > 0
-        rows = [np.nonzero(acc)[0]]
         vals = [{k: v[acc] for k, v in out.items()}]
-        row_all, r_all, w_all = rows[0], vals[0]["r"], vals[0]["w"]
+        row_all, r_all, w_all = np.nonzero(acc)[0], vals[0]["r"], vals[0]["w"]
         sp = _spread_flat(n, row_all, r_all, w_all)
         need = _needs_more_of(*sp, self.accuracy) & (rep < self.max_batches) & ok
         while need.any():
             cnt = np.where(need, _more_batches_of(*sp, self.accuracy, rep), 0)
             cnt = np.minimum(cnt, self.max_batches - rep)
             # the accepted draws alone (flat indices n W + m, W = max(cnt) batches), batch
-            # by batch
+            # by batch; r and w of each taken batch as it is taken, the rest of the round's
+            # taken draws gathered once after it (in the same order)
             at, more = self._proposal.sample_counts_sparse(st, keys, stream + 8 * rep, cnt)
             width = int(cnt.max()) * m
             row, col = at // width, at % width
+            batch = col // m
+            sels = []
             for j in range(int(cnt.max())):
                 take = need & (cnt > j)
                 if not take.any():
                     break
-                sel = np.flatnonzero(take[row] & (col // m == j))
-                rows.append(row[sel])
-                vals.append({k: v[sel] for k, v in more.items()})
-                row_all = np.concatenate([row_all, rows[-1]])
-                r_all = np.concatenate([r_all, vals[-1]["r"]])
-                w_all = np.concatenate([w_all, vals[-1]["w"]])
+                sels.append(np.flatnonzero(take[row] & (batch == j)))
+                row_all = np.concatenate([row_all, row[sels[-1]]])
+                r_all = np.concatenate([r_all, more["r"][sels[-1]]])
+                w_all = np.concatenate([w_all, more["w"][sels[-1]]])
                 rep += take
                 sp = _spread_flat(n, row_all, r_all, w_all)
                 need = _needs_more_of(*sp, self.accuracy) & (rep < self.max_batches)
                 need &= ok
+            if sels:
+                sel = np.concatenate(sels)
+                vals.append({k: v[sel] for k, v in more.items()})
         # each row's accepted draws in draw order: batch after batch, stably by row
         by = np.argsort(row_all, kind="stable")
         got = {k: np.concatenate([v[k] for v in vals])[by] for k in out}
