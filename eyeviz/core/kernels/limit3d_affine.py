@@ -91,9 +91,17 @@ def _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n, dx, dy):
     order, _Eye._affine): a padding or unlit slot gives max_lit -inf - (0 dx + 0 dy) =
     -inf, which changes no maximum, and likewise +inf for min_unlit, as long as dx and dy
     are finite (0 * inf is NaN: then every slot, as the reference)."""
+    l_a, l_t, nl, u_a, u_t, nu = lists
+    return _affine_flat(a_lit, t_lit, a_unl, t_unl, l_a, l_t, nl, u_a, u_t, nu, n, dx, dy)
+
+
+@_jit_inline
+def _affine_flat(a_lit, t_lit, a_unl, t_unl, l_a, l_t, nl, u_a, u_t, nu, n, dx, dy):
+    """:func:`_affine_lists` with the lists' six arrays passed one by one: a caller in a
+    loop unpacks the tuple once (each unpacking counts a reference on each array, atomic
+    operations that cost more than the evaluation)."""
     if not (math.isfinite(dx) and math.isfinite(dy)):
         return _affine_at(a_lit, t_lit, a_unl, t_unl, n, dx, dy)
-    l_a, l_t, nl, u_a, u_t, nu = lists
     # a plain compare-and-select, not numpy's NaN-first _max / _min: with dx, dy finite
     # and the lists' forms finite nothing here is NaN, so the value is the same, and the
     # loop compiles to a few instructions a cell (2.3x the evaluations a second)

@@ -19,7 +19,7 @@ from numba import njit
 
 from eyeviz.core.kernels import limit3d_affine, limit3d_region
 from eyeviz.core.kernels.healpix_boundary import stamp_with
-from eyeviz.core.kernels.limit3d_affine import _affine_lists, _max, _min
+from eyeviz.core.kernels.limit3d_affine import _affine_at, _affine_flat, _max, _min
 from eyeviz.core.kernels.limit3d_region import _M1, _mix64
 
 # before the first kernel: its cache carries the source of the modules it calls as well
@@ -44,12 +44,13 @@ def _clean(x):
 
 
 @_jit_inline
-def _gap_g(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, caz, u, sa_lo, sa_hi,
-           slack):  # fmt: skip
+def _gap_g(a_lit, t_lit, a_unl, t_unl, l_a, l_t, nl, u_a, u_t, nu, c, e1, e2, a, n, cax, cay,
+           caz, u, sa_lo, sa_hi, slack):  # fmt: skip
     """The g test's gap along A's ray at u, in B's sin-angle: min(sin(hi_B + s), sin_hi_A /
     k) - max(sin(lo_B - s), sin_lo_A / k), k = |c_A + u (A - B)| = rho_B / rho (the
     angles clipped to [0, pi / 2]; sa_lo, sa_hi: A's sin(lo_A - s), sin(hi_A + s)). A
-    draw's g interval is not empty iff it is above 0 (the prior's g range aside)."""
+    draw's g interval is not empty iff it is above 0 (the prior's g range aside). B's model
+    as :func:`.limit3d_affine._affine_flat` (its lists' arrays l_a .. nu)."""
     vx = cax + u * a[0]
     vy = cay + u * a[1]
     vz = caz + u * a[2]
@@ -58,10 +59,10 @@ def _gap_g(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, caz, u,
     cc = vx * c[n, 0] + vy * c[n, 1] + vz * c[n, 2]
     x = vx * e1[n, 0] + vy * e1[n, 1] + vz * e1[n, 2]
     y = vx * e2[n, 0] + vy * e2[n, 1] + vz * e2[n, 2]
-    lo, hi = _affine_lists(a_lit, t_lit, a_unl, t_unl, lists, n, _clean(x / cc), _clean(y / cc))
-    h2 = 0.5 * math.pi
-    sb_lo = math.sin(_clip_nan(lo - slack, 0.0, h2))
-    sb_hi = math.sin(_clip_nan(hi + slack, 0.0, h2))
+    lo, hi = _affine_flat(a_lit, t_lit, a_unl, t_unl, l_a, l_t, nl, u_a, u_t, nu, n,
+                          _clean(x / cc), _clean(y / cc))  # fmt: skip
+    sb_lo = _sin_clip(lo - slack)
+    sb_hi = _sin_clip(hi + slack)
     return _min(sb_hi, sa_hi / nrm) - _max(sb_lo, sa_lo / nrm)
 
 
@@ -74,7 +75,25 @@ def _clip_nan(x, lo, hi):
 
 
 @_jit_inline
+def _sin_clip(x):
+    """math.sin(_clip_nan(x, 0, pi / 2)), the same bits, the clipped ends without the call:
+    sin(+-0) = +-0 and sin(pi / 2) = 1.0 exactly in binary64."""
+    c = _clip_nan(x, 0.0, 0.5 * math.pi)
+    if c == 0.0:
+        return c
+    if c == 0.5 * math.pi:
+        return 1.0
+    return math.sin(c)
+
+
+@_jit_inline
 def _aim_next(gv, seen, grid):
+    """:func:`_aim_next_at` of the values gv[0 .. grid - 1]."""
+    return _aim_next_at(gv, 0, seen, grid)
+
+
+@_jit_inline
+def _aim_next_at(gv, o, seen, grid):
     """The next grid point of the search along A's ray (:func:`_ray_search`), replayed
     from the values found so far (gv, ``seen`` a bit mask of the points evaluated; grid
     >= 2): (j, first, last), j >= 0 the point to evaluate next, or j = -1 and the
@@ -86,18 +105,20 @@ def _aim_next(gv, seen, grid):
     bracket is a valid proposal (the weight's mixture density uses it); on a unimodal gap
     (rising, a flat top, falling) this is the full scan's bracket ((first, last) of the
     inside points, else the argmax), with about 4.6 of the 8 points evaluated instead of
-    8. ``_ray_bracket`` in limit3d_proposal is the numpy reference."""
+    8. ``_ray_bracket`` in limit3d_proposal is the numpy reference. The values are gv[o ..
+    o + grid - 1] (a lane's row of a flat array: a row as a view would count a reference
+    at each step)."""
     m0 = (grid - 2) // 2
     hit = -1
     for j in (m0, m0 + 1):
         if not (seen >> j) & 1:
             return j, 0, 0
-        if gv[j] > 0.0:
+        if gv[o + j] > 0.0:
             hit = j
             break
     lo = 0
     hi = m0
-    if gv[m0] < gv[m0 + 1]:
+    if gv[o + m0] < gv[o + m0 + 1]:
         lo = m0 + 1
         hi = grid - 1
     while hit < 0 and hi - lo > 1:
@@ -105,11 +126,11 @@ def _aim_next(gv, seen, grid):
         for j in (m, m + 1):
             if not (seen >> j) & 1:
                 return j, 0, 0
-            if gv[j] > 0.0:
+            if gv[o + j] > 0.0:
                 hit = j
                 break
         if hit < 0:
-            if gv[m] < gv[m + 1]:
+            if gv[o + m] < gv[o + m + 1]:
                 lo = m + 1
             else:
                 hi = m
@@ -118,10 +139,10 @@ def _aim_next(gv, seen, grid):
         for j in range(lo, hi + 1):
             if not (seen >> j) & 1:
                 return j, 0, 0
-            if gv[j] > 0.0:
+            if gv[o + j] > 0.0:
                 hit = j
                 break
-            if gv[j] > gv[best]:
+            if gv[o + j] > gv[o + best]:
                 best = j
         if hit < 0:
             return -1, best, best
@@ -129,14 +150,14 @@ def _aim_next(gv, seen, grid):
     while first > 0:
         if not (seen >> (first - 1)) & 1:
             return first - 1, 0, 0
-        if not gv[first - 1] > 0.0:
+        if not gv[o + first - 1] > 0.0:
             break
         first -= 1
     last = hit
     while last < grid - 1:
         if not (seen >> (last + 1)) & 1:
             return last + 1, 0, 0
-        if not gv[last + 1] > 0.0:
+        if not gv[o + last + 1] > 0.0:
             break
         last += 1
     return -1, first, last
@@ -149,6 +170,7 @@ def _ray_search(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, ca
     ``rounds`` times on the grid t (gv, uu: work arrays of its size) to the bracket of
     the inside points (:func:`_gap_g` > 0) that :func:`_aim_next` finds."""
     grid = t.size
+    l_a, l_t, nl, u_a, u_t, nu = lists
     for _ in range(rounds):
         for j in range(grid):
             uu[j] = lo_ + (hi_ - lo_) * t[j]
@@ -157,8 +179,8 @@ def _ray_search(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, ca
             j, first, last = _aim_next(gv, seen, grid)
             if j < 0:
                 break
-            gv[j] = _gap_g(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, cax, cay, caz,
-                           uu[j], sa_lo, sa_hi, slack)  # fmt: skip
+            gv[j] = _gap_g(a_lit, t_lit, a_unl, t_unl, l_a, l_t, nl, u_a, u_t, nu, c, e1, e2, a,
+                           n, cax, cay, caz, uu[j], sa_lo, sa_hi, slack)  # fmt: skip
             seen |= 1 << j
         lo_ = uu[max(first - 1, 0)]
         hi_ = uu[min(last + 1, grid - 1)]
@@ -211,22 +233,25 @@ def healpix_prior(r, g, el, az, s_half, g_max, r_min, r_max, el_max, psi, multi)
 
 
 @_jit_np
-def _ray_box(c, e1, e2, a, ext0, ext1, cax, cay, caz):
+def _ray_box(c0, c1, c2, f0, f1, f2, h0, h1, h2, a0, a1, a2, ext0, ext1, cax, cay, caz):
     """limit3d_proposal._ray_in_box for one ray: (lo, hi) of u where B's view of
-    A + c_A / u lies in B's box (c, e1, e2: B's centre and frame; a = A - B)."""
-    ca_ = c[0] * a[0] + c[1] * a[1] + c[2] * a[2]
-    cc = cax * c[0] + cay * c[1] + caz * c[2]
+    A + c_A / u lies in B's box (c, f, h: B's centre and frame e1, e2; a = A - B), from
+    scalars (arrays passed would count references at every draw)."""
+    ca_ = c0 * a0 + c1 * a1 + c2 * a2
+    cc = cax * c0 + cay * c1 + caz * c2
     lo = 0.0
     hi = np.inf
     for j in range(5):
         if j == 0:
             k0, k1 = -cc, -ca_
         else:
-            e = e1 if j < 3 else e2
-            x = ext0 if j < 3 else ext1
+            if j < 3:
+                e0, e1, e2, x = f0, f1, f2, ext0
+            else:
+                e0, e1, e2, x = h0, h1, h2, ext1
             sgn = 1.0 if j % 2 == 1 else -1.0
-            ce = cax * e[0] + cay * e[1] + caz * e[2]
-            k1 = sgn * (e[0] * a[0] + e[1] * a[1] + e[2] * a[2]) - x * ca_
+            ce = cax * e0 + cay * e1 + caz * e2
+            k1 = sgn * (e0 * a0 + e1 * a1 + e2 * a2) - x * ca_
             k0 = sgn * ce - x * cc
         root = -k0 / k1
         if k1 > 0:
@@ -270,7 +295,9 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
     0 (w 0 elsewhere, the others then unset); only the keys ``rows`` (N,) get draws."""
     al, tl, au, tu, la = fa
     bl, sl_, bu, su, lb = fb
-    h2 = 0.5 * math.pi
+    # the lists' arrays unpacked once (an unpacking in the loops would count references)
+    la_a, la_t, la_n, la_ua, la_ut, la_nu = la
+    lb_a, lb_t, lb_n, lb_ua, lb_ut, lb_nu = lb
     lam = n_def / samples
     mt = samples * streams.size
     # a key's draws that reach the ray search: their index and state (A's direction, its
@@ -301,26 +328,45 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
             dy = (cx * e2a[n, 0] + cy * e2a[n, 1] + cz * e2a[n, 2]) / cc
             if not (abs(dx) <= ext[n, 0] and abs(dy) <= ext[n, 1]):
                 continue
-            lo_a, hi_a = _affine_lists(al, tl, au, tu, la, n, dx, dy)
+            # _affine_flat written out (see _ray_searches)
+            if math.isfinite(dx) and math.isfinite(dy):
+                lo_a = -np.inf
+                for k in range(la_n[n]):
+                    fv = la_t[n, k, 0] * dx
+                    fv = fv + la_t[n, k, 1] * dy
+                    fv = la_a[n, k] - fv
+                    lo_a = fv if fv > lo_a else lo_a
+                hi2 = np.inf
+                for k in range(la_nu[n]):
+                    fw = la_ut[n, k, 0] * dx
+                    fw = fw + la_ut[n, k, 1] * dy
+                    fw = la_ua[n, k] - fw
+                    hi2 = fw if fw < hi2 else hi2
+                hi2 = hi2 + (dx * dx + dy * dy)
+                hi_a = math.sqrt(_max(hi2, 0.0))
+            else:
+                lo_a, hi_a = _affine_at(al, tl, au, tu, n, dx, dy)
             if not hi_a - lo_a > -2.0 * sn:
                 continue
-            ulo, uhi = _ray_box(cb[n], e1b[n], e2b[n], ab, ext_b[n, 0], ext_b[n, 1], cx, cy, cz)
+            ulo, uhi = _ray_box(cb[n, 0], cb[n, 1], cb[n, 2], e1b[n, 0], e1b[n, 1], e1b[n, 2],
+                                e2b[n, 0], e2b[n, 1], e2b[n, 2], ab[0], ab[1], ab[2], ext_b[n, 0],
+                                ext_b[n, 1], cx, cy, cz)  # fmt: skip
             ulo = _max(ulo, u_min)
             uhi = _min(uhi, u_max)
             if not uhi > ulo:
                 continue
             q_m[nq] = m
-            v = q_v[nq]
-            v[0], v[1], v[2], v[3] = cx, cy, cz, sp
-            v[4], v[5] = ulo, uhi
-            v[6] = math.sin(_clip_nan(lo_a - sn, 0.0, h2))
-            v[7] = math.sin(_clip_nan(hi_a + sn, 0.0, h2))
+            q_v[nq, 0], q_v[nq, 1], q_v[nq, 2], q_v[nq, 3] = cx, cy, cz, sp
+            q_v[nq, 4], q_v[nq, 5] = ulo, uhi
+            q_v[nq, 6] = _sin_clip(lo_a - sn)
+            q_v[nq, 7] = _sin_clip(hi_a + sn)
             nq += 1
-        _ray_searches(bl, sl_, bu, su, lb, cb, e1b, e2b, ab, n, q_v, nq, sn, t, rounds, q_h)
+        _ray_searches(bl, sl_, bu, su, lb_a, lb_t, lb_n, lb_ua, lb_ut, lb_nu, cb, e1b, e2b, ab, n,
+                      q_v, nq, sn, t, rounds, q_h)  # fmt: skip
         for q in range(nq):
             m = q_m[q]
-            v = q_v[q]
-            cx, cy, cz, sp, ulo, uhi, sa_lo, sa_hi = v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]
+            cx, cy, cz, sp = q_v[q, 0], q_v[q, 1], q_v[q, 2], q_v[q, 3]
+            ulo, uhi, sa_lo, sa_hi = q_v[q, 4], q_v[q, 5], q_v[q, 6], q_v[q, 7]
             hlo, hhi = q_h[q, 0], q_h[q, 1]
             s_m = streams[m // samples]
             j4 = 4 * (m % samples)
@@ -343,13 +389,29 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
             cc = vx * cb[n, 0] + vy * cb[n, 1] + vz * cb[n, 2]
             bx = (vx * e1b[n, 0] + vy * e1b[n, 1] + vz * e1b[n, 2]) / cc
             by = (vx * e2b[n, 0] + vy * e2b[n, 1] + vz * e2b[n, 2]) / cc
-            lo_b, hi_b = _affine_lists(bl, sl_, bu, su, lb, n, bx, by)
+            if math.isfinite(bx) and math.isfinite(by):  # _affine_flat written out
+                lo_b = -np.inf
+                for k in range(lb_n[n]):
+                    fv = lb_t[n, k, 0] * bx
+                    fv = fv + lb_t[n, k, 1] * by
+                    fv = lb_a[n, k] - fv
+                    lo_b = fv if fv > lo_b else lo_b
+                hi2 = np.inf
+                for k in range(lb_nu[n]):
+                    fw = lb_ut[n, k, 0] * bx
+                    fw = fw + lb_ut[n, k, 1] * by
+                    fw = lb_ua[n, k] - fw
+                    hi2 = fw if fw < hi2 else hi2
+                hi2 = hi2 + (bx * bx + by * by)
+                hi_b = math.sqrt(_max(hi2, 0.0))
+            else:
+                lo_b, hi_b = _affine_at(bl, sl_, bu, su, n, bx, by)
             g_lo = rr * s_half
             g_hi = g_max
             g_lo = _max(g_lo, rho * sa_lo)  # A's sines, as the search took them
             g_hi = _min(g_hi, rho * sa_hi)
-            g_lo = _max(g_lo, rho_b * math.sin(_clip_nan(lo_b - sn, 0.0, h2)))
-            g_hi = _min(g_hi, rho_b * math.sin(_clip_nan(hi_b + sn, 0.0, h2)))
+            g_lo = _max(g_lo, rho_b * _sin_clip(lo_b - sn))
+            g_hi = _min(g_hi, rho_b * _sin_clip(hi_b + sn))
             if not g_hi > g_lo:
                 continue
             gg = g_lo + (g_hi - g_lo) * _uniform(base, s_m, j4 + 3)
@@ -371,55 +433,101 @@ _LANES = 4
 
 
 @_jit_inline
-def _ray_searches(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n, qv, nq, slack, t, rounds,
-                  out):  # fmt: skip
+def _ray_searches(a_lit, t_lit, a_unl, t_unl, l_a, l_t, nl, u_a, u_t, nu, c, e1, e2, a, n, qv, nq,
+                  slack, t, rounds, out):  # fmt: skip
     """:func:`_ray_search` of the rays 0 .. nq - 1 of key n (qv[q]: c_A's x, y, z, sp, the
     box's lo, hi along the ray, A's sin(lo_A - s), sin(hi_A + s)), ``_LANES`` of them side
-    by side: each takes the points :func:`_aim_next` asks for in turn, a point of each ray
-    evaluated before the next of any, so the rays' chains of operations (a normalisation,
-    B's model, two sines) overlap; each ray's points, values and bracket are its own search's
-    (a point's value is a function of its u alone). out[q] = (lo, hi)."""
+    by side: each lane takes the points :func:`_aim_next` asks for in turn, a point of each
+    lane evaluated before the next of any, so the rays' chains of operations (a
+    normalisation, B's model, two sines) overlap; a lane whose ray has finished its rounds
+    takes the next ray at once, so the lanes stay full until the last rays. Each ray's
+    points, values and bracket are its own search's (a point's value is a function of its u
+    alone). out[q] = (lo, hi). B's model's lists as :func:`_gap_g` takes them; the lanes'
+    values one flat array (lane i's at i * grid)."""
     grid = t.size
-    gvs = np.empty((_LANES, grid))
+    gvs = np.empty(_LANES * grid)
     uus = np.empty((_LANES, grid))
     seen = np.zeros(_LANES, np.int64)
     pend = np.zeros(_LANES, np.int64)
-    act = np.zeros(_LANES, np.bool_)
-    for q0 in range(0, nq, _LANES):
-        k = min(_LANES, nq - q0)
-        for i in range(k):
-            out[q0 + i, 0] = qv[q0 + i, 4]
-            out[q0 + i, 1] = qv[q0 + i, 5]
-        for _ in range(rounds):
-            for i in range(k):
-                lo_, hi_ = out[q0 + i, 0], out[q0 + i, 1]
-                for j in range(grid):
-                    uus[i, j] = lo_ + (hi_ - lo_) * t[j]
-                seen[i] = 0
-                act[i] = True
+    lane_q = np.full(_LANES, -1, np.int64)
+    lane_r = np.zeros(_LANES, np.int64)
+    nxt = 0
+    while True:
+        more = False
+        for i in range(_LANES):
             while True:
-                more = False
-                for i in range(k):
-                    if not act[i]:
+                if lane_q[i] < 0:
+                    if nxt >= nq:
+                        break
+                    q = nxt
+                    nxt += 1
+                    out[q, 0] = qv[q, 4]
+                    out[q, 1] = qv[q, 5]
+                    if rounds <= 0:
                         continue
-                    j, first, last = _aim_next(gvs[i], seen[i], grid)
-                    if j < 0:
-                        act[i] = False
-                        out[q0 + i, 0] = uus[i, max(first - 1, 0)]
-                        out[q0 + i, 1] = uus[i, min(last + 1, grid - 1)]
-                    else:
-                        pend[i] = j
-                        more = True
-                if not more:
+                    lane_q[i] = q
+                    lane_r[i] = 0
+                    lo_, hi_ = out[q, 0], out[q, 1]
+                    for j in range(grid):
+                        uus[i, j] = lo_ + (hi_ - lo_) * t[j]
+                    seen[i] = 0
+                j, first, last = _aim_next_at(gvs, i * grid, seen[i], grid)
+                if j >= 0:
+                    pend[i] = j
+                    more = True
                     break
-                for i in range(k):
-                    if act[i]:
-                        q = q0 + i
-                        j = pend[i]
-                        gvs[i, j] = _gap_g(a_lit, t_lit, a_unl, t_unl, lists, c, e1, e2, a, n,
-                                           qv[q, 0], qv[q, 1], qv[q, 2], uus[i, j], qv[q, 6],
-                                           qv[q, 7], slack)  # fmt: skip
-                        seen[i] |= 1 << j
+                q = lane_q[i]
+                out[q, 0] = uus[i, max(first - 1, 0)]
+                out[q, 1] = uus[i, min(last + 1, grid - 1)]
+                lane_r[i] += 1
+                if lane_r[i] < rounds:
+                    lo_, hi_ = out[q, 0], out[q, 1]
+                    for j in range(grid):
+                        uus[i, j] = lo_ + (hi_ - lo_) * t[j]
+                    seen[i] = 0
+                else:
+                    lane_q[i] = -1
+        if not more:
+            break
+        for i in range(_LANES):
+            q = lane_q[i]
+            if q >= 0:
+                j = pend[i]
+                # _gap_g written out: a call passing arrays, inlined or not, counts a
+                # reference on each at every evaluation (atomic operations that cost more
+                # than the evaluation); the same operations in the same order
+                u = uus[i, j]
+                vx = qv[q, 0] + u * a[0]
+                vy = qv[q, 1] + u * a[1]
+                vz = qv[q, 2] + u * a[2]
+                nrm = math.sqrt(vx * vx + vy * vy + vz * vz)
+                vx, vy, vz = vx / nrm, vy / nrm, vz / nrm
+                cc = vx * c[n, 0] + vy * c[n, 1] + vz * c[n, 2]
+                x = vx * e1[n, 0] + vy * e1[n, 1] + vz * e1[n, 2]
+                y = vx * e2[n, 0] + vy * e2[n, 1] + vz * e2[n, 2]
+                dx = _clean(x / cc)
+                dy = _clean(y / cc)
+                if math.isfinite(dx) and math.isfinite(dy):  # _affine_flat's loops
+                    lo = -np.inf
+                    for k in range(nl[n]):
+                        v = l_t[n, k, 0] * dx
+                        v = v + l_t[n, k, 1] * dy
+                        v = l_a[n, k] - v
+                        lo = v if v > lo else lo
+                    hi2 = np.inf
+                    for k in range(nu[n]):
+                        w = u_t[n, k, 0] * dx
+                        w = w + u_t[n, k, 1] * dy
+                        w = u_a[n, k] - w
+                        hi2 = w if w < hi2 else hi2
+                    hi2 = hi2 + (dx * dx + dy * dy)
+                    hi = math.sqrt(_max(hi2, 0.0))
+                else:
+                    lo, hi = _affine_at(a_lit, t_lit, a_unl, t_unl, n, dx, dy)
+                sb_lo = _sin_clip(lo - slack)
+                sb_hi = _sin_clip(hi + slack)
+                gvs[i * grid + j] = _min(sb_hi, qv[q, 7] / nrm) - _max(sb_lo, qv[q, 6] / nrm)
+                seen[i] |= 1 << j
 
 
 def warm() -> None:
