@@ -107,6 +107,52 @@ def test_ray_region_kernel_is_the_reference_bit_for_bit(healpix_chunk, monkeypat
     assert set(width) == set(range(1, limit3d_healpix.RAY_GRID))
 
 
+@pytest.mark.parametrize("rounds", [1, 2, 3])
+def test_the_draws_lanes_search_each_ray_as_its_own_search(healpix_chunk, rounds):
+    """The draws' kernel's searches side by side (_ray_searches: four lanes, a lane taking
+    the next ray when its own has done its rounds; the gap and B's model written out in
+    its loop) against the search of one ray at a time (ray_region_kernel: _ray_search of
+    _gap_g), bit for bit, on 0-50 rays of every key (counts that do not fill the lanes,
+    rounds that finish on different steps), with rays whose gap is NaN or 0 wide."""
+    prop, stt, _ = healpix_chunk
+    eb, d = stt["eb"], prop.domain
+    rng = np.random.default_rng(17 + rounds)
+    n, m = eb.c.shape[0], 50
+    v = eb.c[:, None, :] + rng.normal(size=(n, m, 3)) * 0.01
+    rho_b = rng.uniform(d.r_min, d.r_max, (n, m, 1))
+    ca = stt["B"] + rho_b * v / np.linalg.norm(v, axis=2, keepdims=True) - stt["A"]
+    rho = np.linalg.norm(ca, axis=2)
+    ca /= rho[..., None]
+    lo, hi = rng.uniform(0.7, 1.0, (n, m)) / rho, rng.uniform(1.0, 1.3, (n, m)) / rho
+    hi[:, 7] = lo[:, 7]  # no width
+    b_lo, b_hi = eb.bounds(np.zeros((n, 1, 2)))
+    k = rho_b[..., 0] / rho  # rho_B / rho: A's sin radius of B's cap, so either side decides
+    s_lo = np.sin(b_lo) * k * rng.uniform(0.6, 1.1, (n, m))
+    s_hi = np.maximum(np.sin(b_hi) * k * rng.uniform(0.9, 1.6, (n, m)), s_lo)
+    s_hi[:, 11] = np.nan
+    slack = np.ascontiguousarray(np.broadcast_to(stt["slack"], (n, 1))[:, 0], np.float64)
+    t = np.linspace(0.0, 1.0, limit3d_healpix.RAY_GRID)
+    a = np.ascontiguousarray(eb.a, np.float64)
+    want_lo, want_hi = lo.copy(), hi.copy()
+    kd.ray_region_kernel(eb.a_lit, eb.t_lit, eb.a_unl, eb.t_unl, eb.lists, eb.c, eb.e1, eb.e2,
+                         a, ca, want_lo, want_hi, slack, t, rounds, np.ones((n, m), np.bool_),
+                         s_lo, s_hi)  # fmt: skip
+    moved = 0
+    for key in range(n):
+        nq = [0, 1, 3, 4, 5, 13, 50][key % 7]
+        qv = np.empty((m, 8))
+        qv[:, :3], qv[:, 3] = ca[key], 1.0
+        qv[:, 4], qv[:, 5], qv[:, 6], qv[:, 7] = lo[key], hi[key], s_lo[key], s_hi[key]
+        out = np.full((m, 2), -7.0)
+        kd._ray_searches(eb.a_lit, eb.t_lit, eb.a_unl, eb.t_unl, *eb.lists, eb.c, eb.e1, eb.e2,
+                         a, key, qv, nq, slack[key], t, rounds, out)  # fmt: skip
+        assert _same_bits(out[:nq, 0], want_lo[key, :nq]), (key, nq)
+        assert _same_bits(out[:nq, 1], want_hi[key, :nq]), (key, nq)
+        assert np.all(out[nq:] == -7.0)
+        moved += int(np.sum((out[:nq, 0] != lo[key, :nq]) | (out[:nq, 1] != hi[key, :nq])))
+    assert moved > 8  # the searches did narrow the rays
+
+
 def test_the_ray_search_picks_the_reference_s_bracket():
     """The draws' kernel's search along the ray (_aim_next, replayed point by point) against
     its numpy reference (_ray_bracket, every point known) on gap profiles of 2-10 points
