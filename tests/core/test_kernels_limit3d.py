@@ -109,11 +109,11 @@ def test_ray_region_kernel_is_the_reference_bit_for_bit(healpix_chunk, monkeypat
 
 @pytest.mark.parametrize("rounds", [1, 2, 3])
 def test_the_draws_lanes_search_each_ray_as_its_own_search(healpix_chunk, rounds):
-    """The draws' kernel's searches side by side (_ray_searches: four lanes, a lane taking
-    the next ray when its own has done its rounds; the gap and B's model written out in
-    its loop) against the search of one ray at a time (ray_region_kernel: _ray_search of
-    _gap_g), bit for bit, on 0-50 rays of every key (counts that do not fill the lanes,
-    rounds that finish on different steps), with rays whose gap is NaN or 0 wide."""
+    """The draws' kernel's searches side by side (_ray_searches: four lanes, the gap and B's
+    model written out in its loop) against the search of one ray at a time
+    (ray_region_kernel: _ray_search of _gap_g), bit for bit, on 0-50 rays of every key
+    (counts that do not fill the lanes, rays that finish on different steps), with rays
+    whose gap is NaN or 0 wide."""
     prop, stt, _ = healpix_chunk
     eb, d = stt["eb"], prop.domain
     rng = np.random.default_rng(17 + rounds)

@@ -61,8 +61,9 @@ def _gap_g(a_lit, t_lit, a_unl, t_unl, l_a, l_t, nl, u_a, u_t, nu, c, e1, e2, a,
     y = vx * e2[n, 0] + vy * e2[n, 1] + vz * e2[n, 2]
     lo, hi = _affine_flat(a_lit, t_lit, a_unl, t_unl, l_a, l_t, nl, u_a, u_t, nu, n,
                           _clean(x / cc), _clean(y / cc))  # fmt: skip
-    sb_lo = _sin_clip(lo - slack)
-    sb_hi = _sin_clip(hi + slack)
+    h2 = 0.5 * math.pi
+    sb_lo = math.sin(_clip_nan(lo - slack, 0.0, h2))
+    sb_hi = math.sin(_clip_nan(hi + slack, 0.0, h2))
     return _min(sb_hi, sa_hi / nrm) - _max(sb_lo, sa_lo / nrm)
 
 
@@ -72,18 +73,6 @@ def _clip_nan(x, lo, hi):
     if x != x:
         return x
     return min(max(x, lo), hi)
-
-
-@_jit_inline
-def _sin_clip(x):
-    """math.sin(_clip_nan(x, 0, pi / 2)), the same bits, the clipped ends without the call:
-    sin(+-0) = +-0 and sin(pi / 2) = 1.0 exactly in binary64."""
-    c = _clip_nan(x, 0.0, 0.5 * math.pi)
-    if c == 0.0:
-        return c
-    if c == 0.5 * math.pi:
-        return 1.0
-    return math.sin(c)
 
 
 @_jit_inline
@@ -233,9 +222,9 @@ def healpix_prior(r, g, el, az, s_half, g_max, r_min, r_max, el_max, psi, multi)
 
 
 @_jit_np
-def _ray_box(c0, c1, c2, f0, f1, f2, h0, h1, h2, a0, a1, a2, ext0, ext1, cax, cay, caz):
+def _ray_box(c0, c1, c2, p0, p1, p2, s0, s1, s2, a0, a1, a2, ext0, ext1, cax, cay, caz):
     """limit3d_proposal._ray_in_box for one ray: (lo, hi) of u where B's view of
-    A + c_A / u lies in B's box (c, f, h: B's centre and frame e1, e2; a = A - B), from
+    A + c_A / u lies in B's box (c, p, s: B's centre and frame e1, e2; a = A - B), from
     scalars (arrays passed would count references at every draw)."""
     ca_ = c0 * a0 + c1 * a1 + c2 * a2
     cc = cax * c0 + cay * c1 + caz * c2
@@ -246,9 +235,9 @@ def _ray_box(c0, c1, c2, f0, f1, f2, h0, h1, h2, a0, a1, a2, ext0, ext1, cax, ca
             k0, k1 = -cc, -ca_
         else:
             if j < 3:
-                e0, e1, e2, x = f0, f1, f2, ext0
+                e0, e1, e2, x = p0, p1, p2, ext0
             else:
-                e0, e1, e2, x = h0, h1, h2, ext1
+                e0, e1, e2, x = s0, s1, s2, ext1
             sgn = 1.0 if j % 2 == 1 else -1.0
             ce = cax * e0 + cay * e1 + caz * e2
             k1 = sgn * (e0 * a0 + e1 * a1 + e2 * a2) - x * ca_
@@ -295,6 +284,7 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
     0 (w 0 elsewhere, the others then unset); only the keys ``rows`` (N,) get draws."""
     al, tl, au, tu, la = fa
     bl, sl_, bu, su, lb = fb
+    h2 = 0.5 * math.pi
     # the lists' arrays unpacked once (an unpacking in the loops would count references)
     la_a, la_t, la_n, la_ua, la_ut, la_nu = la
     lb_a, lb_t, lb_n, lb_ua, lb_ut, lb_nu = lb
@@ -358,8 +348,8 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
             q_m[nq] = m
             q_v[nq, 0], q_v[nq, 1], q_v[nq, 2], q_v[nq, 3] = cx, cy, cz, sp
             q_v[nq, 4], q_v[nq, 5] = ulo, uhi
-            q_v[nq, 6] = _sin_clip(lo_a - sn)
-            q_v[nq, 7] = _sin_clip(hi_a + sn)
+            q_v[nq, 6] = math.sin(_clip_nan(lo_a - sn, 0.0, h2))
+            q_v[nq, 7] = math.sin(_clip_nan(hi_a + sn, 0.0, h2))
             nq += 1
         _ray_searches(bl, sl_, bu, su, lb_a, lb_t, lb_n, lb_ua, lb_ut, lb_nu, cb, e1b, e2b, ab, n,
                       q_v, nq, sn, t, rounds, q_h)  # fmt: skip
@@ -410,8 +400,8 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
             g_hi = g_max
             g_lo = _max(g_lo, rho * sa_lo)  # A's sines, as the search took them
             g_hi = _min(g_hi, rho * sa_hi)
-            g_lo = _max(g_lo, rho_b * _sin_clip(lo_b - sn))
-            g_hi = _min(g_hi, rho_b * _sin_clip(hi_b + sn))
+            g_lo = _max(g_lo, rho_b * math.sin(_clip_nan(lo_b - sn, 0.0, h2)))
+            g_hi = _min(g_hi, rho_b * math.sin(_clip_nan(hi_b + sn, 0.0, h2)))
             if not g_hi > g_lo:
                 continue
             gg = g_lo + (g_hi - g_lo) * _uniform(base, s_m, j4 + 3)
@@ -437,97 +427,86 @@ def _ray_searches(a_lit, t_lit, a_unl, t_unl, l_a, l_t, nl, u_a, u_t, nu, c, e1,
                   slack, t, rounds, out):  # fmt: skip
     """:func:`_ray_search` of the rays 0 .. nq - 1 of key n (qv[q]: c_A's x, y, z, sp, the
     box's lo, hi along the ray, A's sin(lo_A - s), sin(hi_A + s)), ``_LANES`` of them side
-    by side: each lane takes the points :func:`_aim_next` asks for in turn, a point of each
-    lane evaluated before the next of any, so the rays' chains of operations (a
-    normalisation, B's model, two sines) overlap; a lane whose ray has finished its rounds
-    takes the next ray at once, so the lanes stay full until the last rays. Each ray's
-    points, values and bracket are its own search's (a point's value is a function of its u
-    alone). out[q] = (lo, hi). B's model's lists as :func:`_gap_g` takes them; the lanes'
-    values one flat array (lane i's at i * grid)."""
+    by side: each takes the points :func:`_aim_next` asks for in turn, a point of each ray
+    evaluated before the next of any, so the rays' chains of operations (a normalisation,
+    B's model, two sines) overlap; each ray's points, values and bracket are its own
+    search's (a point's value is a function of its u alone). out[q] = (lo, hi). B's model's
+    lists as :func:`_gap_g` takes them; the lanes' values one flat array (lane i's at
+    i * grid: a row as a view would count a reference at each step)."""
     grid = t.size
+    h2 = 0.5 * math.pi
     gvs = np.empty(_LANES * grid)
     uus = np.empty((_LANES, grid))
     seen = np.zeros(_LANES, np.int64)
     pend = np.zeros(_LANES, np.int64)
-    lane_q = np.full(_LANES, -1, np.int64)
-    lane_r = np.zeros(_LANES, np.int64)
-    nxt = 0
-    while True:
-        more = False
-        for i in range(_LANES):
+    act = np.zeros(_LANES, np.bool_)
+    for q0 in range(0, nq, _LANES):
+        kk = min(_LANES, nq - q0)
+        for i in range(kk):
+            out[q0 + i, 0] = qv[q0 + i, 4]
+            out[q0 + i, 1] = qv[q0 + i, 5]
+        for _ in range(rounds):
+            for i in range(kk):
+                lo_, hi_ = out[q0 + i, 0], out[q0 + i, 1]
+                for j in range(grid):
+                    uus[i, j] = lo_ + (hi_ - lo_) * t[j]
+                seen[i] = 0
+                act[i] = True
             while True:
-                if lane_q[i] < 0:
-                    if nxt >= nq:
-                        break
-                    q = nxt
-                    nxt += 1
-                    out[q, 0] = qv[q, 4]
-                    out[q, 1] = qv[q, 5]
-                    if rounds <= 0:
+                more = False
+                for i in range(kk):
+                    if not act[i]:
                         continue
-                    lane_q[i] = q
-                    lane_r[i] = 0
-                    lo_, hi_ = out[q, 0], out[q, 1]
-                    for j in range(grid):
-                        uus[i, j] = lo_ + (hi_ - lo_) * t[j]
-                    seen[i] = 0
-                j, first, last = _aim_next_at(gvs, i * grid, seen[i], grid)
-                if j >= 0:
-                    pend[i] = j
-                    more = True
+                    j, first, last = _aim_next_at(gvs, i * grid, seen[i], grid)
+                    if j < 0:
+                        act[i] = False
+                        out[q0 + i, 0] = uus[i, max(first - 1, 0)]
+                        out[q0 + i, 1] = uus[i, min(last + 1, grid - 1)]
+                    else:
+                        pend[i] = j
+                        more = True
+                if not more:
                     break
-                q = lane_q[i]
-                out[q, 0] = uus[i, max(first - 1, 0)]
-                out[q, 1] = uus[i, min(last + 1, grid - 1)]
-                lane_r[i] += 1
-                if lane_r[i] < rounds:
-                    lo_, hi_ = out[q, 0], out[q, 1]
-                    for j in range(grid):
-                        uus[i, j] = lo_ + (hi_ - lo_) * t[j]
-                    seen[i] = 0
-                else:
-                    lane_q[i] = -1
-        if not more:
-            break
-        for i in range(_LANES):
-            q = lane_q[i]
-            if q >= 0:
-                j = pend[i]
-                # _gap_g written out: a call passing arrays, inlined or not, counts a
-                # reference on each at every evaluation (atomic operations that cost more
-                # than the evaluation); the same operations in the same order
-                u = uus[i, j]
-                vx = qv[q, 0] + u * a[0]
-                vy = qv[q, 1] + u * a[1]
-                vz = qv[q, 2] + u * a[2]
-                nrm = math.sqrt(vx * vx + vy * vy + vz * vz)
-                vx, vy, vz = vx / nrm, vy / nrm, vz / nrm
-                cc = vx * c[n, 0] + vy * c[n, 1] + vz * c[n, 2]
-                x = vx * e1[n, 0] + vy * e1[n, 1] + vz * e1[n, 2]
-                y = vx * e2[n, 0] + vy * e2[n, 1] + vz * e2[n, 2]
-                dx = _clean(x / cc)
-                dy = _clean(y / cc)
-                if math.isfinite(dx) and math.isfinite(dy):  # _affine_flat's loops
-                    lo = -np.inf
-                    for k in range(nl[n]):
-                        v = l_t[n, k, 0] * dx
-                        v = v + l_t[n, k, 1] * dy
-                        v = l_a[n, k] - v
-                        lo = v if v > lo else lo
-                    hi2 = np.inf
-                    for k in range(nu[n]):
-                        w = u_t[n, k, 0] * dx
-                        w = w + u_t[n, k, 1] * dy
-                        w = u_a[n, k] - w
-                        hi2 = w if w < hi2 else hi2
-                    hi2 = hi2 + (dx * dx + dy * dy)
-                    hi = math.sqrt(_max(hi2, 0.0))
-                else:
-                    lo, hi = _affine_at(a_lit, t_lit, a_unl, t_unl, n, dx, dy)
-                sb_lo = _sin_clip(lo - slack)
-                sb_hi = _sin_clip(hi + slack)
-                gvs[i * grid + j] = _min(sb_hi, qv[q, 7] / nrm) - _max(sb_lo, qv[q, 6] / nrm)
-                seen[i] |= 1 << j
+                for i in range(kk):
+                    if act[i]:
+                        q = q0 + i
+                        j = pend[i]
+                        # _gap_g written out: a call passing arrays, inlined or not, counts
+                        # a reference on each at every evaluation (atomic operations that
+                        # cost more than the evaluation); the same operations, same order
+                        u = uus[i, j]
+                        vx = qv[q, 0] + u * a[0]
+                        vy = qv[q, 1] + u * a[1]
+                        vz = qv[q, 2] + u * a[2]
+                        nrm = math.sqrt(vx * vx + vy * vy + vz * vz)
+                        vx, vy, vz = vx / nrm, vy / nrm, vz / nrm
+                        cc = vx * c[n, 0] + vy * c[n, 1] + vz * c[n, 2]
+                        x = vx * e1[n, 0] + vy * e1[n, 1] + vz * e1[n, 2]
+                        y = vx * e2[n, 0] + vy * e2[n, 1] + vz * e2[n, 2]
+                        dx = _clean(x / cc)
+                        dy = _clean(y / cc)
+                        if math.isfinite(dx) and math.isfinite(dy):  # _affine_flat's loops
+                            lo = -np.inf
+                            for k in range(nl[n]):
+                                v = l_t[n, k, 0] * dx
+                                v = v + l_t[n, k, 1] * dy
+                                v = l_a[n, k] - v
+                                lo = v if v > lo else lo
+                            hi2 = np.inf
+                            for k in range(nu[n]):
+                                w = u_t[n, k, 0] * dx
+                                w = w + u_t[n, k, 1] * dy
+                                w = u_a[n, k] - w
+                                hi2 = w if w < hi2 else hi2
+                            hi2 = hi2 + (dx * dx + dy * dy)
+                            hi = math.sqrt(_max(hi2, 0.0))
+                        else:
+                            lo, hi = _affine_at(a_lit, t_lit, a_unl, t_unl, n, dx, dy)
+                        sb_lo = math.sin(_clip_nan(lo - slack, 0.0, h2))
+                        sb_hi = math.sin(_clip_nan(hi + slack, 0.0, h2))
+                        gv = _min(sb_hi, qv[q, 7] / nrm) - _max(sb_lo, qv[q, 6] / nrm)
+                        gvs[i * grid + j] = gv
+                        seen[i] |= 1 << j
 
 
 def warm() -> None:
