@@ -26,6 +26,7 @@ __all__ = [
     "dir_grid_kernel",
     "measured_prior",
     "bcentre",
+    "bcentre_at",
     "same_rows_kernel",
     "spread_rows_kernel",
     "constraining_kernel",
@@ -42,8 +43,10 @@ _jit_np = njit(cache=True, nogil=True, error_model="numpy")
 #: numba: a call it does not inline counts a reference on every array it passes and is
 #: not inlined by LLVM either, which cost more than a cone distance's arithmetic
 #: (docs/limit3d.md, "bee33c"). Only measured_limit's kernels inline array-taking ones
-#: (its fold and walks over one table of both eyes' live facets, ``bcentre_inline`` in
-#: the draws' kernel): each inlined copy costs compile time; the cone bounds keep calls.
+#: (its fold and walks over one table of both eyes' live facets; the draws' kernel and the
+#: box search write theirs out with scalars, ``bcentre_at``, as an inlined function's
+#: arrays count references too: "bee33h"): each inlined copy costs compile time; the cone
+#: bounds keep calls.
 _inline = njit(cache=True, nogil=True, inline="always")
 _inline_np = njit(cache=True, nogil=True, error_model="numpy", inline="always")
 
@@ -153,8 +156,28 @@ def bcentre(u0, e1, e2, d0, d1, beta, fa, bhat, blen):
     return fa[0] + vx * rho, fa[1] + vy * rho, fa[2] + vz * rho, rho, drho
 
 
-#: :func:`bcentre` inlined, for the draws' kernel (measured_limit.mixture_draws_kernel)
-bcentre_inline = _inline_np(bcentre.py_func)
+@_inline_np
+def bcentre_at(u00, u01, u02, e10, e11, e12, e20, e21, e22, d0, d1, beta, f0, f1, f2, b0, b1,
+               b2, blen):  # fmt: skip
+    """:func:`bcentre` with the frame u0, e1, e2, A's centre fa and b_hat as scalars, in
+    the same operations: an array passed to a function, even an inlined one, counts an
+    atomic reference on entry and exit (docs/limit3d.md, "hp31h"), which per draw cost
+    more than the arithmetic."""
+    vx = u00 + d0 * e10 + d1 * e20
+    vy = u01 + d0 * e11 + d1 * e21
+    vz = u02 + d0 * e12 + d1 * e22
+    nv = math.sqrt(vx * vx + vy * vy + vz * vz)
+    vx, vy, vz = vx / nv, vy / nv, vz / nv
+    ca = min(max(vx * b0 + vy * b1 + vz * b2, -1.0), 1.0)
+    sa = math.sqrt((1.0 - ca) * (1.0 + ca))
+    rho, drho = np.nan, np.nan
+    if beta > 0 and beta < math.pi:
+        sb, cb = math.sin(beta), math.cos(beta)
+        s_ab = sa * cb + ca * sb
+        if s_ab > 0.0:
+            rho = blen * sb / s_ab
+            drho = blen * sa / (s_ab * s_ab)
+    return f0 + vx * rho, f1 + vy * rho, f2 + vz * rho, rho, drho
 
 
 @_inline_np

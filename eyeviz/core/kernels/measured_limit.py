@@ -4,8 +4,8 @@ limit3d_measured.MeasuredProposal._hb`; both searches key by key in one call:
 ``box_kernel``), the draws, the direction search and the reference search's step.
 The region test and the draws walk both eyes' constraining facets of a key as one
 table of its live facets (limit3d_cones.both_columns), the facet that rules a point out
-moved to the front (:func:`_walk1`): no branch per facet on its eye or its padding (a
-mispredicted branch costs more than a fold: docs/limit3d.md, "bee33e").
+moved to the front (:func:`_walk_slack`, the draws' written-out walk): no branch per facet
+on its eye or its padding (a mispredicted branch costs more than a fold: docs/limit3d.md, "bee33e").
 
 It calls :mod:`.limit3d_region`'s functions (``bcentre``, ``_empty``), so its numba
 cache is stamped with that module's source as well as its own (:class:`_WithRegionSource`,
@@ -32,7 +32,7 @@ from eyeviz.core.kernels.limit3d_region import (
     _max,
     _min,
     bcentre,
-    bcentre_inline,
+    bcentre_at,
     measured_prior,
 )
 
@@ -71,15 +71,16 @@ if _WithRegionSource not in _LOCATORS:
 
 
 @_inline_np
-def _fold1(pos, ax, ch, sh, lit, n, k, cx, cy, cz, lo, hi):
-    """limit3d_region._cone_fold, the lens distance |c - p_k| taken only where it is read
-    (a lit facet's lens, an unlit cone's apex): the same values."""
-    vx, vy, vz = cx - pos[n, k, 0], cy - pos[n, k, 1], cz - pos[n, k, 2]
-    a0, a1, a2 = ax[n, k, 0], ax[n, k, 1], ax[n, k, 2]
+def _fold_at(vx, vy, vz, a0, a1, a2, c, sn, lt, lo, hi):
+    """limit3d_region._cone_fold of one facet given by its values (v = c - p_k the centre
+    from its lens, unit axis a, cos and sin of its half angle, lit), the lens distance |v|
+    taken only where it is read (a lit facet's lens, an unlit cone's apex): the same
+    values. Scalars only: an array passed even to an inlined function counts an atomic
+    reference on entry and exit, per facet more than the fold's arithmetic
+    (docs/limit3d.md, "bee33h")."""
     s = vx * a0 + vy * a1 + vz * a2
     wx, wy, wz = vy * a2 - vz * a1, vz * a0 - vx * a2, vx * a1 - vy * a0
     q = math.sqrt(wx * wx + wy * wy + wz * wz)
-    c, sn = ch[n, k], sh[n, k]
     m = q * c - s * sn
     if m <= 0.0:
         d = 0.0
@@ -87,37 +88,23 @@ def _fold1(pos, ax, ch, sh, lit, n, k, cx, cy, cz, lo, hi):
         d = m
     else:
         d = math.sqrt(vx * vx + vy * vy + vz * vz)
-    if lit[n, k]:
+    if lt:
         return _max(lo, d), _min(hi, math.sqrt(vx * vx + vy * vy + vz * vz))
     return lo, _min(hi, d)
 
 
 @_inline_np
-def _walk1(pos, ax, ch, sh, lit, order, nl, n, cx, cy, cz, lo_, hi_):
-    """One draw's g interval (lo_, hi_ coming in as the prior's bounds) over key n's nl
-    live facets of both eyes' table (limit3d_cones.both_columns), the early exit: the facets are
-    folded in one at a time in the key's order ``order[n]``, stopping at the first after
-    which the interval is empty (lo only grows and hi only shrinks, and
-    limit3d_region._empty is monotone, so a partial interval that is empty gives the full
-    one's verdict); the facet that stops a draw is moved to the front, so the facets that
-    rule most draws out are tried first. Returns (stopped, lo, hi)."""
-    if _empty(lo_, hi_):
-        return True, lo_, hi_
-    for p in range(nl):
-        k = order[n, p]
-        lo_, hi_ = _fold1(pos, ax, ch, sh, lit, n, k, cx, cy, cz, lo_, hi_)
-        if _empty(lo_, hi_):
-            for j in range(p, 0, -1):
-                order[n, j] = order[n, j - 1]
-            order[n, 0] = k
-            return True, lo_, hi_
-    return False, lo_, hi_
+def _fold1(pos, ax, ch, sh, lit, n, k, cx, cy, cz, lo, hi):
+    """:func:`_fold_at` of facet k of key n's table."""
+    return _fold_at(cx - pos[n, k, 0], cy - pos[n, k, 1], cz - pos[n, k, 2], ax[n, k, 0],
+                    ax[n, k, 1], ax[n, k, 2], ch[n, k], sh[n, k], lit[n, k], lo, hi)  # fmt: skip
 
 
 @_jit_np
 def _walk_slack(pos, ax, ch, sh, lit, order, nl, n, cx, cy, cz, lo_, hi_, slack):
-    """:func:`_walk1` with the region test's stop, H = hi - lo < -slack (or NaN): the facet
-    that stops a point moved to the front. Returns (lo, hi): the whole walk's where it
+    """The region test's walk over key n's nl live facets (limit3d_cones.both_columns) in
+    its order ``order[n]``, stopped at the first after which H = hi - lo < -slack (or NaN):
+    the facet that stops a point moved to the front. Returns (lo, hi): the whole walk's where it
     does not stop, else the partial ones (then H < -slack all the same: lo only grows, hi
     only shrinks)."""
     if not (hi_ - lo_ >= -slack):
@@ -263,30 +250,6 @@ def box_kernel(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos, ax
 
 
 @_inline_np
-def _component(counts, n, j):
-    """The mixture component of a batch's draw j of key n: the first counts[n, 0] draws
-    come from component 0, the next counts[n, 1] from 1, ..., the rest from the last."""
-    c, acc = 0, counts[n, 0]
-    while j >= acc and c < counts.shape[1] - 1:
-        c += 1
-        acc += counts[n, c]
-    return c
-
-
-@_inline_np
-def _density(boxes, dens, n, d0, d1, beta):
-    """The mixture's density in (delta, beta) at a point: the sum of dens[n, c] (share /
-    volume) over the components whose box holds it."""
-    q = 0.0
-    for c in range(boxes.shape[1]):
-        if (dens[n, c] > 0.0 and boxes[n, c, 0, 0] <= d0 <= boxes[n, c, 1, 0]
-                and boxes[n, c, 0, 1] <= d1 <= boxes[n, c, 1, 1]
-                and boxes[n, c, 0, 2] <= beta <= boxes[n, c, 1, 2]):  # fmt: skip
-            q += dens[n, c]
-    return q
-
-
-@_inline_np
 def _u01(base, s, j):
     """limit3d_proposal._uniforms' uniform of counter j in stream s of a key whose hash
     times _M1 is ``base`` (limit3d_region.uniforms_kernel's hash: the same bits)."""
@@ -306,12 +269,13 @@ def mixture_draws_kernel(keys, streams, nst, u, boxes, counts, dens, samples, u0
                          pos, ax, ch, sh, lit, nls, at, x, y, z, g, r, az, el, w):  # fmt: skip
     """limit3d_measured.MeasuredProposal.sample up to the exact check, draw by draw, from
     a deterministic mixture of boxes in (delta, beta) (boxes (N, C, 2, 3): lo, hi): of
-    each batch of ``samples`` draws, counts[n, c] from box c in turn (:func:`_component`),
+    each batch of ``samples`` draws, counts[n, c] from box c in turn (the last takes the rest),
     (delta, beta) and g from four uniforms, the centre, its g interval (the walk of
-    :func:`_walk1`, stopping once it is empty; each component keeps its own facet order),
+    facets, stopping once it is empty, the facet that stops it moved to the front; each
+    component keeps its own facet order),
     the prior and the weight prior x Jacobian x the interval's length / the mixture's
-    density (:func:`_density`, dens (N, C) = share / volume). Only the keys ``rows`` (N,)
-    get draws.
+    density (the sum of dens[n, c] = share / volume over the boxes that hold the point).
+    Only the keys ``rows`` (N,) get draws.
 
     The uniforms: u (N, M, 4) where given (u.shape[0] == N), else those of
     limit3d_proposal._batch_uniforms of the key hashes ``keys`` (N,) and key n's streams
@@ -320,24 +284,36 @@ def mixture_draws_kernel(keys, streams, nst, u, boxes, counts, dens, samples, u0
     its g never draws its last). The draws weighted above 0 only, in draw order (key by
     key): at (their flat index n M + m), x, y, z, g, r, az, el, w, the first
     returned-count entries of each (arrays of N M or more)."""
-    nc = boxes.shape[1]
+    nc, nk = boxes.shape[1], counts.shape[1]
     given = u.shape[0] == rows.shape[0]
     mm = u.shape[1] if given else samples * streams.shape[1]
     order = np.empty((nc, rows.shape[0], pos.shape[1]), np.int64)
+    f0, f1, f2 = fa[0], fa[1], fa[2]
+    b0, b1, b2 = bhat[0], bhat[1], bhat[2]
+    o0, o1, o2 = origin[0], origin[1], origin[2]
     cnt = 0
+    # the component, the centre, the walk and the density written out with scalars: an
+    # array passed to a helper, even an inlined one, counts an atomic reference a draw
+    # (or a facet), more than their arithmetic (docs/limit3d.md, "bee33h")
     for n in range(rows.shape[0]):
         if not rows[n]:
             continue
         nl = nls[n]
         base = keys[n] * _M1
+        a00, a01, a02 = u0[n, 0], u0[n, 1], u0[n, 2]
+        e10, e11, e12 = e1[n, 0], e1[n, 1], e1[n, 2]
+        e20, e21, e22 = e2[n, 0], e2[n, 1], e2[n, 2]
         for c in range(nc):
             for k in range(order.shape[2]):
                 order[c, n, k] = k
         for m in range(mm if given else samples * nst[n]):
             jm = m % samples
             sm = streams[n, m // samples] if not given else 0
-            c = _component(counts, n, jm)
-            lo_, hi_ = boxes[n, c, 0], boxes[n, c, 1]
+            # _component
+            c, acc = 0, counts[n, 0]
+            while jm >= acc and c < nk - 1:
+                c += 1
+                acc += counts[n, c]
             if given:
                 u0_, u1_, u2_ = u[n, m, 0], u[n, m, 1], u[n, m, 2]
             else:
@@ -346,18 +322,38 @@ def mixture_draws_kernel(keys, streams, nst, u, boxes, counts, dens, samples, u0
                     _u01(base, sm, 4 * jm + 1),
                     _u01(base, sm, 4 * jm + 2),
                 )
-            d0 = lo_[0] + (hi_[0] - lo_[0]) * u0_
-            d1 = lo_[1] + (hi_[1] - lo_[1]) * u1_
-            beta = lo_[2] + (hi_[2] - lo_[2]) * u2_
-            cx, cy, cz, rho, drho = bcentre_inline(
-                u0[n], e1[n], e2[n], d0, d1, beta, fa, bhat, blen
-            )
+            l0, l1, l2 = boxes[n, c, 0, 0], boxes[n, c, 0, 1], boxes[n, c, 0, 2]
+            d0 = l0 + (boxes[n, c, 1, 0] - l0) * u0_
+            d1 = l1 + (boxes[n, c, 1, 1] - l1) * u1_
+            beta = l2 + (boxes[n, c, 1, 2] - l2) * u2_
+            cx, cy, cz, rho, drho = bcentre_at(
+                a00, a01, a02, e10, e11, e12, e20, e21, e22, d0, d1, beta, f0, f1, f2, b0, b1,
+                b2, blen,
+            )  # fmt: skip
             if not math.isfinite(rho):
                 continue
-            qx, qy, qz = cx - origin[0], cy - origin[1], cz - origin[2]
+            qx, qy, qz = cx - o0, cy - o1, cz - o2
             rr = math.sqrt(qx * qx + qy * qy + qz * qz)
-            out, g_lo, g_hi = _walk1(pos, ax, ch, sh, lit, order[c], nl, n, cx, cy, cz,
-                                     rr * s_half, min(rr, g_max))  # fmt: skip
+            # the walk: key n's live facets in component c's order, stopped at the first
+            # after which the g interval is empty (lo only grows, hi only shrinks and
+            # limit3d_region._empty is monotone, so a partial interval's verdict is the
+            # full one's); that facet moved to the front, so the facets that rule most
+            # draws out are tried first
+            g_lo, g_hi = rr * s_half, min(rr, g_max)
+            out = _empty(g_lo, g_hi)
+            if not out:
+                for p in range(nl):
+                    k = order[c, n, p]
+                    g_lo, g_hi = _fold_at(cx - pos[n, k, 0], cy - pos[n, k, 1],
+                                          cz - pos[n, k, 2], ax[n, k, 0], ax[n, k, 1],
+                                          ax[n, k, 2], ch[n, k], sh[n, k], lit[n, k], g_lo,
+                                          g_hi)  # fmt: skip
+                    if _empty(g_lo, g_hi):
+                        for j in range(p, 0, -1):
+                            order[c, n, j] = order[c, n, j - 1]
+                        order[c, n, 0] = k
+                        out = True
+                        break
             if out:
                 continue
             pad = 1e-9 * g_hi
@@ -368,7 +364,14 @@ def mixture_draws_kernel(keys, streams, nst, u, boxes, counts, dens, samples, u0
             phi = math.atan2(qy, qx)
             dens_p = measured_prior(rr, gg, e, phi, s_half, g_max, r_min, r_max, el_max, multi)
             jac = rho * rho * (1.0 + (d0 * d0 + d1 * d1)) ** -1.5 * drho
-            wt = dens_p * jac * ((g_hi - g_lo) / _density(boxes, dens, n, d0, d1, beta))
+            # _density
+            q = 0.0
+            for cc in range(nc):
+                if (dens[n, cc] > 0.0 and boxes[n, cc, 0, 0] <= d0 <= boxes[n, cc, 1, 0]
+                        and boxes[n, cc, 0, 1] <= d1 <= boxes[n, cc, 1, 1]
+                        and boxes[n, cc, 0, 2] <= beta <= boxes[n, cc, 1, 2]):  # fmt: skip
+                    q += dens[n, cc]
+            wt = dens_p * jac * ((g_hi - g_lo) / q)
             if not (math.isfinite(wt) and wt > 0.0):
                 continue
             at[cnt] = n * mm + m
