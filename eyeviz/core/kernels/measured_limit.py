@@ -145,28 +145,6 @@ def region_kernel(x, u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack,
             h[n, g] = hv if math.isfinite(hv) else -np.inf
 
 
-#: the walk inlined into box_kernel's point test (about 0.11 against 0.13 s of its time per
-#: 160 honeybee keys; +1.1 s of cold compile: docs/limit3d.md, "bee33g")
-_walk_slack_inline = _inline_np(_walk_slack.py_func)
-
-
-@_inline_np
-def _feasible(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos, ax, ch, sh,
-              lit, nls, order, n, d0, d1, beta):  # fmt: skip
-    """region_kernel's verdict H >= -slack at one point (d0, d1, beta) of key n (its
-    walk's facet order ``order[n]``, moved to the front as there: max and min are exact,
-    so the verdict is the same in any order)."""
-    cx, cy, cz, rho, _ = bcentre(u0[n], e1[n], e2[n], d0, d1, beta, fa, bhat, blen)
-    if not math.isfinite(rho):
-        return False
-    qx, qy, qz = cx - origin[0], cy - origin[1], cz - origin[2]
-    rr = math.sqrt(qx * qx + qy * qy + qz * qz)
-    lo_, hi_ = _walk_slack_inline(pos, ax, ch, sh, lit, order, nls[n], n, cx, cy, cz,
-                                  rr * s_half, min(rr, g_max), slack)  # fmt: skip
-    hv = hi_ - lo_
-    return math.isfinite(hv) and hv >= -slack
-
-
 @_jit_np
 def box_kernel(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos, ax, ch, sh,
                lit, nls, beta0, reach, widen, floor, dirs, iters, up, rounds, box_lo, box_hi,
@@ -181,36 +159,92 @@ def box_kernel(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos, ax
     until no face is; t_lo, t_hi, t_n the last round's feasible points' box and number.
     The same arithmetic as the numpy loops there, so the same boxes bit for bit."""
     order = np.empty((u0.shape[0], pos.shape[1]), np.int64)
-    nd = dirs.shape[0]
+    nd, nu = dirs.shape[0], up.shape[1]
     lo = np.empty(nd)
     hi = np.empty(nd)
+    pts = np.empty((max(nd, nu), 3))
+    ok = np.empty(max(nd, nu), np.bool_)
+    f0, f1, f2 = fa[0], fa[1], fa[2]
+    h0, h1, h2 = bhat[0], bhat[1], bhat[2]
+    o0, o1, o2 = origin[0], origin[1], origin[2]
     for n in range(u0.shape[0]):
         for k in range(order.shape[1]):
             order[n, k] = k
+        nl = nls[n]
+        a00, a01, a02 = u0[n, 0], u0[n, 1], u0[n, 2]
+        e10, e11, e12 = e1[n, 0], e1[n, 1], e1[n, 2]
+        e20, e21, e22 = e2[n, 0], e2[n, 1], e2[n, 2]
         c = (0.0, 0.0, beta0[n])
         for q in range(nd):
             lo[q] = 0.0
             hi[q] = reach
-        for _ in range(iters):
-            for q in range(nd):
-                mid = 0.5 * (lo[q] + hi[q])
-                if _feasible(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos,
-                             ax, ch, sh, lit, nls, order, n, c[0] + mid * dirs[q, 0],
-                             c[1] + mid * dirs[q, 1], c[2] + mid * dirs[q, 2]):  # fmt: skip
-                    lo[q] = mid
-                else:
-                    hi[q] = mid
-        for j in range(3):
-            pmin, pmax = np.inf, -np.inf
-            for q in range(nd):
-                v = hi[q] * dirs[q, j]
-                pmin = min(pmin, v)
-                pmax = max(pmax, v)
-            box_lo[n, j] = min(c[j] + min(pmin, 0.0) * widen, c[j] - floor)
-            box_hi[n, j] = max(c[j] + max(pmax, 0.0) * widen, c[j] + floor)
-        for _ in range(rounds):
-            l0, l1, l2 = box_lo[n, 0], box_lo[n, 1], box_lo[n, 2]
-            s0, s1, s2 = box_hi[n, 0] - l0, box_hi[n, 1] - l1, box_hi[n, 2] - l2
+        # the bisection's steps, the box, then the pilot's rounds: each step or round a
+        # batch of points, their verdicts taken in order in one loop below
+        l0 = l1 = l2 = s0 = s1 = s2 = 0.0
+        for stage in range(iters + 1 + rounds):
+            if stage == iters:
+                for j in range(3):
+                    pmin, pmax = np.inf, -np.inf
+                    for q in range(nd):
+                        v = hi[q] * dirs[q, j]
+                        pmin = min(pmin, v)
+                        pmax = max(pmax, v)
+                    box_lo[n, j] = min(c[j] + min(pmin, 0.0) * widen, c[j] - floor)
+                    box_hi[n, j] = max(c[j] + max(pmax, 0.0) * widen, c[j] + floor)
+                continue
+            if stage < iters:
+                npt = nd
+                for q in range(nd):
+                    mid = 0.5 * (lo[q] + hi[q])
+                    pts[q, 0] = c[0] + mid * dirs[q, 0]
+                    pts[q, 1] = c[1] + mid * dirs[q, 1]
+                    pts[q, 2] = c[2] + mid * dirs[q, 2]
+            else:
+                npt = nu
+                l0, l1, l2 = box_lo[n, 0], box_lo[n, 1], box_lo[n, 2]
+                s0, s1, s2 = box_hi[n, 0] - l0, box_hi[n, 1] - l1, box_hi[n, 2] - l2
+                for q in range(nu):
+                    pts[q, 0] = l0 + s0 * up[n, q, 0]
+                    pts[q, 1] = l1 + s1 * up[n, q, 1]
+                    pts[q, 2] = l2 + s2 * up[n, q, 2]
+            # region_kernel's verdict H >= -slack at each point, its walk written out with
+            # scalars (an array passed to a helper, even an inlined one, counts an atomic
+            # reference a point or a facet: docs/limit3d.md, "bee33h"); the facet that
+            # stops a point moved to the front of order[n] (max and min are exact, so the
+            # verdict is the same in any order)
+            for q in range(npt):
+                ok[q] = False
+                cx, cy, cz, rho, _ = bcentre_at(
+                    a00, a01, a02, e10, e11, e12, e20, e21, e22, pts[q, 0], pts[q, 1],
+                    pts[q, 2], f0, f1, f2, h0, h1, h2, blen,
+                )  # fmt: skip
+                if not math.isfinite(rho):
+                    continue
+                qx, qy, qz = cx - o0, cy - o1, cz - o2
+                rr = math.sqrt(qx * qx + qy * qy + qz * qz)
+                lo_, hi_ = rr * s_half, min(rr, g_max)
+                if hi_ - lo_ >= -slack:
+                    for p in range(nl):
+                        k = order[n, p]
+                        lo_, hi_ = _fold_at(cx - pos[n, k, 0], cy - pos[n, k, 1],
+                                            cz - pos[n, k, 2], ax[n, k, 0], ax[n, k, 1],
+                                            ax[n, k, 2], ch[n, k], sh[n, k], lit[n, k], lo_,
+                                            hi_)  # fmt: skip
+                        if not (hi_ - lo_ >= -slack):
+                            for j in range(p, 0, -1):
+                                order[n, j] = order[n, j - 1]
+                            order[n, 0] = k
+                            break
+                hv = hi_ - lo_
+                ok[q] = math.isfinite(hv) and hv >= -slack
+            if stage < iters:
+                for q in range(nd):
+                    mid = 0.5 * (lo[q] + hi[q])
+                    if ok[q]:
+                        lo[q] = mid
+                    else:
+                        hi[q] = mid
+                continue
             b0, b1, b2 = 0.1 * s0, 0.1 * s1, 0.1 * s2
             a0, a1, a2 = l0 + b0, l1 + b1, l2 + b2
             z0, z1, z2 = box_hi[n, 0] - b0, box_hi[n, 1] - b1, box_hi[n, 2] - b2
@@ -218,13 +252,10 @@ def box_kernel(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos, ax
             x0 = x1 = x2 = -np.inf
             nlo0 = nlo1 = nlo2 = nhi0 = nhi1 = nhi2 = False
             cnt = 0
-            for g in range(up.shape[1]):
-                p0 = l0 + s0 * up[n, g, 0]
-                p1 = l1 + s1 * up[n, g, 1]
-                p2 = l2 + s2 * up[n, g, 2]
-                if not _feasible(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack,
-                                 pos, ax, ch, sh, lit, nls, order, n, p0, p1, p2):  # fmt: skip
+            for q in range(nu):
+                if not ok[q]:
                     continue
+                p0, p1, p2 = pts[q, 0], pts[q, 1], pts[q, 2]
                 cnt += 1
                 m0, m1, m2 = min(m0, p0), min(m1, p1), min(m2, p2)
                 x0, x1, x2 = max(x0, p0), max(x1, p1), max(x2, p2)
