@@ -43,10 +43,10 @@ _jit_np = njit(cache=True, nogil=True, error_model="numpy")
 #: numba: a call it does not inline counts a reference on every array it passes and is
 #: not inlined by LLVM either, which cost more than a cone distance's arithmetic
 #: (docs/limit3d.md, "bee33c"). Only measured_limit's kernels inline array-taking ones
-#: (its fold and walks over one table of both eyes' live facets; the draws' kernel and the
-#: box search write theirs out with scalars, ``bcentre_at``, as an inlined function's
-#: arrays count references too: "bee33h"): each inlined copy costs compile time; the cone
-#: bounds keep calls.
+#: (its fold and walks over one table of both eyes' live facets, ``bcentre_inline`` in
+#: the draws' kernel; the box search writes its walk out with scalars, ``bcentre_at``, as
+#: an inlined function's arrays count references too: "bee33h"): each inlined copy costs
+#: compile time; the cone bounds keep calls.
 _inline = njit(cache=True, nogil=True, inline="always")
 _inline_np = njit(cache=True, nogil=True, error_model="numpy", inline="always")
 
@@ -178,6 +178,10 @@ def bcentre_at(u00, u01, u02, e10, e11, e12, e20, e21, e22, d0, d1, beta, f0, f1
             rho = blen * sb / s_ab
             drho = blen * sa / (s_ab * s_ab)
     return f0 + vx * rho, f1 + vy * rho, f2 + vz * rho, rho, drho
+
+
+#: :func:`bcentre` inlined, for the draws' kernel (measured_limit.mixture_draws_kernel)
+bcentre_inline = _inline_np(bcentre.py_func)
 
 
 @_inline_np

@@ -4,8 +4,8 @@ limit3d_measured.MeasuredProposal._hb`; both searches key by key in one call:
 ``box_kernel``), the draws, the direction search and the reference search's step.
 The region test and the draws walk both eyes' constraining facets of a key as one
 table of its live facets (limit3d_cones.both_columns), the facet that rules a point out
-moved to the front (:func:`_walk_slack`, the draws' written-out walk): no branch per facet
-on its eye or its padding (a mispredicted branch costs more than a fold: docs/limit3d.md, "bee33e").
+moved to the front (:func:`_walk1`): no branch per facet on its eye or its padding (a
+mispredicted branch costs more than a fold: docs/limit3d.md, "bee33e").
 
 It calls :mod:`.limit3d_region`'s functions (``bcentre``, ``_empty``), so its numba
 cache is stamped with that module's source as well as its own (:class:`_WithRegionSource`,
@@ -33,6 +33,7 @@ from eyeviz.core.kernels.limit3d_region import (
     _min,
     bcentre,
     bcentre_at,
+    bcentre_inline,
     measured_prior,
 )
 
@@ -100,11 +101,32 @@ def _fold1(pos, ax, ch, sh, lit, n, k, cx, cy, cz, lo, hi):
                     ax[n, k, 1], ax[n, k, 2], ch[n, k], sh[n, k], lit[n, k], lo, hi)  # fmt: skip
 
 
+@_inline_np
+def _walk1(pos, ax, ch, sh, lit, order, nl, n, cx, cy, cz, lo_, hi_):
+    """One draw's g interval (lo_, hi_ coming in as the prior's bounds) over key n's nl
+    live facets of both eyes' table (limit3d_cones.both_columns), the early exit: the facets are
+    folded in one at a time in the key's order ``order[n]``, stopping at the first after
+    which the interval is empty (lo only grows and hi only shrinks, and
+    limit3d_region._empty is monotone, so a partial interval that is empty gives the full
+    one's verdict); the facet that stops a draw is moved to the front, so the facets that
+    rule most draws out are tried first. Returns (stopped, lo, hi)."""
+    if _empty(lo_, hi_):
+        return True, lo_, hi_
+    for p in range(nl):
+        k = order[n, p]
+        lo_, hi_ = _fold1(pos, ax, ch, sh, lit, n, k, cx, cy, cz, lo_, hi_)
+        if _empty(lo_, hi_):
+            for j in range(p, 0, -1):
+                order[n, j] = order[n, j - 1]
+            order[n, 0] = k
+            return True, lo_, hi_
+    return False, lo_, hi_
+
+
 @_jit_np
 def _walk_slack(pos, ax, ch, sh, lit, order, nl, n, cx, cy, cz, lo_, hi_, slack):
-    """The region test's walk over key n's nl live facets (limit3d_cones.both_columns) in
-    its order ``order[n]``, stopped at the first after which H = hi - lo < -slack (or NaN):
-    the facet that stops a point moved to the front. Returns (lo, hi): the whole walk's where it
+    """:func:`_walk1` with the region test's stop, H = hi - lo < -slack (or NaN): the facet
+    that stops a point moved to the front. Returns (lo, hi): the whole walk's where it
     does not stop, else the partial ones (then H < -slack all the same: lo only grows, hi
     only shrinks)."""
     if not (hi_ - lo_ >= -slack):
@@ -281,6 +303,30 @@ def box_kernel(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos, ax
 
 
 @_inline_np
+def _component(counts, n, j):
+    """The mixture component of a batch's draw j of key n: the first counts[n, 0] draws
+    come from component 0, the next counts[n, 1] from 1, ..., the rest from the last."""
+    c, acc = 0, counts[n, 0]
+    while j >= acc and c < counts.shape[1] - 1:
+        c += 1
+        acc += counts[n, c]
+    return c
+
+
+@_inline_np
+def _density(boxes, dens, n, d0, d1, beta):
+    """The mixture's density in (delta, beta) at a point: the sum of dens[n, c] (share /
+    volume) over the components whose box holds it."""
+    q = 0.0
+    for c in range(boxes.shape[1]):
+        if (dens[n, c] > 0.0 and boxes[n, c, 0, 0] <= d0 <= boxes[n, c, 1, 0]
+                and boxes[n, c, 0, 1] <= d1 <= boxes[n, c, 1, 1]
+                and boxes[n, c, 0, 2] <= beta <= boxes[n, c, 1, 2]):  # fmt: skip
+            q += dens[n, c]
+    return q
+
+
+@_inline_np
 def _u01(base, s, j):
     """limit3d_proposal._uniforms' uniform of counter j in stream s of a key whose hash
     times _M1 is ``base`` (limit3d_region.uniforms_kernel's hash: the same bits)."""
@@ -300,13 +346,12 @@ def mixture_draws_kernel(keys, streams, nst, u, boxes, counts, dens, samples, u0
                          pos, ax, ch, sh, lit, nls, at, x, y, z, g, r, az, el, w):  # fmt: skip
     """limit3d_measured.MeasuredProposal.sample up to the exact check, draw by draw, from
     a deterministic mixture of boxes in (delta, beta) (boxes (N, C, 2, 3): lo, hi): of
-    each batch of ``samples`` draws, counts[n, c] from box c in turn (the last takes the rest),
+    each batch of ``samples`` draws, counts[n, c] from box c in turn (:func:`_component`),
     (delta, beta) and g from four uniforms, the centre, its g interval (the walk of
-    facets, stopping once it is empty, the facet that stops it moved to the front; each
-    component keeps its own facet order),
+    :func:`_walk1`, stopping once it is empty; each component keeps its own facet order),
     the prior and the weight prior x Jacobian x the interval's length / the mixture's
-    density (the sum of dens[n, c] = share / volume over the boxes that hold the point).
-    Only the keys ``rows`` (N,) get draws.
+    density (:func:`_density`, dens (N, C) = share / volume). Only the keys ``rows`` (N,)
+    get draws.
 
     The uniforms: u (N, M, 4) where given (u.shape[0] == N), else those of
     limit3d_proposal._batch_uniforms of the key hashes ``keys`` (N,) and key n's streams
@@ -315,36 +360,24 @@ def mixture_draws_kernel(keys, streams, nst, u, boxes, counts, dens, samples, u0
     its g never draws its last). The draws weighted above 0 only, in draw order (key by
     key): at (their flat index n M + m), x, y, z, g, r, az, el, w, the first
     returned-count entries of each (arrays of N M or more)."""
-    nc, nk = boxes.shape[1], counts.shape[1]
+    nc = boxes.shape[1]
     given = u.shape[0] == rows.shape[0]
     mm = u.shape[1] if given else samples * streams.shape[1]
     order = np.empty((nc, rows.shape[0], pos.shape[1]), np.int64)
-    f0, f1, f2 = fa[0], fa[1], fa[2]
-    b0, b1, b2 = bhat[0], bhat[1], bhat[2]
-    o0, o1, o2 = origin[0], origin[1], origin[2]
     cnt = 0
-    # the component, the centre, the walk and the density written out with scalars: an
-    # array passed to a helper, even an inlined one, counts an atomic reference a draw
-    # (or a facet), more than their arithmetic (docs/limit3d.md, "bee33h")
     for n in range(rows.shape[0]):
         if not rows[n]:
             continue
         nl = nls[n]
         base = keys[n] * _M1
-        a00, a01, a02 = u0[n, 0], u0[n, 1], u0[n, 2]
-        e10, e11, e12 = e1[n, 0], e1[n, 1], e1[n, 2]
-        e20, e21, e22 = e2[n, 0], e2[n, 1], e2[n, 2]
         for c in range(nc):
             for k in range(order.shape[2]):
                 order[c, n, k] = k
         for m in range(mm if given else samples * nst[n]):
             jm = m % samples
             sm = streams[n, m // samples] if not given else 0
-            # _component
-            c, acc = 0, counts[n, 0]
-            while jm >= acc and c < nk - 1:
-                c += 1
-                acc += counts[n, c]
+            c = _component(counts, n, jm)
+            lo_, hi_ = boxes[n, c, 0], boxes[n, c, 1]
             if given:
                 u0_, u1_, u2_ = u[n, m, 0], u[n, m, 1], u[n, m, 2]
             else:
@@ -353,38 +386,18 @@ def mixture_draws_kernel(keys, streams, nst, u, boxes, counts, dens, samples, u0
                     _u01(base, sm, 4 * jm + 1),
                     _u01(base, sm, 4 * jm + 2),
                 )
-            l0, l1, l2 = boxes[n, c, 0, 0], boxes[n, c, 0, 1], boxes[n, c, 0, 2]
-            d0 = l0 + (boxes[n, c, 1, 0] - l0) * u0_
-            d1 = l1 + (boxes[n, c, 1, 1] - l1) * u1_
-            beta = l2 + (boxes[n, c, 1, 2] - l2) * u2_
-            cx, cy, cz, rho, drho = bcentre_at(
-                a00, a01, a02, e10, e11, e12, e20, e21, e22, d0, d1, beta, f0, f1, f2, b0, b1,
-                b2, blen,
-            )  # fmt: skip
+            d0 = lo_[0] + (hi_[0] - lo_[0]) * u0_
+            d1 = lo_[1] + (hi_[1] - lo_[1]) * u1_
+            beta = lo_[2] + (hi_[2] - lo_[2]) * u2_
+            cx, cy, cz, rho, drho = bcentre_inline(
+                u0[n], e1[n], e2[n], d0, d1, beta, fa, bhat, blen
+            )
             if not math.isfinite(rho):
                 continue
-            qx, qy, qz = cx - o0, cy - o1, cz - o2
+            qx, qy, qz = cx - origin[0], cy - origin[1], cz - origin[2]
             rr = math.sqrt(qx * qx + qy * qy + qz * qz)
-            # the walk: key n's live facets in component c's order, stopped at the first
-            # after which the g interval is empty (lo only grows, hi only shrinks and
-            # limit3d_region._empty is monotone, so a partial interval's verdict is the
-            # full one's); that facet moved to the front, so the facets that rule most
-            # draws out are tried first
-            g_lo, g_hi = rr * s_half, min(rr, g_max)
-            out = _empty(g_lo, g_hi)
-            if not out:
-                for p in range(nl):
-                    k = order[c, n, p]
-                    g_lo, g_hi = _fold_at(cx - pos[n, k, 0], cy - pos[n, k, 1],
-                                          cz - pos[n, k, 2], ax[n, k, 0], ax[n, k, 1],
-                                          ax[n, k, 2], ch[n, k], sh[n, k], lit[n, k], g_lo,
-                                          g_hi)  # fmt: skip
-                    if _empty(g_lo, g_hi):
-                        for j in range(p, 0, -1):
-                            order[c, n, j] = order[c, n, j - 1]
-                        order[c, n, 0] = k
-                        out = True
-                        break
+            out, g_lo, g_hi = _walk1(pos, ax, ch, sh, lit, order[c], nl, n, cx, cy, cz,
+                                     rr * s_half, min(rr, g_max))  # fmt: skip
             if out:
                 continue
             pad = 1e-9 * g_hi
@@ -395,14 +408,7 @@ def mixture_draws_kernel(keys, streams, nst, u, boxes, counts, dens, samples, u0
             phi = math.atan2(qy, qx)
             dens_p = measured_prior(rr, gg, e, phi, s_half, g_max, r_min, r_max, el_max, multi)
             jac = rho * rho * (1.0 + (d0 * d0 + d1 * d1)) ** -1.5 * drho
-            # _density
-            q = 0.0
-            for cc in range(nc):
-                if (dens[n, cc] > 0.0 and boxes[n, cc, 0, 0] <= d0 <= boxes[n, cc, 1, 0]
-                        and boxes[n, cc, 0, 1] <= d1 <= boxes[n, cc, 1, 1]
-                        and boxes[n, cc, 0, 2] <= beta <= boxes[n, cc, 1, 2]):  # fmt: skip
-                    q += dens[n, cc]
-            wt = dens_p * jac * ((g_hi - g_lo) / q)
+            wt = dens_p * jac * ((g_hi - g_lo) / _density(boxes, dens, n, d0, d1, beta))
             if not (math.isfinite(wt) and wt > 0.0):
                 continue
             at[cnt] = n * mm + m
