@@ -422,6 +422,8 @@ def healpix_draws_kernel(keys, streams, rows, th_lo, th_hi, box, ext, ext_b, sla
 _LANES = 4
 
 
+# long: four searches side by side with the model and the gap written out with scalars (a
+# helper taking arrays counts atomic references per call: docs/limit3d.md, "hp31h")
 @_jit_inline
 def _ray_searches(a_lit, t_lit, a_unl, t_unl, l_a, l_t, nl, u_a, u_t, nu, c, e1, e2, a, n, qv, nq,
                   slack, t, rounds, out):  # fmt: skip

@@ -37,15 +37,8 @@ from eyeviz.core.kernels.limit3d_region import (
     measured_prior,
 )
 
-__all__ = [
-    "box_kernel",
-    "direction_kernel",
-    "locate_kernel",
-    "mixture_draws_kernel",
-    "region_kernel",
-    "search_kernel",
-    "warm",
-]
+__all__ = ["box_kernel", "direction_kernel", "locate_kernel", "mixture_draws_kernel"]
+__all__ += ["region_kernel", "search_kernel", "warm"]
 
 
 class _WithRegionSource(caching.InTreeCacheLocator):
@@ -167,6 +160,8 @@ def region_kernel(x, u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack,
             h[n, g] = hv if math.isfinite(hv) else -np.inf
 
 
+# long: the bisection's steps and the pilot's rounds as batches of points whose region
+# test is written out with scalars (a helper taking arrays counts atomic references per call)
 @_jit_np
 def box_kernel(u0, e1, e2, fa, bhat, blen, origin, s_half, g_max, slack, pos, ax, ch, sh,
                lit, nls, beta0, reach, widen, floor, dirs, iters, up, rounds, box_lo, box_hi,
