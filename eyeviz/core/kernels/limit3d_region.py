@@ -129,40 +129,13 @@ def _empty(lo, hi):
     return not (hi + pad > low)
 
 
-@_jit_np
-def bcentre(u0, e1, e2, d0, d1, beta, fa, bhat, blen):
-    """limit3d_measured.MeasuredProposal._bcentres for one draw: (centre x, y, z, rho,
-    d rho / d beta) at gnomonic offsets (d0, d1) of A's direction about u0 (frame e1, e2)
-    and angle beta at o_B (rho = |b| sin(beta) / sin(a + beta)); rho and d rho NaN where
-    the rays do not meet in front (beta <= 0 or a + beta >= pi). Without the reference's
-    arccos and three sines: cos a = v . b_hat, sin a = sqrt((1 - cos a)(1 + cos a)) (a in
-    [0, pi]), sin(a + beta) = sin a cos beta + cos a sin beta; for beta in (0, pi), a +
-    beta lies in (0, 2 pi), so the rays meet in front iff sin(a + beta) > 0 (the draws'
-    kernel 1.1-1.2x, docs/limit3d.md "bee33e")."""
-    vx = u0[0] + d0 * e1[0] + d1 * e2[0]
-    vy = u0[1] + d0 * e1[1] + d1 * e2[1]
-    vz = u0[2] + d0 * e1[2] + d1 * e2[2]
-    nv = math.sqrt(vx * vx + vy * vy + vz * vz)
-    vx, vy, vz = vx / nv, vy / nv, vz / nv
-    ca = min(max(vx * bhat[0] + vy * bhat[1] + vz * bhat[2], -1.0), 1.0)
-    sa = math.sqrt((1.0 - ca) * (1.0 + ca))
-    rho, drho = np.nan, np.nan
-    if beta > 0 and beta < math.pi:
-        sb, cb = math.sin(beta), math.cos(beta)
-        s_ab = sa * cb + ca * sb
-        if s_ab > 0.0:
-            rho = blen * sb / s_ab
-            drho = blen * sa / (s_ab * s_ab)
-    return fa[0] + vx * rho, fa[1] + vy * rho, fa[2] + vz * rho, rho, drho
-
-
 @_inline_np
 def bcentre_at(u00, u01, u02, e10, e11, e12, e20, e21, e22, d0, d1, beta, f0, f1, f2, b0, b1,
                b2, blen):  # fmt: skip
-    """:func:`bcentre` with the frame u0, e1, e2, A's centre fa and b_hat as scalars, in
-    the same operations: an array passed to a function, even an inlined one, counts an
-    atomic reference on entry and exit (docs/limit3d.md, "hp31h"), which per draw cost
-    more than the arithmetic."""
+    """:func:`bcentre` with the frame u0, e1, e2, A's centre fa and b_hat as scalars (its
+    body: :func:`bcentre` reads its arrays' items and calls this): an array passed to a
+    function, even an inlined one, counts an atomic reference on entry and exit
+    (docs/limit3d.md, "hp31h"), which per draw cost more than the arithmetic."""
     vx = u00 + d0 * e10 + d1 * e20
     vy = u01 + d0 * e11 + d1 * e21
     vz = u02 + d0 * e12 + d1 * e22
@@ -178,6 +151,20 @@ def bcentre_at(u00, u01, u02, e10, e11, e12, e20, e21, e22, d0, d1, beta, f0, f1
             rho = blen * sb / s_ab
             drho = blen * sa / (s_ab * s_ab)
     return f0 + vx * rho, f1 + vy * rho, f2 + vz * rho, rho, drho
+
+
+@_jit_np
+def bcentre(u0, e1, e2, d0, d1, beta, fa, bhat, blen):
+    """limit3d_measured.MeasuredProposal._bcentres for one draw: (centre x, y, z, rho,
+    d rho / d beta) at gnomonic offsets (d0, d1) of A's direction about u0 (frame e1, e2)
+    and angle beta at o_B (rho = |b| sin(beta) / sin(a + beta)); rho and d rho NaN where
+    the rays do not meet in front (beta <= 0 or a + beta >= pi). Without the reference's
+    arccos and three sines: cos a = v . b_hat, sin a = sqrt((1 - cos a)(1 + cos a)) (a in
+    [0, pi]), sin(a + beta) = sin a cos beta + cos a sin beta; for beta in (0, pi), a +
+    beta lies in (0, 2 pi), so the rays meet in front iff sin(a + beta) > 0 (the draws'
+    kernel 1.1-1.2x, docs/limit3d.md "bee33e")."""
+    return bcentre_at(u0[0], u0[1], u0[2], e1[0], e1[1], e1[2], e2[0], e2[1], e2[2], d0, d1,
+                      beta, fa[0], fa[1], fa[2], bhat[0], bhat[1], bhat[2], blen)  # fmt: skip
 
 
 #: :func:`bcentre` inlined, for the draws' kernel (measured_limit.mixture_draws_kernel)
